@@ -1,0 +1,246 @@
+//! Images of mirrorbox: linear RGB float images, the contract's sRGB output, and files.
+//!
+//! Linear radiance is stored as EXR (float32 RGB, with provenance in the header); what a
+//! person looks at is an 8-bit sRGB PNG made with [`srgb`]'s exposure + transfer function,
+//! the tone mapping that `docs/shading.md` fixes. Every write goes to a temporary file in
+//! the destination folder and is renamed into place, so a failed or interrupted write never
+//! leaves a half-written output behind.
+
+pub mod srgb;
+
+use std::path::{Path, PathBuf};
+
+/// A linear RGB image, row-major, top row first (the project's pixel convention).
+#[derive(Clone, Debug, PartialEq)]
+pub struct RgbImage {
+    pub width: u32,
+    pub height: u32,
+    pub pixels: Vec<[f32; 3]>,
+}
+
+impl RgbImage {
+    pub fn new(width: u32, height: u32) -> Self {
+        RgbImage {
+            width,
+            height,
+            pixels: vec![[0.0; 3]; width as usize * height as usize],
+        }
+    }
+
+    pub fn from_fn(width: u32, height: u32, f: impl Fn(u32, u32) -> [f32; 3]) -> Self {
+        let pixels = (0..height)
+            .flat_map(|y| (0..width).map(move |x| (x, y)))
+            .map(|(x, y)| f(x, y))
+            .collect();
+        RgbImage {
+            width,
+            height,
+            pixels,
+        }
+    }
+
+    pub fn get(&self, x: u32, y: u32) -> [f32; 3] {
+        self.pixels[(y * self.width + x) as usize]
+    }
+
+    /// 8-bit sRGB bytes (RGB, row-major) after the contract's tone mapping.
+    pub fn to_srgb8(&self, exposure: f32) -> Vec<u8> {
+        self.pixels
+            .iter()
+            .flat_map(|p| p.map(|c| srgb::encode8(c * exposure)))
+            .collect()
+    }
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum ImageError {
+    #[error("{path}: {message}")]
+    Io { path: PathBuf, message: String },
+    #[error("{path}: unsupported image type (expected .exr or .png)")]
+    UnsupportedType { path: PathBuf },
+}
+
+fn io_error(path: &Path, message: impl ToString) -> ImageError {
+    ImageError::Io {
+        path: path.to_path_buf(),
+        message: message.to_string(),
+    }
+}
+
+/// Runs `write` on a temporary path beside `path`, then renames it into place. On error the
+/// temporary file is removed and `path` is left untouched.
+pub fn write_atomically(
+    path: &Path,
+    write: impl FnOnce(&Path) -> Result<(), String>,
+) -> Result<(), ImageError> {
+    let file_name = path
+        .file_name()
+        .ok_or_else(|| io_error(path, "not a file path"))?;
+    let mut tmp_name = std::ffi::OsString::from(".");
+    tmp_name.push(file_name);
+    tmp_name.push(format!(".{}.tmp", std::process::id()));
+    let tmp = path.with_file_name(tmp_name);
+    let result = write(&tmp).and_then(|()| std::fs::rename(&tmp, path).map_err(|e| e.to_string()));
+    if let Err(message) = result {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(io_error(path, message));
+    }
+    Ok(())
+}
+
+/// Writes the contract's tone-mapped sRGB image as an 8-bit PNG.
+pub fn write_png(path: &Path, image: &RgbImage, exposure: f32) -> Result<(), ImageError> {
+    let bytes = image.to_srgb8(exposure);
+    write_atomically(path, |tmp| {
+        image::save_buffer_with_format(
+            tmp,
+            &bytes,
+            image.width,
+            image.height,
+            image::ColorType::Rgb8,
+            image::ImageFormat::Png,
+        )
+        .map_err(|e| e.to_string())
+    })
+}
+
+/// Writes linear float32 RGB EXR with `attributes` as text attributes in the header
+/// (provenance: scene hash, spp, depth, time, ...).
+pub fn write_exr(
+    path: &Path,
+    image: &RgbImage,
+    attributes: &[(&str, String)],
+) -> Result<(), ImageError> {
+    use exr::prelude::*;
+    let mut text = Vec::with_capacity(attributes.len());
+    for (key, value) in attributes {
+        let k = Text::new_or_none(key)
+            .ok_or_else(|| io_error(path, format!("header key {key:?} is not ASCII")))?;
+        let v = Text::new_or_none(value)
+            .ok_or_else(|| io_error(path, format!("header value {value:?} is not ASCII")))?;
+        text.push((k, AttributeValue::Text(v)));
+    }
+    let channels = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
+        let p = image.pixels[y * image.width as usize + x];
+        (p[0], p[1], p[2])
+    });
+    let mut exr_image =
+        Image::from_channels((image.width as usize, image.height as usize), channels);
+    exr_image.attributes.other.extend(text);
+    write_atomically(path, |tmp| {
+        exr_image.write().to_file(tmp).map_err(|e| e.to_string())
+    })
+}
+
+/// The text attributes of an EXR header (the ones [`write_exr`] stores).
+pub fn read_exr_attributes(path: &Path) -> Result<Vec<(String, String)>, ImageError> {
+    let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| io_error(path, e))?;
+    let mut out: Vec<(String, String)> = meta
+        .headers
+        .iter()
+        .flat_map(|h| {
+            h.shared_attributes
+                .other
+                .iter()
+                .chain(h.own_attributes.other.iter())
+        })
+        .filter_map(|(k, v)| match v {
+            exr::meta::attribute::AttributeValue::Text(t) => Some((k.to_string(), t.to_string())),
+            _ => None,
+        })
+        .collect();
+    out.sort();
+    Ok(out)
+}
+
+/// Reads an image as linear RGB: EXR as stored; PNG decoded through the inverse sRGB
+/// transfer (no exposure is undone).
+pub fn read_image(path: &Path) -> Result<RgbImage, ImageError> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("exr") => read_exr(path),
+        Some("png") => {
+            let img = image::open(path).map_err(|e| io_error(path, e))?.to_rgb8();
+            let (w, h) = img.dimensions();
+            let pixels = img.pixels().map(|p| p.0.map(srgb::decode8)).collect();
+            Ok(RgbImage {
+                width: w,
+                height: h,
+                pixels,
+            })
+        }
+        _ => Err(ImageError::UnsupportedType {
+            path: path.to_path_buf(),
+        }),
+    }
+}
+
+fn read_exr(path: &Path) -> Result<RgbImage, ImageError> {
+    use exr::prelude::*;
+    let image = read_first_rgba_layer_from_file(
+        path,
+        |size, _| RgbImage::new(size.width() as u32, size.height() as u32),
+        |img: &mut RgbImage, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+            let w = img.width as usize;
+            img.pixels[pos.y() * w + pos.x()] = [r, g, b];
+        },
+    )
+    .map_err(|e| io_error(path, e))?;
+    Ok(image.layer_data.channel_data.pixels)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn gradient() -> RgbImage {
+        RgbImage::from_fn(7, 5, |x, y| [x as f32 * 0.25, y as f32 * 0.5, 3.5])
+    }
+
+    #[test]
+    fn exr_round_trip_is_exact_and_keeps_attributes() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("a.exr");
+        let img = gradient();
+        write_exr(&path, &img, &[("mirrorbox.spp", "16".into())]).unwrap();
+        assert_eq!(read_image(&path).unwrap(), img);
+        let attrs = read_exr_attributes(&path).unwrap();
+        assert!(
+            attrs.contains(&("mirrorbox.spp".into(), "16".into())),
+            "{attrs:?}"
+        );
+        // Only the file itself is left in the folder: no temporary file.
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    #[test]
+    fn png_round_trip_within_quantization() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("a.png");
+        let img = RgbImage::from_fn(4, 3, |x, y| [x as f32 / 4.0, y as f32 / 3.0, 0.5]);
+        write_png(&path, &img, 1.0).unwrap();
+        let back = read_image(&path).unwrap();
+        for (a, b) in img.pixels.iter().zip(&back.pixels) {
+            for c in 0..3 {
+                // One 8-bit sRGB step is at most ~0.0055 in linear near 1.
+                assert!((a[c] - b[c]).abs() < 0.006, "{a:?} vs {b:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn failed_write_leaves_nothing_behind() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("out.exr");
+        let err = write_atomically(&path, |tmp| {
+            std::fs::write(tmp, b"partial").unwrap();
+            Err("simulated failure".into())
+        })
+        .unwrap_err();
+        assert!(err.to_string().contains("simulated failure"));
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+    }
+}

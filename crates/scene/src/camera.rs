@@ -1,0 +1,261 @@
+//! The pinhole camera shared by both renderers.
+//!
+//! **Pixel convention** (one for the whole project): pixel `(x, y)` covers
+//! `[x, x+1) × [y, y+1)` in continuous image coordinates, `y` pointing down, `(0, 0)` the
+//! top-left corner. A sample at sub-pixel offset `(u, v) ∈ [0,1)²` sits at `(x+u, y+v)`.
+//! NDC: `ndc_x = 2·px/W − 1`, `ndc_y = 1 − 2·py/H` — the mapping wgpu's viewport applies,
+//! so a rasterized pixel centre and [`Camera::primary_ray`] at `(x+½, y+½)` see one point.
+//!
+//! View space is right-handed, y up, looking down −z (glam's `rh` camera module); the
+//! projection maps depth to `[0, 1]` (WebGPU), see [`Camera::projection`].
+
+use glam::{Mat4, Vec2, Vec3, Vec4};
+
+/// A ray with origin and unit direction.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ray {
+    pub origin: Vec3,
+    pub dir: Vec3,
+}
+
+impl Ray {
+    pub fn at(&self, t: f32) -> Vec3 {
+        self.origin + self.dir * t
+    }
+}
+
+/// A validated pinhole camera (see `docs/scene-format.md`, `camera`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Camera {
+    pub position: Vec3,
+    pub look_at: Vec3,
+    /// World up hint (unit); the true up is orthogonalized against the view direction.
+    pub up: Vec3,
+    /// Vertical field of view in degrees, in (0, 180).
+    pub fov_y_deg: f32,
+    pub width: u32,
+    pub height: u32,
+    /// Linear multiplier applied to radiance before the sRGB transfer (`docs/shading.md`).
+    pub exposure: f32,
+}
+
+impl Camera {
+    pub fn aspect(&self) -> f32 {
+        self.width as f32 / self.height as f32
+    }
+
+    /// The same camera at another image size (the CLI's `--width/--height`). The vertical
+    /// field of view is kept, so the horizontal one follows the new aspect ratio.
+    pub fn with_size(&self, width: u32, height: u32) -> Camera {
+        Camera {
+            width,
+            height,
+            ..self.clone()
+        }
+    }
+
+    /// World → view transform (right-handed, looking down −z).
+    pub fn view(&self) -> Mat4 {
+        glam::camera::rh::view::look_at_mat4(self.position, self.look_at, self.up)
+    }
+
+    /// View → clip transform with depth in `[0, 1]` (WebGPU/DirectX convention).
+    pub fn projection(&self, near: f32, far: f32) -> Mat4 {
+        glam::camera::rh::proj::directx::perspective(
+            self.fov_y_deg.to_radians(),
+            self.aspect(),
+            near,
+            far,
+        )
+    }
+
+    /// The ray through continuous image position `(px, py)` (pixel convention above).
+    pub fn primary_ray(&self, px: f32, py: f32) -> Ray {
+        self.ray_generator().ray(px, py)
+    }
+
+    /// Precomputes the camera frame for generating many rays.
+    pub fn ray_generator(&self) -> RayGenerator {
+        let forward = (self.look_at - self.position).normalize();
+        let right = forward.cross(self.up).normalize();
+        let up = right.cross(forward);
+        let tan_half = (0.5 * self.fov_y_deg.to_radians()).tan();
+        RayGenerator {
+            origin: self.position,
+            right: right * (tan_half * self.aspect()),
+            up: up * tan_half,
+            forward,
+            width: self.width as f32,
+            height: self.height as f32,
+        }
+    }
+
+    /// Continuous image position of a world point, through `projection · view`; `None` if
+    /// the point is not in front of the camera.
+    pub fn project_to_pixel(&self, p: Vec3) -> Option<Vec2> {
+        let clip = self.projection(0.01, 1000.0) * self.view() * p.extend(1.0);
+        (clip.w > 0.0).then(|| ndc_to_pixel(clip.truncate().truncate() / clip.w, self.size()))
+    }
+
+    pub fn size(&self) -> Vec2 {
+        Vec2::new(self.width as f32, self.height as f32)
+    }
+}
+
+/// Generates primary rays for one camera (its frame precomputed).
+#[derive(Clone, Copy, Debug)]
+pub struct RayGenerator {
+    origin: Vec3,
+    /// Camera right scaled by tan(fov/2)·aspect.
+    right: Vec3,
+    /// Camera up scaled by tan(fov/2).
+    up: Vec3,
+    forward: Vec3,
+    width: f32,
+    height: f32,
+}
+
+impl RayGenerator {
+    /// `d = normalize(forward + ndc_x·tan(fov/2)·aspect·right + ndc_y·tan(fov/2)·up)`,
+    /// the inverse of [`Camera::projection`] on the plane z_view = −1.
+    pub fn ray(&self, px: f32, py: f32) -> Ray {
+        let ndc = pixel_to_ndc(Vec2::new(px, py), Vec2::new(self.width, self.height));
+        let dir = (self.forward + self.right * ndc.x + self.up * ndc.y).normalize();
+        Ray {
+            origin: self.origin,
+            dir,
+        }
+    }
+}
+
+/// Continuous image position → NDC (x right, y up, both in [−1, 1] over the image).
+pub fn pixel_to_ndc(p: Vec2, size: Vec2) -> Vec2 {
+    Vec2::new(2.0 * p.x / size.x - 1.0, 1.0 - 2.0 * p.y / size.y)
+}
+
+/// NDC → continuous image position (inverse of [`pixel_to_ndc`]).
+pub fn ndc_to_pixel(ndc: Vec2, size: Vec2) -> Vec2 {
+    Vec2::new((ndc.x + 1.0) * 0.5 * size.x, (1.0 - ndc.y) * 0.5 * size.y)
+}
+
+/// The fixed `s × s` grid of sub-pixel sample positions shared by the tracer (`--spp s²`)
+/// and the rasterizer (`--ssaa s`): offsets `((i+½)/s, (j+½)/s)` for `j` (rows) then `i`.
+///
+/// Rendering at `s×` resolution puts high-resolution pixel `(s·x+i, s·y+j)`'s centre at
+/// `x + (i+½)/s` in low-resolution coordinates, so box-filtering the supersampled raster
+/// image averages exactly these positions.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SubpixelGrid {
+    pub per_axis: u32,
+}
+
+impl SubpixelGrid {
+    pub fn new(per_axis: u32) -> Self {
+        assert!(
+            per_axis > 0,
+            "a sub-pixel grid needs at least one sample per axis"
+        );
+        SubpixelGrid { per_axis }
+    }
+    pub fn samples_per_pixel(&self) -> u32 {
+        self.per_axis * self.per_axis
+    }
+    /// The sample offsets within a pixel, row by row.
+    pub fn offsets(&self) -> impl Iterator<Item = Vec2> + '_ {
+        let s = self.per_axis;
+        (0..s).flat_map(move |j| {
+            (0..s).map(move |i| Vec2::new((i as f32 + 0.5) / s as f32, (j as f32 + 0.5) / s as f32))
+        })
+    }
+}
+
+/// Homogeneous point helper used in tests and by the renderers.
+pub fn point4(p: Vec3) -> Vec4 {
+    p.extend(1.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    pub(crate) fn test_camera() -> Camera {
+        Camera {
+            position: Vec3::new(0.7, 1.6, 1.5),
+            look_at: Vec3::new(-0.4, 1.1, -2.0),
+            up: Vec3::Y,
+            fov_y_deg: 55.0,
+            width: 64,
+            height: 36,
+            exposure: 1.0,
+        }
+    }
+
+    #[test]
+    fn primary_ray_hits_the_point_projected_to_its_subpixel_position() {
+        let cam = test_camera();
+        for (px, py) in [
+            (0.0, 0.0),
+            (12.25, 7.75),
+            (31.5, 17.5),
+            (63.9, 35.9),
+            (5.1, 30.3),
+        ] {
+            let ray = cam.primary_ray(px, py);
+            for t in [0.5, 3.0, 40.0] {
+                let p = ray.at(t);
+                let back = cam.project_to_pixel(p).unwrap();
+                assert!(
+                    (back - Vec2::new(px, py)).length() < 2e-3,
+                    "({px},{py}) at t={t} projects to {back}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn centre_ray_looks_at_the_target_and_frame_is_right_handed() {
+        let cam = test_camera();
+        let r = cam.primary_ray(32.0, 18.0);
+        let expected = (cam.look_at - cam.position).normalize();
+        assert!(r.dir.abs_diff_eq(expected, 1e-6));
+        // Moving right in the image turns the ray to the camera's right (forward × up).
+        let right = expected.cross(Vec3::Y);
+        assert!(cam.primary_ray(60.0, 18.0).dir.dot(right) > 0.0);
+        // Moving down in the image lowers the ray.
+        assert!(cam.primary_ray(32.0, 35.0).dir.y < r.dir.y);
+    }
+
+    #[test]
+    fn vertical_fov_spans_the_image_height() {
+        let cam = test_camera();
+        let top = cam.primary_ray(32.0, 0.0).dir;
+        let bottom = cam.primary_ray(32.0, 36.0).dir;
+        let angle = top.angle_between(bottom).to_degrees();
+        assert!((angle - cam.fov_y_deg).abs() < 1e-3, "{angle}");
+    }
+
+    #[test]
+    fn subpixel_grid_matches_supersampled_pixel_centres() {
+        let grid = SubpixelGrid::new(3);
+        let offsets: Vec<Vec2> = grid.offsets().collect();
+        assert_eq!(offsets.len(), 9);
+        let (x, y) = (5u32, 2u32);
+        for j in 0..3 {
+            for i in 0..3 {
+                let hi_res_centre = Vec2::new((3 * x + i) as f32 + 0.5, (3 * y + j) as f32 + 0.5);
+                let expected = hi_res_centre / 3.0;
+                let got = Vec2::new(x as f32, y as f32) + offsets[(j * 3 + i) as usize];
+                assert!(got.abs_diff_eq(expected, 1e-6));
+            }
+        }
+    }
+
+    #[test]
+    fn ndc_round_trip() {
+        let size = Vec2::new(640.0, 360.0);
+        for p in [Vec2::ZERO, Vec2::new(320.0, 180.0), Vec2::new(640.0, 360.0)] {
+            assert!(ndc_to_pixel(pixel_to_ndc(p, size), size).abs_diff_eq(p, 1e-4));
+        }
+        assert_eq!(pixel_to_ndc(Vec2::ZERO, size), Vec2::new(-1.0, 1.0));
+    }
+}

@@ -1,0 +1,141 @@
+//! The scene file as written on disk (JSON). Field-by-field documentation with units and
+//! defaults: `docs/scene-format.md`. Unknown fields are rejected everywhere, so a typo never
+//! silently falls back to a default. Numbers are read here and checked in [`crate::load`].
+
+use serde::Deserialize;
+
+pub type Rgb = [f32; 3];
+pub type Vec3f = [f32; 3];
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    pub camera: CameraDesc,
+    #[serde(default)]
+    pub mirrors: Vec<MirrorDesc>,
+    #[serde(default)]
+    pub objects: Vec<ObjectDesc>,
+    #[serde(default)]
+    pub lights: Vec<LightDesc>,
+    #[serde(default)]
+    pub ambient: Option<Rgb>,
+    #[serde(default)]
+    pub background: Option<Rgb>,
+    #[serde(default)]
+    pub terminal: Option<Rgb>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraDesc {
+    pub position: Vec3f,
+    pub look_at: Vec3f,
+    #[serde(default)]
+    pub up: Option<Vec3f>,
+    pub fov_y_deg: f32,
+    pub width: u32,
+    pub height: u32,
+    #[serde(default)]
+    pub exposure: Option<f32>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MirrorDesc {
+    #[serde(default)]
+    pub name: Option<String>,
+    pub center: Vec3f,
+    pub normal: Vec3f,
+    pub up: Vec3f,
+    pub width: f32,
+    pub height: f32,
+    #[serde(default)]
+    pub reflectance: Option<Rgb>,
+    #[serde(default)]
+    pub back_albedo: Option<Rgb>,
+}
+
+/// The kind of an object's shape (the `type` field).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ShapeKind {
+    Box,
+    Sphere,
+    Quad,
+    Mesh,
+}
+
+impl ShapeKind {
+    /// The shape-specific fields this kind accepts (all others are refused).
+    pub fn allowed_fields(self) -> &'static [&'static str] {
+        match self {
+            ShapeKind::Box => &["size"],
+            ShapeKind::Sphere => &["radius", "subdivisions"],
+            ShapeKind::Quad => &["size"],
+            ShapeKind::Mesh => &["path"],
+        }
+    }
+    pub fn name(self) -> &'static str {
+        match self {
+            ShapeKind::Box => "box",
+            ShapeKind::Sphere => "sphere",
+            ShapeKind::Quad => "quad",
+            ShapeKind::Mesh => "mesh",
+        }
+    }
+}
+
+/// One object. The shape parameters are flat optional fields (rather than a tagged enum) so
+/// that every error keeps its exact field path and line; [`crate::load`] refuses fields
+/// that do not belong to the object's `type`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObjectDesc {
+    #[serde(rename = "type")]
+    pub kind: ShapeKind,
+    #[serde(default)]
+    pub name: Option<String>,
+    /// box: [x, y, z] edge lengths; quad: [width, height].
+    #[serde(default)]
+    pub size: Option<Vec<f32>>,
+    #[serde(default)]
+    pub radius: Option<f32>,
+    #[serde(default)]
+    pub subdivisions: Option<u32>,
+    #[serde(default)]
+    pub path: Option<String>,
+    #[serde(default)]
+    pub transform: Option<TransformDesc>,
+    #[serde(default)]
+    pub albedo: Option<Rgb>,
+    #[serde(default)]
+    pub emission: Option<Rgb>,
+}
+
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TransformDesc {
+    #[serde(default)]
+    pub translate: Option<Vec3f>,
+    /// Euler angles in degrees, applied about x, then y, then z (R = Rz·Ry·Rx).
+    #[serde(default)]
+    pub rotate_deg: Option<Vec3f>,
+    #[serde(default)]
+    pub scale: Option<Scale>,
+}
+
+/// A uniform (`2.0`) or per-axis (`[1, 2, 1]`) scale.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(untagged, expecting = "a number or an array of 3 numbers")]
+pub enum Scale {
+    Uniform(f32),
+    PerAxis(Vec3f),
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LightDesc {
+    pub position: Vec3f,
+    /// Radiant intensity in W/sr per RGB channel.
+    pub intensity: Rgb,
+}

@@ -1,0 +1,132 @@
+//! The one triangle list both renderers consume.
+//!
+//! Every triangle is stored by value in world space, wound counter-clockwise as seen from
+//! its front side, and carries the id of its [`Surface`]. Shading uses the *face* normal
+//! (`(v1 − v0) × (v2 − v0)`, normalized), never interpolated normals, so that the rasterizer,
+//! the tracer and Mitsuba (`face_normals`) all see exactly the same surface.
+
+use glam::Vec3;
+use std::ops::Range;
+
+/// Index into [`Geometry::surfaces`].
+pub type SurfaceId = u32;
+
+/// What a triangle is made of. See `docs/shading.md` for how each is shaded.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Surface {
+    /// Lambertian reflector (two-sided) with optional emission (front side only).
+    Diffuse { albedo: Vec3, emission: Vec3 },
+    /// Front side of mirror `mirror` (index into `Scene::mirrors`) reflects `reflectance`;
+    /// the back side is diffuse with `back_albedo`.
+    Mirror {
+        mirror: usize,
+        reflectance: Vec3,
+        back_albedo: Vec3,
+    },
+}
+
+/// A named group of consecutive triangles (one scene object or one mirror).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Part {
+    pub name: String,
+    pub surface: SurfaceId,
+    pub triangles: Range<usize>,
+}
+
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Geometry {
+    pub triangles: Vec<[Vec3; 3]>,
+    /// `surface_of[i]` is the surface of `triangles[i]`.
+    pub surface_of: Vec<SurfaceId>,
+    pub surfaces: Vec<Surface>,
+    pub parts: Vec<Part>,
+    /// Triangles dropped at load because they had (near) zero area.
+    pub degenerate_dropped: usize,
+}
+
+/// Twice the area below which a triangle is considered degenerate and dropped, relative to
+/// the square of its longest edge (a sliver this thin has no reliable normal).
+const DEGENERATE_RELATIVE_AREA: f32 = 1e-7;
+
+impl Geometry {
+    /// Appends a part; degenerate triangles are dropped (and counted) so that every stored
+    /// triangle has a well-defined face normal.
+    pub fn push_part(&mut self, name: String, surface: Surface, triangles: Vec<[Vec3; 3]>) {
+        let id = self.surfaces.len() as SurfaceId;
+        self.surfaces.push(surface);
+        let start = self.triangles.len();
+        for t in triangles {
+            let doubled_area = (t[1] - t[0]).cross(t[2] - t[0]).length();
+            let longest = (t[1] - t[0])
+                .length_squared()
+                .max((t[2] - t[1]).length_squared())
+                .max((t[0] - t[2]).length_squared());
+            if !(doubled_area > DEGENERATE_RELATIVE_AREA * longest) {
+                self.degenerate_dropped += 1;
+                continue;
+            }
+            self.triangles.push(t);
+            self.surface_of.push(id);
+        }
+        let end = self.triangles.len();
+        self.parts.push(Part {
+            name,
+            surface: id,
+            triangles: start..end,
+        });
+    }
+
+    /// Unit face normal of triangle `i` (front side).
+    pub fn face_normal(&self, i: usize) -> Vec3 {
+        let [a, b, c] = self.triangles[i];
+        (b - a).cross(c - a).normalize()
+    }
+
+    pub fn surface(&self, triangle: usize) -> &Surface {
+        &self.surfaces[self.surface_of[triangle] as usize]
+    }
+
+    pub fn mirror_triangle_count(&self) -> usize {
+        self.surface_of
+            .iter()
+            .filter(|&&s| matches!(self.surfaces[s as usize], Surface::Mirror { .. }))
+            .count()
+    }
+
+    pub(crate) fn set_mirror_reflectance(&mut self, value: Vec3) {
+        for s in &mut self.surfaces {
+            if let Surface::Mirror { reflectance, .. } = s {
+                *reflectance = value;
+            }
+        }
+    }
+
+    /// Axis-aligned bounds (min, max) of all triangles; `None` for an empty scene.
+    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        let mut it = self.triangles.iter().flatten();
+        let first = *it.next()?;
+        Some(it.fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p))))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn degenerate_triangles_are_dropped_and_counted() {
+        let mut g = Geometry::default();
+        let good = [Vec3::ZERO, Vec3::X, Vec3::Y];
+        let collinear = [Vec3::ZERO, Vec3::X, Vec3::X * 2.0];
+        let repeated = [Vec3::ONE, Vec3::ONE, Vec3::Y];
+        let diffuse = Surface::Diffuse {
+            albedo: Vec3::splat(0.5),
+            emission: Vec3::ZERO,
+        };
+        g.push_part("p".into(), diffuse, vec![good, collinear, repeated]);
+        assert_eq!(g.triangles, vec![good]);
+        assert_eq!(g.degenerate_dropped, 2);
+        assert_eq!(g.parts[0].triangles, 0..1);
+        assert_eq!(g.face_normal(0), Vec3::Z);
+    }
+}

@@ -1,0 +1,493 @@
+//! Reading, checking and compiling a scene file into a [`Scene`].
+//!
+//! Syntax and type errors carry `file:line:column` and the field path where parsing stopped;
+//! meaning errors carry the field path (`mirrors[1].normal`) and what is allowed. Nothing
+//! here panics on any input.
+
+use crate::error::{FieldPath, SceneError};
+use crate::format::{
+    CameraDesc, LightDesc, MirrorDesc, ObjectDesc, Rgb, Scale, SceneFile, ShapeKind, TransformDesc,
+    Vec3f,
+};
+use crate::geometry::{Geometry, Surface};
+use crate::shading::{Lighting, PointLight};
+use crate::tessellate::{self, MAX_SPHERE_SUBDIVISIONS};
+use crate::{Camera, Mirror, Scene};
+use glam::{EulerRot, Mat4, Quat, Vec3};
+use std::path::{Path, PathBuf};
+
+/// Defaults, documented in `docs/scene-format.md`.
+pub mod defaults {
+    pub const CAMERA_UP: [f32; 3] = [0.0, 1.0, 0.0];
+    pub const EXPOSURE: f32 = 1.0;
+    pub const MIRROR_REFLECTANCE: [f32; 3] = [0.9, 0.9, 0.9];
+    pub const MIRROR_BACK_ALBEDO: [f32; 3] = [0.2, 0.2, 0.2];
+    pub const ALBEDO: [f32; 3] = [0.8, 0.8, 0.8];
+    pub const SPHERE_RADIUS: f32 = 1.0;
+    pub const SPHERE_SUBDIVISIONS: u32 = 3;
+    pub const BOX_SIZE: [f32; 3] = [1.0, 1.0, 1.0];
+    pub const QUAD_SIZE: [f32; 2] = [1.0, 1.0];
+    /// Largest image side accepted.
+    pub const MAX_IMAGE_SIDE: u32 = 16384;
+}
+
+/// Loads, checks and compiles the scene file at `path`.
+pub fn load_scene(path: &Path) -> Result<Scene> {
+    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Read {
+        file: path.to_path_buf(),
+        source,
+    })?;
+    parse_scene(&text, path)
+}
+
+/// Parses scene JSON `text`; `path` names the file in messages and anchors relative OBJ paths.
+pub fn parse_scene(text: &str, path: &Path) -> Result<Scene> {
+    let syntax = |field: Option<String>, e: serde_json::Error| SceneError::Syntax {
+        file: path.to_path_buf(),
+        line: e.line(),
+        column: e.column(),
+        path: field.filter(|f| f != "."),
+        message: strip_position(&e.to_string()),
+    };
+    let mut de = serde_json::Deserializer::from_str(text);
+    let file: SceneFile = serde_path_to_error::deserialize(&mut de).map_err(|e| {
+        let field = e.path().to_string();
+        syntax(Some(field), e.into_inner())
+    })?;
+    de.end().map_err(|e| syntax(None, e))?;
+    Checker { file: path }.compile(file)
+}
+
+/// serde_json appends " at line L column C"; we print the position in front instead.
+fn strip_position(message: &str) -> String {
+    match message.rfind(" at line ") {
+        Some(i) => message[..i].to_string(),
+        None => message.to_string(),
+    }
+}
+
+struct Checker<'a> {
+    file: &'a Path,
+}
+
+type Result<T> = std::result::Result<T, SceneError>;
+
+impl Checker<'_> {
+    fn invalid(&self, path: &FieldPath, message: impl Into<String>) -> SceneError {
+        SceneError::Invalid {
+            file: self.file.to_path_buf(),
+            path: path.to_string(),
+            message: message.into(),
+        }
+    }
+
+    fn finite(&self, path: &FieldPath, x: f32) -> Result<f32> {
+        if x.is_finite() {
+            Ok(x)
+        } else {
+            Err(self.invalid(path, format!("must be a finite number, got {x}")))
+        }
+    }
+
+    fn positive(&self, path: &FieldPath, x: f32) -> Result<f32> {
+        let x = self.finite(path, x)?;
+        if x > 0.0 {
+            Ok(x)
+        } else {
+            Err(self.invalid(path, format!("must be greater than 0, got {x}")))
+        }
+    }
+
+    fn vec3(&self, path: &FieldPath, v: Vec3f) -> Result<Vec3> {
+        for (i, &c) in v.iter().enumerate() {
+            self.finite(&path.index(i), c)?;
+        }
+        Ok(Vec3::from_array(v))
+    }
+
+    fn direction(&self, path: &FieldPath, v: Vec3f) -> Result<Vec3> {
+        let v = self.vec3(path, v)?;
+        v.try_normalize().ok_or_else(|| {
+            self.invalid(
+                path,
+                format!("must be a non-zero direction, got {}", show(v)),
+            )
+        })
+    }
+
+    /// RGB with every channel in `[lo, hi]`.
+    fn rgb(
+        &self,
+        path: &FieldPath,
+        v: Option<Rgb>,
+        default: Rgb,
+        lo: f32,
+        hi: f32,
+    ) -> Result<Vec3> {
+        let v = v.unwrap_or(default);
+        for (i, &c) in v.iter().enumerate() {
+            let c = self.finite(&path.index(i), c)?;
+            if !(lo..=hi).contains(&c) {
+                let allowed = if hi.is_finite() {
+                    format!("in [{lo}, {hi}]")
+                } else {
+                    format!("≥ {lo}")
+                };
+                return Err(self.invalid(&path.index(i), format!("must be {allowed}, got {c}")));
+            }
+        }
+        Ok(Vec3::from_array(v))
+    }
+
+    fn reflectance(&self, path: &FieldPath, v: Option<Rgb>, default: Rgb) -> Result<Vec3> {
+        self.rgb(path, v, default, 0.0, 1.0)
+    }
+
+    fn radiance(&self, path: &FieldPath, v: Option<Rgb>) -> Result<Vec3> {
+        self.rgb(path, v, [0.0; 3], 0.0, f32::INFINITY)
+    }
+
+    fn compile(&self, file: SceneFile) -> Result<Scene> {
+        let camera = self.camera(&FieldPath::root("camera"), &file.camera)?;
+        let mut geometry = Geometry::default();
+        let objects = FieldPath::root("objects");
+        for (i, object) in file.objects.iter().enumerate() {
+            self.object(&objects.index(i), i, object, &mut geometry)?;
+        }
+        let mut mirrors = Vec::with_capacity(file.mirrors.len());
+        let mirror_paths = FieldPath::root("mirrors");
+        for (i, desc) in file.mirrors.iter().enumerate() {
+            let mirror = self.mirror(&mirror_paths.index(i), i, desc)?;
+            let [a, b, c, d] = mirror.corners();
+            geometry.push_part(
+                mirror.name.clone(),
+                Surface::Mirror {
+                    mirror: i,
+                    reflectance: mirror.reflectance,
+                    back_albedo: mirror.back_albedo,
+                },
+                vec![[a, b, c], [a, c, d]],
+            );
+            mirrors.push(mirror);
+        }
+        let lights_path = FieldPath::root("lights");
+        let lights = file
+            .lights
+            .iter()
+            .enumerate()
+            .map(|(i, l)| self.light(&lights_path.index(i), l))
+            .collect::<Result<Vec<_>>>()?;
+        Ok(Scene {
+            source: self.file.to_path_buf(),
+            camera,
+            mirrors,
+            lighting: Lighting {
+                lights,
+                ambient: self.radiance(&FieldPath::root("ambient"), file.ambient)?,
+            },
+            background: self.radiance(&FieldPath::root("background"), file.background)?,
+            terminal: self.radiance(&FieldPath::root("terminal"), file.terminal)?,
+            geometry,
+        })
+    }
+
+    fn camera(&self, path: &FieldPath, c: &CameraDesc) -> Result<Camera> {
+        let position = self.vec3(&path.field("position"), c.position)?;
+        let look_at = self.vec3(&path.field("look_at"), c.look_at)?;
+        let forward = (look_at - position).try_normalize().ok_or_else(|| {
+            self.invalid(&path.field("look_at"), "must differ from camera.position")
+        })?;
+        let up_path = path.field("up");
+        let up = self.direction(&up_path, c.up.unwrap_or(defaults::CAMERA_UP))?;
+        if forward.cross(up).length() < 1e-4 {
+            return Err(self.invalid(
+                &up_path,
+                "must not be parallel to the view direction (look_at − position)",
+            ));
+        }
+        let fov_path = path.field("fov_y_deg");
+        let fov = self.finite(&fov_path, c.fov_y_deg)?;
+        if !(fov > 0.0 && fov < 180.0) {
+            return Err(self.invalid(&fov_path, format!("must be in (0, 180) degrees, got {fov}")));
+        }
+        for (name, side) in [("width", c.width), ("height", c.height)] {
+            if side == 0 || side > defaults::MAX_IMAGE_SIDE {
+                return Err(self.invalid(
+                    &path.field(name),
+                    format!(
+                        "must be in [1, {}] pixels, got {side}",
+                        defaults::MAX_IMAGE_SIDE
+                    ),
+                ));
+            }
+        }
+        let exposure = self.positive(
+            &path.field("exposure"),
+            c.exposure.unwrap_or(defaults::EXPOSURE),
+        )?;
+        Ok(Camera {
+            position,
+            look_at,
+            up,
+            fov_y_deg: fov,
+            width: c.width,
+            height: c.height,
+            exposure,
+        })
+    }
+
+    fn mirror(&self, path: &FieldPath, index: usize, m: &MirrorDesc) -> Result<Mirror> {
+        let center = self.vec3(&path.field("center"), m.center)?;
+        let normal = self.direction(&path.field("normal"), m.normal)?;
+        let up_path = path.field("up");
+        let up = self.direction(&up_path, m.up)?;
+        if normal.cross(up).length() < 1e-4 {
+            return Err(self.invalid(&up_path, "must not be parallel to the mirror's normal"));
+        }
+        // Gram–Schmidt: keep the part of `up` in the mirror plane.
+        let up = (up - normal * normal.dot(up)).normalize();
+        let width = self.positive(&path.field("width"), m.width)?;
+        let height = self.positive(&path.field("height"), m.height)?;
+        Ok(Mirror {
+            name: m.name.clone().unwrap_or_else(|| format!("mirror {index}")),
+            center,
+            normal,
+            up,
+            width,
+            height,
+            reflectance: self.reflectance(
+                &path.field("reflectance"),
+                m.reflectance,
+                defaults::MIRROR_REFLECTANCE,
+            )?,
+            back_albedo: self.reflectance(
+                &path.field("back_albedo"),
+                m.back_albedo,
+                defaults::MIRROR_BACK_ALBEDO,
+            )?,
+        })
+    }
+
+    fn light(&self, path: &FieldPath, l: &LightDesc) -> Result<PointLight> {
+        Ok(PointLight {
+            position: self.vec3(&path.field("position"), l.position)?,
+            intensity: self.radiance(&path.field("intensity"), Some(l.intensity))?,
+        })
+    }
+
+    fn object(
+        &self,
+        path: &FieldPath,
+        index: usize,
+        o: &ObjectDesc,
+        geometry: &mut Geometry,
+    ) -> Result<()> {
+        let present = [
+            ("size", o.size.is_some()),
+            ("radius", o.radius.is_some()),
+            ("subdivisions", o.subdivisions.is_some()),
+            ("path", o.path.is_some()),
+        ];
+        let allowed = o.kind.allowed_fields();
+        for (field, is_present) in present {
+            if is_present && !allowed.contains(&field) {
+                return Err(self.invalid(
+                    &path.field(field),
+                    format!(
+                        "is not a field of a \"{}\" object (its shape fields: {})",
+                        o.kind.name(),
+                        allowed.join(", ")
+                    ),
+                ));
+            }
+        }
+        let local = match o.kind {
+            ShapeKind::Box => {
+                let s = self.sizes(&path.field("size"), o.size.as_deref(), &defaults::BOX_SIZE)?;
+                tessellate::cuboid(Vec3::new(s[0], s[1], s[2]))
+            }
+            ShapeKind::Quad => {
+                let s = self.sizes(&path.field("size"), o.size.as_deref(), &defaults::QUAD_SIZE)?;
+                tessellate::quad(s[0], s[1])
+            }
+            ShapeKind::Sphere => {
+                let radius = self.positive(
+                    &path.field("radius"),
+                    o.radius.unwrap_or(defaults::SPHERE_RADIUS),
+                )?;
+                let level = o.subdivisions.unwrap_or(defaults::SPHERE_SUBDIVISIONS);
+                if level > MAX_SPHERE_SUBDIVISIONS {
+                    return Err(self.invalid(
+                        &path.field("subdivisions"),
+                        format!("must be in [0, {MAX_SPHERE_SUBDIVISIONS}] (20·4^s triangles), got {level}"),
+                    ));
+                }
+                tessellate::icosphere(radius, level)
+            }
+            ShapeKind::Mesh => {
+                let mesh_path = path.field("path");
+                let rel = o
+                    .path
+                    .as_deref()
+                    .ok_or_else(|| self.invalid(&mesh_path, "is required for a \"mesh\" object (an OBJ file, relative to the scene file)"))?;
+                self.obj(&mesh_path, rel)?
+            }
+        };
+        let transform = self.transform(&path.field("transform"), o.transform.as_ref())?;
+        let flips = transform.determinant() < 0.0;
+        let world = local
+            .into_iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|p| transform.transform_point3(p));
+                if flips { [a, c, b] } else { [a, b, c] }
+            })
+            .collect();
+        let surface = Surface::Diffuse {
+            albedo: self.reflectance(&path.field("albedo"), o.albedo, defaults::ALBEDO)?,
+            emission: self.radiance(&path.field("emission"), o.emission)?,
+        };
+        let name = o
+            .name
+            .clone()
+            .unwrap_or_else(|| format!("{} {index}", o.kind.name()));
+        geometry.push_part(name, surface, world);
+        Ok(())
+    }
+
+    /// Positive edge lengths, exactly as many as `default` has.
+    fn sizes(&self, path: &FieldPath, given: Option<&[f32]>, default: &[f32]) -> Result<Vec<f32>> {
+        let values = given.unwrap_or(default);
+        if values.len() != default.len() {
+            return Err(self.invalid(
+                path,
+                format!("must have {} numbers, got {}", default.len(), values.len()),
+            ));
+        }
+        values
+            .iter()
+            .enumerate()
+            .map(|(i, &x)| self.positive(&path.index(i), x))
+            .collect()
+    }
+
+    /// `T · Rz · Ry · Rx · S` (scale, then rotate about x, y, z, then translate).
+    fn transform(&self, path: &FieldPath, t: Option<&TransformDesc>) -> Result<Mat4> {
+        let default = TransformDesc::default();
+        let t = t.unwrap_or(&default);
+        let translate = self.vec3(&path.field("translate"), t.translate.unwrap_or([0.0; 3]))?;
+        let angles = self.vec3(&path.field("rotate_deg"), t.rotate_deg.unwrap_or([0.0; 3]))?;
+        let scale_path = path.field("scale");
+        let scale = match t.scale {
+            None => Vec3::ONE,
+            Some(Scale::Uniform(s)) => Vec3::splat(self.finite(&scale_path, s)?),
+            Some(Scale::PerAxis(v)) => self.vec3(&scale_path, v)?,
+        };
+        if scale.cmpeq(Vec3::ZERO).any() {
+            return Err(self.invalid(
+                &scale_path,
+                format!("must be non-zero on every axis, got {}", show(scale)),
+            ));
+        }
+        let rotation = Quat::from_euler(
+            EulerRot::ZYX,
+            angles.z.to_radians(),
+            angles.y.to_radians(),
+            angles.x.to_radians(),
+        );
+        Ok(Mat4::from_scale_rotation_translation(
+            scale, rotation, translate,
+        ))
+    }
+
+    /// Triangles of an OBJ file, relative to the scene file's folder.
+    fn obj(&self, path: &FieldPath, rel: &str) -> Result<Vec<[Vec3; 3]>> {
+        let resolved: PathBuf = self.file.parent().unwrap_or(Path::new(".")).join(rel);
+        let bytes = std::fs::read(&resolved).map_err(|e| {
+            self.invalid(
+                path,
+                format!(
+                    "cannot read OBJ file \"{rel}\" (at {}): {e}",
+                    resolved.display()
+                ),
+            )
+        })?;
+        let models = parse_obj(&bytes).map_err(|(line, e)| {
+            let at = line.map(|l| format!(" at line {l}")).unwrap_or_default();
+            self.invalid(path, format!("malformed OBJ file \"{rel}\"{at}: {e}"))
+        })?;
+        let mut tris = Vec::new();
+        for model in &models {
+            let m = &model.mesh;
+            let vertex = |i: u32| {
+                let i = i as usize * 3;
+                Vec3::new(m.positions[i], m.positions[i + 1], m.positions[i + 2])
+            };
+            for f in m.indices.chunks_exact(3) {
+                tris.push([vertex(f[0]), vertex(f[1]), vertex(f[2])]);
+            }
+        }
+        if let Some(bad) = tris.iter().flatten().find(|p| !p.is_finite()) {
+            return Err(self.invalid(
+                path,
+                format!("OBJ file \"{rel}\" has a non-finite vertex {}", show(*bad)),
+            ));
+        }
+        if tris.is_empty() {
+            return Err(self.invalid(path, format!("OBJ file \"{rel}\" contains no faces")));
+        }
+        Ok(tris)
+    }
+}
+
+fn obj_options() -> tobj::LoadOptions {
+    tobj::LoadOptions {
+        triangulate: true,
+        single_index: false,
+        ignore_points: true,
+        ignore_lines: true,
+    }
+}
+
+fn parse_obj_prefix(bytes: &[u8]) -> std::result::Result<Vec<tobj::Model>, tobj::LoadError> {
+    let mut reader = std::io::BufReader::new(bytes);
+    // Materials are not used (the scene gives albedo); a missing .mtl is not an error.
+    tobj::load_obj_buf(&mut reader, &obj_options(), |_| {
+        Err(tobj::LoadError::OpenFileFailed)
+    })
+    .map(|(models, _materials)| models)
+}
+
+/// Parses an OBJ with tobj. tobj's errors carry no position, so on failure the first failing
+/// line is found by bisecting over line prefixes (parsing is sequential: once a prefix fails,
+/// every longer one does).
+fn parse_obj(
+    bytes: &[u8],
+) -> std::result::Result<Vec<tobj::Model>, (Option<usize>, tobj::LoadError)> {
+    let err = match parse_obj_prefix(bytes) {
+        Ok(models) => return Ok(models),
+        Err(e) => e,
+    };
+    let line_ends: Vec<usize> = bytes
+        .iter()
+        .enumerate()
+        .filter(|&(_, &b)| b == b'\n')
+        .map(|(i, _)| i + 1)
+        .chain(std::iter::once(bytes.len()))
+        .collect();
+    // Find the smallest k such that the first k lines fail.
+    let (mut lo, mut hi) = (0usize, line_ends.len()); // prefix of `hi` lines fails
+    while lo + 1 < hi {
+        let mid = (lo + hi) / 2;
+        if parse_obj_prefix(&bytes[..line_ends[mid - 1]]).is_err() {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    let line = (hi >= 1 && parse_obj_prefix(&bytes[..line_ends[hi - 1]]).is_err()).then_some(hi);
+    Err((line, err))
+}
+
+fn show(v: Vec3) -> String {
+    format!("[{}, {}, {}]", v.x, v.y, v.z)
+}
