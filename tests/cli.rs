@@ -1,1 +1,281 @@
+//! End-to-end tests of the `mirrorbox` command line: real processes, real files, exit codes
+//! and messages as a user sees them.
 
+use serde_json::{json, Value};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+struct Output {
+    code: i32,
+    stdout: String,
+    stderr: String,
+}
+
+fn mirrorbox(args: &[&str], envs: &[(&str, &str)]) -> Output {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_mirrorbox"));
+    cmd.args(args).current_dir(repo());
+    for (k, v) in envs {
+        cmd.env(k, v);
+    }
+    let out = cmd.output().expect("run mirrorbox");
+    Output {
+        code: out.status.code().expect("exited normally, not by a signal"),
+        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
+        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
+    }
+}
+
+/// A small valid scene; each test breaks one thing in it.
+fn valid_scene() -> Value {
+    json!({
+        "camera": { "position": [0, 1, 3], "look_at": [0, 1, 0], "fov_y_deg": 60,
+                    "width": 32, "height": 24 },
+        "mirrors": [
+            { "center": [0, 1, -2], "normal": [0, 0, 1], "up": [0, 1, 0], "width": 4, "height": 3 },
+            { "center": [0, 1, 2], "normal": [0, 0, -1], "up": [0, 1, 0], "width": 4, "height": 3 }
+        ],
+        "objects": [ { "type": "sphere", "radius": 0.5 } ],
+        "lights": [ { "position": [0, 2.5, 0], "intensity": [10, 10, 10] } ]
+    })
+}
+
+/// Writes `text` as `name` in a fresh folder and runs `mirrorbox check` on it.
+fn check_text(name: &str, text: &str, extra_files: &[(&str, &str)]) -> (Output, tempfile::TempDir) {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join(name);
+    std::fs::write(&path, text).unwrap();
+    for (file, content) in extra_files {
+        std::fs::write(dir.path().join(file), content).unwrap();
+    }
+    let out = mirrorbox(&["check", path.to_str().unwrap()], &[]);
+    (out, dir)
+}
+
+/// Breaks the valid scene with `edit`, runs `check`, and asserts exit code 2 and that stderr
+/// contains the file name and every expected fragment.
+fn assert_rejected(edit: impl FnOnce(&mut Value), expected: &[&str]) -> Output {
+    assert_rejected_with_files(edit, &[], expected)
+}
+
+fn assert_rejected_with_files(edit: impl FnOnce(&mut Value), files: &[(&str, &str)], expected: &[&str]) -> Output {
+    let mut scene = valid_scene();
+    edit(&mut scene);
+    let text = serde_json::to_string_pretty(&scene).unwrap();
+    let (out, _dir) = check_text("scene.json", &text, files);
+    assert_eq!(out.code, 2, "stderr: {}", out.stderr);
+    assert!(out.stderr.contains("scene.json"), "file not named: {}", out.stderr);
+    for fragment in expected {
+        assert!(out.stderr.contains(fragment), "missing {fragment:?} in: {}", out.stderr);
+    }
+    assert!(!out.stderr.contains("panicked"), "{}", out.stderr);
+    out
+}
+
+#[test]
+fn check_accepts_every_bundled_scene() {
+    let mut scenes: Vec<String> = std::fs::read_dir(repo().join("scenes"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "json"))
+        .map(|p| p.strip_prefix(repo()).unwrap().to_string_lossy().into_owned())
+        .collect();
+    scenes.sort();
+    for required in ["mirror_box", "single_mirror", "tilted_pair", "mirror_room"] {
+        assert!(scenes.iter().any(|s| s.contains(required)), "scenes/{required}.json missing");
+    }
+    let args: Vec<&str> = std::iter::once("check").chain(scenes.iter().map(String::as_str)).collect();
+    let out = mirrorbox(&args, &[]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    assert_eq!(out.stdout.lines().count(), scenes.len());
+    assert!(out.stdout.contains("scenes/mirror_box.json: ok: 2 mirrors"), "{}", out.stdout);
+    assert!(out.stdout.contains("scenes/mirror_room.json: ok: 4 mirrors"), "{}", out.stdout);
+}
+
+#[test]
+fn the_valid_test_scene_is_valid() {
+    let text = serde_json::to_string(&valid_scene()).unwrap();
+    let (out, _dir) = check_text("scene.json", &text, &[]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    assert!(out.stdout.contains("2 mirrors, 1284 triangles (4 on mirrors), 1 light, 32x24"), "{}", out.stdout);
+}
+
+#[test]
+fn json_syntax_error_gives_file_line_and_column() {
+    let text = "{\n  \"camera\": {\n    \"position\": [0, 1, 3]\n    \"look_at\": [0, 1, 0]\n  }\n}\n";
+    let (out, _dir) = check_text("broken.json", text, &[]);
+    assert_eq!(out.code, 2);
+    assert!(out.stderr.contains("broken.json:4:5: "), "{}", out.stderr);
+    assert!(out.stderr.contains("expected `,` or `}`"), "{}", out.stderr);
+}
+
+#[test]
+fn nan_literal_is_a_syntax_error_with_position() {
+    let text = "{ \"camera\": { \"position\": [0, NaN, 3] } }";
+    let (out, _dir) = check_text("nan.json", text, &[]);
+    assert_eq!(out.code, 2);
+    assert!(out.stderr.contains("nan.json:1:31: "), "{}", out.stderr);
+}
+
+#[test]
+fn infinite_number_names_its_field() {
+    assert_rejected(
+        |s| s["camera"]["position"] = json!([1e39, 1, 3]),
+        &["camera.position[0]: must be a finite number, got inf"],
+    );
+}
+
+#[test]
+fn zero_size_mirror() {
+    assert_rejected(|s| s["mirrors"][1]["width"] = json!(0), &["mirrors[1].width: must be greater than 0, got 0"]);
+    assert_rejected(|s| s["mirrors"][0]["height"] = json!(-3), &["mirrors[0].height: must be greater than 0, got -3"]);
+}
+
+#[test]
+fn degenerate_mirror_with_up_parallel_to_normal() {
+    assert_rejected(
+        |s| s["mirrors"][0]["up"] = json!([0, 0, -2]),
+        &["mirrors[0].up: must not be parallel to the mirror's normal"],
+    );
+}
+
+#[test]
+fn zero_normal() {
+    assert_rejected(
+        |s| s["mirrors"][1]["normal"] = json!([0, 0, 0]),
+        &["mirrors[1].normal: must be a non-zero direction, got [0, 0, 0]"],
+    );
+}
+
+#[test]
+fn reflectance_outside_unit_interval() {
+    assert_rejected(
+        |s| s["mirrors"][0]["reflectance"] = json!([0.5, 1.2, 0.5]),
+        &["mirrors[0].reflectance[1]: must be in [0, 1], got 1.2"],
+    );
+    assert_rejected(
+        |s| s["objects"][0]["albedo"] = json!([-0.1, 0.5, 0.5]),
+        &["objects[0].albedo[0]: must be in [0, 1], got -0.1"],
+    );
+}
+
+#[test]
+fn unknown_field_is_refused_with_its_path_and_position() {
+    let out = assert_rejected(
+        |s| s["mirrors"][1]["reflectence"] = json!([0.9, 0.9, 0.9]),
+        &["mirrors[1]", "unknown field `reflectence`", "expected one of"],
+    );
+    // serde_json reports where the offending key ends: line and column are present.
+    assert!(out.stderr.contains("scene.json:"), "{}", out.stderr);
+    assert_rejected(|s| s["colour"] = json!([1, 0, 0]), &["unknown field `colour`"]);
+}
+
+#[test]
+fn wrong_type_names_the_field() {
+    assert_rejected(|s| s["mirrors"][0]["width"] = json!("wide"), &["mirrors[0].width", "invalid type: string \"wide\""]);
+}
+
+#[test]
+fn shape_field_of_another_type_is_refused() {
+    assert_rejected(
+        |s| s["objects"][0]["size"] = json!([1, 1, 1]),
+        &["objects[0].size: is not a field of a \"sphere\" object (its shape fields: radius, subdivisions)"],
+    );
+}
+
+#[test]
+fn missing_obj_file() {
+    assert_rejected(
+        |s| s["objects"] = json!([{ "type": "mesh", "path": "meshes/nowhere.obj" }]),
+        &["objects[0].path: cannot read OBJ file \"meshes/nowhere.obj\""],
+    );
+}
+
+#[test]
+fn malformed_obj_file_names_the_line() {
+    let obj = "# a triangle with a broken vertex\nv 0 0 0\nv 1 zero 0\nv 0 1 0\nf 1 2 3\n";
+    assert_rejected_with_files(
+        |s| s["objects"] = json!([{ "type": "mesh", "path": "bad.obj" }]),
+        &[("bad.obj", obj)],
+        &["objects[0].path: malformed OBJ file \"bad.obj\" at line 3: position parse error"],
+    );
+    let out_of_range = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n";
+    assert_rejected_with_files(
+        |s| s["objects"] = json!([{ "type": "mesh", "path": "bad.obj" }]),
+        &[("bad.obj", out_of_range)],
+        &["objects[0].path: malformed OBJ file \"bad.obj\"", "out of bounds"],
+    );
+}
+
+#[test]
+fn obj_without_faces() {
+    assert_rejected_with_files(
+        |s| s["objects"] = json!([{ "type": "mesh", "path": "empty.obj" }]),
+        &[("empty.obj", "v 0 0 0\nv 1 0 0\n")],
+        &["objects[0].path: OBJ file \"empty.obj\" contains no faces"],
+    );
+}
+
+#[test]
+fn camera_errors() {
+    assert_rejected(|s| s["camera"]["fov_y_deg"] = json!(180), &["camera.fov_y_deg: must be in (0, 180) degrees, got 180"]);
+    assert_rejected(|s| s["camera"]["look_at"] = json!([0, 1, 3]), &["camera.look_at: must differ from camera.position"]);
+    assert_rejected(|s| s["camera"]["width"] = json!(0), &["camera.width: must be in [1, 16384] pixels, got 0"]);
+}
+
+#[test]
+fn zero_scale_is_refused() {
+    assert_rejected(
+        |s| s["objects"][0]["transform"] = json!({ "scale": [1, 0, 1] }),
+        &["objects[0].transform.scale: must be non-zero on every axis"],
+    );
+}
+
+#[test]
+fn missing_scene_file_is_bad_input() {
+    let out = mirrorbox(&["check", "scenes/does_not_exist.json"], &[]);
+    assert_eq!(out.code, 2);
+    assert!(out.stderr.contains("scenes/does_not_exist.json: cannot read scene file"), "{}", out.stderr);
+}
+
+#[test]
+fn check_reports_every_file_and_fails_if_any_fails() {
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("bad.json");
+    std::fs::write(&bad, "{").unwrap();
+    let out = mirrorbox(&["check", "scenes/mirror_box.json", bad.to_str().unwrap()], &[]);
+    assert_eq!(out.code, 2);
+    assert!(out.stdout.contains("scenes/mirror_box.json: ok"));
+    assert!(out.stderr.contains("bad.json:1:1: "), "{}", out.stderr);
+    assert!(out.stderr.contains("1 of 2 scene files failed to load"));
+}
+
+#[test]
+fn bad_arguments_exit_with_2() {
+    assert_eq!(mirrorbox(&["check"], &[]).code, 2);
+    assert_eq!(mirrorbox(&["frobnicate"], &[]).code, 2);
+}
+
+#[test]
+fn info_reports_the_adapter_and_its_timing_support() {
+    let out = mirrorbox(&["info", "--json"], &[]);
+    assert_eq!(out.code, 0, "no adapter? stderr: {}", out.stderr);
+    let v: Value = serde_json::from_str(out.stdout.trim()).unwrap();
+    assert!(!v["name"].as_str().unwrap().is_empty());
+    assert!(["vulkan", "gl"].contains(&v["backend"].as_str().unwrap()), "{v}");
+    assert!(v["timestamp_query"].is_boolean());
+}
+
+#[test]
+fn wgpu_backend_override_is_honoured_and_checked() {
+    let out = mirrorbox(&["info", "--json"], &[("WGPU_BACKEND", "gl")]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let v: Value = serde_json::from_str(out.stdout.trim()).unwrap();
+    assert_eq!(v["backend"], "gl");
+    let out = mirrorbox(&["info"], &[("WGPU_BACKEND", "nonsense")]);
+    assert_eq!(out.code, 2);
+    assert!(out.stderr.contains("WGPU_BACKEND=\"nonsense\" names no backend"), "{}", out.stderr);
+}

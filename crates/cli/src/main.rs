@@ -1,1 +1,80 @@
-fn main() {}
+//! `mirrorbox`: the command-line harness. A thin layer: it parses arguments, calls the
+//! crates (scene → renderers → images → metrics → reports) and maps failures to exit codes:
+//! 0 success, 2 bad input (unreadable or invalid scene, bad arguments), 1 anything else.
+//!
+//! One module per subcommand under `commands/`; later subcommands (`trace`, `render`,
+//! `compare`, `sweep`, `table1`, `export-mitsuba`) slot in the same way.
+
+mod commands;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(name = "mirrorbox", version, about = "Rasterized infinity mirrors measured against ray-traced truth")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Validate scene files and print one summary line per scene.
+    Check(commands::check::Args),
+    /// Print the wgpu adapter mirrorbox would render and time on.
+    Info(commands::info::Args),
+}
+
+/// Mesa's Vulkan device-select layer prints "error: XDG_RUNTIME_DIR is invalid" on headless
+/// machines, which reads like one of our own errors. wgpu enumerates every device itself, so
+/// the layer adds nothing here; disable it unless the user set `NODEVICE_SELECT` themselves.
+fn quiet_mesa_device_select() {
+    if std::env::var_os("NODEVICE_SELECT").is_none() {
+        // SAFETY: called first thing in `main`, before any other thread exists.
+        unsafe { std::env::set_var("NODEVICE_SELECT", "1") };
+    }
+}
+
+/// `n thing` or `n things`.
+pub fn count(n: usize, thing: &str) -> String {
+    if n == 1 { format!("1 {thing}") } else { format!("{n} {thing}s") }
+}
+
+/// Why a command failed; decides the exit code.
+#[derive(Debug)]
+pub enum Failure {
+    /// The user's input is wrong (exit 2). The message names the file and field.
+    BadInput(String),
+    /// Anything else (exit 1).
+    Other(String),
+}
+
+impl Failure {
+    fn exit_code(&self) -> u8 {
+        match self {
+            Failure::BadInput(_) => 2,
+            Failure::Other(_) => 1,
+        }
+    }
+    fn message(&self) -> &str {
+        match self {
+            Failure::BadInput(m) | Failure::Other(m) => m,
+        }
+    }
+}
+
+fn main() -> ExitCode {
+    quiet_mesa_device_select();
+    let cli = Cli::parse(); // clap exits with 2 on bad arguments, matching our convention
+    let result = match cli.command {
+        Command::Check(args) => commands::check::run(&args),
+        Command::Info(args) => commands::info::run(&args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(failure) => {
+            eprintln!("error: {}", failure.message());
+            ExitCode::from(failure.exit_code())
+        }
+    }
+}

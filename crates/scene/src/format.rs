@@ -126,7 +126,7 @@ pub struct TransformDesc {
 
 /// A uniform (`2.0`) or per-axis (`[1, 2, 1]`) scale.
 #[derive(Clone, Copy, Debug, Deserialize)]
-#[serde(untagged, expecting = "a number or an array of 3 numbers")]
+#[serde(untagged, expecting = "must be a number or an array of 3 numbers")]
 pub enum Scale {
     Uniform(f32),
     PerAxis(Vec3f),

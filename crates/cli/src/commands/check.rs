@@ -1,0 +1,48 @@
+//! `mirrorbox check SCENE...`: load and validate each scene; one line per scene.
+
+use crate::{count, Failure};
+use mirrorbox_scene::load_scene;
+use std::path::PathBuf;
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Scene files (JSON, see docs/scene-format.md).
+    #[arg(required = true)]
+    scenes: Vec<PathBuf>,
+}
+
+pub fn run(args: &Args) -> Result<(), Failure> {
+    let mut failed = 0;
+    for path in &args.scenes {
+        match load_scene(path) {
+            Ok(scene) => {
+                let g = &scene.geometry;
+                let dropped = match g.degenerate_dropped {
+                    0 => String::new(),
+                    n => format!(", {n} degenerate triangles dropped"),
+                };
+                println!(
+                    "{}: ok: {}, {} ({} on mirrors), {}, {}x{}{dropped}",
+                    path.display(),
+                    count(scene.mirrors.len(), "mirror"),
+                    count(g.triangles.len(), "triangle"),
+                    g.mirror_triangle_count(),
+                    count(scene.lighting.lights.len(), "light"),
+                    scene.camera.width,
+                    scene.camera.height,
+                );
+            }
+            Err(e) => {
+                eprintln!("error: {e}");
+                failed += 1;
+            }
+        }
+    }
+    match failed {
+        0 => Ok(()),
+        n => Err(Failure::BadInput(format!(
+            "{n} of {} scene files failed to load",
+            args.scenes.len()
+        ))),
+    }
+}

@@ -1,0 +1,124 @@
+//! Adapter selection: one rule for every command, so `mirrorbox info` reports exactly the
+//! adapter that `render` and `sweep` will time.
+//!
+//! Order: the backends named by `WGPU_BACKEND` (e.g. `vulkan`, `gl`) when it is set;
+//! otherwise Vulkan, then GL. Within a backend wgpu's high-performance preference decides
+//! (a real GPU before a CPU rasterizer).
+
+use std::fmt;
+
+/// The chosen adapter with the instance that owns it.
+pub struct SelectedAdapter {
+    pub instance: wgpu::Instance,
+    pub adapter: wgpu::Adapter,
+    pub report: AdapterReport,
+}
+
+/// What an adapter is and which of the features mirrorbox relies on it has.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct AdapterReport {
+    pub name: String,
+    pub backend: String,
+    pub device_type: String,
+    pub driver: String,
+    pub driver_info: String,
+    /// GPU timestamps at pass boundaries (`Features::TIMESTAMP_QUERY`).
+    pub timestamp_query: bool,
+    /// Timestamps inside encoders and passes (finer-grained timing).
+    pub timestamp_query_inside_passes: bool,
+    /// `clip_distances` in WGSL (the unrolled method clips with them; otherwise it discards).
+    pub clip_distances: bool,
+}
+
+impl AdapterReport {
+    fn of(adapter: &wgpu::Adapter) -> Self {
+        let info = adapter.get_info();
+        let features = adapter.features();
+        AdapterReport {
+            name: info.name,
+            backend: info.backend.to_string(),
+            device_type: format!("{:?}", info.device_type),
+            driver: info.driver,
+            driver_info: info.driver_info,
+            timestamp_query: features.contains(wgpu::Features::TIMESTAMP_QUERY),
+            timestamp_query_inside_passes: features.contains(
+                wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS
+                    | wgpu::Features::TIMESTAMP_QUERY_INSIDE_PASSES,
+            ),
+            clip_distances: features.contains(wgpu::Features::CLIP_DISTANCES),
+        }
+    }
+}
+
+impl fmt::Display for AdapterReport {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let yes_no = |b: bool| if b { "yes" } else { "no" };
+        writeln!(f, "adapter:          {}", self.name)?;
+        writeln!(f, "backend:          {}", self.backend)?;
+        writeln!(f, "device type:      {}", self.device_type)?;
+        writeln!(f, "driver:           {} {}", self.driver, self.driver_info)?;
+        writeln!(f, "timestamp query:  {}", yes_no(self.timestamp_query))?;
+        writeln!(f, "  inside passes:  {}", yes_no(self.timestamp_query_inside_passes))?;
+        write!(f, "clip distances:   {}", yes_no(self.clip_distances))
+    }
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum AdapterError {
+    #[error(
+        "no wgpu adapter found (tried: {tried}).\n\
+         hint: on Debian/Ubuntu install Mesa's software Vulkan driver with\n  \
+         sudo apt-get install mesa-vulkan-drivers libvulkan1\n\
+         (scripts/install-system-deps.sh does this), or Mesa's EGL/GL drivers\n  \
+         (libegl1 libegl-mesa0 libgl1-mesa-dri); WGPU_BACKEND=vulkan|gl picks a backend."
+    )]
+    NoneFound { tried: String },
+    #[error("WGPU_BACKEND={value:?} names no backend wgpu knows (use vulkan, gl, metal or dx12)")]
+    BadOverride { value: String },
+}
+
+fn try_backends(backends: wgpu::Backends) -> Option<SelectedAdapter> {
+    let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+    desc.backends = backends;
+    // Keep validation/debug flags controllable from the environment (WGPU_VALIDATION=1, ...).
+    desc.flags = wgpu::InstanceFlags::default().with_env();
+    let instance = wgpu::Instance::new(desc);
+    let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+        power_preference: wgpu::PowerPreference::HighPerformance,
+        force_fallback_adapter: false,
+        compatible_surface: None,
+        ..Default::default()
+    }))
+    .ok()?;
+    let report = AdapterReport::of(&adapter);
+    Some(SelectedAdapter {
+        instance,
+        adapter,
+        report,
+    })
+}
+
+/// Chooses the adapter (see the module docs for the order).
+pub fn select_adapter() -> Result<SelectedAdapter, AdapterError> {
+    let order: Vec<(&str, wgpu::Backends)> = match std::env::var("WGPU_BACKEND") {
+        Ok(value) => {
+            let backends = wgpu::Backends::from_comma_list(&value);
+            if backends.is_empty() {
+                return Err(AdapterError::BadOverride { value });
+            }
+            vec![("WGPU_BACKEND", backends)]
+        }
+        Err(_) => vec![("Vulkan", wgpu::Backends::VULKAN), ("GL", wgpu::Backends::GL)],
+    };
+    for (_, backends) in &order {
+        if let Some(selected) = try_backends(*backends) {
+            return Ok(selected);
+        }
+    }
+    let tried = order
+        .iter()
+        .map(|(name, b)| format!("{name} ({b:?})"))
+        .collect::<Vec<_>>()
+        .join(", then ");
+    Err(AdapterError::NoneFound { tried })
+}
