@@ -1,7 +1,7 @@
 //! End-to-end tests of the `mirrorbox` command line: real processes, real files, exit codes
 //! and messages as a user sees them.
 
-use serde_json::{json, Value};
+use serde_json::{Value, json};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -61,15 +61,27 @@ fn assert_rejected(edit: impl FnOnce(&mut Value), expected: &[&str]) -> Output {
     assert_rejected_with_files(edit, &[], expected)
 }
 
-fn assert_rejected_with_files(edit: impl FnOnce(&mut Value), files: &[(&str, &str)], expected: &[&str]) -> Output {
+fn assert_rejected_with_files(
+    edit: impl FnOnce(&mut Value),
+    files: &[(&str, &str)],
+    expected: &[&str],
+) -> Output {
     let mut scene = valid_scene();
     edit(&mut scene);
     let text = serde_json::to_string_pretty(&scene).unwrap();
     let (out, _dir) = check_text("scene.json", &text, files);
     assert_eq!(out.code, 2, "stderr: {}", out.stderr);
-    assert!(out.stderr.contains("scene.json"), "file not named: {}", out.stderr);
+    assert!(
+        out.stderr.contains("scene.json"),
+        "file not named: {}",
+        out.stderr
+    );
     for fragment in expected {
-        assert!(out.stderr.contains(fragment), "missing {fragment:?} in: {}", out.stderr);
+        assert!(
+            out.stderr.contains(fragment),
+            "missing {fragment:?} in: {}",
+            out.stderr
+        );
     }
     assert!(!out.stderr.contains("panicked"), "{}", out.stderr);
     out
@@ -81,18 +93,37 @@ fn check_accepts_every_bundled_scene() {
         .unwrap()
         .map(|e| e.unwrap().path())
         .filter(|p| p.extension().is_some_and(|e| e == "json"))
-        .map(|p| p.strip_prefix(repo()).unwrap().to_string_lossy().into_owned())
+        .map(|p| {
+            p.strip_prefix(repo())
+                .unwrap()
+                .to_string_lossy()
+                .into_owned()
+        })
         .collect();
     scenes.sort();
     for required in ["mirror_box", "single_mirror", "tilted_pair", "mirror_room"] {
-        assert!(scenes.iter().any(|s| s.contains(required)), "scenes/{required}.json missing");
+        assert!(
+            scenes.iter().any(|s| s.contains(required)),
+            "scenes/{required}.json missing"
+        );
     }
-    let args: Vec<&str> = std::iter::once("check").chain(scenes.iter().map(String::as_str)).collect();
+    let args: Vec<&str> = std::iter::once("check")
+        .chain(scenes.iter().map(String::as_str))
+        .collect();
     let out = mirrorbox(&args, &[]);
     assert_eq!(out.code, 0, "{}", out.stderr);
     assert_eq!(out.stdout.lines().count(), scenes.len());
-    assert!(out.stdout.contains("scenes/mirror_box.json: ok: 2 mirrors"), "{}", out.stdout);
-    assert!(out.stdout.contains("scenes/mirror_room.json: ok: 4 mirrors"), "{}", out.stdout);
+    assert!(
+        out.stdout.contains("scenes/mirror_box.json: ok: 2 mirrors"),
+        "{}",
+        out.stdout
+    );
+    assert!(
+        out.stdout
+            .contains("scenes/mirror_room.json: ok: 4 mirrors"),
+        "{}",
+        out.stdout
+    );
 }
 
 #[test]
@@ -100,12 +131,18 @@ fn the_valid_test_scene_is_valid() {
     let text = serde_json::to_string(&valid_scene()).unwrap();
     let (out, _dir) = check_text("scene.json", &text, &[]);
     assert_eq!(out.code, 0, "{}", out.stderr);
-    assert!(out.stdout.contains("2 mirrors, 1284 triangles (4 on mirrors), 1 light, 32x24"), "{}", out.stdout);
+    assert!(
+        out.stdout
+            .contains("2 mirrors, 1284 triangles (4 on mirrors), 1 light, 32x24"),
+        "{}",
+        out.stdout
+    );
 }
 
 #[test]
 fn json_syntax_error_gives_file_line_and_column() {
-    let text = "{\n  \"camera\": {\n    \"position\": [0, 1, 3]\n    \"look_at\": [0, 1, 0]\n  }\n}\n";
+    let text =
+        "{\n  \"camera\": {\n    \"position\": [0, 1, 3]\n    \"look_at\": [0, 1, 0]\n  }\n}\n";
     let (out, _dir) = check_text("broken.json", text, &[]);
     assert_eq!(out.code, 2);
     assert!(out.stderr.contains("broken.json:4:5: "), "{}", out.stderr);
@@ -130,8 +167,14 @@ fn infinite_number_names_its_field() {
 
 #[test]
 fn zero_size_mirror() {
-    assert_rejected(|s| s["mirrors"][1]["width"] = json!(0), &["mirrors[1].width: must be greater than 0, got 0"]);
-    assert_rejected(|s| s["mirrors"][0]["height"] = json!(-3), &["mirrors[0].height: must be greater than 0, got -3"]);
+    assert_rejected(
+        |s| s["mirrors"][1]["width"] = json!(0),
+        &["mirrors[1].width: must be greater than 0, got 0"],
+    );
+    assert_rejected(
+        |s| s["mirrors"][0]["height"] = json!(-3),
+        &["mirrors[0].height: must be greater than 0, got -3"],
+    );
 }
 
 #[test]
@@ -166,23 +209,35 @@ fn reflectance_outside_unit_interval() {
 fn unknown_field_is_refused_with_its_path_and_position() {
     let out = assert_rejected(
         |s| s["mirrors"][1]["reflectence"] = json!([0.9, 0.9, 0.9]),
-        &["mirrors[1]", "unknown field `reflectence`", "expected one of"],
+        &[
+            "mirrors[1]",
+            "unknown field `reflectence`",
+            "expected one of",
+        ],
     );
     // serde_json reports where the offending key ends: line and column are present.
     assert!(out.stderr.contains("scene.json:"), "{}", out.stderr);
-    assert_rejected(|s| s["colour"] = json!([1, 0, 0]), &["unknown field `colour`"]);
+    assert_rejected(
+        |s| s["colour"] = json!([1, 0, 0]),
+        &["unknown field `colour`"],
+    );
 }
 
 #[test]
 fn wrong_type_names_the_field() {
-    assert_rejected(|s| s["mirrors"][0]["width"] = json!("wide"), &["mirrors[0].width", "invalid type: string \"wide\""]);
+    assert_rejected(
+        |s| s["mirrors"][0]["width"] = json!("wide"),
+        &["mirrors[0].width", "invalid type: string \"wide\""],
+    );
 }
 
 #[test]
 fn shape_field_of_another_type_is_refused() {
     assert_rejected(
         |s| s["objects"][0]["size"] = json!([1, 1, 1]),
-        &["objects[0].size: is not a field of a \"sphere\" object (its shape fields: radius, subdivisions)"],
+        &[
+            "objects[0].size: is not a field of a \"sphere\" object (its shape fields: radius, subdivisions)",
+        ],
     );
 }
 
@@ -206,7 +261,10 @@ fn malformed_obj_file_names_the_line() {
     assert_rejected_with_files(
         |s| s["objects"] = json!([{ "type": "mesh", "path": "bad.obj" }]),
         &[("bad.obj", out_of_range)],
-        &["objects[0].path: malformed OBJ file \"bad.obj\"", "out of bounds"],
+        &[
+            "objects[0].path: malformed OBJ file \"bad.obj\"",
+            "out of bounds",
+        ],
     );
 }
 
@@ -221,9 +279,18 @@ fn obj_without_faces() {
 
 #[test]
 fn camera_errors() {
-    assert_rejected(|s| s["camera"]["fov_y_deg"] = json!(180), &["camera.fov_y_deg: must be in (0, 180) degrees, got 180"]);
-    assert_rejected(|s| s["camera"]["look_at"] = json!([0, 1, 3]), &["camera.look_at: must differ from camera.position"]);
-    assert_rejected(|s| s["camera"]["width"] = json!(0), &["camera.width: must be in [1, 16384] pixels, got 0"]);
+    assert_rejected(
+        |s| s["camera"]["fov_y_deg"] = json!(180),
+        &["camera.fov_y_deg: must be in (0, 180) degrees, got 180"],
+    );
+    assert_rejected(
+        |s| s["camera"]["look_at"] = json!([0, 1, 3]),
+        &["camera.look_at: must differ from camera.position"],
+    );
+    assert_rejected(
+        |s| s["camera"]["width"] = json!(0),
+        &["camera.width: must be in [1, 16384] pixels, got 0"],
+    );
 }
 
 #[test]
@@ -238,7 +305,12 @@ fn zero_scale_is_refused() {
 fn missing_scene_file_is_bad_input() {
     let out = mirrorbox(&["check", "scenes/does_not_exist.json"], &[]);
     assert_eq!(out.code, 2);
-    assert!(out.stderr.contains("scenes/does_not_exist.json: cannot read scene file"), "{}", out.stderr);
+    assert!(
+        out.stderr
+            .contains("scenes/does_not_exist.json: cannot read scene file"),
+        "{}",
+        out.stderr
+    );
 }
 
 #[test]
@@ -246,7 +318,10 @@ fn check_reports_every_file_and_fails_if_any_fails() {
     let dir = tempfile::tempdir().unwrap();
     let bad = dir.path().join("bad.json");
     std::fs::write(&bad, "{").unwrap();
-    let out = mirrorbox(&["check", "scenes/mirror_box.json", bad.to_str().unwrap()], &[]);
+    let out = mirrorbox(
+        &["check", "scenes/mirror_box.json", bad.to_str().unwrap()],
+        &[],
+    );
     assert_eq!(out.code, 2);
     assert!(out.stdout.contains("scenes/mirror_box.json: ok"));
     assert!(out.stderr.contains("bad.json:1:1: "), "{}", out.stderr);
@@ -265,7 +340,10 @@ fn info_reports_the_adapter_and_its_timing_support() {
     assert_eq!(out.code, 0, "no adapter? stderr: {}", out.stderr);
     let v: Value = serde_json::from_str(out.stdout.trim()).unwrap();
     assert!(!v["name"].as_str().unwrap().is_empty());
-    assert!(["vulkan", "gl"].contains(&v["backend"].as_str().unwrap()), "{v}");
+    assert!(
+        ["vulkan", "gl"].contains(&v["backend"].as_str().unwrap()),
+        "{v}"
+    );
     assert!(v["timestamp_query"].is_boolean());
 }
 
@@ -277,5 +355,10 @@ fn wgpu_backend_override_is_honoured_and_checked() {
     assert_eq!(v["backend"], "gl");
     let out = mirrorbox(&["info"], &[("WGPU_BACKEND", "nonsense")]);
     assert_eq!(out.code, 2);
-    assert!(out.stderr.contains("WGPU_BACKEND=\"nonsense\" names no backend"), "{}", out.stderr);
+    assert!(
+        out.stderr
+            .contains("WGPU_BACKEND=\"nonsense\" names no backend"),
+        "{}",
+        out.stderr
+    );
 }

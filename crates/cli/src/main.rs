@@ -11,7 +11,11 @@ use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
 #[derive(Parser)]
-#[command(name = "mirrorbox", version, about = "Rasterized infinity mirrors measured against ray-traced truth")]
+#[command(
+    name = "mirrorbox",
+    version,
+    about = "Rasterized infinity mirrors measured against ray-traced truth"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -37,7 +41,11 @@ fn quiet_mesa_device_select() {
 
 /// `n thing` or `n things`.
 pub fn count(n: usize, thing: &str) -> String {
-    if n == 1 { format!("1 {thing}") } else { format!("{n} {thing}s") }
+    if n == 1 {
+        format!("1 {thing}")
+    } else {
+        format!("{n} {thing}s")
+    }
 }
 
 /// Why a command failed; decides the exit code.

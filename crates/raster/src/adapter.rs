@@ -58,7 +58,11 @@ impl fmt::Display for AdapterReport {
         writeln!(f, "device type:      {}", self.device_type)?;
         writeln!(f, "driver:           {} {}", self.driver, self.driver_info)?;
         writeln!(f, "timestamp query:  {}", yes_no(self.timestamp_query))?;
-        writeln!(f, "  inside passes:  {}", yes_no(self.timestamp_query_inside_passes))?;
+        writeln!(
+            f,
+            "  inside passes:  {}",
+            yes_no(self.timestamp_query_inside_passes)
+        )?;
         write!(f, "clip distances:   {}", yes_no(self.clip_distances))
     }
 }
@@ -108,7 +112,10 @@ pub fn select_adapter() -> Result<SelectedAdapter, AdapterError> {
             }
             vec![("WGPU_BACKEND", backends)]
         }
-        Err(_) => vec![("Vulkan", wgpu::Backends::VULKAN), ("GL", wgpu::Backends::GL)],
+        Err(_) => vec![
+            ("Vulkan", wgpu::Backends::VULKAN),
+            ("GL", wgpu::Backends::GL),
+        ],
     };
     for (_, backends) in &order {
         if let Some(selected) = try_backends(*backends) {

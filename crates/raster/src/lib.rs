@@ -6,4 +6,4 @@
 
 pub mod adapter;
 
-pub use adapter::{select_adapter, AdapterError, AdapterReport, SelectedAdapter};
+pub use adapter::{AdapterError, AdapterReport, SelectedAdapter, select_adapter};

@@ -61,7 +61,7 @@ impl Geometry {
                 .length_squared()
                 .max((t[2] - t[1]).length_squared())
                 .max((t[0] - t[2]).length_squared());
-            if !(doubled_area > DEGENERATE_RELATIVE_AREA * longest) {
+            if doubled_area.is_nan() || doubled_area <= DEGENERATE_RELATIVE_AREA * longest {
                 self.degenerate_dropped += 1;
                 continue;
             }

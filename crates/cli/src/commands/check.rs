@@ -1,6 +1,6 @@
 //! `mirrorbox check SCENE...`: load and validate each scene; one line per scene.
 
-use crate::{count, Failure};
+use crate::{Failure, count};
 use mirrorbox_scene::load_scene;
 use std::path::PathBuf;
 

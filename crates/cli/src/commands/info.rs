@@ -1,7 +1,7 @@
 //! `mirrorbox info`: the wgpu adapter the raster commands would use.
 
 use crate::Failure;
-use mirrorbox_raster::{select_adapter, AdapterError};
+use mirrorbox_raster::{AdapterError, select_adapter};
 
 #[derive(clap::Args)]
 pub struct Args {

@@ -1,0 +1,47 @@
+#!/usr/bin/env bash
+# Installs what mirrorbox needs from the system and is missing, saying what it does.
+#   - Mesa's software Vulkan driver (lavapipe) and the Vulkan loader, so wgpu can render
+#     on a machine without a GPU (Debian/Ubuntu: mesa-vulkan-drivers, libvulkan1);
+#   - Mesa's EGL/GL drivers as the fallback backend (libegl1, libegl-mesa0, libgl1-mesa-dri).
+# Uses apt-get when run as root (or through sudo when available). Idempotent: does nothing
+# when everything is present. Never fails the caller: without a driver, GPU tests will say so.
+set -u
+
+have_vulkan_driver() {
+  ls /usr/share/vulkan/icd.d/*.json /etc/vulkan/icd.d/*.json >/dev/null 2>&1 &&
+    ldconfig -p 2>/dev/null | grep -q 'libvulkan\.so\.1'
+}
+have_egl() {
+  ldconfig -p 2>/dev/null | grep -q 'libEGL_mesa\.so\.0'
+}
+
+missing=()
+have_vulkan_driver || missing+=(mesa-vulkan-drivers libvulkan1)
+have_egl || missing+=(libegl1 libegl-mesa0 libgl1-mesa-dri)
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-system-deps: Vulkan driver and EGL present; nothing to install."
+  exit 0
+fi
+
+if ! command -v apt-get >/dev/null 2>&1; then
+  echo "install-system-deps: missing ${missing[*]} and no apt-get here; install Mesa's Vulkan (lavapipe) or EGL drivers by hand." >&2
+  exit 0
+fi
+if [ "$(id -u)" -eq 0 ]; then
+  sudo=()
+elif command -v sudo >/dev/null 2>&1; then
+  sudo=(sudo)
+else
+  echo "install-system-deps: missing ${missing[*]}; run as root to install them." >&2
+  exit 0
+fi
+
+echo "install-system-deps: installing ${missing[*]} with apt-get (software rendering for wgpu)..."
+export DEBIAN_FRONTEND=noninteractive
+if "${sudo[@]}" apt-get update -qq && "${sudo[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null; then
+  echo "install-system-deps: done."
+else
+  echo "install-system-deps: apt-get failed; wgpu may find no adapter (mirrorbox info will say)." >&2
+fi
+exit 0
