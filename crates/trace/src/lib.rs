@@ -1,8 +1,17 @@
 //! The obvhs ray tracer: mirrorbox's ground truth.
 //!
-//! This crate owns the acceleration structure over the scene's single triangle list
-//! ([`SceneBvh`]); integrators build on its closest-hit query.
+//! - [`bvh`]: one obvhs hierarchy over all the scene's triangles, watertight triangle tests.
+//! - [`whitted`]: the integrator that follows the shading contract to deep bounce counts.
+//! - [`sampler`]: the shared sub-pixel grid, or stratified jitter.
+//! - [`render`]: the parallel image loop and its statistics.
 
 pub mod bvh;
+pub mod render;
+pub mod sampler;
+pub mod watertight;
+pub mod whitted;
 
-pub use bvh::{Hit, SceneBvh};
+pub use bvh::{BvhKind, Hit, SceneBvh};
+pub use render::{TraceOutput, TraceSettings, TraceStats, render};
+pub use sampler::Sampling;
+pub use whitted::{PathResult, Termination, Whitted, WhittedSettings};

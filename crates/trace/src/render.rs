@@ -1,0 +1,128 @@
+//! The image loop: every pixel's samples through the integrator, rows in parallel (rayon).
+//!
+//! Each pixel depends only on the scene, the settings and its own index, and its samples are
+//! summed in a fixed order, so the image is bit-identical whatever the thread count.
+
+use crate::bvh::SceneBvh;
+use crate::sampler::Sampling;
+use crate::whitted::{Termination, Whitted, WhittedSettings};
+use mirrorbox_image::RgbImage;
+use mirrorbox_scene::Scene;
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicU32, Ordering};
+use std::time::{Duration, Instant};
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TraceSettings {
+    pub sampling: Sampling,
+    pub whitted: WhittedSettings,
+}
+
+/// Counters over all paths of a render.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct TraceStats {
+    pub paths: u64,
+    pub rays: u64,
+    pub diffuse: u64,
+    pub escaped: u64,
+    pub cut_by_depth: u64,
+    pub cut_by_throughput: u64,
+    /// Most mirror reflections followed by any path.
+    pub deepest: u32,
+}
+
+impl TraceStats {
+    fn record(&mut self, bounces: u32, termination: Termination, rays: u32) {
+        self.paths += 1;
+        self.rays += rays as u64;
+        self.deepest = self.deepest.max(bounces);
+        match termination {
+            Termination::Diffuse => self.diffuse += 1,
+            Termination::Escaped => self.escaped += 1,
+            Termination::Depth => self.cut_by_depth += 1,
+            Termination::Throughput => self.cut_by_throughput += 1,
+        }
+    }
+    fn merge(mut self, o: TraceStats) -> TraceStats {
+        self.paths += o.paths;
+        self.rays += o.rays;
+        self.diffuse += o.diffuse;
+        self.escaped += o.escaped;
+        self.cut_by_depth += o.cut_by_depth;
+        self.cut_by_throughput += o.cut_by_throughput;
+        self.deepest = self.deepest.max(o.deepest);
+        self
+    }
+}
+
+pub struct TraceOutput {
+    /// Linear radiance, the mean over each pixel's samples.
+    pub image: RgbImage,
+    /// Mean number of mirror reflections per pixel (the same value in all three channels).
+    pub bounces: RgbImage,
+    pub stats: TraceStats,
+    /// Wall time of the image loop (BVH build excluded; see [`SceneBvh::build_time`]).
+    pub wall: Duration,
+    pub threads: usize,
+}
+
+/// Renders `scene` (its camera's size) with `bvh`. `progress(rows_done)` is called as rows
+/// finish, from worker threads.
+pub fn render(
+    scene: &Scene,
+    bvh: &SceneBvh,
+    settings: &TraceSettings,
+    progress: &(dyn Fn(u32) + Sync),
+) -> TraceOutput {
+    let cam = &scene.camera;
+    let (w, h) = (cam.width, cam.height);
+    let rays = cam.ray_generator();
+    let whitted = Whitted::new(scene, bvh, settings.whitted);
+    let spp = settings.sampling.grid().samples_per_pixel() as f32;
+    let done = AtomicU32::new(0);
+    let start = Instant::now();
+    let rows: Vec<(Vec<[f32; 3]>, Vec<[f32; 3]>, TraceStats)> = (0..h)
+        .into_par_iter()
+        .map(|y| {
+            let mut offsets = Vec::new();
+            let mut stats = TraceStats::default();
+            let mut colour = Vec::with_capacity(w as usize);
+            let mut depth = Vec::with_capacity(w as usize);
+            for x in 0..w {
+                settings
+                    .sampling
+                    .offsets(y as u64 * w as u64 + x as u64, &mut offsets);
+                let mut sum = glam::Vec3::ZERO;
+                let mut bounces = 0u64;
+                for o in &offsets {
+                    let r = whitted.radiance(rays.ray(x as f32 + o.x, y as f32 + o.y));
+                    sum += r.radiance;
+                    bounces += r.bounces as u64;
+                    stats.record(r.bounces, r.termination, r.rays);
+                }
+                colour.push((sum / spp).to_array());
+                depth.push([bounces as f32 / spp; 3]);
+            }
+            progress(done.fetch_add(1, Ordering::Relaxed) + 1);
+            (colour, depth, stats)
+        })
+        .collect();
+    let wall = start.elapsed();
+    let mut image = RgbImage::new(w, h);
+    let mut bounces = RgbImage::new(w, h);
+    let mut stats = TraceStats::default();
+    image.pixels.clear();
+    bounces.pixels.clear();
+    for (c, d, s) in rows {
+        image.pixels.extend(c);
+        bounces.pixels.extend(d);
+        stats = stats.merge(s);
+    }
+    TraceOutput {
+        image,
+        bounces,
+        stats,
+        wall,
+        threads: rayon::current_num_threads(),
+    }
+}

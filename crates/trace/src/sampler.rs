@@ -1,0 +1,94 @@
+//! Sub-pixel sample positions.
+//!
+//! The default is the fixed `s × s` grid of [`mirrorbox_scene::SubpixelGrid`], which the
+//! rasterizer reproduces exactly by `s×` supersampling. `--jitter` instead draws one
+//! uniformly random position inside each of the `s × s` strata, from a generator seeded by
+//! (`seed`, pixel index) only, so results do not depend on thread scheduling.
+
+use glam::Vec2;
+use mirrorbox_scene::SubpixelGrid;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Sampling {
+    Grid(SubpixelGrid),
+    Jittered { grid: SubpixelGrid, seed: u64 },
+}
+
+impl Sampling {
+    pub fn grid(&self) -> SubpixelGrid {
+        match *self {
+            Sampling::Grid(g) | Sampling::Jittered { grid: g, .. } => g,
+        }
+    }
+
+    /// The sample offsets (in `[0,1)²`) for pixel number `pixel` (row-major index).
+    pub fn offsets(&self, pixel: u64, out: &mut Vec<Vec2>) {
+        out.clear();
+        match *self {
+            Sampling::Grid(g) => out.extend(g.offsets()),
+            Sampling::Jittered { grid, seed } => {
+                let s = grid.per_axis;
+                let mut rng = SplitMix64(seed ^ pixel.wrapping_mul(0x9E37_79B9_7F4A_7C15));
+                for j in 0..s {
+                    for i in 0..s {
+                        let u = (i as f32 + rng.next_unit()) / s as f32;
+                        let v = (j as f32 + rng.next_unit()) / s as f32;
+                        out.push(Vec2::new(u.min(ONE_BELOW), v.min(ONE_BELOW)));
+                    }
+                }
+            }
+        }
+    }
+
+    pub fn describe(&self) -> String {
+        let s = self.grid().per_axis;
+        match self {
+            Sampling::Grid(_) => format!("{s}x{s} grid"),
+            Sampling::Jittered { seed, .. } => format!("{s}x{s} jittered, seed {seed}"),
+        }
+    }
+}
+
+/// Largest f32 below 1, so an offset never reaches the next pixel.
+const ONE_BELOW: f32 = 1.0 - f32::EPSILON / 2.0;
+
+/// SplitMix64 (Steele, Lea, Flood 2014): tiny, fast, well distributed; enough for jitter.
+struct SplitMix64(u64);
+
+impl SplitMix64 {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+    /// Uniform in [0, 1) with 24 bits.
+    fn next_unit(&mut self) -> f32 {
+        (self.next() >> 40) as f32 / (1u64 << 24) as f32
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn jitter_stays_in_its_stratum_and_is_reproducible() {
+        let s = Sampling::Jittered {
+            grid: SubpixelGrid::new(3),
+            seed: 7,
+        };
+        let (mut a, mut b, mut c) = (Vec::new(), Vec::new(), Vec::new());
+        s.offsets(42, &mut a);
+        s.offsets(42, &mut b);
+        s.offsets(43, &mut c);
+        assert_eq!(a, b);
+        assert_ne!(a, c);
+        for (k, o) in a.iter().enumerate() {
+            let (i, j) = ((k % 3) as f32, (k / 3) as f32);
+            assert!(o.x >= i / 3.0 && o.x < (i + 1.0) / 3.0, "{o}");
+            assert!(o.y >= j / 3.0 && o.y < (j + 1.0) / 3.0, "{o}");
+        }
+    }
+}

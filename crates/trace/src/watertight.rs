@@ -1,0 +1,180 @@
+//! Watertight ray/triangle intersection (Woop, Benthin, Wald, "Watertight Ray/Triangle
+//! Intersection", JCGT 2013).
+//!
+//! Why not obvhs' `Triangle::intersect`: its Möller–Trumbore test treats a barycentric of
+//! `-0.0` as outside, so a ray passing exactly through the edge shared by two triangles can
+//! miss both — a mirror's diagonal seam would leak the background. Here the ray is sheared so
+//! that it runs along +z from the origin; each edge function is then a 2D cross product of
+//! the two endpoint projections, computed identically (up to sign) for both triangles that
+//! share the edge, and exact zeros are re-evaluated in f64. A ray through an edge or vertex
+//! therefore hits at least one of the triangles around it.
+
+use glam::Vec3;
+
+/// Per-ray constants of the shear transform.
+#[derive(Clone, Copy, Debug)]
+pub struct WatertightRay {
+    origin: Vec3,
+    kx: usize,
+    ky: usize,
+    kz: usize,
+    sx: f32,
+    sy: f32,
+    sz: f32,
+}
+
+impl WatertightRay {
+    pub fn new(origin: Vec3, dir: Vec3) -> Self {
+        let a = dir.abs();
+        let kz = if a.x >= a.y && a.x >= a.z {
+            0
+        } else if a.y >= a.z {
+            1
+        } else {
+            2
+        };
+        let mut kx = (kz + 1) % 3;
+        let mut ky = (kx + 1) % 3;
+        // Keep the winding of the projected triangle: swap when looking down −kz.
+        if dir[kz] < 0.0 {
+            std::mem::swap(&mut kx, &mut ky);
+        }
+        WatertightRay {
+            origin,
+            kx,
+            ky,
+            kz,
+            sx: dir[kx] / dir[kz],
+            sy: dir[ky] / dir[kz],
+            sz: 1.0 / dir[kz],
+        }
+    }
+
+    /// Distance `t` to the triangle if hit with `t_min ≤ t ≤ t_max`, else `f32::INFINITY`.
+    /// Two-sided.
+    #[inline]
+    pub fn intersect(&self, v0: Vec3, v1: Vec3, v2: Vec3, t_min: f32, t_max: f32) -> f32 {
+        let (kx, ky, kz) = (self.kx, self.ky, self.kz);
+        let a = v0 - self.origin;
+        let b = v1 - self.origin;
+        let c = v2 - self.origin;
+        let ax = a[kx] - self.sx * a[kz];
+        let ay = a[ky] - self.sy * a[kz];
+        let bx = b[kx] - self.sx * b[kz];
+        let by = b[ky] - self.sy * b[kz];
+        let cx = c[kx] - self.sx * c[kz];
+        let cy = c[ky] - self.sy * c[kz];
+        let mut u = cx * by - cy * bx;
+        let mut v = ax * cy - ay * cx;
+        let mut w = bx * ay - by * ax;
+        if u == 0.0 || v == 0.0 || w == 0.0 {
+            let (ax, ay, bx, by, cx, cy) = (
+                ax as f64, ay as f64, bx as f64, by as f64, cx as f64, cy as f64,
+            );
+            u = (cx * by - cy * bx) as f32;
+            v = (ax * cy - ay * cx) as f32;
+            w = (bx * ay - by * ax) as f32;
+        }
+        if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
+            return f32::INFINITY;
+        }
+        let det = u + v + w;
+        if det == 0.0 {
+            return f32::INFINITY;
+        }
+        let az = self.sz * a[kz];
+        let bz = self.sz * b[kz];
+        let cz = self.sz * c[kz];
+        let t = (u * az + v * bz + w * cz) / det;
+        if t >= t_min && t <= t_max {
+            t
+        } else {
+            f32::INFINITY
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hits_inside_misses_outside_both_sides() {
+        let (v0, v1, v2) = (
+            Vec3::new(-1.0, -1.0, 0.0),
+            Vec3::new(1.0, -1.0, 0.0),
+            Vec3::new(0.0, 1.0, 0.0),
+        );
+        let down = WatertightRay::new(Vec3::new(0.0, 0.0, 2.0), Vec3::NEG_Z);
+        assert!((down.intersect(v0, v1, v2, 0.0, f32::INFINITY) - 2.0).abs() < 1e-6);
+        let up = WatertightRay::new(Vec3::new(0.0, 0.0, -3.0), Vec3::Z);
+        assert!((up.intersect(v0, v1, v2, 0.0, f32::INFINITY) - 3.0).abs() < 1e-6);
+        let outside = WatertightRay::new(Vec3::new(0.9, 0.9, 2.0), Vec3::NEG_Z);
+        assert_eq!(
+            outside.intersect(v0, v1, v2, 0.0, f32::INFINITY),
+            f32::INFINITY
+        );
+        // Range limits.
+        assert_eq!(down.intersect(v0, v1, v2, 0.0, 1.5), f32::INFINITY);
+        assert_eq!(down.intersect(v0, v1, v2, 2.5, 9.0), f32::INFINITY);
+    }
+
+    /// Rays aimed at interior points of the diagonal shared by two triangles of general
+    /// (randomly oriented) quads, from random origins, always hit one of the two triangles.
+    /// The same rays leak through obvhs' Möller–Trumbore test (880 of 19 800 when this was
+    /// written), which is why the tracer does not use it; the guard below keeps this
+    /// configuration one that really exercises the seam.
+    #[test]
+    fn shared_edges_do_not_leak() {
+        let mut state = 1u64;
+        let mut rnd = move || {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            ((state >> 40) as f32 / (1u64 << 24) as f32) * 2.0 - 1.0
+        };
+        let (mut rays, mut leaks, mut naive_leaks) = (0, 0, 0);
+        for _ in 0..200 {
+            let corner = if rnd() > 0.0 {
+                Vec3::ZERO
+            } else {
+                Vec3::new(rnd(), rnd(), rnd()) * 3.0
+            };
+            let u = Vec3::new(rnd(), rnd(), rnd()).normalize() * 2.0;
+            let v = u.cross(Vec3::new(rnd(), rnd(), rnd())).normalize() * 1.5;
+            let q = [corner, corner + u, corner + u + v, corner + v];
+            let tris = [[q[0], q[1], q[2]], [q[0], q[2], q[3]]];
+            for i in 1..100 {
+                let on_diagonal = q[0] + (q[2] - q[0]) * (i as f32 / 100.0);
+                let origin = on_diagonal + Vec3::new(rnd(), rnd(), rnd()) * 5.0;
+                let dir = (on_diagonal - origin).normalize();
+                rays += 1;
+                let ray = WatertightRay::new(origin, dir);
+                let hit = tris
+                    .iter()
+                    .map(|t| ray.intersect(t[0], t[1], t[2], 0.0, f32::INFINITY))
+                    .fold(f32::INFINITY, f32::min);
+                leaks += !hit.is_finite() as usize;
+                let naive = obvhs::ray::Ray::new(origin.into(), dir.into(), 0.0, f32::INFINITY);
+                let naive_hit = tris
+                    .iter()
+                    .map(|t| {
+                        obvhs::triangle::Triangle {
+                            v0: t[0].into(),
+                            v1: t[1].into(),
+                            v2: t[2].into(),
+                        }
+                        .intersect(&naive)
+                    })
+                    .fold(f32::INFINITY, f32::min);
+                naive_leaks += !naive_hit.is_finite() as usize;
+            }
+        }
+        assert_eq!(rays, 19_800);
+        assert_eq!(leaks, 0, "watertight test leaked");
+        assert!(
+            naive_leaks > 0,
+            "configuration no longer exercises the seam"
+        );
+    }
+}

@@ -1,0 +1,167 @@
+//! The `whitted` integrator: the shading contract (`docs/shading.md`) followed exactly.
+//!
+//! From the camera, follow perfect mirror reflections (throughput × reflectance at each
+//! bounce) until a diffuse surface (shaded by [`mirrorbox_scene::Lighting`]), the background,
+//! or termination: `max_depth` reflections followed, or a throughput whose largest channel
+//! would fall below `min_throughput`. A terminated path shows the scene's `terminal`
+//! radiance on the mirror it could not follow, times the throughput so far.
+//!
+//! **Deep paths without drift.** A mirror hit is re-solved in f64 against the mirror's exact
+//! plane (`t = (offset − n·o)/(n·d)`) and the reflected ray keeps an f64 origin and
+//! direction; the BVH only decides *which* mirror is hit. The next ray ignores the mirror it
+//! leaves (a planar mirror cannot be hit again by its own reflection), so no offset epsilon
+//! is needed and nothing self-intersects. Position error after k bounces stays at f64
+//! rounding, far below a pixel even at k = 10 000 (tested against the closed form).
+
+use crate::bvh::SceneBvh;
+use glam::{DVec3, Vec3};
+use mirrorbox_scene::shading::{Interaction, interaction};
+use mirrorbox_scene::{Ray, Scene};
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WhittedSettings {
+    /// Most mirror reflections a path follows (the `--max-depth`).
+    pub max_depth: u32,
+    /// A path stops when the largest channel of its throughput would drop below this.
+    pub min_throughput: f32,
+}
+
+impl Default for WhittedSettings {
+    fn default() -> Self {
+        WhittedSettings {
+            max_depth: 10_000,
+            min_throughput: 1e-4,
+        }
+    }
+}
+
+/// How a path ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Termination {
+    /// Shaded at a diffuse surface.
+    Diffuse,
+    /// Left the scene (background).
+    Escaped,
+    /// Cut at `max_depth`.
+    Depth,
+    /// Cut because its throughput fell below `min_throughput`.
+    Throughput,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PathResult {
+    pub radiance: Vec3,
+    /// Mirror reflections followed.
+    pub bounces: u32,
+    pub termination: Termination,
+    /// Rays cast (closest-hit queries).
+    pub rays: u32,
+}
+
+pub struct Whitted<'a> {
+    scene: &'a Scene,
+    bvh: &'a SceneBvh,
+    settings: WhittedSettings,
+    face_normals: Vec<Vec3>,
+    /// Per mirror: exact plane (unit normal, offset) in f64.
+    mirror_planes: Vec<(DVec3, f64)>,
+}
+
+impl<'a> Whitted<'a> {
+    pub fn new(scene: &'a Scene, bvh: &'a SceneBvh, settings: WhittedSettings) -> Self {
+        let g = &scene.geometry;
+        let face_normals = (0..g.triangles.len()).map(|i| g.face_normal(i)).collect();
+        let mirror_planes = scene
+            .mirrors
+            .iter()
+            .map(|m| {
+                let n = m.normal.as_dvec3().normalize();
+                (n, n.dot(m.center.as_dvec3()))
+            })
+            .collect();
+        Whitted {
+            scene,
+            bvh,
+            settings,
+            face_normals,
+            mirror_planes,
+        }
+    }
+
+    pub fn settings(&self) -> WhittedSettings {
+        self.settings
+    }
+
+    /// Radiance along `ray`.
+    pub fn radiance(&self, ray: Ray) -> PathResult {
+        self.trace(ray, |_, _, _| {})
+    }
+
+    /// Radiance along `ray`, calling `on_mirror(k, point, mirror)` at the k-th reflection
+    /// (k from 1) with the exact hit point (tests and diagnostics; the closure inlines away).
+    pub fn trace(&self, ray: Ray, mut on_mirror: impl FnMut(u32, DVec3, usize)) -> PathResult {
+        let scene = self.scene;
+        let mut origin = ray.origin.as_dvec3();
+        let mut dir = ray.dir.as_dvec3();
+        let mut throughput = Vec3::ONE;
+        let mut radiance = Vec3::ZERO;
+        let mut bounces = 0u32;
+        let mut rays = 0u32;
+        let mut leaving: Option<usize> = None;
+        let termination = loop {
+            rays += 1;
+            let query = Ray {
+                origin: origin.as_vec3(),
+                dir: dir.as_vec3(),
+            };
+            let Some(hit) = self.bvh.closest_hit(&query, 0.0, f32::INFINITY, leaving) else {
+                radiance += throughput * scene.background;
+                break Termination::Escaped;
+            };
+            let normal = self.face_normals[hit.triangle];
+            let front = normal.dot(query.dir) < 0.0;
+            let surface = scene.geometry.surface(hit.triangle);
+            match interaction(surface, front) {
+                Interaction::Diffuse { albedo, emission } => {
+                    let p = query.at(hit.t);
+                    radiance += throughput
+                        * scene
+                            .lighting
+                            .diffuse_radiance(p, normal, -query.dir, albedo, emission);
+                    break Termination::Diffuse;
+                }
+                Interaction::Reflect { reflectance } => {
+                    let mirrorbox_scene::Surface::Mirror { mirror, .. } = *surface else {
+                        unreachable!("only mirrors reflect")
+                    };
+                    let next = throughput * reflectance;
+                    let cut = if bounces >= self.settings.max_depth {
+                        Some(Termination::Depth)
+                    } else if next.max_element() < self.settings.min_throughput {
+                        Some(Termination::Throughput)
+                    } else {
+                        None
+                    };
+                    if let Some(reason) = cut {
+                        radiance += throughput * scene.terminal;
+                        break reason;
+                    }
+                    throughput = next;
+                    bounces += 1;
+                    let (n, offset) = self.mirror_planes[mirror];
+                    let t = (offset - n.dot(origin)) / n.dot(dir);
+                    origin += dir * t;
+                    dir = (dir - 2.0 * dir.dot(n) * n).normalize();
+                    leaving = Some(mirror);
+                    on_mirror(bounces, origin, mirror);
+                }
+            }
+        };
+        PathResult {
+            radiance,
+            bounces,
+            termination,
+            rays,
+        }
+    }
+}
