@@ -27,6 +27,8 @@ enum Command {
     Check(commands::check::Args),
     /// Print the wgpu adapter mirrorbox would render and time on.
     Info(commands::info::Args),
+    /// Render the ray-traced ground truth (obvhs, all CPU cores).
+    Trace(commands::trace::Args),
 }
 
 /// Mesa's Vulkan device-select layer prints "error: XDG_RUNTIME_DIR is invalid" on headless
@@ -64,7 +66,7 @@ impl Failure {
             Failure::Other(_) => 1,
         }
     }
-    fn message(&self) -> &str {
+    pub fn message(&self) -> &str {
         match self {
             Failure::BadInput(m) | Failure::Other(m) => m,
         }
@@ -77,6 +79,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Check(args) => commands::check::run(&args),
         Command::Info(args) => commands::info::run(&args),
+        Command::Trace(args) => commands::trace::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -6,6 +6,7 @@
 //! the destination folder and is renamed into place, so a failed or interrupted write never
 //! leaves a half-written output behind.
 
+pub mod colormap;
 pub mod srgb;
 
 use std::path::{Path, PathBuf};
@@ -90,13 +91,22 @@ pub fn write_atomically(
 
 /// Writes the contract's tone-mapped sRGB image as an 8-bit PNG.
 pub fn write_png(path: &Path, image: &RgbImage, exposure: f32) -> Result<(), ImageError> {
-    let bytes = image.to_srgb8(exposure);
+    write_png_bytes(path, image.width, image.height, &image.to_srgb8(exposure))
+}
+
+/// Writes 8-bit sRGB bytes (RGB, row-major) as a PNG.
+pub fn write_png_bytes(
+    path: &Path,
+    width: u32,
+    height: u32,
+    bytes: &[u8],
+) -> Result<(), ImageError> {
     write_atomically(path, |tmp| {
         image::save_buffer_with_format(
             tmp,
-            &bytes,
-            image.width,
-            image.height,
+            bytes,
+            width,
+            height,
             image::ColorType::Rgb8,
             image::ImageFormat::Png,
         )

@@ -92,3 +92,65 @@ impl Scene {
         self.geometry.set_mirror_reflectance(reflectance);
     }
 }
+
+impl Scene {
+    /// A 64-bit FNV-1a hash of everything that affects an image (camera, mirrors, lighting,
+    /// background, terminal, triangles and surfaces; not the file path). Floats enter through
+    /// their exact shortest round-trip text, so equal hashes mean equal inputs. Used to label
+    /// outputs and as the key of cached ground truths.
+    pub fn content_hash(&self) -> u64 {
+        use std::fmt::Write;
+        let mut h = Fnv1a(0xcbf2_9ce4_8422_2325);
+        let g = &self.geometry;
+        let _ = write!(
+            h,
+            "{:?}{:?}{:?}{:?}{:?}{:?}{:?}{:?}",
+            self.camera,
+            self.mirrors,
+            self.lighting,
+            self.background,
+            self.terminal,
+            g.triangles,
+            g.surface_of,
+            g.surfaces
+        );
+        h.0
+    }
+}
+
+struct Fnv1a(u64);
+
+impl std::fmt::Write for Fnv1a {
+    fn write_str(&mut self, s: &str) -> std::fmt::Result {
+        for b in s.bytes() {
+            self.0 ^= b as u64;
+            self.0 = self.0.wrapping_mul(0x0000_0100_0000_01b3);
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn content_hash_tracks_what_affects_the_image() {
+        let text = r#"{ "camera": { "position": [0, 1, 3], "look_at": [0, 1, 0], "fov_y_deg": 60,
+            "width": 32, "height": 24 },
+            "mirrors": [ { "center": [0, 1, -2], "normal": [0, 0, 1], "up": [0, 1, 0], "width": 4, "height": 3 } ] }"#;
+        let a = load::parse_scene(text, std::path::Path::new("a.json")).unwrap();
+        let b = load::parse_scene(text, std::path::Path::new("elsewhere/b.json")).unwrap();
+        assert_eq!(
+            a.content_hash(),
+            b.content_hash(),
+            "the path must not matter"
+        );
+        let mut c = a.clone();
+        c.set_reflectance(Vec3::splat(0.7));
+        assert_ne!(a.content_hash(), c.content_hash());
+        let mut d = a.clone();
+        d.camera = d.camera.with_size(33, 24);
+        assert_ne!(a.content_hash(), d.content_hash());
+    }
+}

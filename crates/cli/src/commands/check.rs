@@ -1,7 +1,6 @@
 //! `mirrorbox check SCENE...`: load and validate each scene; one line per scene.
 
 use crate::{Failure, count};
-use mirrorbox_scene::load_scene;
 use std::path::PathBuf;
 
 #[derive(clap::Args)]
@@ -14,7 +13,7 @@ pub struct Args {
 pub fn run(args: &Args) -> Result<(), Failure> {
     let mut failed = 0;
     for path in &args.scenes {
-        match load_scene(path) {
+        match super::load(path) {
             Ok(scene) => {
                 let g = &scene.geometry;
                 let dropped = match g.degenerate_dropped {
@@ -33,7 +32,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
                 );
             }
             Err(e) => {
-                eprintln!("error: {e}");
+                eprintln!("error: {}", e.message());
                 failed += 1;
             }
         }

@@ -1,2 +1,66 @@
 pub mod check;
 pub mod info;
+pub mod trace;
+
+use crate::Failure;
+use mirrorbox_scene::{Scene, load_scene};
+use std::path::{Path, PathBuf};
+
+/// Loads a scene; any problem with it is the user's input (exit 2).
+pub fn load(path: &Path) -> Result<Scene, Failure> {
+    load_scene(path).map_err(|e| Failure::BadInput(e.to_string()))
+}
+
+/// Applies `--width/--height` overrides (each 1..=16384).
+pub fn resize(scene: &mut Scene, width: Option<u32>, height: Option<u32>) -> Result<(), Failure> {
+    let max = mirrorbox_scene::load::defaults::MAX_IMAGE_SIDE;
+    for (flag, v) in [("--width", width), ("--height", height)] {
+        if let Some(v) = v
+            && (v == 0 || v > max)
+        {
+            return Err(Failure::BadInput(format!(
+                "{flag} must be in [1, {max}] pixels, got {v}"
+            )));
+        }
+    }
+    let cam = &scene.camera;
+    scene.camera = cam.with_size(width.unwrap_or(cam.width), height.unwrap_or(cam.height));
+    Ok(())
+}
+
+/// Checks that `path` has extension `ext` and that its folder exists, before any work.
+pub fn output_path(flag: &str, path: &Path, ext: &str) -> Result<PathBuf, Failure> {
+    let has_ext = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case(ext));
+    if !has_ext {
+        return Err(Failure::BadInput(format!(
+            "{flag} {}: must name a .{ext} file",
+            path.display()
+        )));
+    }
+    let parent = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    if !parent.is_dir() {
+        return Err(Failure::BadInput(format!(
+            "{flag} {}: folder {} does not exist",
+            path.display(),
+            parent.display()
+        )));
+    }
+    Ok(path.to_path_buf())
+}
+
+/// A progress bar on stderr (drawn only when stderr is a terminal).
+pub fn progress_bar(len: u64, what: &str) -> indicatif::ProgressBar {
+    let bar = indicatif::ProgressBar::new(len);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} {per_sec} ETA {eta}")
+            .expect("static template")
+            .progress_chars("=> "),
+    );
+    bar.set_message(what.to_string());
+    bar
+}

@@ -1,0 +1,261 @@
+//! `mirrorbox trace SCENE -o OUT.exr`: the ground truth, rendered on the CPU with obvhs.
+
+use super::{load, output_path, progress_bar, resize};
+use crate::Failure;
+use mirrorbox_image::{RgbImage, colormap, write_exr, write_png, write_png_bytes};
+use mirrorbox_scene::SubpixelGrid;
+use mirrorbox_trace::{
+    BvhKind, Sampling, SceneBvh, TraceOutput, TraceSettings, WhittedSettings, render,
+};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub enum Bvh {
+    Cwbvh,
+    Bvh2,
+}
+
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub enum Integrator {
+    /// Perfect mirror chains, the contract's lighting at the first diffuse hit.
+    Whitted,
+}
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Scene file (JSON).
+    scene: PathBuf,
+    /// Output EXR (linear float32 RGB); an sRGB PNG is written beside it.
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Image width in pixels (overrides the scene's).
+    #[arg(long)]
+    width: Option<u32>,
+    /// Image height in pixels (overrides the scene's).
+    #[arg(long)]
+    height: Option<u32>,
+    /// Samples per pixel: a perfect square s², taken as the s×s sub-pixel grid the
+    /// rasterizer reproduces with --ssaa s.
+    #[arg(long, default_value_t = 16)]
+    spp: u32,
+    /// Override every mirror's reflectance (the α being measured), in [0, 1].
+    #[arg(long)]
+    reflectance: Option<f32>,
+    /// Most mirror reflections a path follows.
+    #[arg(long, default_value_t = 10_000)]
+    max_depth: u32,
+    /// Stop a path when its throughput's largest channel would fall below this, in [0, 1).
+    #[arg(long, default_value_t = 1e-4)]
+    min_throughput: f32,
+    /// Stratified random sub-pixel positions instead of the fixed grid.
+    #[arg(long)]
+    jitter: bool,
+    /// Seed of --jitter.
+    #[arg(long, default_value_t = 0, requires = "jitter")]
+    seed: u64,
+    /// Also write the mean number of mirror bounces per pixel (EXR, with a heat-map PNG beside it).
+    #[arg(long, value_name = "FILE.exr")]
+    bounces: Option<PathBuf>,
+    #[arg(long, value_enum, default_value_t = Integrator::Whitted)]
+    integrator: Integrator,
+    /// obvhs hierarchy to traverse.
+    #[arg(long, value_enum, default_value_t = Bvh::Cwbvh)]
+    bvh: Bvh,
+    /// Print the summary as one JSON object.
+    #[arg(long)]
+    json: bool,
+}
+
+fn check_args(args: &Args) -> Result<(SubpixelGrid, WhittedSettings), Failure> {
+    let s = (args.spp as f64).sqrt().round() as u32;
+    if args.spp == 0 || s * s != args.spp {
+        return Err(Failure::BadInput(format!(
+            "--spp {} must be a perfect square (the s×s sub-pixel grid): 1, 4, 9, 16, 25, ...",
+            args.spp
+        )));
+    }
+    if let Some(r) = args.reflectance
+        && !(0.0..=1.0).contains(&r)
+    {
+        return Err(Failure::BadInput(format!(
+            "--reflectance must be in [0, 1], got {r}"
+        )));
+    }
+    if !(0.0..1.0).contains(&args.min_throughput) {
+        return Err(Failure::BadInput(format!(
+            "--min-throughput must be in [0, 1), got {}",
+            args.min_throughput
+        )));
+    }
+    Ok((
+        SubpixelGrid::new(s),
+        WhittedSettings {
+            max_depth: args.max_depth,
+            min_throughput: args.min_throughput,
+        },
+    ))
+}
+
+fn write_failed(e: impl ToString) -> Failure {
+    Failure::Other(e.to_string())
+}
+
+pub fn run(args: &Args) -> Result<(), Failure> {
+    let (grid, whitted) = check_args(args)?;
+    let exr_path = output_path("-o", &args.output, "exr")?;
+    let bounces_path = args
+        .bounces
+        .as_deref()
+        .map(|p| output_path("--bounces", p, "exr"))
+        .transpose()?;
+    let mut scene = load(&args.scene)?;
+    resize(&mut scene, args.width, args.height)?;
+    if let Some(r) = args.reflectance {
+        scene.set_reflectance(glam::Vec3::splat(r));
+    }
+    let sampling = if args.jitter {
+        Sampling::Jittered {
+            grid,
+            seed: args.seed,
+        }
+    } else {
+        Sampling::Grid(grid)
+    };
+    let kind = match args.bvh {
+        Bvh::Cwbvh => BvhKind::Cwbvh,
+        Bvh::Bvh2 => BvhKind::Bvh2,
+    };
+    let started = Instant::now();
+    let bvh = SceneBvh::build_with(&scene.geometry, kind);
+    let settings = TraceSettings { sampling, whitted };
+    let bar = progress_bar(scene.camera.height as u64, "tracing rows");
+    let out = render(&scene, &bvh, &settings, &|rows| {
+        bar.set_position(rows as u64)
+    });
+    bar.finish_and_clear();
+    let total = started.elapsed();
+
+    let reflectance = args
+        .reflectance
+        .map_or("as in scene".to_string(), |r| r.to_string());
+    let attributes = [
+        ("mirrorbox.version", env!("CARGO_PKG_VERSION").to_string()),
+        ("mirrorbox.scene", args.scene.display().to_string()),
+        (
+            "mirrorbox.scene_hash",
+            format!("{:016x}", scene.content_hash()),
+        ),
+        ("mirrorbox.integrator", "whitted".to_string()),
+        ("mirrorbox.spp", grid.samples_per_pixel().to_string()),
+        ("mirrorbox.sampling", sampling.describe()),
+        ("mirrorbox.max_depth", whitted.max_depth.to_string()),
+        (
+            "mirrorbox.min_throughput",
+            whitted.min_throughput.to_string(),
+        ),
+        ("mirrorbox.reflectance", reflectance),
+        (
+            "mirrorbox.render_seconds",
+            format!("{:.3}", out.wall.as_secs_f64()),
+        ),
+        ("mirrorbox.rays", out.stats.rays.to_string()),
+        ("mirrorbox.deepest_path", out.stats.deepest.to_string()),
+    ];
+    write_exr(&exr_path, &out.image, &attributes).map_err(write_failed)?;
+    let png_path = exr_path.with_extension("png");
+    write_png(&png_path, &out.image, scene.camera.exposure).map_err(write_failed)?;
+    let mut written = vec![exr_path.clone(), png_path];
+    if let Some(path) = &bounces_path {
+        written.extend(write_bounces(
+            path,
+            &out.bounces,
+            out.stats.deepest,
+            &attributes,
+        )?);
+    }
+    report(args, &scene, &bvh, &out, grid, total, &written);
+    Ok(())
+}
+
+/// The bounce AOV: EXR of the mean count, and a heat map (log scale up to the deepest path).
+fn write_bounces(
+    path: &Path,
+    image: &RgbImage,
+    deepest: u32,
+    attributes: &[(&str, String)],
+) -> Result<Vec<PathBuf>, Failure> {
+    write_exr(path, image, attributes).map_err(write_failed)?;
+    let scale = (1.0 + deepest.max(1) as f32).ln();
+    let bytes: Vec<u8> = image
+        .pixels
+        .iter()
+        .flat_map(|p| colormap::heat((1.0 + p[0]).ln() / scale))
+        .collect();
+    let png = path.with_extension("png");
+    write_png_bytes(&png, image.width, image.height, &bytes).map_err(write_failed)?;
+    Ok(vec![path.to_path_buf(), png])
+}
+
+fn report(
+    args: &Args,
+    scene: &mirrorbox_scene::Scene,
+    bvh: &SceneBvh,
+    out: &TraceOutput,
+    grid: SubpixelGrid,
+    total: std::time::Duration,
+    written: &[PathBuf],
+) {
+    let s = &out.stats;
+    let secs = out.wall.as_secs_f64();
+    let mrays = s.rays as f64 / secs / 1e6;
+    let (w, h) = (scene.camera.width, scene.camera.height);
+    if args.json {
+        let v = serde_json::json!({
+            "scene": args.scene.display().to_string(),
+            "scene_hash": format!("{:016x}", scene.content_hash()),
+            "width": w, "height": h, "spp": grid.samples_per_pixel(),
+            "paths": s.paths, "rays": s.rays, "mrays_per_s": mrays,
+            "deepest_path": s.deepest, "render_seconds": secs, "total_seconds": total.as_secs_f64(),
+            "bvh": format!("{:?}", bvh.kind).to_lowercase(), "bvh_build_seconds": bvh.build_time.as_secs_f64(),
+            "threads": out.threads,
+            "ended": { "diffuse": s.diffuse, "escaped": s.escaped, "max_depth": s.cut_by_depth,
+                       "min_throughput": s.cut_by_throughput },
+            "outputs": written.iter().map(|p| p.display().to_string()).collect::<Vec<_>>(),
+        });
+        println!("{v}");
+        return;
+    }
+    println!(
+        "traced {}: {w}x{h}, {} spp ({}x{} grid{}), {} rays, {mrays:.2} Mrays/s, deepest path {} bounces, {secs:.2} s on {} threads",
+        args.scene.display(),
+        grid.samples_per_pixel(),
+        grid.per_axis,
+        grid.per_axis,
+        if args.jitter { ", jittered" } else { "" },
+        s.rays,
+        s.deepest,
+        out.threads,
+    );
+    println!(
+        "  {} paths ended: {} at diffuse surfaces, {} escaped, {} cut by --max-depth {}, {} cut by --min-throughput {}",
+        s.paths,
+        s.diffuse,
+        s.escaped,
+        s.cut_by_depth,
+        args.max_depth,
+        s.cut_by_throughput,
+        args.min_throughput
+    );
+    println!(
+        "  {:?} over {} triangles built in {:.1} ms; wrote {}",
+        bvh.kind,
+        scene.geometry.triangles.len(),
+        bvh.build_time.as_secs_f64() * 1e3,
+        written
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+}
