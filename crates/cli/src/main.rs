@@ -7,7 +7,7 @@
 
 mod commands;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use std::process::ExitCode;
 
 #[derive(Parser)]
@@ -75,7 +75,10 @@ impl Failure {
 
 fn main() -> ExitCode {
     quiet_mesa_device_select();
-    let cli = Cli::parse(); // clap exits with 2 on bad arguments, matching our convention
+    // A repeated flag: the last one wins, as in most command lines (scripts append overrides).
+    let command = Cli::command().mut_subcommands(|s| s.args_override_self(true));
+    // clap exits with 2 on bad arguments, matching our convention.
+    let cli = Cli::from_arg_matches(&command.get_matches()).unwrap_or_else(|e| e.exit());
     let result = match cli.command {
         Command::Check(args) => commands::check::run(&args),
         Command::Info(args) => commands::info::run(&args),

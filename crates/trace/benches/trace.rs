@@ -1,0 +1,38 @@
+//! Tracer throughput on `scenes/mirror_box.json` at 640×360, reported by criterion as rays
+//! per second ("elements" = rays cast, counted once up front; rendering is deterministic).
+//! Compares the two obvhs hierarchies (CWBVH, BVH2) and two reflectances: 0.9 as in the scene
+//! and the paper's α = 0.7. Run: `cargo bench -p mirrorbox-trace`.
+
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use glam::Vec3;
+use mirrorbox_scene::{load_scene, SubpixelGrid};
+use mirrorbox_trace::{render, BvhKind, SceneBvh, Sampling, TraceSettings, WhittedSettings};
+use std::path::Path;
+
+fn bench(c: &mut Criterion) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/mirror_box.json");
+    let base = load_scene(&path).expect("bundled scene loads");
+    let settings = TraceSettings {
+        sampling: Sampling::Grid(SubpixelGrid::new(2)),
+        whitted: WhittedSettings::default(),
+    };
+    let mut group = c.benchmark_group("mirror_box_640x360_4spp");
+    group.sample_size(10);
+    for reflectance in [0.9f32, 0.7] {
+        let mut scene = base.clone();
+        scene.camera = scene.camera.with_size(640, 360);
+        scene.set_reflectance(Vec3::splat(reflectance));
+        for kind in [BvhKind::Cwbvh, BvhKind::Bvh2] {
+            let bvh = SceneBvh::build_with(&scene.geometry, kind);
+            let rays = render(&scene, &bvh, &settings, &|_| {}).stats.rays;
+            group.throughput(Throughput::Elements(rays));
+            group.bench_function(format!("{kind:?}/R={reflectance}"), |b| {
+                b.iter(|| render(&scene, &bvh, &settings, &|_| {}))
+            });
+        }
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
