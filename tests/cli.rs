@@ -367,7 +367,18 @@ fn wgpu_backend_override_is_honoured_and_checked() {
 // trace
 
 fn trace_args<'a>(out: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
-    let mut args = vec!["trace", "scenes/mirror_box.json", "-o", out, "--width", "48", "--height", "27", "--spp", "4"];
+    let mut args = vec![
+        "trace",
+        "scenes/mirror_box.json",
+        "-o",
+        out,
+        "--width",
+        "48",
+        "--height",
+        "27",
+        "--spp",
+        "4",
+    ];
     args.extend_from_slice(extra);
     args
 }
@@ -378,16 +389,29 @@ fn trace_writes_exr_png_and_bounces_with_provenance() {
     let exr = dir.path().join("truth.exr");
     let bounces = dir.path().join("bounces.exr");
     let (exr_s, bounces_s) = (exr.to_str().unwrap(), bounces.to_str().unwrap());
-    let out = mirrorbox(&trace_args(exr_s, &["--bounces", bounces_s, "--reflectance", "0.7"]), &[]);
+    let out = mirrorbox(
+        &trace_args(exr_s, &["--bounces", bounces_s, "--reflectance", "0.7"]),
+        &[],
+    );
     assert_eq!(out.code, 0, "{}", out.stderr);
-    assert!(out.stdout.contains("traced scenes/mirror_box.json: 48x27, 4 spp (2x2 grid)"), "{}", out.stdout);
+    assert!(
+        out.stdout
+            .contains("traced scenes/mirror_box.json: 48x27, 4 spp (2x2 grid)"),
+        "{}",
+        out.stdout
+    );
     assert!(out.stdout.contains("Mrays/s"));
     assert!(out.stdout.contains("cut by --max-depth 10000"));
     for f in ["truth.exr", "truth.png", "bounces.exr", "bounces.png"] {
         assert!(dir.path().join(f).is_file(), "{f} missing");
     }
     let attrs = mirrorbox_image::read_exr_attributes(&exr).unwrap();
-    let get = |k: &str| attrs.iter().find(|(key, _)| key == k).map(|(_, v)| v.clone());
+    let get = |k: &str| {
+        attrs
+            .iter()
+            .find(|(key, _)| key == k)
+            .map(|(_, v)| v.clone())
+    };
     assert_eq!(get("mirrorbox.spp").as_deref(), Some("4"));
     assert_eq!(get("mirrorbox.max_depth").as_deref(), Some("10000"));
     assert_eq!(get("mirrorbox.reflectance").as_deref(), Some("0.7"));
@@ -396,7 +420,10 @@ fn trace_writes_exr_png_and_bounces_with_provenance() {
     let image = mirrorbox_image::read_image(&exr).unwrap();
     assert_eq!((image.width, image.height), (48, 27));
     let depth = mirrorbox_image::read_image(&bounces).unwrap();
-    assert!(depth.pixels.iter().any(|p| p[0] > 2.0), "some pixels look deep into the mirrors");
+    assert!(
+        depth.pixels.iter().any(|p| p[0] > 2.0),
+        "some pixels look deep into the mirrors"
+    );
 }
 
 #[test]
@@ -405,12 +432,21 @@ fn trace_is_deterministic_to_the_byte() {
     let a = dir.path().join("a.exr");
     let b = dir.path().join("b.exr");
     for (p, threads) in [(&a, "1"), (&b, "2")] {
-        let out = mirrorbox(&trace_args(p.to_str().unwrap(), &["--jitter", "--seed", "9"]), &[("RAYON_NUM_THREADS", threads)]);
+        let out = mirrorbox(
+            &trace_args(p.to_str().unwrap(), &["--jitter", "--seed", "9"]),
+            &[("RAYON_NUM_THREADS", threads)],
+        );
         assert_eq!(out.code, 0, "{}", out.stderr);
     }
     // The PNG is byte-identical; the EXR's pixels are (its header records the render time).
-    assert_eq!(std::fs::read(a.with_extension("png")).unwrap(), std::fs::read(b.with_extension("png")).unwrap());
-    assert_eq!(mirrorbox_image::read_image(&a).unwrap(), mirrorbox_image::read_image(&b).unwrap());
+    assert_eq!(
+        std::fs::read(a.with_extension("png")).unwrap(),
+        std::fs::read(b.with_extension("png")).unwrap()
+    );
+    assert_eq!(
+        mirrorbox_image::read_image(&a).unwrap(),
+        mirrorbox_image::read_image(&b).unwrap()
+    );
 }
 
 #[test]
@@ -419,12 +455,30 @@ fn trace_refuses_bad_arguments_before_writing_anything() {
     let exr = dir.path().join("x.exr");
     let exr_s = exr.to_str().unwrap();
     let cases: [(Vec<&str>, &str); 6] = [
-        (trace_args(exr_s, &["--spp", "5"]), "--spp 5 must be a perfect square"),
-        (trace_args(exr_s, &["--reflectance", "1.5"]), "--reflectance must be in [0, 1], got 1.5"),
-        (trace_args(exr_s, &["--min-throughput", "1"]), "--min-throughput must be in [0, 1)"),
-        (trace_args("out.png", &[]), "-o out.png: must name a .exr file"),
-        (trace_args("/nonexistent/dir/x.exr", &[]), "folder /nonexistent/dir does not exist"),
-        (trace_args(exr_s, &["--width", "0"]), "--width must be in [1, 16384] pixels, got 0"),
+        (
+            trace_args(exr_s, &["--spp", "5"]),
+            "--spp 5 must be a perfect square",
+        ),
+        (
+            trace_args(exr_s, &["--reflectance", "1.5"]),
+            "--reflectance must be in [0, 1], got 1.5",
+        ),
+        (
+            trace_args(exr_s, &["--min-throughput", "1"]),
+            "--min-throughput must be in [0, 1)",
+        ),
+        (
+            trace_args("out.png", &[]),
+            "-o out.png: must name a .exr file",
+        ),
+        (
+            trace_args("/nonexistent/dir/x.exr", &[]),
+            "folder /nonexistent/dir does not exist",
+        ),
+        (
+            trace_args(exr_s, &["--width", "0"]),
+            "--width must be in [1, 16384] pixels, got 0",
+        ),
     ];
     for (args, message) in cases {
         let out = mirrorbox(&args, &[]);
@@ -433,5 +487,9 @@ fn trace_refuses_bad_arguments_before_writing_anything() {
     }
     let bad_scene = mirrorbox(&["trace", "scenes/nope.json", "-o", exr_s], &[]);
     assert_eq!(bad_scene.code, 2);
-    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0, "nothing may be written on bad input");
+    assert_eq!(
+        std::fs::read_dir(dir.path()).unwrap().count(),
+        0,
+        "nothing may be written on bad input"
+    );
 }

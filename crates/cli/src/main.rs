@@ -29,6 +29,8 @@ enum Command {
     Info(commands::info::Args),
     /// Render the ray-traced ground truth (obvhs, all CPU cores).
     Trace(commands::trace::Args),
+    /// Export a scene as Mitsuba 3 XML (tools/mitsuba renders and compares it).
+    ExportMitsuba(commands::export_mitsuba::Args),
 }
 
 /// Mesa's Vulkan device-select layer prints "error: XDG_RUNTIME_DIR is invalid" on headless
@@ -83,6 +85,7 @@ fn main() -> ExitCode {
         Command::Check(args) => commands::check::run(&args),
         Command::Info(args) => commands::info::run(&args),
         Command::Trace(args) => commands::trace::run(&args),
+        Command::ExportMitsuba(args) => commands::export_mitsuba::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

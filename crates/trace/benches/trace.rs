@@ -3,10 +3,10 @@
 //! Compares the two obvhs hierarchies (CWBVH, BVH2) and two reflectances: 0.9 as in the scene
 //! and the paper's α = 0.7. Run: `cargo bench -p mirrorbox-trace`.
 
-use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::Vec3;
-use mirrorbox_scene::{load_scene, SubpixelGrid};
-use mirrorbox_trace::{render, BvhKind, SceneBvh, Sampling, TraceSettings, WhittedSettings};
+use mirrorbox_scene::{SubpixelGrid, load_scene};
+use mirrorbox_trace::{BvhKind, Sampling, SceneBvh, TraceSettings, WhittedSettings, render};
 use std::path::Path;
 
 fn bench(c: &mut Criterion) {

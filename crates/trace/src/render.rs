@@ -66,6 +66,9 @@ pub struct TraceOutput {
     pub threads: usize,
 }
 
+/// One finished image row: radiance, mean bounces, statistics.
+type Row = (Vec<[f32; 3]>, Vec<[f32; 3]>, TraceStats);
+
 /// Renders `scene` (its camera's size) with `bvh`. `progress(rows_done)` is called as rows
 /// finish, from worker threads.
 pub fn render(
@@ -81,7 +84,7 @@ pub fn render(
     let spp = settings.sampling.grid().samples_per_pixel() as f32;
     let done = AtomicU32::new(0);
     let start = Instant::now();
-    let rows: Vec<(Vec<[f32; 3]>, Vec<[f32; 3]>, TraceStats)> = (0..h)
+    let rows: Vec<Row> = (0..h)
         .into_par_iter()
         .map(|y| {
             let mut offsets = Vec::new();

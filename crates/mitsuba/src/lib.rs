@@ -1,0 +1,251 @@
+//! Mitsuba 3 export: the same scene as Mitsuba XML, so our ground truth can be checked
+//! against the reference renderer of the field (`tools/mitsuba/`, `docs/mitsuba.md`).
+//!
+//! Mapping (each choice is what makes Mitsuba compute our shading contract):
+//! - camera → `perspective` with `fov_axis = "y"` (Mitsuba's default axis is x) and a
+//!   `lookat`; film `hdrfilm`, float32 RGB, **box** filter (the default is Gaussian); sampler
+//!   `stratified` without jitter, whose s² samples are exactly our s×s sub-pixel grid;
+//! - every part (object or mirror) → its own OBJ beside the XML holding *our* triangles, the
+//!   coordinates written as the shortest text that round-trips to the same f32, loaded with
+//!   `face_normals = true`;
+//! - diffuse → `twosided` `diffuse` (our diffuse is two-sided); emission → an `area`
+//!   emitter (one-sided, like ours);
+//! - mirror → `twosided` with a `conductor` (`material = none`: reflects exactly
+//!   `specular_reflectance` at every angle) in front and a `diffuse` of the back albedo behind;
+//! - point light → `point` (intensity in W/sr); background → `constant` emitter.
+//!
+//! What Mitsuba cannot express — the ambient term, the terminal radiance and the exposure —
+//! goes into `mirrorbox.json` beside the XML, which the Whitted integrator in
+//! `tools/mitsuba/render.py` reads (Mitsuba's own `path` cannot use it: see the docs).
+
+use glam::Vec3;
+use mirrorbox_scene::{Scene, Surface};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// Export settings that are not part of the scene.
+#[derive(Clone, Copy, Debug)]
+pub struct ExportSettings {
+    /// Samples per pixel; a perfect square (the stratified grid).
+    pub spp: u32,
+}
+
+fn rgb(v: Vec3) -> String {
+    format!("{}, {}, {}", v.x, v.y, v.z)
+}
+
+/// Writes `xml_path` and its meshes (under `meshes/` beside it) and `mirrorbox.json`;
+/// returns every file written. Each file is written to a temporary name and renamed.
+pub fn export(
+    scene: &Scene,
+    xml_path: &Path,
+    settings: ExportSettings,
+) -> std::io::Result<Vec<PathBuf>> {
+    let dir = xml_path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let mesh_dir = dir.join("meshes");
+    std::fs::create_dir_all(&mesh_dir)?;
+    let mut written = Vec::new();
+    let cam = &scene.camera;
+    let mut xml = String::new();
+    let _ = writeln!(xml, "<?xml version=\"1.0\" encoding=\"utf-8\"?>");
+    let _ = writeln!(
+        xml,
+        "<!-- Exported by mirrorbox {} from {} (scene hash {:016x}).\n     \
+         Ambient, terminal radiance and exposure are in mirrorbox.json; see docs/mitsuba.md. -->",
+        env!("CARGO_PKG_VERSION"),
+        scene.source.display(),
+        scene.content_hash()
+    );
+    let _ = writeln!(xml, "<scene version=\"3.0.0\">");
+    let _ = writeln!(xml, "  <default name=\"spp\" value=\"{}\"/>", settings.spp);
+    let _ = writeln!(xml, "  <default name=\"max_depth\" value=\"66\"/>");
+    let _ = writeln!(
+        xml,
+        "  <integrator type=\"path\">\n    <integer name=\"max_depth\" value=\"$max_depth\"/>\n    \
+         <integer name=\"rr_depth\" value=\"100000\"/>\n  </integrator>"
+    );
+    let _ = writeln!(
+        xml,
+        "  <sensor type=\"perspective\">\n    <string name=\"fov_axis\" value=\"y\"/>\n    \
+         <float name=\"fov\" value=\"{}\"/>\n    <float name=\"near_clip\" value=\"0.0001\"/>\n    \
+         <float name=\"far_clip\" value=\"1000000\"/>\n    <transform name=\"to_world\">\n      \
+         <lookat origin=\"{}\" target=\"{}\" up=\"{}\"/>\n    </transform>\n    \
+         <sampler type=\"stratified\">\n      <integer name=\"sample_count\" value=\"$spp\"/>\n      \
+         <boolean name=\"jitter\" value=\"false\"/>\n    </sampler>\n    <film type=\"hdrfilm\">\n      \
+         <integer name=\"width\" value=\"{}\"/>\n      <integer name=\"height\" value=\"{}\"/>\n      \
+         <string name=\"pixel_format\" value=\"rgb\"/>\n      \
+         <string name=\"component_format\" value=\"float32\"/>\n      <rfilter type=\"box\"/>\n    \
+         </film>\n  </sensor>",
+        cam.fov_y_deg,
+        rgb(cam.position),
+        rgb(cam.look_at),
+        rgb(cam.up),
+        cam.width,
+        cam.height
+    );
+    let _ = writeln!(
+        xml,
+        "  <emitter type=\"constant\">\n    <rgb name=\"radiance\" value=\"{}\"/>\n  </emitter>",
+        rgb(scene.background)
+    );
+    for light in &scene.lighting.lights {
+        let _ = writeln!(
+            xml,
+            "  <emitter type=\"point\">\n    <point name=\"position\" value=\"{}\"/>\n    \
+             <rgb name=\"intensity\" value=\"{}\"/>\n  </emitter>",
+            rgb(light.position),
+            rgb(light.intensity)
+        );
+    }
+    let g = &scene.geometry;
+    for (i, part) in g.parts.iter().enumerate() {
+        if part.triangles.is_empty() {
+            continue;
+        }
+        let file = format!("{i:03}_{}.obj", slug(&part.name));
+        let mut obj = format!(
+            "# {} ({} triangles), exported by mirrorbox\n",
+            part.name,
+            part.triangles.len()
+        );
+        for t in &g.triangles[part.triangles.clone()] {
+            for v in t {
+                let _ = writeln!(obj, "v {} {} {}", v.x, v.y, v.z);
+            }
+        }
+        for k in 0..part.triangles.len() {
+            let _ = writeln!(obj, "f {} {} {}", 3 * k + 1, 3 * k + 2, 3 * k + 3);
+        }
+        let path = mesh_dir.join(&file);
+        write_atomically(&path, obj.as_bytes())?;
+        written.push(path);
+        let bsdf = match &g.surfaces[part.surface as usize] {
+            Surface::Diffuse { albedo, .. } => format!(
+                "    <bsdf type=\"twosided\">\n      <bsdf type=\"diffuse\">\n        \
+                 <rgb name=\"reflectance\" value=\"{}\"/>\n      </bsdf>\n    </bsdf>",
+                rgb(*albedo)
+            ),
+            Surface::Mirror {
+                reflectance,
+                back_albedo,
+                ..
+            } => format!(
+                "    <bsdf type=\"twosided\">\n      <bsdf type=\"conductor\">\n        \
+                 <string name=\"material\" value=\"none\"/>\n        \
+                 <rgb name=\"specular_reflectance\" value=\"{}\"/>\n      </bsdf>\n      \
+                 <bsdf type=\"diffuse\">\n        <rgb name=\"reflectance\" value=\"{}\"/>\n      </bsdf>\n    </bsdf>",
+                rgb(*reflectance),
+                rgb(*back_albedo)
+            ),
+        };
+        let emitter = match &g.surfaces[part.surface as usize] {
+            Surface::Diffuse { emission, .. } if *emission != Vec3::ZERO => format!(
+                "\n    <emitter type=\"area\">\n      <rgb name=\"radiance\" value=\"{}\"/>\n    </emitter>",
+                rgb(*emission)
+            ),
+            _ => String::new(),
+        };
+        let _ = writeln!(
+            xml,
+            "  <!-- {} -->\n  <shape type=\"obj\">\n    <string name=\"filename\" value=\"meshes/{file}\"/>\n    \
+             <boolean name=\"face_normals\" value=\"true\"/>\n{bsdf}{emitter}\n  </shape>",
+            xml_comment(&part.name)
+        );
+    }
+    let _ = writeln!(xml, "</scene>");
+    let sidecar = serde_json::json!({
+        "scene": scene.source.display().to_string(),
+        "scene_hash": format!("{:016x}", scene.content_hash()),
+        "ambient": scene.lighting.ambient.to_array(),
+        "background": scene.background.to_array(),
+        "terminal": scene.terminal.to_array(),
+        "exposure": cam.exposure,
+        "width": cam.width,
+        "height": cam.height,
+        "spp": settings.spp,
+    });
+    let sidecar_path = dir.join("mirrorbox.json");
+    write_atomically(&sidecar_path, format!("{sidecar:#}\n").as_bytes())?;
+    write_atomically(xml_path, xml.as_bytes())?;
+    written.push(sidecar_path);
+    written.push(xml_path.to_path_buf());
+    Ok(written)
+}
+
+fn slug(name: &str) -> String {
+    let s: String = name
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() {
+                c.to_ascii_lowercase()
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    s.trim_matches('_').chars().take(40).collect()
+}
+
+fn xml_comment(s: &str) -> String {
+    s.replace("--", "- -")
+}
+
+fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let tmp = path.with_extension(format!("{}.tmp", std::process::id()));
+    std::fs::write(&tmp, bytes)
+        .and_then(|()| std::fs::rename(&tmp, path))
+        .inspect_err(|_| {
+            let _ = std::fs::remove_file(&tmp);
+        })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn exported_meshes_hold_exactly_our_triangles() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/single_mirror.json");
+        let scene = mirrorbox_scene::load_scene(&path).unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let xml = dir.path().join("scene.xml");
+        let files = export(&scene, &xml, ExportSettings { spp: 4 }).unwrap();
+        assert_eq!(files.len(), scene.geometry.parts.len() + 2);
+        // Read every OBJ back (in part order) and compare bit for bit.
+        let mut triangles = Vec::new();
+        for f in files
+            .iter()
+            .filter(|f| f.extension().is_some_and(|e| e == "obj"))
+        {
+            let text = std::fs::read_to_string(f).unwrap();
+            let v: Vec<Vec3> = text
+                .lines()
+                .filter_map(|l| l.strip_prefix("v "))
+                .map(|l| {
+                    let c: Vec<f32> = l.split(' ').map(|x| x.parse().unwrap()).collect();
+                    Vec3::new(c[0], c[1], c[2])
+                })
+                .collect();
+            triangles.extend(v.chunks(3).map(|c| [c[0], c[1], c[2]]));
+        }
+        assert_eq!(triangles, scene.geometry.triangles);
+        let text = std::fs::read_to_string(&xml).unwrap();
+        assert!(text.contains("<string name=\"fov_axis\" value=\"y\"/>"));
+        assert!(text.contains("<rfilter type=\"box\"/>"));
+        assert!(text.contains("<string name=\"component_format\" value=\"float32\"/>"));
+        assert!(text.contains("<string name=\"material\" value=\"none\"/>"));
+        assert_eq!(
+            text.matches("<shape type=\"obj\">").count(),
+            scene.geometry.parts.len()
+        );
+        // No temporary files are left.
+        assert!(
+            std::fs::read_dir(dir.path().join("meshes"))
+                .unwrap()
+                .all(|e| { !e.unwrap().path().to_string_lossy().ends_with(".tmp") })
+        );
+    }
+}
