@@ -1,9 +1,9 @@
 //! The wgpu rasterizer of mirrorbox.
 //!
-//! [`adapter`] chooses the adapter every raster method runs on — Vulkan first (Mesa's
-//! lavapipe on a CPU-only machine), then GL through EGL (llvmpipe), `WGPU_BACKEND`
-//! overriding — and reports what it can time and clip.
+//! - [`adapter`]: the one adapter rule (Vulkan, then GL; `WGPU_BACKEND` overrides).
+//! - [`plan`]: the seed paper's recursion (naive and auxiliary), planned on the CPU.
 
 pub mod adapter;
+pub mod plan;
 
 pub use adapter::{AdapterError, AdapterReport, SelectedAdapter, select_adapter};

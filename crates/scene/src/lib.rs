@@ -15,6 +15,7 @@ pub mod error;
 pub mod format;
 pub mod geometry;
 pub mod load;
+pub mod polygon;
 pub mod reflection;
 pub mod shading;
 pub mod tessellate;
