@@ -29,6 +29,8 @@ enum Command {
     Info(commands::info::Args),
     /// Render the ray-traced ground truth (obvhs, all CPU cores).
     Trace(commands::trace::Args),
+    /// Render with a raster method (wgpu), timed.
+    Render(commands::render::Args),
     /// Export a scene as Mitsuba 3 XML (tools/mitsuba renders and compares it).
     ExportMitsuba(commands::export_mitsuba::Args),
 }
@@ -85,6 +87,7 @@ fn main() -> ExitCode {
         Command::Check(args) => commands::check::run(&args),
         Command::Info(args) => commands::info::run(&args),
         Command::Trace(args) => commands::trace::run(&args),
+        Command::Render(args) => commands::render::run(&args),
         Command::ExportMitsuba(args) => commands::export_mitsuba::run(&args),
     };
     match result {

@@ -84,6 +84,28 @@ pub struct Scene {
 }
 
 impl Scene {
+    /// The same scene with its mirrors removed (their triangles included): what every method
+    /// renders identically, so comparing raster and trace on it measures the floor of the
+    /// comparison — rasterization and arithmetic, no mirror effect.
+    pub fn without_mirrors(&self) -> Scene {
+        let mut geometry = Geometry::default();
+        for part in &self.geometry.parts {
+            let surface = &self.geometry.surfaces[part.surface as usize];
+            if matches!(surface, Surface::Diffuse { .. }) {
+                geometry.push_part(
+                    part.name.clone(),
+                    surface.clone(),
+                    self.geometry.triangles[part.triangles.clone()].to_vec(),
+                );
+            }
+        }
+        Scene {
+            mirrors: Vec::new(),
+            geometry,
+            ..self.clone()
+        }
+    }
+
     /// Replaces every mirror's reflectance (the harness sets it to the α being measured),
     /// keeping [`Scene::geometry`]'s surfaces in step.
     pub fn set_reflectance(&mut self, reflectance: Vec3) {

@@ -249,21 +249,8 @@ fn scene_without_mirrors_equals_the_contract_reference_exactly() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/single_mirror.json");
     let mut s = mirrorbox_scene::load_scene(&path).unwrap();
     s.camera = s.camera.with_size(48, 27);
-    // Drop the mirror: keep only diffuse parts.
-    let mut g = mirrorbox_scene::Geometry::default();
-    for part in &s.geometry.parts {
-        if let surface @ mirrorbox_scene::Surface::Diffuse { .. } =
-            &s.geometry.surfaces[part.surface as usize]
-        {
-            g.push_part(
-                part.name.clone(),
-                surface.clone(),
-                s.geometry.triangles[part.triangles.clone()].to_vec(),
-            );
-        }
-    }
-    s.geometry = g;
-    s.mirrors.clear();
+    let s = s.without_mirrors();
+    assert!(s.mirrors.is_empty() && s.geometry.mirror_triangle_count() == 0);
     let grid = SubpixelGrid::new(2);
     let bvh = SceneBvh::build(&s.geometry);
     let out = render(

@@ -1,6 +1,7 @@
 pub mod check;
 pub mod export_mitsuba;
 pub mod info;
+pub mod render;
 pub mod trace;
 
 use crate::Failure;

@@ -1,0 +1,190 @@
+//! `mirrorbox render SCENE --method naive|auxiliary -o OUT.png`: the seed paper's raster
+//! methods with wgpu, timed.
+
+use super::{load, output_path, resize};
+use crate::Failure;
+use mirrorbox_image::{write_exr, write_png};
+use mirrorbox_raster::plan::PlanError;
+use mirrorbox_raster::{Gpu, Method, RasterError, RenderSettings, render};
+use std::path::PathBuf;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum MethodName {
+    /// The paper's Algorithm 1: recursive mirror textures, each mirror hidden in its own recursion.
+    Naive,
+    /// The paper's §3.1–3.2: n auxiliary mirrors (n + 2 in the queue), attenuation α^k.
+    Auxiliary,
+}
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Scene file (JSON).
+    scene: PathBuf,
+    #[arg(long, value_enum, default_value_t = MethodName::Naive)]
+    method: MethodName,
+    /// Auxiliary mirrors (auxiliary method only).
+    #[arg(long)]
+    n: Option<u32>,
+    /// Attenuation per reflection; also sets every mirror's reflectance (the truth to compare
+    /// with is `trace --reflectance α`). In [0, 1]. Default: the scene's reflectances.
+    #[arg(long)]
+    alpha: Option<f32>,
+    #[arg(long)]
+    width: Option<u32>,
+    #[arg(long)]
+    height: Option<u32>,
+    /// Supersampling factor s: renders at s× and box-filters down, the tracer's `--spp s²` grid.
+    #[arg(long, default_value_t = 1)]
+    ssaa: u32,
+    /// Timed frames (after --warmup untimed ones).
+    #[arg(long, default_value_t = 1)]
+    frames: u32,
+    #[arg(long, default_value_t = 2)]
+    warmup: u32,
+    /// Refuse, before any work, a configuration needing more scene passes per frame.
+    #[arg(long, default_value_t = 5000)]
+    max_passes: usize,
+    /// Mirror texture resolution relative to the mirror's footprint on screen (1 = exact).
+    #[arg(long, default_value_t = 1.0)]
+    texture_scale: f32,
+    /// Print one JSON object with timings, counts, adapter and parameters.
+    #[arg(long)]
+    json: bool,
+    /// Output PNG (sRGB); the linear EXR is written beside it.
+    #[arg(short, long)]
+    output: PathBuf,
+}
+
+fn bad(message: String) -> Failure {
+    Failure::BadInput(message)
+}
+
+pub fn run(args: &Args) -> Result<(), Failure> {
+    let method = match (args.method, args.n) {
+        (MethodName::Naive, None) => Method::Naive,
+        (MethodName::Naive, Some(_)) => {
+            return Err(bad("--n applies to --method auxiliary only".into()));
+        }
+        (MethodName::Auxiliary, n) => Method::Auxiliary { n: n.unwrap_or(0) },
+    };
+    if let Some(a) = args.alpha
+        && !(0.0..=1.0).contains(&a)
+    {
+        return Err(bad(format!("--alpha must be in [0, 1], got {a}")));
+    }
+    if !(1..=8).contains(&args.ssaa) {
+        return Err(bad(format!("--ssaa must be in [1, 8], got {}", args.ssaa)));
+    }
+    if !(args.texture_scale > 0.0 && args.texture_scale <= 4.0) {
+        return Err(bad(format!(
+            "--texture-scale must be in (0, 4], got {}",
+            args.texture_scale
+        )));
+    }
+    if args.frames == 0 {
+        return Err(bad("--frames must be at least 1".into()));
+    }
+    let png = output_path("-o", &args.output, "png")?;
+    let mut scene = load(&args.scene)?;
+    resize(&mut scene, args.width, args.height)?;
+    if let Some(a) = args.alpha {
+        scene.set_reflectance(glam::Vec3::splat(a));
+    }
+    let settings = RenderSettings {
+        method,
+        ssaa: args.ssaa,
+        frames: args.frames,
+        warmup: args.warmup,
+        max_passes: args.max_passes,
+        texture_scale: args.texture_scale,
+    };
+    // Plan first: a refused configuration costs no GPU set-up.
+    let (w, h) = (
+        scene.camera.width * args.ssaa,
+        scene.camera.height * args.ssaa,
+    );
+    mirrorbox_raster::plan::plan(&scene, method, w, h, args.max_passes).map_err(plan_failure)?;
+    let gpu = Gpu::new().map_err(raster_failure)?;
+    let out = render(&gpu, &scene, &settings).map_err(raster_failure)?;
+    let exr = png.with_extension("exr");
+    let method_text = match method {
+        Method::Naive => "naive".to_string(),
+        Method::Auxiliary { n } => format!("auxiliary n={n}"),
+    };
+    let alpha = args
+        .alpha
+        .map_or("as in scene".to_string(), |a| a.to_string());
+    let attributes = [
+        ("mirrorbox.version", env!("CARGO_PKG_VERSION").to_string()),
+        ("mirrorbox.scene", args.scene.display().to_string()),
+        (
+            "mirrorbox.scene_hash",
+            format!("{:016x}", scene.content_hash()),
+        ),
+        ("mirrorbox.method", method_text.clone()),
+        ("mirrorbox.alpha", alpha.clone()),
+        ("mirrorbox.ssaa", args.ssaa.to_string()),
+        ("mirrorbox.passes", out.stats.passes.to_string()),
+        ("mirrorbox.adapter", gpu.report.name.clone()),
+    ];
+    let write_failed = |e: mirrorbox_image::ImageError| Failure::Other(e.to_string());
+    write_exr(&exr, &out.image, &attributes).map_err(write_failed)?;
+    write_png(&png, &out.image, scene.camera.exposure).map_err(write_failed)?;
+    let s = &out.stats;
+    let t = &out.timing;
+    if args.json {
+        let v = serde_json::json!({
+            "scene": args.scene.display().to_string(),
+            "scene_hash": format!("{:016x}", scene.content_hash()),
+            "method": match method { Method::Naive => "naive", Method::Auxiliary { .. } => "auxiliary" },
+            "n": match method { Method::Naive => None, Method::Auxiliary { n } => Some(n) },
+            "alpha": args.alpha,
+            "width": scene.camera.width, "height": scene.camera.height, "ssaa": args.ssaa,
+            "texture_scale": args.texture_scale, "frames": args.frames, "warmup": args.warmup,
+            "ms_per_frame_median": t.median_ms(), "ms_per_frame_min": t.min_ms(),
+            "frames_ms": t.frames_ms, "timing_source": t.source.name(),
+            "passes": s.passes, "texture_renders": s.texture_renders, "draws": s.draws, "depth": s.depth,
+            "adapter": gpu.report.name, "backend": gpu.report.backend, "device_type": gpu.report.device_type,
+            "outputs": [png.display().to_string(), exr.display().to_string()],
+        });
+        println!("{v}");
+    } else {
+        println!(
+            "rendered {} with {method_text}, alpha {alpha}: {}x{}, ssaa {}; {} passes ({} texture renders, {} reflections deep), {} draws per frame",
+            args.scene.display(),
+            scene.camera.width,
+            scene.camera.height,
+            args.ssaa,
+            s.passes,
+            s.texture_renders,
+            s.depth,
+            s.draws
+        );
+        println!(
+            "  {:.2} ms/frame median, {:.2} min over {} frames ({}) on {} ({}); wrote {}, {}",
+            t.median_ms(),
+            t.min_ms(),
+            t.frames_ms.len(),
+            t.source.name(),
+            gpu.report.name,
+            gpu.report.backend,
+            png.display(),
+            exr.display()
+        );
+    }
+    Ok(())
+}
+
+fn plan_failure(e: PlanError) -> Failure {
+    Failure::BadInput(e.to_string())
+}
+
+fn raster_failure(e: RasterError) -> Failure {
+    match e {
+        RasterError::Plan(p) => plan_failure(p),
+        RasterError::Adapter(mirrorbox_raster::AdapterError::BadOverride { .. }) => {
+            Failure::BadInput(e.to_string())
+        }
+        other => Failure::Other(other.to_string()),
+    }
+}

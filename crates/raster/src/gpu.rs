@@ -1,0 +1,82 @@
+//! The device every raster method renders with, and the errors a raster command can meet.
+
+use crate::adapter::{AdapterError, AdapterReport, select_adapter};
+use std::sync::{Arc, Mutex};
+
+#[derive(Debug, thiserror::Error)]
+pub enum RasterError {
+    #[error(transparent)]
+    Adapter(#[from] AdapterError),
+    #[error(transparent)]
+    Plan(#[from] crate::plan::PlanError),
+    #[error("cannot create the wgpu device on {adapter}: {message}")]
+    Device { adapter: String, message: String },
+    #[error("wgpu reported an error: {0}")]
+    Gpu(String),
+}
+
+pub struct Gpu {
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    pub report: AdapterReport,
+    /// GPU timestamps are available (and enabled) on this device.
+    pub timestamps: bool,
+    errors: Arc<Mutex<Vec<String>>>,
+}
+
+impl Gpu {
+    /// Opens the adapter of [`select_adapter`] with timestamp queries when it has them.
+    pub fn new() -> Result<Gpu, RasterError> {
+        let selected = select_adapter()?;
+        let timestamps = selected.report.timestamp_query;
+        let mut features = wgpu::Features::empty();
+        if timestamps {
+            features |= wgpu::Features::TIMESTAMP_QUERY;
+        }
+        let (device, queue) =
+            pollster::block_on(selected.adapter.request_device(&wgpu::DeviceDescriptor {
+                label: Some("mirrorbox"),
+                required_features: features,
+                required_limits:
+                    wgpu::Limits::default().using_resolution(selected.adapter.limits()),
+                ..Default::default()
+            }))
+            .map_err(|e| RasterError::Device {
+                adapter: selected.report.name.clone(),
+                message: e.to_string(),
+            })?;
+        let errors = Arc::new(Mutex::new(Vec::new()));
+        let sink = errors.clone();
+        // Validation errors become a returned error instead of wgpu's default panic.
+        device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
+            sink.lock().expect("error list").push(e.to_string());
+        }));
+        Ok(Gpu {
+            device,
+            queue,
+            report: selected.report,
+            timestamps,
+            errors,
+        })
+    }
+
+    /// Fails with the first error wgpu reported since the last check.
+    pub fn check(&self) -> Result<(), RasterError> {
+        let mut errors = self.errors.lock().expect("error list");
+        match errors.first().cloned() {
+            Some(e) => {
+                errors.clear();
+                Err(RasterError::Gpu(e))
+            }
+            None => Ok(()),
+        }
+    }
+
+    /// Blocks until all submitted work is done.
+    pub fn wait(&self) -> Result<(), RasterError> {
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map(|_| ())
+            .map_err(|e| RasterError::Gpu(e.to_string()))
+    }
+}

@@ -1,0 +1,230 @@
+//! The shading contract in WGSL (`shaders/shading.wgsl`) and the scene data it reads.
+//!
+//! WGSL has no includes: every pipeline's module is `shading.wgsl` followed by its own file.
+
+use bytemuck::{Pod, Zeroable};
+use mirrorbox_scene::{Scene, Surface};
+use wgpu::util::DeviceExt;
+
+pub const SHADING_WGSL: &str = include_str!("../../../shaders/shading.wgsl");
+
+/// Compiles `shading.wgsl` + `entry_points`.
+pub fn module(device: &wgpu::Device, label: &str, entry_points: &str) -> wgpu::ShaderModule {
+    device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(label),
+        source: wgpu::ShaderSource::Wgsl(format!("{SHADING_WGSL}\n{entry_points}").into()),
+    })
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+pub struct GpuSurface {
+    albedo: [f32; 3],
+    kind: u32,
+    emission: [f32; 3],
+    mirror: u32,
+    reflectance: [f32; 3],
+    _pad0: u32,
+    back_albedo: [f32; 3],
+    _pad1: u32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct GpuLight {
+    position: [f32; 3],
+    _pad0: f32,
+    intensity: [f32; 3],
+    _pad1: f32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct GpuFrame {
+    ambient: [f32; 3],
+    light_count: u32,
+    background: [f32; 3],
+    _pad0: u32,
+    terminal: [f32; 3],
+    _pad1: u32,
+}
+
+/// One vertex: position, the triangle's face normal (the same f32 values the tracer uses)
+/// and its surface id.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+pub struct Vertex {
+    position: [f32; 3],
+    normal: [f32; 3],
+    surface: u32,
+}
+
+pub const VERTEX_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
+    array_stride: std::mem::size_of::<Vertex>() as u64,
+    step_mode: wgpu::VertexStepMode::Vertex,
+    attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Uint32],
+};
+
+/// The scene on the GPU: vertices (objects first, then each mirror's two triangles) and the
+/// group-0 bind group of `shading.wgsl`.
+pub struct SceneBuffers {
+    pub vertices: wgpu::Buffer,
+    /// Vertex range of all non-mirror triangles.
+    pub objects: std::ops::Range<u32>,
+    /// Vertex range of each scene mirror.
+    pub mirrors: Vec<std::ops::Range<u32>>,
+    pub layout: wgpu::BindGroupLayout,
+    pub bind_group: wgpu::BindGroup,
+}
+
+impl SceneBuffers {
+    pub fn new(device: &wgpu::Device, scene: &Scene) -> Self {
+        let g = &scene.geometry;
+        let vertex = |i: usize| {
+            let n = g.face_normal(i).to_array();
+            g.triangles[i].map(|p| Vertex {
+                position: p.to_array(),
+                normal: n,
+                surface: g.surface_of[i],
+            })
+        };
+        let mut vertices: Vec<Vertex> = Vec::with_capacity(g.triangles.len() * 3);
+        let mut mirror_tris = vec![Vec::new(); scene.mirrors.len()];
+        for i in 0..g.triangles.len() {
+            match g.surface(i) {
+                Surface::Diffuse { .. } => vertices.extend(vertex(i)),
+                Surface::Mirror { mirror, .. } => mirror_tris[*mirror].push(i),
+            }
+        }
+        let objects = 0..vertices.len() as u32;
+        let mut mirrors = Vec::new();
+        for tris in mirror_tris {
+            let start = vertices.len() as u32;
+            for i in tris {
+                vertices.extend(vertex(i));
+            }
+            mirrors.push(start..vertices.len() as u32);
+        }
+        let surfaces: Vec<GpuSurface> = g
+            .surfaces
+            .iter()
+            .map(|s| match s {
+                Surface::Diffuse { albedo, emission } => GpuSurface {
+                    albedo: albedo.to_array(),
+                    emission: emission.to_array(),
+                    ..Zeroable::zeroed()
+                },
+                Surface::Mirror {
+                    mirror,
+                    reflectance,
+                    back_albedo,
+                } => GpuSurface {
+                    kind: 1,
+                    mirror: *mirror as u32,
+                    reflectance: reflectance.to_array(),
+                    back_albedo: back_albedo.to_array(),
+                    ..Zeroable::zeroed()
+                },
+            })
+            .collect();
+        let mut lights: Vec<GpuLight> = scene
+            .lighting
+            .lights
+            .iter()
+            .map(|l| GpuLight {
+                position: l.position.to_array(),
+                intensity: l.intensity.to_array(),
+                ..Zeroable::zeroed()
+            })
+            .collect();
+        let light_count = lights.len() as u32;
+        if lights.is_empty() {
+            lights.push(Zeroable::zeroed()); // a storage buffer may not be empty
+        }
+        let frame = GpuFrame {
+            ambient: scene.lighting.ambient.to_array(),
+            light_count,
+            background: scene.background.to_array(),
+            terminal: scene.terminal.to_array(),
+            ..Zeroable::zeroed()
+        };
+        let init = |label, contents: &[u8], usage| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage,
+            })
+        };
+        let vertices_buf = init(
+            "vertices",
+            bytemuck::cast_slice(&vertices),
+            wgpu::BufferUsages::VERTEX,
+        );
+        let frame_buf = init(
+            "frame",
+            bytemuck::bytes_of(&frame),
+            wgpu::BufferUsages::UNIFORM,
+        );
+        let surfaces_buf = init(
+            "surfaces",
+            bytemuck::cast_slice(&surfaces),
+            wgpu::BufferUsages::STORAGE,
+        );
+        let lights_buf = init(
+            "lights",
+            bytemuck::cast_slice(&lights),
+            wgpu::BufferUsages::STORAGE,
+        );
+        let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+            ty,
+            count: None,
+        };
+        let storage = wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only: true },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        };
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("scene"),
+            entries: &[
+                entry(
+                    0,
+                    wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                ),
+                entry(1, storage),
+                entry(2, storage),
+            ],
+        });
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("scene"),
+            layout: &layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: frame_buf.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: surfaces_buf.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: lights_buf.as_entire_binding(),
+                },
+            ],
+        });
+        SceneBuffers {
+            vertices: vertices_buf,
+            objects,
+            mirrors,
+            layout,
+            bind_group,
+        }
+    }
+}
