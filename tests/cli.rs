@@ -493,3 +493,73 @@ fn trace_refuses_bad_arguments_before_writing_anything() {
         "nothing may be written on bad input"
     );
 }
+
+// ---------------------------------------------------------------------------------------
+// render
+
+#[test]
+fn render_writes_png_and_exr_and_reports_timing_as_json() {
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("aux.png");
+    let out = mirrorbox(
+        &[
+            "render", "scenes/mirror_box.json", "--method", "auxiliary", "--n", "2", "--alpha", "0.7",
+            "--width", "64", "--height", "36", "--frames", "3", "--warmup", "1", "--json", "-o", png.to_str().unwrap(),
+        ],
+        &[],
+    );
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let v: Value = serde_json::from_str(out.stdout.trim()).unwrap();
+    assert_eq!(v["method"], "auxiliary");
+    assert_eq!(v["n"], 2);
+    assert_eq!(v["passes"], 15);
+    assert_eq!(v["texture_renders"], 14);
+    assert_eq!(v["depth"], 4);
+    assert_eq!(v["frames_ms"].as_array().unwrap().len(), 3);
+    assert!(v["ms_per_frame_median"].as_f64().unwrap() > 0.0);
+    assert!(v["ms_per_frame_min"].as_f64().unwrap() <= v["ms_per_frame_median"].as_f64().unwrap());
+    assert!(["gpu-timestamps", "wall-clock"].contains(&v["timing_source"].as_str().unwrap()));
+    assert!(!v["adapter"].as_str().unwrap().is_empty());
+    assert!(png.is_file() && png.with_extension("exr").is_file());
+    let img = mirrorbox_image::read_image(&png.with_extension("exr")).unwrap();
+    assert_eq!((img.width, img.height), (64, 36));
+}
+
+#[test]
+fn render_refuses_too_many_passes_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("x.png");
+    let out = mirrorbox(
+        &["render", "scenes/mirror_box.json", "--method", "auxiliary", "--n", "4", "--max-passes", "100", "-o", png.to_str().unwrap()],
+        &[],
+    );
+    assert_eq!(out.code, 2, "{}", out.stderr);
+    assert!(out.stderr.contains("would render 139 scene passes per frame, above --max-passes 100"), "{}", out.stderr);
+    let exact = mirrorbox(
+        &["render", "scenes/mirror_box.json", "--method", "auxiliary", "--n", "4", "--max-passes", "138", "-o", png.to_str().unwrap()],
+        &[],
+    );
+    assert!(exact.stderr.contains("would render 139 scene passes per frame"), "{}", exact.stderr);
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+}
+
+#[test]
+fn render_refuses_bad_arguments() {
+    let cases: [(&[&str], &str); 5] = [
+        (&["--method", "naive", "--n", "2"], "--n applies to --method auxiliary only"),
+        (&["--alpha", "1.5"], "--alpha must be in [0, 1], got 1.5"),
+        (&["--ssaa", "0"], "--ssaa must be in [1, 8], got 0"),
+        (&["--frames", "0"], "--frames must be at least 1"),
+        (&["--texture-scale", "0"], "--texture-scale must be in (0, 4], got 0"),
+    ];
+    for (extra, message) in cases {
+        let mut args = vec!["render", "scenes/mirror_box.json", "-o", "/tmp/never.png"];
+        args.extend_from_slice(extra);
+        let out = mirrorbox(&args, &[]);
+        assert_eq!(out.code, 2, "{args:?}: {}", out.stderr);
+        assert!(out.stderr.contains(message), "{args:?}: {}", out.stderr);
+    }
+    let out = mirrorbox(&["render", "scenes/mirror_room.json", "--method", "auxiliary", "-o", "/tmp/never.png"], &[]);
+    assert_eq!(out.code, 2);
+    assert!(out.stderr.contains("the auxiliary method needs exactly 2 mirrors"), "{}", out.stderr);
+}

@@ -30,6 +30,9 @@ use mirrorbox_scene::{Plane, Scene};
 pub const NEAR: f32 = 0.01;
 pub const FAR: f32 = 10_000.0;
 
+/// Plans are counted exactly up to this many texture renders.
+const COUNT_CEILING: usize = 1_000_000;
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Method {
     Naive,
@@ -274,12 +277,14 @@ pub fn plan(
         size: Vec2::new(width as f32, height as f32),
     };
     let main = ReflectedView::direct(camera.view());
-    let textures = planner.count(&main, None, &mut Vec::new(), max_passes);
+    // Count exactly (cheap: a few polygon clips per call) up to a hard ceiling, so a refusal
+    // can state the predicted count; only astronomically large plans say "or more".
+    let textures = planner.count(&main, None, &mut Vec::new(), COUNT_CEILING.max(max_passes));
     if 1 + textures > max_passes {
         return Err(PlanError::TooManyPasses {
             predicted: 1 + textures,
             limit: max_passes,
-            exceeded_count: textures > max_passes,
+            exceeded_count: textures > COUNT_CEILING.max(max_passes),
         });
     }
     let roots: Vec<TextureNode> = planner
@@ -368,8 +373,12 @@ mod tests {
                 exceeded_count: false
             }
         );
-        // n = 7 would need 11 146 passes: refused quickly, without building the tree.
-        assert!(plan(&s, Method::Auxiliary { n: 7 }, 320, 180, 5000).is_err());
+        // n = 7 would need 11 146 passes (the formula of the module docs): refused, with the
+        // count, without building the tree.
+        assert_eq!(
+            plan(&s, Method::Auxiliary { n: 7 }, 320, 180, 5000).unwrap_err(),
+            PlanError::TooManyPasses { predicted: 11_146, limit: 5000, exceeded_count: false }
+        );
         assert_eq!(
             plan(
                 &scene("mirror_room.json"),
