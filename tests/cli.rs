@@ -503,8 +503,25 @@ fn render_writes_png_and_exr_and_reports_timing_as_json() {
     let png = dir.path().join("aux.png");
     let out = mirrorbox(
         &[
-            "render", "scenes/mirror_box.json", "--method", "auxiliary", "--n", "2", "--alpha", "0.7",
-            "--width", "64", "--height", "36", "--frames", "3", "--warmup", "1", "--json", "-o", png.to_str().unwrap(),
+            "render",
+            "scenes/mirror_box.json",
+            "--method",
+            "auxiliary",
+            "--n",
+            "2",
+            "--alpha",
+            "0.7",
+            "--width",
+            "64",
+            "--height",
+            "36",
+            "--frames",
+            "3",
+            "--warmup",
+            "1",
+            "--json",
+            "-o",
+            png.to_str().unwrap(),
         ],
         &[],
     );
@@ -530,27 +547,66 @@ fn render_refuses_too_many_passes_before_any_work() {
     let dir = tempfile::tempdir().unwrap();
     let png = dir.path().join("x.png");
     let out = mirrorbox(
-        &["render", "scenes/mirror_box.json", "--method", "auxiliary", "--n", "4", "--max-passes", "100", "-o", png.to_str().unwrap()],
+        &[
+            "render",
+            "scenes/mirror_box.json",
+            "--method",
+            "auxiliary",
+            "--n",
+            "4",
+            "--max-passes",
+            "100",
+            "-o",
+            png.to_str().unwrap(),
+        ],
         &[],
     );
     assert_eq!(out.code, 2, "{}", out.stderr);
-    assert!(out.stderr.contains("would render 139 scene passes per frame, above --max-passes 100"), "{}", out.stderr);
+    assert!(
+        out.stderr
+            .contains("would render 139 scene passes per frame, above --max-passes 100"),
+        "{}",
+        out.stderr
+    );
     let exact = mirrorbox(
-        &["render", "scenes/mirror_box.json", "--method", "auxiliary", "--n", "4", "--max-passes", "138", "-o", png.to_str().unwrap()],
+        &[
+            "render",
+            "scenes/mirror_box.json",
+            "--method",
+            "auxiliary",
+            "--n",
+            "4",
+            "--max-passes",
+            "138",
+            "-o",
+            png.to_str().unwrap(),
+        ],
         &[],
     );
-    assert!(exact.stderr.contains("would render 139 scene passes per frame"), "{}", exact.stderr);
+    assert!(
+        exact
+            .stderr
+            .contains("would render 139 scene passes per frame"),
+        "{}",
+        exact.stderr
+    );
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
 }
 
 #[test]
 fn render_refuses_bad_arguments() {
     let cases: [(&[&str], &str); 5] = [
-        (&["--method", "naive", "--n", "2"], "--n applies to --method auxiliary only"),
+        (
+            &["--method", "naive", "--n", "2"],
+            "--n applies to --method auxiliary only",
+        ),
         (&["--alpha", "1.5"], "--alpha must be in [0, 1], got 1.5"),
         (&["--ssaa", "0"], "--ssaa must be in [1, 8], got 0"),
         (&["--frames", "0"], "--frames must be at least 1"),
-        (&["--texture-scale", "0"], "--texture-scale must be in (0, 4], got 0"),
+        (
+            &["--texture-scale", "0"],
+            "--texture-scale must be in (0, 4], got 0",
+        ),
     ];
     for (extra, message) in cases {
         let mut args = vec!["render", "scenes/mirror_box.json", "-o", "/tmp/never.png"];
@@ -559,7 +615,22 @@ fn render_refuses_bad_arguments() {
         assert_eq!(out.code, 2, "{args:?}: {}", out.stderr);
         assert!(out.stderr.contains(message), "{args:?}: {}", out.stderr);
     }
-    let out = mirrorbox(&["render", "scenes/mirror_room.json", "--method", "auxiliary", "-o", "/tmp/never.png"], &[]);
+    let out = mirrorbox(
+        &[
+            "render",
+            "scenes/mirror_room.json",
+            "--method",
+            "auxiliary",
+            "-o",
+            "/tmp/never.png",
+        ],
+        &[],
+    );
     assert_eq!(out.code, 2);
-    assert!(out.stderr.contains("the auxiliary method needs exactly 2 mirrors"), "{}", out.stderr);
+    assert!(
+        out.stderr
+            .contains("the auxiliary method needs exactly 2 mirrors"),
+        "{}",
+        out.stderr
+    );
 }

@@ -7,6 +7,7 @@
 //! leaves a half-written output behind.
 
 pub mod colormap;
+pub mod metrics;
 pub mod srgb;
 
 use std::path::{Path, PathBuf};

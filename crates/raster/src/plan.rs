@@ -377,7 +377,11 @@ mod tests {
         // count, without building the tree.
         assert_eq!(
             plan(&s, Method::Auxiliary { n: 7 }, 320, 180, 5000).unwrap_err(),
-            PlanError::TooManyPasses { predicted: 11_146, limit: 5000, exceeded_count: false }
+            PlanError::TooManyPasses {
+                predicted: 11_146,
+                limit: 5000,
+                exceeded_count: false
+            }
         );
         assert_eq!(
             plan(

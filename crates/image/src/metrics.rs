@@ -1,0 +1,272 @@
+//! Image error metrics between a reference (the truth) and a test image of the same size.
+//!
+//! On linear HDR radiance, over all pixels and the three channels:
+//! - RMSE = √mean((x − y)²);
+//! - relMSE = mean((x − y)² / (y² + ε)) and SMAPE = mean(|x − y| / (|x| + |y| + ε)), ε = 0.01,
+//!   with y the reference (the definitions of the rendering literature's denoising work);
+//! - the largest absolute difference.
+//!
+//! On the contract's tone-mapped 8-bit sRGB images ([`crate::srgb`], the camera's exposure):
+//! - PSNR = 10·log10(255² / MSE) (infinite for identical images);
+//! - SSIM (Wang et al. 2004): 11×11 Gaussian window, σ = 1.5, K1 = 0.01, K2 = 0.03, on values
+//!   in [0, 1], over the "valid" region (window fully inside the image), averaged over the
+//!   three channels — the same numbers as scikit-image's `structural_similarity` with
+//!   `gaussian_weights=True, sigma=1.5, use_sample_covariance=False, data_range=1`;
+//! - FLIP (NVIDIA's LDR-FLIP through the `nv-flip` crate) at [`FLIP_PIXELS_PER_DEGREE`]: mean
+//!   and the 95th/99th percentiles (nearest rank) of the per-pixel error map.
+
+use crate::RgbImage;
+
+/// FLIP's default viewing condition: a 0.7 m wide 4K monitor seen from 0.7 m (67 px/°).
+pub const FLIP_PIXELS_PER_DEGREE: f32 = nv_flip::DEFAULT_PIXELS_PER_DEGREE;
+/// ε of relMSE and SMAPE.
+pub const EPSILON: f64 = 0.01;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Metrics {
+    pub rmse: f64,
+    pub relmse: f64,
+    pub smape: f64,
+    pub max_abs: f64,
+    /// dB; `f64::INFINITY` when the tone-mapped images are identical.
+    pub psnr: f64,
+    pub ssim: f64,
+    pub flip_mean: f64,
+    pub flip_p95: f64,
+    pub flip_p99: f64,
+}
+
+#[derive(Debug, thiserror::Error, PartialEq, Eq)]
+pub enum MetricsError {
+    #[error("images differ in size: reference {0}x{1}, test {2}x{3}")]
+    SizeMismatch(u32, u32, u32, u32),
+    #[error("images of {0}x{1} are too small for SSIM's 11x11 window")]
+    TooSmall(u32, u32),
+}
+
+/// Every metric of `test` against `reference`; tone mapping uses `exposure`.
+pub fn compare(
+    reference: &RgbImage,
+    test: &RgbImage,
+    exposure: f32,
+) -> Result<Metrics, MetricsError> {
+    if (reference.width, reference.height) != (test.width, test.height) {
+        return Err(MetricsError::SizeMismatch(
+            reference.width,
+            reference.height,
+            test.width,
+            test.height,
+        ));
+    }
+    if reference.width < 11 || reference.height < 11 {
+        return Err(MetricsError::TooSmall(reference.width, reference.height));
+    }
+    let (mut se, mut rel, mut smape, mut max_abs) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    for (y, x) in reference.pixels.iter().zip(&test.pixels) {
+        for c in 0..3 {
+            let (x, y) = (x[c] as f64, y[c] as f64);
+            let d = x - y;
+            se += d * d;
+            rel += d * d / (y * y + EPSILON);
+            smape += d.abs() / (x.abs() + y.abs() + EPSILON);
+            max_abs = max_abs.max(d.abs());
+        }
+    }
+    let n = (reference.pixels.len() * 3) as f64;
+    let r8 = reference.to_srgb8(exposure);
+    let t8 = test.to_srgb8(exposure);
+    let (flip_mean, flip_p95, flip_p99) = flip(&r8, &t8, reference.width, reference.height);
+    Ok(Metrics {
+        rmse: (se / n).sqrt(),
+        relmse: rel / n,
+        smape: smape / n,
+        max_abs,
+        psnr: psnr(&r8, &t8),
+        ssim: ssim(
+            &r8,
+            &t8,
+            reference.width as usize,
+            reference.height as usize,
+        ),
+        flip_mean,
+        flip_p95,
+        flip_p99,
+    })
+}
+
+/// PSNR of two 8-bit images (same length).
+pub fn psnr(a: &[u8], b: &[u8]) -> f64 {
+    let mse = a
+        .iter()
+        .zip(b)
+        .map(|(&x, &y)| (x as f64 - y as f64).powi(2))
+        .sum::<f64>()
+        / a.len() as f64;
+    if mse == 0.0 {
+        f64::INFINITY
+    } else {
+        10.0 * (255.0f64 * 255.0 / mse).log10()
+    }
+}
+
+/// Normalized 1-D Gaussian of 11 taps, σ = 1.5.
+fn gaussian_11() -> [f64; 11] {
+    let mut k = [0.0; 11];
+    for (i, v) in k.iter_mut().enumerate() {
+        let x = i as f64 - 5.0;
+        *v = (-(x * x) / (2.0 * 1.5 * 1.5)).exp();
+    }
+    let sum: f64 = k.iter().sum();
+    k.map(|v| v / sum)
+}
+
+/// Mean SSIM of two interleaved RGB 8-bit images (values taken as /255), averaged over the
+/// channels, on the valid region.
+pub fn ssim(a: &[u8], b: &[u8], w: usize, h: usize) -> f64 {
+    let k = gaussian_11();
+    let (c1, c2) = ((0.01f64).powi(2), (0.03f64).powi(2));
+    let (vw, vh) = (w - 10, h - 10);
+    let mut total = 0.0;
+    for c in 0..3 {
+        let plane = |img: &[u8]| -> Vec<f64> {
+            (0..w * h).map(|i| img[3 * i + c] as f64 / 255.0).collect()
+        };
+        let (x, y) = (plane(a), plane(b));
+        let xx: Vec<f64> = x.iter().map(|v| v * v).collect();
+        let yy: Vec<f64> = y.iter().map(|v| v * v).collect();
+        let xy: Vec<f64> = x.iter().zip(&y).map(|(p, q)| p * q).collect();
+        // Separable valid filtering: rows, then columns.
+        let filter = |src: &[f64]| -> Vec<f64> {
+            let mut rows = vec![0.0; vw * h];
+            for r in 0..h {
+                for i in 0..vw {
+                    rows[r * vw + i] = (0..11).map(|t| k[t] * src[r * w + i + t]).sum();
+                }
+            }
+            let mut out = vec![0.0; vw * vh];
+            for j in 0..vh {
+                for i in 0..vw {
+                    out[j * vw + i] = (0..11).map(|t| k[t] * rows[(j + t) * vw + i]).sum();
+                }
+            }
+            out
+        };
+        let (mx, my, mxx, myy, mxy) = (
+            filter(&x),
+            filter(&y),
+            filter(&xx),
+            filter(&yy),
+            filter(&xy),
+        );
+        let mut sum = 0.0;
+        for i in 0..vw * vh {
+            let (ux, uy) = (mx[i], my[i]);
+            let (vx, vy, cxy) = (mxx[i] - ux * ux, myy[i] - uy * uy, mxy[i] - ux * uy);
+            sum += ((2.0 * ux * uy + c1) * (2.0 * cxy + c2))
+                / ((ux * ux + uy * uy + c1) * (vx + vy + c2));
+        }
+        total += sum / (vw * vh) as f64;
+    }
+    total / 3.0
+}
+
+/// FLIP mean, 95th and 99th percentile (nearest rank) of two interleaved RGB 8-bit images.
+pub fn flip(reference: &[u8], test: &[u8], w: u32, h: u32) -> (f64, f64, f64) {
+    let map = flip_map(reference, test, w, h);
+    let mut v = map;
+    let mean = v.iter().map(|&x| x as f64).sum::<f64>() / v.len() as f64;
+    v.sort_by(f32::total_cmp);
+    let rank =
+        |p: f64| v[(((p * v.len() as f64).ceil() as usize).max(1) - 1).min(v.len() - 1)] as f64;
+    (mean, rank(0.95), rank(0.99))
+}
+
+/// FLIP's per-pixel error map (row-major, values in [0, 1]).
+pub fn flip_map(reference: &[u8], test: &[u8], w: u32, h: u32) -> Vec<f32> {
+    let r = nv_flip::FlipImageRgb8::with_data(w, h, reference);
+    let t = nv_flip::FlipImageRgb8::with_data(w, h, test);
+    nv_flip::flip(r, t, FLIP_PIXELS_PER_DEGREE).to_vec()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn constant(w: u32, h: u32, v: [f32; 3]) -> RgbImage {
+        RgbImage::from_fn(w, h, |_, _| v)
+    }
+
+    fn pattern(w: u32, h: u32, seed: u32) -> RgbImage {
+        RgbImage::from_fn(w, h, |x, y| {
+            let v = ((x * 7 + y * 13 + seed * 31) % 17) as f32 / 17.0;
+            [v, (v * 0.5 + 0.1 * (x % 3) as f32).min(1.0), 1.0 - v]
+        })
+    }
+
+    #[test]
+    fn identical_images() {
+        let a = pattern(32, 24, 1);
+        let m = compare(&a, &a, 1.0).unwrap();
+        assert_eq!((m.rmse, m.relmse, m.smape, m.max_abs), (0.0, 0.0, 0.0, 0.0));
+        assert_eq!(m.psnr, f64::INFINITY);
+        assert!((m.ssim - 1.0).abs() < 1e-12);
+        assert_eq!((m.flip_mean, m.flip_p95, m.flip_p99), (0.0, 0.0, 0.0));
+    }
+
+    /// Constant images: every metric has a closed form.
+    #[test]
+    fn closed_forms_on_constant_images() {
+        let (y, x) = (0.25f32, 0.5f32);
+        let r = constant(20, 16, [y; 3]);
+        let t = constant(20, 16, [x; 3]);
+        let m = compare(&r, &t, 1.0).unwrap();
+        let (x, y) = (x as f64, y as f64);
+        assert!((m.rmse - 0.25).abs() < 1e-12);
+        assert!((m.max_abs - 0.25).abs() < 1e-12);
+        assert!((m.relmse - (x - y).powi(2) / (y * y + 0.01)).abs() < 1e-12);
+        assert!((m.smape - (x - y).abs() / (x + y + 0.01)).abs() < 1e-12);
+        // Tone mapped: 0.25 → sRGB 137, 0.5 → 188 (round(255·sRGB(v))).
+        let (a8, b8) = (
+            crate::srgb::encode8(0.25) as f64,
+            crate::srgb::encode8(0.5) as f64,
+        );
+        assert_eq!((a8, b8), (137.0, 188.0));
+        assert!((m.psnr - 10.0 * (255.0f64.powi(2) / (a8 - b8).powi(2)).log10()).abs() < 1e-9);
+        // Flat windows: variances and covariance vanish, only the luminance term is left.
+        let (ua, ub, c1) = (a8 / 255.0, b8 / 255.0, 1e-4);
+        let expected = (2.0 * ua * ub + c1) / (ua * ua + ub * ub + c1);
+        assert!((m.ssim - expected).abs() < 1e-9, "{} vs {expected}", m.ssim);
+    }
+
+    #[test]
+    fn size_mismatch_and_tiny_images_are_errors() {
+        assert_eq!(
+            compare(
+                &constant(20, 16, [0.0; 3]),
+                &constant(16, 20, [0.0; 3]),
+                1.0
+            )
+            .unwrap_err(),
+            MetricsError::SizeMismatch(20, 16, 16, 20)
+        );
+        assert_eq!(
+            compare(&constant(8, 8, [0.0; 3]), &constant(8, 8, [0.0; 3]), 1.0).unwrap_err(),
+            MetricsError::TooSmall(8, 8)
+        );
+    }
+
+    #[test]
+    fn flip_grows_with_the_difference() {
+        let r = constant(32, 32, [0.2; 3]);
+        let small = compare(&r, &constant(32, 32, [0.22; 3]), 1.0)
+            .unwrap()
+            .flip_mean;
+        let large = compare(&r, &constant(32, 32, [0.6; 3]), 1.0)
+            .unwrap()
+            .flip_mean;
+        assert!(
+            0.0 < small && small < large && large <= 1.0,
+            "{small} {large}"
+        );
+    }
+}
