@@ -31,6 +31,8 @@ enum Command {
     Trace(commands::trace::Args),
     /// Render with a raster method (wgpu), timed.
     Render(commands::render::Args),
+    /// Compare an image with a reference: linear and perceptual metrics.
+    Compare(commands::compare::Args),
     /// Export a scene as Mitsuba 3 XML (tools/mitsuba renders and compares it).
     ExportMitsuba(commands::export_mitsuba::Args),
 }
@@ -88,6 +90,7 @@ fn main() -> ExitCode {
         Command::Info(args) => commands::info::run(&args),
         Command::Trace(args) => commands::trace::run(&args),
         Command::Render(args) => commands::render::run(&args),
+        Command::Compare(args) => commands::compare::run(&args),
         Command::ExportMitsuba(args) => commands::export_mitsuba::run(&args),
     };
     match result {

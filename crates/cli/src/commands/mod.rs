@@ -1,4 +1,5 @@
 pub mod check;
+pub mod compare;
 pub mod export_mitsuba;
 pub mod info;
 pub mod render;

@@ -1,0 +1,88 @@
+//! `mirrorbox compare REF TEST`: every metric of TEST against the reference REF.
+
+use super::output_path;
+use crate::Failure;
+use mirrorbox_image::metrics::{FLIP_PIXELS_PER_DEGREE, Metrics, compare, flip_map};
+use mirrorbox_image::{colormap, read_image, write_png_bytes};
+use std::path::PathBuf;
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Reference image (the truth): EXR (linear) or PNG (sRGB).
+    reference: PathBuf,
+    /// Test image of the same size.
+    test: PathBuf,
+    /// Exposure of the tone mapping for PSNR, SSIM and FLIP (the scene camera's; default 1).
+    #[arg(long, default_value_t = 1.0)]
+    exposure: f32,
+    /// Print one JSON object.
+    #[arg(long)]
+    json: bool,
+    /// Write the FLIP error map as a heat-map PNG.
+    #[arg(long, value_name = "OUT.png")]
+    heatmap: Option<PathBuf>,
+}
+
+/// Metrics as JSON (an infinite PSNR, for identical images, is `null`).
+pub fn metrics_json(m: &Metrics) -> serde_json::Value {
+    serde_json::json!({
+        "rmse": m.rmse, "relmse": m.relmse, "smape": m.smape, "max_abs": m.max_abs,
+        "psnr": m.psnr.is_finite().then_some(m.psnr), "ssim": m.ssim,
+        "flip_mean": m.flip_mean, "flip_p95": m.flip_p95, "flip_p99": m.flip_p99,
+        "flip_ppd": FLIP_PIXELS_PER_DEGREE,
+    })
+}
+
+pub fn run(args: &Args) -> Result<(), Failure> {
+    if !(args.exposure > 0.0 && args.exposure.is_finite()) {
+        return Err(Failure::BadInput(format!(
+            "--exposure must be a positive number, got {}",
+            args.exposure
+        )));
+    }
+    let heatmap = args
+        .heatmap
+        .as_deref()
+        .map(|p| output_path("--heatmap", p, "png"))
+        .transpose()?;
+    let read = |p: &PathBuf| read_image(p).map_err(|e| Failure::BadInput(e.to_string()));
+    let (r, t) = (read(&args.reference)?, read(&args.test)?);
+    let m = compare(&r, &t, args.exposure).map_err(|e| {
+        Failure::BadInput(format!(
+            "{} vs {}: {e}",
+            args.reference.display(),
+            args.test.display()
+        ))
+    })?;
+    if let Some(path) = &heatmap {
+        let map = flip_map(
+            &r.to_srgb8(args.exposure),
+            &t.to_srgb8(args.exposure),
+            r.width,
+            r.height,
+        );
+        let bytes: Vec<u8> = map.iter().flat_map(|&v| colormap::heat(v)).collect();
+        write_png_bytes(path, r.width, r.height, &bytes)
+            .map_err(|e| Failure::Other(e.to_string()))?;
+    }
+    if args.json {
+        println!("{}", metrics_json(&m));
+    } else {
+        println!(
+            "{} vs {} ({}x{}):",
+            args.test.display(),
+            args.reference.display(),
+            r.width,
+            r.height
+        );
+        println!(
+            "  linear:  RMSE {:.6}  relMSE {:.6}  SMAPE {:.6}  max |d| {:.6}",
+            m.rmse, m.relmse, m.smape, m.max_abs
+        );
+        println!(
+            "  sRGB:    PSNR {:.2} dB  SSIM {:.6}  FLIP mean {:.6} p95 {:.6} p99 {:.6} ({} px/deg)",
+            m.psnr, m.ssim, m.flip_mean, m.flip_p95, m.flip_p99, FLIP_PIXELS_PER_DEGREE
+        );
+    }
+    Ok(())
+}
