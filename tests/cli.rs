@@ -634,3 +634,313 @@ fn render_refuses_bad_arguments() {
         out.stderr
     );
 }
+
+// ---------------------------------------------------------------------------------------
+// compare, sweep
+
+#[test]
+fn compare_reports_metrics_and_refuses_mismatched_sizes() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = dir.path().join("a.exr");
+    let b = dir.path().join("b.exr");
+    for (p, r) in [(&a, "1"), (&b, "0.5")] {
+        let out = mirrorbox(&trace_args(p.to_str().unwrap(), &["--reflectance", r]), &[]);
+        assert_eq!(out.code, 0, "{}", out.stderr);
+    }
+    let heat = dir.path().join("heat.png");
+    let out = mirrorbox(
+        &[
+            "compare",
+            a.to_str().unwrap(),
+            b.to_str().unwrap(),
+            "--json",
+            "--heatmap",
+            heat.to_str().unwrap(),
+        ],
+        &[],
+    );
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let v: Value = serde_json::from_str(out.stdout.trim()).unwrap();
+    for k in [
+        "rmse",
+        "relmse",
+        "smape",
+        "max_abs",
+        "psnr",
+        "ssim",
+        "flip_mean",
+        "flip_p95",
+        "flip_p99",
+        "flip_ppd",
+    ] {
+        assert!(v[k].is_number(), "{k}: {v}");
+    }
+    assert!(v["rmse"].as_f64().unwrap() > 0.0 && v["ssim"].as_f64().unwrap() < 1.0);
+    assert!(heat.is_file());
+    let same = mirrorbox(
+        &[
+            "compare",
+            a.to_str().unwrap(),
+            a.to_str().unwrap(),
+            "--json",
+        ],
+        &[],
+    );
+    let v: Value = serde_json::from_str(same.stdout.trim()).unwrap();
+    assert_eq!(v["rmse"], 0.0);
+    assert!(v["psnr"].is_null(), "identical images have infinite PSNR");
+    // A different size, and a file that is not there.
+    let small = dir.path().join("small.exr");
+    mirrorbox(
+        &[
+            "trace",
+            "scenes/mirror_box.json",
+            "-o",
+            small.to_str().unwrap(),
+            "--width",
+            "32",
+            "--height",
+            "18",
+            "--spp",
+            "1",
+        ],
+        &[],
+    );
+    let out = mirrorbox(
+        &["compare", a.to_str().unwrap(), small.to_str().unwrap()],
+        &[],
+    );
+    assert_eq!(out.code, 2);
+    assert!(
+        out.stderr
+            .contains("images differ in size: reference 48x27, test 32x18"),
+        "{}",
+        out.stderr
+    );
+    let out = mirrorbox(&["compare", a.to_str().unwrap(), "nowhere.exr"], &[]);
+    assert_eq!(out.code, 2);
+    assert!(out.stderr.contains("nowhere.exr"), "{}", out.stderr);
+}
+
+fn sweep(out: &Path) -> Output {
+    mirrorbox(
+        &[
+            "sweep",
+            "scenes/mirror_box.json",
+            "--out",
+            out.to_str().unwrap(),
+            "--methods",
+            "naive,auxiliary",
+            "--n",
+            "0..3",
+            "--alpha",
+            "0.7",
+            "--width",
+            "64",
+            "--height",
+            "36",
+            "--frames",
+            "1",
+            "--warmup",
+            "0",
+        ],
+        &[],
+    )
+}
+
+fn records(out: &Path) -> Vec<Value> {
+    std::fs::read_to_string(out.join("results.jsonl"))
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect()
+}
+
+#[test]
+fn sweep_writes_every_output_and_error_falls_with_n() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("sweep");
+    let run = sweep(&out);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    assert!(
+        run.stdout.contains("6 points computed, 0 reused"),
+        "{}",
+        run.stdout
+    );
+    for f in [
+        "results.jsonl",
+        "results.csv",
+        "report.md",
+        "report.html",
+        "plot_flip_vs_ms.svg",
+        "plot_flip_vs_n.svg",
+    ] {
+        assert!(out.join(f).is_file(), "{f} missing");
+    }
+    let recs = records(&out);
+    assert_eq!(recs.len(), 6, "floor + naive + auxiliary n=0..3");
+    for r in &recs {
+        for k in [
+            "method",
+            "alpha",
+            "ms_median",
+            "ms_min",
+            "timing_source",
+            "passes",
+            "draws",
+            "metrics",
+            "adapter",
+            "key",
+        ] {
+            assert!(!r[k].is_null(), "{k} missing in {r}");
+        }
+        for k in [
+            "rmse",
+            "relmse",
+            "smape",
+            "ssim",
+            "flip_mean",
+            "flip_p95",
+            "flip_p99",
+        ] {
+            assert!(r["metrics"][k].is_number(), "{k} in {r}");
+        }
+    }
+    let floor = recs.iter().find(|r| r["kind"] == "floor").unwrap();
+    let aux: Vec<&Value> = recs.iter().filter(|r| r["method"] == "auxiliary").collect();
+    let err: Vec<f64> = aux
+        .iter()
+        .map(|r| r["metrics"]["relmse"].as_f64().unwrap())
+        .collect();
+    for w in err.windows(2) {
+        assert!(
+            w[1] < w[0],
+            "relMSE must fall as n grows at α = 0.7: {err:?}"
+        );
+    }
+    let passes: Vec<u64> = aux.iter().map(|r| r["passes"].as_u64().unwrap()).collect();
+    assert_eq!(passes, vec![3, 7, 15, 46]);
+    assert!(
+        floor["metrics"]["relmse"].as_f64().unwrap() < err[3],
+        "the floor is below every method's error"
+    );
+    let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(
+        md.contains("Reproduction of the paper's Table 1") && md.contains("| 3 | 435 |"),
+        "{md}"
+    );
+    assert!(md.contains("Floor of the comparison"));
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(
+        html.contains("data:image/png;base64,") && html.contains("<svg"),
+        "self-contained HTML"
+    );
+    let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 7);
+}
+
+#[test]
+fn sweep_resumes_without_recomputing_finished_points() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("sweep");
+    assert_eq!(sweep(&out).code, 0);
+    let first = std::fs::read_to_string(out.join("results.jsonl")).unwrap();
+    // A complete re-run recomputes nothing.
+    let again = sweep(&out);
+    assert_eq!(again.code, 0, "{}", again.stderr);
+    assert!(
+        again
+            .stdout
+            .contains("0 points computed, 6 reused; truths: 0 traced, 0 from cache"),
+        "{}",
+        again.stdout
+    );
+    assert_eq!(
+        std::fs::read_to_string(out.join("results.jsonl")).unwrap(),
+        first
+    );
+    // Interrupted after two points, mid-way through writing the third line.
+    let lines: Vec<&str> = first.lines().collect();
+    std::fs::write(
+        out.join("results.jsonl"),
+        format!("{}\n{}\n{{\"key\": \"auxil", lines[0], lines[1]),
+    )
+    .unwrap();
+    let resumed = sweep(&out);
+    assert_eq!(resumed.code, 0, "{}", resumed.stderr);
+    assert!(
+        resumed
+            .stdout
+            .contains("4 points computed, 2 reused; truths: 0 traced, 4 from cache"),
+        "{}",
+        resumed.stdout
+    );
+    let keys: Vec<String> = records_lenient(&out)
+        .iter()
+        .map(|r| r["key"].as_str().unwrap().to_string())
+        .collect();
+    assert_eq!(keys.len(), 6);
+    let originals: Vec<String> = first
+        .lines()
+        .map(|l| {
+            serde_json::from_str::<Value>(l).unwrap()["key"]
+                .as_str()
+                .unwrap()
+                .to_string()
+        })
+        .collect();
+    let mut a = keys.clone();
+    let mut b = originals.clone();
+    a.sort();
+    b.sort();
+    assert_eq!(a, b);
+}
+
+fn records_lenient(out: &Path) -> Vec<Value> {
+    std::fs::read_to_string(out.join("results.jsonl"))
+        .unwrap()
+        .lines()
+        .filter_map(|l| serde_json::from_str(l).ok())
+        .collect()
+}
+
+#[test]
+fn sweep_refuses_bad_arguments() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("s");
+    let o = out.to_str().unwrap();
+    let cases: [(&[&str], &str); 4] = [
+        (&["--n", "3..1"], "--n \"3..1\": expected a range like 0..4"),
+        (
+            &["--alpha", "0.7,2"],
+            "--alpha \"0.7,2\": each value must be a number in [0, 1], got \"2\"",
+        ),
+        (
+            &["--methods", "naive,magic"],
+            "--methods: unknown method \"magic\"",
+        ),
+        (
+            &["--n", "7", "--methods", "auxiliary"],
+            "auxiliary n=7 α=0.7: this configuration would render 11146 scene passes",
+        ),
+    ];
+    for (extra, message) in cases {
+        let mut args = vec![
+            "sweep",
+            "scenes/mirror_box.json",
+            "--out",
+            o,
+            "--alpha",
+            "0.7",
+            "--width",
+            "32",
+            "--height",
+            "18",
+        ];
+        args.extend_from_slice(extra);
+        let r = mirrorbox(&args, &[]);
+        assert_eq!(r.code, 2, "{args:?}: {}", r.stderr);
+        assert!(r.stderr.contains(message), "{args:?}: {}", r.stderr);
+    }
+    assert!(!out.exists(), "nothing is written on bad input");
+}

@@ -33,6 +33,10 @@ enum Command {
     Render(commands::render::Args),
     /// Compare an image with a reference: linear and perceptual metrics.
     Compare(commands::compare::Args),
+    /// Sweep methods, n and α: time, compare with cached truths, write reports (resumable).
+    Sweep(commands::sweep::Args),
+    /// The preset sweep reproducing the paper's Table 1 (writes reports/table1/).
+    Table1(commands::sweep::Table1Args),
     /// Export a scene as Mitsuba 3 XML (tools/mitsuba renders and compares it).
     ExportMitsuba(commands::export_mitsuba::Args),
 }
@@ -91,6 +95,8 @@ fn main() -> ExitCode {
         Command::Trace(args) => commands::trace::run(&args),
         Command::Render(args) => commands::render::run(&args),
         Command::Compare(args) => commands::compare::run(&args),
+        Command::Sweep(args) => commands::sweep::run(&args),
+        Command::Table1(args) => commands::sweep::run_table1(&args),
         Command::ExportMitsuba(args) => commands::export_mitsuba::run(&args),
     };
     match result {

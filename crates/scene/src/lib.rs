@@ -14,6 +14,7 @@ pub mod camera;
 pub mod error;
 pub mod format;
 pub mod geometry;
+pub mod hash;
 pub mod load;
 pub mod polygon;
 pub mod reflection;
@@ -123,7 +124,7 @@ impl Scene {
     /// outputs and as the key of cached ground truths.
     pub fn content_hash(&self) -> u64 {
         use std::fmt::Write;
-        let mut h = Fnv1a(0xcbf2_9ce4_8422_2325);
+        let mut h = hash::Fnv1a::new();
         let g = &self.geometry;
         let _ = write!(
             h,
@@ -137,19 +138,7 @@ impl Scene {
             g.surface_of,
             g.surfaces
         );
-        h.0
-    }
-}
-
-struct Fnv1a(u64);
-
-impl std::fmt::Write for Fnv1a {
-    fn write_str(&mut self, s: &str) -> std::fmt::Result {
-        for b in s.bytes() {
-            self.0 ^= b as u64;
-            self.0 = self.0.wrapping_mul(0x0000_0100_0000_01b3);
-        }
-        Ok(())
+        h.finish()
     }
 }
 

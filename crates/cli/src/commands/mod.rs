@@ -3,6 +3,7 @@ pub mod compare;
 pub mod export_mitsuba;
 pub mod info;
 pub mod render;
+pub mod sweep;
 pub mod trace;
 
 use crate::Failure;

@@ -1,0 +1,81 @@
+//! Sweep results and the reports made from them. This crate knows records, files and text —
+//! nothing about renderers or GPUs.
+//!
+//! - [`Record`]: one measured point (one JSON line of `results.jsonl`).
+//! - [`write_report`]: `results.csv`, `report.md`, a self-contained `report.html` and the SVG
+//!   plots, including the reproduction of the seed paper's Table 1 ([`table1`]).
+
+pub mod plot;
+pub mod table1;
+mod write;
+
+pub use write::{read_records, write_report};
+
+use serde::{Deserialize, Serialize};
+
+/// Error metrics of one comparison (see `mirrorbox_image::metrics`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MetricValues {
+    pub rmse: f64,
+    pub relmse: f64,
+    pub smape: f64,
+    pub max_abs: f64,
+    /// `None` when the images are identical (infinite PSNR).
+    pub psnr: Option<f64>,
+    pub ssim: f64,
+    pub flip_mean: f64,
+    pub flip_p95: f64,
+    pub flip_p99: f64,
+}
+
+/// One point of a sweep: a method at one setting, timed and compared with the truth.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Record {
+    /// Identifies the point; a resumed sweep skips keys it already has.
+    pub key: String,
+    /// `"point"`, or `"floor"`: raster vs trace on the scene without mirrors.
+    pub kind: String,
+    pub scene: String,
+    pub scene_hash: String,
+    pub method: String,
+    /// Auxiliary mirrors (auxiliary method).
+    pub n: Option<u32>,
+    /// Reflection depth (depth-limited methods).
+    pub depth: Option<u32>,
+    pub alpha: f32,
+    pub width: u32,
+    pub height: u32,
+    pub ssaa: u32,
+    pub ms_median: f64,
+    pub ms_min: f64,
+    pub timing_source: String,
+    pub frames: u32,
+    pub passes: usize,
+    pub draws: usize,
+    pub texture_renders: usize,
+    /// Reflections the method can show.
+    pub reflections: usize,
+    pub metrics: MetricValues,
+    pub adapter: String,
+    pub backend: String,
+    /// Images relative to the sweep folder.
+    pub truth_image: String,
+    pub raster_image: String,
+    pub heatmap_image: String,
+}
+
+/// Facts about the whole sweep, printed at the top of every report.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct SweepInfo {
+    pub command: String,
+    /// UTC, RFC 3339.
+    pub date: String,
+    pub cpu: String,
+    pub adapter: String,
+    pub backend: String,
+    pub device_type: String,
+    pub versions: String,
+    pub scene: String,
+    pub resolution: String,
+    pub truth: String,
+}

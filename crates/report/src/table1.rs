@@ -1,0 +1,154 @@
+//! The reproduction of the seed paper's Table 1: ms/frame of the auxiliary method for
+//! n = 0…4, the paper's (Safari) beside ours, with the pass counts that explain the growth.
+
+use crate::Record;
+
+/// Table 1 of the seed paper: ms/frame for n = 0…4 auxiliary mirrors, "tested on Safari".
+pub const PAPER_MS: [f64; 5] = [25.0, 61.0, 142.0, 435.0, 1330.0];
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Row {
+    pub n: u32,
+    pub paper_ms: f64,
+    pub ms_median: f64,
+    pub ms_min: f64,
+    pub passes: usize,
+    /// Step ratios to the previous row (None for n = 0).
+    pub paper_step: Option<f64>,
+    pub ours_step: Option<f64>,
+}
+
+/// Rows for the auxiliary points with n = 0…4 at one α (0.7 — the paper's — if measured,
+/// else the first α found), in n order; empty if none.
+pub fn rows(records: &[Record]) -> (Option<f32>, Vec<Row>) {
+    let aux: Vec<&Record> = records
+        .iter()
+        .filter(|r| r.kind == "point" && r.method == "auxiliary")
+        .collect();
+    let alpha = aux
+        .iter()
+        .map(|r| r.alpha)
+        .find(|a| (*a - 0.7).abs() < 1e-6)
+        .or_else(|| aux.first().map(|r| r.alpha));
+    let Some(alpha) = alpha else {
+        return (None, Vec::new());
+    };
+    let mut rows: Vec<Row> = Vec::new();
+    for n in 0..PAPER_MS.len() as u32 {
+        let Some(r) = aux.iter().find(|r| r.n == Some(n) && r.alpha == alpha) else {
+            continue;
+        };
+        let prev = rows.last().filter(|p| p.n + 1 == n);
+        rows.push(Row {
+            n,
+            paper_ms: PAPER_MS[n as usize],
+            ms_median: r.ms_median,
+            ms_min: r.ms_min,
+            passes: r.passes,
+            paper_step: prev.map(|p| PAPER_MS[n as usize] / p.paper_ms),
+            ours_step: prev.map(|p| r.ms_median / p.ms_median),
+        });
+    }
+    (Some(alpha), rows)
+}
+
+/// Least-squares slope of log(ms) against log(passes): 1 means time proportional to passes.
+pub fn slope(points: &[(f64, f64)]) -> Option<f64> {
+    let pts: Vec<(f64, f64)> = points
+        .iter()
+        .filter(|(p, t)| *p > 0.0 && *t > 0.0)
+        .map(|(p, t)| (p.ln(), t.ln()))
+        .collect();
+    if pts.len() < 2 {
+        return None;
+    }
+    let n = pts.len() as f64;
+    let (mx, my) = (
+        pts.iter().map(|p| p.0).sum::<f64>() / n,
+        pts.iter().map(|p| p.1).sum::<f64>() / n,
+    );
+    let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
+    let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+    (sxx > 0.0).then(|| sxy / sxx)
+}
+
+/// A sentence saying whether our growth matches the paper's, and why.
+pub fn growth_sentence(rows: &[Row]) -> String {
+    if rows.len() < 2 {
+        return "Too few points to compare growth.".into();
+    }
+    let ours = slope(
+        &rows
+            .iter()
+            .map(|r| (r.passes as f64, r.ms_median))
+            .collect::<Vec<_>>(),
+    );
+    let paper = slope(
+        &rows
+            .iter()
+            .map(|r| (r.passes as f64, r.paper_ms))
+            .collect::<Vec<_>>(),
+    );
+    let per_pass: Vec<f64> = rows.iter().map(|r| r.ms_median / r.passes as f64).collect();
+    let paper_per_pass: Vec<f64> = rows.iter().map(|r| r.paper_ms / r.passes as f64).collect();
+    let range = |v: &[f64]| {
+        let (lo, hi) = v
+            .iter()
+            .fold((f64::INFINITY, 0.0f64), |(a, b), &x| (a.min(x), b.max(x)));
+        format!("{lo:.1}–{hi:.1}")
+    };
+    let (Some(o), Some(p)) = (ours, paper) else {
+        return "Growth could not be fitted.".into();
+    };
+    let verdict = if (o - p).abs() <= 0.2 {
+        "matches"
+    } else {
+        "does not match"
+    };
+    format!(
+        "The growth {verdict}: fitting log(ms/frame) against log(passes), our exponent is {o:.2} and the \
+         paper's is {p:.2} (1 = time proportional to the number of scene passes). The pass count of \
+         the paper's recursion grows factorially with n (every mirror camera recurses into every \
+         unhidden auxiliary mirror on the other side), and each pass costs about the same: \
+         {} ms per pass here, {} ms per pass for the paper's Safari figures.",
+        range(&per_pass),
+        range(&paper_per_pass)
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn slope_of_a_power_law() {
+        let pts: Vec<(f64, f64)> = [3.0, 7.0, 15.0, 46.0, 139.0]
+            .iter()
+            .map(|&p| (p, 9.0 * p))
+            .collect();
+        assert!((slope(&pts).unwrap() - 1.0).abs() < 1e-12);
+        let sq: Vec<(f64, f64)> = [1.0, 2.0, 4.0].iter().map(|&p| (p, p * p)).collect();
+        assert!((slope(&sq).unwrap() - 2.0).abs() < 1e-12);
+        assert_eq!(slope(&[(1.0, 1.0)]), None);
+    }
+
+    #[test]
+    fn the_papers_own_figures_grow_with_the_pass_count() {
+        let rows: Vec<Row> = [3usize, 7, 15, 46, 139]
+            .iter()
+            .enumerate()
+            .map(|(n, &passes)| Row {
+                n: n as u32,
+                paper_ms: PAPER_MS[n],
+                ms_median: PAPER_MS[n],
+                ms_min: PAPER_MS[n],
+                passes,
+                paper_step: None,
+                ours_step: None,
+            })
+            .collect();
+        let s = growth_sentence(&rows);
+        assert!(s.starts_with("The growth matches"), "{s}");
+        assert!(s.contains("8.3–9.6 ms per pass for the paper"), "{s}");
+    }
+}

@@ -1,0 +1,527 @@
+//! Writing the sweep's files. Markdown and HTML are rendered from one document model, so
+//! they always say the same thing.
+
+use crate::plot::{Chart, Series};
+use crate::table1;
+use crate::{Record, SweepInfo};
+use base64::Engine;
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// Reads `results.jsonl`; a line that does not parse (an interrupted write) is skipped.
+pub fn read_records(path: &Path) -> std::io::Result<Vec<Record>> {
+    let text = match std::fs::read_to_string(path) {
+        Ok(t) => t,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
+        Err(e) => return Err(e),
+    };
+    Ok(text
+        .lines()
+        .filter_map(|l| serde_json::from_str(l).ok())
+        .collect())
+}
+
+enum Block {
+    Heading(u8, String),
+    Paragraph(String),
+    Bullets(Vec<String>),
+    Table(Vec<String>, Vec<Vec<String>>),
+    /// Images side by side: (caption, path relative to the report).
+    Images(Vec<(String, String)>),
+    /// An SVG chart, written to `file` and embedded in the HTML.
+    Chart(String, String),
+}
+
+fn f(v: f64, digits: usize) -> String {
+    if v.is_finite() {
+        format!("{v:.digits$}")
+    } else {
+        "–".into()
+    }
+}
+
+fn sci(v: f64) -> String {
+    if v.is_finite() {
+        format!("{v:.3e}")
+    } else {
+        "–".into()
+    }
+}
+
+fn label(r: &Record) -> String {
+    match (r.n, r.depth) {
+        (Some(n), _) => format!("{} n={n}", r.method),
+        (None, Some(d)) => format!("{} depth={d}", r.method),
+        _ => r.method.clone(),
+    }
+}
+
+fn setting(r: &Record) -> f64 {
+    r.n.or(r.depth).map_or(0.0, f64::from)
+}
+
+/// Writes `results.csv`, `report.md`, `report.html` and the `plot_*.svg` files into `dir`.
+pub fn write_report(dir: &Path, info: &SweepInfo, records: &[Record]) -> std::io::Result<()> {
+    write_csv(&dir.join("results.csv"), records)?;
+    let blocks = document(info, records);
+    let mut md = String::new();
+    let mut html = String::from(
+        "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>mirrorbox report</title><style>\
+         body{font-family:sans-serif;max-width:1100px;margin:2em auto;padding:0 1em}\
+         table{border-collapse:collapse;margin:1em 0}td,th{border:1px solid #ccc;padding:3px 8px;text-align:right}\
+         th{background:#f3f3f3}figure{display:inline-block;margin:4px}figcaption{font-size:12px}\
+         img{max-width:340px}</style></head><body>\n",
+    );
+    for b in &blocks {
+        match b {
+            Block::Heading(level, t) => {
+                let _ = writeln!(md, "{} {t}\n", "#".repeat(*level as usize));
+                let _ = writeln!(html, "<h{level}>{}</h{level}>", esc(t));
+            }
+            Block::Paragraph(t) => {
+                let _ = writeln!(md, "{t}\n");
+                let _ = writeln!(html, "<p>{}</p>", esc(t));
+            }
+            Block::Bullets(items) => {
+                for i in items {
+                    let _ = writeln!(md, "- {i}");
+                }
+                md.push('\n');
+                let _ = writeln!(
+                    html,
+                    "<ul>{}</ul>",
+                    items
+                        .iter()
+                        .map(|i| format!("<li>{}</li>", esc(i)))
+                        .collect::<String>()
+                );
+            }
+            Block::Table(head, rows) => {
+                let _ = writeln!(md, "| {} |", head.join(" | "));
+                let _ = writeln!(md, "|{}", "---|".repeat(head.len()));
+                for r in rows {
+                    let _ = writeln!(md, "| {} |", r.join(" | "));
+                }
+                md.push('\n');
+                let _ = write!(
+                    html,
+                    "<table><tr>{}</tr>",
+                    head.iter()
+                        .map(|h| format!("<th>{}</th>", esc(h)))
+                        .collect::<String>()
+                );
+                for r in rows {
+                    let _ = write!(
+                        html,
+                        "<tr>{}</tr>",
+                        r.iter()
+                            .map(|c| format!("<td>{}</td>", esc(c)))
+                            .collect::<String>()
+                    );
+                }
+                html.push_str("</table>\n");
+            }
+            Block::Images(images) => {
+                let line: Vec<String> = images
+                    .iter()
+                    .map(|(cap, p)| format!("![{cap}]({p})"))
+                    .collect();
+                let _ = writeln!(md, "{}\n", line.join(" "));
+                html.push_str("<div>");
+                for (cap, p) in images {
+                    let src = match std::fs::read(dir.join(p)) {
+                        Ok(bytes) => format!(
+                            "data:image/png;base64,{}",
+                            base64::engine::general_purpose::STANDARD.encode(bytes)
+                        ),
+                        Err(_) => p.clone(),
+                    };
+                    let _ = write!(
+                        html,
+                        "<figure><img src=\"{src}\" alt=\"{0}\"><figcaption>{0}</figcaption></figure>",
+                        esc(cap)
+                    );
+                }
+                html.push_str("</div>\n");
+            }
+            Block::Chart(file, svg) => {
+                std::fs::write(dir.join(file), svg)?;
+                let _ = writeln!(md, "![{file}]({file})\n");
+                let _ = writeln!(html, "<div>{svg}</div>");
+            }
+        }
+    }
+    html.push_str("</body></html>\n");
+    std::fs::write(dir.join("report.md"), md)?;
+    std::fs::write(dir.join("report.html"), html)
+}
+
+fn esc(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+fn write_csv(path: &Path, records: &[Record]) -> std::io::Result<()> {
+    let mut s = String::from(
+        "kind,method,n,depth,alpha,width,height,ssaa,ms_median,ms_min,timing_source,frames,passes,draws,texture_renders,reflections,\
+         rmse,relmse,smape,max_abs,psnr,ssim,flip_mean,flip_p95,flip_p99,adapter,backend,scene,scene_hash\n",
+    );
+    for r in records {
+        let m = &r.metrics;
+        let opt = |v: Option<u32>| v.map_or(String::new(), |x| x.to_string());
+        let _ = writeln!(
+            s,
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},\"{}\",{},\"{}\",{}",
+            r.kind,
+            r.method,
+            opt(r.n),
+            opt(r.depth),
+            r.alpha,
+            r.width,
+            r.height,
+            r.ssaa,
+            r.ms_median,
+            r.ms_min,
+            r.timing_source,
+            r.frames,
+            r.passes,
+            r.draws,
+            r.texture_renders,
+            r.reflections,
+            m.rmse,
+            m.relmse,
+            m.smape,
+            m.max_abs,
+            m.psnr.map_or("inf".into(), |p| p.to_string()),
+            m.ssim,
+            m.flip_mean,
+            m.flip_p95,
+            m.flip_p99,
+            r.adapter.replace('"', "'"),
+            r.backend,
+            r.scene.replace('"', "'"),
+            r.scene_hash
+        );
+    }
+    std::fs::write(path, s)
+}
+
+fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
+    let mut b = vec![
+        Block::Heading(1, format!("mirrorbox sweep: {}", info.scene)),
+        Block::Bullets(vec![
+            format!("Resolution: {}", info.resolution),
+            format!("Ground truth: {}", info.truth),
+            format!(
+                "Device: {} — adapter {} ({}, {})",
+                info.cpu, info.adapter, info.backend, info.device_type
+            ),
+            format!("Versions: {}", info.versions),
+            format!("Date: {}", info.date),
+            format!("Command: `{}`", info.command),
+        ]),
+    ];
+    let points: Vec<&Record> = records.iter().filter(|r| r.kind == "point").collect();
+    let floor = records.iter().find(|r| r.kind == "floor");
+
+    let (alpha, rows) = table1::rows(records);
+    if !rows.is_empty() {
+        b.push(Block::Heading(
+            2,
+            "Reproduction of the paper's Table 1".into(),
+        ));
+        b.push(Block::Paragraph(format!(
+            "Auxiliary method, α = {}; ours is the median (and minimum) ms/frame over the timed frames. \
+             The paper's column is its Table 1 (Safari, hardware not stated).",
+            alpha.unwrap_or(f32::NAN)
+        )));
+        let step = |s: Option<f64>| s.map_or("–".into(), |v| format!("{v:.2}"));
+        b.push(Block::Table(
+            [
+                "n",
+                "paper ms/frame",
+                "ours ms/frame",
+                "passes",
+                "ours ms/pass",
+                "paper ms/pass",
+                "step ratio paper",
+                "step ratio ours",
+            ]
+            .map(String::from)
+            .to_vec(),
+            rows.iter()
+                .map(|r| {
+                    vec![
+                        r.n.to_string(),
+                        f(r.paper_ms, 0),
+                        format!("{} ({})", f(r.ms_median, 1), f(r.ms_min, 1)),
+                        r.passes.to_string(),
+                        f(r.ms_median / r.passes as f64, 2),
+                        f(r.paper_ms / r.passes as f64, 2),
+                        step(r.paper_step),
+                        step(r.ours_step),
+                    ]
+                })
+                .collect(),
+        ));
+        b.push(Block::Paragraph(table1::growth_sentence(&rows)));
+    }
+
+    if let Some(fl) = floor {
+        b.push(Block::Heading(2, "Floor of the comparison".into()));
+        b.push(Block::Paragraph(format!(
+            "Raster vs trace on the scene without its mirrors (nothing to truncate, same sub-pixel grid): \
+             RMSE {}, relMSE {}, FLIP mean {}, SSIM {}. Every error below is to be read against this floor.",
+            sci(fl.metrics.rmse),
+            sci(fl.metrics.relmse),
+            sci(fl.metrics.flip_mean),
+            f(fl.metrics.ssim, 6)
+        )));
+    }
+
+    let mut groups: Vec<(String, f32)> = Vec::new();
+    for r in &points {
+        if !groups.contains(&(r.method.clone(), r.alpha)) {
+            groups.push((r.method.clone(), r.alpha));
+        }
+    }
+    let series = |x: &dyn Fn(&Record) -> f64, y: &dyn Fn(&Record) -> f64| -> Vec<Series> {
+        groups
+            .iter()
+            .map(|(m, a)| {
+                let mut pts: Vec<&&Record> = points
+                    .iter()
+                    .filter(|r| &r.method == m && r.alpha == *a)
+                    .collect();
+                pts.sort_by(|p, q| setting(p).total_cmp(&setting(q)));
+                Series {
+                    name: format!("{m}, α={a}"),
+                    points: pts.iter().map(|r| (x(r), y(r))).collect(),
+                    labels: pts
+                        .iter()
+                        .map(|r| {
+                            r.n.map(|n| format!("n={n}"))
+                                .or(r.depth.map(|d| format!("d={d}")))
+                                .unwrap_or_default()
+                        })
+                        .collect(),
+                }
+            })
+            .collect()
+    };
+    let floor_line = |v: fn(&Record) -> f64| {
+        floor
+            .map(|fl| vec![("floor (no mirrors)".to_string(), v(fl))])
+            .unwrap_or_default()
+    };
+    if !points.is_empty() {
+        b.push(Block::Heading(2, "Error against time".into()));
+        b.push(Block::Chart(
+            "plot_flip_vs_ms.svg".into(),
+            Chart {
+                title: "FLIP mean vs ms/frame".into(),
+                x_label: "ms/frame (median)".into(),
+                y_label: "FLIP mean (lower is better)".into(),
+                x_log: true,
+                y_log: true,
+                series: series(&|r| r.ms_median, &|r| r.metrics.flip_mean),
+                reference_lines: floor_line(|r| r.metrics.flip_mean),
+            }
+            .to_svg(),
+        ));
+        b.push(Block::Chart(
+            "plot_relmse_vs_ms.svg".into(),
+            Chart {
+                title: "relMSE (linear radiance) vs ms/frame".into(),
+                x_label: "ms/frame (median)".into(),
+                y_label: "relMSE".into(),
+                x_log: true,
+                y_log: true,
+                series: series(&|r| r.ms_median, &|r| r.metrics.relmse),
+                reference_lines: floor_line(|r| r.metrics.relmse),
+            }
+            .to_svg(),
+        ));
+        b.push(Block::Heading(2, "Error against n".into()));
+        b.push(Block::Chart(
+            "plot_flip_vs_n.svg".into(),
+            Chart {
+                title: "FLIP mean vs n (auxiliary mirrors) or depth".into(),
+                x_label: "n".into(),
+                y_label: "FLIP mean".into(),
+                x_log: false,
+                y_log: true,
+                series: series(&setting, &|r| r.metrics.flip_mean),
+                reference_lines: floor_line(|r| r.metrics.flip_mean),
+            }
+            .to_svg(),
+        ));
+        b.push(Block::Heading(2, "All points".into()));
+        b.push(Block::Table(
+            [
+                "point",
+                "α",
+                "ms/frame median",
+                "min",
+                "timing",
+                "passes",
+                "draws",
+                "RMSE",
+                "relMSE",
+                "SMAPE",
+                "PSNR dB",
+                "SSIM",
+                "FLIP mean",
+                "p95",
+                "p99",
+            ]
+            .map(String::from)
+            .to_vec(),
+            points
+                .iter()
+                .map(|r| {
+                    let m = &r.metrics;
+                    vec![
+                        label(r),
+                        r.alpha.to_string(),
+                        f(r.ms_median, 2),
+                        f(r.ms_min, 2),
+                        r.timing_source.clone(),
+                        r.passes.to_string(),
+                        r.draws.to_string(),
+                        sci(m.rmse),
+                        sci(m.relmse),
+                        sci(m.smape),
+                        m.psnr.map_or("∞".into(), |p| f(p, 2)),
+                        f(m.ssim, 5),
+                        sci(m.flip_mean),
+                        f(m.flip_p95, 4),
+                        f(m.flip_p99, 4),
+                    ]
+                })
+                .collect(),
+        ));
+        b.push(Block::Heading(2, "Truth | raster | FLIP error".into()));
+        for (m, a) in &groups {
+            let mut pts: Vec<&&Record> = points
+                .iter()
+                .filter(|r| &r.method == m && r.alpha == *a)
+                .collect();
+            pts.sort_by(|p, q| setting(p).total_cmp(&setting(q)));
+            let chosen: Vec<&&Record> = match pts.len() {
+                0 => vec![],
+                1 => vec![pts[0]],
+                n => vec![pts[0], pts[n - 1]],
+            };
+            for r in chosen {
+                b.push(Block::Paragraph(format!(
+                    "{}, α = {}: FLIP mean {}",
+                    label(r),
+                    r.alpha,
+                    sci(r.metrics.flip_mean)
+                )));
+                b.push(Block::Images(vec![
+                    (format!("truth (α={})", r.alpha), r.truth_image.clone()),
+                    (label(r), r.raster_image.clone()),
+                    ("FLIP error".into(), r.heatmap_image.clone()),
+                ]));
+            }
+        }
+    }
+    b
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::MetricValues;
+
+    fn record(n: u32, ms: f64, passes: usize, flip: f64) -> Record {
+        Record {
+            key: format!("auxiliary n={n}"),
+            kind: "point".into(),
+            scene: "s.json".into(),
+            scene_hash: "00".into(),
+            method: "auxiliary".into(),
+            n: Some(n),
+            depth: None,
+            alpha: 0.7,
+            width: 16,
+            height: 16,
+            ssaa: 1,
+            ms_median: ms,
+            ms_min: ms,
+            timing_source: "gpu-timestamps".into(),
+            frames: 1,
+            passes,
+            draws: 2 * passes,
+            texture_renders: passes - 1,
+            reflections: n as usize + 2,
+            metrics: MetricValues {
+                rmse: flip,
+                relmse: flip,
+                smape: flip,
+                max_abs: flip,
+                psnr: Some(30.0),
+                ssim: 0.9,
+                flip_mean: flip,
+                flip_p95: flip,
+                flip_p99: flip,
+            },
+            adapter: "test".into(),
+            backend: "vulkan".into(),
+            truth_image: "t.png".into(),
+            raster_image: "r.png".into(),
+            heatmap_image: "h.png".into(),
+        }
+    }
+
+    #[test]
+    fn report_files_hold_the_table_and_the_points() {
+        let dir = tempfile::tempdir().unwrap();
+        let records = vec![
+            record(0, 20.0, 3, 0.1),
+            record(1, 45.0, 7, 0.05),
+            record(2, 100.0, 15, 0.02),
+        ];
+        write_report(
+            dir.path(),
+            &SweepInfo {
+                scene: "s.json".into(),
+                ..Default::default()
+            },
+            &records,
+        )
+        .unwrap();
+        let md = std::fs::read_to_string(dir.path().join("report.md")).unwrap();
+        assert!(md.contains("Reproduction of the paper's Table 1"));
+        assert!(md.contains("| 2 | 142 | 100.0 (100.0) | 15 |"), "{md}");
+        let html = std::fs::read_to_string(dir.path().join("report.html")).unwrap();
+        assert!(html.contains("<svg") && html.contains("<table>"));
+        let csv = std::fs::read_to_string(dir.path().join("results.csv")).unwrap();
+        assert_eq!(csv.lines().count(), 4);
+        for f in [
+            "plot_flip_vs_ms.svg",
+            "plot_relmse_vs_ms.svg",
+            "plot_flip_vs_n.svg",
+        ] {
+            assert!(dir.path().join(f).is_file(), "{f}");
+        }
+    }
+
+    #[test]
+    fn interrupted_lines_are_skipped_when_reading() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("results.jsonl");
+        let good = serde_json::to_string(&record(0, 1.0, 3, 0.1)).unwrap();
+        std::fs::write(&p, format!("{good}\n{{\"key\": \"trunc")).unwrap();
+        assert_eq!(read_records(&p).unwrap().len(), 1);
+        assert!(
+            read_records(&dir.path().join("none.jsonl"))
+                .unwrap()
+                .is_empty()
+        );
+    }
+}
