@@ -6,6 +6,9 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 export NODEVICE_SELECT=1          # quiet Mesa's device-select layer on headless machines
 scripts/install-system-deps.sh
+# Mitsuba 3 for the agreement tests (tests/mitsuba.rs): a pinned venv, and libllvm19 via apt.
+tools/mitsuba/setup.sh
+export MIRRORBOX_MITSUBA_PYTHON="$PWD/tools/mitsuba/.venv/bin/python"
 
 echo "== cargo fmt --check"
 cargo fmt --all -- --check

@@ -40,6 +40,7 @@ def parse_args():
                    help="mirror reflections (whitted) or path segments (path)")
     p.add_argument("--min-throughput", type=float, default=1e-4)
     p.add_argument("--runs", type=int, default=1, help="timed renders after the first")
+    p.add_argument("--seed", type=int, default=0, help="seed of Mitsuba's sampler")
     return p.parse_args()
 
 
@@ -117,7 +118,7 @@ def main():
 
     def render():
         t = time.perf_counter()
-        image = mi.render(scene, integrator=integrator, spp=spp)
+        image = mi.render(scene, integrator=integrator, spp=spp, seed=args.seed)
         dr.eval(image)
         dr.sync_thread()
         return image, time.perf_counter() - t

@@ -169,6 +169,7 @@ fn truth(
     let settings = TraceSettings {
         sampling: Sampling::Grid(SubpixelGrid::new(config.ssaa)),
         whitted: *t,
+        path: None,
     };
     let out = mirrorbox_trace::render(scene, &bvh, &settings, &|_| {});
     write_exr(

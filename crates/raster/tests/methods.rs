@@ -40,6 +40,7 @@ fn trace(s: &Scene, per_axis: u32) -> RgbImage {
     let settings = TraceSettings {
         sampling: Sampling::Grid(SubpixelGrid::new(per_axis)),
         whitted: WhittedSettings::default(),
+        path: None,
     };
     mirrorbox_trace::render(s, &bvh, &settings, &|_| {}).image
 }

@@ -15,6 +15,7 @@ fn bench(c: &mut Criterion) {
     let settings = TraceSettings {
         sampling: Sampling::Grid(SubpixelGrid::new(2)),
         whitted: WhittedSettings::default(),
+        path: None,
     };
     let mut group = c.benchmark_group("mirror_box_640x360_4spp");
     group.sample_size(10);

@@ -131,11 +131,25 @@ impl SceneBvh {
         t_max: f32,
         skip_mirror: Option<usize>,
     ) -> Option<Hit> {
+        self.closest_hit_skipping(ray, t_min, t_max, skip_mirror, None)
+    }
+
+    /// [`SceneBvh::closest_hit`] that also ignores triangle `skip_triangle` (the planar
+    /// triangle a secondary ray starts on cannot be hit again by it).
+    pub fn closest_hit_skipping(
+        &self,
+        ray: &Ray,
+        t_min: f32,
+        t_max: f32,
+        skip_mirror: Option<usize>,
+        skip_triangle: Option<usize>,
+    ) -> Option<Hit> {
         let skip = skip_mirror.map_or(NOT_A_MIRROR, |m| m as u32);
+        let skip_tri = skip_triangle.map_or(u32::MAX, |t| t as u32);
         let wt = WatertightRay::new(ray.origin, ray.dir);
         let test = |r: &obvhs::ray::Ray, slot: usize| {
             let s = &self.slots[slot];
-            if s.mirror == skip && skip != NOT_A_MIRROR {
+            if (s.mirror == skip && skip != NOT_A_MIRROR) || self.original[slot] == skip_tri {
                 return f32::INFINITY;
             }
             wt.intersect(s.v[0], s.v[1], s.v[2], r.tmin, r.tmax)

@@ -4,7 +4,8 @@
 //! summed in a fixed order, so the image is bit-identical whatever the thread count.
 
 use crate::bvh::SceneBvh;
-use crate::sampler::Sampling;
+use crate::path::{PathSettings, PathTracer};
+use crate::sampler::{Sampling, SplitMix64};
 use crate::whitted::{Termination, Whitted, WhittedSettings};
 use mirrorbox_image::RgbImage;
 use mirrorbox_scene::Scene;
@@ -16,6 +17,8 @@ use std::time::{Duration, Instant};
 pub struct TraceSettings {
     pub sampling: Sampling,
     pub whitted: WhittedSettings,
+    /// `Some`: render with the physically based `path` integrator instead of `whitted`.
+    pub path: Option<PathSettings>,
 }
 
 /// Counters over all paths of a render.
@@ -81,6 +84,9 @@ pub fn render(
     let (w, h) = (cam.width, cam.height);
     let rays = cam.ray_generator();
     let whitted = Whitted::new(scene, bvh, settings.whitted);
+    let path = settings
+        .path
+        .map(|p| (PathTracer::new(scene, bvh, p), p.seed));
     let spp = settings.sampling.grid().samples_per_pixel() as f32;
     let done = AtomicU32::new(0);
     let start = Instant::now();
@@ -97,8 +103,14 @@ pub fn render(
                     .offsets(y as u64 * w as u64 + x as u64, &mut offsets);
                 let mut sum = glam::Vec3::ZERO;
                 let mut bounces = 0u64;
+                let pixel = y as u64 * w as u64 + x as u64;
+                let mut rng = SplitMix64::for_pixel(path.as_ref().map_or(0, |p| p.1), pixel);
                 for o in &offsets {
-                    let r = whitted.radiance(rays.ray(x as f32 + o.x, y as f32 + o.y));
+                    let ray = rays.ray(x as f32 + o.x, y as f32 + o.y);
+                    let r = match &path {
+                        Some((tracer, _)) => tracer.radiance(ray, &mut rng),
+                        None => whitted.radiance(ray),
+                    };
                     sum += r.radiance;
                     bounces += r.bounces as u64;
                     stats.record(r.bounces, r.termination, r.rays);

@@ -28,7 +28,7 @@ impl Sampling {
             Sampling::Grid(g) => out.extend(g.offsets()),
             Sampling::Jittered { grid, seed } => {
                 let s = grid.per_axis;
-                let mut rng = SplitMix64(seed ^ pixel.wrapping_mul(0x9E37_79B9_7F4A_7C15));
+                let mut rng = SplitMix64::for_pixel(seed, pixel);
                 for j in 0..s {
                     for i in 0..s {
                         let u = (i as f32 + rng.next_unit()) / s as f32;
@@ -52,10 +52,15 @@ impl Sampling {
 /// Largest f32 below 1, so an offset never reaches the next pixel.
 const ONE_BELOW: f32 = 1.0 - f32::EPSILON / 2.0;
 
-/// SplitMix64 (Steele, Lea, Flood 2014): tiny, fast, well distributed; enough for jitter.
-struct SplitMix64(u64);
+/// SplitMix64 (Steele, Lea, Flood 2014): tiny, fast, well distributed; enough for jitter
+/// and for the path integrator's per-pixel streams.
+pub struct SplitMix64(u64);
 
 impl SplitMix64 {
+    /// The stream of pixel `pixel` for `seed` (independent of thread scheduling).
+    pub fn for_pixel(seed: u64, pixel: u64) -> Self {
+        SplitMix64(seed ^ pixel.wrapping_mul(0x9E37_79B9_7F4A_7C15))
+    }
     fn next(&mut self) -> u64 {
         self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
         let mut z = self.0;
@@ -64,7 +69,7 @@ impl SplitMix64 {
         z ^ (z >> 31)
     }
     /// Uniform in [0, 1) with 24 bits.
-    fn next_unit(&mut self) -> f32 {
+    pub fn next_unit(&mut self) -> f32 {
         (self.next() >> 40) as f32 / (1u64 << 24) as f32
     }
 }

@@ -171,6 +171,7 @@ fn nothing_is_brighter_than_the_contract_allows() {
     let settings = TraceSettings {
         sampling: Sampling::Grid(SubpixelGrid::new(2)),
         whitted: WhittedSettings::default(),
+        path: None,
     };
     let out = render(&s, &bvh, &settings, &|_| {});
     let mut brightest = Vec3::ZERO;
@@ -198,6 +199,7 @@ fn image_is_identical_whatever_the_thread_count() {
             seed: 3,
         },
         whitted: WhittedSettings::default(),
+        path: None,
     };
     let run = |threads| {
         let pool = rayon::ThreadPoolBuilder::new()
@@ -234,6 +236,7 @@ fn rays_along_the_mirror_seam_do_not_leak() {
     let settings = TraceSettings {
         sampling: Sampling::Grid(SubpixelGrid::new(3)),
         whitted: WhittedSettings::default(),
+        path: None,
     };
     let out = render(&s, &bvh, &settings, &|_| {});
     for (i, p) in out.image.pixels.iter().enumerate() {
@@ -259,6 +262,7 @@ fn scene_without_mirrors_equals_the_contract_reference_exactly() {
         &TraceSettings {
             sampling: Sampling::Grid(grid),
             whitted: WhittedSettings::default(),
+            path: None,
         },
         &|_| {},
     );

@@ -16,10 +16,12 @@ pub enum Bvh {
     Bvh2,
 }
 
-#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Integrator {
     /// Perfect mirror chains, the contract's lighting at the first diffuse hit.
     Whitted,
+    /// Physically based path tracing (shadows, interreflection), to compare with Mitsuba's `path`.
+    Path,
 }
 
 #[derive(clap::Args)]
@@ -42,17 +44,21 @@ pub struct Args {
     /// Override every mirror's reflectance (the α being measured), in [0, 1].
     #[arg(long)]
     reflectance: Option<f32>,
-    /// Most mirror reflections a path follows.
+    /// whitted: most mirror reflections a path follows; path: longest path in segments
+    /// (Mitsuba's max_depth: N visible reflections need N + 2).
     #[arg(long, default_value_t = 10_000)]
     max_depth: u32,
+    /// path: depth from which Russian roulette may end paths (Mitsuba's rr_depth).
+    #[arg(long, default_value_t = 5)]
+    rr_depth: u32,
     /// Stop a path when its throughput's largest channel would fall below this, in [0, 1).
     #[arg(long, default_value_t = 1e-4)]
     min_throughput: f32,
     /// Stratified random sub-pixel positions instead of the fixed grid.
     #[arg(long)]
     jitter: bool,
-    /// Seed of --jitter.
-    #[arg(long, default_value_t = 0, requires = "jitter")]
+    /// Seed of --jitter and of the path integrator's random numbers.
+    #[arg(long, default_value_t = 0)]
     seed: u64,
     /// Also write the mean number of mirror bounces per pixel (EXR, with a heat-map PNG beside it).
     #[arg(long, value_name = "FILE.exr")]
@@ -128,7 +134,16 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     };
     let started = Instant::now();
     let bvh = SceneBvh::build_with(&scene.geometry, kind);
-    let settings = TraceSettings { sampling, whitted };
+    let path = (args.integrator == Integrator::Path).then_some(mirrorbox_trace::PathSettings {
+        max_depth: args.max_depth,
+        rr_depth: args.rr_depth,
+        seed: args.seed,
+    });
+    let settings = TraceSettings {
+        sampling,
+        whitted,
+        path,
+    };
     let bar = progress_bar(scene.camera.height as u64, "tracing rows");
     let out = render(&scene, &bvh, &settings, &|rows| {
         bar.set_position(rows as u64)
@@ -146,7 +161,10 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             "mirrorbox.scene_hash",
             format!("{:016x}", scene.content_hash()),
         ),
-        ("mirrorbox.integrator", "whitted".to_string()),
+        (
+            "mirrorbox.integrator",
+            format!("{:?}", args.integrator).to_lowercase(),
+        ),
         ("mirrorbox.spp", grid.samples_per_pixel().to_string()),
         ("mirrorbox.sampling", sampling.describe()),
         ("mirrorbox.max_depth", whitted.max_depth.to_string()),

@@ -1,0 +1,280 @@
+//! The `path` integrator: physically based, for comparison with Mitsuba 3's `path`.
+//!
+//! Unidirectional path tracing of the same surfaces as the contract (two-sided Lambertian,
+//! one-sided emission, perfect mirrors with a diffuse back), with shadows and diffuse
+//! interreflection, which the Whitted model leaves out:
+//! - **next-event estimation**: every point light through a shadow ray; one emissive
+//!   triangle chosen in proportion to its area × emitted luminance, a uniform point on it,
+//!   combined with BSDF sampling by multiple importance sampling (power heuristic);
+//! - cosine-weighted sampling of the diffuse lobe on the side the path arrives from;
+//! - mirrors are delta reflections (no light sampling through them, as in Mitsuba: light that
+//!   reaches a surface only via a mirror is found by BSDF sampling alone);
+//! - the background is a constant environment emitter, found by escaping rays;
+//! - **Russian roulette** from depth `rr_depth` on, survival probability max(throughput) ≤ 0.95.
+//!
+//! Depth follows Mitsuba's `max_depth`: it counts path segments, so 1 shows only directly
+//! visible emitters, 2 adds direct light, and N visible reflections need N + 2. The ambient
+//! term of the contract is not physical and is not used here.
+
+use crate::bvh::SceneBvh;
+use crate::sampler::SplitMix64;
+use crate::whitted::{PathResult, Termination};
+use glam::{DVec3, Vec3};
+use mirrorbox_scene::shading::{Interaction, interaction};
+use mirrorbox_scene::{Ray, Scene, Surface};
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PathSettings {
+    /// Longest path in segments (Mitsuba's `max_depth`).
+    pub max_depth: u32,
+    /// Depth from which Russian roulette may end paths (Mitsuba's `rr_depth`).
+    pub rr_depth: u32,
+    /// Seed of the per-pixel random streams.
+    pub seed: u64,
+}
+
+impl Default for PathSettings {
+    fn default() -> Self {
+        PathSettings {
+            max_depth: 66,
+            rr_depth: 5,
+            seed: 0,
+        }
+    }
+}
+
+struct Emitter {
+    triangle: usize,
+    area: f32,
+    emission: Vec3,
+}
+
+pub struct PathTracer<'a> {
+    scene: &'a Scene,
+    bvh: &'a SceneBvh,
+    settings: PathSettings,
+    normals: Vec<Vec3>,
+    emitters: Vec<Emitter>,
+    /// Cumulative selection probabilities of `emitters`.
+    cdf: Vec<f32>,
+    /// Selection probability of each triangle as an emitter (0 if not one).
+    select_pdf: Vec<f32>,
+    mirror_planes: Vec<(DVec3, f64)>,
+}
+
+fn luminance(c: Vec3) -> f32 {
+    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
+}
+
+/// Cosine-weighted direction around unit `n` (Malley's method).
+fn cosine_sample(n: Vec3, u1: f32, u2: f32) -> Vec3 {
+    let r = u1.sqrt();
+    let phi = 2.0 * std::f32::consts::PI * u2;
+    let (t, b) = n.any_orthonormal_pair();
+    (t * (r * phi.cos()) + b * (r * phi.sin()) + n * (1.0 - u1).max(0.0).sqrt()).normalize()
+}
+
+impl<'a> PathTracer<'a> {
+    pub fn new(scene: &'a Scene, bvh: &'a SceneBvh, settings: PathSettings) -> Self {
+        let g = &scene.geometry;
+        let normals: Vec<Vec3> = (0..g.triangles.len()).map(|i| g.face_normal(i)).collect();
+        let mut emitters = Vec::new();
+        for (i, t) in g.triangles.iter().enumerate() {
+            if let Surface::Diffuse { emission, .. } = g.surface(i)
+                && luminance(*emission) > 0.0
+            {
+                let area = 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length();
+                emitters.push(Emitter {
+                    triangle: i,
+                    area,
+                    emission: *emission,
+                });
+            }
+        }
+        let weights: Vec<f32> = emitters
+            .iter()
+            .map(|e| e.area * luminance(e.emission))
+            .collect();
+        let total: f32 = weights.iter().sum();
+        let mut cdf = Vec::with_capacity(weights.len());
+        let mut acc = 0.0;
+        let mut select_pdf = vec![0.0; g.triangles.len()];
+        for (e, w) in emitters.iter().zip(&weights) {
+            acc += w / total;
+            cdf.push(acc);
+            select_pdf[e.triangle] = w / total;
+        }
+        let mirror_planes = scene
+            .mirrors
+            .iter()
+            .map(|m| {
+                let n = m.normal.as_dvec3().normalize();
+                (n, n.dot(m.center.as_dvec3()))
+            })
+            .collect();
+        PathTracer {
+            scene,
+            bvh,
+            settings,
+            normals,
+            emitters,
+            cdf,
+            select_pdf,
+            mirror_planes,
+        }
+    }
+
+    /// Whether the segment from `p` (on triangle `from`) to `q` is unblocked.
+    fn visible(&self, p: Vec3, from: usize, q: Vec3, to: Option<usize>) -> bool {
+        let d = q - p;
+        let dist = d.length();
+        let ray = Ray {
+            origin: p,
+            dir: d / dist,
+        };
+        match self
+            .bvh
+            .closest_hit_skipping(&ray, 0.0, dist * (1.0 - 1e-4), None, Some(from))
+        {
+            None => true,
+            Some(h) => Some(h.triangle) == to,
+        }
+    }
+
+    /// Radiance along `ray`, random numbers from `rng`.
+    pub fn radiance(&self, ray: Ray, rng: &mut SplitMix64) -> PathResult {
+        let scene = self.scene;
+        let g = &scene.geometry;
+        let mut ray = ray;
+        let mut beta = Vec3::ONE;
+        let mut radiance = Vec3::ZERO;
+        let mut rays = 0u32;
+        let mut bounces = 0u32;
+        // Solid-angle pdf of the BSDF sample that produced `ray`; None after the camera or a mirror.
+        let mut bsdf_pdf: Option<f32> = None;
+        let mut from_triangle: Option<usize> = None;
+        let mut from_mirror: Option<usize> = None;
+        let mut depth = 0u32;
+        let termination = loop {
+            rays += 1;
+            let Some(hit) =
+                self.bvh
+                    .closest_hit_skipping(&ray, 0.0, f32::INFINITY, from_mirror, from_triangle)
+            else {
+                radiance += beta * scene.background;
+                break Termination::Escaped;
+            };
+            let p = ray.at(hit.t);
+            let n_f = self.normals[hit.triangle];
+            let front = n_f.dot(ray.dir) < 0.0;
+            let inter = interaction(g.surface(hit.triangle), front);
+            if let Interaction::Diffuse { emission, .. } = inter
+                && front
+                && emission != Vec3::ZERO
+            {
+                let weight = match bsdf_pdf {
+                    None => 1.0,
+                    Some(p_bsdf) => {
+                        let cos_l = n_f.dot(-ray.dir).max(1e-8);
+                        let area = 0.5 * {
+                            let t = g.triangles[hit.triangle];
+                            (t[1] - t[0]).cross(t[2] - t[0]).length()
+                        };
+                        let p_light = self.select_pdf[hit.triangle] / area * hit.t * hit.t / cos_l;
+                        p_bsdf * p_bsdf / (p_bsdf * p_bsdf + p_light * p_light)
+                    }
+                };
+                radiance += beta * emission * weight;
+            }
+            if depth + 1 >= self.settings.max_depth {
+                break Termination::Depth;
+            }
+            match inter {
+                Interaction::Reflect { reflectance } => {
+                    let Surface::Mirror { mirror, .. } = *g.surface(hit.triangle) else {
+                        unreachable!("only mirrors reflect")
+                    };
+                    beta *= reflectance;
+                    let (n, offset) = self.mirror_planes[mirror];
+                    let (o, d) = (ray.origin.as_dvec3(), ray.dir.as_dvec3());
+                    let t = (offset - n.dot(o)) / n.dot(d);
+                    let origin = o + d * t;
+                    let dir = (d - 2.0 * d.dot(n) * n).normalize();
+                    ray = Ray {
+                        origin: origin.as_vec3(),
+                        dir: dir.as_vec3(),
+                    };
+                    bsdf_pdf = None;
+                    from_mirror = Some(mirror);
+                    from_triangle = None;
+                    bounces += 1;
+                }
+                Interaction::Diffuse { albedo, .. } => {
+                    let n = if front { n_f } else { -n_f };
+                    let f = albedo * std::f32::consts::FRAC_1_PI;
+                    for light in &scene.lighting.lights {
+                        let to = light.position - p;
+                        let r2 = to.length_squared();
+                        let cos = n.dot(to) / r2.sqrt();
+                        if cos > 0.0
+                            && r2 > 1e-8
+                            && self.visible(p, hit.triangle, light.position, None)
+                        {
+                            rays += 1;
+                            radiance += beta * f * light.intensity * (cos / r2);
+                        }
+                    }
+                    if !self.emitters.is_empty() {
+                        let u = rng.next_unit();
+                        let k = self
+                            .cdf
+                            .partition_point(|&c| c <= u)
+                            .min(self.emitters.len() - 1);
+                        let e = &self.emitters[k];
+                        let t = g.triangles[e.triangle];
+                        let (mut a, mut b) = (rng.next_unit(), rng.next_unit());
+                        if a + b > 1.0 {
+                            (a, b) = (1.0 - a, 1.0 - b);
+                        }
+                        let q = t[0] + (t[1] - t[0]) * a + (t[2] - t[0]) * b;
+                        let to = q - p;
+                        let r2 = to.length_squared();
+                        let l = to / r2.sqrt();
+                        let cos_p = n.dot(l);
+                        let cos_l = -self.normals[e.triangle].dot(l);
+                        if cos_p > 0.0
+                            && cos_l > 0.0
+                            && self.visible(p, hit.triangle, q, Some(e.triangle))
+                        {
+                            rays += 1;
+                            let p_light = self.select_pdf[e.triangle] / e.area * r2 / cos_l;
+                            let p_bsdf = cos_p * std::f32::consts::FRAC_1_PI;
+                            let w = p_light * p_light / (p_light * p_light + p_bsdf * p_bsdf);
+                            radiance += beta * f * e.emission * (cos_p / p_light) * w;
+                        }
+                    }
+                    let dir = cosine_sample(n, rng.next_unit(), rng.next_unit());
+                    bsdf_pdf = Some(n.dot(dir) * std::f32::consts::FRAC_1_PI);
+                    beta *= albedo; // f·cos/pdf = ρ/π·cos/(cos/π)
+                    ray = Ray { origin: p, dir };
+                    from_triangle = Some(hit.triangle);
+                    from_mirror = None;
+                }
+            }
+            depth += 1;
+            if depth >= self.settings.rr_depth {
+                let q = beta.max_element().min(0.95);
+                if q <= 0.0 || rng.next_unit() >= q {
+                    break Termination::Throughput;
+                }
+                beta /= q;
+            }
+        };
+        PathResult {
+            radiance,
+            bounces,
+            termination,
+            rays,
+        }
+    }
+}
