@@ -134,9 +134,9 @@ fn block_differences(a: &RgbImage, b: &RgbImage, k: u32) -> Vec<f64> {
 }
 
 /// Monte Carlo: the two image means must agree within a tolerance set by measured noise.
-/// At this size and 256 spp the image mean of one render varies by 0.10 % (ours) and
-/// 0.06 % (Mitsuba) between seeds (standard deviations over 4 seeds each, measured
-/// 2026-11-21), so one difference carries ~0.12 % of noise: the 1 % tolerance is ~8σ — a
+/// At this size and 256 spp the image mean of one render varies by 0.020 % (ours) and
+/// 0.063 % (Mitsuba) between seeds (standard deviations over 4 seeds each, measured
+/// 2026-11-21), so one difference carries ~0.066 % of noise: the 1 % tolerance is ~15σ — a
 /// real disagreement of 1 % fails, noise never does. The block t statistic is printed as a
 /// diagnostic only: Mitsuba's sampler correlates neighbouring pixels, so blocks are not
 /// independent enough for a strict test (see docs/mitsuba.md for the open ~0.1 % question).

@@ -52,21 +52,31 @@ impl Sampling {
 /// Largest f32 below 1, so an offset never reaches the next pixel.
 const ONE_BELOW: f32 = 1.0 - f32::EPSILON / 2.0;
 
+const GAMMA: u64 = 0x9E37_79B9_7F4A_7C15;
+
+/// SplitMix64's output function: a bijection of u64 with full avalanche.
+fn mix(mut z: u64) -> u64 {
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
 /// SplitMix64 (Steele, Lea, Flood 2014): tiny, fast, well distributed; enough for jitter
 /// and for the path integrator's per-pixel streams.
 pub struct SplitMix64(u64);
 
 impl SplitMix64 {
     /// The stream of pixel `pixel` for `seed` (independent of thread scheduling).
+    ///
+    /// The start state goes through the finalizer twice: SplitMix64 walks its state in steps
+    /// of γ, so starting pixel p at `seed ^ p·γ` (as an earlier version did) would make pixel
+    /// p + 1's stream pixel p's shifted by one number — neighbouring pixels correlated.
     pub fn for_pixel(seed: u64, pixel: u64) -> Self {
-        SplitMix64(seed ^ pixel.wrapping_mul(0x9E37_79B9_7F4A_7C15))
+        SplitMix64(mix(mix(seed).wrapping_add(pixel)))
     }
     fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
+        self.0 = self.0.wrapping_add(GAMMA);
+        mix(self.0)
     }
     /// Uniform in [0, 1) with 24 bits.
     pub fn next_unit(&mut self) -> f32 {
@@ -77,6 +87,33 @@ impl SplitMix64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Streams of neighbouring pixels are unrelated: no stream is another shifted by a few
+    /// numbers, and their first values are uncorrelated.
+    #[test]
+    fn pixel_streams_are_independent() {
+        let first: Vec<Vec<f32>> = (0..256u64)
+            .map(|p| {
+                let mut r = SplitMix64::for_pixel(0, p);
+                (0..8).map(|_| r.next_unit()).collect()
+            })
+            .collect();
+        for p in 0..255 {
+            for shift in 0..4 {
+                assert_ne!(
+                    first[p][shift..shift + 4],
+                    first[p + 1][..4],
+                    "pixel {} = pixel {p} shifted by {shift}",
+                    p + 1
+                );
+            }
+        }
+        // Lag-1 correlation between neighbouring pixels' first numbers.
+        let x: Vec<f64> = first.iter().map(|v| v[0] as f64 - 0.5).collect();
+        let c: f64 =
+            x.windows(2).map(|w| w[0] * w[1]).sum::<f64>() / x.iter().map(|v| v * v).sum::<f64>();
+        assert!(c.abs() < 0.2, "correlation {c}");
+    }
 
     #[test]
     fn jitter_stays_in_its_stratum_and_is_reproducible() {
