@@ -7,6 +7,7 @@
 //! - [`render`]: the parallel image loop and its statistics.
 
 pub mod bvh;
+pub mod mirror_bounce;
 pub mod path;
 pub mod render;
 pub mod sampler;

@@ -17,9 +17,10 @@
 //! term of the contract is not physical and is not used here.
 
 use crate::bvh::SceneBvh;
+use crate::mirror_bounce::MirrorPlanes;
 use crate::sampler::SplitMix64;
 use crate::whitted::{PathResult, Termination};
-use glam::{DVec3, Vec3};
+use glam::Vec3;
 use mirrorbox_scene::shading::{Interaction, interaction};
 use mirrorbox_scene::{Ray, Scene, Surface};
 
@@ -59,7 +60,7 @@ pub struct PathTracer<'a> {
     cdf: Vec<f32>,
     /// Selection probability of each triangle as an emitter (0 if not one).
     select_pdf: Vec<f32>,
-    mirror_planes: Vec<(DVec3, f64)>,
+    mirror_planes: MirrorPlanes,
 }
 
 fn luminance(c: Vec3) -> f32 {
@@ -104,14 +105,7 @@ impl<'a> PathTracer<'a> {
             cdf.push(acc);
             select_pdf[e.triangle] = w / total;
         }
-        let mirror_planes = scene
-            .mirrors
-            .iter()
-            .map(|m| {
-                let n = m.normal.as_dvec3().normalize();
-                (n, n.dot(m.center.as_dvec3()))
-            })
-            .collect();
+        let mirror_planes = MirrorPlanes::new(scene);
         PathTracer {
             scene,
             bvh,
@@ -195,11 +189,11 @@ impl<'a> PathTracer<'a> {
                         unreachable!("only mirrors reflect")
                     };
                     beta *= reflectance;
-                    let (n, offset) = self.mirror_planes[mirror];
-                    let (o, d) = (ray.origin.as_dvec3(), ray.dir.as_dvec3());
-                    let t = (offset - n.dot(o)) / n.dot(d);
-                    let origin = o + d * t;
-                    let dir = (d - 2.0 * d.dot(n) * n).normalize();
+                    let (origin, dir) = self.mirror_planes.reflect(
+                        mirror,
+                        ray.origin.as_dvec3(),
+                        ray.dir.as_dvec3(),
+                    );
                     ray = Ray {
                         origin: origin.as_vec3(),
                         dir: dir.as_vec3(),

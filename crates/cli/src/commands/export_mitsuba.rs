@@ -1,6 +1,6 @@
 //! `mirrorbox export-mitsuba SCENE -o DIR/scene.xml`: the scene as Mitsuba 3 XML.
 
-use super::{load, output_path, resize};
+use super::{grid_side, load, output_path, resize, unit_interval};
 use crate::Failure;
 use mirrorbox_mitsuba::{ExportSettings, export};
 use std::path::PathBuf;
@@ -25,20 +25,8 @@ pub struct Args {
 }
 
 pub fn run(args: &Args) -> Result<(), Failure> {
-    let s = (args.spp as f64).sqrt().round() as u32;
-    if args.spp == 0 || s * s != args.spp {
-        return Err(Failure::BadInput(format!(
-            "--spp {} must be a perfect square: 1, 4, 9, 16, ...",
-            args.spp
-        )));
-    }
-    if let Some(r) = args.reflectance
-        && !(0.0..=1.0).contains(&r)
-    {
-        return Err(Failure::BadInput(format!(
-            "--reflectance must be in [0, 1], got {r}"
-        )));
-    }
+    grid_side(args.spp)?;
+    unit_interval("--reflectance", args.reflectance)?;
     // The export is a folder of files: make the folder if needed.
     if let Some(dir) = args.output.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).map_err(|e| {

@@ -15,6 +15,27 @@ pub fn load(path: &Path) -> Result<Scene, Failure> {
     load_scene(path).map_err(|e| Failure::BadInput(e.to_string()))
 }
 
+/// The s of `--spp s²`: samples per pixel must be a perfect square (the s×s sub-pixel grid).
+pub fn grid_side(spp: u32) -> Result<u32, Failure> {
+    let s = (spp as f64).sqrt().round() as u32;
+    if spp == 0 || s * s != spp {
+        return Err(Failure::BadInput(format!(
+            "--spp {spp} must be a perfect square (the s×s sub-pixel grid): 1, 4, 9, 16, 25, ..."
+        )));
+    }
+    Ok(s)
+}
+
+/// A reflectance override (`--reflectance`), in [0, 1].
+pub fn unit_interval(flag: &str, value: Option<f32>) -> Result<Option<f32>, Failure> {
+    match value {
+        Some(v) if !(0.0..=1.0).contains(&v) => Err(Failure::BadInput(format!(
+            "{flag} must be in [0, 1], got {v}"
+        ))),
+        v => Ok(v),
+    }
+}
+
 /// Applies `--width/--height` overrides (each 1..=16384).
 pub fn resize(scene: &mut Scene, width: Option<u32>, height: Option<u32>) -> Result<(), Failure> {
     let max = mirrorbox_scene::load::defaults::MAX_IMAGE_SIDE;

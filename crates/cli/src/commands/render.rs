@@ -1,7 +1,7 @@
 //! `mirrorbox render SCENE --method naive|auxiliary -o OUT.png`: the seed paper's raster
 //! methods with wgpu, timed.
 
-use super::{load, output_path, resize};
+use super::{load, output_path, resize, unit_interval};
 use crate::Failure;
 use mirrorbox_image::{write_exr, write_png};
 use mirrorbox_raster::plan::PlanError;
@@ -67,11 +67,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         }
         (MethodName::Auxiliary, n) => Method::Auxiliary { n: n.unwrap_or(0) },
     };
-    if let Some(a) = args.alpha
-        && !(0.0..=1.0).contains(&a)
-    {
-        return Err(bad(format!("--alpha must be in [0, 1], got {a}")));
-    }
+    unit_interval("--alpha", args.alpha)?;
     if !(1..=8).contains(&args.ssaa) {
         return Err(bad(format!("--ssaa must be in [1, 8], got {}", args.ssaa)));
     }

@@ -1,6 +1,6 @@
 //! `mirrorbox trace SCENE -o OUT.exr`: the ground truth, rendered on the CPU with obvhs.
 
-use super::{load, output_path, progress_bar, resize};
+use super::{grid_side, load, output_path, progress_bar, resize, unit_interval};
 use crate::Failure;
 use mirrorbox_image::{RgbImage, colormap, write_exr, write_png, write_png_bytes};
 use mirrorbox_scene::SubpixelGrid;
@@ -74,20 +74,8 @@ pub struct Args {
 }
 
 fn check_args(args: &Args) -> Result<(SubpixelGrid, WhittedSettings), Failure> {
-    let s = (args.spp as f64).sqrt().round() as u32;
-    if args.spp == 0 || s * s != args.spp {
-        return Err(Failure::BadInput(format!(
-            "--spp {} must be a perfect square (the s×s sub-pixel grid): 1, 4, 9, 16, 25, ...",
-            args.spp
-        )));
-    }
-    if let Some(r) = args.reflectance
-        && !(0.0..=1.0).contains(&r)
-    {
-        return Err(Failure::BadInput(format!(
-            "--reflectance must be in [0, 1], got {r}"
-        )));
-    }
+    let s = grid_side(args.spp)?;
+    unit_interval("--reflectance", args.reflectance)?;
     if !(0.0..1.0).contains(&args.min_throughput) {
         return Err(Failure::BadInput(format!(
             "--min-throughput must be in [0, 1), got {}",
