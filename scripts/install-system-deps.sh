@@ -8,7 +8,8 @@
 set -u
 
 have_vulkan_driver() {
-  ls /usr/share/vulkan/icd.d/*.json /etc/vulkan/icd.d/*.json >/dev/null 2>&1 &&
+  # Either folder may hold the drivers' ICD files (ls fails if any of its globs is empty).
+  { ls /usr/share/vulkan/icd.d/*.json >/dev/null 2>&1 || ls /etc/vulkan/icd.d/*.json >/dev/null 2>&1; } &&
     ldconfig -p 2>/dev/null | grep -q 'libvulkan\.so\.1'
 }
 have_egl() {
