@@ -181,3 +181,39 @@ fn more_auxiliary_mirrors_show_more_reflections() {
         assert!(w[1] > w[0], "pixels matching the truth by n: {matching:?}");
     }
 }
+
+/// Geometry behind a mirror must never leak into it: a bright emissive box sits right behind
+/// a single mirror that fills most of the view. The oblique near plane must cut it from the
+/// mirror camera, so the raster image equals the trace (which can never see it) up to the
+/// contract test's tolerance, and nothing of the box's colour appears.
+#[test]
+fn geometry_behind_a_mirror_does_not_leak() {
+    let text = serde_json::json!({
+        "camera": { "position": [0.3, 1.2, 2.5], "look_at": [0, 1, -2], "fov_y_deg": 50, "width": 64, "height": 48 },
+        "mirrors": [ { "center": [0, 1.5, -2], "normal": [0, 0, 1], "up": [0, 1, 0], "width": 4, "height": 3 } ],
+        "objects": [
+            { "type": "quad", "size": [4, 4], "transform": { "rotate_deg": [-90, 0, 0] } },
+            { "type": "sphere", "radius": 0.4, "transform": { "translate": [0, 0.6, 0] }, "albedo": [0.2, 0.4, 0.8] },
+            { "type": "box", "size": [1.5, 1.5, 0.5], "albedo": [0, 0, 0], "emission": [0, 50, 0],
+              "transform": { "translate": [0, 1.5, -2.4] } }
+        ],
+        "lights": [ { "position": [0, 2.5, 1], "intensity": [10, 10, 10] } ],
+    });
+    let s = mirrorbox_scene::load::parse_scene(&text.to_string(), Path::new("leak.json")).unwrap();
+    let r = raster(&s, Method::Naive, 1);
+    let t = trace(&s, 1);
+    let green = r.pixels.iter().filter(|p| p[1] > 5.0).count();
+    assert_eq!(
+        green, 0,
+        "the emissive box behind the mirror leaked into {green} pixels"
+    );
+    let d = differences(&r, &t);
+    let off = d.iter().filter(|&&x| x > 1e-4).count();
+    if off * 100 > d.len() {
+        let where_ = dump("leak", &r, &t);
+        panic!(
+            "{off} of {} pixels differ from the trace; {where_}",
+            d.len()
+        );
+    }
+}
