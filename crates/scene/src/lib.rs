@@ -18,6 +18,7 @@ pub mod hash;
 pub mod load;
 pub mod polygon;
 pub mod reflection;
+pub mod reflection_paths;
 pub mod shading;
 pub mod tessellate;
 
