@@ -25,6 +25,8 @@ use std::path::{Path, PathBuf};
 pub enum MethodKind {
     Naive,
     Auxiliary,
+    /// Exact stencil recursion, swept over `depths`.
+    Portal,
 }
 
 #[derive(Clone, Debug)]
@@ -34,6 +36,8 @@ pub struct SweepConfig {
     pub methods: Vec<MethodKind>,
     /// Auxiliary mirror counts (auxiliary method).
     pub ns: Vec<u32>,
+    /// Reflection depths (portal method).
+    pub depths: Vec<u32>,
     pub alphas: Vec<f32>,
     pub width: Option<u32>,
     pub height: Option<u32>,
@@ -108,18 +112,27 @@ fn points(config: &SweepConfig, base_hash: u64, w: u32, h: u32) -> Vec<Point> {
                 MethodKind::Auxiliary => {
                     config.ns.iter().map(|&n| Method::Auxiliary { n }).collect()
                 }
+                MethodKind::Portal => config
+                    .depths
+                    .iter()
+                    .map(|&depth| Method::Portal { depth })
+                    .collect(),
             };
             for method in methods {
                 let (name, n) = match method {
                     Method::Naive => ("naive".to_string(), String::new()),
                     Method::Auxiliary { n } => ("auxiliary".to_string(), format!(" n={n}")),
+                    Method::Portal { depth } => ("portal".to_string(), format!(" depth={depth}")),
                 };
                 out.push(Point {
                     method: Some(method),
                     alpha,
                     key: format!("{name}{n}|alpha={alpha}|{common}"),
                     label: format!("{name}{n} α={alpha}"),
-                    slug: format!("{name}{}_a{alpha}", n.replace(" n=", "_n")),
+                    slug: format!(
+                        "{name}{}_a{alpha}",
+                        n.replace(" n=", "_n").replace(" depth=", "_d")
+                    ),
                 });
             }
         }
@@ -238,7 +251,7 @@ pub fn run_sweep(
     let all = points(config, base_hash, w, h);
     // Refuse over-budget points before any work.
     for p in &all {
-        if let Some(method) = p.method {
+        if let Some(method @ (Method::Naive | Method::Auxiliary { .. })) = p.method {
             plan::plan(
                 &base,
                 method,
@@ -290,6 +303,8 @@ pub fn run_sweep(
             warmup: config.warmup,
             max_passes: config.max_passes,
             texture_scale: 1.0,
+            min_portal_area: 0.0,
+            min_attenuation: 1e-4,
         };
         let rendered = mirrorbox_raster::render(&gpu, &scene, &settings).map_err(other)?;
         let m = compare(&truth_image, &rendered.image, scene.camera.exposure).map_err(other)?;
@@ -330,6 +345,7 @@ pub fn run_sweep(
             method: match p.method {
                 Some(Method::Auxiliary { .. }) => "auxiliary",
                 Some(Method::Naive) => "naive",
+                Some(Method::Portal { .. }) => "portal",
                 None => "floor",
             }
             .into(),
@@ -337,7 +353,10 @@ pub fn run_sweep(
                 Some(Method::Auxiliary { n }) => Some(n),
                 _ => None,
             },
-            depth: None,
+            depth: match p.method {
+                Some(Method::Portal { depth }) => Some(depth),
+                _ => None,
+            },
             alpha: p.alpha,
             width: w,
             height: h,

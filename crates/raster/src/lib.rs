@@ -5,12 +5,14 @@
 //! - [`shading`]: the shading contract in WGSL and the scene buffers it reads.
 //! - [`plan`]: the seed paper's recursion (naive and auxiliary), planned on the CPU.
 //! - [`recursive_texture`]: executes that plan with render-to-texture mirror cameras.
+//! - [`portal_stencil`]: exact mirrors by stencil recursion over the reflection paths.
 //! - [`frame`]: targets, SSAA resolve, GPU timing, readback.
 
 pub mod adapter;
 pub mod frame;
 pub mod gpu;
 pub mod plan;
+pub mod portal_stencil;
 pub mod recursive_texture;
 pub mod shading;
 
@@ -22,6 +24,9 @@ pub use recursive_texture::FrameStats;
 
 use mirrorbox_image::RgbImage;
 use mirrorbox_scene::Scene;
+
+/// Most reflection paths the portal method draws per frame (memory and time bound).
+pub const MAX_PORTAL_PATHS: usize = 200_000;
 
 /// How to render.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -35,6 +40,10 @@ pub struct RenderSettings {
     pub max_passes: usize,
     /// Mirror texture resolution relative to the mirror's footprint (1 = exact).
     pub texture_scale: f32,
+    /// Exact methods: prune reflection paths whose portal is smaller (pixels², at render
+    /// resolution) or whose attenuation falls below `min_attenuation`.
+    pub min_portal_area: f32,
+    pub min_attenuation: f32,
 }
 
 pub struct RenderOutput {
@@ -54,9 +63,6 @@ pub fn render(
         scene.camera.width * settings.ssaa,
         scene.camera.height * settings.ssaa,
     );
-    let plan = plan::plan(scene, settings.method, w, h, settings.max_passes)?;
-    let method =
-        recursive_texture::RecursiveTexture::new(gpu, scene, &plan, settings.texture_scale);
     let target = frame::RenderTarget::new(
         &gpu.device,
         "view",
@@ -65,10 +71,42 @@ pub fn render(
         wgpu::TextureUsages::TEXTURE_BINDING,
     );
     let resolve = frame::Resolve::new(&gpu.device, &target, settings.ssaa);
+    let (method, stats): (Box<dyn frame::FrameEncoder>, FrameStats) = match settings.method {
+        Method::Portal { depth } => {
+            let projection = scene
+                .camera
+                .with_size(w, h)
+                .projection(plan::NEAR, plan::FAR);
+            let limits = mirrorbox_scene::reflection_paths::PathLimits {
+                max_depth: depth,
+                min_portal_area: settings.min_portal_area,
+                min_attenuation: settings.min_attenuation,
+                max_paths: MAX_PORTAL_PATHS,
+            };
+            let paths = mirrorbox_scene::reflection_paths::reflection_paths(
+                scene, w, h, projection, &limits,
+            );
+            if paths.truncated {
+                return Err(RasterError::Plan(plan::PlanError::TooManyPaths {
+                    limit: MAX_PORTAL_PATHS,
+                }));
+            }
+            let m = portal_stencil::PortalStencil::new(gpu, scene, &paths, w, h, projection)?;
+            let stats = m.stats;
+            (Box::new(m), stats)
+        }
+        method => {
+            let plan = plan::plan(scene, method, w, h, settings.max_passes)?;
+            let m =
+                recursive_texture::RecursiveTexture::new(gpu, scene, &plan, settings.texture_scale);
+            let stats = m.stats;
+            (Box::new(m), stats)
+        }
+    };
     gpu.check()?;
     let (image, timing) = frame::run_frames(
         gpu,
-        &method,
+        method.as_ref(),
         &target,
         &resolve,
         settings.warmup,
@@ -77,6 +115,6 @@ pub fn render(
     Ok(RenderOutput {
         image,
         timing,
-        stats: method.stats,
+        stats,
     })
 }

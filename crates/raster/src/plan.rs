@@ -36,7 +36,14 @@ const COUNT_CEILING: usize = 1_000_000;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Method {
     Naive,
-    Auxiliary { n: u32 },
+    Auxiliary {
+        n: u32,
+    },
+    /// Exact stencil recursion over reflection paths up to `depth` mirrors (not a
+    /// render-to-texture plan: see `portal_stencil`).
+    Portal {
+        depth: u32,
+    },
 }
 
 /// One mirror of the rendering queue: a real mirror or an auxiliary copy of one.
@@ -95,6 +102,14 @@ pub enum PlanError {
     )]
     NotAPair(usize),
     #[error(
+        "more than {limit} reflection paths are visible: raise --min-portal-area (pixels²) or --min-attenuation, or lower --depth"
+    )]
+    TooManyPaths { limit: usize },
+    #[error(
+        "this frame would draw {triangles} triangles, above the limit of {limit}: raise --min-portal-area or --min-attenuation, or lower --depth"
+    )]
+    TooManyTriangles { triangles: usize, limit: usize },
+    #[error(
         "this configuration would render {predicted}{} scene passes per frame, above --max-passes {limit}",
         if *.exceeded_count { " or more" } else { "" }
     )]
@@ -108,7 +123,7 @@ pub enum PlanError {
 /// The rendering queue of a method.
 pub fn instances(scene: &Scene, method: Method) -> Result<Vec<MirrorInstance>, PlanError> {
     match method {
-        Method::Naive => Ok((0..scene.mirrors.len())
+        Method::Naive | Method::Portal { .. } => Ok((0..scene.mirrors.len())
             .map(|i| MirrorInstance {
                 mirror: i,
                 label: format!("mirror {}", i + 1),

@@ -73,6 +73,8 @@ pub struct SceneBuffers {
     pub objects: std::ops::Range<u32>,
     /// Vertex range of each scene mirror.
     pub mirrors: Vec<std::ops::Range<u32>>,
+    /// Vertex range and world-space bounds (min, max) of each non-mirror part, inside `objects`.
+    pub parts: Vec<(std::ops::Range<u32>, glam::Vec3, glam::Vec3)>,
     pub layout: wgpu::BindGroupLayout,
     pub bind_group: wgpu::BindGroup,
 }
@@ -97,6 +99,24 @@ impl SceneBuffers {
             }
         }
         let objects = 0..vertices.len() as u32;
+        // Diffuse parts are contiguous, in geometry order, inside `objects`.
+        let mut parts = Vec::new();
+        let mut start = 0u32;
+        for part in &g.parts {
+            if !matches!(g.surfaces[part.surface as usize], Surface::Diffuse { .. })
+                || part.triangles.is_empty()
+            {
+                continue;
+            }
+            let tris = &g.triangles[part.triangles.clone()];
+            let (lo, hi) = tris.iter().flatten().fold(
+                (glam::Vec3::INFINITY, glam::Vec3::NEG_INFINITY),
+                |(a, b), p| (a.min(*p), b.max(*p)),
+            );
+            let end = start + 3 * tris.len() as u32;
+            parts.push((start..end, lo, hi));
+            start = end;
+        }
         let mut mirrors = Vec::new();
         for tris in mirror_tris {
             let start = vertices.len() as u32;
@@ -223,6 +243,7 @@ impl SceneBuffers {
             vertices: vertices_buf,
             objects,
             mirrors,
+            parts,
             layout,
             bind_group,
         }

@@ -24,6 +24,8 @@ pub struct PathLimits {
     pub min_portal_area: f32,
     /// Paths whose attenuation (largest channel) falls below this are pruned.
     pub min_attenuation: f32,
+    /// Enumeration stops (and [`PathSet::truncated`] is set) beyond this many paths.
+    pub max_paths: usize,
 }
 
 #[derive(Clone, Debug)]
@@ -50,10 +52,28 @@ pub struct PathSet {
     pub pruned_attenuation: usize,
     pub capped: usize,
     pub deepest: usize,
+    /// More paths were visible than `max_paths` allowed: the set is incomplete.
+    pub truncated: bool,
+}
+
+/// Drops vertices that (nearly) repeat their predecessor: clipping leaves such duplicates,
+/// and a zero-length edge has no usable direction.
+fn without_duplicates(poly: Vec<Vec2>) -> Vec<Vec2> {
+    let mut out: Vec<Vec2> = Vec::with_capacity(poly.len());
+    for p in poly {
+        if out.last().is_none_or(|q| q.distance_squared(p) > 1e-8) {
+            out.push(p);
+        }
+    }
+    while out.len() > 1 && out[0].distance_squared(out[out.len() - 1]) <= 1e-8 {
+        out.pop();
+    }
+    out
 }
 
 /// Keeps the part of convex polygon `poly` inside convex polygon `clip` (any orientation).
 pub fn clip_convex(poly: &[Vec2], clip: &[Vec2]) -> Vec<Vec2> {
+    let clip = without_duplicates(clip.to_vec());
     let twice: f32 = (0..clip.len())
         .map(|i| clip[i].perp_dot(clip[(i + 1) % clip.len()]))
         .sum();
@@ -64,9 +84,10 @@ pub fn clip_convex(poly: &[Vec2], clip: &[Vec2]) -> Vec<Vec2> {
             break;
         }
         let (a, b) = (clip[i], clip[(i + 1) % clip.len()]);
-        out = clip_by(&out, |p| orientation * (b - a).perp_dot(p - a));
+        let edge = (b - a).normalize_or_zero();
+        out = clip_by(&out, |p| orientation * edge.perp_dot(p - a));
     }
-    out
+    without_duplicates(out)
 }
 
 fn to_f64(m: Mat4) -> DMat4 {
@@ -173,6 +194,10 @@ pub fn reflection_paths(
                 set.capped += 1;
                 continue;
             }
+            if set.paths.len() >= limits.max_paths {
+                set.truncated = true;
+                return set;
+            }
             let view64 = views64[parent] * reflection_f64(&mirror_plane);
             let mut mirrors = set.paths[parent].mirrors.clone();
             mirrors.push(m);
@@ -214,6 +239,7 @@ mod tests {
             max_depth,
             min_portal_area: 0.0,
             min_attenuation: 1e-4,
+            max_paths: 100_000,
         }
     }
 
@@ -268,12 +294,37 @@ mod tests {
                 max_depth: 64,
                 min_portal_area: 1.0,
                 min_attenuation: 1e-4,
+                max_paths: 100_000,
             },
         );
         let branching = set.paths.iter().filter(|p| p.children.len() > 1).count();
         assert!(branching > 0, "the room branches");
         assert!(set.paths.len() < 20_000, "{} paths", set.paths.len());
         assert!(set.pruned_small + set.pruned_empty > 0);
+        assert!(!set.truncated);
+        let tight = run(
+            &s,
+            &PathLimits {
+                max_depth: 64,
+                min_portal_area: 1.0,
+                min_attenuation: 1e-4,
+                max_paths: 50,
+            },
+        );
+        assert!(tight.truncated && tight.paths.len() == 50);
+    }
+
+    /// A clip polygon with a repeated vertex (as clipping produces) must not cut everything.
+    #[test]
+    fn repeated_vertices_do_not_empty_the_clip() {
+        let a = [
+            Vec2::new(0.0, 0.0),
+            Vec2::new(2.0, 0.0),
+            Vec2::new(2.0, 2.0),
+            Vec2::new(0.0, 2.0),
+        ];
+        let with_repeat = [a[0], a[1], a[2], a[2] + Vec2::new(0.0, 4e-6), a[3]];
+        assert!((area(&clip_convex(&a, &with_repeat)) - 4.0).abs() < 1e-4);
     }
 
     #[test]

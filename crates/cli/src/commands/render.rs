@@ -14,6 +14,8 @@ pub enum MethodName {
     Naive,
     /// The paper's §3.1–3.2: n auxiliary mirrors (n + 2 in the queue), attenuation α^k.
     Auxiliary,
+    /// Exact: stencil recursion over the reflection paths, one pass, cost linear in depth.
+    Portal,
 }
 
 #[derive(clap::Args)]
@@ -25,6 +27,15 @@ pub struct Args {
     /// Auxiliary mirrors (auxiliary method only).
     #[arg(long)]
     n: Option<u32>,
+    /// Most mirrors along a reflection path (portal method only).
+    #[arg(long)]
+    depth: Option<u32>,
+    /// Portal method: prune paths whose portal covers fewer pixels² (at render resolution).
+    #[arg(long, default_value_t = 0.5)]
+    min_portal_area: f32,
+    /// Portal method: prune paths whose attenuation falls below this (the tracer's --min-throughput).
+    #[arg(long, default_value_t = 1e-4)]
+    min_attenuation: f32,
     /// Attenuation per reflection; also sets every mirror's reflectance (the truth to compare
     /// with is `trace --reflectance α`). In [0, 1]. Default: the scene's reflectances.
     #[arg(long)]
@@ -60,13 +71,29 @@ fn bad(message: String) -> Failure {
 }
 
 pub fn run(args: &Args) -> Result<(), Failure> {
-    let method = match (args.method, args.n) {
-        (MethodName::Naive, None) => Method::Naive,
-        (MethodName::Naive, Some(_)) => {
-            return Err(bad("--n applies to --method auxiliary only".into()));
-        }
-        (MethodName::Auxiliary, n) => Method::Auxiliary { n: n.unwrap_or(0) },
+    if args.n.is_some() && args.method != MethodName::Auxiliary {
+        return Err(bad("--n applies to --method auxiliary only".into()));
+    }
+    if args.depth.is_some() && args.method != MethodName::Portal {
+        return Err(bad("--depth applies to --method portal only".into()));
+    }
+    let method = match args.method {
+        MethodName::Naive => Method::Naive,
+        MethodName::Auxiliary => Method::Auxiliary {
+            n: args.n.unwrap_or(0),
+        },
+        MethodName::Portal => match args.depth.unwrap_or(64) {
+            d @ 1..=4096 => Method::Portal { depth: d },
+            d => return Err(bad(format!("--depth must be in [1, 4096], got {d}"))),
+        },
     };
+    unit_interval("--min-attenuation", Some(args.min_attenuation))?;
+    if !(args.min_portal_area >= 0.0 && args.min_portal_area.is_finite()) {
+        return Err(bad(format!(
+            "--min-portal-area must be ≥ 0, got {}",
+            args.min_portal_area
+        )));
+    }
     unit_interval("--alpha", args.alpha)?;
     if !(1..=8).contains(&args.ssaa) {
         return Err(bad(format!("--ssaa must be in [1, 8], got {}", args.ssaa)));
@@ -93,6 +120,8 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         warmup: args.warmup,
         max_passes: args.max_passes,
         texture_scale: args.texture_scale,
+        min_portal_area: args.min_portal_area,
+        min_attenuation: args.min_attenuation,
     };
     // Plan first: a refused configuration costs no GPU set-up.
     let (w, h) = (
@@ -106,6 +135,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     let method_text = match method {
         Method::Naive => "naive".to_string(),
         Method::Auxiliary { n } => format!("auxiliary n={n}"),
+        Method::Portal { depth } => format!("portal depth={depth}"),
     };
     let alpha = args
         .alpha
@@ -132,8 +162,9 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         let v = serde_json::json!({
             "scene": args.scene.display().to_string(),
             "scene_hash": format!("{:016x}", scene.content_hash()),
-            "method": match method { Method::Naive => "naive", Method::Auxiliary { .. } => "auxiliary" },
-            "n": match method { Method::Naive => None, Method::Auxiliary { n } => Some(n) },
+            "method": match method { Method::Naive => "naive", Method::Auxiliary { .. } => "auxiliary", Method::Portal { .. } => "portal" },
+            "n": match method { Method::Auxiliary { n } => Some(n), _ => None },
+            "depth_limit": match method { Method::Portal { depth } => Some(depth), _ => None },
             "alpha": args.alpha,
             "width": scene.camera.width, "height": scene.camera.height, "ssaa": args.ssaa,
             "texture_scale": args.texture_scale, "frames": args.frames, "warmup": args.warmup,

@@ -14,12 +14,15 @@ pub struct Args {
     /// Output folder (results.jsonl, results.csv, report.md, report.html, plots, images, cache).
     #[arg(long)]
     out: PathBuf,
-    /// Methods, comma separated: naive, auxiliary.
+    /// Methods, comma separated: naive, auxiliary, portal.
     #[arg(long, default_value = "naive,auxiliary")]
     methods: String,
     /// Auxiliary mirror counts: a range `A..B` (inclusive) or a list `0,2,4`.
     #[arg(long, default_value = "0..4")]
     n: String,
+    /// Reflection depths of the portal method: a range `A..B` or a list `1,4,16,64`.
+    #[arg(long, default_value = "1,2,4,8,16,32,64")]
+    depth: String,
     /// Reflectances α, comma separated, each in [0, 1].
     #[arg(long, default_value = "0.5,0.7,0.9,1.0")]
     alpha: String,
@@ -91,6 +94,29 @@ fn parse_ns(s: &str) -> Result<Vec<u32>, Failure> {
     Ok(v)
 }
 
+fn parse_depths(s: &str) -> Result<Vec<u32>, Failure> {
+    let err = || {
+        bad(format!(
+            "--depth {s:?}: expected a range like 1..8 or a list like 1,4,16,64 of depths 1..=4096"
+        ))
+    };
+    let v: Vec<u32> = if let Some((a, b)) = s.split_once("..") {
+        let (a, b): (u32, u32) = (
+            a.trim().parse().map_err(|_| err())?,
+            b.trim().parse().map_err(|_| err())?,
+        );
+        (a..=b).collect()
+    } else {
+        s.split(',')
+            .map(|x| x.trim().parse().map_err(|_| err()))
+            .collect::<Result<_, _>>()?
+    };
+    if v.is_empty() || v.iter().any(|&d| d == 0 || d > 4096) {
+        return Err(err());
+    }
+    Ok(v)
+}
+
 fn parse_alphas(s: &str) -> Result<Vec<f32>, Failure> {
     s.split(',')
         .map(|x| match x.trim().parse::<f32>() {
@@ -130,6 +156,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         out: args.out.clone(),
         methods: parse_methods(&args.methods)?,
         ns: parse_ns(&args.n)?,
+        depths: parse_depths(&args.depth)?,
         alphas: parse_alphas(&args.alpha)?,
         width: args.width,
         height: args.height,
@@ -152,6 +179,7 @@ pub fn run_table1(args: &Table1Args) -> Result<(), Failure> {
         out: args.out.clone(),
         methods: vec![MethodKind::Auxiliary],
         ns: (0..=4).collect(),
+        depths: Vec::new(),
         alphas: vec![1.0, 0.7],
         width: None,
         height: None,

@@ -1,0 +1,553 @@
+//! `portal`: exact mirrors by stencil recursion (SGI course notes '99, §11.1.5.1), over the
+//! reflection paths of [`mirrorbox_scene::reflection_paths`]. Entry points:
+//! `shaders/portal_stencil.wgsl`.
+//!
+//! Everything happens in one render pass. A path's region of the screen holds its stencil
+//! value; its world (the scene through `view · R₁ · … · Rₖ`, the last mirror as oblique near
+//! plane, winding flipped on odd depth — culling is off — colours × the product of the
+//! reflectances) is drawn there. For each kept child the child's mirror is drawn from the
+//! parent's camera with the depth test against the parent's world (so it is marked only where
+//! it is really visible) and its stencil incremented; depth is then reset to far inside the
+//! child's region, and the child's world drawn and recursed into. Finished regions are set
+//! to 0. For a path's last child the parent's remainder is retired first and the child's
+//! value decremented back, so a chain of any length uses one stencil value: only branches
+//! that still have siblings to draw hold one — at most 254 (refused beyond, before any work).
+
+use crate::frame::{COLOR_FORMAT, FrameEncoder, RenderTarget};
+use crate::gpu::{Gpu, RasterError};
+use crate::recursive_texture::FrameStats;
+use crate::shading::{SceneBuffers, VERTEX_LAYOUT, module};
+use bytemuck::{Pod, Zeroable};
+use glam::{Mat4, Vec3};
+use mirrorbox_scene::Scene;
+use mirrorbox_scene::reflection::oblique_near_plane;
+use mirrorbox_scene::reflection_paths::PathSet;
+
+const STENCIL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth24PlusStencil8;
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct PathUniform {
+    clip_from_world: [[f32; 4]; 4],
+    eye: [f32; 3],
+    _pad0: f32,
+    attenuation: [f32; 3],
+    _pad1: f32,
+}
+
+/// One step of the frame, in order.
+#[derive(Clone, Copy, Debug)]
+enum Op {
+    /// Draw path `path`'s world where the stencil equals `value`.
+    World {
+        path: usize,
+        value: u32,
+    },
+    /// Increment the stencil (from `value`) where scene mirror `mirror` is visible from `path`.
+    Mark {
+        path: usize,
+        mirror: usize,
+        value: u32,
+    },
+    /// Reset depth to far and colour to the attenuated background in path `path`'s region.
+    ClearRegion {
+        path: usize,
+        value: u32,
+    },
+    Retire {
+        value: u32,
+    },
+    Decrement {
+        value: u32,
+    },
+}
+
+#[derive(Debug, thiserror::Error)]
+#[error(
+    "the reflection tree branches {0} levels deep with siblings pending; the 8-bit stencil allows 254"
+)]
+pub struct TooDeep(u32);
+
+/// Orders the frame's steps (see the module docs).
+fn schedule(paths: &PathSet) -> Result<Vec<Op>, TooDeep> {
+    fn process(paths: &PathSet, p: usize, v: u32, ops: &mut Vec<Op>) -> Result<(), TooDeep> {
+        let children = &paths.paths[p].children;
+        if children.is_empty() {
+            ops.push(Op::Retire { value: v });
+            return Ok(());
+        }
+        for (i, &c) in children.iter().enumerate() {
+            let mirror = *paths.paths[c]
+                .mirrors
+                .last()
+                .expect("a child path looks through a mirror");
+            ops.push(Op::Mark {
+                path: p,
+                mirror,
+                value: v,
+            });
+            let cv = if i + 1 == children.len() {
+                ops.push(Op::Retire { value: v });
+                ops.push(Op::Decrement { value: v + 1 });
+                v
+            } else {
+                v + 1
+            };
+            if cv > 254 {
+                return Err(TooDeep(cv));
+            }
+            ops.push(Op::ClearRegion { path: c, value: cv });
+            ops.push(Op::World { path: c, value: cv });
+            process(paths, c, cv, ops)?;
+        }
+        Ok(())
+    }
+    let mut ops = vec![Op::World { path: 0, value: 1 }];
+    process(paths, 0, 1, &mut ops)?;
+    Ok(ops)
+}
+
+/// A frame may draw at most this many triangles: llvmpipe bins a whole pass in memory, about
+/// 2 KB per triangle here (8 M triangles took 17.8 GB), so 2 M keeps a frame near 4 GB.
+pub const MAX_TRIANGLES_PER_FRAME: usize = 2_000_000;
+
+/// Whether the box `lo..hi` can project into the screen rectangle `portal` (pixels) through
+/// `clip_from_world` — conservative: a box reaching behind the eye counts as visible.
+fn box_may_touch(
+    clip_from_world: Mat4,
+    lo: Vec3,
+    hi: Vec3,
+    portal: (glam::Vec2, glam::Vec2),
+    size: glam::Vec2,
+) -> bool {
+    let mut min = glam::Vec2::splat(f32::INFINITY);
+    let mut max = glam::Vec2::splat(f32::NEG_INFINITY);
+    let mut all_behind_near = true;
+    for i in 0..8 {
+        let p = Vec3::new(
+            if i & 1 == 0 { lo.x } else { hi.x },
+            if i & 2 == 0 { lo.y } else { hi.y },
+            if i & 4 == 0 { lo.z } else { hi.z },
+        );
+        let c = clip_from_world * p.extend(1.0);
+        if c.w <= 1e-6 {
+            return true;
+        }
+        all_behind_near &= c.z < 0.0;
+        let px = mirrorbox_scene::camera::ndc_to_pixel(glam::Vec2::new(c.x / c.w, c.y / c.w), size);
+        min = min.min(px);
+        max = max.max(px);
+    }
+    !all_behind_near
+        && max.x >= portal.0.x
+        && min.x <= portal.1.x
+        && max.y >= portal.0.y
+        && min.y <= portal.1.y
+}
+
+pub struct PortalStencil {
+    scene_buffers: SceneBuffers,
+    /// Per path: the non-mirror parts that can be seen through its portal.
+    visible_parts: Vec<Vec<usize>>,
+    depth_stencil: wgpu::TextureView,
+    path_bind_group: wgpu::BindGroup,
+    offsets: Vec<u32>,
+    /// Last mirror of each path (not drawn in its own world: it is the near plane).
+    last_mirror: Vec<Option<usize>>,
+    ops: Vec<Op>,
+    objects: wgpu::RenderPipeline,
+    mirrors: wgpu::RenderPipeline,
+    mark: wgpu::RenderPipeline,
+    clear_region: wgpu::RenderPipeline,
+    retire: wgpu::RenderPipeline,
+    decrement: wgpu::RenderPipeline,
+    background: Vec3,
+    mirror_count: usize,
+    pub stats: FrameStats,
+}
+
+fn stencil(compare: wgpu::CompareFunction, pass_op: wgpu::StencilOperation) -> wgpu::StencilState {
+    let face = wgpu::StencilFaceState {
+        compare,
+        fail_op: wgpu::StencilOperation::Keep,
+        depth_fail_op: wgpu::StencilOperation::Keep,
+        pass_op,
+    };
+    wgpu::StencilState {
+        front: face,
+        back: face,
+        read_mask: 0xff,
+        write_mask: 0xff,
+    }
+}
+
+impl PortalStencil {
+    pub fn new(
+        gpu: &Gpu,
+        scene: &Scene,
+        paths: &PathSet,
+        width: u32,
+        height: u32,
+        projection: Mat4,
+    ) -> Result<Self, RasterError> {
+        use wgpu::util::DeviceExt;
+        let device = &gpu.device;
+        let ops = schedule(paths).map_err(|e| RasterError::Gpu(e.to_string()))?;
+        let scene_buffers = SceneBuffers::new(device, scene);
+        let size = glam::Vec2::new(width as f32, height as f32);
+        let alignment = device.limits().min_uniform_buffer_offset_alignment as usize;
+        let mut bytes = Vec::new();
+        let mut offsets = Vec::with_capacity(paths.paths.len());
+        let mut visible_parts = Vec::with_capacity(paths.paths.len());
+        for p in &paths.paths {
+            let clip = match p.plane {
+                None => projection * p.view.view,
+                Some(plane) => {
+                    oblique_near_plane(projection, plane.coefficients_in(p.view.view)) * p.view.view
+                }
+            };
+            let bbox = p.portal.iter().fold(
+                (
+                    glam::Vec2::splat(f32::INFINITY),
+                    glam::Vec2::splat(f32::NEG_INFINITY),
+                ),
+                |(a, b), q| (a.min(*q), b.max(*q)),
+            );
+            visible_parts.push(
+                (0..scene_buffers.parts.len())
+                    .filter(|&k| {
+                        let (_, lo, hi) = &scene_buffers.parts[k];
+                        box_may_touch(clip, *lo, *hi, bbox, size)
+                    })
+                    .collect::<Vec<usize>>(),
+            );
+            let u = PathUniform {
+                clip_from_world: clip.to_cols_array_2d(),
+                eye: p.view.eye().to_array(),
+                _pad0: 0.0,
+                attenuation: p.attenuation.to_array(),
+                _pad1: 0.0,
+            };
+            let offset = bytes.len().next_multiple_of(alignment);
+            bytes.resize(offset, 0);
+            bytes.extend_from_slice(bytemuck::bytes_of(&u));
+            offsets.push(offset as u32);
+        }
+        let uniforms = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("paths"),
+            contents: &bytes,
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let path_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("path"),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: true,
+                    min_binding_size: None,
+                },
+                count: None,
+            }],
+        });
+        let path_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("path"),
+            layout: &path_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: &uniforms,
+                    offset: 0,
+                    size: std::num::NonZeroU64::new(std::mem::size_of::<PathUniform>() as u64),
+                }),
+            }],
+        });
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("portal"),
+            bind_group_layouts: &[Some(&scene_buffers.layout), Some(&path_layout)],
+            immediate_size: 0,
+        });
+        let shader = module(
+            device,
+            "portal stencil",
+            include_str!("../../../shaders/portal_stencil.wgsl"),
+        );
+        let pipeline = |label: &str,
+                        vertex: &str,
+                        fragment: &str,
+                        color: bool,
+                        depth_write: bool,
+                        depth_compare,
+                        st: wgpu::StencilState| {
+            let buffers: &[Option<wgpu::VertexBufferLayout>] = if vertex == "vs_main" {
+                &[Some(VERTEX_LAYOUT)]
+            } else {
+                &[]
+            };
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(label),
+                layout: Some(&layout),
+                vertex: wgpu::VertexState {
+                    module: &shader,
+                    entry_point: Some(vertex),
+                    compilation_options: Default::default(),
+                    buffers,
+                },
+                primitive: wgpu::PrimitiveState {
+                    cull_mode: None,
+                    ..Default::default()
+                },
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: STENCIL_FORMAT,
+                    depth_write_enabled: Some(depth_write),
+                    depth_compare: Some(depth_compare),
+                    stencil: st,
+                    bias: Default::default(),
+                }),
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &shader,
+                    entry_point: Some(fragment),
+                    compilation_options: Default::default(),
+                    targets: &[Some(wgpu::ColorTargetState {
+                        format: COLOR_FORMAT,
+                        blend: None,
+                        write_mask: if color {
+                            wgpu::ColorWrites::ALL
+                        } else {
+                            wgpu::ColorWrites::empty()
+                        },
+                    })],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        use wgpu::{CompareFunction as C, StencilOperation as S};
+        let keep_equal = stencil(C::Equal, S::Keep);
+        let objects = pipeline(
+            "portal objects",
+            "vs_main",
+            "fs_object",
+            true,
+            true,
+            C::LessEqual,
+            keep_equal.clone(),
+        );
+        let mirrors = pipeline(
+            "portal mirrors",
+            "vs_main",
+            "fs_mirror",
+            true,
+            true,
+            C::LessEqual,
+            keep_equal.clone(),
+        );
+        let mark = pipeline(
+            "portal mark",
+            "vs_main",
+            "fs_none",
+            false,
+            false,
+            C::LessEqual,
+            stencil(C::Equal, S::IncrementClamp),
+        );
+        let clear_region = pipeline(
+            "portal region clear",
+            "vs_fullscreen",
+            "fs_background",
+            true,
+            true,
+            C::Always,
+            keep_equal,
+        );
+        let retire = pipeline(
+            "portal retire",
+            "vs_fullscreen",
+            "fs_none",
+            false,
+            false,
+            C::Always,
+            stencil(C::Equal, S::Zero),
+        );
+        let decrement = pipeline(
+            "portal decrement",
+            "vs_fullscreen",
+            "fs_none",
+            false,
+            false,
+            C::Always,
+            stencil(C::Equal, S::DecrementClamp),
+        );
+        let depth_stencil = device
+            .create_texture(&wgpu::TextureDescriptor {
+                label: Some("portal depth-stencil"),
+                size: wgpu::Extent3d {
+                    width,
+                    height,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: STENCIL_FORMAT,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+                view_formats: &[],
+            })
+            .create_view(&Default::default());
+        let mirror_count = scene.mirrors.len();
+        let world_triangles = |path: usize| -> usize {
+            visible_parts[path]
+                .iter()
+                .map(|&k| scene_buffers.parts[k].0.len() / 3)
+                .sum::<usize>()
+                + 2 * mirror_count
+        };
+        let triangles: usize = ops
+            .iter()
+            .map(|op| {
+                if let Op::World { path, .. } = op {
+                    world_triangles(*path)
+                } else {
+                    1
+                }
+            })
+            .sum();
+        if triangles > MAX_TRIANGLES_PER_FRAME {
+            return Err(RasterError::Plan(
+                crate::plan::PlanError::TooManyTriangles {
+                    triangles,
+                    limit: MAX_TRIANGLES_PER_FRAME,
+                },
+            ));
+        }
+        let draws = ops
+            .iter()
+            .map(|op| match op {
+                Op::World { path, .. } => {
+                    visible_parts[*path].len() + mirror_count
+                        - usize::from(paths.paths[*path].plane.is_some())
+                }
+                _ => 1,
+            })
+            .sum::<usize>()
+            + 1;
+        let stats = FrameStats {
+            passes: 1,
+            texture_renders: 0,
+            draws,
+            depth: paths.deepest,
+        };
+        Ok(PortalStencil {
+            scene_buffers,
+            visible_parts,
+            depth_stencil,
+            path_bind_group,
+            offsets,
+            last_mirror: paths
+                .paths
+                .iter()
+                .map(|p| p.mirrors.last().copied())
+                .collect(),
+            ops,
+            objects,
+            mirrors,
+            mark,
+            clear_region,
+            retire,
+            decrement,
+            background: scene.background,
+            mirror_count,
+            stats,
+        })
+    }
+}
+
+impl FrameEncoder for PortalStencil {
+    fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &RenderTarget,
+        first_pass: Option<wgpu::RenderPassTimestampWrites<'_>>,
+    ) {
+        let bg = self.background;
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("portal"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &target.color_view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color {
+                        r: bg.x as f64,
+                        g: bg.y as f64,
+                        b: bg.z as f64,
+                        a: 1.0,
+                    }),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &self.depth_stencil,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Discard,
+                }),
+                stencil_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1),
+                    store: wgpu::StoreOp::Discard,
+                }),
+            }),
+            timestamp_writes: first_pass,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_vertex_buffer(0, self.scene_buffers.vertices.slice(..));
+        pass.set_bind_group(0, &self.scene_buffers.bind_group, &[]);
+        pass.set_bind_group(1, &self.path_bind_group, &[self.offsets[0]]);
+        for op in &self.ops {
+            match *op {
+                Op::World { path, value } => {
+                    pass.set_stencil_reference(value);
+                    pass.set_bind_group(1, &self.path_bind_group, &[self.offsets[path]]);
+                    pass.set_pipeline(&self.objects);
+                    for &k in &self.visible_parts[path] {
+                        pass.draw(self.scene_buffers.parts[k].0.clone(), 0..1);
+                    }
+                    pass.set_pipeline(&self.mirrors);
+                    for m in 0..self.mirror_count {
+                        if self.last_mirror[path] != Some(m) {
+                            pass.draw(self.scene_buffers.mirrors[m].clone(), 0..1);
+                        }
+                    }
+                }
+                Op::Mark {
+                    path,
+                    mirror,
+                    value,
+                } => {
+                    pass.set_stencil_reference(value);
+                    pass.set_bind_group(1, &self.path_bind_group, &[self.offsets[path]]);
+                    pass.set_pipeline(&self.mark);
+                    pass.draw(self.scene_buffers.mirrors[mirror].clone(), 0..1);
+                }
+                Op::ClearRegion { path, value } => {
+                    pass.set_stencil_reference(value);
+                    pass.set_bind_group(1, &self.path_bind_group, &[self.offsets[path]]);
+                    pass.set_pipeline(&self.clear_region);
+                    pass.draw(0..3, 0..1);
+                }
+                Op::Retire { value } | Op::Decrement { value } => {
+                    pass.set_stencil_reference(value);
+                    pass.set_pipeline(if matches!(op, Op::Retire { .. }) {
+                        &self.retire
+                    } else {
+                        &self.decrement
+                    });
+                    pass.draw(0..3, 0..1);
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,77 @@
+// Entry points of crates/raster/src/portal_stencil.rs: exact mirrors by stencil recursion.
+// Each reflection path draws its world where the stencil holds its value, attenuated by the
+// product of the reflectances along it. Prepended with shading.wgsl.
+
+struct Path {
+    clip_from_world: mat4x4f,
+    eye: vec3f,
+    _pad0: f32,
+    attenuation: vec3f,
+    _pad1: f32,
+}
+
+@group(1) @binding(0) var<uniform> path: Path;
+
+struct VertexIn {
+    @location(0) position: vec3f,
+    @location(1) normal: vec3f,
+    @location(2) surface: u32,
+}
+
+struct VertexOut {
+    // Invariant: a mirror marked in the stencil pass must meet the depth its world pass wrote.
+    @builtin(position) @invariant clip: vec4f,
+    @location(0) world: vec3f,
+    @location(1) @interpolate(flat) normal: vec3f,
+    @location(2) @interpolate(flat) surface: u32,
+}
+
+@vertex
+fn vs_main(v: VertexIn) -> VertexOut {
+    var out: VertexOut;
+    out.clip = path.clip_from_world * vec4f(v.position, 1.0);
+    out.world = v.position;
+    out.normal = v.normal;
+    out.surface = v.surface;
+    return out;
+}
+
+fn shade(in: VertexOut, albedo: vec3f, emission: vec3f) -> vec3f {
+    return path.attenuation * diffuse_radiance(in.world, in.normal, normalize(path.eye - in.world), albedo, emission);
+}
+
+@fragment
+fn fs_object(in: VertexOut) -> @location(0) vec4f {
+    let s = surfaces[in.surface];
+    return vec4f(shade(in, s.albedo, s.emission), 1.0);
+}
+
+// A mirror in a path's world: its front shows the terminal radiance (overwritten by the
+// child path's world wherever that path was kept); its back is diffuse.
+@fragment
+fn fs_mirror(in: VertexOut) -> @location(0) vec4f {
+    let s = surfaces[in.surface];
+    if (dot(in.normal, path.eye - in.world) > 0.0) {
+        return vec4f(path.attenuation * frame.terminal, 1.0);
+    }
+    return vec4f(shade(in, s.back_albedo, vec3f(0.0)), 1.0);
+}
+
+// A path's empty pixels see the background through its mirrors.
+@fragment
+fn fs_background() -> @location(0) vec4f {
+    return vec4f(path.attenuation * frame.background, 1.0);
+}
+
+// Stencil-only draws write no colour.
+@fragment
+fn fs_none() -> @location(0) vec4f {
+    return vec4f(0.0);
+}
+
+// A screen-covering triangle at the far plane (depth 1), for depth clears and stencil edits.
+@vertex
+fn vs_fullscreen(@builtin(vertex_index) i: u32) -> @builtin(position) vec4f {
+    let uv = vec2f(f32((i << 1u) & 2u), f32(i & 2u));
+    return vec4f(uv * 2.0 - 1.0, 1.0, 1.0);
+}
