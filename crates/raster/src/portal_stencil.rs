@@ -39,27 +39,21 @@ struct PathUniform {
 #[derive(Clone, Copy, Debug)]
 enum Op {
     /// Draw path `path`'s world where the stencil equals `value`.
-    World {
-        path: usize,
-        value: u32,
-    },
-    /// Increment the stencil (from `value`) where scene mirror `mirror` is visible from `path`.
+    World { path: usize, value: u32 },
+    /// Increment the stencil (from `value`) where scene mirror `mirror` is visible from `path`;
+    /// `child` is the path it opens.
     Mark {
         path: usize,
+        child: usize,
         mirror: usize,
         value: u32,
     },
     /// Reset depth to far and colour to the attenuated background in path `path`'s region.
-    ClearRegion {
-        path: usize,
-        value: u32,
-    },
-    Retire {
-        value: u32,
-    },
-    Decrement {
-        value: u32,
-    },
+    ClearRegion { path: usize, value: u32 },
+    /// Set `value` to 0 inside path `path`'s portal (its region is finished).
+    Retire { path: usize, value: u32 },
+    /// Lower `value` by one inside path `path`'s portal.
+    Decrement { path: usize, value: u32 },
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -73,7 +67,7 @@ fn schedule(paths: &PathSet) -> Result<Vec<Op>, TooDeep> {
     fn process(paths: &PathSet, p: usize, v: u32, ops: &mut Vec<Op>) -> Result<(), TooDeep> {
         let children = &paths.paths[p].children;
         if children.is_empty() {
-            ops.push(Op::Retire { value: v });
+            ops.push(Op::Retire { path: p, value: v });
             return Ok(());
         }
         for (i, &c) in children.iter().enumerate() {
@@ -83,12 +77,16 @@ fn schedule(paths: &PathSet) -> Result<Vec<Op>, TooDeep> {
                 .expect("a child path looks through a mirror");
             ops.push(Op::Mark {
                 path: p,
+                child: c,
                 mirror,
                 value: v,
             });
             let cv = if i + 1 == children.len() {
-                ops.push(Op::Retire { value: v });
-                ops.push(Op::Decrement { value: v + 1 });
+                ops.push(Op::Retire { path: p, value: v });
+                ops.push(Op::Decrement {
+                    path: c,
+                    value: v + 1,
+                });
                 v
             } else {
                 v + 1
@@ -147,6 +145,9 @@ fn box_may_touch(
 
 pub struct PortalStencil {
     scene_buffers: SceneBuffers,
+    /// Per path: its portal's bounding rectangle (x, y, w, h) at render resolution; every
+    /// operation on a path is scissored to it, so deep bounces cost in proportion to their size.
+    scissors: Vec<[u32; 4]>,
     /// Per path: the non-mirror parts that can be seen through its portal.
     visible_parts: Vec<Vec<usize>>,
     depth_stencil: wgpu::TextureView,
@@ -199,6 +200,7 @@ impl PortalStencil {
         let mut bytes = Vec::new();
         let mut offsets = Vec::with_capacity(paths.paths.len());
         let mut visible_parts = Vec::with_capacity(paths.paths.len());
+        let mut scissors = Vec::with_capacity(paths.paths.len());
         for p in &paths.paths {
             let clip = match p.plane {
                 None => projection * p.view.view,
@@ -213,6 +215,16 @@ impl PortalStencil {
                 ),
                 |(a, b), q| (a.min(*q), b.max(*q)),
             );
+            let x0 = (bbox.0.x.floor() - 1.0).clamp(0.0, size.x) as u32;
+            let y0 = (bbox.0.y.floor() - 1.0).clamp(0.0, size.y) as u32;
+            let x1 = (bbox.1.x.ceil() + 1.0).clamp(0.0, size.x) as u32;
+            let y1 = (bbox.1.y.ceil() + 1.0).clamp(0.0, size.y) as u32;
+            scissors.push([
+                x0,
+                y0,
+                x1.saturating_sub(x0).max(1),
+                y1.saturating_sub(y0).max(1),
+            ]);
             visible_parts.push(
                 (0..scene_buffers.parts.len())
                     .filter(|&k| {
@@ -441,6 +453,7 @@ impl PortalStencil {
         };
         Ok(PortalStencil {
             scene_buffers,
+            scissors,
             visible_parts,
             depth_stencil,
             path_bind_group,
@@ -506,9 +519,14 @@ impl FrameEncoder for PortalStencil {
         pass.set_vertex_buffer(0, self.scene_buffers.vertices.slice(..));
         pass.set_bind_group(0, &self.scene_buffers.bind_group, &[]);
         pass.set_bind_group(1, &self.path_bind_group, &[self.offsets[0]]);
+        let scissor = |pass: &mut wgpu::RenderPass<'_>, path: usize| {
+            let [x, y, w, h] = self.scissors[path];
+            pass.set_scissor_rect(x, y, w, h);
+        };
         for op in &self.ops {
             match *op {
                 Op::World { path, value } => {
+                    scissor(&mut pass, path);
                     pass.set_stencil_reference(value);
                     pass.set_bind_group(1, &self.path_bind_group, &[self.offsets[path]]);
                     pass.set_pipeline(&self.objects);
@@ -524,21 +542,25 @@ impl FrameEncoder for PortalStencil {
                 }
                 Op::Mark {
                     path,
+                    child,
                     mirror,
                     value,
                 } => {
+                    scissor(&mut pass, child);
                     pass.set_stencil_reference(value);
                     pass.set_bind_group(1, &self.path_bind_group, &[self.offsets[path]]);
                     pass.set_pipeline(&self.mark);
                     pass.draw(self.scene_buffers.mirrors[mirror].clone(), 0..1);
                 }
                 Op::ClearRegion { path, value } => {
+                    scissor(&mut pass, path);
                     pass.set_stencil_reference(value);
                     pass.set_bind_group(1, &self.path_bind_group, &[self.offsets[path]]);
                     pass.set_pipeline(&self.clear_region);
                     pass.draw(0..3, 0..1);
                 }
-                Op::Retire { value } | Op::Decrement { value } => {
+                Op::Retire { path, value } | Op::Decrement { path, value } => {
+                    scissor(&mut pass, path);
                     pass.set_stencil_reference(value);
                     pass.set_pipeline(if matches!(op, Op::Retire { .. }) {
                         &self.retire
