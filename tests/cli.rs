@@ -944,3 +944,51 @@ fn sweep_refuses_bad_arguments() {
     }
     assert!(!out.exists(), "nothing is written on bad input");
 }
+
+#[test]
+fn sweep_measures_the_portal_method_by_depth() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("p");
+    let run = mirrorbox(
+        &[
+            "sweep",
+            "scenes/mirror_box.json",
+            "--out",
+            out.to_str().unwrap(),
+            "--methods",
+            "portal",
+            "--depth",
+            "2,8,32",
+            "--alpha",
+            "0.7",
+            "--width",
+            "64",
+            "--height",
+            "36",
+            "--frames",
+            "1",
+            "--warmup",
+            "0",
+        ],
+        &[],
+    );
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let recs: Vec<Value> = records(&out)
+        .into_iter()
+        .filter(|r| r["method"] == "portal")
+        .collect();
+    let depths: Vec<u64> = recs.iter().map(|r| r["depth"].as_u64().unwrap()).collect();
+    assert_eq!(depths, vec![2, 8, 32]);
+    assert!(
+        recs.iter().all(|r| r["passes"] == 1),
+        "one pass whatever the depth"
+    );
+    let err: Vec<f64> = recs
+        .iter()
+        .map(|r| r["metrics"]["relmse"].as_f64().unwrap())
+        .collect();
+    assert!(
+        err[0] > err[1] && err[1] > err[2],
+        "error falls with depth: {err:?}"
+    );
+}

@@ -133,8 +133,9 @@ fn parse_methods(s: &str) -> Result<Vec<MethodKind>, Failure> {
         .map(|m| match m.trim() {
             "naive" => Ok(MethodKind::Naive),
             "auxiliary" => Ok(MethodKind::Auxiliary),
+            "portal" => Ok(MethodKind::Portal),
             other => Err(bad(format!(
-                "--methods: unknown method {other:?} (known: naive, auxiliary)"
+                "--methods: unknown method {other:?} (known: naive, auxiliary, portal)"
             ))),
         })
         .collect()
