@@ -10,7 +10,7 @@
 //! not flipped, the winding is). Reflections compose on the right: looking through mirror 1
 //! and then (in it) mirror 2 is `view · R₁ · R₂`.
 
-use glam::{Mat3, Mat4, Vec3, Vec4};
+use glam::{DMat3, DMat4, Mat4, Vec3, Vec4};
 
 /// An oriented plane `{x : normal·x = offset}`; the front side has positive signed distance.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -46,10 +46,16 @@ impl Plane {
 
     /// The reflection as an affine matrix `[[I − 2nnᵀ, 2·offset·n], [0, 1]]`.
     pub fn reflection_matrix(&self) -> Mat4 {
-        let n = self.normal;
-        let linear = Mat3::IDENTITY - 2.0 * Mat3::from_cols(n * n.x, n * n.y, n * n.z);
-        let mut m = Mat4::from_mat3(linear);
-        m.w_axis = (2.0 * self.offset * n).extend(1.0);
+        self.reflection_matrix_f64().as_mat4()
+    }
+
+    /// [`Plane::reflection_matrix`] in f64, for composing long chains of reflections without
+    /// accumulating rounding (a 1000-reflection view stays exact to f64).
+    pub fn reflection_matrix_f64(&self) -> DMat4 {
+        let n = self.normal.as_dvec3();
+        let linear = DMat3::IDENTITY - 2.0 * DMat3::from_cols(n * n.x, n * n.y, n * n.z);
+        let mut m = DMat4::from_mat3(linear);
+        m.w_axis = (2.0 * self.offset as f64 * n).extend(1.0);
         m
     }
 

@@ -14,7 +14,7 @@
 use crate::Scene;
 use crate::polygon::{area, clip_by, screen_footprint};
 use crate::reflection::{Plane, ReflectedView};
-use glam::{DMat4, DVec3, Mat4, Vec2, Vec3};
+use glam::{DVec3, Mat4, Vec2, Vec3};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PathLimits {
@@ -90,26 +90,6 @@ pub fn clip_convex(poly: &[Vec2], clip: &[Vec2]) -> Vec<Vec2> {
     without_duplicates(out)
 }
 
-fn to_f64(m: Mat4) -> DMat4 {
-    DMat4::from_cols_array(&m.to_cols_array().map(f64::from))
-}
-
-fn reflection_f64(plane: &Plane) -> DMat4 {
-    let n = plane.normal.as_dvec3();
-    let d = plane.offset as f64;
-    let cols = [
-        DVec3::X - 2.0 * n.x * n,
-        DVec3::Y - 2.0 * n.y * n,
-        DVec3::Z - 2.0 * n.z * n,
-    ];
-    DMat4::from_cols(
-        cols[0].extend(0.0),
-        cols[1].extend(0.0),
-        cols[2].extend(0.0),
-        (2.0 * d * n).extend(1.0),
-    )
-}
-
 /// Enumerates the reflection paths of `scene` seen by its camera at `width × height` with
 /// `projection` (the raster projection: its near plane bounds the root portal).
 pub fn reflection_paths(
@@ -128,7 +108,7 @@ pub fn reflection_paths(
         Vec2::new(0.0, size.y),
     ];
     let mut set = PathSet::default();
-    let root_view = to_f64(camera.view());
+    let root_view = camera.view().as_dmat4();
     set.paths.push(ReflectionPath {
         mirrors: Vec::new(),
         view: ReflectedView::direct(camera.view()),
@@ -198,7 +178,7 @@ pub fn reflection_paths(
                 set.truncated = true;
                 return set;
             }
-            let view64 = views64[parent] * reflection_f64(&mirror_plane);
+            let view64 = views64[parent] * mirror_plane.reflection_matrix_f64();
             let mut mirrors = set.paths[parent].mirrors.clone();
             mirrors.push(m);
             let child = set.paths.len();
