@@ -58,8 +58,9 @@ pub struct PathTracer<'a> {
     emitters: Vec<Emitter>,
     /// Cumulative selection probabilities of `emitters`.
     cdf: Vec<f32>,
-    /// Selection probability of each triangle as an emitter (0 if not one).
-    select_pdf: Vec<f32>,
+    /// Per triangle: the area density of emitter sampling, selection probability / area (0
+    /// for non-emitters); turned into a solid-angle pdf by distance² / cos.
+    area_pdf: Vec<f32>,
     mirror_planes: MirrorPlanes,
 }
 
@@ -99,11 +100,11 @@ impl<'a> PathTracer<'a> {
         let total: f32 = weights.iter().sum();
         let mut cdf = Vec::with_capacity(weights.len());
         let mut acc = 0.0;
-        let mut select_pdf = vec![0.0; g.triangles.len()];
+        let mut area_pdf = vec![0.0; g.triangles.len()];
         for (e, w) in emitters.iter().zip(&weights) {
             acc += w / total;
             cdf.push(acc);
-            select_pdf[e.triangle] = w / total;
+            area_pdf[e.triangle] = w / total / e.area;
         }
         let mirror_planes = MirrorPlanes::new(scene);
         PathTracer {
@@ -113,7 +114,7 @@ impl<'a> PathTracer<'a> {
             normals,
             emitters,
             cdf,
-            select_pdf,
+            area_pdf,
             mirror_planes,
         }
     }
@@ -170,11 +171,7 @@ impl<'a> PathTracer<'a> {
                     None => 1.0,
                     Some(p_bsdf) => {
                         let cos_l = n_f.dot(-ray.dir).max(1e-8);
-                        let area = 0.5 * {
-                            let t = g.triangles[hit.triangle];
-                            (t[1] - t[0]).cross(t[2] - t[0]).length()
-                        };
-                        let p_light = self.select_pdf[hit.triangle] / area * hit.t * hit.t / cos_l;
+                        let p_light = self.area_pdf[hit.triangle] * hit.t * hit.t / cos_l;
                         p_bsdf * p_bsdf / (p_bsdf * p_bsdf + p_light * p_light)
                     }
                 };
@@ -241,7 +238,7 @@ impl<'a> PathTracer<'a> {
                             && self.visible(p, hit.triangle, q, Some(e.triangle))
                         {
                             rays += 1;
-                            let p_light = self.select_pdf[e.triangle] / e.area * r2 / cos_l;
+                            let p_light = self.area_pdf[e.triangle] * r2 / cos_l;
                             let p_bsdf = cos_p * std::f32::consts::FRAC_1_PI;
                             let w = p_light * p_light / (p_light * p_light + p_bsdf * p_bsdf);
                             radiance += beta * f * e.emission * (cos_p / p_light) * w;
