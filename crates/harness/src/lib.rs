@@ -21,12 +21,19 @@ use std::fmt::Write as _;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
+/// The exact methods' path pruning in sweeps (the `render` command's defaults): portals
+/// under half a pixel² and attenuations under 1e-4 (the truth's `--min-throughput`).
+pub const EXACT_MIN_PORTAL_AREA: f32 = 0.5;
+pub const EXACT_MIN_ATTENUATION: f32 = 1e-4;
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum MethodKind {
     Naive,
     Auxiliary,
     /// Exact stencil recursion, swept over `depths`.
     Portal,
+    /// Exact instanced unrolling, swept over `depths`.
+    Unrolled,
 }
 
 #[derive(Clone, Debug)]
@@ -36,7 +43,7 @@ pub struct SweepConfig {
     pub methods: Vec<MethodKind>,
     /// Auxiliary mirror counts (auxiliary method).
     pub ns: Vec<u32>,
-    /// Reflection depths (portal method).
+    /// Reflection depths (exact methods: portal, unrolled).
     pub depths: Vec<u32>,
     pub alphas: Vec<f32>,
     pub width: Option<u32>,
@@ -117,13 +124,15 @@ fn points(config: &SweepConfig, base_hash: u64, w: u32, h: u32) -> Vec<Point> {
                     .iter()
                     .map(|&depth| Method::Portal { depth })
                     .collect(),
+                MethodKind::Unrolled => config
+                    .depths
+                    .iter()
+                    .map(|&depth| Method::Unrolled { depth })
+                    .collect(),
             };
             for method in methods {
-                let (name, n) = match method {
-                    Method::Naive => ("naive".to_string(), String::new()),
-                    Method::Auxiliary { n } => ("auxiliary".to_string(), format!(" n={n}")),
-                    Method::Portal { depth } => ("portal".to_string(), format!(" depth={depth}")),
-                };
+                let name = method.name();
+                let n = method.to_string()[name.len()..].to_string();
                 out.push(Point {
                     method: Some(method),
                     alpha,
@@ -303,8 +312,9 @@ pub fn run_sweep(
             warmup: config.warmup,
             max_passes: config.max_passes,
             texture_scale: 1.0,
-            min_portal_area: 0.0,
-            min_attenuation: 1e-4,
+            min_portal_area: EXACT_MIN_PORTAL_AREA,
+            min_attenuation: EXACT_MIN_ATTENUATION,
+            fragment_clipping: false,
         };
         let rendered = mirrorbox_raster::render(&gpu, &scene, &settings).map_err(other)?;
         let m = compare(&truth_image, &rendered.image, scene.camera.exposure).map_err(other)?;
@@ -342,21 +352,9 @@ pub fn run_sweep(
             kind: if p.method.is_some() { "point" } else { "floor" }.into(),
             scene: config.scene.display().to_string(),
             scene_hash: format!("{base_hash:016x}"),
-            method: match p.method {
-                Some(Method::Auxiliary { .. }) => "auxiliary",
-                Some(Method::Naive) => "naive",
-                Some(Method::Portal { .. }) => "portal",
-                None => "floor",
-            }
-            .into(),
-            n: match p.method {
-                Some(Method::Auxiliary { n }) => Some(n),
-                _ => None,
-            },
-            depth: match p.method {
-                Some(Method::Portal { depth }) => Some(depth),
-                _ => None,
-            },
+            method: p.method.map_or("floor", |m| m.name()).into(),
+            n: p.method.and_then(|m| m.n()),
+            depth: p.method.and_then(|m| m.depth_limit()),
             alpha: p.alpha,
             width: w,
             height: h,
@@ -369,6 +367,8 @@ pub fn run_sweep(
             draws: s.draws,
             texture_renders: s.texture_renders,
             reflections: s.depth,
+            triangles: Some(s.triangles),
+            paths: s.paths.map(|c| c.kept),
             metrics: metric_values(&m),
             adapter: gpu.report.name.clone(),
             backend: gpu.report.backend.clone(),

@@ -15,6 +15,71 @@ pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
 /// A method that draws one frame's scene passes, ending with the full view in `target`.
+/// Per-frame counts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FrameStats {
+    /// Scene passes: the main view plus one per texture render.
+    pub passes: usize,
+    pub texture_renders: usize,
+    /// Draw calls, including the SSAA resolve's one.
+    pub draws: usize,
+    /// Deepest chain of textures or reflection path: the reflections the method can show.
+    pub depth: usize,
+    /// Triangles submitted per frame (each instance counted), before any clipping.
+    pub triangles: usize,
+    /// Exact methods: the reflection paths drawn and pruned.
+    pub paths: Option<PathCounts>,
+    /// `unrolled`: how instances are clipped to their cells.
+    pub clipping: Option<Clipping>,
+}
+
+/// How the unrolled method clips an instance to its cell.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Clipping {
+    /// Hardware clip distances (plus the per-fragment guard where a part needs it).
+    ClipDistances,
+    /// Every test per fragment, with discard.
+    FragmentDiscard,
+}
+
+impl Clipping {
+    pub fn name(&self) -> &'static str {
+        match self {
+            Clipping::ClipDistances => "clip distances",
+            Clipping::FragmentDiscard => "fragment discard",
+        }
+    }
+}
+
+/// How many reflection paths an exact method kept and why it dropped the others
+/// (see `mirrorbox_scene::reflection_paths`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PathCounts {
+    /// Paths through at least one mirror that are drawn (the camera itself not counted).
+    pub kept: usize,
+    pub pruned_empty: usize,
+    pub pruned_small: usize,
+    pub pruned_attenuation: usize,
+    /// Paths cut by the depth cap.
+    pub capped: usize,
+}
+
+impl PathCounts {
+    pub fn of(set: &mirrorbox_scene::reflection_paths::PathSet) -> Self {
+        PathCounts {
+            kept: set.paths.len().saturating_sub(1),
+            pruned_empty: set.pruned_empty,
+            pruned_small: set.pruned_small,
+            pruned_attenuation: set.pruned_attenuation,
+            capped: set.capped,
+        }
+    }
+
+    pub fn pruned(&self) -> usize {
+        self.pruned_empty + self.pruned_small + self.pruned_attenuation + self.capped
+    }
+}
+
 pub trait FrameEncoder {
     /// `first_pass` carries the timestamp write the method must attach to its first pass.
     fn encode(

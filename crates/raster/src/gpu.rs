@@ -21,6 +21,8 @@ pub struct Gpu {
     pub report: AdapterReport,
     /// GPU timestamps are available (and enabled) on this device.
     pub timestamps: bool,
+    /// WGSL `clip_distances` is enabled on this device (the unrolled method clips with them).
+    pub clip_distances: bool,
     errors: Arc<Mutex<Vec<String>>>,
 }
 
@@ -32,6 +34,10 @@ impl Gpu {
         let mut features = wgpu::Features::empty();
         if timestamps {
             features |= wgpu::Features::TIMESTAMP_QUERY;
+        }
+        let clip_distances = selected.report.clip_distances;
+        if clip_distances {
+            features |= wgpu::Features::CLIP_DISTANCES;
         }
         let (device, queue) =
             pollster::block_on(selected.adapter.request_device(&wgpu::DeviceDescriptor {
@@ -56,6 +62,7 @@ impl Gpu {
             queue,
             report: selected.report,
             timestamps,
+            clip_distances,
             errors,
         })
     }

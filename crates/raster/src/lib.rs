@@ -6,26 +6,30 @@
 //! - [`plan`]: the seed paper's recursion (naive and auxiliary), planned on the CPU.
 //! - [`recursive_texture`]: executes that plan with render-to-texture mirror cameras.
 //! - [`portal_stencil`]: exact mirrors by stencil recursion over the reflection paths.
+//! - [`unrolled`]: exact mirrors with every reflection path an instance of the scene.
+//! - [`culling`]: parts against a path's portal, for both exact methods.
 //! - [`frame`]: targets, SSAA resolve, GPU timing, readback.
 
 pub mod adapter;
+pub mod culling;
 pub mod frame;
 pub mod gpu;
 pub mod plan;
 pub mod portal_stencil;
 pub mod recursive_texture;
 pub mod shading;
+pub mod unrolled;
 
 pub use adapter::{AdapterError, AdapterReport, SelectedAdapter, select_adapter};
+pub use frame::{Clipping, FrameStats, PathCounts};
 pub use frame::{FrameTiming, TimingSource};
 pub use gpu::{Gpu, RasterError};
 pub use plan::Method;
-pub use recursive_texture::FrameStats;
 
 use mirrorbox_image::RgbImage;
 use mirrorbox_scene::Scene;
 
-/// Most reflection paths the portal method draws per frame (memory and time bound).
+/// Most reflection paths an exact method draws per frame (memory and time bound).
 pub const MAX_PORTAL_PATHS: usize = 200_000;
 
 /// How to render.
@@ -44,12 +48,16 @@ pub struct RenderSettings {
     /// resolution) or whose attenuation falls below `min_attenuation`.
     pub min_portal_area: f32,
     pub min_attenuation: f32,
+    /// `unrolled`: clip per fragment even where the adapter has clip distances.
+    pub fragment_clipping: bool,
 }
 
 pub struct RenderOutput {
     pub image: RgbImage,
     pub timing: FrameTiming,
     pub stats: FrameStats,
+    /// Conditions under which the image may not be what the method promises.
+    pub warnings: Vec<String>,
 }
 
 /// Plans, then renders `scene` at its camera's size with `settings`. The plan (and the
@@ -71,8 +79,9 @@ pub fn render(
         wgpu::TextureUsages::TEXTURE_BINDING,
     );
     let resolve = frame::Resolve::new(&gpu.device, &target, settings.ssaa);
+    let mut warnings = Vec::new();
     let (method, stats): (Box<dyn frame::FrameEncoder>, FrameStats) = match settings.method {
-        Method::Portal { depth } => {
+        Method::Portal { depth } | Method::Unrolled { depth } => {
             let projection = scene
                 .camera
                 .with_size(w, h)
@@ -91,9 +100,30 @@ pub fn render(
                     limit: MAX_PORTAL_PATHS,
                 }));
             }
-            let m = portal_stencil::PortalStencil::new(gpu, scene, &paths, w, h, projection)?;
-            let stats = m.stats;
-            (Box::new(m), stats)
+            if matches!(settings.method, Method::Portal { .. }) {
+                let m = portal_stencil::PortalStencil::new(gpu, scene, &paths, w, h, projection)?;
+                let stats = m.stats;
+                (Box::new(m), stats)
+            } else {
+                let m = unrolled::Unrolled::new(
+                    gpu,
+                    scene,
+                    &paths,
+                    w,
+                    h,
+                    projection,
+                    settings.fragment_clipping,
+                )?;
+                if m.overlapping_siblings > 0 {
+                    warnings.push(format!(
+                        "{} pairs of sibling portals overlap (a mirror hides part of another): \
+                         unrolled may be wrong there; --method portal is exact",
+                        m.overlapping_siblings
+                    ));
+                }
+                let stats = m.stats;
+                (Box::new(m), stats)
+            }
         }
         method => {
             let plan = plan::plan(scene, method, w, h, settings.max_passes)?;
@@ -116,5 +146,6 @@ pub fn render(
         image,
         timing,
         stats,
+        warnings,
     })
 }

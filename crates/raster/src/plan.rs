@@ -44,6 +44,52 @@ pub enum Method {
     Portal {
         depth: u32,
     },
+    /// Exact: every reflection path up to `depth` mirrors drawn as an instance of the scene,
+    /// clipped to its cell (see `unrolled`).
+    Unrolled {
+        depth: u32,
+    },
+}
+
+impl Method {
+    /// The CLI and report name.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Method::Naive => "naive",
+            Method::Auxiliary { .. } => "auxiliary",
+            Method::Portal { .. } => "portal",
+            Method::Unrolled { .. } => "unrolled",
+        }
+    }
+
+    /// Auxiliary mirrors (auxiliary method).
+    pub fn n(&self) -> Option<u32> {
+        match *self {
+            Method::Auxiliary { n } => Some(n),
+            _ => None,
+        }
+    }
+
+    /// The depth cap of the exact (reflection-path) methods.
+    pub fn depth_limit(&self) -> Option<u32> {
+        match *self {
+            Method::Portal { depth } | Method::Unrolled { depth } => Some(depth),
+            _ => None,
+        }
+    }
+}
+
+impl std::fmt::Display for Method {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())?;
+        if let Some(n) = self.n() {
+            write!(f, " n={n}")?;
+        }
+        if let Some(d) = self.depth_limit() {
+            write!(f, " depth={d}")?;
+        }
+        Ok(())
+    }
 }
 
 /// One mirror of the rendering queue: a real mirror or an auxiliary copy of one.
@@ -123,12 +169,14 @@ pub enum PlanError {
 /// The rendering queue of a method.
 pub fn instances(scene: &Scene, method: Method) -> Result<Vec<MirrorInstance>, PlanError> {
     match method {
-        Method::Naive | Method::Portal { .. } => Ok((0..scene.mirrors.len())
-            .map(|i| MirrorInstance {
-                mirror: i,
-                label: format!("mirror {}", i + 1),
-            })
-            .collect()),
+        Method::Naive | Method::Portal { .. } | Method::Unrolled { .. } => {
+            Ok((0..scene.mirrors.len())
+                .map(|i| MirrorInstance {
+                    mirror: i,
+                    label: format!("mirror {}", i + 1),
+                })
+                .collect())
+        }
         Method::Auxiliary { n } => {
             if scene.mirrors.len() != 2 {
                 return Err(PlanError::NotAPair(scene.mirrors.len()));

@@ -13,9 +13,9 @@
 //! value decremented back, so a chain of any length uses one stencil value: only branches
 //! that still have siblings to draw hold one — at most 254 (refused beyond, before any work).
 
-use crate::frame::{COLOR_FORMAT, FrameEncoder, RenderTarget};
+use crate::culling::{box_may_touch, portal_bounds};
+use crate::frame::{COLOR_FORMAT, FrameEncoder, FrameStats, PathCounts, RenderTarget};
 use crate::gpu::{Gpu, RasterError};
-use crate::recursive_texture::FrameStats;
 use crate::shading::{SceneBuffers, VERTEX_LAYOUT, module};
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
@@ -109,40 +109,6 @@ fn schedule(paths: &PathSet) -> Result<Vec<Op>, TooDeep> {
 /// 2 KB per triangle here (8 M triangles took 17.8 GB), so 2 M keeps a frame near 4 GB.
 pub const MAX_TRIANGLES_PER_FRAME: usize = 2_000_000;
 
-/// Whether the box `lo..hi` can project into the screen rectangle `portal` (pixels) through
-/// `clip_from_world` — conservative: a box reaching behind the eye counts as visible.
-fn box_may_touch(
-    clip_from_world: Mat4,
-    lo: Vec3,
-    hi: Vec3,
-    portal: (glam::Vec2, glam::Vec2),
-    size: glam::Vec2,
-) -> bool {
-    let mut min = glam::Vec2::splat(f32::INFINITY);
-    let mut max = glam::Vec2::splat(f32::NEG_INFINITY);
-    let mut all_behind_near = true;
-    for i in 0..8 {
-        let p = Vec3::new(
-            if i & 1 == 0 { lo.x } else { hi.x },
-            if i & 2 == 0 { lo.y } else { hi.y },
-            if i & 4 == 0 { lo.z } else { hi.z },
-        );
-        let c = clip_from_world * p.extend(1.0);
-        if c.w <= 1e-6 {
-            return true;
-        }
-        all_behind_near &= c.z < 0.0;
-        let px = mirrorbox_scene::camera::ndc_to_pixel(glam::Vec2::new(c.x / c.w, c.y / c.w), size);
-        min = min.min(px);
-        max = max.max(px);
-    }
-    !all_behind_near
-        && max.x >= portal.0.x
-        && min.x <= portal.1.x
-        && max.y >= portal.0.y
-        && min.y <= portal.1.y
-}
-
 pub struct PortalStencil {
     scene_buffers: SceneBuffers,
     /// Per path: its portal's bounding rectangle (x, y, w, h) at render resolution; every
@@ -208,13 +174,7 @@ impl PortalStencil {
                     oblique_near_plane(projection, plane.coefficients_in(p.view.view)) * p.view.view
                 }
             };
-            let bbox = p.portal.iter().fold(
-                (
-                    glam::Vec2::splat(f32::INFINITY),
-                    glam::Vec2::splat(f32::NEG_INFINITY),
-                ),
-                |(a, b), q| (a.min(*q), b.max(*q)),
-            );
+            let bbox = portal_bounds(&p.portal);
             let x0 = (bbox.0.x.floor() - 1.0).clamp(0.0, size.x) as u32;
             let y0 = (bbox.0.y.floor() - 1.0).clamp(0.0, size.y) as u32;
             let x1 = (bbox.1.x.ceil() + 1.0).clamp(0.0, size.x) as u32;
@@ -450,6 +410,9 @@ impl PortalStencil {
             texture_renders: 0,
             draws,
             depth: paths.deepest,
+            triangles,
+            paths: Some(PathCounts::of(paths)),
+            clipping: None,
         };
         Ok(PortalStencil {
             scene_buffers,

@@ -10,7 +10,9 @@
 //! `texture_scale` of 1. Textures are rendered depth first (children before the pass that
 //! applies them) and recycled by exact size once applied.
 
-use crate::frame::{COLOR_FORMAT, DEPTH_FORMAT, FrameEncoder, RenderTarget, texture_entry};
+use crate::frame::{
+    COLOR_FORMAT, DEPTH_FORMAT, FrameEncoder, FrameStats, RenderTarget, texture_entry,
+};
 use crate::gpu::Gpu;
 use crate::plan::{Plan, Rect, TextureNode};
 use crate::shading::{SceneBuffers, VERTEX_LAYOUT, module};
@@ -38,18 +40,6 @@ struct MirrorUniform {
     texels_per_pixel: [f32; 2],
     exact: u32,
     has_texture: u32,
-}
-
-/// Per-frame counts.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct FrameStats {
-    /// Scene passes: the main view plus one per texture render.
-    pub passes: usize,
-    pub texture_renders: usize,
-    /// Draw calls, including the SSAA resolve's one.
-    pub draws: usize,
-    /// Deepest chain of textures: the reflections the method can show.
-    pub depth: usize,
 }
 
 enum Target {
@@ -388,11 +378,19 @@ impl RecursiveTexture {
             "fs_mirror",
         );
         let draws: usize = b.passes.iter().map(|p| 1 + p.draws.len()).sum::<usize>() + 1;
+        let object_triangles = scene_buffers.objects.len() / 3;
         let stats = FrameStats {
             passes: plan.passes,
             texture_renders: plan.passes - 1,
             draws,
             depth: plan.depth,
+            triangles: b
+                .passes
+                .iter()
+                .map(|p| object_triangles + 2 * p.draws.len())
+                .sum(),
+            paths: None,
+            clipping: None,
         };
         RecursiveTexture {
             scene_buffers,

@@ -28,6 +28,7 @@ fn settings(method: Method, ssaa: u32) -> RenderSettings {
         texture_scale: 1.0,
         min_portal_area: 0.0,
         min_attenuation: 1e-4,
+        fragment_clipping: false,
     }
 }
 

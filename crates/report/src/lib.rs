@@ -55,6 +55,12 @@ pub struct Record {
     pub texture_renders: usize,
     /// Reflections the method can show.
     pub reflections: usize,
+    /// Triangles submitted per frame (absent in records older than this field).
+    #[serde(default)]
+    pub triangles: Option<usize>,
+    /// Exact methods: reflection paths drawn.
+    #[serde(default)]
+    pub paths: Option<usize>,
     pub metrics: MetricValues,
     pub adapter: String,
     pub backend: String,

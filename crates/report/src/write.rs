@@ -459,6 +459,8 @@ mod tests {
             draws: 2 * passes,
             texture_renders: passes - 1,
             reflections: n as usize + 2,
+            triangles: None,
+            paths: None,
             metrics: MetricValues {
                 rmse: flip,
                 relmse: flip,

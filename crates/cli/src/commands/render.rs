@@ -1,5 +1,5 @@
-//! `mirrorbox render SCENE --method naive|auxiliary -o OUT.png`: the seed paper's raster
-//! methods with wgpu, timed.
+//! `mirrorbox render SCENE --method naive|auxiliary|portal|unrolled -o OUT.png`: the seed
+//! paper's raster methods and the exact ones with wgpu, timed.
 
 use super::{load, output_path, resize, unit_interval};
 use crate::Failure;
@@ -16,6 +16,8 @@ pub enum MethodName {
     Auxiliary,
     /// Exact: stencil recursion over the reflection paths, one pass, cost linear in depth.
     Portal,
+    /// Exact: every reflection path an instance of the scene, clipped to its cell; a handful of draws.
+    Unrolled,
 }
 
 #[derive(clap::Args)]
@@ -27,15 +29,19 @@ pub struct Args {
     /// Auxiliary mirrors (auxiliary method only).
     #[arg(long)]
     n: Option<u32>,
-    /// Most mirrors along a reflection path (portal method only).
+    /// Most mirrors along a reflection path (exact methods: portal, unrolled). Default 64.
     #[arg(long)]
     depth: Option<u32>,
-    /// Portal method: prune paths whose portal covers fewer pixels² (at render resolution).
+    /// Exact methods: prune paths whose portal covers fewer pixels² (at render resolution).
     #[arg(long, default_value_t = 0.5)]
     min_portal_area: f32,
-    /// Portal method: prune paths whose attenuation falls below this (the tracer's --min-throughput).
+    /// Exact methods: prune paths whose attenuation falls below this (the tracer's --min-throughput).
     #[arg(long, default_value_t = 1e-4)]
     min_attenuation: f32,
+    /// Unrolled method: clip every instance per fragment (discard) even where the adapter
+    /// has hardware clip distances — to measure what they save.
+    #[arg(long)]
+    fragment_clipping: bool,
     /// Attenuation per reflection; also sets every mirror's reflectance (the truth to compare
     /// with is `trace --reflectance α`). In [0, 1]. Default: the scene's reflectances.
     #[arg(long)]
@@ -74,18 +80,28 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     if args.n.is_some() && args.method != MethodName::Auxiliary {
         return Err(bad("--n applies to --method auxiliary only".into()));
     }
-    if args.depth.is_some() && args.method != MethodName::Portal {
-        return Err(bad("--depth applies to --method portal only".into()));
+    let exact = matches!(args.method, MethodName::Portal | MethodName::Unrolled);
+    if args.depth.is_some() && !exact {
+        return Err(bad(
+            "--depth applies to --method portal or unrolled only".into()
+        ));
     }
+    if args.fragment_clipping && args.method != MethodName::Unrolled {
+        return Err(bad(
+            "--fragment-clipping applies to --method unrolled only".into()
+        ));
+    }
+    let depth = match args.depth.unwrap_or(64) {
+        d @ 1..=4096 => d,
+        d => return Err(bad(format!("--depth must be in [1, 4096], got {d}"))),
+    };
     let method = match args.method {
         MethodName::Naive => Method::Naive,
         MethodName::Auxiliary => Method::Auxiliary {
             n: args.n.unwrap_or(0),
         },
-        MethodName::Portal => match args.depth.unwrap_or(64) {
-            d @ 1..=4096 => Method::Portal { depth: d },
-            d => return Err(bad(format!("--depth must be in [1, 4096], got {d}"))),
-        },
+        MethodName::Portal => Method::Portal { depth },
+        MethodName::Unrolled => Method::Unrolled { depth },
     };
     unit_interval("--min-attenuation", Some(args.min_attenuation))?;
     if !(args.min_portal_area >= 0.0 && args.min_portal_area.is_finite()) {
@@ -122,6 +138,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         texture_scale: args.texture_scale,
         min_portal_area: args.min_portal_area,
         min_attenuation: args.min_attenuation,
+        fragment_clipping: args.fragment_clipping,
     };
     // Plan first: a refused configuration costs no GPU set-up.
     let (w, h) = (
@@ -132,11 +149,10 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     let gpu = Gpu::new().map_err(raster_failure)?;
     let out = render(&gpu, &scene, &settings).map_err(raster_failure)?;
     let exr = png.with_extension("exr");
-    let method_text = match method {
-        Method::Naive => "naive".to_string(),
-        Method::Auxiliary { n } => format!("auxiliary n={n}"),
-        Method::Portal { depth } => format!("portal depth={depth}"),
-    };
+    let method_text = method.to_string();
+    for w in &out.warnings {
+        eprintln!("warning: {w}");
+    }
     let alpha = args
         .alpha
         .map_or("as in scene".to_string(), |a| a.to_string());
@@ -162,15 +178,22 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         let v = serde_json::json!({
             "scene": args.scene.display().to_string(),
             "scene_hash": format!("{:016x}", scene.content_hash()),
-            "method": match method { Method::Naive => "naive", Method::Auxiliary { .. } => "auxiliary", Method::Portal { .. } => "portal" },
-            "n": match method { Method::Auxiliary { n } => Some(n), _ => None },
-            "depth_limit": match method { Method::Portal { depth } => Some(depth), _ => None },
+            "method": method.name(),
+            "n": method.n(),
+            "depth_limit": method.depth_limit(),
             "alpha": args.alpha,
             "width": scene.camera.width, "height": scene.camera.height, "ssaa": args.ssaa,
             "texture_scale": args.texture_scale, "frames": args.frames, "warmup": args.warmup,
             "ms_per_frame_median": t.median_ms(), "ms_per_frame_min": t.min_ms(),
             "frames_ms": t.frames_ms, "timing_source": t.source.name(),
             "passes": s.passes, "texture_renders": s.texture_renders, "draws": s.draws, "depth": s.depth,
+            "triangles": s.triangles,
+            "paths": s.paths.map(|c| serde_json::json!({
+                "kept": c.kept, "pruned_empty": c.pruned_empty, "pruned_small": c.pruned_small,
+                "pruned_attenuation": c.pruned_attenuation, "capped": c.capped,
+            })),
+            "clipping": s.clipping.map(|c| c.name()),
+            "warnings": out.warnings,
             "adapter": gpu.report.name, "backend": gpu.report.backend, "device_type": gpu.report.device_type,
             "outputs": [png.display().to_string(), exr.display().to_string()],
         });
@@ -187,6 +210,20 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             s.depth,
             s.draws
         );
+        if let Some(c) = s.paths {
+            println!(
+                "  reflection paths: {} kept; pruned {} (empty {}, under --min-portal-area {}, under --min-attenuation {}, past --depth {}); {} triangles submitted{}",
+                c.kept,
+                c.pruned(),
+                c.pruned_empty,
+                c.pruned_small,
+                c.pruned_attenuation,
+                c.capped,
+                s.triangles,
+                s.clipping
+                    .map_or(String::new(), |c| format!(", clipped by {}", c.name()))
+            );
+        }
         println!(
             "  {:.2} ms/frame median, {:.2} min over {} frames ({}) on {} ({}); wrote {}, {}",
             t.median_ms(),

@@ -1,0 +1,46 @@
+//! Conservative screen-space culling of scene parts against a reflection path's portal,
+//! shared by the exact methods (`portal_stencil`, `unrolled`).
+
+use glam::{Mat4, Vec2, Vec3};
+
+/// The bounding rectangle (min, max) of a portal polygon, in pixels.
+pub fn portal_bounds(portal: &[Vec2]) -> (Vec2, Vec2) {
+    portal.iter().fold(
+        (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY)),
+        |(a, b), q| (a.min(*q), b.max(*q)),
+    )
+}
+
+/// Whether the box `lo..hi` can project into the screen rectangle `portal` (pixels) through
+/// `clip_from_world` — conservative: a box reaching behind the eye counts as visible.
+pub fn box_may_touch(
+    clip_from_world: Mat4,
+    lo: Vec3,
+    hi: Vec3,
+    portal: (Vec2, Vec2),
+    size: Vec2,
+) -> bool {
+    let mut min = Vec2::splat(f32::INFINITY);
+    let mut max = Vec2::splat(f32::NEG_INFINITY);
+    let mut all_behind_near = true;
+    for i in 0..8 {
+        let p = Vec3::new(
+            if i & 1 == 0 { lo.x } else { hi.x },
+            if i & 2 == 0 { lo.y } else { hi.y },
+            if i & 4 == 0 { lo.z } else { hi.z },
+        );
+        let c = clip_from_world * p.extend(1.0);
+        if c.w <= 1e-6 {
+            return true;
+        }
+        all_behind_near &= c.z < 0.0;
+        let px = mirrorbox_scene::camera::ndc_to_pixel(Vec2::new(c.x / c.w, c.y / c.w), size);
+        min = min.min(px);
+        max = max.max(px);
+    }
+    !all_behind_near
+        && max.x >= portal.0.x
+        && min.x <= portal.1.x
+        && max.y >= portal.0.y
+        && min.y <= portal.1.y
+}

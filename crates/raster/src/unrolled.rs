@@ -1,0 +1,674 @@
+//! `unrolled`: exact mirrors with every reflection path drawn as an instance of the scene.
+//! Entry points: `shaders/unrolled.wgsl` (+ `shaders/unrolled_clip_distances.wgsl`).
+//!
+//! A path `P = (m₁ … mₖ)` of [`mirrorbox_scene::reflection_paths`] sees the scene through the
+//! composed reflection `R₁·…·Rₖ`; its instance draws the real scene with
+//! `clip_from_world = proj · view · R₁·…·Rₖ` and keeps only its *cell*: beyond `mₖ`'s plane
+//! (distance `n·x − d ≥ 0` in scene space) and inside its portal, the convex screen polygon
+//! the path is seen through (each edge a half-plane `a·x_c + b·y_c + c·w_c ≥ 0` in clip
+//! space, i.e. a plane through the eye). Colours are scaled by the product of the
+//! reflectances along the path. Every instance shares one projection — the camera's, with
+//! infinite reversed Z in a 32-bit float buffer, so depth stays precise a thousand
+//! reflections deep — and the depth test resolves visibility between instances: inside a
+//! cell, the unfolded ray meets that path's world only.
+//!
+//! Clipping uses hardware clip distances where the adapter has them (the mirror plane and up
+//! to 7 portal edges); a portal with more edges, or a part that may lie behind some mirror,
+//! goes to the *guarded* stage, which tests the same half-planes per fragment and also
+//! discards points whose segment from the cell's entry crosses another mirror's front —
+//! geometry behind a mirror never leaks into it.
+//!
+//! Draws: one per (part or mirror, stage) over the list of paths that can see it (culled by
+//! the portal's rectangle, as in `portal_stencil`), plus one for the portals' backgrounds — a
+//! handful whatever the depth. A mirror is drawn in a path's world only where that mirror's
+//! own path was not kept (pruned or capped): its front then shows the terminal radiance.
+//!
+//! Exactness assumes sibling portals do not overlap (no mirror hides part of another from
+//! the same cell; true in the convex rooms of the bundled scenes). Overlaps are counted in
+//! [`Unrolled::overlapping_siblings`] and reported by `render`.
+
+use crate::culling::{box_may_touch, portal_bounds};
+use crate::frame::{COLOR_FORMAT, Clipping, FrameEncoder, FrameStats, PathCounts, RenderTarget};
+use crate::gpu::{Gpu, RasterError};
+use crate::shading::{SHADING_WGSL, SceneBuffers, VERTEX_LAYOUT};
+use bytemuck::{Pod, Zeroable};
+use glam::{Mat4, Vec2, Vec3, Vec4};
+use mirrorbox_scene::Scene;
+use mirrorbox_scene::camera::pixel_to_ndc;
+use mirrorbox_scene::reflection_paths::{PathSet, clip_convex};
+use std::ops::Range;
+
+const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
+/// Portal edges the clip-distance stage handles (distance 0 is the mirror plane).
+pub const CLIP_EDGES: usize = 7;
+
+/// Scene-space tolerance of "in front of a mirror" (as `GUARD_EPSILON` in the shader).
+const FRONT_EPSILON: f32 = 1e-5;
+
+/// Submitted triangles (instances × triangles) a frame may hold; beyond, the frame is
+/// refused with a hint. Clipped triangles cost only vertex work on llvmpipe, so this is a
+/// time bound, not the memory bound of `portal_stencil`.
+pub const MAX_TRIANGLES_PER_FRAME: usize = 50_000_000;
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct PathData {
+    clip_from_world: [[f32; 4]; 4],
+    plane: [f32; 4],
+    eye: [f32; 3],
+    edge_first: u32,
+    attenuation: [f32; 3],
+    edge_count: u32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct MirrorRect {
+    plane: [f32; 4],
+    center: [f32; 3],
+    half_width: f32,
+    right: [f32; 3],
+    half_height: f32,
+    up: [f32; 3],
+    _pad: f32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct BackgroundVertex {
+    ndc: [f32; 2],
+    attenuation: [f32; 3],
+}
+
+/// The camera's `[0, 1]`-depth projection with its depth row replaced by infinite reversed
+/// Z: `z_ndc = near / w`, 1 at the near plane and → 0 at infinity. x, y and w (hence every
+/// pixel's coverage) are the camera's own.
+pub fn infinite_reversed_z(projection: Mat4, near: f32) -> Mat4 {
+    let mut m = projection;
+    m.x_axis.z = 0.0;
+    m.y_axis.z = 0.0;
+    m.z_axis.z = 0.0;
+    m.w_axis.z = near;
+    m
+}
+
+/// The clip-space half-planes `a·x + b·y + c·w ≥ 0` bounding a convex screen polygon
+/// (pixels, any orientation) — each a plane through the eye.
+pub fn portal_edges(portal: &[Vec2], size: Vec2) -> Vec<Vec4> {
+    let ndc: Vec<Vec2> = portal.iter().map(|&p| pixel_to_ndc(p, size)).collect();
+    let twice: f32 = (0..ndc.len())
+        .map(|i| ndc[i].perp_dot(ndc[(i + 1) % ndc.len()]))
+        .sum();
+    let s = twice.signum();
+    (0..ndc.len())
+        .filter_map(|i| {
+            let (a, b) = (ndc[i], ndc[(i + 1) % ndc.len()]);
+            // Inside: s · (b − a) × (p − a) ≥ 0.
+            let n = s * Vec2::new(-(b.y - a.y), b.x - a.x);
+            let len = n.length();
+            (len > 0.0).then(|| {
+                let n = n / len;
+                Vec4::new(n.x, n.y, -n.dot(a), 0.0)
+            })
+        })
+        .collect()
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Stage {
+    Clipped,
+    Guarded,
+}
+
+/// One instanced draw: a vertex range for the paths `ids[instances]`.
+struct Draw {
+    stage: Stage,
+    mirror: bool,
+    vertices: Range<u32>,
+    instances: Range<u32>,
+}
+
+/// Something drawn per path: a diffuse part or a scene mirror.
+struct Item {
+    vertices: Range<u32>,
+    lo: Vec3,
+    hi: Vec3,
+    mirror: Option<usize>,
+    /// Lies in front of every mirror's plane: no ray can reach it through a mirror's front,
+    /// so it needs no guard.
+    in_front_of_all_mirrors: bool,
+}
+
+pub struct Unrolled {
+    scene_buffers: SceneBuffers,
+    bind_group: wgpu::BindGroup,
+    draws: Vec<Draw>,
+    background: Option<(wgpu::Buffer, u32)>,
+    depth: wgpu::TextureView,
+    clipped_object: Option<wgpu::RenderPipeline>,
+    clipped_mirror: Option<wgpu::RenderPipeline>,
+    guarded_object: wgpu::RenderPipeline,
+    guarded_mirror: wgpu::RenderPipeline,
+    background_pipeline: wgpu::RenderPipeline,
+    clear: Vec3,
+    /// Pairs of sibling paths whose portals overlap (more than 0.01 px²): where they do, the
+    /// depth test alone decides between two cells and the image may be wrong.
+    pub overlapping_siblings: usize,
+    pub stats: FrameStats,
+}
+
+impl Unrolled {
+    /// `projection` is the camera's `[0, 1]` projection at `width × height` (the one the
+    /// paths were enumerated with); `fragment_clipping` forces the guarded stage everywhere.
+    pub fn new(
+        gpu: &Gpu,
+        scene: &Scene,
+        paths: &PathSet,
+        width: u32,
+        height: u32,
+        projection: Mat4,
+        fragment_clipping: bool,
+    ) -> Result<Self, RasterError> {
+        use wgpu::util::DeviceExt;
+        let device = &gpu.device;
+        let clip_distances = gpu.clip_distances && !fragment_clipping;
+        let scene_buffers = SceneBuffers::new(device, scene);
+        let size = Vec2::new(width as f32, height as f32);
+        let reversed = infinite_reversed_z(projection, crate::plan::NEAR);
+        let planes: Vec<Vec4> = scene
+            .mirrors
+            .iter()
+            .map(|m| m.plane().coefficients())
+            .collect();
+        let in_front_of_all = |lo: Vec3, hi: Vec3| {
+            (0..8).all(|i| {
+                let p = Vec3::new(
+                    if i & 1 == 0 { lo.x } else { hi.x },
+                    if i & 2 == 0 { lo.y } else { hi.y },
+                    if i & 4 == 0 { lo.z } else { hi.z },
+                );
+                planes
+                    .iter()
+                    .all(|pl| pl.dot(p.extend(1.0)) >= -FRONT_EPSILON)
+            })
+        };
+        let mut items: Vec<Item> = scene_buffers
+            .parts
+            .iter()
+            .map(|(range, lo, hi)| Item {
+                vertices: range.clone(),
+                lo: *lo,
+                hi: *hi,
+                mirror: None,
+                in_front_of_all_mirrors: in_front_of_all(*lo, *hi),
+            })
+            .collect();
+        for (m, mirror) in scene.mirrors.iter().enumerate() {
+            let c = mirror.corners();
+            let lo = c.iter().fold(Vec3::INFINITY, |a, p| a.min(*p));
+            let hi = c.iter().fold(Vec3::NEG_INFINITY, |a, p| a.max(*p));
+            items.push(Item {
+                vertices: scene_buffers.mirrors[m].clone(),
+                lo,
+                hi,
+                mirror: Some(m),
+                in_front_of_all_mirrors: in_front_of_all(lo, hi),
+            });
+        }
+
+        // Per path: its data, its edges, and which items it draws with which stage.
+        let mut path_data = Vec::with_capacity(paths.paths.len());
+        let mut edges: Vec<Vec4> = Vec::new();
+        let mut lists: Vec<[Vec<u32>; 2]> = vec![[Vec::new(), Vec::new()]; items.len()];
+        let mut background: Vec<BackgroundVertex> = Vec::new();
+        let mut overlapping_siblings = 0;
+        for (id, p) in paths.paths.iter().enumerate() {
+            let view_clip = projection * p.view.view;
+            let plane = p.plane.map_or(Vec4::W, |pl| pl.coefficients());
+            let path_edges = if p.plane.is_some() {
+                portal_edges(&p.portal, size)
+            } else {
+                Vec::new() // the camera's portal is the viewport
+            };
+            let bounds = portal_bounds(&p.portal);
+            let edge_first = edges.len() as u32;
+            let edge_count = path_edges.len();
+            edges.extend(&path_edges);
+            path_data.push(PathData {
+                clip_from_world: (reversed * p.view.view).to_cols_array_2d(),
+                plane: plane.to_array(),
+                eye: p.view.eye().to_array(),
+                edge_first,
+                attenuation: p.attenuation.to_array(),
+                edge_count: edge_count as u32,
+            });
+            let kept_mirrors: Vec<usize> = p
+                .children
+                .iter()
+                .filter_map(|&c| paths.paths[c].mirrors.last().copied())
+                .collect();
+            for (k, item) in items.iter().enumerate() {
+                if let Some(m) = item.mirror
+                    && (p.mirrors.last() == Some(&m) || kept_mirrors.contains(&m))
+                {
+                    continue;
+                }
+                let behind_plane = p.plane.is_some()
+                    && (0..8).all(|i| {
+                        let q = Vec3::new(
+                            if i & 1 == 0 { item.lo.x } else { item.hi.x },
+                            if i & 2 == 0 { item.lo.y } else { item.hi.y },
+                            if i & 4 == 0 { item.lo.z } else { item.hi.z },
+                        );
+                        plane.dot(q.extend(1.0)) < 0.0
+                    });
+                if behind_plane || !box_may_touch(view_clip, item.lo, item.hi, bounds, size) {
+                    continue;
+                }
+                let stage =
+                    if clip_distances && edge_count <= CLIP_EDGES && item.in_front_of_all_mirrors {
+                        Stage::Clipped
+                    } else {
+                        Stage::Guarded
+                    };
+                lists[k][stage as usize].push(id as u32);
+            }
+            if p.plane.is_some() {
+                let ndc: Vec<Vec2> = p.portal.iter().map(|&q| pixel_to_ndc(q, size)).collect();
+                for i in 1..ndc.len().saturating_sub(1) {
+                    for v in [ndc[0], ndc[i], ndc[i + 1]] {
+                        background.push(BackgroundVertex {
+                            ndc: v.to_array(),
+                            attenuation: p.attenuation.to_array(),
+                        });
+                    }
+                }
+            }
+            for (i, &a) in p.children.iter().enumerate() {
+                for &b in &p.children[i + 1..] {
+                    let shared = clip_convex(&paths.paths[a].portal, &paths.paths[b].portal);
+                    if shared.len() >= 3 && mirrorbox_scene::polygon::area(&shared) > 0.01 {
+                        overlapping_siblings += 1;
+                    }
+                }
+            }
+        }
+
+        let mut ids: Vec<u32> = Vec::new();
+        let mut draws = Vec::new();
+        let mut triangles = background.len() / 3;
+        for (item, list) in items.iter().zip(&lists) {
+            for (stage, list) in [Stage::Clipped, Stage::Guarded].into_iter().zip(list) {
+                if list.is_empty() {
+                    continue;
+                }
+                let first = ids.len() as u32;
+                ids.extend(list);
+                triangles += list.len() * item.vertices.len() / 3;
+                draws.push(Draw {
+                    stage,
+                    mirror: item.mirror.is_some(),
+                    vertices: item.vertices.clone(),
+                    instances: first..ids.len() as u32,
+                });
+            }
+        }
+        if triangles > MAX_TRIANGLES_PER_FRAME {
+            return Err(RasterError::Plan(
+                crate::plan::PlanError::TooManyTriangles {
+                    triangles,
+                    limit: MAX_TRIANGLES_PER_FRAME,
+                },
+            ));
+        }
+
+        let mirror_rects: Vec<MirrorRect> = scene
+            .mirrors
+            .iter()
+            .map(|m| MirrorRect {
+                plane: m.plane().coefficients().to_array(),
+                center: m.center.to_array(),
+                half_width: 0.5 * m.width,
+                right: m.right().to_array(),
+                half_height: 0.5 * m.height,
+                up: m.up.to_array(),
+                _pad: 0.0,
+            })
+            .collect();
+        // Storage buffers may not be empty.
+        let nonempty = |mut v: Vec<u8>| {
+            if v.is_empty() {
+                v.resize(16, 0);
+            }
+            v
+        };
+        let storage = |label: &str, bytes: Vec<u8>| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents: &nonempty(bytes),
+                usage: wgpu::BufferUsages::STORAGE,
+            })
+        };
+        let buffers = [
+            storage("unrolled paths", bytemuck::cast_slice(&path_data).to_vec()),
+            storage(
+                "unrolled edges",
+                bytemuck::cast_slice(&edges.iter().map(|e| e.to_array()).collect::<Vec<_>>())
+                    .to_vec(),
+            ),
+            storage("unrolled ids", bytemuck::cast_slice(&ids).to_vec()),
+            storage(
+                "unrolled mirrors",
+                bytemuck::cast_slice(&mirror_rects).to_vec(),
+            ),
+        ];
+        let entries: Vec<wgpu::BindGroupLayoutEntry> = (0..4)
+            .map(|binding| wgpu::BindGroupLayoutEntry {
+                binding,
+                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Storage { read_only: true },
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            })
+            .collect();
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("unrolled"),
+            entries: &entries,
+        });
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("unrolled"),
+            layout: &layout,
+            entries: &buffers
+                .iter()
+                .enumerate()
+                .map(|(i, b)| wgpu::BindGroupEntry {
+                    binding: i as u32,
+                    resource: b.as_entire_binding(),
+                })
+                .collect::<Vec<_>>(),
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("unrolled"),
+            bind_group_layouts: &[Some(&scene_buffers.layout), Some(&layout)],
+            immediate_size: 0,
+        });
+        let entry_points = include_str!("../../../shaders/unrolled.wgsl");
+        let guarded_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("unrolled"),
+            source: wgpu::ShaderSource::Wgsl(format!("{SHADING_WGSL}\n{entry_points}").into()),
+        });
+        let clipped_module = clip_distances.then(|| {
+            device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some("unrolled clip distances"),
+                source: wgpu::ShaderSource::Wgsl(
+                    format!(
+                        "enable clip_distances;\n{SHADING_WGSL}\n{entry_points}\n{}",
+                        include_str!("../../../shaders/unrolled_clip_distances.wgsl")
+                    )
+                    .into(),
+                ),
+            })
+        });
+        let background_layout = wgpu::VertexBufferLayout {
+            array_stride: std::mem::size_of::<BackgroundVertex>() as u64,
+            step_mode: wgpu::VertexStepMode::Vertex,
+            attributes: &wgpu::vertex_attr_array![0 => Float32x2, 1 => Float32x3],
+        };
+        let pipeline = |label: &str,
+                        module: &wgpu::ShaderModule,
+                        vertex: &str,
+                        fragment: &str,
+                        buffer: wgpu::VertexBufferLayout<'_>,
+                        background: bool| {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(label),
+                layout: Some(&pipeline_layout),
+                vertex: wgpu::VertexState {
+                    module,
+                    entry_point: Some(vertex),
+                    compilation_options: Default::default(),
+                    buffers: &[Some(buffer)],
+                },
+                // Odd reflections flip the winding and shading is two-sided: no culling.
+                primitive: wgpu::PrimitiveState {
+                    cull_mode: None,
+                    ..Default::default()
+                },
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: DEPTH_FORMAT,
+                    depth_write_enabled: Some(!background),
+                    depth_compare: Some(if background {
+                        wgpu::CompareFunction::Always
+                    } else {
+                        wgpu::CompareFunction::Greater
+                    }),
+                    stencil: Default::default(),
+                    bias: Default::default(),
+                }),
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module,
+                    entry_point: Some(fragment),
+                    compilation_options: Default::default(),
+                    targets: &[Some(COLOR_FORMAT.into())],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        let m = &guarded_module;
+        let guarded_object = pipeline(
+            "unrolled objects (guarded)",
+            m,
+            "vs_guarded",
+            "fs_object_guarded",
+            VERTEX_LAYOUT,
+            false,
+        );
+        let guarded_mirror = pipeline(
+            "unrolled mirrors (guarded)",
+            m,
+            "vs_guarded",
+            "fs_mirror_guarded",
+            VERTEX_LAYOUT,
+            false,
+        );
+        let background_pipeline = pipeline(
+            "unrolled backgrounds",
+            m,
+            "vs_background",
+            "fs_background",
+            background_layout,
+            true,
+        );
+        let clipped_object = clipped_module.as_ref().map(|m| {
+            pipeline(
+                "unrolled objects (clip distances)",
+                m,
+                "vs_clipped",
+                "fs_object_clipped",
+                VERTEX_LAYOUT,
+                false,
+            )
+        });
+        let clipped_mirror = clipped_module.as_ref().map(|m| {
+            pipeline(
+                "unrolled mirrors (clip distances)",
+                m,
+                "vs_clipped",
+                "fs_mirror_clipped",
+                VERTEX_LAYOUT,
+                false,
+            )
+        });
+        let depth = device
+            .create_texture(&wgpu::TextureDescriptor {
+                label: Some("unrolled depth"),
+                size: wgpu::Extent3d {
+                    width,
+                    height,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: DEPTH_FORMAT,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+                view_formats: &[],
+            })
+            .create_view(&Default::default());
+        let background = (!background.is_empty()).then(|| {
+            (
+                device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("unrolled backgrounds"),
+                    contents: bytemuck::cast_slice(&background),
+                    usage: wgpu::BufferUsages::VERTEX,
+                }),
+                background.len() as u32,
+            )
+        });
+        let stats = FrameStats {
+            passes: 1,
+            texture_renders: 0,
+            draws: draws.len() + usize::from(background.is_some()) + 1,
+            depth: paths.deepest,
+            triangles,
+            paths: Some(PathCounts::of(paths)),
+            clipping: Some(if clip_distances {
+                Clipping::ClipDistances
+            } else {
+                Clipping::FragmentDiscard
+            }),
+        };
+        Ok(Unrolled {
+            scene_buffers,
+            bind_group,
+            draws,
+            background,
+            depth,
+            clipped_object,
+            clipped_mirror,
+            guarded_object,
+            guarded_mirror,
+            background_pipeline,
+            clear: scene.background,
+            overlapping_siblings,
+            stats,
+        })
+    }
+}
+
+impl FrameEncoder for Unrolled {
+    fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &RenderTarget,
+        first_pass: Option<wgpu::RenderPassTimestampWrites<'_>>,
+    ) {
+        let bg = self.clear;
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("unrolled"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &target.color_view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color {
+                        r: bg.x as f64,
+                        g: bg.y as f64,
+                        b: bg.z as f64,
+                        a: 1.0,
+                    }),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &self.depth,
+                // Reversed Z: 0 is infinitely far.
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(0.0),
+                    store: wgpu::StoreOp::Discard,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: first_pass,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_bind_group(0, &self.scene_buffers.bind_group, &[]);
+        pass.set_bind_group(1, &self.bind_group, &[]);
+        if let Some((buffer, count)) = &self.background {
+            pass.set_pipeline(&self.background_pipeline);
+            pass.set_vertex_buffer(0, buffer.slice(..));
+            pass.draw(0..*count, 0..1);
+        }
+        pass.set_vertex_buffer(0, self.scene_buffers.vertices.slice(..));
+        for d in &self.draws {
+            let pipeline = match (d.stage, d.mirror) {
+                (Stage::Clipped, false) => self.clipped_object.as_ref(),
+                (Stage::Clipped, true) => self.clipped_mirror.as_ref(),
+                (Stage::Guarded, false) => Some(&self.guarded_object),
+                (Stage::Guarded, true) => Some(&self.guarded_mirror),
+            }
+            .expect("clipped draws exist only with clip distances");
+            pass.set_pipeline(pipeline);
+            pass.draw(d.vertices.clone(), d.instances.clone());
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reversed_z_keeps_coverage_and_orders_depth_far_to_zero() {
+        let p = glam::camera::rh::proj::directx::perspective(1.0, 1.5, 0.01, 1e4);
+        let r = infinite_reversed_z(p, 0.01);
+        for z in [-0.01f32, -1.0, -10.0, -5000.0] {
+            let v = glam::Vec4::new(0.3, -0.2, z, 1.0);
+            let (a, b) = (p * v, r * v);
+            assert_eq!((a.x, a.y, a.w), (b.x, b.y, b.w));
+        }
+        let depth = |z: f32| {
+            let c = r * glam::Vec4::new(0.0, 0.0, z, 1.0);
+            c.z / c.w
+        };
+        assert!((depth(-0.01) - 1.0).abs() < 1e-6);
+        // Strictly decreasing with distance, and still resolving 1 part in 1e5 at 4 km.
+        assert!(depth(-1.0) > depth(-2.0));
+        assert!(depth(-4000.0) > depth(-4000.05));
+    }
+
+    #[test]
+    fn portal_edges_keep_the_inside_in_either_orientation() {
+        let size = Vec2::new(100.0, 50.0);
+        let square = [
+            Vec2::new(10.0, 10.0),
+            Vec2::new(30.0, 10.0),
+            Vec2::new(30.0, 40.0),
+            Vec2::new(10.0, 40.0),
+        ];
+        let mut reversed = square;
+        reversed.reverse();
+        for poly in [&square[..], &reversed[..]] {
+            let edges = portal_edges(poly, size);
+            assert_eq!(edges.len(), 4);
+            let inside = |px: Vec2, w: f32| {
+                let n = pixel_to_ndc(px, size);
+                // The same point at clip w: (x·w, y·w, w).
+                edges
+                    .iter()
+                    .all(|e| e.x * n.x * w + e.y * n.y * w + e.z * w >= 0.0)
+            };
+            assert!(inside(Vec2::new(20.0, 25.0), 1.0));
+            assert!(inside(Vec2::new(20.0, 25.0), 7.5));
+            assert!(!inside(Vec2::new(5.0, 25.0), 1.0));
+            assert!(!inside(Vec2::new(20.0, 45.0), 3.0));
+        }
+    }
+}
