@@ -22,8 +22,9 @@ use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 /// The exact methods' path pruning in sweeps (the `render` command's defaults): portals
-/// under half a pixel² and attenuations under 1e-4 (the truth's `--min-throughput`).
-pub const EXACT_MIN_PORTAL_AREA: f32 = 0.5;
+/// holding no pixel centre (always; exact) and attenuations under 1e-4 (the truth's
+/// `--min-throughput`); no lossy area threshold.
+pub const EXACT_MIN_PORTAL_AREA: f32 = 0.0;
 pub const EXACT_MIN_ATTENUATION: f32 = 1e-4;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

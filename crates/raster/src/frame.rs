@@ -58,6 +58,9 @@ pub struct PathCounts {
     /// Paths through at least one mirror that are drawn (the camera itself not counted).
     pub kept: usize,
     pub pruned_empty: usize,
+    /// Portals holding no sample (exact pruning).
+    pub pruned_no_sample: usize,
+    /// Portals under `--min-portal-area` (lossy).
     pub pruned_small: usize,
     pub pruned_attenuation: usize,
     /// Paths cut by the depth cap.
@@ -69,6 +72,7 @@ impl PathCounts {
         PathCounts {
             kept: set.paths.len().saturating_sub(1),
             pruned_empty: set.pruned_empty,
+            pruned_no_sample: set.pruned_no_sample,
             pruned_small: set.pruned_small,
             pruned_attenuation: set.pruned_attenuation,
             capped: set.capped,
@@ -76,7 +80,11 @@ impl PathCounts {
     }
 
     pub fn pruned(&self) -> usize {
-        self.pruned_empty + self.pruned_small + self.pruned_attenuation + self.capped
+        self.pruned_empty
+            + self.pruned_no_sample
+            + self.pruned_small
+            + self.pruned_attenuation
+            + self.capped
     }
 }
 

@@ -29,6 +29,10 @@ pub use plan::Method;
 use mirrorbox_image::RgbImage;
 use mirrorbox_scene::Scene;
 
+/// Most triangles (instances counted) an exact method submits per frame: a time bound
+/// (about 10 s on lavapipe, 2 cores); refused beyond with a hint.
+pub const MAX_TRIANGLES_PER_FRAME: usize = 50_000_000;
+
 /// Most reflection paths an exact method draws per frame (memory and time bound).
 pub const MAX_PORTAL_PATHS: usize = 200_000;
 

@@ -105,9 +105,11 @@ fn schedule(paths: &PathSet) -> Result<Vec<Op>, TooDeep> {
     Ok(ops)
 }
 
-/// A frame may draw at most this many triangles: llvmpipe bins a whole pass in memory, about
-/// 2 KB per triangle here (8 M triangles took 17.8 GB), so 2 M keeps a frame near 4 GB.
-pub const MAX_TRIANGLES_PER_FRAME: usize = 2_000_000;
+/// A frame may draw at most this many triangles: lavapipe records every draw of the one
+/// pass and holds it until the pass ends, about 1 KB per triangle here (mirror_room, depth 64,
+/// 160×90: 6.5 M triangles, 6.1 GB peak; splitting the frame into several passes did not
+/// lower it), so 8 M keeps a frame under ~8 GB.
+pub const MAX_TRIANGLES_PER_FRAME: usize = 8_000_000;
 
 pub struct PortalStencil {
     scene_buffers: SceneBuffers,

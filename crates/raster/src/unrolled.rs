@@ -46,11 +46,6 @@ pub const CLIP_EDGES: usize = 7;
 /// Scene-space tolerance of "in front of a mirror" (as `GUARD_EPSILON` in the shader).
 const FRONT_EPSILON: f32 = 1e-5;
 
-/// Submitted triangles (instances × triangles) a frame may hold; beyond, the frame is
-/// refused with a hint. Clipped triangles cost only vertex work on llvmpipe, so this is a
-/// time bound, not the memory bound of `portal_stencil`.
-pub const MAX_TRIANGLES_PER_FRAME: usize = 50_000_000;
-
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 struct PathData {
@@ -314,11 +309,11 @@ impl Unrolled {
                 });
             }
         }
-        if triangles > MAX_TRIANGLES_PER_FRAME {
+        if triangles > crate::MAX_TRIANGLES_PER_FRAME {
             return Err(RasterError::Plan(
                 crate::plan::PlanError::TooManyTriangles {
                     triangles,
-                    limit: MAX_TRIANGLES_PER_FRAME,
+                    limit: crate::MAX_TRIANGLES_PER_FRAME,
                 },
             ));
         }

@@ -222,13 +222,10 @@ fn geometry_behind_a_mirror_does_not_leak() {
 }
 
 // ---------------------------------------------------------------------------------------
-// portal: exact stencil recursion
+// Exact methods: portal (stencil recursion) and unrolled (instanced paths)
 
-fn portal(depth: u32) -> RenderSettings {
-    RenderSettings {
-        min_portal_area: 0.5,
-        ..settings(Method::Portal { depth }, 1)
-    }
+fn exact(method: Method) -> RenderSettings {
+    settings(method, 1)
 }
 
 fn trace_depth(s: &Scene, depth: u32) -> RgbImage {
@@ -244,65 +241,129 @@ fn trace_depth(s: &Scene, depth: u32) -> RgbImage {
     mirrorbox_trace::render(s, &bvh, &settings, &|_| {}).image
 }
 
-/// The portal method against the truth traced to the same depth and throughput cut. Only
-/// samples on a mirror's edge may differ (the rasterizer's top-left rule vs the tracer's
-/// inclusive watertight test decide them differently, which shifts them by one reflection);
-/// measured at 160×90: mirror_box depth 64 FLIP 7e-5 (relMSE 8e-7), tilted_pair depth 64
-/// FLIP 3e-4. The mirror room branches too much for depth 64 within the frame's triangle
-/// budget on lavapipe; it is checked at depth 8.
-#[test]
-fn portal_matches_the_truth_at_depth() {
+/// The floor of the comparison: raster (naive) vs trace with the mirrors removed.
+fn floor_flip(s: &Scene) -> f64 {
+    let bare = s.without_mirrors();
     let gpu = Gpu::new().unwrap();
-    // The room's horizon is dense with reflected wall corners, where a sample on the line
-    // between two mirrors goes to either: 10 of 14 400 pixels, FLIP 1.4e-3 (a missing path,
-    // the bug this test was written against, gave FLIP 1.8e-2 and thousands of pixels).
+    let r = render(&gpu, &bare, &settings(Method::Naive, 1))
+        .unwrap()
+        .image;
+    let t = trace_depth(&bare, 1);
+    mirrorbox_image::metrics::compare(&t, &r, 1.0)
+        .unwrap()
+        .flip_mean
+}
+
+/// Both exact methods against the truth traced to the same depth (64) and throughput cut.
+/// Off the mirrors' edges they are exact; only samples lying on a mirror's edge (to float
+/// precision, deep in the recursion) may go to the other side than in the tracer — the
+/// rasterizer's top-left rule and its f32 transforms vs the tracer's inclusive watertight
+/// test in f64 — which shifts them by one reflection. Measured at 160×90 (96×54 for the room,
+/// whose branching makes the portal method ~4 s a frame there): mirror_box FLIP 7e-5,
+/// tilted_pair 3e-4, mirror_room 1.5e-3 — 7, 10 and ~10 pixels; the floor (no mirrors) is
+/// ~1e-6. A missing or misplaced path shows thousands of pixels and FLIP > 1e-2.
+#[test]
+fn exact_methods_match_the_truth_at_depth_64() {
+    let gpu = Gpu::new().unwrap();
     let cases = [
-        ("mirror_box.json", 64, 1e-3),
-        ("tilted_pair.json", 64, 1e-3),
-        ("mirror_room.json", 8, 2e-3),
+        ("mirror_box.json", 160, 90, 1e-3),
+        ("tilted_pair.json", 160, 90, 1e-3),
+        ("mirror_room.json", 96, 54, 3e-3),
     ];
-    for (name, depth, flip) in cases {
-        let s = scene(name, 160, 90);
-        let out = render(&gpu, &s, &portal(depth)).unwrap();
-        assert_eq!(out.stats.passes, 1);
-        let truth = trace_depth(&s, depth);
-        let d = differences(&out.image, &truth);
-        let off = d.iter().filter(|&&x| x > 1e-3).count();
-        let m = mirrorbox_image::metrics::compare(&truth, &out.image, 1.0).unwrap();
-        println!(
-            "{name} depth {depth}: {off} of {} pixels off by > 1e-3, FLIP {:.2e}, relMSE {:.2e}",
-            d.len(),
-            m.flip_mean,
-            m.relmse
-        );
-        if off * 200 > d.len() || m.flip_mean > flip {
-            let where_ = dump(&format!("portal_{name}"), &out.image, &truth);
-            panic!("{name}: {off} pixels off, FLIP {}; {where_}", m.flip_mean);
+    for (name, w, h, flip) in cases {
+        let s = scene(name, w, h);
+        let truth = trace_depth(&s, 64);
+        let floor = floor_flip(&s);
+        for method in [Method::Portal { depth: 64 }, Method::Unrolled { depth: 64 }] {
+            let out = render(&gpu, &s, &exact(method)).unwrap();
+            assert_eq!(out.stats.passes, 1);
+            assert!(out.warnings.is_empty(), "{:?}", out.warnings);
+            let paths = out.stats.paths.unwrap();
+            // Either the cap is reached or the recursion ends by itself (tilted mirrors
+            // diverge: their paths leave the view after 13 reflections).
+            assert!(
+                out.stats.depth == 64 || paths.capped == 0,
+                "{name}: depth {}, {} capped",
+                out.stats.depth,
+                paths.capped
+            );
+            let d = differences(&out.image, &truth);
+            let off = d.iter().filter(|&&x| x > 1e-3).count();
+            let m = mirrorbox_image::metrics::compare(&truth, &out.image, 1.0).unwrap();
+            println!(
+                "{name} {method}: {} paths kept, {} pruned; {off} of {} pixels off by > 1e-3, \
+                 FLIP {:.2e} (floor {floor:.2e}), relMSE {:.2e}",
+                paths.kept,
+                paths.pruned(),
+                d.len(),
+                m.flip_mean,
+                m.relmse
+            );
+            if off * 200 > d.len() || m.flip_mean > flip {
+                let where_ = dump(&format!("{}_{name}", method.name()), &out.image, &truth);
+                panic!(
+                    "{name} {method}: {off} pixels off, FLIP {}; {where_}",
+                    m.flip_mean
+                );
+            }
         }
     }
 }
 
-/// One pass whatever the depth, and draws growing linearly with it on a chain of mirrors.
 #[test]
-fn portal_cost_grows_linearly_with_depth() {
+fn golden_unrolled_depth64_mirror_box() {
+    let s = scene("mirror_box.json", 160, 90);
     let gpu = Gpu::new().unwrap();
-    let s = scene("mirror_box.json", 64, 36);
-    let draws: Vec<usize> = [8, 16, 32]
-        .iter()
-        .map(|&d| render(&gpu, &s, &portal(d)).unwrap().stats.draws)
-        .collect();
-    let (a, b) = (draws[1] - draws[0], draws[2] - draws[1]);
-    assert_eq!(b, 2 * a, "draws at depth 8, 16, 32: {draws:?}");
+    let out = render(&gpu, &s, &exact(Method::Unrolled { depth: 64 })).unwrap();
+    assert_golden("unrolled_depth64_mirror_box", &out.image);
 }
 
+/// Portal: one pass whatever the depth, and draws growing linearly with it on a chain.
+/// Unrolled: the same handful of draws at every depth (one per part and stage, the
+/// backgrounds, the resolve); only the instances grow, linearly.
 #[test]
-fn portal_keeps_geometry_behind_a_mirror_out() {
+fn exact_methods_cost_grows_linearly_with_depth() {
+    let gpu = Gpu::new().unwrap();
+    let s = scene("mirror_box.json", 64, 36);
+    let stats = |method| render(&gpu, &s, &exact(method)).unwrap().stats;
+    let portal: Vec<usize> = [8, 16, 32]
+        .iter()
+        .map(|&depth| stats(Method::Portal { depth }).draws)
+        .collect();
+    let (a, b) = (portal[1] - portal[0], portal[2] - portal[1]);
+    assert_eq!(b, 2 * a, "portal draws at depth 8, 16, 32: {portal:?}");
+    let unrolled: Vec<_> = [1, 8, 16, 32]
+        .iter()
+        .map(|&depth| stats(Method::Unrolled { depth }))
+        .collect();
+    assert!(
+        unrolled[1..]
+            .iter()
+            .all(|u| u.draws == unrolled[1].draws && u.draws <= 12),
+        "unrolled draws: {:?}",
+        unrolled.iter().map(|u| u.draws).collect::<Vec<_>>()
+    );
+    let t: Vec<usize> = unrolled.iter().map(|u| u.triangles).collect();
+    let (a, b) = (t[2] - t[1], t[3] - t[2]);
+    assert!(
+        a > 0 && b.abs_diff(2 * a) * 10 <= b,
+        "unrolled triangles at depth 1, 8, 16, 32: {t:?}"
+    );
+}
+
+/// Geometry behind a mirror: a bright emissive box sits right behind the first of two
+/// facing mirrors. It lies inside every cell's cone, so only the exact methods' cell tests
+/// (stencil + oblique plane; the unrolled guard) keep it out. The unrolled method must agree
+/// with the truth with hardware clip distances and with fragment discard alike.
+#[test]
+fn exact_methods_keep_geometry_behind_a_mirror_out() {
     let text = serde_json::json!({
         "camera": { "position": [0.3, 1.2, 2.5], "look_at": [0, 1, -2], "fov_y_deg": 50, "width": 64, "height": 48 },
         "mirrors": [ { "center": [0, 1.5, -2], "normal": [0, 0, 1], "up": [0, 1, 0], "width": 4, "height": 3 },
                      { "center": [0, 1.5, 3], "normal": [0, 0, -1], "up": [0, 1, 0], "width": 4, "height": 3 } ],
         "objects": [
             { "type": "quad", "size": [4, 4], "transform": { "rotate_deg": [-90, 0, 0] } },
+            { "type": "sphere", "radius": 0.4, "transform": { "translate": [0, 0.6, 0] }, "albedo": [0.2, 0.4, 0.8] },
             { "type": "box", "size": [1.5, 1.5, 0.5], "albedo": [0, 0, 0], "emission": [0, 50, 0],
               "transform": { "translate": [0, 1.5, -2.4] } }
         ],
@@ -310,10 +371,59 @@ fn portal_keeps_geometry_behind_a_mirror_out() {
     });
     let s = mirrorbox_scene::load::parse_scene(&text.to_string(), Path::new("leak.json")).unwrap();
     let gpu = Gpu::new().unwrap();
-    let r = render(&gpu, &s, &portal(16)).unwrap().image;
+    let truth = trace_depth(&s, 16);
+    let runs = [
+        ("portal", exact(Method::Portal { depth: 16 })),
+        ("unrolled", exact(Method::Unrolled { depth: 16 })),
+        (
+            "unrolled-fragment",
+            RenderSettings {
+                fragment_clipping: true,
+                ..exact(Method::Unrolled { depth: 16 })
+            },
+        ),
+    ];
+    for (label, settings) in runs {
+        let r = render(&gpu, &s, &settings).unwrap().image;
+        let green = r.pixels.iter().filter(|p| p[1] > 5.0).count();
+        let d = differences(&r, &truth);
+        let off = d.iter().filter(|&&x| x > 1e-3).count();
+        if green > 0 || off * 100 > d.len() {
+            let where_ = dump(&format!("leak_{label}"), &r, &truth);
+            panic!("{label}: the box leaked into {green} pixels; {off} pixels off; {where_}");
+        }
+    }
+}
+
+/// The unrolled method's two clipping stages implement the same cell test: hardware clip
+/// distances and per-fragment discard give the same image up to samples on portal edges.
+#[test]
+fn unrolled_clip_distances_and_fragment_discard_agree() {
+    let gpu = Gpu::new().unwrap();
+    if !gpu.clip_distances {
+        eprintln!("skipped: this adapter has no clip distances");
+        return;
+    }
+    let s = scene("mirror_room.json", 96, 54);
+    let a = render(&gpu, &s, &exact(Method::Unrolled { depth: 16 })).unwrap();
+    let b = render(
+        &gpu,
+        &s,
+        &RenderSettings {
+            fragment_clipping: true,
+            ..exact(Method::Unrolled { depth: 16 })
+        },
+    )
+    .unwrap();
     assert_eq!(
-        r.pixels.iter().filter(|p| p[1] > 5.0).count(),
-        0,
-        "the box behind the mirror leaked"
+        a.stats.clipping,
+        Some(mirrorbox_raster::Clipping::ClipDistances)
     );
+    assert_eq!(
+        b.stats.clipping,
+        Some(mirrorbox_raster::Clipping::FragmentDiscard)
+    );
+    let d = differences(&a.image, &b.image);
+    let off = d.iter().filter(|&&x| x > 1e-3).count();
+    assert!(off * 500 <= d.len(), "{off} of {} pixels differ", d.len());
 }

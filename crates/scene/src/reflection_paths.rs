@@ -4,8 +4,11 @@
 //! front of the path's last mirror, and inside the path's portal — the mirror's polygon is
 //! clipped by the last mirror's plane, projected, clipped to the view and then to the
 //! parent's portal (seed 001's pruning of invisible cells, made general). A path is pruned
-//! when its portal is empty or smaller than `min_portal_area` pixels, or when the product of
-//! reflectances along it falls below `min_attenuation`, and capped at `max_depth` mirrors.
+//! when its portal is empty or holds no sample position (pixel centre at the render
+//! resolution — the only points a rasterizer looks at, so this pruning changes no pixel),
+//! optionally when it is smaller than `min_portal_area` pixels² (lossy, for speed), or when
+//! the product of reflectances along it falls below `min_attenuation`, and capped at
+//! `max_depth` mirrors.
 //! Two parallel mirrors give chains; a mirror room branches, and pruning keeps it tractable.
 //!
 //! Views are composed in f64 (`view · R₁ · … · Rₖ`), so a 1000-reflection path is as exact as
@@ -20,7 +23,8 @@ use glam::{DVec3, Mat4, Vec2, Vec3};
 pub struct PathLimits {
     /// Most mirrors along a path.
     pub max_depth: u32,
-    /// Portals smaller than this (pixels²) are pruned; 0 prunes only empty portals.
+    /// Portals smaller than this (pixels²) are pruned, though they may hold a sample (lossy);
+    /// 0 prunes only portals holding no sample, which is exact.
     pub min_portal_area: f32,
     /// Paths whose attenuation (largest channel) falls below this are pruned.
     pub min_attenuation: f32,
@@ -48,6 +52,8 @@ pub struct PathSet {
     /// `paths[0]` is the camera; children follow their parents.
     pub paths: Vec<ReflectionPath>,
     pub pruned_empty: usize,
+    /// Non-empty portals holding no pixel centre.
+    pub pruned_no_sample: usize,
     pub pruned_small: usize,
     pub pruned_attenuation: usize,
     pub capped: usize,
@@ -69,6 +75,47 @@ fn without_duplicates(poly: Vec<Vec2>) -> Vec<Vec2> {
         out.pop();
     }
     out
+}
+
+/// Whether convex polygon `poly` (pixels, any orientation) contains a pixel centre
+/// `(i + ½, j + ½)`, edges included. Conservative: a polygon whose bounding box spans more
+/// than 256 centres counts as holding one without looking.
+pub fn holds_a_sample(poly: &[Vec2]) -> bool {
+    let (lo, hi) = poly.iter().fold(
+        (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY)),
+        |(a, b), p| (a.min(*p), b.max(*p)),
+    );
+    // Centres c with lo ≤ c ≤ hi: i from ceil(lo − ½) to floor(hi − ½).
+    let (i0, i1) = ((lo.x - 0.5).ceil(), (hi.x - 0.5).floor());
+    let (j0, j1) = ((lo.y - 0.5).ceil(), (hi.y - 0.5).floor());
+    if i1 < i0 || j1 < j0 {
+        return false;
+    }
+    if (i1 - i0 + 1.0) * (j1 - j0 + 1.0) > 256.0 {
+        return true;
+    }
+    let twice: f32 = (0..poly.len())
+        .map(|i| poly[i].perp_dot(poly[(i + 1) % poly.len()]))
+        .sum();
+    let orientation = twice.signum();
+    let inside = |c: Vec2| {
+        (0..poly.len()).all(|k| {
+            let (a, b) = (poly[k], poly[(k + 1) % poly.len()]);
+            orientation * (b - a).perp_dot(c - a) >= 0.0
+        })
+    };
+    let mut j = j0;
+    while j <= j1 {
+        let mut i = i0;
+        while i <= i1 {
+            if inside(Vec2::new(i + 0.5, j + 0.5)) {
+                return true;
+            }
+            i += 1.0;
+        }
+        j += 1.0;
+    }
+    false
 }
 
 /// Keeps the part of convex polygon `poly` inside convex polygon `clip` (any orientation).
@@ -159,6 +206,10 @@ pub fn reflection_paths(
             };
             if visible.len() < 3 || area(&visible) == 0.0 {
                 set.pruned_empty += 1;
+                continue;
+            }
+            if !holds_a_sample(&visible) {
+                set.pruned_no_sample += 1;
                 continue;
             }
             if area(&visible) < limits.min_portal_area {
@@ -254,13 +305,12 @@ mod tests {
             let parent = &set.paths[p.parent.unwrap()];
             assert!(area(&p.portal) <= area(&parent.portal) + 1e-3);
         }
-        // Two parallel mirrors 4 apart: every two reflections move the virtual eye by +8 in z.
-        let deep = set
-            .paths
-            .iter()
-            .find(|p| p.mirrors.len() == 200)
-            .expect("R = 1 reaches depth 200");
-        let expected = s.camera.position.z as f64 + 4.0 * 200.0;
+        // Two parallel mirrors 4 apart: every two reflections move the virtual eye by +8 in
+        // z. With R = 1 the chain ends only when its portal holds no pixel centre.
+        let depth = set.deepest / 2 * 2;
+        assert!(depth >= 100, "R = 1 reaches depth {}", set.deepest);
+        let deep = set.paths.iter().find(|p| p.mirrors.len() == depth).unwrap();
+        let expected = s.camera.position.z as f64 + 4.0 * depth as f64;
         let eye = deep.view.eye();
         assert!((eye.z as f64 - expected).abs() < 1e-2, "{eye}");
     }
@@ -305,6 +355,34 @@ mod tests {
         ];
         let with_repeat = [a[0], a[1], a[2], a[2] + Vec2::new(0.0, 4e-6), a[3]];
         assert!((area(&clip_convex(&a, &with_repeat)) - 4.0).abs() < 1e-4);
+    }
+
+    #[test]
+    fn a_portal_holds_a_sample_only_around_a_pixel_centre() {
+        let square = |c: Vec2, r: f32| {
+            vec![
+                c + Vec2::new(-r, -r),
+                c + Vec2::new(r, -r),
+                c + Vec2::new(r, r),
+                c + Vec2::new(-r, r),
+            ]
+        };
+        assert!(holds_a_sample(&square(Vec2::new(3.5, 7.5), 0.1)));
+        // Area 0.64 px² between four centres: no sample.
+        assert!(!holds_a_sample(&square(Vec2::new(4.0, 8.0), 0.4)));
+        // Edges count; orientation does not matter.
+        let mut edge = square(Vec2::new(3.5, 7.9), 0.4);
+        assert!(holds_a_sample(&edge));
+        edge.reverse();
+        assert!(holds_a_sample(&edge));
+        // A thin sliver between two rows of centres, 30 px long.
+        let sliver = [
+            Vec2::new(0.0, 2.1),
+            Vec2::new(30.0, 2.1),
+            Vec2::new(30.0, 2.4),
+            Vec2::new(0.0, 2.4),
+        ];
+        assert!(!holds_a_sample(&sliver));
     }
 
     #[test]

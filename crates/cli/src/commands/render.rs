@@ -32,8 +32,10 @@ pub struct Args {
     /// Most mirrors along a reflection path (exact methods: portal, unrolled). Default 64.
     #[arg(long)]
     depth: Option<u32>,
-    /// Exact methods: prune paths whose portal covers fewer pixels² (at render resolution).
-    #[arg(long, default_value_t = 0.5)]
+    /// Exact methods: also prune paths whose portal covers fewer pixels² (at render
+    /// resolution) though it may hold a pixel centre — lossy, for speed. Portals holding no
+    /// pixel centre are always pruned (that changes no pixel).
+    #[arg(long, default_value_t = 0.0)]
     min_portal_area: f32,
     /// Exact methods: prune paths whose attenuation falls below this (the tracer's --min-throughput).
     #[arg(long, default_value_t = 1e-4)]
@@ -189,7 +191,8 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             "passes": s.passes, "texture_renders": s.texture_renders, "draws": s.draws, "depth": s.depth,
             "triangles": s.triangles,
             "paths": s.paths.map(|c| serde_json::json!({
-                "kept": c.kept, "pruned_empty": c.pruned_empty, "pruned_small": c.pruned_small,
+                "kept": c.kept, "pruned_empty": c.pruned_empty, "pruned_no_sample": c.pruned_no_sample,
+                "pruned_small": c.pruned_small,
                 "pruned_attenuation": c.pruned_attenuation, "capped": c.capped,
             })),
             "clipping": s.clipping.map(|c| c.name()),
@@ -212,10 +215,11 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         );
         if let Some(c) = s.paths {
             println!(
-                "  reflection paths: {} kept; pruned {} (empty {}, under --min-portal-area {}, under --min-attenuation {}, past --depth {}); {} triangles submitted{}",
+                "  reflection paths: {} kept; pruned {} (empty {}, no pixel centre {}, under --min-portal-area {}, under --min-attenuation {}, past --depth {}); {} triangles submitted{}",
                 c.kept,
                 c.pruned(),
                 c.pruned_empty,
+                c.pruned_no_sample,
                 c.pruned_small,
                 c.pruned_attenuation,
                 c.capped,
