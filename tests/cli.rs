@@ -595,10 +595,22 @@ fn render_refuses_too_many_passes_before_any_work() {
 
 #[test]
 fn render_refuses_bad_arguments() {
-    let cases: [(&[&str], &str); 5] = [
+    let cases: [(&[&str], &str); 8] = [
         (
             &["--method", "naive", "--n", "2"],
             "--n applies to --method auxiliary only",
+        ),
+        (
+            &["--method", "auxiliary", "--depth", "8"],
+            "--depth applies to --method portal or unrolled only",
+        ),
+        (
+            &["--method", "portal", "--fragment-clipping"],
+            "--fragment-clipping applies to --method unrolled only",
+        ),
+        (
+            &["--method", "unrolled", "--depth", "0"],
+            "--depth must be in [1, 4096], got 0",
         ),
         (&["--alpha", "1.5"], "--alpha must be in [0, 1], got 1.5"),
         (&["--ssaa", "0"], "--ssaa must be in [1, 8], got 0"),
@@ -946,7 +958,7 @@ fn sweep_refuses_bad_arguments() {
 }
 
 #[test]
-fn sweep_measures_the_portal_method_by_depth() {
+fn sweep_measures_the_exact_methods_by_depth() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("p");
     let run = mirrorbox(
@@ -956,7 +968,7 @@ fn sweep_measures_the_portal_method_by_depth() {
             "--out",
             out.to_str().unwrap(),
             "--methods",
-            "portal",
+            "portal,unrolled",
             "--depth",
             "2,8,32",
             "--alpha",
@@ -973,22 +985,70 @@ fn sweep_measures_the_portal_method_by_depth() {
         &[],
     );
     assert_eq!(run.code, 0, "{}", run.stderr);
-    let recs: Vec<Value> = records(&out)
-        .into_iter()
-        .filter(|r| r["method"] == "portal")
-        .collect();
-    let depths: Vec<u64> = recs.iter().map(|r| r["depth"].as_u64().unwrap()).collect();
-    assert_eq!(depths, vec![2, 8, 32]);
-    assert!(
-        recs.iter().all(|r| r["passes"] == 1),
-        "one pass whatever the depth"
+    let all = records(&out);
+    for method in ["portal", "unrolled"] {
+        let recs: Vec<&Value> = all.iter().filter(|r| r["method"] == method).collect();
+        let depths: Vec<u64> = recs.iter().map(|r| r["depth"].as_u64().unwrap()).collect();
+        assert_eq!(depths, vec![2, 8, 32], "{method}");
+        assert!(
+            recs.iter().all(|r| r["passes"] == 1),
+            "{method}: one pass whatever the depth"
+        );
+        assert!(recs.iter().all(|r| r["paths"].as_u64().unwrap() >= 2));
+        let err: Vec<f64> = recs
+            .iter()
+            .map(|r| r["metrics"]["relmse"].as_f64().unwrap())
+            .collect();
+        assert!(
+            err[0] > err[1] && err[1] > err[2],
+            "{method}: error falls with depth: {err:?}"
+        );
+    }
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(report.contains("## Exact methods: cost against depth"));
+    assert!(report.contains("ms per extra reflection"));
+    assert!(out.join("plot_ms_vs_depth.svg").exists());
+}
+
+#[test]
+fn render_unrolled_reports_paths_and_clipping() {
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("u.png");
+    let out = mirrorbox(
+        &[
+            "render",
+            "scenes/mirror_room.json",
+            "--method",
+            "unrolled",
+            "--depth",
+            "4",
+            "--width",
+            "64",
+            "--height",
+            "36",
+            "--frames",
+            "1",
+            "--json",
+            "-o",
+            png.to_str().unwrap(),
+        ],
+        &[],
     );
-    let err: Vec<f64> = recs
-        .iter()
-        .map(|r| r["metrics"]["relmse"].as_f64().unwrap())
-        .collect();
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let v: Value = serde_json::from_str(out.stdout.trim()).unwrap();
+    assert_eq!(v["method"], "unrolled");
+    assert_eq!(v["depth_limit"], 4);
+    assert_eq!(v["passes"], 1);
+    let paths = &v["paths"];
     assert!(
-        err[0] > err[1] && err[1] > err[2],
-        "error falls with depth: {err:?}"
+        paths["kept"].as_u64().unwrap() > 4,
+        "the room branches: {paths}"
     );
+    assert!(
+        paths["capped"].as_u64().unwrap() > 0,
+        "depth 4 caps it: {paths}"
+    );
+    assert!(v["clipping"].is_string());
+    assert!(v["triangles"].as_u64().unwrap() > 0);
+    assert!(png.exists() && png.with_extension("exr").exists());
 }

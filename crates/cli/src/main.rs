@@ -3,7 +3,7 @@
 //! 0 success, 2 bad input (unreadable or invalid scene, bad arguments), 1 anything else.
 //!
 //! One module per subcommand under `commands/`; later subcommands (`trace`, `render`,
-//! `compare`, `sweep`, `table1`, `export-mitsuba`) slot in the same way.
+//! `compare`, `sweep`, `table1`, `depth-scaling`, `export-mitsuba`) slot in the same way.
 
 mod commands;
 
@@ -35,8 +35,10 @@ enum Command {
     Compare(commands::compare::Args),
     /// Sweep methods, n and α: time, compare with cached truths, write reports (resumable).
     Sweep(commands::sweep::Args),
-    /// The preset sweep reproducing the paper's Table 1 (writes reports/table1/).
-    Table1(commands::sweep::Table1Args),
+    /// The preset sweep reproducing the paper's Table 1, exact methods beside it (writes reports/table1/).
+    Table1(commands::sweep::PresetArgs),
+    /// The preset sweep of the exact methods' cost against depth 1…1024 (writes reports/depth_scaling/).
+    DepthScaling(commands::sweep::PresetArgs),
     /// Export a scene as Mitsuba 3 XML (tools/mitsuba renders and compares it).
     ExportMitsuba(commands::export_mitsuba::Args),
 }
@@ -97,6 +99,7 @@ fn main() -> ExitCode {
         Command::Compare(args) => commands::compare::run(&args),
         Command::Sweep(args) => commands::sweep::run(&args),
         Command::Table1(args) => commands::sweep::run_table1(&args),
+        Command::DepthScaling(args) => commands::sweep::run_depth_scaling(&args),
         Command::ExportMitsuba(args) => commands::export_mitsuba::run(&args),
     };
     match result {

@@ -5,6 +5,7 @@
 //! - [`write_report`]: `results.csv`, `report.md`, a self-contained `report.html` and the SVG
 //!   plots, including the reproduction of the seed paper's Table 1 ([`table1`]).
 
+pub mod exact;
 pub mod plot;
 pub mod table1;
 mod write;

@@ -2,8 +2,8 @@
 //! they always say the same thing.
 
 use crate::plot::{Chart, Series};
-use crate::table1;
 use crate::{Record, SweepInfo};
+use crate::{exact, table1};
 use base64::Engine;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -208,6 +208,164 @@ fn write_csv(path: &Path, records: &[Record]) -> std::io::Result<()> {
     std::fs::write(path, s)
 }
 
+/// The exact methods beside the paper's method at the Table 1 α: time and error.
+fn exact_comparison(records: &[Record], rows: &[table1::Row], alpha: f32) -> Vec<Block> {
+    let exact = exact::comparison_points(records, alpha);
+    if exact.is_empty() {
+        return Vec::new();
+    }
+    let aux: Vec<&Record> = rows
+        .iter()
+        .filter_map(|row| {
+            records.iter().find(|r| {
+                r.kind == "point"
+                    && r.method == "auxiliary"
+                    && r.n == Some(row.n)
+                    && r.alpha == alpha
+            })
+        })
+        .collect();
+    let line = |r: &Record| {
+        vec![
+            label(r),
+            format!("{} ({})", f(r.ms_median, 1), f(r.ms_min, 1)),
+            r.passes.to_string(),
+            r.draws.to_string(),
+            r.reflections.to_string(),
+            sci(r.metrics.flip_mean),
+            sci(r.metrics.relmse),
+        ]
+    };
+    let mut out = vec![
+        Block::Heading(3, format!("The exact methods beside it (α = {alpha})")),
+        Block::Table(
+            [
+                "method",
+                "ms/frame median (min)",
+                "passes",
+                "draws",
+                "reflections shown",
+                "FLIP mean",
+                "relMSE",
+            ]
+            .map(String::from)
+            .to_vec(),
+            aux.iter().chain(&exact).map(|r| line(r)).collect(),
+        ),
+    ];
+    let times = |ratio: f64| {
+        if ratio >= 1.0 {
+            format!("{ratio:.1}× faster")
+        } else {
+            format!("{:.1}× slower", 1.0 / ratio)
+        }
+    };
+    let sentences: Vec<String> = exact
+        .iter()
+        .map(|e| {
+            let against: Vec<String> = aux
+                .iter()
+                .filter(|a| matches!(a.n, Some(2) | Some(4)))
+                .map(|a| {
+                    format!(
+                        "against {} (FLIP {}, {} ms): {:.0}× lower error, {}",
+                        label(a),
+                        sci(a.metrics.flip_mean),
+                        f(a.ms_median, 1),
+                        a.metrics.flip_mean / e.metrics.flip_mean,
+                        times(a.ms_median / e.ms_median)
+                    )
+                })
+                .collect();
+            format!(
+                "{} shows {} reflections with FLIP {} in {} ms; {}.",
+                label(e),
+                e.reflections,
+                sci(e.metrics.flip_mean),
+                f(e.ms_median, 1),
+                against.join("; ")
+            )
+        })
+        .collect();
+    out.push(Block::Bullets(sentences));
+    out
+}
+
+/// ms/frame against the depth cap for each exact method with several depths.
+fn depth_scaling(records: &[Record], floor: Option<&Record>) -> Vec<Block> {
+    let groups = exact::depth_scaling(records);
+    if groups.is_empty() {
+        return Vec::new();
+    }
+    let mut out = vec![
+        Block::Heading(2, "Exact methods: cost against depth".into()),
+        Block::Chart(
+            "plot_ms_vs_depth.svg".into(),
+            Chart {
+                title: "ms/frame vs depth cap".into(),
+                x_label: "depth cap (most mirrors along a path)".into(),
+                y_label: "ms/frame (median)".into(),
+                x_log: true,
+                y_log: true,
+                series: groups
+                    .iter()
+                    .map(|g| Series {
+                        name: format!("{}, α={}", g.method, g.alpha),
+                        points: g.points.iter().map(|r| (setting(r), r.ms_median)).collect(),
+                        labels: Vec::new(),
+                    })
+                    .collect(),
+                reference_lines: floor
+                    .map(|fl| vec![("one full-scene pass".to_string(), fl.ms_median)])
+                    .unwrap_or_default(),
+            }
+            .to_svg(),
+        ),
+        Block::Table(
+            [
+                "method",
+                "α",
+                "depth cap",
+                "reflections shown",
+                "paths",
+                "passes",
+                "draws",
+                "triangles",
+                "ms/frame median (min)",
+                "FLIP mean",
+            ]
+            .map(String::from)
+            .to_vec(),
+            groups
+                .iter()
+                .flat_map(|g| &g.points)
+                .map(|r| {
+                    let opt = |v: Option<usize>| v.map_or("–".into(), |x| x.to_string());
+                    vec![
+                        r.method.clone(),
+                        r.alpha.to_string(),
+                        opt(r.depth.map(|d| d as usize)),
+                        r.reflections.to_string(),
+                        opt(r.paths),
+                        r.passes.to_string(),
+                        r.draws.to_string(),
+                        opt(r.triangles),
+                        format!("{} ({})", f(r.ms_median, 2), f(r.ms_min, 2)),
+                        sci(r.metrics.flip_mean),
+                    ]
+                })
+                .collect(),
+        ),
+    ];
+    out.push(Block::Bullets(
+        groups
+            .iter()
+            .map(|g| exact::bounce_sentence(g, floor.map(|fl| fl.ms_median)))
+            .collect(),
+    ));
+    out
+}
+
 fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
     let mut b = vec![
         Block::Heading(1, format!("mirrorbox sweep: {}", info.scene)),
@@ -267,6 +425,9 @@ fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
                 .collect(),
         ));
         b.push(Block::Paragraph(table1::growth_sentence(&rows)));
+        if let Some(a) = alpha {
+            b.extend(exact_comparison(records, &rows, a));
+        }
     }
 
     if let Some(fl) = floor {
@@ -280,6 +441,8 @@ fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
             f(fl.metrics.ssim, 6)
         )));
     }
+
+    b.extend(depth_scaling(records, floor));
 
     let mut groups: Vec<(String, f32)> = Vec::new();
     for r in &points {

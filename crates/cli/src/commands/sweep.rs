@@ -14,13 +14,14 @@ pub struct Args {
     /// Output folder (results.jsonl, results.csv, report.md, report.html, plots, images, cache).
     #[arg(long)]
     out: PathBuf,
-    /// Methods, comma separated: naive, auxiliary, portal.
+    /// Methods, comma separated: naive, auxiliary, portal, unrolled.
     #[arg(long, default_value = "naive,auxiliary")]
     methods: String,
     /// Auxiliary mirror counts: a range `A..B` (inclusive) or a list `0,2,4`.
     #[arg(long, default_value = "0..4")]
     n: String,
-    /// Reflection depths of the portal method: a range `A..B` or a list `1,4,16,64`.
+    /// Reflection depths of the exact methods (portal, unrolled): a range `A..B` or a list
+    /// `1,4,16,64`.
     #[arg(long, default_value = "1,2,4,8,16,32,64")]
     depth: String,
     /// Reflectances α, comma separated, each in [0, 1].
@@ -51,14 +52,16 @@ pub struct Args {
     fresh: bool,
 }
 
+/// The options of the preset sweeps (`table1`, `depth-scaling`).
 #[derive(clap::Args)]
-pub struct Table1Args {
-    /// Output folder of the committed report.
-    #[arg(long, default_value = "reports/table1")]
-    out: PathBuf,
-    /// Timed frames per point (9: lavapipe on 2 shared cores is noisy).
-    #[arg(long, default_value_t = 9)]
-    frames: u32,
+pub struct PresetArgs {
+    /// Output folder of the committed report (default: the preset's folder in reports/).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Timed frames per point (default: 9 for table1, 5 for depth-scaling; lavapipe on 2
+    /// shared cores is noisy).
+    #[arg(long)]
+    frames: Option<u32>,
     /// Discard earlier results and measure every point again (cached truths stay).
     #[arg(long)]
     fresh: bool,
@@ -134,8 +137,9 @@ fn parse_methods(s: &str) -> Result<Vec<MethodKind>, Failure> {
             "naive" => Ok(MethodKind::Naive),
             "auxiliary" => Ok(MethodKind::Auxiliary),
             "portal" => Ok(MethodKind::Portal),
+            "unrolled" => Ok(MethodKind::Unrolled),
             other => Err(bad(format!(
-                "--methods: unknown method {other:?} (known: naive, auxiliary, portal)"
+                "--methods: unknown method {other:?} (known: naive, auxiliary, portal, unrolled)"
             ))),
         })
         .collect()
@@ -174,24 +178,65 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     execute(&config, args.fresh)
 }
 
-pub fn run_table1(args: &Table1Args) -> Result<(), Failure> {
+/// Table 1 of the seed paper: the auxiliary method for n = 0…4 on mirror_box at α = 1 and
+/// the paper's 0.7, with the exact methods at depth 64 beside it.
+pub fn run_table1(args: &PresetArgs) -> Result<(), Failure> {
     let config = SweepConfig {
         scene: PathBuf::from("scenes/mirror_box.json"),
-        out: args.out.clone(),
-        methods: vec![MethodKind::Auxiliary],
+        out: args
+            .out
+            .clone()
+            .unwrap_or_else(|| PathBuf::from("reports/table1")),
+        methods: vec![
+            MethodKind::Auxiliary,
+            MethodKind::Portal,
+            MethodKind::Unrolled,
+        ],
         ns: (0..=4).collect(),
-        depths: Vec::new(),
+        depths: vec![64],
         alphas: vec![1.0, 0.7],
         width: None,
         height: None,
         ssaa: 1,
-        frames: args.frames,
+        frames: preset_frames(args, 9)?,
         warmup: 2,
         max_passes: 5000,
         truth: WhittedSettings::default(),
         command: command_line(),
     };
     execute(&config, args.fresh)
+}
+
+/// The exact methods' cost against depth, 1 to 1024, on mirror_box with perfect mirrors
+/// (α = 1: no path ends by attenuation, only when its portal holds no pixel centre).
+pub fn run_depth_scaling(args: &PresetArgs) -> Result<(), Failure> {
+    let config = SweepConfig {
+        scene: PathBuf::from("scenes/mirror_box.json"),
+        out: args
+            .out
+            .clone()
+            .unwrap_or_else(|| PathBuf::from("reports/depth_scaling")),
+        methods: vec![MethodKind::Portal, MethodKind::Unrolled],
+        ns: Vec::new(),
+        depths: (0..=10).map(|k| 1 << k).collect(),
+        alphas: vec![1.0],
+        width: None,
+        height: None,
+        ssaa: 1,
+        frames: preset_frames(args, 5)?,
+        warmup: 2,
+        max_passes: 5000,
+        truth: WhittedSettings::default(),
+        command: command_line(),
+    };
+    execute(&config, args.fresh)
+}
+
+fn preset_frames(args: &PresetArgs, default: u32) -> Result<u32, Failure> {
+    match args.frames.unwrap_or(default) {
+        0 => Err(bad("--frames must be at least 1".into())),
+        f => Ok(f),
+    }
 }
 
 fn execute(config: &SweepConfig, fresh: bool) -> Result<(), Failure> {

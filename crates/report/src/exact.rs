@@ -1,0 +1,122 @@
+//! The exact methods (portal, unrolled) in a report: beside the paper's method in the Table 1
+//! comparison, and their cost against reflection depth.
+//!
+//! The cost of one more bounce is the slope of a least-squares line of ms/frame against the
+//! reflections actually shown (a depth cap above the scene's natural end adds none), read
+//! against one full-scene pass: the floor point, which renders the scene without mirrors
+//! once.
+
+use crate::Record;
+
+/// Method names of the exact methods, as records carry them.
+pub const EXACT_METHODS: [&str; 2] = ["portal", "unrolled"];
+
+pub fn is_exact(r: &Record) -> bool {
+    r.kind == "point" && EXACT_METHODS.contains(&r.method.as_str())
+}
+
+/// Least-squares line `y = a + b·x`: returns `(a, b)`, or None with fewer than two distinct x.
+pub fn linear_fit(points: &[(f64, f64)]) -> Option<(f64, f64)> {
+    if points.len() < 2 {
+        return None;
+    }
+    let n = points.len() as f64;
+    let mx = points.iter().map(|p| p.0).sum::<f64>() / n;
+    let my = points.iter().map(|p| p.1).sum::<f64>() / n;
+    let sxx: f64 = points.iter().map(|p| (p.0 - mx).powi(2)).sum();
+    let sxy: f64 = points.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+    (sxx > 0.0).then(|| (my - sxy / sxx * mx, sxy / sxx))
+}
+
+/// One method's cost against depth at one α.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DepthScaling {
+    pub method: String,
+    pub alpha: f32,
+    /// Points in depth order.
+    pub points: Vec<Record>,
+    /// ms/frame per extra reflection shown (fit over every point).
+    pub ms_per_bounce: Option<f64>,
+}
+
+/// Groups the exact points by (method, α), each with at least two depths.
+pub fn depth_scaling(records: &[Record]) -> Vec<DepthScaling> {
+    let mut out: Vec<DepthScaling> = Vec::new();
+    for r in records.iter().filter(|r| is_exact(r)) {
+        match out
+            .iter_mut()
+            .find(|g| g.method == r.method && g.alpha == r.alpha)
+        {
+            Some(g) => g.points.push(r.clone()),
+            None => out.push(DepthScaling {
+                method: r.method.clone(),
+                alpha: r.alpha,
+                points: vec![r.clone()],
+                ms_per_bounce: None,
+            }),
+        }
+    }
+    out.retain(|g| g.points.len() >= 2);
+    for g in &mut out {
+        g.points.sort_by_key(|r| r.depth);
+        let pts: Vec<(f64, f64)> = g
+            .points
+            .iter()
+            .map(|r| (r.reflections as f64, r.ms_median))
+            .collect();
+        g.ms_per_bounce = linear_fit(&pts).map(|(_, b)| b);
+    }
+    out
+}
+
+/// A sentence on the cost of one more bounce against one full-scene pass (`pass_ms`).
+pub fn bounce_sentence(g: &DepthScaling, pass_ms: Option<f64>) -> String {
+    let Some(b) = g.ms_per_bounce else {
+        return format!("{}: too few distinct depths to fit.", g.method);
+    };
+    let deepest = g.points.iter().map(|r| r.reflections).max().unwrap_or(0);
+    let mut s = format!(
+        "{}, α = {}: {:.3} ms per extra reflection (least-squares over {} depths, up to {} reflections shown)",
+        g.method,
+        g.alpha,
+        b,
+        g.points.len(),
+        deepest
+    );
+    if let Some(p) = pass_ms.filter(|p| *p > 0.0) {
+        s.push_str(&format!(
+            "; one full-scene pass (the floor point: the scene without mirrors, rendered once) takes {p:.2} ms, \
+             so one more bounce costs {:.1} % of a pass",
+            100.0 * b / p
+        ));
+    }
+    s.push('.');
+    s
+}
+
+/// Among the exact points at α, the one closest to depth 64 per method, for the Table 1
+/// comparison.
+pub fn comparison_points(records: &[Record], alpha: f32) -> Vec<&Record> {
+    let mut out: Vec<&Record> = Vec::new();
+    for m in EXACT_METHODS {
+        let best = records
+            .iter()
+            .filter(|r| is_exact(r) && r.method == m && r.alpha == alpha)
+            .min_by_key(|r| r.depth.unwrap_or(0).abs_diff(64));
+        out.extend(best);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_line_is_fitted_exactly() {
+        let pts: Vec<(f64, f64)> = (0..5).map(|i| (i as f64, 2.0 + 0.5 * i as f64)).collect();
+        let (a, b) = linear_fit(&pts).unwrap();
+        assert!((a - 2.0).abs() < 1e-12 && (b - 0.5).abs() < 1e-12);
+        assert!(linear_fit(&[(1.0, 1.0), (1.0, 2.0)]).is_none());
+    }
+}
