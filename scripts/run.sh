@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The main job (README): installs missing system packages, builds mirrorbox in release mode,
 # validates every bundled scene, reports the wgpu adapter, and regenerates the reproduction
-# of the seed paper's Table 1 in reports/table1/ (measuring every point again; cached
+# of the seed paper's Table 1 in reports/table1/ and the exact methods' cost against depth in
+# reports/depth_scaling/ (measuring every point again; cached
 # ground truths are reused when present).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -15,3 +16,5 @@ echo "== mirrorbox info"
 "$bin" info
 echo "== mirrorbox table1 --fresh"
 "$bin" table1 --fresh
+echo "== mirrorbox depth-scaling --fresh"
+"$bin" depth-scaling --fresh
