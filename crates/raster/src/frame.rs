@@ -158,6 +158,21 @@ impl RenderTarget {
         clear: glam::Vec3,
         timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
     ) -> wgpu::RenderPass<'e> {
+        self.begin_pass_with(encoder, clear, &self.depth_view, 1.0, None, timestamps)
+    }
+
+    /// Begins a pass that clears colour to `clear` and the depth(-stencil) attachment `depth`
+    /// to `depth_clear` (and its stencil to `stencil_clear`, if it has one). Depth and stencil
+    /// are not kept after the pass.
+    pub fn begin_pass_with<'e>(
+        &self,
+        encoder: &'e mut wgpu::CommandEncoder,
+        clear: glam::Vec3,
+        depth: &wgpu::TextureView,
+        depth_clear: f32,
+        stencil_clear: Option<u32>,
+        timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
+    ) -> wgpu::RenderPass<'e> {
         encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: None,
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -175,12 +190,15 @@ impl RenderTarget {
                 },
             })],
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &self.depth_view,
+                view: depth,
                 depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
+                    load: wgpu::LoadOp::Clear(depth_clear),
                     store: wgpu::StoreOp::Discard,
                 }),
-                stencil_ops: None,
+                stencil_ops: stencil_clear.map(|v| wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(v),
+                    store: wgpu::StoreOp::Discard,
+                }),
             }),
             timestamp_writes: timestamps,
             occlusion_query_set: None,

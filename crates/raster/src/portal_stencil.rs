@@ -449,38 +449,14 @@ impl FrameEncoder for PortalStencil {
         target: &RenderTarget,
         first_pass: Option<wgpu::RenderPassTimestampWrites<'_>>,
     ) {
-        let bg = self.background;
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("portal"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &target.color_view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color {
-                        r: bg.x as f64,
-                        g: bg.y as f64,
-                        b: bg.z as f64,
-                        a: 1.0,
-                    }),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &self.depth_stencil,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
-                    store: wgpu::StoreOp::Discard,
-                }),
-                stencil_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1),
-                    store: wgpu::StoreOp::Discard,
-                }),
-            }),
-            timestamp_writes: first_pass,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let mut pass = target.begin_pass_with(
+            encoder,
+            self.background,
+            &self.depth_stencil,
+            1.0,
+            Some(1),
+            first_pass,
+        );
         pass.set_vertex_buffer(0, self.scene_buffers.vertices.slice(..));
         pass.set_bind_group(0, &self.scene_buffers.bind_group, &[]);
         pass.set_bind_group(1, &self.path_bind_group, &[self.offsets[0]]);

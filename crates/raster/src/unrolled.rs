@@ -564,36 +564,9 @@ impl FrameEncoder for Unrolled {
         target: &RenderTarget,
         first_pass: Option<wgpu::RenderPassTimestampWrites<'_>>,
     ) {
-        let bg = self.clear;
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("unrolled"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &target.color_view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color {
-                        r: bg.x as f64,
-                        g: bg.y as f64,
-                        b: bg.z as f64,
-                        a: 1.0,
-                    }),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &self.depth,
-                // Reversed Z: 0 is infinitely far.
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(0.0),
-                    store: wgpu::StoreOp::Discard,
-                }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: first_pass,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        // Reversed Z: depth 0 is infinitely far.
+        let mut pass =
+            target.begin_pass_with(encoder, self.clear, &self.depth, 0.0, None, first_pass);
         pass.set_bind_group(0, &self.scene_buffers.bind_group, &[]);
         pass.set_bind_group(1, &self.bind_group, &[]);
         if let Some((buffer, count)) = &self.background {
