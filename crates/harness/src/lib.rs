@@ -370,6 +370,7 @@ pub fn run_sweep(
             reflections: s.depth,
             triangles: Some(s.triangles),
             paths: s.paths.map(|c| c.kept),
+            paths_pruned: s.paths.map(|c| c.pruned()),
             metrics: metric_values(&m),
             adapter: gpu.report.name.clone(),
             backend: gpu.report.backend.clone(),

@@ -427,3 +427,38 @@ fn unrolled_clip_distances_and_fragment_discard_agree() {
     let off = d.iter().filter(|&&x| x > 1e-3).count();
     assert!(off * 500 <= d.len(), "{off} of {} pixels differ", d.len());
 }
+
+/// A small mirror in front of a large one hides part of it: the two sibling portals overlap,
+/// which the unrolled method cannot resolve by depth alone. It must say so; the portal
+/// method (stencil marks with the depth test) stays exact there.
+#[test]
+fn overlapping_sibling_portals_are_reported_and_portal_stays_exact() {
+    let text = serde_json::json!({
+        "camera": { "position": [0.2, 1.2, 3], "look_at": [0, 1.2, -2], "fov_y_deg": 50, "width": 64, "height": 48 },
+        "mirrors": [ { "center": [0, 1.5, -2], "normal": [0, 0, 1], "up": [0, 1, 0], "width": 4, "height": 3 },
+                     { "center": [0.3, 1.3, -0.5], "normal": [0.3, 0, 1], "up": [0, 1, 0], "width": 0.8, "height": 0.8 } ],
+        "objects": [
+            { "type": "quad", "size": [4, 6], "transform": { "rotate_deg": [-90, 0, 0], "translate": [0, 0, 1] } },
+            { "type": "sphere", "radius": 0.4, "transform": { "translate": [-0.8, 0.6, 1.0] }, "albedo": [0.2, 0.4, 0.8] }
+        ],
+        "lights": [ { "position": [0, 2.5, 1], "intensity": [10, 10, 10] } ],
+    });
+    let s =
+        mirrorbox_scene::load::parse_scene(&text.to_string(), Path::new("overlap.json")).unwrap();
+    let gpu = Gpu::new().unwrap();
+    let unrolled = render(&gpu, &s, &exact(Method::Unrolled { depth: 8 })).unwrap();
+    assert!(
+        unrolled.warnings.iter().any(|w| w.contains("overlap")),
+        "{:?}",
+        unrolled.warnings
+    );
+    let portal = render(&gpu, &s, &exact(Method::Portal { depth: 8 })).unwrap();
+    assert!(portal.warnings.is_empty());
+    let truth = trace_depth(&s, 8);
+    let d = differences(&portal.image, &truth);
+    let off = d.iter().filter(|&&x| x > 1e-3).count();
+    if off * 100 > d.len() {
+        let where_ = dump("overlap_portal", &portal.image, &truth);
+        panic!("portal: {off} of {} pixels off; {where_}", d.len());
+    }
+}

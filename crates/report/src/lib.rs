@@ -62,6 +62,10 @@ pub struct Record {
     /// Exact methods: reflection paths drawn.
     #[serde(default)]
     pub paths: Option<usize>,
+    /// Exact methods: reflection paths pruned (empty or sample-free portal, attenuation,
+    /// depth cap).
+    #[serde(default)]
+    pub paths_pruned: Option<usize>,
     pub metrics: MetricValues,
     pub adapter: String,
     pub backend: String,
