@@ -1,0 +1,98 @@
+//! The scene crate's reflection paths (what the exact raster methods draw) against the
+//! tracer: the mirrors a traced ray meets must be a kept path, in order, and every kept
+//! path must be met by the ray through its portal.
+
+use glam::Vec2;
+use mirrorbox_scene::load::parse_scene;
+use mirrorbox_scene::reflection_paths::{PathLimits, PathSet, reflection_paths};
+use mirrorbox_scene::{Scene, polygon::area};
+use mirrorbox_trace::{SceneBvh, Whitted, WhittedSettings};
+use std::path::Path;
+
+const DEPTH: u32 = 6;
+
+/// The mirror room with its objects removed, so that nothing but mirrors can stop a ray
+/// (portals know nothing of occluders).
+fn bare_room(width: u32, height: u32) -> Scene {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/mirror_room.json");
+    let mut v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    v["objects"] = serde_json::json!([]);
+    v["camera"]["width"] = width.into();
+    v["camera"]["height"] = height.into();
+    parse_scene(&v.to_string(), &path).unwrap()
+}
+
+fn paths(s: &Scene) -> PathSet {
+    let (w, h) = (s.camera.width, s.camera.height);
+    let limits = PathLimits {
+        max_depth: DEPTH,
+        min_portal_area: 0.0,
+        min_attenuation: 0.0,
+        max_paths: 100_000,
+    };
+    reflection_paths(s, w, h, s.camera.projection(0.01, 1e4), &limits)
+}
+
+/// The mirrors (in order, at most `DEPTH`) that the ray through image position `p` meets.
+fn traced_mirrors(s: &Scene, whitted: &Whitted, p: Vec2) -> Vec<usize> {
+    let mut seen = Vec::new();
+    whitted.trace(s.camera.primary_ray(p.x, p.y), |_, _, m| seen.push(m));
+    seen
+}
+
+fn whitted_for(s: &Scene) -> (SceneBvh, WhittedSettings) {
+    let settings = WhittedSettings {
+        max_depth: DEPTH,
+        min_throughput: 0.0,
+    };
+    (SceneBvh::build(&s.geometry), settings)
+}
+
+/// Every pixel centre's traced mirror sequence is a kept path whose portal holds the pixel:
+/// no path the rasterizer needs is missing.
+#[test]
+fn every_traced_mirror_sequence_is_a_kept_path() {
+    let s = bare_room(64, 36);
+    let set = paths(&s);
+    let (bvh, settings) = whitted_for(&s);
+    let whitted = Whitted::new(&s, &bvh, settings);
+    let mut checked = 0;
+    for y in 0..s.camera.height {
+        for x in 0..s.camera.width {
+            let centre = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+            let seen = traced_mirrors(&s, &whitted, centre);
+            let found = set.paths.iter().any(|p| p.mirrors == seen);
+            assert!(
+                found,
+                "pixel ({x}, {y}) meets mirrors {seen:?}, which no kept path follows"
+            );
+            checked += usize::from(!seen.is_empty());
+        }
+    }
+    assert!(checked > 1000, "most pixels see a mirror: {checked}");
+}
+
+/// The ray through a point well inside a kept path's portal meets that path's mirrors first.
+#[test]
+fn the_ray_through_a_portal_follows_its_path() {
+    let s = bare_room(160, 90);
+    let set = paths(&s);
+    let (bvh, settings) = whitted_for(&s);
+    let whitted = Whitted::new(&s, &bvh, settings);
+    let mut checked = 0;
+    for p in set.paths.iter().skip(1) {
+        if area(&p.portal) < 4.0 {
+            continue; // its centroid may lie within rounding of an edge
+        }
+        let centroid = p.portal.iter().copied().sum::<Vec2>() / p.portal.len() as f32;
+        let seen = traced_mirrors(&s, &whitted, centroid);
+        assert!(
+            seen.starts_with(&p.mirrors),
+            "portal of {:?} (centroid {centroid}) traced as {seen:?}",
+            p.mirrors
+        );
+        checked += 1;
+    }
+    assert!(checked > 50, "{checked} paths checked");
+}
