@@ -311,11 +311,13 @@ fn exact_methods_match_the_truth_at_depth_64() {
 }
 
 #[test]
-fn golden_unrolled_depth64_mirror_box() {
+fn golden_exact_methods_depth64_mirror_box() {
     let s = scene("mirror_box.json", 160, 90);
     let gpu = Gpu::new().unwrap();
-    let out = render(&gpu, &s, &exact(Method::Unrolled { depth: 64 })).unwrap();
-    assert_golden("unrolled_depth64_mirror_box", &out.image);
+    for method in [Method::Portal { depth: 64 }, Method::Unrolled { depth: 64 }] {
+        let out = render(&gpu, &s, &exact(method)).unwrap();
+        assert_golden(&format!("{}_depth64_mirror_box", method.name()), &out.image);
+    }
 }
 
 /// Portal: one pass whatever the depth, and draws growing linearly with it on a chain.
