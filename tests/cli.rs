@@ -353,6 +353,26 @@ fn wgpu_backend_override_is_honoured_and_checked() {
     assert_eq!(out.code, 0, "{}", out.stderr);
     let v: Value = serde_json::from_str(out.stdout.trim()).unwrap();
     assert_eq!(v["backend"], "gl");
+    // GL is found, but wgpu's GL backend cannot render the RGBA32F targets the methods use:
+    // a clear failure, nothing written.
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("gl.png");
+    let out = mirrorbox(
+        &[
+            "render",
+            "scenes/mirror_box.json",
+            "-o",
+            png.to_str().unwrap(),
+        ],
+        &[("WGPU_BACKEND", "gl")],
+    );
+    assert_eq!(out.code, 1, "{}", out.stderr);
+    assert!(
+        out.stderr.contains("cannot render to RGBA32F"),
+        "{}",
+        out.stderr
+    );
+    assert!(!png.exists());
     let out = mirrorbox(&["info"], &[("WGPU_BACKEND", "nonsense")]);
     assert_eq!(out.code, 2);
     assert!(

@@ -30,6 +30,23 @@ impl Gpu {
     /// Opens the adapter of [`select_adapter`] with timestamp queries when it has them.
     pub fn new() -> Result<Gpu, RasterError> {
         let selected = select_adapter()?;
+        // Every method renders linear radiance into RGBA32F targets; wgpu's GL backend does
+        // not offer them as render attachments (downlevel), so say so instead of failing later.
+        let rgba32f = selected
+            .adapter
+            .get_texture_format_features(crate::frame::COLOR_FORMAT);
+        if !rgba32f
+            .allowed_usages
+            .contains(wgpu::TextureUsages::RENDER_ATTACHMENT)
+        {
+            return Err(RasterError::Device {
+                adapter: format!("{} ({})", selected.report.name, selected.report.backend),
+                message: "it cannot render to RGBA32F targets, which every raster method needs \
+                          (wgpu's GL backend never can); install Mesa's Vulkan driver \
+                          (scripts/install-system-deps.sh) or use a Vulkan adapter"
+                    .into(),
+            });
+        }
         let timestamps = selected.report.timestamp_query;
         let mut features = wgpu::Features::empty();
         if timestamps {
