@@ -12,12 +12,6 @@ struct Path {
 
 @group(1) @binding(0) var<uniform> path: Path;
 
-struct VertexIn {
-    @location(0) position: vec3f,
-    @location(1) normal: vec3f,
-    @location(2) surface: u32,
-}
-
 struct VertexOut {
     // Invariant: a mirror marked in the stencil pass must meet the depth its world pass wrote.
     @builtin(position) @invariant clip: vec4f,

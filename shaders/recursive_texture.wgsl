@@ -27,12 +27,6 @@ struct MirrorDraw {
 @group(2) @binding(0) var<uniform> mirror: MirrorDraw;
 @group(2) @binding(1) var mirror_texture: texture_2d<f32>;
 
-struct VertexIn {
-    @location(0) position: vec3f,
-    @location(1) normal: vec3f,
-    @location(2) surface: u32,
-}
-
 struct VertexOut {
     @builtin(position) clip: vec4f,
     @location(0) world: vec3f,

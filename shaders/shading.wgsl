@@ -31,6 +31,14 @@ struct Frame {
     _pad1: u32,
 }
 
+// One scene vertex (VERTEX_LAYOUT in crates/raster/src/shading.rs): position, the
+// triangle's face normal and its surface id.
+struct VertexIn {
+    @location(0) position: vec3f,
+    @location(1) normal: vec3f,
+    @location(2) surface: u32,
+}
+
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<storage, read> surfaces: array<Surface>;
 @group(0) @binding(2) var<storage, read> lights: array<Light>;

@@ -37,12 +37,6 @@ struct MirrorRect {
 @group(1) @binding(2) var<storage, read> ids: array<u32>;
 @group(1) @binding(3) var<storage, read> mirror_rects: array<MirrorRect>;
 
-struct VertexIn {
-    @location(0) position: vec3f,
-    @location(1) normal: vec3f,
-    @location(2) surface: u32,
-}
-
 struct GuardedOut {
     @builtin(position) clip: vec4f,
     @location(0) world: vec3f,

@@ -3,12 +3,15 @@
 
 use glam::{Mat4, Vec2, Vec3};
 
-/// The bounding rectangle (min, max) of a portal polygon, in pixels.
-pub fn portal_bounds(portal: &[Vec2]) -> (Vec2, Vec2) {
-    portal.iter().fold(
-        (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY)),
-        |(a, b), q| (a.min(*q), b.max(*q)),
-    )
+/// The 8 corners of the box `lo..hi`.
+pub fn box_corners(lo: Vec3, hi: Vec3) -> [Vec3; 8] {
+    std::array::from_fn(|i| {
+        Vec3::new(
+            if i & 1 == 0 { lo.x } else { hi.x },
+            if i & 2 == 0 { lo.y } else { hi.y },
+            if i & 4 == 0 { lo.z } else { hi.z },
+        )
+    })
 }
 
 /// Whether the box `lo..hi` can project into the screen rectangle `portal` (pixels) through
@@ -23,12 +26,7 @@ pub fn box_may_touch(
     let mut min = Vec2::splat(f32::INFINITY);
     let mut max = Vec2::splat(f32::NEG_INFINITY);
     let mut all_behind_near = true;
-    for i in 0..8 {
-        let p = Vec3::new(
-            if i & 1 == 0 { lo.x } else { hi.x },
-            if i & 2 == 0 { lo.y } else { hi.y },
-            if i & 4 == 0 { lo.z } else { hi.z },
-        );
+    for p in box_corners(lo, hi) {
         let c = clip_from_world * p.extend(1.0);
         if c.w <= 1e-6 {
             return true;

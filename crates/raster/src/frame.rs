@@ -107,6 +107,31 @@ pub struct RenderTarget {
     pub height: u32,
 }
 
+/// A single-sample 2D texture of `width × height` (targets, depth and stencil attachments).
+pub fn texture_2d(
+    device: &wgpu::Device,
+    label: &str,
+    width: u32,
+    height: u32,
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+) -> wgpu::Texture {
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage,
+        view_formats: &[],
+    })
+}
+
 impl RenderTarget {
     pub fn new(
         device: &wgpu::Device,
@@ -115,22 +140,15 @@ impl RenderTarget {
         height: u32,
         extra: wgpu::TextureUsages,
     ) -> Self {
-        let size = wgpu::Extent3d {
-            width,
-            height,
-            depth_or_array_layers: 1,
-        };
         let texture = |format, usage, suffix: &str| {
-            device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(&format!("{label} {suffix}")),
-                size,
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
+            texture_2d(
+                device,
+                &format!("{label} {suffix}"),
+                width,
+                height,
                 format,
                 usage,
-                view_formats: &[],
-            })
+            )
         };
         let color = texture(
             COLOR_FORMAT,

@@ -13,7 +13,7 @@
 //! value decremented back, so a chain of any length uses one stencil value: only branches
 //! that still have siblings to draw hold one — at most 254 (refused beyond, before any work).
 
-use crate::culling::{box_may_touch, portal_bounds};
+use crate::culling::box_may_touch;
 use crate::frame::{COLOR_FORMAT, FrameEncoder, FrameStats, PathCounts, RenderTarget};
 use crate::gpu::{Gpu, RasterError};
 use crate::shading::{SceneBuffers, VERTEX_LAYOUT, module};
@@ -176,7 +176,7 @@ impl PortalStencil {
                     oblique_near_plane(projection, plane.coefficients_in(p.view.view)) * p.view.view
                 }
             };
-            let bbox = portal_bounds(&p.portal);
+            let bbox = mirrorbox_scene::polygon::bounds(&p.portal);
             let x0 = (bbox.0.x.floor() - 1.0).clamp(0.0, size.x) as u32;
             let y0 = (bbox.0.y.floor() - 1.0).clamp(0.0, size.y) as u32;
             let x1 = (bbox.1.x.ceil() + 1.0).clamp(0.0, size.x) as u32;
@@ -354,22 +354,15 @@ impl PortalStencil {
             C::Always,
             stencil(C::Equal, S::DecrementClamp),
         );
-        let depth_stencil = device
-            .create_texture(&wgpu::TextureDescriptor {
-                label: Some("portal depth-stencil"),
-                size: wgpu::Extent3d {
-                    width,
-                    height,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: STENCIL_FORMAT,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-                view_formats: &[],
-            })
-            .create_view(&Default::default());
+        let depth_stencil = crate::frame::texture_2d(
+            device,
+            "portal depth-stencil",
+            width,
+            height,
+            STENCIL_FORMAT,
+            wgpu::TextureUsages::RENDER_ATTACHMENT,
+        )
+        .create_view(&Default::default());
         let mirror_count = scene.mirrors.len();
         let world_triangles = |path: usize| -> usize {
             visible_parts[path]

@@ -27,7 +27,7 @@
 //! the same cell; true in the convex rooms of the bundled scenes). Overlaps are counted in
 //! [`Unrolled::overlapping_siblings`] and reported by `render`.
 
-use crate::culling::{box_may_touch, portal_bounds};
+use crate::culling::{box_corners, box_may_touch};
 use crate::frame::{COLOR_FORMAT, Clipping, FrameEncoder, FrameStats, PathCounts, RenderTarget};
 use crate::gpu::{Gpu, RasterError};
 use crate::shading::{SHADING_WGSL, SceneBuffers, VERTEX_LAYOUT};
@@ -35,6 +35,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use mirrorbox_scene::Scene;
 use mirrorbox_scene::camera::pixel_to_ndc;
+use mirrorbox_scene::polygon::{area, bounds, orientation};
 use mirrorbox_scene::reflection_paths::{PathSet, clip_convex};
 use std::ops::Range;
 
@@ -92,10 +93,7 @@ pub fn infinite_reversed_z(projection: Mat4, near: f32) -> Mat4 {
 /// (pixels, any orientation) — each a plane through the eye.
 pub fn portal_edges(portal: &[Vec2], size: Vec2) -> Vec<Vec4> {
     let ndc: Vec<Vec2> = portal.iter().map(|&p| pixel_to_ndc(p, size)).collect();
-    let twice: f32 = (0..ndc.len())
-        .map(|i| ndc[i].perp_dot(ndc[(i + 1) % ndc.len()]))
-        .sum();
-    let s = twice.signum();
+    let s = orientation(&ndc);
     (0..ndc.len())
         .filter_map(|i| {
             let (a, b) = (ndc[i], ndc[(i + 1) % ndc.len()]);
@@ -177,12 +175,7 @@ impl Unrolled {
             .map(|m| m.plane().coefficients())
             .collect();
         let in_front_of_all = |lo: Vec3, hi: Vec3| {
-            (0..8).all(|i| {
-                let p = Vec3::new(
-                    if i & 1 == 0 { lo.x } else { hi.x },
-                    if i & 2 == 0 { lo.y } else { hi.y },
-                    if i & 4 == 0 { lo.z } else { hi.z },
-                );
+            box_corners(lo, hi).iter().all(|p| {
                 planes
                     .iter()
                     .all(|pl| pl.dot(p.extend(1.0)) >= -FRONT_EPSILON)
@@ -226,7 +219,7 @@ impl Unrolled {
             } else {
                 Vec::new() // the camera's portal is the viewport
             };
-            let bounds = portal_bounds(&p.portal);
+            let portal_rect = bounds(&p.portal);
             let edge_first = edges.len() as u32;
             let edge_count = path_edges.len();
             edges.extend(&path_edges);
@@ -250,15 +243,10 @@ impl Unrolled {
                     continue;
                 }
                 let behind_plane = p.plane.is_some()
-                    && (0..8).all(|i| {
-                        let q = Vec3::new(
-                            if i & 1 == 0 { item.lo.x } else { item.hi.x },
-                            if i & 2 == 0 { item.lo.y } else { item.hi.y },
-                            if i & 4 == 0 { item.lo.z } else { item.hi.z },
-                        );
-                        plane.dot(q.extend(1.0)) < 0.0
-                    });
-                if behind_plane || !box_may_touch(view_clip, item.lo, item.hi, bounds, size) {
+                    && box_corners(item.lo, item.hi)
+                        .iter()
+                        .all(|q| plane.dot(q.extend(1.0)) < 0.0);
+                if behind_plane || !box_may_touch(view_clip, item.lo, item.hi, portal_rect, size) {
                     continue;
                 }
                 let stage =
@@ -283,7 +271,7 @@ impl Unrolled {
             for (i, &a) in p.children.iter().enumerate() {
                 for &b in &p.children[i + 1..] {
                     let shared = clip_convex(&paths.paths[a].portal, &paths.paths[b].portal);
-                    if shared.len() >= 3 && mirrorbox_scene::polygon::area(&shared) > 0.01 {
+                    if shared.len() >= 3 && area(&shared) > 0.01 {
                         overlapping_siblings += 1;
                     }
                 }
@@ -500,22 +488,15 @@ impl Unrolled {
                 false,
             )
         });
-        let depth = device
-            .create_texture(&wgpu::TextureDescriptor {
-                label: Some("unrolled depth"),
-                size: wgpu::Extent3d {
-                    width,
-                    height,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: DEPTH_FORMAT,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-                view_formats: &[],
-            })
-            .create_view(&Default::default());
+        let depth = crate::frame::texture_2d(
+            device,
+            "unrolled depth",
+            width,
+            height,
+            DEPTH_FORMAT,
+            wgpu::TextureUsages::RENDER_ATTACHMENT,
+        )
+        .create_view(&Default::default());
         let background = (!background.is_empty()).then(|| {
             (
                 device.create_buffer_init(&wgpu::util::BufferInitDescriptor {

@@ -6,26 +6,13 @@
 //! against one full-scene pass: the floor point, which renders the scene without mirrors
 //! once.
 
-use crate::Record;
+use crate::{Record, linear_fit};
 
 /// Method names of the exact methods, as records carry them.
 pub const EXACT_METHODS: [&str; 2] = ["portal", "unrolled"];
 
 pub fn is_exact(r: &Record) -> bool {
     r.kind == "point" && EXACT_METHODS.contains(&r.method.as_str())
-}
-
-/// Least-squares line `y = a + b·x`: returns `(a, b)`, or None with fewer than two distinct x.
-pub fn linear_fit(points: &[(f64, f64)]) -> Option<(f64, f64)> {
-    if points.len() < 2 {
-        return None;
-    }
-    let n = points.len() as f64;
-    let mx = points.iter().map(|p| p.0).sum::<f64>() / n;
-    let my = points.iter().map(|p| p.1).sum::<f64>() / n;
-    let sxx: f64 = points.iter().map(|p| (p.0 - mx).powi(2)).sum();
-    let sxy: f64 = points.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
-    (sxx > 0.0).then(|| (my - sxy / sxx * mx, sxy / sxx))
 }
 
 /// One method's cost against depth at one α.

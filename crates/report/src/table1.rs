@@ -59,17 +59,7 @@ pub fn slope(points: &[(f64, f64)]) -> Option<f64> {
         .filter(|(p, t)| *p > 0.0 && *t > 0.0)
         .map(|(p, t)| (p.ln(), t.ln()))
         .collect();
-    if pts.len() < 2 {
-        return None;
-    }
-    let n = pts.len() as f64;
-    let (mx, my) = (
-        pts.iter().map(|p| p.0).sum::<f64>() / n,
-        pts.iter().map(|p| p.1).sum::<f64>() / n,
-    );
-    let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
-    let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
-    (sxx > 0.0).then(|| sxy / sxx)
+    crate::linear_fit(&pts).map(|(_, b)| b)
 }
 
 /// A sentence saying whether our growth matches the paper's, and why.

@@ -53,12 +53,30 @@ pub fn screen_footprint(world: &[Vec3], clip_from_world: glam::Mat4, size: Vec2)
         .collect()
 }
 
+/// Twice the signed area (shoelace): positive for counter-clockwise in a y-up frame.
+fn twice_signed_area(poly: &[Vec2]) -> f32 {
+    (0..poly.len())
+        .map(|i| poly[i].perp_dot(poly[(i + 1) % poly.len()]))
+        .sum()
+}
+
 /// Area of a polygon by the shoelace formula (absolute value).
 pub fn area(poly: &[Vec2]) -> f32 {
-    let twice: f32 = (0..poly.len())
-        .map(|i| poly[i].perp_dot(poly[(i + 1) % poly.len()]))
-        .sum();
-    0.5 * twice.abs()
+    0.5 * twice_signed_area(poly).abs()
+}
+
+/// +1 or −1 by the polygon's winding (the sign of its signed area): multiplying an edge's
+/// `(b − a) × (p − a)` by it makes the inside positive whatever the orientation.
+pub fn orientation(poly: &[Vec2]) -> f32 {
+    twice_signed_area(poly).signum()
+}
+
+/// The bounding rectangle (min, max) of a polygon.
+pub fn bounds(poly: &[Vec2]) -> (Vec2, Vec2) {
+    poly.iter().fold(
+        (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY)),
+        |(a, b), q| (a.min(*q), b.max(*q)),
+    )
 }
 
 #[cfg(test)]

@@ -15,7 +15,7 @@
 //! a short one, and converted to f32 once.
 
 use crate::Scene;
-use crate::polygon::{area, clip_by, screen_footprint};
+use crate::polygon::{area, bounds, clip_by, orientation, screen_footprint};
 use crate::reflection::{Plane, ReflectedView};
 use glam::{DVec3, Mat4, Vec2, Vec3};
 
@@ -81,10 +81,7 @@ fn without_duplicates(poly: Vec<Vec2>) -> Vec<Vec2> {
 /// `(i + ½, j + ½)`, edges included. Conservative: a polygon whose bounding box spans more
 /// than 256 centres counts as holding one without looking.
 pub fn holds_a_sample(poly: &[Vec2]) -> bool {
-    let (lo, hi) = poly.iter().fold(
-        (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY)),
-        |(a, b), p| (a.min(*p), b.max(*p)),
-    );
+    let (lo, hi) = bounds(poly);
     // Centres c with lo ≤ c ≤ hi: i from ceil(lo − ½) to floor(hi − ½).
     let (i0, i1) = ((lo.x - 0.5).ceil(), (hi.x - 0.5).floor());
     let (j0, j1) = ((lo.y - 0.5).ceil(), (hi.y - 0.5).floor());
@@ -94,10 +91,7 @@ pub fn holds_a_sample(poly: &[Vec2]) -> bool {
     if (i1 - i0 + 1.0) * (j1 - j0 + 1.0) > 256.0 {
         return true;
     }
-    let twice: f32 = (0..poly.len())
-        .map(|i| poly[i].perp_dot(poly[(i + 1) % poly.len()]))
-        .sum();
-    let orientation = twice.signum();
+    let orientation = orientation(poly);
     let inside = |c: Vec2| {
         (0..poly.len()).all(|k| {
             let (a, b) = (poly[k], poly[(k + 1) % poly.len()]);
@@ -121,10 +115,7 @@ pub fn holds_a_sample(poly: &[Vec2]) -> bool {
 /// Keeps the part of convex polygon `poly` inside convex polygon `clip` (any orientation).
 pub fn clip_convex(poly: &[Vec2], clip: &[Vec2]) -> Vec<Vec2> {
     let clip = without_duplicates(clip.to_vec());
-    let twice: f32 = (0..clip.len())
-        .map(|i| clip[i].perp_dot(clip[(i + 1) % clip.len()]))
-        .sum();
-    let orientation = twice.signum();
+    let orientation = orientation(&clip);
     let mut out = poly.to_vec();
     for i in 0..clip.len() {
         if out.is_empty() {

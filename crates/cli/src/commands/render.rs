@@ -142,12 +142,16 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         min_attenuation: args.min_attenuation,
         fragment_clipping: args.fragment_clipping,
     };
-    // Plan first: a refused configuration costs no GPU set-up.
-    let (w, h) = (
-        scene.camera.width * args.ssaa,
-        scene.camera.height * args.ssaa,
-    );
-    mirrorbox_raster::plan::plan(&scene, method, w, h, args.max_passes).map_err(plan_failure)?;
+    // Plan the paper's recursion first: a refused configuration costs no GPU set-up. (The
+    // exact methods have no such plan; their path enumeration happens inside `render`.)
+    if method.depth_limit().is_none() {
+        let (w, h) = (
+            scene.camera.width * args.ssaa,
+            scene.camera.height * args.ssaa,
+        );
+        mirrorbox_raster::plan::plan(&scene, method, w, h, args.max_passes)
+            .map_err(plan_failure)?;
+    }
     let gpu = Gpu::new().map_err(raster_failure)?;
     let out = render(&gpu, &scene, &settings).map_err(raster_failure)?;
     let exr = png.with_extension("exr");
