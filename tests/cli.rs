@@ -615,7 +615,7 @@ fn render_refuses_too_many_passes_before_any_work() {
 
 #[test]
 fn render_refuses_bad_arguments() {
-    let cases: [(&[&str], &str); 8] = [
+    let cases: [(&[&str], &str); 10] = [
         (
             &["--method", "naive", "--n", "2"],
             "--n applies to --method auxiliary only",
@@ -638,6 +638,14 @@ fn render_refuses_bad_arguments() {
         (
             &["--texture-scale", "0"],
             "--texture-scale must be in (0, 4], got 0",
+        ),
+        (
+            &["--method", "naive", "--min-attenuation", "0.01"],
+            "--min-attenuation applies to --method portal or unrolled only",
+        ),
+        (
+            &["--method", "portal", "--texture-scale", "2"],
+            "--texture-scale applies to --method naive or auxiliary only",
         ),
     ];
     for (extra, message) in cases {
@@ -941,7 +949,7 @@ fn sweep_refuses_bad_arguments() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("s");
     let o = out.to_str().unwrap();
-    let cases: [(&[&str], &str); 4] = [
+    let cases: [(&[&str], &str); 6] = [
         (&["--n", "3..1"], "--n \"3..1\": expected a range like 0..4"),
         (
             &["--alpha", "0.7,2"],
@@ -954,6 +962,14 @@ fn sweep_refuses_bad_arguments() {
         (
             &["--n", "7", "--methods", "auxiliary"],
             "auxiliary n=7 α=0.7: this configuration would render 11146 scene passes",
+        ),
+        (
+            &["--methods", "naive,auxiliary", "--fragment-clipping"],
+            "--fragment-clipping applies to --method unrolled only",
+        ),
+        (
+            &["--methods", "portal", "--depth", "0,4"],
+            "--depth \"0,4\": expected a range like 1..8 or a list like 1,4,16,64 of depths 1..=4096",
         ),
     ];
     for (extra, message) in cases {

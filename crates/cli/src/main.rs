@@ -71,6 +71,39 @@ pub enum Failure {
     Other(String),
 }
 
+/// A refused input exits 2, a failing device or driver 1 (`RasterError::is_refusal`).
+impl From<mirrorbox_raster::RasterError> for Failure {
+    fn from(e: mirrorbox_raster::RasterError) -> Self {
+        if e.is_refusal() {
+            Failure::BadInput(e.to_string())
+        } else {
+            Failure::Other(e.to_string())
+        }
+    }
+}
+
+impl From<mirrorbox_raster::PlanError> for Failure {
+    fn from(e: mirrorbox_raster::PlanError) -> Self {
+        Failure::BadInput(e.to_string())
+    }
+}
+
+impl From<mirrorbox_raster::ParamError> for Failure {
+    fn from(e: mirrorbox_raster::ParamError) -> Self {
+        Failure::BadInput(e.to_string())
+    }
+}
+
+impl From<mirrorbox_harness::HarnessError> for Failure {
+    fn from(e: mirrorbox_harness::HarnessError) -> Self {
+        if e.is_refusal() {
+            Failure::BadInput(e.to_string())
+        } else {
+            Failure::Other(e.to_string())
+        }
+    }
+}
+
 impl Failure {
     fn exit_code(&self) -> u8 {
         match self {

@@ -11,63 +11,151 @@
 //!   when there is no mirror effect to truncate.
 
 use glam::Vec3;
-use mirrorbox_image::metrics::{compare, flip_map};
-use mirrorbox_image::{RgbImage, colormap, read_image, write_exr, write_png, write_png_bytes};
-use mirrorbox_raster::{Gpu, Method, RasterError, RenderSettings, plan};
+use mirrorbox_image::metrics::{MetricsError, compare, flip_map};
+use mirrorbox_image::{
+    ImageError, RgbImage, colormap, read_image, write_exr, write_png, write_png_bytes,
+};
+use mirrorbox_raster::{Gpu, METHODS, Method, PlanError, RasterError, RenderSettings};
 use mirrorbox_report::{MetricValues, Record, SweepInfo, read_records, write_report};
-use mirrorbox_scene::{Scene, SubpixelGrid, load_scene};
-use mirrorbox_trace::{Sampling, SceneBvh, TraceSettings, WhittedSettings};
+use mirrorbox_scene::{Scene, SceneError, load_scene};
+use mirrorbox_trace::{SceneBvh, TraceSettings, WhittedSettings};
 use std::fmt::Write as _;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
-
-/// The exact methods' path pruning in sweeps (the `render` command's defaults): portals
-/// holding no pixel centre (always; exact) and attenuations under 1e-4 (the truth's
-/// `--min-throughput`); no lossy area threshold.
-pub const EXACT_MIN_PORTAL_AREA: f32 = 0.0;
-pub const EXACT_MIN_ATTENUATION: f32 = 1e-4;
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum MethodKind {
-    Naive,
-    Auxiliary,
-    /// Exact stencil recursion, swept over `depths`.
-    Portal,
-    /// Exact instanced unrolling, swept over `depths`.
-    Unrolled,
-}
 
 #[derive(Clone, Debug)]
 pub struct SweepConfig {
     pub scene: PathBuf,
     pub out: PathBuf,
-    pub methods: Vec<MethodKind>,
-    /// Auxiliary mirror counts (auxiliary method).
-    pub ns: Vec<u32>,
-    /// Reflection depths (exact methods: portal, unrolled).
-    pub depths: Vec<u32>,
+    /// Every configured method to measure at each α (one point each), e.g. `auxiliary n=0`
+    /// … `auxiliary n=4`, `portal depth=64`.
+    pub methods: Vec<Method>,
     pub alphas: Vec<f32>,
     pub width: Option<u32>,
     pub height: Option<u32>,
     pub ssaa: u32,
     pub frames: u32,
     pub warmup: u32,
-    pub max_passes: usize,
     pub truth: WhittedSettings,
     /// The command line, for the report.
     pub command: String,
 }
 
-#[derive(Debug, thiserror::Error)]
-pub enum HarnessError {
-    #[error("{0}")]
-    BadInput(String),
-    #[error("{0}")]
-    Other(String),
+/// The methods `name` at each value of its swept option (`"auxiliary"`, `[0, 1, 2]`), every
+/// other option at its default.
+pub fn swept(name: &str, values: impl IntoIterator<Item = u32>) -> Vec<Method> {
+    let base = Method::named(name).unwrap_or_else(|e| panic!("preset: {e}"));
+    let option = base.entry().swept.expect("preset methods are swept");
+    values
+        .into_iter()
+        .map(|v| {
+            base.clone()
+                .with(option, mirrorbox_raster::ParamValue::Count(v))
+                .unwrap_or_else(|e| panic!("preset: {e}"))
+        })
+        .collect()
 }
 
-fn other(e: impl ToString) -> HarnessError {
-    HarnessError::Other(e.to_string())
+impl SweepConfig {
+    /// A sweep of `scene` into `out` with the defaults of the presets: native resolution,
+    /// no SSAA, 5 timed frames after 2 warm-up frames, the default truth.
+    pub fn new(scene: PathBuf, out: PathBuf, methods: Vec<Method>, alphas: Vec<f32>) -> Self {
+        SweepConfig {
+            scene,
+            out,
+            methods,
+            alphas,
+            width: None,
+            height: None,
+            ssaa: 1,
+            frames: 5,
+            warmup: 2,
+            truth: WhittedSettings::default(),
+            command: String::new(),
+        }
+    }
+
+    /// Table 1 of the seed paper: the auxiliary method for n = 0…4 on mirror_box at α = 1 and
+    /// the paper's 0.7, with the exact methods at depth 64 beside it; 9 timed frames.
+    pub fn table1(out: PathBuf) -> Self {
+        let mut methods = swept(mirrorbox_report::table1::PAPER_METHOD, 0..=4);
+        for m in METHODS.iter().filter(|e| e.exact) {
+            methods.extend(swept(m.name, [64]));
+        }
+        SweepConfig {
+            frames: 9,
+            ..SweepConfig::new(
+                PathBuf::from("scenes/mirror_box.json"),
+                out,
+                methods,
+                vec![1.0, 0.7],
+            )
+        }
+    }
+
+    /// The exact methods' cost against depth, 1 to 1024, on mirror_box with perfect mirrors
+    /// (α = 1: no path ends by attenuation, only when its portal holds no pixel centre).
+    pub fn depth_scaling(out: PathBuf) -> Self {
+        let methods = METHODS
+            .iter()
+            .filter(|e| e.exact)
+            .flat_map(|e| swept(e.name, (0..=10).map(|k| 1 << k)))
+            .collect();
+        SweepConfig::new(
+            PathBuf::from("scenes/mirror_box.json"),
+            out,
+            methods,
+            vec![1.0],
+        )
+    }
+}
+
+/// Why a sweep failed. [`HarnessError::is_refusal`] tells the user's input (exit 2) from
+/// everything else (exit 1).
+#[derive(Debug, thiserror::Error)]
+pub enum HarnessError {
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    /// A point's configuration is refused before any work (too many passes, …).
+    #[error("{point}: {source}")]
+    Refused { point: String, source: PlanError },
+    #[error(transparent)]
+    Raster(#[from] RasterError),
+    #[error("{}: {source}", .path.display())]
+    OutputFolder {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{}: {source}", .path.display())]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error(transparent)]
+    Image(#[from] ImageError),
+    #[error(transparent)]
+    Metrics(#[from] MetricsError),
+    #[error("a result could not be encoded: {0}")]
+    Encode(#[from] serde_json::Error),
+}
+
+impl HarnessError {
+    pub fn is_refusal(&self) -> bool {
+        match self {
+            HarnessError::Scene(_)
+            | HarnessError::Refused { .. }
+            | HarnessError::OutputFolder { .. } => true,
+            HarnessError::Raster(e) => e.is_refusal(),
+            _ => false,
+        }
+    }
+}
+
+fn io(path: &Path) -> impl FnOnce(std::io::Error) -> HarnessError + '_ {
+    move |source| HarnessError::Io {
+        path: path.to_path_buf(),
+        source,
+    }
 }
 
 /// Progress of a sweep.
@@ -101,6 +189,15 @@ struct Point {
     slug: String,
 }
 
+/// The resume key of a point: the method's stable [`Method::key`], then the α, size, SSAA,
+/// frames and scene. Frozen: earlier `results.jsonl` files resume by it.
+fn point_key(method: Option<&Method>, alpha: f32, common: &str) -> String {
+    match method {
+        Some(m) => format!("{}|alpha={alpha}|{common}", m.key()),
+        None => format!("floor|{common}"),
+    }
+}
+
 fn points(config: &SweepConfig, base_hash: u64, w: u32, h: u32) -> Vec<Point> {
     let common = format!(
         "{w}x{h}|ssaa={}|frames={}|scene={base_hash:016x}",
@@ -109,42 +206,19 @@ fn points(config: &SweepConfig, base_hash: u64, w: u32, h: u32) -> Vec<Point> {
     let mut out = vec![Point {
         method: None,
         alpha: 1.0,
-        key: format!("floor|{common}"),
+        key: point_key(None, 1.0, &common),
         label: "floor (no mirrors)".into(),
         slug: "floor".into(),
     }];
     for &alpha in &config.alphas {
-        for &m in &config.methods {
-            let methods: Vec<Method> = match m {
-                MethodKind::Naive => vec![Method::Naive],
-                MethodKind::Auxiliary => {
-                    config.ns.iter().map(|&n| Method::Auxiliary { n }).collect()
-                }
-                MethodKind::Portal => config
-                    .depths
-                    .iter()
-                    .map(|&depth| Method::Portal { depth })
-                    .collect(),
-                MethodKind::Unrolled => config
-                    .depths
-                    .iter()
-                    .map(|&depth| Method::Unrolled { depth })
-                    .collect(),
-            };
-            for method in methods {
-                let name = method.name();
-                let n = method.to_string()[name.len()..].to_string();
-                out.push(Point {
-                    method: Some(method),
-                    alpha,
-                    key: format!("{name}{n}|alpha={alpha}|{common}"),
-                    label: format!("{name}{n} α={alpha}"),
-                    slug: format!(
-                        "{name}{}_a{alpha}",
-                        n.replace(" n=", "_n").replace(" depth=", "_d")
-                    ),
-                });
-            }
+        for method in &config.methods {
+            out.push(Point {
+                key: point_key(Some(method), alpha, &common),
+                label: format!("{method} α={alpha}"),
+                slug: format!("{}_a{alpha}", method.slug()),
+                method: Some(method.clone()),
+                alpha,
+            });
         }
     }
     out
@@ -189,24 +263,18 @@ fn truth(
         return Ok((img, path));
     }
     let bvh = SceneBvh::build(&scene.geometry);
-    let settings = TraceSettings {
-        sampling: Sampling::Grid(SubpixelGrid::new(config.ssaa)),
-        whitted: *t,
-        path: None,
-    };
+    let settings = TraceSettings::whitted(config.ssaa).with_integrator(*t);
     let out = mirrorbox_trace::render(scene, &bvh, &settings, &|_| {});
     write_exr(
         &path,
         &out.image,
         &[("mirrorbox.cache_key", format!("{:016x}", key.finish()))],
-    )
-    .map_err(other)?;
+    )?;
     write_png(
         &path.with_extension("png"),
         &out.image,
         scene.camera.exposure,
-    )
-    .map_err(other)?;
+    )?;
     summary.truths_traced += 1;
     Ok((out.image, path))
 }
@@ -237,13 +305,52 @@ fn salvage(results: &Path, records: &[Record]) -> Result<(), HarnessError> {
     }
     let mut clean = String::new();
     for r in records {
-        clean.push_str(&serde_json::to_string(r).map_err(other)?);
+        clean.push_str(&serde_json::to_string(r)?);
         clean.push('\n');
     }
     let tmp = results.with_extension("jsonl.tmp");
     std::fs::write(&tmp, clean)
         .and_then(|()| std::fs::rename(&tmp, results))
-        .map_err(other)
+        .map_err(io(results))
+}
+
+/// The method every floor point renders the mirror-free scene with: one scene pass.
+pub const FLOOR_METHOD: &str = "naive";
+
+/// A point's scene (mirrors removed for the floor, reflectance α) and render settings.
+fn point_setup(base: &Scene, p: &Point, config: &SweepConfig) -> (Scene, RenderSettings) {
+    let mut scene = if p.method.is_some() {
+        base.clone()
+    } else {
+        base.without_mirrors()
+    };
+    scene.set_reflectance(Vec3::splat(p.alpha));
+    let method = p
+        .method
+        .clone()
+        .unwrap_or_else(|| Method::named(FLOOR_METHOD).expect("the floor method is registered"));
+    let settings = RenderSettings {
+        method,
+        ssaa: config.ssaa,
+        frames: config.frames,
+        warmup: config.warmup,
+    };
+    (scene, settings)
+}
+
+/// The resume keys of every point of `config` (the floor first), in sweep order, without
+/// rendering anything.
+pub fn point_keys(config: &SweepConfig) -> Result<Vec<String>, HarnessError> {
+    let mut base = load_scene(&config.scene)?;
+    let (w, h) = (
+        config.width.unwrap_or(base.camera.width),
+        config.height.unwrap_or(base.camera.height),
+    );
+    base.camera = base.camera.with_size(w, h);
+    Ok(points(config, base.content_hash(), w, h)
+        .into_iter()
+        .map(|p| p.key)
+        .collect())
 }
 
 /// Runs (or resumes) the sweep and writes its reports.
@@ -251,7 +358,7 @@ pub fn run_sweep(
     config: &SweepConfig,
     progress: &mut dyn FnMut(Event),
 ) -> Result<Summary, HarnessError> {
-    let mut base = load_scene(&config.scene).map_err(|e| HarnessError::BadInput(e.to_string()))?;
+    let mut base = load_scene(&config.scene)?;
     let (w, h) = (
         config.width.unwrap_or(base.camera.width),
         config.height.unwrap_or(base.camera.height),
@@ -259,27 +366,27 @@ pub fn run_sweep(
     base.camera = base.camera.with_size(w, h);
     let base_hash = base.content_hash();
     let all = points(config, base_hash, w, h);
-    // Refuse over-budget points before any work.
+    // Refuse over-budget points before any work: plan every point on the CPU (and drop the
+    // plan; it is made again when the point is rendered, so memory stays one point's).
     for p in &all {
-        if let Some(method @ (Method::Naive | Method::Auxiliary { .. })) = p.method {
-            plan::plan(
-                &base,
-                method,
-                w * config.ssaa,
-                h * config.ssaa,
-                config.max_passes,
-            )
-            .map_err(|e| HarnessError::BadInput(format!("{}: {e}", p.label)))?;
-        }
+        let (scene, settings) = point_setup(&base, p, config);
+        mirrorbox_raster::plan_frame(&scene, &settings).map_err(|source| {
+            HarnessError::Refused {
+                point: p.label.clone(),
+                source,
+            }
+        })?;
     }
     let out = &config.out;
     let (images, cache) = (out.join("images"), out.join("cache"));
     for d in [out, &images, &cache] {
-        std::fs::create_dir_all(d)
-            .map_err(|e| HarnessError::BadInput(format!("{}: {e}", d.display())))?;
+        std::fs::create_dir_all(d).map_err(|source| HarnessError::OutputFolder {
+            path: d.to_path_buf(),
+            source,
+        })?;
     }
     let results = out.join("results.jsonl");
-    let existing = read_records(&results).map_err(other)?;
+    let existing = read_records(&results).map_err(io(&results))?;
     salvage(&results, &existing)?;
     let done: Vec<String> = existing.into_iter().map(|r| r.key).collect();
     let todo: Vec<&Point> = all.iter().filter(|p| !done.contains(&p.key)).collect();
@@ -291,36 +398,15 @@ pub fn run_sweep(
         todo: todo.len(),
         reused: summary.reused,
     });
-    let gpu = Gpu::new().map_err(|e| match e {
-        RasterError::Adapter(mirrorbox_raster::AdapterError::BadOverride { .. }) => {
-            HarnessError::BadInput(e.to_string())
-        }
-        e => other(e),
-    })?;
+    let gpu = Gpu::new()?;
     for p in todo {
         progress(Event::Started { label: &p.label });
-        let mut scene = if p.method.is_some() {
-            base.clone()
-        } else {
-            base.without_mirrors()
-        };
-        scene.set_reflectance(Vec3::splat(p.alpha));
+        let (scene, settings) = point_setup(&base, p, config);
         let (truth_image, truth_path) = truth(&scene, config, &cache, &mut summary)?;
-        let settings = RenderSettings {
-            method: p.method.unwrap_or(Method::Naive),
-            ssaa: config.ssaa,
-            frames: config.frames,
-            warmup: config.warmup,
-            max_passes: config.max_passes,
-            texture_scale: 1.0,
-            min_portal_area: EXACT_MIN_PORTAL_AREA,
-            min_attenuation: EXACT_MIN_ATTENUATION,
-            fragment_clipping: false,
-        };
-        let rendered = mirrorbox_raster::render(&gpu, &scene, &settings).map_err(other)?;
-        let m = compare(&truth_image, &rendered.image, scene.camera.exposure).map_err(other)?;
+        let rendered = mirrorbox_raster::render(&gpu, &scene, &settings)?;
+        let m = compare(&truth_image, &rendered.image, scene.camera.exposure)?;
         let raster_png = images.join(format!("{}.png", p.slug));
-        write_png(&raster_png, &rendered.image, scene.camera.exposure).map_err(other)?;
+        write_png(&raster_png, &rendered.image, scene.camera.exposure)?;
         let exposure = scene.camera.exposure;
         let map = flip_map(
             &truth_image.to_srgb8(exposure),
@@ -330,7 +416,7 @@ pub fn run_sweep(
         );
         let heat: Vec<u8> = map.iter().flat_map(|&v| colormap::heat(v)).collect();
         let heat_png = images.join(format!("{}_flip.png", p.slug));
-        write_png_bytes(&heat_png, w, h, &heat).map_err(other)?;
+        write_png_bytes(&heat_png, w, h, &heat)?;
         let truth_png = images.join(format!(
             "truth_{}.png",
             if p.method.is_some() {
@@ -339,7 +425,7 @@ pub fn run_sweep(
                 "floor".into()
             }
         ));
-        std::fs::copy(truth_path.with_extension("png"), &truth_png).map_err(other)?;
+        std::fs::copy(truth_path.with_extension("png"), &truth_png).map_err(io(&truth_png))?;
         let rel = |q: &Path| {
             q.strip_prefix(out)
                 .unwrap_or(q)
@@ -353,9 +439,9 @@ pub fn run_sweep(
             kind: if p.method.is_some() { "point" } else { "floor" }.into(),
             scene: config.scene.display().to_string(),
             scene_hash: format!("{base_hash:016x}"),
-            method: p.method.map_or("floor", |m| m.name()).into(),
-            n: p.method.and_then(|m| m.n()),
-            depth: p.method.and_then(|m| m.depth_limit()),
+            method: p.method.as_ref().map_or("floor", |m| m.name()).into(),
+            n: p.method.as_ref().and_then(|m| m.count_of("n")),
+            depth: p.method.as_ref().and_then(|m| m.count_of("depth")),
             alpha: p.alpha,
             width: w,
             height: h,
@@ -378,19 +464,19 @@ pub fn run_sweep(
             raster_image: rel(&raster_png),
             heatmap_image: rel(&heat_png),
         };
-        let line = serde_json::to_string(&record).map_err(other)?;
+        let line = serde_json::to_string(&record)?;
         let mut f = std::fs::OpenOptions::new()
             .create(true)
             .append(true)
             .open(&results)
-            .map_err(other)?;
+            .map_err(io(&results))?;
         f.write_all(format!("{line}\n").as_bytes())
             .and_then(|()| f.sync_data())
-            .map_err(other)?;
+            .map_err(io(&results))?;
         summary.computed += 1;
         progress(Event::Finished { record: &record });
     }
-    let records = read_records(&results).map_err(other)?;
+    let records = read_records(&results).map_err(io(&results))?;
     // Report the points of this configuration only (results.jsonl may hold others).
     let keys: Vec<&String> = all.iter().map(|p| &p.key).collect();
     let records: Vec<Record> = records
@@ -417,12 +503,18 @@ pub fn run_sweep(
             "whitted, max depth {}, min throughput {}, traced at reflectance α",
             config.truth.max_depth, config.truth.min_throughput
         ),
+        exact_methods: METHODS
+            .iter()
+            .filter(|e| e.exact)
+            .map(|e| e.name.to_string())
+            .collect(),
     };
+    let sweep_json = out.join("sweep.json");
     std::fs::write(
-        out.join("sweep.json"),
+        &sweep_json,
         serde_json::json!({ "command": info.command, "date": info.date }).to_string(),
     )
-    .map_err(other)?;
-    write_report(out, &info, &records).map_err(other)?;
+    .map_err(io(&sweep_json))?;
+    write_report(out, &info, &records).map_err(io(out))?;
     Ok(summary)
 }

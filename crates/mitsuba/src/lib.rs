@@ -208,8 +208,7 @@ mod tests {
 
     #[test]
     fn exported_meshes_hold_exactly_our_triangles() {
-        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/single_mirror.json");
-        let scene = mirrorbox_scene::load_scene(&path).unwrap();
+        let scene = mirrorbox_scene::load::bundled_scene("single_mirror.json");
         let dir = tempfile::tempdir().unwrap();
         let xml = dir.path().join("scene.xml");
         let files = export(&scene, &xml, ExportSettings { spp: 4 }).unwrap();

@@ -1,7 +1,33 @@
-//! Conservative screen-space culling of scene parts against a reflection path's portal,
-//! shared by the exact methods (`portal_stencil`, `unrolled`).
+//! Conservative screen-space geometry shared by the methods: the pixel rectangle of a
+//! footprint (mirror textures, scissors), and culling of scene parts against a reflection
+//! path's portal (`portal_stencil`, `unrolled`).
 
 use glam::{Mat4, Vec2, Vec3};
+
+/// Integer pixel rectangle at render resolution.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Rect {
+    pub x: u32,
+    pub y: u32,
+    pub w: u32,
+    pub h: u32,
+}
+
+/// The pixels covering the screen-space bounds `lo..hi` (pixels) of a footprint, with one
+/// pixel of margin against CPU/GPU rounding at its edge, clamped to the `size` screen; `None`
+/// when nothing of it is on screen.
+pub fn footprint_rect(lo: Vec2, hi: Vec2, size: Vec2) -> Option<Rect> {
+    let x0 = (lo.x.floor() - 1.0).clamp(0.0, size.x) as u32;
+    let y0 = (lo.y.floor() - 1.0).clamp(0.0, size.y) as u32;
+    let x1 = (hi.x.ceil() + 1.0).clamp(0.0, size.x) as u32;
+    let y1 = (hi.y.ceil() + 1.0).clamp(0.0, size.y) as u32;
+    (x1 > x0 && y1 > y0).then_some(Rect {
+        x: x0,
+        y: y0,
+        w: x1 - x0,
+        h: y1 - y0,
+    })
+}
 
 /// The 8 corners of the box `lo..hi`.
 pub fn box_corners(lo: Vec3, hi: Vec3) -> [Vec3; 8] {

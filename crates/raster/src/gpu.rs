@@ -13,6 +13,22 @@ pub enum RasterError {
     Device { adapter: String, message: String },
     #[error("wgpu reported an error: {0}")]
     Gpu(String),
+    #[error("--method {method} needs the adapter feature {feature}, which {adapter} lacks")]
+    MissingFeature {
+        method: &'static str,
+        feature: String,
+        adapter: String,
+    },
+}
+
+impl RasterError {
+    /// Whether the user's input was refused (exit 2) rather than the device failing (exit 1).
+    pub fn is_refusal(&self) -> bool {
+        matches!(
+            self,
+            RasterError::Plan(_) | RasterError::Adapter(AdapterError::BadOverride { .. })
+        )
+    }
 }
 
 pub struct Gpu {
@@ -21,20 +37,22 @@ pub struct Gpu {
     pub report: AdapterReport,
     /// GPU timestamps are available (and enabled) on this device.
     pub timestamps: bool,
-    /// WGSL `clip_distances` is enabled on this device (the unrolled method clips with them).
-    pub clip_distances: bool,
+    /// The features enabled on this device: timestamps where available, and every feature
+    /// a registered method needs or can use that the adapter has.
+    pub features: wgpu::Features,
     errors: Arc<Mutex<Vec<String>>>,
 }
 
 impl Gpu {
-    /// Opens the adapter of [`select_adapter`] with timestamp queries when it has them.
-    pub fn new() -> Result<Gpu, RasterError> {
+    /// Opens the adapter of [`select_adapter`] with those of `wanted` (and timestamp queries)
+    /// that it has.
+    pub fn with_features(wanted: wgpu::Features) -> Result<Gpu, RasterError> {
         let selected = select_adapter()?;
         // Every method renders linear radiance into RGBA32F targets; wgpu's GL backend does
         // not offer them as render attachments (downlevel), so say so instead of failing later.
         let rgba32f = selected
             .adapter
-            .get_texture_format_features(crate::frame::COLOR_FORMAT);
+            .get_texture_format_features(crate::targets::COLOR_FORMAT);
         if !rgba32f
             .allowed_usages
             .contains(wgpu::TextureUsages::RENDER_ATTACHMENT)
@@ -48,14 +66,7 @@ impl Gpu {
             });
         }
         let timestamps = selected.report.timestamp_query;
-        let mut features = wgpu::Features::empty();
-        if timestamps {
-            features |= wgpu::Features::TIMESTAMP_QUERY;
-        }
-        let clip_distances = selected.report.clip_distances;
-        if clip_distances {
-            features |= wgpu::Features::CLIP_DISTANCES;
-        }
+        let features = (wanted | wgpu::Features::TIMESTAMP_QUERY) & selected.adapter.features();
         let (device, queue) =
             pollster::block_on(selected.adapter.request_device(&wgpu::DeviceDescriptor {
                 label: Some("mirrorbox"),
@@ -79,7 +90,7 @@ impl Gpu {
             queue,
             report: selected.report,
             timestamps,
-            clip_distances,
+            features,
             errors,
         })
     }
@@ -102,5 +113,50 @@ impl Gpu {
             .poll(wgpu::PollType::wait_indefinitely())
             .map(|_| ())
             .map_err(|e| RasterError::Gpu(e.to_string()))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::plan::PlanError;
+
+    /// Every refusal of an input is exit 2, every device failure exit 1 (the CLI maps
+    /// `is_refusal`); a new variant must be placed on one side here.
+    #[test]
+    fn refusals_and_device_failures_are_told_apart() {
+        let refusals = [
+            PlanError::NotAPair(3),
+            PlanError::TooManyPaths { limit: 1 },
+            PlanError::TooManyTriangles {
+                triangles: 2,
+                limit: 1,
+            },
+            PlanError::TooManyPasses {
+                predicted: 2,
+                limit: 1,
+                exceeded_count: false,
+            },
+            PlanError::StencilTooDeep(255),
+        ];
+        for p in refusals {
+            assert!(RasterError::Plan(p).is_refusal());
+        }
+        assert!(RasterError::Adapter(AdapterError::BadOverride { value: "x".into() }).is_refusal());
+        let failures = [
+            RasterError::Device {
+                adapter: "a".into(),
+                message: "m".into(),
+            },
+            RasterError::Gpu("lost".into()),
+            RasterError::MissingFeature {
+                method: "m",
+                feature: "f".into(),
+                adapter: "a".into(),
+            },
+        ];
+        for f in failures {
+            assert!(!f.is_refusal(), "{f}");
+        }
     }
 }

@@ -33,63 +33,13 @@ pub const FAR: f32 = 10_000.0;
 /// Plans are counted exactly up to this many texture renders.
 const COUNT_CEILING: usize = 1_000_000;
 
+/// The rendering queue of the paper's recursion.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Method {
-    Naive,
-    Auxiliary {
-        n: u32,
-    },
-    /// Exact stencil recursion over reflection paths up to `depth` mirrors (not a
-    /// render-to-texture plan: see `portal_stencil`).
-    Portal {
-        depth: u32,
-    },
-    /// Exact: every reflection path up to `depth` mirrors drawn as an instance of the scene,
-    /// clipped to its cell (see `unrolled`).
-    Unrolled {
-        depth: u32,
-    },
-}
-
-impl Method {
-    /// The CLI and report name.
-    pub fn name(&self) -> &'static str {
-        match self {
-            Method::Naive => "naive",
-            Method::Auxiliary { .. } => "auxiliary",
-            Method::Portal { .. } => "portal",
-            Method::Unrolled { .. } => "unrolled",
-        }
-    }
-
-    /// Auxiliary mirrors (auxiliary method).
-    pub fn n(&self) -> Option<u32> {
-        match *self {
-            Method::Auxiliary { n } => Some(n),
-            _ => None,
-        }
-    }
-
-    /// The depth cap of the exact (reflection-path) methods.
-    pub fn depth_limit(&self) -> Option<u32> {
-        match *self {
-            Method::Portal { depth } | Method::Unrolled { depth } => Some(depth),
-            _ => None,
-        }
-    }
-}
-
-impl std::fmt::Display for Method {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())?;
-        if let Some(n) = self.n() {
-            write!(f, " n={n}")?;
-        }
-        if let Some(d) = self.depth_limit() {
-            write!(f, " depth={d}")?;
-        }
-        Ok(())
-    }
+pub enum Queue {
+    /// `naive`: the scene's mirrors.
+    SceneMirrors,
+    /// `auxiliary`: the two real mirrors and n auxiliary copies of them.
+    Auxiliary { n: u32 },
 }
 
 /// One mirror of the rendering queue: a real mirror or an auxiliary copy of one.
@@ -101,14 +51,7 @@ pub struct MirrorInstance {
     pub label: String,
 }
 
-/// Integer pixel rectangle at render resolution.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Rect {
-    pub x: u32,
-    pub y: u32,
-    pub w: u32,
-    pub h: u32,
-}
+pub use crate::culling::Rect;
 
 /// One `MIRRORTEXTURE` call.
 #[derive(Clone, Debug)]
@@ -164,20 +107,22 @@ pub enum PlanError {
         limit: usize,
         exceeded_count: bool,
     },
+    #[error(
+        "the reflection tree branches {0} levels deep with siblings pending; the 8-bit stencil of --method portal allows 254: lower --depth or use --method unrolled"
+    )]
+    StencilTooDeep(u32),
 }
 
 /// The rendering queue of a method.
-pub fn instances(scene: &Scene, method: Method) -> Result<Vec<MirrorInstance>, PlanError> {
-    match method {
-        Method::Naive | Method::Portal { .. } | Method::Unrolled { .. } => {
-            Ok((0..scene.mirrors.len())
-                .map(|i| MirrorInstance {
-                    mirror: i,
-                    label: format!("mirror {}", i + 1),
-                })
-                .collect())
-        }
-        Method::Auxiliary { n } => {
+pub fn instances(scene: &Scene, queue: Queue) -> Result<Vec<MirrorInstance>, PlanError> {
+    match queue {
+        Queue::SceneMirrors => Ok((0..scene.mirrors.len())
+            .map(|i| MirrorInstance {
+                mirror: i,
+                label: format!("mirror {}", i + 1),
+            })
+            .collect()),
+        Queue::Auxiliary { n } => {
             if scene.mirrors.len() != 2 {
                 return Err(PlanError::NotAPair(scene.mirrors.len()));
             }
@@ -300,17 +245,7 @@ fn bounding_rect(poly: &[Vec2], size: Vec2) -> Option<Rect> {
     let hi = poly
         .iter()
         .fold(Vec2::splat(f32::NEG_INFINITY), |a, p| a.max(*p));
-    // One pixel of margin guards against CPU/GPU rounding at the footprint's edge.
-    let x0 = (lo.x.floor() - 1.0).clamp(0.0, size.x) as u32;
-    let y0 = (lo.y.floor() - 1.0).clamp(0.0, size.y) as u32;
-    let x1 = (hi.x.ceil() + 1.0).clamp(0.0, size.x) as u32;
-    let y1 = (hi.y.ceil() + 1.0).clamp(0.0, size.y) as u32;
-    (x1 > x0 && y1 > y0).then_some(Rect {
-        x: x0,
-        y: y0,
-        w: x1 - x0,
-        h: y1 - y0,
-    })
+    crate::culling::footprint_rect(lo, hi, size)
 }
 
 fn depth(nodes: &[TextureNode]) -> usize {
@@ -321,16 +256,16 @@ fn depth(nodes: &[TextureNode]) -> usize {
         .unwrap_or(0)
 }
 
-/// Plans a frame of `method` at render resolution `width × height`; refuses, before any
+/// Plans a frame of the recursion over `queue` at render resolution `width × height`; refuses, before any
 /// work, a plan of more than `max_passes` scene passes.
 pub fn plan(
     scene: &Scene,
-    method: Method,
+    queue: Queue,
     width: u32,
     height: u32,
     max_passes: usize,
 ) -> Result<Plan, PlanError> {
-    let instances = instances(scene, method)?;
+    let instances = instances(scene, queue)?;
     let camera = scene.camera.with_size(width, height);
     let projection = camera.projection(NEAR, FAR);
     let planner = Planner {
@@ -370,14 +305,7 @@ pub fn plan(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::path::Path;
-
-    fn scene(name: &str) -> Scene {
-        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../../scenes")
-            .join(name);
-        mirrorbox_scene::load_scene(&path).unwrap()
-    }
+    use mirrorbox_scene::load::bundled_scene as scene;
 
     /// The pass counts of the paper's auxiliary method on `mirror_box` (see the module docs
     /// for the formula): factorial growth, as in Table 1.
@@ -386,7 +314,7 @@ mod tests {
         let s = scene("mirror_box.json");
         let passes: Vec<usize> = (0..=4)
             .map(|n| {
-                plan(&s, Method::Auxiliary { n }, 320, 180, 5000)
+                plan(&s, Queue::Auxiliary { n }, 320, 180, 5000)
                     .unwrap()
                     .passes
             })
@@ -394,7 +322,7 @@ mod tests {
         assert_eq!(passes, vec![3, 7, 15, 46, 139]);
         let depths: Vec<usize> = (0..=4)
             .map(|n| {
-                plan(&s, Method::Auxiliary { n }, 320, 180, 5000)
+                plan(&s, Queue::Auxiliary { n }, 320, 180, 5000)
                     .unwrap()
                     .depth
             })
@@ -408,7 +336,14 @@ mod tests {
 
     #[test]
     fn naive_shows_exactly_two_reflections_between_facing_mirrors() {
-        let p = plan(&scene("mirror_box.json"), Method::Naive, 320, 180, 5000).unwrap();
+        let p = plan(
+            &scene("mirror_box.json"),
+            Queue::SceneMirrors,
+            320,
+            180,
+            5000,
+        )
+        .unwrap();
         assert_eq!(p.depth, 2);
         assert_eq!(p.passes, 3);
         assert_eq!(p.roots.len(), 1, "the camera sees one mirror");
@@ -422,12 +357,12 @@ mod tests {
     #[test]
     fn too_many_passes_are_refused_with_the_prediction() {
         let s = scene("mirror_box.json");
-        let err = plan(&s, Method::Auxiliary { n: 4 }, 320, 180, 100).unwrap_err();
+        let err = plan(&s, Queue::Auxiliary { n: 4 }, 320, 180, 100).unwrap_err();
         assert!(
             matches!(err, PlanError::TooManyPasses { limit: 100, .. }),
             "{err:?}"
         );
-        let exact = plan(&s, Method::Auxiliary { n: 4 }, 320, 180, 138).unwrap_err();
+        let exact = plan(&s, Queue::Auxiliary { n: 4 }, 320, 180, 138).unwrap_err();
         assert_eq!(
             exact,
             PlanError::TooManyPasses {
@@ -439,7 +374,7 @@ mod tests {
         // n = 7 would need 11 146 passes (the formula of the module docs): refused, with the
         // count, without building the tree.
         assert_eq!(
-            plan(&s, Method::Auxiliary { n: 7 }, 320, 180, 5000).unwrap_err(),
+            plan(&s, Queue::Auxiliary { n: 7 }, 320, 180, 5000).unwrap_err(),
             PlanError::TooManyPasses {
                 predicted: 11_146,
                 limit: 5000,
@@ -449,7 +384,7 @@ mod tests {
         assert_eq!(
             plan(
                 &scene("mirror_room.json"),
-                Method::Auxiliary { n: 1 },
+                Queue::Auxiliary { n: 1 },
                 32,
                 18,
                 10
@@ -463,17 +398,24 @@ mod tests {
     fn auxiliary_zero_is_the_naive_queue() {
         let s = scene("mirror_box.json");
         assert_eq!(
-            instances(&s, Method::Auxiliary { n: 0 }).unwrap(),
-            instances(&s, Method::Naive).unwrap()
+            instances(&s, Queue::Auxiliary { n: 0 }).unwrap(),
+            instances(&s, Queue::SceneMirrors).unwrap()
         );
-        let q = instances(&s, Method::Auxiliary { n: 3 }).unwrap();
+        let q = instances(&s, Queue::Auxiliary { n: 3 }).unwrap();
         let sides: Vec<usize> = q.iter().map(|i| i.mirror).collect();
         assert_eq!(sides, vec![0, 1, 0, 1, 0]);
     }
 
     #[test]
     fn footprints_lie_inside_the_image() {
-        let p = plan(&scene("mirror_room.json"), Method::Naive, 64, 36, 5000).unwrap();
+        let p = plan(
+            &scene("mirror_room.json"),
+            Queue::SceneMirrors,
+            64,
+            36,
+            5000,
+        )
+        .unwrap();
         fn walk(n: &TextureNode, w: u32, h: u32) -> usize {
             assert!(n.footprint.x + n.footprint.w <= w && n.footprint.y + n.footprint.h <= h);
             1 + n.children.iter().map(|c| walk(c, w, h)).sum::<usize>()

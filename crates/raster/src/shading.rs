@@ -1,19 +1,22 @@
 //! The shading contract in WGSL (`shaders/shading.wgsl`) and the scene data it reads.
 //!
-//! WGSL has no includes: every pipeline's module is `shading.wgsl` followed by its own file.
+//! WGSL composition (the contract first in every scene pipeline) lives in [`crate::wgsl`].
 
 use bytemuck::{Pod, Zeroable};
 use mirrorbox_scene::{Scene, Surface};
 use wgpu::util::DeviceExt;
 
-pub const SHADING_WGSL: &str = include_str!("../../../shaders/shading.wgsl");
-
-/// Compiles `shading.wgsl` + `entry_points`.
-pub fn module(device: &wgpu::Device, label: &str, entry_points: &str) -> wgpu::ShaderModule {
-    device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some(label),
-        source: wgpu::ShaderSource::Wgsl(format!("{SHADING_WGSL}\n{entry_points}").into()),
-    })
+/// The `#[repr(C)]` structs of `shading.wgsl`, for the layout test of [`crate::wgsl`].
+pub fn gpu_structs() -> Vec<crate::wgsl::HostLayout> {
+    vec![
+        crate::host_layout!(GpuSurface as "Surface" {
+            albedo, kind, emission, mirror, reflectance, _pad0, back_albedo, _pad1
+        }),
+        crate::host_layout!(GpuLight as "Light" { position, _pad0, intensity, _pad1 }),
+        crate::host_layout!(GpuFrame as "Frame" {
+            ambient, light_count, background, _pad0, terminal, _pad1
+        }),
+    ]
 }
 
 #[repr(C)]

@@ -8,11 +8,10 @@
 
 use crate::{Record, linear_fit};
 
-/// Method names of the exact methods, as records carry them.
-pub const EXACT_METHODS: [&str; 2] = ["portal", "unrolled"];
-
-pub fn is_exact(r: &Record) -> bool {
-    r.kind == "point" && EXACT_METHODS.contains(&r.method.as_str())
+/// Whether `r` is a point of one of the `exact` methods (names from the raster registry,
+/// carried by [`crate::SweepInfo::exact_methods`]).
+pub fn is_exact(exact: &[String], r: &Record) -> bool {
+    r.kind == "point" && exact.contains(&r.method)
 }
 
 /// One method's cost against depth at one α.
@@ -27,9 +26,9 @@ pub struct DepthScaling {
 }
 
 /// Groups the exact points by (method, α), each with at least two depths.
-pub fn depth_scaling(records: &[Record]) -> Vec<DepthScaling> {
+pub fn depth_scaling(exact: &[String], records: &[Record]) -> Vec<DepthScaling> {
     let mut out: Vec<DepthScaling> = Vec::new();
-    for r in records.iter().filter(|r| is_exact(r)) {
+    for r in records.iter().filter(|r| is_exact(exact, r)) {
         match out
             .iter_mut()
             .find(|g| g.method == r.method && g.alpha == r.alpha)
@@ -83,12 +82,16 @@ pub fn bounce_sentence(g: &DepthScaling, pass_ms: Option<f64>) -> String {
 
 /// Among the exact points at α, the one closest to depth 64 per method, for the Table 1
 /// comparison.
-pub fn comparison_points(records: &[Record], alpha: f32) -> Vec<&Record> {
+pub fn comparison_points<'r>(
+    exact: &[String],
+    records: &'r [Record],
+    alpha: f32,
+) -> Vec<&'r Record> {
     let mut out: Vec<&Record> = Vec::new();
-    for m in EXACT_METHODS {
+    for m in exact {
         let best = records
             .iter()
-            .filter(|r| is_exact(r) && r.method == m && r.alpha == alpha)
+            .filter(|r| r.kind == "point" && &r.method == m && r.alpha == alpha)
             .min_by_key(|r| r.depth.unwrap_or(0).abs_diff(64));
         out.extend(best);
     }

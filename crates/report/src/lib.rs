@@ -89,6 +89,10 @@ pub struct SweepInfo {
     pub scene: String,
     pub resolution: String,
     pub truth: String,
+    /// The exact methods' names, from the raster registry (the report groups them by depth
+    /// and sets them beside the paper's method).
+    #[serde(default)]
+    pub exact_methods: Vec<String>,
 }
 
 /// Least-squares line `y = a + b·x`: returns `(a, b)`, or None with fewer than two distinct x.

@@ -1,6 +1,10 @@
 //! The reproduction of the seed paper's Table 1: ms/frame of the auxiliary method for
 //! n = 0…4, the paper's (Safari) beside ours, with the pass counts that explain the growth.
 
+/// The method the paper's Table 1 measures (a raster registry name; the harness's tests
+/// check it is registered).
+pub const PAPER_METHOD: &str = "auxiliary";
+
 use crate::Record;
 
 /// Table 1 of the seed paper: ms/frame for n = 0…4 auxiliary mirrors, "tested on Safari".
@@ -23,7 +27,7 @@ pub struct Row {
 pub fn rows(records: &[Record]) -> (Option<f32>, Vec<Row>) {
     let aux: Vec<&Record> = records
         .iter()
-        .filter(|r| r.kind == "point" && r.method == "auxiliary")
+        .filter(|r| r.kind == "point" && r.method == PAPER_METHOD)
         .collect();
     let alpha = aux
         .iter()

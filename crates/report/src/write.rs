@@ -209,8 +209,13 @@ fn write_csv(path: &Path, records: &[Record]) -> std::io::Result<()> {
 }
 
 /// The exact methods beside the paper's method at the Table 1 α: time and error.
-fn exact_comparison(records: &[Record], rows: &[table1::Row], alpha: f32) -> Vec<Block> {
-    let exact = exact::comparison_points(records, alpha);
+fn exact_comparison(
+    info: &SweepInfo,
+    records: &[Record],
+    rows: &[table1::Row],
+    alpha: f32,
+) -> Vec<Block> {
+    let exact = exact::comparison_points(&info.exact_methods, records, alpha);
     if exact.is_empty() {
         return Vec::new();
     }
@@ -219,7 +224,7 @@ fn exact_comparison(records: &[Record], rows: &[table1::Row], alpha: f32) -> Vec
         .filter_map(|row| {
             records.iter().find(|r| {
                 r.kind == "point"
-                    && r.method == "auxiliary"
+                    && r.method == table1::PAPER_METHOD
                     && r.n == Some(row.n)
                     && r.alpha == alpha
             })
@@ -292,8 +297,8 @@ fn exact_comparison(records: &[Record], rows: &[table1::Row], alpha: f32) -> Vec
 }
 
 /// ms/frame against the depth cap for each exact method with several depths.
-fn depth_scaling(records: &[Record], floor: Option<&Record>) -> Vec<Block> {
-    let groups = exact::depth_scaling(records);
+fn depth_scaling(info: &SweepInfo, records: &[Record], floor: Option<&Record>) -> Vec<Block> {
+    let groups = exact::depth_scaling(&info.exact_methods, records);
     if groups.is_empty() {
         return Vec::new();
     }
@@ -426,7 +431,7 @@ fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
         ));
         b.push(Block::Paragraph(table1::growth_sentence(&rows)));
         if let Some(a) = alpha {
-            b.extend(exact_comparison(records, &rows, a));
+            b.extend(exact_comparison(info, records, &rows, a));
         }
     }
 
@@ -442,7 +447,7 @@ fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
         )));
     }
 
-    b.extend(depth_scaling(records, floor));
+    b.extend(depth_scaling(info, records, floor));
 
     let mut groups: Vec<(String, f32)> = Vec::new();
     for r in &points {

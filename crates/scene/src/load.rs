@@ -31,6 +31,16 @@ pub mod defaults {
     pub const MAX_IMAGE_SIDE: u32 = 16384;
 }
 
+/// A scene of this repository's `scenes/` folder by file name (`"mirror_box.json"`) — for
+/// the workspace's own tests and benches: the path is this source tree's, fixed at compile
+/// time. Panics if it does not load.
+pub fn bundled_scene(name: &str) -> Scene {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../scenes")
+        .join(name);
+    load_scene(&path).unwrap_or_else(|e| panic!("bundled scene {name}: {e}"))
+}
+
 /// Loads, checks and compiles the scene file at `path`.
 pub fn load_scene(path: &Path) -> Result<Scene> {
     let text = std::fs::read_to_string(path).map_err(|source| SceneError::Read {

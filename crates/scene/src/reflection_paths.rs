@@ -247,14 +247,8 @@ pub fn reflection_paths(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::path::Path;
 
-    fn scene(name: &str) -> Scene {
-        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../../scenes")
-            .join(name);
-        crate::load_scene(&path).unwrap()
-    }
+    use crate::load::bundled_scene as scene;
 
     fn limits(max_depth: u32) -> PathLimits {
         PathLimits {

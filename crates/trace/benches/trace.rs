@@ -5,18 +5,11 @@
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::Vec3;
-use mirrorbox_scene::{SubpixelGrid, load_scene};
-use mirrorbox_trace::{BvhKind, Sampling, SceneBvh, TraceSettings, WhittedSettings, render};
-use std::path::Path;
+use mirrorbox_trace::{BvhKind, SceneBvh, TraceSettings, render};
 
 fn bench(c: &mut Criterion) {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/mirror_box.json");
-    let base = load_scene(&path).expect("bundled scene loads");
-    let settings = TraceSettings {
-        sampling: Sampling::Grid(SubpixelGrid::new(2)),
-        whitted: WhittedSettings::default(),
-        path: None,
-    };
+    let base = mirrorbox_scene::load::bundled_scene("mirror_box.json");
+    let settings = TraceSettings::whitted(2);
     let mut group = c.benchmark_group("mirror_box_640x360_4spp");
     group.sample_size(10);
     for reflectance in [0.9f32, 0.7] {

@@ -1,21 +1,23 @@
 //! The obvhs ray tracer: mirrorbox's ground truth.
 //!
 //! - [`bvh`]: one obvhs hierarchy over all the scene's triangles, watertight triangle tests.
-//! - [`whitted`]: the integrator that follows the shading contract to deep bounce counts.
-//! - [`path`]: the physically based integrator, for comparison with Mitsuba's `path`.
+//! - [`integrator`]: the [`Integrator`] trait and its implementations, chosen by
+//!   [`IntegratorSettings`]:
+//!   - [`whitted`]: the integrator that follows the shading contract to deep bounce counts;
+//!   - [`path`]: the physically based integrator, for comparison with Mitsuba's `path`.
 //! - [`sampler`]: the shared sub-pixel grid, or stratified jitter.
-//! - [`render`]: the parallel image loop and its statistics.
+//! - [`render`](mod@render): the parallel image loop and its statistics.
 
 pub mod bvh;
+pub mod integrator;
 pub mod mirror_bounce;
-pub mod path;
 pub mod render;
 pub mod sampler;
 pub mod watertight;
-pub mod whitted;
 
 pub use bvh::{BvhKind, Hit, SceneBvh};
+pub use integrator::{Integrator, IntegratorSettings, PathResult, Termination, path, whitted};
 pub use path::{PathSettings, PathTracer};
 pub use render::{TraceOutput, TraceSettings, TraceStats, render};
 pub use sampler::Sampling;
-pub use whitted::{PathResult, Termination, Whitted, WhittedSettings};
+pub use whitted::{Whitted, WhittedSettings};

@@ -4,21 +4,55 @@
 //! summed in a fixed order, so the image is bit-identical whatever the thread count.
 
 use crate::bvh::SceneBvh;
-use crate::path::{PathSettings, PathTracer};
+use crate::integrator::{IntegratorSettings, Termination};
+use crate::path::PathSettings;
 use crate::sampler::{Sampling, SplitMix64};
-use crate::whitted::{Termination, Whitted, WhittedSettings};
 use mirrorbox_image::RgbImage;
-use mirrorbox_scene::Scene;
+use mirrorbox_scene::{Scene, SubpixelGrid};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::time::{Duration, Instant};
 
+/// What to render with: sub-pixel sampling and the integrator. The default is the
+/// command line's: the 4×4 grid (16 spp) and `whitted` at its defaults. Change only what
+/// differs: `TraceSettings::whitted(2).with_integrator(WhittedSettings { .. })`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TraceSettings {
     pub sampling: Sampling,
-    pub whitted: WhittedSettings,
-    /// `Some`: render with the physically based `path` integrator instead of `whitted`.
-    pub path: Option<PathSettings>,
+    pub integrator: IntegratorSettings,
+}
+
+impl Default for TraceSettings {
+    fn default() -> Self {
+        TraceSettings::whitted(4)
+    }
+}
+
+impl TraceSettings {
+    /// `whitted` at its defaults on the `grid_side × grid_side` sub-pixel grid.
+    pub fn whitted(grid_side: u32) -> Self {
+        TraceSettings {
+            sampling: Sampling::Grid(SubpixelGrid::new(grid_side)),
+            integrator: IntegratorSettings::default(),
+        }
+    }
+
+    /// `path` with `settings` on the `grid_side × grid_side` sub-pixel grid.
+    pub fn path(grid_side: u32, settings: PathSettings) -> Self {
+        TraceSettings::whitted(grid_side).with_integrator(settings)
+    }
+
+    pub fn with_sampling(self, sampling: Sampling) -> Self {
+        TraceSettings { sampling, ..self }
+    }
+
+    /// Takes [`IntegratorSettings`], or a `WhittedSettings` / `PathSettings` directly.
+    pub fn with_integrator(self, integrator: impl Into<IntegratorSettings>) -> Self {
+        TraceSettings {
+            integrator: integrator.into(),
+            ..self
+        }
+    }
 }
 
 /// Counters over all paths of a render.
@@ -28,8 +62,12 @@ pub struct TraceStats {
     pub rays: u64,
     pub diffuse: u64,
     pub escaped: u64,
+    /// Cut at `max_depth`.
     pub cut_by_depth: u64,
+    /// Cut at `min_throughput` (`whitted`).
     pub cut_by_throughput: u64,
+    /// Ended by Russian roulette (`path`).
+    pub cut_by_roulette: u64,
     /// Most mirror reflections followed by any path.
     pub deepest: u32,
 }
@@ -44,6 +82,7 @@ impl TraceStats {
             Termination::Escaped => self.escaped += 1,
             Termination::Depth => self.cut_by_depth += 1,
             Termination::Throughput => self.cut_by_throughput += 1,
+            Termination::Roulette => self.cut_by_roulette += 1,
         }
     }
     fn merge(mut self, o: TraceStats) -> TraceStats {
@@ -53,6 +92,7 @@ impl TraceStats {
         self.escaped += o.escaped;
         self.cut_by_depth += o.cut_by_depth;
         self.cut_by_throughput += o.cut_by_throughput;
+        self.cut_by_roulette += o.cut_by_roulette;
         self.deepest = self.deepest.max(o.deepest);
         self
     }
@@ -83,10 +123,8 @@ pub fn render(
     let cam = &scene.camera;
     let (w, h) = (cam.width, cam.height);
     let rays = cam.ray_generator();
-    let whitted = Whitted::new(scene, bvh, settings.whitted);
-    let path = settings
-        .path
-        .map(|p| (PathTracer::new(scene, bvh, p), p.seed));
+    let integrator = settings.integrator.build(scene, bvh);
+    let seed = settings.integrator.seed();
     let spp = settings.sampling.grid().samples_per_pixel() as f32;
     let done = AtomicU32::new(0);
     let start = Instant::now();
@@ -104,13 +142,10 @@ pub fn render(
                 let mut sum = glam::Vec3::ZERO;
                 let mut bounces = 0u64;
                 let pixel = y as u64 * w as u64 + x as u64;
-                let mut rng = SplitMix64::for_pixel(path.as_ref().map_or(0, |p| p.1), pixel);
+                let mut rng = SplitMix64::for_pixel(seed, pixel);
                 for o in &offsets {
                     let ray = rays.ray(x as f32 + o.x, y as f32 + o.y);
-                    let r = match &path {
-                        Some((tracer, _)) => tracer.radiance(ray, &mut rng),
-                        None => whitted.radiance(ray),
-                    };
+                    let r = integrator.radiance(ray, &mut rng);
                     sum += r.radiance;
                     bounces += r.bounces as u64;
                     stats.record(r.bounces, r.termination, r.rays);

@@ -148,8 +148,7 @@ fn closest_point_on_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
 /// distance from each light to any diffuse triangle (mirrors only redirect, never add).
 #[test]
 fn nothing_is_brighter_than_the_contract_allows() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/mirror_box.json");
-    let mut s = mirrorbox_scene::load_scene(&path).unwrap();
+    let mut s = mirrorbox_scene::load::bundled_scene("mirror_box.json");
     s.set_reflectance(Vec3::ONE);
     s.camera = s.camera.with_size(96, 54);
     let g = &s.geometry;
@@ -168,11 +167,7 @@ fn nothing_is_brighter_than_the_contract_allows() {
             bound.max(emission + albedo * (irradiance / std::f32::consts::PI + s.lighting.ambient));
     }
     let bvh = SceneBvh::build(&s.geometry);
-    let settings = TraceSettings {
-        sampling: Sampling::Grid(SubpixelGrid::new(2)),
-        whitted: WhittedSettings::default(),
-        path: None,
-    };
+    let settings = TraceSettings::whitted(2);
     let out = render(&s, &bvh, &settings, &|_| {});
     let mut brightest = Vec3::ZERO;
     for p in &out.image.pixels {
@@ -189,18 +184,13 @@ fn nothing_is_brighter_than_the_contract_allows() {
 
 #[test]
 fn image_is_identical_whatever_the_thread_count() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/mirror_room.json");
-    let mut s = mirrorbox_scene::load_scene(&path).unwrap();
+    let mut s = mirrorbox_scene::load::bundled_scene("mirror_room.json");
     s.camera = s.camera.with_size(64, 36);
     let bvh = SceneBvh::build(&s.geometry);
-    let settings = TraceSettings {
-        sampling: Sampling::Jittered {
-            grid: SubpixelGrid::new(2),
-            seed: 3,
-        },
-        whitted: WhittedSettings::default(),
-        path: None,
-    };
+    let settings = TraceSettings::default().with_sampling(Sampling::Jittered {
+        grid: SubpixelGrid::new(2),
+        seed: 3,
+    });
     let run = |threads| {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
@@ -233,11 +223,7 @@ fn rays_along_the_mirror_seam_do_not_leak() {
         "background": [1, 0, 0],
     }));
     let bvh = SceneBvh::build(&s.geometry);
-    let settings = TraceSettings {
-        sampling: Sampling::Grid(SubpixelGrid::new(3)),
-        whitted: WhittedSettings::default(),
-        path: None,
-    };
+    let settings = TraceSettings::whitted(3);
     let out = render(&s, &bvh, &settings, &|_| {});
     for (i, p) in out.image.pixels.iter().enumerate() {
         assert_eq!(*p, [0.5, 0.5, 0.5], "pixel {} {} leaks", i % 64, i / 64);
@@ -249,23 +235,13 @@ fn rays_along_the_mirror_seam_do_not_leak() {
 /// averaging add nothing.
 #[test]
 fn scene_without_mirrors_equals_the_contract_reference_exactly() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/single_mirror.json");
-    let mut s = mirrorbox_scene::load_scene(&path).unwrap();
+    let mut s = mirrorbox_scene::load::bundled_scene("single_mirror.json");
     s.camera = s.camera.with_size(48, 27);
     let s = s.without_mirrors();
     assert!(s.mirrors.is_empty() && s.geometry.mirror_triangle_count() == 0);
     let grid = SubpixelGrid::new(2);
     let bvh = SceneBvh::build(&s.geometry);
-    let out = render(
-        &s,
-        &bvh,
-        &TraceSettings {
-            sampling: Sampling::Grid(grid),
-            whitted: WhittedSettings::default(),
-            path: None,
-        },
-        &|_| {},
-    );
+    let out = render(&s, &bvh, &TraceSettings::whitted(grid.per_axis), &|_| {});
     let cam = &s.camera;
     for y in 0..cam.height {
         for x in 0..cam.width {

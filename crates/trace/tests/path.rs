@@ -1,9 +1,9 @@
 //! The path integrator against answers known in closed form.
 
 use glam::Vec3;
+use mirrorbox_scene::Scene;
 use mirrorbox_scene::load::parse_scene;
-use mirrorbox_scene::{Scene, SubpixelGrid};
-use mirrorbox_trace::{PathSettings, Sampling, SceneBvh, TraceSettings, WhittedSettings, render};
+use mirrorbox_trace::{IntegratorSettings, PathSettings, SceneBvh, TraceSettings, render};
 use serde_json::json;
 use std::path::Path;
 
@@ -11,13 +11,13 @@ fn scene(v: serde_json::Value) -> Scene {
     parse_scene(&v.to_string(), Path::new("test.json")).unwrap()
 }
 
-fn trace(s: &Scene, spp_axis: u32, path: Option<PathSettings>) -> mirrorbox_image::RgbImage {
+fn trace(
+    s: &Scene,
+    spp_axis: u32,
+    integrator: impl Into<IntegratorSettings>,
+) -> mirrorbox_image::RgbImage {
     let bvh = SceneBvh::build(&s.geometry);
-    let settings = TraceSettings {
-        sampling: Sampling::Grid(SubpixelGrid::new(spp_axis)),
-        whitted: WhittedSettings::default(),
-        path,
-    };
+    let settings = TraceSettings::whitted(spp_axis).with_integrator(integrator);
     render(s, &bvh, &settings, &|_| {}).image
 }
 
@@ -34,13 +34,13 @@ fn direct_light_equals_the_contract() {
     let path = trace(
         &s,
         2,
-        Some(PathSettings {
+        PathSettings {
             max_depth: 2,
             rr_depth: 1000,
             seed: 0,
-        }),
+        },
     );
-    let whitted = trace(&s, 2, None);
+    let whitted = trace(&s, 2, IntegratorSettings::default());
     for (p, w) in path.pixels.iter().zip(&whitted.pixels) {
         for c in 0..3 {
             assert!(
@@ -49,6 +49,31 @@ fn direct_light_equals_the_contract() {
             );
         }
     }
+}
+
+/// Russian roulette ends are counted as such, never as `whitted`'s throughput cuts.
+#[test]
+fn roulette_ends_are_counted_separately() {
+    let s = scene(json!({
+        "camera": { "position": [0, 2, 3], "look_at": [0, 0, 0], "fov_y_deg": 50, "width": 16, "height": 12 },
+        "objects": [ { "type": "quad", "size": [6, 6], "transform": { "rotate_deg": [-90, 0, 0] }, "albedo": [0.7, 0.5, 0.3] } ],
+        "lights": [ { "position": [0.5, 1.5, 0.2], "intensity": [4, 4, 4] } ],
+    }));
+    let bvh = SceneBvh::build(&s.geometry);
+    let path = PathSettings {
+        max_depth: 100,
+        rr_depth: 1,
+        seed: 2,
+    };
+    let stats = render(&s, &bvh, &TraceSettings::path(2, path), &|_| {}).stats;
+    assert!(stats.cut_by_roulette > 0, "{stats:?}");
+    assert_eq!(stats.cut_by_throughput, 0, "{stats:?}");
+    assert_eq!(
+        stats.paths,
+        stats.diffuse + stats.escaped + stats.cut_by_depth + stats.cut_by_roulette
+    );
+    let whitted = render(&s, &bvh, &TraceSettings::whitted(2), &|_| {}).stats;
+    assert_eq!(whitted.cut_by_roulette, 0, "{whitted:?}");
 }
 
 /// A white furnace: a closed box of inward-facing quads, all emitting E with albedo ρ. Every
@@ -95,11 +120,11 @@ fn white_furnace_converges_to_e_over_one_minus_rho() {
     let img = trace(
         &s,
         8,
-        Some(PathSettings {
+        PathSettings {
             max_depth: 10_000,
             rr_depth: 3,
             seed: 1,
-        }),
+        },
     );
     let mean = img.pixels.iter().map(|p| p[0] as f64).sum::<f64>() / img.pixels.len() as f64;
     let expected = (e / (1.0 - rho)) as f64;

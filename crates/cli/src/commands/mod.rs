@@ -2,6 +2,7 @@ pub mod check;
 pub mod compare;
 pub mod export_mitsuba;
 pub mod info;
+pub mod method_flags;
 pub mod render;
 pub mod sweep;
 pub mod trace;

@@ -1,49 +1,22 @@
-//! `mirrorbox render SCENE --method naive|auxiliary|portal|unrolled -o OUT.png`: the seed
-//! paper's raster methods and the exact ones with wgpu, timed.
+//! `mirrorbox render SCENE --method METHOD [its options] -o OUT.png`: one raster method of
+//! the registry (`mirrorbox_raster::METHODS`) with wgpu, timed.
 
+use super::method_flags::{RenderOptions, method_value_parser};
 use super::{load, output_path, resize, unit_interval};
 use crate::Failure;
 use mirrorbox_image::{write_exr, write_png};
-use mirrorbox_raster::plan::PlanError;
-use mirrorbox_raster::{Gpu, Method, RasterError, RenderSettings, render};
+use mirrorbox_raster::{Gpu, RenderSettings, plan_frame, render_planned};
 use std::path::PathBuf;
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum MethodName {
-    /// The paper's Algorithm 1: recursive mirror textures, each mirror hidden in its own recursion.
-    Naive,
-    /// The paper's §3.1–3.2: n auxiliary mirrors (n + 2 in the queue), attenuation α^k.
-    Auxiliary,
-    /// Exact: stencil recursion over the reflection paths, one pass, cost linear in depth.
-    Portal,
-    /// Exact: every reflection path an instance of the scene, clipped to its cell; a handful of draws.
-    Unrolled,
-}
 
 #[derive(clap::Args)]
 pub struct Args {
     /// Scene file (JSON).
     scene: PathBuf,
-    #[arg(long, value_enum, default_value_t = MethodName::Naive)]
-    method: MethodName,
-    /// Auxiliary mirrors (auxiliary method only).
-    #[arg(long)]
-    n: Option<u32>,
-    /// Most mirrors along a reflection path (exact methods: portal, unrolled). Default 64.
-    #[arg(long)]
-    depth: Option<u32>,
-    /// Exact methods: also prune paths whose portal covers fewer pixels² (at render
-    /// resolution) though it may hold a pixel centre — lossy, for speed. Portals holding no
-    /// pixel centre are always pruned (that changes no pixel).
-    #[arg(long, default_value_t = 0.0)]
-    min_portal_area: f32,
-    /// Exact methods: prune paths whose attenuation falls below this (the tracer's --min-throughput).
-    #[arg(long, default_value_t = 1e-4)]
-    min_attenuation: f32,
-    /// Unrolled method: clip every instance per fragment (discard) even where the adapter
-    /// has hardware clip distances — to measure what they save.
-    #[arg(long)]
-    fragment_clipping: bool,
+    /// The raster method (the registry's table; its options are the flags below).
+    #[arg(long, default_value = "naive", value_parser = method_value_parser())]
+    method: String,
+    #[command(flatten)]
+    options: RenderOptions,
     /// Attenuation per reflection; also sets every mirror's reflectance (the truth to compare
     /// with is `trace --reflectance α`). In [0, 1]. Default: the scene's reflectances.
     #[arg(long)]
@@ -60,12 +33,6 @@ pub struct Args {
     frames: u32,
     #[arg(long, default_value_t = 2)]
     warmup: u32,
-    /// Refuse, before any work, a configuration needing more scene passes per frame.
-    #[arg(long, default_value_t = 5000)]
-    max_passes: usize,
-    /// Mirror texture resolution relative to the mirror's footprint on screen (1 = exact).
-    #[arg(long, default_value_t = 1.0)]
-    texture_scale: f32,
     /// Print one JSON object with timings, counts, adapter and parameters.
     #[arg(long)]
     json: bool,
@@ -79,48 +46,12 @@ fn bad(message: String) -> Failure {
 }
 
 pub fn run(args: &Args) -> Result<(), Failure> {
-    if args.n.is_some() && args.method != MethodName::Auxiliary {
-        return Err(bad("--n applies to --method auxiliary only".into()));
-    }
-    let exact = matches!(args.method, MethodName::Portal | MethodName::Unrolled);
-    if args.depth.is_some() && !exact {
-        return Err(bad(
-            "--depth applies to --method portal or unrolled only".into()
-        ));
-    }
-    if args.fragment_clipping && args.method != MethodName::Unrolled {
-        return Err(bad(
-            "--fragment-clipping applies to --method unrolled only".into()
-        ));
-    }
-    let depth = match args.depth.unwrap_or(64) {
-        d @ 1..=4096 => d,
-        d => return Err(bad(format!("--depth must be in [1, 4096], got {d}"))),
-    };
-    let method = match args.method {
-        MethodName::Naive => Method::Naive,
-        MethodName::Auxiliary => Method::Auxiliary {
-            n: args.n.unwrap_or(0),
-        },
-        MethodName::Portal => Method::Portal { depth },
-        MethodName::Unrolled => Method::Unrolled { depth },
-    };
-    unit_interval("--min-attenuation", Some(args.min_attenuation))?;
-    if !(args.min_portal_area >= 0.0 && args.min_portal_area.is_finite()) {
-        return Err(bad(format!(
-            "--min-portal-area must be ≥ 0, got {}",
-            args.min_portal_area
-        )));
-    }
+    let entry = mirrorbox_raster::registry::find(&args.method)
+        .ok_or_else(|| bad(format!("unknown method {:?}", args.method)))?;
+    let method = args.options.0.configure(entry)?;
     unit_interval("--alpha", args.alpha)?;
     if !(1..=8).contains(&args.ssaa) {
         return Err(bad(format!("--ssaa must be in [1, 8], got {}", args.ssaa)));
-    }
-    if !(args.texture_scale > 0.0 && args.texture_scale <= 4.0) {
-        return Err(bad(format!(
-            "--texture-scale must be in (0, 4], got {}",
-            args.texture_scale
-        )));
     }
     if args.frames == 0 {
         return Err(bad("--frames must be at least 1".into()));
@@ -132,28 +63,15 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         scene.set_reflectance(glam::Vec3::splat(a));
     }
     let settings = RenderSettings {
-        method,
+        method: method.clone(),
         ssaa: args.ssaa,
         frames: args.frames,
         warmup: args.warmup,
-        max_passes: args.max_passes,
-        texture_scale: args.texture_scale,
-        min_portal_area: args.min_portal_area,
-        min_attenuation: args.min_attenuation,
-        fragment_clipping: args.fragment_clipping,
     };
-    // Plan the paper's recursion first: a refused configuration costs no GPU set-up. (The
-    // exact methods have no such plan; their path enumeration happens inside `render`.)
-    if method.depth_limit().is_none() {
-        let (w, h) = (
-            scene.camera.width * args.ssaa,
-            scene.camera.height * args.ssaa,
-        );
-        mirrorbox_raster::plan::plan(&scene, method, w, h, args.max_passes)
-            .map_err(plan_failure)?;
-    }
-    let gpu = Gpu::new().map_err(raster_failure)?;
-    let out = render(&gpu, &scene, &settings).map_err(raster_failure)?;
+    // Plan first: a refused configuration costs no GPU set-up.
+    let planned = plan_frame(&scene, &settings)?;
+    let gpu = Gpu::new()?;
+    let out = render_planned(&gpu, &scene, planned, &settings)?;
     let exr = png.with_extension("exr");
     let method_text = method.to_string();
     for w in &out.warnings {
@@ -185,11 +103,20 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             "scene": args.scene.display().to_string(),
             "scene_hash": format!("{:016x}", scene.content_hash()),
             "method": method.name(),
-            "n": method.n(),
-            "depth_limit": method.depth_limit(),
+            "key": method.key(),
+            "params": method.entry().options.iter().map(|o| {
+                let v = method.params().get(o).expect("declared");
+                (o.name.to_string(), match v {
+                    mirrorbox_raster::ParamValue::Count(c) => serde_json::json!(c),
+                    mirrorbox_raster::ParamValue::Real(r) => serde_json::json!(r),
+                    mirrorbox_raster::ParamValue::Switch(s) => serde_json::json!(s),
+                })
+            }).collect::<serde_json::Map<_, _>>(),
+            "n": method.count_of("n"),
+            "depth_limit": method.count_of("depth"),
             "alpha": args.alpha,
             "width": scene.camera.width, "height": scene.camera.height, "ssaa": args.ssaa,
-            "texture_scale": args.texture_scale, "frames": args.frames, "warmup": args.warmup,
+            "frames": args.frames, "warmup": args.warmup,
             "ms_per_frame_median": t.median_ms(), "ms_per_frame_min": t.min_ms(),
             "frames_ms": t.frames_ms, "timing_source": t.source.name(),
             "passes": s.passes, "texture_renders": s.texture_renders, "draws": s.draws, "depth": s.depth,
@@ -245,18 +172,4 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         );
     }
     Ok(())
-}
-
-fn plan_failure(e: PlanError) -> Failure {
-    Failure::BadInput(e.to_string())
-}
-
-fn raster_failure(e: RasterError) -> Failure {
-    match e {
-        RasterError::Plan(p) => plan_failure(p),
-        RasterError::Adapter(mirrorbox_raster::AdapterError::BadOverride { .. }) => {
-            Failure::BadInput(e.to_string())
-        }
-        other => Failure::Other(other.to_string()),
-    }
 }

@@ -1,9 +1,11 @@
 //! `mirrorbox sweep SCENE --out DIR` and its preset `mirrorbox table1`: raster methods timed
 //! and compared with cached ground truths, resumable, with reports.
 
+use super::method_flags::SweepOptions;
 use super::progress_bar;
 use crate::Failure;
-use mirrorbox_harness::{Event, HarnessError, MethodKind, SweepConfig, run_sweep};
+use mirrorbox_harness::{Event, SweepConfig, run_sweep};
+use mirrorbox_raster::registry::{find, names};
 use mirrorbox_trace::WhittedSettings;
 use std::path::PathBuf;
 
@@ -14,16 +16,13 @@ pub struct Args {
     /// Output folder (results.jsonl, results.csv, report.md, report.html, plots, images, cache).
     #[arg(long)]
     out: PathBuf,
-    /// Methods, comma separated: naive, auxiliary, portal, unrolled.
+    /// Methods, comma separated (the registry's: see `render --help`).
     #[arg(long, default_value = "naive,auxiliary")]
     methods: String,
-    /// Auxiliary mirror counts: a range `A..B` (inclusive) or a list `0,2,4`.
-    #[arg(long, default_value = "0..4")]
-    n: String,
-    /// Reflection depths of the exact methods (portal, unrolled): a range `A..B` or a list
-    /// `1,4,16,64`.
-    #[arg(long, default_value = "1,2,4,8,16,32,64")]
-    depth: String,
+    /// Each method is swept over its swept option's axis (`--n` for auxiliary, `--depth` for
+    /// the exact methods); its other options take one value, for the methods that have them.
+    #[command(flatten)]
+    options: SweepOptions,
     /// Reflectances α, comma separated, each in [0, 1].
     #[arg(long, default_value = "0.5,0.7,0.9,1.0")]
     alpha: String,
@@ -39,8 +38,6 @@ pub struct Args {
     frames: u32,
     #[arg(long, default_value_t = 2)]
     warmup: u32,
-    #[arg(long, default_value_t = 5000)]
-    max_passes: usize,
     /// Ground truth: most mirror reflections a path follows.
     #[arg(long, default_value_t = 10_000)]
     max_depth: u32,
@@ -71,55 +68,6 @@ fn bad(m: String) -> Failure {
     Failure::BadInput(m)
 }
 
-fn parse_ns(s: &str) -> Result<Vec<u32>, Failure> {
-    let err = || {
-        bad(format!(
-            "--n {s:?}: expected a range like 0..4 or a list like 0,2,4 of counts 0..=16"
-        ))
-    };
-    let v: Vec<u32> = if let Some((a, b)) = s.split_once("..") {
-        let (a, b): (u32, u32) = (
-            a.trim().parse().map_err(|_| err())?,
-            b.trim().parse().map_err(|_| err())?,
-        );
-        if a > b {
-            return Err(err());
-        }
-        (a..=b).collect()
-    } else {
-        s.split(',')
-            .map(|x| x.trim().parse().map_err(|_| err()))
-            .collect::<Result<_, _>>()?
-    };
-    if v.is_empty() || v.iter().any(|&n| n > 16) {
-        return Err(err());
-    }
-    Ok(v)
-}
-
-fn parse_depths(s: &str) -> Result<Vec<u32>, Failure> {
-    let err = || {
-        bad(format!(
-            "--depth {s:?}: expected a range like 1..8 or a list like 1,4,16,64 of depths 1..=4096"
-        ))
-    };
-    let v: Vec<u32> = if let Some((a, b)) = s.split_once("..") {
-        let (a, b): (u32, u32) = (
-            a.trim().parse().map_err(|_| err())?,
-            b.trim().parse().map_err(|_| err())?,
-        );
-        (a..=b).collect()
-    } else {
-        s.split(',')
-            .map(|x| x.trim().parse().map_err(|_| err()))
-            .collect::<Result<_, _>>()?
-    };
-    if v.is_empty() || v.iter().any(|&d| d == 0 || d > 4096) {
-        return Err(err());
-    }
-    Ok(v)
-}
-
 fn parse_alphas(s: &str) -> Result<Vec<f32>, Failure> {
     s.split(',')
         .map(|x| match x.trim().parse::<f32>() {
@@ -131,18 +79,31 @@ fn parse_alphas(s: &str) -> Result<Vec<f32>, Failure> {
         .collect()
 }
 
-fn parse_methods(s: &str) -> Result<Vec<MethodKind>, Failure> {
-    s.split(',')
-        .map(|m| match m.trim() {
-            "naive" => Ok(MethodKind::Naive),
-            "auxiliary" => Ok(MethodKind::Auxiliary),
-            "portal" => Ok(MethodKind::Portal),
-            "unrolled" => Ok(MethodKind::Unrolled),
-            other => Err(bad(format!(
-                "--methods: unknown method {other:?} (known: naive, auxiliary, portal, unrolled)"
-            ))),
-        })
-        .collect()
+/// The configured methods of `--methods` with their axes and options. An option that none
+/// of the chosen methods has is an error, as on `render`.
+fn parse_methods(
+    s: &str,
+    options: &SweepOptions,
+) -> Result<Vec<mirrorbox_raster::Method>, Failure> {
+    let mut entries = Vec::new();
+    for m in s.split(',') {
+        let entry = find(m.trim()).ok_or_else(|| {
+            bad(format!(
+                "--methods: unknown method {:?} (known: {})",
+                m.trim(),
+                names()
+            ))
+        })?;
+        entries.push(entry);
+    }
+    if let Some(unused) = options.unused_by(&entries) {
+        return Err(bad(unused));
+    }
+    let mut methods = Vec::new();
+    for e in entries {
+        methods.extend(options.methods_of(e)?);
+    }
+    Ok(methods)
 }
 
 fn command_line() -> String {
@@ -159,16 +120,13 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     let config = SweepConfig {
         scene: args.scene.clone(),
         out: args.out.clone(),
-        methods: parse_methods(&args.methods)?,
-        ns: parse_ns(&args.n)?,
-        depths: parse_depths(&args.depth)?,
+        methods: parse_methods(&args.methods, &args.options)?,
         alphas: parse_alphas(&args.alpha)?,
         width: args.width,
         height: args.height,
         ssaa: args.ssaa,
         frames: args.frames,
         warmup: args.warmup,
-        max_passes: args.max_passes,
         truth: WhittedSettings {
             max_depth: args.max_depth,
             min_throughput: args.min_throughput,
@@ -178,65 +136,31 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     execute(&config, args.fresh)
 }
 
-/// Table 1 of the seed paper: the auxiliary method for n = 0…4 on mirror_box at α = 1 and
-/// the paper's 0.7, with the exact methods at depth 64 beside it.
+/// Table 1 of the seed paper (`SweepConfig::table1`), into `reports/table1/` by default.
 pub fn run_table1(args: &PresetArgs) -> Result<(), Failure> {
-    let config = SweepConfig {
-        scene: PathBuf::from("scenes/mirror_box.json"),
-        out: args
-            .out
-            .clone()
-            .unwrap_or_else(|| PathBuf::from("reports/table1")),
-        methods: vec![
-            MethodKind::Auxiliary,
-            MethodKind::Portal,
-            MethodKind::Unrolled,
-        ],
-        ns: (0..=4).collect(),
-        depths: vec![64],
-        alphas: vec![1.0, 0.7],
-        width: None,
-        height: None,
-        ssaa: 1,
-        frames: preset_frames(args, 9)?,
-        warmup: 2,
-        max_passes: 5000,
-        truth: WhittedSettings::default(),
-        command: command_line(),
-    };
-    execute(&config, args.fresh)
+    let out = args.out.clone().unwrap_or_else(|| "reports/table1".into());
+    run_preset(SweepConfig::table1(out), args)
 }
 
-/// The exact methods' cost against depth, 1 to 1024, on mirror_box with perfect mirrors
-/// (α = 1: no path ends by attenuation, only when its portal holds no pixel centre).
+/// The exact methods' cost against depth (`SweepConfig::depth_scaling`), into
+/// `reports/depth_scaling/` by default.
 pub fn run_depth_scaling(args: &PresetArgs) -> Result<(), Failure> {
-    let config = SweepConfig {
-        scene: PathBuf::from("scenes/mirror_box.json"),
-        out: args
-            .out
-            .clone()
-            .unwrap_or_else(|| PathBuf::from("reports/depth_scaling")),
-        methods: vec![MethodKind::Portal, MethodKind::Unrolled],
-        ns: Vec::new(),
-        depths: (0..=10).map(|k| 1 << k).collect(),
-        alphas: vec![1.0],
-        width: None,
-        height: None,
-        ssaa: 1,
-        frames: preset_frames(args, 5)?,
-        warmup: 2,
-        max_passes: 5000,
-        truth: WhittedSettings::default(),
-        command: command_line(),
-    };
-    execute(&config, args.fresh)
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| "reports/depth_scaling".into());
+    run_preset(SweepConfig::depth_scaling(out), args)
 }
 
-fn preset_frames(args: &PresetArgs, default: u32) -> Result<u32, Failure> {
-    match args.frames.unwrap_or(default) {
-        0 => Err(bad("--frames must be at least 1".into())),
-        f => Ok(f),
+fn run_preset(mut config: SweepConfig, args: &PresetArgs) -> Result<(), Failure> {
+    if let Some(frames) = args.frames {
+        if frames == 0 {
+            return Err(bad("--frames must be at least 1".into()));
+        }
+        config.frames = frames;
     }
+    config.command = command_line();
+    execute(&config, args.fresh)
 }
 
 fn execute(config: &SweepConfig, fresh: bool) -> Result<(), Failure> {
@@ -281,10 +205,7 @@ fn execute(config: &SweepConfig, fresh: bool) -> Result<(), Failure> {
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
-    let summary = result.map_err(|e| match e {
-        HarnessError::BadInput(m) => Failure::BadInput(m),
-        HarnessError::Other(m) => Failure::Other(m),
-    })?;
+    let summary = result?;
     println!(
         "sweep done in {:.1} s: {} points computed, {} reused; truths: {} traced, {} from cache; wrote {}",
         started.elapsed().as_secs_f64(),

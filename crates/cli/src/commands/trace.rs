@@ -122,16 +122,18 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     };
     let started = Instant::now();
     let bvh = SceneBvh::build_with(&scene.geometry, kind);
-    let path = (args.integrator == Integrator::Path).then_some(mirrorbox_trace::PathSettings {
-        max_depth: args.max_depth,
-        rr_depth: args.rr_depth,
-        seed: args.seed,
-    });
-    let settings = TraceSettings {
-        sampling,
-        whitted,
-        path,
+    let integrator: mirrorbox_trace::IntegratorSettings = match args.integrator {
+        Integrator::Path => mirrorbox_trace::PathSettings {
+            max_depth: args.max_depth,
+            rr_depth: args.rr_depth,
+            seed: args.seed,
+        }
+        .into(),
+        Integrator::Whitted => whitted.into(),
     };
+    let settings = TraceSettings::default()
+        .with_sampling(sampling)
+        .with_integrator(integrator);
     let bar = progress_bar(scene.camera.height as u64, "tracing rows");
     let out = render(&scene, &bvh, &settings, &|rows| {
         bar.set_position(rows as u64)
@@ -226,7 +228,7 @@ fn report(
             "bvh": format!("{:?}", bvh.kind).to_lowercase(), "bvh_build_seconds": bvh.build_time.as_secs_f64(),
             "threads": out.threads,
             "ended": { "diffuse": s.diffuse, "escaped": s.escaped, "max_depth": s.cut_by_depth,
-                       "min_throughput": s.cut_by_throughput },
+                       "min_throughput": s.cut_by_throughput, "roulette": s.cut_by_roulette },
             "outputs": written.iter().map(|p| p.display().to_string()).collect::<Vec<_>>(),
         });
         println!("{v}");
@@ -244,14 +246,22 @@ fn report(
         out.threads,
     );
     println!(
-        "  {} paths ended: {} at diffuse surfaces, {} escaped, {} cut by --max-depth {}, {} cut by --min-throughput {}",
+        "  {} paths ended: {} at diffuse surfaces, {} escaped, {} cut by --max-depth {}, {} cut by --min-throughput {}{}",
         s.paths,
         s.diffuse,
         s.escaped,
         s.cut_by_depth,
         args.max_depth,
         s.cut_by_throughput,
-        args.min_throughput
+        args.min_throughput,
+        if args.integrator == Integrator::Path {
+            format!(
+                ", {} by Russian roulette from --rr-depth {}",
+                s.cut_by_roulette, args.rr_depth
+            )
+        } else {
+            String::new()
+        }
     );
     println!(
         "  {:?} over {} triangles built in {:.1} ms; wrote {}",

@@ -9,8 +9,10 @@
 //! **Deep paths without drift**: mirror bounces are plane-exact in f64 and skip the mirror
 //! they leave ([`crate::mirror_bounce`]).
 
+use super::{Integrator, PathResult, Termination, face_normals};
 use crate::bvh::SceneBvh;
 use crate::mirror_bounce::MirrorPlanes;
+use crate::sampler::SplitMix64;
 use glam::{DVec3, Vec3};
 use mirrorbox_scene::shading::{Interaction, interaction};
 use mirrorbox_scene::{Ray, Scene};
@@ -32,29 +34,6 @@ impl Default for WhittedSettings {
     }
 }
 
-/// How a path ended.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Termination {
-    /// Shaded at a diffuse surface.
-    Diffuse,
-    /// Left the scene (background).
-    Escaped,
-    /// Cut at `max_depth`.
-    Depth,
-    /// Cut because its throughput fell below `min_throughput`.
-    Throughput,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PathResult {
-    pub radiance: Vec3,
-    /// Mirror reflections followed.
-    pub bounces: u32,
-    pub termination: Termination,
-    /// Rays cast (closest-hit queries).
-    pub rays: u32,
-}
-
 pub struct Whitted<'a> {
     scene: &'a Scene,
     bvh: &'a SceneBvh,
@@ -65,8 +44,7 @@ pub struct Whitted<'a> {
 
 impl<'a> Whitted<'a> {
     pub fn new(scene: &'a Scene, bvh: &'a SceneBvh, settings: WhittedSettings) -> Self {
-        let g = &scene.geometry;
-        let face_normals = (0..g.triangles.len()).map(|i| g.face_normal(i)).collect();
+        let face_normals = face_normals(&scene.geometry);
         let mirror_planes = MirrorPlanes::new(scene);
         Whitted {
             scene,
@@ -81,7 +59,7 @@ impl<'a> Whitted<'a> {
         self.settings
     }
 
-    /// Radiance along `ray`.
+    /// Radiance along `ray` (what [`Integrator::radiance`] returns; no random numbers).
     pub fn radiance(&self, ray: Ray) -> PathResult {
         self.trace(ray, |_, _, _| {})
     }
@@ -149,5 +127,11 @@ impl<'a> Whitted<'a> {
             termination,
             rays,
         }
+    }
+}
+
+impl Integrator for Whitted<'_> {
+    fn radiance(&self, ray: Ray, _rng: &mut SplitMix64) -> PathResult {
+        Whitted::radiance(self, ray)
     }
 }

@@ -16,10 +16,10 @@
 //! visible emitters, 2 adds direct light, and N visible reflections need N + 2. The ambient
 //! term of the contract is not physical and is not used here.
 
+use super::{Integrator, PathResult, Termination, face_normals};
 use crate::bvh::SceneBvh;
 use crate::mirror_bounce::MirrorPlanes;
 use crate::sampler::SplitMix64;
-use crate::whitted::{PathResult, Termination};
 use glam::Vec3;
 use mirrorbox_scene::shading::{Interaction, interaction};
 use mirrorbox_scene::{Ray, Scene, Surface};
@@ -79,7 +79,7 @@ fn cosine_sample(n: Vec3, u1: f32, u2: f32) -> Vec3 {
 impl<'a> PathTracer<'a> {
     pub fn new(scene: &'a Scene, bvh: &'a SceneBvh, settings: PathSettings) -> Self {
         let g = &scene.geometry;
-        let normals: Vec<Vec3> = (0..g.triangles.len()).map(|i| g.face_normal(i)).collect();
+        let normals = face_normals(g);
         let mut emitters = Vec::new();
         for (i, t) in g.triangles.iter().enumerate() {
             if let Surface::Diffuse { emission, .. } = g.surface(i)
@@ -135,9 +135,11 @@ impl<'a> PathTracer<'a> {
             Some(h) => Some(h.triangle) == to,
         }
     }
+}
 
+impl Integrator for PathTracer<'_> {
     /// Radiance along `ray`, random numbers from `rng`.
-    pub fn radiance(&self, ray: Ray, rng: &mut SplitMix64) -> PathResult {
+    fn radiance(&self, ray: Ray, rng: &mut SplitMix64) -> PathResult {
         let scene = self.scene;
         let g = &scene.geometry;
         let mut ray = ray;
@@ -256,7 +258,7 @@ impl<'a> PathTracer<'a> {
             if depth >= self.settings.rr_depth {
                 let q = beta.max_element().min(0.95);
                 if q <= 0.0 || rng.next_unit() >= q {
-                    break Termination::Throughput;
+                    break Termination::Roulette;
                 }
                 beta /= q;
             }

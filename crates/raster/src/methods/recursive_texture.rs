@@ -10,17 +10,169 @@
 //! `texture_scale` of 1. Textures are rendered depth first (children before the pass that
 //! applies them) and recycled by exact size once applied.
 
-use crate::frame::{
-    COLOR_FORMAT, DEPTH_FORMAT, FrameEncoder, FrameStats, RenderTarget, texture_entry,
+use crate::gpu::{Gpu, RasterError};
+use crate::method::{
+    BuiltFrame, FrameStats, MethodEntry, OptionKind, OptionSpec, ParamValue, Params, PlannedFrame,
+    RasterMethod, SweepAxis,
 };
-use crate::gpu::Gpu;
-use crate::plan::{Plan, Rect, TextureNode};
-use crate::shading::{SceneBuffers, VERTEX_LAYOUT, module};
+use crate::pipeline::{
+    ScenePipeline, UniformArena, depth_state, dynamic_uniform_entry, pipeline_layout,
+    record_binding,
+};
+use crate::plan::{Plan, PlanError, Queue, Rect, TextureNode};
+use crate::shading::{SceneBuffers, VERTEX_LAYOUT};
+use crate::targets::{DEPTH_FORMAT, RenderTarget, texture_entry};
+use crate::timing::FrameEncoder;
+use crate::wgsl::{HostLayout, WgslSource, shader_module};
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec2, Vec3};
 use mirrorbox_scene::reflection::{ReflectedView, oblique_near_plane};
 use mirrorbox_scene::{Plane, Scene};
 use std::collections::HashMap;
+
+/// The seed paper's Algorithm 1 as printed: the queue is the scene's mirrors (two
+/// reflections on `mirror_box`, its Figure 2).
+pub static NAIVE: MethodEntry = MethodEntry {
+    name: "naive",
+    help: "The paper's Algorithm 1: recursive mirror textures, each mirror hidden in its own recursion.",
+    exact: false,
+    options: &[&TEXTURE_SCALE, &MAX_PASSES],
+    swept: None,
+    optional_features: wgpu::Features::empty(),
+    required_features: wgpu::Features::empty(),
+    shaders: &[&SHADER],
+    gpu_structs,
+    configure: |p| Box::new(RecursiveTextureMethod::new(Queue::SceneMirrors, p)),
+};
+
+/// The paper's §3.1–3.2: n auxiliary mirrors coincide with the two real ones (n + 2 in the
+/// queue), the k-th reflection attenuated by α^k.
+pub static AUXILIARY: MethodEntry = MethodEntry {
+    name: "auxiliary",
+    help: "The paper's §3.1–3.2: n auxiliary mirrors (n + 2 in the queue), attenuation α^k.",
+    exact: false,
+    options: &[&AUXILIARY_MIRRORS, &TEXTURE_SCALE, &MAX_PASSES],
+    swept: Some(&AUXILIARY_MIRRORS),
+    optional_features: wgpu::Features::empty(),
+    required_features: wgpu::Features::empty(),
+    shaders: &[&SHADER],
+    gpu_structs,
+    configure: |p| {
+        Box::new(RecursiveTextureMethod::new(
+            Queue::Auxiliary {
+                n: p.count(&AUXILIARY_MIRRORS),
+            },
+            p,
+        ))
+    },
+};
+
+static SHADER: WgslSource = WgslSource {
+    label: "recursive texture",
+    enable: &[],
+    parts: &[
+        crate::wgsl::SHADING,
+        include_str!("../../../../shaders/recursive_texture.wgsl"),
+    ],
+};
+
+fn gpu_structs() -> Vec<HostLayout> {
+    vec![
+        crate::host_layout!(PassUniform as "Pass" {
+            clip_from_world, eye, _pad0, origin, pixels_per_texel
+        }),
+        crate::host_layout!(MirrorUniform as "MirrorDraw" {
+            origin, size, texels_per_pixel, exact, has_texture
+        }),
+    ]
+}
+
+/// `--n`: auxiliary mirrors. Bounded by 16: at n = 7 the plan already needs 11 146 passes.
+pub static AUXILIARY_MIRRORS: OptionSpec = OptionSpec {
+    name: "n",
+    help: "Auxiliary mirrors (the paper's n).",
+    kind: OptionKind::Count { min: 0, max: 16 },
+    default: ParamValue::Count(0),
+    sweep: Some(SweepAxis {
+        default: "0..4",
+        range_example: "0..4",
+        list_example: "0,2,4",
+        noun: "counts",
+    }),
+};
+
+/// `--texture-scale`: mirror texture resolution relative to the mirror's footprint.
+pub static TEXTURE_SCALE: OptionSpec = OptionSpec {
+    name: "texture-scale",
+    help: "Mirror texture resolution relative to the mirror's footprint on screen (1 = exact).",
+    kind: OptionKind::Real {
+        min: 0.0,
+        min_open: true,
+        max: Some(4.0),
+    },
+    default: ParamValue::Real(1.0),
+    sweep: None,
+};
+
+/// `--max-passes`: refuse, before any work, a plan needing more scene passes per frame.
+pub static MAX_PASSES: OptionSpec = OptionSpec {
+    name: "max-passes",
+    help: "Refuse, before any work, a configuration needing more scene passes per frame.",
+    kind: OptionKind::Count {
+        min: 1,
+        max: 1_000_000,
+    },
+    default: ParamValue::Count(5000),
+    sweep: None,
+};
+
+/// The typed settings of `naive` and `auxiliary`.
+struct RecursiveTextureMethod {
+    queue: Queue,
+    texture_scale: f32,
+    max_passes: usize,
+}
+
+impl RecursiveTextureMethod {
+    fn new(queue: Queue, p: &Params) -> Self {
+        RecursiveTextureMethod {
+            queue,
+            texture_scale: p.real(&TEXTURE_SCALE),
+            max_passes: p.count(&MAX_PASSES) as usize,
+        }
+    }
+}
+
+impl RasterMethod for RecursiveTextureMethod {
+    fn plan(
+        &self,
+        scene: &Scene,
+        width: u32,
+        height: u32,
+    ) -> Result<Box<dyn PlannedFrame>, PlanError> {
+        let plan = crate::plan::plan(scene, self.queue, width, height, self.max_passes)?;
+        Ok(Box::new(PlannedTextures {
+            plan,
+            texture_scale: self.texture_scale,
+        }))
+    }
+}
+
+struct PlannedTextures {
+    plan: Plan,
+    texture_scale: f32,
+}
+
+impl PlannedFrame for PlannedTextures {
+    fn build(self: Box<Self>, gpu: &Gpu, scene: &Scene) -> Result<BuiltFrame, RasterError> {
+        let m = RecursiveTexture::new(gpu, scene, &self.plan, self.texture_scale);
+        Ok(BuiltFrame {
+            stats: m.stats,
+            encoder: Box::new(m),
+            warnings: Vec::new(),
+        })
+    }
+}
 
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
@@ -76,8 +228,7 @@ struct Builder<'a> {
     scene: &'a Scene,
     plan: &'a Plan,
     texture_scale: f32,
-    alignment: usize,
-    uniforms: Vec<u8>,
+    uniforms: UniformArena,
     /// Free slots by exact texture size.
     free: HashMap<(u32, u32), Vec<usize>>,
     slot_sizes: Vec<(u32, u32)>,
@@ -87,13 +238,6 @@ struct Builder<'a> {
 }
 
 impl Builder<'_> {
-    fn push_uniform<T: Pod>(&mut self, value: &T) -> u32 {
-        let offset = self.uniforms.len().next_multiple_of(self.alignment);
-        self.uniforms.resize(offset, 0);
-        self.uniforms.extend_from_slice(bytemuck::bytes_of(value));
-        offset as u32
-    }
-
     fn texture_size(&self, r: Rect) -> (u32, u32) {
         let s = |v: u32| ((v as f32 * self.texture_scale).round() as u32).max(1);
         (s(r.w), s(r.h))
@@ -114,7 +258,7 @@ impl Builder<'_> {
         let size = self.texture_size(node.footprint);
         let slot = self.alloc(size);
         let clip = mirror_camera_clip(self.plan, &node.view, &node.plane, node.footprint);
-        let offset = self.push_uniform(&PassUniform {
+        let offset = self.uniforms.push(&PassUniform {
             clip_from_world: clip.to_cols_array_2d(),
             eye: node.view.eye().to_array(),
             _pad0: 0.0,
@@ -166,7 +310,7 @@ impl Builder<'_> {
                     let f = child.footprint;
                     let texels_per_pixel = [tw as f32 / f.w as f32, th as f32 / f.h as f32];
                     let exact = texels_per_pixel == [1.0, 1.0];
-                    let offset = self.push_uniform(&MirrorUniform {
+                    let offset = self.uniforms.push(&MirrorUniform {
                         origin: [f.x as f32, f.y as f32],
                         size: [f.w as f32, f.h as f32],
                         texels_per_pixel,
@@ -175,7 +319,7 @@ impl Builder<'_> {
                     });
                     (offset, Some(*slot))
                 }
-                None => (self.push_uniform(&MirrorUniform::zeroed()), None),
+                None => (self.uniforms.push(&MirrorUniform::zeroed()), None),
             };
             self.mirror_bindings.push(binding);
             draws.push(MirrorDraw {
@@ -210,31 +354,15 @@ fn crop(r: Rect, w: u32, h: u32) -> Mat4 {
     )
 }
 
-fn dynamic_uniform(binding: u32) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Uniform,
-            has_dynamic_offset: true,
-            min_binding_size: None,
-        },
-        count: None,
-    }
-}
-
 impl RecursiveTexture {
     pub fn new(gpu: &Gpu, scene: &Scene, plan: &Plan, texture_scale: f32) -> Self {
-        use wgpu::util::DeviceExt;
         let device = &gpu.device;
         let scene_buffers = SceneBuffers::new(device, scene);
-        let alignment = device.limits().min_uniform_buffer_offset_alignment as usize;
         let mut b = Builder {
             scene,
             plan,
             texture_scale,
-            alignment,
-            uniforms: Vec::new(),
+            uniforms: UniformArena::new(device),
             free: HashMap::new(),
             slot_sizes: Vec::new(),
             passes: Vec::new(),
@@ -242,7 +370,7 @@ impl RecursiveTexture {
         };
         let roots: Vec<(&TextureNode, usize)> = plan.roots.iter().map(|n| (n, b.emit(n))).collect();
         let camera = scene.camera.with_size(plan.width, plan.height);
-        let main_offset = b.push_uniform(&PassUniform {
+        let main_offset = b.uniforms.push(&PassUniform {
             clip_from_world: (plan.projection * camera.view()).to_cols_array_2d(),
             eye: camera.position.to_array(),
             _pad0: 0.0,
@@ -256,32 +384,23 @@ impl RecursiveTexture {
             draws: main_draws,
         });
 
-        let uniforms = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("recursive texture uniforms"),
-            contents: &b.uniforms,
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
+        let arena = std::mem::replace(&mut b.uniforms, UniformArena::new(device));
+        let uniforms = arena.into_buffer(device, "recursive texture uniforms");
+        let stages = wgpu::ShaderStages::VERTEX_FRAGMENT;
         let pass_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("pass"),
-            entries: &[dynamic_uniform(0)],
+            entries: &[dynamic_uniform_entry(0, stages)],
         });
         let mirror_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("mirror"),
-            entries: &[dynamic_uniform(0), texture_entry(1)],
+            entries: &[dynamic_uniform_entry(0, stages), texture_entry(1)],
         });
-        let binding = |size: usize| {
-            wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                buffer: &uniforms,
-                offset: 0,
-                size: std::num::NonZeroU64::new(size as u64),
-            })
-        };
         let pass_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("pass"),
             layout: &pass_layout,
             entries: &[wgpu::BindGroupEntry {
                 binding: 0,
-                resource: binding(std::mem::size_of::<PassUniform>()),
+                resource: record_binding::<PassUniform>(&uniforms),
             }],
         });
         let slots: Vec<RenderTarget> = b
@@ -315,7 +434,7 @@ impl RecursiveTexture {
                     entries: &[
                         wgpu::BindGroupEntry {
                             binding: 0,
-                            resource: binding(std::mem::size_of::<MirrorUniform>()),
+                            resource: record_binding::<MirrorUniform>(&uniforms),
                         },
                         wgpu::BindGroupEntry {
                             binding: 1,
@@ -326,55 +445,39 @@ impl RecursiveTexture {
             })
             .collect();
 
-        let shader = module(
-            device,
-            "recursive texture",
-            include_str!("../../../shaders/recursive_texture.wgsl"),
-        );
-        let pipeline = |label: &str, layouts: &[Option<&wgpu::BindGroupLayout>], fragment: &str| {
-            let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some(label),
-                bind_group_layouts: layouts,
-                immediate_size: 0,
-            });
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(label),
-                layout: Some(&layout),
-                vertex: wgpu::VertexState {
-                    module: &shader,
-                    entry_point: Some("vs_main"),
-                    compilation_options: Default::default(),
-                    buffers: &[Some(VERTEX_LAYOUT)],
-                },
-                // Reflections flip the winding and shading is two-sided: no culling.
-                primitive: wgpu::PrimitiveState {
-                    cull_mode: None,
-                    ..Default::default()
-                },
-                depth_stencil: Some(wgpu::DepthStencilState {
-                    format: DEPTH_FORMAT,
-                    depth_write_enabled: Some(true),
-                    // LessEqual: of coincident mirror instances the last drawn wins, deterministically.
-                    depth_compare: Some(wgpu::CompareFunction::LessEqual),
-                    stencil: Default::default(),
-                    bias: Default::default(),
-                }),
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &shader,
-                    entry_point: Some(fragment),
-                    compilation_options: Default::default(),
-                    targets: &[Some(COLOR_FORMAT.into())],
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
-        };
+        let shader = shader_module(device, &SHADER);
         let sl = &scene_buffers.layout;
-        let objects_pipeline = pipeline("objects", &[Some(sl), Some(&pass_layout)], "fs_object");
+        let pipeline = |label: &str, layout: &wgpu::PipelineLayout, fragment: &str| {
+            ScenePipeline {
+                label,
+                layout,
+                module: &shader,
+                vertex: "vs_main",
+                fragment,
+                buffers: &[Some(VERTEX_LAYOUT)],
+                // LessEqual: of coincident mirror instances the last drawn wins, deterministically.
+                depth_stencil: depth_state(
+                    DEPTH_FORMAT,
+                    true,
+                    wgpu::CompareFunction::LessEqual,
+                    Default::default(),
+                ),
+                color_writes: wgpu::ColorWrites::ALL,
+            }
+            .build(device)
+        };
+        let objects_pipeline = pipeline(
+            "recursive texture objects",
+            &pipeline_layout(device, "recursive texture objects", &[sl, &pass_layout]),
+            "fs_object",
+        );
         let mirror_pipeline = pipeline(
-            "mirrors",
-            &[Some(sl), Some(&pass_layout), Some(&mirror_layout)],
+            "recursive texture mirrors",
+            &pipeline_layout(
+                device,
+                "recursive texture mirrors",
+                &[sl, &pass_layout, &mirror_layout],
+            ),
             "fs_mirror",
         );
         let draws: usize = b.passes.iter().map(|p| 1 + p.draws.len()).sum::<usize>() + 1;
@@ -415,11 +518,11 @@ impl FrameEncoder for RecursiveTexture {
     ) {
         let mut first_pass = first_pass;
         for spec in &self.passes {
-            let target = match spec.target {
-                Target::Slot(s) => &self.slots[s],
-                Target::Main => main,
+            let (target, label) = match spec.target {
+                Target::Slot(s) => (&self.slots[s], "mirror texture pass"),
+                Target::Main => (main, "main view pass"),
             };
-            let mut pass = target.begin_pass(encoder, self.background, first_pass.take());
+            let mut pass = target.begin_pass(encoder, label, self.background, first_pass.take());
             pass.set_vertex_buffer(0, self.scene_buffers.vertices.slice(..));
             pass.set_bind_group(0, &self.scene_buffers.bind_group, &[]);
             pass.set_bind_group(1, &self.pass_bind_group, &[spec.offset]);

@@ -28,18 +28,138 @@
 //! [`Unrolled::overlapping_siblings`] and reported by `render`.
 
 use crate::culling::{box_corners, box_may_touch};
-use crate::frame::{COLOR_FORMAT, Clipping, FrameEncoder, FrameStats, PathCounts, RenderTarget};
+use crate::exact_paths::{DEPTH, MIN_ATTENUATION, MIN_PORTAL_AREA, PlannedPaths, plan_paths};
 use crate::gpu::{Gpu, RasterError};
-use crate::shading::{SHADING_WGSL, SceneBuffers, VERTEX_LAYOUT};
+use crate::method::{
+    BuiltFrame, Clipping, FrameStats, MethodEntry, OptionKind, OptionSpec, ParamValue, PathCounts,
+    PlannedFrame, RasterMethod,
+};
+use crate::pipeline::{ScenePipeline, depth_state, pipeline_layout};
+use crate::plan::PlanError;
+use crate::shading::{SceneBuffers, VERTEX_LAYOUT};
+use crate::targets::{DEPTH_FORMAT, DepthClear, RenderTarget};
+use crate::timing::FrameEncoder;
+use crate::wgsl::{HostLayout, WgslSource, shader_module};
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use mirrorbox_scene::Scene;
 use mirrorbox_scene::camera::pixel_to_ndc;
 use mirrorbox_scene::polygon::{area, bounds, orientation};
-use mirrorbox_scene::reflection_paths::{PathSet, clip_convex};
+use mirrorbox_scene::reflection_paths::{PathLimits, clip_convex};
 use std::ops::Range;
 
-const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+/// Exact: every reflection path an instance of the scene, clipped to its cell.
+pub static UNROLLED: MethodEntry = MethodEntry {
+    name: "unrolled",
+    help: "Exact: every reflection path an instance of the scene, clipped to its cell; a handful of draws.",
+    exact: true,
+    options: &[
+        &DEPTH,
+        &MIN_PORTAL_AREA,
+        &MIN_ATTENUATION,
+        &FRAGMENT_CLIPPING,
+    ],
+    swept: Some(&DEPTH),
+    optional_features: wgpu::Features::CLIP_DISTANCES,
+    required_features: wgpu::Features::empty(),
+    shaders: &[&GUARDED_SHADER, &CLIP_DISTANCE_SHADER],
+    gpu_structs,
+    configure: |p| {
+        Box::new(UnrolledMethod {
+            limits: crate::exact_paths::limits(p),
+            fragment_clipping: p.switch(&FRAGMENT_CLIPPING),
+        })
+    },
+};
+
+/// `--fragment-clipping`: measure what hardware clip distances save.
+pub static FRAGMENT_CLIPPING: OptionSpec = OptionSpec {
+    name: "fragment-clipping",
+    help: "Clip every instance per fragment (discard) even where the adapter has hardware clip \
+           distances — to measure what they save.",
+    kind: OptionKind::Switch,
+    default: ParamValue::Switch(false),
+    sweep: None,
+};
+
+const ENTRY_POINTS: &str = include_str!("../../../../shaders/unrolled.wgsl");
+
+/// The guarded (per-fragment) stage, the background fans and the shading: every adapter.
+static GUARDED_SHADER: WgslSource = WgslSource {
+    label: "unrolled",
+    enable: &[],
+    parts: &[crate::wgsl::SHADING, ENTRY_POINTS],
+};
+
+/// Adds the hardware clip-distance stage, for adapters with `CLIP_DISTANCES`.
+static CLIP_DISTANCE_SHADER: WgslSource = WgslSource {
+    label: "unrolled clip distances",
+    enable: &["clip_distances"],
+    parts: &[
+        crate::wgsl::SHADING,
+        ENTRY_POINTS,
+        include_str!("../../../../shaders/unrolled_clip_distances.wgsl"),
+    ],
+};
+
+fn gpu_structs() -> Vec<HostLayout> {
+    vec![
+        crate::host_layout!(PathData as "PathData" {
+            clip_from_world, plane, eye, edge_first, attenuation, edge_count
+        }),
+        crate::host_layout!(MirrorRect as "MirrorRect" {
+            plane, center, half_width, right, half_height, up, _pad
+        }),
+    ]
+}
+
+/// The typed settings of `unrolled`.
+struct UnrolledMethod {
+    limits: PathLimits,
+    fragment_clipping: bool,
+}
+
+impl RasterMethod for UnrolledMethod {
+    fn plan(
+        &self,
+        scene: &Scene,
+        width: u32,
+        height: u32,
+    ) -> Result<Box<dyn PlannedFrame>, PlanError> {
+        Ok(Box::new(PlannedUnrolled {
+            planned: plan_paths(scene, width, height, &self.limits)?,
+            fragment_clipping: self.fragment_clipping,
+        }))
+    }
+}
+
+struct PlannedUnrolled {
+    planned: PlannedPaths,
+    fragment_clipping: bool,
+}
+
+impl PlannedFrame for PlannedUnrolled {
+    fn build(self: Box<Self>, gpu: &Gpu, scene: &Scene) -> Result<BuiltFrame, RasterError> {
+        let m = Unrolled::new(gpu, scene, &self.planned, self.fragment_clipping)?;
+        let mut warnings = Vec::new();
+        if m.overlapping_siblings > 0 {
+            warnings.push(format!(
+                "{} pairs of sibling portals overlap (a mirror hides part of another): \
+                 unrolled may be wrong there; --method portal is exact",
+                m.overlapping_siblings
+            ));
+        }
+        Ok(BuiltFrame {
+            stats: m.stats,
+            encoder: Box::new(m),
+            warnings,
+        })
+    }
+}
+
+/// Most triangles (instances counted) `unrolled` submits per frame — a time bound (about
+/// 10 s on lavapipe, 2 cores); refused beyond with a hint.
+pub const MAX_TRIANGLES_PER_FRAME: usize = 50_000_000;
 
 /// Portal edges the clip-distance stage handles (distance 0 is the mirror plane).
 pub const CLIP_EDGES: usize = 7;
@@ -152,20 +272,20 @@ pub struct Unrolled {
 }
 
 impl Unrolled {
-    /// `projection` is the camera's `[0, 1]` projection at `width × height` (the one the
-    /// paths were enumerated with); `fragment_clipping` forces the guarded stage everywhere.
-    pub fn new(
+    /// `planned` holds the paths and the camera's `[0, 1]` projection they were enumerated
+    /// with; `fragment_clipping` forces the guarded stage everywhere.
+    fn new(
         gpu: &Gpu,
         scene: &Scene,
-        paths: &PathSet,
-        width: u32,
-        height: u32,
-        projection: Mat4,
+        planned: &PlannedPaths,
         fragment_clipping: bool,
     ) -> Result<Self, RasterError> {
         use wgpu::util::DeviceExt;
         let device = &gpu.device;
-        let clip_distances = gpu.clip_distances && !fragment_clipping;
+        let (paths, projection) = (&planned.paths, planned.projection);
+        let (width, height) = (planned.width, planned.height);
+        let clip_distances =
+            gpu.features.contains(wgpu::Features::CLIP_DISTANCES) && !fragment_clipping;
         let scene_buffers = SceneBuffers::new(device, scene);
         let size = Vec2::new(width as f32, height as f32);
         let reversed = infinite_reversed_z(projection, crate::plan::NEAR);
@@ -297,13 +417,11 @@ impl Unrolled {
                 });
             }
         }
-        if triangles > crate::MAX_TRIANGLES_PER_FRAME {
-            return Err(RasterError::Plan(
-                crate::plan::PlanError::TooManyTriangles {
-                    triangles,
-                    limit: crate::MAX_TRIANGLES_PER_FRAME,
-                },
-            ));
+        if triangles > MAX_TRIANGLES_PER_FRAME {
+            return Err(RasterError::Plan(PlanError::TooManyTriangles {
+                triangles,
+                limit: MAX_TRIANGLES_PER_FRAME,
+            }));
         }
 
         let mirror_rects: Vec<MirrorRect> = scene
@@ -374,28 +492,9 @@ impl Unrolled {
                 })
                 .collect::<Vec<_>>(),
         });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("unrolled"),
-            bind_group_layouts: &[Some(&scene_buffers.layout), Some(&layout)],
-            immediate_size: 0,
-        });
-        let entry_points = include_str!("../../../shaders/unrolled.wgsl");
-        let guarded_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("unrolled"),
-            source: wgpu::ShaderSource::Wgsl(format!("{SHADING_WGSL}\n{entry_points}").into()),
-        });
-        let clipped_module = clip_distances.then(|| {
-            device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                label: Some("unrolled clip distances"),
-                source: wgpu::ShaderSource::Wgsl(
-                    format!(
-                        "enable clip_distances;\n{SHADING_WGSL}\n{entry_points}\n{}",
-                        include_str!("../../../shaders/unrolled_clip_distances.wgsl")
-                    )
-                    .into(),
-                ),
-            })
-        });
+        let layout = pipeline_layout(device, "unrolled", &[&scene_buffers.layout, &layout]);
+        let guarded_module = shader_module(device, &GUARDED_SHADER);
+        let clipped_module = clip_distances.then(|| shader_module(device, &CLIP_DISTANCE_SHADER));
         let background_layout = wgpu::VertexBufferLayout {
             array_stride: std::mem::size_of::<BackgroundVertex>() as u64,
             step_mode: wgpu::VertexStepMode::Vertex,
@@ -407,41 +506,27 @@ impl Unrolled {
                         fragment: &str,
                         buffer: wgpu::VertexBufferLayout<'_>,
                         background: bool| {
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(label),
-                layout: Some(&pipeline_layout),
-                vertex: wgpu::VertexState {
-                    module,
-                    entry_point: Some(vertex),
-                    compilation_options: Default::default(),
-                    buffers: &[Some(buffer)],
-                },
-                // Odd reflections flip the winding and shading is two-sided: no culling.
-                primitive: wgpu::PrimitiveState {
-                    cull_mode: None,
-                    ..Default::default()
-                },
-                depth_stencil: Some(wgpu::DepthStencilState {
-                    format: DEPTH_FORMAT,
-                    depth_write_enabled: Some(!background),
-                    depth_compare: Some(if background {
+            ScenePipeline {
+                label,
+                layout: &layout,
+                module,
+                vertex,
+                fragment,
+                buffers: &[Some(buffer)],
+                // Reversed Z: nearer is greater. Backgrounds lie behind everything.
+                depth_stencil: depth_state(
+                    DEPTH_FORMAT,
+                    !background,
+                    if background {
                         wgpu::CompareFunction::Always
                     } else {
                         wgpu::CompareFunction::Greater
-                    }),
-                    stencil: Default::default(),
-                    bias: Default::default(),
-                }),
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module,
-                    entry_point: Some(fragment),
-                    compilation_options: Default::default(),
-                    targets: &[Some(COLOR_FORMAT.into())],
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
+                    },
+                    Default::default(),
+                ),
+                color_writes: wgpu::ColorWrites::ALL,
+            }
+            .build(device)
         };
         let m = &guarded_module;
         let guarded_object = pipeline(
@@ -488,7 +573,7 @@ impl Unrolled {
                 false,
             )
         });
-        let depth = crate::frame::texture_2d(
+        let depth = crate::targets::texture_2d(
             device,
             "unrolled depth",
             width,
@@ -546,8 +631,17 @@ impl FrameEncoder for Unrolled {
         first_pass: Option<wgpu::RenderPassTimestampWrites<'_>>,
     ) {
         // Reversed Z: depth 0 is infinitely far.
-        let mut pass =
-            target.begin_pass_with(encoder, self.clear, &self.depth, 0.0, None, first_pass);
+        let mut pass = target.begin_pass_with(
+            encoder,
+            "unrolled pass",
+            self.clear,
+            DepthClear {
+                view: &self.depth,
+                depth: 0.0,
+                stencil: None,
+            },
+            first_pass,
+        );
         pass.set_bind_group(0, &self.scene_buffers.bind_group, &[]);
         pass.set_bind_group(1, &self.bind_group, &[]);
         if let Some((buffer, count)) = &self.background {

@@ -13,17 +13,85 @@
 //! value decremented back, so a chain of any length uses one stencil value: only branches
 //! that still have siblings to draw hold one — at most 254 (refused beyond, before any work).
 
-use crate::culling::box_may_touch;
-use crate::frame::{COLOR_FORMAT, FrameEncoder, FrameStats, PathCounts, RenderTarget};
+use crate::culling::{box_may_touch, footprint_rect};
+use crate::exact_paths::{DEPTH, MIN_ATTENUATION, MIN_PORTAL_AREA, PlannedPaths, plan_paths};
 use crate::gpu::{Gpu, RasterError};
-use crate::shading::{SceneBuffers, VERTEX_LAYOUT, module};
+use crate::method::{BuiltFrame, FrameStats, MethodEntry, PathCounts, PlannedFrame, RasterMethod};
+use crate::pipeline::{
+    ScenePipeline, UniformArena, depth_state, dynamic_uniform_entry, pipeline_layout,
+    record_binding,
+};
+use crate::plan::PlanError;
+use crate::shading::{SceneBuffers, VERTEX_LAYOUT};
+use crate::targets::{DEPTH_STENCIL_FORMAT, DepthClear, RenderTarget};
+use crate::timing::FrameEncoder;
+use crate::wgsl::{HostLayout, WgslSource, shader_module};
 use bytemuck::{Pod, Zeroable};
-use glam::{Mat4, Vec3};
+use glam::Vec3;
 use mirrorbox_scene::Scene;
 use mirrorbox_scene::reflection::oblique_near_plane;
-use mirrorbox_scene::reflection_paths::PathSet;
+use mirrorbox_scene::reflection_paths::{PathLimits, PathSet};
 
-const STENCIL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth24PlusStencil8;
+/// Exact: stencil recursion over the reflection paths in one pass, cost linear in depth.
+pub static PORTAL: MethodEntry = MethodEntry {
+    name: "portal",
+    help: "Exact: stencil recursion over the reflection paths, one pass, cost linear in depth.",
+    exact: true,
+    options: &[&DEPTH, &MIN_PORTAL_AREA, &MIN_ATTENUATION],
+    swept: Some(&DEPTH),
+    optional_features: wgpu::Features::empty(),
+    required_features: wgpu::Features::empty(),
+    shaders: &[&SHADER],
+    gpu_structs,
+    configure: |p| Box::new(Portal(crate::exact_paths::limits(p))),
+};
+
+static SHADER: WgslSource = WgslSource {
+    label: "portal stencil",
+    enable: &[],
+    parts: &[
+        crate::wgsl::SHADING,
+        include_str!("../../../../shaders/portal_stencil.wgsl"),
+    ],
+};
+
+fn gpu_structs() -> Vec<HostLayout> {
+    vec![crate::host_layout!(PathUniform as "Path" {
+        clip_from_world, eye, _pad0, attenuation, _pad1
+    })]
+}
+
+/// The typed settings of `portal`: its path limits.
+struct Portal(PathLimits);
+
+impl RasterMethod for Portal {
+    fn plan(
+        &self,
+        scene: &Scene,
+        width: u32,
+        height: u32,
+    ) -> Result<Box<dyn PlannedFrame>, PlanError> {
+        let planned = plan_paths(scene, width, height, &self.0)?;
+        let ops = schedule(&planned.paths)?;
+        Ok(Box::new(PlannedPortal { planned, ops }))
+    }
+}
+
+struct PlannedPortal {
+    planned: PlannedPaths,
+    ops: Vec<Op>,
+}
+
+impl PlannedFrame for PlannedPortal {
+    fn build(self: Box<Self>, gpu: &Gpu, scene: &Scene) -> Result<BuiltFrame, RasterError> {
+        let m = PortalStencil::new(gpu, scene, &self.planned, self.ops)?;
+        Ok(BuiltFrame {
+            stats: m.stats,
+            encoder: Box::new(m),
+            warnings: Vec::new(),
+        })
+    }
+}
 
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
@@ -56,15 +124,9 @@ enum Op {
     Decrement { path: usize, value: u32 },
 }
 
-#[derive(Debug, thiserror::Error)]
-#[error(
-    "the reflection tree branches {0} levels deep with siblings pending; the 8-bit stencil allows 254"
-)]
-pub struct TooDeep(u32);
-
 /// Orders the frame's steps (see the module docs).
-fn schedule(paths: &PathSet) -> Result<Vec<Op>, TooDeep> {
-    fn process(paths: &PathSet, p: usize, v: u32, ops: &mut Vec<Op>) -> Result<(), TooDeep> {
+fn schedule(paths: &PathSet) -> Result<Vec<Op>, PlanError> {
+    fn process(paths: &PathSet, p: usize, v: u32, ops: &mut Vec<Op>) -> Result<(), PlanError> {
         let children = &paths.paths[p].children;
         if children.is_empty() {
             ops.push(Op::Retire { path: p, value: v });
@@ -92,7 +154,7 @@ fn schedule(paths: &PathSet) -> Result<Vec<Op>, TooDeep> {
                 v + 1
             };
             if cv > 254 {
-                return Err(TooDeep(cv));
+                return Err(PlanError::StencilTooDeep(cv));
             }
             ops.push(Op::ClearRegion { path: c, value: cv });
             ops.push(Op::World { path: c, value: cv });
@@ -105,11 +167,11 @@ fn schedule(paths: &PathSet) -> Result<Vec<Op>, TooDeep> {
     Ok(ops)
 }
 
-/// A frame may draw at most this many triangles: lavapipe records every draw of the one
+/// A frame may draw at most this many triangles — a memory bound: lavapipe records every draw of the one
 /// pass and holds it until the pass ends, about 1 KB per triangle here (mirror_room, depth 64,
 /// 160×90: 6.5 M triangles, 6.1 GB peak; splitting the frame into several passes did not
 /// lower it), so 8 M keeps a frame under ~8 GB.
-pub const MAX_TRIANGLES_PER_FRAME: usize = 8_000_000;
+pub const MAX_TRIANGLES_IN_ONE_PASS: usize = 8_000_000;
 
 pub struct PortalStencil {
     scene_buffers: SceneBuffers,
@@ -151,21 +213,17 @@ fn stencil(compare: wgpu::CompareFunction, pass_op: wgpu::StencilOperation) -> w
 }
 
 impl PortalStencil {
-    pub fn new(
+    fn new(
         gpu: &Gpu,
         scene: &Scene,
-        paths: &PathSet,
-        width: u32,
-        height: u32,
-        projection: Mat4,
+        planned: &PlannedPaths,
+        ops: Vec<Op>,
     ) -> Result<Self, RasterError> {
-        use wgpu::util::DeviceExt;
         let device = &gpu.device;
-        let ops = schedule(paths).map_err(|e| RasterError::Gpu(e.to_string()))?;
+        let (paths, projection) = (&planned.paths, planned.projection);
         let scene_buffers = SceneBuffers::new(device, scene);
-        let size = glam::Vec2::new(width as f32, height as f32);
-        let alignment = device.limits().min_uniform_buffer_offset_alignment as usize;
-        let mut bytes = Vec::new();
+        let size = glam::Vec2::new(planned.width as f32, planned.height as f32);
+        let mut arena = UniformArena::new(device);
         let mut offsets = Vec::with_capacity(paths.paths.len());
         let mut visible_parts = Vec::with_capacity(paths.paths.len());
         let mut scissors = Vec::with_capacity(paths.paths.len());
@@ -177,16 +235,9 @@ impl PortalStencil {
                 }
             };
             let bbox = mirrorbox_scene::polygon::bounds(&p.portal);
-            let x0 = (bbox.0.x.floor() - 1.0).clamp(0.0, size.x) as u32;
-            let y0 = (bbox.0.y.floor() - 1.0).clamp(0.0, size.y) as u32;
-            let x1 = (bbox.1.x.ceil() + 1.0).clamp(0.0, size.x) as u32;
-            let y1 = (bbox.1.y.ceil() + 1.0).clamp(0.0, size.y) as u32;
-            scissors.push([
-                x0,
-                y0,
-                x1.saturating_sub(x0).max(1),
-                y1.saturating_sub(y0).max(1),
-            ]);
+            scissors.push(
+                footprint_rect(bbox.0, bbox.1, size).map_or([0, 0, 1, 1], |r| [r.x, r.y, r.w, r.h]),
+            );
             visible_parts.push(
                 (0..scene_buffers.parts.len())
                     .filter(|&k| {
@@ -202,51 +253,26 @@ impl PortalStencil {
                 attenuation: p.attenuation.to_array(),
                 _pad1: 0.0,
             };
-            let offset = bytes.len().next_multiple_of(alignment);
-            bytes.resize(offset, 0);
-            bytes.extend_from_slice(bytemuck::bytes_of(&u));
-            offsets.push(offset as u32);
+            offsets.push(arena.push(&u));
         }
-        let uniforms = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("paths"),
-            contents: &bytes,
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
+        let uniforms = arena.into_buffer(device, "portal paths");
         let path_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("path"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: true,
-                    min_binding_size: None,
-                },
-                count: None,
-            }],
+            label: Some("portal path"),
+            entries: &[dynamic_uniform_entry(
+                0,
+                wgpu::ShaderStages::VERTEX_FRAGMENT,
+            )],
         });
         let path_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("path"),
+            label: Some("portal path"),
             layout: &path_layout,
             entries: &[wgpu::BindGroupEntry {
                 binding: 0,
-                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                    buffer: &uniforms,
-                    offset: 0,
-                    size: std::num::NonZeroU64::new(std::mem::size_of::<PathUniform>() as u64),
-                }),
+                resource: record_binding::<PathUniform>(&uniforms),
             }],
         });
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("portal"),
-            bind_group_layouts: &[Some(&scene_buffers.layout), Some(&path_layout)],
-            immediate_size: 0,
-        });
-        let shader = module(
-            device,
-            "portal stencil",
-            include_str!("../../../shaders/portal_stencil.wgsl"),
-        );
+        let layout = pipeline_layout(device, "portal", &[&scene_buffers.layout, &path_layout]);
+        let shader = shader_module(device, &SHADER);
         let pipeline = |label: &str,
                         vertex: &str,
                         fragment: &str,
@@ -259,44 +285,21 @@ impl PortalStencil {
             } else {
                 &[]
             };
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(label),
-                layout: Some(&layout),
-                vertex: wgpu::VertexState {
-                    module: &shader,
-                    entry_point: Some(vertex),
-                    compilation_options: Default::default(),
-                    buffers,
+            ScenePipeline {
+                label,
+                layout: &layout,
+                module: &shader,
+                vertex,
+                fragment,
+                buffers,
+                depth_stencil: depth_state(DEPTH_STENCIL_FORMAT, depth_write, depth_compare, st),
+                color_writes: if color {
+                    wgpu::ColorWrites::ALL
+                } else {
+                    wgpu::ColorWrites::empty()
                 },
-                primitive: wgpu::PrimitiveState {
-                    cull_mode: None,
-                    ..Default::default()
-                },
-                depth_stencil: Some(wgpu::DepthStencilState {
-                    format: STENCIL_FORMAT,
-                    depth_write_enabled: Some(depth_write),
-                    depth_compare: Some(depth_compare),
-                    stencil: st,
-                    bias: Default::default(),
-                }),
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &shader,
-                    entry_point: Some(fragment),
-                    compilation_options: Default::default(),
-                    targets: &[Some(wgpu::ColorTargetState {
-                        format: COLOR_FORMAT,
-                        blend: None,
-                        write_mask: if color {
-                            wgpu::ColorWrites::ALL
-                        } else {
-                            wgpu::ColorWrites::empty()
-                        },
-                    })],
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
+            }
+            .build(device)
         };
         use wgpu::{CompareFunction as C, StencilOperation as S};
         let keep_equal = stencil(C::Equal, S::Keep);
@@ -354,12 +357,12 @@ impl PortalStencil {
             C::Always,
             stencil(C::Equal, S::DecrementClamp),
         );
-        let depth_stencil = crate::frame::texture_2d(
+        let depth_stencil = crate::targets::texture_2d(
             device,
             "portal depth-stencil",
-            width,
-            height,
-            STENCIL_FORMAT,
+            planned.width,
+            planned.height,
+            DEPTH_STENCIL_FORMAT,
             wgpu::TextureUsages::RENDER_ATTACHMENT,
         )
         .create_view(&Default::default());
@@ -381,11 +384,11 @@ impl PortalStencil {
                 }
             })
             .sum();
-        if triangles > MAX_TRIANGLES_PER_FRAME {
+        if triangles > MAX_TRIANGLES_IN_ONE_PASS {
             return Err(RasterError::Plan(
                 crate::plan::PlanError::TooManyTriangles {
                     triangles,
-                    limit: MAX_TRIANGLES_PER_FRAME,
+                    limit: MAX_TRIANGLES_IN_ONE_PASS,
                 },
             ));
         }
@@ -444,10 +447,13 @@ impl FrameEncoder for PortalStencil {
     ) {
         let mut pass = target.begin_pass_with(
             encoder,
+            "portal stencil pass",
             self.background,
-            &self.depth_stencil,
-            1.0,
-            Some(1),
+            DepthClear {
+                view: &self.depth_stencil,
+                depth: 1.0,
+                stencil: Some(1),
+            },
             first_pass,
         );
         pass.set_vertex_buffer(0, self.scene_buffers.vertices.slice(..));

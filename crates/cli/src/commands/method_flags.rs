@@ -1,0 +1,189 @@
+//! The raster methods' options as command-line flags, made from the registry
+//! (`mirrorbox_raster::METHODS`): every option any method declares becomes one flag of
+//! `render` (`--NAME VALUE`, a switch `--NAME`), and of `sweep`, where a method's swept option
+//! (`--n`, `--depth`) takes a range or list instead. A flag given for a method that does not
+//! declare it is an error naming the methods that do.
+
+use crate::Failure;
+use clap::{Arg, ArgAction, ArgMatches, Command};
+use mirrorbox_raster::method::OptionKind;
+use mirrorbox_raster::registry::{all_options, methods_accepting};
+use mirrorbox_raster::{METHODS, Method, MethodEntry, OptionSpec, ParamValue};
+
+/// Whether an option is a sweep axis (some method sweeps it).
+fn is_axis(option: &OptionSpec) -> bool {
+    METHODS
+        .iter()
+        .any(|e| e.swept.is_some_and(|s| s.name == option.name))
+}
+
+fn arg(option: &'static OptionSpec, sweep: bool) -> Arg {
+    let methods = methods_accepting(option);
+    let arg = Arg::new(option.name).long(option.name);
+    if matches!(option.kind, OptionKind::Switch) {
+        return arg
+            .action(ArgAction::SetTrue)
+            .help(format!("{} [{methods}]", option.help));
+    }
+    let (value_name, default) = match (&option.sweep, sweep) {
+        (Some(axis), true) => ("LIST", axis.default.to_string()),
+        _ => ("VALUE", option.default.to_string()),
+    };
+    arg.action(ArgAction::Set)
+        .value_name(value_name)
+        .help(format!(
+            "{} [{methods}; {}; default {default}]",
+            option.help,
+            option.allowed()
+        ))
+}
+
+/// The `--method` values with their one-line help.
+pub fn method_value_parser() -> clap::builder::PossibleValuesParser {
+    clap::builder::PossibleValuesParser::new(
+        METHODS
+            .iter()
+            .map(|e| clap::builder::PossibleValue::new(e.name).help(e.help)),
+    )
+}
+
+/// The options given on the command line, unchecked.
+#[derive(Clone, Debug, Default)]
+pub struct GivenOptions(Vec<(&'static OptionSpec, String)>);
+
+impl GivenOptions {
+    fn from_matches(m: &ArgMatches) -> Self {
+        let mut given = Vec::new();
+        for o in all_options() {
+            if matches!(o.kind, OptionKind::Switch) {
+                if m.get_flag(o.name) {
+                    given.push((o, "true".to_string()));
+                }
+            } else if let Some(v) = m.get_one::<String>(o.name) {
+                given.push((o, v.clone()));
+            }
+        }
+        GivenOptions(given)
+    }
+
+    /// `entry` configured with the given options (exit 2 on one it does not accept or out
+    /// of bounds).
+    pub fn configure(&self, entry: &'static MethodEntry) -> Result<Method, Failure> {
+        let mut m = Method::defaults(entry);
+        for (o, text) in &self.0 {
+            m = m.with(o, o.parse(text)?)?;
+        }
+        Ok(m)
+    }
+}
+
+/// `render`'s method flags: every option once.
+#[derive(Clone, Debug, Default)]
+pub struct RenderOptions(pub GivenOptions);
+
+impl clap::FromArgMatches for RenderOptions {
+    fn from_arg_matches(m: &ArgMatches) -> Result<Self, clap::Error> {
+        Ok(RenderOptions(GivenOptions::from_matches(m)))
+    }
+    fn update_from_arg_matches(&mut self, m: &ArgMatches) -> Result<(), clap::Error> {
+        *self = Self::from_arg_matches(m)?;
+        Ok(())
+    }
+}
+
+impl clap::Args for RenderOptions {
+    fn augment_args(cmd: Command) -> Command {
+        all_options()
+            .into_iter()
+            .fold(cmd, |c, o| c.arg(arg(o, false)))
+    }
+    fn augment_args_for_update(cmd: Command) -> Command {
+        Self::augment_args(cmd)
+    }
+}
+
+/// `sweep`'s method flags: swept options as axes (a range or list, with the axis default),
+/// the others as one value each for every method that has them.
+#[derive(Clone, Debug, Default)]
+pub struct SweepOptions {
+    /// Axes, each with its text as given (or its default).
+    pub axes: Vec<(&'static OptionSpec, String)>,
+    pub fixed: GivenOptions,
+}
+
+impl SweepOptions {
+    /// A message when a fixed option was given that none of `entries` has.
+    pub fn unused_by(&self, entries: &[&'static MethodEntry]) -> Option<String> {
+        self.fixed.0.iter().find_map(|(o, _)| {
+            (!entries.iter().any(|e| e.accepts(o))).then(|| {
+                format!(
+                    "--{} applies to --method {} only",
+                    o.name,
+                    methods_accepting(o)
+                )
+            })
+        })
+    }
+
+    /// The points of one method: its defaults with the fixed options applied, once per value
+    /// of its swept option's axis.
+    pub fn methods_of(&self, entry: &'static MethodEntry) -> Result<Vec<Method>, Failure> {
+        let mut base = Method::defaults(entry);
+        for (o, text) in &self.fixed.0 {
+            // Fixed options apply to the methods that have them.
+            if entry.accepts(o) {
+                base = base.with(o, o.parse(text)?)?;
+            }
+        }
+        let Some(swept) = entry.swept else {
+            return Ok(vec![base]);
+        };
+        let text = self
+            .axes
+            .iter()
+            .find(|(o, _)| o.name == swept.name)
+            .map(|(_, t)| t.as_str())
+            .expect("every swept option is an axis");
+        swept
+            .parse_axis(text)
+            .map_err(Failure::BadInput)?
+            .into_iter()
+            .map(|v: ParamValue| Ok(base.clone().with(swept, v)?))
+            .collect()
+    }
+}
+
+impl clap::FromArgMatches for SweepOptions {
+    fn from_arg_matches(m: &ArgMatches) -> Result<Self, clap::Error> {
+        let mut out = SweepOptions::default();
+        for o in all_options() {
+            if is_axis(o) {
+                let default = o.sweep.as_ref().map_or("", |a| a.default);
+                let text = m
+                    .get_one::<String>(o.name)
+                    .cloned()
+                    .unwrap_or_else(|| default.to_string());
+                out.axes.push((o, text));
+            }
+        }
+        let mut fixed = GivenOptions::from_matches(m);
+        fixed.0.retain(|(o, _)| !is_axis(o));
+        out.fixed = fixed;
+        Ok(out)
+    }
+    fn update_from_arg_matches(&mut self, m: &ArgMatches) -> Result<(), clap::Error> {
+        *self = Self::from_arg_matches(m)?;
+        Ok(())
+    }
+}
+
+impl clap::Args for SweepOptions {
+    fn augment_args(cmd: Command) -> Command {
+        all_options()
+            .into_iter()
+            .fold(cmd, |c, o| c.arg(arg(o, is_axis(o))))
+    }
+    fn augment_args_for_update(cmd: Command) -> Command {
+        Self::augment_args(cmd)
+    }
+}

@@ -1,0 +1,53 @@
+//! Sweeps resume by key: the keys this code gives the preset sweeps must be exactly those of
+//! the `results.jsonl` files written before the method registry existed (copied into
+//! `tests/data/` from `reports/` at commit 83da7cf), or every earlier sweep would be measured
+//! again from scratch.
+
+use mirrorbox_harness::{SweepConfig, point_keys};
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn keys_in(file: &str) -> BTreeSet<String> {
+    let text = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(file)).unwrap();
+    text.lines()
+        .map(|l| {
+            let v: serde_json::Value = serde_json::from_str(l).unwrap();
+            v["key"].as_str().unwrap().to_string()
+        })
+        .collect()
+}
+
+fn keys_of(mut config: SweepConfig) -> BTreeSet<String> {
+    config.scene = root().join(&config.scene);
+    let keys = point_keys(&config).unwrap();
+    let set: BTreeSet<String> = keys.iter().cloned().collect();
+    assert_eq!(set.len(), keys.len(), "duplicate keys: {keys:?}");
+    set
+}
+
+#[test]
+fn table1_keys_are_those_of_earlier_sweeps() {
+    let now = keys_of(SweepConfig::table1("unused".into()));
+    let before = keys_in("tests/data/table1_results_session2.jsonl");
+    assert_eq!(now, before);
+    assert_eq!(now.len(), 1 + 2 * (5 + 2));
+}
+
+#[test]
+fn depth_scaling_keys_are_those_of_earlier_sweeps() {
+    let now = keys_of(SweepConfig::depth_scaling("unused".into()));
+    let before = keys_in("tests/data/depth_scaling_results_session2.jsonl");
+    assert_eq!(now, before);
+    assert_eq!(now.len(), 1 + 2 * 11);
+}
+
+#[test]
+fn the_paper_method_is_registered() {
+    let m = mirrorbox_raster::registry::find(mirrorbox_report::table1::PAPER_METHOD)
+        .expect("Table 1's method is in the raster registry");
+    assert!(m.swept.is_some_and(|o| o.name == "n"));
+}

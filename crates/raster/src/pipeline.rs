@@ -1,0 +1,150 @@
+//! The pieces of wgpu set-up every method shares: the scene-pipeline builder, a uniform
+//! arena for dynamic offsets, and bind-group layout entries.
+//!
+//! Every scene pipeline draws linear radiance into one [`COLOR_FORMAT`] target, with culling
+//! off (reflections flip the winding and shading is two-sided, `docs/shading.md`) and no
+//! multisampling (supersampling is the SSAA grid); what differs between methods is the shader
+//! entry points, the vertex buffers, the depth/stencil state and which colours are written.
+
+use crate::targets::COLOR_FORMAT;
+use bytemuck::Pod;
+use wgpu::util::DeviceExt;
+
+/// One scene pipeline. Build with [`ScenePipeline::build`]; labels show in captures and in
+/// validation errors.
+pub struct ScenePipeline<'a> {
+    pub label: &'a str,
+    pub layout: &'a wgpu::PipelineLayout,
+    pub module: &'a wgpu::ShaderModule,
+    pub vertex: &'a str,
+    pub fragment: &'a str,
+    pub buffers: &'a [Option<wgpu::VertexBufferLayout<'a>>],
+    pub depth_stencil: wgpu::DepthStencilState,
+    /// Colour channels written (none for stencil-only passes).
+    pub color_writes: wgpu::ColorWrites,
+}
+
+impl ScenePipeline<'_> {
+    pub fn build(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
+        device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some(self.label),
+            layout: Some(self.layout),
+            vertex: wgpu::VertexState {
+                module: self.module,
+                entry_point: Some(self.vertex),
+                compilation_options: Default::default(),
+                buffers: self.buffers,
+            },
+            primitive: wgpu::PrimitiveState {
+                cull_mode: None,
+                ..Default::default()
+            },
+            depth_stencil: Some(self.depth_stencil.clone()),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: self.module,
+                entry_point: Some(self.fragment),
+                compilation_options: Default::default(),
+                targets: &[Some(wgpu::ColorTargetState {
+                    format: COLOR_FORMAT,
+                    blend: None,
+                    write_mask: self.color_writes,
+                })],
+            }),
+            multiview_mask: None,
+            cache: None,
+        })
+    }
+}
+
+/// A depth (or depth-stencil) state without bias.
+pub fn depth_state(
+    format: wgpu::TextureFormat,
+    write: bool,
+    compare: wgpu::CompareFunction,
+    stencil: wgpu::StencilState,
+) -> wgpu::DepthStencilState {
+    wgpu::DepthStencilState {
+        format,
+        depth_write_enabled: Some(write),
+        depth_compare: Some(compare),
+        stencil,
+        bias: Default::default(),
+    }
+}
+
+/// A labelled pipeline layout over `groups` (bind groups 0, 1, …).
+pub fn pipeline_layout(
+    device: &wgpu::Device,
+    label: &str,
+    groups: &[&wgpu::BindGroupLayout],
+) -> wgpu::PipelineLayout {
+    let groups: Vec<Option<&wgpu::BindGroupLayout>> = groups.iter().map(|g| Some(*g)).collect();
+    device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(label),
+        bind_group_layouts: &groups,
+        immediate_size: 0,
+    })
+}
+
+/// A uniform-buffer binding of one record, read at a dynamic offset.
+pub fn dynamic_uniform_entry(
+    binding: u32,
+    visibility: wgpu::ShaderStages,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: true,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+/// Uniform records packed into one buffer at the device's offset alignment, each bound by
+/// its dynamic offset (one buffer and bind group for all passes or paths of a frame).
+pub struct UniformArena {
+    alignment: usize,
+    bytes: Vec<u8>,
+}
+
+impl UniformArena {
+    pub fn new(device: &wgpu::Device) -> Self {
+        UniformArena {
+            alignment: device.limits().min_uniform_buffer_offset_alignment as usize,
+            bytes: Vec::new(),
+        }
+    }
+
+    /// Appends `value`; returns its dynamic offset.
+    pub fn push<T: Pod>(&mut self, value: &T) -> u32 {
+        let offset = self.bytes.len().next_multiple_of(self.alignment);
+        self.bytes.resize(offset, 0);
+        self.bytes.extend_from_slice(bytemuck::bytes_of(value));
+        offset as u32
+    }
+
+    /// The buffer holding every record pushed (at least one aligned block).
+    pub fn into_buffer(mut self, device: &wgpu::Device, label: &str) -> wgpu::Buffer {
+        if self.bytes.is_empty() {
+            self.bytes.resize(self.alignment.max(16), 0);
+        }
+        device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(label),
+            contents: &self.bytes,
+            usage: wgpu::BufferUsages::UNIFORM,
+        })
+    }
+}
+
+/// The binding of one `T` record of an arena's buffer, at a dynamic offset.
+pub fn record_binding<T>(buffer: &wgpu::Buffer) -> wgpu::BindingResource<'_> {
+    wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+        buffer,
+        offset: 0,
+        size: std::num::NonZeroU64::new(std::mem::size_of::<T>() as u64),
+    })
+}

@@ -1,0 +1,315 @@
+//! The registry: the table of methods ([`METHODS`], in [`crate::methods`]) looked up by
+//! name, and configured methods ([`Method`]) with their stable keys.
+
+use crate::method::{MethodEntry, OptionSpec, ParamError, ParamValue, Params, RasterMethod};
+pub use crate::methods::METHODS;
+use std::fmt;
+
+impl crate::gpu::Gpu {
+    /// Opens the adapter of [`crate::adapter::select_adapter`] with timestamp queries, and
+    /// every feature a registered method needs or can use, where the adapter has them.
+    pub fn new() -> Result<crate::gpu::Gpu, crate::gpu::RasterError> {
+        crate::gpu::Gpu::with_features(crate::methods::wanted_features())
+    }
+}
+
+/// The registry entry of `name`.
+pub fn find(name: &str) -> Option<&'static MethodEntry> {
+    METHODS.iter().copied().find(|e| e.name == name)
+}
+
+/// The registered method names, comma separated (for messages).
+pub fn names() -> String {
+    METHODS
+        .iter()
+        .map(|e| e.name)
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// A configured raster method: an entry of [`METHODS`] with a value for each of its options.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Method {
+    params: Params,
+}
+
+impl Method {
+    /// `entry` with every option at its default.
+    pub fn defaults(entry: &'static MethodEntry) -> Method {
+        Method {
+            params: Params::defaults(entry),
+        }
+    }
+
+    /// The registered method `name` with every option at its default.
+    pub fn named(name: &str) -> Result<Method, ParamError> {
+        find(name)
+            .map(Method::defaults)
+            .ok_or_else(|| ParamError::UnknownMethod {
+                name: name.into(),
+                known: names(),
+            })
+    }
+
+    /// Sets `option` (checked against its bounds and against the method's options).
+    pub fn with(mut self, option: &OptionSpec, value: ParamValue) -> Result<Method, ParamError> {
+        let entry = self.params.entry();
+        let Some(i) = entry.options.iter().position(|o| o.name == option.name) else {
+            let methods: Vec<&str> = METHODS
+                .iter()
+                .filter(|e| e.accepts(option))
+                .map(|e| e.name)
+                .collect();
+            return Err(ParamError::NotAccepted {
+                option: option.name.into(),
+                methods: or_list(&methods),
+            });
+        };
+        self.params.set(i, entry.options[i].check(value)?);
+        Ok(self)
+    }
+
+    /// Parses a key (`"auxiliary n=2"`, `"portal depth=64"`, `"unrolled depth=8
+    /// fragment-clipping=true"`): the inverse of [`Method::key`].
+    pub fn parse(key: &str) -> Result<Method, ParamError> {
+        let mut words = key.split_whitespace();
+        let mut m = Method::named(words.next().unwrap_or(""))?;
+        for w in words {
+            let (name, value) = w.split_once('=').unwrap_or((w, "true"));
+            let option = m
+                .params
+                .entry()
+                .options
+                .iter()
+                .copied()
+                .find(|o| o.name == name)
+                .or_else(|| all_options().into_iter().find(|o| o.name == name))
+                .ok_or_else(|| ParamError::NotAccepted {
+                    option: name.into(),
+                    methods: "(no method has it)".into(),
+                })?;
+            let v = option.parse(value)?;
+            m = m.with(option, v)?;
+        }
+        Ok(m)
+    }
+
+    pub fn entry(&self) -> &'static MethodEntry {
+        self.params.entry()
+    }
+
+    pub fn name(&self) -> &'static str {
+        self.params.entry().name
+    }
+
+    pub fn params(&self) -> &Params {
+        &self.params
+    }
+
+    /// The value of the swept option, if the method has one (`n`, `depth`).
+    pub fn swept_value(&self) -> Option<ParamValue> {
+        self.entry()
+            .swept
+            .map(|o| self.params.get(o).expect("the swept option is declared"))
+    }
+
+    /// The value of a count option, if the method has it (records' `n`, `depth`).
+    pub fn count(&self, option: &OptionSpec) -> Option<u32> {
+        match self.params.get(option) {
+            Some(ParamValue::Count(v)) => Some(v),
+            _ => None,
+        }
+    }
+
+    /// The value of the count option named `name` (`"n"`, `"depth"`), if the method has one.
+    pub fn count_of(&self, name: &str) -> Option<u32> {
+        let o = self.entry().options.iter().find(|o| o.name == name)?;
+        self.count(o)
+    }
+
+    /// The stable identity of the method and its parameters, the part of a sweep's resume
+    /// key that names the method: the name, then ` option=value` for the swept option and
+    /// for every other option not at its default, in the entry's option order. This format
+    /// is frozen — `results.jsonl` files resume by it (test `keys_of_earlier_sweeps`).
+    pub fn key(&self) -> String {
+        let entry = self.entry();
+        let mut key = entry.name.to_string();
+        for (o, v) in entry.options.iter().zip(self.params.values()) {
+            let swept = entry.swept.is_some_and(|s| s.name == o.name);
+            if swept || *v != o.default {
+                key.push_str(&format!(" {}={v}", o.name));
+            }
+        }
+        key
+    }
+
+    /// A file-name-safe form of the key: `auxiliary_n2`, `portal_d64` (sweep image names).
+    pub fn slug(&self) -> String {
+        let mut s = self.key().replace(" n=", "_n").replace(" depth=", "_d");
+        s = s.replace([' ', '='], "_");
+        s
+    }
+
+    /// The method's typed settings.
+    pub fn configure(&self) -> Box<dyn RasterMethod> {
+        (self.entry().configure)(&self.params)
+    }
+}
+
+impl fmt::Display for Method {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.key())
+    }
+}
+
+/// Every distinct option of every registered method, in table order.
+pub fn all_options() -> Vec<&'static OptionSpec> {
+    let mut out: Vec<&'static OptionSpec> = Vec::new();
+    for e in METHODS {
+        for &o in e.options {
+            if !out.iter().any(|p| p.name == o.name) {
+                out.push(o);
+            }
+        }
+    }
+    out
+}
+
+/// The methods that accept `option`, as `a`, `a or b`, `a, b or c`.
+pub fn methods_accepting(option: &OptionSpec) -> String {
+    let m: Vec<&str> = METHODS
+        .iter()
+        .filter(|e| e.accepts(option))
+        .map(|e| e.name)
+        .collect();
+    or_list(&m)
+}
+
+fn or_list(items: &[&str]) -> String {
+    match items {
+        [] => String::new(),
+        [one] => one.to_string(),
+        [init @ .., last] => format!("{} or {last}", init.join(", ")),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_are_unique_and_options_consistent() {
+        for (i, e) in METHODS.iter().enumerate() {
+            assert!(
+                METHODS[..i].iter().all(|o| o.name != e.name),
+                "{} registered twice",
+                e.name
+            );
+            if let Some(s) = e.swept {
+                assert!(
+                    e.accepts(s),
+                    "{}: swept option --{} not declared",
+                    e.name,
+                    s.name
+                );
+                assert!(
+                    s.sweep.is_some(),
+                    "--{} is swept but has no sweep axis",
+                    s.name
+                );
+            }
+            for o in e.options {
+                o.check(o.default).unwrap_or_else(|err| {
+                    panic!(
+                        "{}: default of --{} out of its own bounds: {err}",
+                        e.name, o.name
+                    )
+                });
+            }
+        }
+        // Two options with one name must be one option (one meaning, one flag).
+        let all = all_options();
+        for e in METHODS {
+            for o in e.options {
+                let first = all.iter().find(|a| a.name == o.name).unwrap();
+                assert!(std::ptr::eq(*first, *o), "--{} declared twice", o.name);
+            }
+        }
+    }
+
+    #[test]
+    fn every_method_configures_from_its_defaults() {
+        // A method reading an option its entry does not declare panics here.
+        let scene = mirrorbox_scene::load::bundled_scene("mirror_box.json");
+        for e in METHODS {
+            let m = Method::defaults(e);
+            m.configure()
+                .plan(&scene, 32, 18)
+                .unwrap_or_else(|err| panic!("{}: {err}", e.name));
+        }
+    }
+
+    /// Keys written by the sweeps before the registry existed must still name the same
+    /// points, or every earlier `results.jsonl` would be re-measured.
+    #[test]
+    fn keys_of_earlier_sweeps() {
+        for key in [
+            "naive",
+            "auxiliary n=0",
+            "auxiliary n=4",
+            "portal depth=64",
+            "unrolled depth=1024",
+        ] {
+            let m = Method::parse(key).unwrap();
+            assert_eq!(m.key(), key);
+            assert_eq!(m.to_string(), key);
+        }
+        assert_eq!(
+            Method::parse("auxiliary n=2").unwrap().slug(),
+            "auxiliary_n2"
+        );
+        assert_eq!(
+            Method::parse("portal depth=64").unwrap().slug(),
+            "portal_d64"
+        );
+        assert_eq!(Method::parse("naive").unwrap().slug(), "naive");
+        let m = Method::parse("unrolled depth=8 fragment-clipping").unwrap();
+        assert_eq!(m.key(), "unrolled depth=8 fragment-clipping=true");
+    }
+
+    #[test]
+    fn options_are_checked_and_refused_where_they_do_not_apply() {
+        let aux = Method::named("auxiliary").unwrap();
+        let n = aux.entry().swept.unwrap();
+        assert_eq!(
+            Method::named("naive")
+                .unwrap()
+                .with(n, ParamValue::Count(2))
+                .unwrap_err()
+                .to_string(),
+            "--n applies to --method auxiliary only"
+        );
+        let depth = find("portal").unwrap().swept.unwrap();
+        assert_eq!(
+            aux.clone()
+                .with(depth, ParamValue::Count(8))
+                .unwrap_err()
+                .to_string(),
+            "--depth applies to --method portal or unrolled only"
+        );
+        let portal = Method::named("portal").unwrap();
+        assert_eq!(
+            portal
+                .with(depth, ParamValue::Count(0))
+                .unwrap_err()
+                .to_string(),
+            "--depth must be in [1, 4096], got 0"
+        );
+        assert!(Method::named("magic").is_err());
+        assert_eq!(
+            n.parse_axis("3..1").unwrap_err(),
+            "--n \"3..1\": expected a range like 0..4 or a list like 0,2,4 of counts 0..=16"
+        );
+        assert_eq!(n.parse_axis("0..2").unwrap().len(), 3);
+    }
+}

@@ -1,0 +1,143 @@
+//! GPU timing of frames. A frame is every scene pass of the method plus the resolve. With
+//! `TIMESTAMP_QUERY` the time is measured on the GPU from the start of the frame's first pass
+//! to the end of the resolve; otherwise it is the wall clock from submission to completion.
+//! Frames are submitted and waited for one by one, after `warmup` untimed frames.
+
+use crate::gpu::{Gpu, RasterError};
+use crate::readback::{map_read, read_texture};
+use crate::resolve::Resolve;
+use crate::targets::RenderTarget;
+use mirrorbox_image::RgbImage;
+use std::time::Instant;
+
+/// A method that draws one frame's scene passes, ending with the full view in `target`.
+pub trait FrameEncoder {
+    /// `first_pass` carries the timestamp write the method must attach to its first pass.
+    fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &RenderTarget,
+        first_pass: Option<wgpu::RenderPassTimestampWrites<'_>>,
+    );
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TimingSource {
+    GpuTimestamps,
+    WallClock,
+}
+
+impl TimingSource {
+    pub fn name(self) -> &'static str {
+        match self {
+            TimingSource::GpuTimestamps => "gpu-timestamps",
+            TimingSource::WallClock => "wall-clock",
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct FrameTiming {
+    pub source: TimingSource,
+    /// Milliseconds of each timed frame, in order.
+    pub frames_ms: Vec<f64>,
+}
+
+impl FrameTiming {
+    pub fn median_ms(&self) -> f64 {
+        let mut v = self.frames_ms.clone();
+        v.sort_by(f64::total_cmp);
+        let n = v.len();
+        if n == 0 {
+            f64::NAN
+        } else if n % 2 == 1 {
+            v[n / 2]
+        } else {
+            0.5 * (v[n / 2 - 1] + v[n / 2])
+        }
+    }
+    pub fn min_ms(&self) -> f64 {
+        self.frames_ms.iter().copied().fold(f64::INFINITY, f64::min)
+    }
+}
+
+/// Renders `warmup + frames` frames, times the last `frames`, and reads the final image back.
+pub fn run_frames(
+    gpu: &Gpu,
+    method: &dyn FrameEncoder,
+    target: &RenderTarget,
+    resolve: &Resolve,
+    warmup: u32,
+    frames: u32,
+) -> Result<(RgbImage, FrameTiming), RasterError> {
+    let device = &gpu.device;
+    let queries = gpu.timestamps.then(|| {
+        let set = device.create_query_set(&wgpu::QuerySetDescriptor {
+            label: Some("frame"),
+            ty: wgpu::QueryType::Timestamp,
+            count: 2,
+        });
+        let resolved = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("timestamps"),
+            size: 16,
+            usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let read = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("timestamps read"),
+            size: 16,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        (set, resolved, read)
+    });
+    let period_ns = gpu.queue.get_timestamp_period() as f64;
+    let mut frames_ms = Vec::with_capacity(frames as usize);
+    for frame in 0..warmup + frames.max(1) {
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("frame"),
+        });
+        let begin = queries
+            .as_ref()
+            .map(|(set, _, _)| wgpu::RenderPassTimestampWrites {
+                query_set: set,
+                beginning_of_pass_write_index: Some(0),
+                end_of_pass_write_index: None,
+            });
+        method.encode(&mut encoder, target, begin);
+        let end = queries
+            .as_ref()
+            .map(|(set, _, _)| wgpu::RenderPassTimestampWrites {
+                query_set: set,
+                beginning_of_pass_write_index: None,
+                end_of_pass_write_index: Some(1),
+            });
+        resolve.encode(&mut encoder, end);
+        if let Some((set, resolved, read)) = &queries {
+            encoder.resolve_query_set(set, 0..2, resolved, 0);
+            encoder.copy_buffer_to_buffer(resolved, 0, read, 0, 16);
+        }
+        let started = Instant::now();
+        gpu.queue.submit([encoder.finish()]);
+        gpu.wait()?;
+        let wall_ms = started.elapsed().as_secs_f64() * 1e3;
+        gpu.check()?;
+        let ms = match &queries {
+            Some((_, _, read)) => {
+                let ticks: Vec<u64> = map_read(gpu, read)?;
+                ticks[1].wrapping_sub(ticks[0]) as f64 * period_ns / 1e6
+            }
+            None => wall_ms,
+        };
+        if frame >= warmup {
+            frames_ms.push(ms);
+        }
+    }
+    let source = if queries.is_some() {
+        TimingSource::GpuTimestamps
+    } else {
+        TimingSource::WallClock
+    };
+    let image = read_texture(gpu, &resolve.output)?;
+    Ok((image, FrameTiming { source, frames_ms }))
+}

@@ -1,0 +1,168 @@
+//! All WGSL composition. WGSL has no includes: a shader is an optional `enable` line, then
+//! its parts in order — `shaders/shading.wgsl` (the contract, `docs/shading.md`) first for
+//! every scene pipeline, then the method's own file(s).
+//!
+//! Each method lists its shader variants in its registry entry ([`MethodEntry::shaders`]),
+//! and its `#[repr(C)]` GPU structs ([`MethodEntry::gpu_structs`]); the tests below parse and
+//! validate every variant with naga on every machine (whatever the adapter supports) and
+//! check every struct's size and field offsets against its WGSL twin.
+//!
+//! [`MethodEntry::shaders`]: crate::method::MethodEntry::shaders
+//! [`MethodEntry::gpu_structs`]: crate::method::MethodEntry::gpu_structs
+
+/// `shaders/shading.wgsl`: the shading contract and the scene bindings (group 0).
+pub const SHADING: &str = include_str!("../../../shaders/shading.wgsl");
+
+/// One shader variant: what a pipeline's module is made of.
+#[derive(Debug)]
+pub struct WgslSource {
+    /// Module label (captures, validation errors).
+    pub label: &'static str,
+    /// WGSL extensions to `enable` (e.g. `clip_distances`); the device must have the
+    /// matching feature to compile it.
+    pub enable: &'static [&'static str],
+    /// The parts, concatenated in order.
+    pub parts: &'static [&'static str],
+}
+
+impl WgslSource {
+    /// The composed WGSL text.
+    pub fn source(&self) -> String {
+        let mut s = String::new();
+        for e in self.enable {
+            s.push_str(&format!("enable {e};\n"));
+        }
+        for p in self.parts {
+            s.push_str(p);
+            s.push('\n');
+        }
+        s
+    }
+}
+
+/// The SSAA resolve (no scene bindings).
+pub static RESOLVE: WgslSource = WgslSource {
+    label: "resolve",
+    enable: &[],
+    parts: &[include_str!("../../../shaders/resolve.wgsl")],
+};
+
+/// Compiles a variant on `device`.
+pub fn shader_module(device: &wgpu::Device, shader: &WgslSource) -> wgpu::ShaderModule {
+    device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(shader.label),
+        source: wgpu::ShaderSource::Wgsl(shader.source().into()),
+    })
+}
+
+/// A host struct's layout, to compare with the WGSL struct `wgsl_name`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct HostLayout {
+    pub wgsl_name: &'static str,
+    pub size: usize,
+    /// Field names and byte offsets, in declaration order.
+    pub fields: Vec<(&'static str, usize)>,
+}
+
+/// `host_layout!(RustStruct as "WgslStruct" { field, ... })`: the layout of a `#[repr(C)]`
+/// struct from `size_of` and `offset_of!`. List every field the WGSL struct has; padding
+/// fields of the Rust struct that WGSL leaves implicit are omitted.
+#[macro_export]
+macro_rules! host_layout {
+    ($ty:ty as $name:literal { $($field:ident),* $(,)? }) => {
+        $crate::wgsl::HostLayout {
+            wgsl_name: $name,
+            size: std::mem::size_of::<$ty>(),
+            fields: vec![$((stringify!($field), std::mem::offset_of!($ty, $field))),*],
+        }
+    };
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::methods::METHODS;
+
+    fn every_source() -> Vec<(&'static str, &'static WgslSource)> {
+        let mut all = vec![("resolve", &RESOLVE)];
+        for e in METHODS {
+            assert!(!e.shaders.is_empty(), "{} lists no shader", e.name);
+            all.extend(e.shaders.iter().map(|s| (e.name, *s)));
+        }
+        all
+    }
+
+    fn parse(shader: &WgslSource) -> naga::Module {
+        naga::front::wgsl::parse_str(&shader.source())
+            .unwrap_or_else(|e| panic!("{}: {}", shader.label, e.emit_to_string(&shader.source())))
+    }
+
+    /// Every variant parses and validates, including those only some adapters compile
+    /// (clip distances), so a shader error cannot hide behind a missing feature.
+    #[test]
+    fn every_shader_variant_validates() {
+        for (method, shader) in every_source() {
+            let module = parse(shader);
+            naga::valid::Validator::new(
+                naga::valid::ValidationFlags::all(),
+                naga::valid::Capabilities::all(),
+            )
+            .validate(&module)
+            .unwrap_or_else(|e| {
+                panic!(
+                    "{method}: shader {}: {}",
+                    shader.label,
+                    e.emit_to_string(&shader.source())
+                )
+            });
+        }
+    }
+
+    /// The WGSL struct `name`'s size and member offsets, from the first variant defining it.
+    fn wgsl_layout(name: &str) -> Option<(usize, Vec<(String, usize)>)> {
+        for (_, shader) in every_source() {
+            let module = parse(shader);
+            let mut layouter = naga::proc::Layouter::default();
+            layouter.update(module.to_ctx()).unwrap();
+            for (handle, ty) in module.types.iter() {
+                if ty.name.as_deref() != Some(name) {
+                    continue;
+                }
+                if let naga::TypeInner::Struct { members, .. } = &ty.inner {
+                    let fields = members
+                        .iter()
+                        .map(|m| (m.name.clone().unwrap_or_default(), m.offset as usize))
+                        .collect();
+                    return Some((layouter[handle].size as usize, fields));
+                }
+            }
+        }
+        None
+    }
+
+    /// Every `#[repr(C)]` struct sent to the GPU has its WGSL twin's size and offsets.
+    #[test]
+    fn host_structs_match_their_wgsl_structs() {
+        let mut layouts = crate::shading::gpu_structs();
+        for e in METHODS {
+            layouts.extend((e.gpu_structs)());
+        }
+        assert!(layouts.len() >= 8, "{layouts:?}");
+        for host in layouts {
+            let (size, fields) = wgsl_layout(host.wgsl_name)
+                .unwrap_or_else(|| panic!("no WGSL struct {}", host.wgsl_name));
+            assert_eq!(host.size, size, "size of {}", host.wgsl_name);
+            assert_eq!(
+                host.fields.len(),
+                fields.len(),
+                "{}: host fields {:?}, WGSL members {:?}",
+                host.wgsl_name,
+                host.fields,
+                fields
+            );
+            for ((hn, ho), (wn, wo)) in host.fields.iter().zip(&fields) {
+                assert_eq!(ho, wo, "{}.{hn} (WGSL {wn}) offset", host.wgsl_name);
+            }
+        }
+    }
+}

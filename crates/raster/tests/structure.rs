@@ -1,0 +1,95 @@
+//! The raster crate's modules import one another without cycles (the thin wgpu layer below
+//! the methods, the methods below the registry): every `crate::module` reference outside
+//! comments and tests is an edge; the graph must be acyclic.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::Path;
+
+fn module_graph() -> BTreeMap<String, BTreeSet<String>> {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut files = Vec::new();
+    for dir in [src.clone(), src.join("methods")] {
+        for e in std::fs::read_dir(&dir).unwrap() {
+            let p = e.unwrap().path();
+            if p.extension().is_some_and(|x| x == "rs") {
+                files.push(p);
+            }
+        }
+    }
+    let mut graph = BTreeMap::new();
+    for f in files {
+        let rel = f.strip_prefix(&src).unwrap().with_extension("");
+        let name = rel.to_string_lossy().replace("/mod", "").replace('/', "::");
+        if name == "lib" {
+            continue;
+        }
+        let text = std::fs::read_to_string(&f).unwrap();
+        let code = text.split("#[cfg(test)]").next().unwrap();
+        let mut deps = BTreeSet::new();
+        for line in code.lines() {
+            let line = line.split("//").next().unwrap();
+            for (i, _) in line.match_indices("crate::") {
+                let rest = &line[i + 7..];
+                let word: String = rest
+                    .chars()
+                    .take_while(|c| c.is_alphanumeric() || *c == '_')
+                    .collect();
+                let mut dep = word.clone();
+                if word == "methods" {
+                    let sub: String = rest[word.len()..]
+                        .trim_start_matches("::")
+                        .chars()
+                        .take_while(|c| c.is_alphanumeric() || *c == '_')
+                        .collect();
+                    if src.join("methods").join(format!("{sub}.rs")).is_file() {
+                        dep = format!("methods::{sub}");
+                    }
+                }
+                // `crate::host_layout!` is a macro, not a module.
+                if dep != name && dep != "host_layout" {
+                    deps.insert(dep);
+                }
+            }
+            if name == "methods"
+                && let Some(m) = line.trim().strip_prefix("pub mod ")
+            {
+                deps.insert(format!("methods::{}", m.trim_end_matches(';')));
+            }
+        }
+        graph.insert(name, deps);
+    }
+    graph
+}
+
+#[test]
+fn module_imports_have_no_cycle() {
+    let graph = module_graph();
+    assert!(graph.len() >= 15, "{graph:?}");
+    assert!(graph["methods"].contains("methods::unrolled"));
+    // Depth-first search for a back edge.
+    fn visit(
+        n: &str,
+        graph: &BTreeMap<String, BTreeSet<String>>,
+        state: &mut BTreeMap<String, u8>,
+        path: &mut Vec<String>,
+    ) {
+        match state.get(n) {
+            Some(2) => return,
+            Some(1) => panic!("import cycle: {} -> {n}", path.join(" -> ")),
+            _ => {}
+        }
+        state.insert(n.to_string(), 1);
+        path.push(n.to_string());
+        for d in graph.get(n).into_iter().flatten() {
+            if graph.contains_key(d) {
+                visit(d, graph, state, path);
+            }
+        }
+        path.pop();
+        state.insert(n.to_string(), 2);
+    }
+    let mut state = BTreeMap::new();
+    for n in graph.keys() {
+        visit(n, &graph, &mut state, &mut Vec::new());
+    }
+}

@@ -1,0 +1,110 @@
+//! Integrators: the radiance of one camera sample.
+//!
+//! - [`whitted`]: the shading contract followed to deep bounce counts (the ground truth).
+//! - [`path`]: physically based, for comparison with Mitsuba's `path`.
+//!
+//! Every integrator implements [`Integrator`]; [`IntegratorSettings`] has one variant per
+//! integrator and builds it for a scene, once per render. Adding one:
+//! `docs/adding-an-integrator.md`.
+
+pub mod path;
+pub mod whitted;
+
+use crate::bvh::SceneBvh;
+use crate::sampler::SplitMix64;
+use glam::Vec3;
+use mirrorbox_scene::{Geometry, Ray, Scene};
+use path::{PathSettings, PathTracer};
+use whitted::{Whitted, WhittedSettings};
+
+/// The radiance of one camera sample. `Sync`: the image loop shares one integrator across
+/// its threads.
+pub trait Integrator: Sync {
+    /// Radiance along the camera ray `ray`. Random numbers come from `rng`, the pixel's own
+    /// stream (seeded by [`IntegratorSettings::seed`] and the pixel index, shared by the
+    /// pixel's samples in order); a deterministic integrator ignores it.
+    fn radiance(&self, ray: Ray, rng: &mut SplitMix64) -> PathResult;
+}
+
+/// How a path ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Termination {
+    /// Shaded at a diffuse surface.
+    Diffuse,
+    /// Left the scene (background).
+    Escaped,
+    /// Cut at `max_depth`.
+    Depth,
+    /// Cut because its throughput fell below `min_throughput`.
+    Throughput,
+    /// Ended by Russian roulette.
+    Roulette,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PathResult {
+    pub radiance: Vec3,
+    /// Mirror reflections followed.
+    pub bounces: u32,
+    pub termination: Termination,
+    /// Rays cast (closest-hit and shadow queries).
+    pub rays: u32,
+}
+
+/// Which integrator renders, with its settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum IntegratorSettings {
+    Whitted(WhittedSettings),
+    Path(PathSettings),
+}
+
+impl Default for IntegratorSettings {
+    fn default() -> Self {
+        IntegratorSettings::Whitted(WhittedSettings::default())
+    }
+}
+
+impl From<WhittedSettings> for IntegratorSettings {
+    fn from(s: WhittedSettings) -> Self {
+        IntegratorSettings::Whitted(s)
+    }
+}
+
+impl From<PathSettings> for IntegratorSettings {
+    fn from(s: PathSettings) -> Self {
+        IntegratorSettings::Path(s)
+    }
+}
+
+impl IntegratorSettings {
+    /// The integrator for `scene` and its `bvh`.
+    pub fn build<'a>(&self, scene: &'a Scene, bvh: &'a SceneBvh) -> Box<dyn Integrator + 'a> {
+        match *self {
+            IntegratorSettings::Whitted(s) => Box::new(Whitted::new(scene, bvh, s)),
+            IntegratorSettings::Path(s) => Box::new(PathTracer::new(scene, bvh, s)),
+        }
+    }
+
+    /// The name on the command line and in image metadata.
+    pub fn name(&self) -> &'static str {
+        match self {
+            IntegratorSettings::Whitted(_) => "whitted",
+            IntegratorSettings::Path(_) => "path",
+        }
+    }
+
+    /// Seed of the per-pixel random streams; 0 for integrators that draw no random numbers.
+    pub fn seed(&self) -> u64 {
+        match self {
+            IntegratorSettings::Whitted(_) => 0,
+            IntegratorSettings::Path(p) => p.seed,
+        }
+    }
+}
+
+/// Unit face normal of every triangle of `geometry`, by index (front side).
+pub fn face_normals(geometry: &Geometry) -> Vec<Vec3> {
+    (0..geometry.triangles.len())
+        .map(|i| geometry.face_normal(i))
+        .collect()
+}
