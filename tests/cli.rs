@@ -615,7 +615,7 @@ fn render_refuses_too_many_passes_before_any_work() {
 
 #[test]
 fn render_refuses_bad_arguments() {
-    let cases: [(&[&str], &str); 10] = [
+    let cases: [(&[&str], &str); 11] = [
         (
             &["--method", "naive", "--n", "2"],
             "--n applies to --method auxiliary only",
@@ -646,6 +646,10 @@ fn render_refuses_bad_arguments() {
         (
             &["--method", "portal", "--texture-scale", "2"],
             "--texture-scale applies to --method naive or auxiliary only",
+        ),
+        (
+            &["--method", "naive", "--depth", "0"],
+            "--depth applies to --method portal or unrolled only",
         ),
     ];
     for (extra, message) in cases {
@@ -949,7 +953,7 @@ fn sweep_refuses_bad_arguments() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("s");
     let o = out.to_str().unwrap();
-    let cases: [(&[&str], &str); 6] = [
+    let cases: [(&[&str], &str); 8] = [
         (&["--n", "3..1"], "--n \"3..1\": expected a range like 0..4"),
         (
             &["--alpha", "0.7,2"],
@@ -970,6 +974,14 @@ fn sweep_refuses_bad_arguments() {
         (
             &["--methods", "portal", "--depth", "0,4"],
             "--depth \"0,4\": expected a range like 1..8 or a list like 1,4,16,64 of depths 1..=4096",
+        ),
+        (
+            &["--methods", "portal", "--depth", "0..4"],
+            "--depth \"0..4\": expected a range like 1..8",
+        ),
+        (
+            &["--methods", "naive", "--n", "5"],
+            "--n applies to --method auxiliary only",
         ),
     ];
     for (extra, message) in cases {

@@ -79,8 +79,9 @@ impl SweepConfig {
     /// the paper's 0.7, with the exact methods at depth 64 beside it; 9 timed frames.
     pub fn table1(out: PathBuf) -> Self {
         let mut methods = swept(mirrorbox_report::table1::PAPER_METHOD, 0..=4);
-        for m in METHODS.iter().filter(|e| e.exact) {
-            methods.extend(swept(m.name, [64]));
+        // A preset is a fixed experiment: its methods are named, not taken from the table.
+        for m in ["portal", "unrolled"] {
+            methods.extend(swept(m, [64]));
         }
         SweepConfig {
             frames: 9,
@@ -96,10 +97,9 @@ impl SweepConfig {
     /// The exact methods' cost against depth, 1 to 1024, on mirror_box with perfect mirrors
     /// (α = 1: no path ends by attenuation, only when its portal holds no pixel centre).
     pub fn depth_scaling(out: PathBuf) -> Self {
-        let methods = METHODS
-            .iter()
-            .filter(|e| e.exact)
-            .flat_map(|e| swept(e.name, (0..=10).map(|k| 1 << k)))
+        let methods = ["portal", "unrolled"]
+            .into_iter()
+            .flat_map(|m| swept(m, (0..=10).map(|k| 1 << k)))
             .collect();
         SweepConfig::new(
             PathBuf::from("scenes/mirror_box.json"),
@@ -366,9 +366,18 @@ pub fn run_sweep(
     base.camera = base.camera.with_size(w, h);
     let base_hash = base.content_hash();
     let all = points(config, base_hash, w, h);
-    // Refuse over-budget points before any work: plan every point on the CPU (and drop the
-    // plan; it is made again when the point is rendered, so memory stays one point's).
-    for p in &all {
+    let out = &config.out;
+    let results = out.join("results.jsonl");
+    let existing = read_records(&results).map_err(io(&results))?;
+    let done: Vec<&str> = existing.iter().map(|r| r.key.as_str()).collect();
+    let todo: Vec<&Point> = all
+        .iter()
+        .filter(|p| !done.contains(&p.key.as_str()))
+        .collect();
+    // Refuse over-budget points before any work: plan every point still to do on the CPU
+    // (and drop the plan; it is made again when the point is rendered, so memory stays one
+    // point's). Nothing is written before this.
+    for p in &todo {
         let (scene, settings) = point_setup(&base, p, config);
         mirrorbox_raster::plan_frame(&scene, &settings).map_err(|source| {
             HarnessError::Refused {
@@ -377,7 +386,6 @@ pub fn run_sweep(
             }
         })?;
     }
-    let out = &config.out;
     let (images, cache) = (out.join("images"), out.join("cache"));
     for d in [out, &images, &cache] {
         std::fs::create_dir_all(d).map_err(|source| HarnessError::OutputFolder {
@@ -385,11 +393,7 @@ pub fn run_sweep(
             source,
         })?;
     }
-    let results = out.join("results.jsonl");
-    let existing = read_records(&results).map_err(io(&results))?;
     salvage(&results, &existing)?;
-    let done: Vec<String> = existing.into_iter().map(|r| r.key).collect();
-    let todo: Vec<&Point> = all.iter().filter(|p| !done.contains(&p.key)).collect();
     let mut summary = Summary {
         reused: all.len() - todo.len(),
         ..Default::default()

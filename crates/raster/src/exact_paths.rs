@@ -23,6 +23,7 @@ pub static DEPTH: OptionSpec = OptionSpec {
         list_example: "1,4,16,64",
         noun: "depths",
     }),
+    in_key: true,
 };
 
 /// `--min-portal-area`: lossy pruning of small portals.
@@ -38,6 +39,7 @@ pub static MIN_PORTAL_AREA: OptionSpec = OptionSpec {
     },
     default: ParamValue::Real(0.0),
     sweep: None,
+    in_key: true,
 };
 
 /// `--min-attenuation`: the tracer's `--min-throughput`.
@@ -51,6 +53,7 @@ pub static MIN_ATTENUATION: OptionSpec = OptionSpec {
     },
     default: ParamValue::Real(1e-4),
     sweep: None,
+    in_key: true,
 };
 
 /// The path limits of an exact method's parameters.

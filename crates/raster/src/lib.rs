@@ -1,12 +1,7 @@
 //! The wgpu rasterizer of mirrorbox.
 //!
-//! [`methods`] (one file each, one row each in [`METHODS`]; see `CONTRIBUTING.md`):
-//! - [`methods::recursive_texture`]: the seed paper's `naive` and `auxiliary` methods,
-//!   executing a [`plan`] of render-to-texture mirror cameras.
-//! - [`methods::portal_stencil`]: `portal`, exact mirrors by stencil recursion over
-//!   reflection paths.
-//! - [`methods::unrolled`]: `unrolled`, exact mirrors with every reflection path an instance
-//!   of the scene.
+//! [`methods`]: the raster methods, one file each, one row each in [`METHODS`] (see
+//! `CONTRIBUTING.md`); [`plan`] is the CPU plan of the seed paper's recursion.
 //!
 //! What they share:
 //! - [`method`]: the interface — [`MethodEntry`], the [`RasterMethod`] trait, options,
@@ -88,12 +83,22 @@ pub struct RenderOutput {
 
 /// A frame planned on the CPU: a refused configuration (too many passes, paths, …) fails
 /// here, before any GPU resource exists.
-pub struct Planned(Box<dyn method::PlannedFrame>);
+pub struct Planned {
+    frame: Box<dyn method::PlannedFrame>,
+    /// What it was planned for: the method's key and the render size.
+    key: String,
+    size: (u32, u32),
+}
 
 /// Plans `settings.method` for `scene` at render resolution, without a GPU.
 pub fn plan_frame(scene: &Scene, settings: &RenderSettings) -> Result<Planned, PlanError> {
     let (w, h) = settings.render_size(scene);
-    settings.method.configure().plan(scene, w, h).map(Planned)
+    let frame = settings.method.configure().plan(scene, w, h)?;
+    Ok(Planned {
+        frame,
+        key: settings.method.key(),
+        size: (w, h),
+    })
 }
 
 /// Renders a planned frame at the scene camera's size.
@@ -105,6 +110,14 @@ pub fn render_planned(
 ) -> Result<RenderOutput, RasterError> {
     settings.method.entry().check_features(gpu)?;
     let (w, h) = settings.render_size(scene);
+    assert!(
+        planned.key == settings.method.key() && planned.size == (w, h),
+        "a frame planned for {} at {:?} rendered as {} at {:?}",
+        planned.key,
+        planned.size,
+        settings.method.key(),
+        (w, h)
+    );
     let target = targets::RenderTarget::new(
         &gpu.device,
         "view",
@@ -113,7 +126,7 @@ pub fn render_planned(
         wgpu::TextureUsages::TEXTURE_BINDING,
     );
     let resolve = resolve::Resolve::new(&gpu.device, &target, settings.ssaa);
-    let built = planned.0.build(gpu, scene)?;
+    let built = planned.frame.build(gpu, scene)?;
     gpu.check()?;
     let (image, timing) = timing::run_frames(
         gpu,

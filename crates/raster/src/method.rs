@@ -189,6 +189,9 @@ pub struct OptionSpec {
     pub default: ParamValue,
     /// How a sweep varies it, if it is some method's swept option.
     pub sweep: Option<SweepAxis>,
+    /// Whether a non-default value names a different point (resume keys). False for
+    /// options that change neither the image nor its timing, such as a refusal limit.
+    pub in_key: bool,
 }
 
 /// A sweep axis: the values a sweep takes by default and how its error message shows them.
@@ -347,7 +350,9 @@ impl OptionSpec {
                 if a > b || b - a > 100_000 {
                     return Err(err());
                 }
-                (a..=b).map(ParamValue::Count).collect()
+                (a..=b)
+                    .map(|v| self.check(ParamValue::Count(v)).map_err(|_| err()))
+                    .collect::<Result<_, _>>()?
             }
             _ => text
                 .split(',')

@@ -55,18 +55,26 @@ impl Method {
     pub fn with(mut self, option: &OptionSpec, value: ParamValue) -> Result<Method, ParamError> {
         let entry = self.params.entry();
         let Some(i) = entry.options.iter().position(|o| o.name == option.name) else {
-            let methods: Vec<&str> = METHODS
-                .iter()
-                .filter(|e| e.accepts(option))
-                .map(|e| e.name)
-                .collect();
             return Err(ParamError::NotAccepted {
                 option: option.name.into(),
-                methods: or_list(&methods),
+                methods: methods_accepting(option),
             });
         };
         self.params.set(i, entry.options[i].check(value)?);
         Ok(self)
+    }
+
+    /// Sets `option` from its command-line text: refused first if the method does not have
+    /// it, then parsed and checked against its bounds.
+    pub fn with_text(self, option: &OptionSpec, text: &str) -> Result<Method, ParamError> {
+        if !self.entry().accepts(option) {
+            return Err(ParamError::NotAccepted {
+                option: option.name.into(),
+                methods: methods_accepting(option),
+            });
+        }
+        let value = option.parse(text)?;
+        self.with(option, value)
     }
 
     /// Parses a key (`"auxiliary n=2"`, `"portal depth=64"`, `"unrolled depth=8
@@ -129,14 +137,15 @@ impl Method {
 
     /// The stable identity of the method and its parameters, the part of a sweep's resume
     /// key that names the method: the name, then ` option=value` for the swept option and
-    /// for every other option not at its default, in the entry's option order. This format
+    /// for every other option not at its default that changes the point (`in_key`), in the
+    /// entry's option order. This format
     /// is frozen — `results.jsonl` files resume by it (test `keys_of_earlier_sweeps`).
     pub fn key(&self) -> String {
         let entry = self.entry();
         let mut key = entry.name.to_string();
         for (o, v) in entry.options.iter().zip(self.params.values()) {
             let swept = entry.swept.is_some_and(|s| s.name == o.name);
-            if swept || *v != o.default {
+            if swept || (o.in_key && *v != o.default) {
                 key.push_str(&format!(" {}={v}", o.name));
             }
         }
@@ -275,6 +284,9 @@ mod tests {
         assert_eq!(Method::parse("naive").unwrap().slug(), "naive");
         let m = Method::parse("unrolled depth=8 fragment-clipping").unwrap();
         assert_eq!(m.key(), "unrolled depth=8 fragment-clipping=true");
+        // A refusal limit changes no point: old sweeps run with --max-passes resume.
+        let m = Method::parse("auxiliary n=7 max-passes=20000").unwrap();
+        assert_eq!(m.key(), "auxiliary n=7");
     }
 
     #[test]
@@ -311,5 +323,9 @@ mod tests {
             "--n \"3..1\": expected a range like 0..4 or a list like 0,2,4 of counts 0..=16"
         );
         assert_eq!(n.parse_axis("0..2").unwrap().len(), 3);
+        assert_eq!(
+            depth.parse_axis("0..4").unwrap_err(),
+            "--depth \"0..4\": expected a range like 1..8 or a list like 1,4,16,64 of depths 1..=4096"
+        );
     }
 }

@@ -118,9 +118,10 @@ mod tests {
         }
     }
 
-    /// The WGSL struct `name`'s size and member offsets, from the first variant defining it.
-    fn wgsl_layout(name: &str) -> Option<(usize, Vec<(String, usize)>)> {
-        for (_, shader) in every_source() {
+    /// The WGSL struct `name`'s size and member offsets, from the first of `shaders`
+    /// defining it.
+    fn wgsl_layout(name: &str, shaders: &[&WgslSource]) -> Option<(usize, Vec<(String, usize)>)> {
+        for shader in shaders {
             let module = parse(shader);
             let mut layouter = naga::proc::Layouter::default();
             layouter.update(module.to_ctx()).unwrap();
@@ -143,13 +144,23 @@ mod tests {
     /// Every `#[repr(C)]` struct sent to the GPU has its WGSL twin's size and offsets.
     #[test]
     fn host_structs_match_their_wgsl_structs() {
-        let mut layouts = crate::shading::gpu_structs();
+        // The contract's structs, in every scene shader; each method's, in its own shaders
+        // only (two methods may both have a struct `Path`).
+        let every: Vec<&WgslSource> = every_source().into_iter().map(|(_, s)| s).collect();
+        let mut layouts: Vec<(HostLayout, Vec<&WgslSource>)> = crate::shading::gpu_structs()
+            .into_iter()
+            .map(|l| (l, every.clone()))
+            .collect();
         for e in METHODS {
-            layouts.extend((e.gpu_structs)());
+            layouts.extend(
+                (e.gpu_structs)()
+                    .into_iter()
+                    .map(|l| (l, e.shaders.to_vec())),
+            );
         }
-        assert!(layouts.len() >= 8, "{layouts:?}");
-        for host in layouts {
-            let (size, fields) = wgsl_layout(host.wgsl_name)
+        assert!(layouts.len() >= 8, "{} structs", layouts.len());
+        for (host, shaders) in layouts {
+            let (size, fields) = wgsl_layout(host.wgsl_name, &shaders)
                 .unwrap_or_else(|| panic!("no WGSL struct {}", host.wgsl_name));
             assert_eq!(host.size, size, "size of {}", host.wgsl_name);
             assert_eq!(

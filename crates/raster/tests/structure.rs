@@ -93,3 +93,34 @@ fn module_imports_have_no_cycle() {
         visit(n, &graph, &mut state, &mut Vec::new());
     }
 }
+
+/// Every `MethodEntry` declared in a file of `src/methods/` has its row in `METHODS`: a
+/// method whose row was forgotten would compile and silently be missing everywhere.
+#[test]
+fn every_declared_method_has_its_row_in_the_table() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("src/methods");
+    let mut declared = Vec::new();
+    for e in std::fs::read_dir(&dir).unwrap() {
+        let p = e.unwrap().path();
+        let text = std::fs::read_to_string(&p).unwrap();
+        let mut rest = text.as_str();
+        while let Some(i) = rest.find(": MethodEntry = MethodEntry {") {
+            rest = &rest[i..];
+            let name = rest
+                .split("name: \"")
+                .nth(1)
+                .and_then(|s| s.split('"').next())
+                .unwrap_or_else(|| panic!("{}: an entry without a name", p.display()));
+            declared.push(name.to_string());
+            rest = &rest[1..];
+        }
+    }
+    assert!(declared.len() >= 4, "{declared:?}");
+    for name in &declared {
+        assert!(
+            mirrorbox_raster::registry::find(name).is_some(),
+            "method {name} is declared but has no row in METHODS (src/methods/mod.rs)"
+        );
+    }
+    assert_eq!(declared.len(), mirrorbox_raster::METHODS.len());
+}

@@ -71,7 +71,7 @@ impl GivenOptions {
     pub fn configure(&self, entry: &'static MethodEntry) -> Result<Method, Failure> {
         let mut m = Method::defaults(entry);
         for (o, text) in &self.0 {
-            m = m.with(o, o.parse(text)?)?;
+            m = m.with_text(o, text)?;
         }
         Ok(m)
     }
@@ -106,15 +106,14 @@ impl clap::Args for RenderOptions {
 /// the others as one value each for every method that has them.
 #[derive(Clone, Debug, Default)]
 pub struct SweepOptions {
-    /// Axes, each with its text as given (or its default).
-    pub axes: Vec<(&'static OptionSpec, String)>,
-    pub fixed: GivenOptions,
+    /// Every option given on the command line, axes included, as given.
+    pub given: GivenOptions,
 }
 
 impl SweepOptions {
-    /// A message when a fixed option was given that none of `entries` has.
+    /// A message when an option was given that none of `entries` has.
     pub fn unused_by(&self, entries: &[&'static MethodEntry]) -> Option<String> {
-        self.fixed.0.iter().find_map(|(o, _)| {
+        self.given.0.iter().find_map(|(o, _)| {
             (!entries.iter().any(|e| e.accepts(o))).then(|| {
                 format!(
                     "--{} applies to --method {} only",
@@ -125,25 +124,42 @@ impl SweepOptions {
         })
     }
 
-    /// The points of one method: its defaults with the fixed options applied, once per value
-    /// of its swept option's axis.
+    fn given_text(&self, option: &OptionSpec) -> Option<&str> {
+        self.given
+            .0
+            .iter()
+            .find(|(o, _)| o.name == option.name)
+            .map(|(_, t)| t.as_str())
+    }
+
+    /// The points of one method: its defaults with the given options it has applied, once
+    /// per value of its swept option's axis (given, or the axis default). An axis flag that
+    /// the method has but does not sweep must hold one value.
     pub fn methods_of(&self, entry: &'static MethodEntry) -> Result<Vec<Method>, Failure> {
         let mut base = Method::defaults(entry);
-        for (o, text) in &self.fixed.0 {
-            // Fixed options apply to the methods that have them.
-            if entry.accepts(o) {
-                base = base.with(o, o.parse(text)?)?;
+        let swept_name = entry.swept.map(|s| s.name);
+        for (o, text) in &self.given.0 {
+            if !entry.accepts(o) || Some(o.name) == swept_name {
+                continue;
+            }
+            if is_axis(o) {
+                let values = o.parse_axis(text).map_err(Failure::BadInput)?;
+                let [value] = values[..] else {
+                    return Err(Failure::BadInput(format!(
+                        "--{} {text:?}: --method {} does not sweep it; give one value",
+                        o.name, entry.name
+                    )));
+                };
+                base = base.with(o, value)?;
+            } else {
+                base = base.with_text(o, text)?;
             }
         }
         let Some(swept) = entry.swept else {
             return Ok(vec![base]);
         };
-        let text = self
-            .axes
-            .iter()
-            .find(|(o, _)| o.name == swept.name)
-            .map(|(_, t)| t.as_str())
-            .expect("every swept option is an axis");
+        let default = swept.sweep.as_ref().map_or("", |a| a.default);
+        let text = self.given_text(swept).unwrap_or(default);
         swept
             .parse_axis(text)
             .map_err(Failure::BadInput)?
@@ -155,21 +171,9 @@ impl SweepOptions {
 
 impl clap::FromArgMatches for SweepOptions {
     fn from_arg_matches(m: &ArgMatches) -> Result<Self, clap::Error> {
-        let mut out = SweepOptions::default();
-        for o in all_options() {
-            if is_axis(o) {
-                let default = o.sweep.as_ref().map_or("", |a| a.default);
-                let text = m
-                    .get_one::<String>(o.name)
-                    .cloned()
-                    .unwrap_or_else(|| default.to_string());
-                out.axes.push((o, text));
-            }
-        }
-        let mut fixed = GivenOptions::from_matches(m);
-        fixed.0.retain(|(o, _)| !is_axis(o));
-        out.fixed = fixed;
-        Ok(out)
+        Ok(SweepOptions {
+            given: GivenOptions::from_matches(m),
+        })
     }
     fn update_from_arg_matches(&mut self, m: &ArgMatches) -> Result<(), clap::Error> {
         *self = Self::from_arg_matches(m)?;

@@ -104,14 +104,14 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             "scene_hash": format!("{:016x}", scene.content_hash()),
             "method": method.name(),
             "key": method.key(),
-            "params": method.entry().options.iter().map(|o| {
-                let v = method.params().get(o).expect("declared");
-                (o.name.to_string(), match v {
-                    mirrorbox_raster::ParamValue::Count(c) => serde_json::json!(c),
-                    mirrorbox_raster::ParamValue::Real(r) => serde_json::json!(r),
-                    mirrorbox_raster::ParamValue::Switch(s) => serde_json::json!(s),
-                })
-            }).collect::<serde_json::Map<_, _>>(),
+            "params": method.entry().options.iter()
+                .map(|o| (o.name.to_string(), param_json(method.params().get(o))))
+                .collect::<serde_json::Map<_, _>>(),
+            "texture_scale": param_json(
+                mirrorbox_raster::registry::all_options().into_iter()
+                    .find(|o| o.name == "texture-scale")
+                    .and_then(|o| method.params().get(o)),
+            ),
             "n": method.count_of("n"),
             "depth_limit": method.count_of("depth"),
             "alpha": args.alpha,
@@ -172,4 +172,15 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         );
     }
     Ok(())
+}
+
+/// A parameter value as JSON (`null` where the method has no such option).
+fn param_json(value: Option<mirrorbox_raster::ParamValue>) -> serde_json::Value {
+    use mirrorbox_raster::ParamValue;
+    match value {
+        Some(ParamValue::Count(c)) => serde_json::json!(c),
+        Some(ParamValue::Real(r)) => serde_json::json!(r),
+        Some(ParamValue::Switch(s)) => serde_json::json!(s),
+        None => serde_json::Value::Null,
+    }
 }

@@ -99,6 +99,7 @@ pub static AUXILIARY_MIRRORS: OptionSpec = OptionSpec {
         list_example: "0,2,4",
         noun: "counts",
     }),
+    in_key: true,
 };
 
 /// `--texture-scale`: mirror texture resolution relative to the mirror's footprint.
@@ -112,6 +113,7 @@ pub static TEXTURE_SCALE: OptionSpec = OptionSpec {
     },
     default: ParamValue::Real(1.0),
     sweep: None,
+    in_key: true,
 };
 
 /// `--max-passes`: refuse, before any work, a plan needing more scene passes per frame.
@@ -124,6 +126,7 @@ pub static MAX_PASSES: OptionSpec = OptionSpec {
     },
     default: ParamValue::Count(5000),
     sweep: None,
+    in_key: false,
 };
 
 /// The typed settings of `naive` and `auxiliary`.

@@ -80,6 +80,7 @@ pub static FRAGMENT_CLIPPING: OptionSpec = OptionSpec {
     kind: OptionKind::Switch,
     default: ParamValue::Switch(false),
     sweep: None,
+    in_key: true,
 };
 
 const ENTRY_POINTS: &str = include_str!("../../../../shaders/unrolled.wgsl");
