@@ -338,15 +338,21 @@ fn point_setup(base: &Scene, p: &Point, config: &SweepConfig) -> (Scene, RenderS
     (scene, settings)
 }
 
-/// The resume keys of every point of `config` (the floor first), in sweep order, without
-/// rendering anything.
-pub fn point_keys(config: &SweepConfig) -> Result<Vec<String>, HarnessError> {
+/// The sweep's scene at its size (`--width/--height` over the camera's), and that size.
+fn base_scene(config: &SweepConfig) -> Result<(Scene, u32, u32), HarnessError> {
     let mut base = load_scene(&config.scene)?;
     let (w, h) = (
         config.width.unwrap_or(base.camera.width),
         config.height.unwrap_or(base.camera.height),
     );
     base.camera = base.camera.with_size(w, h);
+    Ok((base, w, h))
+}
+
+/// The resume keys of every point of `config` (the floor first), in sweep order, without
+/// rendering anything.
+pub fn point_keys(config: &SweepConfig) -> Result<Vec<String>, HarnessError> {
+    let (base, w, h) = base_scene(config)?;
     Ok(points(config, base.content_hash(), w, h)
         .into_iter()
         .map(|p| p.key)
@@ -358,12 +364,7 @@ pub fn run_sweep(
     config: &SweepConfig,
     progress: &mut dyn FnMut(Event),
 ) -> Result<Summary, HarnessError> {
-    let mut base = load_scene(&config.scene)?;
-    let (w, h) = (
-        config.width.unwrap_or(base.camera.width),
-        config.height.unwrap_or(base.camera.height),
-    );
-    base.camera = base.camera.with_size(w, h);
+    let (base, w, h) = base_scene(config)?;
     let base_hash = base.content_hash();
     let all = points(config, base_hash, w, h);
     let out = &config.out;

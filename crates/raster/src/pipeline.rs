@@ -128,13 +128,17 @@ impl UniformArena {
     }
 
     /// The buffer holding every record pushed (at least one aligned block).
-    pub fn into_buffer(mut self, device: &wgpu::Device, label: &str) -> wgpu::Buffer {
-        if self.bytes.is_empty() {
-            self.bytes.resize(self.alignment.max(16), 0);
-        }
+    pub fn buffer(&self, device: &wgpu::Device, label: &str) -> wgpu::Buffer {
+        // A buffer may not be empty.
+        let empty = vec![0; self.alignment.max(16)];
+        let bytes = if self.bytes.is_empty() {
+            &empty
+        } else {
+            &self.bytes
+        };
         device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some(label),
-            contents: &self.bytes,
+            contents: bytes,
             usage: wgpu::BufferUsages::UNIFORM,
         })
     }

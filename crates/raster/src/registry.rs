@@ -84,20 +84,14 @@ impl Method {
         let mut m = Method::named(words.next().unwrap_or(""))?;
         for w in words {
             let (name, value) = w.split_once('=').unwrap_or((w, "true"));
-            let option = m
-                .params
-                .entry()
-                .options
-                .iter()
-                .copied()
+            let option = all_options()
+                .into_iter()
                 .find(|o| o.name == name)
-                .or_else(|| all_options().into_iter().find(|o| o.name == name))
                 .ok_or_else(|| ParamError::NotAccepted {
                     option: name.into(),
                     methods: "(no method has it)".into(),
                 })?;
-            let v = option.parse(value)?;
-            m = m.with(option, v)?;
+            m = m.with_text(option, value)?;
         }
         Ok(m)
     }
@@ -114,25 +108,13 @@ impl Method {
         &self.params
     }
 
-    /// The value of the swept option, if the method has one (`n`, `depth`).
-    pub fn swept_value(&self) -> Option<ParamValue> {
-        self.entry()
-            .swept
-            .map(|o| self.params.get(o).expect("the swept option is declared"))
-    }
-
-    /// The value of a count option, if the method has it (records' `n`, `depth`).
-    pub fn count(&self, option: &OptionSpec) -> Option<u32> {
-        match self.params.get(option) {
-            Some(ParamValue::Count(v)) => Some(v),
-            _ => None,
-        }
-    }
-
     /// The value of the count option named `name` (`"n"`, `"depth"`), if the method has one.
     pub fn count_of(&self, name: &str) -> Option<u32> {
         let o = self.entry().options.iter().find(|o| o.name == name)?;
-        self.count(o)
+        match self.params.get(o) {
+            Some(ParamValue::Count(v)) => Some(v),
+            _ => None,
+        }
     }
 
     /// The stable identity of the method and its parameters, the part of a sweep's resume
@@ -154,9 +136,10 @@ impl Method {
 
     /// A file-name-safe form of the key: `auxiliary_n2`, `portal_d64` (sweep image names).
     pub fn slug(&self) -> String {
-        let mut s = self.key().replace(" n=", "_n").replace(" depth=", "_d");
-        s = s.replace([' ', '='], "_");
-        s
+        self.key()
+            .replace(" n=", "_n")
+            .replace(" depth=", "_d")
+            .replace([' ', '='], "_")
     }
 
     /// The method's typed settings.

@@ -5,6 +5,7 @@ use super::method_flags::{RenderOptions, method_value_parser};
 use super::{load, output_path, resize, unit_interval};
 use crate::Failure;
 use mirrorbox_image::{write_exr, write_png};
+use mirrorbox_raster::methods::recursive_texture::TEXTURE_SCALE;
 use mirrorbox_raster::{Gpu, RenderSettings, plan_frame, render_planned};
 use std::path::PathBuf;
 
@@ -107,11 +108,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             "params": method.entry().options.iter()
                 .map(|o| (o.name.to_string(), param_json(method.params().get(o))))
                 .collect::<serde_json::Map<_, _>>(),
-            "texture_scale": param_json(
-                mirrorbox_raster::registry::all_options().into_iter()
-                    .find(|o| o.name == "texture-scale")
-                    .and_then(|o| method.params().get(o)),
-            ),
+            "texture_scale": param_json(method.params().get(&TEXTURE_SCALE)),
             "n": method.count_of("n"),
             "depth_limit": method.count_of("depth"),
             "alpha": args.alpha,

@@ -255,7 +255,7 @@ impl PortalStencil {
             };
             offsets.push(arena.push(&u));
         }
-        let uniforms = arena.into_buffer(device, "portal paths");
+        let uniforms = arena.buffer(device, "portal paths");
         let path_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("portal path"),
             entries: &[dynamic_uniform_entry(

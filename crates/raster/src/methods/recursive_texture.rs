@@ -387,8 +387,7 @@ impl RecursiveTexture {
             draws: main_draws,
         });
 
-        let arena = std::mem::replace(&mut b.uniforms, UniformArena::new(device));
-        let uniforms = arena.into_buffer(device, "recursive texture uniforms");
+        let uniforms = b.uniforms.buffer(device, "recursive texture uniforms");
         let stages = wgpu::ShaderStages::VERTEX_FRAGMENT;
         let pass_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("pass"),
