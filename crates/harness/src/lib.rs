@@ -11,12 +11,14 @@
 //!   when there is no mirror effect to truncate.
 
 use glam::Vec3;
+use mirrorbox_files::{FileError, FolderLock, write_atomically};
 use mirrorbox_image::metrics::{MetricsError, compare, flip_map};
 use mirrorbox_image::{
     ImageError, RgbImage, colormap, read_image, write_exr, write_png, write_png_bytes,
 };
 use mirrorbox_raster::{Gpu, METHODS, Method, PlanError, RasterError, RenderSettings};
 use mirrorbox_report::{MetricValues, Record, SweepInfo, read_records, write_report};
+use mirrorbox_scene::limits::{SettingError, unit_interval};
 use mirrorbox_scene::{Scene, SceneError, load_scene};
 use mirrorbox_trace::{SceneBvh, TraceSettings, WhittedSettings};
 use std::fmt::Write as _;
@@ -110,6 +112,43 @@ impl SweepConfig {
     }
 }
 
+/// Most points in one sweep (methods × α, plus the floor): each renders, times and compares
+/// one image, and keeps one record; a longer list is a typo, not an experiment.
+pub const MAX_POINTS: usize = 10_000;
+
+impl SweepConfig {
+    /// The one check of a sweep's settings, before anything is loaded or written: α each in
+    /// `[0, 1]`, the truth's settings as `trace` checks them, and at most [`MAX_POINTS`]
+    /// points. SSAA, frames and warm-up are checked as `render` checks them
+    /// ([`RenderSettings::check`]), and the image size as everywhere ([`Scene::resize`]),
+    /// once the scene is loaded.
+    pub fn validate(&self) -> Result<(), HarnessError> {
+        if self.alphas.is_empty() {
+            return Err(
+                SettingError::new("--alpha", "at least one value in [0, 1]", "none").into(),
+            );
+        }
+        for &a in &self.alphas {
+            unit_interval("--alpha", a)?;
+        }
+        self.truth.check()?;
+        let points = 1 + self.methods.len().saturating_mul(self.alphas.len());
+        if points > MAX_POINTS {
+            return Err(SettingError::new(
+                "--methods × their axes × --alpha",
+                format!("at most {MAX_POINTS} points"),
+                format!(
+                    "{} configured methods × {} α = {points} points",
+                    self.methods.len(),
+                    self.alphas.len()
+                ),
+            )
+            .into());
+        }
+        Ok(())
+    }
+}
+
 /// Why a sweep failed. [`HarnessError::is_refusal`] tells the user's input (exit 2) from
 /// everything else (exit 1).
 #[derive(Debug, thiserror::Error)]
@@ -137,6 +176,12 @@ pub enum HarnessError {
     Metrics(#[from] MetricsError),
     #[error("a result could not be encoded: {0}")]
     Encode(#[from] serde_json::Error),
+    /// A sweep setting out of range, worded as `trace` and `render` word it.
+    #[error(transparent)]
+    Setting(#[from] SettingError),
+    /// An output file could not be written, or the output folder is in use.
+    #[error(transparent)]
+    File(#[from] FileError),
 }
 
 impl HarnessError {
@@ -144,8 +189,10 @@ impl HarnessError {
         match self {
             HarnessError::Scene(_)
             | HarnessError::Refused { .. }
+            | HarnessError::Setting(_)
             | HarnessError::OutputFolder { .. } => true,
             HarnessError::Raster(e) => e.is_refusal(),
+            HarnessError::File(e) => e.refused,
             _ => false,
         }
     }
@@ -212,8 +259,13 @@ fn points(config: &SweepConfig, base_hash: u64, w: u32, h: u32) -> Vec<Point> {
     }];
     for &alpha in &config.alphas {
         for method in &config.methods {
+            let key = point_key(Some(method), alpha, &common);
+            // A value listed twice (`--depth 1,1`, `--alpha 0.7,0.7`) is one point.
+            if out.iter().any(|p| p.key == key) {
+                continue;
+            }
             out.push(Point {
-                key: point_key(Some(method), alpha, &common),
+                key,
                 label: format!("{method} α={alpha}"),
                 slug: format!("{}_a{alpha}", method.slug()),
                 method: Some(method.clone()),
@@ -308,10 +360,7 @@ fn salvage(results: &Path, records: &[Record]) -> Result<(), HarnessError> {
         clean.push_str(&serde_json::to_string(r)?);
         clean.push('\n');
     }
-    let tmp = results.with_extension("jsonl.tmp");
-    std::fs::write(&tmp, clean)
-        .and_then(|()| std::fs::rename(&tmp, results))
-        .map_err(io(results))
+    Ok(write_atomically(results, clean.as_bytes())?)
 }
 
 /// The method every floor point renders the mirror-free scene with: one scene pass.
@@ -340,12 +389,32 @@ fn point_setup(base: &Scene, p: &Point, config: &SweepConfig) -> (Scene, RenderS
 
 /// The sweep's scene at its size (`--width/--height` over the camera's), and that size.
 fn base_scene(config: &SweepConfig) -> Result<(Scene, u32, u32), HarnessError> {
+    config.validate()?;
     let mut base = load_scene(&config.scene)?;
-    let (w, h) = (
-        config.width.unwrap_or(base.camera.width),
-        config.height.unwrap_or(base.camera.height),
-    );
-    base.camera = base.camera.with_size(w, h);
+    base.resize(config.width, config.height)?;
+    let min = mirrorbox_image::metrics::MIN_SIDE;
+    for (flag, side) in [
+        ("--width", base.camera.width),
+        ("--height", base.camera.height),
+    ] {
+        if side < min {
+            return Err(SettingError::new(
+                flag,
+                format!("at least {min} pixels in a sweep (SSIM's window)"),
+                side,
+            )
+            .into());
+        }
+    }
+    let floor = Method::named(FLOOR_METHOD).expect("the floor method is registered");
+    RenderSettings {
+        method: floor,
+        ssaa: config.ssaa,
+        frames: config.frames,
+        warmup: config.warmup,
+    }
+    .check(&base)?;
+    let (w, h) = (base.camera.width, base.camera.height);
     Ok((base, w, h))
 }
 
@@ -359,9 +428,12 @@ pub fn point_keys(config: &SweepConfig) -> Result<Vec<String>, HarnessError> {
         .collect())
 }
 
-/// Runs (or resumes) the sweep and writes its reports.
+/// Runs (or resumes) the sweep and writes its reports; `fresh` discards the points already
+/// in `results.jsonl` first (cached truths stay). The output folder is locked for the whole
+/// run: a second sweep into it is refused at once, naming the process that holds it.
 pub fn run_sweep(
     config: &SweepConfig,
+    fresh: bool,
     progress: &mut dyn FnMut(Event),
 ) -> Result<Summary, HarnessError> {
     let (base, w, h) = base_scene(config)?;
@@ -369,16 +441,20 @@ pub fn run_sweep(
     let all = points(config, base_hash, w, h);
     let out = &config.out;
     let results = out.join("results.jsonl");
-    let existing = read_records(&results).map_err(io(&results))?;
-    let done: Vec<&str> = existing.iter().map(|r| r.key.as_str()).collect();
-    let todo: Vec<&Point> = all
-        .iter()
-        .filter(|p| !done.contains(&p.key.as_str()))
-        .collect();
+    let still_to_do = |done: &[Record]| -> Vec<&Point> {
+        all.iter()
+            .filter(|p| !done.iter().any(|r| r.key == p.key))
+            .collect()
+    };
     // Refuse over-budget points before any work: plan every point still to do on the CPU
     // (and drop the plan; it is made again when the point is rendered, so memory stays one
     // point's). Nothing is written before this.
-    for p in &todo {
+    let done_before = if fresh {
+        Vec::new()
+    } else {
+        read_records(&results).map_err(io(&results))?
+    };
+    for p in still_to_do(&done_before) {
         let (scene, settings) = point_setup(&base, p, config);
         mirrorbox_raster::plan_frame(&scene, &settings).map_err(|source| {
             HarnessError::Refused {
@@ -394,7 +470,14 @@ pub fn run_sweep(
             source,
         })?;
     }
+    let _lock = FolderLock::try_acquire(out)?;
+    if fresh && results.exists() {
+        std::fs::remove_file(&results).map_err(io(&results))?;
+    }
+    // Read again under the lock: the points done now (a subset of what was planned).
+    let existing = read_records(&results).map_err(io(&results))?;
     salvage(&results, &existing)?;
+    let todo = still_to_do(&existing);
     let mut summary = Summary {
         reused: all.len() - todo.len(),
         ..Default::default()
@@ -514,12 +597,12 @@ pub fn run_sweep(
             .map(|e| e.name.to_string())
             .collect(),
     };
-    let sweep_json = out.join("sweep.json");
-    std::fs::write(
-        &sweep_json,
-        serde_json::json!({ "command": info.command, "date": info.date }).to_string(),
-    )
-    .map_err(io(&sweep_json))?;
-    write_report(out, &info, &records).map_err(io(out))?;
+    write_atomically(
+        &out.join("sweep.json"),
+        serde_json::json!({ "command": info.command, "date": info.date })
+            .to_string()
+            .as_bytes(),
+    )?;
+    write_report(out, &info, &records)?;
     Ok(summary)
 }

@@ -69,25 +69,13 @@ fn io_error(path: &Path, message: impl ToString) -> ImageError {
     }
 }
 
-/// Runs `write` on a temporary path beside `path`, then renames it into place. On error the
-/// temporary file is removed and `path` is left untouched.
-pub fn write_atomically(
+/// Runs `write` on a temporary path beside `path`, then renames it into place
+/// ([`mirrorbox_files::write_atomically_with`]): `path` is never left half-written.
+fn write_atomically(
     path: &Path,
     write: impl FnOnce(&Path) -> Result<(), String>,
 ) -> Result<(), ImageError> {
-    let file_name = path
-        .file_name()
-        .ok_or_else(|| io_error(path, "not a file path"))?;
-    let mut tmp_name = std::ffi::OsString::from(".");
-    tmp_name.push(file_name);
-    tmp_name.push(format!(".{}.tmp", std::process::id()));
-    let tmp = path.with_file_name(tmp_name);
-    let result = write(&tmp).and_then(|()| std::fs::rename(&tmp, path).map_err(|e| e.to_string()));
-    if let Err(message) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(io_error(path, message));
-    }
-    Ok(())
+    mirrorbox_files::write_atomically_with(path, write).map_err(|e| io_error(&e.path, e.message))
 }
 
 /// Writes the contract's tone-mapped sRGB image as an 8-bit PNG.
@@ -240,18 +228,5 @@ mod tests {
                 assert!((a[c] - b[c]).abs() < 0.006, "{a:?} vs {b:?}");
             }
         }
-    }
-
-    #[test]
-    fn failed_write_leaves_nothing_behind() {
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("out.exr");
-        let err = write_atomically(&path, |tmp| {
-            std::fs::write(tmp, b"partial").unwrap();
-            Err("simulated failure".into())
-        })
-        .unwrap_err();
-        assert!(err.to_string().contains("simulated failure"));
-        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
     }
 }

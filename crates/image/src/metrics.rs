@@ -36,6 +36,9 @@ pub struct Metrics {
     pub flip_p99: f64,
 }
 
+/// Smallest image side the metrics accept: SSIM's window.
+pub const MIN_SIDE: u32 = 11;
+
 #[derive(Debug, thiserror::Error, PartialEq, Eq)]
 pub enum MetricsError {
     #[error("images differ in size: reference {0}x{1}, test {2}x{3}")]
@@ -58,7 +61,7 @@ pub fn compare(
             test.height,
         ));
     }
-    if reference.width < 11 || reference.height < 11 {
+    if reference.width < MIN_SIDE || reference.height < MIN_SIDE {
         return Err(MetricsError::TooSmall(reference.width, reference.height));
     }
     let (mut se, mut rel, mut smape, mut max_abs) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);

@@ -19,6 +19,7 @@
 //! `tools/mitsuba/render.py` reads (Mitsuba's own `path` cannot use it: see the docs).
 
 use glam::Vec3;
+use mirrorbox_files::{FileError, write_atomically};
 use mirrorbox_scene::{Scene, Surface};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -40,13 +41,17 @@ pub fn export(
     scene: &Scene,
     xml_path: &Path,
     settings: ExportSettings,
-) -> std::io::Result<Vec<PathBuf>> {
+) -> Result<Vec<PathBuf>, FileError> {
     let dir = xml_path
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
     let mesh_dir = dir.join("meshes");
-    std::fs::create_dir_all(&mesh_dir)?;
+    std::fs::create_dir_all(&mesh_dir).map_err(|e| FileError {
+        path: mesh_dir.clone(),
+        message: format!("cannot create the folder: {e}"),
+        refused: false,
+    })?;
     let mut written = Vec::new();
     let cam = &scene.camera;
     let mut xml = String::new();
@@ -191,15 +196,6 @@ fn slug(name: &str) -> String {
 
 fn xml_comment(s: &str) -> String {
     s.replace("--", "- -")
-}
-
-fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    let tmp = path.with_extension(format!("{}.tmp", std::process::id()));
-    std::fs::write(&tmp, bytes)
-        .and_then(|()| std::fs::rename(&tmp, path))
-        .inspect_err(|_| {
-            let _ = std::fs::remove_file(&tmp);
-        })
 }
 
 #[cfg(test)]

@@ -13,6 +13,16 @@ pub enum RasterError {
     Device { adapter: String, message: String },
     #[error("wgpu reported an error: {0}")]
     Gpu(String),
+    /// A resource this frame needs is larger than the device allows (checked before it is
+    /// created).
+    #[error("this frame needs {what} of {needed}, more than {adapter} allows ({limit}){advice}")]
+    ExceedsDevice {
+        what: String,
+        needed: String,
+        limit: String,
+        adapter: String,
+        advice: &'static str,
+    },
     #[error("--method {method} needs the adapter feature {feature}, which {adapter} lacks")]
     MissingFeature {
         method: &'static str,
@@ -26,7 +36,9 @@ impl RasterError {
     pub fn is_refusal(&self) -> bool {
         matches!(
             self,
-            RasterError::Plan(_) | RasterError::Adapter(AdapterError::BadOverride { .. })
+            RasterError::Plan(_)
+                | RasterError::ExceedsDevice { .. }
+                | RasterError::Adapter(AdapterError::BadOverride { .. })
         )
     }
 }
@@ -43,7 +55,52 @@ pub struct Gpu {
     errors: Arc<Mutex<Vec<String>>>,
 }
 
+/// wgpu's defaults, raised to what the adapter offers for image sizes and buffer sizes (the
+/// default 256 MiB buffer holds only 3 M triangles; the scene limit is 4 M).
+fn device_limits(adapter: &wgpu::Limits) -> wgpu::Limits {
+    wgpu::Limits {
+        max_buffer_size: adapter.max_buffer_size,
+        max_storage_buffer_binding_size: adapter.max_storage_buffer_binding_size,
+        ..wgpu::Limits::default().using_resolution(adapter.clone())
+    }
+}
+
 impl Gpu {
+    /// Refuses a buffer of `bytes` for `what` that this device cannot hold.
+    pub fn check_buffer(&self, what: &str, bytes: u64, storage: bool) -> Result<(), RasterError> {
+        let limits = self.device.limits();
+        let limit = if storage {
+            u64::from(limits.max_storage_buffer_binding_size).min(limits.max_buffer_size)
+        } else {
+            limits.max_buffer_size
+        };
+        if bytes > limit {
+            return Err(RasterError::ExceedsDevice {
+                what: format!("a {what} buffer"),
+                needed: mirrorbox_files::human_bytes(bytes),
+                limit: mirrorbox_files::human_bytes(limit),
+                adapter: self.report.name.clone(),
+                advice: "; use fewer triangles",
+            });
+        }
+        Ok(())
+    }
+
+    /// Refuses a render target of `width × height` beyond the device's largest texture.
+    pub fn check_target(&self, width: u32, height: u32) -> Result<(), RasterError> {
+        let limit = self.device.limits().max_texture_dimension_2d;
+        if width.max(height) > limit {
+            return Err(RasterError::ExceedsDevice {
+                what: "a render target".into(),
+                needed: format!("{width}×{height} pixels"),
+                limit: format!("{limit} pixels per side"),
+                adapter: self.report.name.clone(),
+                advice: "; lower --ssaa or the image size",
+            });
+        }
+        Ok(())
+    }
+
     /// Opens the adapter of [`select_adapter`] with those of `wanted` (and timestamp queries)
     /// that it has.
     pub fn with_features(wanted: wgpu::Features) -> Result<Gpu, RasterError> {
@@ -71,8 +128,7 @@ impl Gpu {
             pollster::block_on(selected.adapter.request_device(&wgpu::DeviceDescriptor {
                 label: Some("mirrorbox"),
                 required_features: features,
-                required_limits:
-                    wgpu::Limits::default().using_resolution(selected.adapter.limits()),
+                required_limits: device_limits(&selected.adapter.limits()),
                 ..Default::default()
             }))
             .map_err(|e| RasterError::Device {

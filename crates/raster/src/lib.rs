@@ -41,6 +41,17 @@ pub use timing::{FrameTiming, TimingSource};
 
 use mirrorbox_image::RgbImage;
 use mirrorbox_scene::Scene;
+use mirrorbox_scene::limits::SettingError;
+
+/// Largest supersampling factor.
+pub const MAX_SSAA: u32 = 8;
+/// Most timed frames per render (each keeps two GPU timestamps and one duration).
+pub const MAX_FRAMES: u32 = 10_000;
+/// Most untimed warm-up frames.
+pub const MAX_WARMUP: u32 = 1_000;
+/// Largest render-target side (camera × SSAA); the device's `max_texture_dimension_2d` may
+/// be lower (checked when the frame is built).
+pub const MAX_RENDER_SIDE: u32 = mirrorbox_scene::limits::MAX_IMAGE_SIDE;
 
 /// How to render: the method and what every method shares.
 #[derive(Clone, Debug, PartialEq)]
@@ -62,6 +73,50 @@ impl RenderSettings {
             frames: 1,
             warmup: 2,
         }
+    }
+
+    /// The one check of the settings every method shares (`render` and `sweep` alike):
+    /// SSAA in `[1, MAX_SSAA]`, `frames` in `[1, MAX_FRAMES]`, `warmup` at most
+    /// `MAX_WARMUP`, and a render size (camera × SSAA) of at most `MAX_RENDER_SIDE` per side
+    /// and [`MAX_PIXELS`](mirrorbox_scene::limits::MAX_PIXELS) in all (an RGBA32F target of
+    /// that size is 1.1 GB).
+    pub fn check(&self, scene: &Scene) -> Result<(), SettingError> {
+        if !(1..=MAX_SSAA).contains(&self.ssaa) {
+            return Err(SettingError::new(
+                "--ssaa",
+                format!("in [1, {MAX_SSAA}]"),
+                self.ssaa,
+            ));
+        }
+        if !(1..=MAX_FRAMES).contains(&self.frames) {
+            return Err(SettingError::new(
+                "--frames",
+                format!("in [1, {MAX_FRAMES}]"),
+                self.frames,
+            ));
+        }
+        if self.warmup > MAX_WARMUP {
+            return Err(SettingError::new(
+                "--warmup",
+                format!("in [0, {MAX_WARMUP}]"),
+                self.warmup,
+            ));
+        }
+        let (w, h) = (
+            u64::from(scene.camera.width) * u64::from(self.ssaa),
+            u64::from(scene.camera.height) * u64::from(self.ssaa),
+        );
+        let max_pixels = mirrorbox_scene::limits::MAX_PIXELS;
+        if w.max(h) > u64::from(MAX_RENDER_SIDE) || w * h > max_pixels {
+            return Err(SettingError::new(
+                "--ssaa",
+                format!(
+                    "such that the render (image × SSAA) is at most {MAX_RENDER_SIDE} pixels per side and {max_pixels} in all"
+                ),
+                format!("{} (a {w}×{h} render)", self.ssaa),
+            ));
+        }
+        Ok(())
     }
 
     /// Render resolution: the scene camera's size × SSAA.
@@ -92,6 +147,7 @@ pub struct Planned {
 
 /// Plans `settings.method` for `scene` at render resolution, without a GPU.
 pub fn plan_frame(scene: &Scene, settings: &RenderSettings) -> Result<Planned, PlanError> {
+    settings.check(scene)?;
     let (w, h) = settings.render_size(scene);
     let frame = settings.method.configure().plan(scene, w, h)?;
     Ok(Planned {
@@ -118,6 +174,8 @@ pub fn render_planned(
         settings.method.key(),
         (w, h)
     );
+    gpu.check_target(w, h)?;
+    shading::SceneBuffers::check_fits(gpu, scene)?;
     let target = targets::RenderTarget::new(
         &gpu.device,
         "view",

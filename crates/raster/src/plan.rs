@@ -111,6 +111,9 @@ pub enum PlanError {
         "the reflection tree branches {0} levels deep with siblings pending; the 8-bit stencil of --method portal allows 254: lower --depth or use --method unrolled"
     )]
     StencilTooDeep(u32),
+    /// A render setting out of range (`--ssaa`, `--frames`, `--warmup`, the render size).
+    #[error(transparent)]
+    Setting(#[from] mirrorbox_scene::limits::SettingError),
 }
 
 /// The rendering queue of a method.

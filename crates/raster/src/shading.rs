@@ -83,6 +83,17 @@ pub struct SceneBuffers {
 }
 
 impl SceneBuffers {
+    /// Refuses a scene whose buffers this device cannot hold, before any is created.
+    pub fn check_fits(gpu: &crate::Gpu, scene: &Scene) -> Result<(), crate::RasterError> {
+        let g = &scene.geometry;
+        let vertices = 3 * g.triangles.len() as u64 * std::mem::size_of::<Vertex>() as u64;
+        gpu.check_buffer("vertex", vertices, false)?;
+        let surfaces = g.surfaces.len() as u64 * std::mem::size_of::<GpuSurface>() as u64;
+        gpu.check_buffer("surface", surfaces, true)?;
+        let lights = scene.lighting.lights.len() as u64 * std::mem::size_of::<GpuLight>() as u64;
+        gpu.check_buffer("light", lights, true)
+    }
+
     pub fn new(device: &wgpu::Device, scene: &Scene) -> Self {
         let g = &scene.geometry;
         let vertex = |i: usize| {
@@ -128,7 +139,12 @@ impl SceneBuffers {
             }
             mirrors.push(start..vertices.len() as u32);
         }
-        let surfaces: Vec<GpuSurface> = g
+        if vertices.is_empty() {
+            // An empty scene (camera only) renders its background; a zero-sized buffer
+            // cannot be bound, so hold one vertex that no draw range covers.
+            vertices.push(Zeroable::zeroed());
+        }
+        let mut surfaces: Vec<GpuSurface> = g
             .surfaces
             .iter()
             .map(|s| match s {
@@ -160,6 +176,9 @@ impl SceneBuffers {
                 ..Zeroable::zeroed()
             })
             .collect();
+        if surfaces.is_empty() {
+            surfaces.push(Zeroable::zeroed()); // a storage buffer may not be empty
+        }
         let light_count = lights.len() as u32;
         if lights.is_empty() {
             lights.push(Zeroable::zeroed()); // a storage buffer may not be empty

@@ -5,20 +5,34 @@ use crate::plot::{Chart, Series};
 use crate::{Record, SweepInfo};
 use crate::{exact, table1};
 use base64::Engine;
+use mirrorbox_files::{FileError, write_atomically};
 use std::fmt::Write as _;
 use std::path::Path;
 
-/// Reads `results.jsonl`; a line that does not parse (an interrupted write) is skipped.
+/// Reads `results.jsonl`; a line that does not parse (an interrupted write) is skipped, and
+/// a key written more than once (two sweeps, an older tool) counts once: its last record, at
+/// the place of its first — whatever the file holds, a report shows each point once.
 pub fn read_records(path: &Path) -> std::io::Result<Vec<Record>> {
     let text = match std::fs::read_to_string(path) {
         Ok(t) => t,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
         Err(e) => return Err(e),
     };
-    Ok(text
+    let mut records: Vec<Record> = Vec::new();
+    let mut index = std::collections::HashMap::new();
+    for record in text
         .lines()
-        .filter_map(|l| serde_json::from_str(l).ok())
-        .collect())
+        .filter_map(|l| serde_json::from_str::<Record>(l).ok())
+    {
+        match index.get(&record.key) {
+            Some(&i) => records[i] = record,
+            None => {
+                index.insert(record.key.clone(), records.len());
+                records.push(record);
+            }
+        }
+    }
+    Ok(records)
 }
 
 enum Block {
@@ -61,7 +75,9 @@ fn setting(r: &Record) -> f64 {
 }
 
 /// Writes `results.csv`, `report.md`, `report.html` and the `plot_*.svg` files into `dir`.
-pub fn write_report(dir: &Path, info: &SweepInfo, records: &[Record]) -> std::io::Result<()> {
+/// Each file is written atomically: a failure (a full disk) leaves the previous file or
+/// none, and names the file.
+pub fn write_report(dir: &Path, info: &SweepInfo, records: &[Record]) -> Result<(), FileError> {
     write_csv(&dir.join("results.csv"), records)?;
     let blocks = document(info, records);
     let mut md = String::new();
@@ -145,15 +161,15 @@ pub fn write_report(dir: &Path, info: &SweepInfo, records: &[Record]) -> std::io
                 html.push_str("</div>\n");
             }
             Block::Chart(file, svg) => {
-                std::fs::write(dir.join(file), svg)?;
+                write_atomically(&dir.join(file), svg.as_bytes())?;
                 let _ = writeln!(md, "![{file}]({file})\n");
                 let _ = writeln!(html, "<div>{svg}</div>");
             }
         }
     }
     html.push_str("</body></html>\n");
-    std::fs::write(dir.join("report.md"), md)?;
-    std::fs::write(dir.join("report.html"), html)
+    write_atomically(&dir.join("report.md"), md.as_bytes())?;
+    write_atomically(&dir.join("report.html"), html.as_bytes())
 }
 
 fn esc(s: &str) -> String {
@@ -163,7 +179,7 @@ fn esc(s: &str) -> String {
         .replace('"', "&quot;")
 }
 
-fn write_csv(path: &Path, records: &[Record]) -> std::io::Result<()> {
+fn write_csv(path: &Path, records: &[Record]) -> Result<(), FileError> {
     let mut s = String::from(
         "kind,method,n,depth,alpha,width,height,ssaa,ms_median,ms_min,timing_source,frames,passes,draws,texture_renders,reflections,\
          rmse,relmse,smape,max_abs,psnr,ssim,flip_mean,flip_p95,flip_p99,adapter,backend,scene,scene_hash\n",
@@ -205,7 +221,7 @@ fn write_csv(path: &Path, records: &[Record]) -> std::io::Result<()> {
             r.scene_hash
         );
     }
-    std::fs::write(path, s)
+    write_atomically(path, s.as_bytes())
 }
 
 /// The exact methods beside the paper's method at the Table 1 α: time and error.
@@ -694,5 +710,43 @@ mod tests {
                 .unwrap()
                 .is_empty()
         );
+    }
+
+    #[test]
+    fn a_key_written_twice_is_read_once_as_its_last_record() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("results.jsonl");
+        let (a, b) = (record(0, 1.0, 3, 0.1), record(1, 1.0, 7, 0.05));
+        let mut a2 = a.clone();
+        a2.ms_median = 42.0;
+        let lines: Vec<String> = [&a, &b, &a2, &b]
+            .iter()
+            .map(|r| serde_json::to_string(r).unwrap())
+            .collect();
+        std::fs::write(&p, lines.join("\n") + "\n").unwrap();
+        let read = read_records(&p).unwrap();
+        assert_eq!(read.len(), 2, "two keys, each once");
+        assert_eq!(
+            (read[0].key.as_str(), read[0].ms_median),
+            (a.key.as_str(), 42.0)
+        );
+        assert_eq!(read[1].key, b.key);
+    }
+
+    #[test]
+    fn a_failed_report_write_names_the_file_and_leaves_no_partial_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let records = vec![record(0, 1.0, 3, 0.1)];
+        // A folder where the report file should go: the rename fails, like a full disk would.
+        std::fs::create_dir(dir.path().join("report.md")).unwrap();
+        std::fs::write(dir.path().join("report.md").join("x"), "").unwrap();
+        let e = write_report(dir.path(), &SweepInfo::default(), &records).unwrap_err();
+        assert!(e.to_string().contains("report.md"), "{e}");
+        let leftovers: Vec<String> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .filter(|n| n.ends_with(".tmp"))
+            .collect();
+        assert!(leftovers.is_empty(), "{leftovers:?}");
     }
 }

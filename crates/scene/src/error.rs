@@ -7,11 +7,8 @@ use std::path::PathBuf;
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
     /// The scene file could not be read at all.
-    #[error("{file}: cannot read scene file: {source}")]
-    Read {
-        file: PathBuf,
-        source: std::io::Error,
-    },
+    #[error("{file}: {message}")]
+    Read { file: PathBuf, message: String },
     /// Not valid JSON, or a value of the wrong type / an unknown field.
     #[error("{file}:{line}:{column}: {}{message}", path_prefix(path))]
     Syntax {

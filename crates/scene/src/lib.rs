@@ -15,6 +15,7 @@ pub mod error;
 pub mod format;
 pub mod geometry;
 pub mod hash;
+pub mod limits;
 pub mod load;
 pub mod polygon;
 pub mod reflection;
@@ -106,6 +107,26 @@ impl Scene {
             geometry,
             ..self.clone()
         }
+    }
+
+    /// Overrides the camera's image size (`--width`, `--height`), each side and the area
+    /// checked as everywhere else ([`limits::image_size`]).
+    pub fn resize(
+        &mut self,
+        width: Option<u32>,
+        height: Option<u32>,
+    ) -> Result<(), limits::SettingError> {
+        for (flag, side) in [("--width", width), ("--height", height)] {
+            if let Some(side) = side {
+                limits::image_side(flag, side)?;
+            }
+        }
+        let (w, h) = limits::image_size(
+            width.unwrap_or(self.camera.width),
+            height.unwrap_or(self.camera.height),
+        )?;
+        self.camera = self.camera.with_size(w, h);
+        Ok(())
     }
 
     /// Replaces every mirror's reflectance (the harness sets it to the α being measured),

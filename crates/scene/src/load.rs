@@ -10,6 +10,10 @@ use crate::format::{
     Vec3f,
 };
 use crate::geometry::{Geometry, Surface};
+use crate::limits::{
+    MAX_COORDINATE, MAX_IMAGE_SIDE, MAX_OBJ_FILE_BYTES, MAX_PIXELS, MAX_SCENE_FILE_BYTES,
+    MAX_TRIANGLES, MEMORY_PER_TRIANGLE, within_extent,
+};
 use crate::shading::{Lighting, PointLight};
 use crate::tessellate::{self, MAX_SPHERE_SUBDIVISIONS};
 use crate::{Camera, Mirror, Scene};
@@ -27,8 +31,6 @@ pub mod defaults {
     pub const SPHERE_SUBDIVISIONS: u32 = 3;
     pub const BOX_SIZE: [f32; 3] = [1.0, 1.0, 1.0];
     pub const QUAD_SIZE: [f32; 2] = [1.0, 1.0];
-    /// Largest image side accepted.
-    pub const MAX_IMAGE_SIDE: u32 = 16384;
 }
 
 /// A scene of this repository's `scenes/` folder by file name (`"mirror_box.json"`) — for
@@ -41,12 +43,14 @@ pub fn bundled_scene(name: &str) -> Scene {
     load_scene(&path).unwrap_or_else(|e| panic!("bundled scene {name}: {e}"))
 }
 
-/// Loads, checks and compiles the scene file at `path`.
+/// Loads, checks and compiles the scene file at `path` (a regular file of at most
+/// [`MAX_SCENE_FILE_BYTES`]).
 pub fn load_scene(path: &Path) -> Result<Scene> {
-    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Read {
-        file: path.to_path_buf(),
-        source,
-    })?;
+    let text = mirrorbox_files::read_bounded_text(path, MAX_SCENE_FILE_BYTES, "scene file")
+        .map_err(|e| SceneError::Read {
+            file: path.to_path_buf(),
+            message: e.message,
+        })?;
     parse_scene(&text, path)
 }
 
@@ -125,6 +129,39 @@ impl Checker<'_> {
         })
     }
 
+    /// A point of the scene: finite and within [`MAX_COORDINATE`] on every axis.
+    fn position(&self, path: &FieldPath, v: Vec3f) -> Result<Vec3> {
+        let p = self.vec3(path, v)?;
+        if !within_extent(p) {
+            return Err(self.invalid(
+                path,
+                format!(
+                    "must lie within the scene extent, every coordinate within ±{MAX_COORDINATE:e}, got {}",
+                    show(p)
+                ),
+            ));
+        }
+        Ok(p)
+    }
+
+    /// Refuses a part of `adding` triangles that would take the scene past [`MAX_TRIANGLES`],
+    /// before it is built.
+    fn triangle_budget(&self, path: &FieldPath, have: usize, adding: u64) -> Result<()> {
+        let total = have as u64 + adding;
+        if total > MAX_TRIANGLES as u64 {
+            return Err(self.invalid(
+                path,
+                format!(
+                    "adds {adding} triangles, taking the scene to {total}; at most {MAX_TRIANGLES} are accepted \
+                     (the scene would need about {} to trace, at most about {})",
+                    mirrorbox_files::human_bytes(total.saturating_mul(MEMORY_PER_TRIANGLE)),
+                    mirrorbox_files::human_bytes(MAX_TRIANGLES as u64 * MEMORY_PER_TRIANGLE)
+                ),
+            ));
+        }
+        Ok(())
+    }
+
     /// RGB with every channel in `[lo, hi]`.
     fn rgb(
         &self,
@@ -167,7 +204,9 @@ impl Checker<'_> {
         let mut mirrors = Vec::with_capacity(file.mirrors.len());
         let mirror_paths = FieldPath::root("mirrors");
         for (i, desc) in file.mirrors.iter().enumerate() {
-            let mirror = self.mirror(&mirror_paths.index(i), i, desc)?;
+            let mirror_path = mirror_paths.index(i);
+            self.triangle_budget(&mirror_path, geometry.triangles.len(), 2)?;
+            let mirror = self.mirror(&mirror_path, i, desc)?;
             let [a, b, c, d] = mirror.corners();
             geometry.push_part(
                 mirror.name.clone(),
@@ -202,8 +241,8 @@ impl Checker<'_> {
     }
 
     fn camera(&self, path: &FieldPath, c: &CameraDesc) -> Result<Camera> {
-        let position = self.vec3(&path.field("position"), c.position)?;
-        let look_at = self.vec3(&path.field("look_at"), c.look_at)?;
+        let position = self.position(&path.field("position"), c.position)?;
+        let look_at = self.position(&path.field("look_at"), c.look_at)?;
         let forward = (look_at - position).try_normalize().ok_or_else(|| {
             self.invalid(&path.field("look_at"), "must differ from camera.position")
         })?;
@@ -221,15 +260,22 @@ impl Checker<'_> {
             return Err(self.invalid(&fov_path, format!("must be in (0, 180) degrees, got {fov}")));
         }
         for (name, side) in [("width", c.width), ("height", c.height)] {
-            if side == 0 || side > defaults::MAX_IMAGE_SIDE {
+            if side == 0 || side > MAX_IMAGE_SIDE {
                 return Err(self.invalid(
                     &path.field(name),
-                    format!(
-                        "must be in [1, {}] pixels, got {side}",
-                        defaults::MAX_IMAGE_SIDE
-                    ),
+                    format!("must be in [1, {MAX_IMAGE_SIDE}] pixels, got {side}"),
                 ));
             }
+        }
+        let pixels = u64::from(c.width) * u64::from(c.height);
+        if pixels > MAX_PIXELS {
+            return Err(self.invalid(
+                &path.field("width"),
+                format!(
+                    "width × height must be at most {MAX_PIXELS} pixels (8192²), got {}×{} = {pixels}",
+                    c.width, c.height
+                ),
+            ));
         }
         let exposure = self.positive(
             &path.field("exposure"),
@@ -247,7 +293,7 @@ impl Checker<'_> {
     }
 
     fn mirror(&self, path: &FieldPath, index: usize, m: &MirrorDesc) -> Result<Mirror> {
-        let center = self.vec3(&path.field("center"), m.center)?;
+        let center = self.position(&path.field("center"), m.center)?;
         let normal = self.direction(&path.field("normal"), m.normal)?;
         let up_path = path.field("up");
         let up = self.direction(&up_path, m.up)?;
@@ -258,7 +304,7 @@ impl Checker<'_> {
         let up = (up - normal * normal.dot(up)).normalize();
         let width = self.positive(&path.field("width"), m.width)?;
         let height = self.positive(&path.field("height"), m.height)?;
-        Ok(Mirror {
+        let mirror = Mirror {
             name: m.name.clone().unwrap_or_else(|| format!("mirror {index}")),
             center,
             normal,
@@ -275,12 +321,22 @@ impl Checker<'_> {
                 m.back_albedo,
                 defaults::MIRROR_BACK_ALBEDO,
             )?,
-        })
+        };
+        if let Some(corner) = mirror.corners().into_iter().find(|c| !within_extent(*c)) {
+            return Err(self.invalid(
+                &path.field("width"),
+                format!(
+                    "puts the corner {} outside the scene extent: every coordinate must be within ±{MAX_COORDINATE:e}",
+                    show(corner)
+                ),
+            ));
+        }
+        Ok(mirror)
     }
 
     fn light(&self, path: &FieldPath, l: &LightDesc) -> Result<PointLight> {
         Ok(PointLight {
-            position: self.vec3(&path.field("position"), l.position)?,
+            position: self.position(&path.field("position"), l.position)?,
             intensity: self.radiance(&path.field("intensity"), Some(l.intensity))?,
         })
     }
@@ -332,6 +388,7 @@ impl Checker<'_> {
                         format!("must be in [0, {MAX_SPHERE_SUBDIVISIONS}] (20·4^s triangles), got {level}"),
                     ));
                 }
+                self.triangle_budget(path, geometry.triangles.len(), 20 << (2 * level))?;
                 tessellate::icosphere(radius, level)
             }
             ShapeKind::Mesh => {
@@ -343,15 +400,26 @@ impl Checker<'_> {
                 self.obj(&mesh_path, rel)?
             }
         };
-        let transform = self.transform(&path.field("transform"), o.transform.as_ref())?;
+        self.triangle_budget(path, geometry.triangles.len(), local.len() as u64)?;
+        let transform_path = path.field("transform");
+        let transform = self.transform(&transform_path, o.transform.as_ref())?;
         let flips = transform.determinant() < 0.0;
-        let world = local
+        let world: Vec<[Vec3; 3]> = local
             .into_iter()
             .map(|t| {
                 let [a, b, c] = t.map(|p| transform.transform_point3(p));
                 if flips { [a, c, b] } else { [a, b, c] }
             })
             .collect();
+        if let Some(p) = world.iter().flatten().find(|p| !within_extent(**p)) {
+            return Err(self.invalid(
+                &transform_path,
+                format!(
+                    "places the vertex {} outside the scene extent: every coordinate must be within ±{MAX_COORDINATE:e}",
+                    show(*p)
+                ),
+            ));
+        }
         let surface = Surface::Diffuse {
             albedo: self.reflectance(&path.field("albedo"), o.albedo, defaults::ALBEDO)?,
             emission: self.radiance(&path.field("emission"), o.emission)?,
@@ -412,15 +480,13 @@ impl Checker<'_> {
     /// Triangles of an OBJ file, relative to the scene file's folder.
     fn obj(&self, path: &FieldPath, rel: &str) -> Result<Vec<[Vec3; 3]>> {
         let resolved: PathBuf = self.file.parent().unwrap_or(Path::new(".")).join(rel);
-        let bytes = std::fs::read(&resolved).map_err(|e| {
-            self.invalid(
-                path,
-                format!(
-                    "cannot read OBJ file \"{rel}\" (at {}): {e}",
-                    resolved.display()
-                ),
-            )
-        })?;
+        let bytes = mirrorbox_files::read_bounded(&resolved, MAX_OBJ_FILE_BYTES, "OBJ file")
+            .map_err(|e| {
+                self.invalid(
+                    path,
+                    format!("\"{rel}\" (at {}): {}", resolved.display(), e.message),
+                )
+            })?;
         let models = parse_obj(&bytes).map_err(|(line, e)| {
             let at = line.map(|l| format!(" at line {l}")).unwrap_or_default();
             self.invalid(path, format!("malformed OBJ file \"{rel}\"{at}: {e}"))
@@ -500,4 +566,89 @@ fn parse_obj(
 
 fn show(v: Vec3) -> String {
     format!("[{}, {}, {}]", v.x, v.y, v.z)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const CAMERA: &str = r#""camera": { "position": [0, 1, 3], "look_at": [0, 1, 0], "fov_y_deg": 60, "width": 32, "height": 24 }"#;
+
+    fn scene_with(rest: &str) -> Result<Scene> {
+        parse_scene(&format!("{{ {CAMERA}{rest} }}"), Path::new("s.json"))
+    }
+
+    fn refused(rest: &str) -> String {
+        match scene_with(rest) {
+            Ok(_) => panic!("accepted: {rest}"),
+            Err(e) => e.to_string(),
+        }
+    }
+
+    #[test]
+    fn positions_beyond_the_scene_extent_are_refused_with_their_field() {
+        let e = refused(
+            r#", "objects": [ { "type": "box", "transform": { "translate": [3.4e38, 0, 0] } } ]"#,
+        );
+        assert!(
+            e.contains("objects[0].transform") && e.contains("scene extent"),
+            "{e}"
+        );
+        let e =
+            refused(r#", "objects": [ { "type": "sphere", "radius": 2e6, "subdivisions": 0 } ]"#);
+        assert!(e.contains("objects[0].transform"), "{e}");
+        let e = refused(
+            r#", "mirrors": [ { "center": [0, 0, -2], "normal": [0, 0, 1], "up": [0, 1, 0], "width": 3e6, "height": 1 } ]"#,
+        );
+        assert!(e.contains("mirrors[0].width"), "{e}");
+        let e = refused(r#", "lights": [ { "position": [0, -1e7, 0], "intensity": [1, 1, 1] } ]"#);
+        assert!(e.contains("lights[0].position"), "{e}");
+        // At the limit is fine.
+        scene_with(
+            r#", "objects": [ { "type": "box", "transform": { "translate": [999999, 0, 0] } } ]"#,
+        )
+        .unwrap();
+    }
+
+    #[test]
+    fn the_triangle_budget_is_checked_before_tessellating() {
+        // 13 spheres at level 7 = 4 259 840 > 2²² triangles; the 13th is refused.
+        let sphere = r#"{ "type": "sphere", "subdivisions": 7 }"#;
+        let many = vec![sphere; 13].join(", ");
+        let e = refused(&format!(r#", "objects": [ {many} ]"#));
+        assert!(
+            e.contains("objects[12]") && e.contains("at most 4194304") && e.contains("GB"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn an_obj_path_to_a_device_or_folder_is_refused_without_reading() {
+        let dir = std::env::temp_dir();
+        for (path, kind) in [("/dev/zero", "character device"), (".", "folder")] {
+            let text =
+                format!(r#"{{ {CAMERA}, "objects": [ {{ "type": "mesh", "path": "{path}" }} ] }}"#);
+            let e = parse_scene(&text, &dir.join("s.json"))
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains("objects[0].path") && e.contains(kind), "{e}");
+        }
+    }
+
+    #[test]
+    fn a_scene_file_that_is_not_a_regular_file_is_refused() {
+        let e = load_scene(Path::new("/dev/urandom"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("/dev/urandom") && e.contains("regular file"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn an_empty_scene_loads() {
+        let s = scene_with("").unwrap();
+        assert!(s.geometry.triangles.is_empty() && s.mirrors.is_empty());
+    }
 }

@@ -10,6 +10,7 @@
 
 use crate::watertight::WatertightRay;
 use glam::{Vec3, Vec3A};
+use mirrorbox_scene::limits::{MAX_COORDINATE, within_extent};
 use mirrorbox_scene::{Geometry, Ray, Surface};
 use obvhs::BvhBuildParams;
 use obvhs::bvh2::Bvh2;
@@ -65,7 +66,21 @@ impl SceneBvh {
         Self::build_with(geometry, BvhKind::default())
     }
 
+    /// Builds `kind` over `geometry`. Every vertex must lie within the scene extent
+    /// ([`MAX_COORDINATE`], what loading a scene checks): obvhs indexes out of bounds on
+    /// non-finite or overflowing bounds, so they are never handed to it.
     pub fn build_with(geometry: &Geometry, kind: BvhKind) -> Self {
+        if let Some(p) = geometry
+            .triangles
+            .iter()
+            .flatten()
+            .find(|p| !within_extent(**p))
+        {
+            panic!(
+                "a vertex at {p} lies outside the scene extent ±{MAX_COORDINATE:e}: \
+                 scenes from mirrorbox_scene::load_scene never have one"
+            );
+        }
         let tris: Vec<Triangle> = geometry
             .triangles
             .iter()

@@ -44,7 +44,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         scene.set_reflectance(glam::Vec3::splat(r));
     }
     let written = export(&scene, &xml, ExportSettings { spp: args.spp })
-        .map_err(|e| Failure::Other(format!("{}: {e}", xml.display())))?;
+        .map_err(|e| Failure::Other(e.to_string()))?;
     println!(
         "exported {} to {} ({} files)",
         args.scene.display(),

@@ -16,42 +16,27 @@ pub fn load(path: &Path) -> Result<Scene, Failure> {
     load_scene(path).map_err(|e| Failure::BadInput(e.to_string()))
 }
 
-/// The s of `--spp s²`: samples per pixel must be a perfect square (the s×s sub-pixel grid).
+/// The s of `--spp s²` ([`mirrorbox_scene::limits::spp_grid_side`]).
 pub fn grid_side(spp: u32) -> Result<u32, Failure> {
-    let s = (spp as f64).sqrt().round() as u32;
-    if spp == 0 || s * s != spp {
-        return Err(Failure::BadInput(format!(
-            "--spp {spp} must be a perfect square (the s×s sub-pixel grid): 1, 4, 9, 16, 25, ..."
-        )));
-    }
-    Ok(s)
+    mirrorbox_scene::limits::spp_grid_side(spp).map_err(setting)
 }
 
-/// A reflectance override (`--reflectance`), in [0, 1].
+/// A reflectance override (`--reflectance`, `--alpha`), in [0, 1].
 pub fn unit_interval(flag: &str, value: Option<f32>) -> Result<Option<f32>, Failure> {
-    match value {
-        Some(v) if !(0.0..=1.0).contains(&v) => Err(Failure::BadInput(format!(
-            "{flag} must be in [0, 1], got {v}"
-        ))),
-        v => Ok(v),
-    }
+    value
+        .map(|v| mirrorbox_scene::limits::unit_interval(flag, v))
+        .transpose()
+        .map_err(setting)
 }
 
-/// Applies `--width/--height` overrides (each 1..=16384).
+/// Applies `--width/--height` overrides ([`Scene::resize`]).
 pub fn resize(scene: &mut Scene, width: Option<u32>, height: Option<u32>) -> Result<(), Failure> {
-    let max = mirrorbox_scene::load::defaults::MAX_IMAGE_SIDE;
-    for (flag, v) in [("--width", width), ("--height", height)] {
-        if let Some(v) = v
-            && (v == 0 || v > max)
-        {
-            return Err(Failure::BadInput(format!(
-                "{flag} must be in [1, {max}] pixels, got {v}"
-            )));
-        }
-    }
-    let cam = &scene.camera;
-    scene.camera = cam.with_size(width.unwrap_or(cam.width), height.unwrap_or(cam.height));
-    Ok(())
+    scene.resize(width, height).map_err(setting)
+}
+
+/// A setting out of its range is the user's input (exit 2).
+pub fn setting(e: mirrorbox_scene::limits::SettingError) -> Failure {
+    Failure::BadInput(e.to_string())
 }
 
 /// Checks that `path` has extension `ext` and that its folder exists, before any work.

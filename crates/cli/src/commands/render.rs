@@ -51,12 +51,6 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         .ok_or_else(|| bad(format!("unknown method {:?}", args.method)))?;
     let method = args.options.0.configure(entry)?;
     unit_interval("--alpha", args.alpha)?;
-    if !(1..=8).contains(&args.ssaa) {
-        return Err(bad(format!("--ssaa must be in [1, 8], got {}", args.ssaa)));
-    }
-    if args.frames == 0 {
-        return Err(bad("--frames must be at least 1".into()));
-    }
     let png = output_path("-o", &args.output, "png")?;
     let mut scene = load(&args.scene)?;
     resize(&mut scene, args.width, args.height)?;

@@ -1,6 +1,6 @@
 //! `mirrorbox trace SCENE -o OUT.exr`: the ground truth, rendered on the CPU with obvhs.
 
-use super::{grid_side, load, output_path, progress_bar, resize, unit_interval};
+use super::{grid_side, load, output_path, progress_bar, resize, setting, unit_interval};
 use crate::Failure;
 use mirrorbox_image::{RgbImage, colormap, write_exr, write_png, write_png_bytes};
 use mirrorbox_scene::SubpixelGrid;
@@ -76,19 +76,12 @@ pub struct Args {
 fn check_args(args: &Args) -> Result<(SubpixelGrid, WhittedSettings), Failure> {
     let s = grid_side(args.spp)?;
     unit_interval("--reflectance", args.reflectance)?;
-    if !(0.0..1.0).contains(&args.min_throughput) {
-        return Err(Failure::BadInput(format!(
-            "--min-throughput must be in [0, 1), got {}",
-            args.min_throughput
-        )));
-    }
-    Ok((
-        SubpixelGrid::new(s),
-        WhittedSettings {
-            max_depth: args.max_depth,
-            min_throughput: args.min_throughput,
-        },
-    ))
+    let whitted = WhittedSettings {
+        max_depth: args.max_depth,
+        min_throughput: args.min_throughput,
+    };
+    whitted.check().map_err(setting)?;
+    Ok((SubpixelGrid::new(s), whitted))
 }
 
 fn write_failed(e: impl ToString) -> Failure {

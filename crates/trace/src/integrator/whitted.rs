@@ -34,6 +34,21 @@ impl Default for WhittedSettings {
     }
 }
 
+impl WhittedSettings {
+    /// The one check of these settings (`trace` and `sweep` alike): `min_throughput` in
+    /// `[0, 1)`; any depth is fine (paths are followed iteratively, nothing per bounce is kept).
+    pub fn check(&self) -> Result<(), mirrorbox_scene::limits::SettingError> {
+        if !(0.0..1.0).contains(&self.min_throughput) {
+            return Err(mirrorbox_scene::limits::SettingError::new(
+                "--min-throughput",
+                "in [0, 1)",
+                self.min_throughput,
+            ));
+        }
+        Ok(())
+    }
+}
+
 pub struct Whitted<'a> {
     scene: &'a Scene,
     bvh: &'a SceneBvh,

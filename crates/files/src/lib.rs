@@ -1,0 +1,275 @@
+//! Files as a demanding user expects them: every output is written whole or not at all
+//! (temporary file beside it, then one rename), every input a user names is a regular file
+//! read within a stated bound (no `/dev/zero`, no FIFO that blocks forever), and an output
+//! folder is held by one process at a time. Every error names the file.
+
+use std::fs::File;
+use std::io::Read;
+use std::path::{Path, PathBuf};
+
+/// A file operation that failed, with the file it failed on.
+#[derive(Debug, thiserror::Error)]
+#[error("{}: {message}", .path.display())]
+pub struct FileError {
+    pub path: PathBuf,
+    pub message: String,
+    /// True when the file itself is not acceptable (not a regular file, too large, in use):
+    /// the user's input, not the machine, is at fault.
+    pub refused: bool,
+}
+
+impl FileError {
+    fn io(path: &Path, message: impl ToString) -> Self {
+        FileError {
+            path: path.to_path_buf(),
+            message: message.to_string(),
+            refused: false,
+        }
+    }
+
+    fn refused(path: &Path, message: impl ToString) -> Self {
+        FileError {
+            refused: true,
+            ..FileError::io(path, message)
+        }
+    }
+}
+
+/// Runs `write` on a temporary path beside `path` (same folder, so the rename is atomic),
+/// then renames it into place. On any error the temporary file is removed and `path` is left
+/// as it was; a crash leaves at most a `.NAME.PID.tmp` file, never a truncated `NAME`.
+pub fn write_atomically_with(
+    path: &Path,
+    write: impl FnOnce(&Path) -> Result<(), String>,
+) -> Result<(), FileError> {
+    let file_name = path
+        .file_name()
+        .ok_or_else(|| FileError::refused(path, "not a file path"))?;
+    let mut tmp_name = std::ffi::OsString::from(".");
+    tmp_name.push(file_name);
+    tmp_name.push(format!(".{}.tmp", std::process::id()));
+    let tmp = path.with_file_name(tmp_name);
+    let result = write(&tmp).and_then(|()| {
+        // Data on disk before the name points at it: a power cut leaves old or new, not empty.
+        File::open(&tmp)
+            .and_then(|f| f.sync_all())
+            .and_then(|()| std::fs::rename(&tmp, path))
+            .map_err(|e| e.to_string())
+    });
+    if let Err(message) = result {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(FileError::io(path, message));
+    }
+    Ok(())
+}
+
+/// Writes `bytes` to `path` atomically ([`write_atomically_with`]).
+pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), FileError> {
+    write_atomically_with(path, |tmp| {
+        std::fs::write(tmp, bytes).map_err(|e| e.to_string())
+    })
+}
+
+/// Reads the regular file at `path`, refusing anything else (a device such as `/dev/zero`, a
+/// FIFO, a folder) and any file larger than `max_bytes` — before reading a byte of it.
+/// `what` names the file's role in messages ("scene file", "OBJ file").
+pub fn read_bounded(path: &Path, max_bytes: u64, what: &str) -> Result<Vec<u8>, FileError> {
+    // `metadata` follows symbolic links and does not open the file: a FIFO cannot block here.
+    let meta = std::fs::metadata(path)
+        .map_err(|e| FileError::io(path, format!("cannot read {what}: {e}")))?;
+    if !meta.is_file() {
+        return Err(FileError::refused(
+            path,
+            format!("{what} must be a regular file, not {}", kind_of(&meta)),
+        ));
+    }
+    let too_large = |size: u64| {
+        FileError::refused(
+            path,
+            format!(
+                "{what} is {}, more than the {} accepted",
+                human_bytes(size),
+                human_bytes(max_bytes)
+            ),
+        )
+    };
+    if meta.len() > max_bytes {
+        return Err(too_large(meta.len()));
+    }
+    let file =
+        File::open(path).map_err(|e| FileError::io(path, format!("cannot read {what}: {e}")))?;
+    // The file may grow between `metadata` and here: never read past the bound.
+    let mut bytes = Vec::with_capacity(meta.len() as usize);
+    file.take(max_bytes + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| FileError::io(path, format!("cannot read {what}: {e}")))?;
+    if bytes.len() as u64 > max_bytes {
+        return Err(too_large(bytes.len() as u64));
+    }
+    Ok(bytes)
+}
+
+/// [`read_bounded`] for text: the file must be UTF-8.
+pub fn read_bounded_text(path: &Path, max_bytes: u64, what: &str) -> Result<String, FileError> {
+    String::from_utf8(read_bounded(path, max_bytes, what)?).map_err(|e| {
+        FileError::refused(
+            path,
+            format!(
+                "{what} is not UTF-8 text (invalid byte at offset {})",
+                e.utf8_error().valid_up_to()
+            ),
+        )
+    })
+}
+
+fn kind_of(meta: &std::fs::Metadata) -> &'static str {
+    use std::os::unix::fs::FileTypeExt;
+    let t = meta.file_type();
+    if t.is_dir() {
+        "a folder"
+    } else if t.is_fifo() {
+        "a FIFO (named pipe)"
+    } else if t.is_char_device() {
+        "a character device"
+    } else if t.is_block_device() {
+        "a block device"
+    } else if t.is_socket() {
+        "a socket"
+    } else {
+        "a special file"
+    }
+}
+
+/// `1.5 GB`, `36 KB`, `12 bytes` (decimal units, as disks and memory are sold).
+pub fn human_bytes(n: u64) -> String {
+    const UNITS: [(&str, f64); 4] = [("TB", 1e12), ("GB", 1e9), ("MB", 1e6), ("KB", 1e3)];
+    for (unit, size) in UNITS {
+        if n as f64 >= size {
+            return format!("{:.1} {unit}", n as f64 / size);
+        }
+    }
+    format!("{n} bytes")
+}
+
+/// An output folder held by this process: the advisory lock on `DIR/.mirrorbox.lock`
+/// (`flock`), released when this value is dropped or the process dies — a killed sweep never
+/// leaves a stale lock behind.
+#[derive(Debug)]
+pub struct FolderLock {
+    _file: File,
+    path: PathBuf,
+}
+
+/// The lock file's name inside a locked folder.
+pub const LOCK_FILE: &str = ".mirrorbox.lock";
+
+impl FolderLock {
+    /// Takes the folder's lock, or refuses at once (naming the process that holds it) when
+    /// another process has it. The folder must exist.
+    pub fn try_acquire(dir: &Path) -> Result<FolderLock, FileError> {
+        let path = dir.join(LOCK_FILE);
+        let mut file = std::fs::OpenOptions::new()
+            .read(true)
+            .write(true)
+            .create(true)
+            .truncate(false)
+            .open(&path)
+            .map_err(|e| FileError::io(&path, format!("cannot create the lock file: {e}")))?;
+        match file.try_lock() {
+            Ok(()) => {}
+            Err(std::fs::TryLockError::WouldBlock) => {
+                let mut holder = String::new();
+                let _ = file.read_to_string(&mut holder);
+                let holder = holder.trim();
+                let who = if holder.is_empty() {
+                    "another process".to_string()
+                } else {
+                    format!("another process ({holder})")
+                };
+                return Err(FileError::refused(
+                    dir,
+                    format!(
+                        "this folder is in use by {who}; wait for it to finish or choose another output folder"
+                    ),
+                ));
+            }
+            Err(std::fs::TryLockError::Error(e)) => {
+                return Err(FileError::io(&path, format!("cannot lock: {e}")));
+            }
+        }
+        use std::io::{Seek, Write};
+        let _ = file.set_len(0);
+        let _ = file.seek(std::io::SeekFrom::Start(0));
+        let _ = writeln!(file, "pid {}", std::process::id());
+        Ok(FolderLock { _file: file, path })
+    }
+
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_failed_write_leaves_the_old_file_and_no_temporary() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("report.md");
+        write_atomically(&path, b"old").unwrap();
+        let err = write_atomically_with(&path, |tmp| {
+            std::fs::write(tmp, b"half").unwrap();
+            Err("disk full".into())
+        })
+        .unwrap_err();
+        assert!(err.to_string().contains("report.md") && err.to_string().contains("disk full"));
+        assert_eq!(std::fs::read(&path).unwrap(), b"old");
+        let names: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+        assert_eq!(names.len(), 1, "the temporary file must be gone");
+    }
+
+    #[test]
+    fn special_files_and_large_files_are_refused_before_reading() {
+        for (path, kind) in [("/dev/zero", "character device"), ("/", "folder")] {
+            let e = read_bounded(Path::new(path), 1 << 20, "OBJ file").unwrap_err();
+            assert!(e.refused && e.message.contains(kind), "{e}");
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let fifo = dir.path().join("pipe");
+        let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+        if made.is_ok_and(|s| s.success()) {
+            // Would block forever if opened.
+            let e = read_bounded(&fifo, 1 << 20, "OBJ file").unwrap_err();
+            assert!(e.message.contains("FIFO"), "{e}");
+        }
+        let big = dir.path().join("big.obj");
+        std::fs::write(&big, vec![b'#'; 101]).unwrap();
+        let e = read_bounded(&big, 100, "OBJ file").unwrap_err();
+        assert!(e.refused && e.message.contains("101 bytes"), "{e}");
+        assert_eq!(read_bounded(&big, 101, "OBJ file").unwrap().len(), 101);
+    }
+
+    #[test]
+    fn a_folder_is_held_by_one_lock_at_a_time() {
+        let dir = tempfile::tempdir().unwrap();
+        let first = FolderLock::try_acquire(dir.path()).unwrap();
+        let second = FolderLock::try_acquire(dir.path()).unwrap_err();
+        assert!(second.refused, "{second}");
+        assert!(
+            second
+                .message
+                .contains(&format!("pid {}", std::process::id())),
+            "{second}"
+        );
+        drop(first);
+        FolderLock::try_acquire(dir.path()).expect("free again once released");
+    }
+
+    #[test]
+    fn sizes_read_as_people_say_them() {
+        assert_eq!(human_bytes(12), "12 bytes");
+        assert_eq!(human_bytes(36_000), "36.0 KB");
+        assert_eq!(human_bytes(34_359_738_368), "34.4 GB");
+    }
+}
