@@ -1,33 +1,11 @@
 //! End-to-end tests of the `mirrorbox` command line: real processes, real files, exit codes
 //! and messages as a user sees them.
 
+mod common;
+
+use common::{Output, mirrorbox, repo};
 use serde_json::{Value, json};
 use std::path::{Path, PathBuf};
-use std::process::Command;
-
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
-
-struct Output {
-    code: i32,
-    stdout: String,
-    stderr: String,
-}
-
-fn mirrorbox(args: &[&str], envs: &[(&str, &str)]) -> Output {
-    let mut cmd = Command::new(env!("CARGO_BIN_EXE_mirrorbox"));
-    cmd.args(args).current_dir(repo());
-    for (k, v) in envs {
-        cmd.env(k, v);
-    }
-    let out = cmd.output().expect("run mirrorbox");
-    Output {
-        code: out.status.code().expect("exited normally, not by a signal"),
-        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
-        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
-    }
-}
 
 /// A small valid scene; each test breaks one thing in it.
 fn valid_scene() -> Value {

@@ -35,30 +35,129 @@ impl FileError {
     }
 }
 
-/// Runs `write` on a temporary path beside `path` (same folder, so the rename is atomic),
-/// then renames it into place. On any error the temporary file is removed and `path` is left
-/// as it was; a crash leaves at most a `.NAME.PID.tmp` file, never a truncated `NAME`.
-pub fn write_atomically_with(
-    path: &Path,
-    write: impl FnOnce(&Path) -> Result<(), String>,
-) -> Result<(), FileError> {
+/// The temporary name of `path` while it is written: `.NAME.PID.tmp` beside it (same
+/// folder, so the final rename is atomic).
+fn temporary_path(path: &Path) -> Result<PathBuf, FileError> {
     let file_name = path
         .file_name()
         .ok_or_else(|| FileError::refused(path, "not a file path"))?;
     let mut tmp_name = std::ffi::OsString::from(".");
     tmp_name.push(file_name);
     tmp_name.push(format!(".{}.tmp", std::process::id()));
-    let tmp = path.with_file_name(tmp_name);
-    let result = write(&tmp).and_then(|()| {
-        // Data on disk before the name points at it: a power cut leaves old or new, not empty.
-        File::open(&tmp)
+    Ok(path.with_file_name(tmp_name))
+}
+
+/// Runs `write` on `tmp` and flushes it to disk (data before name: a power cut leaves the
+/// old file or the new one, never an empty one). Removes `tmp` on failure.
+fn write_temporary(
+    path: &Path,
+    tmp: &Path,
+    write: impl FnOnce(&Path) -> Result<(), String>,
+) -> Result<(), FileError> {
+    let result = write(tmp).and_then(|()| {
+        File::open(tmp)
             .and_then(|f| f.sync_all())
-            .and_then(|()| std::fs::rename(&tmp, path))
             .map_err(|e| e.to_string())
     });
-    if let Err(message) = result {
+    result.map_err(|message| {
+        let _ = std::fs::remove_file(tmp);
+        FileError::io(path, message)
+    })
+}
+
+/// Runs `write` on a temporary path beside `path`, then renames it into place. On any error
+/// the temporary file is removed and `path` is left as it was; a crash leaves at most a
+/// `.NAME.PID.tmp` file, never a truncated `NAME`.
+pub fn write_atomically_with(
+    path: &Path,
+    write: impl FnOnce(&Path) -> Result<(), String>,
+) -> Result<(), FileError> {
+    let tmp = temporary_path(path)?;
+    write_temporary(path, &tmp, write)?;
+    std::fs::rename(&tmp, path).map_err(|e| {
         let _ = std::fs::remove_file(&tmp);
-        return Err(FileError::io(path, message));
+        FileError::io(path, e)
+    })
+}
+
+/// Several outputs of one command, written all or none: each is staged under its temporary
+/// name, and only when every one is written are they renamed into place. Dropped before
+/// [`StagedFiles::commit`], it removes what it staged.
+#[derive(Debug, Default)]
+pub struct StagedFiles {
+    staged: Vec<(PathBuf, PathBuf)>,
+}
+
+impl StagedFiles {
+    pub fn new() -> Self {
+        StagedFiles::default()
+    }
+
+    /// Writes `path`'s content (through `write`, given the temporary path) without showing it
+    /// under its name yet.
+    pub fn stage_with(
+        &mut self,
+        path: &Path,
+        write: impl FnOnce(&Path) -> Result<(), String>,
+    ) -> Result<(), FileError> {
+        let tmp = temporary_path(path)?;
+        write_temporary(path, &tmp, write)?;
+        self.staged.push((tmp, path.to_path_buf()));
+        Ok(())
+    }
+
+    /// Renames every staged file into place; returns their paths.
+    pub fn commit(mut self) -> Result<Vec<PathBuf>, FileError> {
+        let staged = std::mem::take(&mut self.staged);
+        let mut done = Vec::with_capacity(staged.len());
+        let mut pending = staged.into_iter();
+        while let Some((tmp, path)) = pending.next() {
+            if let Err(e) = std::fs::rename(&tmp, &path) {
+                let _ = std::fs::remove_file(&tmp);
+                for (tmp, _) in pending {
+                    let _ = std::fs::remove_file(tmp);
+                }
+                return Err(FileError::io(&path, e));
+            }
+            done.push(path);
+        }
+        Ok(done)
+    }
+}
+
+impl Drop for StagedFiles {
+    fn drop(&mut self) {
+        for (tmp, _) in &self.staged {
+            let _ = std::fs::remove_file(tmp);
+        }
+    }
+}
+
+/// Refuses a set of outputs in which two name the same file (`-o a.exr --bounces a.exr`, or
+/// a PNG written beside an EXR that another output names), before anything is written.
+pub fn check_distinct(outputs: &[(&str, PathBuf)]) -> Result<(), FileError> {
+    // The folders exist (outputs are checked first): resolve them, `..` and links included.
+    let absolute = |p: &Path| {
+        let parent = p
+            .parent()
+            .filter(|d| !d.as_os_str().is_empty())
+            .unwrap_or(Path::new("."));
+        match (parent.canonicalize(), p.file_name()) {
+            (Ok(dir), Some(name)) => dir.join(name),
+            _ => std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf()),
+        }
+    };
+    for (i, (flag_a, a)) in outputs.iter().enumerate() {
+        for (flag_b, b) in &outputs[..i] {
+            if absolute(a) == absolute(b) {
+                return Err(FileError::refused(
+                    a,
+                    format!(
+                        "{flag_a} and {flag_b} would both write this file; give them different names"
+                    ),
+                ));
+            }
+        }
     }
     Ok(())
 }
@@ -264,6 +363,56 @@ mod tests {
         );
         drop(first);
         FolderLock::try_acquire(dir.path()).expect("free again once released");
+    }
+
+    #[test]
+    fn staged_files_appear_together_or_not_at_all() {
+        let dir = tempfile::tempdir().unwrap();
+        let (a, b) = (dir.path().join("a.exr"), dir.path().join("b.exr"));
+        let mut staged = StagedFiles::new();
+        staged
+            .stage_with(&a, |t| std::fs::write(t, "a").map_err(|e| e.to_string()))
+            .unwrap();
+        assert!(!a.exists(), "not visible before commit");
+        let e = staged
+            .stage_with(&b, |_| Err("disk full".into()))
+            .unwrap_err();
+        assert!(e.to_string().contains("b.exr"));
+        drop(staged);
+        assert_eq!(
+            std::fs::read_dir(dir.path()).unwrap().count(),
+            0,
+            "nothing left"
+        );
+
+        let mut staged = StagedFiles::new();
+        for p in [&a, &b] {
+            staged
+                .stage_with(p, |t| std::fs::write(t, "x").map_err(|e| e.to_string()))
+                .unwrap();
+        }
+        assert_eq!(staged.commit().unwrap(), vec![a.clone(), b.clone()]);
+        assert!(a.is_file() && b.is_file());
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
+    }
+
+    #[test]
+    fn colliding_outputs_are_named() {
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        std::fs::create_dir(d.join("sub")).unwrap();
+        let distinct = [
+            ("-o", d.join("a.exr")),
+            ("-o (its PNG)", d.join("a.png")),
+            ("--bounces", d.join("sub/a.exr")),
+        ];
+        assert!(check_distinct(&distinct).is_ok());
+        let same = [
+            ("-o", d.join("a.exr")),
+            ("--bounces", d.join("sub/../a.exr")),
+        ];
+        let e = check_distinct(&same).unwrap_err();
+        assert!(e.refused && e.message.contains("--bounces and -o"), "{e}");
     }
 
     #[test]

@@ -10,6 +10,7 @@ pub mod colormap;
 pub mod metrics;
 pub mod srgb;
 
+pub use mirrorbox_files::StagedFiles;
 use std::path::{Path, PathBuf};
 
 /// A linear RGB image, row-major, top row first (the project's pixel convention).
@@ -69,18 +70,40 @@ fn io_error(path: &Path, message: impl ToString) -> ImageError {
     }
 }
 
-/// Runs `write` on a temporary path beside `path`, then renames it into place
-/// ([`mirrorbox_files::write_atomically_with`]): `path` is never left half-written.
-fn write_atomically(
+/// Runs `write` on a temporary path beside `path`, then renames it into place — at once
+/// ([`mirrorbox_files::write_atomically_with`]), or with the other outputs of a command when
+/// `staged` is given ([`StagedFiles`]). `path` is never left half-written.
+fn put(
     path: &Path,
+    staged: Option<&mut StagedFiles>,
     write: impl FnOnce(&Path) -> Result<(), String>,
 ) -> Result<(), ImageError> {
-    mirrorbox_files::write_atomically_with(path, write).map_err(|e| io_error(&e.path, e.message))
+    match staged {
+        None => mirrorbox_files::write_atomically_with(path, write),
+        Some(staged) => staged.stage_with(path, write),
+    }
+    .map_err(|e| io_error(&e.path, e.message))
 }
 
 /// Writes the contract's tone-mapped sRGB image as an 8-bit PNG.
 pub fn write_png(path: &Path, image: &RgbImage, exposure: f32) -> Result<(), ImageError> {
     write_png_bytes(path, image.width, image.height, &image.to_srgb8(exposure))
+}
+
+/// [`write_png`], staged with the other outputs of a command.
+pub fn stage_png(
+    staged: &mut StagedFiles,
+    path: &Path,
+    image: &RgbImage,
+    exposure: f32,
+) -> Result<(), ImageError> {
+    png(
+        path,
+        Some(staged),
+        image.width,
+        image.height,
+        &image.to_srgb8(exposure),
+    )
 }
 
 /// Writes 8-bit sRGB bytes (RGB, row-major) as a PNG.
@@ -90,7 +113,28 @@ pub fn write_png_bytes(
     height: u32,
     bytes: &[u8],
 ) -> Result<(), ImageError> {
-    write_atomically(path, |tmp| {
+    png(path, None, width, height, bytes)
+}
+
+/// [`write_png_bytes`], staged with the other outputs of a command.
+pub fn stage_png_bytes(
+    staged: &mut StagedFiles,
+    path: &Path,
+    width: u32,
+    height: u32,
+    bytes: &[u8],
+) -> Result<(), ImageError> {
+    png(path, Some(staged), width, height, bytes)
+}
+
+fn png(
+    path: &Path,
+    staged: Option<&mut StagedFiles>,
+    width: u32,
+    height: u32,
+    bytes: &[u8],
+) -> Result<(), ImageError> {
+    put(path, staged, |tmp| {
         image::save_buffer_with_format(
             tmp,
             bytes,
@@ -110,6 +154,25 @@ pub fn write_exr(
     image: &RgbImage,
     attributes: &[(&str, String)],
 ) -> Result<(), ImageError> {
+    exr_file(path, None, image, attributes)
+}
+
+/// [`write_exr`], staged with the other outputs of a command.
+pub fn stage_exr(
+    staged: &mut StagedFiles,
+    path: &Path,
+    image: &RgbImage,
+    attributes: &[(&str, String)],
+) -> Result<(), ImageError> {
+    exr_file(path, Some(staged), image, attributes)
+}
+
+fn exr_file(
+    path: &Path,
+    staged: Option<&mut StagedFiles>,
+    image: &RgbImage,
+    attributes: &[(&str, String)],
+) -> Result<(), ImageError> {
     use exr::prelude::*;
     let mut text = Vec::with_capacity(attributes.len());
     for (key, value) in attributes {
@@ -126,7 +189,7 @@ pub fn write_exr(
     let mut exr_image =
         Image::from_channels((image.width as usize, image.height as usize), channels);
     exr_image.attributes.other.extend(text);
-    write_atomically(path, |tmp| {
+    put(path, staged, |tmp| {
         exr_image.write().to_file(tmp).map_err(|e| e.to_string())
     })
 }

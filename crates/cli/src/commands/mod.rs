@@ -50,6 +50,12 @@ pub fn output_path(flag: &str, path: &Path, ext: &str) -> Result<PathBuf, Failur
             path.display()
         )));
     }
+    if path.is_dir() {
+        return Err(Failure::BadInput(format!(
+            "{flag} {}: is a folder; name a .{ext} file",
+            path.display()
+        )));
+    }
     let parent = path
         .parent()
         .filter(|p| !p.as_os_str().is_empty())

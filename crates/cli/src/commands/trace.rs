@@ -2,7 +2,7 @@
 
 use super::{grid_side, load, output_path, progress_bar, resize, setting, unit_interval};
 use crate::Failure;
-use mirrorbox_image::{RgbImage, colormap, write_exr, write_png, write_png_bytes};
+use mirrorbox_image::{RgbImage, StagedFiles, colormap, stage_exr, stage_png, stage_png_bytes};
 use mirrorbox_scene::SubpixelGrid;
 use mirrorbox_trace::{
     BvhKind, Sampling, SceneBvh, TraceOutput, TraceSettings, WhittedSettings, render,
@@ -96,6 +96,15 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         .as_deref()
         .map(|p| output_path("--bounces", p, "exr"))
         .transpose()?;
+    let mut outputs = vec![
+        ("-o", exr_path.clone()),
+        ("-o (its PNG)", exr_path.with_extension("png")),
+    ];
+    if let Some(b) = &bounces_path {
+        outputs.push(("--bounces", b.clone()));
+        outputs.push(("--bounces (its PNG)", b.with_extension("png")));
+    }
+    mirrorbox_files::check_distinct(&outputs).map_err(|e| Failure::BadInput(e.to_string()))?;
     let mut scene = load(&args.scene)?;
     resize(&mut scene, args.width, args.height)?;
     if let Some(r) = args.reflectance {
@@ -163,30 +172,34 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         ("mirrorbox.rays", out.stats.rays.to_string()),
         ("mirrorbox.deepest_path", out.stats.deepest.to_string()),
     ];
-    write_exr(&exr_path, &out.image, &attributes).map_err(write_failed)?;
+    // Every output appears together, or none does (a failing --bounces leaves no image).
+    let mut staged = StagedFiles::new();
+    stage_exr(&mut staged, &exr_path, &out.image, &attributes).map_err(write_failed)?;
     let png_path = exr_path.with_extension("png");
-    write_png(&png_path, &out.image, scene.camera.exposure).map_err(write_failed)?;
-    let mut written = vec![exr_path.clone(), png_path];
+    stage_png(&mut staged, &png_path, &out.image, scene.camera.exposure).map_err(write_failed)?;
     if let Some(path) = &bounces_path {
-        written.extend(write_bounces(
+        stage_bounces(
+            &mut staged,
             path,
             &out.bounces,
             out.stats.deepest,
             &attributes,
-        )?);
+        )?;
     }
+    let written = staged.commit().map_err(write_failed)?;
     report(args, &scene, &bvh, &out, grid, total, &written);
     Ok(())
 }
 
 /// The bounce AOV: EXR of the mean count, and a heat map (log scale up to the deepest path).
-fn write_bounces(
+fn stage_bounces(
+    staged: &mut StagedFiles,
     path: &Path,
     image: &RgbImage,
     deepest: u32,
     attributes: &[(&str, String)],
-) -> Result<Vec<PathBuf>, Failure> {
-    write_exr(path, image, attributes).map_err(write_failed)?;
+) -> Result<(), Failure> {
+    stage_exr(staged, path, image, attributes).map_err(write_failed)?;
     let scale = (1.0 + deepest.max(1) as f32).ln();
     let bytes: Vec<u8> = image
         .pixels
@@ -194,8 +207,7 @@ fn write_bounces(
         .flat_map(|p| colormap::heat((1.0 + p[0]).ln() / scale))
         .collect();
     let png = path.with_extension("png");
-    write_png_bytes(&png, image.width, image.height, &bytes).map_err(write_failed)?;
-    Ok(vec![path.to_path_buf(), png])
+    stage_png_bytes(staged, &png, image.width, image.height, &bytes).map_err(write_failed)
 }
 
 fn report(

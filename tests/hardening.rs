@@ -1,0 +1,379 @@
+//! End-to-end tests of issue #12: inputs that used to panic, abort for memory, block or write
+//! half a file. Every case runs the real binary; each must end with a clear message and exit 2
+//! (or just work), never a panic (101), an abort (134) or a signal.
+
+mod common;
+
+use common::{Output, mirrorbox};
+use serde_json::{Value, json};
+use std::path::{Path, PathBuf};
+
+/// A small valid two-mirror scene, as `tests/cli.rs` uses.
+fn scene() -> Value {
+    json!({
+        "camera": { "position": [0, 1, 3], "look_at": [0, 1, 0], "fov_y_deg": 60,
+                    "width": 32, "height": 24 },
+        "mirrors": [
+            { "center": [0, 1, -2], "normal": [0, 0, 1], "up": [0, 1, 0], "width": 4, "height": 3 },
+            { "center": [0, 1, 2], "normal": [0, 0, -1], "up": [0, 1, 0], "width": 4, "height": 3 }
+        ],
+        "objects": [ { "type": "sphere", "radius": 0.5 } ],
+        "lights": [ { "position": [0, 2.5, 0], "intensity": [10, 10, 10] } ]
+    })
+}
+
+fn write_scene(dir: &Path, name: &str, scene: &Value) -> PathBuf {
+    let path = dir.join(name);
+    std::fs::write(&path, serde_json::to_string_pretty(scene).unwrap()).unwrap();
+    path
+}
+
+fn files_in(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+fn assert_refused(args: &[&str], out: &Output, fragments: &[&str]) {
+    assert_eq!(
+        out.code, 2,
+        "{args:?} should be refused (exit 2):\n{}",
+        out.stderr
+    );
+    assert!(!out.stderr.contains("panicked"), "{args:?}: {}", out.stderr);
+    for f in fragments {
+        assert!(
+            out.stderr.contains(f),
+            "{args:?}: missing {f:?} in:\n{}",
+            out.stderr
+        );
+    }
+}
+
+/// The edge-case table: command lines that must be refused with these words, nothing written.
+#[test]
+fn edge_cases_are_refused_with_a_clear_message_and_nothing_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let ok = write_scene(d, "ok.json", &scene());
+    let mut far = scene();
+    far["objects"][0]["transform"] = json!({ "translate": [3.4e38, 0, 0] });
+    let far = write_scene(d, "far.json", &far);
+    let mut heavy = scene();
+    heavy["objects"] = Value::Array(vec![json!({ "type": "sphere", "subdivisions": 7 }); 20]);
+    let heavy = write_scene(d, "heavy.json", &heavy);
+    let mut zero_obj = scene();
+    zero_obj["objects"] = json!([{ "type": "mesh", "path": "/dev/zero" }]);
+    let zero_obj = write_scene(d, "zero_obj.json", &zero_obj);
+    let out = d.join("out");
+    std::fs::create_dir(&out).unwrap();
+    let (ok, far, heavy, zero_obj) = (
+        ok.to_str().unwrap(),
+        far.to_str().unwrap(),
+        heavy.to_str().unwrap(),
+        zero_obj.to_str().unwrap(),
+    );
+    let exr = out.join("t.exr");
+    let png = out.join("r.png");
+    let sweep_out = out.join("sweep");
+    let (exr, png, sweep_out) = (
+        exr.to_str().unwrap(),
+        png.to_str().unwrap(),
+        sweep_out.to_str().unwrap(),
+    );
+    let sweep = |extra: &[&'static str]| -> Vec<String> {
+        let mut a = vec!["sweep", ok, "--out", sweep_out, "--methods", "naive"];
+        a.extend_from_slice(extra);
+        a.into_iter().map(String::from).collect()
+    };
+    let own = |a: &[&str]| -> Vec<String> { a.iter().map(|s| s.to_string()).collect() };
+    let cases: Vec<(Vec<String>, Vec<&str>)> = vec![
+        // An object near the float limit used to panic inside obvhs (exit 101).
+        (
+            own(&["trace", far, "-o", exr]),
+            vec!["objects[0].transform", "scene extent"],
+        ),
+        (
+            own(&["render", far, "-o", png]),
+            vec!["objects[0].transform"],
+        ),
+        // 6.5 M triangles in a 1.3 KB file: refused before tessellating, with the memory.
+        (
+            own(&["check", heavy]),
+            vec!["objects[12]", "at most 4194304", "GB"],
+        ),
+        (own(&["render", heavy, "-o", png]), vec!["objects[12]"]),
+        // Sizes that used to abort for memory.
+        (
+            own(&["trace", ok, "-o", exr, "--spp", "4294836225"]),
+            vec!["--spp must be a positive perfect square", "got 4294836225"],
+        ),
+        (
+            own(&["trace", ok, "-o", exr, "--spp", "0"]),
+            vec!["a positive perfect square"],
+        ),
+        (
+            own(&["render", ok, "-o", png, "--frames", "4294967295"]),
+            vec!["--frames must be in [1, 10000]"],
+        ),
+        (
+            own(&["render", ok, "-o", png, "--warmup", "4294967295"]),
+            vec!["--warmup must be in [0, 1000]"],
+        ),
+        (
+            own(&[
+                "render",
+                ok,
+                "-o",
+                png,
+                "--method",
+                "auxiliary",
+                "--n",
+                "4294967295",
+            ]),
+            vec!["--n", "4294967295"],
+        ),
+        (
+            own(&["render", ok, "-o", png, "--width", "16384", "--ssaa", "8"]),
+            vec!["--ssaa must be such that the render"],
+        ),
+        (
+            own(&[
+                "trace", ok, "-o", exr, "--width", "16384", "--height", "16384",
+            ]),
+            vec!["--width × --height must be at most 67108864 pixels"],
+        ),
+        // A device or FIFO as an input: refused without reading.
+        (
+            own(&["check", zero_obj]),
+            vec!["objects[0].path", "character device"],
+        ),
+        (
+            own(&["check", "/dev/zero"]),
+            vec!["/dev/zero", "must be a regular file"],
+        ),
+        // Sweeps validate exactly as trace and render do.
+        (
+            sweep(&["--width", "0"]),
+            vec!["--width must be in [1, 16384]"],
+        ),
+        (
+            sweep(&["--width", "2147483648"]),
+            vec!["--width must be in [1, 16384] pixels, got 2147483648"],
+        ),
+        (
+            sweep(&["--height", "100000"]),
+            vec!["--height must be in [1, 16384]"],
+        ),
+        (
+            sweep(&["--width", "1"]),
+            vec!["--width must be at least 11 pixels in a sweep"],
+        ),
+        (
+            sweep(&["--min-throughput", "nan"]),
+            vec!["--min-throughput must be in [0, 1), got NaN"],
+        ),
+        (
+            sweep(&["--frames", "0"]),
+            vec!["--frames must be in [1, 10000]"],
+        ),
+        (sweep(&["--ssaa", "9"]), vec!["--ssaa must be in [1, 8]"]),
+        (
+            sweep(&["--methods", "auxiliary", "--n", "0..4294967295"]),
+            vec!["--n \"0..4294967295\""],
+        ),
+        (
+            sweep(&["--methods", "portal", "--depth", "0..4294967295"]),
+            vec!["--depth \"0..4294967295\""],
+        ),
+        // Outputs that collide.
+        (
+            own(&["trace", ok, "-o", exr, "--bounces", exr]),
+            vec!["--bounces and -o would both write this file"],
+        ),
+    ];
+    for (args, fragments) in &cases {
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let started = std::time::Instant::now();
+        let r = mirrorbox(&args, &[]);
+        assert_refused(&args, &r, fragments);
+        assert!(
+            started.elapsed().as_secs() < 20,
+            "{args:?} took {:?} to refuse",
+            started.elapsed()
+        );
+        assert!(
+            files_in(&out).is_empty(),
+            "{args:?} wrote {:?}",
+            files_in(&out)
+        );
+    }
+}
+
+#[test]
+fn a_fifo_as_obj_file_is_refused_instead_of_blocking() {
+    let dir = tempfile::tempdir().unwrap();
+    let fifo = dir.path().join("mesh.obj");
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+    assert!(made.is_ok_and(|s| s.success()), "mkfifo");
+    let mut s = scene();
+    s["objects"] = json!([{ "type": "mesh", "path": "mesh.obj" }]);
+    let path = write_scene(dir.path(), "s.json", &s);
+    let args = ["check", path.to_str().unwrap()];
+    let r = mirrorbox(&args, &[]);
+    assert_refused(&args, &r, &["objects[0].path", "FIFO"]);
+}
+
+/// An output named like an existing folder is refused before the trace, nothing written.
+/// (A write that fails later leaves nothing either: every output is staged and renamed
+/// together, `mirrorbox_files::StagedFiles`.)
+#[test]
+fn an_output_that_is_a_folder_is_refused_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let ok = write_scene(d, "ok.json", &scene());
+    std::fs::create_dir(d.join("b.exr")).unwrap();
+    let (exr, bounces) = (d.join("t.exr"), d.join("b.exr"));
+    let args = [
+        "trace",
+        ok.to_str().unwrap(),
+        "-o",
+        exr.to_str().unwrap(),
+        "--bounces",
+        bounces.to_str().unwrap(),
+    ];
+    let r = mirrorbox(&args, &[]);
+    assert_refused(&args, &r, &["--bounces", "b.exr", "is a folder"]);
+    assert_eq!(files_in(d), ["b.exr", "ok.json"], "nothing else written");
+}
+
+/// A scene with only a camera renders its background with every method, as the tracer does.
+#[test]
+fn an_empty_scene_renders_its_background_with_every_method() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let empty = json!({
+        "camera": { "position": [0, 1, 3], "look_at": [0, 1, 0], "fov_y_deg": 60,
+                    "width": 16, "height": 12 },
+        "background": [0.25, 0.5, 0.75]
+    });
+    let path = write_scene(d, "empty.json", &empty);
+    let listed = mirrorbox(&["render", "--help"], &[]);
+    let methods: Vec<String> = mirrorbox_raster::METHODS
+        .iter()
+        .map(|e| e.name.to_string())
+        .collect();
+    assert!(methods.iter().all(|m| listed.stdout.contains(m.as_str())));
+    for method in &methods {
+        let png = d.join(format!("{method}.png"));
+        let args = [
+            "render",
+            path.to_str().unwrap(),
+            "--method",
+            method,
+            "-o",
+            png.to_str().unwrap(),
+        ];
+        let r = mirrorbox(&args, &[]);
+        assert_eq!(r.code, 0, "{method}: {}", r.stderr);
+        let image = mirrorbox_image::read_image(&png.with_extension("exr")).unwrap();
+        for p in &image.pixels {
+            for c in 0..3 {
+                assert!(
+                    (p[c] - [0.25, 0.5, 0.75][c]).abs() < 1e-6,
+                    "{method}: {p:?}"
+                );
+            }
+        }
+    }
+}
+
+fn small_sweep(scene: &Path, out: &Path, depth: &str) -> std::process::Command {
+    let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_mirrorbox"));
+    cmd.args([
+        "sweep",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--methods",
+        "portal",
+        "--depth",
+        depth,
+        "--alpha",
+        "0.7",
+        "--width",
+        "24",
+        "--height",
+        "16",
+        "--frames",
+        "1",
+        "--warmup",
+        "0",
+    ]);
+    cmd
+}
+
+fn keys(out: &Path) -> Vec<String> {
+    std::fs::read_to_string(out.join("results.jsonl"))
+        .unwrap()
+        .lines()
+        .map(|l| {
+            serde_json::from_str::<Value>(l).unwrap()["key"]
+                .as_str()
+                .unwrap()
+                .to_string()
+        })
+        .collect()
+}
+
+/// A second sweep into a folder in use is refused (naming the first), and a value listed twice
+/// is one point.
+#[test]
+fn concurrent_sweeps_do_not_share_a_folder_and_points_are_unique() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let s = write_scene(d, "s.json", &scene());
+    let out = d.join("sweep");
+    let mut first = small_sweep(&s, &out, "1,2,4,8,16,32,64")
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let lock = out.join(".mirrorbox.lock");
+    let waited = std::time::Instant::now();
+    while !std::fs::read_to_string(&lock).is_ok_and(|t| t.contains("pid")) {
+        assert!(
+            waited.elapsed().as_secs() < 60,
+            "the first sweep never took its lock"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let second = small_sweep(&s, &out, "1,1").output().unwrap();
+    let stderr = String::from_utf8_lossy(&second.stderr);
+    let first_status = first.wait().unwrap();
+    assert!(first_status.success());
+    assert_eq!(second.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("in use by another process (pid ") && stderr.contains("sweep"),
+        "{stderr}"
+    );
+    // Now free: `--depth 1,1` is one point (already done, so nothing new is written).
+    let again = small_sweep(&s, &out, "1,1").output().unwrap();
+    assert!(
+        again.status.success(),
+        "{}",
+        String::from_utf8_lossy(&again.stderr)
+    );
+    let mut k = keys(&out);
+    let n = k.len();
+    k.sort();
+    k.dedup();
+    assert_eq!(k.len(), n, "every key once");
+    assert_eq!(n, 8, "floor + 7 depths");
+    // The report is of the last configuration: the floor and depth 1, each once.
+    let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 1 + 2, "{csv}");
+}
