@@ -15,11 +15,11 @@ pub const MAX_OBJ_FILE_BYTES: u64 = 256 << 20;
 /// Most triangles in a scene, objects and mirrors together (2²², e.g. twelve spheres at
 /// subdivision level 7). See [`MEMORY_PER_TRIANGLE`].
 pub const MAX_TRIANGLES: usize = 1 << 22;
-/// Peak bytes per triangle of the scene, measured (`/usr/bin/time -v mirrorbox trace` on a
-/// scene of 16 spheres at subdivision 7, 5.2 M triangles, on the development machine: the
-/// geometry, the CWBVH build and the tracer's slots), rounded up. Used to say what a refused
-/// scene would have needed.
-pub const MEMORY_PER_TRIANGLE: u64 = 600;
+/// Peak bytes per triangle of a scene, measured: `mirrorbox trace --spp 1` of twelve spheres
+/// at subdivision level 7 (3.93 M triangles) peaked at 1.25 GB resident on the development
+/// machine (geometry, CWBVH build, the tracer's slots): 318 bytes each; `render --method
+/// naive` of it peaked at 0.98 GB. Used to say what a refused scene would have needed.
+pub const MEMORY_PER_TRIANGLE: u64 = 320;
 /// Every position in a scene (vertices after their transform, mirror corners, camera, lights)
 /// lies within `±MAX_COORDINATE` scene units on every axis, so that every triangle, its
 /// bounds, the BVH and the products the intersection tests form stay finite in f32 (their
