@@ -7,14 +7,20 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 export NODEVICE_SELECT=1
-scripts/install-system-deps.sh
-cargo build --release --locked -p mirrorbox
+# Each step says when it starts and how long it took; the sweeps end with their peak memory.
+step=0
+run_step() {
+  step=$((step + 1))
+  echo "== [$step/6] $*"
+  local started=$SECONDS
+  "$@"
+  echo "== [$step/6] done in $((SECONDS - started)) s"
+}
+run_step scripts/install-system-deps.sh
+run_step cargo build --release --locked -p mirrorbox
 bin=target/release/mirrorbox
-echo "== mirrorbox check scenes/*.json"
-"$bin" check scenes/*.json
-echo "== mirrorbox info"
-"$bin" info
-echo "== mirrorbox table1 --fresh"
-"$bin" table1 --fresh
-echo "== mirrorbox depth-scaling --fresh"
-"$bin" depth-scaling --fresh
+run_step "$bin" check scenes/*.json
+run_step "$bin" info
+run_step "$bin" table1 --fresh
+run_step "$bin" depth-scaling --fresh
+echo "== main job done in $SECONDS s"

@@ -5,7 +5,7 @@ mod common;
 
 use common::{Output, mirrorbox, repo};
 use serde_json::{Value, json};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// A small valid scene; each test breaks one thing in it.
 fn valid_scene() -> Value {

@@ -70,7 +70,9 @@ impl Gpu {
     pub fn check_buffer(&self, what: &str, bytes: u64, storage: bool) -> Result<(), RasterError> {
         let limits = self.device.limits();
         let limit = if storage {
-            u64::from(limits.max_storage_buffer_binding_size).min(limits.max_buffer_size)
+            limits
+                .max_storage_buffer_binding_size
+                .min(limits.max_buffer_size)
         } else {
             limits.max_buffer_size
         };

@@ -20,7 +20,7 @@ fn buffers_and_targets_beyond_the_device_are_refused_with_the_numbers() {
     );
     gpu.check_buffer("vertex", limits.max_buffer_size, false)
         .expect("at the limit is fine");
-    let storage = u64::from(limits.max_storage_buffer_binding_size);
+    let storage = limits.max_storage_buffer_binding_size;
     assert!(gpu.check_buffer("surface", storage + 1, true).is_err());
     let side = limits.max_texture_dimension_2d;
     let e = gpu.check_target(side + 1, 16).unwrap_err().to_string();

@@ -165,9 +165,8 @@ fn mutate(scene: &Value, rng: &mut Rng) -> Value {
                     _ => None,
                 };
                 // Mostly a number for a number (deep into the renderers), sometimes any value.
-                let value = if current.is_some_and(|c| c.is_number()) && rng.below(8) != 0 {
-                    rng.pick(&extreme_numbers()).clone()
-                } else if rng.below(2) == 0 {
+                let numeric = current.is_some_and(|c| c.is_number()) && rng.below(8) != 0;
+                let value = if numeric || rng.below(2) == 0 {
                     rng.pick(&extreme_numbers()).clone()
                 } else {
                     rng.pick(&odd_values()).clone()

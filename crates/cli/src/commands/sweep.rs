@@ -193,8 +193,9 @@ fn execute(config: &SweepConfig, fresh: bool) -> Result<(), Failure> {
     }
     let summary = result?;
     println!(
-        "sweep done in {:.1} s: {} points computed, {} reused; truths: {} traced, {} from cache; wrote {}",
+        "sweep done in {:.1} s (peak memory {}): {} points computed, {} reused; truths: {} traced, {} from cache; wrote {}",
         started.elapsed().as_secs_f64(),
+        super::peak_memory().unwrap_or_else(|| "unknown".into()),
         summary.computed,
         summary.reused,
         summary.truths_traced,
