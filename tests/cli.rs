@@ -223,7 +223,10 @@ fn shape_field_of_another_type_is_refused() {
 fn missing_obj_file() {
     assert_rejected(
         |s| s["objects"] = json!([{ "type": "mesh", "path": "meshes/nowhere.obj" }]),
-        &["objects[0].path: cannot read OBJ file \"meshes/nowhere.obj\""],
+        &[
+            "objects[0].path: \"meshes/nowhere.obj\" (at ",
+            "cannot read OBJ file: No such file",
+        ],
     );
 }
 
@@ -455,7 +458,7 @@ fn trace_refuses_bad_arguments_before_writing_anything() {
     let cases: [(Vec<&str>, &str); 6] = [
         (
             trace_args(exr_s, &["--spp", "5"]),
-            "--spp 5 must be a perfect square",
+            "--spp must be a positive perfect square (the s×s sub-pixel grid) of at most 65536: 1, 4, 9, 16, …, got 5",
         ),
         (
             trace_args(exr_s, &["--reflectance", "1.5"]),
@@ -612,7 +615,7 @@ fn render_refuses_bad_arguments() {
         ),
         (&["--alpha", "1.5"], "--alpha must be in [0, 1], got 1.5"),
         (&["--ssaa", "0"], "--ssaa must be in [1, 8], got 0"),
-        (&["--frames", "0"], "--frames must be at least 1"),
+        (&["--frames", "0"], "--frames must be in [1, 10000], got 0"),
         (
             &["--texture-scale", "0"],
             "--texture-scale must be in (0, 4], got 0",
