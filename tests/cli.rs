@@ -462,7 +462,7 @@ fn trace_refuses_bad_arguments_before_writing_anything() {
         ),
         (
             trace_args(exr_s, &["--reflectance", "1.5"]),
-            "--reflectance must be in [0, 1], got 1.5",
+            "--alpha must be in [0, 1], got 1.5",
         ),
         (
             trace_args(exr_s, &["--min-throughput", "1"]),
@@ -1080,4 +1080,106 @@ fn render_unrolled_reports_paths_and_clipping() {
     assert!(v["clipping"].is_string());
     assert!(v["triangles"].as_u64().unwrap() > 0);
     assert!(png.exists() && png.with_extension("exr").exists());
+}
+
+/// Issue #13: small values print in scientific notation, never as `0.000000`.
+#[test]
+fn compare_prints_small_values_in_scientific_notation() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = dir.path().join("a.exr");
+    let b = dir.path().join("b.exr");
+    for (p, r) in [(&a, "0.9"), (&b, "0.9001")] {
+        let out = mirrorbox(&trace_args(p.to_str().unwrap(), &["--alpha", r]), &[]);
+        assert_eq!(out.code, 0, "{}", out.stderr);
+    }
+    let out = mirrorbox(&["compare", a.to_str().unwrap(), b.to_str().unwrap()], &[]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    assert!(!out.stdout.contains("0.000000"), "{}", out.stdout);
+    let relmse = out
+        .stdout
+        .split("relMSE ")
+        .nth(1)
+        .and_then(|t| t.split_whitespace().next())
+        .unwrap();
+    let value: f64 = relmse.parse().unwrap();
+    assert!(
+        value > 0.0 && value < 1e-4 && relmse.contains('e'),
+        "{relmse}"
+    );
+}
+
+/// Issue #13: one name per concept (`--alpha`, alias `--reflectance`, everywhere), and a
+/// negative value gets our range message, not clap's tip about `--`.
+#[test]
+fn alpha_and_reflectance_are_one_flag_everywhere() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = dir.path().join("x.exr");
+    let png = dir.path().join("x.png");
+    let xml = dir.path().join("x.xml");
+    let (o, png, xml) = (
+        o.to_str().unwrap(),
+        png.to_str().unwrap(),
+        xml.to_str().unwrap(),
+    );
+    let s = "scenes/mirror_box.json";
+    for flag in ["--alpha", "--reflectance"] {
+        for args in [
+            vec!["trace", s, "-o", o, flag, "-1"],
+            vec!["render", s, "-o", png, flag, "-1"],
+            vec!["export-mitsuba", s, "-o", xml, flag, "-1"],
+        ] {
+            let r = mirrorbox(&args, &[]);
+            assert_eq!(r.code, 2, "{args:?}: {}", r.stderr);
+            assert!(
+                r.stderr.contains("--alpha must be in [0, 1], got -1"),
+                "{args:?}: {}",
+                r.stderr
+            );
+        }
+        let r = mirrorbox(
+            &["sweep", s, "--out", o, flag, "0.5,-1", "--methods", "naive"],
+            &[],
+        );
+        assert_eq!(r.code, 2, "{}", r.stderr);
+        assert!(
+            r.stderr.contains("each value must be a number in [0, 1]"),
+            "{}",
+            r.stderr
+        );
+    }
+}
+
+/// Issue #13: `mirrorbox check … | head` ends quietly (SIGPIPE), no "Broken pipe" panic.
+#[test]
+fn printing_into_a_closed_pipe_ends_quietly() {
+    use std::os::unix::process::ExitStatusExt;
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("s.json");
+    std::fs::write(
+        &scene,
+        r#"{ "camera": { "position": [0, 1, 3], "look_at": [0, 1, 0], "fov_y_deg": 60, "width": 8, "height": 8 } }"#,
+    )
+    .unwrap();
+    let path = scene.to_str().unwrap();
+    // ~5000 lines, far more than a pipe buffer holds: the writes must hit the closed pipe.
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_mirrorbox"))
+        .arg("check")
+        .args(std::iter::repeat_n(path, 5000))
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !stderr.contains("panicked") && !stderr.contains("Broken pipe"),
+        "{stderr}"
+    );
+    assert_eq!(
+        out.status.signal(),
+        Some(13),
+        "ended by SIGPIPE: {:?}",
+        out.status
+    );
 }

@@ -76,6 +76,24 @@ fn release_freed_memory_promptly() {
     }
 }
 
+/// Printing into a closed pipe (`mirrorbox check … | head`) ends the process quietly, as Unix
+/// tools do, instead of Rust's "failed printing to stdout: Broken pipe" panic: restore the
+/// default action of SIGPIPE, which Rust's runtime sets to ignore.
+fn die_quietly_on_closed_pipe() {
+    #[cfg(unix)]
+    {
+        const SIGPIPE: std::ffi::c_int = 13;
+        const SIG_DFL: usize = 0;
+        unsafe extern "C" {
+            fn signal(signum: std::ffi::c_int, handler: usize) -> usize;
+        }
+        // SAFETY: called first thing in `main`, before any other thread exists.
+        unsafe {
+            signal(SIGPIPE, SIG_DFL);
+        }
+    }
+}
+
 /// `n thing` or `n things`.
 pub fn count(n: usize, thing: &str) -> String {
     if n == 1 {
@@ -144,6 +162,7 @@ impl Failure {
 fn main() -> ExitCode {
     quiet_mesa_device_select();
     release_freed_memory_promptly();
+    die_quietly_on_closed_pipe();
     // A repeated flag: the last one wins, as in most command lines (scripts append overrides).
     let command = Cli::command().mut_subcommands(|s| s.args_override_self(true));
     // clap exits with 2 on bad arguments, matching our convention.
@@ -165,5 +184,25 @@ fn main() -> ExitCode {
             eprintln!("error: {}", failure.message());
             ExitCode::from(failure.exit_code())
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Issue #13: every flag and argument of every subcommand says what it is.
+    #[test]
+    fn every_flag_has_help() {
+        let command = Cli::command();
+        let mut missing = Vec::new();
+        for sub in command.get_subcommands() {
+            for arg in sub.get_arguments() {
+                if arg.get_help().is_none() && arg.get_long_help().is_none() {
+                    missing.push(format!("{} --{}", sub.get_name(), arg.get_id()));
+                }
+            }
+        }
+        assert!(missing.is_empty(), "no help: {missing:?}");
     }
 }

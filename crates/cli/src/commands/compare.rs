@@ -76,11 +76,11 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             r.height
         );
         println!(
-            "  linear:  RMSE {:.6}  relMSE {:.6}  SMAPE {:.6}  max |d| {:.6}",
+            "  linear:  RMSE {:.4e}  relMSE {:.4e}  SMAPE {:.4e}  max |d| {:.4e}",
             m.rmse, m.relmse, m.smape, m.max_abs
         );
         println!(
-            "  sRGB:    PSNR {:.2} dB  SSIM {:.6}  FLIP mean {:.6} p95 {:.6} p99 {:.6} ({} px/deg)",
+            "  sRGB:    PSNR {:.2} dB  SSIM {:.6}  FLIP mean {:.4e} p95 {:.4e} p99 {:.4e} ({} px/deg)",
             m.psnr, m.ssim, m.flip_mean, m.flip_p95, m.flip_p99, FLIP_PIXELS_PER_DEGREE
         );
     }

@@ -12,21 +12,27 @@ pub struct Args {
     /// Output XML; meshes go to meshes/ beside it, with mirrorbox.json (what Mitsuba cannot express).
     #[arg(short, long)]
     output: PathBuf,
+    /// Image width in pixels, 1..16384 (default: the scene camera's).
     #[arg(long)]
     width: Option<u32>,
+    /// Image height in pixels, 1..16384 (default: the scene camera's).
     #[arg(long)]
     height: Option<u32>,
     /// Samples per pixel (a perfect square: Mitsuba's unjittered stratified grid = ours).
     #[arg(long, default_value_t = 16)]
     spp: u32,
-    /// Override every mirror's reflectance, in [0, 1].
-    #[arg(long)]
+    /// α: override every mirror's reflectance, in [0, 1]. `--reflectance` is the same flag.
+    #[arg(
+        long = "alpha",
+        visible_alias = "reflectance",
+        allow_negative_numbers = true
+    )]
     reflectance: Option<f32>,
 }
 
 pub fn run(args: &Args) -> Result<(), Failure> {
     grid_side(args.spp)?;
-    unit_interval("--reflectance", args.reflectance)?;
+    unit_interval("--alpha", args.reflectance)?;
     // The export is a folder of files: make the folder if needed.
     if let Some(dir) = args.output.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).map_err(|e| {

@@ -18,12 +18,16 @@ pub struct Args {
     method: String,
     #[command(flatten)]
     options: RenderOptions,
-    /// Attenuation per reflection; also sets every mirror's reflectance (the truth to compare
-    /// with is `trace --reflectance α`). In [0, 1]. Default: the scene's reflectances.
-    #[arg(long)]
+    /// α: attenuation per reflection; sets every mirror's reflectance (the truth to compare
+    /// with is `trace --alpha α`). In [0, 1]. Default: the scene's reflectances.
+    /// `--reflectance` is the same flag.
+    #[arg(long, visible_alias = "reflectance", allow_negative_numbers = true)]
     alpha: Option<f32>,
+    /// Image width in pixels, 1..16384 (default: the scene camera's; the vertical field of
+    /// view is kept).
     #[arg(long)]
     width: Option<u32>,
+    /// Image height in pixels, 1..16384 (default: the scene camera's).
     #[arg(long)]
     height: Option<u32>,
     /// Supersampling factor s: renders at s× and box-filters down, the tracer's `--spp s²` grid.
@@ -32,6 +36,7 @@ pub struct Args {
     /// Timed frames (after --warmup untimed ones).
     #[arg(long, default_value_t = 1)]
     frames: u32,
+    /// Untimed frames rendered first (driver caches, pipeline compilation), 0..1000.
     #[arg(long, default_value_t = 2)]
     warmup: u32,
     /// Print one JSON object with timings, counts, adapter and parameters.

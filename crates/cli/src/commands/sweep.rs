@@ -23,11 +23,20 @@ pub struct Args {
     /// the exact methods); its other options take one value, for the methods that have them.
     #[command(flatten)]
     options: SweepOptions,
-    /// Reflectances α, comma separated, each in [0, 1].
-    #[arg(long, default_value = "0.5,0.7,0.9,1.0")]
+    /// α: mirror reflectances, comma separated, each in [0, 1]. `--reflectance` is the same
+    /// flag.
+    #[arg(
+        long,
+        visible_alias = "reflectance",
+        default_value = "0.5,0.7,0.9,1.0",
+        allow_hyphen_values = true
+    )]
     alpha: String,
+    /// Image width in pixels, 1..16384 (default: the scene camera's; the vertical field of
+    /// view is kept).
     #[arg(long)]
     width: Option<u32>,
+    /// Image height in pixels, 1..16384 (default: the scene camera's).
     #[arg(long)]
     height: Option<u32>,
     /// Supersampling s of the raster (the truth uses the same s×s sub-pixel grid).
@@ -36,13 +45,14 @@ pub struct Args {
     /// Timed frames per point (after --warmup untimed ones).
     #[arg(long, default_value_t = 5)]
     frames: u32,
+    /// Untimed frames rendered first (driver caches, pipeline compilation), 0..1000.
     #[arg(long, default_value_t = 2)]
     warmup: u32,
     /// Ground truth: most mirror reflections a path follows.
     #[arg(long, default_value_t = 10_000)]
     max_depth: u32,
-    /// Ground truth: stop a path below this throughput.
-    #[arg(long, default_value_t = 1e-4)]
+    /// Ground truth: stop a path below this throughput, in [0, 1).
+    #[arg(long, default_value_t = 1e-4, allow_negative_numbers = true)]
     min_throughput: f32,
     /// Discard earlier results in --out and measure every point again (cached truths stay).
     #[arg(long)]

@@ -41,8 +41,13 @@ pub struct Args {
     /// rasterizer reproduces with --ssaa s.
     #[arg(long, default_value_t = 16)]
     spp: u32,
-    /// Override every mirror's reflectance (the α being measured), in [0, 1].
-    #[arg(long)]
+    /// α: override every mirror's reflectance (the attenuation per reflection being measured),
+    /// in [0, 1]. `--reflectance` is the same flag.
+    #[arg(
+        long = "alpha",
+        visible_alias = "reflectance",
+        allow_negative_numbers = true
+    )]
     reflectance: Option<f32>,
     /// whitted: most mirror reflections a path follows; path: longest path in segments
     /// (Mitsuba's max_depth: N visible reflections need N + 2).
@@ -52,7 +57,7 @@ pub struct Args {
     #[arg(long, default_value_t = 5)]
     rr_depth: u32,
     /// Stop a path when its throughput's largest channel would fall below this, in [0, 1).
-    #[arg(long, default_value_t = 1e-4)]
+    #[arg(long, default_value_t = 1e-4, allow_negative_numbers = true)]
     min_throughput: f32,
     /// Stratified random sub-pixel positions instead of the fixed grid.
     #[arg(long)]
@@ -63,6 +68,7 @@ pub struct Args {
     /// Also write the mean number of mirror bounces per pixel (EXR, with a heat-map PNG beside it).
     #[arg(long, value_name = "FILE.exr")]
     bounces: Option<PathBuf>,
+    /// How paths are followed: the contract's Whitted chains, or physically based paths.
     #[arg(long, value_enum, default_value_t = Integrator::Whitted)]
     integrator: Integrator,
     /// obvhs hierarchy to traverse.
@@ -75,7 +81,7 @@ pub struct Args {
 
 fn check_args(args: &Args) -> Result<(SubpixelGrid, WhittedSettings), Failure> {
     let s = grid_side(args.spp)?;
-    unit_interval("--reflectance", args.reflectance)?;
+    unit_interval("--alpha", args.reflectance)?;
     let whitted = WhittedSettings {
         max_depth: args.max_depth,
         min_throughput: args.min_throughput,
