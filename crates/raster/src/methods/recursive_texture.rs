@@ -410,7 +410,7 @@ impl RecursiveTexture {
             .iter()
             .map(|&(w, h)| {
                 RenderTarget::new(
-                    device,
+                    gpu,
                     "mirror texture",
                     w,
                     h,
@@ -419,7 +419,7 @@ impl RecursiveTexture {
             })
             .collect();
         let none = RenderTarget::new(
-            device,
+            gpu,
             "no texture",
             1,
             1,
@@ -466,7 +466,7 @@ impl RecursiveTexture {
                 ),
                 color_writes: wgpu::ColorWrites::ALL,
             }
-            .build(device)
+            .build(gpu)
         };
         let objects_pipeline = pipeline(
             "recursive texture objects",
