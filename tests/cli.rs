@@ -727,24 +727,49 @@ fn render_refuses_bad_arguments() {
         assert_eq!(out.code, 2, "{args:?}: {}", out.stderr);
         assert!(out.stderr.contains(message), "{args:?}: {}", out.stderr);
     }
-    let out = mirrorbox(
-        &[
-            "render",
+    // auxiliary on more than two mirrors: within --max-passes it renders (tests/methods.rs);
+    // beyond, it is refused with the count — or, past counting, "or more" — at once; a lone
+    // mirror has nothing for copies to alternate with.
+    let refusals: [(&str, &str, &str); 3] = [
+        (
             "scenes/mirror_room.json",
-            "--method",
-            "auxiliary",
-            "-o",
-            "/tmp/never.png",
-        ],
-        &[],
-    );
-    assert_eq!(out.code, 2);
-    assert!(
-        out.stderr
-            .contains("the auxiliary method needs exactly 2 mirrors"),
-        "{}",
-        out.stderr
-    );
+            "3",
+            "would render 120199 scene passes per frame, above --max-passes 5000",
+        ),
+        (
+            "scenes/mirror_room.json",
+            "16",
+            "scene passes per frame, above --max-passes 5000",
+        ),
+        (
+            "scenes/single_mirror.json",
+            "1",
+            "--n above 0 needs at least 2 mirrors; the scene has 1",
+        ),
+    ];
+    for (scene, n, message) in refusals {
+        let started = std::time::Instant::now();
+        let out = mirrorbox(
+            &[
+                "render",
+                scene,
+                "--method",
+                "auxiliary",
+                "--n",
+                n,
+                "-o",
+                "/tmp/never.png",
+            ],
+            &[],
+        );
+        assert_eq!(out.code, 2, "{scene} --n {n}: {}", out.stderr);
+        assert!(out.stderr.contains(message), "{}", out.stderr);
+        assert!(
+            started.elapsed().as_secs_f64() < 5.0,
+            "{scene} --n {n}: refused after {:?}",
+            started.elapsed()
+        );
+    }
 }
 
 // ---------------------------------------------------------------------------------------

@@ -139,7 +139,7 @@ mod tests {
     #[test]
     fn refusals_and_device_failures_are_told_apart() {
         let refusals = [
-            PlanError::NotAPair(3),
+            PlanError::NoMirrorToAlternateWith(1),
             PlanError::TooManyPaths { limit: 1 },
             PlanError::TooManyTriangles {
                 triangles: 2,
