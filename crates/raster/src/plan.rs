@@ -23,14 +23,14 @@
 //! (consecutive planes distinct, each visible from the camera reflected in the previous
 //! ones, mirror i used at most c_i + 1 times for its c_i copies): a chain that has used
 //! mirror j t times continues into j in c_j + 1 − t ways, so the calls along one plane chain
-//! are the product of those counts. For two facing mirrors with a instances on the side the
-//! camera sees and b on the other (a = 1 + ⌈n/2⌉, b = 1 + ⌊n/2⌋ when it looks into mirror
-//! 1) there is one plane chain per length and the sum is a + a·b + a·b·(a−1) +
+//! are the product of those counts. For two facing mirrors, with a instances on the side
+//! the camera sees and b on the other (a = 1 + ⌈n/2⌉, b = 1 + ⌊n/2⌋ when it looks into
+//! mirror 1), there is one plane chain per length and the sum is a + a·b + a·b·(a−1) +
 //! a·b·(a−1)·(b−1) + …: 3, 7, 15, 46, 139 passes for n = 0…4 on `mirror_box`. The growth is
 //! factorial, which is what the paper's Table 1 (25, 61, 142, 435, 1330 ms) shows: divided
-//! by these counts it is 8.3–9.6 ms per pass. Counting visits each plane chain once and stops
-//! after `--max-passes` of them, so a refusal costs at most that many visibility tests, however
-//! large the plan.
+//! by these counts it is 8.3–9.6 ms per pass. Counting visits each plane chain once and
+//! stops after `--max-passes` of them, so a refusal costs at most that many visibility
+//! tests, however large the plan.
 
 use glam::{Mat4, Vec2};
 use mirrorbox_scene::polygon::{clip_by, screen_footprint};
