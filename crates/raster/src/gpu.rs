@@ -1,7 +1,7 @@
 //! The device every raster method renders with, and the errors a raster command can meet.
 
 use crate::adapter::{AdapterError, AdapterReport, select_adapter_from};
-use crate::targets::{COLOR_FORMAT_ENV, ColorFormat};
+use crate::color_format::{COLOR_FORMAT_ENV, ColorFormat};
 use std::sync::{Arc, Mutex};
 
 #[derive(Debug, thiserror::Error)]

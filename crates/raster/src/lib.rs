@@ -11,11 +11,12 @@
 //! - [`culling`]: footprint rectangles and parts against a path's portal.
 //! - [`shading`]: the scene buffers the contract's WGSL reads; [`wgsl`]: all WGSL composition.
 //! - The thin wgpu layer: [`adapter`] (Vulkan, then GL; `WGPU_BACKEND` overrides), [`gpu`]
-//!   (device, its colour format, errors), [`targets`] (the colour format: RGBA32F, else
-//!   RGBA16F; `MIRRORBOX_COLOR_FORMAT` forces one), [`pipeline`] (scene-pipeline builder, uniform arena),
+//!   (device and errors), [`color_format`] (RGBA32F, else RGBA16F;
+//!   `MIRRORBOX_COLOR_FORMAT` forces one), [`targets`], [`pipeline`] (scene-pipeline builder, uniform arena),
 //!   [`resolve`] (SSAA), [`timing`] (GPU timestamps), [`readback`].
 
 pub mod adapter;
+pub mod color_format;
 pub mod culling;
 pub mod exact_paths;
 pub mod gpu;
@@ -32,13 +33,13 @@ pub mod timing;
 pub mod wgsl;
 
 pub use adapter::{AdapterError, AdapterReport, SelectedAdapter, select_adapter};
+pub use color_format::ColorFormat;
 pub use gpu::{Gpu, GpuOptions, RasterError};
 pub use method::{
     Clipping, FrameStats, MethodEntry, OptionSpec, ParamError, ParamValue, PathCounts, RasterMethod,
 };
 pub use plan::PlanError;
 pub use registry::{METHODS, Method};
-pub use targets::ColorFormat;
 pub use timing::{FrameTiming, TimingSource};
 
 use mirrorbox_image::RgbImage;

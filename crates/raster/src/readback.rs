@@ -1,7 +1,7 @@
 //! Reading textures and buffers back to the CPU.
 
+use crate::color_format::ColorFormat;
 use crate::gpu::{Gpu, RasterError};
-use crate::targets::ColorFormat;
 use half::f16;
 use mirrorbox_image::RgbImage;
 
