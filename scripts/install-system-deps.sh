@@ -2,7 +2,9 @@
 # Installs what mirrorbox needs from the system and is missing, saying what it does.
 #   - Mesa's software Vulkan driver (lavapipe) and the Vulkan loader, so wgpu can render
 #     on a machine without a GPU (Debian/Ubuntu: mesa-vulkan-drivers, libvulkan1);
-#   - Mesa's EGL/GL drivers as the fallback backend (libegl1, libegl-mesa0, libgl1-mesa-dri).
+#   - Mesa's EGL/GL drivers as the fallback backend, which the GL backend tests render with
+#     (libegl1: the libEGL.so.1 wgpu loads; libegl-mesa0: Mesa's EGL vendor library;
+#     libgl1-mesa-dri: llvmpipe, swrast_dri.so).
 # Uses apt-get when run as root (or through sudo when available). Idempotent: does nothing
 # when everything is present. Never fails the caller: without a driver, GPU tests will say so.
 set -u
@@ -13,7 +15,9 @@ have_vulkan_driver() {
     ldconfig -p 2>/dev/null | grep -q 'libvulkan\.so\.1'
 }
 have_egl() {
-  ldconfig -p 2>/dev/null | grep -q 'libEGL_mesa\.so\.0'
+  ldconfig -p 2>/dev/null | grep -q 'libEGL\.so\.1' &&
+    ldconfig -p 2>/dev/null | grep -q 'libEGL_mesa\.so\.0' &&
+    ls /usr/lib/*/dri/swrast_dri.so /usr/lib*/dri/swrast_dri.so 2>/dev/null | grep -q .
 }
 
 missing=()

@@ -326,6 +326,53 @@ fn info_reports_the_adapter_and_its_timing_support() {
         "{v}"
     );
     assert!(v["timestamp_query"].is_boolean());
+    assert!(
+        ["rgba32float", "rgba16float"].contains(&v["color_format"].as_str().unwrap()),
+        "{v}"
+    );
+}
+
+/// `MIRRORBOX_COLOR_FORMAT` forces the colour format: `info` and `render` say so; a value
+/// that names no format is refused (exit 2) before anything is written.
+#[test]
+fn the_colour_format_can_be_forced_and_is_reported() {
+    let env = [("MIRRORBOX_COLOR_FORMAT", "rgba16float")];
+    let out = mirrorbox(&["info", "--json"], &env);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let v: Value = serde_json::from_str(out.stdout.trim()).unwrap();
+    assert_eq!(v["color_format"], "rgba16float", "{v}");
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("half.png");
+    let render = |env: &[(&str, &str)]| {
+        mirrorbox(
+            &[
+                "render",
+                "scenes/mirror_box.json",
+                "--width",
+                "32",
+                "--height",
+                "18",
+                "--json",
+                "-o",
+                png.to_str().unwrap(),
+            ],
+            env,
+        )
+    };
+    let out = render(&env);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let r: Value = serde_json::from_str(out.stdout.trim()).unwrap();
+    assert_eq!(r["color_format"], "rgba16float");
+    std::fs::remove_file(&png).unwrap();
+    let out = render(&[("MIRRORBOX_COLOR_FORMAT", "rgba8")]);
+    assert_eq!(out.code, 2, "{}", out.stderr);
+    assert!(
+        out.stderr
+            .contains("MIRRORBOX_COLOR_FORMAT=\"rgba8\" names no colour format"),
+        "{}",
+        out.stderr
+    );
+    assert!(!png.exists());
 }
 
 #[test]
@@ -334,26 +381,47 @@ fn wgpu_backend_override_is_honoured_and_checked() {
     assert_eq!(out.code, 0, "{}", out.stderr);
     let v: Value = serde_json::from_str(out.stdout.trim()).unwrap();
     assert_eq!(v["backend"], "gl");
-    // GL is found, but wgpu's GL backend cannot render the RGBA32F targets the methods use:
-    // a clear failure, nothing written.
+    // GL renders, into RGBA16F where it has no float colour buffers (wgpu on core-profile GL):
+    // `info` says which format, and `render --json` and the EXR header record it.
+    let format = v["color_format"]
+        .as_str()
+        .expect("GL has a colour format")
+        .to_string();
+    assert!(
+        ["rgba32float", "rgba16float"].contains(&format.as_str()),
+        "{v}"
+    );
     let dir = tempfile::tempdir().unwrap();
     let png = dir.path().join("gl.png");
     let out = mirrorbox(
         &[
             "render",
             "scenes/mirror_box.json",
+            "--method",
+            "auxiliary",
+            "--n",
+            "1",
+            "--width",
+            "64",
+            "--height",
+            "36",
+            "--json",
             "-o",
             png.to_str().unwrap(),
         ],
         &[("WGPU_BACKEND", "gl")],
     );
-    assert_eq!(out.code, 1, "{}", out.stderr);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let r: Value = serde_json::from_str(out.stdout.trim()).unwrap();
+    assert_eq!(r["backend"], "gl");
+    assert_eq!(r["color_format"], format.as_str());
+    assert_eq!(r["depth"], 3);
+    assert!(png.is_file());
+    let exr = std::fs::read(png.with_extension("exr")).unwrap();
     assert!(
-        out.stderr.contains("cannot render to RGBA32F"),
-        "{}",
-        out.stderr
+        exr.windows(format.len()).any(|w| w == format.as_bytes()),
+        "the EXR header names the colour format"
     );
-    assert!(!png.exists());
     let out = mirrorbox(&["info"], &[("WGPU_BACKEND", "nonsense")]);
     assert_eq!(out.code, 2);
     assert!(
@@ -640,24 +708,49 @@ fn render_refuses_bad_arguments() {
         assert_eq!(out.code, 2, "{args:?}: {}", out.stderr);
         assert!(out.stderr.contains(message), "{args:?}: {}", out.stderr);
     }
-    let out = mirrorbox(
-        &[
-            "render",
+    // auxiliary on more than two mirrors: within --max-passes it renders (tests/methods.rs);
+    // beyond, it is refused with the count — or, past counting, "or more" — at once; a lone
+    // mirror has nothing for copies to alternate with.
+    let refusals: [(&str, &str, &str); 3] = [
+        (
             "scenes/mirror_room.json",
-            "--method",
-            "auxiliary",
-            "-o",
-            "/tmp/never.png",
-        ],
-        &[],
-    );
-    assert_eq!(out.code, 2);
-    assert!(
-        out.stderr
-            .contains("the auxiliary method needs exactly 2 mirrors"),
-        "{}",
-        out.stderr
-    );
+            "3",
+            "would render 120199 scene passes per frame, above --max-passes 5000",
+        ),
+        (
+            "scenes/mirror_room.json",
+            "16",
+            "scene passes per frame, above --max-passes 5000",
+        ),
+        (
+            "scenes/single_mirror.json",
+            "1",
+            "--n above 0 needs at least 2 mirrors; the scene has 1",
+        ),
+    ];
+    for (scene, n, message) in refusals {
+        let started = std::time::Instant::now();
+        let out = mirrorbox(
+            &[
+                "render",
+                scene,
+                "--method",
+                "auxiliary",
+                "--n",
+                n,
+                "-o",
+                "/tmp/never.png",
+            ],
+            &[],
+        );
+        assert_eq!(out.code, 2, "{scene} --n {n}: {}", out.stderr);
+        assert!(out.stderr.contains(message), "{}", out.stderr);
+        assert!(
+            started.elapsed().as_secs_f64() < 5.0,
+            "{scene} --n {n}: refused after {:?}",
+            started.elapsed()
+        );
+    }
 }
 
 // ---------------------------------------------------------------------------------------
@@ -815,6 +908,7 @@ fn sweep_writes_every_output_and_error_falls_with_n() {
             "draws",
             "metrics",
             "adapter",
+            "color_format",
             "key",
         ] {
             assert!(!r[k].is_null(), "{k} missing in {r}");

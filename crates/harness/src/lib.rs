@@ -548,6 +548,7 @@ pub fn run_sweep(
             metrics: metric_values(&m),
             adapter: gpu.report.name.clone(),
             backend: gpu.report.backend.clone(),
+            color_format: rendered.color_format.name().into(),
             truth_image: rel(&truth_png),
             raster_image: rel(&raster_png),
             heatmap_image: rel(&heat_png),

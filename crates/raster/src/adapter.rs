@@ -104,15 +104,23 @@ fn try_backends(backends: wgpu::Backends) -> Option<SelectedAdapter> {
 
 /// Chooses the adapter (see the module docs for the order).
 pub fn select_adapter() -> Result<SelectedAdapter, AdapterError> {
-    let order: Vec<(&str, wgpu::Backends)> = match std::env::var("WGPU_BACKEND") {
-        Ok(value) => {
+    select_adapter_from(None)
+}
+
+/// Chooses the adapter among `backends` when given, else as [`select_adapter`] does.
+pub fn select_adapter_from(
+    backends: Option<wgpu::Backends>,
+) -> Result<SelectedAdapter, AdapterError> {
+    let order: Vec<(&str, wgpu::Backends)> = match (backends, std::env::var("WGPU_BACKEND")) {
+        (Some(backends), _) => vec![("the caller's choice", backends)],
+        (None, Ok(value)) => {
             let backends = wgpu::Backends::from_comma_list(&value);
             if backends.is_empty() {
                 return Err(AdapterError::BadOverride { value });
             }
             vec![("WGPU_BACKEND", backends)]
         }
-        Err(_) => vec![
+        (None, Err(_)) => vec![
             ("Vulkan", wgpu::Backends::VULKAN),
             ("GL", wgpu::Backends::GL),
         ],

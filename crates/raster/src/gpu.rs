@@ -1,6 +1,7 @@
 //! The device every raster method renders with, and the errors a raster command can meet.
 
-use crate::adapter::{AdapterError, AdapterReport, select_adapter};
+use crate::adapter::{AdapterError, AdapterReport, select_adapter_from};
+use crate::color_format::{COLOR_FORMAT_ENV, ColorFormat};
 use std::sync::{Arc, Mutex};
 
 #[derive(Debug, thiserror::Error)]
@@ -11,6 +12,8 @@ pub enum RasterError {
     Plan(#[from] crate::plan::PlanError),
     #[error("cannot create the wgpu device on {adapter}: {message}")]
     Device { adapter: String, message: String },
+    #[error("{COLOR_FORMAT_ENV}={value:?} names no colour format (use rgba32float or rgba16float)")]
+    BadColorFormat { value: String },
     #[error("wgpu reported an error: {0}")]
     Gpu(String),
     /// A resource this frame needs is larger than the device allows (checked before it is
@@ -39,14 +42,27 @@ impl RasterError {
             RasterError::Plan(_)
                 | RasterError::ExceedsDevice { .. }
                 | RasterError::Adapter(AdapterError::BadOverride { .. })
+                | RasterError::BadColorFormat { .. }
         )
     }
+}
+
+/// What to open, where the environment should not decide: the backends to try and the
+/// colour format. `None` leaves each to the environment (`WGPU_BACKEND`,
+/// `MIRRORBOX_COLOR_FORMAT`) and then to the defaults (Vulkan, then GL; the best colour
+/// format the adapter has).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct GpuOptions {
+    pub backends: Option<wgpu::Backends>,
+    pub color_format: Option<ColorFormat>,
 }
 
 pub struct Gpu {
     pub device: wgpu::Device,
     pub queue: wgpu::Queue,
     pub report: AdapterReport,
+    /// The format of every colour target and mirror texture on this device.
+    pub color_format: ColorFormat,
     /// GPU timestamps are available (and enabled) on this device.
     pub timestamps: bool,
     /// The features enabled on this device: timestamps where available, and every feature
@@ -103,27 +119,22 @@ impl Gpu {
         Ok(())
     }
 
-    /// Opens the adapter of [`select_adapter`] with those of `wanted` (and timestamp queries)
-    /// that it has.
-    pub fn with_features(wanted: wgpu::Features) -> Result<Gpu, RasterError> {
-        let selected = select_adapter()?;
-        // Every method renders linear radiance into RGBA32F targets; wgpu's GL backend does
-        // not offer them as render attachments (downlevel), so say so instead of failing later.
-        let rgba32f = selected
-            .adapter
-            .get_texture_format_features(crate::targets::COLOR_FORMAT);
-        if !rgba32f
-            .allowed_usages
-            .contains(wgpu::TextureUsages::RENDER_ATTACHMENT)
-        {
-            return Err(RasterError::Device {
+    /// Opens the adapter `options` (or the environment) selects, with those of `wanted` (and
+    /// timestamp queries) that it has, and chooses its colour format (see [`ColorFormat`]).
+    pub fn open(wanted: wgpu::Features, options: GpuOptions) -> Result<Gpu, RasterError> {
+        let forced = match options.color_format {
+            Some(f) => Some(f),
+            None => {
+                ColorFormat::from_env().map_err(|value| RasterError::BadColorFormat { value })?
+            }
+        };
+        let selected = select_adapter_from(options.backends)?;
+        let color_format = ColorFormat::choose(&selected.adapter, forced).map_err(|message| {
+            RasterError::Device {
                 adapter: format!("{} ({})", selected.report.name, selected.report.backend),
-                message: "it cannot render to RGBA32F targets, which every raster method needs \
-                          (wgpu's GL backend never can); install Mesa's Vulkan driver \
-                          (scripts/install-system-deps.sh) or use a Vulkan adapter"
-                    .into(),
-            });
-        }
+                message,
+            }
+        })?;
         let timestamps = selected.report.timestamp_query;
         let features = (wanted | wgpu::Features::TIMESTAMP_QUERY) & selected.adapter.features();
         let (device, queue) =
@@ -147,6 +158,7 @@ impl Gpu {
             device,
             queue,
             report: selected.report,
+            color_format,
             timestamps,
             features,
             errors,
@@ -184,7 +196,7 @@ mod tests {
     #[test]
     fn refusals_and_device_failures_are_told_apart() {
         let refusals = [
-            PlanError::NotAPair(3),
+            PlanError::NoMirrorToAlternateWith(1),
             PlanError::TooManyPaths { limit: 1 },
             PlanError::TooManyTriangles {
                 triangles: 2,
@@ -201,6 +213,7 @@ mod tests {
             assert!(RasterError::Plan(p).is_refusal());
         }
         assert!(RasterError::Adapter(AdapterError::BadOverride { value: "x".into() }).is_refusal());
+        assert!(RasterError::BadColorFormat { value: "x".into() }.is_refusal());
         let failures = [
             RasterError::Device {
                 adapter: "a".into(),

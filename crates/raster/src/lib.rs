@@ -11,10 +11,12 @@
 //! - [`culling`]: footprint rectangles and parts against a path's portal.
 //! - [`shading`]: the scene buffers the contract's WGSL reads; [`wgsl`]: all WGSL composition.
 //! - The thin wgpu layer: [`adapter`] (Vulkan, then GL; `WGPU_BACKEND` overrides), [`gpu`]
-//!   (device and errors), [`targets`], [`pipeline`] (scene-pipeline builder, uniform arena),
+//!   (device and errors), [`color_format`] (RGBA32F, else RGBA16F;
+//!   `MIRRORBOX_COLOR_FORMAT` forces one), [`targets`], [`pipeline`] (scene-pipeline builder, uniform arena),
 //!   [`resolve`] (SSAA), [`timing`] (GPU timestamps), [`readback`].
 
 pub mod adapter;
+pub mod color_format;
 pub mod culling;
 pub mod exact_paths;
 pub mod gpu;
@@ -31,7 +33,8 @@ pub mod timing;
 pub mod wgsl;
 
 pub use adapter::{AdapterError, AdapterReport, SelectedAdapter, select_adapter};
-pub use gpu::{Gpu, RasterError};
+pub use color_format::ColorFormat;
+pub use gpu::{Gpu, GpuOptions, RasterError};
 pub use method::{
     Clipping, FrameStats, MethodEntry, OptionSpec, ParamError, ParamValue, PathCounts, RasterMethod,
 };
@@ -132,6 +135,9 @@ pub struct RenderOutput {
     pub image: RgbImage,
     pub timing: FrameTiming,
     pub stats: FrameStats,
+    /// The format of every colour target and mirror texture it was rendered into (RGBA16F
+    /// adds its rounding, `ColorFormat::relative_store_error`, each time a value is stored).
+    pub color_format: ColorFormat,
     /// Conditions under which the image may not be what the method promises.
     pub warnings: Vec<String>,
 }
@@ -176,14 +182,9 @@ pub fn render_planned(
     );
     gpu.check_target(w, h)?;
     shading::SceneBuffers::check_fits(gpu, scene)?;
-    let target = targets::RenderTarget::new(
-        &gpu.device,
-        "view",
-        w,
-        h,
-        wgpu::TextureUsages::TEXTURE_BINDING,
-    );
-    let resolve = resolve::Resolve::new(&gpu.device, &target, settings.ssaa);
+    let target =
+        targets::RenderTarget::new(gpu, "view", w, h, wgpu::TextureUsages::TEXTURE_BINDING);
+    let resolve = resolve::Resolve::new(gpu, &target, settings.ssaa);
     let built = planned.frame.build(gpu, scene)?;
     gpu.check()?;
     let (image, timing) = timing::run_frames(
@@ -198,6 +199,7 @@ pub fn render_planned(
         image,
         timing,
         stats: built.stats,
+        color_format: gpu.color_format,
         warnings: built.warnings,
     })
 }

@@ -1,12 +1,13 @@
 //! The pieces of wgpu set-up every method shares: the scene-pipeline builder, a uniform
 //! arena for dynamic offsets, and bind-group layout entries.
 //!
-//! Every scene pipeline draws linear radiance into one [`COLOR_FORMAT`] target, with culling
+//! Every scene pipeline draws linear radiance into a target of the device's colour format
+//! ([`crate::targets::ColorFormat`]), with culling
 //! off (reflections flip the winding and shading is two-sided, `docs/shading.md`) and no
 //! multisampling (supersampling is the SSAA grid); what differs between methods is the shader
 //! entry points, the vertex buffers, the depth/stencil state and which colours are written.
 
-use crate::targets::COLOR_FORMAT;
+use crate::gpu::Gpu;
 use bytemuck::Pod;
 use wgpu::util::DeviceExt;
 
@@ -25,35 +26,37 @@ pub struct ScenePipeline<'a> {
 }
 
 impl ScenePipeline<'_> {
-    pub fn build(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
-        device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some(self.label),
-            layout: Some(self.layout),
-            vertex: wgpu::VertexState {
-                module: self.module,
-                entry_point: Some(self.vertex),
-                compilation_options: Default::default(),
-                buffers: self.buffers,
-            },
-            primitive: wgpu::PrimitiveState {
-                cull_mode: None,
-                ..Default::default()
-            },
-            depth_stencil: Some(self.depth_stencil.clone()),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: self.module,
-                entry_point: Some(self.fragment),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: COLOR_FORMAT,
-                    blend: None,
-                    write_mask: self.color_writes,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        })
+    /// The pipeline on `gpu`, drawing into its colour format.
+    pub fn build(&self, gpu: &Gpu) -> wgpu::RenderPipeline {
+        gpu.device
+            .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(self.label),
+                layout: Some(self.layout),
+                vertex: wgpu::VertexState {
+                    module: self.module,
+                    entry_point: Some(self.vertex),
+                    compilation_options: Default::default(),
+                    buffers: self.buffers,
+                },
+                primitive: wgpu::PrimitiveState {
+                    cull_mode: None,
+                    ..Default::default()
+                },
+                depth_stencil: Some(self.depth_stencil.clone()),
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: self.module,
+                    entry_point: Some(self.fragment),
+                    compilation_options: Default::default(),
+                    targets: &[Some(wgpu::ColorTargetState {
+                        format: gpu.color_format.texture_format(),
+                        blend: None,
+                        write_mask: self.color_writes,
+                    })],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
     }
 }
 

@@ -9,17 +9,28 @@
 //! - `naive` (Algorithm 1 as printed): the queue is the scene's mirrors. Two facing mirrors
 //!   A, B seen through A give the chain A → B and stop (A is hidden inside B's recursion):
 //!   exactly two reflections, the paper's Figure 2.
-//! - `auxiliary` (§3.1): n auxiliary mirrors coincide with the two real ones, alternating
-//!   sides by label parity (odd labels on mirror 1's side, even on mirror 2's), so the queue
-//!   holds n + 2 mirrors and chains reach n + 2 reflections. Each instance hides only itself,
-//!   so every camera recurses into *every* unhidden instance on the other side.
+//! - `auxiliary` (§3.1): n auxiliary mirrors coincide with real ones, alternating sides by
+//!   label parity, so chains can use a mirror again. With two mirrors (the paper's setting)
+//!   odd labels lie on mirror 1, even on mirror 2: the queue holds n + 2 mirrors and chains
+//!   reach n + 2 reflections. With more mirrors every mirror pairs with its [`partner`] —
+//!   the mirror it faces most directly — and each pair gets the paper's n auxiliary
+//!   mirrors, odd labels on the pair's first mirror in scene order, even on the other, so
+//!   mirror i holds ⌈n/2⌉ or ⌊n/2⌋ copies ([`auxiliary_copies`]). Each instance hides only
+//!   itself, so every camera recurses into *every* unhidden instance it sees.
 //!
-//! **Pass count.** One scene pass for the frame plus one per `MIRRORTEXTURE` call. With a
-//! mirrors on the side the camera sees and b on the other (a = 1 + ⌈n/2⌉, b = 1 + ⌊n/2⌋ when
-//! the camera looks into mirror 1), the calls are the alternating chains of distinct
-//! instances: a + a·b + a·b·(a−1) + a·b·(a−1)·(b−1) + …, i.e. 3, 7, 15, 46, 139 passes for
-//! n = 0…4 on `mirror_box`. The growth is factorial, which is what the paper's Table 1
-//! (25, 61, 142, 435, 1330 ms) shows: divided by these counts it is 8.3–9.6 ms per pass.
+//! **Pass count.** One scene pass for the frame plus one per `MIRRORTEXTURE` call. Coincident
+//! instances see the same things, so the calls are counted over chains of mirror *planes*
+//! (consecutive planes distinct, each visible from the camera reflected in the previous
+//! ones, mirror i used at most c_i + 1 times for its c_i copies): a chain that has used
+//! mirror j t times continues into j in c_j + 1 − t ways, so the calls along one plane chain
+//! are the product of those counts. For two facing mirrors, with a instances on the side
+//! the camera sees and b on the other (a = 1 + ⌈n/2⌉, b = 1 + ⌊n/2⌋ when it looks into
+//! mirror 1), there is one plane chain per length and the sum is a + a·b + a·b·(a−1) +
+//! a·b·(a−1)·(b−1) + …: 3, 7, 15, 46, 139 passes for n = 0…4 on `mirror_box`. The growth is
+//! factorial, which is what the paper's Table 1 (25, 61, 142, 435, 1330 ms) shows: divided
+//! by these counts it is 8.3–9.6 ms per pass. Counting visits each plane chain once and
+//! stops after `--max-passes` of them, so a refusal costs at most that many visibility
+//! tests, however large the plan.
 
 use glam::{Mat4, Vec2};
 use mirrorbox_scene::polygon::{clip_by, screen_footprint};
@@ -30,7 +41,8 @@ use mirrorbox_scene::{Plane, Scene};
 pub const NEAR: f32 = 0.01;
 pub const FAR: f32 = 10_000.0;
 
-/// Plans are counted exactly up to this many texture renders.
+/// Plans are counted exactly up to this many texture renders (when that takes at most
+/// `--max-passes` plane chains).
 const COUNT_CEILING: usize = 1_000_000;
 
 /// The rendering queue of the paper's recursion.
@@ -38,7 +50,8 @@ const COUNT_CEILING: usize = 1_000_000;
 pub enum Queue {
     /// `naive`: the scene's mirrors.
     SceneMirrors,
-    /// `auxiliary`: the two real mirrors and n auxiliary copies of them.
+    /// `auxiliary`: the real mirrors and, for each mirror and its [`partner`], n auxiliary
+    /// copies alternating between the two ([`auxiliary_copies`]).
     Auxiliary { n: u32 },
 }
 
@@ -87,9 +100,9 @@ pub struct Plan {
 #[derive(Debug, thiserror::Error, PartialEq, Eq)]
 pub enum PlanError {
     #[error(
-        "the auxiliary method needs exactly 2 mirrors (the paper's setting); the scene has {0}"
+        "auxiliary mirrors alternate between a mirror and the one it faces, so --n above 0 needs at least 2 mirrors; the scene has {0}"
     )]
-    NotAPair(usize),
+    NoMirrorToAlternateWith(usize),
     #[error(
         "more than {limit} reflection paths are visible: raise --min-portal-area (pixels²) or --min-attenuation, or lower --depth"
     )]
@@ -116,44 +129,99 @@ pub enum PlanError {
     Setting(#[from] mirrorbox_scene::limits::SettingError),
 }
 
-/// The rendering queue of a method.
+/// The mirror whose copies alternate with mirror `i`'s (§3.1: "an auxiliary mirror at the
+/// other side opposite to the previous one"): among the mirrors `i` faces — each one's centre
+/// in front of the other's plane — the one whose normal is most opposed to `i`'s (the first
+/// in scene order on a tie); if it faces none, the most opposed of all. `None` for a lone
+/// mirror. Of two mirrors each is the other's partner, facing or not (the paper's setting).
+pub fn partner(scene: &Scene, i: usize) -> Option<usize> {
+    let me = &scene.mirrors[i];
+    let faces = |j: usize| {
+        let other = &scene.mirrors[j];
+        me.plane().signed_distance(other.center) > 0.0
+            && other.plane().signed_distance(me.center) > 0.0
+    };
+    let others: Vec<usize> = (0..scene.mirrors.len()).filter(|&j| j != i).collect();
+    let facing: Vec<usize> = others.iter().copied().filter(|&j| faces(j)).collect();
+    let candidates = if facing.is_empty() { others } else { facing };
+    candidates.into_iter().min_by(|&a, &b| {
+        let opposed = |j: usize| me.normal.dot(scene.mirrors[j].normal);
+        opposed(a).total_cmp(&opposed(b))
+    })
+}
+
+/// Whether the paper's auxiliary label `k` (1…n) of mirror `i`'s pair lies on `i`: odd labels
+/// on the pair's first mirror in scene order, even ones on the other.
+fn label_lies_on(scene: &Scene, i: usize, k: u32) -> bool {
+    let first = partner(scene, i).is_some_and(|p| i < p);
+    (k % 2 == 1) == first
+}
+
+/// Auxiliary copies of each scene mirror for `n` auxiliary mirrors per pair: ⌈n/2⌉ on a
+/// pair's first mirror, ⌊n/2⌋ on the other (none on a lone mirror).
+pub fn auxiliary_copies(scene: &Scene, n: u32) -> Vec<u32> {
+    (0..scene.mirrors.len())
+        .map(|i| {
+            if partner(scene, i).is_none() {
+                0
+            } else {
+                (1..=n).filter(|&k| label_lies_on(scene, i, k)).count() as u32
+            }
+        })
+        .collect()
+}
+
+/// The rendering queue of a method: the scene's mirrors, then (`auxiliary`) the copies by
+/// label, each label's in scene order — for two mirrors "auxiliary 1" on mirror 1,
+/// "auxiliary 2" on mirror 2, … as in the paper.
 pub fn instances(scene: &Scene, queue: Queue) -> Result<Vec<MirrorInstance>, PlanError> {
-    match queue {
-        Queue::SceneMirrors => Ok((0..scene.mirrors.len())
-            .map(|i| MirrorInstance {
-                mirror: i,
-                label: format!("mirror {}", i + 1),
-            })
-            .collect()),
-        Queue::Auxiliary { n } => {
-            if scene.mirrors.len() != 2 {
-                return Err(PlanError::NotAPair(scene.mirrors.len()));
-            }
-            let mut queue = vec![
-                MirrorInstance {
-                    mirror: 0,
-                    label: "mirror 1".into(),
-                },
-                MirrorInstance {
-                    mirror: 1,
-                    label: "mirror 2".into(),
-                },
-            ];
-            for k in 1..=n as usize {
-                let mirror = if k % 2 == 1 { 0 } else { 1 };
-                queue.push(MirrorInstance {
-                    mirror,
-                    label: format!("auxiliary {k}"),
-                });
-            }
-            Ok(queue)
+    let mut instances: Vec<MirrorInstance> = (0..scene.mirrors.len())
+        .map(|i| MirrorInstance {
+            mirror: i,
+            label: format!("mirror {}", i + 1),
+        })
+        .collect();
+    if let Queue::Auxiliary { n } = queue {
+        if n > 0 && scene.mirrors.len() < 2 {
+            return Err(PlanError::NoMirrorToAlternateWith(scene.mirrors.len()));
         }
+        for k in 1..=n {
+            for mirror in 0..scene.mirrors.len() {
+                if label_lies_on(scene, mirror, k) {
+                    instances.push(MirrorInstance {
+                        mirror,
+                        label: format!("auxiliary {k}"),
+                    });
+                }
+            }
+        }
+    }
+    Ok(instances)
+}
+
+/// A running count of texture renders over plane chains (see the module docs).
+struct Tally {
+    /// Texture renders counted so far (saturating).
+    renders: usize,
+    /// Plane chains visited so far.
+    chains: usize,
+    /// Stop after this many chains …
+    max_chains: usize,
+    /// … or this many renders.
+    max_renders: usize,
+}
+
+impl Tally {
+    fn stopped(&self) -> bool {
+        self.chains > self.max_chains || self.renders > self.max_renders
     }
 }
 
 struct Planner<'a> {
     scene: &'a Scene,
     instances: &'a [MirrorInstance],
+    /// Instances of each scene mirror (1 + its auxiliary copies).
+    per_mirror: Vec<usize>,
     projection: Mat4,
     size: Vec2,
 }
@@ -166,27 +234,28 @@ impl Planner<'_> {
         near: Option<&Plane>,
         hidden: &[usize],
     ) -> Vec<(usize, Rect)> {
-        let eye = view.eye();
-        let clip_from_world = self.projection * view.view;
-        let mut out = Vec::new();
-        for (i, inst) in self.instances.iter().enumerate() {
-            if hidden.contains(&i) {
-                continue;
-            }
-            let mirror = &self.scene.mirrors[inst.mirror];
-            if mirror.plane().signed_distance(eye) <= 0.0 {
-                continue; // seen from behind (or edge-on): not a mirror from here
-            }
-            let mut poly = mirror.corners().to_vec();
-            if let Some(plane) = near {
-                poly = clip_by(&poly, |p| plane.signed_distance(p));
-            }
-            let fp = screen_footprint(&poly, clip_from_world, self.size);
-            if let Some(rect) = bounding_rect(&fp, self.size) {
-                out.push((i, rect));
-            }
+        (0..self.instances.len())
+            .filter(|i| !hidden.contains(i))
+            .filter_map(|i| Some((i, self.footprint(self.instances[i].mirror, view, near)?)))
+            .collect()
+    }
+
+    /// Mirror `mirror`'s footprint seen from `view` (clipped by the near plane), if it is a
+    /// mirror from there: facing the eye and inside the view.
+    fn footprint(&self, mirror: usize, view: &ReflectedView, near: Option<&Plane>) -> Option<Rect> {
+        let mirror = &self.scene.mirrors[mirror];
+        if mirror.plane().signed_distance(view.eye()) <= 0.0 {
+            return None; // seen from behind (or edge-on): not a mirror from here
         }
-        out
+        let mut poly = mirror.corners().to_vec();
+        if let Some(plane) = near {
+            poly = clip_by(&poly, |p| plane.signed_distance(p));
+        }
+        let clip_from_world = self.projection * view.view;
+        bounding_rect(
+            &screen_footprint(&poly, clip_from_world, self.size),
+            self.size,
+        )
     }
 
     fn node(
@@ -215,26 +284,36 @@ impl Planner<'_> {
         }
     }
 
-    /// Counts texture renders below `view`, giving up once `budget` is exceeded.
+    /// Adds to `tally` the texture renders below `view`, reached through `ways` instance
+    /// chains, where mirror j has been used `used[j]` times: each visible mirror with an
+    /// instance left is one more plane chain, continued in (instances − used) ways.
     fn count(
         &self,
         view: &ReflectedView,
         near: Option<&Plane>,
-        hidden: &mut Vec<usize>,
-        budget: usize,
-    ) -> usize {
-        let mut total = 0;
-        for (i, _) in self.visible(view, near, hidden) {
-            if total > budget {
-                break;
+        used: &mut [usize],
+        ways: usize,
+        tally: &mut Tally,
+    ) {
+        for mirror in 0..self.scene.mirrors.len() {
+            let left = self.per_mirror[mirror] - used[mirror];
+            if left == 0 || self.footprint(mirror, view, near).is_none() {
+                continue;
             }
-            let plane = self.scene.mirrors[self.instances[i].mirror].plane();
-            let child = view.through(&plane);
-            hidden.push(i);
-            total += 1 + self.count(&child, Some(&plane), hidden, budget - total);
-            hidden.pop();
+            let ways = ways.saturating_mul(left);
+            tally.chains += 1;
+            tally.renders = tally.renders.saturating_add(ways);
+            if tally.stopped() {
+                return;
+            }
+            let plane = self.scene.mirrors[mirror].plane();
+            used[mirror] += 1;
+            self.count(&view.through(&plane), Some(&plane), used, ways, tally);
+            used[mirror] -= 1;
+            if tally.stopped() {
+                return;
+            }
         }
-        total
     }
 }
 
@@ -259,8 +338,73 @@ fn depth(nodes: &[TextureNode]) -> usize {
         .unwrap_or(0)
 }
 
-/// Plans a frame of the recursion over `queue` at render resolution `width × height`; refuses, before any
-/// work, a plan of more than `max_passes` scene passes.
+/// Scene passes per frame of a plan, counted over plane chains (module docs).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PassCount {
+    /// 1 + the texture renders: exact when `exact`, else a lower bound above the limit.
+    pub passes: usize,
+    pub exact: bool,
+    /// Plane chains visited to count them (each needs one visibility test per mirror): at
+    /// most `max_passes + 1`, however large the plan.
+    pub chains_visited: usize,
+}
+
+impl<'a> Planner<'a> {
+    fn new(scene: &'a Scene, instances: &'a [MirrorInstance], width: u32, height: u32) -> Self {
+        let mut per_mirror = vec![0; scene.mirrors.len()];
+        for inst in instances {
+            per_mirror[inst.mirror] += 1;
+        }
+        Planner {
+            scene,
+            instances,
+            per_mirror,
+            projection: scene.camera.with_size(width, height).projection(NEAR, FAR),
+            size: Vec2::new(width as f32, height as f32),
+        }
+    }
+
+    fn main_view(&self, width: u32, height: u32) -> ReflectedView {
+        ReflectedView::direct(self.scene.camera.with_size(width, height).view())
+    }
+
+    /// Counts exactly up to a hard ceiling, so that a refusal can state the predicted count,
+    /// but visits at most `max_passes` plane chains: a plan within the limit has no more
+    /// (each chain is at least one render), so any plan over it is refused after that many.
+    fn count_passes(&self, main: &ReflectedView, max_passes: usize) -> PassCount {
+        let mut tally = Tally {
+            renders: 0,
+            chains: 0,
+            max_chains: max_passes,
+            max_renders: COUNT_CEILING.max(max_passes),
+        };
+        let mut used = vec![0; self.scene.mirrors.len()];
+        self.count(main, None, &mut used, 1, &mut tally);
+        PassCount {
+            passes: tally.renders.saturating_add(1),
+            exact: !tally.stopped(),
+            chains_visited: tally.chains,
+        }
+    }
+}
+
+/// Counts the scene passes per frame of the recursion over `queue` at render resolution
+/// `width × height`, without building the plan; stops once it knows there are more than
+/// `max_passes`.
+pub fn count_passes(
+    scene: &Scene,
+    queue: Queue,
+    width: u32,
+    height: u32,
+    max_passes: usize,
+) -> Result<PassCount, PlanError> {
+    let instances = instances(scene, queue)?;
+    let planner = Planner::new(scene, &instances, width, height);
+    Ok(planner.count_passes(&planner.main_view(width, height), max_passes))
+}
+
+/// Plans a frame of the recursion over `queue` at render resolution `width × height`;
+/// refuses, before any work, a plan of more than `max_passes` scene passes.
 pub fn plan(
     scene: &Scene,
     queue: Queue,
@@ -269,23 +413,14 @@ pub fn plan(
     max_passes: usize,
 ) -> Result<Plan, PlanError> {
     let instances = instances(scene, queue)?;
-    let camera = scene.camera.with_size(width, height);
-    let projection = camera.projection(NEAR, FAR);
-    let planner = Planner {
-        scene,
-        instances: &instances,
-        projection,
-        size: Vec2::new(width as f32, height as f32),
-    };
-    let main = ReflectedView::direct(camera.view());
-    // Count exactly (cheap: a few polygon clips per call) up to a hard ceiling, so a refusal
-    // can state the predicted count; only astronomically large plans say "or more".
-    let textures = planner.count(&main, None, &mut Vec::new(), COUNT_CEILING.max(max_passes));
-    if 1 + textures > max_passes {
+    let planner = Planner::new(scene, &instances, width, height);
+    let main = planner.main_view(width, height);
+    let count = planner.count_passes(&main, max_passes);
+    if !count.exact || count.passes > max_passes {
         return Err(PlanError::TooManyPasses {
-            predicted: 1 + textures,
+            predicted: count.passes,
             limit: max_passes,
-            exceeded_count: textures > COUNT_CEILING.max(max_passes),
+            exceeded_count: !count.exact,
         });
     }
     let roots: Vec<TextureNode> = planner
@@ -295,12 +430,12 @@ pub fn plan(
         .collect();
     let depth = depth(&roots);
     Ok(Plan {
+        projection: planner.projection,
         instances,
         width,
         height,
-        projection,
         roots,
-        passes: 1 + textures,
+        passes: count.passes,
         depth,
     })
 }
@@ -384,17 +519,6 @@ mod tests {
                 exceeded_count: false
             }
         );
-        assert_eq!(
-            plan(
-                &scene("mirror_room.json"),
-                Queue::Auxiliary { n: 1 },
-                32,
-                18,
-                10
-            )
-            .unwrap_err(),
-            PlanError::NotAPair(4)
-        );
     }
 
     #[test]
@@ -425,5 +549,92 @@ mod tests {
         }
         let total: usize = p.roots.iter().map(|n| walk(n, 64, 36)).sum();
         assert_eq!(total + 1, p.passes);
+    }
+
+    /// Every mirror of the room pairs with the wall opposite it (the one it faces most
+    /// directly), and each pair takes the paper's n auxiliary mirrors, odd labels on its
+    /// first mirror: north and west hold ⌈n/2⌉ copies, south and east ⌊n/2⌋. Two mirrors
+    /// pair with each other whatever their orientation; a lone mirror has no partner.
+    #[test]
+    fn every_mirror_alternates_with_the_one_opposite() {
+        let room = scene("mirror_room.json");
+        let names: Vec<&str> = room.mirrors.iter().map(|m| m.name.as_str()).collect();
+        assert_eq!(names, ["north", "south", "west", "east"]);
+        let partners: Vec<Option<usize>> = (0..4).map(|i| partner(&room, i)).collect();
+        assert_eq!(partners, [Some(1), Some(0), Some(3), Some(2)]);
+        let copies: Vec<Vec<u32>> = (0..=4).map(|n| auxiliary_copies(&room, n)).collect();
+        assert_eq!(
+            copies,
+            [
+                [0, 0, 0, 0],
+                [1, 0, 1, 0],
+                [1, 1, 1, 1],
+                [2, 1, 2, 1],
+                [2, 2, 2, 2]
+            ]
+        );
+        let tilted = scene("tilted_pair.json");
+        assert_eq!(
+            (partner(&tilted, 0), partner(&tilted, 1)),
+            (Some(1), Some(0))
+        );
+        let single = scene("single_mirror.json");
+        assert_eq!(partner(&single, 0), None);
+        assert_eq!(
+            instances(&single, Queue::Auxiliary { n: 1 }).unwrap_err(),
+            PlanError::NoMirrorToAlternateWith(1)
+        );
+        assert_eq!(
+            instances(&single, Queue::Auxiliary { n: 0 }).unwrap(),
+            instances(&single, Queue::SceneMirrors).unwrap()
+        );
+    }
+
+    /// In the mirror room each auxiliary label adds a reflection to every chain that uses it:
+    /// 4, 6, 8 reflections for n = 0, 1, 2. The closed count over plane chains is the number
+    /// of `MIRRORTEXTURE` calls the built tree holds, and n = 3 (120 199 passes) is refused at
+    /// the default limit with that count.
+    #[test]
+    fn the_mirror_room_gains_reflections_with_auxiliary_mirrors() {
+        let s = scene("mirror_room.json");
+        fn calls(n: &TextureNode) -> usize {
+            1 + n.children.iter().map(calls).sum::<usize>()
+        }
+        let mut seen = Vec::new();
+        for n in 0..=2 {
+            let p = plan(&s, Queue::Auxiliary { n }, 96, 54, 5000).unwrap();
+            assert_eq!(p.passes, 1 + p.roots.iter().map(calls).sum::<usize>());
+            seen.push((p.passes, p.depth));
+        }
+        assert_eq!(seen, [(22, 4), (273, 6), (3761, 8)]);
+        assert_eq!(
+            plan(&s, Queue::Auxiliary { n: 3 }, 96, 54, 5000).unwrap_err(),
+            PlanError::TooManyPasses {
+                predicted: 120_199,
+                limit: 5000,
+                exceeded_count: false
+            }
+        );
+    }
+
+    /// A refusal costs at most `max_passes + 1` plane chains, however large the plan: the
+    /// largest `--n` at the largest `--max-passes` is refused after a few (the factorial
+    /// count passes the ceiling within the first chains), where counting the calls one by
+    /// one would visit a million of them.
+    #[test]
+    fn refusal_visits_at_most_max_passes_chains() {
+        for name in ["mirror_box.json", "mirror_room.json"] {
+            let s = scene(name);
+            for max_passes in [5000, 1_000_000] {
+                let count =
+                    count_passes(&s, Queue::Auxiliary { n: 16 }, 640, 360, max_passes).unwrap();
+                assert!(!count.exact, "{name}");
+                assert!(count.passes > max_passes, "{name}: {count:?}");
+                assert!(count.chains_visited <= 100, "{name}: {count:?}");
+            }
+            // A small limit: refused after at most limit + 1 chains.
+            let count = count_passes(&s, Queue::Auxiliary { n: 4 }, 640, 360, 10).unwrap();
+            assert!(count.chains_visited <= 11, "{name}: {count:?}");
+        }
     }
 }

@@ -1,6 +1,8 @@
 //! Reading textures and buffers back to the CPU.
 
+use crate::color_format::ColorFormat;
 use crate::gpu::{Gpu, RasterError};
+use half::f16;
 use mirrorbox_image::RgbImage;
 
 pub fn map_read<T: bytemuck::Pod>(gpu: &Gpu, buffer: &wgpu::Buffer) -> Result<Vec<T>, RasterError> {
@@ -21,10 +23,16 @@ pub fn map_read<T: bytemuck::Pod>(gpu: &Gpu, buffer: &wgpu::Buffer) -> Result<Ve
     Ok(data)
 }
 
-/// Copies an `Rgba32Float` texture into a linear RGB image.
+/// Copies an RGBA32F or RGBA16F texture into a linear RGB image (halves widened to f32,
+/// exactly: every f16 is an f32).
 pub fn read_texture(gpu: &Gpu, texture: &wgpu::Texture) -> Result<RgbImage, RasterError> {
+    let format = match texture.format() {
+        wgpu::TextureFormat::Rgba32Float => ColorFormat::Rgba32Float,
+        wgpu::TextureFormat::Rgba16Float => ColorFormat::Rgba16Float,
+        other => panic!("read_texture: {other:?} is not a colour format of the methods"),
+    };
     let (w, h) = (texture.width(), texture.height());
-    let row = w * 16;
+    let row = w * format.texel_bytes();
     let padded =
         row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
     let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
@@ -51,10 +59,17 @@ pub fn read_texture(gpu: &Gpu, texture: &wgpu::Texture) -> Result<RgbImage, Rast
         texture.size(),
     );
     gpu.queue.submit([encoder.finish()]);
-    let floats: Vec<f32> = map_read(gpu, &buffer)?;
-    let per_row = (padded / 4) as usize;
+    // Channels as f32, row by row (rows padded to the copy alignment).
+    let (channels, per_row): (Vec<f32>, usize) = match format {
+        ColorFormat::Rgba32Float => (map_read(gpu, &buffer)?, padded as usize / 4),
+        ColorFormat::Rgba16Float => {
+            let bits: Vec<u16> = map_read(gpu, &buffer)?;
+            let floats = bits.iter().map(|&b| f16::from_bits(b).to_f32()).collect();
+            (floats, padded as usize / 2)
+        }
+    };
     Ok(RgbImage::from_fn(w, h, |x, y| {
         let i = y as usize * per_row + x as usize * 4;
-        [floats[i], floats[i + 1], floats[i + 2]]
+        [channels[i], channels[i + 1], channels[i + 2]]
     }))
 }

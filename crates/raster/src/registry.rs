@@ -9,7 +9,15 @@ impl crate::gpu::Gpu {
     /// Opens the adapter of [`crate::adapter::select_adapter`] with timestamp queries, and
     /// every feature a registered method needs or can use, where the adapter has them.
     pub fn new() -> Result<crate::gpu::Gpu, crate::gpu::RasterError> {
-        crate::gpu::Gpu::with_features(crate::methods::wanted_features())
+        Self::with_options(Default::default())
+    }
+
+    /// As [`Gpu::new`](crate::gpu::Gpu::new), with the backends and colour format `options`
+    /// names instead of the environment's.
+    pub fn with_options(
+        options: crate::gpu::GpuOptions,
+    ) -> Result<crate::gpu::Gpu, crate::gpu::RasterError> {
+        crate::gpu::Gpu::open(crate::methods::wanted_features(), options)
     }
 }
 

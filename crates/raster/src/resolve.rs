@@ -1,7 +1,8 @@
 //! The SSAA resolve: box-filters the `factor × factor` supersampled view into the output
 //! image (`shaders/resolve.wgsl`).
 
-use crate::targets::{COLOR_FORMAT, RenderTarget, texture_entry};
+use crate::gpu::Gpu;
+use crate::targets::{RenderTarget, texture_entry};
 
 /// Box-filters the `factor × factor` supersampled view into the output image.
 pub struct Resolve {
@@ -12,8 +13,10 @@ pub struct Resolve {
 }
 
 impl Resolve {
-    pub fn new(device: &wgpu::Device, source: &RenderTarget, factor: u32) -> Self {
+    /// The resolve of `source` on `gpu`; the output has `gpu`'s colour format.
+    pub fn new(gpu: &Gpu, source: &RenderTarget, factor: u32) -> Self {
         use wgpu::util::DeviceExt;
+        let device = &gpu.device;
         let module = crate::wgsl::shader_module(device, &crate::wgsl::RESOLVE);
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("resolve"),
@@ -71,7 +74,7 @@ impl Resolve {
                 module: &module,
                 entry_point: Some("fs_main"),
                 compilation_options: Default::default(),
-                targets: &[Some(COLOR_FORMAT.into())],
+                targets: &[Some(gpu.color_format.texture_format().into())],
             }),
             multiview_mask: None,
             cache: None,
@@ -86,7 +89,7 @@ impl Resolve {
             mip_level_count: 1,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
-            format: COLOR_FORMAT,
+            format: gpu.color_format.texture_format(),
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
             view_formats: &[],
         });

@@ -1,8 +1,8 @@
-//! Render targets: the one colour format every method renders linear radiance into, the
-//! depth formats, and colour + depth pairs.
+//! Render targets: the depth formats, and colour + depth pairs in the device's colour format
+//! ([`crate::color_format::ColorFormat`]).
 
-/// Linear radiance, unclamped.
-pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+use crate::gpu::Gpu;
+
 /// The one depth format of every depth-only attachment (the exact methods' reversed Z needs
 /// 32-bit float).
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
@@ -52,8 +52,9 @@ pub fn texture_2d(
 }
 
 impl RenderTarget {
+    /// A target of `gpu`'s colour format with a depth attachment.
     pub fn new(
-        device: &wgpu::Device,
+        gpu: &Gpu,
         label: &str,
         width: u32,
         height: u32,
@@ -61,7 +62,7 @@ impl RenderTarget {
     ) -> Self {
         let texture = |format, usage, suffix: &str| {
             texture_2d(
-                device,
+                &gpu.device,
                 &format!("{label} {suffix}"),
                 width,
                 height,
@@ -70,7 +71,7 @@ impl RenderTarget {
             )
         };
         let color = texture(
-            COLOR_FORMAT,
+            gpu.color_format.texture_format(),
             wgpu::TextureUsages::RENDER_ATTACHMENT | extra,
             "colour",
         );

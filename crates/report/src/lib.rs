@@ -69,10 +69,20 @@ pub struct Record {
     pub metrics: MetricValues,
     pub adapter: String,
     pub backend: String,
+    /// The colour format of the raster targets (`rgba32float`, or `rgba16float` where the
+    /// adapter has no float colour buffers). Records older than this field were all rendered
+    /// into RGBA32F, the only format then.
+    #[serde(default = "rgba32float")]
+    pub color_format: String,
     /// Images relative to the sweep folder.
     pub truth_image: String,
     pub raster_image: String,
     pub heatmap_image: String,
+}
+
+/// The colour format of records written before [`Record::color_format`] existed.
+fn rgba32float() -> String {
+    "rgba32float".into()
 }
 
 /// Facts about the whole sweep, printed at the top of every report.

@@ -182,14 +182,14 @@ fn esc(s: &str) -> String {
 fn write_csv(path: &Path, records: &[Record]) -> Result<(), FileError> {
     let mut s = String::from(
         "kind,method,n,depth,alpha,width,height,ssaa,ms_median,ms_min,timing_source,frames,passes,draws,texture_renders,reflections,\
-         rmse,relmse,smape,max_abs,psnr,ssim,flip_mean,flip_p95,flip_p99,adapter,backend,scene,scene_hash\n",
+         rmse,relmse,smape,max_abs,psnr,ssim,flip_mean,flip_p95,flip_p99,adapter,backend,scene,scene_hash,color_format\n",
     );
     for r in records {
         let m = &r.metrics;
         let opt = |v: Option<u32>| v.map_or(String::new(), |x| x.to_string());
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},\"{}\",{},\"{}\",{}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},\"{}\",{},\"{}\",{},{}",
             r.kind,
             r.method,
             opt(r.n),
@@ -218,7 +218,8 @@ fn write_csv(path: &Path, records: &[Record]) -> Result<(), FileError> {
             r.adapter.replace('"', "'"),
             r.backend,
             r.scene.replace('"', "'"),
-            r.scene_hash
+            r.scene_hash,
+            r.color_format
         );
     }
     write_atomically(path, s.as_bytes())
@@ -387,6 +388,19 @@ fn depth_scaling(info: &SweepInfo, records: &[Record], floor: Option<&Record>) -
     out
 }
 
+/// The colour formats the records were rendered into, e.g. `rgba32float` (several where a
+/// sweep was resumed on another device).
+fn color_formats(records: &[Record]) -> String {
+    let mut formats: Vec<&str> = records.iter().map(|r| r.color_format.as_str()).collect();
+    formats.sort_unstable();
+    formats.dedup();
+    if formats.is_empty() {
+        "none recorded".into()
+    } else {
+        formats.join(", ")
+    }
+}
+
 fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
     let mut b = vec![
         Block::Heading(1, format!("mirrorbox sweep: {}", info.scene)),
@@ -394,8 +408,12 @@ fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
             format!("Resolution: {}", info.resolution),
             format!("Ground truth: {}", info.truth),
             format!(
-                "Device: {} — adapter {} ({}, {})",
-                info.cpu, info.adapter, info.backend, info.device_type
+                "Device: {} — adapter {} ({}, {}); colour targets: {}",
+                info.cpu,
+                info.adapter,
+                info.backend,
+                info.device_type,
+                color_formats(records)
             ),
             format!("Versions: {}", info.versions),
             format!("Date: {}", info.date),
@@ -659,6 +677,7 @@ mod tests {
             },
             adapter: "test".into(),
             backend: "vulkan".into(),
+            color_format: "rgba32float".into(),
             truth_image: "t.png".into(),
             raster_image: "r.png".into(),
             heatmap_image: "h.png".into(),
@@ -748,5 +767,48 @@ mod tests {
             .filter(|n| n.ends_with(".tmp"))
             .collect();
         assert!(leftovers.is_empty(), "{leftovers:?}");
+    }
+
+    /// `results.jsonl` files written before records had a colour format (the committed
+    /// reports, the harness's test data) load in full — a line that failed to parse would be
+    /// skipped silently and its point measured again — and say RGBA32F, the only format then.
+    #[test]
+    fn records_older_than_the_colour_format_load_as_rgba32float() {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        for file in [
+            "reports/table1/results.jsonl",
+            "reports/depth_scaling/results.jsonl",
+            "crates/harness/tests/data/table1_results_session2.jsonl",
+        ] {
+            let path = root.join(file);
+            let lines = std::fs::read_to_string(&path).unwrap().lines().count();
+            let records = read_records(&path).unwrap();
+            assert_eq!(records.len(), lines, "{file}");
+            assert!(
+                records.iter().all(|r| r.color_format == "rgba32float"),
+                "{file}"
+            );
+        }
+    }
+
+    #[test]
+    fn the_report_names_the_colour_formats_of_its_points() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut half = record(1, 45.0, 7, 0.05);
+        half.color_format = "rgba16float".into();
+        write_report(
+            dir.path(),
+            &SweepInfo::default(),
+            &[record(0, 20.0, 3, 0.1), half],
+        )
+        .unwrap();
+        let md = std::fs::read_to_string(dir.path().join("report.md")).unwrap();
+        assert!(
+            md.contains("colour targets: rgba16float, rgba32float"),
+            "{md}"
+        );
+        let csv = std::fs::read_to_string(dir.path().join("results.csv")).unwrap();
+        assert!(csv.lines().next().unwrap().ends_with(",color_format"));
+        assert!(csv.lines().nth(2).unwrap().ends_with(",rgba16float"));
     }
 }

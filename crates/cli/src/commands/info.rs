@@ -1,7 +1,7 @@
 //! `mirrorbox info`: the wgpu adapter the raster commands would use.
 
 use crate::Failure;
-use mirrorbox_raster::{AdapterError, select_adapter};
+use mirrorbox_raster::{AdapterError, ColorFormat, select_adapter};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -15,6 +15,11 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         AdapterError::BadOverride { .. } => Failure::BadInput(e.to_string()),
         AdapterError::NoneFound { .. } => Failure::Other(e.to_string()),
     })?;
+    let forced = ColorFormat::from_env().map_err(|value| {
+        Failure::BadInput(mirrorbox_raster::RasterError::BadColorFormat { value }.to_string())
+    })?;
+    // The colour format `render` and `sweep` would use on this adapter (or why none fits).
+    let color_format = ColorFormat::choose(&selected.adapter, forced);
     let r = &selected.report;
     if args.json {
         let value = serde_json::json!({
@@ -26,10 +31,16 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             "timestamp_query": r.timestamp_query,
             "timestamp_query_inside_passes": r.timestamp_query_inside_passes,
             "clip_distances": r.clip_distances,
+            "color_format": color_format.as_ref().ok().map(|f| f.name()),
+            "color_format_error": color_format.as_ref().err(),
         });
         println!("{value}");
     } else {
         println!("{r}");
+        match &color_format {
+            Ok(f) => println!("colour targets:   {f}"),
+            Err(why) => println!("colour targets:   none: {why}"),
+        }
     }
     Ok(())
 }

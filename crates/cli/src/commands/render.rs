@@ -92,6 +92,10 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         ("mirrorbox.ssaa", args.ssaa.to_string()),
         ("mirrorbox.passes", out.stats.passes.to_string()),
         ("mirrorbox.adapter", gpu.report.name.clone()),
+        (
+            "mirrorbox.color_format",
+            out.color_format.name().to_string(),
+        ),
     ];
     let write_failed = |e: mirrorbox_image::ImageError| Failure::Other(e.to_string());
     write_exr(&exr, &out.image, &attributes).map_err(write_failed)?;
@@ -125,6 +129,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             "clipping": s.clipping.map(|c| c.name()),
             "warnings": out.warnings,
             "adapter": gpu.report.name, "backend": gpu.report.backend, "device_type": gpu.report.device_type,
+            "color_format": out.color_format.name(),
             "outputs": [png.display().to_string(), exr.display().to_string()],
         });
         println!("{v}");
@@ -156,13 +161,14 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             );
         }
         println!(
-            "  {:.2} ms/frame median, {:.2} min over {} frames ({}) on {} ({}); wrote {}, {}",
+            "  {:.2} ms/frame median, {:.2} min over {} frames ({}) on {} ({}, {} targets); wrote {}, {}",
             t.median_ms(),
             t.min_ms(),
             t.frames_ms.len(),
             t.source.name(),
             gpu.report.name,
             gpu.report.backend,
+            out.color_format,
             png.display(),
             exr.display()
         );

@@ -299,7 +299,7 @@ impl PortalStencil {
                     wgpu::ColorWrites::empty()
                 },
             }
-            .build(device)
+            .build(gpu)
         };
         use wgpu::{CompareFunction as C, StencilOperation as S};
         let keep_equal = stencil(C::Equal, S::Keep);

@@ -46,10 +46,11 @@ pub static NAIVE: MethodEntry = MethodEntry {
 };
 
 /// The paper's §3.1–3.2: n auxiliary mirrors coincide with the two real ones (n + 2 in the
-/// queue), the k-th reflection attenuated by α^k.
+/// queue), the k-th reflection attenuated by α^k; with more mirrors, n per mirror and the
+/// mirror opposite it (`plan::partner`, docs/methods.md).
 pub static AUXILIARY: MethodEntry = MethodEntry {
     name: "auxiliary",
-    help: "The paper's §3.1–3.2: n auxiliary mirrors (n + 2 in the queue), attenuation α^k.",
+    help: "The paper's §3.1–3.2: n auxiliary mirrors per facing pair (n + 2 in the queue for two mirrors), attenuation α^k.",
     exact: false,
     options: &[&AUXILIARY_MIRRORS, &TEXTURE_SCALE, &MAX_PASSES],
     swept: Some(&AUXILIARY_MIRRORS),
@@ -87,10 +88,11 @@ fn gpu_structs() -> Vec<HostLayout> {
     ]
 }
 
-/// `--n`: auxiliary mirrors. Bounded by 16: at n = 7 the plan already needs 11 146 passes.
+/// `--n`: auxiliary mirrors (per mirror pair beyond two mirrors). Bounded by 16: at n = 7 the
+/// plan already needs 11 146 passes on `mirror_box`, at n = 3 120 199 in `mirror_room`.
 pub static AUXILIARY_MIRRORS: OptionSpec = OptionSpec {
     name: "n",
-    help: "Auxiliary mirrors (the paper's n).",
+    help: "Auxiliary mirrors (the paper's n), per pair of opposite mirrors.",
     kind: OptionKind::Count { min: 0, max: 16 },
     default: ParamValue::Count(0),
     sweep: Some(SweepAxis {
@@ -410,7 +412,7 @@ impl RecursiveTexture {
             .iter()
             .map(|&(w, h)| {
                 RenderTarget::new(
-                    device,
+                    gpu,
                     "mirror texture",
                     w,
                     h,
@@ -419,7 +421,7 @@ impl RecursiveTexture {
             })
             .collect();
         let none = RenderTarget::new(
-            device,
+            gpu,
             "no texture",
             1,
             1,
@@ -466,7 +468,7 @@ impl RecursiveTexture {
                 ),
                 color_writes: wgpu::ColorWrites::ALL,
             }
-            .build(device)
+            .build(gpu)
         };
         let objects_pipeline = pipeline(
             "recursive texture objects",

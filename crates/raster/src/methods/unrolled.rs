@@ -527,7 +527,7 @@ impl Unrolled {
                 ),
                 color_writes: wgpu::ColorWrites::ALL,
             }
-            .build(device)
+            .build(gpu)
         };
         let m = &guarded_module;
         let guarded_object = pipeline(
