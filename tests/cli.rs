@@ -1277,3 +1277,28 @@ fn printing_into_a_closed_pipe_ends_quietly() {
         out.status
     );
 }
+
+/// Issue #13: one rule for output folders in every command — the folder must exist.
+#[test]
+fn every_command_refuses_an_output_in_a_missing_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("no/such");
+    let m = |f: &str| missing.join(f).to_str().unwrap().to_string();
+    let s = "scenes/mirror_box.json";
+    for args in [
+        vec!["trace".to_string(), s.into(), "-o".into(), m("t.exr")],
+        vec!["render".into(), s.into(), "-o".into(), m("r.png")],
+        vec!["export-mitsuba".into(), s.into(), "-o".into(), m("x.xml")],
+        vec!["sweep".into(), s.into(), "--out".into(), m("sweep")],
+    ] {
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let r = mirrorbox(&args, &[]);
+        assert_eq!(r.code, 2, "{args:?}: {}", r.stderr);
+        assert!(
+            r.stderr.contains("does not exist"),
+            "{args:?}: {}",
+            r.stderr
+        );
+    }
+    assert!(!dir.path().join("no").exists(), "no folder created");
+}

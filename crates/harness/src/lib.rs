@@ -440,6 +440,21 @@ pub fn run_sweep(
     let base_hash = base.content_hash();
     let all = points(config, base_hash, w, h);
     let out = &config.out;
+    // The sweep creates its own folder, inside one that must exist (as every command's
+    // outputs): a mistyped path is refused, not created.
+    let parent = out
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    if !parent.is_dir() {
+        return Err(HarnessError::OutputFolder {
+            path: out.clone(),
+            source: std::io::Error::new(
+                std::io::ErrorKind::NotFound,
+                format!("folder {} does not exist", parent.display()),
+            ),
+        });
+    }
     let results = out.join("results.jsonl");
     let still_to_do = |done: &[Record]| -> Vec<&Point> {
         all.iter()

@@ -33,16 +33,8 @@ pub struct Args {
 pub fn run(args: &Args) -> Result<(), Failure> {
     grid_side(args.spp)?;
     unit_interval("--alpha", args.reflectance)?;
-    // The export is a folder of files: make the folder if needed.
-    if let Some(dir) = args.output.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).map_err(|e| {
-            Failure::BadInput(format!(
-                "-o {}: cannot create {}: {e}",
-                args.output.display(),
-                dir.display()
-            ))
-        })?;
-    }
+    // One rule for every command: the folder an output goes into must exist (a typo never
+    // silently creates folders); the export creates only its own `meshes/` inside it.
     let xml = output_path("-o", &args.output, "xml")?;
     let mut scene = load(&args.scene)?;
     resize(&mut scene, args.width, args.height)?;

@@ -39,7 +39,10 @@ pub fn setting(e: mirrorbox_scene::limits::SettingError) -> Failure {
     Failure::BadInput(e.to_string())
 }
 
-/// Checks that `path` has extension `ext` and that its folder exists, before any work.
+/// Checks that `path` has extension `ext` and that its folder exists, before any work. The
+/// rule of every command: an output's folder must exist — a mistyped folder is refused, not
+/// created; commands create only folders of their own inside it (`sweep`'s `--out` and its
+/// `images/` and `cache/`, `export-mitsuba`'s `meshes/`).
 pub fn output_path(flag: &str, path: &Path, ext: &str) -> Result<PathBuf, Failure> {
     let has_ext = path
         .extension()
