@@ -7,13 +7,17 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 export NODEVICE_SELECT=1
-# Each step says when it starts and how long it took; the sweeps end with their peak memory.
+# Each step says when it starts, how long it took and (with GNU time) its peak memory.
 step=0
 run_step() {
   step=$((step + 1))
   echo "== [$step/6] $*"
   local started=$SECONDS
-  "$@"
+  if [ -x /usr/bin/time ]; then
+    /usr/bin/time -f "== [$step/6] peak memory %M KB (largest process)" "$@"
+  else
+    "$@"
+  fi
   echo "== [$step/6] done in $((SECONDS - started)) s"
 }
 run_step scripts/install-system-deps.sh

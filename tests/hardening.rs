@@ -68,6 +68,10 @@ fn edge_cases_are_refused_with_a_clear_message_and_nothing_written() {
     let mut zero_obj = scene();
     zero_obj["objects"] = json!([{ "type": "mesh", "path": "/dev/zero" }]);
     let zero_obj = write_scene(d, "zero_obj.json", &zero_obj);
+    let mut random_obj = scene();
+    random_obj["objects"] = json!([{ "type": "mesh", "path": "/dev/urandom" }]);
+    let random_obj = write_scene(d, "random_obj.json", &random_obj);
+    let random_obj = random_obj.to_str().unwrap().to_string();
     let out = d.join("out");
     std::fs::create_dir(&out).unwrap();
     let (ok, far, heavy, zero_obj) = (
@@ -146,9 +150,31 @@ fn edge_cases_are_refused_with_a_clear_message_and_nothing_written() {
             ]),
             vec!["--width × --height must be at most 67108864 pixels"],
         ),
+        // Mirror textures beyond the frame's budget: refused before they are created.
+        (
+            own(&[
+                "render",
+                ok,
+                "-o",
+                png,
+                "--method",
+                "auxiliary",
+                "--texture-scale",
+                "4",
+                "--width",
+                "8192",
+                "--height",
+                "4608",
+            ]),
+            vec!["mirror textures", "lower --texture-scale"],
+        ),
         // A device or FIFO as an input: refused without reading.
         (
             own(&["check", zero_obj]),
+            vec!["objects[0].path", "character device"],
+        ),
+        (
+            own(&["check", &random_obj]),
             vec!["objects[0].path", "character device"],
         ),
         (
@@ -175,6 +201,10 @@ fn edge_cases_are_refused_with_a_clear_message_and_nothing_written() {
         (
             sweep(&["--min-throughput", "nan"]),
             vec!["--min-throughput must be in [0, 1), got NaN"],
+        ),
+        (
+            sweep(&["--alpha", "nan"]),
+            vec!["--alpha must be in [0, 1], got NaN"],
         ),
         (
             sweep(&["--frames", "0"]),
@@ -248,6 +278,27 @@ fn an_output_that_is_a_folder_is_refused_before_any_work() {
     let r = mirrorbox(&args, &[]);
     assert_refused(&args, &r, &["--bounces", "b.exr", "is a folder"]);
     assert_eq!(files_in(d), ["b.exr", "ok.json"], "nothing else written");
+    // The PNG written beside an output, too: `t.png` a folder refuses `-o t.exr`.
+    std::fs::create_dir(d.join("t.png")).unwrap();
+    let args = ["trace", ok.to_str().unwrap(), "-o", exr.to_str().unwrap()];
+    let r = mirrorbox(&args, &[]);
+    assert_refused(
+        &args,
+        &r,
+        &[
+            "t.png",
+            "-o (its PNG) would write this file, but it is a folder",
+        ],
+    );
+    let png = d.join("t.png");
+    let args = ["render", ok.to_str().unwrap(), "-o", png.to_str().unwrap()];
+    let r = mirrorbox(&args, &[]);
+    assert_refused(&args, &r, &["t.png", "is a folder"]);
+    assert_eq!(
+        files_in(d),
+        ["b.exr", "ok.json", "t.png"],
+        "nothing else written"
+    );
 }
 
 /// A scene with only a camera renders its background with every method, as the tracer does.
@@ -329,51 +380,54 @@ fn keys(out: &Path) -> Vec<String> {
         .collect()
 }
 
-/// A second sweep into a folder in use is refused (naming the first), and a value listed twice
-/// is one point.
+/// A sweep into a folder another process holds is refused at once, naming that process;
+/// once free, it runs.
 #[test]
-fn concurrent_sweeps_do_not_share_a_folder_and_points_are_unique() {
+fn a_sweep_into_a_folder_in_use_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let s = write_scene(d, "s.json", &scene());
+    let out = d.join("results");
+    std::fs::create_dir(&out).unwrap();
+    // This test process holds the folder, as a running sweep would.
+    let held = mirrorbox_files::FolderLock::try_acquire(&out).unwrap();
+    let second = small_sweep(&s, &out, "1").output().unwrap();
+    let stderr = String::from_utf8_lossy(&second.stderr);
+    assert_eq!(second.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains(&format!(
+            "in use by another process (pid {})",
+            std::process::id()
+        )),
+        "{stderr}"
+    );
+    assert!(!out.join("results.jsonl").exists(), "nothing measured");
+    drop(held);
+    let free = small_sweep(&s, &out, "1").output().unwrap();
+    assert!(
+        free.status.success(),
+        "{}",
+        String::from_utf8_lossy(&free.stderr)
+    );
+}
+
+/// A value listed twice is one point (`--depth 1,1`, `--alpha 0.7,0.7`).
+#[test]
+fn a_value_listed_twice_is_one_point() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let s = write_scene(d, "s.json", &scene());
     let out = d.join("sweep");
-    let mut first = small_sweep(&s, &out, "1,2,4,8,16,32,64")
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::null())
-        .spawn()
-        .unwrap();
-    let lock = out.join(".mirrorbox.lock");
-    let waited = std::time::Instant::now();
-    while !std::fs::read_to_string(&lock).is_ok_and(|t| t.contains("pid")) {
-        assert!(
-            waited.elapsed().as_secs() < 60,
-            "the first sweep never took its lock"
-        );
-        std::thread::sleep(std::time::Duration::from_millis(20));
-    }
-    let second = small_sweep(&s, &out, "1,1").output().unwrap();
-    let stderr = String::from_utf8_lossy(&second.stderr);
-    let first_status = first.wait().unwrap();
-    assert!(first_status.success());
-    assert_eq!(second.status.code(), Some(2), "{stderr}");
+    let mut cmd = small_sweep(&s, &out, "1,1,2,1");
+    cmd.args(["--alpha", "0.7,0.7"]);
+    let run = cmd.output().unwrap();
     assert!(
-        stderr.contains("in use by another process (pid ") && stderr.contains("sweep"),
-        "{stderr}"
-    );
-    // Now free: `--depth 1,1` is one point (already done, so nothing new is written).
-    let again = small_sweep(&s, &out, "1,1").output().unwrap();
-    assert!(
-        again.status.success(),
+        run.status.success(),
         "{}",
-        String::from_utf8_lossy(&again.stderr)
+        String::from_utf8_lossy(&run.stderr)
     );
-    let mut k = keys(&out);
-    let n = k.len();
-    k.sort();
-    k.dedup();
-    assert_eq!(k.len(), n, "every key once");
-    assert_eq!(n, 8, "floor + 7 depths");
-    // The report is of the last configuration: the floor and depth 1, each once.
+    let k = keys(&out);
+    assert_eq!(k.len(), 3, "floor, depth 1, depth 2: {k:?}");
     let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
-    assert_eq!(csv.lines().count(), 1 + 2, "{csv}");
+    assert_eq!(csv.lines().count(), 1 + 3, "{csv}");
 }

@@ -191,6 +191,14 @@ fn main() -> ExitCode {
 mod tests {
     use super::*;
 
+    /// The image crate reads what the scene's limits allow to be written, no more, no less.
+    #[test]
+    fn image_and_scene_limits_agree() {
+        use mirrorbox_scene::limits;
+        assert_eq!(mirrorbox_image::MAX_PIXELS, limits::MAX_PIXELS);
+        assert_eq!(mirrorbox_image::MAX_IMAGE_SIDE, limits::MAX_IMAGE_SIDE);
+    }
+
     /// Issue #13: every flag and argument of every subcommand says what it is.
     #[test]
     fn every_flag_has_help() {

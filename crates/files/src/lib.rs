@@ -133,8 +133,22 @@ impl Drop for StagedFiles {
     }
 }
 
-/// Refuses a set of outputs in which two name the same file (`-o a.exr --bounces a.exr`, or
-/// a PNG written beside an EXR that another output names), before anything is written.
+/// Refuses, before anything is computed or written, a set of outputs of which one is a
+/// folder or two name the same file (`-o a.exr --bounces a.exr`, or a PNG written beside an
+/// EXR that another output names). With [`StagedFiles`], the outputs then appear together.
+pub fn check_outputs(outputs: &[(&str, PathBuf)]) -> Result<(), FileError> {
+    for (flag, path) in outputs {
+        if path.is_dir() {
+            return Err(FileError::refused(
+                path,
+                format!("{flag} would write this file, but it is a folder"),
+            ));
+        }
+    }
+    check_distinct(outputs)
+}
+
+/// Refuses a set of paths in which two name the same file.
 pub fn check_distinct(outputs: &[(&str, PathBuf)]) -> Result<(), FileError> {
     // The folders exist (outputs are checked first): resolve them, `..` and links included.
     let absolute = |p: &Path| {
@@ -173,39 +187,55 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), FileError> {
 /// FIFO, a folder) and any file larger than `max_bytes` — before reading a byte of it.
 /// `what` names the file's role in messages ("scene file", "OBJ file").
 pub fn read_bounded(path: &Path, max_bytes: u64, what: &str) -> Result<Vec<u8>, FileError> {
-    // `metadata` follows symbolic links and does not open the file: a FIFO cannot block here.
-    let meta = std::fs::metadata(path)
-        .map_err(|e| FileError::io(path, format!("cannot read {what}: {e}")))?;
+    let file = open_regular(path, max_bytes, what)?;
+    let cannot = |e: std::io::Error| FileError::io(path, format!("cannot read {what}: {e}"));
+    // The file may grow after the check: never read past the bound.
+    let len = file.metadata().map_err(cannot)?.len();
+    let mut bytes = Vec::with_capacity(len.min(max_bytes) as usize);
+    file.take(max_bytes + 1)
+        .read_to_end(&mut bytes)
+        .map_err(cannot)?;
+    if bytes.len() as u64 > max_bytes {
+        return Err(too_large(path, bytes.len() as u64, max_bytes, what));
+    }
+    Ok(bytes)
+}
+
+/// Opens `path` for reading if it is a regular file of at most `max_bytes`; refuses anything
+/// else (a device such as `/dev/zero`, a FIFO, a folder) before reading a byte. The file is
+/// opened non-blocking and checked *as opened*, so a FIFO swapped in after a check can
+/// neither block nor slip through.
+pub fn open_regular(path: &Path, max_bytes: u64, what: &str) -> Result<File, FileError> {
+    use std::os::unix::fs::OpenOptionsExt;
+    const O_NONBLOCK: i32 = 0o4000; // Linux, every architecture Rust targets there
+    let cannot = |e: std::io::Error| FileError::io(path, format!("cannot read {what}: {e}"));
+    let file = std::fs::OpenOptions::new()
+        .read(true)
+        .custom_flags(O_NONBLOCK)
+        .open(path)
+        .map_err(cannot)?;
+    let meta = file.metadata().map_err(cannot)?;
     if !meta.is_file() {
         return Err(FileError::refused(
             path,
             format!("{what} must be a regular file, not {}", kind_of(&meta)),
         ));
     }
-    let too_large = |size: u64| {
-        FileError::refused(
-            path,
-            format!(
-                "{what} is {}, more than the {} accepted",
-                human_bytes(size),
-                human_bytes(max_bytes)
-            ),
-        )
-    };
     if meta.len() > max_bytes {
-        return Err(too_large(meta.len()));
+        return Err(too_large(path, meta.len(), max_bytes, what));
     }
-    let file =
-        File::open(path).map_err(|e| FileError::io(path, format!("cannot read {what}: {e}")))?;
-    // The file may grow between `metadata` and here: never read past the bound.
-    let mut bytes = Vec::with_capacity(meta.len() as usize);
-    file.take(max_bytes + 1)
-        .read_to_end(&mut bytes)
-        .map_err(|e| FileError::io(path, format!("cannot read {what}: {e}")))?;
-    if bytes.len() as u64 > max_bytes {
-        return Err(too_large(bytes.len() as u64));
-    }
-    Ok(bytes)
+    Ok(file)
+}
+
+fn too_large(path: &Path, size: u64, max_bytes: u64, what: &str) -> FileError {
+    FileError::refused(
+        path,
+        format!(
+            "{what} is {}, more than the {} accepted",
+            human_bytes(size),
+            human_bytes(max_bytes)
+        ),
+    )
 }
 
 /// [`read_bounded`] for text: the file must be UTF-8.
@@ -406,7 +436,10 @@ mod tests {
             ("-o (its PNG)", d.join("a.png")),
             ("--bounces", d.join("sub/a.exr")),
         ];
-        assert!(check_distinct(&distinct).is_ok());
+        assert!(check_outputs(&distinct).is_ok());
+        let folder = [("-o (its PNG)", d.join("sub"))];
+        let e = check_outputs(&folder).unwrap_err();
+        assert!(e.refused && e.message.contains("is a folder"), "{e}");
         let same = [
             ("-o", d.join("a.exr")),
             ("--bounces", d.join("sub/../a.exr")),

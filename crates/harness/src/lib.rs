@@ -14,7 +14,8 @@ use glam::Vec3;
 use mirrorbox_files::{FileError, FolderLock, write_atomically};
 use mirrorbox_image::metrics::{MetricsError, compare, flip_map};
 use mirrorbox_image::{
-    ImageError, RgbImage, colormap, read_image, write_exr, write_png, write_png_bytes,
+    ImageError, RgbImage, StagedFiles, colormap, read_image, stage_exr, stage_png, write_png,
+    write_png_bytes,
 };
 use mirrorbox_raster::{Gpu, METHODS, Method, PlanError, RasterError, RenderSettings};
 use mirrorbox_report::{MetricValues, Record, SweepInfo, read_records, write_report};
@@ -308,7 +309,9 @@ fn truth(
         env!("CARGO_PKG_VERSION")
     );
     let path = cache.join(format!("truth-{:016x}.exr", key.finish()));
+    // A hit needs both files (a sweep killed between them once left an EXR alone).
     if path.is_file()
+        && path.with_extension("png").is_file()
         && let Ok(img) = read_image(&path)
     {
         summary.truths_cached += 1;
@@ -317,16 +320,21 @@ fn truth(
     let bvh = SceneBvh::build(&scene.geometry);
     let settings = TraceSettings::whitted(config.ssaa).with_integrator(*t);
     let out = mirrorbox_trace::render(scene, &bvh, &settings, &|_| {});
-    write_exr(
+    // Both files or neither.
+    let mut staged = StagedFiles::new();
+    stage_exr(
+        &mut staged,
         &path,
         &out.image,
         &[("mirrorbox.cache_key", format!("{:016x}", key.finish()))],
     )?;
-    write_png(
+    stage_png(
+        &mut staged,
         &path.with_extension("png"),
         &out.image,
         scene.camera.exposure,
     )?;
+    staged.commit()?;
     summary.truths_traced += 1;
     Ok((out.image, path))
 }
@@ -528,7 +536,12 @@ pub fn run_sweep(
                 "floor".into()
             }
         ));
-        std::fs::copy(truth_path.with_extension("png"), &truth_png).map_err(io(&truth_png))?;
+        let truth_source = truth_path.with_extension("png");
+        mirrorbox_files::write_atomically_with(&truth_png, |tmp| {
+            std::fs::copy(&truth_source, tmp)
+                .map(|_| ())
+                .map_err(|e| format!("cannot copy {}: {e}", truth_source.display()))
+        })?;
         let rel = |q: &Path| {
             q.strip_prefix(out)
                 .unwrap_or(q)

@@ -222,26 +222,69 @@ pub fn read_image(path: &Path) -> Result<RgbImage, ImageError> {
         .extension()
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase);
-    match ext.as_deref() {
-        Some("exr") => read_exr(path),
-        Some("png") => {
-            let img = image::open(path).map_err(|e| io_error(path, e))?.to_rgb8();
-            let (w, h) = img.dimensions();
-            let pixels = img.pixels().map(|p| p.0.map(srgb::decode8)).collect();
-            Ok(RgbImage {
-                width: w,
-                height: h,
-                pixels,
-            })
-        }
-        _ => Err(ImageError::UnsupportedType {
+    if !matches!(ext.as_deref(), Some("exr" | "png")) {
+        return Err(ImageError::UnsupportedType {
             path: path.to_path_buf(),
-        }),
+        });
     }
+    // A regular file of bounded size (no FIFO that blocks, no device that never ends).
+    mirrorbox_files::open_regular(path, MAX_IMAGE_FILE_BYTES, "image file")
+        .map_err(|e| io_error(path, e.message))?;
+    if ext.as_deref() == Some("exr") {
+        read_exr(path)
+    } else {
+        let mut reader = image::ImageReader::open(path).map_err(|e| io_error(path, e))?;
+        let mut limits = image::Limits::default();
+        limits.max_image_width = Some(MAX_IMAGE_SIDE);
+        limits.max_image_height = Some(MAX_IMAGE_SIDE);
+        limits.max_alloc = Some(MAX_PIXELS * 16);
+        reader.limits(limits);
+        let decoded = reader.decode().map_err(|e| io_error(path, e))?;
+        check_size(path, decoded.width(), decoded.height())?;
+        let img = decoded.to_rgb8();
+        let (w, h) = img.dimensions();
+        let pixels = img.pixels().map(|p| p.0.map(srgb::decode8)).collect();
+        Ok(RgbImage {
+            width: w,
+            height: h,
+            pixels,
+        })
+    }
+}
+
+/// Largest image file read (an 8192² float RGBA EXR, uncompressed, is 1.07 GB).
+pub const MAX_IMAGE_FILE_BYTES: u64 = 3 << 29;
+/// Largest image side read; the scene's limit (`mirrorbox_scene::limits::MAX_IMAGE_SIDE`).
+pub const MAX_IMAGE_SIDE: u32 = 16384;
+/// Most pixels in an image read; the scene's limit (`mirrorbox_scene::limits::MAX_PIXELS`).
+pub const MAX_PIXELS: u64 = 1 << 26;
+
+/// Refuses an image beyond the sizes mirrorbox writes, before its pixels are allocated.
+fn check_size(path: &Path, width: u32, height: u32) -> Result<(), ImageError> {
+    let pixels = u64::from(width) * u64::from(height);
+    if width.max(height) > MAX_IMAGE_SIDE || pixels > MAX_PIXELS || pixels == 0 {
+        return Err(io_error(
+            path,
+            format!(
+                "a {width}×{height} image; images of 1..{MAX_IMAGE_SIDE} pixels per side and at most {MAX_PIXELS} pixels are read"
+            ),
+        ));
+    }
+    Ok(())
 }
 
 fn read_exr(path: &Path) -> Result<RgbImage, ImageError> {
     use exr::prelude::*;
+    // The header first: the size it claims is checked before any pixel is allocated.
+    let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| io_error(path, e))?;
+    for header in &meta.headers {
+        let size = header.layer_size;
+        check_size(
+            path,
+            u32::try_from(size.width()).unwrap_or(u32::MAX),
+            u32::try_from(size.height()).unwrap_or(u32::MAX),
+        )?;
+    }
     let image = read_first_rgba_layer_from_file(
         path,
         |size, _| RgbImage::new(size.width() as u32, size.height() as u32),

@@ -397,7 +397,7 @@ impl Checker<'_> {
                     .path
                     .as_deref()
                     .ok_or_else(|| self.invalid(&mesh_path, "is required for a \"mesh\" object (an OBJ file, relative to the scene file)"))?;
-                self.obj(&mesh_path, rel)?
+                self.obj(&mesh_path, rel, geometry.triangles.len())?
             }
         };
         self.triangle_budget(path, geometry.triangles.len(), local.len() as u64)?;
@@ -478,7 +478,7 @@ impl Checker<'_> {
     }
 
     /// Triangles of an OBJ file, relative to the scene file's folder.
-    fn obj(&self, path: &FieldPath, rel: &str) -> Result<Vec<[Vec3; 3]>> {
+    fn obj(&self, path: &FieldPath, rel: &str, have: usize) -> Result<Vec<[Vec3; 3]>> {
         let resolved: PathBuf = self.file.parent().unwrap_or(Path::new(".")).join(rel);
         let bytes = mirrorbox_files::read_bounded(&resolved, MAX_OBJ_FILE_BYTES, "OBJ file")
             .map_err(|e| {
@@ -487,6 +487,7 @@ impl Checker<'_> {
                     format!("\"{rel}\" (at {}): {}", resolved.display(), e.message),
                 )
             })?;
+        self.triangle_budget(path, have, obj_triangle_count(&bytes))?;
         let models = parse_obj(&bytes).map_err(|(line, e)| {
             let at = line.map(|l| format!(" at line {l}")).unwrap_or_default();
             self.invalid(path, format!("malformed OBJ file \"{rel}\"{at}: {e}"))
@@ -534,8 +535,8 @@ fn parse_obj_prefix(bytes: &[u8]) -> std::result::Result<Vec<tobj::Model>, tobj:
 }
 
 /// Parses an OBJ with tobj. tobj's errors carry no position, so on failure the first failing
-/// line is found by bisecting over line prefixes (parsing is sequential: once a prefix fails,
-/// every longer one does).
+/// line is found by bisecting over byte offsets, each extended to its line's end (parsing is
+/// sequential: once a prefix fails, every longer one does) — no per-line table is built.
 fn parse_obj(
     bytes: &[u8],
 ) -> std::result::Result<Vec<tobj::Model>, (Option<usize>, tobj::LoadError)> {
@@ -543,25 +544,44 @@ fn parse_obj(
         Ok(models) => return Ok(models),
         Err(e) => e,
     };
-    let line_ends: Vec<usize> = bytes
-        .iter()
-        .enumerate()
-        .filter(|&(_, &b)| b == b'\n')
-        .map(|(i, _)| i + 1)
-        .chain(std::iter::once(bytes.len()))
-        .collect();
-    // Find the smallest k such that the first k lines fail.
-    let (mut lo, mut hi) = (0usize, line_ends.len()); // prefix of `hi` lines fails
-    while lo + 1 < hi {
-        let mid = (lo + hi) / 2;
-        if parse_obj_prefix(&bytes[..line_ends[mid - 1]]).is_err() {
+    // The end of the line holding byte `p - 1` (0 for the empty prefix).
+    let line_end = |p: usize| -> usize {
+        if p == 0 || bytes[p - 1] == b'\n' {
+            p
+        } else {
+            bytes[p..]
+                .iter()
+                .position(|&b| b == b'\n')
+                .map_or(bytes.len(), |i| p + i + 1)
+        }
+    };
+    let fails = |p: usize| parse_obj_prefix(&bytes[..line_end(p)]).is_err();
+    let (mut lo, mut hi) = (0usize, bytes.len()); // the whole file fails
+    while lo < hi {
+        let mid = lo + (hi - lo) / 2;
+        if fails(mid) {
             hi = mid;
         } else {
-            lo = mid;
+            lo = mid + 1;
         }
     }
-    let line = (hi >= 1 && parse_obj_prefix(&bytes[..line_ends[hi - 1]]).is_err()).then_some(hi);
+    let end = line_end(lo);
+    let line = (end > 0).then(|| 1 + bytes[..end - 1].iter().filter(|&&b| b == b'\n').count());
     Err((line, err))
+}
+
+/// Triangles the faces of an OBJ make once triangulated (k − 2 for a face of k vertices),
+/// counted without parsing a number, so the scene's budget is checked before tobj allocates.
+fn obj_triangle_count(bytes: &[u8]) -> u64 {
+    bytes
+        .split(|&b| b == b'\n')
+        .filter_map(|line| {
+            let mut tokens = line
+                .split(|b| b.is_ascii_whitespace())
+                .filter(|t| !t.is_empty());
+            (tokens.next()? == b"f").then(|| tokens.count().saturating_sub(2) as u64)
+        })
+        .sum()
 }
 
 fn show(v: Vec3) -> String {
@@ -632,6 +652,40 @@ mod tests {
                 .unwrap_err()
                 .to_string();
             assert!(e.contains("objects[0].path") && e.contains(kind), "{e}");
+        }
+    }
+
+    #[test]
+    fn an_obj_is_counted_against_the_budget_before_it_is_parsed() {
+        let dir = tempfile::tempdir().unwrap();
+        // One face of 4.2 M corners: 8 MB of text, 4.2 M triangles once triangulated.
+        let mut obj = String::from("v 0 0 0\nv 1 0 0\nv 0 1 0\nf");
+        obj.push_str(&" 1 2 3".repeat(1_400_000));
+        std::fs::write(dir.path().join("fan.obj"), obj).unwrap();
+        let text =
+            format!(r#"{{ {CAMERA}, "objects": [ {{ "type": "mesh", "path": "fan.obj" }} ] }}"#);
+        let e = parse_scene(&text, &dir.path().join("s.json"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("objects[0].path") && e.contains("adds 4199998 triangles"),
+            "{e}"
+        );
+        assert_eq!(
+            obj_triangle_count(b"f 1 2 3\nv 1 2 3\n  f 1 2 3 4 5\nf 1 2"),
+            1 + 3
+        );
+    }
+
+    #[test]
+    fn a_malformed_obj_line_is_found_by_bisection() {
+        let good = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+        for bad_line in 1..=4 {
+            let mut lines: Vec<&[u8]> = good.split(|&b| b == b'\n').collect();
+            lines[bad_line - 1] = b"v x y z";
+            let text = lines.join(&b'\n');
+            let (line, _) = parse_obj(&text).unwrap_err();
+            assert_eq!(line, Some(bad_line), "{}", String::from_utf8_lossy(&text));
         }
     }
 

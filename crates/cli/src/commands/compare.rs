@@ -45,6 +45,15 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         .as_deref()
         .map(|p| output_path("--heatmap", p, "png"))
         .transpose()?;
+    if let Some(h) = &heatmap {
+        // The heat map must not overwrite an image being compared.
+        mirrorbox_files::check_distinct(&[
+            ("--heatmap", h.clone()),
+            ("REFERENCE", args.reference.clone()),
+            ("TEST", args.test.clone()),
+        ])
+        .map_err(|e| Failure::BadInput(e.to_string()))?;
+    }
     let read = |p: &PathBuf| read_image(p).map_err(|e| Failure::BadInput(e.to_string()));
     let (r, t) = (read(&args.reference)?, read(&args.test)?);
     let m = compare(&r, &t, args.exposure).map_err(|e| {

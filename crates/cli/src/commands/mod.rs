@@ -88,6 +88,12 @@ pub fn peak_memory() -> Option<String> {
     Some(mirrorbox_files::human_bytes(kb * 1024))
 }
 
+/// The files one command writes: none a folder, no two the same file — checked before any
+/// work (write them with `StagedFiles`, so they appear together or not at all).
+pub fn check_outputs(outputs: &[(&str, PathBuf)]) -> Result<(), Failure> {
+    mirrorbox_files::check_outputs(outputs).map_err(|e| Failure::BadInput(e.to_string()))
+}
+
 /// A progress bar on stderr (drawn only when stderr is a terminal).
 pub fn progress_bar(len: u64, what: &str) -> indicatif::ProgressBar {
     let bar = indicatif::ProgressBar::new(len);

@@ -2,9 +2,9 @@
 //! the registry (`mirrorbox_raster::METHODS`) with wgpu, timed.
 
 use super::method_flags::{RenderOptions, method_value_parser};
-use super::{load, output_path, resize, unit_interval};
+use super::{check_outputs, load, output_path, resize, unit_interval};
 use crate::Failure;
-use mirrorbox_image::{write_exr, write_png};
+use mirrorbox_image::{StagedFiles, stage_exr, stage_png};
 use mirrorbox_raster::methods::recursive_texture::TEXTURE_SCALE;
 use mirrorbox_raster::{Gpu, RenderSettings, plan_frame, render_planned};
 use std::path::PathBuf;
@@ -57,6 +57,8 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     let method = args.options.0.configure(entry)?;
     unit_interval("--alpha", args.alpha)?;
     let png = output_path("-o", &args.output, "png")?;
+    let exr = png.with_extension("exr");
+    check_outputs(&[("-o", png.clone()), ("-o (its EXR)", exr.clone())])?;
     let mut scene = load(&args.scene)?;
     resize(&mut scene, args.width, args.height)?;
     if let Some(a) = args.alpha {
@@ -72,7 +74,6 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     let planned = plan_frame(&scene, &settings)?;
     let gpu = Gpu::new()?;
     let out = render_planned(&gpu, &scene, planned, &settings)?;
-    let exr = png.with_extension("exr");
     let method_text = method.to_string();
     for w in &out.warnings {
         eprintln!("warning: {w}");
@@ -98,8 +99,10 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         ),
     ];
     let write_failed = |e: mirrorbox_image::ImageError| Failure::Other(e.to_string());
-    write_exr(&exr, &out.image, &attributes).map_err(write_failed)?;
-    write_png(&png, &out.image, scene.camera.exposure).map_err(write_failed)?;
+    let mut staged = StagedFiles::new();
+    stage_exr(&mut staged, &exr, &out.image, &attributes).map_err(write_failed)?;
+    stage_png(&mut staged, &png, &out.image, scene.camera.exposure).map_err(write_failed)?;
+    staged.commit().map_err(|e| Failure::Other(e.to_string()))?;
     let s = &out.stats;
     let t = &out.timing;
     if args.json {

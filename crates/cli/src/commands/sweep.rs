@@ -78,13 +78,16 @@ fn bad(m: String) -> Failure {
     Failure::BadInput(m)
 }
 
+/// The numbers of `--alpha`; their range is checked with every other sweep setting
+/// (`SweepConfig::validate`, the check `trace` and `render` use).
 fn parse_alphas(s: &str) -> Result<Vec<f32>, Failure> {
     s.split(',')
-        .map(|x| match x.trim().parse::<f32>() {
-            Ok(a) if (0.0..=1.0).contains(&a) => Ok(a),
-            _ => Err(bad(format!(
-                "--alpha {s:?}: each value must be a number in [0, 1], got {x:?}"
-            ))),
+        .map(|x| {
+            x.trim().parse::<f32>().map_err(|_| {
+                bad(format!(
+                    "--alpha {s:?}: each value must be a number in [0, 1], got {x:?}"
+                ))
+            })
         })
         .collect()
 }

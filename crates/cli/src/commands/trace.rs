@@ -1,6 +1,8 @@
 //! `mirrorbox trace SCENE -o OUT.exr`: the ground truth, rendered on the CPU with obvhs.
 
-use super::{grid_side, load, output_path, progress_bar, resize, setting, unit_interval};
+use super::{
+    check_outputs, grid_side, load, output_path, progress_bar, resize, setting, unit_interval,
+};
 use crate::Failure;
 use mirrorbox_image::{RgbImage, StagedFiles, colormap, stage_exr, stage_png, stage_png_bytes};
 use mirrorbox_scene::SubpixelGrid;
@@ -110,7 +112,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         outputs.push(("--bounces", b.clone()));
         outputs.push(("--bounces (its PNG)", b.with_extension("png")));
     }
-    mirrorbox_files::check_distinct(&outputs).map_err(|e| Failure::BadInput(e.to_string()))?;
+    check_outputs(&outputs)?;
     let mut scene = load(&args.scene)?;
     resize(&mut scene, args.width, args.height)?;
     if let Some(r) = args.reflectance {

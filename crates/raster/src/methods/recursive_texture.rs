@@ -170,7 +170,7 @@ struct PlannedTextures {
 
 impl PlannedFrame for PlannedTextures {
     fn build(self: Box<Self>, gpu: &Gpu, scene: &Scene) -> Result<BuiltFrame, RasterError> {
-        let m = RecursiveTexture::new(gpu, scene, &self.plan, self.texture_scale);
+        let m = RecursiveTexture::new(gpu, scene, &self.plan, self.texture_scale)?;
         Ok(BuiltFrame {
             stats: m.stats,
             encoder: Box::new(m),
@@ -359,8 +359,44 @@ fn crop(r: Rect, w: u32, h: u32) -> Mat4 {
     )
 }
 
+/// Most bytes the mirror textures of one frame may take (colour and depth), so that
+/// `--texture-scale` on a large image is refused with the numbers instead of failing in the
+/// driver or aborting for memory.
+pub const MAX_MIRROR_TEXTURE_BYTES: u64 = 2_000_000_000;
+
+/// Refuses mirror textures larger than the device's largest texture, or more of them in
+/// bytes than [`MAX_MIRROR_TEXTURE_BYTES`], before any is created.
+fn check_mirror_textures(gpu: &Gpu, sizes: &[(u32, u32)]) -> Result<(), RasterError> {
+    for &(w, h) in sizes {
+        gpu.check_target(w, h)?;
+    }
+    // RGBA32F colour (at most 16 bytes) and 32-bit depth per texel.
+    let bytes: u64 = sizes
+        .iter()
+        .map(|&(w, h)| u64::from(w) * u64::from(h) * 20)
+        .sum();
+    if bytes > MAX_MIRROR_TEXTURE_BYTES {
+        return Err(RasterError::ExceedsDevice {
+            what: format!("{} mirror textures", sizes.len()),
+            needed: mirrorbox_files::human_bytes(bytes),
+            limit: format!(
+                "at most {}",
+                mirrorbox_files::human_bytes(MAX_MIRROR_TEXTURE_BYTES)
+            ),
+            adapter: "mirrorbox".into(),
+            advice: "; lower --texture-scale, --n or the image size",
+        });
+    }
+    Ok(())
+}
+
 impl RecursiveTexture {
-    pub fn new(gpu: &Gpu, scene: &Scene, plan: &Plan, texture_scale: f32) -> Self {
+    pub fn new(
+        gpu: &Gpu,
+        scene: &Scene,
+        plan: &Plan,
+        texture_scale: f32,
+    ) -> Result<Self, RasterError> {
         let device = &gpu.device;
         let scene_buffers = SceneBuffers::new(device, scene);
         let mut b = Builder {
@@ -407,6 +443,7 @@ impl RecursiveTexture {
                 resource: record_binding::<PassUniform>(&uniforms),
             }],
         });
+        check_mirror_textures(gpu, &b.slot_sizes)?;
         let slots: Vec<RenderTarget> = b
             .slot_sizes
             .iter()
@@ -499,7 +536,7 @@ impl RecursiveTexture {
             paths: None,
             clipping: None,
         };
-        RecursiveTexture {
+        Ok(RecursiveTexture {
             scene_buffers,
             objects_pipeline,
             mirror_pipeline,
@@ -509,7 +546,7 @@ impl RecursiveTexture {
             passes: b.passes,
             background: scene.background,
             stats,
-        }
+        })
     }
 }
 
