@@ -196,7 +196,7 @@ fn edge_cases_are_refused_with_a_clear_message_and_nothing_written() {
         ),
         (
             sweep(&["--width", "1"]),
-            vec!["--width must be at least 11 pixels in a sweep"],
+            vec!["the image width (--width or camera.width) must be at least 11 pixels in a sweep"],
         ),
         (
             sweep(&["--min-throughput", "nan"]),

@@ -402,8 +402,14 @@ fn base_scene(config: &SweepConfig) -> Result<(Scene, u32, u32), HarnessError> {
     base.resize(config.width, config.height)?;
     let min = mirrorbox_image::metrics::MIN_SIDE;
     for (flag, side) in [
-        ("--width", base.camera.width),
-        ("--height", base.camera.height),
+        (
+            "the image width (--width or camera.width)",
+            base.camera.width,
+        ),
+        (
+            "the image height (--height or camera.height)",
+            base.camera.height,
+        ),
     ] {
         if side < min {
             return Err(SettingError::new(
