@@ -5,8 +5,13 @@
 //! - **Truth cache**: `cache/truth-<key>.exr`, the key an FNV-1a hash of everything that
 //!   affects the traced image (scene content hash after α and size, spp, depth limits,
 //!   integrator, tracer version). A re-run reuses it.
-//! - **Resume**: points whose key is already in `results.jsonl` are skipped; a point is
-//!   written only when complete, so an interrupted sweep loses no finished point.
+//! - **Interleaved timing**: the points still to do are timed round-robin — `frames` rounds,
+//!   each rendering every point's warm-up frames and one timed frame, in an order shuffled
+//!   per round with a fixed seed — so drift of a shared machine hits every point alike. Each
+//!   record holds every frame, the median, its 95 % bootstrap interval and the minimum.
+//! - **Resume**: points whose key is already in `results.jsonl` are skipped. Points are
+//!   written once all rounds are done: an interrupted sweep keeps every point written
+//!   before, and measures the interrupted batch again.
 //! - **Floor**: raster vs trace on the scene without its mirrors, the error that is left
 //!   when there is no mirror effect to truncate.
 
@@ -206,6 +211,9 @@ fn io(path: &Path) -> impl FnOnce(std::io::Error) -> HarnessError + '_ {
     }
 }
 
+/// The seed of the per-round shuffles of interleaved timing.
+pub const INTERLEAVE_SEED: u64 = 2026;
+
 /// Progress of a sweep.
 pub enum Event<'a> {
     /// `todo` points will be computed, `reused` were already in results.jsonl.
@@ -213,8 +221,15 @@ pub enum Event<'a> {
         todo: usize,
         reused: usize,
     },
+    /// A point's truth is being traced or read from the cache.
     Started {
         label: &'a str,
+    },
+    /// A point renders its frame of timing round `round` (1-based) of `rounds`.
+    Timing {
+        label: &'a str,
+        round: u32,
+        rounds: u32,
     },
     Finished {
         record: &'a Record,
@@ -516,12 +531,42 @@ pub fn run_sweep(
         reused: summary.reused,
     });
     let gpu = Gpu::new()?;
-    for p in todo {
+    // Truths first (traced or from the cache), so that timing rounds run back to back.
+    let mut truths = Vec::with_capacity(todo.len());
+    for p in &todo {
         progress(Event::Started { label: &p.label });
-        let (scene, settings) = point_setup(&base, p, config);
-        let (truth_image, truth_path) = truth(&scene, config, &cache, &mut summary)?;
-        let rendered = mirrorbox_raster::render(&gpu, &scene, &settings)?;
-        let m = compare(&truth_image, &rendered.image, scene.camera.exposure)?;
+        let (scene, _) = point_setup(&base, p, config);
+        truths.push(truth(&scene, config, &cache, &mut summary)?);
+    }
+    // Interleaved timing: `frames` rounds; in each, every point renders its warm-up frames
+    // and one timed frame, the points in an order shuffled per round (fixed seed). Drift of a
+    // shared machine then spreads over every point alike instead of landing on a few.
+    let mut timed: Vec<Vec<f64>> = vec![Vec::new(); todo.len()];
+    let mut last: Vec<Option<mirrorbox_raster::RenderOutput>> = todo.iter().map(|_| None).collect();
+    let mut order: Vec<usize> = (0..todo.len()).collect();
+    let mut rng = mirrorbox_report::stats::Rng::new(INTERLEAVE_SEED);
+    for round in 0..config.frames {
+        rng.shuffle(&mut order);
+        for &i in &order {
+            let p = todo[i];
+            progress(Event::Timing {
+                label: &p.label,
+                round: round + 1,
+                rounds: config.frames,
+            });
+            let (scene, mut settings) = point_setup(&base, p, config);
+            settings.frames = 1;
+            let rendered = mirrorbox_raster::render(&gpu, &scene, &settings)?;
+            timed[i].extend(&rendered.timing.frames_ms);
+            last[i] = Some(rendered);
+        }
+    }
+    for (i, p) in todo.iter().enumerate() {
+        let (scene, _) = point_setup(&base, p, config);
+        let (truth_image, truth_path) = &truths[i];
+        let rendered = last[i].take().expect("every point renders in every round");
+        let frames_ms = std::mem::take(&mut timed[i]);
+        let m = compare(truth_image, &rendered.image, scene.camera.exposure)?;
         let raster_png = images.join(format!("{}.png", p.slug));
         write_png(&raster_png, &rendered.image, scene.camera.exposure)?;
         let exposure = scene.camera.exposure;
@@ -556,6 +601,7 @@ pub fn run_sweep(
         };
         let t = &rendered.timing;
         let s = &rendered.stats;
+        let interval = mirrorbox_report::stats::median_interval(&frames_ms);
         let record = Record {
             key: p.key.clone(),
             kind: if p.method.is_some() { "point" } else { "floor" }.into(),
@@ -568,8 +614,11 @@ pub fn run_sweep(
             width: w,
             height: h,
             ssaa: config.ssaa,
-            ms_median: t.median_ms(),
-            ms_min: t.min_ms(),
+            ms_median: mirrorbox_report::stats::median(&frames_ms),
+            ms_min: frames_ms.iter().copied().fold(f64::INFINITY, f64::min),
+            ms_interval: interval.map(|i| [i.low, i.high]),
+            frames_ms,
+            timing_order: "interleaved".into(),
             timing_source: t.source.name().into(),
             frames: config.frames,
             passes: s.passes,

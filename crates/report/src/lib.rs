@@ -7,6 +7,7 @@
 
 pub mod exact;
 pub mod plot;
+pub mod stats;
 pub mod table1;
 mod write;
 
@@ -29,6 +30,10 @@ pub struct MetricValues {
     pub flip_p99: f64,
 }
 
+fn back_to_back() -> String {
+    "back-to-back".into()
+}
+
 /// One point of a sweep: a method at one setting, timed and compared with the truth.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Record {
@@ -49,6 +54,18 @@ pub struct Record {
     pub ssaa: u32,
     pub ms_median: f64,
     pub ms_min: f64,
+    /// The 95 % bootstrap interval of the median, ms ([`stats::median_interval`]); absent in
+    /// records older than it.
+    #[serde(default)]
+    pub ms_interval: Option<[f64; 2]>,
+    /// Every timed frame, ms, in the order measured (empty in older records).
+    #[serde(default)]
+    pub frames_ms: Vec<f64>,
+    /// How the frames were timed: `interleaved` (one frame per point per round, round-robin
+    /// over the sweep's points in an order shuffled per round, so drift of the machine hits
+    /// every point alike) or `back-to-back` (all of a point's frames in a row: older records).
+    #[serde(default = "back_to_back")]
+    pub timing_order: String,
     pub timing_source: String,
     pub frames: u32,
     pub passes: usize,

@@ -16,6 +16,9 @@ pub struct Row {
     pub paper_ms: f64,
     pub ms_median: f64,
     pub ms_min: f64,
+    /// Every timed frame (empty for records older than the field): the bootstrap of the
+    /// exponent resamples them.
+    pub frames_ms: Vec<f64>,
     pub passes: usize,
     /// Step ratios to the previous row (None for n = 0).
     pub paper_step: Option<f64>,
@@ -48,6 +51,7 @@ pub fn rows(records: &[Record]) -> (Option<f32>, Vec<Row>) {
             paper_ms: PAPER_MS[n as usize],
             ms_median: r.ms_median,
             ms_min: r.ms_min,
+            frames_ms: r.frames_ms.clone(),
             passes: r.passes,
             paper_step: prev.map(|p| PAPER_MS[n as usize] / p.paper_ms),
             ours_step: prev.map(|p| r.ms_median / p.ms_median),
@@ -66,7 +70,26 @@ pub fn slope(points: &[(f64, f64)]) -> Option<f64> {
     crate::linear_fit(&pts).map(|(_, b)| b)
 }
 
-/// A sentence saying whether our growth matches the paper's, and why.
+/// The 95 % bootstrap interval of our exponent: every row's frames resampled with
+/// replacement, its median taken, the power law fitted again. `None` without frames.
+pub fn exponent_interval(rows: &[Row]) -> Option<crate::stats::Interval> {
+    let groups: Vec<&[f64]> = rows.iter().map(|r| r.frames_ms.as_slice()).collect();
+    crate::stats::bootstrap(
+        &groups,
+        |resampled| {
+            let pts: Vec<(f64, f64)> = rows
+                .iter()
+                .zip(resampled)
+                .map(|(r, frames)| (r.passes as f64, crate::stats::median(frames)))
+                .collect();
+            slope(&pts).unwrap_or(f64::NAN)
+        },
+        crate::stats::BOOTSTRAP_SEED,
+    )
+}
+
+/// A sentence saying whether our growth matches the paper's — computed: "matches" only if
+/// the paper's exponent lies inside our interval — and why.
 pub fn growth_sentence(rows: &[Row]) -> String {
     if rows.len() < 2 {
         return "Too few points to compare growth.".into();
@@ -94,13 +117,27 @@ pub fn growth_sentence(rows: &[Row]) -> String {
     let (Some(o), Some(p)) = (ours, paper) else {
         return "Growth could not be fitted.".into();
     };
-    let verdict = if (o - p).abs() <= 0.2 {
-        "matches"
-    } else {
-        "does not match"
+    let interval = exponent_interval(rows);
+    let verdict = match interval {
+        Some(i) if i.contains(p) => format!(
+            "matches: the paper's exponent {p:.2} lies inside our 95 % interval [{:.2}, {:.2}] \
+             (bootstrap over frames)",
+            i.low, i.high
+        ),
+        Some(i) => format!(
+            "does not match: the paper's exponent {p:.2} lies {:.2} outside our 95 % interval \
+             [{:.2}, {:.2}] (bootstrap over frames)",
+            (p - i.low).abs().min((p - i.high).abs()),
+            i.low,
+            i.high
+        ),
+        None => format!(
+            "cannot be judged: these records keep no frames to bound our exponent with \
+             (the paper's is {p:.2})"
+        ),
     };
     format!(
-        "The growth {verdict}: fitting log(ms/frame) against log(passes), our exponent is {o:.2} and the \
+        "The growth {verdict}. Fitting log(ms/frame) against log(passes), our exponent is {o:.2} and the \
          paper's is {p:.2} (1 = time proportional to the number of scene passes). The pass count of \
          the paper's recursion grows factorially with n (every mirror camera recurses into every \
          unhidden auxiliary mirror on the other side), and each pass costs about the same: \
@@ -136,13 +173,31 @@ mod tests {
                 paper_ms: PAPER_MS[n],
                 ms_median: PAPER_MS[n],
                 ms_min: PAPER_MS[n],
+                frames_ms: Vec::new(),
                 passes,
                 paper_step: None,
                 ours_step: None,
             })
             .collect();
         let s = growth_sentence(&rows);
-        assert!(s.starts_with("The growth matches"), "{s}");
+        assert!(s.starts_with("The growth cannot be judged"), "{s}");
         assert!(s.contains("8.3–9.6 ms per pass for the paper"), "{s}");
+        // With frames spread ±2 % around the paper's figures, its exponent is inside.
+        let spread = |ms: f64| (0..9).map(|k| ms * (0.98 + 0.005 * k as f64)).collect();
+        let with_frames: Vec<Row> = rows
+            .iter()
+            .map(|r| Row {
+                frames_ms: spread(r.paper_ms),
+                ..r.clone()
+            })
+            .collect();
+        let s = growth_sentence(&with_frames);
+        assert!(s.starts_with("The growth matches"), "{s}");
+        // Twice the time per pass at the top: a steeper exponent, outside the interval.
+        let mut steep = with_frames.clone();
+        steep[4].frames_ms = spread(4.0 * PAPER_MS[4]);
+        steep[4].ms_median = 4.0 * PAPER_MS[4];
+        let s = growth_sentence(&steep);
+        assert!(s.starts_with("The growth does not match"), "{s}");
     }
 }

@@ -62,6 +62,33 @@ fn sci(v: f64) -> String {
     }
 }
 
+/// The 95 % interval of a record's median, if it has one.
+fn interval(r: &Record) -> Option<crate::stats::Interval> {
+    r.ms_interval
+        .map(|[low, high]| crate::stats::Interval { low, high })
+}
+
+/// "median [low–high]" (older records: "median (min m)").
+fn ms_cell(r: &Record, digits: usize) -> String {
+    match r.ms_interval {
+        Some([low, high]) => format!(
+            "{} [{}–{}]",
+            f(r.ms_median, digits),
+            f(low, digits),
+            f(high, digits)
+        ),
+        None => format!("{} (min {})", f(r.ms_median, digits), f(r.ms_min, digits)),
+    }
+}
+
+/// A Table 1 row's interval, "low–high", or "min m" for older records.
+fn row_interval(r: &table1::Row) -> String {
+    match crate::stats::median_interval(&r.frames_ms) {
+        Some(i) => format!("{}–{}", f(i.low, 1), f(i.high, 1)),
+        None => format!("min {}", f(r.ms_min, 1)),
+    }
+}
+
 fn label(r: &Record) -> String {
     match (r.n, r.depth) {
         (Some(n), _) => format!("{} n={n}", r.method),
@@ -181,7 +208,7 @@ fn esc(s: &str) -> String {
 
 fn write_csv(path: &Path, records: &[Record]) -> Result<(), FileError> {
     let mut s = String::from(
-        "kind,method,n,depth,alpha,width,height,ssaa,ms_median,ms_min,timing_source,frames,passes,draws,texture_renders,reflections,\
+        "kind,method,n,depth,alpha,width,height,ssaa,ms_median,ms_ci_low,ms_ci_high,ms_min,timing_order,timing_source,frames,passes,draws,texture_renders,reflections,\
          rmse,relmse,smape,max_abs,psnr,ssim,flip_mean,flip_p95,flip_p99,adapter,backend,scene,scene_hash,color_format\n",
     );
     for r in records {
@@ -189,7 +216,7 @@ fn write_csv(path: &Path, records: &[Record]) -> Result<(), FileError> {
         let opt = |v: Option<u32>| v.map_or(String::new(), |x| x.to_string());
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},\"{}\",{},\"{}\",{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},\"{}\",{},\"{}\",{},{}",
             r.kind,
             r.method,
             opt(r.n),
@@ -199,7 +226,10 @@ fn write_csv(path: &Path, records: &[Record]) -> Result<(), FileError> {
             r.height,
             r.ssaa,
             r.ms_median,
+            r.ms_interval.map_or(String::new(), |i| i[0].to_string()),
+            r.ms_interval.map_or(String::new(), |i| i[1].to_string()),
             r.ms_min,
+            r.timing_order,
             r.timing_source,
             r.frames,
             r.passes,
@@ -250,7 +280,7 @@ fn exact_comparison(
     let line = |r: &Record| {
         vec![
             label(r),
-            format!("{} ({})", f(r.ms_median, 1), f(r.ms_min, 1)),
+            ms_cell(r, 1),
             r.passes.to_string(),
             r.draws.to_string(),
             r.reflections.to_string(),
@@ -263,7 +293,7 @@ fn exact_comparison(
         Block::Table(
             [
                 "method",
-                "ms/frame median (min)",
+                "ms/frame median [95 % CI]",
                 "passes",
                 "draws",
                 "reflections shown",
@@ -275,11 +305,16 @@ fn exact_comparison(
             aux.iter().chain(&exact).map(|r| line(r)).collect(),
         ),
     ];
-    let times = |ratio: f64| {
-        if ratio >= 1.0 {
-            format!("{ratio:.1}× faster")
-        } else {
-            format!("{:.1}× slower", 1.0 / ratio)
+    // A speed ratio is stated only where the 95 % intervals of the two medians are apart.
+    let times = |a: &Record, e: &Record| {
+        let ratio = a.ms_median / e.ms_median;
+        match (interval(a), interval(e)) {
+            (Some(ia), Some(ie)) if ia.overlaps(&ie) => {
+                "indistinguishable in time on this device (95 % intervals overlap)".to_string()
+            }
+            (Some(_), Some(_)) if ratio >= 1.0 => format!("{ratio:.1}× faster"),
+            (Some(_), Some(_)) => format!("{:.1}× slower", 1.0 / ratio),
+            _ => format!("{ratio:.2}× the time (no intervals in these records)"),
         }
     };
     let sentences: Vec<String> = exact
@@ -295,7 +330,7 @@ fn exact_comparison(
                         sci(a.metrics.flip_mean),
                         f(a.ms_median, 1),
                         a.metrics.flip_mean / e.metrics.flip_mean,
-                        times(a.ms_median / e.ms_median)
+                        times(a, e)
                     )
                 })
                 .collect();
@@ -353,7 +388,7 @@ fn depth_scaling(info: &SweepInfo, records: &[Record], floor: Option<&Record>) -
                 "passes",
                 "draws",
                 "triangles",
-                "ms/frame median (min)",
+                "ms/frame median [95 % CI]",
                 "FLIP mean",
             ]
             .map(String::from)
@@ -372,7 +407,7 @@ fn depth_scaling(info: &SweepInfo, records: &[Record], floor: Option<&Record>) -
                         r.passes.to_string(),
                         r.draws.to_string(),
                         opt(r.triangles),
-                        format!("{} ({})", f(r.ms_median, 2), f(r.ms_min, 2)),
+                        ms_cell(r, 2),
                         sci(r.metrics.flip_mean),
                     ]
                 })
@@ -439,7 +474,7 @@ fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
             [
                 "n",
                 "paper ms/frame",
-                "ours ms/frame",
+                "ours ms/frame median [95 % CI]",
                 "passes",
                 "ours ms/pass",
                 "paper ms/pass",
@@ -453,7 +488,7 @@ fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
                     vec![
                         r.n.to_string(),
                         f(r.paper_ms, 0),
-                        format!("{} ({})", f(r.ms_median, 1), f(r.ms_min, 1)),
+                        format!("{} [{}]", f(r.ms_median, 1), row_interval(r)),
                         r.passes.to_string(),
                         f(r.ms_median / r.passes as f64, 2),
                         f(r.paper_ms / r.passes as f64, 2),
@@ -565,7 +600,7 @@ fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
             [
                 "point",
                 "α",
-                "ms/frame median",
+                "ms/frame median [95 % CI]",
                 "min",
                 "timing",
                 "passes",
@@ -588,9 +623,9 @@ fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
                     vec![
                         label(r),
                         r.alpha.to_string(),
-                        f(r.ms_median, 2),
+                        ms_cell(r, 2),
                         f(r.ms_min, 2),
-                        r.timing_source.clone(),
+                        format!("{}, {}", r.timing_source, r.timing_order),
                         r.passes.to_string(),
                         r.draws.to_string(),
                         sci(m.rmse),
@@ -654,6 +689,9 @@ mod tests {
             height: 16,
             ssaa: 1,
             ms_median: ms,
+            ms_interval: None,
+            frames_ms: Vec::new(),
+            timing_order: "back-to-back".into(),
             ms_min: ms,
             timing_source: "gpu-timestamps".into(),
             frames: 1,
@@ -703,7 +741,7 @@ mod tests {
         .unwrap();
         let md = std::fs::read_to_string(dir.path().join("report.md")).unwrap();
         assert!(md.contains("Reproduction of the paper's Table 1"));
-        assert!(md.contains("| 2 | 142 | 100.0 (100.0) | 15 |"), "{md}");
+        assert!(md.contains("| 2 | 142 | 100.0 [min 100.0] | 15 |"), "{md}");
         let html = std::fs::read_to_string(dir.path().join("report.html")).unwrap();
         assert!(html.contains("<svg") && html.contains("<table>"));
         let csv = std::fs::read_to_string(dir.path().join("results.csv")).unwrap();

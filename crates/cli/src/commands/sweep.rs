@@ -180,7 +180,16 @@ fn execute(config: &SweepConfig, fresh: bool) -> Result<(), Failure> {
         }
         Event::Started { label } => {
             if let Some(b) = &bar {
-                b.set_message(label.to_string());
+                b.set_message(format!("truth: {label}"));
+            }
+        }
+        Event::Timing {
+            label,
+            round,
+            rounds,
+        } => {
+            if let Some(b) = &bar {
+                b.set_message(format!("round {round}/{rounds}: {label}"));
             }
         }
         Event::Finished { record } => {
