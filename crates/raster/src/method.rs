@@ -153,6 +153,10 @@ pub struct PathCounts {
     pub pruned_attenuation: usize,
     /// Paths cut by the depth cap.
     pub capped: usize,
+    /// Portals holding pixel centres only where nearer sibling mirrors hide them.
+    pub pruned_hidden: usize,
+    /// Kept paths part of whose portal a nearer sibling mirror hides (drawn as the rest).
+    pub partly_hidden: usize,
 }
 
 impl PathCounts {
@@ -164,6 +168,8 @@ impl PathCounts {
             pruned_small: set.pruned_small,
             pruned_attenuation: set.pruned_attenuation,
             capped: set.capped,
+            pruned_hidden: set.pruned_hidden,
+            partly_hidden: set.partly_hidden,
         }
     }
 
@@ -173,6 +179,7 @@ impl PathCounts {
             + self.pruned_small
             + self.pruned_attenuation
             + self.capped
+            + self.pruned_hidden
     }
 }
 

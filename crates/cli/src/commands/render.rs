@@ -122,6 +122,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
                 "kept": c.kept, "pruned_empty": c.pruned_empty, "pruned_no_sample": c.pruned_no_sample,
                 "pruned_small": c.pruned_small,
                 "pruned_attenuation": c.pruned_attenuation, "capped": c.capped,
+                "pruned_hidden": c.pruned_hidden, "partly_hidden": c.partly_hidden,
             })),
             "clipping": s.clipping.map(|c| c.name()),
             "warnings": out.warnings,
@@ -143,14 +144,16 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         );
         if let Some(c) = s.paths {
             println!(
-                "  reflection paths: {} kept; pruned {} (empty {}, no pixel centre {}, under --min-portal-area {}, under --min-attenuation {}, past --depth {}); {} triangles submitted{}",
+                "  reflection paths: {} kept ({} partly hidden by a nearer sibling mirror); pruned {} (empty {}, no pixel centre {}, under --min-portal-area {}, under --min-attenuation {}, past --depth {}, hidden by nearer siblings {}); {} triangles submitted{}",
                 c.kept,
+                c.partly_hidden,
                 c.pruned(),
                 c.pruned_empty,
                 c.pruned_no_sample,
                 c.pruned_small,
                 c.pruned_attenuation,
                 c.capped,
+                c.pruned_hidden,
                 s.triangles,
                 s.clipping
                     .map_or(String::new(), |c| format!(", clipped by {}", c.name()))
