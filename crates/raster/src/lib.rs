@@ -11,7 +11,8 @@
 //! - [`culling`]: footprint rectangles and parts against a path's portal.
 //! - [`shading`]: the scene buffers the contract's WGSL reads; [`wgsl`]: all WGSL composition.
 //! - The thin wgpu layer: [`adapter`] (Vulkan, then GL; `WGPU_BACKEND` overrides), [`gpu`]
-//!   (device and errors), [`targets`], [`pipeline`] (scene-pipeline builder, uniform arena),
+//!   (device and errors), [`projection`] (the one projection: infinite reversed Z),
+//!   [`targets`], [`pipeline`] (scene-pipeline builder, uniform arena),
 //!   [`resolve`] (SSAA), [`timing`] (GPU timestamps), [`readback`].
 
 pub mod adapter;
@@ -22,6 +23,7 @@ pub mod method;
 pub mod methods;
 pub mod pipeline;
 pub mod plan;
+pub mod projection;
 pub mod readback;
 pub mod registry;
 pub mod resolve;

@@ -42,12 +42,13 @@ use crate::method::{
 };
 use crate::pipeline::{ScenePipeline, depth_state, pipeline_layout};
 use crate::plan::PlanError;
+use crate::projection::{FAR_DEPTH, NEARER};
 use crate::shading::{SceneBuffers, VERTEX_LAYOUT};
 use crate::targets::{DEPTH_FORMAT, DepthClear, RenderTarget};
 use crate::timing::FrameEncoder;
 use crate::wgsl::{HostLayout, WgslSource, shader_module};
 use bytemuck::{Pod, Zeroable};
-use glam::{Mat4, Vec2, Vec3, Vec4};
+use glam::{Vec2, Vec3, Vec4};
 use mirrorbox_scene::Scene;
 use mirrorbox_scene::camera::pixel_to_ndc;
 use mirrorbox_scene::polygon::{bounds, orientation};
@@ -198,18 +199,6 @@ struct BackgroundVertex {
     attenuation: [f32; 3],
 }
 
-/// The camera's `[0, 1]`-depth projection with its depth row replaced by infinite reversed
-/// Z: `z_ndc = near / w`, 1 at the near plane and → 0 at infinity. x, y and w (hence every
-/// pixel's coverage) are the camera's own.
-pub fn infinite_reversed_z(projection: Mat4, near: f32) -> Mat4 {
-    let mut m = projection;
-    m.x_axis.z = 0.0;
-    m.y_axis.z = 0.0;
-    m.z_axis.z = 0.0;
-    m.w_axis.z = near;
-    m
-}
-
 /// The clip-space half-planes `a·x + b·y + c·w ≥ 0` bounding a convex screen polygon
 /// (pixels, any orientation) — each a plane through the eye.
 pub fn portal_edges(portal: &[Vec2], size: Vec2) -> Vec<Vec4> {
@@ -286,7 +275,6 @@ impl Unrolled {
             gpu.features.contains(wgpu::Features::CLIP_DISTANCES) && !fragment_clipping;
         let scene_buffers = SceneBuffers::new(device, scene);
         let size = Vec2::new(width as f32, height as f32);
-        let reversed = infinite_reversed_z(projection, crate::plan::NEAR);
         let planes: Vec<Vec4> = scene
             .mirrors
             .iter()
@@ -356,7 +344,7 @@ impl Unrolled {
                 })
                 .map(|(k, _)| k)
                 .collect();
-            let clip_from_world = (reversed * p.view.view).to_cols_array_2d();
+            let clip_from_world = view_clip.to_cols_array_2d();
             let eye = p.view.eye().to_array();
             for piece in &p.visible {
                 let id = cell_pieces.len() as u32;
@@ -526,7 +514,7 @@ impl Unrolled {
                     if background {
                         wgpu::CompareFunction::Always
                     } else {
-                        wgpu::CompareFunction::Greater
+                        NEARER
                     },
                     Default::default(),
                 ),
@@ -605,11 +593,12 @@ impl Unrolled {
             depth: paths.deepest,
             triangles,
             paths: Some(PathCounts::of(paths)),
-            clipping: Some(if clip_distances {
+            clipping: if clip_distances {
                 Clipping::ClipDistances
             } else {
                 Clipping::FragmentDiscard
-            }),
+            },
+            depth_format: DEPTH_FORMAT,
         };
         Ok(Unrolled {
             scene_buffers,
@@ -635,14 +624,13 @@ impl FrameEncoder for Unrolled {
         target: &RenderTarget,
         first_pass: Option<wgpu::RenderPassTimestampWrites<'_>>,
     ) {
-        // Reversed Z: depth 0 is infinitely far.
         let mut pass = target.begin_pass_with(
             encoder,
             "unrolled pass",
             self.clear,
             DepthClear {
                 view: &self.depth,
-                depth: 0.0,
+                depth: FAR_DEPTH,
                 stencil: None,
             },
             first_pass,
@@ -672,25 +660,6 @@ impl FrameEncoder for Unrolled {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn reversed_z_keeps_coverage_and_orders_depth_far_to_zero() {
-        let p = glam::camera::rh::proj::directx::perspective(1.0, 1.5, 0.01, 1e4);
-        let r = infinite_reversed_z(p, 0.01);
-        for z in [-0.01f32, -1.0, -10.0, -5000.0] {
-            let v = glam::Vec4::new(0.3, -0.2, z, 1.0);
-            let (a, b) = (p * v, r * v);
-            assert_eq!((a.x, a.y, a.w), (b.x, b.y, b.w));
-        }
-        let depth = |z: f32| {
-            let c = r * glam::Vec4::new(0.0, 0.0, z, 1.0);
-            c.z / c.w
-        };
-        assert!((depth(-0.01) - 1.0).abs() < 1e-6);
-        // Strictly decreasing with distance, and still resolving 1 part in 1e5 at 4 km.
-        assert!(depth(-1.0) > depth(-2.0));
-        assert!(depth(-4000.0) > depth(-4000.05));
-    }
 
     #[test]
     fn portal_edges_keep_the_inside_in_either_orientation() {
