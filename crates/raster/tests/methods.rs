@@ -526,14 +526,15 @@ fn exact_methods_are_exact_where_sibling_portals_overlap() {
 }
 
 /// A thin shelf (a flat box 0.02 thick) with an emissive box standing on it, seen from
-/// below through a periscope: two 45° mirrors 0.3 apart (planes y + z = 0 and y + z = 0.3)
-/// bring the camera's rays up and out again, parallel to themselves, under the shelf 50
-/// units above. The rays meet its underside at grazing angles (slopes 0.02 to 0.2), 250 to
-/// 2 500 units from the virtual eye, where the box's bottom lies 0.1 to 1 unit behind the
-/// shelf's along the ray. Any depth resolution coarser than that lets the box leak through
-/// (a standard-Z projection with its near plane moved onto the mirror resolves about
-/// t²·6e-8/0.3 — 3 units at 2 500). No method may show the box; the exact ones must match the
-/// truth, with clip distances and with fragment discard alike.
+/// below through a periscope: two 45° mirrors, centres 0.3 apart (planes y + z = 0 and
+/// y + z = 0.3), bring the camera's rays up and out again, parallel to themselves, under the
+/// shelf 50 units above. The rays meet its underside at grazing angles (slopes 0.02 to 0.2),
+/// 250 to 2 500 units from the virtual eye, where the box's bottom lies 0.1 to 1 unit behind
+/// the shelf's along the ray. Any depth resolution coarser than that lets the box leak through:
+/// with its near plane moved onto the second mirror (about 0.3 from the virtual eye), a
+/// standard-Z projection resolves about t²·2⁻²⁴/0.3 — over a unit at 2 500; the camera's
+/// infinite reversed Z in float resolves t·2⁻²³, 0.3 mm there. No method may show the box;
+/// the exact ones must match the truth, with clip distances and with fragment discard alike.
 #[test]
 fn no_method_lets_a_box_leak_through_a_thin_shelf_seen_through_a_periscope() {
     let text = serde_json::json!({
