@@ -358,7 +358,7 @@ pub fn reflection_paths(
                 continue;
             }
             // The portal inside the parent's visible region, less what nearer siblings hide.
-            let mut pieces = if whole[parent] {
+            let mut pieces: Vec<Vec<Vec2>> = if whole[parent] {
                 vec![visible.clone()]
             } else {
                 set.paths[parent]
@@ -368,6 +368,11 @@ pub fn reflection_paths(
                     .filter(|piece| holds_a_pixel_centre(piece))
                     .collect()
             };
+            if let [inside] = pieces.as_slice()
+                && area(inside) >= area(visible) - 1e-4
+            {
+                pieces = vec![visible.clone()]; // the portal lies in one piece of the parent's
+            }
             for (s, (_, sibling_plane, sibling_portal)) in candidates.iter().enumerate() {
                 if s != c && !pieces.is_empty() {
                     let hidden = rays.met_first(sibling_portal, sibling_plane, mirror_plane);
