@@ -1,6 +1,9 @@
 // Entry points of crates/raster/src/portal_stencil.rs: exact mirrors by stencil recursion.
-// Each reflection path draws its world where the stencil holds its value, attenuated by the
-// product of the reflectances along it. Prepended with shading.wgsl.
+// Each reflection path draws its world where the stencil holds its value, in front of its last
+// mirror, attenuated by the product of the reflectances along it. Prepended with
+// shading.wgsl; followed by mirror_plane_clip_distances.wgsl where the adapter has clip
+// distances (vs_clip_distances with fs_object / fs_mirror / fs_none), else the plane is
+// tested per fragment (vs_main with the *_discard entry points).
 
 struct Path {
     clip_from_world: mat4x4f,
@@ -8,6 +11,9 @@ struct Path {
     _pad0: f32,
     attenuation: vec3f,
     _pad1: f32,
+    // The path's last mirror plane in scene space, front positive ((0, 0, 0, 1) for the
+    // camera): its world is what lies in front of it.
+    plane: vec4f,
 }
 
 @group(1) @binding(0) var<uniform> path: Path;
@@ -18,37 +24,69 @@ struct VertexOut {
     @location(0) world: vec3f,
     @location(1) @interpolate(flat) normal: vec3f,
     @location(2) @interpolate(flat) surface: u32,
+    // Signed distance to the path's last mirror plane (scene units).
+    @location(3) plane_distance: f32,
 }
 
-@vertex
-fn vs_main(v: VertexIn) -> VertexOut {
+fn scene_vertex(v: VertexIn) -> VertexOut {
     var out: VertexOut;
     out.clip = path.clip_from_world * vec4f(v.position, 1.0);
     out.world = v.position;
     out.normal = v.normal;
     out.surface = v.surface;
+    out.plane_distance = dot(path.plane, vec4f(v.position, 1.0));
     return out;
+}
+
+@vertex
+fn vs_main(v: VertexIn) -> VertexOut {
+    return scene_vertex(v);
 }
 
 fn shade(in: VertexOut, albedo: vec3f, emission: vec3f) -> vec3f {
     return path.attenuation * diffuse_radiance(in.world, in.normal, normalize(path.eye - in.world), albedo, emission);
 }
 
-@fragment
-fn fs_object(in: VertexOut) -> @location(0) vec4f {
+fn object_colour(in: VertexOut) -> vec4f {
     let s = surfaces[in.surface];
     return vec4f(shade(in, s.albedo, s.emission), 1.0);
 }
 
 // A mirror in a path's world: its front shows the terminal radiance (overwritten by the
 // child path's world wherever that path was kept); its back is diffuse.
-@fragment
-fn fs_mirror(in: VertexOut) -> @location(0) vec4f {
+fn mirror_colour(in: VertexOut) -> vec4f {
     let s = surfaces[in.surface];
     if (dot(in.normal, path.eye - in.world) > 0.0) {
         return vec4f(path.attenuation * frame.terminal, 1.0);
     }
     return vec4f(shade(in, s.back_albedo, vec3f(0.0)), 1.0);
+}
+
+@fragment
+fn fs_object(in: VertexOut) -> @location(0) vec4f {
+    return object_colour(in);
+}
+
+@fragment
+fn fs_mirror(in: VertexOut) -> @location(0) vec4f {
+    return mirror_colour(in);
+}
+
+// Without clip distances: what lies behind the path's last mirror is discarded here.
+@fragment
+fn fs_object_discard(in: VertexOut) -> @location(0) vec4f {
+    if (in.plane_distance < 0.0) {
+        discard;
+    }
+    return object_colour(in);
+}
+
+@fragment
+fn fs_mirror_discard(in: VertexOut) -> @location(0) vec4f {
+    if (in.plane_distance < 0.0) {
+        discard;
+    }
+    return mirror_colour(in);
 }
 
 // A path's empty pixels see the background through its mirrors.
@@ -63,9 +101,19 @@ fn fs_none() -> @location(0) vec4f {
     return vec4f(0.0);
 }
 
-// A screen-covering triangle at the far plane (depth 1), for depth clears and stencil edits.
+// A mirror's stencil mark without clip distances: not behind the path's last mirror.
+@fragment
+fn fs_mark_discard(in: VertexOut) -> @location(0) vec4f {
+    if (in.plane_distance < 0.0) {
+        discard;
+    }
+    return vec4f(0.0);
+}
+
+// A screen-covering triangle infinitely far (depth 0, reversed Z), for depth clears and
+// stencil edits.
 @vertex
 fn vs_fullscreen(@builtin(vertex_index) i: u32) -> @builtin(position) vec4f {
     let uv = vec2f(f32((i << 1u) & 2u), f32(i & 2u));
-    return vec4f(uv * 2.0 - 1.0, 1.0, 1.0);
+    return vec4f(uv * 2.0 - 1.0, 0.0, 1.0);
 }

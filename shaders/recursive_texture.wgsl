@@ -1,6 +1,9 @@
 // Entry points of crates/raster/src/recursive_texture.rs: one scene pass of the seed paper's
-// Algorithm 1, drawn from a (possibly reflected) camera into a screen-space texture.
-// Prepended with shading.wgsl.
+// Algorithm 1, drawn from a (possibly reflected) camera into a screen-space texture, keeping
+// what lies in front of the pass's mirror. Prepended with shading.wgsl; followed by
+// mirror_plane_clip_distances.wgsl where the adapter has clip distances (vs_clip_distances with
+// fs_object / fs_mirror), else the plane is tested per fragment (vs_main with
+// fs_object_discard / fs_mirror_discard).
 
 struct Pass {
     clip_from_world: mat4x4f,
@@ -11,6 +14,9 @@ struct Pass {
     // pixels), `pixels_per_texel` screen pixels per target texel.
     origin: vec2f,
     pixels_per_texel: vec2f,
+    // The pass's mirror plane in scene space, front positive ((0, 0, 0, 1) for the camera's
+    // pass): the mirror's world is what lies in front of it.
+    plane: vec4f,
 }
 
 struct MirrorDraw {
@@ -28,28 +34,34 @@ struct MirrorDraw {
 @group(2) @binding(1) var mirror_texture: texture_2d<f32>;
 
 struct VertexOut {
-    @builtin(position) clip: vec4f,
+    @builtin(position) @invariant clip: vec4f,
     @location(0) world: vec3f,
     @location(1) @interpolate(flat) normal: vec3f,
     @location(2) @interpolate(flat) surface: u32,
+    // Signed distance to the pass's mirror plane (scene units).
+    @location(3) plane_distance: f32,
 }
 
-@vertex
-fn vs_main(v: VertexIn) -> VertexOut {
+fn scene_vertex(v: VertexIn) -> VertexOut {
     var out: VertexOut;
     out.clip = pass_.clip_from_world * vec4f(v.position, 1.0);
     out.world = v.position;
     out.normal = v.normal;
     out.surface = v.surface;
+    out.plane_distance = dot(pass_.plane, vec4f(v.position, 1.0));
     return out;
+}
+
+@vertex
+fn vs_main(v: VertexIn) -> VertexOut {
+    return scene_vertex(v);
 }
 
 fn shade_diffuse(in: VertexOut, albedo: vec3f, emission: vec3f) -> vec3f {
     return diffuse_radiance(in.world, in.normal, normalize(pass_.eye - in.world), albedo, emission);
 }
 
-@fragment
-fn fs_object(in: VertexOut) -> @location(0) vec4f {
+fn object_colour(in: VertexOut) -> vec4f {
     let s = surfaces[in.surface];
     return vec4f(shade_diffuse(in, s.albedo, s.emission), 1.0);
 }
@@ -74,8 +86,7 @@ fn mirror_lookup(frag: vec2f) -> vec3f {
     return mix(a, b, f.y);
 }
 
-@fragment
-fn fs_mirror(in: VertexOut) -> @location(0) vec4f {
+fn mirror_colour(in: VertexOut) -> vec4f {
     let s = surfaces[in.surface];
     let front = dot(in.normal, pass_.eye - in.world) > 0.0;
     if (!front) {
@@ -85,4 +96,31 @@ fn fs_mirror(in: VertexOut) -> @location(0) vec4f {
         return vec4f(frame.terminal, 1.0);
     }
     return vec4f(s.reflectance * mirror_lookup(in.clip.xy), 1.0);
+}
+
+@fragment
+fn fs_object(in: VertexOut) -> @location(0) vec4f {
+    return object_colour(in);
+}
+
+@fragment
+fn fs_mirror(in: VertexOut) -> @location(0) vec4f {
+    return mirror_colour(in);
+}
+
+// Without clip distances: what lies behind the pass's mirror is discarded here.
+@fragment
+fn fs_object_discard(in: VertexOut) -> @location(0) vec4f {
+    if (in.plane_distance < 0.0) {
+        discard;
+    }
+    return object_colour(in);
+}
+
+@fragment
+fn fs_mirror_discard(in: VertexOut) -> @location(0) vec4f {
+    if (in.plane_distance < 0.0) {
+        discard;
+    }
+    return mirror_colour(in);
 }

@@ -1,15 +1,19 @@
-// Entry points of crates/raster/src/unrolled.rs: every kept reflection path drawn as one
-// instance of the scene. Prepended with shading.wgsl; unrolled_clip_distances.wgsl adds the
-// hardware-clipped vertex stage where the adapter has clip distances.
+// Entry points of crates/raster/src/unrolled.rs: every kept reflection path drawn as
+// instances of the scene, one per convex piece of its visible region. Prepended with
+// shading.wgsl; unrolled_clip_distances.wgsl adds the hardware-clipped vertex stage where the
+// adapter has clip distances.
 //
 // An instance draws the real scene through its path's composed reflection `R₁·…·Rₖ` (inside
 // `clip_from_world`), keeps only what lies beyond its last mirror's plane and inside its
-// portal (planes through the eye and the portal's edges, as clip-space half-planes
+// piece (planes through the eye and the piece's edges, as clip-space half-planes
 // a·x + b·y + c·w ≥ 0) and is attenuated by the product of the reflectances along the path.
-// One depth buffer (infinite reversed Z, shared by every instance: the projection is the
-// camera's) resolves visibility between instances.
+// A path's visible region is its portal less what nearer sibling mirrors hide, so the cells
+// follow each other along every unfolded ray and one depth buffer (infinite reversed Z,
+// shared by every instance: the projection is the camera's) resolves visibility between them.
 
-struct PathData {
+// One convex piece of a path's cell: the path's transform, plane, eye and attenuation, and
+// the piece's edges.
+struct CellPiece {
     clip_from_world: mat4x4f,
     // The last mirror's plane in scene space, front positive; (0, 0, 0, 1) for the camera.
     plane: vec4f,
@@ -31,9 +35,9 @@ struct MirrorRect {
     _pad: f32,
 }
 
-@group(1) @binding(0) var<storage, read> paths: array<PathData>;
+@group(1) @binding(0) var<storage, read> pieces: array<CellPiece>;
 @group(1) @binding(1) var<storage, read> edges: array<vec4f>;
-// Draw `d` covers instances `first_instance..` of this list: instance i draws path ids[i].
+// Draw `d` covers instances `first_instance..` of this list: instance i draws piece ids[i].
 @group(1) @binding(2) var<storage, read> ids: array<u32>;
 @group(1) @binding(3) var<storage, read> mirror_rects: array<MirrorRect>;
 
@@ -42,7 +46,7 @@ struct GuardedOut {
     @location(0) world: vec3f,
     @location(1) @interpolate(flat) normal: vec3f,
     @location(2) @interpolate(flat) surface: u32,
-    @location(3) @interpolate(flat) path: u32,
+    @location(3) @interpolate(flat) piece: u32,
     // Clip-space x, y, w: affine in the world position, so interpolated exactly.
     @location(4) clip_xyw: vec3f,
 }
@@ -52,22 +56,22 @@ struct GuardedOut {
 fn vs_guarded(v: VertexIn, @builtin(instance_index) instance: u32) -> GuardedOut {
     let id = ids[instance];
     var out: GuardedOut;
-    out.clip = paths[id].clip_from_world * vec4f(v.position, 1.0);
+    out.clip = pieces[id].clip_from_world * vec4f(v.position, 1.0);
     out.world = v.position;
     out.normal = v.normal;
     out.surface = v.surface;
-    out.path = id;
+    out.piece = id;
     out.clip_xyw = out.clip.xyw;
     return out;
 }
 
-// Whether scene point `x`, drawn by path `id`, is really seen through the path: beyond its
-// last mirror, inside its portal, and not behind the front of another mirror. The last
+// Whether scene point `x`, drawn by piece `id`, is really seen through its path: beyond its
+// last mirror, inside the piece, and not behind the front of another mirror. The last
 // test is the one clipping cannot do: the segment from where the path's ray enters its cell
 // (on the last mirror; the eye for the camera) to `x` must not cross a mirror's front, or
 // the ray would have been reflected there (an object placed behind a mirror).
 fn in_cell(id: u32, x: vec3f, clip_xyw: vec3f) -> bool {
-    let p = paths[id];
+    let p = pieces[id];
     let d_plane = dot(p.plane, vec4f(x, 1.0));
     if (d_plane < 0.0) {
         return false;
@@ -108,7 +112,7 @@ fn in_cell(id: u32, x: vec3f, clip_xyw: vec3f) -> bool {
 const GUARD_EPSILON: f32 = 1e-5;
 
 fn object_colour(id: u32, world: vec3f, normal: vec3f, surface: u32) -> vec4f {
-    let p = paths[id];
+    let p = pieces[id];
     let s = surfaces[surface];
     return vec4f(p.attenuation * diffuse_radiance(world, normal, normalize(p.eye - world), s.albedo, s.emission), 1.0);
 }
@@ -117,7 +121,7 @@ fn object_colour(id: u32, world: vec3f, normal: vec3f, surface: u32) -> vec4f {
 // its front shows the terminal radiance, its back is diffuse. Mirrors whose path was kept
 // are not drawn in this world at all; the child instance fills them.
 fn mirror_colour(id: u32, world: vec3f, normal: vec3f, surface: u32) -> vec4f {
-    let p = paths[id];
+    let p = pieces[id];
     let s = surfaces[surface];
     if (dot(normal, p.eye - world) > 0.0) {
         return vec4f(p.attenuation * frame.terminal, 1.0);
@@ -127,22 +131,23 @@ fn mirror_colour(id: u32, world: vec3f, normal: vec3f, surface: u32) -> vec4f {
 
 @fragment
 fn fs_object_guarded(in: GuardedOut) -> @location(0) vec4f {
-    if (!in_cell(in.path, in.world, in.clip_xyw)) {
+    if (!in_cell(in.piece, in.world, in.clip_xyw)) {
         discard;
     }
-    return object_colour(in.path, in.world, in.normal, in.surface);
+    return object_colour(in.piece, in.world, in.normal, in.surface);
 }
 
 @fragment
 fn fs_mirror_guarded(in: GuardedOut) -> @location(0) vec4f {
-    if (!in_cell(in.path, in.world, in.clip_xyw)) {
+    if (!in_cell(in.piece, in.world, in.clip_xyw)) {
         discard;
     }
-    return mirror_colour(in.path, in.world, in.normal, in.surface);
+    return mirror_colour(in.piece, in.world, in.normal, in.surface);
 }
 
-// Each path's portal, filled with its attenuated background before any geometry (paths in
-// order, so a child's background covers its parent's); depth stays at the far value 0.
+// Each path's visible region, filled with its attenuated background before any geometry
+// (paths in order, so a child's background covers its parent's); depth stays at the far
+// value 0.
 struct BackgroundOut {
     @builtin(position) clip: vec4f,
     @location(0) @interpolate(flat) colour: vec3f,

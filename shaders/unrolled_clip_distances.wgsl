@@ -1,6 +1,6 @@
 // The clip-distance vertex stage of crates/raster/src/unrolled.rs, compiled only where the
 // adapter has `clip_distances` (the module starts with `enable clip_distances;`, then
-// shading.wgsl and unrolled.wgsl). Distance 0 is the last mirror's plane, 1..=7 the portal's
+// shading.wgsl and unrolled.wgsl). Distance 0 is the last mirror's plane, 1..=7 the piece's
 // edges; the hardware clips, so the fragment stage needs no discard and keeps early depth.
 
 const CLIP_EDGES: u32 = 7u;
@@ -11,7 +11,7 @@ struct ClippedOut {
     @location(0) world: vec3f,
     @location(1) @interpolate(flat) normal: vec3f,
     @location(2) @interpolate(flat) surface: u32,
-    @location(3) @interpolate(flat) path: u32,
+    @location(3) @interpolate(flat) piece: u32,
 }
 
 struct ClippedIn {
@@ -19,13 +19,13 @@ struct ClippedIn {
     @location(0) world: vec3f,
     @location(1) @interpolate(flat) normal: vec3f,
     @location(2) @interpolate(flat) surface: u32,
-    @location(3) @interpolate(flat) path: u32,
+    @location(3) @interpolate(flat) piece: u32,
 }
 
 @vertex
 fn vs_clipped(v: VertexIn, @builtin(instance_index) instance: u32) -> ClippedOut {
     let id = ids[instance];
-    let p = paths[id];
+    let p = pieces[id];
     var out: ClippedOut;
     out.clip = p.clip_from_world * vec4f(v.position, 1.0);
     out.clip_distances[0] = dot(p.plane, vec4f(v.position, 1.0));
@@ -39,16 +39,16 @@ fn vs_clipped(v: VertexIn, @builtin(instance_index) instance: u32) -> ClippedOut
     out.world = v.position;
     out.normal = v.normal;
     out.surface = v.surface;
-    out.path = id;
+    out.piece = id;
     return out;
 }
 
 @fragment
 fn fs_object_clipped(in: ClippedIn) -> @location(0) vec4f {
-    return object_colour(in.path, in.world, in.normal, in.surface);
+    return object_colour(in.piece, in.world, in.normal, in.surface);
 }
 
 @fragment
 fn fs_mirror_clipped(in: ClippedIn) -> @location(0) vec4f {
-    return mirror_colour(in.path, in.world, in.normal, in.surface);
+    return mirror_colour(in.piece, in.world, in.normal, in.surface);
 }

@@ -41,7 +41,8 @@ pub fn box_corners(lo: Vec3, hi: Vec3) -> [Vec3; 8] {
 }
 
 /// Whether the box `lo..hi` can project into the screen rectangle `portal` (pixels) through
-/// `clip_from_world` — conservative: a box reaching behind the eye counts as visible.
+/// `clip_from_world` (reversed Z: a point nearer than the near plane has `z > w`) —
+/// conservative: a box reaching behind the eye counts as visible.
 pub fn box_may_touch(
     clip_from_world: Mat4,
     lo: Vec3,
@@ -57,7 +58,7 @@ pub fn box_may_touch(
         if c.w <= 1e-6 {
             return true;
         }
-        all_behind_near &= c.z < 0.0;
+        all_behind_near &= c.z > c.w;
         let px = mirrorbox_scene::camera::ndc_to_pixel(Vec2::new(c.x / c.w, c.y / c.w), size);
         min = min.min(px);
         max = max.max(px);

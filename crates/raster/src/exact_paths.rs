@@ -3,7 +3,7 @@
 //! GPU work — a frame with too many paths is refused there.
 
 use crate::method::{OptionKind, OptionSpec, ParamValue, Params, SweepAxis};
-use crate::plan::{FAR, NEAR, PlanError};
+use crate::plan::PlanError;
 use glam::Mat4;
 use mirrorbox_scene::Scene;
 use mirrorbox_scene::reflection_paths::{PathLimits, PathSet, reflection_paths};
@@ -72,6 +72,7 @@ pub struct PlannedPaths {
     pub paths: PathSet,
     pub width: u32,
     pub height: u32,
+    /// The camera's projection ([`crate::projection::camera_projection`]).
     pub projection: Mat4,
 }
 
@@ -82,7 +83,7 @@ pub fn plan_paths(
     height: u32,
     limits: &PathLimits,
 ) -> Result<PlannedPaths, PlanError> {
-    let projection = scene.camera.with_size(width, height).projection(NEAR, FAR);
+    let projection = crate::projection::camera_projection(&scene.camera, width, height);
     let paths = reflection_paths(scene, width, height, projection, limits);
     if paths.truncated {
         return Err(PlanError::TooManyPaths { limit: MAX_PATHS });

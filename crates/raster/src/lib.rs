@@ -12,7 +12,8 @@
 //! - [`shading`]: the scene buffers the contract's WGSL reads; [`wgsl`]: all WGSL composition.
 //! - The thin wgpu layer: [`adapter`] (Vulkan, then GL; `WGPU_BACKEND` overrides), [`gpu`]
 //!   (device and errors), [`color_format`] (RGBA32F, else RGBA16F;
-//!   `MIRRORBOX_COLOR_FORMAT` forces one), [`targets`], [`pipeline`] (scene-pipeline builder, uniform arena),
+//!   `MIRRORBOX_COLOR_FORMAT` forces one), [`projection`] (the one projection: infinite
+//!   reversed Z), [`targets`], [`pipeline`] (scene-pipeline builder, uniform arena),
 //!   [`resolve`] (SSAA), [`timing`] (GPU timestamps), [`readback`].
 
 pub mod adapter;
@@ -24,6 +25,7 @@ pub mod method;
 pub mod methods;
 pub mod pipeline;
 pub mod plan;
+pub mod projection;
 pub mod readback;
 pub mod registry;
 pub mod resolve;

@@ -117,17 +117,34 @@ pub struct FrameStats {
     pub triangles: usize,
     /// Exact methods: the reflection paths drawn and pruned.
     pub paths: Option<PathCounts>,
-    /// `unrolled`: how instances are clipped to their cells.
-    pub clipping: Option<Clipping>,
+    /// How a mirror's world is clipped to the mirror's front (and, in `unrolled`, to its
+    /// cell).
+    pub clipping: Clipping,
+    /// The depth (or depth-stencil) format: 32-bit float, except `portal`'s 24-bit fallback on
+    /// an adapter without `DEPTH32FLOAT_STENCIL8`.
+    pub depth_format: wgpu::TextureFormat,
 }
 
-/// How the unrolled method clips an instance to its cell.
+/// How a method clips a mirror's world to the mirror's front (and to its cell).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Clipping {
-    /// Hardware clip distances (plus the per-fragment guard where a part needs it).
+    /// Hardware clip distances (plus, in `unrolled`, the per-fragment guard where a part
+    /// needs it).
     ClipDistances,
-    /// Every test per fragment, with discard.
+    /// Every test per fragment, with discard (an adapter without clip distances, or
+    /// `unrolled --fragment-clipping`).
     FragmentDiscard,
+}
+
+impl Clipping {
+    /// Hardware clip distances where the device has them.
+    pub fn for_features(features: wgpu::Features) -> Clipping {
+        if features.contains(wgpu::Features::CLIP_DISTANCES) {
+            Clipping::ClipDistances
+        } else {
+            Clipping::FragmentDiscard
+        }
+    }
 }
 
 impl Clipping {
@@ -153,6 +170,10 @@ pub struct PathCounts {
     pub pruned_attenuation: usize,
     /// Paths cut by the depth cap.
     pub capped: usize,
+    /// Portals holding pixel centres only where nearer sibling mirrors hide them.
+    pub pruned_hidden: usize,
+    /// Kept paths part of whose portal a nearer sibling mirror hides (drawn as the rest).
+    pub partly_hidden: usize,
 }
 
 impl PathCounts {
@@ -164,6 +185,8 @@ impl PathCounts {
             pruned_small: set.pruned_small,
             pruned_attenuation: set.pruned_attenuation,
             capped: set.capped,
+            pruned_hidden: set.pruned_hidden,
+            partly_hidden: set.partly_hidden,
         }
     }
 
@@ -173,6 +196,7 @@ impl PathCounts {
             + self.pruned_small
             + self.pruned_attenuation
             + self.capped
+            + self.pruned_hidden
     }
 }
 

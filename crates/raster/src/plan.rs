@@ -3,7 +3,7 @@
 //! `MIRRORTEXTURE(M)` renders the scene from M's mirror camera (the current view composed with
 //! M's reflection, seed 002) with M hidden, and first recurses into every mirror visible from
 //! that camera: not hidden, facing the camera, and inside its view — its polygon survives
-//! clipping by the camera's frustum and by M's plane (the oblique near plane). A mirror stays
+//! clipping by the camera's frustum and by M's plane (which clips M's world). A mirror stays
 //! hidden for the whole of its own recursion, so along one chain every mirror is used once.
 //!
 //! - `naive` (Algorithm 1 as printed): the queue is the scene's mirrors. Two facing mirrors
@@ -37,10 +37,6 @@ use mirrorbox_scene::polygon::{clip_by, screen_footprint};
 use mirrorbox_scene::reflection::ReflectedView;
 use mirrorbox_scene::{Plane, Scene};
 
-/// Near and far distances of every raster projection.
-pub const NEAR: f32 = 0.01;
-pub const FAR: f32 = 10_000.0;
-
 /// Plans are counted exactly up to this many texture renders (when that takes at most
 /// `--max-passes` plane chains).
 const COUNT_CEILING: usize = 1_000_000;
@@ -72,7 +68,7 @@ pub struct TextureNode {
     pub instance: usize,
     /// The mirror camera: the parent's view composed with this mirror's reflection.
     pub view: ReflectedView,
-    /// The mirror's plane (front kept): the oblique near plane of this pass.
+    /// The mirror's plane (front kept): this pass clips its world to the front.
     pub plane: Plane,
     /// Screen region the texture covers (the mirror's footprint, 1-pixel margin).
     pub footprint: Rect,
@@ -88,6 +84,7 @@ pub struct Plan {
     /// Render resolution (output × SSAA).
     pub width: u32,
     pub height: u32,
+    /// The camera's projection ([`crate::projection::camera_projection`]).
     pub projection: Mat4,
     /// Textures the frame's main pass applies.
     pub roots: Vec<TextureNode>,
@@ -359,7 +356,11 @@ impl<'a> Planner<'a> {
             scene,
             instances,
             per_mirror,
-            projection: scene.camera.with_size(width, height).projection(NEAR, FAR),
+            projection: crate::projection::camera_projection(
+                &scene.camera.with_size(width, height),
+                width,
+                height,
+            ),
             size: Vec2::new(width as f32, height as f32),
         }
     }

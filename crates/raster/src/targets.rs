@@ -3,11 +3,27 @@
 
 use crate::gpu::Gpu;
 
-/// The one depth format of every depth-only attachment (the exact methods' reversed Z needs
-/// 32-bit float).
+use crate::projection::FAR_DEPTH;
+
+/// The one depth format of every depth-only attachment: 32-bit float, whose relative
+/// precision is what reversed Z needs ([`crate::projection`]).
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
-/// Depth with a stencil, for `portal`'s stencil recursion.
-pub const DEPTH_STENCIL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth24PlusStencil8;
+/// Depth with a stencil, for `portal`'s stencil recursion: 32-bit float depth, an optional
+/// adapter feature (`DEPTH32FLOAT_STENCIL8`).
+pub const DEPTH_STENCIL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32FloatStencil8;
+/// Depth with a stencil where the adapter lacks [`DEPTH_STENCIL_FORMAT`]: 24 bits (or more —
+/// the driver picks), uniform in `z_ndc`, so reversed Z resolves only `t²·2⁻²⁴/NEAR` at
+/// distance `t` (6 cm at 100 m).
+pub const DEPTH_STENCIL_FALLBACK: wgpu::TextureFormat = wgpu::TextureFormat::Depth24PlusStencil8;
+
+/// The depth-stencil format a device with `features` gets.
+pub fn depth_stencil_format(features: wgpu::Features) -> wgpu::TextureFormat {
+    if features.contains(wgpu::Features::DEPTH32FLOAT_STENCIL8) {
+        DEPTH_STENCIL_FORMAT
+    } else {
+        DEPTH_STENCIL_FALLBACK
+    }
+}
 
 /// A depth(-stencil) attachment and the values a pass clears it to.
 pub struct DepthClear<'a> {
@@ -90,7 +106,7 @@ impl RenderTarget {
     }
 
     /// Begins a pass labelled `label` that clears colour to `clear` (linear radiance) and depth
-    /// to 1.
+    /// to far ([`FAR_DEPTH`]).
     pub fn begin_pass<'e>(
         &self,
         encoder: &'e mut wgpu::CommandEncoder,
@@ -100,7 +116,7 @@ impl RenderTarget {
     ) -> wgpu::RenderPass<'e> {
         let depth = DepthClear {
             view: &self.depth_view,
-            depth: 1.0,
+            depth: FAR_DEPTH,
             stencil: None,
         };
         self.begin_pass_with(encoder, label, clear, depth, timestamps)

@@ -1,6 +1,7 @@
 //! All WGSL composition. WGSL has no includes: a shader is an optional `enable` line, then
 //! its parts in order — `shaders/shading.wgsl` (the contract, `docs/shading.md`) first for
-//! every scene pipeline, then the method's own file(s).
+//! every scene pipeline, then the method's own file(s) — and, for the clip-distance variant
+//! of the methods that clip at a mirror's plane, `shaders/mirror_plane_clip_distances.wgsl`.
 //!
 //! Each method lists its shader variants in its registry entry ([`MethodEntry::shaders`]),
 //! and its `#[repr(C)]` GPU structs ([`MethodEntry::gpu_structs`]); the tests below parse and
@@ -12,6 +13,12 @@
 
 /// `shaders/shading.wgsl`: the shading contract and the scene bindings (group 0).
 pub const SHADING: &str = include_str!("../../../shaders/shading.wgsl");
+
+/// `shaders/mirror_plane_clip_distances.wgsl`: the clip-distance vertex stage of the methods
+/// that clip a mirror's world at the mirror's plane (`portal`, `naive`, `auxiliary`); it
+/// follows the method's own file, which defines `VertexOut` and `scene_vertex`.
+pub const MIRROR_PLANE_CLIP_DISTANCES: &str =
+    include_str!("../../../shaders/mirror_plane_clip_distances.wgsl");
 
 /// One shader variant: what a pipeline's module is made of.
 #[derive(Debug)]

@@ -1,4 +1,4 @@
-//! Plane reflections, reflected ("mirror") cameras and oblique near-plane clipping.
+//! Plane reflections and reflected ("mirror") cameras.
 //!
 //! Seed 001 reflects a vertex `v` through the plane with point `o` and unit normal `n`:
 //! `m = v − 2n(n·(v − o))`. As a 4×4 affine matrix that is
@@ -114,24 +114,6 @@ impl ReflectedView {
     }
 }
 
-/// Replaces the near plane of a `[0, 1]`-depth perspective projection by an arbitrary
-/// view-space plane `clip` (Lengyel 2005, "Oblique View Frustum Depth Projection and
-/// Clipping", adapted from GL's `[−1, 1]` to WebGPU's `[0, 1]` depth).
-///
-/// `clip` holds view-space plane coefficients; points with `dot(clip, p) ≥ 0` are kept and
-/// the eye must be on the negative side (`clip.w < 0`). The third row becomes `a·clip`, so
-/// `z_ndc = 0` exactly on the plane; `a = (row₄·q)/(clip·q)` puts the far plane through the
-/// frustum corner `q = P⁻¹(sgn cₓ, sgn c_y, 1, 1)` opposite the plane, keeping depth within
-/// `[0, 1]` for everything visible. Rows one, two and four (hence x, y and w) are unchanged.
-pub fn oblique_near_plane(projection: Mat4, clip: Vec4) -> Mat4 {
-    let corner = Vec4::new(clip.x.signum(), clip.y.signum(), 1.0, 1.0);
-    let q = projection.inverse() * corner;
-    let a = projection.row(3).dot(q) / clip.dot(q);
-    let mut rows = projection.transpose();
-    rows.z_axis = clip * a;
-    rows.transpose()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -236,37 +218,5 @@ mod tests {
         // the virtual eye is R₂(R₁(eye)).
         let eye = v.eye();
         assert!(eye.abs_diff_eq(cam.position + Vec3::Z * 8.0, 1e-4), "{eye}");
-    }
-
-    #[test]
-    fn oblique_near_plane_clips_exactly_at_the_mirror() {
-        let cam = camera();
-        let mirror = Plane::from_point_normal(Vec3::new(0.0, 0.0, -2.0), Vec3::Z);
-        let through = ReflectedView::direct(cam.view()).through(&mirror);
-        // `through.view` takes *world* points (it reflects them itself), so the clip plane is
-        // the mirror plane in world terms: keep what lies in front of the mirror, drop what lies
-        // behind it (which the reflection would otherwise bring between eye and mirror).
-        let clip = mirror.coefficients_in(through.view);
-        assert!(clip.w < 0.0, "eye must be on the clipped side");
-        let proj = cam.projection(0.01, 100.0);
-        let oblique = oblique_near_plane(proj, clip);
-        let depth = |p: Vec3| {
-            let c = oblique * through.view * p.extend(1.0);
-            c.z / c.w
-        };
-        // x, y and w are unchanged.
-        for r in [0, 1, 3] {
-            assert_eq!(oblique.row(r), proj.row(r));
-        }
-        // On the mirror plane depth is 0; behind the mirror (would leak) it is < 0; in front of
-        // it (what the mirror shows) it is in (0, 1].
-        for (x, y) in [(0.0, 1.5), (-1.5, 0.5), (1.9, 2.8)] {
-            assert!(depth(Vec3::new(x, y, -2.0)).abs() < 1e-4);
-            assert!(depth(Vec3::new(x, y, -3.0)) < 0.0);
-            let d = depth(Vec3::new(x, y, 0.5));
-            assert!(d > 0.0 && d <= 1.0, "{d}");
-        }
-        // Depth still increases with distance from the eye along a ray.
-        assert!(depth(Vec3::new(0.0, 1.5, 1.0)) < depth(Vec3::new(0.0, 1.5, 1.4)));
     }
 }

@@ -96,3 +96,66 @@ fn the_ray_through_a_portal_follows_its_path() {
     }
     assert!(checked > 50, "{checked} paths checked");
 }
+
+/// Signed distance (pixels) of `c` inside convex polygon `poly`: positive inside.
+fn inside_by(poly: &[Vec2], c: Vec2) -> f32 {
+    let o = mirrorbox_scene::polygon::orientation(poly);
+    (0..poly.len())
+        .map(|k| {
+            let (a, b) = (poly[k], poly[(k + 1) % poly.len()]);
+            o * (b - a).normalize().perp_dot(c - a)
+        })
+        .fold(f32::INFINITY, f32::min)
+}
+
+/// Where a nearer mirror hides part of a sibling's portal (a small mirror before a large one,
+/// and one tilted across it), the visible regions partition the pixel centres by the mirrors
+/// the traced ray meets: a centre well inside (0.01 px) a path's visible piece meets that
+/// path's mirrors first, and every centre's traced sequence is a kept path whose visible
+/// region holds it (up to 0.01 px).
+#[test]
+fn visible_regions_follow_the_traced_mirrors_where_siblings_overlap() {
+    let text = serde_json::json!({
+        "camera": { "position": [0.1, 1.2, 3], "look_at": [0, 1.2, -2], "fov_y_deg": 50, "width": 96, "height": 54 },
+        "mirrors": [ { "center": [0, 1.5, -2], "normal": [0, 0, 1], "up": [0, 1, 0], "width": 4, "height": 3 },
+                     { "center": [0, 1.2, -0.5], "normal": [0, 1, 1], "up": [0, 1, -1], "width": 0.9, "height": 0.9 },
+                     { "center": [0.9, 1.0, -1.0], "normal": [-0.6, 0, 1], "up": [0, 1, 0], "width": 0.8, "height": 1.2 } ]
+    });
+    let s = parse_scene(&text.to_string(), Path::new("overlap.json")).unwrap();
+    let set = paths(&s);
+    assert!(set.partly_hidden > 0, "the scene has overlapping siblings");
+    let (bvh, settings) = whitted_for(&s);
+    let whitted = Whitted::new(&s, &bvh, settings);
+    let mut checked = 0;
+    for y in 0..s.camera.height {
+        for x in 0..s.camera.width {
+            let centre = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+            let seen = traced_mirrors(&s, &whitted, centre);
+            for p in &set.paths[1..] {
+                let depth = p.visible.iter().map(|piece| inside_by(piece, centre));
+                let depth = depth.fold(f32::NEG_INFINITY, f32::max);
+                if depth > 0.01 {
+                    assert!(
+                        seen.starts_with(&p.mirrors),
+                        "pixel ({x}, {y}) lies in the visible region of {:?} but meets {seen:?}",
+                        p.mirrors
+                    );
+                    checked += 1;
+                }
+                if p.mirrors == seen {
+                    assert!(
+                        depth >= -0.01,
+                        "pixel ({x}, {y}) meets {seen:?} outside its visible region"
+                    );
+                }
+            }
+            if !seen.is_empty() {
+                assert!(
+                    set.paths.iter().any(|p| p.mirrors == seen),
+                    "pixel ({x}, {y}): {seen:?}"
+                );
+            }
+        }
+    }
+    assert!(checked > 500, "{checked} centres checked");
+}

@@ -128,8 +128,10 @@ pub fn run(args: &Args) -> Result<(), Failure> {
                 "kept": c.kept, "pruned_empty": c.pruned_empty, "pruned_no_sample": c.pruned_no_sample,
                 "pruned_small": c.pruned_small,
                 "pruned_attenuation": c.pruned_attenuation, "capped": c.capped,
+                "pruned_hidden": c.pruned_hidden, "partly_hidden": c.partly_hidden,
             })),
-            "clipping": s.clipping.map(|c| c.name()),
+            "clipping": s.clipping.name(),
+            "depth_format": format!("{:?}", s.depth_format),
             "warnings": out.warnings,
             "adapter": gpu.report.name, "backend": gpu.report.backend, "device_type": gpu.report.device_type,
             "color_format": out.color_format.name(),
@@ -138,7 +140,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         println!("{v}");
     } else {
         println!(
-            "rendered {} with {method_text}, alpha {alpha}: {}x{}, ssaa {}; {} passes ({} texture renders, {} reflections deep), {} draws per frame",
+            "rendered {} with {method_text}, alpha {alpha}: {}x{}, ssaa {}; {} passes ({} texture renders, {} reflections deep), {} draws per frame; depth {:?}, mirrors clipped by {}",
             args.scene.display(),
             scene.camera.width,
             scene.camera.height,
@@ -146,21 +148,23 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             s.passes,
             s.texture_renders,
             s.depth,
-            s.draws
+            s.draws,
+            s.depth_format,
+            s.clipping.name()
         );
         if let Some(c) = s.paths {
             println!(
-                "  reflection paths: {} kept; pruned {} (empty {}, no pixel centre {}, under --min-portal-area {}, under --min-attenuation {}, past --depth {}); {} triangles submitted{}",
+                "  reflection paths: {} kept ({} partly hidden by a nearer sibling mirror); pruned {} (empty {}, no pixel centre {}, under --min-portal-area {}, under --min-attenuation {}, past --depth {}, hidden by nearer siblings {}); {} triangles submitted",
                 c.kept,
+                c.partly_hidden,
                 c.pruned(),
                 c.pruned_empty,
                 c.pruned_no_sample,
                 c.pruned_small,
                 c.pruned_attenuation,
                 c.capped,
+                c.pruned_hidden,
                 s.triangles,
-                s.clipping
-                    .map_or(String::new(), |c| format!(", clipped by {}", c.name()))
             );
         }
         println!(

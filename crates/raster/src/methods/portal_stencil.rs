@@ -3,33 +3,41 @@
 //! `shaders/portal_stencil.wgsl`.
 //!
 //! Everything happens in one render pass. A path's region of the screen holds its stencil
-//! value; its world (the scene through `view · R₁ · … · Rₖ`, the last mirror as oblique near
-//! plane, winding flipped on odd depth — culling is off — colours × the product of the
-//! reflectances) is drawn there. For each kept child the child's mirror is drawn from the
+//! value; its world (the scene through `view · R₁ · … · Rₖ` and the camera's projection,
+//! clipped to the front of its last mirror by a clip distance or per fragment, winding
+//! flipped on odd depth — culling is off — colours × the product of the reflectances) is
+//! drawn there. For each kept child the child's mirror is drawn from the
 //! parent's camera with the depth test against the parent's world (so it is marked only where
 //! it is really visible) and its stencil incremented; depth is then reset to far inside the
 //! child's region, and the child's world drawn and recursed into. Finished regions are set
 //! to 0. For a path's last child the parent's remainder is retired first and the child's
 //! value decremented back, so a chain of any length uses one stencil value: only branches
 //! that still have siblings to draw hold one — at most 254 (refused beyond, before any work).
+//!
+//! Depth is the camera's infinite reversed Z ([`crate::projection`]) in every path — the
+//! unfolded distance along the pixel's ray — in a `Depth32FloatStencil8` attachment where the
+//! adapter has that format (an optional feature); elsewhere `Depth24PlusStencil8`, which the
+//! frame's stats and warnings state (far surfaces closer than `t²·2⁻²⁴/NEAR` may swap).
 
-use crate::culling::{box_may_touch, footprint_rect};
+use crate::culling::{box_corners, box_may_touch, footprint_rect};
 use crate::exact_paths::{DEPTH, MIN_ATTENUATION, MIN_PORTAL_AREA, PlannedPaths, plan_paths};
 use crate::gpu::{Gpu, RasterError};
-use crate::method::{BuiltFrame, FrameStats, MethodEntry, PathCounts, PlannedFrame, RasterMethod};
+use crate::method::{
+    BuiltFrame, Clipping, FrameStats, MethodEntry, PathCounts, PlannedFrame, RasterMethod,
+};
 use crate::pipeline::{
     ScenePipeline, UniformArena, depth_state, dynamic_uniform_entry, pipeline_layout,
     record_binding,
 };
 use crate::plan::PlanError;
+use crate::projection::{FAR_DEPTH, NEARER_OR_EQUAL};
 use crate::shading::{SceneBuffers, VERTEX_LAYOUT};
-use crate::targets::{DEPTH_STENCIL_FORMAT, DepthClear, RenderTarget};
+use crate::targets::{DEPTH_STENCIL_FORMAT, DepthClear, RenderTarget, depth_stencil_format};
 use crate::timing::FrameEncoder;
 use crate::wgsl::{HostLayout, WgslSource, shader_module};
 use bytemuck::{Pod, Zeroable};
-use glam::Vec3;
+use glam::{Vec3, Vec4};
 use mirrorbox_scene::Scene;
-use mirrorbox_scene::reflection::oblique_near_plane;
 use mirrorbox_scene::reflection_paths::{PathLimits, PathSet};
 
 /// Exact: stencil recursion over the reflection paths in one pass, cost linear in depth.
@@ -39,25 +47,36 @@ pub static PORTAL: MethodEntry = MethodEntry {
     exact: true,
     options: &[&DEPTH, &MIN_PORTAL_AREA, &MIN_ATTENUATION],
     swept: Some(&DEPTH),
-    optional_features: wgpu::Features::empty(),
+    optional_features: wgpu::Features::CLIP_DISTANCES.union(wgpu::Features::DEPTH32FLOAT_STENCIL8),
     required_features: wgpu::Features::empty(),
-    shaders: &[&SHADER],
+    shaders: &[&SHADER, &CLIP_DISTANCE_SHADER],
     gpu_structs,
     configure: |p| Box::new(Portal(crate::exact_paths::limits(p))),
 };
 
+const ENTRY_POINTS: &str = include_str!("../../../../shaders/portal_stencil.wgsl");
+
+/// Every adapter: the mirror plane tested per fragment (the `*_discard` entry points).
 static SHADER: WgslSource = WgslSource {
     label: "portal stencil",
     enable: &[],
+    parts: &[crate::wgsl::SHADING, ENTRY_POINTS],
+};
+
+/// Adds the hardware clip-distance vertex stage, for adapters with `CLIP_DISTANCES`.
+static CLIP_DISTANCE_SHADER: WgslSource = WgslSource {
+    label: "portal stencil clip distances",
+    enable: &["clip_distances"],
     parts: &[
         crate::wgsl::SHADING,
-        include_str!("../../../../shaders/portal_stencil.wgsl"),
+        ENTRY_POINTS,
+        crate::wgsl::MIRROR_PLANE_CLIP_DISTANCES,
     ],
 };
 
 fn gpu_structs() -> Vec<HostLayout> {
     vec![crate::host_layout!(PathUniform as "Path" {
-        clip_from_world, eye, _pad0, attenuation, _pad1
+        clip_from_world, eye, _pad0, attenuation, _pad1, plane
     })]
 }
 
@@ -85,10 +104,19 @@ struct PlannedPortal {
 impl PlannedFrame for PlannedPortal {
     fn build(self: Box<Self>, gpu: &Gpu, scene: &Scene) -> Result<BuiltFrame, RasterError> {
         let m = PortalStencil::new(gpu, scene, &self.planned, self.ops)?;
+        let depth_format = m.stats.depth_format;
+        let mut warnings = Vec::new();
+        if depth_format != DEPTH_STENCIL_FORMAT {
+            warnings.push(format!(
+                "this adapter lacks {DEPTH_STENCIL_FORMAT:?} (DEPTH32FLOAT_STENCIL8): portal's depth \
+                 is {depth_format:?}, which resolves only t²·6e-6 at distance t (6 cm at 100 \
+                 units), so far surfaces that close may swap"
+            ));
+        }
         Ok(BuiltFrame {
             stats: m.stats,
             encoder: Box::new(m),
-            warnings: Vec::new(),
+            warnings,
         })
     }
 }
@@ -101,6 +129,7 @@ struct PathUniform {
     _pad0: f32,
     attenuation: [f32; 3],
     _pad1: f32,
+    plane: [f32; 4],
 }
 
 /// One step of the frame, in order.
@@ -228,12 +257,8 @@ impl PortalStencil {
         let mut visible_parts = Vec::with_capacity(paths.paths.len());
         let mut scissors = Vec::with_capacity(paths.paths.len());
         for p in &paths.paths {
-            let clip = match p.plane {
-                None => projection * p.view.view,
-                Some(plane) => {
-                    oblique_near_plane(projection, plane.coefficients_in(p.view.view)) * p.view.view
-                }
-            };
+            let clip = projection * p.view.view;
+            let plane = p.plane.map_or(Vec4::W, |pl| pl.coefficients());
             let bbox = mirrorbox_scene::polygon::bounds(&p.portal);
             scissors.push(
                 footprint_rect(bbox.0, bbox.1, size).map_or([0, 0, 1, 1], |r| [r.x, r.y, r.w, r.h]),
@@ -242,7 +267,10 @@ impl PortalStencil {
                 (0..scene_buffers.parts.len())
                     .filter(|&k| {
                         let (_, lo, hi) = &scene_buffers.parts[k];
-                        box_may_touch(clip, *lo, *hi, bbox, size)
+                        let behind_plane = box_corners(*lo, *hi)
+                            .iter()
+                            .all(|q| plane.dot(q.extend(1.0)) < 0.0);
+                        !behind_plane && box_may_touch(clip, *lo, *hi, bbox, size)
                     })
                     .collect::<Vec<usize>>(),
             );
@@ -252,6 +280,7 @@ impl PortalStencil {
                 _pad0: 0.0,
                 attenuation: p.attenuation.to_array(),
                 _pad1: 0.0,
+                plane: plane.to_array(),
             };
             offsets.push(arena.push(&u));
         }
@@ -272,7 +301,25 @@ impl PortalStencil {
             }],
         });
         let layout = pipeline_layout(device, "portal", &[&scene_buffers.layout, &path_layout]);
-        let shader = shader_module(device, &SHADER);
+        let clipping = Clipping::for_features(gpu.features);
+        let depth_format = depth_stencil_format(gpu.features);
+        let shader = shader_module(
+            device,
+            match clipping {
+                Clipping::ClipDistances => &CLIP_DISTANCE_SHADER,
+                Clipping::FragmentDiscard => &SHADER,
+            },
+        );
+        // Scene draws clip at the path's last mirror: by clip distance, or per fragment.
+        let (scene_vertex, fs_object, fs_mirror, fs_mark) = match clipping {
+            Clipping::ClipDistances => ("vs_clip_distances", "fs_object", "fs_mirror", "fs_none"),
+            Clipping::FragmentDiscard => (
+                "vs_main",
+                "fs_object_discard",
+                "fs_mirror_discard",
+                "fs_mark_discard",
+            ),
+        };
         let pipeline = |label: &str,
                         vertex: &str,
                         fragment: &str,
@@ -280,7 +327,7 @@ impl PortalStencil {
                         depth_write: bool,
                         depth_compare,
                         st: wgpu::StencilState| {
-            let buffers: &[Option<wgpu::VertexBufferLayout>] = if vertex == "vs_main" {
+            let buffers: &[Option<wgpu::VertexBufferLayout>] = if vertex == scene_vertex {
                 &[Some(VERTEX_LAYOUT)]
             } else {
                 &[]
@@ -292,7 +339,7 @@ impl PortalStencil {
                 vertex,
                 fragment,
                 buffers,
-                depth_stencil: depth_state(DEPTH_STENCIL_FORMAT, depth_write, depth_compare, st),
+                depth_stencil: depth_state(depth_format, depth_write, depth_compare, st),
                 color_writes: if color {
                     wgpu::ColorWrites::ALL
                 } else {
@@ -305,29 +352,31 @@ impl PortalStencil {
         let keep_equal = stencil(C::Equal, S::Keep);
         let objects = pipeline(
             "portal objects",
-            "vs_main",
-            "fs_object",
+            scene_vertex,
+            fs_object,
             true,
             true,
-            C::LessEqual,
+            NEARER_OR_EQUAL,
             keep_equal.clone(),
         );
         let mirrors = pipeline(
             "portal mirrors",
-            "vs_main",
-            "fs_mirror",
+            scene_vertex,
+            fs_mirror,
             true,
             true,
-            C::LessEqual,
+            NEARER_OR_EQUAL,
             keep_equal.clone(),
         );
+        // Marks where the child's mirror is the nearest surface of the parent's world (which
+        // drew it: equal depth passes).
         let mark = pipeline(
             "portal mark",
-            "vs_main",
-            "fs_none",
+            scene_vertex,
+            fs_mark,
             false,
             false,
-            C::LessEqual,
+            NEARER_OR_EQUAL,
             stencil(C::Equal, S::IncrementClamp),
         );
         let clear_region = pipeline(
@@ -362,7 +411,7 @@ impl PortalStencil {
             "portal depth-stencil",
             planned.width,
             planned.height,
-            DEPTH_STENCIL_FORMAT,
+            depth_format,
             wgpu::TextureUsages::RENDER_ATTACHMENT,
         )
         .create_view(&Default::default());
@@ -410,7 +459,8 @@ impl PortalStencil {
             depth: paths.deepest,
             triangles,
             paths: Some(PathCounts::of(paths)),
-            clipping: None,
+            clipping,
+            depth_format,
         };
         Ok(PortalStencil {
             scene_buffers,
@@ -451,7 +501,7 @@ impl FrameEncoder for PortalStencil {
             self.background,
             DepthClear {
                 view: &self.depth_stencil,
-                depth: 1.0,
+                depth: FAR_DEPTH,
                 stencil: Some(1),
             },
             first_pass,

@@ -3,8 +3,11 @@
 //!
 //! Each call renders the scene from its mirror camera (seed 002: the view composed with the
 //! mirror's reflection, so the image is not flipped but the winding is — culling is off and
-//! shading is two-sided) with the mirror plane as oblique near plane (Lengyel, depth 0..1),
-//! into a texture covering the mirror's footprint on screen. Because every camera shares the
+//! shading is two-sided), keeping what lies in front of the mirror's plane (a hardware clip
+//! distance where the adapter has them, else a per-fragment test: the plane is not made the
+//! near plane, which would tilt the depth range — every pass uses the camera's infinite
+//! reversed Z, [`crate::projection`]), into a texture covering the mirror's footprint on
+//! screen. Because every camera shares the
 //! screen's projection, texel (x, y) of a texture is screen pixel footprint-origin + (x, y):
 //! the mirror looks its texture up by screen position, with no resampling at the default
 //! `texture_scale` of 1. Textures are rendered depth first (children before the pass that
@@ -12,21 +15,22 @@
 
 use crate::gpu::{Gpu, RasterError};
 use crate::method::{
-    BuiltFrame, FrameStats, MethodEntry, OptionKind, OptionSpec, ParamValue, Params, PlannedFrame,
-    RasterMethod, SweepAxis,
+    BuiltFrame, Clipping, FrameStats, MethodEntry, OptionKind, OptionSpec, ParamValue, Params,
+    PlannedFrame, RasterMethod, SweepAxis,
 };
 use crate::pipeline::{
     ScenePipeline, UniformArena, depth_state, dynamic_uniform_entry, pipeline_layout,
     record_binding,
 };
 use crate::plan::{Plan, PlanError, Queue, Rect, TextureNode};
+use crate::projection::NEARER_OR_EQUAL;
 use crate::shading::{SceneBuffers, VERTEX_LAYOUT};
 use crate::targets::{DEPTH_FORMAT, RenderTarget, texture_entry};
 use crate::timing::FrameEncoder;
 use crate::wgsl::{HostLayout, WgslSource, shader_module};
 use bytemuck::{Pod, Zeroable};
-use glam::{Mat4, Vec2, Vec3};
-use mirrorbox_scene::reflection::{ReflectedView, oblique_near_plane};
+use glam::{Mat4, Vec2, Vec3, Vec4};
+use mirrorbox_scene::reflection::ReflectedView;
 use mirrorbox_scene::{Plane, Scene};
 use std::collections::HashMap;
 
@@ -38,9 +42,9 @@ pub static NAIVE: MethodEntry = MethodEntry {
     exact: false,
     options: &[&TEXTURE_SCALE, &MAX_PASSES],
     swept: None,
-    optional_features: wgpu::Features::empty(),
+    optional_features: wgpu::Features::CLIP_DISTANCES,
     required_features: wgpu::Features::empty(),
-    shaders: &[&SHADER],
+    shaders: &[&SHADER, &CLIP_DISTANCE_SHADER],
     gpu_structs,
     configure: |p| Box::new(RecursiveTextureMethod::new(Queue::SceneMirrors, p)),
 };
@@ -54,9 +58,9 @@ pub static AUXILIARY: MethodEntry = MethodEntry {
     exact: false,
     options: &[&AUXILIARY_MIRRORS, &TEXTURE_SCALE, &MAX_PASSES],
     swept: Some(&AUXILIARY_MIRRORS),
-    optional_features: wgpu::Features::empty(),
+    optional_features: wgpu::Features::CLIP_DISTANCES,
     required_features: wgpu::Features::empty(),
-    shaders: &[&SHADER],
+    shaders: &[&SHADER, &CLIP_DISTANCE_SHADER],
     gpu_structs,
     configure: |p| {
         Box::new(RecursiveTextureMethod::new(
@@ -68,19 +72,30 @@ pub static AUXILIARY: MethodEntry = MethodEntry {
     },
 };
 
+const ENTRY_POINTS: &str = include_str!("../../../../shaders/recursive_texture.wgsl");
+
+/// Every adapter: the mirror plane tested per fragment (the `*_discard` entry points).
 static SHADER: WgslSource = WgslSource {
     label: "recursive texture",
     enable: &[],
+    parts: &[crate::wgsl::SHADING, ENTRY_POINTS],
+};
+
+/// Adds the hardware clip-distance vertex stage, for adapters with `CLIP_DISTANCES`.
+static CLIP_DISTANCE_SHADER: WgslSource = WgslSource {
+    label: "recursive texture clip distances",
+    enable: &["clip_distances"],
     parts: &[
         crate::wgsl::SHADING,
-        include_str!("../../../../shaders/recursive_texture.wgsl"),
+        ENTRY_POINTS,
+        crate::wgsl::MIRROR_PLANE_CLIP_DISTANCES,
     ],
 };
 
 fn gpu_structs() -> Vec<HostLayout> {
     vec![
         crate::host_layout!(PassUniform as "Pass" {
-            clip_from_world, eye, _pad0, origin, pixels_per_texel
+            clip_from_world, eye, _pad0, origin, pixels_per_texel, plane
         }),
         crate::host_layout!(MirrorUniform as "MirrorDraw" {
             origin, size, texels_per_pixel, exact, has_texture
@@ -187,6 +202,9 @@ struct PassUniform {
     _pad0: f32,
     origin: [f32; 2],
     pixels_per_texel: [f32; 2],
+    /// The pass's mirror plane in scene space, front positive; `(0, 0, 0, 1)` for the
+    /// camera's pass.
+    plane: [f32; 4],
 }
 
 #[repr(C)]
@@ -262,7 +280,7 @@ impl Builder<'_> {
             node.children.iter().map(|c| (c, self.emit(c))).collect();
         let size = self.texture_size(node.footprint);
         let slot = self.alloc(size);
-        let clip = mirror_camera_clip(self.plan, &node.view, &node.plane, node.footprint);
+        let clip = mirror_camera_clip(self.plan, &node.view, node.footprint);
         let offset = self.uniforms.push(&PassUniform {
             clip_from_world: clip.to_cols_array_2d(),
             eye: node.view.eye().to_array(),
@@ -272,6 +290,7 @@ impl Builder<'_> {
                 node.footprint.w as f32 / size.0 as f32,
                 node.footprint.h as f32 / size.1 as f32,
             ],
+            plane: node.plane.coefficients().to_array(),
         });
         let draws = self.mirror_draws(&node.hidden, Some(&node.plane), &children);
         self.passes.push(PassSpec {
@@ -337,11 +356,10 @@ impl Builder<'_> {
     }
 }
 
-/// `crop(footprint) · oblique(P, mirror plane) · view`: the mirror camera's clip transform,
-/// with the screen region of its texture mapped onto the whole texture.
-fn mirror_camera_clip(plan: &Plan, view: &ReflectedView, plane: &Plane, footprint: Rect) -> Mat4 {
-    let oblique = oblique_near_plane(plan.projection, plane.coefficients_in(view.view));
-    crop(footprint, plan.width, plan.height) * oblique * view.view
+/// `crop(footprint) · P · view`: the mirror camera's clip transform (the camera's projection
+/// `P`), with the screen region of its texture mapped onto the whole texture.
+fn mirror_camera_clip(plan: &Plan, view: &ReflectedView, footprint: Rect) -> Mat4 {
+    crop(footprint, plan.width, plan.height) * plan.projection * view.view
 }
 
 /// Maps the NDC rectangle of screen region `r` (of a `w × h` screen) onto [−1, 1]².
@@ -417,6 +435,7 @@ impl RecursiveTexture {
             _pad0: 0.0,
             origin: [0.0, 0.0],
             pixels_per_texel: [1.0, 1.0],
+            plane: Vec4::W.to_array(),
         });
         let main_draws = b.mirror_draws(&[], None, &roots);
         b.passes.push(PassSpec {
@@ -486,23 +505,32 @@ impl RecursiveTexture {
             })
             .collect();
 
-        let shader = shader_module(device, &SHADER);
+        let clipping = Clipping::for_features(gpu.features);
+        let (shader, vertex, fs_object, fs_mirror) = match clipping {
+            Clipping::ClipDistances => (
+                shader_module(device, &CLIP_DISTANCE_SHADER),
+                "vs_clip_distances",
+                "fs_object",
+                "fs_mirror",
+            ),
+            Clipping::FragmentDiscard => (
+                shader_module(device, &SHADER),
+                "vs_main",
+                "fs_object_discard",
+                "fs_mirror_discard",
+            ),
+        };
         let sl = &scene_buffers.layout;
         let pipeline = |label: &str, layout: &wgpu::PipelineLayout, fragment: &str| {
             ScenePipeline {
                 label,
                 layout,
                 module: &shader,
-                vertex: "vs_main",
+                vertex,
                 fragment,
                 buffers: &[Some(VERTEX_LAYOUT)],
-                // LessEqual: of coincident mirror instances the last drawn wins, deterministically.
-                depth_stencil: depth_state(
-                    DEPTH_FORMAT,
-                    true,
-                    wgpu::CompareFunction::LessEqual,
-                    Default::default(),
-                ),
+                // Of coincident mirror instances the last drawn wins, deterministically.
+                depth_stencil: depth_state(DEPTH_FORMAT, true, NEARER_OR_EQUAL, Default::default()),
                 color_writes: wgpu::ColorWrites::ALL,
             }
             .build(gpu)
@@ -510,7 +538,7 @@ impl RecursiveTexture {
         let objects_pipeline = pipeline(
             "recursive texture objects",
             &pipeline_layout(device, "recursive texture objects", &[sl, &pass_layout]),
-            "fs_object",
+            fs_object,
         );
         let mirror_pipeline = pipeline(
             "recursive texture mirrors",
@@ -519,7 +547,7 @@ impl RecursiveTexture {
                 "recursive texture mirrors",
                 &[sl, &pass_layout, &mirror_layout],
             ),
-            "fs_mirror",
+            fs_mirror,
         );
         let draws: usize = b.passes.iter().map(|p| 1 + p.draws.len()).sum::<usize>() + 1;
         let object_triangles = scene_buffers.objects.len() / 3;
@@ -534,7 +562,8 @@ impl RecursiveTexture {
                 .map(|p| object_triangles + 2 * p.draws.len())
                 .sum(),
             paths: None,
-            clipping: None,
+            clipping,
+            depth_format: DEPTH_FORMAT,
         };
         Ok(RecursiveTexture {
             scene_buffers,

@@ -2,30 +2,36 @@
 //! Entry points: `shaders/unrolled.wgsl` (+ `shaders/unrolled_clip_distances.wgsl`).
 //!
 //! A path `P = (m₁ … mₖ)` of [`mirrorbox_scene::reflection_paths`] sees the scene through the
-//! composed reflection `R₁·…·Rₖ`; its instance draws the real scene with
-//! `clip_from_world = proj · view · R₁·…·Rₖ` and keeps only its *cell*: beyond `mₖ`'s plane
-//! (distance `n·x − d ≥ 0` in scene space) and inside its portal, the convex screen polygon
-//! the path is seen through (each edge a half-plane `a·x_c + b·y_c + c·w_c ≥ 0` in clip
-//! space, i.e. a plane through the eye). Colours are scaled by the product of the
-//! reflectances along the path. Every instance shares one projection — the camera's, with
-//! infinite reversed Z in a 32-bit float buffer, so depth stays precise a thousand
-//! reflections deep — and the depth test resolves visibility between instances: inside a
-//! cell, the unfolded ray meets that path's world only.
+//! composed reflection `R₁·…·Rₖ`; its instances draw the real scene with
+//! `clip_from_world = proj · view · R₁·…·Rₖ` and keep only its *cell*: beyond `mₖ`'s plane
+//! (distance `n·x − d ≥ 0` in scene space) and inside its visible region — its portal less
+//! what nearer sibling mirrors hide, as convex screen pieces, one instance each (each edge a
+//! half-plane `a·x_c + b·y_c + c·w_c ≥ 0` in clip space, i.e. a plane through the eye).
+//! Colours are scaled by the product of the reflectances along the path. Every instance
+//! shares one projection — the camera's, with infinite reversed Z in a 32-bit float buffer,
+//! so depth stays precise a thousand reflections deep — and the depth test resolves
+//! visibility between instances: the cells follow each other along every unfolded ray, and
+//! inside a cell the ray meets that path's world only.
+//!
+//! Why pieces: where a small mirror hides part of a large one from the same cell, the large
+//! mirror's portal (where it *could* be seen) covers the small one's, and behind the small
+//! mirror along those rays lies the large mirror's cell too — often nearer than what the
+//! small mirror shows (the sky it reflects, say). Depth cannot tell the two cells apart there;
+//! cutting the hidden part out of the large mirror's visible region (and so out of every
+//! path through it) can. The cut is CPU work on screen polygons, done only where sibling
+//! portals share pixel centres: elsewhere a path is one piece, its portal, as before.
 //!
 //! Clipping uses hardware clip distances where the adapter has them (the mirror plane and up
-//! to 7 portal edges); a portal with more edges, or a part that may lie behind some mirror,
+//! to 7 piece edges); a piece with more edges, or a part that may lie behind some mirror,
 //! goes to the *guarded* stage, which tests the same half-planes per fragment and also
 //! discards points whose segment from the cell's entry crosses another mirror's front —
 //! geometry behind a mirror never leaks into it.
 //!
-//! Draws: one per (part or mirror, stage) over the list of paths that can see it (culled by
-//! the portal's rectangle, as in `portal_stencil`), plus one for the portals' backgrounds — a
-//! handful whatever the depth. A mirror is drawn in a path's world only where that mirror's
-//! own path was not kept (pruned or capped): its front then shows the terminal radiance.
-//!
-//! Exactness assumes sibling portals do not overlap (no mirror hides part of another from
-//! the same cell; true in the convex rooms of the bundled scenes). Overlaps are counted in
-//! [`Unrolled::overlapping_siblings`] and reported by `render`.
+//! Draws: one per (part or mirror, stage) over the list of pieces whose path can see it
+//! (culled by the portal's rectangle, as in `portal_stencil`), plus one for the pieces'
+//! backgrounds — a handful whatever the depth or the overlaps. A mirror is drawn in a path's
+//! world only where that mirror's own path was not kept (pruned or capped): its front then
+//! shows the terminal radiance.
 
 use crate::culling::{box_corners, box_may_touch};
 use crate::exact_paths::{DEPTH, MIN_ATTENUATION, MIN_PORTAL_AREA, PlannedPaths, plan_paths};
@@ -36,16 +42,17 @@ use crate::method::{
 };
 use crate::pipeline::{ScenePipeline, depth_state, pipeline_layout};
 use crate::plan::PlanError;
+use crate::projection::{FAR_DEPTH, NEARER};
 use crate::shading::{SceneBuffers, VERTEX_LAYOUT};
 use crate::targets::{DEPTH_FORMAT, DepthClear, RenderTarget};
 use crate::timing::FrameEncoder;
 use crate::wgsl::{HostLayout, WgslSource, shader_module};
 use bytemuck::{Pod, Zeroable};
-use glam::{Mat4, Vec2, Vec3, Vec4};
+use glam::{Vec2, Vec3, Vec4};
 use mirrorbox_scene::Scene;
 use mirrorbox_scene::camera::pixel_to_ndc;
-use mirrorbox_scene::polygon::{area, bounds, orientation};
-use mirrorbox_scene::reflection_paths::{PathLimits, clip_convex};
+use mirrorbox_scene::polygon::{bounds, orientation};
+use mirrorbox_scene::reflection_paths::PathLimits;
 use std::ops::Range;
 
 /// Exact: every reflection path an instance of the scene, clipped to its cell.
@@ -105,7 +112,7 @@ static CLIP_DISTANCE_SHADER: WgslSource = WgslSource {
 
 fn gpu_structs() -> Vec<HostLayout> {
     vec![
-        crate::host_layout!(PathData as "PathData" {
+        crate::host_layout!(CellPiece as "CellPiece" {
             clip_from_world, plane, eye, edge_first, attenuation, edge_count
         }),
         crate::host_layout!(MirrorRect as "MirrorRect" {
@@ -142,18 +149,10 @@ struct PlannedUnrolled {
 impl PlannedFrame for PlannedUnrolled {
     fn build(self: Box<Self>, gpu: &Gpu, scene: &Scene) -> Result<BuiltFrame, RasterError> {
         let m = Unrolled::new(gpu, scene, &self.planned, self.fragment_clipping)?;
-        let mut warnings = Vec::new();
-        if m.overlapping_siblings > 0 {
-            warnings.push(format!(
-                "{} pairs of sibling portals overlap (a mirror hides part of another): \
-                 unrolled may be wrong there; --method portal is exact",
-                m.overlapping_siblings
-            ));
-        }
         Ok(BuiltFrame {
             stats: m.stats,
             encoder: Box::new(m),
-            warnings,
+            warnings: Vec::new(),
         })
     }
 }
@@ -168,9 +167,11 @@ pub const CLIP_EDGES: usize = 7;
 /// Scene-space tolerance of "in front of a mirror" (as `GUARD_EPSILON` in the shader).
 const FRONT_EPSILON: f32 = 1e-5;
 
+/// One convex piece of a path's visible region, drawn as one instance: the path's
+/// transform, plane, eye and attenuation, and the piece's edges.
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
-struct PathData {
+struct CellPiece {
     clip_from_world: [[f32; 4]; 4],
     plane: [f32; 4],
     eye: [f32; 3],
@@ -198,18 +199,6 @@ struct BackgroundVertex {
     attenuation: [f32; 3],
 }
 
-/// The camera's `[0, 1]`-depth projection with its depth row replaced by infinite reversed
-/// Z: `z_ndc = near / w`, 1 at the near plane and → 0 at infinity. x, y and w (hence every
-/// pixel's coverage) are the camera's own.
-pub fn infinite_reversed_z(projection: Mat4, near: f32) -> Mat4 {
-    let mut m = projection;
-    m.x_axis.z = 0.0;
-    m.y_axis.z = 0.0;
-    m.z_axis.z = 0.0;
-    m.w_axis.z = near;
-    m
-}
-
 /// The clip-space half-planes `a·x + b·y + c·w ≥ 0` bounding a convex screen polygon
 /// (pixels, any orientation) — each a plane through the eye.
 pub fn portal_edges(portal: &[Vec2], size: Vec2) -> Vec<Vec4> {
@@ -235,7 +224,7 @@ enum Stage {
     Guarded,
 }
 
-/// One instanced draw: a vertex range for the paths `ids[instances]`.
+/// One instanced draw: a vertex range for the cell pieces `ids[instances]`.
 struct Draw {
     stage: Stage,
     mirror: bool,
@@ -266,9 +255,6 @@ pub struct Unrolled {
     guarded_mirror: wgpu::RenderPipeline,
     background_pipeline: wgpu::RenderPipeline,
     clear: Vec3,
-    /// Pairs of sibling paths whose portals overlap (more than 0.01 px²): where they do, the
-    /// depth test alone decides between two cells and the image may be wrong.
-    pub overlapping_siblings: usize,
     pub stats: FrameStats,
 }
 
@@ -289,7 +275,6 @@ impl Unrolled {
             gpu.features.contains(wgpu::Features::CLIP_DISTANCES) && !fragment_clipping;
         let scene_buffers = SceneBuffers::new(device, scene);
         let size = Vec2::new(width as f32, height as f32);
-        let reversed = infinite_reversed_z(projection, crate::plan::NEAR);
         let planes: Vec<Vec4> = scene
             .mirrors
             .iter()
@@ -326,74 +311,79 @@ impl Unrolled {
             });
         }
 
-        // Per path: its data, its edges, and which items it draws with which stage.
-        let mut path_data = Vec::with_capacity(paths.paths.len());
+        // Per path, per piece of its visible region: its data, its edges, and which items it
+        // draws with which stage.
+        let mut cell_pieces = Vec::with_capacity(paths.paths.len());
         let mut edges: Vec<Vec4> = Vec::new();
         let mut lists: Vec<[Vec<u32>; 2]> = vec![[Vec::new(), Vec::new()]; items.len()];
         let mut background: Vec<BackgroundVertex> = Vec::new();
-        let mut overlapping_siblings = 0;
-        for (id, p) in paths.paths.iter().enumerate() {
+        for p in &paths.paths {
             let view_clip = projection * p.view.view;
             let plane = p.plane.map_or(Vec4::W, |pl| pl.coefficients());
-            let path_edges = if p.plane.is_some() {
-                portal_edges(&p.portal, size)
-            } else {
-                Vec::new() // the camera's portal is the viewport
-            };
             let portal_rect = bounds(&p.portal);
-            let edge_first = edges.len() as u32;
-            let edge_count = path_edges.len();
-            edges.extend(&path_edges);
-            path_data.push(PathData {
-                clip_from_world: (reversed * p.view.view).to_cols_array_2d(),
-                plane: plane.to_array(),
-                eye: p.view.eye().to_array(),
-                edge_first,
-                attenuation: p.attenuation.to_array(),
-                edge_count: edge_count as u32,
-            });
             let kept_mirrors: Vec<usize> = p
                 .children
                 .iter()
                 .filter_map(|&c| paths.paths[c].mirrors.last().copied())
                 .collect();
-            for (k, item) in items.iter().enumerate() {
-                if let Some(m) = item.mirror
-                    && (p.mirrors.last() == Some(&m) || kept_mirrors.contains(&m))
-                {
-                    continue;
-                }
-                let behind_plane = p.plane.is_some()
-                    && box_corners(item.lo, item.hi)
-                        .iter()
-                        .all(|q| plane.dot(q.extend(1.0)) < 0.0);
-                if behind_plane || !box_may_touch(view_clip, item.lo, item.hi, portal_rect, size) {
-                    continue;
-                }
-                let stage =
-                    if clip_distances && edge_count <= CLIP_EDGES && item.in_front_of_all_mirrors {
+            // The items this path's world shows (bounds reaching its portal).
+            let drawn: Vec<usize> = items
+                .iter()
+                .enumerate()
+                .filter(|(_, item)| {
+                    let own_or_kept = item
+                        .mirror
+                        .is_some_and(|m| p.mirrors.last() == Some(&m) || kept_mirrors.contains(&m));
+                    let behind_plane = p.plane.is_some()
+                        && box_corners(item.lo, item.hi)
+                            .iter()
+                            .all(|q| plane.dot(q.extend(1.0)) < 0.0);
+                    !own_or_kept
+                        && !behind_plane
+                        && box_may_touch(view_clip, item.lo, item.hi, portal_rect, size)
+                })
+                .map(|(k, _)| k)
+                .collect();
+            let clip_from_world = view_clip.to_cols_array_2d();
+            let eye = p.view.eye().to_array();
+            for piece in &p.visible {
+                let id = cell_pieces.len() as u32;
+                let piece_edges = if p.plane.is_some() {
+                    portal_edges(piece, size)
+                } else {
+                    Vec::new() // the camera's portal is the viewport
+                };
+                let edge_first = edges.len() as u32;
+                let edge_count = piece_edges.len();
+                edges.extend(&piece_edges);
+                cell_pieces.push(CellPiece {
+                    clip_from_world,
+                    plane: plane.to_array(),
+                    eye,
+                    edge_first,
+                    attenuation: p.attenuation.to_array(),
+                    edge_count: edge_count as u32,
+                });
+                for &k in &drawn {
+                    let stage = if clip_distances
+                        && edge_count <= CLIP_EDGES
+                        && items[k].in_front_of_all_mirrors
+                    {
                         Stage::Clipped
                     } else {
                         Stage::Guarded
                     };
-                lists[k][stage as usize].push(id as u32);
-            }
-            if p.plane.is_some() {
-                let ndc: Vec<Vec2> = p.portal.iter().map(|&q| pixel_to_ndc(q, size)).collect();
-                for i in 1..ndc.len().saturating_sub(1) {
-                    for v in [ndc[0], ndc[i], ndc[i + 1]] {
-                        background.push(BackgroundVertex {
-                            ndc: v.to_array(),
-                            attenuation: p.attenuation.to_array(),
-                        });
-                    }
+                    lists[k][stage as usize].push(id);
                 }
-            }
-            for (i, &a) in p.children.iter().enumerate() {
-                for &b in &p.children[i + 1..] {
-                    let shared = clip_convex(&paths.paths[a].portal, &paths.paths[b].portal);
-                    if shared.len() >= 3 && area(&shared) > 0.01 {
-                        overlapping_siblings += 1;
+                if p.plane.is_some() {
+                    let ndc: Vec<Vec2> = piece.iter().map(|&q| pixel_to_ndc(q, size)).collect();
+                    for i in 1..ndc.len().saturating_sub(1) {
+                        for v in [ndc[0], ndc[i], ndc[i + 1]] {
+                            background.push(BackgroundVertex {
+                                ndc: v.to_array(),
+                                attenuation: p.attenuation.to_array(),
+                            });
+                        }
                     }
                 }
             }
@@ -453,7 +443,10 @@ impl Unrolled {
             })
         };
         let buffers = [
-            storage("unrolled paths", bytemuck::cast_slice(&path_data).to_vec()),
+            storage(
+                "unrolled cell pieces",
+                bytemuck::cast_slice(&cell_pieces).to_vec(),
+            ),
             storage(
                 "unrolled edges",
                 bytemuck::cast_slice(&edges.iter().map(|e| e.to_array()).collect::<Vec<_>>())
@@ -521,7 +514,7 @@ impl Unrolled {
                     if background {
                         wgpu::CompareFunction::Always
                     } else {
-                        wgpu::CompareFunction::Greater
+                        NEARER
                     },
                     Default::default(),
                 ),
@@ -600,11 +593,12 @@ impl Unrolled {
             depth: paths.deepest,
             triangles,
             paths: Some(PathCounts::of(paths)),
-            clipping: Some(if clip_distances {
+            clipping: if clip_distances {
                 Clipping::ClipDistances
             } else {
                 Clipping::FragmentDiscard
-            }),
+            },
+            depth_format: DEPTH_FORMAT,
         };
         Ok(Unrolled {
             scene_buffers,
@@ -618,7 +612,6 @@ impl Unrolled {
             guarded_mirror,
             background_pipeline,
             clear: scene.background,
-            overlapping_siblings,
             stats,
         })
     }
@@ -631,14 +624,13 @@ impl FrameEncoder for Unrolled {
         target: &RenderTarget,
         first_pass: Option<wgpu::RenderPassTimestampWrites<'_>>,
     ) {
-        // Reversed Z: depth 0 is infinitely far.
         let mut pass = target.begin_pass_with(
             encoder,
             "unrolled pass",
             self.clear,
             DepthClear {
                 view: &self.depth,
-                depth: 0.0,
+                depth: FAR_DEPTH,
                 stencil: None,
             },
             first_pass,
@@ -668,25 +660,6 @@ impl FrameEncoder for Unrolled {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn reversed_z_keeps_coverage_and_orders_depth_far_to_zero() {
-        let p = glam::camera::rh::proj::directx::perspective(1.0, 1.5, 0.01, 1e4);
-        let r = infinite_reversed_z(p, 0.01);
-        for z in [-0.01f32, -1.0, -10.0, -5000.0] {
-            let v = glam::Vec4::new(0.3, -0.2, z, 1.0);
-            let (a, b) = (p * v, r * v);
-            assert_eq!((a.x, a.y, a.w), (b.x, b.y, b.w));
-        }
-        let depth = |z: f32| {
-            let c = r * glam::Vec4::new(0.0, 0.0, z, 1.0);
-            c.z / c.w
-        };
-        assert!((depth(-0.01) - 1.0).abs() < 1e-6);
-        // Strictly decreasing with distance, and still resolving 1 part in 1e5 at 4 km.
-        assert!(depth(-1.0) > depth(-2.0));
-        assert!(depth(-4000.0) > depth(-4000.05));
-    }
 
     #[test]
     fn portal_edges_keep_the_inside_in_either_orientation() {
