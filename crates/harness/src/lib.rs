@@ -15,6 +15,10 @@
 //! - **Floor**: raster vs trace on the scene without its mirrors, the error that is left
 //!   when there is no mirror effect to truncate.
 
+mod worker;
+
+pub use worker::{RenderJob, RenderReport, Rendered, peak_memory_bytes, serve};
+
 use glam::Vec3;
 use mirrorbox_files::{FileError, FolderLock, write_atomically};
 use mirrorbox_image::metrics::{MetricsError, compare, flip_map};
@@ -47,6 +51,10 @@ pub struct SweepConfig {
     pub truth: WhittedSettings,
     /// The command line, for the report.
     pub command: String,
+    /// Where the timed renders run: in a child process of this executable
+    /// (`EXE render-worker`, [`worker`]), so that the driver's per-frame memory is returned
+    /// after each and every point's peak memory is its own; `None` renders in this process.
+    pub worker: Option<PathBuf>,
 }
 
 /// The methods `name` at each value of its swept option (`"auxiliary"`, `[0, 1, 2]`), every
@@ -80,6 +88,7 @@ impl SweepConfig {
             warmup: 2,
             truth: WhittedSettings::default(),
             command: String::new(),
+            worker: None,
         }
     }
 
@@ -188,6 +197,9 @@ pub enum HarnessError {
     /// An output file could not be written, or the output folder is in use.
     #[error(transparent)]
     File(#[from] FileError),
+    /// A render worker could not be run or failed.
+    #[error("render worker: {0}")]
+    Worker(String),
 }
 
 impl HarnessError {
@@ -542,7 +554,8 @@ pub fn run_sweep(
     // and one timed frame, the points in an order shuffled per round (fixed seed). Drift of a
     // shared machine then spreads over every point alike instead of landing on a few.
     let mut timed: Vec<Vec<f64>> = vec![Vec::new(); todo.len()];
-    let mut last: Vec<Option<mirrorbox_raster::RenderOutput>> = todo.iter().map(|_| None).collect();
+    let mut last: Vec<Option<Rendered>> = todo.iter().map(|_| None).collect();
+    let mut peaks: Vec<Option<u64>> = vec![None; todo.len()];
     let mut order: Vec<usize> = (0..todo.len()).collect();
     let mut rng = mirrorbox_report::stats::Rng::new(INTERLEAVE_SEED);
     for round in 0..config.frames {
@@ -554,10 +567,26 @@ pub fn run_sweep(
                 round: round + 1,
                 rounds: config.frames,
             });
-            let (scene, mut settings) = point_setup(&base, p, config);
-            settings.frames = 1;
-            let rendered = mirrorbox_raster::render(&gpu, &scene, &settings)?;
-            timed[i].extend(&rendered.timing.frames_ms);
+            let (scene, settings) = point_setup(&base, p, config);
+            let job = RenderJob {
+                scene: config.scene.clone(),
+                width: w,
+                height: h,
+                floor: p.method.is_none(),
+                alpha: p.alpha,
+                method: worker::method_text(&settings.method),
+                ssaa: config.ssaa,
+                frames: 1,
+                warmup: config.warmup,
+                scene_hash: scene.content_hash(),
+                image: out.join(format!(".render-{}-{i}.exr", std::process::id())),
+            };
+            let rendered = match &config.worker {
+                Some(exe) => worker::render_in_worker(exe, &job)?,
+                None => worker::run_job(&job, &gpu)?,
+            };
+            timed[i].extend(&rendered.report.frames_ms);
+            peaks[i] = peaks[i].max(rendered.report.peak_memory_bytes);
             last[i] = Some(rendered);
         }
     }
@@ -599,8 +628,7 @@ pub fn run_sweep(
                 .to_string_lossy()
                 .into_owned()
         };
-        let t = &rendered.timing;
-        let s = &rendered.stats;
+        let s = &rendered.report;
         let interval = mirrorbox_report::stats::median_interval(&frames_ms);
         let record = Record {
             key: p.key.clone(),
@@ -619,19 +647,20 @@ pub fn run_sweep(
             ms_interval: interval.map(|i| [i.low, i.high]),
             frames_ms,
             timing_order: "interleaved".into(),
-            timing_source: t.source.name().into(),
+            peak_memory_bytes: peaks[i],
+            timing_source: s.timing_source.clone(),
             frames: config.frames,
             passes: s.passes,
             draws: s.draws,
             texture_renders: s.texture_renders,
             reflections: s.depth,
             triangles: Some(s.triangles),
-            paths: s.paths.map(|c| c.kept),
-            paths_pruned: s.paths.map(|c| c.pruned()),
+            paths: s.paths_kept,
+            paths_pruned: s.paths_pruned,
             metrics: metric_values(&m),
-            adapter: gpu.report.name.clone(),
-            backend: gpu.report.backend.clone(),
-            color_format: rendered.color_format.name().into(),
+            adapter: s.adapter.clone(),
+            backend: s.backend.clone(),
+            color_format: s.color_format.clone(),
             truth_image: rel(&truth_png),
             raster_image: rel(&raster_png),
             heatmap_image: rel(&heat_png),

@@ -66,6 +66,10 @@ pub struct Record {
     /// every point alike) or `back-to-back` (all of a point's frames in a row: older records).
     #[serde(default = "back_to_back")]
     pub timing_order: String,
+    /// Peak resident memory of the process that rendered the point (its render worker),
+    /// bytes; absent in older records.
+    #[serde(default)]
+    pub peak_memory_bytes: Option<u64>,
     pub timing_source: String,
     pub frames: u32,
     pub passes: usize,

@@ -209,14 +209,14 @@ fn esc(s: &str) -> String {
 fn write_csv(path: &Path, records: &[Record]) -> Result<(), FileError> {
     let mut s = String::from(
         "kind,method,n,depth,alpha,width,height,ssaa,ms_median,ms_ci_low,ms_ci_high,ms_min,timing_order,timing_source,frames,passes,draws,texture_renders,reflections,\
-         rmse,relmse,smape,max_abs,psnr,ssim,flip_mean,flip_p95,flip_p99,adapter,backend,scene,scene_hash,color_format\n",
+         rmse,relmse,smape,max_abs,psnr,ssim,flip_mean,flip_p95,flip_p99,adapter,backend,scene,scene_hash,color_format,peak_memory_bytes\n",
     );
     for r in records {
         let m = &r.metrics;
         let opt = |v: Option<u32>| v.map_or(String::new(), |x| x.to_string());
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},\"{}\",{},\"{}\",{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},\"{}\",{},\"{}\",{},{},{}",
             r.kind,
             r.method,
             opt(r.n),
@@ -249,7 +249,8 @@ fn write_csv(path: &Path, records: &[Record]) -> Result<(), FileError> {
             r.backend,
             r.scene.replace('"', "'"),
             r.scene_hash,
-            r.color_format
+            r.color_format,
+            r.peak_memory_bytes.map_or(String::new(), |b| b.to_string())
         );
     }
     write_atomically(path, s.as_bytes())
@@ -692,6 +693,7 @@ mod tests {
             ms_interval: None,
             frames_ms: Vec::new(),
             timing_order: "back-to-back".into(),
+            peak_memory_bytes: None,
             ms_min: ms,
             timing_source: "gpu-timestamps".into(),
             frames: 1,
@@ -846,7 +848,12 @@ mod tests {
             "{md}"
         );
         let csv = std::fs::read_to_string(dir.path().join("results.csv")).unwrap();
-        assert!(csv.lines().next().unwrap().ends_with(",color_format"));
-        assert!(csv.lines().nth(2).unwrap().ends_with(",rgba16float"));
+        assert!(
+            csv.lines()
+                .next()
+                .unwrap()
+                .ends_with(",color_format,peak_memory_bytes")
+        );
+        assert!(csv.lines().nth(2).unwrap().ends_with(",rgba16float,"));
     }
 }

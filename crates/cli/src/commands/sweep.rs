@@ -119,6 +119,12 @@ fn parse_methods(
     Ok(methods)
 }
 
+/// This executable, run as `render-worker` for every timed render of a sweep (see
+/// `mirrorbox_harness::worker`: lavapipe keeps memory from every frame a process executes).
+fn render_worker() -> Option<PathBuf> {
+    std::env::current_exe().ok()
+}
+
 fn command_line() -> String {
     std::env::args().collect::<Vec<_>>().join(" ")
 }
@@ -139,6 +145,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             min_throughput: args.min_throughput,
         },
         command: command_line(),
+        worker: render_worker(),
     };
     execute(&config, args.fresh)
 }
@@ -164,6 +171,7 @@ fn run_preset(mut config: SweepConfig, args: &PresetArgs) -> Result<(), Failure>
         config.frames = frames;
     }
     config.command = command_line();
+    config.worker = render_worker();
     execute(&config, args.fresh)
 }
 

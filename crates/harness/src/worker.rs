@@ -1,0 +1,198 @@
+//! Timed renders in a child process (`mirrorbox render-worker`), one per point and round.
+//!
+//! Why: on lavapipe (Mesa 22.3, Vulkan) every executed frame leaves memory behind in the
+//! process — a few hundred MB per frame of `portal` at depth 512, freed neither when the
+//! frame's resources nor when the device are dropped (measured: `render --frames 16` peaked
+//! at 5.2 GB where one frame peaks at 0.47 GB; wgpu's GL backend does not grow). A sweep that
+//! renders thousands of frames in one process piled that up to 12.7 GB. A child per render
+//! returns it all to the system when it exits, and its peak resident memory is the point's
+//! own, recorded beside its timing.
+//!
+//! The job names the scene by file and the changes the sweep makes to it (size, α, mirrors
+//! removed for the floor); the worker checks that it built the same scene (content hash).
+
+use crate::HarnessError;
+use glam::Vec3;
+use mirrorbox_image::{RgbImage, read_image, write_exr};
+use mirrorbox_raster::{Gpu, Method, RenderSettings};
+use mirrorbox_scene::{Scene, load_scene};
+use serde::{Deserialize, Serialize};
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+
+/// One timed render, as the sweep describes it to a worker.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RenderJob {
+    pub scene: PathBuf,
+    pub width: u32,
+    pub height: u32,
+    /// The floor point: the scene without its mirrors.
+    pub floor: bool,
+    pub alpha: f32,
+    /// The method with every option not at its default (`auxiliary n=2 max-passes=100`).
+    pub method: String,
+    pub ssaa: u32,
+    pub frames: u32,
+    pub warmup: u32,
+    /// The content hash the worker's scene must have (the sweep's, after its changes).
+    pub scene_hash: u64,
+    /// Where the worker writes the rendered image (linear EXR).
+    pub image: PathBuf,
+}
+
+/// What a worker measured.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RenderReport {
+    pub frames_ms: Vec<f64>,
+    pub timing_source: String,
+    pub passes: usize,
+    pub texture_renders: usize,
+    pub draws: usize,
+    pub depth: usize,
+    pub triangles: usize,
+    pub paths_kept: Option<usize>,
+    pub paths_pruned: Option<usize>,
+    pub color_format: String,
+    pub adapter: String,
+    pub backend: String,
+    /// The worker's peak resident memory (Linux `VmHWM`), bytes.
+    pub peak_memory_bytes: Option<u64>,
+}
+
+/// A rendered point: the image and what was measured.
+pub struct Rendered {
+    pub image: RgbImage,
+    pub report: RenderReport,
+}
+
+/// `method` with every option not at its default, in a form [`Method::parse`] reads back.
+pub fn method_text(method: &Method) -> String {
+    let entry = method.entry();
+    let mut text = entry.name.to_string();
+    for (o, v) in entry.options.iter().zip(method.params().values()) {
+        if *v != o.default {
+            text.push_str(&format!(" {}={v}", o.name));
+        }
+    }
+    text
+}
+
+/// The scene a job describes.
+fn job_scene(job: &RenderJob) -> Result<Scene, HarnessError> {
+    let mut scene = load_scene(&job.scene)?;
+    scene.resize(Some(job.width), Some(job.height))?;
+    if job.floor {
+        scene = scene.without_mirrors();
+    }
+    scene.set_reflectance(Vec3::splat(job.alpha));
+    Ok(scene)
+}
+
+/// Runs `job` in this process (the worker's side, or the sweep's when it renders in-process).
+pub fn run_job(job: &RenderJob, gpu: &Gpu) -> Result<Rendered, HarnessError> {
+    let scene = job_scene(job)?;
+    if scene.content_hash() != job.scene_hash {
+        return Err(HarnessError::Worker(format!(
+            "{}: the worker built another scene than the sweep (hash {:016x}, expected {:016x}); was the file changed during the sweep?",
+            job.scene.display(),
+            scene.content_hash(),
+            job.scene_hash
+        )));
+    }
+    let method = Method::parse(&job.method)
+        .map_err(|e| HarnessError::Worker(format!("{}: {e}", job.method)))?;
+    let settings = RenderSettings {
+        method,
+        ssaa: job.ssaa,
+        frames: job.frames,
+        warmup: job.warmup,
+    };
+    let out = mirrorbox_raster::render(gpu, &scene, &settings)?;
+    let s = &out.stats;
+    Ok(Rendered {
+        report: RenderReport {
+            frames_ms: out.timing.frames_ms.clone(),
+            timing_source: out.timing.source.name().into(),
+            passes: s.passes,
+            texture_renders: s.texture_renders,
+            draws: s.draws,
+            depth: s.depth,
+            triangles: s.triangles,
+            paths_kept: s.paths.map(|c| c.kept),
+            paths_pruned: s.paths.map(|c| c.pruned()),
+            color_format: out.color_format.name().into(),
+            adapter: gpu.report.name.clone(),
+            backend: gpu.report.backend.clone(),
+            peak_memory_bytes: peak_memory_bytes(),
+        },
+        image: out.image,
+    })
+}
+
+/// The worker's main: a job as JSON on stdin, the image to `job.image`, the report as JSON
+/// on stdout.
+pub fn serve(
+    stdin: impl std::io::Read,
+    mut stdout: impl std::io::Write,
+) -> Result<(), HarnessError> {
+    let job: RenderJob = serde_json::from_reader(stdin)?;
+    let gpu = Gpu::new()?;
+    let rendered = run_job(&job, &gpu)?;
+    write_exr(&job.image, &rendered.image, &[])?;
+    let mut report = rendered.report;
+    report.peak_memory_bytes = peak_memory_bytes();
+    serde_json::to_writer(&mut stdout, &report)?;
+    stdout
+        .flush()
+        .map_err(|e| HarnessError::Worker(format!("cannot answer the sweep: {e}")))
+}
+
+/// Runs `job` in a child process `exe render-worker` and reads its answer.
+pub fn render_in_worker(exe: &Path, job: &RenderJob) -> Result<Rendered, HarnessError> {
+    let mut child = std::process::Command::new(exe)
+        .arg("render-worker")
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .map_err(|e| HarnessError::Worker(format!("cannot start {}: {e}", exe.display())))?;
+    let input = serde_json::to_vec(job)?;
+    child
+        .stdin
+        .take()
+        .expect("piped stdin")
+        .write_all(&input)
+        .map_err(|e| HarnessError::Worker(format!("cannot send the job: {e}")))?;
+    let out = child
+        .wait_with_output()
+        .map_err(|e| HarnessError::Worker(format!("the worker failed: {e}")))?;
+    if !out.status.success() {
+        let message = String::from_utf8_lossy(&out.stderr).trim().to_string();
+        let message = message
+            .strip_prefix("error: ")
+            .unwrap_or(&message)
+            .to_string();
+        return Err(HarnessError::Worker(format!(
+            "{} ({}): {message}",
+            job.method, out.status
+        )));
+    }
+    let report: RenderReport = serde_json::from_slice(&out.stdout)?;
+    let image = read_image(&job.image)?;
+    let _ = std::fs::remove_file(&job.image);
+    Ok(Rendered { image, report })
+}
+
+/// This process's peak resident memory so far (Linux `VmHWM`), bytes.
+pub fn peak_memory_bytes() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let kb: u64 = status
+        .lines()
+        .find_map(|l| l.strip_prefix("VmHWM:"))?
+        .trim()
+        .trim_end_matches("kB")
+        .trim()
+        .parse()
+        .ok()?;
+    Some(kb * 1024)
+}
