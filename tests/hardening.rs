@@ -429,7 +429,10 @@ fn a_value_listed_twice_is_one_point() {
     let k = keys(&out);
     assert_eq!(k.len(), 3, "floor, depth 1, depth 2: {k:?}");
     // Each point timed in its own render worker, interleaved, with its peak memory.
-    for line in std::fs::read_to_string(out.join("results.jsonl")).unwrap().lines() {
+    for line in std::fs::read_to_string(out.join("results.jsonl"))
+        .unwrap()
+        .lines()
+    {
         let r: Value = serde_json::from_str(line).unwrap();
         assert_eq!(r["timing_order"], "interleaved", "{r}");
         assert_eq!(r["frames_ms"].as_array().unwrap().len(), 1, "{r}");

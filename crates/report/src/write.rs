@@ -466,8 +466,10 @@ fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
             "Reproduction of the paper's Table 1".into(),
         ));
         b.push(Block::Paragraph(format!(
-            "Auxiliary method, α = {}; ours is the median (and minimum) ms/frame over the timed frames. \
-             The paper's column is its Table 1 (Safari, hardware not stated).",
+            "Auxiliary method, α = {}; ours is the median ms/frame over the timed frames with its \
+             95 % bootstrap interval (frames timed interleaved: one per point per round, the points \
+             in an order shuffled per round). The paper's column is its Table 1 (Safari, hardware \
+             not stated).",
             alpha.unwrap_or(f32::NAN)
         )));
         let step = |s: Option<f64>| s.map_or("–".into(), |v| format!("{v:.2}"));
