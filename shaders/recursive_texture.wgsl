@@ -98,29 +98,5 @@ fn mirror_colour(in: VertexOut) -> vec4f {
     return vec4f(s.reflectance * mirror_lookup(in.clip.xy), 1.0);
 }
 
-@fragment
-fn fs_object(in: VertexOut) -> @location(0) vec4f {
-    return object_colour(in);
-}
-
-@fragment
-fn fs_mirror(in: VertexOut) -> @location(0) vec4f {
-    return mirror_colour(in);
-}
-
-// Without clip distances: what lies behind the pass's mirror is discarded here.
-@fragment
-fn fs_object_discard(in: VertexOut) -> @location(0) vec4f {
-    if (in.plane_distance < 0.0) {
-        discard;
-    }
-    return object_colour(in);
-}
-
-@fragment
-fn fs_mirror_discard(in: VertexOut) -> @location(0) vec4f {
-    if (in.plane_distance < 0.0) {
-        discard;
-    }
-    return mirror_colour(in);
-}
+// Entry points fs_object, fs_mirror and their *_discard variants:
+// shaders/mirror_plane_fragments.wgsl, composed after this file.

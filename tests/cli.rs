@@ -3,23 +3,9 @@
 
 mod common;
 
-use common::{Output, mirrorbox, repo};
+use common::{Output, mirrorbox, repo, valid_scene};
 use serde_json::{Value, json};
 use std::path::Path;
-
-/// A small valid scene; each test breaks one thing in it.
-fn valid_scene() -> Value {
-    json!({
-        "camera": { "position": [0, 1, 3], "look_at": [0, 1, 0], "fov_y_deg": 60,
-                    "width": 32, "height": 24 },
-        "mirrors": [
-            { "center": [0, 1, -2], "normal": [0, 0, 1], "up": [0, 1, 0], "width": 4, "height": 3 },
-            { "center": [0, 1, 2], "normal": [0, 0, -1], "up": [0, 1, 0], "width": 4, "height": 3 }
-        ],
-        "objects": [ { "type": "sphere", "radius": 0.5 } ],
-        "lights": [ { "position": [0, 2.5, 0], "intensity": [10, 10, 10] } ]
-    })
-}
 
 /// Writes `text` as `name` in a fresh folder and runs `mirrorbox check` on it.
 fn check_text(name: &str, text: &str, extra_files: &[(&str, &str)]) -> (Output, tempfile::TempDir) {

@@ -8,18 +8,8 @@ use common::{Output, mirrorbox};
 use serde_json::{Value, json};
 use std::path::{Path, PathBuf};
 
-/// A small valid two-mirror scene, as `tests/cli.rs` uses.
 fn scene() -> Value {
-    json!({
-        "camera": { "position": [0, 1, 3], "look_at": [0, 1, 0], "fov_y_deg": 60,
-                    "width": 32, "height": 24 },
-        "mirrors": [
-            { "center": [0, 1, -2], "normal": [0, 0, 1], "up": [0, 1, 0], "width": 4, "height": 3 },
-            { "center": [0, 1, 2], "normal": [0, 0, -1], "up": [0, 1, 0], "width": 4, "height": 3 }
-        ],
-        "objects": [ { "type": "sphere", "radius": 0.5 } ],
-        "lights": [ { "position": [0, 2.5, 0], "intensity": [10, 10, 10] } ]
-    })
+    common::valid_scene()
 }
 
 fn write_scene(dir: &Path, name: &str, scene: &Value) -> PathBuf {

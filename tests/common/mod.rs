@@ -2,6 +2,7 @@
 //! does (a real process, its exit code and its output).
 #![allow(dead_code)] // each test file uses its own subset
 
+use serde_json::{Value, json};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -27,4 +28,18 @@ pub fn mirrorbox(args: &[&str], envs: &[(&str, &str)]) -> Output {
         stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
         stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
     }
+}
+
+/// A small valid two-mirror scene; each test breaks or extends one thing in it.
+pub fn valid_scene() -> Value {
+    json!({
+        "camera": { "position": [0, 1, 3], "look_at": [0, 1, 0], "fov_y_deg": 60,
+                    "width": 32, "height": 24 },
+        "mirrors": [
+            { "center": [0, 1, -2], "normal": [0, 0, 1], "up": [0, 1, 0], "width": 4, "height": 3 },
+            { "center": [0, 1, 2], "normal": [0, 0, -1], "up": [0, 1, 0], "width": 4, "height": 3 }
+        ],
+        "objects": [ { "type": "sphere", "radius": 0.5 } ],
+        "lights": [ { "position": [0, 2.5, 0], "intensity": [10, 10, 10] } ]
+    })
 }

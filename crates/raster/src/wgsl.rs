@@ -19,6 +19,10 @@ pub const SHADING: &str = include_str!("../../../shaders/shading.wgsl");
 /// follows the method's own file, which defines `VertexOut` and `scene_vertex`.
 pub const MIRROR_PLANE_CLIP_DISTANCES: &str =
     include_str!("../../../shaders/mirror_plane_clip_distances.wgsl");
+/// The fragment entry points of the methods that clip a mirror's world at its plane (plain,
+/// and `*_discard` for adapters without clip distances).
+pub const MIRROR_PLANE_FRAGMENTS: &str =
+    include_str!("../../../shaders/mirror_plane_fragments.wgsl");
 
 /// One shader variant: what a pipeline's module is made of.
 #[derive(Debug)]

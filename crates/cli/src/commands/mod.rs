@@ -73,19 +73,10 @@ pub fn output_path(flag: &str, path: &Path, ext: &str) -> Result<PathBuf, Failur
     Ok(path.to_path_buf())
 }
 
-/// This process's peak resident memory so far (Linux `VmHWM`), for the summary lines of long
-/// commands; `None` where `/proc` does not say.
+/// This process's peak resident memory so far, for the summary lines of long commands;
+/// `None` where `/proc` does not say.
 pub fn peak_memory() -> Option<String> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let kb: u64 = status
-        .lines()
-        .find_map(|l| l.strip_prefix("VmHWM:"))?
-        .trim()
-        .trim_end_matches("kB")
-        .trim()
-        .parse()
-        .ok()?;
-    Some(mirrorbox_files::human_bytes(kb * 1024))
+    mirrorbox_harness::peak_memory_bytes().map(mirrorbox_files::human_bytes)
 }
 
 /// The files one command writes: none a folder, no two the same file — checked before any

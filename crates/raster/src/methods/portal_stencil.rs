@@ -60,7 +60,11 @@ const ENTRY_POINTS: &str = include_str!("../../../../shaders/portal_stencil.wgsl
 static SHADER: WgslSource = WgslSource {
     label: "portal stencil",
     enable: &[],
-    parts: &[crate::wgsl::SHADING, ENTRY_POINTS],
+    parts: &[
+        crate::wgsl::SHADING,
+        ENTRY_POINTS,
+        crate::wgsl::MIRROR_PLANE_FRAGMENTS,
+    ],
 };
 
 /// Adds the hardware clip-distance vertex stage, for adapters with `CLIP_DISTANCES`.
@@ -70,6 +74,7 @@ static CLIP_DISTANCE_SHADER: WgslSource = WgslSource {
     parts: &[
         crate::wgsl::SHADING,
         ENTRY_POINTS,
+        crate::wgsl::MIRROR_PLANE_FRAGMENTS,
         crate::wgsl::MIRROR_PLANE_CLIP_DISTANCES,
     ],
 };

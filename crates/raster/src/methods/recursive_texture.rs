@@ -78,7 +78,11 @@ const ENTRY_POINTS: &str = include_str!("../../../../shaders/recursive_texture.w
 static SHADER: WgslSource = WgslSource {
     label: "recursive texture",
     enable: &[],
-    parts: &[crate::wgsl::SHADING, ENTRY_POINTS],
+    parts: &[
+        crate::wgsl::SHADING,
+        ENTRY_POINTS,
+        crate::wgsl::MIRROR_PLANE_FRAGMENTS,
+    ],
 };
 
 /// Adds the hardware clip-distance vertex stage, for adapters with `CLIP_DISTANCES`.
@@ -88,6 +92,7 @@ static CLIP_DISTANCE_SHADER: WgslSource = WgslSource {
     parts: &[
         crate::wgsl::SHADING,
         ENTRY_POINTS,
+        crate::wgsl::MIRROR_PLANE_FRAGMENTS,
         crate::wgsl::MIRROR_PLANE_CLIP_DISTANCES,
     ],
 };
