@@ -43,6 +43,8 @@ fn run(program: &str, args: &[&str]) {
 fn both(py: &str, dir: &Path, integrator: &str, spp: &str, depth: &str) -> (RgbImage, RgbImage) {
     let bin = env!("CARGO_BIN_EXE_mirrorbox");
     let d = dir.join(integrator);
+    // An output's folder must exist (every command's rule).
+    std::fs::create_dir_all(&d).unwrap();
     let xml = d.join("scene.xml");
     let (ours, theirs) = (d.join("ours.exr"), d.join("mitsuba.exr"));
     let size = ["--width", "64", "--height", "36"];

@@ -61,6 +61,7 @@ def main():
             rows = {}
             for integ, spp, depth in (("whitted", args.whitted_spp, 10000), ("path", args.path_spp, args.path_depth)):
                 xml = os.path.join(d, integ, "scene.xml")
+                os.makedirs(os.path.dirname(xml), exist_ok=True)  # outputs' folders must exist
                 run([args.bin, "export-mitsuba", scene, "-o", xml, "--spp", str(spp)] + size)
                 ours = os.path.join(d, integ, "ours.exr")
                 extra = ["--rr-depth", "1000000"] if integ == "path" else []
