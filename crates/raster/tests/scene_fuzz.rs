@@ -304,9 +304,64 @@ fn env_number(name: &str, default: u64) -> u64 {
         .unwrap_or(default)
 }
 
-/// The reproducers, then random mutants of every bundled scene.
+/// Mutants per child process: lavapipe keeps memory from every frame a process executes
+/// (see `mirrorbox_harness::worker`), so the renders are spread over child processes of this
+/// test, each bounded (1 000 mutants in one process peaked at 4.8 GB; 5 000 were killed for
+/// memory at 24 GB).
+const MUTANTS_PER_CHILD: usize = 125;
+
+/// The reproducers, then random mutants of every bundled scene, in chunks of
+/// [`MUTANTS_PER_CHILD`], each in a child process of this test binary.
 #[test]
 fn no_scene_that_loads_crashes_the_tracer_or_a_raster_method() {
+    if let Ok(chunk) = std::env::var("MIRRORBOX_FUZZ_CHUNK") {
+        return fuzz_chunk(chunk.parse().expect("a chunk index"));
+    }
+    let mutants = env_number("MIRRORBOX_FUZZ_MUTANTS", 1000) as usize;
+    let total = 3 + mutants;
+    let mut tally = Tally::default();
+    for chunk in 0..total.div_ceil(MUTANTS_PER_CHILD) {
+        let out = std::process::Command::new(std::env::current_exe().unwrap())
+            .args([
+                "--exact",
+                "no_scene_that_loads_crashes_the_tracer_or_a_raster_method",
+                "--nocapture",
+                "--test-threads",
+                "1",
+            ])
+            .env("MIRRORBOX_FUZZ_CHUNK", chunk.to_string())
+            .output()
+            .expect("run a fuzz chunk");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            out.status.success(),
+            "chunk {chunk} failed ({}):\n{stderr}\n{}",
+            out.status,
+            String::from_utf8_lossy(&out.stdout)
+        );
+        let line = stderr
+            .lines()
+            .find_map(|l| l.strip_prefix("scene fuzz chunk: "))
+            .expect("the chunk's tally");
+        let n: Vec<usize> = line.split(' ').map(|x| x.parse().unwrap()).collect();
+        tally.tried += n[0];
+        tally.refused_by_load += n[1];
+        tally.traced += n[2];
+        tally.rendered += n[3];
+        tally.refused_by_method += n[4];
+    }
+    eprintln!("scene fuzz: {tally:?}");
+    assert_eq!(tally.tried, total);
+    // The fuzzer must reach the renderers, not only the validator.
+    assert!(
+        tally.traced * 4 >= tally.tried && tally.rendered > 0,
+        "{tally:?}"
+    );
+}
+
+/// Mutants `chunk·MUTANTS_PER_CHILD ..` of the whole sequence (every chunk generates the same
+/// sequence from the seed and takes its slice).
+fn fuzz_chunk(chunk: usize) {
     let gpu = Gpu::new().expect("a wgpu adapter (scripts/install-system-deps.sh)");
     let mutants = env_number("MIRRORBOX_FUZZ_MUTANTS", 1000) as usize;
     let mut rng = Rng(env_number("MIRRORBOX_FUZZ_SEED", 12));
@@ -337,7 +392,8 @@ fn no_scene_that_loads_crashes_the_tracer_or_a_raster_method() {
         (path, mutant)
     });
     let all: Vec<(PathBuf, Value)> = reproducers.into_iter().chain(random).collect();
-    for (i, (path, mutant)) in all.iter().enumerate() {
+    let start = chunk * MUTANTS_PER_CHILD;
+    for (i, (path, mutant)) in all.iter().enumerate().skip(start).take(MUTANTS_PER_CHILD) {
         tally.tried += 1;
         let text = serde_json::to_string(mutant).unwrap();
         match load(&text, path) {
@@ -353,17 +409,15 @@ fn no_scene_that_loads_crashes_the_tracer_or_a_raster_method() {
             }
         }
     }
-    eprintln!("scene fuzz: {tally:?}");
+    eprintln!(
+        "scene fuzz chunk: {} {} {} {} {}",
+        tally.tried, tally.refused_by_load, tally.traced, tally.rendered, tally.refused_by_method
+    );
     assert!(
         failures.is_empty(),
         "{} of {} mutants failed:\n{}",
         failures.len(),
         tally.tried,
         failures.join("\n")
-    );
-    // The fuzzer must reach the renderers, not only the validator.
-    assert!(
-        tally.traced * 4 >= tally.tried && tally.rendered > 0,
-        "{tally:?}"
     );
 }
