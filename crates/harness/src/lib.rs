@@ -1,6 +1,7 @@
 //! The sweep: for each method, n and α, render and time with the rasterizer, compare with
 //! the ground truth traced at reflectance α on the same sub-pixel grid, and append one
-//! [`Record`] per point to `results.jsonl` as it completes. Then write the reports.
+//! [`Record`] per point to `results.jsonl` once its timing rounds are done. Then write the
+//! reports.
 //!
 //! - **Truth cache**: `cache/truth-<key>.exr`, the key an FNV-1a hash of everything that
 //!   affects the traced image (scene content hash after α and size, spp, depth limits,
@@ -112,18 +113,22 @@ impl SweepConfig {
     }
 
     /// The exact methods' cost against depth, 1 to 1024, on mirror_box with perfect mirrors
-    /// (α = 1: no path ends by attenuation, only when its portal holds no pixel centre).
+    /// (α = 1: no path ends by attenuation, only when its portal holds no pixel centre); 9
+    /// timed frames, enough for a 95 % interval of each median.
     pub fn depth_scaling(out: PathBuf) -> Self {
         let methods = ["portal", "unrolled"]
             .into_iter()
             .flat_map(|m| swept(m, (0..=10).map(|k| 1 << k)))
             .collect();
-        SweepConfig::new(
-            PathBuf::from("scenes/mirror_box.json"),
-            out,
-            methods,
-            vec![1.0],
-        )
+        SweepConfig {
+            frames: 9,
+            ..SweepConfig::new(
+                PathBuf::from("scenes/mirror_box.json"),
+                out,
+                methods,
+                vec![1.0],
+            )
+        }
     }
 }
 
@@ -200,6 +205,9 @@ pub enum HarnessError {
     /// A render worker could not be run or failed.
     #[error("render worker: {0}")]
     Worker(String),
+    /// A render worker refused its point (exit 2: a resource beyond the device or a budget).
+    #[error("{0}")]
+    WorkerRefused(String),
 }
 
 impl HarnessError {
@@ -208,6 +216,7 @@ impl HarnessError {
             HarnessError::Scene(_)
             | HarnessError::Refused { .. }
             | HarnessError::Setting(_)
+            | HarnessError::WorkerRefused(_)
             | HarnessError::OutputFolder { .. } => true,
             HarnessError::Raster(e) => e.is_refusal(),
             HarnessError::File(e) => e.refused,
@@ -398,6 +407,12 @@ fn salvage(results: &Path, records: &[Record]) -> Result<(), HarnessError> {
     Ok(write_atomically(results, clean.as_bytes())?)
 }
 
+/// Where point `i`'s last render waits between the timing rounds and the reports (in the
+/// sweep's `cache/`, which is not kept in git), named per process.
+fn rendered_image(cache: &Path, i: usize) -> PathBuf {
+    cache.join(format!(".render-{}-{i}.exr", std::process::id()))
+}
+
 /// The method every floor point renders the mirror-free scene with: one scene pass.
 pub const FLOOR_METHOD: &str = "naive";
 
@@ -548,13 +563,15 @@ pub fn run_sweep(
     for p in &todo {
         progress(Event::Started { label: &p.label });
         let (scene, _) = point_setup(&base, p, config);
-        truths.push(truth(&scene, config, &cache, &mut summary)?);
+        // Only the path is kept: a sweep may have thousands of points.
+        truths.push(truth(&scene, config, &cache, &mut summary)?.1);
     }
     // Interleaved timing: `frames` rounds; in each, every point renders its warm-up frames
     // and one timed frame, the points in an order shuffled per round (fixed seed). Drift of a
     // shared machine then spreads over every point alike instead of landing on a few.
     let mut timed: Vec<Vec<f64>> = vec![Vec::new(); todo.len()];
-    let mut last: Vec<Option<Rendered>> = todo.iter().map(|_| None).collect();
+    // Per point: the last round's report; its image waits on disk (not in memory).
+    let mut last: Vec<Option<RenderReport>> = todo.iter().map(|_| None).collect();
     let mut peaks: Vec<Option<u64>> = vec![None; todo.len()];
     let mut order: Vec<usize> = (0..todo.len()).collect();
     let mut rng = mirrorbox_report::stats::Rng::new(INTERLEAVE_SEED);
@@ -579,21 +596,28 @@ pub fn run_sweep(
                 frames: 1,
                 warmup: config.warmup,
                 scene_hash: scene.content_hash(),
-                image: out.join(format!(".render-{}-{i}.exr", std::process::id())),
+                image: rendered_image(&cache, i),
             };
-            let rendered = match &config.worker {
-                Some(exe) => worker::render_in_worker(exe, &job)?,
-                None => worker::run_job(&job, &gpu)?,
+            let report = match &config.worker {
+                Some(exe) => worker::render_in_worker(exe, &job, &p.label)?,
+                None => worker::run_job_to_file(&job, &gpu)?,
             };
-            timed[i].extend(&rendered.report.frames_ms);
-            peaks[i] = peaks[i].max(rendered.report.peak_memory_bytes);
-            last[i] = Some(rendered);
+            timed[i].extend(&report.frames_ms);
+            peaks[i] = peaks[i].max(report.peak_memory_bytes);
+            last[i] = Some(report);
         }
     }
     for (i, p) in todo.iter().enumerate() {
         let (scene, _) = point_setup(&base, p, config);
-        let (truth_image, truth_path) = &truths[i];
-        let rendered = last[i].take().expect("every point renders in every round");
+        let truth_path = &truths[i];
+        let truth_image = &read_image(truth_path)?;
+        let report = last[i].take().expect("every point renders in every round");
+        let image_path = rendered_image(&cache, i);
+        let rendered = Rendered {
+            image: read_image(&image_path)?,
+            report,
+        };
+        let _ = std::fs::remove_file(&image_path);
         let frames_ms = std::mem::take(&mut timed[i]);
         let m = compare(truth_image, &rendered.image, scene.camera.exposure)?;
         let raster_png = images.join(format!("{}.png", p.slug));

@@ -13,7 +13,7 @@
 
 use crate::HarnessError;
 use glam::Vec3;
-use mirrorbox_image::{RgbImage, read_image, write_exr};
+use mirrorbox_image::{RgbImage, write_exr};
 use mirrorbox_raster::{Gpu, Method, RenderSettings};
 use mirrorbox_scene::{Scene, load_scene};
 use serde::{Deserialize, Serialize};
@@ -129,6 +129,13 @@ pub fn run_job(job: &RenderJob, gpu: &Gpu) -> Result<Rendered, HarnessError> {
     })
 }
 
+/// Runs `job` in this process and writes its image to `job.image`, as a worker would.
+pub fn run_job_to_file(job: &RenderJob, gpu: &Gpu) -> Result<RenderReport, HarnessError> {
+    let rendered = run_job(job, gpu)?;
+    write_exr(&job.image, &rendered.image, &[])?;
+    Ok(rendered.report)
+}
+
 /// The worker's main: a job as JSON on stdin, the image to `job.image`, the report as JSON
 /// on stdout.
 pub fn serve(
@@ -137,9 +144,7 @@ pub fn serve(
 ) -> Result<(), HarnessError> {
     let job: RenderJob = serde_json::from_reader(stdin)?;
     let gpu = Gpu::new()?;
-    let rendered = run_job(&job, &gpu)?;
-    write_exr(&job.image, &rendered.image, &[])?;
-    let mut report = rendered.report;
+    let mut report = run_job_to_file(&job, &gpu)?;
     report.peak_memory_bytes = peak_memory_bytes();
     serde_json::to_writer(&mut stdout, &report)?;
     stdout
@@ -147,8 +152,13 @@ pub fn serve(
         .map_err(|e| HarnessError::Worker(format!("cannot answer the sweep: {e}")))
 }
 
-/// Runs `job` in a child process `exe render-worker` and reads its answer.
-pub fn render_in_worker(exe: &Path, job: &RenderJob) -> Result<Rendered, HarnessError> {
+/// Runs `job` (the point `label`) in a child process `exe render-worker` and reads its
+/// answer; the image stays in `job.image`. A worker's refusal (exit 2) stays a refusal.
+pub fn render_in_worker(
+    exe: &Path,
+    job: &RenderJob,
+    label: &str,
+) -> Result<RenderReport, HarnessError> {
     let mut child = std::process::Command::new(exe)
         .arg("render-worker")
         .stdin(std::process::Stdio::piped())
@@ -162,25 +172,28 @@ pub fn render_in_worker(exe: &Path, job: &RenderJob) -> Result<Rendered, Harness
         .take()
         .expect("piped stdin")
         .write_all(&input)
-        .map_err(|e| HarnessError::Worker(format!("cannot send the job: {e}")))?;
+        .map_err(|e| HarnessError::Worker(format!("{label}: cannot send the job: {e}")))?;
     let out = child
         .wait_with_output()
-        .map_err(|e| HarnessError::Worker(format!("the worker failed: {e}")))?;
+        .map_err(|e| HarnessError::Worker(format!("{label}: {e}")))?;
     if !out.status.success() {
-        let message = String::from_utf8_lossy(&out.stderr).trim().to_string();
-        let message = message
-            .strip_prefix("error: ")
-            .unwrap_or(&message)
-            .to_string();
-        return Err(HarnessError::Worker(format!(
-            "{} ({}): {message}",
-            job.method, out.status
-        )));
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        // The worker's own message, not a driver's chatter before it.
+        let message = stderr
+            .lines()
+            .rev()
+            .find_map(|l| l.strip_prefix("error: "))
+            .map_or_else(|| stderr.trim().to_string(), str::to_string);
+        return Err(match out.status.code() {
+            Some(2) => HarnessError::WorkerRefused(format!("{label}: {message}")),
+            Some(code) => HarnessError::Worker(format!("{label} (exit {code}): {message}")),
+            None => HarnessError::Worker(format!(
+                "{label}: the worker was killed ({}; out of memory?)",
+                out.status
+            )),
+        });
     }
-    let report: RenderReport = serde_json::from_slice(&out.stdout)?;
-    let image = read_image(&job.image)?;
-    let _ = std::fs::remove_file(&job.image);
-    Ok(Rendered { image, report })
+    Ok(serde_json::from_slice(&out.stdout)?)
 }
 
 /// This process's peak resident memory so far (Linux `VmHWM`), bytes.

@@ -73,6 +73,12 @@ pub fn slope(points: &[(f64, f64)]) -> Option<f64> {
 /// The 95 % bootstrap interval of our exponent: every row's frames resampled with
 /// replacement, its median taken, the power law fitted again. `None` without frames.
 pub fn exponent_interval(rows: &[Row]) -> Option<crate::stats::Interval> {
+    if rows
+        .iter()
+        .any(|r| r.frames_ms.len() < crate::stats::MIN_FRAMES_FOR_INTERVAL)
+    {
+        return None;
+    }
     let groups: Vec<&[f64]> = rows.iter().map(|r| r.frames_ms.as_slice()).collect();
     crate::stats::bootstrap(
         &groups,

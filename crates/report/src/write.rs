@@ -311,11 +311,19 @@ fn exact_comparison(
         let ratio = a.ms_median / e.ms_median;
         match (interval(a), interval(e)) {
             (Some(ia), Some(ie)) if ia.overlaps(&ie) => {
-                "indistinguishable in time on this device (95 % intervals overlap)".to_string()
+                "not shown apart in time at 95 % on this device (intervals overlap)".to_string()
             }
-            (Some(_), Some(_)) if ratio >= 1.0 => format!("{ratio:.1}× faster"),
-            (Some(_), Some(_)) => format!("{:.1}× slower", 1.0 / ratio),
-            _ => format!("{ratio:.2}× the time (no intervals in these records)"),
+            (Some(_), Some(_)) if ratio >= 1.0 => format!("{ratio:.2}× faster"),
+            (Some(_), Some(_)) => format!("{:.2}× slower", 1.0 / ratio),
+            _ => "no time comparison (too few frames for intervals)".to_string(),
+        }
+    };
+    let lower_error = |a: &Record, e: &Record| {
+        let (fa, fe) = (a.metrics.flip_mean, e.metrics.flip_mean);
+        if fe > 0.0 && fa > fe {
+            format!("{:.0}× lower error", fa / fe)
+        } else {
+            format!("FLIP {} against {}", sci(fe), sci(fa))
         }
     };
     let sentences: Vec<String> = exact
@@ -326,11 +334,11 @@ fn exact_comparison(
                 .filter(|a| matches!(a.n, Some(2) | Some(4)))
                 .map(|a| {
                     format!(
-                        "against {} (FLIP {}, {} ms): {:.0}× lower error, {}",
+                        "against {} (FLIP {}, {} ms): {}, {}",
                         label(a),
                         sci(a.metrics.flip_mean),
-                        f(a.ms_median, 1),
-                        a.metrics.flip_mean / e.metrics.flip_mean,
+                        ms_cell(a, 1),
+                        lower_error(a, e),
                         times(a, e)
                     )
                 })
@@ -340,7 +348,7 @@ fn exact_comparison(
                 label(e),
                 e.reflections,
                 sci(e.metrics.flip_mean),
-                f(e.ms_median, 1),
+                ms_cell(e, 1),
                 against.join("; ")
             )
         })

@@ -65,8 +65,8 @@ pub struct PresetArgs {
     /// Output folder of the committed report (default: the preset's folder in reports/).
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Timed frames per point (default: 9 for table1, 5 for depth-scaling; lavapipe on 2
-    /// shared cores is noisy).
+    /// Timed frames per point, one per interleaved round (default 9; 6 or more give each
+    /// median a 95 % interval).
     #[arg(long)]
     frames: Option<u32>,
     /// Discard earlier results and measure every point again (cached truths stay).
@@ -121,8 +121,15 @@ fn parse_methods(
 
 /// This executable, run as `render-worker` for every timed render of a sweep (see
 /// `mirrorbox_harness::worker`: lavapipe keeps memory from every frame a process executes).
+/// On Linux `/proc/self/exe`, which stays this very binary even if the file is rebuilt
+/// during the sweep.
 fn render_worker() -> Option<PathBuf> {
-    std::env::current_exe().ok()
+    let this = PathBuf::from("/proc/self/exe");
+    if this.exists() {
+        Some(this)
+    } else {
+        std::env::current_exe().ok()
+    }
 }
 
 fn command_line() -> String {
@@ -184,7 +191,11 @@ fn execute(config: &SweepConfig, fresh: bool) -> Result<(), Failure> {
                 "sweep: {todo} points to compute, {reused} already in {}",
                 config.out.join("results.jsonl").display()
             );
-            bar = Some(progress_bar(todo as u64, "sweep"));
+            // One step per timed render (points × rounds).
+            bar = Some(progress_bar(
+                todo as u64 * u64::from(config.frames),
+                "sweep",
+            ));
         }
         Event::Started { label } => {
             if let Some(b) = &bar {
@@ -198,6 +209,7 @@ fn execute(config: &SweepConfig, fresh: bool) -> Result<(), Failure> {
         } => {
             if let Some(b) = &bar {
                 b.set_message(format!("round {round}/{rounds}: {label}"));
+                b.inc(1);
             }
         }
         Event::Finished { record } => {
@@ -210,10 +222,7 @@ fn execute(config: &SweepConfig, fresh: bool) -> Result<(), Failure> {
                 record.metrics.relmse
             );
             match &bar {
-                Some(b) if !b.is_hidden() => {
-                    b.inc(1);
-                    b.println(line);
-                }
+                Some(b) if !b.is_hidden() => b.println(line),
                 _ => eprintln!("{line}"),
             }
         }
