@@ -930,10 +930,8 @@ fn sweep_writes_every_output_and_error_falls_with_n() {
         "the floor is below every method's error"
     );
     let md = std::fs::read_to_string(out.join("report.md")).unwrap();
-    assert!(
-        md.contains("Reproduction of the paper's Table 1") && md.contains("| 3 | 435 |"),
-        "{md}"
-    );
+    // n = 0…3 at 64×36 is a custom sweep, not the paper's experiment: no Table 1 section.
+    assert!(!md.contains("Reproduction of the paper's Table 1"), "{md}");
     assert!(md.contains("Floor of the comparison"));
     let html = std::fs::read_to_string(out.join("report.html")).unwrap();
     assert!(

@@ -23,6 +23,9 @@ pub struct DepthScaling {
     pub points: Vec<Record>,
     /// ms/frame per extra reflection shown (fit over every point).
     pub ms_per_bounce: Option<f64>,
+    /// Its 95 % bootstrap interval: every point's frames resampled, medians refitted
+    /// (`None` where a point has too few frames).
+    pub ms_per_bounce_interval: Option<crate::stats::Interval>,
 }
 
 /// Groups the exact points by (method, α), each with at least two depths.
@@ -39,6 +42,7 @@ pub fn depth_scaling(exact: &[String], records: &[Record]) -> Vec<DepthScaling> 
                 alpha: r.alpha,
                 points: vec![r.clone()],
                 ms_per_bounce: None,
+                ms_per_bounce_interval: None,
             }),
         }
     }
@@ -51,8 +55,34 @@ pub fn depth_scaling(exact: &[String], records: &[Record]) -> Vec<DepthScaling> 
             .map(|r| (r.reflections as f64, r.ms_median))
             .collect();
         g.ms_per_bounce = linear_fit(&pts).map(|(_, b)| b);
+        g.ms_per_bounce_interval = slope_interval(&g.points);
     }
     out
+}
+
+/// The 95 % bootstrap interval of the least-squares slope of median ms/frame against the
+/// reflections shown.
+fn slope_interval(points: &[Record]) -> Option<crate::stats::Interval> {
+    use crate::stats::{BOOTSTRAP_SEED, MIN_FRAMES_FOR_INTERVAL, bootstrap, median};
+    if points
+        .iter()
+        .any(|r| r.frames_ms.len() < MIN_FRAMES_FOR_INTERVAL)
+    {
+        return None;
+    }
+    let groups: Vec<&[f64]> = points.iter().map(|r| r.frames_ms.as_slice()).collect();
+    bootstrap(
+        &groups,
+        |resampled| {
+            let pts: Vec<(f64, f64)> = points
+                .iter()
+                .zip(resampled)
+                .map(|(r, frames)| (r.reflections as f64, median(frames)))
+                .collect();
+            linear_fit(&pts).map_or(f64::NAN, |(_, b)| b)
+        },
+        BOOTSTRAP_SEED,
+    )
 }
 
 /// A sentence on the cost of one more bounce against one full-scene pass (`pass_ms`).
@@ -61,8 +91,11 @@ pub fn bounce_sentence(g: &DepthScaling, pass_ms: Option<f64>) -> String {
         return format!("{}: too few distinct depths to fit.", g.method);
     };
     let deepest = g.points.iter().map(|r| r.reflections).max().unwrap_or(0);
+    let interval = g.ms_per_bounce_interval.map_or(String::new(), |i| {
+        format!(" [95 % CI {:.3}–{:.3}]", i.low, i.high)
+    });
     let mut s = format!(
-        "{}, α = {}: {:.3} ms per extra reflection (least-squares over {} depths, up to {} reflections shown)",
+        "{}, α = {}: {:.3} ms{interval} per extra reflection (least-squares over {} depths, up to {} reflections shown)",
         g.method,
         g.alpha,
         b,
@@ -108,5 +141,46 @@ mod tests {
         let (a, b) = linear_fit(&pts).unwrap();
         assert!((a - 2.0).abs() < 1e-12 && (b - 0.5).abs() < 1e-12);
         assert!(linear_fit(&[(1.0, 1.0), (1.0, 2.0)]).is_none());
+    }
+
+    #[test]
+    fn the_cost_per_bounce_gets_an_interval_from_the_frames() {
+        let point = |depth: u32, ms: f64, spread: f64| {
+            let mut r: Record = serde_json::from_value(serde_json::json!({
+                "key": format!("unrolled depth={depth}"), "kind": "point", "scene": "s",
+                "scene_hash": "0", "method": "unrolled", "n": null, "depth": depth,
+                "alpha": 1.0, "width": 8, "height": 8, "ssaa": 1, "ms_median": ms,
+                "ms_min": ms, "timing_source": "gpu-timestamps", "frames": 9, "passes": 1,
+                "draws": 7, "texture_renders": 0, "reflections": depth,
+                "metrics": { "rmse": 0, "relmse": 0, "smape": 0, "max_abs": 0, "psnr": null,
+                             "ssim": 1, "flip_mean": 0, "flip_p95": 0, "flip_p99": 0 },
+                "adapter": "a", "backend": "b", "truth_image": "", "raster_image": "",
+                "heatmap_image": ""
+            }))
+            .unwrap();
+            r.frames_ms = (0..9).map(|k| ms + spread * (k as f64 - 4.0)).collect();
+            r
+        };
+        let exact = vec!["unrolled".to_string()];
+        // 10 ms + 0.5 ms per bounce, frames spread ±2 ms around each median.
+        let records: Vec<Record> = [1, 4, 16, 64]
+            .iter()
+            .map(|&d| point(d, 10.0 + 0.5 * d as f64, 0.5))
+            .collect();
+        let g = &depth_scaling(&exact, &records)[0];
+        let i = g.ms_per_bounce_interval.expect("9 frames per point");
+        assert!(i.contains(0.5) && i.high - i.low < 0.1, "{i:?}");
+        assert!(bounce_sentence(g, Some(10.0)).contains("[95 % CI "));
+        // Older records without frames: no interval, and the sentence says none.
+        let bare: Vec<Record> = records
+            .iter()
+            .map(|r| Record {
+                frames_ms: Vec::new(),
+                ..r.clone()
+            })
+            .collect();
+        let g = &depth_scaling(&exact, &bare)[0];
+        assert!(g.ms_per_bounce_interval.is_none());
+        assert!(!bounce_sentence(g, None).contains("CI"));
     }
 }

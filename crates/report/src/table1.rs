@@ -70,6 +70,18 @@ pub fn slope(points: &[(f64, f64)]) -> Option<f64> {
     crate::linear_fit(&pts).map(|(_, b)| b)
 }
 
+/// The paper's scene: Table 1 is reproduced only on it.
+pub const PAPER_SCENE: &str = "mirror_box.json";
+
+/// Whether a sweep is the paper's experiment — its method at every n of Table 1 on the paper's
+/// scene — and so gets the Table 1 section; a custom sweep of the method does not.
+pub fn is_papers_sweep(scene: &str, rows: &[Row]) -> bool {
+    let on_papers_scene = std::path::Path::new(scene)
+        .file_name()
+        .is_some_and(|f| f == PAPER_SCENE);
+    on_papers_scene && rows.len() == PAPER_MS.len()
+}
+
 /// The 95 % bootstrap interval of our exponent: every row's frames resampled with
 /// replacement, its median taken, the power law fitted again. `None` without frames.
 pub fn exponent_interval(rows: &[Row]) -> Option<crate::stats::Interval> {

@@ -468,7 +468,7 @@ fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
     let floor = records.iter().find(|r| r.kind == "floor");
 
     let (alpha, rows) = table1::rows(records);
-    if !rows.is_empty() {
+    if table1::is_papers_sweep(&info.scene, &rows) {
         b.push(Block::Heading(
             2,
             "Reproduction of the paper's Table 1".into(),
@@ -741,23 +741,31 @@ mod tests {
             record(0, 20.0, 3, 0.1),
             record(1, 45.0, 7, 0.05),
             record(2, 100.0, 15, 0.02),
+            record(3, 300.0, 46, 0.01),
+            record(4, 900.0, 139, 0.005),
         ];
-        write_report(
-            dir.path(),
-            &SweepInfo {
-                scene: "s.json".into(),
-                ..Default::default()
-            },
-            &records,
-        )
-        .unwrap();
+        let info = |scene: &str| SweepInfo {
+            scene: scene.into(),
+            ..Default::default()
+        };
+        write_report(dir.path(), &info("scenes/mirror_box.json"), &records).unwrap();
         let md = std::fs::read_to_string(dir.path().join("report.md")).unwrap();
         assert!(md.contains("Reproduction of the paper's Table 1"));
         assert!(md.contains("| 2 | 142 | 100.0 [min 100.0] | 15 |"), "{md}");
         let html = std::fs::read_to_string(dir.path().join("report.html")).unwrap();
         assert!(html.contains("<svg") && html.contains("<table>"));
         let csv = std::fs::read_to_string(dir.path().join("results.csv")).unwrap();
-        assert_eq!(csv.lines().count(), 4);
+        assert_eq!(csv.lines().count(), 6);
+        // A custom sweep of the method (another scene, or not every n) has no Table 1.
+        for (scene, points) in [
+            ("scenes/tilted_pair.json", 5),
+            ("scenes/mirror_box.json", 3),
+        ] {
+            let other = tempfile::tempdir().unwrap();
+            write_report(other.path(), &info(scene), &records[..points]).unwrap();
+            let md = std::fs::read_to_string(other.path().join("report.md")).unwrap();
+            assert!(!md.contains("Table 1"), "{scene}, {points} points: {md}");
+        }
         for f in [
             "plot_flip_vs_ms.svg",
             "plot_relmse_vs_ms.svg",
