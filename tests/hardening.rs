@@ -427,6 +427,7 @@ fn a_value_listed_twice_is_one_point() {
         assert_eq!(r["timing_order"], "interleaved", "{r}");
         assert_eq!(r["frames_ms"].as_array().unwrap().len(), 1, "{r}");
         assert!(r["peak_memory_bytes"].as_u64().unwrap() > 1_000_000, "{r}");
+        assert!(r["plan_ms"].as_f64().unwrap() >= 0.0, "{r}");
     }
     let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
     assert_eq!(csv.lines().count(), 1 + 3, "{csv}");

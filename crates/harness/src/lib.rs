@@ -573,6 +573,7 @@ pub fn run_sweep(
     // Per point: the last round's report; its image waits on disk (not in memory).
     let mut last: Vec<Option<RenderReport>> = todo.iter().map(|_| None).collect();
     let mut peaks: Vec<Option<u64>> = vec![None; todo.len()];
+    let mut plans: Vec<Vec<f64>> = vec![Vec::new(); todo.len()];
     let mut order: Vec<usize> = (0..todo.len()).collect();
     let mut rng = mirrorbox_report::stats::Rng::new(INTERLEAVE_SEED);
     for round in 0..config.frames {
@@ -603,6 +604,7 @@ pub fn run_sweep(
                 None => worker::run_job_to_file(&job, &gpu)?,
             };
             timed[i].extend(&report.frames_ms);
+            plans[i].push(report.plan_ms);
             peaks[i] = peaks[i].max(report.peak_memory_bytes);
             last[i] = Some(report);
         }
@@ -672,6 +674,7 @@ pub fn run_sweep(
             frames_ms,
             timing_order: "interleaved".into(),
             peak_memory_bytes: peaks[i],
+            plan_ms: Some(mirrorbox_report::stats::median(&plans[i])),
             timing_source: s.timing_source.clone(),
             frames: config.frames,
             passes: s.passes,

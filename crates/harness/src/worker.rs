@@ -14,7 +14,7 @@
 use crate::HarnessError;
 use glam::Vec3;
 use mirrorbox_image::{RgbImage, write_exr};
-use mirrorbox_raster::{Gpu, Method, RenderSettings};
+use mirrorbox_raster::{Gpu, Method, RasterError, RenderSettings};
 use mirrorbox_scene::{Scene, load_scene};
 use serde::{Deserialize, Serialize};
 use std::io::Write as _;
@@ -57,6 +57,8 @@ pub struct RenderReport {
     pub backend: String,
     /// The worker's peak resident memory (Linux `VmHWM`), bytes.
     pub peak_memory_bytes: Option<u64>,
+    /// Wall time of planning the frame on the CPU, ms.
+    pub plan_ms: f64,
 }
 
 /// A rendered point: the image and what was measured.
@@ -107,7 +109,12 @@ pub fn run_job(job: &RenderJob, gpu: &Gpu) -> Result<Rendered, HarnessError> {
         frames: job.frames,
         warmup: job.warmup,
     };
-    let out = mirrorbox_raster::render(gpu, &scene, &settings)?;
+    // Planning is the CPU's share of a frame (reflection paths, the paper's recursion):
+    // timed on its own, since GPU timestamps do not see it.
+    let started = std::time::Instant::now();
+    let planned = mirrorbox_raster::plan_frame(&scene, &settings).map_err(RasterError::from)?;
+    let plan_ms = started.elapsed().as_secs_f64() * 1e3;
+    let out = mirrorbox_raster::render_planned(gpu, &scene, planned, &settings)?;
     let s = &out.stats;
     Ok(Rendered {
         report: RenderReport {
@@ -124,6 +131,7 @@ pub fn run_job(job: &RenderJob, gpu: &Gpu) -> Result<Rendered, HarnessError> {
             adapter: gpu.report.name.clone(),
             backend: gpu.report.backend.clone(),
             peak_memory_bytes: peak_memory_bytes(),
+            plan_ms,
         },
         image: out.image,
     })

@@ -70,6 +70,10 @@ pub struct Record {
     /// bytes; absent in older records.
     #[serde(default)]
     pub peak_memory_bytes: Option<u64>,
+    /// CPU wall time of planning one frame (reflection paths, the paper's recursion), ms,
+    /// median over the rounds; GPU timestamps do not include it. Absent in older records.
+    #[serde(default)]
+    pub plan_ms: Option<f64>,
     pub timing_source: String,
     pub frames: u32,
     pub passes: usize,

@@ -209,14 +209,14 @@ fn esc(s: &str) -> String {
 fn write_csv(path: &Path, records: &[Record]) -> Result<(), FileError> {
     let mut s = String::from(
         "kind,method,n,depth,alpha,width,height,ssaa,ms_median,ms_ci_low,ms_ci_high,ms_min,timing_order,timing_source,frames,passes,draws,texture_renders,reflections,\
-         rmse,relmse,smape,max_abs,psnr,ssim,flip_mean,flip_p95,flip_p99,adapter,backend,scene,scene_hash,color_format,peak_memory_bytes\n",
+         rmse,relmse,smape,max_abs,psnr,ssim,flip_mean,flip_p95,flip_p99,adapter,backend,scene,scene_hash,color_format,peak_memory_bytes,plan_ms\n",
     );
     for r in records {
         let m = &r.metrics;
         let opt = |v: Option<u32>| v.map_or(String::new(), |x| x.to_string());
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},\"{}\",{},\"{}\",{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},\"{}\",{},\"{}\",{},{},{},{}",
             r.kind,
             r.method,
             opt(r.n),
@@ -250,7 +250,8 @@ fn write_csv(path: &Path, records: &[Record]) -> Result<(), FileError> {
             r.scene.replace('"', "'"),
             r.scene_hash,
             r.color_format,
-            r.peak_memory_bytes.map_or(String::new(), |b| b.to_string())
+            r.peak_memory_bytes.map_or(String::new(), |b| b.to_string()),
+            r.plan_ms.map_or(String::new(), |ms| ms.to_string())
         );
     }
     write_atomically(path, s.as_bytes())
@@ -613,6 +614,7 @@ fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
                 "α",
                 "ms/frame median [95 % CI]",
                 "min",
+                "CPU plan ms",
                 "timing",
                 "passes",
                 "draws",
@@ -636,6 +638,7 @@ fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
                         r.alpha.to_string(),
                         ms_cell(r, 2),
                         f(r.ms_min, 2),
+                        r.plan_ms.map_or("–".into(), |ms| f(ms, 2)),
                         format!("{}, {}", r.timing_source, r.timing_order),
                         r.passes.to_string(),
                         r.draws.to_string(),
@@ -704,6 +707,7 @@ mod tests {
             frames_ms: Vec::new(),
             timing_order: "back-to-back".into(),
             peak_memory_bytes: None,
+            plan_ms: None,
             ms_min: ms,
             timing_source: "gpu-timestamps".into(),
             frames: 1,
@@ -870,8 +874,8 @@ mod tests {
             csv.lines()
                 .next()
                 .unwrap()
-                .ends_with(",color_format,peak_memory_bytes")
+                .ends_with(",color_format,peak_memory_bytes,plan_ms")
         );
-        assert!(csv.lines().nth(2).unwrap().ends_with(",rgba16float,"));
+        assert!(csv.lines().nth(2).unwrap().ends_with(",rgba16float,,"));
     }
 }
