@@ -101,32 +101,29 @@ impl SweepConfig {
         for m in ["portal", "unrolled"] {
             methods.extend(swept(m, [64]));
         }
-        SweepConfig {
-            frames: 9,
-            ..SweepConfig::new(
-                PathBuf::from("scenes/mirror_box.json"),
-                out,
-                methods,
-                vec![1.0, 0.7],
-            )
-        }
+        SweepConfig::preset(out, methods, vec![1.0, 0.7])
     }
 
     /// The exact methods' cost against depth, 1 to 1024, on mirror_box with perfect mirrors
-    /// (α = 1: no path ends by attenuation, only when its portal holds no pixel centre); 9
-    /// timed frames, enough for a 95 % interval of each median.
+    /// (α = 1: no path ends by attenuation, only when its portal holds no pixel centre).
     pub fn depth_scaling(out: PathBuf) -> Self {
         let methods = ["portal", "unrolled"]
             .into_iter()
             .flat_map(|m| swept(m, (0..=10).map(|k| 1 << k)))
             .collect();
+        SweepConfig::preset(out, methods, vec![1.0])
+    }
+
+    /// A preset on the paper's scene (mirror_box) with 9 timed frames: enough for a 95 %
+    /// interval of each median.
+    fn preset(out: PathBuf, methods: Vec<Method>, alphas: Vec<f32>) -> Self {
         SweepConfig {
             frames: 9,
             ..SweepConfig::new(
                 PathBuf::from("scenes/mirror_box.json"),
                 out,
                 methods,
-                vec![1.0],
+                alphas,
             )
         }
     }
@@ -558,13 +555,28 @@ pub fn run_sweep(
         reused: summary.reused,
     });
     let gpu = Gpu::new()?;
-    // Truths first (traced or from the cache), so that timing rounds run back to back.
+    // Truths first (traced or from the cache), so that timing rounds run back to back; and
+    // each point's render job, the same in every round. Only paths are kept: a sweep may
+    // have thousands of points.
     let mut truths = Vec::with_capacity(todo.len());
-    for p in &todo {
+    let mut jobs = Vec::with_capacity(todo.len());
+    for (i, p) in todo.iter().enumerate() {
         progress(Event::Started { label: &p.label });
-        let (scene, _) = point_setup(&base, p, config);
-        // Only the path is kept: a sweep may have thousands of points.
+        let (scene, settings) = point_setup(&base, p, config);
         truths.push(truth(&scene, config, &cache, &mut summary)?.1);
+        jobs.push(RenderJob {
+            scene: config.scene.clone(),
+            width: w,
+            height: h,
+            floor: p.method.is_none(),
+            alpha: p.alpha,
+            method: worker::method_text(&settings.method),
+            ssaa: config.ssaa,
+            frames: 1,
+            warmup: config.warmup,
+            scene_hash: scene.content_hash(),
+            image: rendered_image(&cache, i),
+        });
     }
     // Interleaved timing: `frames` rounds; in each, every point renders its warm-up frames
     // and one timed frame, the points in an order shuffled per round (fixed seed). Drift of a
@@ -585,23 +597,10 @@ pub fn run_sweep(
                 round: round + 1,
                 rounds: config.frames,
             });
-            let (scene, settings) = point_setup(&base, p, config);
-            let job = RenderJob {
-                scene: config.scene.clone(),
-                width: w,
-                height: h,
-                floor: p.method.is_none(),
-                alpha: p.alpha,
-                method: worker::method_text(&settings.method),
-                ssaa: config.ssaa,
-                frames: 1,
-                warmup: config.warmup,
-                scene_hash: scene.content_hash(),
-                image: rendered_image(&cache, i),
-            };
+            let job = &jobs[i];
             let report = match &config.worker {
-                Some(exe) => worker::render_in_worker(exe, &job, &p.label)?,
-                None => worker::run_job_to_file(&job, &gpu)?,
+                Some(exe) => worker::render_in_worker(exe, job, &p.label)?,
+                None => worker::run_job_to_file(job, &gpu)?,
             };
             timed[i].extend(&report.frames_ms);
             plans[i].push(report.plan_ms);
@@ -609,22 +608,21 @@ pub fn run_sweep(
             last[i] = Some(report);
         }
     }
+    // Every point shares the base scene's camera, hence its exposure.
+    let exposure = base.camera.exposure;
     for (i, p) in todo.iter().enumerate() {
-        let (scene, _) = point_setup(&base, p, config);
         let truth_path = &truths[i];
         let truth_image = &read_image(truth_path)?;
         let report = last[i].take().expect("every point renders in every round");
-        let image_path = rendered_image(&cache, i);
         let rendered = Rendered {
-            image: read_image(&image_path)?,
+            image: read_image(&jobs[i].image)?,
             report,
         };
-        let _ = std::fs::remove_file(&image_path);
+        let _ = std::fs::remove_file(&jobs[i].image);
         let frames_ms = std::mem::take(&mut timed[i]);
-        let m = compare(truth_image, &rendered.image, scene.camera.exposure)?;
+        let m = compare(truth_image, &rendered.image, exposure)?;
         let raster_png = images.join(format!("{}.png", p.slug));
-        write_png(&raster_png, &rendered.image, scene.camera.exposure)?;
-        let exposure = scene.camera.exposure;
+        write_png(&raster_png, &rendered.image, exposure)?;
         let map = flip_map(
             &truth_image.to_srgb8(exposure),
             &rendered.image.to_srgb8(exposure),

@@ -152,8 +152,7 @@ pub fn serve(
 ) -> Result<(), HarnessError> {
     let job: RenderJob = serde_json::from_reader(stdin)?;
     let gpu = Gpu::new()?;
-    let mut report = run_job_to_file(&job, &gpu)?;
-    report.peak_memory_bytes = peak_memory_bytes();
+    let report = run_job_to_file(&job, &gpu)?;
     serde_json::to_writer(&mut stdout, &report)?;
     stdout
         .flush()

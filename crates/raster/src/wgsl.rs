@@ -24,6 +24,36 @@ pub const MIRROR_PLANE_CLIP_DISTANCES: &str =
 pub const MIRROR_PLANE_FRAGMENTS: &str =
     include_str!("../../../shaders/mirror_plane_fragments.wgsl");
 
+/// Declares `SHADER` and `CLIP_DISTANCE_SHADER`, the two variants of a method that clips a
+/// mirror's world at the mirror's plane (`portal`, the paper's methods): `SHADER` runs on
+/// every adapter and tests the plane per fragment (the `*_discard` entry points of
+/// [`MIRROR_PLANE_FRAGMENTS`]); `CLIP_DISTANCE_SHADER` adds the hardware clip-distance
+/// vertex stage ([`MIRROR_PLANE_CLIP_DISTANCES`]) for adapters with `CLIP_DISTANCES`.
+#[macro_export]
+macro_rules! mirror_plane_shaders {
+    ($label:literal, $entry_points:expr) => {
+        static SHADER: $crate::wgsl::WgslSource = $crate::wgsl::WgslSource {
+            label: $label,
+            enable: &[],
+            parts: &[
+                $crate::wgsl::SHADING,
+                $entry_points,
+                $crate::wgsl::MIRROR_PLANE_FRAGMENTS,
+            ],
+        };
+        static CLIP_DISTANCE_SHADER: $crate::wgsl::WgslSource = $crate::wgsl::WgslSource {
+            label: concat!($label, " clip distances"),
+            enable: &["clip_distances"],
+            parts: &[
+                $crate::wgsl::SHADING,
+                $entry_points,
+                $crate::wgsl::MIRROR_PLANE_FRAGMENTS,
+                $crate::wgsl::MIRROR_PLANE_CLIP_DISTANCES,
+            ],
+        };
+    };
+}
+
 /// One shader variant: what a pipeline's module is made of.
 #[derive(Debug)]
 pub struct WgslSource {

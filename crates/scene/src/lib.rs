@@ -116,11 +116,7 @@ impl Scene {
         width: Option<u32>,
         height: Option<u32>,
     ) -> Result<(), limits::SettingError> {
-        for (flag, side) in [("--width", width), ("--height", height)] {
-            if let Some(side) = side {
-                limits::image_side(flag, side)?;
-            }
-        }
+        // The camera's own size is valid, so any error names the flag that was given.
         let (w, h) = limits::image_size(
             width.unwrap_or(self.camera.width),
             height.unwrap_or(self.camera.height),

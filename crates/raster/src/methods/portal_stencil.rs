@@ -34,7 +34,7 @@ use crate::projection::{FAR_DEPTH, NEARER_OR_EQUAL};
 use crate::shading::{SceneBuffers, VERTEX_LAYOUT};
 use crate::targets::{DEPTH_STENCIL_FORMAT, DepthClear, RenderTarget, depth_stencil_format};
 use crate::timing::FrameEncoder;
-use crate::wgsl::{HostLayout, WgslSource, shader_module};
+use crate::wgsl::{HostLayout, shader_module};
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec3, Vec4};
 use mirrorbox_scene::Scene;
@@ -56,28 +56,7 @@ pub static PORTAL: MethodEntry = MethodEntry {
 
 const ENTRY_POINTS: &str = include_str!("../../../../shaders/portal_stencil.wgsl");
 
-/// Every adapter: the mirror plane tested per fragment (the `*_discard` entry points).
-static SHADER: WgslSource = WgslSource {
-    label: "portal stencil",
-    enable: &[],
-    parts: &[
-        crate::wgsl::SHADING,
-        ENTRY_POINTS,
-        crate::wgsl::MIRROR_PLANE_FRAGMENTS,
-    ],
-};
-
-/// Adds the hardware clip-distance vertex stage, for adapters with `CLIP_DISTANCES`.
-static CLIP_DISTANCE_SHADER: WgslSource = WgslSource {
-    label: "portal stencil clip distances",
-    enable: &["clip_distances"],
-    parts: &[
-        crate::wgsl::SHADING,
-        ENTRY_POINTS,
-        crate::wgsl::MIRROR_PLANE_FRAGMENTS,
-        crate::wgsl::MIRROR_PLANE_CLIP_DISTANCES,
-    ],
-};
+crate::mirror_plane_shaders!("portal stencil", ENTRY_POINTS);
 
 fn gpu_structs() -> Vec<HostLayout> {
     vec![crate::host_layout!(PathUniform as "Path" {

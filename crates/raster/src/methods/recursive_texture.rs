@@ -27,7 +27,7 @@ use crate::projection::NEARER_OR_EQUAL;
 use crate::shading::{SceneBuffers, VERTEX_LAYOUT};
 use crate::targets::{DEPTH_FORMAT, RenderTarget, texture_entry};
 use crate::timing::FrameEncoder;
-use crate::wgsl::{HostLayout, WgslSource, shader_module};
+use crate::wgsl::{HostLayout, shader_module};
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use mirrorbox_scene::reflection::ReflectedView;
@@ -74,28 +74,7 @@ pub static AUXILIARY: MethodEntry = MethodEntry {
 
 const ENTRY_POINTS: &str = include_str!("../../../../shaders/recursive_texture.wgsl");
 
-/// Every adapter: the mirror plane tested per fragment (the `*_discard` entry points).
-static SHADER: WgslSource = WgslSource {
-    label: "recursive texture",
-    enable: &[],
-    parts: &[
-        crate::wgsl::SHADING,
-        ENTRY_POINTS,
-        crate::wgsl::MIRROR_PLANE_FRAGMENTS,
-    ],
-};
-
-/// Adds the hardware clip-distance vertex stage, for adapters with `CLIP_DISTANCES`.
-static CLIP_DISTANCE_SHADER: WgslSource = WgslSource {
-    label: "recursive texture clip distances",
-    enable: &["clip_distances"],
-    parts: &[
-        crate::wgsl::SHADING,
-        ENTRY_POINTS,
-        crate::wgsl::MIRROR_PLANE_FRAGMENTS,
-        crate::wgsl::MIRROR_PLANE_CLIP_DISTANCES,
-    ],
-};
+crate::mirror_plane_shaders!("recursive texture", ENTRY_POINTS);
 
 fn gpu_structs() -> Vec<HostLayout> {
     vec![
