@@ -190,6 +190,7 @@ fn param_json(value: Option<mirrorbox_raster::ParamValue>) -> serde_json::Value 
         Some(ParamValue::Count(c)) => serde_json::json!(c),
         Some(ParamValue::Real(r)) => serde_json::json!(r),
         Some(ParamValue::Switch(s)) => serde_json::json!(s),
+        Some(ParamValue::Choice(c)) => serde_json::json!(c),
         None => serde_json::Value::Null,
     }
 }
