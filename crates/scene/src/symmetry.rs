@@ -721,4 +721,41 @@ mod tests {
             }
         }
     }
+
+    /// Copies of the bake with a positive area: the cells the objects reach.
+    fn non_empty_copies(symmetry: &Symmetry) -> Vec<u32> {
+        let (baked, origins) =
+            split_and_mirror_with_origins(&symmetry.source, &symmetry.plane_list(), usize::MAX)
+                .unwrap();
+        let mut area_by_copy: BTreeMap<u32, f64> = BTreeMap::new();
+        for (t, o) in baked.triangles.iter().zip(&origins) {
+            *area_by_copy.entry(o.copy).or_default() += area(t) as f64;
+        }
+        area_by_copy
+            .into_iter()
+            .filter(|(_, a)| *a > 1e-6)
+            .map(|(c, _)| c)
+            .collect()
+    }
+
+    /// `scenes/symmetry_star.json` is the 60°-step star: its floor covers the common line, so
+    /// the objects reach all 6 non-empty cells of the cascade (not 2³ = 8; see above).
+    #[test]
+    fn the_bundled_star_reaches_six_of_eight_copies() {
+        let scene = crate::load::bundled_scene("symmetry_star.json");
+        let symmetry = scene.symmetry.as_ref().unwrap();
+        assert_eq!(symmetry.copy_count(), 8);
+        assert_eq!(
+            non_empty_copies(symmetry),
+            vec![0b000, 0b001, 0b011, 0b100, 0b101, 0b111]
+        );
+        // Three perpendicular planes through the objects: every octant is reached.
+        let cube = crate::load::bundled_scene("symmetry_cube.json");
+        assert_eq!(non_empty_copies(cube.symmetry.as_ref().unwrap()).len(), 8);
+        // Ten scattered planes: far fewer than 2¹⁰ cells are reached, and the bake stays small.
+        let many = crate::load::bundled_scene("symmetry_many.json");
+        let reached = non_empty_copies(many.symmetry.as_ref().unwrap()).len();
+        assert!((16..1024).contains(&reached), "{reached}");
+        assert!(many.geometry.triangles.len() < 200_000);
+    }
 }
