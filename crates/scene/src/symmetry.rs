@@ -308,3 +308,454 @@ fn edge_crossing(a: Vec3, da: f32, b: Vec3, db: f32) -> Vec3 {
     };
     a + (b - a) * (da / (da - db))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::Surface;
+    use crate::tessellate;
+    use std::collections::{BTreeMap, HashSet};
+
+    fn diffuse() -> Surface {
+        Surface::Diffuse {
+            albedo: Vec3::splat(0.5),
+            emission: Vec3::ZERO,
+        }
+    }
+
+    fn geometry(triangles: Vec<[Vec3; 3]>) -> Geometry {
+        let mut g = Geometry::default();
+        g.push_part("object".into(), diffuse(), triangles);
+        g
+    }
+
+    /// A closed icosphere (320 triangles) off every plane's special positions.
+    fn ball() -> Geometry {
+        let offset = Vec3::new(0.31, 0.17, -0.23);
+        geometry(
+            tessellate::icosphere(1.0, 2)
+                .into_iter()
+                .map(|t| t.map(|v| v + offset))
+                .collect(),
+        )
+    }
+
+    fn plane(point: [f32; 3], normal: [f32; 3]) -> Plane {
+        Plane::from_point_normal(Vec3::from_array(point), Vec3::from_array(normal))
+    }
+
+    fn area(t: &[Vec3; 3]) -> f32 {
+        0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length()
+    }
+
+    fn total_area(g: &Geometry) -> f64 {
+        g.triangles.iter().map(|t| area(t) as f64).sum()
+    }
+
+    /// Ten planes in general position, each within 0.15 of the ball's centre (planes far
+    /// from the objects soon leave nothing in front: seed 001's invisible spaces).
+    fn scattered_planes() -> Vec<Plane> {
+        let centre = Vec3::new(0.31, 0.17, -0.23);
+        [
+            ([0.1, 0.0, 0.0], [1.0, 0.2, -0.1]),
+            ([0.0, 0.12, 0.1], [0.3, 1.0, 0.4]),
+            ([-0.1, 0.0, 0.05], [-0.5, 0.1, 1.0]),
+            ([0.0, -0.1, 0.0], [0.7, -0.6, 0.2]),
+            ([0.05, 0.1, -0.1], [-0.2, 0.4, -0.9]),
+            ([0.0, 0.0, 0.0], [0.9, 0.9, 0.1]),
+            ([0.1, -0.1, 0.1], [-1.0, 0.3, 0.3]),
+            ([-0.1, 0.05, 0.1], [0.1, -0.8, 0.6]),
+            ([0.15, 0.0, -0.05], [0.6, 0.6, -0.5]),
+            ([0.0, 0.08, 0.0], [-0.3, -0.2, -1.0]),
+        ]
+        .into_iter()
+        .map(|(p, n)| Plane::from_point_normal(centre + Vec3::from_array(p), Vec3::from_array(n)))
+        .collect()
+    }
+
+    #[test]
+    fn no_planes_is_the_identity() {
+        let g = ball();
+        assert_eq!(split_and_mirror(&g, &[], usize::MAX).unwrap(), g);
+    }
+
+    #[test]
+    fn one_plane_in_front_of_the_whole_mesh_doubles_it_with_reflected_normals() {
+        let g = ball();
+        let p = plane([0.0, 0.0, -2.0], [0.0, 0.2, 1.0]);
+        assert!(
+            g.triangles
+                .iter()
+                .flatten()
+                .all(|v| p.signed_distance(*v) > 0.0)
+        );
+        let (baked, origins) = split_and_mirror_with_origins(&g, &[p], usize::MAX).unwrap();
+        let n = g.triangles.len();
+        assert_eq!(baked.triangles.len(), 2 * n);
+        assert_eq!(
+            &baked.triangles[..n],
+            &g.triangles[..],
+            "the front is kept as it is"
+        );
+        for i in 0..n {
+            let m = baked.triangles[n + i];
+            for (j, k) in [(0, 0), (1, 2), (2, 1)] {
+                assert_eq!(m[j], p.reflect_point(g.triangles[i][k]));
+            }
+            let reflected_normal = p.reflect_vector(g.face_normal(i));
+            assert!(baked.face_normal(n + i).abs_diff_eq(reflected_normal, 1e-5));
+            assert_eq!(
+                origins[n + i],
+                CopyOrigin {
+                    source_triangle: i as u32,
+                    copy: 1
+                }
+            );
+        }
+        assert_eq!(baked.parts[0].triangles, 0..2 * n);
+        assert_eq!(baked.surfaces, g.surfaces);
+    }
+
+    #[test]
+    fn a_crossing_triangle_is_cut_not_dropped_and_its_area_doubles() {
+        // A right triangle with legs 2 along x and y; the plane x = 0.5 (front x ≥ 0.5) keeps
+        // the small triangle at the (2, 0) corner: legs 1.5 and 1.5, area 1.125.
+        let t = [
+            Vec3::ZERO,
+            Vec3::new(2.0, 0.0, 0.0),
+            Vec3::new(0.0, 2.0, 0.0),
+        ];
+        let p = plane([0.5, 0.0, 0.0], [1.0, 0.0, 0.0]);
+        let baked = split_and_mirror(&geometry(vec![t]), &[p], usize::MAX).unwrap();
+        assert_eq!(baked.triangles.len(), 2);
+        assert!((total_area(&baked) - 2.0 * 1.125).abs() < 1e-6);
+        // The other side (front x ≤ 0.5) keeps a quad: two triangles, area 2 − 1.125.
+        let baked = split_and_mirror(&geometry(vec![t]), &[p.flipped()], usize::MAX).unwrap();
+        assert_eq!(baked.triangles.len(), 4);
+        assert!((total_area(&baked) - 2.0 * 0.875).abs() < 1e-6);
+        // And a ball cut through: front area + its reflection = twice the front area.
+        let g = ball();
+        let p = plane([0.5, 0.0, 0.0], [1.0, 0.3, 0.0]);
+        let baked = split_and_mirror(&g, &[p], usize::MAX).unwrap();
+        let front: f64 = baked
+            .triangles
+            .iter()
+            .filter(|t| t.iter().all(|v| p.signed_distance(*v) >= -1e-6))
+            .map(|t| area(t) as f64)
+            .sum();
+        assert!((total_area(&baked) - 2.0 * front).abs() < 1e-5 * front);
+        assert!(
+            front < 0.5 * total_area(&g),
+            "the plane cuts more than half away"
+        );
+    }
+
+    /// Every baked triangle's face normal is its source triangle's normal reflected through
+    /// the planes of its copy, in cascade order: no copy is wound backwards.
+    #[test]
+    fn every_copy_has_the_reflected_source_normal() {
+        let g = ball();
+        let planes = scattered_planes();
+        let (baked, origins) = split_and_mirror_with_origins(&g, &planes, usize::MAX).unwrap();
+        assert!(baked.triangles.len() > g.triangles.len());
+        let mut copies = HashSet::new();
+        for (i, origin) in origins.iter().enumerate() {
+            let mut normal = g.face_normal(origin.source_triangle as usize);
+            for (k, p) in planes.iter().enumerate() {
+                if origin.copy & (1 << k) != 0 {
+                    normal = p.reflect_vector(normal);
+                }
+            }
+            let got = baked.face_normal(i);
+            assert!(got.dot(normal) > 0.999, "triangle {i}: {got} vs {normal}");
+            copies.insert(origin.copy);
+        }
+        assert!(copies.len() > 16, "only {} copies", copies.len());
+    }
+
+    /// Unfolds a baked triangle back through its copy's planes, last plane first. Returns,
+    /// for each plane k, the triangle as it stood when plane k acted on it.
+    fn unfold(t: [Vec3; 3], copy: u32, planes: &[Plane]) -> Vec<[Vec3; 3]> {
+        let mut stages = vec![t; planes.len()];
+        let mut t = t;
+        for k in (0..planes.len()).rev() {
+            if copy & (1 << k) != 0 {
+                t = t.map(|v| planes[k].reflect_point(v));
+            }
+            stages[k] = t;
+        }
+        stages.push(t); // the source position
+        stages
+    }
+
+    /// The cascade's invariant. "Nothing lies behind any plane" is false (a later plane moves
+    /// copies behind earlier ones), and so is "symmetric about every plane". What holds:
+    /// unfolding a baked triangle through the planes of its copy, last plane first, it lay in
+    /// front of plane k when plane k acted on it (the seed's shader culls exactly there), and
+    /// unfolded completely it lies inside its source triangle. After the last plane alone,
+    /// the mesh is symmetric about it and no triangle crosses it.
+    #[test]
+    fn each_triangle_unfolds_in_front_of_every_plane_into_its_source() {
+        let g = ball();
+        let planes = scattered_planes();
+        let (baked, origins) = split_and_mirror_with_origins(&g, &planes, usize::MAX).unwrap();
+        let eps = 1e-5;
+        let mut behind_an_earlier_plane = 0;
+        for (t, origin) in baked.triangles.iter().zip(&origins) {
+            let stages = unfold(*t, origin.copy, &planes);
+            for (k, p) in planes.iter().enumerate() {
+                for v in stages[k] {
+                    assert!(
+                        p.signed_distance(v) >= -eps,
+                        "plane {k}: {}",
+                        p.signed_distance(v)
+                    );
+                }
+            }
+            let s = g.triangles[origin.source_triangle as usize];
+            let n = (s[1] - s[0]).cross(s[2] - s[0]);
+            for v in stages[planes.len()] {
+                assert!(
+                    (v - s[0]).dot(n.normalize()).abs() < eps,
+                    "off its source's plane"
+                );
+                for e in 0..3 {
+                    let (a, b) = (s[e], s[(e + 1) % 3]);
+                    let inside = (b - a).cross(v - a).dot(n) / n.length();
+                    assert!(inside >= -eps, "outside its source triangle by {inside}");
+                }
+            }
+            // Not reflected through plane 0, yet behind it: the naive invariant fails.
+            if origin.copy & 1 == 0 && t.iter().any(|v| planes[0].signed_distance(*v) < -0.01) {
+                behind_an_earlier_plane += 1;
+            }
+        }
+        assert!(behind_an_earlier_plane > 0);
+        // After the last plane: no triangle crosses it, and the mesh is its own mirror image.
+        let last = planes[planes.len() - 1];
+        let mut sides = [0, 0];
+        for t in &baked.triangles {
+            let d = t.map(|v| last.signed_distance(v));
+            assert!(
+                d.iter().all(|&x| x >= -eps) || d.iter().all(|&x| x <= eps),
+                "{d:?}"
+            );
+            sides[(d.iter().sum::<f32>() < 0.0) as usize] += 1;
+        }
+        assert_eq!(sides[0], sides[1]);
+    }
+
+    /// A closed mesh stays closed: every edge of the result is shared, bit for bit, by a
+    /// triangle traversing it the other way (cuts agree along shared edges, and the seam on a
+    /// plane joins a piece to its own reflection without a crack).
+    #[test]
+    fn a_closed_mesh_stays_closed_bit_for_bit() {
+        let key = |v: Vec3| v.to_array().map(f32::to_bits);
+        for planes in [&scattered_planes()[..1], &scattered_planes()[..3]] {
+            let baked = split_and_mirror(&ball(), planes, usize::MAX).unwrap();
+            let edges: HashSet<_> = baked
+                .triangles
+                .iter()
+                .flat_map(|t| (0..3).map(move |e| (key(t[e]), key(t[(e + 1) % 3]))))
+                .collect();
+            for (a, b) in &edges {
+                assert!(
+                    edges.contains(&(*b, *a)),
+                    "open edge with {} planes",
+                    planes.len()
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn the_budget_is_refused_with_its_numbers_before_the_step_is_built() {
+        let g = ball(); // 320 triangles, wholly in front of both planes: 640, then 1280.
+        let planes = [
+            plane([0.0, 0.0, -3.0], [0.0, 0.0, 1.0]),
+            plane([-3.0, 0.0, 0.0], [1.0, 0.0, 0.0]),
+        ];
+        assert_eq!(
+            split_and_mirror(&g, &planes, 1280).unwrap().triangles.len(),
+            1280
+        );
+        let e = split_and_mirror(&g, &planes, 1279).unwrap_err();
+        assert_eq!(
+            e,
+            SymmetryError::TooManyTriangles {
+                plane: 1,
+                triangles: 1280,
+                budget: 1279
+            }
+        );
+        let text = e.to_string();
+        assert!(text.contains("after plane 1") && text.contains("1280") && text.contains("1279"));
+        assert_eq!(
+            split_and_mirror(&g, &planes, 639).unwrap_err().plane(),
+            Some(0)
+        );
+    }
+
+    #[test]
+    fn a_reflection_outside_the_scene_extent_is_refused() {
+        let g = geometry(vec![[Vec3::ZERO, Vec3::X, Vec3::Y]]);
+        let far = plane([-6e5, 0.0, 0.0], [1.0, 0.0, 0.0]);
+        let e = split_and_mirror(&g, &[far], usize::MAX).unwrap_err();
+        assert!(
+            matches!(e, SymmetryError::OutsideExtent { plane: 0, .. }),
+            "{e}"
+        );
+    }
+
+    /// Per (source triangle, set of planes reflected through): the area and area-weighted
+    /// centroid of what the bake made of it — independent of how the cut pieces are
+    /// triangulated. `plane_ids[k]` names plane k of this order, so orders can be compared.
+    fn pieces_by_copy(
+        g: &Geometry,
+        planes: &[Plane],
+        plane_ids: &[u32],
+    ) -> BTreeMap<(u32, u32), (f64, [f64; 3])> {
+        let (baked, origins) = split_and_mirror_with_origins(g, planes, usize::MAX).unwrap();
+        let mut out: BTreeMap<(u32, u32), (f64, [f64; 3])> = BTreeMap::new();
+        for (t, o) in baked.triangles.iter().zip(origins) {
+            let copy = (0..planes.len())
+                .filter(|k| o.copy & (1 << k) != 0)
+                .map(|k| 1 << plane_ids[k])
+                .sum();
+            let a = area(t) as f64;
+            let c = ((t[0] + t[1] + t[2]) / 3.0).as_dvec3() * a;
+            let e = out
+                .entry((o.source_triangle, copy))
+                .or_insert((0.0, [0.0; 3]));
+            e.0 += a;
+            for i in 0..3 {
+                e.1[i] += c[i];
+            }
+        }
+        out
+    }
+
+    fn same_pieces(
+        a: &BTreeMap<(u32, u32), (f64, [f64; 3])>,
+        b: &BTreeMap<(u32, u32), (f64, [f64; 3])>,
+    ) -> bool {
+        a.len() == b.len()
+            && a.iter().all(|(k, (area, c))| {
+                b.get(k).is_some_and(|(area2, c2)| {
+                    (area - area2).abs() < 1e-6 && (0..3).all(|i| (c[i] - c2[i]).abs() < 1e-6)
+                })
+            })
+    }
+
+    #[test]
+    fn perpendicular_planes_commute_and_others_do_not() {
+        let g = ball();
+        let x = plane([0.2, 0.0, 0.0], [1.0, 0.0, 0.0]);
+        let y = plane([0.0, 0.4, 0.0], [0.0, -1.0, 0.0]);
+        let z = plane([0.0, 0.0, 0.1], [0.0, 0.0, 1.0]);
+        let xyz = pieces_by_copy(&g, &[x, y, z], &[0, 1, 2]);
+        assert!(same_pieces(
+            &xyz,
+            &pieces_by_copy(&g, &[z, x, y], &[2, 0, 1])
+        ));
+        assert!(same_pieces(
+            &xyz,
+            &pieces_by_copy(&g, &[y, z, x], &[1, 2, 0])
+        ));
+        // Two planes through one line at 60°: the two orders give different meshes.
+        let a = plane([0.0, 0.0, 0.0], [1.0, 0.0, 0.0]);
+        let b = plane([0.0, 0.0, 0.0], [0.5, 0.0, 0.75f32.sqrt()]);
+        let ab = pieces_by_copy(&g, &[a, b], &[0, 1]);
+        let ba = pieces_by_copy(&g, &[b, a], &[1, 0]);
+        assert!(!same_pieces(&ab, &ba));
+    }
+
+    /// The seed's six-pointed star: three planes through one line at 60° to each other.
+    /// Seed 001 says they make "6 spaces instead of 8". The cascade, with each normal the
+    /// previous one turned by +60° about the common line, gives exactly 6 non-empty copies:
+    /// after two planes the four copies tile the full turn in wedges of 120° (copy 00),
+    /// 60° (10), 120° (01) and 60° (11); the third plane's front half-space (180°) meets
+    /// copy 01's wedge in a single ray only, so copy 01 and its reflection 011 are empty
+    /// (written here first plane first; as bit masks, bit k = plane k: 0b010 and 0b110).
+    /// The count depends on which way the normals face: every sign choice is checked.
+    #[test]
+    fn the_six_pointed_star_has_six_non_empty_copies_or_four_with_normals_120_degrees_apart() {
+        // A big slab across the common line (the y axis), so every non-empty cell holds some.
+        let slab = geometry(tessellate::cuboid(Vec3::new(4.0, 0.5, 4.0)));
+        let normal = |deg: f32| {
+            let r = deg.to_radians();
+            [r.cos(), 0.0, r.sin()]
+        };
+        for signs in 0..8u32 {
+            let planes: Vec<Plane> = (0..3)
+                .map(|k| {
+                    let flip = if signs & (1 << k) != 0 { 180.0 } else { 0.0 };
+                    plane([0.0; 3], normal(60.0 * k as f32 + flip))
+                })
+                .collect();
+            let (baked, origins) =
+                split_and_mirror_with_origins(&slab, &planes, usize::MAX).unwrap();
+            let mut area_by_copy: BTreeMap<u32, f64> = BTreeMap::new();
+            for (t, o) in baked.triangles.iter().zip(&origins) {
+                *area_by_copy.entry(o.copy).or_default() += area(t) as f64;
+            }
+            let non_empty: Vec<u32> = area_by_copy
+                .iter()
+                .filter(|(_, a)| **a > 1e-3)
+                .map(|(c, _)| *c)
+                .collect();
+            // Normals 60° apart (signs 000, and 111, 001, 110 which flip the same wedge):
+            // 6 copies. Normals 120° apart (the others): the three front half-spaces share
+            // only the common line, and 4 copies remain. Never 8.
+            let expected = match signs {
+                0b000 | 0b111 | 0b001 | 0b110 => 6,
+                _ => 4,
+            };
+            assert_eq!(
+                non_empty.len(),
+                expected,
+                "signs {signs:03b}: copies {non_empty:?}"
+            );
+            if signs == 0 {
+                assert_eq!(non_empty, vec![0b000, 0b001, 0b011, 0b100, 0b101, 0b111]);
+            }
+        }
+    }
+
+    /// Copies of the bake with a positive area: the cells the objects reach.
+    fn non_empty_copies(symmetry: &Symmetry) -> Vec<u32> {
+        let (baked, origins) =
+            split_and_mirror_with_origins(&symmetry.source, &symmetry.plane_list(), usize::MAX)
+                .unwrap();
+        let mut area_by_copy: BTreeMap<u32, f64> = BTreeMap::new();
+        for (t, o) in baked.triangles.iter().zip(&origins) {
+            *area_by_copy.entry(o.copy).or_default() += area(t) as f64;
+        }
+        area_by_copy
+            .into_iter()
+            .filter(|(_, a)| *a > 1e-6)
+            .map(|(c, _)| c)
+            .collect()
+    }
+
+    /// `scenes/symmetry_star.json` is the 60°-step star: its floor covers the common line, so
+    /// the objects reach all 6 non-empty cells of the cascade (not 2³ = 8; see above).
+    #[test]
+    fn the_bundled_star_reaches_six_of_eight_copies() {
+        let scene = crate::load::bundled_scene("symmetry_star.json");
+        let symmetry = scene.symmetry.as_ref().unwrap();
+        assert_eq!(symmetry.copy_count(), 8);
+        assert_eq!(
+            non_empty_copies(symmetry),
+            vec![0b000, 0b001, 0b011, 0b100, 0b101, 0b111]
+        );
+        // Three perpendicular planes through the objects: every octant is reached.
+        let cube = crate::load::bundled_scene("symmetry_cube.json");
+        assert_eq!(non_empty_copies(cube.symmetry.as_ref().unwrap()).len(), 8);
+        // Ten scattered planes: far fewer than 2¹⁰ cells are reached, and the bake stays small.
+        let many = crate::load::bundled_scene("symmetry_many.json");
+        let reached = non_empty_copies(many.symmetry.as_ref().unwrap()).len();
+        assert!((16..1024).contains(&reached), "{reached}");
+        assert!(many.geometry.triangles.len() < 200_000);
+    }
+}
