@@ -703,7 +703,7 @@ fn render_refuses_too_many_passes_before_any_work() {
 
 #[test]
 fn render_refuses_bad_arguments() {
-    let cases: [(&[&str], &str); 11] = [
+    let cases: [(&[&str], &str); 13] = [
         (
             &["--method", "naive", "--n", "2"],
             "--n applies to --method auxiliary only",
@@ -714,7 +714,7 @@ fn render_refuses_bad_arguments() {
         ),
         (
             &["--method", "portal", "--fragment-clipping"],
-            "--fragment-clipping applies to --method unrolled only",
+            "--fragment-clipping applies to --method unrolled, symmetry or symmetry-pruned only",
         ),
         (
             &["--method", "unrolled", "--depth", "0"],
@@ -738,6 +738,14 @@ fn render_refuses_bad_arguments() {
         (
             &["--method", "naive", "--depth", "0"],
             "--depth applies to --method portal or unrolled only",
+        ),
+        (
+            &["--method", "symmetry", "--symmetry-draws", "bogus"],
+            "--symmetry-draws must be one of instanced, per-copy, got \"bogus\"",
+        ),
+        (
+            &["--method", "naive", "--symmetry-draws", "per-copy"],
+            "--symmetry-draws applies to --method symmetry or symmetry-pruned only",
         ),
     ];
     for (extra, message) in cases {
@@ -1078,7 +1086,7 @@ fn sweep_refuses_bad_arguments() {
         ),
         (
             &["--methods", "naive,auxiliary", "--fragment-clipping"],
-            "--fragment-clipping applies to --method unrolled only",
+            "--fragment-clipping applies to --method unrolled, symmetry or symmetry-pruned only",
         ),
         (
             &["--methods", "portal", "--depth", "0,4"],
