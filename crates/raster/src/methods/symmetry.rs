@@ -475,14 +475,34 @@ pub(crate) fn plan_copies(
 
 impl PlannedFrame for PlannedCopies {
     fn build(self: Box<Self>, gpu: &Gpu, scene: &Scene) -> Result<BuiltFrame, RasterError> {
+        let warnings = copy_id_warning(gpu, self.settings.copy_ids, self.stats.total)
+            .into_iter()
+            .collect();
         let frame = CopiesFrame::new(gpu, scene, *self)?;
         Ok(BuiltFrame {
             stats: frame.stats,
             encoder: Box::new(frame),
-            warnings: Vec::new(),
+            warnings,
             bake_ms: None,
         })
     }
+}
+
+/// Copy ids up to this value are exact in an RGBA16F target (11 significant bits).
+const LARGEST_EXACT_HALF_INTEGER: usize = 2048;
+
+/// `--copy-ids` into RGBA16F targets (wgpu's GL backend) cannot tell copies above 2047 apart.
+pub(crate) fn copy_id_warning(gpu: &Gpu, copy_ids: bool, copies: usize) -> Option<String> {
+    (copy_ids
+        && gpu.color_format == crate::color_format::ColorFormat::Rgba16Float
+        && copies > LARGEST_EXACT_HALF_INTEGER)
+        .then(|| {
+            format!(
+                "--copy-ids writes copy bitmask + 1 into {} targets, exact only up to \
+                 {LARGEST_EXACT_HALF_INTEGER}: ids of the {copies} copies above it are rounded",
+                gpu.color_format
+            )
+        })
 }
 
 /// The symmetry methods' bind group layout: the frame (binding 0), the masks (1) and a copy

@@ -18,8 +18,8 @@ use crate::method::{
     BuiltFrame, Clipping, CopyCounts, FrameStats, MethodEntry, PlannedFrame, RasterMethod,
 };
 use crate::methods::symmetry::{
-    CLIP_DISTANCE_SHADER, COPY_IDS, SHADER, SymmetryFrame, SymmetryInput, gpu_structs, parts_of,
-    uniform_entry,
+    CLIP_DISTANCE_SHADER, COPY_IDS, SHADER, SymmetryFrame, SymmetryInput, copy_id_warning,
+    gpu_structs, parts_of, uniform_entry,
 };
 use crate::pipeline::{ScenePipeline, depth_state, pipeline_layout};
 use crate::plan::PlanError;
@@ -124,11 +124,14 @@ struct PlannedBake {
 impl PlannedFrame for PlannedBake {
     fn build(self: Box<Self>, gpu: &Gpu, scene: &Scene) -> Result<BuiltFrame, RasterError> {
         let bake_ms = self.bake_ms;
+        let warnings = copy_id_warning(gpu, self.copy_of_vertex.is_some(), self.copies.total)
+            .into_iter()
+            .collect();
         let frame = BakedFrame::new(gpu, scene, *self)?;
         Ok(BuiltFrame {
             stats: frame.stats,
             encoder: Box::new(frame),
-            warnings: Vec::new(),
+            warnings,
             bake_ms: Some(bake_ms),
         })
     }
