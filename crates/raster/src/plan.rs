@@ -130,6 +130,8 @@ pub enum PlanError {
         per_copy: usize,
         limit: usize,
     },
+    #[error("{planes} symmetry planes, the symmetry methods' shaders take at most {limit}")]
+    TooManySymmetryPlanes { planes: usize, limit: usize },
     /// `symmetry-baked`'s split-and-mirror refused (too many triangles, a reflected vertex
     /// outside the scene extent).
     #[error("the split-and-mirror bake: {0}")]

@@ -350,10 +350,10 @@ pub(crate) fn plan_copies(
     let planes = &input.planes;
     if planes.len() > MAX_PLANES {
         // The scene format allows no more; a scene built in code might.
-        return Err(PlanError::Bake(format!(
-            "{} symmetry planes, the shaders take at most {MAX_PLANES}",
-            planes.len()
-        )));
+        return Err(PlanError::TooManySymmetryPlanes {
+            planes: planes.len(),
+            limit: MAX_PLANES,
+        });
     }
     let eye = scene.camera.position;
     let mut even: Vec<u32> = Vec::new();
@@ -759,6 +759,42 @@ mod tests {
         assert!(is_closed(&tetra));
         tetra[0] = [a, b, c];
         assert!(!is_closed(&tetra));
+    }
+
+    /// 16 planes through a 1 280-triangle sphere: `symmetry` would submit 2^16 copies of it
+    /// (84 M triangles) and is refused while planning, naming the alternatives;
+    /// `symmetry-pruned` draws only the copies whose cells hold part of the sphere.
+    #[test]
+    fn a_frame_of_too_many_copies_is_refused_while_planning() {
+        let planes: Vec<serde_json::Value> = (0..16)
+            .map(|k| {
+                let a = k as f32 * 0.7;
+                serde_json::json!({ "point": [0, 0, 0], "normal": [a.cos(), a.sin(), 0.3] })
+            })
+            .collect();
+        let text = serde_json::json!({
+            "camera": { "position": [0, 0, 4], "look_at": [0, 0, 0], "fov_y_deg": 50, "width": 32, "height": 18 },
+            "symmetry_planes": planes,
+            "objects": [ { "type": "sphere", "radius": 1, "subdivisions": 3 } ],
+        });
+        let scene =
+            mirrorbox_scene::load::parse_scene(&text.to_string(), std::path::Path::new("s.json"))
+                .unwrap();
+        let plan = |name: &str| {
+            let settings = crate::RenderSettings::new(crate::Method::named(name).unwrap());
+            crate::plan_frame(&scene, &settings).map(|_| ())
+        };
+        let refused = plan("symmetry").unwrap_err();
+        assert!(
+            matches!(
+                refused,
+                PlanError::TooManyCopyTriangles { copies: 65536, .. }
+            ),
+            "{refused}"
+        );
+        assert!(refused.to_string().contains("symmetry-pruned"), "{refused}");
+        plan("symmetry-pruned").unwrap();
+        plan("symmetry-baked").unwrap();
     }
 
     #[test]
