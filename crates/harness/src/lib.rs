@@ -484,11 +484,17 @@ pub fn point_keys(config: &SweepConfig) -> Result<Vec<String>, HarnessError> {
 /// Runs (or resumes) the sweep and writes its reports; `fresh` discards the points already
 /// in `results.jsonl` first (cached truths stay). The output folder is locked for the whole
 /// run: a second sweep into it is refused at once, naming the process that holds it.
+/// The current UTC time, RFC 3339 to the second.
+fn now_rfc3339() -> String {
+    humantime::format_rfc3339_seconds(std::time::SystemTime::now()).to_string()
+}
+
 pub fn run_sweep(
     config: &SweepConfig,
     fresh: bool,
     progress: &mut dyn FnMut(Event),
 ) -> Result<Summary, HarnessError> {
+    let run_started = now_rfc3339();
     let (base, w, h) = base_scene(config)?;
     let base_hash = base.content_hash();
     let all = points(config, base_hash, w, h);
@@ -586,6 +592,7 @@ pub fn run_sweep(
     let mut last: Vec<Option<RenderReport>> = todo.iter().map(|_| None).collect();
     let mut peaks: Vec<Option<u64>> = vec![None; todo.len()];
     let mut plans: Vec<Vec<f64>> = vec![Vec::new(); todo.len()];
+    let mut encodes: Vec<Vec<f64>> = vec![Vec::new(); todo.len()];
     let mut order: Vec<usize> = (0..todo.len()).collect();
     let mut rng = mirrorbox_report::stats::Rng::new(INTERLEAVE_SEED);
     for round in 0..config.frames {
@@ -604,6 +611,7 @@ pub fn run_sweep(
             };
             timed[i].extend(&report.frames_ms);
             plans[i].push(report.plan_ms);
+            encodes[i].extend(&report.encode_ms);
             peaks[i] = peaks[i].max(report.peak_memory_bytes);
             last[i] = Some(report);
         }
@@ -671,8 +679,12 @@ pub fn run_sweep(
             ms_interval: interval.map(|i| [i.low, i.high]),
             frames_ms,
             timing_order: "interleaved".into(),
+            run: Some(run_started.clone()),
             peak_memory_bytes: peaks[i],
             plan_ms: Some(mirrorbox_report::stats::median(&plans[i])),
+            encode_ms: Some(mirrorbox_report::stats::median(&encodes[i])),
+            gpu_buffer_bytes: Some(s.gpu_buffer_bytes),
+            gpu_texture_bytes: Some(s.gpu_texture_bytes),
             timing_source: s.timing_source.clone(),
             frames: config.frames,
             passes: s.passes,
@@ -711,7 +723,7 @@ pub fn run_sweep(
         .collect();
     let info = SweepInfo {
         command: config.command.clone(),
-        date: humantime::format_rfc3339_seconds(std::time::SystemTime::now()).to_string(),
+        date: now_rfc3339(),
         cpu: cpu_description(),
         adapter: gpu.report.name.clone(),
         backend: gpu.report.backend.clone(),

@@ -59,6 +59,12 @@ pub struct RenderReport {
     pub peak_memory_bytes: Option<u64>,
     /// Wall time of planning the frame on the CPU, ms.
     pub plan_ms: f64,
+    /// CPU time of encoding and submitting each timed frame, ms, in order.
+    pub encode_ms: Vec<f64>,
+    /// GPU memory held by buffers and by textures while the frame's resources were alive,
+    /// bytes (`mirrorbox_raster::GpuMemory`).
+    pub gpu_buffer_bytes: u64,
+    pub gpu_texture_bytes: u64,
 }
 
 /// A rendered point: the image and what was measured.
@@ -132,6 +138,9 @@ pub fn run_job(job: &RenderJob, gpu: &Gpu) -> Result<Rendered, HarnessError> {
             backend: gpu.report.backend.clone(),
             peak_memory_bytes: peak_memory_bytes(),
             plan_ms,
+            encode_ms: out.timing.encode_ms.clone(),
+            gpu_buffer_bytes: out.gpu_memory.buffer_bytes,
+            gpu_texture_bytes: out.gpu_memory.texture_bytes,
         },
         image: out.image,
     })

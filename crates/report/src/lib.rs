@@ -66,6 +66,12 @@ pub struct Record {
     /// every point alike) or `back-to-back` (all of a point's frames in a row: older records).
     #[serde(default = "back_to_back")]
     pub timing_order: String,
+    /// When the sweep run that measured this point started (UTC, RFC 3339). Frames are
+    /// interleaved only among the points of one run: a point reused from an earlier run (a
+    /// resumed sweep) was timed beside other points, on the machine of that day, and its frames
+    /// pair with no one else's. Absent in older records.
+    #[serde(default)]
+    pub run: Option<String>,
     /// Peak resident memory of the process that rendered the point (its render worker),
     /// bytes; absent in older records.
     #[serde(default)]
@@ -74,6 +80,18 @@ pub struct Record {
     /// median over the rounds; GPU timestamps do not include it. Absent in older records.
     #[serde(default)]
     pub plan_ms: Option<f64>,
+    /// CPU wall time of encoding and submitting one frame's command buffer (recording every
+    /// pass and draw, until `submit` returns), ms, median over the timed frames. Absent in
+    /// older records.
+    #[serde(default)]
+    pub encode_ms: Option<f64>,
+    /// GPU memory held by buffers, and by textures, while the point's frame was alive
+    /// (wgpu's allocation counters, device-wide in the point's render worker), bytes.
+    /// Absent in older records.
+    #[serde(default)]
+    pub gpu_buffer_bytes: Option<u64>,
+    #[serde(default)]
+    pub gpu_texture_bytes: Option<u64>,
     pub timing_source: String,
     pub frames: u32,
     pub passes: usize,
