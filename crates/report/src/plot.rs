@@ -263,31 +263,33 @@ impl Chart {
                     continue;
                 }
                 let drawable = |v: f64, log: bool| v.is_finite() && (!log || v > 0.0);
-                if let Some([lo, hi]) = series.x_intervals.get(k).copied().flatten() {
-                    if drawable(lo, ax.log) && drawable(hi, ax.log) {
-                        let (x0, x1, yy) = (px(lo), px(hi), py(y));
-                        let _ = writeln!(
-                            s,
-                            r#"<path d="M{x0:.1},{yy:.1}H{x1:.1}M{x0:.1},{:.1}V{:.1}M{x1:.1},{:.1}V{:.1}" stroke="{color}" stroke-width="1.2" fill="none"/>"#,
-                            yy - ERROR_CAP,
-                            yy + ERROR_CAP,
-                            yy - ERROR_CAP,
-                            yy + ERROR_CAP
-                        );
-                    }
+                if let Some([lo, hi]) = series.x_intervals.get(k).copied().flatten()
+                    && drawable(lo, ax.log)
+                    && drawable(hi, ax.log)
+                {
+                    let (x0, x1, yy) = (px(lo), px(hi), py(y));
+                    let _ = writeln!(
+                        s,
+                        r#"<path d="M{x0:.1},{yy:.1}H{x1:.1}M{x0:.1},{:.1}V{:.1}M{x1:.1},{:.1}V{:.1}" stroke="{color}" stroke-width="1.2" fill="none"/>"#,
+                        yy - ERROR_CAP,
+                        yy + ERROR_CAP,
+                        yy - ERROR_CAP,
+                        yy + ERROR_CAP
+                    );
                 }
-                if let Some([lo, hi]) = series.y_intervals.get(k).copied().flatten() {
-                    if drawable(lo, ay.log) && drawable(hi, ay.log) {
-                        let (y0, y1, xx) = (py(lo), py(hi), px(x));
-                        let _ = writeln!(
-                            s,
-                            r#"<path d="M{xx:.1},{y0:.1}V{y1:.1}M{:.1},{y0:.1}H{:.1}M{:.1},{y1:.1}H{:.1}" stroke="{color}" stroke-width="1.2" fill="none"/>"#,
-                            xx - ERROR_CAP,
-                            xx + ERROR_CAP,
-                            xx - ERROR_CAP,
-                            xx + ERROR_CAP
-                        );
-                    }
+                if let Some([lo, hi]) = series.y_intervals.get(k).copied().flatten()
+                    && drawable(lo, ay.log)
+                    && drawable(hi, ay.log)
+                {
+                    let (y0, y1, xx) = (py(lo), py(hi), px(x));
+                    let _ = writeln!(
+                        s,
+                        r#"<path d="M{xx:.1},{y0:.1}V{y1:.1}M{:.1},{y0:.1}H{:.1}M{:.1},{y1:.1}H{:.1}" stroke="{color}" stroke-width="1.2" fill="none"/>"#,
+                        xx - ERROR_CAP,
+                        xx + ERROR_CAP,
+                        xx - ERROR_CAP,
+                        xx + ERROR_CAP
+                    );
                 }
                 let _ = writeln!(
                     s,
