@@ -41,6 +41,8 @@ enum Command {
     DepthScaling(commands::sweep::PresetArgs),
     /// Export a scene as Mitsuba 3 XML (tools/mitsuba renders and compares it).
     ExportMitsuba(commands::export_mitsuba::Args),
+    /// Fill the README's generated regions from the committed reports (--check: only compare).
+    Readme(commands::readme::Args),
     /// Internal: one timed render of a sweep, a job as JSON on stdin (see
     /// `mirrorbox_harness::worker`).
     #[command(hide = true)]
@@ -181,6 +183,7 @@ fn main() -> ExitCode {
         Command::Table1(args) => commands::sweep::run_table1(&args),
         Command::DepthScaling(args) => commands::sweep::run_depth_scaling(&args),
         Command::ExportMitsuba(args) => commands::export_mitsuba::run(&args),
+        Command::Readme(args) => commands::readme::run(&args),
         Command::RenderWorker => {
             mirrorbox_harness::serve(std::io::stdin().lock(), std::io::stdout().lock())
                 .map_err(Failure::from)

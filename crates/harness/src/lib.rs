@@ -749,9 +749,7 @@ pub fn run_sweep(
     };
     write_atomically(
         &out.join("sweep.json"),
-        serde_json::json!({ "command": info.command, "date": info.date })
-            .to_string()
-            .as_bytes(),
+        serde_json::to_string_pretty(&info)?.as_bytes(),
     )?;
     write_report(out, &info, &records)?;
     Ok(summary)

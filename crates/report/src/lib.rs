@@ -4,9 +4,11 @@
 //! - [`Record`]: one measured point (one JSON line of `results.jsonl`).
 //! - [`write_report`]: `results.csv`, `report.md`, a self-contained `report.html` and the SVG
 //!   plots, including the reproduction of the seed paper's Table 1 ([`table1`]).
+//! - [`readme`]: the README's figures, generated from the committed reports.
 
 pub mod exact;
 pub mod plot;
+pub mod readme;
 pub mod stats;
 pub mod table1;
 mod write;
@@ -128,8 +130,10 @@ fn rgba32float() -> String {
     "rgba32float".into()
 }
 
-/// Facts about the whole sweep, printed at the top of every report.
+/// Facts about the whole sweep, printed at the top of every report and kept in the sweep
+/// folder's `sweep.json` (which the README's generated regions read).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
 pub struct SweepInfo {
     pub command: String,
     /// UTC, RFC 3339.

@@ -35,7 +35,7 @@ pub fn read_records(path: &Path) -> std::io::Result<Vec<Record>> {
     Ok(records)
 }
 
-enum Block {
+pub(crate) enum Block {
     Heading(u8, String),
     Paragraph(String),
     Bullets(Vec<String>),
@@ -122,7 +122,6 @@ fn setting(r: &Record) -> f64 {
 pub fn write_report(dir: &Path, info: &SweepInfo, records: &[Record]) -> Result<(), FileError> {
     write_csv(&dir.join("results.csv"), records)?;
     let blocks = document(info, records);
-    let mut md = String::new();
     let mut html = String::from(
         "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>mirrorbox report</title><style>\
          body{font-family:sans-serif;max-width:1100px;margin:2em auto;padding:0 1em}\
@@ -133,18 +132,12 @@ pub fn write_report(dir: &Path, info: &SweepInfo, records: &[Record]) -> Result<
     for b in &blocks {
         match b {
             Block::Heading(level, t) => {
-                let _ = writeln!(md, "{} {t}\n", "#".repeat(*level as usize));
                 let _ = writeln!(html, "<h{level}>{}</h{level}>", esc(t));
             }
             Block::Paragraph(t) => {
-                let _ = writeln!(md, "{t}\n");
                 let _ = writeln!(html, "<p>{}</p>", esc(t));
             }
             Block::Bullets(items) => {
-                for i in items {
-                    let _ = writeln!(md, "- {i}");
-                }
-                md.push('\n');
                 let _ = writeln!(
                     html,
                     "<ul>{}</ul>",
@@ -155,12 +148,6 @@ pub fn write_report(dir: &Path, info: &SweepInfo, records: &[Record]) -> Result<
                 );
             }
             Block::Table(head, rows) => {
-                let _ = writeln!(md, "| {} |", head.join(" | "));
-                let _ = writeln!(md, "|{}", "---|".repeat(head.len()));
-                for r in rows {
-                    let _ = writeln!(md, "| {} |", r.join(" | "));
-                }
-                md.push('\n');
                 let _ = write!(
                     html,
                     "<table><tr>{}</tr>",
@@ -180,11 +167,6 @@ pub fn write_report(dir: &Path, info: &SweepInfo, records: &[Record]) -> Result<
                 html.push_str("</table>\n");
             }
             Block::Images(images) => {
-                let line: Vec<String> = images
-                    .iter()
-                    .map(|(cap, p)| format!("![{cap}]({p})"))
-                    .collect();
-                let _ = writeln!(md, "{}\n", line.join(" "));
                 html.push_str("<div>");
                 for (cap, p) in images {
                     let src = match std::fs::read(dir.join(p)) {
@@ -204,14 +186,53 @@ pub fn write_report(dir: &Path, info: &SweepInfo, records: &[Record]) -> Result<
             }
             Block::Chart(file, svg) => {
                 write_atomically(&dir.join(file), svg.as_bytes())?;
-                let _ = writeln!(md, "![{file}]({file})\n");
                 let _ = writeln!(html, "<div>{svg}</div>");
             }
         }
     }
     html.push_str("</body></html>\n");
-    write_atomically(&dir.join("report.md"), md.as_bytes())?;
+    write_atomically(&dir.join("report.md"), markdown(&blocks).as_bytes())?;
     write_atomically(&dir.join("report.html"), html.as_bytes())
+}
+
+/// The blocks as Markdown (charts and images as links to their files).
+pub(crate) fn markdown(blocks: &[Block]) -> String {
+    let mut md = String::new();
+    for b in blocks {
+        match b {
+            Block::Heading(level, t) => {
+                let _ = writeln!(md, "{} {t}\n", "#".repeat(*level as usize));
+            }
+            Block::Paragraph(t) => {
+                let _ = writeln!(md, "{t}\n");
+            }
+            Block::Bullets(items) => {
+                for i in items {
+                    let _ = writeln!(md, "- {i}");
+                }
+                md.push('\n');
+            }
+            Block::Table(head, rows) => {
+                let _ = writeln!(md, "| {} |", head.join(" | "));
+                let _ = writeln!(md, "|{}", "---|".repeat(head.len()));
+                for r in rows {
+                    let _ = writeln!(md, "| {} |", r.join(" | "));
+                }
+                md.push('\n');
+            }
+            Block::Images(images) => {
+                let line: Vec<String> = images
+                    .iter()
+                    .map(|(cap, p)| format!("![{cap}]({p})"))
+                    .collect();
+                let _ = writeln!(md, "{}\n", line.join(" "));
+            }
+            Block::Chart(file, _) => {
+                let _ = writeln!(md, "![{file}]({file})\n");
+            }
+        }
+    }
+    md
 }
 
 fn esc(s: &str) -> String {
@@ -394,7 +415,11 @@ fn exact_comparison(
 }
 
 /// ms/frame against the depth cap for each exact method with several depths.
-fn depth_scaling(info: &SweepInfo, records: &[Record], floor: Option<&Record>) -> Vec<Block> {
+pub(crate) fn depth_scaling(
+    info: &SweepInfo,
+    records: &[Record],
+    floor: Option<&Record>,
+) -> Vec<Block> {
     let groups = exact::depth_scaling(&info.exact_methods, records);
     if groups.is_empty() {
         return Vec::new();
@@ -470,6 +495,72 @@ fn depth_scaling(info: &SweepInfo, records: &[Record], floor: Option<&Record>) -
     out
 }
 
+/// The reproduction of the paper's Table 1 with the exact methods beside it — only in the
+/// paper's experiment ([`table1::is_papers_sweep`]); empty otherwise.
+pub(crate) fn table1_section(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
+    let mut b = Vec::new();
+    let (alpha, rows) = table1::rows(records);
+    if table1::is_papers_sweep(&info.scene, &rows) {
+        b.push(Block::Heading(
+            2,
+            "Reproduction of the paper's Table 1".into(),
+        ));
+        b.push(Block::Paragraph(format!(
+            "Auxiliary method, α = {}; ours is the median ms/frame over the timed frames with its \
+             95 % bootstrap interval (frames timed interleaved: one per point per round, the points \
+             in an order shuffled per round). The paper's column is its Table 1 (Safari, hardware \
+             not stated).",
+            alpha.unwrap_or(f32::NAN)
+        )));
+        let step = |s: Option<f64>| s.map_or("–".into(), |v| format!("{v:.2}"));
+        b.push(Block::Table(
+            [
+                "n",
+                "paper ms/frame",
+                "ours ms/frame median [95 % CI]",
+                "passes",
+                "ours ms/pass",
+                "paper ms/pass",
+                "step ratio paper",
+                "step ratio ours",
+            ]
+            .map(String::from)
+            .to_vec(),
+            rows.iter()
+                .map(|r| {
+                    vec![
+                        r.n.to_string(),
+                        f(r.paper_ms, 0),
+                        format!("{} [{}]", f(r.ms_median, 1), row_interval(r)),
+                        r.passes.to_string(),
+                        f(r.ms_median / r.passes as f64, 2),
+                        f(r.paper_ms / r.passes as f64, 2),
+                        step(r.paper_step),
+                        step(r.ours_step),
+                    ]
+                })
+                .collect(),
+        ));
+        b.push(Block::Paragraph(table1::growth_sentence(&rows)));
+        if let Some(a) = alpha {
+            b.extend(exact_comparison(info, records, &rows, a));
+        }
+    }
+    b
+}
+
+/// What the comparison cannot resolve: raster vs trace without mirrors.
+pub(crate) fn floor_paragraph(fl: &Record) -> Block {
+    Block::Paragraph(format!(
+        "Raster vs trace on the scene without its mirrors (nothing to truncate, same sub-pixel grid): \
+         RMSE {}, relMSE {}, FLIP mean {}, SSIM {}. Errors are to be read against this floor.",
+        sci(fl.metrics.rmse),
+        sci(fl.metrics.relmse),
+        sci(fl.metrics.flip_mean),
+        f(fl.metrics.ssim, 6)
+    ))
+}
+
 /// The colour formats the records were rendered into, e.g. `rgba32float` (several where a
 /// sweep was resumed on another device).
 fn color_formats(records: &[Record]) -> String {
@@ -526,64 +617,11 @@ fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
         )));
     }
 
-    let (alpha, rows) = table1::rows(records);
-    if table1::is_papers_sweep(&info.scene, &rows) {
-        b.push(Block::Heading(
-            2,
-            "Reproduction of the paper's Table 1".into(),
-        ));
-        b.push(Block::Paragraph(format!(
-            "Auxiliary method, α = {}; ours is the median ms/frame over the timed frames with its \
-             95 % bootstrap interval (frames timed interleaved: one per point per round, the points \
-             in an order shuffled per round). The paper's column is its Table 1 (Safari, hardware \
-             not stated).",
-            alpha.unwrap_or(f32::NAN)
-        )));
-        let step = |s: Option<f64>| s.map_or("–".into(), |v| format!("{v:.2}"));
-        b.push(Block::Table(
-            [
-                "n",
-                "paper ms/frame",
-                "ours ms/frame median [95 % CI]",
-                "passes",
-                "ours ms/pass",
-                "paper ms/pass",
-                "step ratio paper",
-                "step ratio ours",
-            ]
-            .map(String::from)
-            .to_vec(),
-            rows.iter()
-                .map(|r| {
-                    vec![
-                        r.n.to_string(),
-                        f(r.paper_ms, 0),
-                        format!("{} [{}]", f(r.ms_median, 1), row_interval(r)),
-                        r.passes.to_string(),
-                        f(r.ms_median / r.passes as f64, 2),
-                        f(r.paper_ms / r.passes as f64, 2),
-                        step(r.paper_step),
-                        step(r.ours_step),
-                    ]
-                })
-                .collect(),
-        ));
-        b.push(Block::Paragraph(table1::growth_sentence(&rows)));
-        if let Some(a) = alpha {
-            b.extend(exact_comparison(info, records, &rows, a));
-        }
-    }
+    b.extend(table1_section(info, records));
 
     if let Some(fl) = floor {
         b.push(Block::Heading(2, "Floor of the comparison".into()));
-        b.push(Block::Paragraph(format!(
-            "Raster vs trace on the scene without its mirrors (nothing to truncate, same sub-pixel grid): \
-             RMSE {}, relMSE {}, FLIP mean {}, SSIM {}. Every error below is to be read against this floor.",
-            sci(fl.metrics.rmse),
-            sci(fl.metrics.relmse),
-            sci(fl.metrics.flip_mean),
-            f(fl.metrics.ssim, 6)
-        )));
+        b.push(floor_paragraph(fl));
     }
 
     b.extend(depth_scaling(info, records, floor));
