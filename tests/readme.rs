@@ -1,5 +1,6 @@
-//! The README's numbers are the committed reports' numbers: every generated region of
-//! `README.md` must be what `mirrorbox readme` makes from `reports/` (issue #13).
+//! The README's and the docs' numbers are the committed reports' numbers: every generated
+//! region of `README.md` and `docs/methods.md` must be what `mirrorbox readme` makes from
+//! `reports/` (issue #13).
 
 mod common;
 use common::{mirrorbox, repo};
@@ -13,11 +14,14 @@ fn the_readme_agrees_with_the_committed_reports() {
         out.stdout, out.stderr
     );
     // Every region the generator knows is used, so no report figure is quoted by hand.
-    let readme = std::fs::read_to_string(repo().join("README.md")).unwrap();
+    let text: String = ["README.md", "docs/methods.md"]
+        .iter()
+        .map(|f| std::fs::read_to_string(repo().join(f)).unwrap())
+        .collect();
     for (id, _, _) in mirrorbox_report::readme::REGIONS {
         assert!(
-            readme.contains(&format!("<!-- generated: {id} -->")),
-            "README.md has no generated region {id:?}"
+            text.contains(&format!("<!-- generated: {id} -->")),
+            "neither README.md nor docs/methods.md has the generated region {id:?}"
         );
     }
 }
@@ -40,7 +44,6 @@ fn a_changed_figure_in_a_region_is_caught_and_named() {
         &[
             "readme",
             "--check",
-            "--readme",
             copy.to_str().unwrap(),
             "--reports",
             reports.to_str().unwrap(),
@@ -58,7 +61,6 @@ fn a_changed_figure_in_a_region_is_caught_and_named() {
     let out = mirrorbox(
         &[
             "readme",
-            "--readme",
             copy.to_str().unwrap(),
             "--reports",
             reports.to_str().unwrap(),

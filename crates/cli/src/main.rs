@@ -41,7 +41,7 @@ enum Command {
     DepthScaling(commands::sweep::PresetArgs),
     /// Export a scene as Mitsuba 3 XML (tools/mitsuba renders and compares it).
     ExportMitsuba(commands::export_mitsuba::Args),
-    /// Fill the README's generated regions from the committed reports (--check: only compare).
+    /// Fill the generated regions of README.md and docs/methods.md from the committed reports (--check: only compare).
     Readme(commands::readme::Args),
     /// Internal: one timed render of a sweep, a job as JSON on stdin (see
     /// `mirrorbox_harness::worker`).

@@ -1,6 +1,6 @@
-//! The figures the README quotes, generated from the committed reports.
+//! The figures the README and the docs quote, generated from the committed reports.
 //!
-//! A region of `README.md` between `<!-- generated: ID -->` and `<!-- end generated: ID -->`
+//! A region of `README.md` (or `docs/methods.md`) between `<!-- generated: ID -->` and `<!-- end generated: ID -->`
 //! is written by [`fill`] from the report folder its ID names (its `results.jsonl` and
 //! `sweep.json`), with the same sentences and tables the report itself prints — so the prose
 //! cannot drift from the numbers. `mirrorbox readme` rewrites the regions; `mirrorbox readme
@@ -50,6 +50,11 @@ pub const REGIONS: &[(&str, &str, &str)] = &[
         "depth-scaling",
         "depth_scaling",
         "the exact methods' cost per bounce",
+    ),
+    (
+        "depth-scaling-table",
+        "depth_scaling",
+        "the exact methods' cost against depth, every point, and per bounce",
     ),
     (
         "main-job",
@@ -138,12 +143,13 @@ fn table1_region(s: &Sweep) -> Result<String, ReadmeError> {
     Ok(markdown(&blocks))
 }
 
-fn depth_scaling_region(s: &Sweep) -> Result<String, ReadmeError> {
+/// The depth-scaling section's cost per bounce (and with `table`, every point).
+fn depth_scaling_region(s: &Sweep, table: bool) -> Result<String, ReadmeError> {
     let floor = s.records.iter().find(|r| r.kind == "floor");
     let section = prose(depth_scaling(&s.info, &s.records, floor));
     let bullets: Vec<Block> = section
         .into_iter()
-        .filter(|b| matches!(b, Block::Bullets(_)))
+        .filter(|b| table || matches!(b, Block::Bullets(_)))
         .collect();
     if bullets.is_empty() {
         return Err(ReadmeError(format!(
@@ -298,7 +304,8 @@ pub fn generate(id: &str, reports: &Path) -> Result<Region, ReadmeError> {
             &load_sweep(&folder("table1"))?,
             &load_sweep(&folder(source))?,
         )?,
-        "depth-scaling" => depth_scaling_region(&load_sweep(&folder(source))?)?,
+        "depth-scaling" => depth_scaling_region(&load_sweep(&folder(source))?, false)?,
+        "depth-scaling-table" => depth_scaling_region(&load_sweep(&folder(source))?, true)?,
         "main-job" => main_job_region(&folder(source))?,
         _ => unreachable!("every ID in REGIONS has a generator"),
     };
