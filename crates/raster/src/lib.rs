@@ -9,6 +9,8 @@
 //!   their keys.
 //! - [`exact_paths`]: the exact methods' options and reflection-path planning.
 //! - [`culling`]: footprint rectangles and parts against a path's portal.
+//! - [`symmetry_cells`]: seed 001's symmetry cascade on the CPU — copy transforms, cells,
+//!   which copies a frame can leave out.
 //! - [`shading`]: the scene buffers the contract's WGSL reads; [`wgsl`]: all WGSL composition.
 //! - The thin wgpu layer: [`adapter`] (Vulkan, then GL; `WGPU_BACKEND` overrides), [`gpu`]
 //!   (device and errors), [`color_format`] (RGBA32F, else RGBA16F;
@@ -30,6 +32,7 @@ pub mod readback;
 pub mod registry;
 pub mod resolve;
 pub mod shading;
+pub mod symmetry_cells;
 pub mod targets;
 pub mod timing;
 pub mod wgsl;
@@ -38,7 +41,7 @@ pub use adapter::{AdapterError, AdapterReport, SelectedAdapter, select_adapter};
 pub use color_format::ColorFormat;
 pub use gpu::{Gpu, GpuOptions, RasterError};
 pub use method::{
-    Clipping, FrameStats, MethodEntry, OptionSpec, ParamError, ParamValue, PathCounts, RasterMethod,
+    Clipping, CopyCounts, FrameStats, MethodEntry, OptionSpec, ParamError, ParamValue, PathCounts, RasterMethod,
 };
 pub use plan::PlanError;
 pub use registry::{METHODS, Method};
@@ -144,6 +147,9 @@ pub struct RenderOutput {
     pub warnings: Vec<String>,
     /// GPU memory the device held while the frame's resources were alive.
     pub gpu_memory: GpuMemory,
+    /// CPU milliseconds of baking geometry while planning (`symmetry-baked`), apart from the
+    /// frame time ([`method::BuiltFrame::bake_ms`]).
+    pub bake_ms: Option<f64>,
 }
 
 /// Bytes of GPU memory held by the device's buffers and textures (wgpu's internal counters:
@@ -228,6 +234,7 @@ pub fn render_planned(
         color_format: gpu.color_format,
         warnings: built.warnings,
         gpu_memory,
+        bake_ms: built.bake_ms,
     })
 }
 

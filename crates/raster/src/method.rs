@@ -101,6 +101,11 @@ pub struct BuiltFrame {
     pub stats: FrameStats,
     /// Conditions under which the image may not be what the method promises.
     pub warnings: Vec<String>,
+    /// CPU milliseconds spent in planning on baking geometry (`symmetry-baked`'s
+    /// split-and-mirror, seed 001): work a real-time renderer redoes only when the planes
+    /// change, so it is reported apart from the frame time. Not in [`FrameStats`], whose
+    /// counts are the same on every run.
+    pub bake_ms: Option<f64>,
 }
 
 /// Per-frame counts.
@@ -123,6 +128,29 @@ pub struct FrameStats {
     /// The depth (or depth-stencil) format: 32-bit float, except `portal`'s 24-bit fallback on
     /// an adapter without `DEPTH32FLOAT_STENCIL8`.
     pub depth_format: wgpu::TextureFormat,
+    /// The symmetry methods (seed 001): the copies of the objects drawn and pruned.
+    pub copies: Option<CopyCounts>,
+}
+
+/// What a symmetry method (seed 001) drew of the 2^p copies of the objects that p symmetry
+/// planes make.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CopyCounts {
+    /// Symmetry planes p.
+    pub planes: usize,
+    /// 2^p.
+    pub total: usize,
+    /// Copies drawn (instances, or draws with `--symmetry-draws per-copy`).
+    pub drawn: usize,
+    /// Copies whose cell holds no part of the objects' bounds (`symmetry-pruned`).
+    pub pruned_empty: usize,
+    /// Copies wholly outside the view frustum (`symmetry-pruned`).
+    pub pruned_outside_view: usize,
+    /// Object parts drawn with back-face culling: closed, and the eye outside them in every
+    /// copy drawn, so culling removes no surface the eye can see first.
+    pub culled_parts: usize,
+    /// Object parts drawn.
+    pub parts: usize,
 }
 
 /// How a method clips a mirror's world to the mirror's front (and to its cell).
@@ -134,6 +162,8 @@ pub enum Clipping {
     /// Every test per fragment, with discard (an adapter without clip distances, or
     /// `unrolled --fragment-clipping`).
     FragmentDiscard,
+    /// Nothing is clipped: the method draws a mesh as it is (`symmetry-baked`).
+    None,
 }
 
 impl Clipping {
@@ -152,6 +182,7 @@ impl Clipping {
         match self {
             Clipping::ClipDistances => "clip distances",
             Clipping::FragmentDiscard => "fragment discard",
+            Clipping::None => "none",
         }
     }
 }
@@ -242,6 +273,8 @@ pub enum OptionKind {
     },
     /// A switch: present means true.
     Switch,
+    /// One of a few named values.
+    Choice { values: &'static [&'static str] },
 }
 
 /// One option's value.
@@ -250,6 +283,8 @@ pub enum ParamValue {
     Count(u32),
     Real(f32),
     Switch(bool),
+    /// One of an [`OptionKind::Choice`]'s values.
+    Choice(&'static str),
 }
 
 impl PartialEq for ParamValue {
@@ -259,6 +294,7 @@ impl PartialEq for ParamValue {
             (ParamValue::Count(a), ParamValue::Count(b)) => a == b,
             (ParamValue::Real(a), ParamValue::Real(b)) => a.to_bits() == b.to_bits(),
             (ParamValue::Switch(a), ParamValue::Switch(b)) => a == b,
+            (ParamValue::Choice(a), ParamValue::Choice(b)) => a == b,
             _ => false,
         }
     }
@@ -270,6 +306,7 @@ impl fmt::Display for ParamValue {
             ParamValue::Count(v) => write!(f, "{v}"),
             ParamValue::Real(v) => write!(f, "{v}"),
             ParamValue::Switch(v) => write!(f, "{v}"),
+            ParamValue::Choice(v) => f.write_str(v),
         }
     }
 }
@@ -305,6 +342,7 @@ impl OptionSpec {
                 max: None,
             } => format!("{} {min}", if min_open { ">" } else { "≥" }),
             OptionKind::Switch => "a switch (no value)".into(),
+            OptionKind::Choice { values } => format!("one of {}", values.join(", ")),
         }
     }
 
@@ -326,6 +364,7 @@ impl OptionSpec {
                     && max.is_none_or(|m| v <= m)
             }
             (OptionKind::Switch, ParamValue::Switch(_)) => true,
+            (OptionKind::Choice { values }, ParamValue::Choice(v)) => values.contains(&v),
             _ => false,
         };
         if ok {
@@ -342,6 +381,9 @@ impl OptionSpec {
             OptionKind::Count { .. } => t.parse().map(ParamValue::Count).ok(),
             OptionKind::Real { .. } => t.parse().map(ParamValue::Real).ok(),
             OptionKind::Switch => t.parse().map(ParamValue::Switch).ok(),
+            OptionKind::Choice { values } => {
+                values.iter().find(|v| **v == t).map(|v| ParamValue::Choice(v))
+            }
         };
         self.check(value.ok_or_else(|| self.out_of_range(format!("{text:?}")))?)
     }
@@ -458,6 +500,14 @@ impl Params {
         match self.value(option) {
             ParamValue::Switch(v) => v,
             v => panic!("--{} is declared a switch, holds {v:?}", option.name),
+        }
+    }
+
+    /// The value of a choice option the method declares.
+    pub fn choice(&self, option: &OptionSpec) -> &'static str {
+        match self.value(option) {
+            ParamValue::Choice(v) => v,
+            v => panic!("--{} is declared a choice, holds {v:?}", option.name),
         }
     }
 }

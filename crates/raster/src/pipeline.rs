@@ -3,7 +3,9 @@
 //!
 //! Every scene pipeline draws linear radiance into a target of the device's colour format
 //! ([`crate::targets::ColorFormat`]), with culling
-//! off (reflections flip the winding and shading is two-sided, `docs/shading.md`) and no
+//! off (reflections flip the winding and shading is two-sided, `docs/shading.md`) — except
+//! where a method knows back faces cannot be seen first
+//! ([`ScenePipeline::build_culling_back_faces`]) — and no
 //! multisampling (supersampling is the SSAA grid); what differs between methods is the shader
 //! entry points, the vertex buffers, the depth/stencil state and which colours are written.
 
@@ -26,8 +28,29 @@ pub struct ScenePipeline<'a> {
 }
 
 impl ScenePipeline<'_> {
-    /// The pipeline on `gpu`, drawing into its colour format.
+    /// The pipeline on `gpu`, drawing into its colour format, culling nothing.
     pub fn build(&self, gpu: &Gpu) -> wgpu::RenderPipeline {
+        self.build_with(gpu, None, wgpu::FrontFace::Ccw)
+    }
+
+    /// The pipeline culling back faces, a triangle's front being where it winds as
+    /// `front_face` says on screen. Only for closed meshes with the eye outside, where the
+    /// first surface along every ray is a front face (the symmetry methods; a reflected copy
+    /// winds the other way, `Cw`).
+    pub fn build_culling_back_faces(
+        &self,
+        gpu: &Gpu,
+        front_face: wgpu::FrontFace,
+    ) -> wgpu::RenderPipeline {
+        self.build_with(gpu, Some(wgpu::Face::Back), front_face)
+    }
+
+    fn build_with(
+        &self,
+        gpu: &Gpu,
+        cull_mode: Option<wgpu::Face>,
+        front_face: wgpu::FrontFace,
+    ) -> wgpu::RenderPipeline {
         gpu.device
             .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some(self.label),
@@ -39,7 +62,8 @@ impl ScenePipeline<'_> {
                     buffers: self.buffers,
                 },
                 primitive: wgpu::PrimitiveState {
-                    cull_mode: None,
+                    cull_mode,
+                    front_face,
                     ..Default::default()
                 },
                 depth_stencil: Some(self.depth_stencil.clone()),

@@ -121,6 +121,19 @@ pub enum PlanError {
         "the reflection tree branches {0} levels deep with siblings pending; the 8-bit stencil of --method portal allows 254: lower --depth or use --method unrolled"
     )]
     StencilTooDeep(u32),
+    #[error(
+        "this frame would submit {triangles} triangles ({copies} copies of the objects' {per_copy}), above the limit of {limit}: use --method symmetry-pruned (drops copies that cannot be seen) or symmetry-baked, or fewer symmetry planes"
+    )]
+    TooManyCopyTriangles {
+        triangles: usize,
+        copies: usize,
+        per_copy: usize,
+        limit: usize,
+    },
+    /// `symmetry-baked`'s split-and-mirror refused (too many triangles, a reflected vertex
+    /// outside the scene extent).
+    #[error("the split-and-mirror bake: {0}")]
+    Bake(String),
     /// A render setting out of range (`--ssaa`, `--frames`, `--warmup`, the render size).
     #[error(transparent)]
     Setting(#[from] mirrorbox_scene::limits::SettingError),

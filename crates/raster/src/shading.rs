@@ -85,7 +85,15 @@ pub struct SceneBuffers {
 impl SceneBuffers {
     /// Refuses a scene whose buffers this device cannot hold, before any is created.
     pub fn check_fits(gpu: &crate::Gpu, scene: &Scene) -> Result<(), crate::RasterError> {
-        let g = &scene.geometry;
+        Self::check_fits_geometry(gpu, scene, &scene.geometry)
+    }
+
+    /// [`SceneBuffers::check_fits`] for `scene` drawing `g` instead of its geometry.
+    pub fn check_fits_geometry(
+        gpu: &crate::Gpu,
+        scene: &Scene,
+        g: &mirrorbox_scene::Geometry,
+    ) -> Result<(), crate::RasterError> {
         let vertices = 3 * g.triangles.len() as u64 * std::mem::size_of::<Vertex>() as u64;
         gpu.check_buffer("vertex", vertices, false)?;
         let surfaces = g.surfaces.len() as u64 * std::mem::size_of::<GpuSurface>() as u64;
@@ -95,7 +103,17 @@ impl SceneBuffers {
     }
 
     pub fn new(device: &wgpu::Device, scene: &Scene) -> Self {
-        let g = &scene.geometry;
+        Self::for_geometry(device, scene, &scene.geometry)
+    }
+
+    /// `scene`'s buffers drawing `g` (its mirror surfaces index `scene.mirrors`) instead of
+    /// `scene.geometry`: the symmetry methods draw the objects before the planes, or a fresh
+    /// bake.
+    pub fn for_geometry(
+        device: &wgpu::Device,
+        scene: &Scene,
+        g: &mirrorbox_scene::Geometry,
+    ) -> Self {
         let vertex = |i: usize| {
             let n = g.face_normal(i).to_array();
             g.triangles[i].map(|p| Vertex {

@@ -23,6 +23,19 @@ pub struct SceneFile {
     pub background: Option<Rgb>,
     #[serde(default)]
     pub terminal: Option<Rgb>,
+    /// Seed 001's symmetry planes, applied to the objects in this order.
+    #[serde(default)]
+    pub symmetry_planes: Vec<SymmetryPlaneDesc>,
+}
+
+/// One symmetry plane: through `point`, front side towards `normal`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SymmetryPlaneDesc {
+    #[serde(default)]
+    pub name: Option<String>,
+    pub point: Vec3f,
+    pub normal: Vec3f,
 }
 
 #[derive(Debug, Deserialize)]

@@ -48,6 +48,17 @@ pub struct Geometry {
 /// the square of its longest edge (a sliver this thin has no reliable normal).
 const DEGENERATE_RELATIVE_AREA: f32 = 1e-7;
 
+/// True for a triangle of (near) zero area: twice its area at most
+/// [`DEGENERATE_RELATIVE_AREA`] times its longest edge squared, or not a number.
+pub(crate) fn is_degenerate(t: &[Vec3; 3]) -> bool {
+    let doubled_area = (t[1] - t[0]).cross(t[2] - t[0]).length();
+    let longest = (t[1] - t[0])
+        .length_squared()
+        .max((t[2] - t[1]).length_squared())
+        .max((t[0] - t[2]).length_squared());
+    doubled_area.is_nan() || doubled_area <= DEGENERATE_RELATIVE_AREA * longest
+}
+
 impl Geometry {
     /// Appends a part; degenerate triangles are dropped (and counted) so that every stored
     /// triangle has a well-defined face normal.
@@ -56,12 +67,7 @@ impl Geometry {
         self.surfaces.push(surface);
         let start = self.triangles.len();
         for t in triangles {
-            let doubled_area = (t[1] - t[0]).cross(t[2] - t[0]).length();
-            let longest = (t[1] - t[0])
-                .length_squared()
-                .max((t[2] - t[1]).length_squared())
-                .max((t[0] - t[2]).length_squared());
-            if doubled_area.is_nan() || doubled_area <= DEGENERATE_RELATIVE_AREA * longest {
+            if is_degenerate(&t) {
                 self.degenerate_dropped += 1;
                 continue;
             }

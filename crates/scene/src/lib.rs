@@ -21,6 +21,7 @@ pub mod polygon;
 pub mod reflection;
 pub mod reflection_paths;
 pub mod shading;
+pub mod symmetry;
 pub mod tessellate;
 
 pub use camera::{Camera, Ray, SubpixelGrid};
@@ -29,6 +30,7 @@ pub use geometry::{Geometry, Surface, SurfaceId};
 pub use load::load_scene;
 pub use reflection::Plane;
 pub use shading::{Lighting, PointLight};
+pub use symmetry::{Symmetry, SymmetryPlane};
 
 use glam::Vec3;
 
@@ -82,8 +84,12 @@ pub struct Scene {
     /// Radiance a method shows on a mirror it can no longer follow (beyond its depth).
     pub terminal: Vec3,
     /// All triangles (objects and mirrors) with their surfaces: the single geometry both
-    /// renderers consume.
+    /// renderers consume. With symmetry planes, the objects here are already split and
+    /// mirrored ([`symmetry::split_and_mirror`]); the mirrors follow them, untouched.
     pub geometry: Geometry,
+    /// Seed 001's symmetry planes and the objects before them; `None` when the file has no
+    /// `symmetry_planes` (or an empty list).
+    pub symmetry: Option<Symmetry>,
 }
 
 impl Scene {
@@ -125,6 +131,57 @@ impl Scene {
         Ok(())
     }
 
+    /// The same scene keeping only its first `planes` symmetry planes, the objects baked again
+    /// (`planes = 0` gives the scene without symmetry, `symmetry: None`). The mirrors, their
+    /// current reflectance and everything else are kept. A sweep over p uses it.
+    pub fn with_symmetry_planes(&self, planes: usize) -> Result<Scene, symmetry::SymmetryError> {
+        let have = self.symmetry.as_ref().map_or(0, |s| s.planes.len());
+        if planes > have {
+            return Err(symmetry::SymmetryError::NotThatManyPlanes {
+                asked: planes,
+                have,
+            });
+        }
+        let Some(sym) = &self.symmetry else {
+            return Ok(self.clone());
+        };
+        let kept = &sym.planes[..planes];
+        let mirror_parts: Vec<_> = self
+            .geometry
+            .parts
+            .iter()
+            .filter(|part| {
+                matches!(
+                    self.geometry.surfaces[part.surface as usize],
+                    Surface::Mirror { .. }
+                )
+            })
+            .collect();
+        let mirror_triangles: usize = mirror_parts.iter().map(|p| p.triangles.len()).sum();
+        let plane_list: Vec<Plane> = kept.iter().map(|p| p.plane).collect();
+        let mut geometry = symmetry::split_and_mirror(
+            &sym.source,
+            &plane_list,
+            limits::MAX_TRIANGLES.saturating_sub(mirror_triangles),
+        )?;
+        for part in mirror_parts {
+            geometry.push_part(
+                part.name.clone(),
+                self.geometry.surfaces[part.surface as usize].clone(),
+                self.geometry.triangles[part.triangles.clone()].to_vec(),
+            );
+        }
+        geometry.degenerate_dropped = self.geometry.degenerate_dropped;
+        Ok(Scene {
+            geometry,
+            symmetry: (planes > 0).then(|| Symmetry {
+                planes: kept.to_vec(),
+                source: sym.source.clone(),
+            }),
+            ..self.clone()
+        })
+    }
+
     /// Replaces every mirror's reflectance (the harness sets it to the α being measured),
     /// keeping [`Scene::geometry`]'s surfaces in step.
     pub fn set_reflectance(&mut self, reflectance: Vec3) {
@@ -137,7 +194,7 @@ impl Scene {
 
 impl Scene {
     /// A 64-bit FNV-1a hash of everything that affects an image (camera, mirrors, lighting,
-    /// background, terminal, triangles and surfaces; not the file path). Floats enter through
+    /// background, terminal, triangles and surfaces, symmetry planes; not the file path). Floats enter through
     /// their exact shortest round-trip text, so equal hashes mean equal inputs. Used to label
     /// outputs and as the key of cached ground truths.
     pub fn content_hash(&self) -> u64 {
@@ -156,6 +213,10 @@ impl Scene {
             g.surface_of,
             g.surfaces
         );
+        // Scenes without planes keep the hash they had before planes existed (cached truths).
+        if let Some(symmetry) = &self.symmetry {
+            let _ = write!(h, "symmetry{:?}", symmetry.planes);
+        }
         h.finish()
     }
 }

@@ -6,8 +6,8 @@
 
 use crate::error::{FieldPath, SceneError};
 use crate::format::{
-    CameraDesc, LightDesc, MirrorDesc, ObjectDesc, Rgb, Scale, SceneFile, ShapeKind, TransformDesc,
-    Vec3f,
+    CameraDesc, LightDesc, MirrorDesc, ObjectDesc, Rgb, Scale, SceneFile, ShapeKind,
+    SymmetryPlaneDesc, TransformDesc, Vec3f,
 };
 use crate::geometry::{Geometry, Surface};
 use crate::limits::{
@@ -15,8 +15,9 @@ use crate::limits::{
     MAX_TRIANGLES, MEMORY_PER_TRIANGLE, within_extent,
 };
 use crate::shading::{Lighting, PointLight};
+use crate::symmetry::{self, MAX_SYMMETRY_PLANES, Symmetry, SymmetryPlane};
 use crate::tessellate::{self, MAX_SPHERE_SUBDIVISIONS};
-use crate::{Camera, Mirror, Scene};
+use crate::{Camera, Mirror, Plane, Scene};
 use glam::{EulerRot, Mat4, Quat, Vec3};
 use std::path::{Path, PathBuf};
 
@@ -201,6 +202,25 @@ impl Checker<'_> {
         for (i, object) in file.objects.iter().enumerate() {
             self.object(&objects.index(i), i, object, &mut geometry)?;
         }
+        let planes = self.symmetry_planes(&file.symmetry_planes)?;
+        let symmetry = if planes.is_empty() {
+            None
+        } else {
+            // The mirrors' two triangles each come after the bake; leave room for them.
+            let budget = MAX_TRIANGLES.saturating_sub(2 * file.mirrors.len());
+            let plane_list: Vec<Plane> = planes.iter().map(|p| p.plane).collect();
+            let baked =
+                symmetry::split_and_mirror(&geometry, &plane_list, budget).map_err(|e| {
+                    let field = FieldPath::root("symmetry_planes");
+                    let field = match e.plane() {
+                        Some(k) => field.index(k),
+                        None => field,
+                    };
+                    self.invalid(&field, e.to_string())
+                })?;
+            let source = std::mem::replace(&mut geometry, baked);
+            Some(Symmetry { planes, source })
+        };
         let mut mirrors = Vec::with_capacity(file.mirrors.len());
         let mirror_paths = FieldPath::root("mirrors");
         for (i, desc) in file.mirrors.iter().enumerate() {
@@ -237,7 +257,37 @@ impl Checker<'_> {
             background: self.radiance(&FieldPath::root("background"), file.background)?,
             terminal: self.radiance(&FieldPath::root("terminal"), file.terminal)?,
             geometry,
+            symmetry,
         })
+    }
+
+    /// Seed 001's planes, in file order: at most [`MAX_SYMMETRY_PLANES`], each through a point
+    /// within the scene extent with a non-zero normal.
+    fn symmetry_planes(&self, descs: &[SymmetryPlaneDesc]) -> Result<Vec<SymmetryPlane>> {
+        let path = FieldPath::root("symmetry_planes");
+        if descs.len() > MAX_SYMMETRY_PLANES {
+            return Err(self.invalid(
+                &path,
+                format!(
+                    "at most {MAX_SYMMETRY_PLANES} planes are accepted (each doubles the copies \
+                     of the objects: 2^p), got {}",
+                    descs.len()
+                ),
+            ));
+        }
+        descs
+            .iter()
+            .enumerate()
+            .map(|(i, d)| {
+                let path = path.index(i);
+                let point = self.position(&path.field("point"), d.point)?;
+                let normal = self.direction(&path.field("normal"), d.normal)?;
+                Ok(SymmetryPlane {
+                    name: d.name.clone().unwrap_or_else(|| format!("plane {i}")),
+                    plane: Plane::from_point_normal(point, normal),
+                })
+            })
+            .collect()
     }
 
     fn camera(&self, path: &FieldPath, c: &CameraDesc) -> Result<Camera> {

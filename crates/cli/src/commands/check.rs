@@ -20,8 +20,17 @@ pub fn run(args: &Args) -> Result<(), Failure> {
                     0 => String::new(),
                     n => format!(", {n} degenerate triangles dropped"),
                 };
+                let symmetry = match &scene.symmetry {
+                    None => String::new(),
+                    Some(s) => format!(
+                        ", {} (objects: {} before the bake, 2^p = {} copies)",
+                        count(s.planes.len(), "symmetry plane"),
+                        count(s.source.triangles.len(), "triangle"),
+                        s.copy_count()
+                    ),
+                };
                 println!(
-                    "{}: ok: {}, {} ({} on mirrors), {}, {}x{}{dropped}",
+                    "{}: ok: {}, {} ({} on mirrors), {}, {}x{}{dropped}{symmetry}",
                     path.display(),
                     count(scene.mirrors.len(), "mirror"),
                     count(g.triangles.len(), "triangle"),

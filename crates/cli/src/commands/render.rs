@@ -132,6 +132,12 @@ pub fn run(args: &Args) -> Result<(), Failure> {
                 "pruned_attenuation": c.pruned_attenuation, "capped": c.capped,
                 "pruned_hidden": c.pruned_hidden, "partly_hidden": c.partly_hidden,
             })),
+            "copies": s.copies.map(|c| serde_json::json!({
+                "planes": c.planes, "total": c.total, "drawn": c.drawn,
+                "pruned_empty": c.pruned_empty, "pruned_outside_view": c.pruned_outside_view,
+                "culled_parts": c.culled_parts, "parts": c.parts,
+            })),
+            "bake_ms": out.bake_ms,
             "clipping": s.clipping.name(),
             "depth_format": format!("{:?}", s.depth_format),
             "warnings": out.warnings,
@@ -169,6 +175,22 @@ pub fn run(args: &Args) -> Result<(), Failure> {
                 s.triangles,
             );
         }
+        if let Some(c) = s.copies {
+            println!(
+                "  symmetry: {} planes, {} of {} copies drawn (pruned: {} with an empty cell, {} outside the view); {} of {} object parts drawn with back-face culling; {} triangles submitted",
+                c.planes,
+                c.drawn,
+                c.total,
+                c.pruned_empty,
+                c.pruned_outside_view,
+                c.culled_parts,
+                c.parts,
+                s.triangles,
+            );
+        }
+        if let Some(ms) = out.bake_ms {
+            println!("  split-and-mirror bake: {ms:.2} ms on the CPU while planning (not in the frame time)");
+        }
         println!(
             "  {:.2} ms/frame median, {:.2} min over {} frames ({}); CPU encode+submit {:.2} ms median; GPU memory {} in buffers, {} in textures; on {} ({}, {} targets); wrote {}, {}",
             t.median_ms(),
@@ -195,6 +217,7 @@ fn param_json(value: Option<mirrorbox_raster::ParamValue>) -> serde_json::Value 
         Some(ParamValue::Count(c)) => serde_json::json!(c),
         Some(ParamValue::Real(r)) => serde_json::json!(r),
         Some(ParamValue::Switch(s)) => serde_json::json!(s),
+        Some(ParamValue::Choice(c)) => serde_json::json!(c),
         None => serde_json::Value::Null,
     }
 }

@@ -6,6 +6,9 @@
 
 pub mod portal_stencil;
 pub mod recursive_texture;
+pub mod symmetry;
+pub mod symmetry_baked;
+pub mod symmetry_pruned;
 pub mod unrolled;
 
 use crate::method::MethodEntry;
@@ -16,6 +19,9 @@ pub static METHODS: &[&MethodEntry] = &[
     &recursive_texture::AUXILIARY,
     &portal_stencil::PORTAL,
     &unrolled::UNROLLED,
+    &symmetry::SYMMETRY,
+    &symmetry_pruned::SYMMETRY_PRUNED,
+    &symmetry_baked::SYMMETRY_BAKED,
 ];
 
 /// Every adapter feature a registered method needs or can use.

@@ -101,6 +101,7 @@ impl PlannedFrame for PlannedPortal {
             stats: m.stats,
             encoder: Box::new(m),
             warnings,
+            bake_ms: None,
         })
     }
 }
@@ -291,13 +292,13 @@ impl PortalStencil {
             device,
             match clipping {
                 Clipping::ClipDistances => &CLIP_DISTANCE_SHADER,
-                Clipping::FragmentDiscard => &SHADER,
+                Clipping::FragmentDiscard | Clipping::None => &SHADER,
             },
         );
         // Scene draws clip at the path's last mirror: by clip distance, or per fragment.
         let (scene_vertex, fs_object, fs_mirror, fs_mark) = match clipping {
             Clipping::ClipDistances => ("vs_clip_distances", "fs_object", "fs_mirror", "fs_none"),
-            Clipping::FragmentDiscard => (
+            Clipping::FragmentDiscard | Clipping::None => (
                 "vs_main",
                 "fs_object_discard",
                 "fs_mirror_discard",
@@ -445,6 +446,7 @@ impl PortalStencil {
             paths: Some(PathCounts::of(paths)),
             clipping,
             depth_format,
+            copies: None,
         };
         Ok(PortalStencil {
             scene_buffers,

@@ -174,6 +174,7 @@ impl PlannedFrame for PlannedTextures {
             stats: m.stats,
             encoder: Box::new(m),
             warnings: Vec::new(),
+            bake_ms: None,
         })
     }
 }
@@ -497,7 +498,7 @@ impl RecursiveTexture {
                 "fs_object",
                 "fs_mirror",
             ),
-            Clipping::FragmentDiscard => (
+            Clipping::FragmentDiscard | Clipping::None => (
                 shader_module(device, &SHADER),
                 "vs_main",
                 "fs_object_discard",
@@ -548,6 +549,7 @@ impl RecursiveTexture {
             paths: None,
             clipping,
             depth_format: DEPTH_FORMAT,
+            copies: None,
         };
         Ok(RecursiveTexture {
             scene_buffers,

@@ -153,6 +153,7 @@ impl PlannedFrame for PlannedUnrolled {
             stats: m.stats,
             encoder: Box::new(m),
             warnings: Vec::new(),
+            bake_ms: None,
         })
     }
 }
@@ -599,6 +600,7 @@ impl Unrolled {
                 Clipping::FragmentDiscard
             },
             depth_format: DEPTH_FORMAT,
+            copies: None,
         };
         Ok(Unrolled {
             scene_buffers,

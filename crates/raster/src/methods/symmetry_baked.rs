@@ -1,0 +1,290 @@
+//! `symmetry-baked`: seed 001's symmetry planes baked on the CPU — the objects split and
+//! mirrored once ([`mirrorbox_scene::symmetry::split_and_mirror_with_origins`], the same exact
+//! bake the tracer's truth comes from) — and the mesh drawn in one draw. The seed's advice for
+//! many planes: "split and mirror the mesh whenever the configuration of planes changes … The
+//! new mesh can then be rendered once."
+//!
+//! The bake runs while planning and is timed there: `BuiltFrame::bake_ms` (and `render`'s
+//! output) reports it apart from the frame time, which covers drawing only — a renderer
+//! rebakes only when the planes change. Nothing is clipped (`Clipping::None`) and nothing
+//! culled: the bake's triangles are wound as seen from their front, but the mesh is drawn as
+//! the tracer sees it, two-sided. `FrameStats::copies` counts the copies the bake holds a
+//! triangle of (`drawn`) of the 2^p; the rest were empty. Mirrors are drawn as by `symmetry`,
+//! at reflection depth 0. With `--copy-ids` each pixel shows the copy its triangle came from,
+//! as the bake records it.
+
+use crate::gpu::{Gpu, RasterError};
+use crate::method::{
+    BuiltFrame, Clipping, CopyCounts, FrameStats, MethodEntry, PlannedFrame, RasterMethod,
+};
+use crate::methods::symmetry::{
+    CLIP_DISTANCE_SHADER, COPY_IDS, SHADER, SymmetryFrame, SymmetryInput, gpu_structs,
+    parts_of, uniform_entry,
+};
+use crate::pipeline::{ScenePipeline, depth_state, pipeline_layout};
+use crate::plan::PlanError;
+use crate::projection::NEARER;
+use crate::shading::{SceneBuffers, VERTEX_LAYOUT};
+use crate::symmetry_cells::copy_count;
+use crate::targets::{DEPTH_FORMAT, RenderTarget};
+use crate::timing::FrameEncoder;
+use crate::wgsl::shader_module;
+use glam::Vec3;
+use mirrorbox_scene::symmetry::split_and_mirror_with_origins;
+use mirrorbox_scene::{Geometry, Scene};
+use std::ops::Range;
+use std::time::Instant;
+
+/// The CPU split-and-mirror mesh, drawn once.
+pub static SYMMETRY_BAKED: MethodEntry = MethodEntry {
+    name: "symmetry-baked",
+    help: "Seed 001's symmetry planes baked on the CPU (split and mirrored, timed apart as bake_ms), the mesh drawn once.",
+    exact: true,
+    options: &[&COPY_IDS],
+    swept: None,
+    optional_features: wgpu::Features::empty(),
+    required_features: wgpu::Features::empty(),
+    shaders: &[&SHADER, &CLIP_DISTANCE_SHADER],
+    gpu_structs,
+    configure: |p| {
+        Box::new(SymmetryBakedMethod {
+            copy_ids: p.switch(&COPY_IDS),
+        })
+    },
+};
+
+/// The typed settings of `symmetry-baked`.
+struct SymmetryBakedMethod {
+    copy_ids: bool,
+}
+
+impl RasterMethod for SymmetryBakedMethod {
+    fn plan(
+        &self,
+        scene: &Scene,
+        width: u32,
+        height: u32,
+    ) -> Result<Box<dyn PlannedFrame>, PlanError> {
+        let input = SymmetryInput::of(scene);
+        let mirrors: Vec<_> = parts_of(&scene.geometry, true).collect();
+        let mirror_triangles: usize = mirrors.iter().map(|(_, _, t)| t.len()).sum();
+        let budget = mirrorbox_scene::limits::MAX_TRIANGLES.saturating_sub(mirror_triangles);
+        let started = Instant::now();
+        let (mut geometry, origins) =
+            split_and_mirror_with_origins(&input.source, &input.planes, budget)
+                .map_err(|e| PlanError::Bake(e.to_string()))?;
+        let bake_ms = started.elapsed().as_secs_f64() * 1e3;
+        let objects = 3 * geometry.triangles.len() as u32;
+        for (name, surface, triangles) in mirrors {
+            geometry.push_part(name, surface, triangles);
+        }
+        let all = 3 * geometry.triangles.len() as u32;
+        let p = input.planes.len();
+        let mut holds = vec![false; copy_count(p)];
+        for o in &origins {
+            holds[o.copy as usize] = true;
+        }
+        let drawn = holds.iter().filter(|&&h| h).count();
+        let parts = parts_of(&geometry, false).count();
+        Ok(Box::new(PlannedBake {
+            frame: SymmetryFrame::new(scene, width, height, &input.planes),
+            // Per vertex, the copy its triangle came from (objects first, as SceneBuffers
+            // lays them out).
+            copy_of_vertex: self
+                .copy_ids
+                .then(|| origins.iter().flat_map(|o| [o.copy; 3]).collect()),
+            geometry,
+            objects: 0..objects,
+            mirrors: objects..all,
+            copies: CopyCounts {
+                planes: p,
+                total: copy_count(p),
+                drawn,
+                pruned_empty: copy_count(p) - drawn,
+                pruned_outside_view: 0,
+                culled_parts: 0,
+                parts,
+            },
+            bake_ms,
+        }))
+    }
+}
+
+/// The baked mesh, ready for the GPU.
+struct PlannedBake {
+    frame: SymmetryFrame,
+    geometry: Geometry,
+    copy_of_vertex: Option<Vec<u32>>,
+    objects: Range<u32>,
+    mirrors: Range<u32>,
+    copies: CopyCounts,
+    bake_ms: f64,
+}
+
+impl PlannedFrame for PlannedBake {
+    fn build(self: Box<Self>, gpu: &Gpu, scene: &Scene) -> Result<BuiltFrame, RasterError> {
+        let bake_ms = self.bake_ms;
+        let frame = BakedFrame::new(gpu, scene, *self)?;
+        Ok(BuiltFrame {
+            stats: frame.stats,
+            encoder: Box::new(frame),
+            warnings: Vec::new(),
+            bake_ms: Some(bake_ms),
+        })
+    }
+}
+
+struct BakedFrame {
+    scene_buffers: SceneBuffers,
+    bind_group: wgpu::BindGroup,
+    /// `--copy-ids`: each vertex's copy (vertex buffer 1).
+    copy_ids: Option<wgpu::Buffer>,
+    objects: Range<u32>,
+    mirrors: Range<u32>,
+    object_pipeline: wgpu::RenderPipeline,
+    mirror_pipeline: wgpu::RenderPipeline,
+    clear: Vec3,
+    stats: FrameStats,
+}
+
+impl BakedFrame {
+    fn new(gpu: &Gpu, scene: &Scene, planned: PlannedBake) -> Result<Self, RasterError> {
+        use wgpu::util::DeviceExt;
+        let device = &gpu.device;
+        SceneBuffers::check_fits_geometry(gpu, scene, &planned.geometry)?;
+        let scene_buffers = SceneBuffers::for_geometry(device, scene, &planned.geometry);
+        let frame_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("symmetry-baked frame"),
+            contents: bytemuck::bytes_of(&planned.frame),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("symmetry-baked"),
+            entries: &[uniform_entry(0)],
+        });
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("symmetry-baked"),
+            layout: &layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: frame_buffer.as_entire_binding(),
+            }],
+        });
+        let copy_ids = planned.copy_of_vertex.as_ref().map(|ids| {
+            let mut ids = ids.clone();
+            if ids.is_empty() {
+                ids.push(0); // a buffer may not be empty; no draw reads it
+            }
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("symmetry-baked copy ids"),
+                contents: bytemuck::cast_slice(&ids),
+                usage: wgpu::BufferUsages::VERTEX,
+            })
+        });
+        let pipeline_layout =
+            pipeline_layout(device, "symmetry-baked", &[&scene_buffers.layout, &layout]);
+        let module = shader_module(device, &SHADER);
+        const COPY_ID_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
+            array_stride: 4,
+            step_mode: wgpu::VertexStepMode::Vertex,
+            attributes: &wgpu::vertex_attr_array![3 => Uint32],
+        };
+        let pipeline = |label: &str, vertex: &str, fragment: &str, buffers: &[Option<_>]| {
+            ScenePipeline {
+                label,
+                layout: &pipeline_layout,
+                module: &module,
+                vertex,
+                fragment,
+                buffers,
+                depth_stencil: depth_state(DEPTH_FORMAT, true, NEARER, Default::default()),
+                color_writes: wgpu::ColorWrites::ALL,
+            }
+            .build(gpu)
+        };
+        let (object_pipeline, mirror_pipeline) = if copy_ids.is_some() {
+            (
+                pipeline(
+                    "symmetry-baked copy ids",
+                    "vs_baked_copy_id",
+                    "fs_baked_copy_id",
+                    &[Some(VERTEX_LAYOUT), Some(COPY_ID_LAYOUT)],
+                ),
+                pipeline(
+                    "symmetry-baked mirrors",
+                    "vs_unmoved",
+                    "fs_mirror_copy_id",
+                    &[Some(VERTEX_LAYOUT)],
+                ),
+            )
+        } else {
+            (
+                pipeline(
+                    "symmetry-baked objects",
+                    "vs_unmoved",
+                    "fs_unmoved_object",
+                    &[Some(VERTEX_LAYOUT)],
+                ),
+                pipeline(
+                    "symmetry-baked mirrors",
+                    "vs_unmoved",
+                    "fs_mirror",
+                    &[Some(VERTEX_LAYOUT)],
+                ),
+            )
+        };
+        let stats = FrameStats {
+            passes: 1,
+            texture_renders: 0,
+            draws: usize::from(!planned.objects.is_empty())
+                + usize::from(!planned.mirrors.is_empty())
+                + 1,
+            depth: 0,
+            triangles: (planned.mirrors.end / 3) as usize,
+            paths: None,
+            clipping: Clipping::None,
+            depth_format: DEPTH_FORMAT,
+            copies: Some(planned.copies),
+        };
+        Ok(BakedFrame {
+            scene_buffers,
+            bind_group,
+            copy_ids,
+            objects: planned.objects,
+            mirrors: planned.mirrors,
+            object_pipeline,
+            mirror_pipeline,
+            clear: if planned.copy_of_vertex.is_some() {
+                Vec3::ZERO
+            } else {
+                scene.background
+            },
+            stats,
+        })
+    }
+}
+
+impl FrameEncoder for BakedFrame {
+    fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &RenderTarget,
+        first_pass: Option<wgpu::RenderPassTimestampWrites<'_>>,
+    ) {
+        let mut pass = target.begin_pass(encoder, "symmetry-baked pass", self.clear, first_pass);
+        pass.set_bind_group(0, &self.scene_buffers.bind_group, &[]);
+        pass.set_bind_group(1, &self.bind_group, &[]);
+        pass.set_vertex_buffer(0, self.scene_buffers.vertices.slice(..));
+        if let Some(ids) = &self.copy_ids {
+            pass.set_vertex_buffer(1, ids.slice(..));
+        }
+        if !self.objects.is_empty() {
+            pass.set_pipeline(&self.object_pipeline);
+            pass.draw(self.objects.clone(), 0..1);
+        }
+        if !self.mirrors.is_empty() {
+            pass.set_pipeline(&self.mirror_pipeline);
+            pass.draw(self.mirrors.clone(), 0..1);
+        }
+    }
+}
