@@ -65,7 +65,15 @@ fn check_accepts_every_bundled_scene() {
         })
         .collect();
     scenes.sort();
-    for required in ["mirror_box", "single_mirror", "tilted_pair", "mirror_room"] {
+    for required in [
+        "mirror_box",
+        "single_mirror",
+        "tilted_pair",
+        "mirror_room",
+        "symmetry_star",
+        "symmetry_cube",
+        "symmetry_many",
+    ] {
         assert!(
             scenes.iter().any(|s| s.contains(required)),
             "scenes/{required}.json missing"
@@ -85,6 +93,14 @@ fn check_accepts_every_bundled_scene() {
     assert!(
         out.stdout
             .contains("scenes/mirror_room.json: ok: 4 mirrors"),
+        "{}",
+        out.stdout
+    );
+    assert!(
+        out.stdout.contains(
+            "scenes/symmetry_star.json: ok: 0 mirrors, 8188 triangles (0 on mirrors), 1 light, \
+             640x360, 3 symmetry planes (objects: 1870 triangles before the bake, 2^p = 8 copies)"
+        ),
         "{}",
         out.stdout
     );
@@ -154,6 +170,43 @@ fn zero_normal() {
     assert_rejected(
         |s| s["mirrors"][1]["normal"] = json!([0, 0, 0]),
         &["mirrors[1].normal: must be a non-zero direction, got [0, 0, 0]"],
+    );
+}
+
+#[test]
+fn bad_symmetry_planes_are_refused_naming_the_field() {
+    let plane = json!({ "point": [0, 0, 0], "normal": [1, 0, 0] });
+    assert_rejected(
+        |s| s["symmetry_planes"] = json!([plane, { "point": [0, 0, 0], "normal": [0, 0, 0] }]),
+        &["symmetry_planes[1].normal", "must be a non-zero direction"],
+    );
+    assert_rejected(
+        |s| s["symmetry_planes"] = Value::Array(vec![plane.clone(); 17]),
+        &["symmetry_planes", "at most 16 planes", "got 17"],
+    );
+    assert_rejected(
+        |s| {
+            s["symmetry_planes"] =
+                json!([{ "point": [0, 0, 0], "normal": [1, 0, 0], "up": [0, 1, 0] }])
+        },
+        &["symmetry_planes[0].up", "unknown field"],
+    );
+    // Planes beyond the triangle budget: 1 280 sphere triangles, every one in front of each
+    // of 12 planes far away, would double to 1 280 · 2¹² = 5 242 880 > 2²².
+    assert_rejected(
+        |s| {
+            s["objects"] = json!([{ "type": "sphere", "radius": 0.5 }]);
+            s["symmetry_planes"] = (0..12)
+                .map(|k| {
+                    let mut point = [0.0f32; 3];
+                    let mut normal = [0; 3];
+                    point[k % 3] = -2.0 * 4f32.powi(k as i32 / 3);
+                    normal[k % 3] = 1;
+                    json!({ "point": point, "normal": normal })
+                })
+                .collect();
+        },
+        &["symmetry_planes[11]", "5242880 triangles", "fewer planes"],
     );
 }
 

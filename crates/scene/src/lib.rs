@@ -213,9 +213,10 @@ impl Scene {
             g.surface_of,
             g.surfaces
         );
-        // Scenes without planes keep the hash they had before planes existed (cached truths).
+        // Scenes without planes keep the hash they had before planes existed (cached truths);
+        // a plane's name changes no image.
         if let Some(symmetry) = &self.symmetry {
-            let _ = write!(h, "symmetry{:?}", symmetry.planes);
+            let _ = write!(h, "symmetry{:?}", symmetry.plane_list());
         }
         h.finish()
     }
@@ -243,5 +244,80 @@ mod tests {
         let mut d = a.clone();
         d.camera = d.camera.with_size(33, 24);
         assert_ne!(a.content_hash(), d.content_hash());
+    }
+
+    const WITH_PLANES: &str = r#"{ "camera": { "position": [0, 1, 3], "look_at": [0, 1, 0], "fov_y_deg": 60,
+        "width": 32, "height": 24 },
+        "mirrors": [ { "center": [0, 1, -2], "normal": [0, 0, 1], "up": [0, 1, 0], "width": 4, "height": 3 } ],
+        "objects": [ { "type": "sphere", "subdivisions": 1, "transform": { "translate": [0.3, 1, 0.2] } } ],
+        "symmetry_planes": [ { "point": [0, 1, 0], "normal": [1, 0, 0] },
+                             { "point": [0, 1.1, 0], "normal": [0.2, 1, 0] } ] }"#;
+
+    fn without_field(text: &str) -> Scene {
+        let mut value: serde_json::Value = serde_json::from_str(text).unwrap();
+        value.as_object_mut().unwrap().remove("symmetry_planes");
+        load::parse_scene(&value.to_string(), std::path::Path::new("a.json")).unwrap()
+    }
+
+    #[test]
+    fn symmetry_planes_enter_the_hash_and_survive_without_mirrors() {
+        let a = load::parse_scene(WITH_PLANES, std::path::Path::new("a.json")).unwrap();
+        let plain = without_field(WITH_PLANES);
+        assert_ne!(a.content_hash(), plain.content_hash());
+        // Same baked triangles, other planes: still a different hash.
+        let mut b = a.clone();
+        b.symmetry.as_mut().unwrap().planes[0].name = "renamed".into();
+        assert_eq!(
+            a.content_hash(),
+            b.content_hash(),
+            "a name changes no image"
+        );
+        b.symmetry.as_mut().unwrap().planes[0].plane.offset += 1.0;
+        assert_ne!(a.content_hash(), b.content_hash());
+        let bare = a.without_mirrors();
+        assert_eq!(bare.symmetry, a.symmetry);
+        assert_eq!(bare.geometry.mirror_triangle_count(), 0);
+        assert_eq!(
+            bare.geometry.triangles[..],
+            a.geometry.triangles[..a.geometry.triangles.len() - 2]
+        );
+    }
+
+    #[test]
+    fn with_symmetry_planes_rebakes_the_first_p_planes() {
+        let mut a = load::parse_scene(WITH_PLANES, std::path::Path::new("a.json")).unwrap();
+        a.set_reflectance(Vec3::splat(0.7));
+        let all = a.with_symmetry_planes(2).unwrap();
+        assert_eq!(all.geometry, a.geometry);
+        assert_eq!(all.symmetry, a.symmetry);
+        let none = a.with_symmetry_planes(0).unwrap();
+        let mut plain = without_field(WITH_PLANES);
+        plain.set_reflectance(Vec3::splat(0.7));
+        assert!(none.symmetry.is_none());
+        assert_eq!(none.geometry, plain.geometry);
+        assert_eq!(none.content_hash(), plain.content_hash());
+        let one = a.with_symmetry_planes(1).unwrap();
+        let symmetry = one.symmetry.as_ref().unwrap();
+        assert_eq!(
+            symmetry.planes[..],
+            a.symmetry.as_ref().unwrap().planes[..1]
+        );
+        let baked =
+            symmetry::split_and_mirror(&symmetry.source, &symmetry.plane_list(), usize::MAX)
+                .unwrap();
+        assert_eq!(
+            one.geometry.triangles[..baked.triangles.len()],
+            baked.triangles[..]
+        );
+        assert_eq!(one.geometry.mirror_triangle_count(), 2);
+        assert!(matches!(
+            a.with_symmetry_planes(3),
+            Err(symmetry::SymmetryError::NotThatManyPlanes { asked: 3, have: 2 })
+        ));
+        assert!(plain.with_symmetry_planes(1).is_err());
+        assert_eq!(
+            plain.with_symmetry_planes(0).unwrap().geometry,
+            plain.geometry
+        );
     }
 }

@@ -751,6 +751,100 @@ mod tests {
     }
 
     #[test]
+    fn symmetry_planes_are_validated_with_their_field() {
+        let plane = r#"{ "point": [0, 0, 0], "normal": [1, 0, 0] }"#;
+        let cases = [
+            (
+                r#"{ "point": [0, 0, 0], "normal": [0, 0, 0] }"#,
+                "symmetry_planes[0].normal: must be a non-zero direction",
+            ),
+            (
+                r#"{ "point": [0, 2e6, 0], "normal": [0, 1, 0] }"#,
+                "symmetry_planes[0].point: must lie within the scene extent",
+            ),
+            (
+                r#"{ "point": [0, 0, 1e39], "normal": [0, 1, 0] }"#,
+                "symmetry_planes[0].point[2]: must be a finite number",
+            ),
+            (
+                r#"{ "point": [0, 0, 0], "normal": [1, 0, 0], "offset": 1 }"#,
+                "symmetry_planes[0].offset: unknown field `offset`",
+            ),
+            (r#"{ "normal": [1, 0, 0] }"#, "missing field `point`"),
+        ];
+        for (desc, expected) in cases {
+            let e = refused(&format!(r#", "symmetry_planes": [ {desc} ]"#));
+            assert!(e.contains("s.json") && e.contains(expected), "{e}");
+        }
+        let seventeen = vec![plane; 17].join(", ");
+        let e = refused(&format!(r#", "symmetry_planes": [ {seventeen} ]"#));
+        assert!(
+            e.contains("symmetry_planes: at most 16 planes") && e.contains("got 17"),
+            "{e}"
+        );
+        let sixteen = vec![plane; 16].join(", ");
+        scene_with(&format!(r#", "symmetry_planes": [ {sixteen} ]"#)).unwrap();
+    }
+
+    #[test]
+    fn symmetry_planes_are_baked_into_the_geometry_in_order() {
+        let objects = r#", "objects": [ { "type": "box", "transform": { "translate": [0.2, 0, 0] } } ],
+            "mirrors": [ { "center": [0, 0, -3], "normal": [0, 0, 1], "up": [0, 1, 0], "width": 2, "height": 2 } ]"#;
+        let plain = scene_with(objects).unwrap();
+        assert!(plain.symmetry.is_none());
+        let empty = scene_with(&format!(r#"{objects}, "symmetry_planes": []"#)).unwrap();
+        assert!(empty.symmetry.is_none());
+        assert_eq!(empty.geometry, plain.geometry);
+        let s = scene_with(&format!(
+            r#"{objects}, "symmetry_planes": [ {{ "name": "x", "point": [0, 0, 0], "normal": [2, 0, 0] }},
+                {{ "point": [0, 0.1, 0], "normal": [0, 1, 0] }} ]"#
+        ))
+        .unwrap();
+        let symmetry = s.symmetry.as_ref().unwrap();
+        assert_eq!(symmetry.planes[0].name, "x");
+        assert_eq!(symmetry.planes[1].name, "plane 1");
+        assert_eq!(symmetry.planes[0].plane.normal, Vec3::X);
+        assert_eq!(symmetry.source.triangles, plain.geometry.triangles[..12]);
+        let baked =
+            symmetry::split_and_mirror(&symmetry.source, &symmetry.plane_list(), usize::MAX)
+                .unwrap();
+        let objects_end = baked.triangles.len();
+        assert_eq!(s.geometry.triangles[..objects_end], baked.triangles[..]);
+        // The mirror follows the baked objects, untouched.
+        assert_eq!(
+            s.geometry.triangles[objects_end..],
+            plain.geometry.triangles[12..]
+        );
+        assert_eq!(s.geometry.mirror_triangle_count(), 2);
+    }
+
+    #[test]
+    fn a_bake_past_the_triangle_budget_is_refused_naming_the_plane() {
+        // 20 480 triangles, wholly in front of every plane: each doubles them, so plane 7
+        // would take the bake to 2⁸ · 20 480 = 5 242 880 > 2²² (the mirror takes 2 more).
+        // Plane k lies at −2·4^k on axis k mod 3, beyond everything earlier planes made.
+        let planes: Vec<String> = (0..8)
+            .map(|k| {
+                let mut point = [0.0; 3];
+                let mut normal = [0; 3];
+                point[k % 3] = -2.0 * 4f32.powi(k as i32);
+                normal[k % 3] = 1;
+                format!(r#"{{ "point": {point:?}, "normal": {normal:?} }}"#)
+            })
+            .collect();
+        let e = refused(&format!(
+            r#", "objects": [ {{ "type": "sphere", "subdivisions": 5 }} ], "symmetry_planes": [ {} ]"#,
+            planes.join(", ")
+        ));
+        assert!(
+            e.contains("symmetry_planes[7]: after plane 7")
+                && e.contains("5242880 triangles")
+                && e.contains("4194304"),
+            "{e}"
+        );
+    }
+
+    #[test]
     fn an_empty_scene_loads() {
         let s = scene_with("").unwrap();
         assert!(s.geometry.triangles.is_empty() && s.mirrors.is_empty());
