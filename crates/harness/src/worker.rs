@@ -38,6 +38,9 @@ pub struct RenderJob {
     pub scene_hash: u64,
     /// Where the worker writes the rendered image (linear EXR).
     pub image: PathBuf,
+    /// The symmetry planes the scene keeps (a `--symmetry-planes` sweep); `None`: all.
+    #[serde(default)]
+    pub symmetry_planes: Option<u32>,
 }
 
 /// What a worker measured.
@@ -65,6 +68,19 @@ pub struct RenderReport {
     /// bytes (`mirrorbox_raster::GpuMemory`).
     pub gpu_buffer_bytes: u64,
     pub gpu_texture_bytes: u64,
+    /// Symmetry methods: the copies drawn and 2^p.
+    #[serde(default)]
+    pub copies: Option<CopyReport>,
+    /// `symmetry-baked`: CPU time of the bake, ms (outside the frame time).
+    #[serde(default)]
+    pub bake_ms: Option<f64>,
+}
+
+/// [`mirrorbox_raster::method::CopyCounts`] as a worker reports it.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CopyReport {
+    pub drawn: usize,
+    pub total: usize,
 }
 
 /// A rendered point: the image and what was measured.
@@ -91,6 +107,8 @@ fn job_scene(job: &RenderJob) -> Result<Scene, HarnessError> {
     scene.resize(Some(job.width), Some(job.height))?;
     if job.floor {
         scene = scene.without_mirrors();
+    } else if let Some(p) = job.symmetry_planes {
+        scene = scene.with_symmetry_planes(p as usize)?;
     }
     scene.set_reflectance(Vec3::splat(job.alpha));
     Ok(scene)
@@ -141,6 +159,11 @@ pub fn run_job(job: &RenderJob, gpu: &Gpu) -> Result<Rendered, HarnessError> {
             encode_ms: out.timing.encode_ms.clone(),
             gpu_buffer_bytes: out.gpu_memory.buffer_bytes,
             gpu_texture_bytes: out.gpu_memory.texture_bytes,
+            copies: s.copies.map(|c| CopyReport {
+                drawn: c.drawn,
+                total: c.total,
+            }),
+            bake_ms: out.bake_ms,
         },
         image: out.image,
     })

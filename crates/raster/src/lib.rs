@@ -41,7 +41,8 @@ pub use adapter::{AdapterError, AdapterReport, SelectedAdapter, select_adapter};
 pub use color_format::ColorFormat;
 pub use gpu::{Gpu, GpuOptions, RasterError};
 pub use method::{
-    Clipping, CopyCounts, FrameStats, MethodEntry, OptionSpec, ParamError, ParamValue, PathCounts, RasterMethod,
+    Clipping, CopyCounts, FrameStats, MethodEntry, OptionSpec, ParamError, ParamValue, PathCounts,
+    RasterMethod,
 };
 pub use plan::PlanError;
 pub use registry::{METHODS, Method};

@@ -381,9 +381,10 @@ impl OptionSpec {
             OptionKind::Count { .. } => t.parse().map(ParamValue::Count).ok(),
             OptionKind::Real { .. } => t.parse().map(ParamValue::Real).ok(),
             OptionKind::Switch => t.parse().map(ParamValue::Switch).ok(),
-            OptionKind::Choice { values } => {
-                values.iter().find(|v| **v == t).map(|v| ParamValue::Choice(v))
-            }
+            OptionKind::Choice { values } => values
+                .iter()
+                .find(|v| **v == t)
+                .map(|v| ParamValue::Choice(v)),
         };
         self.check(value.ok_or_else(|| self.out_of_range(format!("{text:?}")))?)
     }

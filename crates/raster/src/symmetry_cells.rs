@@ -122,7 +122,10 @@ impl ConvexPolytope {
             [4, 6, 7, 5],
         ];
         ConvexPolytope {
-            faces: faces.iter().map(|f| f.iter().map(|&i| c(i)).collect()).collect(),
+            faces: faces
+                .iter()
+                .map(|f| f.iter().map(|&i| c(i)).collect())
+                .collect(),
         }
     }
 
@@ -181,11 +184,16 @@ impl ConvexPolytope {
 /// The points (coplanar, on a plane with normal `normal`), deduplicated and ordered by angle
 /// about their centroid; `None` for fewer than 3 distinct points.
 fn convex_polygon_on_plane(points: &[DVec3], normal: DVec3) -> Option<Vec<DVec3>> {
-    let scale = points.iter().fold(0.0f64, |m, p| m.max(p.abs().max_element()));
+    let scale = points
+        .iter()
+        .fold(0.0f64, |m, p| m.max(p.abs().max_element()));
     let tolerance = 1e-12 * scale.max(1.0);
     let mut distinct: Vec<DVec3> = Vec::new();
     for &p in points {
-        if !distinct.iter().any(|q| (*q - p).abs().max_element() <= tolerance) {
+        if !distinct
+            .iter()
+            .any(|q| (*q - p).abs().max_element() <= tolerance)
+        {
             distinct.push(p);
         }
     }
@@ -381,7 +389,9 @@ mod tests {
                 }
             }
         }
-        (0..kept.len() as u32).filter(|&m| kept[m as usize]).collect()
+        (0..kept.len() as u32)
+            .filter(|&m| kept[m as usize])
+            .collect()
     }
 
     #[test]
@@ -389,14 +399,22 @@ mod tests {
         let planes = [plane(Vec3::ZERO, Vec3::X)];
         // In front: the copy as it is and its reflection — bit 0 moves nothing a later plane
         // tests, so both share the cell.
-        let front = select_copies(&planes, Some((Vec3::new(1.0, 0.0, 0.0), Vec3::ONE * 2.0)), None);
+        let front = select_copies(
+            &planes,
+            Some((Vec3::new(1.0, 0.0, 0.0), Vec3::ONE * 2.0)),
+            None,
+        );
         assert_eq!(front.drawn, vec![0, 1]);
         // Behind: the cascade culls everything behind the plane, in both copies.
         let behind = select_copies(&planes, Some((-Vec3::ONE * 2.0, -Vec3::ONE)), None);
         assert_eq!(behind.drawn, Vec::<u32>::new());
         assert_eq!(behind.pruned_empty, 2);
         // Lying on the plane (a quad in it): kept, as the cascade keeps d = 0.
-        let on = select_copies(&planes, Some((Vec3::new(0.0, -1.0, -1.0), Vec3::new(0.0, 1.0, 1.0))), None);
+        let on = select_copies(
+            &planes,
+            Some((Vec3::new(0.0, -1.0, -1.0), Vec3::new(0.0, 1.0, 1.0))),
+            None,
+        );
         assert_eq!(on.drawn, vec![0, 1]);
     }
 
@@ -521,7 +539,25 @@ mod tests {
         assert!(half.vertices().all(|v| h.distance(v) >= -1e-12));
         let cap = half.faces.last().unwrap();
         assert_eq!(cap.len(), 4);
-        assert!(cube.clip(&HalfSpace { normal: DVec3::X, offset: 2.0 }, 0.0).is_none());
-        assert_eq!(cube.clip(&HalfSpace { normal: DVec3::X, offset: -1.0 }, 0.0), Some(cube.clone()));
+        assert!(
+            cube.clip(
+                &HalfSpace {
+                    normal: DVec3::X,
+                    offset: 2.0
+                },
+                0.0
+            )
+            .is_none()
+        );
+        assert_eq!(
+            cube.clip(
+                &HalfSpace {
+                    normal: DVec3::X,
+                    offset: -1.0
+                },
+                0.0
+            ),
+            Some(cube.clone())
+        );
     }
 }

@@ -872,7 +872,10 @@ fn copy_ids(image: &RgbImage) -> Vec<u32> {
 
 /// Pixels off the truth by more than 1e-3, and FLIP.
 fn error_against(truth: &RgbImage, image: &RgbImage) -> (usize, f64) {
-    let off = differences(image, truth).iter().filter(|&&x| x > 1e-3).count();
+    let off = differences(image, truth)
+        .iter()
+        .filter(|&&x| x > 1e-3)
+        .count();
     let flip = mirrorbox_image::metrics::compare(truth, image, 1.0)
         .unwrap()
         .flip_mean;
@@ -897,7 +900,9 @@ fn symmetry_methods_match_the_truth_on_every_symmetry_scene() {
         let floor = render(&gpu, &s, &settings(m("naive"), 1)).unwrap().image;
         let (floor_off, floor_flip) = error_against(&truth, &floor);
         let n = truth.pixels.len();
-        println!("{name} ({planes} planes): floor (naive on the baked mesh) {floor_off} of {n} pixels off, FLIP {floor_flip:.2e}");
+        println!(
+            "{name} ({planes} planes): floor (naive on the baked mesh) {floor_off} of {n} pixels off, FLIP {floor_flip:.2e}"
+        );
         let runs = [
             (&gpu, "symmetry"),
             (&gpu, "symmetry fragment-clipping"),
@@ -905,7 +910,10 @@ fn symmetry_methods_match_the_truth_on_every_symmetry_scene() {
             (&gpu, "symmetry symmetry-draws=per-copy"),
             (&gpu, "symmetry-pruned"),
             (&gpu, "symmetry-pruned fragment-clipping"),
-            (&without_clip_distances, "symmetry-pruned symmetry-draws=per-copy"),
+            (
+                &without_clip_distances,
+                "symmetry-pruned symmetry-draws=per-copy",
+            ),
             (&gpu, "symmetry-baked"),
         ];
         for (gpu, key) in runs {
@@ -942,7 +950,9 @@ fn symmetry_methods_match_the_truth_on_every_symmetry_scene() {
             );
             if off > floor_off + n / 1000 || flip > floor_flip + 2e-4 {
                 let where_ = dump(&label, &out.image, &truth);
-                panic!("{label}: {off} pixels off, FLIP {flip} (floor {floor_off}, {floor_flip}); {where_}");
+                panic!(
+                    "{label}: {off} pixels off, FLIP {flip} (floor {floor_off}, {floor_flip}); {where_}"
+                );
             }
         }
         let _ = has_clip_distances;
@@ -1007,7 +1017,10 @@ fn the_same_copies_reach_the_screen_in_every_symmetry_method() {
             if key.starts_with("symmetry-pruned") && !key.contains("fragment") {
                 assert_eq!(differing, 0, "{name} {key}");
             } else {
-                assert!(differing * 500 <= n, "{name} {key}: {differing} pixels differ");
+                assert!(
+                    differing * 500 <= n,
+                    "{name} {key}: {differing} pixels differ"
+                );
             }
         }
     }
@@ -1024,10 +1037,17 @@ fn symmetry_methods_without_planes_are_the_floor() {
         for key in ["symmetry", "symmetry-pruned", "symmetry-baked"] {
             let out = render(&gpu, &s, &settings(m(key), 1)).unwrap();
             let copies = out.stats.copies.unwrap();
-            assert_eq!((copies.planes, copies.total, copies.drawn), (0, 1, 1), "{name} {key}");
+            assert_eq!(
+                (copies.planes, copies.total, copies.drawn),
+                (0, 1, 1),
+                "{name} {key}"
+            );
             let d = differences(&out.image, &floor);
             let off = d.iter().filter(|&&x| x > 1e-5).count();
-            println!("{name} {key}: {off} of {} pixels differ from naive by > 1e-5", d.len());
+            println!(
+                "{name} {key}: {off} of {} pixels differ from naive by > 1e-5",
+                d.len()
+            );
             assert_eq!(off, 0, "{name} {key}");
         }
     }

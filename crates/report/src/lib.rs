@@ -10,6 +10,7 @@ pub mod exact;
 pub mod plot;
 pub mod readme;
 pub mod stats;
+pub mod symmetry;
 pub mod table1;
 mod write;
 
@@ -46,6 +47,22 @@ pub struct Record {
     pub scene: String,
     pub scene_hash: String,
     pub method: String,
+    /// The method's options that are neither swept nor at their default, as
+    /// `name=value` words (e.g. `symmetry-draws=per-copy`): a variant of the method with its
+    /// own series in the report. Empty in older records.
+    #[serde(default)]
+    pub method_options: String,
+    /// Symmetry planes p the point's scene kept (a `--symmetry-planes` sweep, seed 001).
+    #[serde(default)]
+    pub symmetry_planes: Option<u32>,
+    /// Symmetry methods: copies of the objects drawn, and 2^p.
+    #[serde(default)]
+    pub copies_drawn: Option<usize>,
+    #[serde(default)]
+    pub copies_total: Option<usize>,
+    /// `symmetry-baked`: CPU time of the split-and-mirror bake, ms, outside the frame time.
+    #[serde(default)]
+    pub bake_ms: Option<f64>,
     /// Auxiliary mirrors (auxiliary method).
     pub n: Option<u32>,
     /// Reflection depth (depth-limited methods).

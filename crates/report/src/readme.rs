@@ -7,7 +7,9 @@
 //! --check` (run by the tests) fails when a region differs from what the reports give.
 //! Everything outside the regions is left alone, byte for byte.
 
-use crate::write::{Block, depth_scaling, floor_paragraph, markdown, table1_section};
+use crate::write::{
+    Block, depth_scaling, floor_paragraph, markdown, symmetry_section, table1_section,
+};
 use crate::{Record, SweepInfo, read_records, stats, table1};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -55,6 +57,11 @@ pub const REGIONS: &[(&str, &str, &str)] = &[
         "depth-scaling-table",
         "depth_scaling",
         "the exact methods' cost against depth, every point, and per bounce",
+    ),
+    (
+        "symmetry-scaling",
+        "symmetry_scaling",
+        "the symmetry methods against p: every point, the crossover, the pruning",
     ),
     (
         "main-job",
@@ -159,6 +166,19 @@ fn depth_scaling_region(s: &Sweep, table: bool) -> Result<String, ReadmeError> {
     }
     let mut blocks = vec![Block::Paragraph(measured_on(s))];
     blocks.extend(bullets);
+    Ok(markdown(&blocks))
+}
+
+fn symmetry_region(s: &Sweep) -> Result<String, ReadmeError> {
+    let section = prose(symmetry_section(&s.records));
+    if section.is_empty() {
+        return Err(ReadmeError(format!(
+            "{}: no symmetry-planes sweep, nothing to quote",
+            s.info.scene
+        )));
+    }
+    let mut blocks = vec![Block::Paragraph(measured_on(s))];
+    blocks.extend(section);
     Ok(markdown(&blocks))
 }
 
@@ -306,6 +326,7 @@ pub fn generate(id: &str, reports: &Path) -> Result<Region, ReadmeError> {
         )?,
         "depth-scaling" => depth_scaling_region(&load_sweep(&folder(source))?, false)?,
         "depth-scaling-table" => depth_scaling_region(&load_sweep(&folder(source))?, true)?,
+        "symmetry-scaling" => symmetry_region(&load_sweep(&folder(source))?)?,
         "main-job" => main_job_region(&folder(source))?,
         _ => unreachable!("every ID in REGIONS has a generator"),
     };

@@ -105,15 +105,18 @@ fn row_interval(r: &table1::Row) -> String {
 }
 
 fn label(r: &Record) -> String {
-    match (r.n, r.depth) {
-        (Some(n), _) => format!("{} n={n}", r.method),
-        (None, Some(d)) => format!("{} depth={d}", r.method),
-        _ => r.method.clone(),
+    let name = crate::symmetry::variant(r);
+    match (r.n, r.depth, r.symmetry_planes) {
+        (Some(n), _, _) => format!("{name} n={n}"),
+        (None, Some(d), _) => format!("{name} depth={d}"),
+        (None, None, Some(p)) => format!("{name} p={p}"),
+        _ => name,
     }
 }
 
+/// A point's place on its method's axis: n, the depth, or the symmetry planes p.
 fn setting(r: &Record) -> f64 {
-    r.n.or(r.depth).map_or(0.0, f64::from)
+    r.n.or(r.depth).or(r.symmetry_planes).map_or(0.0, f64::from)
 }
 
 /// Writes `results.csv`, `report.md`, `report.html` and the `plot_*.svg` files into `dir`.
@@ -245,14 +248,14 @@ fn esc(s: &str) -> String {
 fn write_csv(path: &Path, records: &[Record]) -> Result<(), FileError> {
     let mut s = String::from(
         "kind,method,n,depth,alpha,width,height,ssaa,ms_median,ms_ci_low,ms_ci_high,ms_min,timing_order,timing_source,frames,passes,draws,texture_renders,reflections,\
-         rmse,relmse,smape,max_abs,psnr,ssim,flip_mean,flip_p95,flip_p99,adapter,backend,scene,scene_hash,color_format,peak_memory_bytes,plan_ms,encode_ms,gpu_buffer_bytes,gpu_texture_bytes\n",
+         rmse,relmse,smape,max_abs,psnr,ssim,flip_mean,flip_p95,flip_p99,adapter,backend,scene,scene_hash,color_format,peak_memory_bytes,plan_ms,encode_ms,gpu_buffer_bytes,gpu_texture_bytes,method_options,symmetry_planes,copies_drawn,copies_total,bake_ms\n",
     );
     for r in records {
         let m = &r.metrics;
         let opt = |v: Option<u32>| v.map_or(String::new(), |x| x.to_string());
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},\"{}\",{},\"{}\",{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},\"{}\",{},\"{}\",{},{},{},{},{},{},{},\"{}\",{},{},{},{}",
             r.kind,
             r.method,
             opt(r.n),
@@ -290,7 +293,12 @@ fn write_csv(path: &Path, records: &[Record]) -> Result<(), FileError> {
             r.plan_ms.map_or(String::new(), |ms| ms.to_string()),
             r.encode_ms.map_or(String::new(), |ms| ms.to_string()),
             r.gpu_buffer_bytes.map_or(String::new(), |b| b.to_string()),
-            r.gpu_texture_bytes.map_or(String::new(), |b| b.to_string())
+            r.gpu_texture_bytes.map_or(String::new(), |b| b.to_string()),
+            r.method_options,
+            opt(r.symmetry_planes),
+            r.copies_drawn.map_or(String::new(), |c| c.to_string()),
+            r.copies_total.map_or(String::new(), |c| c.to_string()),
+            r.bake_ms.map_or(String::new(), |ms| ms.to_string())
         );
     }
     write_atomically(path, s.as_bytes())
@@ -549,6 +557,112 @@ pub(crate) fn table1_section(info: &SweepInfo, records: &[Record]) -> Vec<Block>
     b
 }
 
+/// ms/frame against the symmetry planes p for each symmetry method (seed 001), with the 2^p
+/// growth of the seed's copies beside it, the copies drawn, the bake, and the computed
+/// sentences: where baking starts to win, how much pruning removes.
+pub(crate) fn symmetry_section(records: &[Record]) -> Vec<Block> {
+    use crate::symmetry::{
+        BAKED_METHOD, PRUNED_METHOD, crossover_sentence, plane_scaling, pruning_sentence,
+    };
+    let groups = plane_scaling(records);
+    if groups.is_empty() {
+        return Vec::new();
+    }
+    let mut series: Vec<Series> = groups
+        .iter()
+        .map(|g| Series {
+            name: g.name.clone(),
+            points: g.points.iter().map(|r| (setting(r), r.ms_median)).collect(),
+            labels: Vec::new(),
+            x_intervals: Vec::new(),
+            y_intervals: g.points.iter().map(|r| r.ms_interval).collect(),
+        })
+        .collect();
+    // The seed's worst case: 2^p times the cost of one copy (the first method's p = 0 time).
+    if let Some(base) = groups[0]
+        .points
+        .first()
+        .filter(|r| r.symmetry_planes == Some(0))
+    {
+        let ps: Vec<u32> = groups[0]
+            .points
+            .iter()
+            .filter_map(|r| r.symmetry_planes)
+            .collect();
+        series.push(Series {
+            name: format!("2^p × {}'s p = 0 time", groups[0].name),
+            points: ps
+                .iter()
+                .map(|&p| (f64::from(p), base.ms_median * f64::from(1u32 << p.min(31))))
+                .collect(),
+            labels: Vec::new(),
+            x_intervals: Vec::new(),
+            y_intervals: Vec::new(),
+        });
+    }
+    let opt = |v: Option<usize>| v.map_or("–".into(), |x| x.to_string());
+    let mut out = vec![
+        Block::Heading(2, "Symmetry planes: cost against p".into()),
+        Block::Chart(
+            "plot_ms_vs_planes.svg".into(),
+            Chart {
+                title: "ms/frame vs symmetry planes p".into(),
+                x_label: "symmetry planes p".into(),
+                y_label: "ms/frame (median, 95 % CI bars)".into(),
+                x_log: false,
+                y_log: true,
+                series,
+                reference_lines: Vec::new(),
+            }
+            .to_svg(),
+        ),
+        Block::Table(
+            [
+                "method",
+                "p",
+                "copies drawn / 2^p",
+                "triangles",
+                "bake ms (CPU, once)",
+                "ms/frame median [95 % CI]",
+                "FLIP mean",
+            ]
+            .map(String::from)
+            .to_vec(),
+            groups
+                .iter()
+                .flat_map(|g| &g.points)
+                .map(|r| {
+                    vec![
+                        crate::symmetry::variant(r),
+                        opt(r.symmetry_planes.map(|p| p as usize)),
+                        format!("{} / {}", opt(r.copies_drawn), opt(r.copies_total)),
+                        opt(r.triangles),
+                        r.bake_ms.map_or("–".into(), |ms| f(ms, 2)),
+                        ms_cell(r, 2),
+                        sci(r.metrics.flip_mean),
+                    ]
+                })
+                .collect(),
+        ),
+    ];
+    let mut sentences = Vec::new();
+    if let Some(baked) = groups.iter().find(|g| g.method == BAKED_METHOD) {
+        for other in groups.iter().filter(|g| g.method != BAKED_METHOD) {
+            sentences.push(crossover_sentence(baked, other));
+        }
+    }
+    sentences.extend(
+        groups
+            .iter()
+            .filter(|g| g.method == PRUNED_METHOD)
+            .filter_map(pruning_sentence),
+    );
+    if !sentences.is_empty() {
+        out.push(Block::Bullets(sentences));
+    }
+    out
+}
+
 /// What the comparison cannot resolve: raster vs trace without mirrors.
 pub(crate) fn floor_paragraph(fl: &Record) -> Block {
     Block::Paragraph(format!(
@@ -625,11 +739,13 @@ fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
     }
 
     b.extend(depth_scaling(info, records, floor));
+    b.extend(symmetry_section(records));
 
     let mut groups: Vec<(String, f32)> = Vec::new();
     for r in &points {
-        if !groups.contains(&(r.method.clone(), r.alpha)) {
-            groups.push((r.method.clone(), r.alpha));
+        let group = (crate::symmetry::variant(r), r.alpha);
+        if !groups.contains(&group) {
+            groups.push(group);
         }
     }
     // `ms_on_x`: x is the median time, drawn with its 95 % interval as an error bar.
@@ -640,7 +756,7 @@ fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
                 .map(|(m, a)| {
                     let mut pts: Vec<&&Record> = points
                         .iter()
-                        .filter(|r| &r.method == m && r.alpha == *a)
+                        .filter(|r| &crate::symmetry::variant(r) == m && r.alpha == *a)
                         .collect();
                     pts.sort_by(|p, q| setting(p).total_cmp(&setting(q)));
                     Series {
@@ -776,7 +892,7 @@ fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
         for (m, a) in &groups {
             let mut pts: Vec<&&Record> = points
                 .iter()
-                .filter(|r| &r.method == m && r.alpha == *a)
+                .filter(|r| &crate::symmetry::variant(r) == m && r.alpha == *a)
                 .collect();
             pts.sort_by(|p, q| setting(p).total_cmp(&setting(q)));
             let chosen: Vec<&&Record> = match pts.len() {
@@ -803,17 +919,22 @@ fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::MetricValues;
 
-    fn record(n: u32, ms: f64, passes: usize, flip: f64) -> Record {
+    pub(crate) fn record(n: u32, ms: f64, passes: usize, flip: f64) -> Record {
         Record {
             key: format!("auxiliary n={n}"),
             kind: "point".into(),
             scene: "s.json".into(),
             scene_hash: "00".into(),
             method: "auxiliary".into(),
+            method_options: String::new(),
+            symmetry_planes: None,
+            copies_drawn: None,
+            copies_total: None,
+            bake_ms: None,
             n: Some(n),
             depth: None,
             alpha: 0.7,
@@ -1075,9 +1196,15 @@ mod tests {
         );
         let csv = std::fs::read_to_string(dir.path().join("results.csv")).unwrap();
         assert!(csv.lines().next().unwrap().ends_with(
-            ",color_format,peak_memory_bytes,plan_ms,encode_ms,gpu_buffer_bytes,gpu_texture_bytes"
+            ",color_format,peak_memory_bytes,plan_ms,encode_ms,gpu_buffer_bytes,gpu_texture_bytes,\
+             method_options,symmetry_planes,copies_drawn,copies_total,bake_ms"
         ));
-        assert!(csv.lines().nth(2).unwrap().ends_with(",rgba16float,,,,,"));
+        assert!(
+            csv.lines()
+                .nth(2)
+                .unwrap()
+                .ends_with(",rgba16float,,,,,,\"\",,,,")
+        );
         // Every row has the header's number of columns (no value here holds a comma).
         let columns = |l: &str| l.split(',').count();
         let header = columns(csv.lines().next().unwrap());

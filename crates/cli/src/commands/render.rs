@@ -189,7 +189,9 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             );
         }
         if let Some(ms) = out.bake_ms {
-            println!("  split-and-mirror bake: {ms:.2} ms on the CPU while planning (not in the frame time)");
+            println!(
+                "  split-and-mirror bake: {ms:.2} ms on the CPU while planning (not in the frame time)"
+            );
         }
         println!(
             "  {:.2} ms/frame median, {:.2} min over {} frames ({}); CPU encode+submit {:.2} ms median; GPU memory {} in buffers, {} in textures; on {} ({}, {} targets); wrote {}, {}",

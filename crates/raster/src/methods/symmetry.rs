@@ -34,8 +34,8 @@
 
 use crate::gpu::{Gpu, RasterError};
 use crate::method::{
-    BuiltFrame, Clipping, CopyCounts, FrameStats, MethodEntry, OptionKind, OptionSpec,
-    ParamValue, Params, PlannedFrame, RasterMethod,
+    BuiltFrame, Clipping, CopyCounts, FrameStats, MethodEntry, OptionKind, OptionSpec, ParamValue,
+    Params, PlannedFrame, RasterMethod,
 };
 use crate::methods::unrolled::FRAGMENT_CLIPPING;
 use crate::pipeline::{
@@ -272,9 +272,7 @@ pub fn is_closed(triangles: &[[Vec3; 3]]) -> bool {
     let mut edges: HashMap<([u32; 3], [u32; 3]), u32> = HashMap::new();
     for t in triangles {
         for k in 0..3 {
-            *edges
-                .entry((key(t[k]), key(t[(k + 1) % 3])))
-                .or_default() += 1;
+            *edges.entry((key(t[k]), key(t[(k + 1) % 3]))).or_default() += 1;
         }
     }
     edges
@@ -286,7 +284,12 @@ pub fn is_closed(triangles: &[[Vec3; 3]]) -> bool {
 /// lies outside the box `lo..hi` (by a margin relative to the scene's size): then no copy of
 /// what the box holds surrounds the eye.
 fn eye_outside_every_copy(planes: &[Plane], masks: &[u32], eye: Vec3, lo: Vec3, hi: Vec3) -> bool {
-    let scale = lo.abs().max(hi.abs()).max_element().max(eye.abs().max_element()).max(1.0);
+    let scale = lo
+        .abs()
+        .max(hi.abs())
+        .max_element()
+        .max(eye.abs().max_element())
+        .max(1.0);
     let margin = 1e-4 * scale as f64;
     let (lo, hi) = (lo.as_dvec3() - margin, hi.as_dvec3() + margin);
     masks.iter().all(|&mask| {
@@ -372,12 +375,13 @@ pub(crate) fn plan_copies(
         if triangles.is_empty() {
             continue;
         }
-        let (lo, hi) = triangles.iter().flatten().fold(
-            (Vec3::INFINITY, Vec3::NEG_INFINITY),
-            |(a, b), p| (a.min(*p), b.max(*p)),
-        );
-        let culled =
-            is_closed(&triangles) && eye_outside_every_copy(planes, &masks, eye, lo, hi);
+        let (lo, hi) = triangles
+            .iter()
+            .flatten()
+            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(a, b), p| {
+                (a.min(*p), b.max(*p))
+            });
+        let culled = is_closed(&triangles) && eye_outside_every_copy(planes, &masks, eye, lo, hi);
         if culled {
             culled_parts.push((name, surface, triangles));
         } else {
@@ -618,16 +622,17 @@ impl CopiesFrame {
             (false, true) => "fs_object_clipped",
             (true, true) => "fs_copy_id_clipped",
         };
-        let pipeline = |label: &'static str, vertex: &'static str, fragment: &'static str| ScenePipeline {
-            label,
-            layout: &pipeline_layout,
-            module: &module,
-            vertex,
-            fragment,
-            buffers: &[Some(VERTEX_LAYOUT)],
-            depth_stencil: depth_state(DEPTH_FORMAT, true, NEARER, Default::default()),
-            color_writes: wgpu::ColorWrites::ALL,
-        };
+        let pipeline =
+            |label: &'static str, vertex: &'static str, fragment: &'static str| ScenePipeline {
+                label,
+                layout: &pipeline_layout,
+                module: &module,
+                vertex,
+                fragment,
+                buffers: &[Some(VERTEX_LAYOUT)],
+                depth_stencil: depth_state(DEPTH_FORMAT, true, NEARER, Default::default()),
+                color_writes: wgpu::ColorWrites::ALL,
+            };
         let culled_even = pipeline("symmetry even copies (culled)", vertex, fragment)
             .build_culling_back_faces(gpu, wgpu::FrontFace::Ccw);
         let culled_odd = pipeline("symmetry odd copies (culled)", vertex, fragment)
@@ -638,7 +643,8 @@ impl CopiesFrame {
         } else {
             "fs_mirror"
         };
-        let mirror_pipeline = pipeline("symmetry mirrors", "vs_unmoved", mirror_fragment).build(gpu);
+        let mirror_pipeline =
+            pipeline("symmetry mirrors", "vs_unmoved", mirror_fragment).build(gpu);
 
         let draws = planned.draws;
         let stats = FrameStats {

@@ -18,8 +18,8 @@ use crate::method::{
     BuiltFrame, Clipping, CopyCounts, FrameStats, MethodEntry, PlannedFrame, RasterMethod,
 };
 use crate::methods::symmetry::{
-    CLIP_DISTANCE_SHADER, COPY_IDS, SHADER, SymmetryFrame, SymmetryInput, gpu_structs,
-    parts_of, uniform_entry,
+    CLIP_DISTANCE_SHADER, COPY_IDS, SHADER, SymmetryFrame, SymmetryInput, gpu_structs, parts_of,
+    uniform_entry,
 };
 use crate::pipeline::{ScenePipeline, depth_state, pipeline_layout};
 use crate::plan::PlanError;

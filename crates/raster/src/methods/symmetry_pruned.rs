@@ -52,11 +52,7 @@ impl RasterMethod for SymmetryPrunedMethod {
     ) -> Result<Box<dyn PlannedFrame>, PlanError> {
         let input = SymmetryInput::of(scene);
         let clip_from_world = SymmetryFrame::new(scene, width, height, &[]).clip_from_world();
-        let selection = select_copies(
-            &input.planes,
-            input.source.bounds(),
-            Some(clip_from_world),
-        );
+        let selection = select_copies(&input.planes, input.source.bounds(), Some(clip_from_world));
         plan_copies(scene, &input, width, height, selection, self.settings)
     }
 }
