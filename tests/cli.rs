@@ -1203,10 +1203,18 @@ fn sweep_measures_the_symmetry_methods_by_plane_count() {
     };
     // The star has three planes: asking for more, or for more than any scene may have, is
     // refused before anything is written.
-    for (planes, says) in [("4", "--symmetry-planes"), ("17", "0..=16"), ("2..=1", "0..=16")] {
+    for (planes, says) in [
+        ("4", "--symmetry-planes"),
+        ("17", "0..=16"),
+        ("2..=1", "0..=16"),
+    ] {
         let refused = run(planes);
         assert_eq!(refused.code, 2, "{planes}: {}", refused.stderr);
-        assert!(refused.stderr.contains(says), "{planes}: {}", refused.stderr);
+        assert!(
+            refused.stderr.contains(says),
+            "{planes}: {}",
+            refused.stderr
+        );
         assert!(!out.exists(), "{planes}: nothing written");
     }
     let done = run("0..=3");
@@ -1222,7 +1230,12 @@ fn sweep_measures_the_symmetry_methods_by_plane_count() {
         for r in &recs {
             let p = r["symmetry_planes"].as_u64().unwrap();
             assert_eq!(r["copies_total"].as_u64(), Some(1 << p), "{method}");
-            assert!(r["key"].as_str().unwrap().contains(&format!("|planes={p}|")));
+            assert!(
+                r["key"]
+                    .as_str()
+                    .unwrap()
+                    .contains(&format!("|planes={p}|"))
+            );
         }
     }
     // The seed's six-pointed star: the pruned method keeps 6 of the 8 copies at p = 3.
@@ -1237,7 +1250,10 @@ fn sweep_measures_the_symmetry_methods_by_plane_count() {
         .unwrap();
     assert!(baked["bake_ms"].as_f64().is_some());
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
-    assert!(report.contains("## Symmetry planes: cost against p"), "{report}");
+    assert!(
+        report.contains("## Symmetry planes: cost against p"),
+        "{report}"
+    );
     assert!(out.join("plot_ms_vs_planes.svg").exists());
 }
 

@@ -708,12 +708,13 @@ pub fn run_sweep(
         let heat: Vec<u8> = map.iter().flat_map(|&v| colormap::heat(v)).collect();
         let heat_png = images.join(format!("{}_flip.png", p.slug));
         write_png_bytes(&heat_png, w, h, &heat)?;
+        // One truth per α (and per plane count in a symmetry-planes sweep).
         let truth_png = images.join(format!(
             "truth_{}.png",
-            if p.method.is_some() {
-                format!("a{}", p.alpha)
-            } else {
-                "floor".into()
+            match (&p.method, p.planes) {
+                (None, _) => "floor".into(),
+                (Some(_), None) => format!("a{}", p.alpha),
+                (Some(_), Some(planes)) => format!("p{planes}_a{}", p.alpha),
             }
         ));
         let truth_source = truth_path.with_extension("png");
