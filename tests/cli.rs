@@ -1176,6 +1176,96 @@ fn sweep_measures_the_exact_methods_by_depth() {
 }
 
 #[test]
+fn sweep_measures_the_symmetry_methods_by_plane_count() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("s");
+    let o = out.to_str().unwrap();
+    let args = |planes: &'static str| -> Vec<String> {
+        [
+            "sweep",
+            "scenes/symmetry_star.json",
+            "--out",
+            o,
+            "--methods",
+            "symmetry,symmetry-pruned,symmetry-baked",
+            "--symmetry-planes",
+            planes,
+            "--alpha",
+            "1",
+            "--width",
+            "48",
+            "--height",
+            "27",
+            "--frames",
+            "1",
+            "--warmup",
+            "0",
+        ]
+        .iter()
+        .map(|a| a.to_string())
+        .collect()
+    };
+    let run = |planes: &'static str| {
+        let a = args(planes);
+        mirrorbox(&a.iter().map(String::as_str).collect::<Vec<_>>(), &[])
+    };
+    // The star has three planes: asking for more, or for more than any scene may have, is
+    // refused before anything is written.
+    for (planes, says) in [
+        ("4", "--symmetry-planes"),
+        ("17", "0..=16"),
+        ("2..=1", "0..=16"),
+    ] {
+        let refused = run(planes);
+        assert_eq!(refused.code, 2, "{planes}: {}", refused.stderr);
+        assert!(
+            refused.stderr.contains(says),
+            "{planes}: {}",
+            refused.stderr
+        );
+        assert!(!out.exists(), "{planes}: nothing written");
+    }
+    let done = run("0..=3");
+    assert_eq!(done.code, 0, "{}", done.stderr);
+    let all = records(&out);
+    for method in ["symmetry", "symmetry-pruned", "symmetry-baked"] {
+        let recs: Vec<&Value> = all.iter().filter(|r| r["method"] == method).collect();
+        let planes: Vec<u64> = recs
+            .iter()
+            .map(|r| r["symmetry_planes"].as_u64().unwrap())
+            .collect();
+        assert_eq!(planes, vec![0, 1, 2, 3], "{method}");
+        for r in &recs {
+            let p = r["symmetry_planes"].as_u64().unwrap();
+            assert_eq!(r["copies_total"].as_u64(), Some(1 << p), "{method}");
+            assert!(
+                r["key"]
+                    .as_str()
+                    .unwrap()
+                    .contains(&format!("|planes={p}|"))
+            );
+        }
+    }
+    // The seed's six-pointed star: the pruned method keeps 6 of the 8 copies at p = 3.
+    let pruned = all
+        .iter()
+        .find(|r| r["method"] == "symmetry-pruned" && r["symmetry_planes"] == 3)
+        .unwrap();
+    assert_eq!(pruned["copies_drawn"].as_u64(), Some(6), "{pruned}");
+    let baked = all
+        .iter()
+        .find(|r| r["method"] == "symmetry-baked" && r["symmetry_planes"] == 3)
+        .unwrap();
+    assert!(baked["bake_ms"].as_f64().is_some());
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(
+        report.contains("## Symmetry planes: cost against p"),
+        "{report}"
+    );
+    assert!(out.join("plot_ms_vs_planes.svg").exists());
+}
+
+#[test]
 fn render_unrolled_reports_paths_and_clipping() {
     let dir = tempfile::tempdir().unwrap();
     let png = dir.path().join("u.png");

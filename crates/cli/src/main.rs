@@ -39,8 +39,12 @@ enum Command {
     Table1(commands::sweep::PresetArgs),
     /// The preset sweep of the exact methods' cost against depth 1…1024 (writes reports/depth_scaling/).
     DepthScaling(commands::sweep::PresetArgs),
+    /// The preset sweep of the symmetry methods against the number of planes p = 0…10 (writes reports/symmetry_scaling/).
+    SymmetryScaling(commands::sweep::PresetArgs),
     /// Export a scene as Mitsuba 3 XML (tools/mitsuba renders and compares it).
     ExportMitsuba(commands::export_mitsuba::Args),
+    /// Fill the generated regions of README.md and docs/methods.md from the committed reports (--check: only compare).
+    Readme(commands::readme::Args),
     /// Internal: one timed render of a sweep, a job as JSON on stdin (see
     /// `mirrorbox_harness::worker`).
     #[command(hide = true)]
@@ -180,7 +184,9 @@ fn main() -> ExitCode {
         Command::Sweep(args) => commands::sweep::run(&args),
         Command::Table1(args) => commands::sweep::run_table1(&args),
         Command::DepthScaling(args) => commands::sweep::run_depth_scaling(&args),
+        Command::SymmetryScaling(args) => commands::sweep::run_symmetry_scaling(&args),
         Command::ExportMitsuba(args) => commands::export_mitsuba::run(&args),
+        Command::Readme(args) => commands::readme::run(&args),
         Command::RenderWorker => {
             mirrorbox_harness::serve(std::io::stdin().lock(), std::io::stdout().lock())
                 .map_err(Failure::from)

@@ -56,6 +56,10 @@ pub struct SweepConfig {
     /// (`EXE render-worker`, [`worker`]), so that the driver's per-frame memory is returned
     /// after each and every point's peak memory is its own; `None` renders in this process.
     pub worker: Option<PathBuf>,
+    /// The symmetry planes axis (seed 001): each point's scene keeps the first p of the
+    /// scene's `symmetry_planes`, for every p listed (`--symmetry-planes`); `None` keeps the
+    /// scene as it is.
+    pub symmetry_planes: Option<Vec<u32>>,
 }
 
 /// The methods `name` at each value of its swept option (`"auxiliary"`, `[0, 1, 2]`), every
@@ -90,6 +94,7 @@ impl SweepConfig {
             truth: WhittedSettings::default(),
             command: String::new(),
             worker: None,
+            symmetry_planes: None,
         }
     }
 
@@ -112,6 +117,35 @@ impl SweepConfig {
             .flat_map(|m| swept(m, (0..=10).map(|k| 1 << k)))
             .collect();
         SweepConfig::preset(out, methods, vec![1.0])
+    }
+
+    /// Symmetry planes (seed 001): the seed's method (instanced, and one draw per copy), the
+    /// pruned copies and the CPU-baked mesh for p = 0…10 of `symmetry_many`'s ten planes; no
+    /// mirrors, so one α.
+    pub fn symmetry_scaling(out: PathBuf) -> Self {
+        let named = |name: &str| Method::named(name).unwrap_or_else(|e| panic!("preset: {e}"));
+        let per_copy = named("symmetry")
+            .with_text(
+                &mirrorbox_raster::methods::symmetry::SYMMETRY_DRAWS,
+                "per-copy",
+            )
+            .unwrap_or_else(|e| panic!("preset: {e}"));
+        let methods = vec![
+            named("symmetry"),
+            per_copy,
+            named("symmetry-pruned"),
+            named("symmetry-baked"),
+        ];
+        // The seed's method takes seconds per frame at p = 10 on a CPU rasterizer (2^10
+        // copies of 5 708 triangles): 6 timed frames (the fewest that give an interval) after
+        // one warm-up keep the preset within minutes.
+        SweepConfig {
+            scene: PathBuf::from("scenes/symmetry_many.json"),
+            symmetry_planes: Some((0..=10).collect()),
+            frames: 6,
+            warmup: 1,
+            ..SweepConfig::preset(out, methods, vec![1.0])
+        }
     }
 
     /// A preset on the paper's scene (mirror_box) with 9 timed frames: enough for a 95 %
@@ -149,13 +183,23 @@ impl SweepConfig {
             unit_interval("--alpha", a)?;
         }
         self.truth.check()?;
-        let points = 1 + self.methods.len().saturating_mul(self.alphas.len());
+        let planes = self.symmetry_planes.as_ref().map_or(1, Vec::len);
+        if planes == 0 {
+            return Err(
+                SettingError::new("--symmetry-planes", "at least one plane count", "none").into(),
+            );
+        }
+        let points = 1 + self
+            .methods
+            .len()
+            .saturating_mul(self.alphas.len())
+            .saturating_mul(planes);
         if points > MAX_POINTS {
             return Err(SettingError::new(
-                "--methods × their axes × --alpha",
+                "--methods × their axes × --alpha × --symmetry-planes",
                 format!("at most {MAX_POINTS} points"),
                 format!(
-                    "{} configured methods × {} α = {points} points",
+                    "{} configured methods × {} α × {planes} plane counts = {points} points",
                     self.methods.len(),
                     self.alphas.len()
                 ),
@@ -205,6 +249,9 @@ pub enum HarnessError {
     /// A render worker refused its point (exit 2: a resource beyond the device or a budget).
     #[error("{0}")]
     WorkerRefused(String),
+    /// `--symmetry-planes` asks for more planes than the scene has, or the bake is refused.
+    #[error("--symmetry-planes: {0}")]
+    SymmetryPlanes(#[from] mirrorbox_scene::symmetry::SymmetryError),
 }
 
 impl HarnessError {
@@ -214,6 +261,7 @@ impl HarnessError {
             | HarnessError::Refused { .. }
             | HarnessError::Setting(_)
             | HarnessError::WorkerRefused(_)
+            | HarnessError::SymmetryPlanes(_)
             | HarnessError::OutputFolder { .. } => true,
             HarnessError::Raster(e) => e.is_refusal(),
             HarnessError::File(e) => e.refused,
@@ -265,6 +313,8 @@ pub struct Summary {
 struct Point {
     method: Option<Method>,
     alpha: f32,
+    /// Symmetry planes kept (a `--symmetry-planes` sweep).
+    planes: Option<u32>,
     key: String,
     label: String,
     slug: String,
@@ -272,9 +322,11 @@ struct Point {
 
 /// The resume key of a point: the method's stable [`Method::key`], then the α, size, SSAA,
 /// frames and scene. Frozen: earlier `results.jsonl` files resume by it.
-fn point_key(method: Option<&Method>, alpha: f32, common: &str) -> String {
+/// A symmetry-planes sweep adds `|planes=p` after the method (keys without it are as before).
+fn point_key(method: Option<&Method>, alpha: f32, planes: Option<u32>, common: &str) -> String {
+    let planes = planes.map_or(String::new(), |p| format!("|planes={p}"));
     match method {
-        Some(m) => format!("{}|alpha={alpha}|{common}", m.key()),
+        Some(m) => format!("{}{planes}|alpha={alpha}|{common}", m.key()),
         None => format!("floor|{common}"),
     }
 }
@@ -287,24 +339,35 @@ fn points(config: &SweepConfig, base_hash: u64, w: u32, h: u32) -> Vec<Point> {
     let mut out = vec![Point {
         method: None,
         alpha: 1.0,
-        key: point_key(None, 1.0, &common),
+        planes: None,
+        key: point_key(None, 1.0, None, &common),
         label: "floor (no mirrors)".into(),
         slug: "floor".into(),
     }];
+    let plane_axis: Vec<Option<u32>> = match &config.symmetry_planes {
+        Some(ps) => ps.iter().map(|&p| Some(p)).collect(),
+        None => vec![None],
+    };
     for &alpha in &config.alphas {
-        for method in &config.methods {
-            let key = point_key(Some(method), alpha, &common);
-            // A value listed twice (`--depth 1,1`, `--alpha 0.7,0.7`) is one point.
-            if out.iter().any(|p| p.key == key) {
-                continue;
+        for &planes in &plane_axis {
+            for method in &config.methods {
+                let key = point_key(Some(method), alpha, planes, &common);
+                // A value listed twice (`--depth 1,1`, `--alpha 0.7,0.7`) is one point.
+                if out.iter().any(|p| p.key == key) {
+                    continue;
+                }
+                let (p_label, p_slug) = planes.map_or((String::new(), String::new()), |p| {
+                    (format!(" p={p}"), format!("_p{p}"))
+                });
+                out.push(Point {
+                    key,
+                    label: format!("{method}{p_label} α={alpha}"),
+                    slug: format!("{}{p_slug}_a{alpha}", method.slug()),
+                    method: Some(method.clone()),
+                    alpha,
+                    planes,
+                });
             }
-            out.push(Point {
-                key,
-                label: format!("{method} α={alpha}"),
-                slug: format!("{}_a{alpha}", method.slug()),
-                method: Some(method.clone()),
-                alpha,
-            });
         }
     }
     out
@@ -414,11 +477,15 @@ fn rendered_image(cache: &Path, i: usize) -> PathBuf {
 pub const FLOOR_METHOD: &str = "naive";
 
 /// A point's scene (mirrors removed for the floor, reflectance α) and render settings.
-fn point_setup(base: &Scene, p: &Point, config: &SweepConfig) -> (Scene, RenderSettings) {
-    let mut scene = if p.method.is_some() {
-        base.clone()
-    } else {
-        base.without_mirrors()
+fn point_setup(
+    base: &Scene,
+    p: &Point,
+    config: &SweepConfig,
+) -> Result<(Scene, RenderSettings), HarnessError> {
+    let mut scene = match (&p.method, p.planes) {
+        (None, _) => base.without_mirrors(),
+        (Some(_), Some(planes)) => base.with_symmetry_planes(planes as usize)?,
+        (Some(_), None) => base.clone(),
     };
     scene.set_reflectance(Vec3::splat(p.alpha));
     let method = p
@@ -431,7 +498,7 @@ fn point_setup(base: &Scene, p: &Point, config: &SweepConfig) -> (Scene, RenderS
         frames: config.frames,
         warmup: config.warmup,
     };
-    (scene, settings)
+    Ok((scene, settings))
 }
 
 /// The sweep's scene at its size (`--width/--height` over the camera's), and that size.
@@ -484,11 +551,17 @@ pub fn point_keys(config: &SweepConfig) -> Result<Vec<String>, HarnessError> {
 /// Runs (or resumes) the sweep and writes its reports; `fresh` discards the points already
 /// in `results.jsonl` first (cached truths stay). The output folder is locked for the whole
 /// run: a second sweep into it is refused at once, naming the process that holds it.
+/// The current UTC time, RFC 3339 to the second.
+fn now_rfc3339() -> String {
+    humantime::format_rfc3339_seconds(std::time::SystemTime::now()).to_string()
+}
+
 pub fn run_sweep(
     config: &SweepConfig,
     fresh: bool,
     progress: &mut dyn FnMut(Event),
 ) -> Result<Summary, HarnessError> {
+    let run_started = now_rfc3339();
     let (base, w, h) = base_scene(config)?;
     let base_hash = base.content_hash();
     let all = points(config, base_hash, w, h);
@@ -523,7 +596,7 @@ pub fn run_sweep(
         read_records(&results).map_err(io(&results))?
     };
     for p in still_to_do(&done_before) {
-        let (scene, settings) = point_setup(&base, p, config);
+        let (scene, settings) = point_setup(&base, p, config)?;
         mirrorbox_raster::plan_frame(&scene, &settings).map_err(|source| {
             HarnessError::Refused {
                 point: p.label.clone(),
@@ -562,7 +635,7 @@ pub fn run_sweep(
     let mut jobs = Vec::with_capacity(todo.len());
     for (i, p) in todo.iter().enumerate() {
         progress(Event::Started { label: &p.label });
-        let (scene, settings) = point_setup(&base, p, config);
+        let (scene, settings) = point_setup(&base, p, config)?;
         truths.push(truth(&scene, config, &cache, &mut summary)?.1);
         jobs.push(RenderJob {
             scene: config.scene.clone(),
@@ -576,6 +649,7 @@ pub fn run_sweep(
             warmup: config.warmup,
             scene_hash: scene.content_hash(),
             image: rendered_image(&cache, i),
+            symmetry_planes: p.planes,
         });
     }
     // Interleaved timing: `frames` rounds; in each, every point renders its warm-up frames
@@ -586,6 +660,7 @@ pub fn run_sweep(
     let mut last: Vec<Option<RenderReport>> = todo.iter().map(|_| None).collect();
     let mut peaks: Vec<Option<u64>> = vec![None; todo.len()];
     let mut plans: Vec<Vec<f64>> = vec![Vec::new(); todo.len()];
+    let mut encodes: Vec<Vec<f64>> = vec![Vec::new(); todo.len()];
     let mut order: Vec<usize> = (0..todo.len()).collect();
     let mut rng = mirrorbox_report::stats::Rng::new(INTERLEAVE_SEED);
     for round in 0..config.frames {
@@ -604,6 +679,7 @@ pub fn run_sweep(
             };
             timed[i].extend(&report.frames_ms);
             plans[i].push(report.plan_ms);
+            encodes[i].extend(&report.encode_ms);
             peaks[i] = peaks[i].max(report.peak_memory_bytes);
             last[i] = Some(report);
         }
@@ -632,12 +708,13 @@ pub fn run_sweep(
         let heat: Vec<u8> = map.iter().flat_map(|&v| colormap::heat(v)).collect();
         let heat_png = images.join(format!("{}_flip.png", p.slug));
         write_png_bytes(&heat_png, w, h, &heat)?;
+        // One truth per α (and per plane count in a symmetry-planes sweep).
         let truth_png = images.join(format!(
             "truth_{}.png",
-            if p.method.is_some() {
-                format!("a{}", p.alpha)
-            } else {
-                "floor".into()
+            match (&p.method, p.planes) {
+                (None, _) => "floor".into(),
+                (Some(_), None) => format!("a{}", p.alpha),
+                (Some(_), Some(planes)) => format!("p{planes}_a{}", p.alpha),
             }
         ));
         let truth_source = truth_path.with_extension("png");
@@ -660,6 +737,14 @@ pub fn run_sweep(
             scene: config.scene.display().to_string(),
             scene_hash: format!("{base_hash:016x}"),
             method: p.method.as_ref().map_or("floor", |m| m.name()).into(),
+            method_options: p
+                .method
+                .as_ref()
+                .map_or(String::new(), Method::variant_options),
+            symmetry_planes: p.planes,
+            copies_drawn: s.copies.map(|c| c.drawn),
+            copies_total: s.copies.map(|c| c.total),
+            bake_ms: s.bake_ms,
             n: p.method.as_ref().and_then(|m| m.count_of("n")),
             depth: p.method.as_ref().and_then(|m| m.count_of("depth")),
             alpha: p.alpha,
@@ -671,8 +756,12 @@ pub fn run_sweep(
             ms_interval: interval.map(|i| [i.low, i.high]),
             frames_ms,
             timing_order: "interleaved".into(),
+            run: Some(run_started.clone()),
             peak_memory_bytes: peaks[i],
             plan_ms: Some(mirrorbox_report::stats::median(&plans[i])),
+            encode_ms: Some(mirrorbox_report::stats::median(&encodes[i])),
+            gpu_buffer_bytes: Some(s.gpu_buffer_bytes),
+            gpu_texture_bytes: Some(s.gpu_texture_bytes),
             timing_source: s.timing_source.clone(),
             frames: config.frames,
             passes: s.passes,
@@ -711,7 +800,7 @@ pub fn run_sweep(
         .collect();
     let info = SweepInfo {
         command: config.command.clone(),
-        date: humantime::format_rfc3339_seconds(std::time::SystemTime::now()).to_string(),
+        date: now_rfc3339(),
         cpu: cpu_description(),
         adapter: gpu.report.name.clone(),
         backend: gpu.report.backend.clone(),
@@ -737,9 +826,7 @@ pub fn run_sweep(
     };
     write_atomically(
         &out.join("sweep.json"),
-        serde_json::json!({ "command": info.command, "date": info.date })
-            .to_string()
-            .as_bytes(),
+        serde_json::to_string_pretty(&info)?.as_bytes(),
     )?;
     write_report(out, &info, &records)?;
     Ok(summary)

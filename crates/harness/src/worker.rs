@@ -38,6 +38,9 @@ pub struct RenderJob {
     pub scene_hash: u64,
     /// Where the worker writes the rendered image (linear EXR).
     pub image: PathBuf,
+    /// The symmetry planes the scene keeps (a `--symmetry-planes` sweep); `None`: all.
+    #[serde(default)]
+    pub symmetry_planes: Option<u32>,
 }
 
 /// What a worker measured.
@@ -59,6 +62,25 @@ pub struct RenderReport {
     pub peak_memory_bytes: Option<u64>,
     /// Wall time of planning the frame on the CPU, ms.
     pub plan_ms: f64,
+    /// CPU time of encoding and submitting each timed frame, ms, in order.
+    pub encode_ms: Vec<f64>,
+    /// GPU memory held by buffers and by textures while the frame's resources were alive,
+    /// bytes (`mirrorbox_raster::GpuMemory`).
+    pub gpu_buffer_bytes: u64,
+    pub gpu_texture_bytes: u64,
+    /// Symmetry methods: the copies drawn and 2^p.
+    #[serde(default)]
+    pub copies: Option<CopyReport>,
+    /// `symmetry-baked`: CPU time of the bake, ms (outside the frame time).
+    #[serde(default)]
+    pub bake_ms: Option<f64>,
+}
+
+/// [`mirrorbox_raster::method::CopyCounts`] as a worker reports it.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CopyReport {
+    pub drawn: usize,
+    pub total: usize,
 }
 
 /// A rendered point: the image and what was measured.
@@ -85,6 +107,8 @@ fn job_scene(job: &RenderJob) -> Result<Scene, HarnessError> {
     scene.resize(Some(job.width), Some(job.height))?;
     if job.floor {
         scene = scene.without_mirrors();
+    } else if let Some(p) = job.symmetry_planes {
+        scene = scene.with_symmetry_planes(p as usize)?;
     }
     scene.set_reflectance(Vec3::splat(job.alpha));
     Ok(scene)
@@ -132,6 +156,14 @@ pub fn run_job(job: &RenderJob, gpu: &Gpu) -> Result<Rendered, HarnessError> {
             backend: gpu.report.backend.clone(),
             peak_memory_bytes: peak_memory_bytes(),
             plan_ms,
+            encode_ms: out.timing.encode_ms.clone(),
+            gpu_buffer_bytes: out.gpu_memory.buffer_bytes,
+            gpu_texture_bytes: out.gpu_memory.texture_bytes,
+            copies: s.copies.map(|c| CopyReport {
+                drawn: c.drawn,
+                total: c.total,
+            }),
+            bake_ms: out.bake_ms,
         },
         image: out.image,
     })

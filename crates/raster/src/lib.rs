@@ -146,9 +146,32 @@ pub struct RenderOutput {
     pub color_format: ColorFormat,
     /// Conditions under which the image may not be what the method promises.
     pub warnings: Vec<String>,
+    /// GPU memory the device held while the frame's resources were alive.
+    pub gpu_memory: GpuMemory,
     /// CPU milliseconds of baking geometry while planning (`symmetry-baked`), apart from the
     /// frame time ([`method::BuiltFrame::bake_ms`]).
     pub bake_ms: Option<f64>,
+}
+
+/// Bytes of GPU memory held by the device's buffers and textures (wgpu's internal counters:
+/// the allocation sizes its backend made, alignment included), read while a frame's
+/// resources are alive. Device-wide: in a render worker, which renders one point, that is
+/// the point's footprint plus the resolve target and readback buffers.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct GpuMemory {
+    pub buffer_bytes: u64,
+    pub texture_bytes: u64,
+}
+
+impl GpuMemory {
+    pub fn read(gpu: &Gpu) -> GpuMemory {
+        let hal = gpu.device.get_internal_counters().hal;
+        let bytes = |c: isize| u64::try_from(c).unwrap_or(0);
+        GpuMemory {
+            buffer_bytes: bytes(hal.buffer_memory.read()),
+            texture_bytes: bytes(hal.texture_memory.read()),
+        }
+    }
 }
 
 /// A frame planned on the CPU: a refused configuration (too many passes, paths, …) fails
@@ -204,12 +227,14 @@ pub fn render_planned(
         settings.warmup,
         settings.frames,
     )?;
+    let gpu_memory = GpuMemory::read(gpu);
     Ok(RenderOutput {
         image,
         timing,
         stats: built.stats,
         color_format: gpu.color_format,
         warnings: built.warnings,
+        gpu_memory,
         bake_ms: built.bake_ms,
     })
 }

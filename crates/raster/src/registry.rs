@@ -142,6 +142,21 @@ impl Method {
         key
     }
 
+    /// The options of the key other than the swept one, `name=value` separated by spaces
+    /// (empty at the defaults): what makes this a variant of its method in a report, e.g.
+    /// `symmetry-draws=per-copy`.
+    pub fn variant_options(&self) -> String {
+        let entry = self.entry();
+        let mut words = Vec::new();
+        for (o, v) in entry.options.iter().zip(self.params.values()) {
+            let swept = entry.swept.is_some_and(|s| s.name == o.name);
+            if !swept && o.in_key && *v != o.default {
+                words.push(format!("{}={v}", o.name));
+            }
+        }
+        words.join(" ")
+    }
+
     /// A file-name-safe form of the key: `auxiliary_n2`, `portal_d64` (sweep image names).
     pub fn slug(&self) -> String {
         self.key()

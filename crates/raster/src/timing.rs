@@ -41,6 +41,10 @@ pub struct FrameTiming {
     pub source: TimingSource,
     /// Milliseconds of each timed frame, in order.
     pub frames_ms: Vec<f64>,
+    /// CPU milliseconds of each timed frame's encoding and submission: from creating its
+    /// command encoder until `submit` returns (the driver's share of recording the passes,
+    /// which GPU timestamps do not see), in order.
+    pub encode_ms: Vec<f64>,
 }
 
 impl FrameTiming {
@@ -93,7 +97,9 @@ pub fn run_frames(
     });
     let period_ns = gpu.queue.get_timestamp_period() as f64;
     let mut frames_ms = Vec::with_capacity(frames as usize);
+    let mut encode_ms = Vec::with_capacity(frames as usize);
     for frame in 0..warmup + frames.max(1) {
+        let encoding = Instant::now();
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("frame"),
         });
@@ -119,6 +125,7 @@ pub fn run_frames(
         }
         let started = Instant::now();
         gpu.queue.submit([encoder.finish()]);
+        let encoded_ms = encoding.elapsed().as_secs_f64() * 1e3;
         gpu.wait()?;
         let wall_ms = started.elapsed().as_secs_f64() * 1e3;
         gpu.check()?;
@@ -131,6 +138,7 @@ pub fn run_frames(
         };
         if frame >= warmup {
             frames_ms.push(ms);
+            encode_ms.push(encoded_ms);
         }
     }
     let source = if queries.is_some() {
@@ -139,5 +147,12 @@ pub fn run_frames(
         TimingSource::WallClock
     };
     let image = read_texture(gpu, &resolve.output)?;
-    Ok((image, FrameTiming { source, frames_ms }))
+    Ok((
+        image,
+        FrameTiming {
+            source,
+            frames_ms,
+            encode_ms,
+        },
+    ))
 }

@@ -9,9 +9,11 @@
 use crate::{Record, linear_fit};
 
 /// Whether `r` is a point of one of the `exact` methods (names from the raster registry,
-/// carried by [`crate::SweepInfo::exact_methods`]).
+/// carried by [`crate::SweepInfo::exact_methods`]) at a reflection depth — the mirror
+/// methods; the exact symmetry methods have no depth and are reported over p
+/// ([`crate::symmetry`]).
 pub fn is_exact(exact: &[String], r: &Record) -> bool {
-    r.kind == "point" && exact.contains(&r.method)
+    r.kind == "point" && exact.contains(&r.method) && r.depth.is_some()
 }
 
 /// One method's cost against depth at one α.

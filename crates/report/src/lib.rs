@@ -4,10 +4,13 @@
 //! - [`Record`]: one measured point (one JSON line of `results.jsonl`).
 //! - [`write_report`]: `results.csv`, `report.md`, a self-contained `report.html` and the SVG
 //!   plots, including the reproduction of the seed paper's Table 1 ([`table1`]).
+//! - [`readme`]: the README's figures, generated from the committed reports.
 
 pub mod exact;
 pub mod plot;
+pub mod readme;
 pub mod stats;
+pub mod symmetry;
 pub mod table1;
 mod write;
 
@@ -44,6 +47,22 @@ pub struct Record {
     pub scene: String,
     pub scene_hash: String,
     pub method: String,
+    /// The method's options that are neither swept nor at their default, as
+    /// `name=value` words (e.g. `symmetry-draws=per-copy`): a variant of the method with its
+    /// own series in the report. Empty in older records.
+    #[serde(default)]
+    pub method_options: String,
+    /// Symmetry planes p the point's scene kept (a `--symmetry-planes` sweep, seed 001).
+    #[serde(default)]
+    pub symmetry_planes: Option<u32>,
+    /// Symmetry methods: copies of the objects drawn, and 2^p.
+    #[serde(default)]
+    pub copies_drawn: Option<usize>,
+    #[serde(default)]
+    pub copies_total: Option<usize>,
+    /// `symmetry-baked`: CPU time of the split-and-mirror bake, ms, outside the frame time.
+    #[serde(default)]
+    pub bake_ms: Option<f64>,
     /// Auxiliary mirrors (auxiliary method).
     pub n: Option<u32>,
     /// Reflection depth (depth-limited methods).
@@ -66,6 +85,12 @@ pub struct Record {
     /// every point alike) or `back-to-back` (all of a point's frames in a row: older records).
     #[serde(default = "back_to_back")]
     pub timing_order: String,
+    /// When the sweep run that measured this point started (UTC, RFC 3339). Frames are
+    /// interleaved only among the points of one run: a point reused from an earlier run (a
+    /// resumed sweep) was timed beside other points, on the machine of that day, and its frames
+    /// pair with no one else's. Absent in older records.
+    #[serde(default)]
+    pub run: Option<String>,
     /// Peak resident memory of the process that rendered the point (its render worker),
     /// bytes; absent in older records.
     #[serde(default)]
@@ -74,6 +99,18 @@ pub struct Record {
     /// median over the rounds; GPU timestamps do not include it. Absent in older records.
     #[serde(default)]
     pub plan_ms: Option<f64>,
+    /// CPU wall time of encoding and submitting one frame's command buffer (recording every
+    /// pass and draw, until `submit` returns), ms, median over the timed frames. Absent in
+    /// older records.
+    #[serde(default)]
+    pub encode_ms: Option<f64>,
+    /// GPU memory held by buffers, and by textures, while the point's frame was alive
+    /// (wgpu's allocation counters, device-wide in the point's render worker), bytes.
+    /// Absent in older records.
+    #[serde(default)]
+    pub gpu_buffer_bytes: Option<u64>,
+    #[serde(default)]
+    pub gpu_texture_bytes: Option<u64>,
     pub timing_source: String,
     pub frames: u32,
     pub passes: usize,
@@ -110,8 +147,10 @@ fn rgba32float() -> String {
     "rgba32float".into()
 }
 
-/// Facts about the whole sweep, printed at the top of every report.
+/// Facts about the whole sweep, printed at the top of every report and kept in the sweep
+/// folder's `sweep.json` (which the README's generated regions read).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
 pub struct SweepInfo {
     pub command: String,
     /// UTC, RFC 3339.

@@ -8,6 +8,11 @@ pub struct Series {
     pub points: Vec<(f64, f64)>,
     /// A short label drawn beside each point (e.g. "n=2"); empty for none.
     pub labels: Vec<String>,
+    /// An interval around each point's x (e.g. a 95 % confidence interval of a median time),
+    /// drawn as a horizontal error bar; empty, or `None` for a point without one.
+    pub x_intervals: Vec<Option<[f64; 2]>>,
+    /// The same for y, drawn as a vertical error bar.
+    pub y_intervals: Vec<Option<[f64; 2]>>,
 }
 
 pub struct Chart {
@@ -24,11 +29,18 @@ pub struct Chart {
 const PALETTE: [&str; 8] = [
     "#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#e377c2", "#17becf",
 ];
-const W: f64 = 720.0;
+/// Width of the plot area; the legend's column is added to its right, as wide as its longest
+/// entry needs.
+const PLOT_W: f64 = 450.0;
 const H: f64 = 420.0;
 const LEFT: f64 = 80.0;
-const RIGHT: f64 = 190.0;
+/// Approximate advance of one character of the 12 px sans-serif legend text.
+const LEGEND_CHAR_W: f64 = 7.0;
+/// The legend column: its margin, the sample line and the gap before the text.
+const LEGEND_PAD: f64 = 14.0 + 28.0 + 10.0;
 const TOP: f64 = 40.0;
+/// Half-length of an error bar's end caps, px.
+const ERROR_CAP: f64 = 4.0;
 const BOTTOM: f64 = 50.0;
 
 fn esc(s: &str) -> String {
@@ -116,25 +128,41 @@ fn fmt_tick(v: f64) -> String {
 
 impl Chart {
     pub fn to_svg(&self) -> String {
+        // The axes span the points and their error bars.
+        let bounds = |i: &[Option<[f64; 2]>]| -> Vec<f64> {
+            i.iter().flatten().flatten().copied().collect()
+        };
         let xs = self
             .series
             .iter()
-            .flat_map(|s| s.points.iter().map(|p| p.0));
+            .flat_map(|s| s.points.iter().map(|p| p.0).chain(bounds(&s.x_intervals)));
         let ys = self
             .series
             .iter()
-            .flat_map(|s| s.points.iter().map(|p| p.1))
+            .flat_map(|s| s.points.iter().map(|p| p.1).chain(bounds(&s.y_intervals)))
             .chain(self.reference_lines.iter().map(|r| r.1));
         let (ax, ay) = (Axis::new(xs, self.x_log), Axis::new(ys, self.y_log));
-        let (pw, ph) = (W - LEFT - RIGHT, H - TOP - BOTTOM);
+        let legend_chars = self
+            .series
+            .iter()
+            .map(|s| s.name.chars().count())
+            .chain(
+                self.reference_lines
+                    .iter()
+                    .map(|(n, y)| n.chars().count() + 3 + fmt_tick(*y).len() + " (off axis)".len()),
+            )
+            .max()
+            .unwrap_or(0);
+        let (pw, ph) = (PLOT_W, H - TOP - BOTTOM);
+        let w = (LEFT + pw + LEGEND_PAD + LEGEND_CHAR_W * legend_chars as f64).ceil();
         let px = |x: f64| LEFT + ax.t(x) * pw;
         let py = |y: f64| TOP + (1.0 - ay.t(y)) * ph;
         let mut s = String::new();
         let _ = writeln!(
             s,
-            r#"<svg xmlns="http://www.w3.org/2000/svg" width="{W}" height="{H}" viewBox="0 0 {W} {H}" font-family="sans-serif" font-size="12">"#
+            r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{H}" viewBox="0 0 {w} {H}" font-family="sans-serif" font-size="12">"#
         );
-        let _ = writeln!(s, r#"<rect width="{W}" height="{H}" fill="white"/>"#);
+        let _ = writeln!(s, r#"<rect width="{w}" height="{H}" fill="white"/>"#);
         let _ = writeln!(
             s,
             r#"<text x="{}" y="22" text-anchor="middle" font-size="15">{}</text>"#,
@@ -234,6 +262,35 @@ impl Chart {
                 if !pts.contains(&(x, y)) {
                     continue;
                 }
+                let drawable = |v: f64, log: bool| v.is_finite() && (!log || v > 0.0);
+                if let Some([lo, hi]) = series.x_intervals.get(k).copied().flatten()
+                    && drawable(lo, ax.log)
+                    && drawable(hi, ax.log)
+                {
+                    let (x0, x1, yy) = (px(lo), px(hi), py(y));
+                    let _ = writeln!(
+                        s,
+                        r#"<path d="M{x0:.1},{yy:.1}H{x1:.1}M{x0:.1},{:.1}V{:.1}M{x1:.1},{:.1}V{:.1}" stroke="{color}" stroke-width="1.2" fill="none"/>"#,
+                        yy - ERROR_CAP,
+                        yy + ERROR_CAP,
+                        yy - ERROR_CAP,
+                        yy + ERROR_CAP
+                    );
+                }
+                if let Some([lo, hi]) = series.y_intervals.get(k).copied().flatten()
+                    && drawable(lo, ay.log)
+                    && drawable(hi, ay.log)
+                {
+                    let (y0, y1, xx) = (py(lo), py(hi), px(x));
+                    let _ = writeln!(
+                        s,
+                        r#"<path d="M{xx:.1},{y0:.1}V{y1:.1}M{:.1},{y0:.1}H{:.1}M{:.1},{y1:.1}H{:.1}" stroke="{color}" stroke-width="1.2" fill="none"/>"#,
+                        xx - ERROR_CAP,
+                        xx + ERROR_CAP,
+                        xx - ERROR_CAP,
+                        xx + ERROR_CAP
+                    );
+                }
                 let _ = writeln!(
                     s,
                     r#"<circle cx="{:.1}" cy="{:.1}" r="3.5" fill="{color}"/>"#,
@@ -281,8 +338,10 @@ mod tests {
                 name: "a <b>".into(),
                 points: vec![(10.0, 0.5), (1000.0, 0.1)],
                 labels: vec!["n=0".into(), "n=4".into()],
+                x_intervals: vec![Some([8.0, 12.0]), None],
+                y_intervals: vec![None, Some([0.05, 0.2])],
             }],
-            reference_lines: vec![("floor".into(), 0.05)],
+            reference_lines: vec![("floor (no mirrors)".into(), 0.05)],
         };
         let svg = c.to_svg();
         assert!(svg.starts_with("<svg") && svg.ends_with("</svg>\n"));
@@ -290,8 +349,31 @@ mod tests {
         assert_eq!(svg.matches("<circle").count(), 2);
         for cap in svg.split("<circle cx=\"").skip(1) {
             let cx: f64 = cap.split('"').next().unwrap().parse().unwrap();
-            assert!((LEFT..=W - RIGHT).contains(&cx), "{cx}");
+            assert!((LEFT..=LEFT + PLOT_W).contains(&cx), "{cx}");
         }
         assert!(svg.contains("stroke-dasharray"));
+        // One horizontal and one vertical error bar, each with its caps, inside the plot:
+        // the x axis reaches down to the interval's 8 ms, below the lowest point.
+        let bars: Vec<&str> = svg.split("<path d=\"M").skip(1).collect();
+        assert_eq!(bars.len(), 2);
+        let first_x: f64 = bars[0].split(',').next().unwrap().parse().unwrap();
+        assert!((LEFT..=LEFT + PLOT_W).contains(&first_x), "{first_x}");
+        assert!(bars[0].contains('H') && bars[1].starts_with(|c: char| c.is_ascii_digit()));
+        // The legend's column is wide enough for its longest entry.
+        let width: f64 = svg
+            .split("width=\"")
+            .nth(1)
+            .unwrap()
+            .split('"')
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap();
+        assert!(
+            width
+                >= LEFT
+                    + PLOT_W
+                    + LEGEND_CHAR_W * "floor (no mirrors) = 0.05 (off axis)".len() as f64
+        );
     }
 }

@@ -119,6 +119,39 @@ pub fn median_interval(frames: &[f64]) -> Option<Interval> {
     bootstrap(&[frames], |g| median(&g[0]), BOOTSTRAP_SEED)
 }
 
+/// The 95 % interval of the ratio of two medians, `median(a) / median(b)`, by a **paired**
+/// bootstrap: `a[k]` and `b[k]` were timed in the same interleaved round `k`, so whole rounds
+/// are resampled (the same indices for both) and drift of the machine between rounds, which
+/// moves both alike, cancels in the ratio instead of widening it. `None` unless both have the
+/// same number of frames, at least [`MIN_FRAMES_FOR_INTERVAL`].
+pub fn paired_ratio_interval(a: &[f64], b: &[f64]) -> Option<Interval> {
+    if a.len() != b.len() || a.len() < MIN_FRAMES_FOR_INTERVAL {
+        return None;
+    }
+    let mut rng = Rng::new(BOOTSTRAP_SEED);
+    let (mut ra, mut rb) = (vec![0.0; a.len()], vec![0.0; b.len()]);
+    let mut ratios = Vec::with_capacity(BOOTSTRAP_RESAMPLES);
+    for _ in 0..BOOTSTRAP_RESAMPLES {
+        for k in 0..a.len() {
+            let round = rng.below(a.len());
+            ra[k] = a[round];
+            rb[k] = b[round];
+        }
+        let r = median(&ra) / median(&rb);
+        if r.is_finite() {
+            ratios.push(r);
+        }
+    }
+    if ratios.is_empty() {
+        return None;
+    }
+    ratios.sort_by(f64::total_cmp);
+    Some(Interval {
+        low: quantile(&ratios, 0.025),
+        high: quantile(&ratios, 0.975),
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -156,6 +189,33 @@ mod tests {
             median_interval(&[1.0, 2.0, 3.0, 4.0, 5.0]).is_none(),
             "too few frames"
         );
+    }
+
+    #[test]
+    fn pairing_by_round_cancels_drift_that_unpaired_intervals_cannot() {
+        // Two points timed in the same 9 rounds; the machine slows down round by round
+        // (x1 … x1.8), and b always costs 1.2× a in its round.
+        let drift: Vec<f64> = (0..9).map(|k| 1.0 + 0.1 * k as f64).collect();
+        let a: Vec<f64> = drift.iter().map(|d| 10.0 * d).collect();
+        let b: Vec<f64> = drift.iter().map(|d| 12.0 * d).collect();
+        let (ia, ib) = (median_interval(&a).unwrap(), median_interval(&b).unwrap());
+        assert!(
+            ia.overlaps(&ib),
+            "drift hides the difference: {ia:?} {ib:?}"
+        );
+        let ratio = paired_ratio_interval(&b, &a).unwrap();
+        assert!(
+            (ratio.low - 1.2).abs() < 1e-9 && (ratio.high - 1.2).abs() < 1e-9,
+            "{ratio:?}"
+        );
+        // Unrelated noise: the paired interval holds 1 when the points cost the same.
+        let mut rng = Rng::new(3);
+        let noise = |rng: &mut Rng| 20.0 + (rng.next_u64() % 1000) as f64 / 100.0;
+        let c: Vec<f64> = (0..9).map(|_| noise(&mut rng)).collect();
+        let d: Vec<f64> = (0..9).map(|_| noise(&mut rng)).collect();
+        assert!(paired_ratio_interval(&c, &d).unwrap().contains(1.0));
+        assert!(paired_ratio_interval(&c[..5], &d[..5]).is_none(), "too few");
+        assert!(paired_ratio_interval(&c, &d[..8]).is_none(), "not paired");
     }
 
     #[test]

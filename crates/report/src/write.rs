@@ -35,7 +35,7 @@ pub fn read_records(path: &Path) -> std::io::Result<Vec<Record>> {
     Ok(records)
 }
 
-enum Block {
+pub(crate) enum Block {
     Heading(u8, String),
     Paragraph(String),
     Bullets(Vec<String>),
@@ -45,6 +45,9 @@ enum Block {
     /// An SVG chart, written to `file` and embedded in the HTML.
     Chart(String, String),
 }
+
+/// Bytes in a mebibyte (the tables' memory unit).
+const MIB: f64 = 1024.0 * 1024.0;
 
 fn f(v: f64, digits: usize) -> String {
     if v.is_finite() {
@@ -66,6 +69,18 @@ fn sci(v: f64) -> String {
 fn interval(r: &Record) -> Option<crate::stats::Interval> {
     r.ms_interval
         .map(|[low, high]| crate::stats::Interval { low, high })
+}
+
+/// The paired 95 % interval of `a`'s median time over `b`'s, where both were timed in the
+/// same interleaved rounds of the same run ([`crate::stats::paired_ratio_interval`]).
+fn paired_ratio(a: &Record, b: &Record) -> Option<crate::stats::Interval> {
+    let same_rounds = a.timing_order == "interleaved"
+        && b.timing_order == "interleaved"
+        && a.run.is_some()
+        && a.run == b.run;
+    same_rounds
+        .then(|| crate::stats::paired_ratio_interval(&a.frames_ms, &b.frames_ms))
+        .flatten()
 }
 
 /// "median [low–high]" (older records: "median (min m)").
@@ -90,15 +105,18 @@ fn row_interval(r: &table1::Row) -> String {
 }
 
 fn label(r: &Record) -> String {
-    match (r.n, r.depth) {
-        (Some(n), _) => format!("{} n={n}", r.method),
-        (None, Some(d)) => format!("{} depth={d}", r.method),
-        _ => r.method.clone(),
+    let name = crate::symmetry::variant(r);
+    match (r.n, r.depth, r.symmetry_planes) {
+        (Some(n), _, _) => format!("{name} n={n}"),
+        (None, Some(d), _) => format!("{name} depth={d}"),
+        (None, None, Some(p)) => format!("{name} p={p}"),
+        _ => name,
     }
 }
 
+/// A point's place on its method's axis: n, the depth, or the symmetry planes p.
 fn setting(r: &Record) -> f64 {
-    r.n.or(r.depth).map_or(0.0, f64::from)
+    r.n.or(r.depth).or(r.symmetry_planes).map_or(0.0, f64::from)
 }
 
 /// Writes `results.csv`, `report.md`, `report.html` and the `plot_*.svg` files into `dir`.
@@ -107,7 +125,6 @@ fn setting(r: &Record) -> f64 {
 pub fn write_report(dir: &Path, info: &SweepInfo, records: &[Record]) -> Result<(), FileError> {
     write_csv(&dir.join("results.csv"), records)?;
     let blocks = document(info, records);
-    let mut md = String::new();
     let mut html = String::from(
         "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>mirrorbox report</title><style>\
          body{font-family:sans-serif;max-width:1100px;margin:2em auto;padding:0 1em}\
@@ -118,18 +135,12 @@ pub fn write_report(dir: &Path, info: &SweepInfo, records: &[Record]) -> Result<
     for b in &blocks {
         match b {
             Block::Heading(level, t) => {
-                let _ = writeln!(md, "{} {t}\n", "#".repeat(*level as usize));
                 let _ = writeln!(html, "<h{level}>{}</h{level}>", esc(t));
             }
             Block::Paragraph(t) => {
-                let _ = writeln!(md, "{t}\n");
                 let _ = writeln!(html, "<p>{}</p>", esc(t));
             }
             Block::Bullets(items) => {
-                for i in items {
-                    let _ = writeln!(md, "- {i}");
-                }
-                md.push('\n');
                 let _ = writeln!(
                     html,
                     "<ul>{}</ul>",
@@ -140,12 +151,6 @@ pub fn write_report(dir: &Path, info: &SweepInfo, records: &[Record]) -> Result<
                 );
             }
             Block::Table(head, rows) => {
-                let _ = writeln!(md, "| {} |", head.join(" | "));
-                let _ = writeln!(md, "|{}", "---|".repeat(head.len()));
-                for r in rows {
-                    let _ = writeln!(md, "| {} |", r.join(" | "));
-                }
-                md.push('\n');
                 let _ = write!(
                     html,
                     "<table><tr>{}</tr>",
@@ -165,11 +170,6 @@ pub fn write_report(dir: &Path, info: &SweepInfo, records: &[Record]) -> Result<
                 html.push_str("</table>\n");
             }
             Block::Images(images) => {
-                let line: Vec<String> = images
-                    .iter()
-                    .map(|(cap, p)| format!("![{cap}]({p})"))
-                    .collect();
-                let _ = writeln!(md, "{}\n", line.join(" "));
                 html.push_str("<div>");
                 for (cap, p) in images {
                     let src = match std::fs::read(dir.join(p)) {
@@ -189,14 +189,53 @@ pub fn write_report(dir: &Path, info: &SweepInfo, records: &[Record]) -> Result<
             }
             Block::Chart(file, svg) => {
                 write_atomically(&dir.join(file), svg.as_bytes())?;
-                let _ = writeln!(md, "![{file}]({file})\n");
                 let _ = writeln!(html, "<div>{svg}</div>");
             }
         }
     }
     html.push_str("</body></html>\n");
-    write_atomically(&dir.join("report.md"), md.as_bytes())?;
+    write_atomically(&dir.join("report.md"), markdown(&blocks).as_bytes())?;
     write_atomically(&dir.join("report.html"), html.as_bytes())
+}
+
+/// The blocks as Markdown (charts and images as links to their files).
+pub(crate) fn markdown(blocks: &[Block]) -> String {
+    let mut md = String::new();
+    for b in blocks {
+        match b {
+            Block::Heading(level, t) => {
+                let _ = writeln!(md, "{} {t}\n", "#".repeat(*level as usize));
+            }
+            Block::Paragraph(t) => {
+                let _ = writeln!(md, "{t}\n");
+            }
+            Block::Bullets(items) => {
+                for i in items {
+                    let _ = writeln!(md, "- {i}");
+                }
+                md.push('\n');
+            }
+            Block::Table(head, rows) => {
+                let _ = writeln!(md, "| {} |", head.join(" | "));
+                let _ = writeln!(md, "|{}", "---|".repeat(head.len()));
+                for r in rows {
+                    let _ = writeln!(md, "| {} |", r.join(" | "));
+                }
+                md.push('\n');
+            }
+            Block::Images(images) => {
+                let line: Vec<String> = images
+                    .iter()
+                    .map(|(cap, p)| format!("![{cap}]({p})"))
+                    .collect();
+                let _ = writeln!(md, "{}\n", line.join(" "));
+            }
+            Block::Chart(file, _) => {
+                let _ = writeln!(md, "![{file}]({file})\n");
+            }
+        }
+    }
+    md
 }
 
 fn esc(s: &str) -> String {
@@ -209,14 +248,14 @@ fn esc(s: &str) -> String {
 fn write_csv(path: &Path, records: &[Record]) -> Result<(), FileError> {
     let mut s = String::from(
         "kind,method,n,depth,alpha,width,height,ssaa,ms_median,ms_ci_low,ms_ci_high,ms_min,timing_order,timing_source,frames,passes,draws,texture_renders,reflections,\
-         rmse,relmse,smape,max_abs,psnr,ssim,flip_mean,flip_p95,flip_p99,adapter,backend,scene,scene_hash,color_format,peak_memory_bytes,plan_ms\n",
+         rmse,relmse,smape,max_abs,psnr,ssim,flip_mean,flip_p95,flip_p99,adapter,backend,scene,scene_hash,color_format,peak_memory_bytes,plan_ms,encode_ms,gpu_buffer_bytes,gpu_texture_bytes,method_options,symmetry_planes,copies_drawn,copies_total,bake_ms\n",
     );
     for r in records {
         let m = &r.metrics;
         let opt = |v: Option<u32>| v.map_or(String::new(), |x| x.to_string());
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},\"{}\",{},\"{}\",{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},\"{}\",{},\"{}\",{},{},{},{},{},{},{},\"{}\",{},{},{},{}",
             r.kind,
             r.method,
             opt(r.n),
@@ -251,7 +290,15 @@ fn write_csv(path: &Path, records: &[Record]) -> Result<(), FileError> {
             r.scene_hash,
             r.color_format,
             r.peak_memory_bytes.map_or(String::new(), |b| b.to_string()),
-            r.plan_ms.map_or(String::new(), |ms| ms.to_string())
+            r.plan_ms.map_or(String::new(), |ms| ms.to_string()),
+            r.encode_ms.map_or(String::new(), |ms| ms.to_string()),
+            r.gpu_buffer_bytes.map_or(String::new(), |b| b.to_string()),
+            r.gpu_texture_bytes.map_or(String::new(), |b| b.to_string()),
+            r.method_options,
+            opt(r.symmetry_planes),
+            r.copies_drawn.map_or(String::new(), |c| c.to_string()),
+            r.copies_total.map_or(String::new(), |c| c.to_string()),
+            r.bake_ms.map_or(String::new(), |ms| ms.to_string())
         );
     }
     write_atomically(path, s.as_bytes())
@@ -308,14 +355,31 @@ fn exact_comparison(
         ),
     ];
     // A speed ratio is stated only where the 95 % intervals of the two medians are apart.
+    // Where both points were timed in the same interleaved rounds, the ratio also gets its
+    // paired interval (rounds resampled jointly), which drift of the machine cannot widen.
     let times = |a: &Record, e: &Record| {
         let ratio = a.ms_median / e.ms_median;
-        match (interval(a), interval(e)) {
-            (Some(ia), Some(ie)) if ia.overlaps(&ie) => {
-                "not shown apart in time at 95 % on this device (intervals overlap)".to_string()
+        let paired = paired_ratio(a, e).map(|i| {
+            if ratio >= 1.0 {
+                format!("{:.2}–{:.2}×", i.low, i.high)
+            } else {
+                format!("{:.2}–{:.2}×", 1.0 / i.high, 1.0 / i.low)
             }
-            (Some(_), Some(_)) if ratio >= 1.0 => format!("{ratio:.2}× faster"),
-            (Some(_), Some(_)) => format!("{:.2}× slower", 1.0 / ratio),
+        });
+        let paired_note = |claim: bool| match (&paired, claim) {
+            (Some(p), true) => format!(" (paired by round: {p})"),
+            (Some(p), false) => format!("; paired by round the ratio is {ratio:.2}× [{p}]"),
+            (None, _) => String::new(),
+        };
+        match (interval(a), interval(e)) {
+            (Some(ia), Some(ie)) if ia.overlaps(&ie) => format!(
+                "not shown apart in time at 95 % on this device (intervals overlap){}",
+                paired_note(false)
+            ),
+            (Some(_), Some(_)) if ratio >= 1.0 => {
+                format!("{ratio:.2}× faster{}", paired_note(true))
+            }
+            (Some(_), Some(_)) => format!("{:.2}× slower{}", 1.0 / ratio, paired_note(true)),
             _ => "no time comparison (too few frames for intervals)".to_string(),
         }
     };
@@ -359,7 +423,11 @@ fn exact_comparison(
 }
 
 /// ms/frame against the depth cap for each exact method with several depths.
-fn depth_scaling(info: &SweepInfo, records: &[Record], floor: Option<&Record>) -> Vec<Block> {
+pub(crate) fn depth_scaling(
+    info: &SweepInfo,
+    records: &[Record],
+    floor: Option<&Record>,
+) -> Vec<Block> {
     let groups = exact::depth_scaling(&info.exact_methods, records);
     if groups.is_empty() {
         return Vec::new();
@@ -371,7 +439,7 @@ fn depth_scaling(info: &SweepInfo, records: &[Record], floor: Option<&Record>) -
             Chart {
                 title: "ms/frame vs depth cap".into(),
                 x_label: "depth cap (most mirrors along a path)".into(),
-                y_label: "ms/frame (median)".into(),
+                y_label: "ms/frame (median, 95 % CI bars)".into(),
                 x_log: true,
                 y_log: true,
                 series: groups
@@ -380,6 +448,8 @@ fn depth_scaling(info: &SweepInfo, records: &[Record], floor: Option<&Record>) -
                         name: format!("{}, α={}", g.method, g.alpha),
                         points: g.points.iter().map(|r| (setting(r), r.ms_median)).collect(),
                         labels: Vec::new(),
+                        x_intervals: Vec::new(),
+                        y_intervals: g.points.iter().map(|r| r.ms_interval).collect(),
                     })
                     .collect(),
                 reference_lines: floor
@@ -433,41 +503,10 @@ fn depth_scaling(info: &SweepInfo, records: &[Record], floor: Option<&Record>) -
     out
 }
 
-/// The colour formats the records were rendered into, e.g. `rgba32float` (several where a
-/// sweep was resumed on another device).
-fn color_formats(records: &[Record]) -> String {
-    let mut formats: Vec<&str> = records.iter().map(|r| r.color_format.as_str()).collect();
-    formats.sort_unstable();
-    formats.dedup();
-    if formats.is_empty() {
-        "none recorded".into()
-    } else {
-        formats.join(", ")
-    }
-}
-
-fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
-    let mut b = vec![
-        Block::Heading(1, format!("mirrorbox sweep: {}", info.scene)),
-        Block::Bullets(vec![
-            format!("Resolution: {}", info.resolution),
-            format!("Ground truth: {}", info.truth),
-            format!(
-                "Device: {} — adapter {} ({}, {}); colour targets: {}",
-                info.cpu,
-                info.adapter,
-                info.backend,
-                info.device_type,
-                color_formats(records)
-            ),
-            format!("Versions: {}", info.versions),
-            format!("Date: {}", info.date),
-            format!("Command: `{}`", info.command),
-        ]),
-    ];
-    let points: Vec<&Record> = records.iter().filter(|r| r.kind == "point").collect();
-    let floor = records.iter().find(|r| r.kind == "floor");
-
+/// The reproduction of the paper's Table 1 with the exact methods beside it — only in the
+/// paper's experiment ([`table1::is_papers_sweep`]); empty otherwise.
+pub(crate) fn table1_section(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
+    let mut b = Vec::new();
     let (alpha, rows) = table1::rows(records);
     if table1::is_papers_sweep(&info.scene, &rows) {
         b.push(Block::Heading(
@@ -515,51 +554,232 @@ fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
             b.extend(exact_comparison(info, records, &rows, a));
         }
     }
+    b
+}
 
-    if let Some(fl) = floor {
-        b.push(Block::Heading(2, "Floor of the comparison".into()));
+/// ms/frame against the symmetry planes p for each symmetry method (seed 001), with the 2^p
+/// growth of the seed's copies beside it, the copies drawn, the bake, and the computed
+/// sentences: where baking starts to win, how much pruning removes.
+pub(crate) fn symmetry_section(records: &[Record]) -> Vec<Block> {
+    use crate::symmetry::{
+        BAKED_METHOD, PRUNED_METHOD, crossover_sentence, plane_scaling, pruning_sentence,
+    };
+    let groups = plane_scaling(records);
+    if groups.is_empty() {
+        return Vec::new();
+    }
+    let mut series: Vec<Series> = groups
+        .iter()
+        .map(|g| Series {
+            name: g.name.clone(),
+            points: g.points.iter().map(|r| (setting(r), r.ms_median)).collect(),
+            labels: Vec::new(),
+            x_intervals: Vec::new(),
+            y_intervals: g.points.iter().map(|r| r.ms_interval).collect(),
+        })
+        .collect();
+    // The seed's worst case: 2^p times the cost of one copy (the first method's p = 0 time).
+    if let Some(base) = groups[0]
+        .points
+        .first()
+        .filter(|r| r.symmetry_planes == Some(0))
+    {
+        let ps: Vec<u32> = groups[0]
+            .points
+            .iter()
+            .filter_map(|r| r.symmetry_planes)
+            .collect();
+        series.push(Series {
+            name: format!("2^p × {}'s p = 0 time", groups[0].name),
+            points: ps
+                .iter()
+                .map(|&p| (f64::from(p), base.ms_median * f64::from(1u32 << p.min(31))))
+                .collect(),
+            labels: Vec::new(),
+            x_intervals: Vec::new(),
+            y_intervals: Vec::new(),
+        });
+    }
+    let opt = |v: Option<usize>| v.map_or("–".into(), |x| x.to_string());
+    let mut out = vec![
+        Block::Heading(2, "Symmetry planes: cost against p".into()),
+        Block::Chart(
+            "plot_ms_vs_planes.svg".into(),
+            Chart {
+                title: "ms/frame vs symmetry planes p".into(),
+                x_label: "symmetry planes p".into(),
+                y_label: "ms/frame (median, 95 % CI bars)".into(),
+                x_log: false,
+                y_log: true,
+                series,
+                reference_lines: Vec::new(),
+            }
+            .to_svg(),
+        ),
+        Block::Table(
+            [
+                "method",
+                "p",
+                "copies drawn / 2^p",
+                "triangles",
+                "bake ms (CPU, once)",
+                "ms/frame median [95 % CI]",
+                "FLIP mean",
+            ]
+            .map(String::from)
+            .to_vec(),
+            groups
+                .iter()
+                .flat_map(|g| &g.points)
+                .map(|r| {
+                    vec![
+                        crate::symmetry::variant(r),
+                        opt(r.symmetry_planes.map(|p| p as usize)),
+                        format!("{} / {}", opt(r.copies_drawn), opt(r.copies_total)),
+                        opt(r.triangles),
+                        r.bake_ms.map_or("–".into(), |ms| f(ms, 2)),
+                        ms_cell(r, 2),
+                        sci(r.metrics.flip_mean),
+                    ]
+                })
+                .collect(),
+        ),
+    ];
+    let mut sentences = Vec::new();
+    if let Some(baked) = groups.iter().find(|g| g.method == BAKED_METHOD) {
+        for other in groups.iter().filter(|g| g.method != BAKED_METHOD) {
+            sentences.push(crossover_sentence(baked, other));
+        }
+    }
+    sentences.extend(
+        groups
+            .iter()
+            .filter(|g| g.method == PRUNED_METHOD)
+            .filter_map(pruning_sentence),
+    );
+    if !sentences.is_empty() {
+        out.push(Block::Bullets(sentences));
+    }
+    out
+}
+
+/// What the comparison cannot resolve: raster vs trace without mirrors.
+pub(crate) fn floor_paragraph(fl: &Record) -> Block {
+    Block::Paragraph(format!(
+        "Raster vs trace on the scene without its mirrors (nothing to truncate, same sub-pixel grid): \
+         RMSE {}, relMSE {}, FLIP mean {}, SSIM {}. Errors are to be read against this floor.",
+        sci(fl.metrics.rmse),
+        sci(fl.metrics.relmse),
+        sci(fl.metrics.flip_mean),
+        f(fl.metrics.ssim, 6)
+    ))
+}
+
+/// The colour formats the records were rendered into, e.g. `rgba32float` (several where a
+/// sweep was resumed on another device).
+fn color_formats(records: &[Record]) -> String {
+    let mut formats: Vec<&str> = records.iter().map(|r| r.color_format.as_str()).collect();
+    formats.sort_unstable();
+    formats.dedup();
+    if formats.is_empty() {
+        "none recorded".into()
+    } else {
+        formats.join(", ")
+    }
+}
+
+fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
+    let mut b = vec![
+        Block::Heading(1, format!("mirrorbox sweep: {}", info.scene)),
+        Block::Bullets(vec![
+            format!("Resolution: {}", info.resolution),
+            format!("Ground truth: {}", info.truth),
+            format!(
+                "Device: {} — adapter {} ({}, {}); colour targets: {}",
+                info.cpu,
+                info.adapter,
+                info.backend,
+                info.device_type,
+                color_formats(records)
+            ),
+            format!("Versions: {}", info.versions),
+            format!("Date: {}", info.date),
+            format!("Command: `{}`", info.command),
+        ]),
+    ];
+    let points: Vec<&Record> = records.iter().filter(|r| r.kind == "point").collect();
+    let floor = records.iter().find(|r| r.kind == "floor");
+    let latest_run = records.iter().filter_map(|r| r.run.as_deref()).max();
+    let reused = |r: &Record| latest_run.is_some() && r.run.as_deref() != latest_run;
+    let earlier: Vec<&Record> = records.iter().filter(|r| reused(r)).collect();
+    if !earlier.is_empty() {
+        let mut runs: Vec<&str> = earlier
+            .iter()
+            .map(|r| r.run.as_deref().unwrap_or("an unrecorded run"))
+            .collect();
+        runs.sort_unstable();
+        runs.dedup();
         b.push(Block::Paragraph(format!(
-            "Raster vs trace on the scene without its mirrors (nothing to truncate, same sub-pixel grid): \
-             RMSE {}, relMSE {}, FLIP mean {}, SSIM {}. Every error below is to be read against this floor.",
-            sci(fl.metrics.rmse),
-            sci(fl.metrics.relmse),
-            sci(fl.metrics.flip_mean),
-            f(fl.metrics.ssim, 6)
+            "† {} of {} points were reused from earlier runs of this sweep ({}) rather than measured \
+             in the latest ({}): their frames were interleaved with that run's points, on the machine \
+             of that day, so compare their times with this run's only with care; no paired ratio is \
+             computed across runs. Run with `--fresh` to measure every point together.",
+            earlier.len(),
+            records.len(),
+            runs.join(", "),
+            latest_run.unwrap_or_default()
         )));
     }
 
+    b.extend(table1_section(info, records));
+
+    if let Some(fl) = floor {
+        b.push(Block::Heading(2, "Floor of the comparison".into()));
+        b.push(floor_paragraph(fl));
+    }
+
     b.extend(depth_scaling(info, records, floor));
+    b.extend(symmetry_section(records));
 
     let mut groups: Vec<(String, f32)> = Vec::new();
     for r in &points {
-        if !groups.contains(&(r.method.clone(), r.alpha)) {
-            groups.push((r.method.clone(), r.alpha));
+        let group = (crate::symmetry::variant(r), r.alpha);
+        if !groups.contains(&group) {
+            groups.push(group);
         }
     }
-    let series = |x: &dyn Fn(&Record) -> f64, y: &dyn Fn(&Record) -> f64| -> Vec<Series> {
-        groups
-            .iter()
-            .map(|(m, a)| {
-                let mut pts: Vec<&&Record> = points
-                    .iter()
-                    .filter(|r| &r.method == m && r.alpha == *a)
-                    .collect();
-                pts.sort_by(|p, q| setting(p).total_cmp(&setting(q)));
-                Series {
-                    name: format!("{m}, α={a}"),
-                    points: pts.iter().map(|r| (x(r), y(r))).collect(),
-                    labels: pts
+    // `ms_on_x`: x is the median time, drawn with its 95 % interval as an error bar.
+    let series =
+        |x: &dyn Fn(&Record) -> f64, y: &dyn Fn(&Record) -> f64, ms_on_x: bool| -> Vec<Series> {
+            groups
+                .iter()
+                .map(|(m, a)| {
+                    let mut pts: Vec<&&Record> = points
                         .iter()
-                        .map(|r| {
-                            r.n.map(|n| format!("n={n}"))
-                                .or(r.depth.map(|d| format!("d={d}")))
-                                .unwrap_or_default()
-                        })
-                        .collect(),
-                }
-            })
-            .collect()
-    };
+                        .filter(|r| &crate::symmetry::variant(r) == m && r.alpha == *a)
+                        .collect();
+                    pts.sort_by(|p, q| setting(p).total_cmp(&setting(q)));
+                    Series {
+                        name: format!("{m}, α={a}"),
+                        points: pts.iter().map(|r| (x(r), y(r))).collect(),
+                        labels: pts
+                            .iter()
+                            .map(|r| {
+                                r.n.map(|n| format!("n={n}"))
+                                    .or(r.depth.map(|d| format!("d={d}")))
+                                    .unwrap_or_default()
+                            })
+                            .collect(),
+                        x_intervals: if ms_on_x {
+                            pts.iter().map(|r| r.ms_interval).collect()
+                        } else {
+                            Vec::new()
+                        },
+                        y_intervals: Vec::new(),
+                    }
+                })
+                .collect()
+        };
     let floor_line = |v: fn(&Record) -> f64| {
         floor
             .map(|fl| vec![("floor (no mirrors)".to_string(), v(fl))])
@@ -571,11 +791,11 @@ fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
             "plot_flip_vs_ms.svg".into(),
             Chart {
                 title: "FLIP mean vs ms/frame".into(),
-                x_label: "ms/frame (median)".into(),
+                x_label: "ms/frame (median, 95 % CI bars)".into(),
                 y_label: "FLIP mean (lower is better)".into(),
                 x_log: true,
                 y_log: true,
-                series: series(&|r| r.ms_median, &|r| r.metrics.flip_mean),
+                series: series(&|r| r.ms_median, &|r| r.metrics.flip_mean, true),
                 reference_lines: floor_line(|r| r.metrics.flip_mean),
             }
             .to_svg(),
@@ -584,11 +804,11 @@ fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
             "plot_relmse_vs_ms.svg".into(),
             Chart {
                 title: "relMSE (linear radiance) vs ms/frame".into(),
-                x_label: "ms/frame (median)".into(),
+                x_label: "ms/frame (median, 95 % CI bars)".into(),
                 y_label: "relMSE".into(),
                 x_log: true,
                 y_log: true,
-                series: series(&|r| r.ms_median, &|r| r.metrics.relmse),
+                series: series(&|r| r.ms_median, &|r| r.metrics.relmse, true),
                 reference_lines: floor_line(|r| r.metrics.relmse),
             }
             .to_svg(),
@@ -602,7 +822,7 @@ fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
                 y_label: "FLIP mean".into(),
                 x_log: false,
                 y_log: true,
-                series: series(&setting, &|r| r.metrics.flip_mean),
+                series: series(&setting, &|r| r.metrics.flip_mean, false),
                 reference_lines: floor_line(|r| r.metrics.flip_mean),
             }
             .to_svg(),
@@ -615,6 +835,9 @@ fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
                 "ms/frame median [95 % CI]",
                 "min",
                 "CPU plan ms",
+                "CPU encode ms",
+                "GPU MiB (buffers + textures)",
+                "peak RSS MiB",
                 "timing",
                 "passes",
                 "draws",
@@ -634,11 +857,22 @@ fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
                 .map(|r| {
                     let m = &r.metrics;
                     vec![
-                        label(r),
+                        if reused(r) {
+                            format!("{} †", label(r))
+                        } else {
+                            label(r)
+                        },
                         r.alpha.to_string(),
                         ms_cell(r, 2),
                         f(r.ms_min, 2),
                         r.plan_ms.map_or("–".into(), |ms| f(ms, 2)),
+                        r.encode_ms.map_or("–".into(), |ms| f(ms, 2)),
+                        match (r.gpu_buffer_bytes, r.gpu_texture_bytes) {
+                            (Some(b), Some(t)) => f((b + t) as f64 / MIB, 1),
+                            _ => "–".into(),
+                        },
+                        r.peak_memory_bytes
+                            .map_or("–".into(), |b| f(b as f64 / MIB, 0)),
                         format!("{}, {}", r.timing_source, r.timing_order),
                         r.passes.to_string(),
                         r.draws.to_string(),
@@ -658,7 +892,7 @@ fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
         for (m, a) in &groups {
             let mut pts: Vec<&&Record> = points
                 .iter()
-                .filter(|r| &r.method == m && r.alpha == *a)
+                .filter(|r| &crate::symmetry::variant(r) == m && r.alpha == *a)
                 .collect();
             pts.sort_by(|p, q| setting(p).total_cmp(&setting(q)));
             let chosen: Vec<&&Record> = match pts.len() {
@@ -685,17 +919,22 @@ fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::MetricValues;
 
-    fn record(n: u32, ms: f64, passes: usize, flip: f64) -> Record {
+    pub(crate) fn record(n: u32, ms: f64, passes: usize, flip: f64) -> Record {
         Record {
             key: format!("auxiliary n={n}"),
             kind: "point".into(),
             scene: "s.json".into(),
             scene_hash: "00".into(),
             method: "auxiliary".into(),
+            method_options: String::new(),
+            symmetry_planes: None,
+            copies_drawn: None,
+            copies_total: None,
+            bake_ms: None,
             n: Some(n),
             depth: None,
             alpha: 0.7,
@@ -706,8 +945,12 @@ mod tests {
             ms_interval: None,
             frames_ms: Vec::new(),
             timing_order: "back-to-back".into(),
+            run: None,
             peak_memory_bytes: None,
             plan_ms: None,
+            encode_ms: None,
+            gpu_buffer_bytes: None,
+            gpu_texture_bytes: None,
             ms_min: ms,
             timing_source: "gpu-timestamps".into(),
             frames: 1,
@@ -853,6 +1096,88 @@ mod tests {
         }
     }
 
+    /// `r` timed in 9 interleaved rounds of one run, round k taking `ms · drift(k)`.
+    fn interleaved(mut r: Record, drift: &dyn Fn(usize) -> f64) -> Record {
+        r.frames_ms = (0..9).map(|k| r.ms_median * drift(k)).collect();
+        r.ms_median = crate::stats::median(&r.frames_ms);
+        r.ms_interval = crate::stats::median_interval(&r.frames_ms).map(|i| [i.low, i.high]);
+        r.timing_order = "interleaved".into();
+        r.run = Some("2026-11-22T10:00:00Z".into());
+        r
+    }
+
+    #[test]
+    fn speed_claims_need_intervals_apart_and_carry_the_paired_ratio() {
+        let info = SweepInfo {
+            scene: "scenes/mirror_box.json".into(),
+            exact_methods: vec!["unrolled".into()],
+            ..SweepInfo::default()
+        };
+        let exact_point = |ms: f64, drift: &dyn Fn(usize) -> f64| {
+            let mut e = interleaved(record(0, ms, 1, 1e-4), drift);
+            e.method = "unrolled".into();
+            e.key = "unrolled depth=64".into();
+            (e.n, e.depth) = (None, Some(64));
+            e
+        };
+        let passes = [3, 7, 15, 46, 139];
+        let sentences = |drift: &dyn Fn(usize) -> f64, unrolled_ms: f64| {
+            let mut records: Vec<Record> = (0..5)
+                .map(|n| {
+                    interleaved(
+                        record(
+                            n,
+                            10.0 * passes[n as usize] as f64,
+                            passes[n as usize],
+                            0.01,
+                        ),
+                        drift,
+                    )
+                })
+                .collect();
+            records.push(exact_point(unrolled_ms, drift));
+            let dir = tempfile::tempdir().unwrap();
+            write_report(dir.path(), &info, &records).unwrap();
+            let md = std::fs::read_to_string(dir.path().join("report.md")).unwrap();
+            md.lines()
+                .find(|l| l.starts_with("- unrolled depth=64 shows"))
+                .unwrap_or_else(|| panic!("{md}"))
+                .to_string()
+        };
+        // Steady machine (±1 %): 150 ms against 40 ms, apart; the paired ratio is exact.
+        let steady = sentences(&|k| 1.0 + 0.0025 * k as f64, 40.0);
+        assert!(
+            steady.contains("3.75× faster (paired by round: 3.75–3.75×)"),
+            "{steady}"
+        );
+        // A machine slowing down 10 % per round: the medians' intervals of 150 ms and 120 ms
+        // overlap, so no claim; paired by round the ratio is still visibly 1.25.
+        let drifting = sentences(&|k| 1.0 + 0.1 * k as f64, 120.0);
+        assert!(
+            drifting.contains("against auxiliary n=2 (FLIP")
+                && drifting.contains("not shown apart in time at 95 % on this device (intervals overlap); paired by round the ratio is 1.25× [1.25–1.25×]"),
+            "{drifting}"
+        );
+    }
+
+    #[test]
+    fn points_reused_from_an_earlier_run_are_marked() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut old = record(1, 45.0, 7, 0.05);
+        old.run = Some("2026-11-20T10:00:00Z".into());
+        let mut new = record(0, 20.0, 3, 0.1);
+        new.run = Some("2026-11-22T10:00:00Z".into());
+        write_report(dir.path(), &SweepInfo::default(), &[new.clone(), old]).unwrap();
+        let md = std::fs::read_to_string(dir.path().join("report.md")).unwrap();
+        assert!(md.contains("† 1 of 2 points were reused"), "{md}");
+        assert!(md.contains("| auxiliary n=1 † |"), "{md}");
+        assert!(!md.contains("auxiliary n=0 †"), "{md}");
+        // All from one run: nothing marked.
+        write_report(dir.path(), &SweepInfo::default(), &[new]).unwrap();
+        let md = std::fs::read_to_string(dir.path().join("report.md")).unwrap();
+        assert!(!md.contains('†'), "{md}");
+    }
+
     #[test]
     fn the_report_names_the_colour_formats_of_its_points() {
         let dir = tempfile::tempdir().unwrap();
@@ -870,12 +1195,19 @@ mod tests {
             "{md}"
         );
         let csv = std::fs::read_to_string(dir.path().join("results.csv")).unwrap();
+        assert!(csv.lines().next().unwrap().ends_with(
+            ",color_format,peak_memory_bytes,plan_ms,encode_ms,gpu_buffer_bytes,gpu_texture_bytes,\
+             method_options,symmetry_planes,copies_drawn,copies_total,bake_ms"
+        ));
         assert!(
             csv.lines()
-                .next()
+                .nth(2)
                 .unwrap()
-                .ends_with(",color_format,peak_memory_bytes,plan_ms")
+                .ends_with(",rgba16float,,,,,,\"\",,,,")
         );
-        assert!(csv.lines().nth(2).unwrap().ends_with(",rgba16float,,"));
+        // Every row has the header's number of columns (no value here holds a comma).
+        let columns = |l: &str| l.split(',').count();
+        let header = columns(csv.lines().next().unwrap());
+        assert!(csv.lines().skip(1).all(|l| columns(l) == header), "{csv}");
     }
 }

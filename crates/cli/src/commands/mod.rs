@@ -3,6 +3,7 @@ pub mod compare;
 pub mod export_mitsuba;
 pub mod info;
 pub mod method_flags;
+pub mod readme;
 pub mod render;
 pub mod sweep;
 pub mod trace;

@@ -122,6 +122,8 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             "frames": args.frames, "warmup": args.warmup,
             "ms_per_frame_median": t.median_ms(), "ms_per_frame_min": t.min_ms(),
             "frames_ms": t.frames_ms, "timing_source": t.source.name(),
+            "encode_ms": t.encode_ms,
+            "gpu_buffer_bytes": out.gpu_memory.buffer_bytes, "gpu_texture_bytes": out.gpu_memory.texture_bytes,
             "passes": s.passes, "texture_renders": s.texture_renders, "draws": s.draws, "depth": s.depth,
             "triangles": s.triangles,
             "paths": s.paths.map(|c| serde_json::json!({
@@ -192,11 +194,14 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             );
         }
         println!(
-            "  {:.2} ms/frame median, {:.2} min over {} frames ({}) on {} ({}, {} targets); wrote {}, {}",
+            "  {:.2} ms/frame median, {:.2} min over {} frames ({}); CPU encode+submit {:.2} ms median; GPU memory {} in buffers, {} in textures; on {} ({}, {} targets); wrote {}, {}",
             t.median_ms(),
             t.min_ms(),
             t.frames_ms.len(),
             t.source.name(),
+            mirrorbox_report::stats::median(&t.encode_ms),
+            mirrorbox_files::human_bytes(out.gpu_memory.buffer_bytes),
+            mirrorbox_files::human_bytes(out.gpu_memory.texture_bytes),
             gpu.report.name,
             gpu.report.backend,
             out.color_format,

@@ -57,6 +57,35 @@ pub struct Args {
     /// Discard earlier results in --out and measure every point again (cached truths stay).
     #[arg(long)]
     fresh: bool,
+    /// Symmetry planes p, comma separated or a range `a..=b`: every point is measured on the
+    /// scene keeping its first p `symmetry_planes` (seed 001), for each p; each 0..=16 and at
+    /// most the scene's planes.
+    #[arg(long)]
+    symmetry_planes: Option<String>,
+}
+
+/// `--symmetry-planes`: `0,2,4` or `0..=10`.
+fn parse_planes(text: &str) -> Result<Vec<u32>, Failure> {
+    let bad = || {
+        Failure::BadInput(format!(
+            "--symmetry-planes {text:?}: must be plane counts in 0..=16, comma separated or a range a..=b"
+        ))
+    };
+    let count = |s: &str| -> Result<u32, Failure> {
+        let p: u32 = s.trim().parse().map_err(|_| bad())?;
+        if p > mirrorbox_scene::symmetry::MAX_SYMMETRY_PLANES as u32 {
+            return Err(bad());
+        }
+        Ok(p)
+    };
+    if let Some((a, b)) = text.split_once("..=") {
+        let (a, b) = (count(a)?, count(b)?);
+        if a > b {
+            return Err(bad());
+        }
+        return Ok((a..=b).collect());
+    }
+    text.split(',').map(count).collect()
 }
 
 /// The options of the preset sweeps (`table1`, `depth-scaling`).
@@ -65,7 +94,7 @@ pub struct PresetArgs {
     /// Output folder of the committed report (default: the preset's folder in reports/).
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Timed frames per point, one per interleaved round (default 9; 6 or more give each
+    /// Timed frames per point, one per interleaved round (default: 9, symmetry-scaling 6; 6 or more give each
     /// median a 95 % interval).
     #[arg(long)]
     frames: Option<u32>,
@@ -153,6 +182,11 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         },
         command: command_line(),
         worker: render_worker(),
+        symmetry_planes: args
+            .symmetry_planes
+            .as_deref()
+            .map(parse_planes)
+            .transpose()?,
     };
     execute(&config, args.fresh)
 }
@@ -171,6 +205,16 @@ pub fn run_depth_scaling(args: &PresetArgs) -> Result<(), Failure> {
         .clone()
         .unwrap_or_else(|| "reports/depth_scaling".into());
     run_preset(SweepConfig::depth_scaling(out), args)
+}
+
+/// Symmetry planes' cost against p (`SweepConfig::symmetry_scaling`), into
+/// `reports/symmetry_scaling/` by default.
+pub fn run_symmetry_scaling(args: &PresetArgs) -> Result<(), Failure> {
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| "reports/symmetry_scaling".into());
+    run_preset(SweepConfig::symmetry_scaling(out), args)
 }
 
 fn run_preset(mut config: SweepConfig, args: &PresetArgs) -> Result<(), Failure> {

@@ -1,0 +1,497 @@
+//! The figures the README and the docs quote, generated from the committed reports.
+//!
+//! A region of `README.md` (or `docs/methods.md`) between `<!-- generated: ID -->` and `<!-- end generated: ID -->`
+//! is written by [`fill`] from the report folder its ID names (its `results.jsonl` and
+//! `sweep.json`), with the same sentences and tables the report itself prints — so the prose
+//! cannot drift from the numbers. `mirrorbox readme` rewrites the regions; `mirrorbox readme
+//! --check` (run by the tests) fails when a region differs from what the reports give.
+//! Everything outside the regions is left alone, byte for byte.
+
+use crate::write::{
+    Block, depth_scaling, floor_paragraph, markdown, symmetry_section, table1_section,
+};
+use crate::{Record, SweepInfo, read_records, stats, table1};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+const BEGIN: &str = "<!-- generated: ";
+const END: &str = "<!-- end generated: ";
+const CLOSE: &str = " -->";
+
+/// Why the README's regions could not be generated or filled.
+#[derive(Debug, PartialEq)]
+pub struct ReadmeError(pub String);
+
+impl std::fmt::Display for ReadmeError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+/// One generated region: its ID and its Markdown.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Region {
+    pub id: &'static str,
+    pub text: String,
+}
+
+/// Every region ID the generator knows, with the report folder (under `reports/`) it is made
+/// from and what it holds.
+pub const REGIONS: &[(&str, &str, &str)] = &[
+    (
+        "table1",
+        "table1",
+        "the reproduction of Table 1, the exact methods beside it, the floor",
+    ),
+    (
+        "table1-repeat",
+        "table1_repeat",
+        "Table 1's rows from two consecutive runs side by side",
+    ),
+    (
+        "depth-scaling",
+        "depth_scaling",
+        "the exact methods' cost per bounce",
+    ),
+    (
+        "depth-scaling-table",
+        "depth_scaling",
+        "the exact methods' cost against depth, every point, and per bounce",
+    ),
+    (
+        "symmetry-scaling",
+        "symmetry_scaling",
+        "the symmetry methods against p: every point, the crossover, the pruning",
+    ),
+    (
+        "main-job",
+        "main_job.json",
+        "the main job's steps: time and peak memory",
+    ),
+];
+
+/// A sweep folder's records and facts.
+struct Sweep {
+    info: SweepInfo,
+    records: Vec<Record>,
+}
+
+fn load_sweep(dir: &Path) -> Result<Sweep, ReadmeError> {
+    let info_path = dir.join("sweep.json");
+    let text = std::fs::read_to_string(&info_path)
+        .map_err(|e| ReadmeError(format!("{}: {e}", info_path.display())))?;
+    let info: SweepInfo = serde_json::from_str(&text).map_err(|e| {
+        ReadmeError(format!(
+            "{}: not a sweep description ({e}); regenerate the report with its sweep",
+            info_path.display()
+        ))
+    })?;
+    let results = dir.join("results.jsonl");
+    let records =
+        read_records(&results).map_err(|e| ReadmeError(format!("{}: {e}", results.display())))?;
+    if records.is_empty() {
+        return Err(ReadmeError(format!(
+            "{}: no records to quote",
+            results.display()
+        )));
+    }
+    Ok(Sweep { info, records })
+}
+
+/// "Measured DATE on DEVICE: adapter …, `COMMAND`." The date is the latest run that measured
+/// a record (the report's own date is when it was last written, perhaps by a resume).
+fn measured_on(s: &Sweep) -> String {
+    let info = &s.info;
+    let date = s
+        .records
+        .iter()
+        .filter_map(|r| r.run.as_deref())
+        .max()
+        .unwrap_or(&info.date);
+    format!(
+        "Measured {} on {}: adapter {} ({}, {}), `{}`.",
+        date.split('T').next().unwrap_or(date),
+        info.cpu,
+        info.adapter,
+        info.backend,
+        info.device_type,
+        info.command
+    )
+}
+
+/// The blocks a README quotes: text and tables, not headings, charts or image rows (the
+/// README places those itself).
+fn prose(blocks: Vec<Block>) -> Vec<Block> {
+    blocks
+        .into_iter()
+        .filter(|b| {
+            matches!(
+                b,
+                Block::Paragraph(_) | Block::Bullets(_) | Block::Table(..)
+            )
+        })
+        .collect()
+}
+
+fn table1_region(s: &Sweep) -> Result<String, ReadmeError> {
+    let mut blocks = vec![Block::Paragraph(measured_on(s))];
+    let section = prose(table1_section(&s.info, &s.records));
+    if section.is_empty() {
+        return Err(ReadmeError(format!(
+            "{}: not the paper's experiment (every n of Table 1 on {}), nothing to quote",
+            s.info.scene,
+            table1::PAPER_SCENE
+        )));
+    }
+    blocks.extend(section);
+    if let Some(fl) = s.records.iter().find(|r| r.kind == "floor") {
+        blocks.push(floor_paragraph(fl));
+    }
+    Ok(markdown(&blocks))
+}
+
+/// The depth-scaling section's cost per bounce (and with `table`, every point).
+fn depth_scaling_region(s: &Sweep, table: bool) -> Result<String, ReadmeError> {
+    let floor = s.records.iter().find(|r| r.kind == "floor");
+    let section = prose(depth_scaling(&s.info, &s.records, floor));
+    let bullets: Vec<Block> = section
+        .into_iter()
+        .filter(|b| table || matches!(b, Block::Bullets(_)))
+        .collect();
+    if bullets.is_empty() {
+        return Err(ReadmeError(format!(
+            "{}: no exact method swept over depth, nothing to quote",
+            s.info.scene
+        )));
+    }
+    let mut blocks = vec![Block::Paragraph(measured_on(s))];
+    blocks.extend(bullets);
+    Ok(markdown(&blocks))
+}
+
+fn symmetry_region(s: &Sweep) -> Result<String, ReadmeError> {
+    let section = prose(symmetry_section(&s.records));
+    if section.is_empty() {
+        return Err(ReadmeError(format!(
+            "{}: no symmetry-planes sweep, nothing to quote",
+            s.info.scene
+        )));
+    }
+    let mut blocks = vec![Block::Paragraph(measured_on(s))];
+    blocks.extend(section);
+    Ok(markdown(&blocks))
+}
+
+/// Table 1's rows of two runs side by side: whether each row's intervals overlap, and whether
+/// each run's times keep the order of the pass counts.
+fn repeat_region(first: &Sweep, second: &Sweep) -> Result<String, ReadmeError> {
+    let (alpha_a, a) = table1::rows(&first.records);
+    let (alpha_b, b) = table1::rows(&second.records);
+    if a.len() != table1::PAPER_MS.len() || b.len() != a.len() || alpha_a != alpha_b {
+        return Err(ReadmeError(
+            "reports/table1 and reports/table1_repeat do not both hold Table 1's rows at one α"
+                .into(),
+        ));
+    }
+    let interval = |r: &table1::Row| stats::median_interval(&r.frames_ms);
+    let cell = |r: &table1::Row| match interval(r) {
+        Some(i) => format!("{:.1} [{:.1}–{:.1}]", r.ms_median, i.low, i.high),
+        None => format!("{:.1} (no interval)", r.ms_median),
+    };
+    let mut rows = Vec::new();
+    let mut overlapping = 0;
+    for (ra, rb) in a.iter().zip(&b) {
+        let overlap = match (interval(ra), interval(rb)) {
+            (Some(x), Some(y)) if x.overlaps(&y) => {
+                overlapping += 1;
+                "yes"
+            }
+            (Some(_), Some(_)) => "no",
+            _ => "–",
+        };
+        rows.push(vec![
+            ra.n.to_string(),
+            ra.passes.to_string(),
+            cell(ra),
+            cell(rb),
+            overlap.to_string(),
+        ]);
+    }
+    // Rows are in n order, and the pass count grows with n.
+    let ordered = |rows: &[table1::Row]| rows.windows(2).all(|w| w[0].ms_median < w[1].ms_median);
+    let order = |ok: bool| {
+        if ok {
+            "keeps the order of the pass counts"
+        } else {
+            "does NOT keep the order of the pass counts"
+        }
+    };
+    let mut text = String::new();
+    let _ = write!(
+        text,
+        "First run: {} Second run: {} α = {}.",
+        measured_on(first),
+        measured_on(second),
+        alpha_a.unwrap_or(f32::NAN)
+    );
+    let blocks = vec![
+        Block::Paragraph(text),
+        Block::Table(
+            [
+                "n",
+                "passes",
+                "first run ms/frame [95 % CI]",
+                "second run ms/frame [95 % CI]",
+                "intervals overlap",
+            ]
+            .map(String::from)
+            .to_vec(),
+            rows,
+        ),
+        Block::Paragraph(format!(
+            "The intervals overlap on {overlapping} of {} rows; the first run {}, the second {}.",
+            a.len(),
+            order(ordered(&a)),
+            order(ordered(&b))
+        )),
+    ];
+    Ok(markdown(&blocks))
+}
+
+/// One step of the main job, as `scripts/run.sh` records it in `reports/main_job.json`.
+#[derive(serde::Deserialize)]
+struct Step {
+    name: String,
+    seconds: u64,
+    peak_kb: Option<u64>,
+}
+
+#[derive(serde::Deserialize)]
+struct MainJob {
+    date: String,
+    cpu: String,
+    seconds: u64,
+    steps: Vec<Step>,
+}
+
+fn main_job_region(path: &Path) -> Result<String, ReadmeError> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| ReadmeError(format!("{}: {e}", path.display())))?;
+    let job: MainJob =
+        serde_json::from_str(&text).map_err(|e| ReadmeError(format!("{}: {e}", path.display())))?;
+    let mib = |kb: Option<u64>| kb.map_or("–".into(), |kb| format!("{:.0}", kb as f64 / 1024.0));
+    let blocks = vec![
+        Block::Paragraph(format!(
+            "The last `scripts/run.sh` that wrote the committed reports ({}, {}) took {} s:",
+            job.date.split('T').next().unwrap_or(&job.date),
+            job.cpu,
+            job.seconds
+        )),
+        Block::Table(
+            ["step", "seconds", "peak memory, MiB (largest process)"]
+                .map(String::from)
+                .to_vec(),
+            job.steps
+                .iter()
+                .map(|s| {
+                    vec![
+                        format!("`{}`", s.name),
+                        s.seconds.to_string(),
+                        mib(s.peak_kb),
+                    ]
+                })
+                .collect(),
+        ),
+    ];
+    Ok(markdown(&blocks))
+}
+
+/// Generates the region `id` from the reports under `reports`.
+pub fn generate(id: &str, reports: &Path) -> Result<Region, ReadmeError> {
+    let (id, source, _) = REGIONS
+        .iter()
+        .find(|(name, _, _)| *name == id)
+        .ok_or_else(|| {
+            ReadmeError(format!(
+                "unknown generated region {id:?} (known: {})",
+                REGIONS.iter().map(|r| r.0).collect::<Vec<_>>().join(", ")
+            ))
+        })?;
+    let folder = |name: &str| -> PathBuf { reports.join(name) };
+    let text = match *id {
+        "table1" => table1_region(&load_sweep(&folder(source))?)?,
+        "table1-repeat" => repeat_region(
+            &load_sweep(&folder("table1"))?,
+            &load_sweep(&folder(source))?,
+        )?,
+        "depth-scaling" => depth_scaling_region(&load_sweep(&folder(source))?, false)?,
+        "depth-scaling-table" => depth_scaling_region(&load_sweep(&folder(source))?, true)?,
+        "symmetry-scaling" => symmetry_region(&load_sweep(&folder(source))?)?,
+        "main-job" => main_job_region(&folder(source))?,
+        _ => unreachable!("every ID in REGIONS has a generator"),
+    };
+    Ok(Region { id, text })
+}
+
+/// A region found in the README: its ID and the byte range of its content (between the
+/// markers' lines).
+struct Found {
+    id: String,
+    content: std::ops::Range<usize>,
+}
+
+fn find_regions(readme: &str) -> Result<Vec<Found>, ReadmeError> {
+    let mut found = Vec::new();
+    let mut at = 0;
+    let line_of = |pos: usize| readme[..pos].lines().count() + 1;
+    while let Some(start) = readme[at..].find(BEGIN).map(|p| p + at) {
+        let id_end = readme[start..]
+            .find(CLOSE)
+            .map(|p| p + start)
+            .ok_or_else(|| ReadmeError(format!("line {}: unclosed marker", line_of(start))))?;
+        let id = readme[start + BEGIN.len()..id_end].trim().to_string();
+        let content_start = readme[id_end..]
+            .find('\n')
+            .map(|p| p + id_end + 1)
+            .unwrap_or(readme.len());
+        let end_marker = format!("{END}{id}{CLOSE}");
+        let end = readme[content_start..]
+            .find(&end_marker)
+            .map(|p| p + content_start)
+            .ok_or_else(|| {
+                ReadmeError(format!(
+                    "line {}: region {id:?} has no `{end_marker}`",
+                    line_of(start)
+                ))
+            })?;
+        if let Some(nested) = readme[content_start..end].find(BEGIN) {
+            return Err(ReadmeError(format!(
+                "line {}: a region begins inside region {id:?}",
+                line_of(content_start + nested)
+            )));
+        }
+        if found.iter().any(|f: &Found| f.id == id) {
+            return Err(ReadmeError(format!(
+                "line {}: region {id:?} appears twice",
+                line_of(start)
+            )));
+        }
+        found.push(Found {
+            id,
+            content: content_start..end,
+        });
+        at = end + end_marker.len();
+    }
+    if let Some(stray) = readme[at..].find(END) {
+        return Err(ReadmeError(format!(
+            "line {}: an end marker without its beginning",
+            line_of(at + stray)
+        )));
+    }
+    Ok(found)
+}
+
+/// The README with every region replaced by its generated text.
+pub fn fill(readme: &str, reports: &Path) -> Result<String, ReadmeError> {
+    let mut out = String::with_capacity(readme.len());
+    let mut at = 0;
+    for f in find_regions(readme)? {
+        let region = generate(&f.id, reports)?;
+        out.push_str(&readme[at..f.content.start]);
+        out.push_str(&region.text);
+        at = f.content.end;
+    }
+    out.push_str(&readme[at..]);
+    Ok(out)
+}
+
+/// The regions whose text differs from what the reports give, each with its first differing
+/// line (README, then generated).
+pub fn stale_regions(
+    readme: &str,
+    reports: &Path,
+) -> Result<Vec<(String, String, String)>, ReadmeError> {
+    let mut stale = Vec::new();
+    for f in find_regions(readme)? {
+        let region = generate(&f.id, reports)?;
+        let current = &readme[f.content.clone()];
+        if current != region.text {
+            let (have, want) = current
+                .lines()
+                .map(Some)
+                .chain(std::iter::repeat(None))
+                .zip(region.text.lines().map(Some).chain(std::iter::repeat(None)))
+                .take_while(|(a, b)| a.is_some() || b.is_some())
+                .find(|(a, b)| a != b)
+                .unwrap_or((None, None));
+            stale.push((
+                f.id.clone(),
+                have.unwrap_or("(nothing)").to_string(),
+                want.unwrap_or("(nothing)").to_string(),
+            ));
+        }
+    }
+    Ok(stale)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn main_job(dir: &Path, seconds: u64) {
+        std::fs::write(
+            dir.join("main_job.json"),
+            format!(
+                r#"{{"date":"2026-11-22T10:00:00Z","cpu":"a test CPU","seconds":{seconds},
+                   "steps":[{{"name":"cargo build","seconds":{seconds},"peak_kb":2048}}]}}"#
+            ),
+        )
+        .unwrap();
+    }
+
+    #[test]
+    fn regions_are_filled_and_the_rest_is_kept() {
+        let dir = tempfile::tempdir().unwrap();
+        main_job(dir.path(), 300);
+        let readme = "# Title\n\nBefore.\n<!-- generated: main-job -->\nstale text\n<!-- end generated: main-job -->\nAfter.\n";
+        let filled = fill(readme, dir.path()).unwrap();
+        assert!(filled.starts_with("# Title\n\nBefore.\n<!-- generated: main-job -->\n"));
+        assert!(filled.ends_with("<!-- end generated: main-job -->\nAfter.\n"));
+        assert!(filled.contains("took 300 s") && filled.contains("| `cargo build` | 300 | 2 |"));
+        assert!(!filled.contains("stale text"));
+        // Filled, it is up to date; a changed report makes it stale, naming the line.
+        assert!(stale_regions(&filled, dir.path()).unwrap().is_empty());
+        assert_eq!(fill(&filled, dir.path()).unwrap(), filled, "idempotent");
+        main_job(dir.path(), 301);
+        let stale = stale_regions(&filled, dir.path()).unwrap();
+        assert_eq!(stale.len(), 1);
+        assert_eq!(stale[0].0, "main-job");
+        assert!(stale[0].1.contains("took 300 s") && stale[0].2.contains("took 301 s"));
+    }
+
+    #[test]
+    fn malformed_regions_are_refused_with_their_line() {
+        let dir = tempfile::tempdir().unwrap();
+        main_job(dir.path(), 1);
+        let err = |text: &str| fill(text, dir.path()).unwrap_err().0;
+        assert!(
+            err("a\n<!-- generated: main-job -->\nx\n")
+                .contains("line 2: region \"main-job\" has no")
+        );
+        assert!(
+            err("<!-- generated: nonsense -->\n<!-- end generated: nonsense -->\n")
+                .contains("unknown generated region \"nonsense\"")
+        );
+        assert!(err("<!-- generated: main-job -->\n<!-- generated: table1 -->\n<!-- end generated: main-job -->\n").contains("begins inside"));
+        assert!(
+            err("x\n<!-- end generated: main-job -->\n").contains("line 2: an end marker without")
+        );
+        let twice = "<!-- generated: main-job -->\n<!-- end generated: main-job -->\n";
+        assert!(err(&twice.repeat(2)).contains("appears twice"));
+        // A region whose report is missing names the file.
+        assert!(
+            err("<!-- generated: table1 -->\n<!-- end generated: table1 -->\n")
+                .contains("table1/sweep.json")
+        );
+    }
+}
