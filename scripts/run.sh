@@ -11,7 +11,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 export NODEVICE_SELECT=1
 bin=target/release/mirrorbox
-steps_total=10
+steps_total=9
 step=0
 steps_json=""
 started_at=$(date -u +%Y-%m-%dT%H:%M:%SZ)
