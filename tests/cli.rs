@@ -1151,6 +1151,17 @@ fn sweep_measures_the_exact_methods_by_depth() {
     );
     assert_eq!(run.code, 0, "{}", run.stderr);
     let all = records(&out);
+    // Beside its GPU time every point records the CPU's share (planning, encoding and
+    // submitting), the GPU memory its frame held, its worker's peak memory and its run.
+    for r in &all {
+        for field in ["plan_ms", "encode_ms"] {
+            assert!(r[field].as_f64().is_some_and(|ms| ms > 0.0), "{field}: {r}");
+        }
+        for field in ["gpu_buffer_bytes", "gpu_texture_bytes", "peak_memory_bytes"] {
+            assert!(r[field].as_u64().is_some_and(|b| b > 0), "{field}: {r}");
+        }
+        assert_eq!(r["run"], all[0]["run"], "one run");
+    }
     for method in ["portal", "unrolled"] {
         let recs: Vec<&Value> = all.iter().filter(|r| r["method"] == method).collect();
         let depths: Vec<u64> = recs.iter().map(|r| r["depth"].as_u64().unwrap()).collect();
