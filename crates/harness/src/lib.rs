@@ -20,7 +20,6 @@ mod worker;
 
 pub use worker::{RenderJob, RenderReport, Rendered, peak_memory_bytes, serve};
 
-use glam::Vec3;
 use mirrorbox_files::{FileError, FolderLock, write_atomically};
 use mirrorbox_image::metrics::{MetricsError, compare, flip_map};
 use mirrorbox_image::{
@@ -482,12 +481,7 @@ fn point_setup(
     p: &Point,
     config: &SweepConfig,
 ) -> Result<(Scene, RenderSettings), HarnessError> {
-    let mut scene = match (&p.method, p.planes) {
-        (None, _) => base.without_mirrors(),
-        (Some(_), Some(planes)) => base.with_symmetry_planes(planes as usize)?,
-        (Some(_), None) => base.clone(),
-    };
-    scene.set_reflectance(Vec3::splat(p.alpha));
+    let scene = worker::point_scene(base, p.method.is_none(), p.planes, p.alpha)?;
     let method = p
         .method
         .clone()

@@ -105,12 +105,24 @@ pub fn method_text(method: &Method) -> String {
 fn job_scene(job: &RenderJob) -> Result<Scene, HarnessError> {
     let mut scene = load_scene(&job.scene)?;
     scene.resize(Some(job.width), Some(job.height))?;
-    if job.floor {
-        scene = scene.without_mirrors();
-    } else if let Some(p) = job.symmetry_planes {
-        scene = scene.with_symmetry_planes(p as usize)?;
-    }
-    scene.set_reflectance(Vec3::splat(job.alpha));
+    point_scene(&scene, job.floor, job.symmetry_planes, job.alpha)
+}
+
+/// A point's scene made from the sweep's scene, the one derivation the sweep and its workers
+/// share (the worker's scene hash must equal the sweep's): the floor drops the mirrors, a
+/// symmetry-planes point keeps the first p planes, and every mirror reflects α.
+pub(crate) fn point_scene(
+    base: &Scene,
+    floor: bool,
+    planes: Option<u32>,
+    alpha: f32,
+) -> Result<Scene, HarnessError> {
+    let mut scene = match (floor, planes) {
+        (true, _) => base.without_mirrors(),
+        (false, Some(p)) => base.with_symmetry_planes(p as usize)?,
+        (false, None) => base.clone(),
+    };
+    scene.set_reflectance(Vec3::splat(alpha));
     Ok(scene)
 }
 

@@ -803,17 +803,7 @@ fn rgba16float_targets_change_only_the_rounding() {
 /// adapter (scripts/install-system-deps.sh installs Mesa's EGL for one).
 #[test]
 fn every_registered_method_renders_on_the_gl_backend() {
-    let gl = match Gpu::with_options(GpuOptions {
-        backends: Some(wgpu::Backends::GL),
-        color_format: None,
-    }) {
-        Ok(gpu) => gpu,
-        Err(mirrorbox_raster::RasterError::Adapter(e)) => {
-            eprintln!("skipped: no GL adapter ({e})");
-            return;
-        }
-        Err(e) => panic!("the GL adapter cannot render: {e}"),
-    };
+    let Some(gl) = gl_gpu() else { return };
     assert_eq!(gl.report.backend, "gl");
     let reference = gpu_with(Some(wgpu::Backends::VULKAN), ColorFormat::Rgba32Float)
         .map_err(|e| eprintln!("no Vulkan reference ({e}): GL images are not compared"))
@@ -825,32 +815,66 @@ fn every_registered_method_renders_on_the_gl_backend() {
             .unwrap_or_else(|e| panic!("{method} on GL: {e}"));
         assert_eq!(out.color_format, gl.color_format);
         let Some(vulkan) = &reference else { continue };
-        let expected = render(vulkan, &s, &settings(method.clone(), 1)).unwrap();
-        assert_eq!(
-            out.stats, expected.stats,
-            "{method}: GL planned another frame"
+        assert_gl_matches_vulkan(
+            &out,
+            vulkan,
+            &s,
+            &method,
+            &method.to_string(),
+            &method.slug(),
         );
-        let off = if out.color_format == ColorFormat::Rgba16Float {
-            off_half_bound(&out.image, &expected.image, roundings(&out), 0.0)
-        } else {
-            differences(&out.image, &expected.image)
-                .iter()
-                .filter(|&&d| d > 1e-4)
-                .count()
-        };
-        let n = out.image.pixels.len();
-        println!(
-            "{method} on GL ({}): {off} of {n} pixels beyond the rounding bound of Vulkan's",
-            out.color_format
-        );
-        if off * 200 > n {
-            let where_ = dump(
-                &format!("gl_{}", method.slug()),
-                &out.image,
-                &expected.image,
-            );
-            panic!("{method} on GL: {off} of {n} pixels differ from Vulkan's; {where_}");
+    }
+}
+
+/// wgpu's GL adapter (llvmpipe through EGL), or `None`, saying so, where there is none.
+fn gl_gpu() -> Option<Gpu> {
+    match Gpu::with_options(GpuOptions {
+        backends: Some(wgpu::Backends::GL),
+        color_format: None,
+    }) {
+        Ok(gpu) => Some(gpu),
+        Err(mirrorbox_raster::RasterError::Adapter(e)) => {
+            eprintln!("skipped: no GL adapter ({e})");
+            None
         }
+        Err(e) => panic!("the GL adapter cannot render: {e}"),
+    }
+}
+
+/// `out`, `method` rendered on GL, against the same render on `vulkan` (RGBA32F): the same
+/// stats, and the images equal up to the half-precision bound (RGBA16F targets) or 1e-4,
+/// except on 0.5 % of pixels (edge samples the backends may rasterize differently). `what`
+/// names the case in messages, `dump_name` the diff images written on failure.
+fn assert_gl_matches_vulkan(
+    out: &RenderOutput,
+    vulkan: &Gpu,
+    s: &Scene,
+    method: &Method,
+    what: &str,
+    dump_name: &str,
+) {
+    let expected = render(vulkan, s, &settings(method.clone(), 1)).unwrap();
+    assert_eq!(
+        out.stats, expected.stats,
+        "{what}: GL planned another frame"
+    );
+    let off = if out.color_format == ColorFormat::Rgba16Float {
+        off_half_bound(&out.image, &expected.image, roundings(out), 0.0)
+    } else {
+        differences(&out.image, &expected.image)
+            .iter()
+            .filter(|&&d| d > 1e-4)
+            .count()
+    };
+    let n = out.image.pixels.len();
+    println!(
+        "{what} on GL ({}, {}): {off} of {n} pixels beyond the rounding bound of Vulkan's",
+        out.color_format,
+        out.stats.clipping.name()
+    );
+    if off * 200 > n {
+        let where_ = dump(&format!("gl_{dump_name}"), &out.image, &expected.image);
+        panic!("{what} on GL: {off} of {n} pixels differ from Vulkan's; {where_}");
     }
 }
 
@@ -1057,17 +1081,7 @@ fn symmetry_methods_without_planes_are_the_floor() {
 /// Skipped, saying so, where there is no GL adapter.
 #[test]
 fn symmetry_methods_render_on_the_gl_backend() {
-    let gl = match Gpu::with_options(GpuOptions {
-        backends: Some(wgpu::Backends::GL),
-        color_format: None,
-    }) {
-        Ok(gpu) => gpu,
-        Err(mirrorbox_raster::RasterError::Adapter(e)) => {
-            eprintln!("skipped: no GL adapter ({e})");
-            return;
-        }
-        Err(e) => panic!("the GL adapter cannot render: {e}"),
-    };
+    let Some(gl) = gl_gpu() else { return };
     let Ok(vulkan) = gpu_with(Some(wgpu::Backends::VULKAN), ColorFormat::Rgba32Float) else {
         eprintln!("skipped: no Vulkan reference");
         return;
@@ -1083,33 +1097,14 @@ fn symmetry_methods_render_on_the_gl_backend() {
             let method = m(key);
             let out = render(&gl, &s, &settings(method.clone(), 1))
                 .unwrap_or_else(|e| panic!("{name} {method} on GL: {e}"));
-            let expected = render(&vulkan, &s, &settings(method.clone(), 1)).unwrap();
-            assert_eq!(
-                out.stats, expected.stats,
-                "{name} {method}: GL planned another frame"
+            assert_gl_matches_vulkan(
+                &out,
+                &vulkan,
+                &s,
+                &method,
+                &format!("{name} {method}"),
+                &format!("{name}_{}", method.slug()),
             );
-            let off = if out.color_format == ColorFormat::Rgba16Float {
-                off_half_bound(&out.image, &expected.image, roundings(&out), 0.0)
-            } else {
-                differences(&out.image, &expected.image)
-                    .iter()
-                    .filter(|&&d| d > 1e-4)
-                    .count()
-            };
-            let n = out.image.pixels.len();
-            println!(
-                "{name} {method} on GL ({}, {}): {off} of {n} pixels beyond the rounding bound of Vulkan's",
-                out.color_format,
-                out.stats.clipping.name()
-            );
-            if off * 200 > n {
-                let where_ = dump(
-                    &format!("gl_{name}_{}", method.slug()),
-                    &out.image,
-                    &expected.image,
-                );
-                panic!("{name} {method} on GL: {off} of {n} pixels differ from Vulkan's; {where_}");
-            }
         }
     }
 }

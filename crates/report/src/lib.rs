@@ -142,6 +142,14 @@ pub struct Record {
     pub heatmap_image: String,
 }
 
+impl Record {
+    /// The 95 % interval of the median time, if the record has one.
+    pub fn ms_ci(&self) -> Option<stats::Interval> {
+        self.ms_interval
+            .map(|[low, high]| stats::Interval { low, high })
+    }
+}
+
 /// The colour format of records written before [`Record::color_format`] existed.
 fn rgba32float() -> String {
     "rgba32float".into()

@@ -8,7 +8,7 @@
 //! Everything outside the regions is left alone, byte for byte.
 
 use crate::write::{
-    Block, depth_scaling, floor_paragraph, markdown, symmetry_section, table1_section,
+    Block, depth_scaling, floor_paragraph, markdown, row_cell, symmetry_section, table1_section,
 };
 use crate::{Record, SweepInfo, read_records, stats, table1};
 use std::fmt::Write as _;
@@ -194,10 +194,6 @@ fn repeat_region(first: &Sweep, second: &Sweep) -> Result<String, ReadmeError> {
         ));
     }
     let interval = |r: &table1::Row| stats::median_interval(&r.frames_ms);
-    let cell = |r: &table1::Row| match interval(r) {
-        Some(i) => format!("{:.1} [{:.1}–{:.1}]", r.ms_median, i.low, i.high),
-        None => format!("{:.1} (no interval)", r.ms_median),
-    };
     let mut rows = Vec::new();
     let mut overlapping = 0;
     for (ra, rb) in a.iter().zip(&b) {
@@ -212,8 +208,8 @@ fn repeat_region(first: &Sweep, second: &Sweep) -> Result<String, ReadmeError> {
         rows.push(vec![
             ra.n.to_string(),
             ra.passes.to_string(),
-            cell(ra),
-            cell(rb),
+            row_cell(ra),
+            row_cell(rb),
             overlap.to_string(),
         ]);
     }

@@ -3,7 +3,6 @@
 //! empty or out of view, and the CPU's split-and-mirror mesh is drawn once.
 
 use crate::Record;
-use crate::stats::Interval;
 
 /// The method that draws the CPU-baked mesh once; the others are compared with it.
 pub const BAKED_METHOD: &str = "symmetry-baked";
@@ -54,10 +53,6 @@ pub fn plane_scaling(records: &[Record]) -> Vec<PlaneScaling> {
     out
 }
 
-fn interval(r: &Record) -> Option<Interval> {
-    r.ms_interval.map(|[low, high]| Interval { low, high })
-}
-
 /// Where drawing the baked mesh once becomes faster than drawing the copies: the smallest p
 /// from which the baked method is faster than `other` at every measured p, with the 95 %
 /// intervals apart; and the speed-up there and at the largest p.
@@ -74,7 +69,7 @@ pub fn crossover_sentence(baked: &PlaneScaling, other: &PlaneScaling) -> String 
     if pairs.is_empty() {
         return format!("{} and {} share no p.", baked.name, other.name);
     }
-    let faster = |b: &Record, o: &Record| match (interval(b), interval(o)) {
+    let faster = |b: &Record, o: &Record| match (b.ms_ci(), o.ms_ci()) {
         (Some(ib), Some(io)) => ib.high < io.low,
         _ => false,
     };

@@ -65,12 +65,6 @@ fn sci(v: f64) -> String {
     }
 }
 
-/// The 95 % interval of a record's median, if it has one.
-fn interval(r: &Record) -> Option<crate::stats::Interval> {
-    r.ms_interval
-        .map(|[low, high]| crate::stats::Interval { low, high })
-}
-
 /// The paired 95 % interval of `a`'s median time over `b`'s, where both were timed in the
 /// same interleaved rounds of the same run ([`crate::stats::paired_ratio_interval`]).
 fn paired_ratio(a: &Record, b: &Record) -> Option<crate::stats::Interval> {
@@ -94,6 +88,11 @@ fn ms_cell(r: &Record, digits: usize) -> String {
         ),
         None => format!("{} (min {})", f(r.ms_median, digits), f(r.ms_min, digits)),
     }
+}
+
+/// A Table 1 row's cell: "median [low–high]", or "median [min m]" for older records.
+pub(crate) fn row_cell(r: &table1::Row) -> String {
+    format!("{} [{}]", f(r.ms_median, 1), row_interval(r))
 }
 
 /// A Table 1 row's interval, "low–high", or "min m" for older records.
@@ -371,7 +370,7 @@ fn exact_comparison(
             (Some(p), false) => format!("; paired by round the ratio is {ratio:.2}× [{p}]"),
             (None, _) => String::new(),
         };
-        match (interval(a), interval(e)) {
+        match (a.ms_ci(), e.ms_ci()) {
             (Some(ia), Some(ie)) if ia.overlaps(&ie) => format!(
                 "not shown apart in time at 95 % on this device (intervals overlap){}",
                 paired_note(false)
@@ -539,7 +538,7 @@ pub(crate) fn table1_section(info: &SweepInfo, records: &[Record]) -> Vec<Block>
                     vec![
                         r.n.to_string(),
                         f(r.paper_ms, 0),
-                        format!("{} [{}]", f(r.ms_median, 1), row_interval(r)),
+                        row_cell(r),
                         r.passes.to_string(),
                         f(r.ms_median / r.passes as f64, 2),
                         f(r.paper_ms / r.passes as f64, 2),
