@@ -251,6 +251,13 @@ pub enum HarnessError {
     /// `--symmetry-planes` asks for more planes than the scene has, or the bake is refused.
     #[error("--symmetry-planes: {0}")]
     SymmetryPlanes(#[from] mirrorbox_scene::symmetry::SymmetryError),
+    /// At a swept reflectance (or the truth's threshold) the scene's light images exceed
+    /// their budget.
+    #[error("{}: {source}", .scene.display())]
+    LightImages {
+        scene: PathBuf,
+        source: mirrorbox_scene::light_images::TooManyLightImages,
+    },
 }
 
 impl HarnessError {
@@ -261,6 +268,7 @@ impl HarnessError {
             | HarnessError::Setting(_)
             | HarnessError::WorkerRefused(_)
             | HarnessError::SymmetryPlanes(_)
+            | HarnessError::LightImages { .. }
             | HarnessError::OutputFolder { .. } => true,
             HarnessError::Raster(e) => e.is_refusal(),
             HarnessError::File(e) => e.refused,
@@ -412,6 +420,22 @@ fn truth(
         summary.truths_cached += 1;
         return Ok((img, path));
     }
+    // Light images are pruned at the truth's own threshold, as its eye paths are.
+    let relit;
+    let scene = if scene.lighting.mirrored_lights > 0
+        && scene.lighting.images.min_throughput != t.min_throughput
+    {
+        let mut s = scene.clone();
+        s.enumerate_light_images(t.min_throughput)
+            .map_err(|source| HarnessError::LightImages {
+                scene: scene.source.clone(),
+                source,
+            })?;
+        relit = s;
+        &relit
+    } else {
+        scene
+    };
     let bvh = SceneBvh::build(&scene.geometry);
     let settings = TraceSettings::whitted(config.ssaa).with_integrator(*t);
     let out = mirrorbox_trace::render(scene, &bvh, &settings, &|_| {});

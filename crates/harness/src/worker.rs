@@ -122,7 +122,12 @@ pub(crate) fn point_scene(
         (false, Some(p)) => base.with_symmetry_planes(p as usize)?,
         (false, None) => base.clone(),
     };
-    scene.set_reflectance(Vec3::splat(alpha));
+    scene
+        .set_reflectance(Vec3::splat(alpha))
+        .map_err(|source| HarnessError::LightImages {
+            scene: base.source.clone(),
+            source,
+        })?;
     Ok(scene)
 }
 

@@ -157,7 +157,7 @@ fn every_registered_method_matches_its_golden_and_the_truth_at_its_depth() {
 #[test]
 fn golden_auxiliary_n2_alpha07_mirror_box() {
     let mut s = scene("mirror_box.json", 160, 90);
-    s.set_reflectance(Vec3::splat(0.7));
+    s.set_reflectance(Vec3::splat(0.7)).unwrap();
     assert_golden(
         "auxiliary_n2_alpha0.7_mirror_box",
         &raster(&s, m("auxiliary n=2"), 1),
@@ -200,7 +200,7 @@ fn auxiliary_with_no_auxiliary_mirrors_is_naive() {
 #[test]
 fn more_auxiliary_mirrors_show_more_reflections() {
     let mut s = scene("mirror_box.json", 128, 72);
-    s.set_reflectance(Vec3::splat(0.7));
+    s.set_reflectance(Vec3::splat(0.7)).unwrap();
     let truth = trace(&s, 1);
     let matching: Vec<usize> = (0..=3)
         .map(|n| {
@@ -749,7 +749,7 @@ fn rgba16float_targets_change_only_the_rounding() {
     assert_eq!(half.color_format, ColorFormat::Rgba16Float);
     let s = scene("mirror_box.json", 160, 90);
     let mut dim = s.clone();
-    dim.set_reflectance(Vec3::splat(0.7));
+    dim.set_reflectance(Vec3::splat(0.7)).unwrap();
     let mut cases: Vec<(&Scene, Method)> = mirrorbox_raster::METHODS
         .iter()
         .map(|e| (&s, Method::defaults(e)))

@@ -19,6 +19,9 @@ pub struct SceneFile {
     pub lights: Vec<LightDesc>,
     #[serde(default)]
     pub ambient: Option<Rgb>,
+    /// Shadows and mirrored light sources (opt-in; absent: neither).
+    #[serde(default)]
+    pub lighting: Option<LightingDesc>,
     #[serde(default)]
     pub background: Option<Rgb>,
     #[serde(default)]
@@ -143,6 +146,18 @@ pub struct TransformDesc {
 pub enum Scale {
     Uniform(f32),
     PerAxis(Vec3f),
+}
+
+/// How light reaches diffuse surfaces beyond the contract's default (`docs/shading.md`).
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LightingDesc {
+    /// Straight legs from a surface to a light must be unoccluded.
+    #[serde(default)]
+    pub shadows: Option<bool>,
+    /// Most mirrors between a light and a surface (0: light reaches surfaces only directly).
+    #[serde(default)]
+    pub mirrored_lights: Option<u32>,
 }
 
 #[derive(Debug, Deserialize)]

@@ -15,6 +15,7 @@ pub mod error;
 pub mod format;
 pub mod geometry;
 pub mod hash;
+pub mod light_images;
 pub mod limits;
 pub mod load;
 pub mod polygon;
@@ -183,12 +184,37 @@ impl Scene {
     }
 
     /// Replaces every mirror's reflectance (the harness sets it to the α being measured),
-    /// keeping [`Scene::geometry`]'s surfaces in step.
-    pub fn set_reflectance(&mut self, reflectance: Vec3) {
+    /// keeping [`Scene::geometry`]'s surfaces and the light images in step. A higher
+    /// reflectance keeps more light images and may exceed their budget (never without
+    /// `lighting.mirrored_lights`).
+    pub fn set_reflectance(
+        &mut self,
+        reflectance: Vec3,
+    ) -> Result<(), light_images::TooManyLightImages> {
         for m in &mut self.mirrors {
             m.reflectance = reflectance;
         }
         self.geometry.set_mirror_reflectance(reflectance);
+        if self.lighting.mirrored_lights > 0 {
+            self.enumerate_light_images(self.lighting.images.min_throughput)?;
+        }
+        Ok(())
+    }
+
+    /// (Re)computes [`Lighting::images`] for chains of at most `lighting.mirrored_lights`
+    /// mirrors, pruning chains dimmer than `min_throughput` (the tracer's `--min-throughput`;
+    /// loading uses [`light_images::DEFAULT_MIN_THROUGHPUT`]).
+    pub fn enumerate_light_images(
+        &mut self,
+        min_throughput: f32,
+    ) -> Result<(), light_images::TooManyLightImages> {
+        self.lighting.images = light_images::light_images(
+            self,
+            &self.lighting.lights,
+            self.lighting.mirrored_lights,
+            min_throughput,
+        )?;
+        Ok(())
     }
 }
 
@@ -203,10 +229,11 @@ impl Scene {
         let g = &self.geometry;
         let _ = write!(
             h,
-            "{:?}{:?}{:?}{:?}{:?}{:?}{:?}{:?}",
+            "{:?}{:?}Lighting {{ lights: {:?}, ambient: {:?} }}{:?}{:?}{:?}{:?}{:?}",
             self.camera,
             self.mirrors,
-            self.lighting,
+            self.lighting.lights,
+            self.lighting.ambient,
             self.background,
             self.terminal,
             g.triangles,
@@ -217,6 +244,16 @@ impl Scene {
         // a plane's name changes no image.
         if let Some(symmetry) = &self.symmetry {
             let _ = write!(h, "symmetry{:?}", symmetry.plane_list());
+        }
+        // Likewise scenes with the default lighting (no shadows, no mirrored lights). The
+        // images follow from the rest, but their pruning threshold does not.
+        let l = &self.lighting;
+        if l.shadows || l.mirrored_lights > 0 {
+            let _ = write!(
+                h,
+                "lighting{} {} {:?}",
+                l.shadows, l.mirrored_lights, l.images.min_throughput
+            );
         }
         h.finish()
     }
@@ -239,7 +276,7 @@ mod tests {
             "the path must not matter"
         );
         let mut c = a.clone();
-        c.set_reflectance(Vec3::splat(0.7));
+        c.set_reflectance(Vec3::splat(0.7)).unwrap();
         assert_ne!(a.content_hash(), c.content_hash());
         let mut d = a.clone();
         d.camera = d.camera.with_size(33, 24);
@@ -286,13 +323,13 @@ mod tests {
     #[test]
     fn with_symmetry_planes_rebakes_the_first_p_planes() {
         let mut a = load::parse_scene(WITH_PLANES, std::path::Path::new("a.json")).unwrap();
-        a.set_reflectance(Vec3::splat(0.7));
+        a.set_reflectance(Vec3::splat(0.7)).unwrap();
         let all = a.with_symmetry_planes(2).unwrap();
         assert_eq!(all.geometry, a.geometry);
         assert_eq!(all.symmetry, a.symmetry);
         let none = a.with_symmetry_planes(0).unwrap();
         let mut plain = without_field(WITH_PLANES);
-        plain.set_reflectance(Vec3::splat(0.7));
+        plain.set_reflectance(Vec3::splat(0.7)).unwrap();
         assert!(none.symmetry.is_none());
         assert_eq!(none.geometry, plain.geometry);
         assert_eq!(none.content_hash(), plain.content_hash());

@@ -14,6 +14,7 @@ use crate::limits::{
     MAX_COORDINATE, MAX_IMAGE_SIDE, MAX_OBJ_FILE_BYTES, MAX_PIXELS, MAX_SCENE_FILE_BYTES,
     MAX_TRIANGLES, MEMORY_PER_TRIANGLE, within_extent,
 };
+use crate::light_images::{DEFAULT_MIN_THROUGHPUT, MAX_MIRRORED_LIGHTS};
 use crate::shading::{Lighting, PointLight};
 use crate::symmetry::{self, MAX_SYMMETRY_PLANES, Symmetry, SymmetryPlane};
 use crate::tessellate::{self, MAX_SPHERE_SUBDIVISIONS};
@@ -246,19 +247,38 @@ impl Checker<'_> {
             .enumerate()
             .map(|(i, l)| self.light(&lights_path.index(i), l))
             .collect::<Result<Vec<_>>>()?;
-        Ok(Scene {
+        let lighting_desc = file.lighting.as_ref();
+        let mirrored_lights = lighting_desc.and_then(|l| l.mirrored_lights).unwrap_or(0);
+        let mirrored_path = FieldPath::root("lighting").field("mirrored_lights");
+        if mirrored_lights > MAX_MIRRORED_LIGHTS {
+            return Err(self.invalid(
+                &mirrored_path,
+                format!(
+                    "must be in [0, {MAX_MIRRORED_LIGHTS}] (mirrors between a light and a \
+                     surface), got {mirrored_lights}"
+                ),
+            ));
+        }
+        let mut scene = Scene {
             source: self.file.to_path_buf(),
             camera,
             mirrors,
             lighting: Lighting {
                 lights,
                 ambient: self.radiance(&FieldPath::root("ambient"), file.ambient)?,
+                shadows: lighting_desc.and_then(|l| l.shadows).unwrap_or(false),
+                mirrored_lights,
+                images: Default::default(),
             },
             background: self.radiance(&FieldPath::root("background"), file.background)?,
             terminal: self.radiance(&FieldPath::root("terminal"), file.terminal)?,
             geometry,
             symmetry,
-        })
+        };
+        scene
+            .enumerate_light_images(DEFAULT_MIN_THROUGHPUT)
+            .map_err(|e| self.invalid(&mirrored_path, e.to_string()))?;
+        Ok(scene)
     }
 
     /// Seed 001's planes, in file order: at most [`MAX_SYMMETRY_PLANES`], each through a point

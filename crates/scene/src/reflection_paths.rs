@@ -455,7 +455,7 @@ mod tests {
     #[test]
     fn portals_nest_and_views_stay_exact_deep_down() {
         let mut s = scene("mirror_box.json");
-        s.set_reflectance(Vec3::ONE);
+        s.set_reflectance(Vec3::ONE).unwrap();
         let set = run(&s, &limits(1000));
         for p in &set.paths[1..] {
             let parent = &set.paths[p.parent.unwrap()];

@@ -7,10 +7,16 @@
 //!
 //! with `n` the face normal turned towards the viewer (diffuse is two-sided), `E` the
 //! emission (front side only), `ρ` the albedo, `Iᵢ` the point lights' intensities (W/sr) at
-//! distance `rᵢ` in unit direction `lᵢ`, and `A` the ambient term. There are no shadows. A
-//! mirror's front returns its reflectance times the radiance along the reflected ray.
+//! distance `rᵢ` in unit direction `lᵢ`, and `A` the ambient term. A mirror's front returns its
+//! reflectance times the radiance along the reflected ray.
+//!
+//! Opt-in (`lighting` in the scene file): with `mirrored_lights = k` the sum also runs over
+//! the lights' images through chains of at most k mirrors ([`crate::light_images`]), each
+//! where its chain is valid; with `shadows`, each straight leg of a light's path must be
+//! unoccluded (the caller decides, [`Lighting::diffuse_radiance_with`]).
 
 use crate::geometry::Surface;
+use crate::light_images::{LightImages, for_each_leg};
 use glam::Vec3;
 
 /// An isotropic point light.
@@ -26,6 +32,13 @@ pub struct PointLight {
 pub struct Lighting {
     pub lights: Vec<PointLight>,
     pub ambient: Vec3,
+    /// `lighting.shadows`: every straight leg from a surface to a light (or through mirrors to
+    /// it) must be unoccluded.
+    pub shadows: bool,
+    /// `lighting.mirrored_lights`: most mirrors between a light and a surface (0: none).
+    pub mirrored_lights: u32,
+    /// The lights' images through chains of at most `mirrored_lights` mirrors.
+    pub images: LightImages,
 }
 
 /// Squared distance below which a light is considered to touch the surface and ignored
@@ -33,7 +46,27 @@ pub struct Lighting {
 pub const MIN_LIGHT_DISTANCE_SQUARED: f32 = 1e-8;
 
 impl Lighting {
-    /// Radiance leaving a diffuse point `p` towards the viewer.
+    /// One line for outputs' provenance: `direct, no shadows` (the default contract), or the
+    /// shadows and the light images with what pruning left out.
+    pub fn describe(&self) -> String {
+        let shadows = if self.shadows { "shadows" } else { "no shadows" };
+        if self.mirrored_lights == 0 {
+            return format!("direct, {shadows}");
+        }
+        let i = &self.images;
+        format!(
+            "mirrored lights through <= {} mirrors ({} light images; {} dim chains pruned below {}, \
+             changing no pixel by more than {:.3e}), {shadows}",
+            self.mirrored_lights,
+            i.images.len(),
+            i.pruned_dim,
+            i.min_throughput,
+            i.pruned_bound
+        )
+    }
+
+    /// Radiance leaving a diffuse point `p` towards the viewer, every light reaching it
+    /// (no occlusion test: what a renderer without shadows computes).
     ///
     /// `face_normal` is the triangle's front normal, `to_viewer` the unit direction from `p`
     /// back towards the viewer (−ray direction).
@@ -45,22 +78,63 @@ impl Lighting {
         albedo: Vec3,
         emission: Vec3,
     ) -> Vec3 {
+        self.diffuse_radiance_with(p, face_normal, to_viewer, albedo, emission, |_, _, _, _| {
+            true
+        })
+    }
+
+    /// [`Lighting::diffuse_radiance`], with shadows when [`Lighting::shadows`] is set:
+    /// `unoccluded(a, a_mirror, b, b_mirror)` says whether the straight leg from `a` to `b`
+    /// is clear (`a_mirror`, `b_mirror`: the mirror an end lies on, if any; the first leg
+    /// starts at `p`). It is asked only for lights that would add something.
+    pub fn diffuse_radiance_with(
+        &self,
+        p: Vec3,
+        face_normal: Vec3,
+        to_viewer: Vec3,
+        albedo: Vec3,
+        emission: Vec3,
+        mut unoccluded: impl FnMut(Vec3, Option<usize>, Vec3, Option<usize>) -> bool,
+    ) -> Vec3 {
         let front = face_normal.dot(to_viewer) >= 0.0;
         let n = if front { face_normal } else { -face_normal };
         let mut irradiance = Vec3::ZERO;
         for light in &self.lights {
-            let to_light = light.position - p;
-            let r2 = to_light.length_squared();
-            if r2 < MIN_LIGHT_DISTANCE_SQUARED {
+            let e = point_irradiance(p, n, light.position, light.intensity);
+            if e != Vec3::ZERO && (!self.shadows || unoccluded(p, None, light.position, None)) {
+                irradiance += e;
+            }
+        }
+        for (i, image) in self.images.images.iter().enumerate() {
+            if !image.lights(p) {
                 continue;
             }
-            let cos = n.dot(to_light) / r2.sqrt();
-            if cos > 0.0 {
-                irradiance += light.intensity * (cos / r2);
+            let e = point_irradiance(p, n, image.position, image.intensity);
+            if e != Vec3::ZERO
+                && (!self.shadows
+                    || for_each_leg(&self.images.images, &self.lights, i, p, &mut unoccluded))
+            {
+                irradiance += e;
             }
         }
         let emitted = if front { emission } else { Vec3::ZERO };
         emitted + albedo * (irradiance * std::f32::consts::FRAC_1_PI + self.ambient)
+    }
+}
+
+/// `I·max(0, n·l)/r²` from a point source at `source` (zero closer than
+/// [`MIN_LIGHT_DISTANCE_SQUARED`]).
+fn point_irradiance(p: Vec3, n: Vec3, source: Vec3, intensity: Vec3) -> Vec3 {
+    let to_light = source - p;
+    let r2 = to_light.length_squared();
+    if r2 < MIN_LIGHT_DISTANCE_SQUARED {
+        return Vec3::ZERO;
+    }
+    let cos = n.dot(to_light) / r2.sqrt();
+    if cos > 0.0 {
+        intensity * (cos / r2)
+    } else {
+        Vec3::ZERO
     }
 }
 
@@ -102,7 +176,7 @@ mod tests {
                 position,
                 intensity: Vec3::splat(intensity),
             }],
-            ambient: Vec3::ZERO,
+            ..Default::default()
         }
     }
 

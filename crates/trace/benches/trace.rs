@@ -15,7 +15,7 @@ fn bench(c: &mut Criterion) {
     for reflectance in [0.9f32, 0.7] {
         let mut scene = base.clone();
         scene.camera = scene.camera.with_size(640, 360);
-        scene.set_reflectance(Vec3::splat(reflectance));
+        scene.set_reflectance(Vec3::splat(reflectance)).unwrap();
         for kind in [BvhKind::Cwbvh, BvhKind::Bvh2] {
             let bvh = SceneBvh::build_with(&scene.geometry, kind);
             let rays = render(&scene, &bvh, &settings, &|_| {}).stats.rays;

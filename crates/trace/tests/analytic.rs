@@ -149,7 +149,7 @@ fn closest_point_on_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
 #[test]
 fn nothing_is_brighter_than_the_contract_allows() {
     let mut s = mirrorbox_scene::load::bundled_scene("mirror_box.json");
-    s.set_reflectance(Vec3::ONE);
+    s.set_reflectance(Vec3::ONE).unwrap();
     s.camera = s.camera.with_size(96, 54);
     let g = &s.geometry;
     let mut bound = s.background.max(s.terminal);

@@ -39,7 +39,9 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     let mut scene = load(&args.scene)?;
     resize(&mut scene, args.width, args.height)?;
     if let Some(r) = args.reflectance {
-        scene.set_reflectance(glam::Vec3::splat(r));
+        scene
+            .set_reflectance(glam::Vec3::splat(r))
+            .map_err(|e| super::light_budget(&scene, "--reflectance", e))?;
     }
     let written = export(&scene, &xml, ExportSettings { spp: args.spp })
         .map_err(|e| Failure::Other(e.to_string()))?;

@@ -36,6 +36,16 @@ pub fn resize(scene: &mut Scene, width: Option<u32>, height: Option<u32>) -> Res
 }
 
 /// A setting out of its range is the user's input (exit 2).
+/// A flag (`--alpha`, `--reflectance`, `--min-throughput`) that makes `scene`'s light images
+/// exceed their budget (exit 2).
+pub fn light_budget(
+    scene: &Scene,
+    flag: &str,
+    e: mirrorbox_scene::light_images::TooManyLightImages,
+) -> Failure {
+    Failure::BadInput(format!("{}: {flag}: {e}", scene.source.display()))
+}
+
 pub fn setting(e: mirrorbox_scene::limits::SettingError) -> Failure {
     Failure::BadInput(e.to_string())
 }

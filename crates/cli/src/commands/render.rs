@@ -62,7 +62,9 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     let mut scene = load(&args.scene)?;
     resize(&mut scene, args.width, args.height)?;
     if let Some(a) = args.alpha {
-        scene.set_reflectance(glam::Vec3::splat(a));
+        scene
+            .set_reflectance(glam::Vec3::splat(a))
+            .map_err(|e| super::light_budget(&scene, "--alpha", e))?;
     }
     let settings = RenderSettings {
         method: method.clone(),

@@ -116,7 +116,15 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     let mut scene = load(&args.scene)?;
     resize(&mut scene, args.width, args.height)?;
     if let Some(r) = args.reflectance {
-        scene.set_reflectance(glam::Vec3::splat(r));
+        scene
+            .set_reflectance(glam::Vec3::splat(r))
+            .map_err(|e| super::light_budget(&scene, "--reflectance", e))?;
+    }
+    if scene.lighting.mirrored_lights > 0 {
+        // The light images are pruned at the tracer's own threshold, as its eye paths are.
+        scene
+            .enumerate_light_images(whitted.min_throughput)
+            .map_err(|e| super::light_budget(&scene, "--min-throughput", e))?;
     }
     let sampling = if args.jitter {
         Sampling::Jittered {
@@ -179,6 +187,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         ),
         ("mirrorbox.rays", out.stats.rays.to_string()),
         ("mirrorbox.deepest_path", out.stats.deepest.to_string()),
+        ("mirrorbox.lighting", scene.lighting.describe()),
     ];
     // Every output appears together, or none does (a failing --bounces leaves no image).
     let mut staged = StagedFiles::new();
@@ -243,6 +252,11 @@ fn report(
             "ended": { "diffuse": s.diffuse, "escaped": s.escaped, "max_depth": s.cut_by_depth,
                        "min_throughput": s.cut_by_throughput, "roulette": s.cut_by_roulette },
             "outputs": written.iter().map(|p| p.display().to_string()).collect::<Vec<_>>(),
+            "lighting": { "shadows": scene.lighting.shadows,
+                          "mirrored_lights": scene.lighting.mirrored_lights,
+                          "light_images": scene.lighting.images.images.len(),
+                          "pruned_dim": scene.lighting.images.pruned_dim,
+                          "pruned_bound": scene.lighting.images.pruned_bound },
         });
         println!("{v}");
         return;
@@ -276,6 +290,7 @@ fn report(
             String::new()
         }
     );
+    println!("  lighting: {}", scene.lighting.describe());
     println!(
         "  {:?} over {} triangles built in {:.1} ms; wrote {}",
         bvh.kind,

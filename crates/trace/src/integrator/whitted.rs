@@ -1,7 +1,8 @@
 //! The `whitted` integrator: the shading contract (`docs/shading.md`) followed exactly.
 //!
 //! From the camera, follow perfect mirror reflections (throughput × reflectance at each
-//! bounce) until a diffuse surface (shaded by [`mirrorbox_scene::Lighting`]), the background,
+//! bounce) until a diffuse surface (shaded by [`mirrorbox_scene::Lighting`], with its shadow
+//! legs traced through the BVH when the scene asks for shadows), the background,
 //! or termination: `max_depth` reflections followed, or a throughput whose largest channel
 //! would fall below `min_throughput`. A terminated path shows the scene's `terminal`
 //! radiance on the mirror it could not follow, times the throughput so far.
@@ -74,6 +75,26 @@ impl<'a> Whitted<'a> {
         self.settings
     }
 
+    /// Whether the straight leg from `a` to `b` is unoccluded (`lighting.shadows`). It
+    /// starts on mirror `a_mirror`, or else on triangle `from` (the shaded point); either is
+    /// skipped, being planar. The leg ends at a light or on a mirror: hits within 10⁻⁴ of
+    /// its length from `b` are not counted, as the `path` integrator's shadow rays do.
+    fn leg_unoccluded(&self, a: Vec3, a_mirror: Option<usize>, from: usize, b: Vec3) -> bool {
+        let d = b - a;
+        let length = d.length();
+        if length == 0.0 {
+            return true;
+        }
+        let ray = Ray {
+            origin: a,
+            dir: d / length,
+        };
+        let skip_triangle = if a_mirror.is_none() { Some(from) } else { None };
+        self.bvh
+            .closest_hit_skipping(&ray, 0.0, length * (1.0 - 1e-4), a_mirror, skip_triangle)
+            .is_none()
+    }
+
     /// Radiance along `ray` (what [`Integrator::radiance`] returns; no random numbers).
     pub fn radiance(&self, ray: Ray) -> PathResult {
         self.trace(ray, |_, _, _| {})
@@ -106,10 +127,18 @@ impl<'a> Whitted<'a> {
             match interaction(surface, front) {
                 Interaction::Diffuse { albedo, emission } => {
                     let p = query.at(hit.t);
-                    radiance += throughput
-                        * scene
-                            .lighting
-                            .diffuse_radiance(p, normal, -query.dir, albedo, emission);
+                    let shaded = scene.lighting.diffuse_radiance_with(
+                        p,
+                        normal,
+                        -query.dir,
+                        albedo,
+                        emission,
+                        |a, a_mirror, b, _| {
+                            rays += 1;
+                            self.leg_unoccluded(a, a_mirror, hit.triangle, b)
+                        },
+                    );
+                    radiance += throughput * shaded;
                     break Termination::Diffuse;
                 }
                 Interaction::Reflect { reflectance } => {
