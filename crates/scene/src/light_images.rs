@@ -325,3 +325,275 @@ pub fn for_each_leg(
     }
     true
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::load::parse_scene;
+    use std::path::Path;
+
+    /// Two facing mirrors at z = ±1 (reflectance 0.8, wide enough to count as infinite for
+    /// points near the axis), a light at `light`, `lighting` as given.
+    fn parallel_pair(light: [f32; 3], lighting: &str, objects: &str) -> Scene {
+        let text = format!(
+            r#"{{ "camera": {{ "position": [0, 0, 0.5], "look_at": [0, -1, 0], "fov_y_deg": 40,
+                "width": 16, "height": 16 }},
+              "mirrors": [
+                {{ "center": [0, 0, -1], "normal": [0, 0, 1], "up": [0, 1, 0], "width": 2000,
+                   "height": 2000, "reflectance": [0.8, 0.8, 0.8] }},
+                {{ "center": [0, 0, 1], "normal": [0, 0, -1], "up": [0, 1, 0], "width": 2000,
+                   "height": 2000, "reflectance": [0.8, 0.8, 0.8] }} ],
+              "objects": [ {objects} ],
+              "lights": [ {{ "position": {light:?}, "intensity": [2, 2, 2] }} ],
+              "lighting": {lighting} }}"#
+        );
+        parse_scene(&text, Path::new("pair.json")).unwrap()
+    }
+
+    /// The closed form for two parallel mirrors 2 apart: the light at z₀ has images at
+    /// `4m + z₀` (|2m| reflections) and `4m + 2 − z₀` (|2m + 1| reflections); a point lit by
+    /// all of them with ≤ k reflections receives Σ ρʲ·I·max(0, n·l)/r².
+    fn pair_irradiance(light: Vec3, x: Vec3, n: Vec3, k: i32, rho: f32, intensity: f32) -> f32 {
+        let mut e = 0.0;
+        for m in -k..=k {
+            for (z, j) in [
+                (4.0 * m as f32 + light.z, (2 * m).abs()),
+                (4.0 * m as f32 + 2.0 - light.z, (2 * m + 1).abs()),
+            ] {
+                if j > k {
+                    continue;
+                }
+                let to = Vec3::new(light.x, light.y, z) - x;
+                let cos = n.dot(to.normalize()).max(0.0);
+                e += rho.powi(j) * intensity * cos / to.length_squared();
+            }
+        }
+        e
+    }
+
+    #[test]
+    fn parallel_mirrors_light_a_patch_with_the_sum_over_images() {
+        let light = Vec3::new(0.1, 0.5, 0.3);
+        let albedo = Vec3::splat(0.5);
+        for k in [0u32, 1, 2, 5, 8] {
+            let scene = parallel_pair(
+                light.to_array(),
+                &format!(r#"{{ "mirrored_lights": {k} }}"#),
+                "",
+            );
+            assert_eq!(scene.lighting.images.images.len(), 2 * k as usize);
+            for x in [
+                Vec3::new(0.4, -0.5, -0.2),
+                Vec3::new(-0.7, -0.5, 0.8),
+                Vec3::new(0.0, -0.5, 0.0),
+            ] {
+                let got = scene
+                    .lighting
+                    .diffuse_radiance(x, Vec3::Y, Vec3::Y, albedo, Vec3::ZERO);
+                let want = 0.5 / std::f32::consts::PI
+                    * pair_irradiance(light, x, Vec3::Y, k as i32, 0.8, 2.0);
+                assert!(
+                    (got.x - want).abs() <= 1e-5 * want,
+                    "k = {k}, x = {x}: {} vs closed form {want}",
+                    got.x
+                );
+            }
+        }
+    }
+
+    /// Brute force: fold the segment from `x` to the image back through the chain's mirrors
+    /// and check each crossing (front face, inside the rectangle, in order).
+    fn valid_by_folding(scene: &Scene, set: &LightImages, index: usize, x: Vec3) -> bool {
+        let mut from = x.as_dvec3();
+        let mut current = Some(index);
+        while let Some(i) = current {
+            let image = &set.images[i];
+            let mirror = &scene.mirrors[image.mirror];
+            let n = mirror.normal.as_dvec3();
+            let c = mirror.center.as_dvec3();
+            let target = image.position.as_dvec3();
+            let (da, db) = (n.dot(from - c), n.dot(target - c));
+            if da <= 0.0 || db >= 0.0 {
+                return false;
+            }
+            let hit = from + (target - from) * (da / (da - db));
+            let local = hit - c;
+            let right = mirror.right().as_dvec3();
+            if local.dot(right).abs() > 0.5 * mirror.width as f64
+                || local.dot(mirror.up.as_dvec3()).abs() > 0.5 * mirror.height as f64
+            {
+                return false;
+            }
+            from = hit;
+            current = image.parent;
+        }
+        true
+    }
+
+    #[test]
+    fn beams_agree_with_folding_the_segment_back() {
+        // Finite, tilted mirrors: windows get clipped, beams split.
+        let text = r#"{ "camera": { "position": [0, 1, 0], "look_at": [0, 1, -1], "fov_y_deg": 60,
+            "width": 16, "height": 16 },
+          "mirrors": [
+            { "center": [0, 1.5, -2], "normal": [0.1, 0, 1], "up": [0, 1, 0], "width": 3, "height": 2 },
+            { "center": [0.3, 1.2, 2], "normal": [0, 0.05, -1], "up": [0, 1, 0], "width": 2, "height": 3 },
+            { "center": [-2, 1.5, 0], "normal": [1, 0, 0.2], "up": [0, 1, 0], "width": 3.5, "height": 2.5 } ],
+          "lights": [ { "position": [0.4, 2.2, 0.3], "intensity": [1, 1, 1] } ],
+          "lighting": { "mirrored_lights": 5 } }"#;
+        let scene = parse_scene(text, Path::new("tilted.json")).unwrap();
+        let set = &scene.lighting.images;
+        assert!(set.images.len() > 10, "{} images", set.images.len());
+        assert!(set.pruned_invalid > 0);
+        // A deterministic spread of points in and around the mirrors' box.
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f32 / (1u64 << 53) as f32
+        };
+        let (mut lit, mut checked) = (0, 0);
+        for _ in 0..4000 {
+            let x = Vec3::new(5.0 * next() - 2.5, 3.0 * next(), 5.0 * next() - 2.5);
+            for i in 0..set.images.len() {
+                let by_beam = set.images[i].lights(x);
+                let by_folding = valid_by_folding(&scene, set, i, x);
+                if by_beam != by_folding {
+                    // Only a hair from a beam's boundary may the two roundings disagree.
+                    let margin = set.images[i]
+                        .beam
+                        .iter()
+                        .map(|p| p.dot(x.extend(1.0)).abs())
+                        .fold(f32::INFINITY, f32::min);
+                    assert!(margin < 1e-4, "image {i}, x = {x}: beam {by_beam}, folding {by_folding}");
+                }
+                lit += usize::from(by_folding);
+                checked += 1;
+            }
+        }
+        assert!(lit > checked / 50, "only {lit} of {checked} lit: the test sees too little");
+    }
+
+    #[test]
+    fn pruning_bound_holds() {
+        let light = Vec3::new(0.1, 0.5, 0.3);
+        let full = parallel_pair(light.to_array(), r#"{ "mirrored_lights": 24 }"#, "");
+        let mut pruned = full.clone();
+        pruned.enumerate_light_images(0.05).unwrap();
+        assert!(pruned.lighting.images.pruned_dim > 0);
+        assert!(pruned.lighting.images.images.len() < full.lighting.images.images.len());
+        let mut all = full.clone();
+        all.enumerate_light_images(0.0).unwrap();
+        assert_eq!(all.lighting.images.images.len(), 48);
+        let bound = pruned.lighting.images.pruned_bound;
+        // The bound covers the scene's own surfaces: here only the mirrors' backs.
+        let albedo = match full.geometry.surfaces[0] {
+            crate::Surface::Mirror { back_albedo, .. } => back_albedo,
+            _ => unreachable!("the scene holds only mirrors"),
+        };
+        let mut worst = 0.0f32;
+        for i in 0..200 {
+            let t = i as f32 / 200.0;
+            let x = Vec3::new(2.0 * t - 1.0, -0.5, 1.9 * t - 0.95);
+            for n in [Vec3::Y, Vec3::Z, -Vec3::Z, Vec3::new(0.6, 0.8, 0.0)] {
+                let a = all.lighting.diffuse_radiance(x, n, n, albedo, Vec3::ZERO);
+                let p = pruned.lighting.diffuse_radiance(x, n, n, albedo, Vec3::ZERO);
+                worst = worst.max((a - p).max_element());
+            }
+        }
+        assert!(worst > 0.0, "the pruning must change something to test the bound");
+        assert!(worst <= bound, "changed a point by {worst}, bound {bound}");
+    }
+
+    #[test]
+    fn shadow_legs_fold_through_the_mirrors() {
+        let light = Vec3::new(0.1, 0.5, 0.3);
+        let scene = parallel_pair(light.to_array(), r#"{ "mirrored_lights": 3 }"#, "");
+        let x = Vec3::new(0.4, -0.5, -0.2);
+        let set = &scene.lighting.images.images;
+        for (i, image) in set.iter().enumerate() {
+            let mut legs = Vec::new();
+            let all = for_each_leg(set, &scene.lighting.lights, i, x, |a, am, b, bm| {
+                legs.push((a, am, b, bm));
+                true
+            });
+            assert!(all);
+            assert_eq!(legs.len(), image.depth as usize + 1);
+            assert_eq!(legs[0].0, x);
+            assert_eq!(legs.last().unwrap().2, light);
+            // Consecutive legs meet on a mirror, the folded path is as long as |x − L′|.
+            let mut length = 0.0;
+            for w in legs.windows(2) {
+                assert_eq!(w[0].2, w[1].0);
+                assert_eq!(w[0].3, w[1].1);
+                let m = w[0].3.unwrap();
+                assert!(scene.mirrors[m].plane().signed_distance(w[0].2).abs() < 1e-5);
+            }
+            for (a, _, b, _) in &legs {
+                length += a.distance(*b);
+            }
+            assert!((length - x.distance(image.position)).abs() < 1e-4);
+            // Stopping at a blocked leg.
+            let mut asked = 0;
+            assert!(!for_each_leg(set, &scene.lighting.lights, i, x, |_, _, _, _| {
+                asked += 1;
+                false
+            }));
+            assert_eq!(asked, 1);
+        }
+    }
+
+    #[test]
+    fn the_image_budget_is_refused_with_the_field() {
+        // A mirror room's chains multiply: 6 walls and 64 mirrors deep exceed 2¹⁶ images.
+        let walls = [
+            ([0, 0, -1], [0, 0, 1]),
+            ([0, 0, 1], [0, 0, -1]),
+            ([-1, 0, 0], [1, 0, 0]),
+            ([1, 0, 0], [-1, 0, 0]),
+        ]
+        .map(|(c, n)| {
+            format!(
+                r#"{{ "center": {c:?}, "normal": {n:?}, "up": [0, 1, 0], "width": 2, "height": 2,
+                      "reflectance": [1, 1, 1] }}"#
+            )
+        })
+        .join(",");
+        let text = format!(
+            r#"{{ "camera": {{ "position": [0, 0, 0], "look_at": [0, 0, -1], "fov_y_deg": 60,
+                "width": 8, "height": 8 }}, "mirrors": [{walls}],
+              "lights": [ {{ "position": [0.1, 0.2, 0.3], "intensity": [1, 1, 1] }} ],
+              "lighting": {{ "mirrored_lights": 64 }} }}"#
+        );
+        let e = parse_scene(&text, Path::new("room.json")).unwrap_err().to_string();
+        assert!(
+            e.contains("room.json: lighting.mirrored_lights:") && e.contains("65536"),
+            "{e}"
+        );
+        let e = parse_scene(&text.replace(": 64 }", ": 65 }"), Path::new("room.json"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("lighting.mirrored_lights: must be in [0, 64]"), "{e}");
+        let e = parse_scene(
+            &text.replace(r#""mirrored_lights": 64"#, r#""mirrored_light": 2"#),
+            Path::new("room.json"),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("mirrored_light"), "{e}");
+    }
+
+    #[test]
+    fn default_lighting_keeps_the_hash_and_the_contract() {
+        let light = [0.1, 0.5, 0.3];
+        let plain = parallel_pair(light, "{}", "");
+        let off = parallel_pair(light, r#"{ "shadows": false, "mirrored_lights": 0 }"#, "");
+        assert_eq!(plain.content_hash(), off.content_hash());
+        assert!(plain.lighting.images.images.is_empty());
+        let on = parallel_pair(light, r#"{ "mirrored_lights": 1 }"#, "");
+        assert_ne!(plain.content_hash(), on.content_hash());
+        let shadows = parallel_pair(light, r#"{ "shadows": true }"#, "");
+        assert_ne!(plain.content_hash(), shadows.content_hash());
+    }
+}
