@@ -219,10 +219,16 @@ pub fn light_images(
                     });
                 }
                 let position = node.position - 2.0 * source_distance * n;
-                let mut beam = vec![Vec4::new(n.x as f32, n.y as f32, n.z as f32, -offset as f32)];
+                let mut beam = vec![Vec4::new(
+                    n.x as f32,
+                    n.y as f32,
+                    n.z as f32,
+                    -offset as f32,
+                )];
                 beam.extend(
-                    side_planes(position, &window)
-                        .map(|(pn, pw)| Vec4::new(pn.x as f32, pn.y as f32, pn.z as f32, pw as f32)),
+                    side_planes(position, &window).map(|(pn, pw)| {
+                        Vec4::new(pn.x as f32, pn.y as f32, pn.z as f32, pw as f32)
+                    }),
                 );
                 let index = out.images.len();
                 out.images.push(LightImage {
@@ -466,13 +472,19 @@ mod tests {
                         .iter()
                         .map(|p| p.dot(x.extend(1.0)).abs())
                         .fold(f32::INFINITY, f32::min);
-                    assert!(margin < 1e-4, "image {i}, x = {x}: beam {by_beam}, folding {by_folding}");
+                    assert!(
+                        margin < 1e-4,
+                        "image {i}, x = {x}: beam {by_beam}, folding {by_folding}"
+                    );
                 }
                 lit += usize::from(by_folding);
                 checked += 1;
             }
         }
-        assert!(lit > checked / 50, "only {lit} of {checked} lit: the test sees too little");
+        assert!(
+            lit > checked / 50,
+            "only {lit} of {checked} lit: the test sees too little"
+        );
     }
 
     #[test]
@@ -498,11 +510,16 @@ mod tests {
             let x = Vec3::new(2.0 * t - 1.0, -0.5, 1.9 * t - 0.95);
             for n in [Vec3::Y, Vec3::Z, -Vec3::Z, Vec3::new(0.6, 0.8, 0.0)] {
                 let a = all.lighting.diffuse_radiance(x, n, n, albedo, Vec3::ZERO);
-                let p = pruned.lighting.diffuse_radiance(x, n, n, albedo, Vec3::ZERO);
+                let p = pruned
+                    .lighting
+                    .diffuse_radiance(x, n, n, albedo, Vec3::ZERO);
                 worst = worst.max((a - p).max_element());
             }
         }
-        assert!(worst > 0.0, "the pruning must change something to test the bound");
+        assert!(
+            worst > 0.0,
+            "the pruning must change something to test the bound"
+        );
         assert!(worst <= bound, "changed a point by {worst}, bound {bound}");
     }
 
@@ -536,10 +553,16 @@ mod tests {
             assert!((length - x.distance(image.position)).abs() < 1e-4);
             // Stopping at a blocked leg.
             let mut asked = 0;
-            assert!(!for_each_leg(set, &scene.lighting.lights, i, x, |_, _, _, _| {
-                asked += 1;
-                false
-            }));
+            assert!(!for_each_leg(
+                set,
+                &scene.lighting.lights,
+                i,
+                x,
+                |_, _, _, _| {
+                    asked += 1;
+                    false
+                }
+            ));
             assert_eq!(asked, 1);
         }
     }
@@ -566,7 +589,9 @@ mod tests {
               "lights": [ {{ "position": [0.1, 0.2, 0.3], "intensity": [1, 1, 1] }} ],
               "lighting": {{ "mirrored_lights": 64 }} }}"#
         );
-        let e = parse_scene(&text, Path::new("room.json")).unwrap_err().to_string();
+        let e = parse_scene(&text, Path::new("room.json"))
+            .unwrap_err()
+            .to_string();
         assert!(
             e.contains("room.json: lighting.mirrored_lights:") && e.contains("65536"),
             "{e}"
@@ -574,7 +599,10 @@ mod tests {
         let e = parse_scene(&text.replace(": 64 }", ": 65 }"), Path::new("room.json"))
             .unwrap_err()
             .to_string();
-        assert!(e.contains("lighting.mirrored_lights: must be in [0, 64]"), "{e}");
+        assert!(
+            e.contains("lighting.mirrored_lights: must be in [0, 64]"),
+            "{e}"
+        );
         let e = parse_scene(
             &text.replace(r#""mirrored_lights": 64"#, r#""mirrored_light": 2"#),
             Path::new("room.json"),

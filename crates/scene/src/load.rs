@@ -10,11 +10,11 @@ use crate::format::{
     SymmetryPlaneDesc, TransformDesc, Vec3f,
 };
 use crate::geometry::{Geometry, Surface};
+use crate::light_images::{DEFAULT_MIN_THROUGHPUT, MAX_MIRRORED_LIGHTS};
 use crate::limits::{
     MAX_COORDINATE, MAX_IMAGE_SIDE, MAX_OBJ_FILE_BYTES, MAX_PIXELS, MAX_SCENE_FILE_BYTES,
     MAX_TRIANGLES, MEMORY_PER_TRIANGLE, within_extent,
 };
-use crate::light_images::{DEFAULT_MIN_THROUGHPUT, MAX_MIRRORED_LIGHTS};
 use crate::shading::{Lighting, PointLight};
 use crate::symmetry::{self, MAX_SYMMETRY_PLANES, Symmetry, SymmetryPlane};
 use crate::tessellate::{self, MAX_SPHERE_SUBDIVISIONS};

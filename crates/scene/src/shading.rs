@@ -49,7 +49,11 @@ impl Lighting {
     /// One line for outputs' provenance: `direct, no shadows` (the default contract), or the
     /// shadows and the light images with what pruning left out.
     pub fn describe(&self) -> String {
-        let shadows = if self.shadows { "shadows" } else { "no shadows" };
+        let shadows = if self.shadows {
+            "shadows"
+        } else {
+            "no shadows"
+        };
         if self.mirrored_lights == 0 {
             return format!("direct, {shadows}");
         }
