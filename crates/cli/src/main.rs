@@ -41,6 +41,8 @@ enum Command {
     DepthScaling(commands::sweep::PresetArgs),
     /// The preset sweep of the symmetry methods against the number of planes p = 0…10 (writes reports/symmetry_scaling/).
     SymmetryScaling(commands::sweep::PresetArgs),
+    /// The preset sweep of lighting variants (direct, mirrored lights, shadow maps) against mirrored-light depth k on the lit mirror box and room (writes reports/lighting/ and reports/lighting_room/).
+    Lighting(commands::sweep::PresetArgs),
     /// Export a scene as Mitsuba 3 XML (tools/mitsuba renders and compares it).
     ExportMitsuba(commands::export_mitsuba::Args),
     /// Fill the generated regions of README.md and docs/methods.md from the committed reports (--check: only compare).
@@ -185,6 +187,7 @@ fn main() -> ExitCode {
         Command::Table1(args) => commands::sweep::run_table1(&args),
         Command::DepthScaling(args) => commands::sweep::run_depth_scaling(&args),
         Command::SymmetryScaling(args) => commands::sweep::run_symmetry_scaling(&args),
+        Command::Lighting(args) => commands::sweep::run_lighting(&args),
         Command::ExportMitsuba(args) => commands::export_mitsuba::run(&args),
         Command::Readme(args) => commands::readme::run(&args),
         Command::RenderWorker => {

@@ -28,6 +28,7 @@ use mirrorbox_image::{
 };
 use mirrorbox_raster::{Gpu, METHODS, Method, PlanError, RasterError, RenderSettings};
 use mirrorbox_report::{MetricValues, Record, SweepInfo, read_records, write_report};
+use mirrorbox_scene::light_images::MAX_MIRRORED_LIGHTS;
 use mirrorbox_scene::limits::{SettingError, unit_interval};
 use mirrorbox_scene::{Scene, SceneError, load_scene};
 use mirrorbox_trace::{SceneBvh, TraceSettings, WhittedSettings};
@@ -59,6 +60,10 @@ pub struct SweepConfig {
     /// scene's `symmetry_planes`, for every p listed (`--symmetry-planes`); `None` keeps the
     /// scene as it is.
     pub symmetry_planes: Option<Vec<u32>>,
+    /// The mirrored-lights axis (issue 15, `docs/shading.md`): each point's scene lights its
+    /// diffuse surfaces through chains of at most k mirrors (`lighting.mirrored_lights = k`),
+    /// for every k listed (`--mirrored-lights`); `None` keeps the scene's own.
+    pub mirrored_lights: Option<Vec<u32>>,
 }
 
 /// The methods `name` at each value of its swept option (`"auxiliary"`, `[0, 1, 2]`), every
@@ -74,6 +79,11 @@ pub fn swept(name: &str, values: impl IntoIterator<Item = u32>) -> Vec<Method> {
                 .unwrap_or_else(|e| panic!("preset: {e}"))
         })
         .collect()
+}
+
+/// `base` with the options of `words` (`"lights=direct shadow-map=1024"`, or empty) set.
+fn with_options(base: &Method, words: &str) -> Method {
+    Method::parse(&format!("{} {words}", base.key())).unwrap_or_else(|e| panic!("preset: {e}"))
 }
 
 impl SweepConfig {
@@ -94,6 +104,7 @@ impl SweepConfig {
             command: String::new(),
             worker: None,
             symmetry_planes: None,
+            mirrored_lights: None,
         }
     }
 
@@ -147,6 +158,52 @@ impl SweepConfig {
         }
     }
 
+    /// Shadows and mirrored lights (issue 15) on `mirror_box_lit`: the paper's auxiliary
+    /// method n = 0…4 and the exact methods at depth 64, each ignoring mirrored light
+    /// (`lights=direct`), with the light images but no shadows, and with 1024² shadow maps
+    /// (`unrolled` also at 256² and 4096²), against truths lit through k = 0, 1, 2, 4, 8
+    /// mirrors; 6 timed frames after one warm-up.
+    pub fn lighting(out: PathBuf) -> Self {
+        let mut methods = Vec::new();
+        let mut bases = swept(mirrorbox_report::table1::PAPER_METHOD, 0..=4);
+        bases.extend(swept("unrolled", [64]));
+        bases.extend(swept("portal", [64]));
+        for base in &bases {
+            for variant in ["lights=direct", "", "shadow-map=1024"] {
+                methods.push(with_options(base, variant));
+            }
+        }
+        let unrolled = &bases[5];
+        for variant in ["shadow-map=256", "shadow-map=4096"] {
+            methods.push(with_options(unrolled, variant));
+        }
+        SweepConfig {
+            scene: PathBuf::from("scenes/mirror_box_lit.json"),
+            mirrored_lights: Some(vec![0, 1, 2, 4, 8]),
+            frames: 6,
+            warmup: 1,
+            ..SweepConfig::preset(out, methods, vec![0.9])
+        }
+    }
+
+    /// [`SweepConfig::lighting`]'s mirror-room variant: the exact methods only (the room's
+    /// light images grow with k², 477 at k = 8), k = 0, 2, 4, 8.
+    pub fn lighting_room(out: PathBuf) -> Self {
+        let mut methods = Vec::new();
+        for base in swept("unrolled", [64]).iter().chain(&swept("portal", [64])) {
+            for variant in ["lights=direct", "", "shadow-map=1024"] {
+                methods.push(with_options(base, variant));
+            }
+        }
+        SweepConfig {
+            scene: PathBuf::from("scenes/mirror_room_lit.json"),
+            mirrored_lights: Some(vec![0, 2, 4, 8]),
+            frames: 6,
+            warmup: 1,
+            ..SweepConfig::preset(out, methods, vec![0.9])
+        }
+    }
+
     /// A preset on the paper's scene (mirror_box) with 9 timed frames: enough for a 95 %
     /// interval of each median.
     fn preset(out: PathBuf, methods: Vec<Method>, alphas: Vec<f32>) -> Self {
@@ -188,17 +245,35 @@ impl SweepConfig {
                 SettingError::new("--symmetry-planes", "at least one plane count", "none").into(),
             );
         }
+        let lights = self.mirrored_lights.as_ref().map_or(1, Vec::len);
+        if lights == 0 {
+            return Err(
+                SettingError::new("--mirrored-lights", "at least one depth", "none").into(),
+            );
+        }
+        for &k in self.mirrored_lights.iter().flatten() {
+            if k > MAX_MIRRORED_LIGHTS {
+                return Err(SettingError::new(
+                    "--mirrored-lights",
+                    format!("each in [0, {MAX_MIRRORED_LIGHTS}]"),
+                    k,
+                )
+                .into());
+            }
+        }
         let points = 1 + self
             .methods
             .len()
             .saturating_mul(self.alphas.len())
-            .saturating_mul(planes);
+            .saturating_mul(planes)
+            .saturating_mul(lights);
         if points > MAX_POINTS {
             return Err(SettingError::new(
-                "--methods × their axes × --alpha × --symmetry-planes",
+                "--methods × their axes × --alpha × --symmetry-planes × --mirrored-lights",
                 format!("at most {MAX_POINTS} points"),
                 format!(
-                    "{} configured methods × {} α × {planes} plane counts = {points} points",
+                    "{} configured methods × {} α × {planes} plane counts × {lights} \
+                     mirrored-light depths = {points} points",
                     self.methods.len(),
                     self.alphas.len()
                 ),
@@ -322,6 +397,8 @@ struct Point {
     alpha: f32,
     /// Symmetry planes kept (a `--symmetry-planes` sweep).
     planes: Option<u32>,
+    /// `lighting.mirrored_lights` (a `--mirrored-lights` sweep).
+    lights: Option<u32>,
     key: String,
     label: String,
     slug: String,
@@ -329,11 +406,19 @@ struct Point {
 
 /// The resume key of a point: the method's stable [`Method::key`], then the α, size, SSAA,
 /// frames and scene. Frozen: earlier `results.jsonl` files resume by it.
-/// A symmetry-planes sweep adds `|planes=p` after the method (keys without it are as before).
-fn point_key(method: Option<&Method>, alpha: f32, planes: Option<u32>, common: &str) -> String {
+/// A symmetry-planes sweep adds `|planes=p` after the method, a mirrored-lights sweep
+/// `|mirrored_lights=k` (keys without them are as before).
+fn point_key(
+    method: Option<&Method>,
+    alpha: f32,
+    planes: Option<u32>,
+    lights: Option<u32>,
+    common: &str,
+) -> String {
     let planes = planes.map_or(String::new(), |p| format!("|planes={p}"));
+    let lights = lights.map_or(String::new(), |k| format!("|mirrored_lights={k}"));
     match method {
-        Some(m) => format!("{}{planes}|alpha={alpha}|{common}", m.key()),
+        Some(m) => format!("{}{planes}{lights}|alpha={alpha}|{common}", m.key()),
         None => format!("floor|{common}"),
     }
 }
@@ -347,7 +432,8 @@ fn points(config: &SweepConfig, base_hash: u64, w: u32, h: u32) -> Vec<Point> {
         method: None,
         alpha: 1.0,
         planes: None,
-        key: point_key(None, 1.0, None, &common),
+        lights: None,
+        key: point_key(None, 1.0, None, None, &common),
         label: "floor (no mirrors)".into(),
         slug: "floor".into(),
     }];
@@ -355,25 +441,35 @@ fn points(config: &SweepConfig, base_hash: u64, w: u32, h: u32) -> Vec<Point> {
         Some(ps) => ps.iter().map(|&p| Some(p)).collect(),
         None => vec![None],
     };
+    let light_axis: Vec<Option<u32>> = match &config.mirrored_lights {
+        Some(ks) => ks.iter().map(|&k| Some(k)).collect(),
+        None => vec![None],
+    };
     for &alpha in &config.alphas {
         for &planes in &plane_axis {
-            for method in &config.methods {
-                let key = point_key(Some(method), alpha, planes, &common);
-                // A value listed twice (`--depth 1,1`, `--alpha 0.7,0.7`) is one point.
-                if out.iter().any(|p| p.key == key) {
-                    continue;
+            for &lights in &light_axis {
+                for method in &config.methods {
+                    let key = point_key(Some(method), alpha, planes, lights, &common);
+                    // A value listed twice (`--depth 1,1`, `--alpha 0.7,0.7`) is one point.
+                    if out.iter().any(|p| p.key == key) {
+                        continue;
+                    }
+                    let (p_label, p_slug) = planes.map_or((String::new(), String::new()), |p| {
+                        (format!(" p={p}"), format!("_p{p}"))
+                    });
+                    let (k_label, k_slug) = lights.map_or((String::new(), String::new()), |k| {
+                        (format!(" k={k}"), format!("_k{k}"))
+                    });
+                    out.push(Point {
+                        key,
+                        label: format!("{method}{p_label}{k_label} α={alpha}"),
+                        slug: format!("{}{p_slug}{k_slug}_a{alpha}", method.slug()),
+                        method: Some(method.clone()),
+                        alpha,
+                        planes,
+                        lights,
+                    });
                 }
-                let (p_label, p_slug) = planes.map_or((String::new(), String::new()), |p| {
-                    (format!(" p={p}"), format!("_p{p}"))
-                });
-                out.push(Point {
-                    key,
-                    label: format!("{method}{p_label} α={alpha}"),
-                    slug: format!("{}{p_slug}_a{alpha}", method.slug()),
-                    method: Some(method.clone()),
-                    alpha,
-                    planes,
-                });
             }
         }
     }
@@ -505,7 +601,7 @@ fn point_setup(
     p: &Point,
     config: &SweepConfig,
 ) -> Result<(Scene, RenderSettings), HarnessError> {
-    let scene = worker::point_scene(base, p.method.is_none(), p.planes, p.alpha)?;
+    let scene = worker::point_scene(base, p.method.is_none(), p.planes, p.lights, p.alpha)?;
     let method = p
         .method
         .clone()
@@ -668,6 +764,7 @@ pub fn run_sweep(
             scene_hash: scene.content_hash(),
             image: rendered_image(&cache, i),
             symmetry_planes: p.planes,
+            mirrored_lights: p.lights,
         });
     }
     // Interleaved timing: `frames` rounds; in each, every point renders its warm-up frames
@@ -729,10 +826,14 @@ pub fn run_sweep(
         // One truth per α (and per plane count in a symmetry-planes sweep).
         let truth_png = images.join(format!(
             "truth_{}.png",
-            match (&p.method, p.planes) {
-                (None, _) => "floor".into(),
-                (Some(_), None) => format!("a{}", p.alpha),
-                (Some(_), Some(planes)) => format!("p{planes}_a{}", p.alpha),
+            match (&p.method, p.planes, p.lights) {
+                (None, _, _) => "floor".into(),
+                (Some(_), planes, lights) => format!(
+                    "{}{}a{}",
+                    planes.map_or(String::new(), |p| format!("p{p}_")),
+                    lights.map_or(String::new(), |k| format!("k{k}_")),
+                    p.alpha
+                ),
             }
         ));
         let truth_source = truth_path.with_extension("png");
@@ -760,6 +861,7 @@ pub fn run_sweep(
                 .as_ref()
                 .map_or(String::new(), Method::variant_options),
             symmetry_planes: p.planes,
+            mirrored_lights: p.lights,
             copies_drawn: s.copies.map(|c| c.drawn),
             copies_total: s.copies.map(|c| c.total),
             bake_ms: s.bake_ms,

@@ -41,6 +41,10 @@ pub struct RenderJob {
     /// The symmetry planes the scene keeps (a `--symmetry-planes` sweep); `None`: all.
     #[serde(default)]
     pub symmetry_planes: Option<u32>,
+    /// `lighting.mirrored_lights` of the scene (a `--mirrored-lights` sweep); `None`: the
+    /// scene's own.
+    #[serde(default)]
+    pub mirrored_lights: Option<u32>,
 }
 
 /// What a worker measured.
@@ -105,16 +109,24 @@ pub fn method_text(method: &Method) -> String {
 fn job_scene(job: &RenderJob) -> Result<Scene, HarnessError> {
     let mut scene = load_scene(&job.scene)?;
     scene.resize(Some(job.width), Some(job.height))?;
-    point_scene(&scene, job.floor, job.symmetry_planes, job.alpha)
+    point_scene(
+        &scene,
+        job.floor,
+        job.symmetry_planes,
+        job.mirrored_lights,
+        job.alpha,
+    )
 }
 
 /// A point's scene made from the sweep's scene, the one derivation the sweep and its workers
 /// share (the worker's scene hash must equal the sweep's): the floor drops the mirrors, a
-/// symmetry-planes point keeps the first p planes, and every mirror reflects α.
+/// symmetry-planes point keeps the first p planes, a mirrored-lights point lights through
+/// chains of at most k mirrors, and every mirror reflects α (the light images follow).
 pub(crate) fn point_scene(
     base: &Scene,
     floor: bool,
     planes: Option<u32>,
+    mirrored_lights: Option<u32>,
     alpha: f32,
 ) -> Result<Scene, HarnessError> {
     let mut scene = match (floor, planes) {
@@ -122,12 +134,16 @@ pub(crate) fn point_scene(
         (false, Some(p)) => base.with_symmetry_planes(p as usize)?,
         (false, None) => base.clone(),
     };
-    scene
-        .set_reflectance(Vec3::splat(alpha))
-        .map_err(|source| HarnessError::LightImages {
-            scene: base.source.clone(),
-            source,
-        })?;
+    if let Some(k) = mirrored_lights {
+        scene.lighting.mirrored_lights = k;
+    }
+    let budget = |source| HarnessError::LightImages {
+        scene: base.source.clone(),
+        source,
+    };
+    scene.set_reflectance(Vec3::splat(alpha)).map_err(budget)?;
+    let threshold = scene.lighting.images.min_throughput;
+    scene.enumerate_light_images(threshold).map_err(budget)?;
     Ok(scene)
 }
 

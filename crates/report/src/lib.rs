@@ -7,6 +7,7 @@
 //! - [`readme`]: the README's figures, generated from the committed reports.
 
 pub mod exact;
+pub mod lighting;
 pub mod plot;
 pub mod readme;
 pub mod stats;
@@ -55,6 +56,9 @@ pub struct Record {
     /// Symmetry planes p the point's scene kept (a `--symmetry-planes` sweep, seed 001).
     #[serde(default)]
     pub symmetry_planes: Option<u32>,
+    /// `lighting.mirrored_lights` of the point's scene (a `--mirrored-lights` sweep, issue 15).
+    #[serde(default)]
+    pub mirrored_lights: Option<u32>,
     /// Symmetry methods: copies of the objects drawn, and 2^p.
     #[serde(default)]
     pub copies_drawn: Option<usize>,

@@ -49,7 +49,7 @@ pub(crate) enum Block {
 /// Bytes in a mebibyte (the tables' memory unit).
 const MIB: f64 = 1024.0 * 1024.0;
 
-fn f(v: f64, digits: usize) -> String {
+pub(crate) fn f(v: f64, digits: usize) -> String {
     if v.is_finite() {
         format!("{v:.digits$}")
     } else {
@@ -57,7 +57,7 @@ fn f(v: f64, digits: usize) -> String {
     }
 }
 
-fn sci(v: f64) -> String {
+pub(crate) fn sci(v: f64) -> String {
     if v.is_finite() {
         format!("{v:.3e}")
     } else {
@@ -78,7 +78,7 @@ fn paired_ratio(a: &Record, b: &Record) -> Option<crate::stats::Interval> {
 }
 
 /// "median [low–high]" (older records: "median (min m)").
-fn ms_cell(r: &Record, digits: usize) -> String {
+pub(crate) fn ms_cell(r: &Record, digits: usize) -> String {
     match r.ms_interval {
         Some([low, high]) => format!(
             "{} [{}–{}]",
@@ -105,11 +105,15 @@ fn row_interval(r: &table1::Row) -> String {
 
 fn label(r: &Record) -> String {
     let name = crate::symmetry::variant(r);
-    match (r.n, r.depth, r.symmetry_planes) {
+    let at = match (r.n, r.depth, r.symmetry_planes) {
         (Some(n), _, _) => format!("{name} n={n}"),
         (None, Some(d), _) => format!("{name} depth={d}"),
         (None, None, Some(p)) => format!("{name} p={p}"),
         _ => name,
+    };
+    match r.mirrored_lights {
+        Some(k) => format!("{at} k={k}"),
+        None => at,
     }
 }
 
@@ -247,14 +251,14 @@ fn esc(s: &str) -> String {
 fn write_csv(path: &Path, records: &[Record]) -> Result<(), FileError> {
     let mut s = String::from(
         "kind,method,n,depth,alpha,width,height,ssaa,ms_median,ms_ci_low,ms_ci_high,ms_min,timing_order,timing_source,frames,passes,draws,texture_renders,reflections,\
-         rmse,relmse,smape,max_abs,psnr,ssim,flip_mean,flip_p95,flip_p99,adapter,backend,scene,scene_hash,color_format,peak_memory_bytes,plan_ms,encode_ms,gpu_buffer_bytes,gpu_texture_bytes,method_options,symmetry_planes,copies_drawn,copies_total,bake_ms\n",
+         rmse,relmse,smape,max_abs,psnr,ssim,flip_mean,flip_p95,flip_p99,adapter,backend,scene,scene_hash,color_format,peak_memory_bytes,plan_ms,encode_ms,gpu_buffer_bytes,gpu_texture_bytes,method_options,symmetry_planes,copies_drawn,copies_total,bake_ms,mirrored_lights\n",
     );
     for r in records {
         let m = &r.metrics;
         let opt = |v: Option<u32>| v.map_or(String::new(), |x| x.to_string());
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},\"{}\",{},\"{}\",{},{},{},{},{},{},{},\"{}\",{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},\"{}\",{},\"{}\",{},{},{},{},{},{},{},\"{}\",{},{},{},{},{}",
             r.kind,
             r.method,
             opt(r.n),
@@ -297,7 +301,8 @@ fn write_csv(path: &Path, records: &[Record]) -> Result<(), FileError> {
             opt(r.symmetry_planes),
             r.copies_drawn.map_or(String::new(), |c| c.to_string()),
             r.copies_total.map_or(String::new(), |c| c.to_string()),
-            r.bake_ms.map_or(String::new(), |ms| ms.to_string())
+            r.bake_ms.map_or(String::new(), |ms| ms.to_string()),
+            opt(r.mirrored_lights)
         );
     }
     write_atomically(path, s.as_bytes())
@@ -739,6 +744,7 @@ fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
 
     b.extend(depth_scaling(info, records, floor));
     b.extend(symmetry_section(records));
+    b.extend(crate::lighting::lighting_section(records));
 
     let mut groups: Vec<(String, f32)> = Vec::new();
     for r in &points {
@@ -931,6 +937,7 @@ pub(crate) mod tests {
             method: "auxiliary".into(),
             method_options: String::new(),
             symmetry_planes: None,
+            mirrored_lights: None,
             copies_drawn: None,
             copies_total: None,
             bake_ms: None,
@@ -1196,7 +1203,7 @@ pub(crate) mod tests {
         let csv = std::fs::read_to_string(dir.path().join("results.csv")).unwrap();
         assert!(csv.lines().next().unwrap().ends_with(
             ",color_format,peak_memory_bytes,plan_ms,encode_ms,gpu_buffer_bytes,gpu_texture_bytes,\
-             method_options,symmetry_planes,copies_drawn,copies_total,bake_ms"
+             method_options,symmetry_planes,copies_drawn,copies_total,bake_ms,mirrored_lights"
         ));
         assert!(
             csv.lines()

@@ -109,9 +109,16 @@ impl Scene {
                 );
             }
         }
+        let mut lighting = self.lighting.clone();
+        // No mirror, no light image (their beams would still light points).
+        lighting.images = light_images::LightImages {
+            min_throughput: lighting.images.min_throughput,
+            ..Default::default()
+        };
         Scene {
             mirrors: Vec::new(),
             geometry,
+            lighting,
             ..self.clone()
         }
     }

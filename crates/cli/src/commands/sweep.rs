@@ -62,18 +62,33 @@ pub struct Args {
     /// most the scene's planes.
     #[arg(long)]
     symmetry_planes: Option<String>,
+    /// Mirrored-light depths k, comma separated or a range `a..=b`: every point is measured on
+    /// the scene lighting its surfaces through chains of up to k mirrors
+    /// (`lighting.mirrored_lights`, docs/shading.md), for each k; each 0..=64.
+    #[arg(long)]
+    mirrored_lights: Option<String>,
 }
 
 /// `--symmetry-planes`: `0,2,4` or `0..=10`.
 fn parse_planes(text: &str) -> Result<Vec<u32>, Failure> {
+    parse_counts(
+        "--symmetry-planes",
+        "plane counts",
+        mirrorbox_scene::symmetry::MAX_SYMMETRY_PLANES as u32,
+        text,
+    )
+}
+
+/// A list of counts each in `0..=max`: `0,2,4` or `0..=10` (`flag` and `what` for the error).
+fn parse_counts(flag: &str, what: &str, max: u32, text: &str) -> Result<Vec<u32>, Failure> {
     let bad = || {
         Failure::BadInput(format!(
-            "--symmetry-planes {text:?}: must be plane counts in 0..=16, comma separated or a range a..=b"
+            "{flag} {text:?}: must be {what} in 0..={max}, comma separated or a range a..=b"
         ))
     };
     let count = |s: &str| -> Result<u32, Failure> {
         let p: u32 = s.trim().parse().map_err(|_| bad())?;
-        if p > mirrorbox_scene::symmetry::MAX_SYMMETRY_PLANES as u32 {
+        if p > max {
             return Err(bad());
         }
         Ok(p)
@@ -187,6 +202,18 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             .as_deref()
             .map(parse_planes)
             .transpose()?,
+        mirrored_lights: args
+            .mirrored_lights
+            .as_deref()
+            .map(|t| {
+                parse_counts(
+                    "--mirrored-lights",
+                    "mirror counts",
+                    mirrorbox_scene::light_images::MAX_MIRRORED_LIGHTS,
+                    t,
+                )
+            })
+            .transpose()?,
     };
     execute(&config, args.fresh)
 }
@@ -215,6 +242,20 @@ pub fn run_symmetry_scaling(args: &PresetArgs) -> Result<(), Failure> {
         .clone()
         .unwrap_or_else(|| "reports/symmetry_scaling".into());
     run_preset(SweepConfig::symmetry_scaling(out), args)
+}
+
+/// Lighting variants against mirrored-light depth (`SweepConfig::lighting`): the lit mirror
+/// box into `reports/lighting/` and the lit mirror room into `reports/lighting_room/` (with
+/// `--out DIR`: `DIR` and `DIR_room`).
+pub fn run_lighting(args: &PresetArgs) -> Result<(), Failure> {
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| "reports/lighting".into());
+    let mut room = out.clone().into_os_string();
+    room.push("_room");
+    run_preset(SweepConfig::lighting(out), args)?;
+    run_preset(SweepConfig::lighting_room(room.into()), args)
 }
 
 fn run_preset(mut config: SweepConfig, args: &PresetArgs) -> Result<(), Failure> {

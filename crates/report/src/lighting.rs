@@ -1,0 +1,347 @@
+//! Shadows and mirrored lights (issue 15, `docs/shading.md`) in a report: the error each
+//! raster lighting variant leaves against a truth lit the same way, and its cost, against the
+//! depth k of the mirrored lights (`lighting.mirrored_lights`).
+//!
+//! A point's lighting variant is read from its method options (`lights=…`,
+//! `shadow-map=…`): the report knows their names, not the rasterizer.
+
+use crate::Record;
+use crate::plot::{Chart, Series};
+use crate::write::{Block, f, ms_cell, sci};
+
+/// The raster option that chooses direct or mirrored lights.
+pub const LIGHTS_OPTION: &str = "lights";
+/// The raster option that sets the shadow-map resolution (0: no shadows).
+pub const SHADOW_MAP_OPTION: &str = "shadow-map";
+
+fn is_lighting_word(word: &str) -> bool {
+    [LIGHTS_OPTION, SHADOW_MAP_OPTION]
+        .iter()
+        .any(|o| word.split_once('=').is_some_and(|(name, _)| name == *o))
+}
+
+/// The method a point measured, without its lighting options: `auxiliary n=2`,
+/// `unrolled depth=64`.
+pub fn method_of(r: &Record) -> String {
+    let mut words = vec![r.method.clone()];
+    if let Some(n) = r.n {
+        words.push(format!("n={n}"));
+    }
+    if let Some(d) = r.depth {
+        words.push(format!("depth={d}"));
+    }
+    words.extend(
+        r.method_options
+            .split_whitespace()
+            .filter(|w| !is_lighting_word(w))
+            .map(String::from),
+    );
+    words.join(" ")
+}
+
+/// The point's lighting variant in words: `direct only, no shadows`, `mirrored, shadow maps
+/// 1024²`. Options at their defaults are absent from the record: mirrored lights (what the
+/// scene asks for), no shadow maps.
+pub fn lighting_of(r: &Record) -> String {
+    let value = |name: &str| {
+        r.method_options.split_whitespace().find_map(|w| {
+            w.split_once('=')
+                .filter(|(n, _)| *n == name)
+                .map(|(_, v)| v)
+        })
+    };
+    let lights = match value(LIGHTS_OPTION) {
+        Some("direct") => "direct only",
+        _ => "mirrored",
+    };
+    match value(SHADOW_MAP_OPTION) {
+        Some(res) if res != "0" => format!("{lights}, shadow maps {res}²"),
+        _ => format!("{lights}, no shadows"),
+    }
+}
+
+/// The points of a mirrored-lights sweep.
+fn lit_points(records: &[Record]) -> Vec<&Record> {
+    records
+        .iter()
+        .filter(|r| r.kind == "point" && r.mirrored_lights.is_some())
+        .collect()
+}
+
+fn distinct(values: impl Iterator<Item = String>) -> Vec<String> {
+    let mut out: Vec<String> = Vec::new();
+    for v in values {
+        if !out.contains(&v) {
+            out.push(v);
+        }
+    }
+    out
+}
+
+/// The method the sentences and the error-against-k chart follow: the first exact one
+/// measured (`unrolled`, `portal`), else the first.
+fn reference_method(points: &[&Record]) -> Option<String> {
+    let methods = distinct(points.iter().map(|r| method_of(r)));
+    methods
+        .iter()
+        .find(|m| m.starts_with("unrolled") || m.starts_with("portal"))
+        .or(methods.first())
+        .cloned()
+}
+
+/// What each lighting variant of `method` leaves and costs at depth `k`, in sentences.
+pub fn sentences(records: &[Record]) -> Vec<String> {
+    let points = lit_points(records);
+    let Some(method) = reference_method(&points) else {
+        return Vec::new();
+    };
+    let Some(k) = points.iter().filter_map(|r| r.mirrored_lights).max() else {
+        return Vec::new();
+    };
+    let at = |lighting: &str| {
+        points.iter().copied().find(|r| {
+            method_of(r) == method && r.mirrored_lights == Some(k) && lighting_of(r) == lighting
+        })
+    };
+    let variants = distinct(points.iter().map(|r| lighting_of(r)));
+    let mut out = Vec::new();
+    let describe = |r: &Record| {
+        format!(
+            "FLIP mean {}, RMSE {} at {} ms/frame",
+            sci(r.metrics.flip_mean),
+            sci(r.metrics.rmse),
+            ms_cell(r, 1)
+        )
+    };
+    if let Some(direct) = at("direct only, no shadows") {
+        out.push(format!(
+            "Ignoring mirrored light (`{method}` with `lights=direct`, today's raster) against the \
+             truth lit through up to k = {k} mirrors: {}.",
+            describe(direct)
+        ));
+    }
+    for v in variants.iter().filter(|v| !v.starts_with("direct only")) {
+        if let Some(r) = at(v) {
+            out.push(format!("`{method}`, {v}: {}.", describe(r)));
+        }
+    }
+    // How the error of ignoring mirrored light grows with k.
+    let direct: Vec<&Record> = {
+        let mut d: Vec<&Record> = points
+            .iter()
+            .copied()
+            .filter(|r| method_of(r) == method && lighting_of(r) == "direct only, no shadows")
+            .collect();
+        d.sort_by_key(|r| r.mirrored_lights);
+        d
+    };
+    if let (Some(first), Some(last)) = (direct.first(), direct.last())
+        && first.mirrored_lights != last.mirrored_lights
+    {
+        out.push(format!(
+            "The error of ignoring mirrored light grows with the truth's depth: FLIP mean {} at \
+             k = {} to {} at k = {}.",
+            sci(first.metrics.flip_mean),
+            first.mirrored_lights.unwrap_or(0),
+            sci(last.metrics.flip_mean),
+            last.mirrored_lights.unwrap_or(0)
+        ));
+    }
+    out
+}
+
+/// The report section of a mirrored-lights sweep (empty for any other sweep).
+pub(crate) fn lighting_section(records: &[Record]) -> Vec<Block> {
+    let points = lit_points(records);
+    if points.is_empty() {
+        return Vec::new();
+    }
+    let k_max = points
+        .iter()
+        .filter_map(|r| r.mirrored_lights)
+        .max()
+        .unwrap_or(0);
+    let variants = distinct(points.iter().map(|r| lighting_of(r)));
+    let error_vs_ms: Vec<Series> = variants
+        .iter()
+        .map(|v| {
+            let at_k: Vec<&Record> = points
+                .iter()
+                .copied()
+                .filter(|r| &lighting_of(r) == v && r.mirrored_lights == Some(k_max))
+                .collect();
+            Series {
+                name: v.clone(),
+                points: at_k
+                    .iter()
+                    .map(|r| (r.ms_median, r.metrics.flip_mean))
+                    .collect(),
+                labels: at_k.iter().map(|r| method_of(r)).collect(),
+                x_intervals: at_k.iter().map(|r| r.ms_interval).collect(),
+                y_intervals: Vec::new(),
+            }
+        })
+        .collect();
+    let mut out = vec![
+        Block::Heading(2, "Lighting: shadows and mirrored lights".into()),
+        Block::Paragraph(format!(
+            "The truth lights every diffuse point through the lights' images in chains of up to \
+             k mirrors (the point's k), with the scene's shadows; each raster point uses the \
+             lighting variant named beside its method. The plots take k = {k_max}."
+        )),
+        Block::Chart(
+            "plot_lighting_error_vs_ms.svg".into(),
+            Chart {
+                title: format!("FLIP mean vs ms/frame by lighting variant, k = {k_max}"),
+                x_label: "ms/frame (median, 95 % CI bars)".into(),
+                y_label: "FLIP mean".into(),
+                x_log: true,
+                y_log: true,
+                series: error_vs_ms,
+                reference_lines: Vec::new(),
+            }
+            .to_svg(),
+        ),
+    ];
+    if let Some(method) = reference_method(&points) {
+        let series: Vec<Series> = variants
+            .iter()
+            .map(|v| {
+                let mut pts: Vec<&Record> = points
+                    .iter()
+                    .copied()
+                    .filter(|r| &lighting_of(r) == v && method_of(r) == method)
+                    .collect();
+                pts.sort_by_key(|r| r.mirrored_lights);
+                Series {
+                    name: v.clone(),
+                    points: pts
+                        .iter()
+                        .map(|r| {
+                            (
+                                f64::from(r.mirrored_lights.unwrap_or(0)),
+                                r.metrics.flip_mean,
+                            )
+                        })
+                        .collect(),
+                    labels: Vec::new(),
+                    x_intervals: Vec::new(),
+                    y_intervals: Vec::new(),
+                }
+            })
+            .collect();
+        out.push(Block::Chart(
+            "plot_lighting_error_vs_k.svg".into(),
+            Chart {
+                title: format!("FLIP mean vs mirrored-light depth k, {method}"),
+                x_label: "k (most mirrors between a light and a surface)".into(),
+                y_label: "FLIP mean".into(),
+                x_log: false,
+                y_log: true,
+                series,
+                reference_lines: Vec::new(),
+            }
+            .to_svg(),
+        ));
+    }
+    let mut rows: Vec<&Record> = points.clone();
+    rows.sort_by(|a, b| {
+        (method_of(a), lighting_of(a), a.mirrored_lights).cmp(&(
+            method_of(b),
+            lighting_of(b),
+            b.mirrored_lights,
+        ))
+    });
+    out.push(Block::Table(
+        [
+            "method",
+            "lighting",
+            "k",
+            "ms/frame median [95 % CI]",
+            "passes",
+            "FLIP mean",
+            "RMSE",
+            "SSIM",
+        ]
+        .map(String::from)
+        .to_vec(),
+        rows.iter()
+            .map(|r| {
+                vec![
+                    method_of(r),
+                    lighting_of(r),
+                    r.mirrored_lights.map_or("–".into(), |k| k.to_string()),
+                    ms_cell(r, 2),
+                    r.passes.to_string(),
+                    sci(r.metrics.flip_mean),
+                    sci(r.metrics.rmse),
+                    f(r.metrics.ssim, 4),
+                ]
+            })
+            .collect(),
+    ));
+    let s = sentences(records);
+    if !s.is_empty() {
+        out.push(Block::Bullets(s));
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn record(method: &str, options: &str, k: u32, flip: f64) -> Record {
+        let mut r = crate::write::tests::record(0, 10.0, 1, flip);
+        r.method = method.into();
+        r.n = None;
+        r.method_options = options.into();
+        r.mirrored_lights = Some(k);
+        r.metrics.flip_mean = flip;
+        if method == "unrolled" {
+            r.depth = Some(64);
+        }
+        r
+    }
+
+    #[test]
+    fn variants_are_read_from_the_options() {
+        let r = record("unrolled", "lights=direct", 4, 0.1);
+        assert_eq!(method_of(&r), "unrolled depth=64");
+        assert_eq!(lighting_of(&r), "direct only, no shadows");
+        let r = record("auxiliary", "shadow-map=1024 max-passes=9", 4, 0.1);
+        assert_eq!(method_of(&r), "auxiliary max-passes=9");
+        assert_eq!(lighting_of(&r), "mirrored, shadow maps 1024²");
+        assert_eq!(
+            lighting_of(&record("portal", "", 0, 0.1)),
+            "mirrored, no shadows"
+        );
+    }
+
+    #[test]
+    fn sentences_follow_the_exact_method_at_the_deepest_k() {
+        let records = vec![
+            record("auxiliary", "lights=direct", 8, 0.5),
+            record("unrolled", "lights=direct", 0, 0.01),
+            record("unrolled", "lights=direct", 8, 0.2),
+            record("unrolled", "", 8, 0.05),
+            record("unrolled", "shadow-map=1024", 8, 0.02),
+        ];
+        let s = sentences(&records).join("\n");
+        assert!(
+            s.contains("`unrolled depth=64` with `lights=direct`"),
+            "{s}"
+        );
+        assert!(s.contains("up to k = 8 mirrors: FLIP mean 2.000e-1"), "{s}");
+        assert!(
+            s.contains("mirrored, shadow maps 1024²: FLIP mean 2.000e-2"),
+            "{s}"
+        );
+        assert!(s.contains("1.000e-2 at k = 0 to 2.000e-1 at k = 8"), "{s}");
+        assert!(lighting_section(&records).len() >= 5);
+        // Not a mirrored-lights sweep: no section.
+        let mut plain = records[0].clone();
+        plain.mirrored_lights = None;
+        assert!(lighting_section(&[plain]).is_empty());
+    }
+}
