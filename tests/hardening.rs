@@ -62,6 +62,10 @@ fn edge_cases_are_refused_with_a_clear_message_and_nothing_written() {
     random_obj["objects"] = json!([{ "type": "mesh", "path": "/dev/urandom" }]);
     let random_obj = write_scene(d, "random_obj.json", &random_obj);
     let random_obj = random_obj.to_str().unwrap().to_string();
+    let mut deep_lights = scene();
+    deep_lights["lighting"] = json!({ "mirrored_lights": 99 });
+    let deep_lights = write_scene(d, "deep_lights.json", &deep_lights);
+    let deep_lights = deep_lights.to_str().unwrap().to_string();
     let out = d.join("out");
     std::fs::create_dir(&out).unwrap();
     let (ok, far, heavy, zero_obj) = (
@@ -201,6 +205,17 @@ fn edge_cases_are_refused_with_a_clear_message_and_nothing_written() {
             vec!["--frames must be in [1, 10000]"],
         ),
         (sweep(&["--ssaa", "9"]), vec!["--ssaa must be in [1, 8]"]),
+        (
+            sweep(&["--mirrored-lights", "0,65"]),
+            vec!["--mirrored-lights \"0,65\": must be mirror counts in 0..=64"],
+        ),
+        (
+            own(&["trace", &deep_lights, "-o", exr]),
+            vec![
+                "deep_lights.json: lighting.mirrored_lights: must be in [0, 64]",
+                "got 99",
+            ],
+        ),
         (
             sweep(&["--methods", "auxiliary", "--n", "0..4294967295"]),
             vec!["--n \"0..4294967295\""],
