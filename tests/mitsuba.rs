@@ -41,6 +41,18 @@ fn run(program: &str, args: &[&str]) {
 
 /// Renders `mirror_box` with both renderers and returns (ours, Mitsuba).
 fn both(py: &str, dir: &Path, integrator: &str, spp: &str, depth: &str) -> (RgbImage, RgbImage) {
+    both_of(py, "scenes/mirror_box.json", dir, integrator, spp, depth)
+}
+
+/// Renders `scene` with both renderers at 64×36 and returns (ours, Mitsuba).
+fn both_of(
+    py: &str,
+    scene: &str,
+    dir: &Path,
+    integrator: &str,
+    spp: &str,
+    depth: &str,
+) -> (RgbImage, RgbImage) {
     let bin = env!("CARGO_BIN_EXE_mirrorbox");
     let d = dir.join(integrator);
     // An output's folder must exist (every command's rule).
@@ -50,19 +62,12 @@ fn both(py: &str, dir: &Path, integrator: &str, spp: &str, depth: &str) -> (RgbI
     let size = ["--width", "64", "--height", "36"];
     let s = |p: &Path| p.to_str().unwrap().to_string();
     let (xml_s, ours_s, theirs_s) = (s(&xml), s(&ours), s(&theirs));
-    let mut export = vec![
-        "export-mitsuba",
-        "scenes/mirror_box.json",
-        "-o",
-        &xml_s,
-        "--spp",
-        spp,
-    ];
+    let mut export = vec!["export-mitsuba", scene, "-o", &xml_s, "--spp", spp];
     export.extend(size);
     run(bin, &export);
     let mut trace = vec![
         "trace",
-        "scenes/mirror_box.json",
+        scene,
         "-o",
         &ours_s,
         "--spp",
@@ -147,7 +152,32 @@ fn path_agrees_with_mitsuba_within_monte_carlo_noise() {
     let Some(py) = python() else { return };
     let dir = tempfile::tempdir().unwrap();
     let (a, b) = both(&py, dir.path(), "path", "256", "66");
-    let d = block_differences(&a, &b, 4);
+    assert_means_agree("mirror_box", &a, &b, 0.005);
+}
+
+/// Light through mirrors checked by an independent renderer (issue 15): `mirror_box_lit`
+/// lit only by its emissive lamp (its point light removed), whose light reaches the floor and
+/// the objects through the mirrors by each renderer's own sampling — the area-light version
+/// of the scene whose point light `whitted` mirrors by images.
+#[test]
+fn light_through_mirrors_agrees_with_mitsuba() {
+    let Some(py) = python() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(repo().join("scenes/mirror_box_lit.json")).unwrap();
+    let mut scene: serde_json::Value = serde_json::from_str(&text).unwrap();
+    scene["lights"] = serde_json::json!([]);
+    let path = dir.path().join("lamp_only.json");
+    std::fs::write(&path, scene.to_string()).unwrap();
+    let (a, b) = both_of(&py, path.to_str().unwrap(), dir.path(), "path", "256", "66");
+    // Measured 2026-11-22: −0.19 % apart, t = −0.83. A small emitter found through mirrors
+    // by BSDF sampling alone is noisier than the point light of `mirror_box`: 1 %.
+    assert_means_agree("mirror_box_lit, lamp only", &a, &b, 0.01);
+}
+
+/// The two image means agree within `tolerance` (relative), with the block t statistic
+/// checked loosely (see the doc of the test above).
+fn assert_means_agree(what: &str, a: &RgbImage, b: &RgbImage, tolerance: f64) {
+    let d = block_differences(a, b, 4);
     let n = d.len() as f64;
     let mean = d.iter().sum::<f64>() / n;
     let sd = (d.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
@@ -160,14 +190,14 @@ fn path_agrees_with_mitsuba_within_monte_carlo_noise() {
         .sum::<f64>()
         / (3 * a.pixels.len()) as f64;
     println!(
-        "path vs Mitsuba: {} blocks, mean difference {mean:.3e} ({:.3} % of {image_mean:.4}), t = {t:.2}",
+        "{what}: path vs Mitsuba: {} blocks, mean difference {mean:.3e} ({:.3} % of {image_mean:.4}), t = {t:.2}",
         d.len(),
         100.0 * mean / image_mean
     );
-    assert!(t.abs() < 4.5, "t = {t}");
+    assert!(t.abs() < 4.5, "{what}: t = {t}");
     assert!(
-        (mean / image_mean).abs() < 0.005,
-        "relative mean difference {}",
+        (mean / image_mean).abs() < tolerance,
+        "{what}: relative mean difference {}",
         mean / image_mean
     );
 }
