@@ -64,6 +64,21 @@ pub const REGIONS: &[(&str, &str, &str)] = &[
         "the symmetry methods against p: every point, the crossover, the pruning",
     ),
     (
+        "lighting",
+        "lighting",
+        "shadows and mirrored lights on the lit mirror box: each lighting variant's error and cost",
+    ),
+    (
+        "lighting-room",
+        "lighting_room",
+        "the same on the lit mirror room",
+    ),
+    (
+        "lighting-trace-cost",
+        "lighting/trace_cost.jsonl",
+        "the tracer's time against the mirrored-light depth k on both lit scenes",
+    ),
+    (
         "main-job",
         "main_job.json",
         "the main job's steps: time and peak memory",
@@ -180,6 +195,99 @@ fn symmetry_region(s: &Sweep) -> Result<String, ReadmeError> {
     let mut blocks = vec![Block::Paragraph(measured_on(s))];
     blocks.extend(section);
     Ok(markdown(&blocks))
+}
+
+fn lighting_region(s: &Sweep) -> Result<String, ReadmeError> {
+    let sentences = crate::lighting::sentences(&s.records);
+    if sentences.is_empty() {
+        return Err(ReadmeError(format!(
+            "{}: no mirrored-lights sweep, nothing to quote",
+            s.info.scene
+        )));
+    }
+    Ok(markdown(&[
+        Block::Paragraph(measured_on(s)),
+        Block::Bullets(sentences),
+    ]))
+}
+
+/// One `trace --json` run of `scripts/lighting-trace-cost.sh`.
+#[derive(serde::Deserialize)]
+struct TraceRun {
+    scene: String,
+    mirrored_lights: u32,
+    render_seconds: f64,
+    rays: u64,
+    threads: usize,
+    lighting: TraceLighting,
+}
+
+#[derive(serde::Deserialize)]
+struct TraceLighting {
+    light_images: usize,
+}
+
+/// The tracer's median time per scene and k, with the light images and rays behind it.
+fn trace_cost_region(path: &Path) -> Result<String, ReadmeError> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| ReadmeError(format!("{}: {e}", path.display())))?;
+    let mut runs = Vec::new();
+    for (i, line) in text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty()) {
+        let run: TraceRun = serde_json::from_str(line)
+            .map_err(|e| ReadmeError(format!("{}:{}: {e}", path.display(), i + 1)))?;
+        runs.push(run);
+    }
+    let mut groups: Vec<(String, u32)> = Vec::new();
+    for r in &runs {
+        let g = (r.scene.clone(), r.mirrored_lights);
+        if !groups.contains(&g) {
+            groups.push(g);
+        }
+    }
+    groups.sort();
+    if groups.is_empty() {
+        return Err(ReadmeError(format!("{}: no runs to quote", path.display())));
+    }
+    let rows = groups
+        .iter()
+        .map(|(scene, k)| {
+            let of: Vec<&TraceRun> = runs
+                .iter()
+                .filter(|r| &r.scene == scene && r.mirrored_lights == *k)
+                .collect();
+            let mut secs: Vec<f64> = of.iter().map(|r| r.render_seconds).collect();
+            secs.sort_by(f64::total_cmp);
+            let (lo, hi) = (secs[0], secs[secs.len() - 1]);
+            vec![
+                format!("`{scene}`"),
+                k.to_string(),
+                of[0].lighting.light_images.to_string(),
+                format!("{:.2} [{lo:.2}–{hi:.2}]", stats::median(&secs)),
+                format!("{:.1}", of[0].rays as f64 / 1e6),
+                of.len().to_string(),
+            ]
+        })
+        .collect();
+    let threads = runs.first().map_or(0, |r| r.threads);
+    Ok(markdown(&[
+        Block::Paragraph(format!(
+            "`scripts/lighting-trace-cost.sh`: `mirrorbox trace --mirrored-lights k --spp 1` at \
+             640×360 with shadows, {threads} threads, runs interleaved."
+        )),
+        Block::Table(
+            [
+                "scene",
+                "k",
+                "light images",
+                "trace s, median [min–max]",
+                "Mrays (shadow legs included)",
+                "runs",
+            ]
+            .map(String::from)
+            .to_vec(),
+            rows,
+        ),
+    ]))
 }
 
 /// Table 1's rows of two runs side by side: whether each row's intervals overlap, and whether
@@ -323,6 +431,8 @@ pub fn generate(id: &str, reports: &Path) -> Result<Region, ReadmeError> {
         "depth-scaling" => depth_scaling_region(&load_sweep(&folder(source))?, false)?,
         "depth-scaling-table" => depth_scaling_region(&load_sweep(&folder(source))?, true)?,
         "symmetry-scaling" => symmetry_region(&load_sweep(&folder(source))?)?,
+        "lighting" | "lighting-room" => lighting_region(&load_sweep(&folder(source))?)?,
+        "lighting-trace-cost" => trace_cost_region(&folder(source))?,
         "main-job" => main_job_region(&folder(source))?,
         _ => unreachable!("every ID in REGIONS has a generator"),
     };

@@ -51,6 +51,11 @@ pub struct Args {
         allow_negative_numbers = true
     )]
     reflectance: Option<f32>,
+    /// Light surfaces through chains of up to this many mirrors, 0..=64 (overrides the
+    /// scene's `lighting.mirrored_lights`; docs/shading.md). Whitted only: `path` finds light
+    /// through mirrors by its own sampling, and never from point lights.
+    #[arg(long)]
+    mirrored_lights: Option<u32>,
     /// whitted: most mirror reflections a path follows; path: longest path in segments
     /// (Mitsuba's max_depth: N visible reflections need N + 2).
     #[arg(long, default_value_t = 10_000)]
@@ -120,7 +125,16 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             .set_reflectance(glam::Vec3::splat(r))
             .map_err(|e| super::light_budget(&scene, "--reflectance", e))?;
     }
-    if scene.lighting.mirrored_lights > 0 {
+    if let Some(k) = args.mirrored_lights {
+        let max = mirrorbox_scene::light_images::MAX_MIRRORED_LIGHTS;
+        if k > max {
+            return Err(Failure::BadInput(format!(
+                "--mirrored-lights must be in [0, {max}], got {k}"
+            )));
+        }
+        scene.lighting.mirrored_lights = k;
+    }
+    if args.mirrored_lights.is_some() || scene.lighting.mirrored_lights > 0 {
         // The light images are pruned at the tracer's own threshold, as its eye paths are.
         scene
             .enumerate_light_images(whitted.min_throughput)

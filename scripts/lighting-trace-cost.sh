@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# The tracer's cost against the mirrored-light depth k (issue 15): `mirrorbox trace` of the lit
+# mirror box and mirror room at k = 0, 1, 2, 4, 8 (640×360, 1 spp, shadows on), each run 3
+# times with the runs interleaved (k order shuffled per round), into
+# reports/lighting/trace_cost.jsonl (one `trace --json` line per run). `mirrorbox readme`
+# quotes the medians (region lighting-trace-cost).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bin=${MIRRORBOX:-target/release/mirrorbox}
+out=reports/lighting/trace_cost.jsonl
+mkdir -p reports/lighting
+tmp=$(mktemp reports/lighting/.trace_cost.XXXXXX)
+work=$(mktemp -d)
+trap 'rm -rf "$work" "$tmp"' EXIT
+for round in 1 2 3; do
+  for run in $(printf '%s\n' box:0 box:1 box:2 box:4 box:8 room:0 room:1 room:2 room:4 room:8 | shuf --random-source=<(yes "$round")); do
+    scene=scenes/mirror_${run%%:*}_lit.json
+    k=${run##*:}
+    "$bin" trace "$scene" --mirrored-lights "$k" --spp 1 --json -o "$work/t.exr" |
+      sed "s/^{/{\"round\":$round,\"mirrored_lights\":$k,/" >>"$tmp"
+  done
+done
+mv "$tmp" "$out"
+echo "wrote $out"
