@@ -23,6 +23,7 @@ pub mod color_format;
 pub mod culling;
 pub mod exact_paths;
 pub mod gpu;
+pub mod lighting;
 pub mod method;
 pub mod methods;
 pub mod pipeline;
@@ -185,6 +186,7 @@ pub struct Planned {
 
 /// Plans `settings.method` for `scene` at render resolution, without a GPU.
 pub fn plan_frame(scene: &Scene, settings: &RenderSettings) -> Result<Planned, PlanError> {
+    let scene = &*lighting::lit_scene(scene, &settings.method);
     settings.check(scene)?;
     let (w, h) = settings.render_size(scene);
     let frame = settings.method.configure().plan(scene, w, h)?;
@@ -202,6 +204,7 @@ pub fn render_planned(
     planned: Planned,
     settings: &RenderSettings,
 ) -> Result<RenderOutput, RasterError> {
+    let scene = &*lighting::lit_scene(scene, &settings.method);
     settings.method.entry().check_features(gpu)?;
     let (w, h) = settings.render_size(scene);
     assert!(

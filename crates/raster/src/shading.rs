@@ -12,7 +12,9 @@ pub fn gpu_structs() -> Vec<crate::wgsl::HostLayout> {
         crate::host_layout!(GpuSurface as "Surface" {
             albedo, kind, emission, mirror, reflectance, _pad0, back_albedo, _pad1
         }),
-        crate::host_layout!(GpuLight as "Light" { position, _pad0, intensity, _pad1 }),
+        crate::host_layout!(GpuLight as "Light" {
+            position, first_plane, intensity, plane_count
+        }),
         crate::host_layout!(GpuFrame as "Frame" {
             ambient, light_count, background, _pad0, terminal, _pad1
         }),
@@ -36,9 +38,9 @@ pub struct GpuSurface {
 #[derive(Clone, Copy, Pod, Zeroable)]
 struct GpuLight {
     position: [f32; 3],
-    _pad0: f32,
+    first_plane: u32,
     intensity: [f32; 3],
-    _pad1: f32,
+    plane_count: u32,
 }
 
 #[repr(C)]
@@ -98,8 +100,15 @@ impl SceneBuffers {
         gpu.check_buffer("vertex", vertices, false)?;
         let surfaces = g.surfaces.len() as u64 * std::mem::size_of::<GpuSurface>() as u64;
         gpu.check_buffer("surface", surfaces, true)?;
-        let lights = scene.lighting.lights.len() as u64 * std::mem::size_of::<GpuLight>() as u64;
-        gpu.check_buffer("light", lights, true)
+        let l = &scene.lighting;
+        let count = (l.lights.len() + l.images.images.len()) as u64;
+        gpu.check_buffer(
+            "light",
+            count * std::mem::size_of::<GpuLight>() as u64,
+            true,
+        )?;
+        let planes: usize = l.images.images.iter().map(|i| i.beam.len()).sum();
+        gpu.check_buffer("light plane", planes as u64 * 16, true)
     }
 
     pub fn new(device: &wgpu::Device, scene: &Scene) -> Self {
@@ -184,6 +193,7 @@ impl SceneBuffers {
                 },
             })
             .collect();
+        // The real lights, then their images with their beams' planes.
         let mut lights: Vec<GpuLight> = scene
             .lighting
             .lights
@@ -194,6 +204,19 @@ impl SceneBuffers {
                 ..Zeroable::zeroed()
             })
             .collect();
+        let mut planes: Vec<[f32; 4]> = Vec::new();
+        for image in &scene.lighting.images.images {
+            lights.push(GpuLight {
+                position: image.position.to_array(),
+                first_plane: planes.len() as u32,
+                intensity: image.intensity.to_array(),
+                plane_count: image.beam.len() as u32,
+            });
+            planes.extend(image.beam.iter().map(|p| p.to_array()));
+        }
+        if planes.is_empty() {
+            planes.push([0.0; 4]); // a storage buffer may not be empty
+        }
         if surfaces.is_empty() {
             surfaces.push(Zeroable::zeroed()); // a storage buffer may not be empty
         }
@@ -235,6 +258,11 @@ impl SceneBuffers {
             bytemuck::cast_slice(&lights),
             wgpu::BufferUsages::STORAGE,
         );
+        let planes_buf = init(
+            "light planes",
+            bytemuck::cast_slice(&planes),
+            wgpu::BufferUsages::STORAGE,
+        );
         let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
             binding,
             visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
@@ -259,6 +287,7 @@ impl SceneBuffers {
                 ),
                 entry(1, storage),
                 entry(2, storage),
+                entry(3, storage),
             ],
         });
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -276,6 +305,10 @@ impl SceneBuffers {
                 wgpu::BindGroupEntry {
                     binding: 2,
                     resource: lights_buf.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: planes_buf.as_entire_binding(),
                 },
             ],
         });

@@ -1135,3 +1135,44 @@ fn symmetry_culls_back_faces_only_where_no_back_face_can_be_seen() {
         assert_matches_truth(&format!("room {key}"), &out.image, &truth, 1e-3);
     }
 }
+
+/// Mirrored lights (issue 15) in the contract's WGSL: on the lit box and room without
+/// shadows (which no raster variant here draws), the exact methods with the light images
+/// match the truth lit the same way; `lights=direct` is the scene without images, pixel for
+/// pixel, and far from that truth.
+#[test]
+fn light_images_match_the_truth_and_direct_ignores_them() {
+    let gpu = Gpu::new().unwrap();
+    for (name, w, h, flip) in [
+        ("mirror_box_lit.json", 160, 90, 1e-3),
+        // The room's edge samples (measured: 23 scattered pixels, FLIP 4.3e-3) weigh more
+        // than in `mirror_room` where they fall on the bright lamps' receding images.
+        ("mirror_room_lit.json", 96, 54, 6e-3),
+    ] {
+        let mut s = scene(name, w, h);
+        s.lighting.shadows = false;
+        assert!(!s.lighting.images.images.is_empty());
+        let truth = trace_depth(&s, 64);
+        for key in ["unrolled depth=64", "portal depth=64"] {
+            let image = render(&gpu, &s, &exact(m(key))).unwrap().image;
+            assert_matches_truth(&format!("{name} {key}"), &image, &truth, flip);
+        }
+        let direct = render(&gpu, &s, &exact(m("unrolled depth=64 lights=direct")))
+            .unwrap()
+            .image;
+        let mut unlit = s.clone();
+        unlit.lighting.mirrored_lights = 0;
+        unlit.enumerate_light_images(1e-4).unwrap();
+        let plain = render(&gpu, &unlit, &exact(m("unrolled depth=64")))
+            .unwrap()
+            .image;
+        assert_eq!(direct.pixels, plain.pixels, "{name}: lights=direct");
+        let ignored = mirrorbox_image::metrics::compare(&truth, &direct, 1.0).unwrap();
+        println!("{name}: lights=direct FLIP {:.2e}", ignored.flip_mean);
+        assert!(
+            ignored.flip_mean > 20.0 * flip,
+            "{name}: ignoring mirrored light must show: FLIP {}",
+            ignored.flip_mean
+        );
+    }
+}

@@ -2,8 +2,8 @@
 //! raster lighting variant leaves against a truth lit the same way, and its cost, against the
 //! depth k of the mirrored lights (`lighting.mirrored_lights`).
 //!
-//! A point's lighting variant is read from its method options (`lights=…`,
-//! `shadow-map=…`): the report knows their names, not the rasterizer.
+//! A point's lighting variant is read from its method options (`lights=…`): the report knows
+//! the option's name, not the rasterizer. No raster variant draws shadows yet.
 
 use crate::Record;
 use crate::plot::{Chart, Series};
@@ -11,13 +11,10 @@ use crate::write::{Block, f, ms_cell, sci};
 
 /// The raster option that chooses direct or mirrored lights.
 pub const LIGHTS_OPTION: &str = "lights";
-/// The raster option that sets the shadow-map resolution (0: no shadows).
-pub const SHADOW_MAP_OPTION: &str = "shadow-map";
 
 fn is_lighting_word(word: &str) -> bool {
-    [LIGHTS_OPTION, SHADOW_MAP_OPTION]
-        .iter()
-        .any(|o| word.split_once('=').is_some_and(|(name, _)| name == *o))
+    word.split_once('=')
+        .is_some_and(|(name, _)| name == LIGHTS_OPTION)
 }
 
 /// The method a point measured, without its lighting options: `auxiliary n=2`,
@@ -39,25 +36,16 @@ pub fn method_of(r: &Record) -> String {
     words.join(" ")
 }
 
-/// The point's lighting variant in words: `direct only, no shadows`, `mirrored, shadow maps
-/// 1024²`. Options at their defaults are absent from the record: mirrored lights (what the
-/// scene asks for), no shadow maps.
+/// The point's lighting variant in words: `direct only, no shadows` or `mirrored, no
+/// shadows`. An option at its default is absent from the record: mirrored lights (what the
+/// scene asks for).
 pub fn lighting_of(r: &Record) -> String {
-    let value = |name: &str| {
-        r.method_options.split_whitespace().find_map(|w| {
-            w.split_once('=')
-                .filter(|(n, _)| *n == name)
-                .map(|(_, v)| v)
-        })
-    };
-    let lights = match value(LIGHTS_OPTION) {
-        Some("direct") => "direct only",
-        _ => "mirrored",
-    };
-    match value(SHADOW_MAP_OPTION) {
-        Some(res) if res != "0" => format!("{lights}, shadow maps {res}²"),
-        _ => format!("{lights}, no shadows"),
-    }
+    let direct = r
+        .method_options
+        .split_whitespace()
+        .any(|w| w == format!("{LIGHTS_OPTION}=direct"));
+    let lights = if direct { "direct only" } else { "mirrored" };
+    format!("{lights}, no shadows")
 }
 
 /// The points of a mirrored-lights sweep.
@@ -187,7 +175,8 @@ pub(crate) fn lighting_section(records: &[Record]) -> Vec<Block> {
         Block::Paragraph(format!(
             "The truth lights every diffuse point through the lights' images in chains of up to \
              k mirrors (the point's k), with the scene's shadows; each raster point uses the \
-             lighting variant named beside its method. The plots take k = {k_max}."
+             lighting variant named beside its method, without shadows (no raster variant \
+             draws them yet). The plots take k = {k_max}."
         )),
         Block::Chart(
             "plot_lighting_error_vs_ms.svg".into(),
@@ -309,9 +298,9 @@ mod tests {
         let r = record("unrolled", "lights=direct", 4, 0.1);
         assert_eq!(method_of(&r), "unrolled depth=64");
         assert_eq!(lighting_of(&r), "direct only, no shadows");
-        let r = record("auxiliary", "shadow-map=1024 max-passes=9", 4, 0.1);
+        let r = record("auxiliary", "lights=mirrored max-passes=9", 4, 0.1);
         assert_eq!(method_of(&r), "auxiliary max-passes=9");
-        assert_eq!(lighting_of(&r), "mirrored, shadow maps 1024²");
+        assert_eq!(lighting_of(&r), "mirrored, no shadows");
         assert_eq!(
             lighting_of(&record("portal", "", 0, 0.1)),
             "mirrored, no shadows"
@@ -325,7 +314,6 @@ mod tests {
             record("unrolled", "lights=direct", 0, 0.01),
             record("unrolled", "lights=direct", 8, 0.2),
             record("unrolled", "", 8, 0.05),
-            record("unrolled", "shadow-map=1024", 8, 0.02),
         ];
         let s = sentences(&records).join("\n");
         assert!(
@@ -334,7 +322,7 @@ mod tests {
         );
         assert!(s.contains("up to k = 8 mirrors: FLIP mean 2.000e-1"), "{s}");
         assert!(
-            s.contains("mirrored, shadow maps 1024²: FLIP mean 2.000e-2"),
+            s.contains("mirrored, no shadows: FLIP mean 5.000e-2"),
             "{s}"
         );
         assert!(s.contains("1.000e-2 at k = 0 to 2.000e-1 at k = 8"), "{s}");

@@ -232,7 +232,11 @@ fn trace_cost_region(path: &Path) -> Result<String, ReadmeError> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| ReadmeError(format!("{}: {e}", path.display())))?;
     let mut runs = Vec::new();
-    for (i, line) in text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty()) {
+    for (i, line) in text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty())
+    {
         let run: TraceRun = serde_json::from_str(line)
             .map_err(|e| ReadmeError(format!("{}:{}: {e}", path.display(), i + 1)))?;
         runs.push(run);

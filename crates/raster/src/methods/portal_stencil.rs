@@ -45,7 +45,12 @@ pub static PORTAL: MethodEntry = MethodEntry {
     name: "portal",
     help: "Exact: stencil recursion over the reflection paths, one pass, cost linear in depth.",
     exact: true,
-    options: &[&DEPTH, &MIN_PORTAL_AREA, &MIN_ATTENUATION],
+    options: &[
+        &DEPTH,
+        &MIN_PORTAL_AREA,
+        &MIN_ATTENUATION,
+        &crate::lighting::LIGHTS,
+    ],
     swept: Some(&DEPTH),
     optional_features: wgpu::Features::CLIP_DISTANCES.union(wgpu::Features::DEPTH32FLOAT_STENCIL8),
     required_features: wgpu::Features::empty(),

@@ -61,7 +61,12 @@ pub static SYMMETRY: MethodEntry = MethodEntry {
     name: "symmetry",
     help: "Seed 001's symmetry planes: the objects drawn 2^p times, each copy an instance clipped to its cell; even and odd copies with opposite front faces.",
     exact: true,
-    options: &[&SYMMETRY_DRAWS, &FRAGMENT_CLIPPING, &COPY_IDS],
+    options: &[
+        &SYMMETRY_DRAWS,
+        &FRAGMENT_CLIPPING,
+        &COPY_IDS,
+        &crate::lighting::LIGHTS,
+    ],
     swept: None,
     optional_features: wgpu::Features::CLIP_DISTANCES,
     required_features: wgpu::Features::empty(),

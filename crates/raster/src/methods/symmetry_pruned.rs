@@ -25,7 +25,12 @@ pub static SYMMETRY_PRUNED: MethodEntry = MethodEntry {
     name: "symmetry-pruned",
     help: "Seed 001's symmetry planes as `symmetry`, leaving out copies whose cell is empty or outside the view.",
     exact: true,
-    options: &[&SYMMETRY_DRAWS, &FRAGMENT_CLIPPING, &COPY_IDS],
+    options: &[
+        &SYMMETRY_DRAWS,
+        &FRAGMENT_CLIPPING,
+        &COPY_IDS,
+        &crate::lighting::LIGHTS,
+    ],
     swept: None,
     optional_features: wgpu::Features::CLIP_DISTANCES,
     required_features: wgpu::Features::empty(),

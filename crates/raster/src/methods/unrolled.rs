@@ -65,6 +65,7 @@ pub static UNROLLED: MethodEntry = MethodEntry {
         &MIN_PORTAL_AREA,
         &MIN_ATTENUATION,
         &FRAGMENT_CLIPPING,
+        &crate::lighting::LIGHTS,
     ],
     swept: Some(&DEPTH),
     optional_features: wgpu::Features::CLIP_DISTANCES,
