@@ -186,7 +186,7 @@ pub struct Planned {
 
 /// Plans `settings.method` for `scene` at render resolution, without a GPU.
 pub fn plan_frame(scene: &Scene, settings: &RenderSettings) -> Result<Planned, PlanError> {
-    let scene = &*lighting::lit_scene(scene, &settings.method);
+    let scene = &*lighting::lit_scene(scene, settings.method.params());
     settings.check(scene)?;
     let (w, h) = settings.render_size(scene);
     let frame = settings.method.configure().plan(scene, w, h)?;
@@ -204,7 +204,7 @@ pub fn render_planned(
     planned: Planned,
     settings: &RenderSettings,
 ) -> Result<RenderOutput, RasterError> {
-    let scene = &*lighting::lit_scene(scene, &settings.method);
+    let scene = &*lighting::lit_scene(scene, settings.method.params());
     settings.method.entry().check_features(gpu)?;
     let (w, h) = settings.render_size(scene);
     assert!(

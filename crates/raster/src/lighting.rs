@@ -5,8 +5,7 @@
 //! (`shaders/shading.wgsl`): one extra light per image, each lighting a fragment only inside
 //! its beam.
 
-use crate::method::{OptionKind, OptionSpec, ParamValue};
-use crate::registry::Method;
+use crate::method::{OptionKind, OptionSpec, ParamValue, Params};
 use mirrorbox_scene::Scene;
 use std::borrow::Cow;
 
@@ -24,10 +23,10 @@ pub static LIGHTS: OptionSpec = OptionSpec {
     in_key: true,
 };
 
-/// The scene `method` renders: `scene` itself, or with `lights=direct` a copy without light
-/// images.
-pub fn lit_scene<'a>(scene: &'a Scene, method: &Method) -> Cow<'a, Scene> {
-    let direct = method.params().get(&LIGHTS) == Some(ParamValue::Choice("direct"));
+/// The scene a method with `params` renders: `scene` itself, or with `lights=direct` a copy
+/// without light images.
+pub fn lit_scene<'a>(scene: &'a Scene, params: &Params) -> Cow<'a, Scene> {
+    let direct = params.get(&LIGHTS) == Some(ParamValue::Choice("direct"));
     if direct && !scene.lighting.images.images.is_empty() {
         let mut s = scene.clone();
         s.lighting.images.images.clear();

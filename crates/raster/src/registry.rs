@@ -334,4 +334,15 @@ mod tests {
             "--depth \"0..4\": expected a range like 1..8 or a list like 1,4,16,64 of depths 1..=4096"
         );
     }
+
+    #[test]
+    fn every_method_takes_the_lights_option() {
+        let lights = &crate::lighting::LIGHTS;
+        for entry in METHODS {
+            assert!(entry.accepts(lights), "{} lacks --lights", entry.name);
+            let m = Method::parse(&format!("{} lights=direct", entry.name)).unwrap();
+            assert!(m.key().ends_with("lights=direct"), "{}", m.key());
+            assert!(!Method::named(entry.name).unwrap().key().contains("lights"));
+        }
+    }
 }

@@ -1209,7 +1209,7 @@ pub(crate) mod tests {
             csv.lines()
                 .nth(2)
                 .unwrap()
-                .ends_with(",rgba16float,,,,,,\"\",,,,")
+                .ends_with(",rgba16float,,,,,,\"\",,,,,")
         );
         // Every row has the header's number of columns (no value here holds a comma).
         let columns = |l: &str| l.split(',').count();

@@ -66,6 +66,13 @@ impl Mirror {
         [c - r - u, c + r - u, c + r + u, c - r + u]
     }
 
+    /// The mirror's plane in f64: unit normal `n` and offset `n·center` (plane-exact deep
+    /// bounces and far light images).
+    pub fn plane_f64(&self) -> (glam::DVec3, f64) {
+        let n = self.normal.as_dvec3().normalize();
+        (n, n.dot(self.center.as_dvec3()))
+    }
+
     /// The mirror's plane, oriented so that the front side has positive signed distance.
     pub fn plane(&self) -> Plane {
         Plane::from_point_normal(self.center, self.normal)

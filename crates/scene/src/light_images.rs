@@ -31,6 +31,7 @@
 //!   pixel changes by more (eye paths only attenuate it further).
 
 use crate::Scene;
+use crate::polygon::clip_by;
 use glam::{DVec3, Vec3, Vec4};
 
 /// Windows thinner than this (scene units²) light nothing of positive measure and are pruned.
@@ -116,14 +117,7 @@ pub fn light_images(
     if mirrored_lights == 0 || scene.mirrors.is_empty() {
         return Ok(out);
     }
-    let planes: Vec<(DVec3, f64)> = scene
-        .mirrors
-        .iter()
-        .map(|m| {
-            let n = m.normal.as_dvec3().normalize();
-            (n, n.dot(m.center.as_dvec3()))
-        })
-        .collect();
+    let planes: Vec<(DVec3, f64)> = scene.mirrors.iter().map(crate::Mirror::plane_f64).collect();
     let rectangles: Vec<Vec<DVec3>> = scene
         .mirrors
         .iter()
@@ -187,12 +181,12 @@ pub fn light_images(
                     None => rectangles[m].clone(),
                     Some(last) => {
                         let mut w =
-                            clip_f64(&rectangles[m], |p| planes[last].0.dot(p) - planes[last].1);
+                            clip_by(&rectangles[m], |p| planes[last].0.dot(p) - planes[last].1);
                         for plane in side_planes(node.position, &node.window) {
                             if w.len() < 3 {
                                 break;
                             }
-                            w = clip_f64(&w, |p| plane.0.dot(p) + plane.1);
+                            w = clip_by(&w, |p| plane.0.dot(p) + plane.1);
                         }
                         w
                     }
@@ -268,23 +262,6 @@ fn side_planes(apex: DVec3, window: &[DVec3]) -> impl Iterator<Item = (DVec3, f6
         let n = if n.dot(centroid - apex) < 0.0 { -n } else { n };
         Some((n, -n.dot(apex)))
     })
-}
-
-/// Keeps the part of convex polygon `poly` where `distance(p) ≥ 0` (Sutherland–Hodgman in
-/// f64: images of deep chains lie far away, and their windows stay exact).
-fn clip_f64(poly: &[DVec3], distance: impl Fn(DVec3) -> f64) -> Vec<DVec3> {
-    let mut out = Vec::with_capacity(poly.len() + 1);
-    for (i, &a) in poly.iter().enumerate() {
-        let b = poly[(i + 1) % poly.len()];
-        let (da, db) = (distance(a), distance(b));
-        if da >= 0.0 {
-            out.push(a);
-        }
-        if (da >= 0.0) != (db >= 0.0) {
-            out.push(a + (b - a) * (da / (da - db)));
-        }
-    }
-    out
 }
 
 /// Area of a planar convex polygon in 3-D.

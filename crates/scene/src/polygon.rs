@@ -3,21 +3,22 @@
 
 use glam::{Vec2, Vec3, Vec4};
 
-/// Keeps the part of convex polygon `poly` where `distance(p) ≥ 0` (one clipping plane).
-pub fn clip_by<
-    P: Copy + std::ops::Add<Output = P> + std::ops::Sub<Output = P> + std::ops::Mul<f32, Output = P>,
->(
-    poly: &[P],
-    distance: impl Fn(P) -> f32,
-) -> Vec<P> {
+/// Keeps the part of convex polygon `poly` where `distance(p) ≥ 0` (one clipping plane), in
+/// the precision of the distances (`f32`, or `f64` where far light images need it).
+pub fn clip_by<P, S>(poly: &[P], distance: impl Fn(P) -> S) -> Vec<P>
+where
+    P: Copy + std::ops::Add<Output = P> + std::ops::Sub<Output = P> + std::ops::Mul<S, Output = P>,
+    S: Copy + Default + PartialOrd + std::ops::Sub<Output = S> + std::ops::Div<Output = S>,
+{
+    let zero = S::default();
     let mut out = Vec::with_capacity(poly.len() + 1);
     for (i, &a) in poly.iter().enumerate() {
         let b = poly[(i + 1) % poly.len()];
         let (da, db) = (distance(a), distance(b));
-        if da >= 0.0 {
+        if da >= zero {
             out.push(a);
         }
-        if (da >= 0.0) != (db >= 0.0) {
+        if (da >= zero) != (db >= zero) {
             out.push(a + (b - a) * (da / (da - db)));
         }
     }

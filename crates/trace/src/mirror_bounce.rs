@@ -19,10 +19,7 @@ impl MirrorPlanes {
         let planes = scene
             .mirrors
             .iter()
-            .map(|m| {
-                let n = m.normal.as_dvec3().normalize();
-                (n, n.dot(m.center.as_dvec3()))
-            })
+            .map(mirrorbox_scene::Mirror::plane_f64)
             .collect();
         MirrorPlanes { planes }
     }
