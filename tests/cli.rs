@@ -1445,3 +1445,32 @@ fn every_command_refuses_an_output_in_a_missing_folder() {
     }
     assert!(!dir.path().join("no").exists(), "no folder created");
 }
+
+/// `report` remakes a sweep folder's report from its records alone (no GPU, no truth): the
+/// committed GPU Table 1 gives its own Markdown back; a folder without a sweep is exit 2,
+/// named.
+#[test]
+fn report_rewrites_a_sweep_folder_from_its_records() {
+    let from = repo().join("reports/gpu/table1");
+    let dir = tempfile::tempdir().unwrap();
+    for f in ["sweep.json", "results.jsonl"] {
+        std::fs::copy(from.join(f), dir.path().join(f)).unwrap();
+    }
+    let out = mirrorbox(&["report", dir.path().to_str().unwrap()], &[]);
+    assert_eq!(out.code, 0, "stderr: {}", out.stderr);
+    assert!(out.stdout.contains("from 15 records"), "{}", out.stdout);
+    let want = std::fs::read_to_string(from.join("report.md")).unwrap();
+    let have = std::fs::read_to_string(dir.path().join("report.md")).unwrap();
+    assert_eq!(
+        have, want,
+        "run `mirrorbox report reports/gpu/table1` after changing the report"
+    );
+    for f in ["report.html", "results.csv", "plot_flip_vs_ms.svg"] {
+        assert!(dir.path().join(f).is_file(), "{f} not written");
+    }
+
+    let empty = tempfile::tempdir().unwrap();
+    let out = mirrorbox(&["report", empty.path().to_str().unwrap()], &[]);
+    assert_eq!(out.code, 2, "stderr: {}", out.stderr);
+    assert!(out.stderr.contains("sweep.json"), "{}", out.stderr);
+}

@@ -47,6 +47,8 @@ enum Command {
     ExportMitsuba(commands::export_mitsuba::Args),
     /// Fill the generated regions of README.md and docs/methods.md from the committed reports (--check: only compare).
     Readme(commands::readme::Args),
+    /// Rewrite a sweep folder's report (Markdown, HTML, CSV, plots) from its results.jsonl, without rendering.
+    Report(commands::report::Args),
     /// Internal: one timed render of a sweep, a job as JSON on stdin (see
     /// `mirrorbox_harness::worker`).
     #[command(hide = true)]
@@ -190,6 +192,7 @@ fn main() -> ExitCode {
         Command::Lighting(args) => commands::sweep::run_lighting(&args),
         Command::ExportMitsuba(args) => commands::export_mitsuba::run(&args),
         Command::Readme(args) => commands::readme::run(&args),
+        Command::Report(args) => commands::report::run(&args),
         Command::RenderWorker => {
             mirrorbox_harness::serve(std::io::stdin().lock(), std::io::stdout().lock())
                 .map_err(Failure::from)

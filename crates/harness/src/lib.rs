@@ -931,6 +931,9 @@ pub fn run_sweep(
         adapter: gpu.report.name.clone(),
         backend: gpu.report.backend.clone(),
         device_type: gpu.report.device_type.clone(),
+        driver: format!("{} {}", gpu.report.driver, gpu.report.driver_info)
+            .trim()
+            .to_string(),
         versions: format!(
             "mirrorbox {}, wgpu 30.0.1, obvhs 0.4.0",
             env!("CARGO_PKG_VERSION")

@@ -87,6 +87,8 @@ fn slope_interval(points: &[Record]) -> Option<crate::stats::Interval> {
     )
 }
 
+use crate::write::{ms, ms_digits};
+
 /// A sentence on the cost of one more bounce against one full-scene pass (`pass_ms`).
 pub fn bounce_sentence(g: &DepthScaling, pass_ms: Option<f64>) -> String {
     let Some(b) = g.ms_per_bounce else {
@@ -94,20 +96,22 @@ pub fn bounce_sentence(g: &DepthScaling, pass_ms: Option<f64>) -> String {
     };
     let deepest = g.points.iter().map(|r| r.reflections).max().unwrap_or(0);
     let interval = g.ms_per_bounce_interval.map_or(String::new(), |i| {
-        format!(" [95 % CI {:.3}–{:.3}]", i.low, i.high)
+        let d = ms_digits(b, 3);
+        format!(" [95 % CI {:.d$}–{:.d$}]", i.low, i.high)
     });
     let mut s = format!(
-        "{}, α = {}: {:.3} ms{interval} per extra reflection (least-squares over {} depths, up to {} reflections shown)",
+        "{}, α = {}: {} ms{interval} per extra reflection (least-squares over {} depths, up to {} reflections shown)",
         g.method,
         g.alpha,
-        b,
+        ms(b, 3),
         g.points.len(),
         deepest
     );
     if let Some(p) = pass_ms.filter(|p| *p > 0.0) {
         s.push_str(&format!(
-            "; one full-scene pass (the floor point: the scene without mirrors, rendered once) takes {p:.2} ms, \
+            "; one full-scene pass (the floor point: the scene without mirrors, rendered once) takes {} ms, \
              so one more bounce costs {:.1} % of a pass",
+            ms(p, 2),
             100.0 * b / p
         ));
     }

@@ -7,14 +7,17 @@
 //! - [`readme`]: the README's figures, generated from the committed reports.
 
 pub mod exact;
+mod folder;
 pub mod lighting;
 pub mod plot;
 pub mod readme;
+mod runs;
 pub mod stats;
 pub mod symmetry;
 pub mod table1;
 mod write;
 
+pub use folder::rewrite_report;
 pub use write::{read_records, write_report};
 
 use serde::{Deserialize, Serialize};
@@ -171,6 +174,9 @@ pub struct SweepInfo {
     pub adapter: String,
     pub backend: String,
     pub device_type: String,
+    /// The adapter's driver and its version (`wgpu::AdapterInfo::driver` and `driver_info`);
+    /// empty in sweeps written before it was recorded.
+    pub driver: String,
     pub versions: String,
     pub scene: String,
     pub resolution: String,
@@ -179,6 +185,21 @@ pub struct SweepInfo {
     /// and sets them beside the paper's method).
     #[serde(default)]
     pub exact_methods: Vec<String>,
+}
+
+impl SweepInfo {
+    /// "adapter NAME (backend, type[, driver D])": the device a sweep's timings belong to.
+    pub fn adapter_description(&self) -> String {
+        let driver = if self.driver.trim().is_empty() {
+            String::new()
+        } else {
+            format!(", driver {}", self.driver.trim())
+        };
+        format!(
+            "adapter {} ({}, {}{driver})",
+            self.adapter, self.backend, self.device_type
+        )
+    }
 }
 
 /// Least-squares line `y = a + b·x`: returns `(a, b)`, or None with fewer than two distinct x.

@@ -7,10 +7,12 @@
 //! --check` (run by the tests) fails when a region differs from what the reports give.
 //! Everything outside the regions is left alone, byte for byte.
 
+use crate::folder::{Sweep, load_sweep};
 use crate::write::{
-    Block, depth_scaling, floor_paragraph, markdown, row_cell, symmetry_section, table1_section,
+    Block, depth_scaling, floor_paragraph, markdown, ms_cell, row_cell, symmetry_section,
+    table1_section,
 };
-use crate::{Record, SweepInfo, read_records, stats, table1};
+use crate::{stats, table1};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -79,39 +81,36 @@ pub const REGIONS: &[(&str, &str, &str)] = &[
         "the tracer's time against the mirrored-light depth k on both lit scenes",
     ),
     (
+        "gpu-table1",
+        "gpu/table1",
+        "Table 1 and the exact methods beside it, measured on a GPU",
+    ),
+    (
+        "gpu-column",
+        "gpu/table1",
+        "Table 1's points on lavapipe (reports/table1) and on a GPU side by side",
+    ),
+    (
+        "gpu-depth-scaling",
+        "gpu/depth_scaling",
+        "the exact methods' cost per bounce, measured on a GPU",
+    ),
+    (
+        "gpu-room",
+        "gpu/room_1080p.jsonl",
+        "the mirror room at 1920×1080 against depth on a GPU: where real time ends",
+    ),
+    (
+        "gpu-trace-threads",
+        "gpu/trace_threads.jsonl",
+        "the tracer against its thread count on the GPU machine's CPU",
+    ),
+    (
         "main-job",
         "main_job.json",
         "the main job's steps: time and peak memory",
     ),
 ];
-
-/// A sweep folder's records and facts.
-struct Sweep {
-    info: SweepInfo,
-    records: Vec<Record>,
-}
-
-fn load_sweep(dir: &Path) -> Result<Sweep, ReadmeError> {
-    let info_path = dir.join("sweep.json");
-    let text = std::fs::read_to_string(&info_path)
-        .map_err(|e| ReadmeError(format!("{}: {e}", info_path.display())))?;
-    let info: SweepInfo = serde_json::from_str(&text).map_err(|e| {
-        ReadmeError(format!(
-            "{}: not a sweep description ({e}); regenerate the report with its sweep",
-            info_path.display()
-        ))
-    })?;
-    let results = dir.join("results.jsonl");
-    let records =
-        read_records(&results).map_err(|e| ReadmeError(format!("{}: {e}", results.display())))?;
-    if records.is_empty() {
-        return Err(ReadmeError(format!(
-            "{}: no records to quote",
-            results.display()
-        )));
-    }
-    Ok(Sweep { info, records })
-}
 
 /// "Measured DATE on DEVICE: adapter …, `COMMAND`." The date is the latest run that measured
 /// a record (the report's own date is when it was last written, perhaps by a resume).
@@ -124,12 +123,10 @@ fn measured_on(s: &Sweep) -> String {
         .max()
         .unwrap_or(&info.date);
     format!(
-        "Measured {} on {}: adapter {} ({}, {}), `{}`.",
+        "Measured {} on {}: {}, `{}`.",
         date.split('T').next().unwrap_or(date),
         info.cpu,
-        info.adapter,
-        info.backend,
-        info.device_type,
+        info.adapter_description(),
         info.command
     )
 }
@@ -294,6 +291,63 @@ fn trace_cost_region(path: &Path) -> Result<String, ReadmeError> {
     ]))
 }
 
+/// The points two sweeps of one configuration share, measured on two devices, side by side:
+/// each one's ms/frame and FLIP, and how many times faster the second device is. Times compare
+/// only as ratios of medians here (the devices ran at different times); errors should agree up
+/// to each device's floor, which the last row shows.
+fn device_column_region(first: &Sweep, second: &Sweep) -> Result<String, ReadmeError> {
+    let device = |s: &Sweep| s.info.adapter.clone();
+    let mut rows = Vec::new();
+    for a in &first.records {
+        let Some(b) = second
+            .records
+            .iter()
+            .find(|b| b.key == a.key && b.kind == a.kind)
+        else {
+            continue;
+        };
+        let name = if a.kind == "floor" {
+            "floor (no mirrors)".to_string()
+        } else {
+            crate::write::label(a)
+        };
+        rows.push(vec![
+            name,
+            format!("{}", a.alpha),
+            ms_cell(a, 1),
+            ms_cell(b, 1),
+            format!("{:.0}×", a.ms_median / b.ms_median),
+            crate::write::sci(a.metrics.flip_mean),
+            crate::write::sci(b.metrics.flip_mean),
+        ]);
+    }
+    if rows.is_empty() {
+        return Err(ReadmeError(format!(
+            "{} and {}: no point in common",
+            first.info.command, second.info.command
+        )));
+    }
+    Ok(markdown(&[
+        Block::Paragraph(format!(
+            "First: {} Second: {}",
+            measured_on(first),
+            measured_on(second)
+        )),
+        Block::Table(
+            vec![
+                "point".into(),
+                "α".into(),
+                format!("{} ms/frame [95 % CI]", device(first)),
+                format!("{} ms/frame [95 % CI]", device(second)),
+                "ratio of medians".into(),
+                format!("FLIP {}", device(first)),
+                format!("FLIP {}", device(second)),
+            ],
+            rows,
+        ),
+    ]))
+}
+
 /// Table 1's rows of two runs side by side: whether each row's intervals overlap, and whether
 /// each run's times keep the order of the pass counts.
 fn repeat_region(first: &Sweep, second: &Sweep) -> Result<String, ReadmeError> {
@@ -427,16 +481,29 @@ pub fn generate(id: &str, reports: &Path) -> Result<Region, ReadmeError> {
         })?;
     let folder = |name: &str| -> PathBuf { reports.join(name) };
     let text = match *id {
-        "table1" => table1_region(&load_sweep(&folder(source))?)?,
+        "table1" | "gpu-table1" => table1_region(&load_sweep(&folder(source))?)?,
         "table1-repeat" => repeat_region(
             &load_sweep(&folder("table1"))?,
             &load_sweep(&folder(source))?,
         )?,
-        "depth-scaling" => depth_scaling_region(&load_sweep(&folder(source))?, false)?,
+        "depth-scaling" | "gpu-depth-scaling" => {
+            depth_scaling_region(&load_sweep(&folder(source))?, false)?
+        }
         "depth-scaling-table" => depth_scaling_region(&load_sweep(&folder(source))?, true)?,
         "symmetry-scaling" => symmetry_region(&load_sweep(&folder(source))?)?,
         "lighting" | "lighting-room" => lighting_region(&load_sweep(&folder(source))?)?,
         "lighting-trace-cost" => trace_cost_region(&folder(source))?,
+        "gpu-column" => device_column_region(
+            &load_sweep(&folder("table1"))?,
+            &load_sweep(&folder(source))?,
+        )?,
+        "gpu-room" => crate::runs::room_region(&folder(source))?,
+        "gpu-trace-threads" => {
+            let cpu_file = folder("gpu/cpu.txt");
+            let cpu = mirrorbox_files::read_bounded_text(&cpu_file, 4096, "a CPU name")
+                .map_err(|e| ReadmeError(e.to_string()))?;
+            crate::runs::threads_region(&folder(source), cpu.trim())?
+        }
         "main-job" => main_job_region(&folder(source))?,
         _ => unreachable!("every ID in REGIONS has a generator"),
     };

@@ -3,6 +3,7 @@
 //! empty or out of view, and the CPU's split-and-mirror mesh is drawn once.
 
 use crate::Record;
+use crate::write::ms;
 
 /// The method that draws the CPU-baked mesh once; the others are compared with it.
 pub const BAKED_METHOD: &str = "symmetry-baked";
@@ -80,21 +81,24 @@ pub fn crossover_sentence(baked: &PlaneScaling, other: &PlaneScaling) -> String 
     match from {
         Some((p, b, o)) => format!(
             "Against `{}`, `{}` is faster from p = {p} on, with the 95 % intervals apart at every p \
-             from there: {:.2}× at p = {p} ({:.1} against {:.1} ms), {:.2}× at p = {last_p} \
-             ({:.1} against {:.1} ms).",
+             from there: {:.2}× at p = {p} ({} against {} ms), {:.2}× at p = {last_p} \
+             ({} against {} ms).",
             other.name,
             baked.name,
             o.ms_median / b.ms_median,
-            b.ms_median,
-            o.ms_median,
+            ms(b.ms_median, 1),
+            ms(o.ms_median, 1),
             last_o.ms_median / last_b.ms_median,
-            last_b.ms_median,
-            last_o.ms_median
+            ms(last_b.ms_median, 1),
+            ms(last_o.ms_median, 1)
         ),
         None => format!(
             "Against `{}`, `{}` is not shown faster at 95 % up to p = {last_p} on this device \
-             ({:.1} against {:.1} ms there).",
-            other.name, baked.name, last_b.ms_median, last_o.ms_median
+             ({} against {} ms there).",
+            other.name,
+            baked.name,
+            ms(last_b.ms_median, 1),
+            ms(last_o.ms_median, 1)
         ),
     }
 }

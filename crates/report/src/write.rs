@@ -57,6 +57,21 @@ pub(crate) fn f(v: f64, digits: usize) -> String {
     }
 }
 
+/// Decimals for a time: at least `digits`, and enough for three significant digits below 100
+/// (a GPU frame of 0.403 ms must not print as "0.4"), at most six.
+pub(crate) fn ms_digits(v: f64, digits: usize) -> usize {
+    if !(v.is_finite() && v > 0.0) || v >= 100.0 {
+        return digits;
+    }
+    let needed = (2.0 - v.log10().floor()).max(0.0) as usize;
+    digits.max(needed.min(6))
+}
+
+/// A time in ms with [`ms_digits`] decimals.
+pub(crate) fn ms(v: f64, digits: usize) -> String {
+    f(v, ms_digits(v, digits))
+}
+
 pub(crate) fn sci(v: f64) -> String {
     if v.is_finite() {
         format!("{v:.3e}")
@@ -77,8 +92,9 @@ fn paired_ratio(a: &Record, b: &Record) -> Option<crate::stats::Interval> {
         .flatten()
 }
 
-/// "median [low–high]" (older records: "median (min m)").
+/// "median [low–high]" (older records: "median (min m)"), all with the median's decimals.
 pub(crate) fn ms_cell(r: &Record, digits: usize) -> String {
+    let digits = ms_digits(r.ms_median, digits);
     match r.ms_interval {
         Some([low, high]) => format!(
             "{} [{}–{}]",
@@ -92,18 +108,19 @@ pub(crate) fn ms_cell(r: &Record, digits: usize) -> String {
 
 /// A Table 1 row's cell: "median [low–high]", or "median [min m]" for older records.
 pub(crate) fn row_cell(r: &table1::Row) -> String {
-    format!("{} [{}]", f(r.ms_median, 1), row_interval(r))
+    let digits = ms_digits(r.ms_median, 1);
+    format!("{} [{}]", f(r.ms_median, digits), row_interval(r, digits))
 }
 
 /// A Table 1 row's interval, "low–high", or "min m" for older records.
-fn row_interval(r: &table1::Row) -> String {
+fn row_interval(r: &table1::Row, digits: usize) -> String {
     match crate::stats::median_interval(&r.frames_ms) {
-        Some(i) => format!("{}–{}", f(i.low, 1), f(i.high, 1)),
-        None => format!("min {}", f(r.ms_min, 1)),
+        Some(i) => format!("{}–{}", f(i.low, digits), f(i.high, digits)),
+        None => format!("min {}", f(r.ms_min, digits)),
     }
 }
 
-fn label(r: &Record) -> String {
+pub(crate) fn label(r: &Record) -> String {
     let name = crate::symmetry::variant(r);
     let at = match (r.n, r.depth, r.symmetry_planes) {
         (Some(n), _, _) => format!("{name} n={n}"),
@@ -545,8 +562,8 @@ pub(crate) fn table1_section(info: &SweepInfo, records: &[Record]) -> Vec<Block>
                         f(r.paper_ms, 0),
                         row_cell(r),
                         r.passes.to_string(),
-                        f(r.ms_median / r.passes as f64, 2),
-                        f(r.paper_ms / r.passes as f64, 2),
+                        ms(r.ms_median / r.passes as f64, 2),
+                        ms(r.paper_ms / r.passes as f64, 2),
                         step(r.paper_step),
                         step(r.ours_step),
                     ]
@@ -699,11 +716,9 @@ fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
             format!("Resolution: {}", info.resolution),
             format!("Ground truth: {}", info.truth),
             format!(
-                "Device: {} — adapter {} ({}, {}); colour targets: {}",
+                "Device: {} — {}; colour targets: {}",
                 info.cpu,
-                info.adapter,
-                info.backend,
-                info.device_type,
+                info.adapter_description(),
                 color_formats(records)
             ),
             format!("Versions: {}", info.versions),
@@ -869,7 +884,7 @@ fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
                         },
                         r.alpha.to_string(),
                         ms_cell(r, 2),
-                        f(r.ms_min, 2),
+                        ms(r.ms_min, 2),
                         r.plan_ms.map_or("–".into(), |ms| f(ms, 2)),
                         r.encode_ms.map_or("–".into(), |ms| f(ms, 2)),
                         match (r.gpu_buffer_bytes, r.gpu_texture_bytes) {

@@ -5,6 +5,7 @@ pub mod info;
 pub mod method_flags;
 pub mod readme;
 pub mod render;
+pub mod report;
 pub mod sweep;
 pub mod trace;
 

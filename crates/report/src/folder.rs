@@ -1,0 +1,80 @@
+//! A sweep's folder as the reports read it: `sweep.json` (the [`SweepInfo`] the sweep wrote)
+//! and `results.jsonl` (its [`Record`]s). Shared by the README's generated regions and by
+//! [`rewrite_report`], which remakes a folder's report from its records alone — no renderer,
+//! no GPU: a report measured on another machine is regenerated here after a change to the
+//! report's text.
+
+use crate::readme::ReadmeError;
+use crate::{Record, SweepInfo, read_records, write_report};
+use std::path::Path;
+
+/// `sweep.json` is a few KB; the bound keeps a wrong path from being read whole.
+const MAX_SWEEP_JSON_BYTES: u64 = 1 << 20;
+
+/// A sweep folder's records and facts.
+pub(crate) struct Sweep {
+    pub info: SweepInfo,
+    pub records: Vec<Record>,
+}
+
+/// Reads `dir/sweep.json` and `dir/results.jsonl`; a folder without records is an error.
+pub(crate) fn load_sweep(dir: &Path) -> Result<Sweep, ReadmeError> {
+    let info_path = dir.join("sweep.json");
+    let text =
+        mirrorbox_files::read_bounded_text(&info_path, MAX_SWEEP_JSON_BYTES, "a sweep description")
+            .map_err(|e| ReadmeError(e.to_string()))?;
+    let info: SweepInfo = serde_json::from_str(&text).map_err(|e| {
+        ReadmeError(format!(
+            "{}: not a sweep description ({e}); regenerate the report with its sweep",
+            info_path.display()
+        ))
+    })?;
+    let results = dir.join("results.jsonl");
+    let records =
+        read_records(&results).map_err(|e| ReadmeError(format!("{}: {e}", results.display())))?;
+    if records.is_empty() {
+        return Err(ReadmeError(format!(
+            "{}: no records to quote",
+            results.display()
+        )));
+    }
+    Ok(Sweep { info, records })
+}
+
+/// Rewrites `results.csv`, `report.md`, `report.html` and the plots of the sweep folder `dir`
+/// from its `sweep.json` and `results.jsonl`; returns the number of records reported.
+pub fn rewrite_report(dir: &Path) -> Result<usize, ReadmeError> {
+    let sweep = load_sweep(dir)?;
+    write_report(dir, &sweep.info, &sweep.records).map_err(|e| ReadmeError(e.to_string()))?;
+    Ok(sweep.records.len())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_folder_without_a_sweep_description_is_named_in_the_error() {
+        let dir = tempfile::tempdir().unwrap();
+        let e = rewrite_report(dir.path()).err().unwrap();
+        assert!(e.0.contains("sweep.json"), "{e}");
+        std::fs::write(dir.path().join("sweep.json"), "[1, 2]").unwrap();
+        let e = rewrite_report(dir.path()).err().unwrap();
+        assert!(e.0.contains("not a sweep description"), "{e}");
+    }
+
+    #[test]
+    fn a_committed_report_is_rewritten_byte_for_byte() {
+        // The committed table1 report was written by the sweep; remaking it from its records
+        // must give the same Markdown (the report's date is the sweep's, not today's).
+        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../reports/table1");
+        let dir = tempfile::tempdir().unwrap();
+        for f in ["sweep.json", "results.jsonl"] {
+            std::fs::copy(root.join(f), dir.path().join(f)).unwrap();
+        }
+        assert!(rewrite_report(dir.path()).unwrap() > 0);
+        let want = std::fs::read_to_string(root.join("report.md")).unwrap();
+        let have = std::fs::read_to_string(dir.path().join("report.md")).unwrap();
+        assert_eq!(have, want);
+    }
+}

@@ -1,0 +1,176 @@
+#!/usr/bin/env bash
+# Issue 21: every GPU measurement in one command, run on a lent GPU machine (NVIDIA H100/H200)
+# through the workplace's device tool. That machine reaches no package registry and has no Rust
+# toolchain, so everything it runs is built here first (scripts/gpu-prepare.sh):
+#   .gpu/mirrorbox.gz          stripped release binary
+#   .gpu/<test>.gz             the raster crate's test binaries (goldens, truth agreement)
+#   .gl/*.deb                  the Vulkan/EGL loaders (libvulkan1, libglvnd, …)
+# Usage there (repository root, `.gl` and `.gpu` carried):
+#   scripts/gpu-measure.sh STEP...      steps: info table1 table1-repeat table1-1080p depth
+#                                       depth-1080p room trace tests retest symmetry lighting
+# Results go to reports/gpu/ and, packed, to $OUT/gpu.tar.gz (what comes back). Each step is
+# skipped once less than its own budget is left of MIRRORBOX_GPU_DEADLINE seconds (default 540),
+# so the command ends inside the tool's 10-minute limit; sweeps resume where a cut one stopped.
+set -uo pipefail
+cd "$(dirname "$0")/.."
+out=${OUT:-/tmp/gpu-out}
+mkdir -p "$out" reports/gpu
+log=$out/log.txt
+deadline=${MIRRORBOX_GPU_DEADLINE:-540}
+started=$SECONDS
+say() { echo "[$((SECONDS - started)) s] $*" | tee -a "$log"; }
+
+# The loaders, unpacked into / where none is installed (the machine is bare and thrown away
+# after the lease).
+if ! ldconfig -p | grep -q 'libvulkan.so.1 '; then
+  for f in .gl/*.deb; do dpkg -x "$f" /; done
+  ldconfig
+fi
+if [ -f /usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json ]; then
+  export VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
+fi
+mkdir -p /tmp/gpu-bin
+for f in .gpu/*.gz; do gunzip -c "$f" >"/tmp/gpu-bin/$(basename "$f" .gz)"; done
+chmod +x /tmp/gpu-bin/*
+bin=/tmp/gpu-bin/mirrorbox
+
+pack() {
+  # 1920×1080 images (several MiB each) stay behind: too large to bring back (16 MiB a file)
+  # or to keep in git; those reports keep their numbers and plots.
+  tar -czf "$out/gpu.tar.gz.part" --exclude='*/cache' --exclude='.mirrorbox.lock' \
+    --exclude='reports/gpu/*_1080p/images' reports/gpu &&
+    mv "$out/gpu.tar.gz.part" "$out/gpu.tar.gz"
+}
+
+# step NAME BUDGET_SECONDS COMMAND...: runs COMMAND (a program with a timeout of what is left,
+# or a function below) if at least BUDGET seconds are left.
+step() {
+  local name=$1 budget=$2
+  shift 2
+  local left=$((deadline - (SECONDS - started)))
+  if [ "$left" -lt "$budget" ]; then
+    say "== $name: skipped ($left s left, needs $budget)"
+    return
+  fi
+  say "== $name: start"
+  if declare -F "$1" >/dev/null; then
+    "$@" >>"$log" 2>&1 # a function of this script: its commands carry their own timeouts
+  else
+    timeout "$left" "$@" >>"$log" 2>&1
+  fi
+  say "== $name: exit $?"
+  pack
+}
+
+info() {
+  nvidia-smi --query-gpu=name,driver_version,memory.total,clocks.max.sm --format=csv
+  grep -m1 'model name' /proc/cpuinfo
+  nproc
+  "$bin" info | tee reports/gpu/info.txt
+  "$bin" info --json >reports/gpu/info.json
+  nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader >reports/gpu/nvidia-smi.txt
+  grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//' >reports/gpu/cpu.txt
+}
+
+# The mirror room at 1920×1080: unrolled and portal, depth 1…1024, 3 rounds in an order shuffled
+# per round, 5 timed frames each (2 warm-up). One `render --json` line per run, or a refusal.
+room() {
+  local file=reports/gpu/room_1080p.jsonl tmp
+  tmp=$(mktemp reports/gpu/.room.XXXXXX)
+  for round in 1 2 3; do
+    for run in $(for m in unrolled portal; do for d in ${ROOM_DEPTHS:-1 2 4 8 16 32 64 128 256 512 1024}; do
+      echo "$m:$d"; done; done | shuf --random-source=<(yes "$round")); do
+      local m=${run%%:*} d=${run##*:} line
+      if line=$(timeout 120 "$bin" render scenes/mirror_room.json --method "$m" --depth "$d" \
+        --width "${ROOM_WIDTH:-1920}" --height "${ROOM_HEIGHT:-1080}" --frames 5 --warmup 2 --json -o /tmp/room.png 2>/tmp/room.err); then
+        echo "$line" | sed "s/^{/{\"round\":$round,/" >>"$tmp"
+      else
+        local code=$? why
+        why=$(tr '\n"\\' '   ' </tmp/room.err | cut -c1-400)
+        echo "{\"round\":$round,\"method\":\"$m\",\"depth\":$d,\"exit\":$code,\"refused\":\"$why\"}" >>"$tmp"
+      fi
+    done
+  done
+  mv "$tmp" "$file"
+}
+
+# The tracer on 1, 2, 4, 8 and 16 threads: the mirror room at 960×540, 16 spp, 3 rounds in an
+# order shuffled per round. One `trace --json` line per run.
+trace_threads() {
+  local file=reports/gpu/trace_threads.jsonl tmp
+  tmp=$(mktemp reports/gpu/.trace.XXXXXX)
+  for round in 1 2 3; do
+    for t in $(printf '%s\n' 1 2 4 8 16 | shuf --random-source=<(yes "$round")); do
+      RAYON_NUM_THREADS=$t "$bin" trace scenes/mirror_room.json --width 960 --height 540 --json \
+        -o /tmp/trace.exr | sed "s/^{/{\"round\":$round,/" >>"$tmp"
+    done
+  done
+  mv "$tmp" "$file"
+}
+
+# The raster crate's tests (goldens, agreement with the truth) on the GPU. The binaries look for
+# the repository where they were built (/work/main); point that path here.
+tests() {
+  if [ ! -e /work/main ]; then
+    mkdir -p /work && ln -s "$PWD" /work/main
+  fi
+  local t rc=0
+  for t in /tmp/gpu-bin/*; do
+    [ "$t" = "$bin" ] && continue
+    echo "---- $(basename "$t")"
+    (cd crates/raster && "$t" --test-threads 4) 2>&1 | tee "reports/gpu/tests_$(basename "$t").txt" | tail -n 40 || rc=1
+  done
+  return $rc
+}
+
+# The tests that failed on the GPU in the first run, one at a time, with the images they write
+# on failure kept; and wgpu's GL backend on the NVIDIA driver (EGL) by hand.
+retest() {
+  if [ ! -e /work/main ]; then
+    mkdir -p /work && ln -s "$PWD" /work/main
+  fi
+  local t
+  for t in light_images_match_the_truth_and_direct_ignores_them \
+    symmetry_methods_match_the_truth_on_every_symmetry_scene \
+    every_registered_method_renders_on_the_gl_backend; do
+    (cd crates/raster && RUST_BACKTRACE=0 /tmp/gpu-bin/test_methods --exact "$t" --test-threads 1 --nocapture) 2>&1 |
+      tail -n 30
+  done
+  WGPU_BACKEND=gl "$bin" info
+  WGPU_BACKEND=gl "$bin" render scenes/mirror_box.json --method unrolled -o /tmp/gl.png --json | cut -c1-300
+  mkdir -p reports/gpu/golden-failures
+  cp -r target/tmp/golden-failures/. reports/gpu/golden-failures/ 2>/dev/null
+  ls -la reports/gpu/golden-failures
+}
+
+# The paper's experiment and the depth scaling again at 1920×1080, where a GPU has work to do.
+table1_1080p() {
+  timeout 240 "$bin" sweep scenes/mirror_box.json --methods auxiliary,portal,unrolled --n 0,1,2,3,4 \
+    --depth 64 --alpha 1,0.7 --width 1920 --height 1080 --frames 9 --out reports/gpu/table1_1080p
+}
+depth_1080p() {
+  timeout 240 "$bin" sweep scenes/mirror_box.json --methods portal,unrolled \
+    --depth 1,2,4,8,16,32,64,128,256,512,1024 --alpha 1 --width 1920 --height 1080 --frames 9 \
+    --out reports/gpu/depth_scaling_1080p
+}
+
+say "steps: $*"
+for s in "$@"; do
+  case $s in
+  info) step info 10 info ;;
+  table1) step table1 120 "$bin" table1 --out reports/gpu/table1 ;;
+  depth) step depth-scaling 120 "$bin" depth-scaling --out reports/gpu/depth_scaling ;;
+  room) step room 120 room ;;
+  trace) step trace-threads 60 trace_threads ;;
+  tests) step tests 60 tests ;;
+  retest) step retest 30 retest ;;
+  table1-repeat) step table1-repeat 60 "$bin" table1 --out reports/gpu/table1_repeat ;;
+  table1-1080p) step table1-1080p 60 table1_1080p ;;
+  depth-1080p) step depth-1080p 60 depth_1080p ;;
+  symmetry) step symmetry-scaling 120 "$bin" symmetry-scaling --out reports/gpu/symmetry_scaling ;;
+  lighting) step lighting 120 "$bin" lighting --out reports/gpu/lighting ;;
+  *) say "unknown step $s" ;;
+  esac
+done
+pack
+say "done"
