@@ -19,20 +19,29 @@ struct Surface {
 // and mirrored lights"): an image lights a point only inside its beam, the planes
 // light_planes[first_plane ..][.. plane_count] (the first strict, the others ≥ 0). Real
 // lights have no planes.
+//
+// With shadow maps (crates/raster/src/shadow_maps.rs) a light also names its first layer
+// (six cube faces for a real light, one layer through its last mirror for an image), the
+// image's layer transform, its texel size, and the light the chain's previous leg leads to.
 struct Light {
     position: vec3f,
     first_plane: u32,
     intensity: vec3f,
     plane_count: u32,
+    shadow_from_world: mat4x4f,
+    shadow_layer: u32,
+    parent: u32,
+    shadow_texel: f32,
+    _pad: u32,
 }
 
 struct Frame {
     ambient: vec3f,
     light_count: u32,
     background: vec3f,
-    _pad0: u32,
+    shadow_bias: f32,
     terminal: vec3f,
-    _pad1: u32,
+    shadows: u32,
 }
 
 // One scene vertex (VERTEX_LAYOUT in crates/raster/src/shading.rs): position, the
@@ -47,6 +56,8 @@ struct VertexIn {
 @group(0) @binding(1) var<storage, read> surfaces: array<Surface>;
 @group(0) @binding(2) var<storage, read> lights: array<Light>;
 @group(0) @binding(3) var<storage, read> light_planes: array<vec4f>;
+// Distance from each layer's light to the nearest surface, per texel.
+@group(0) @binding(4) var shadow_maps: texture_2d_array<f32>;
 
 const FRAC_1_PI: f32 = 0.31830988618379067;
 const MIN_LIGHT_DISTANCE_SQUARED: f32 = 1e-8;
@@ -68,6 +79,73 @@ fn in_beam(light: Light, p: vec3f) -> bool {
     return true;
 }
 
+// The longest chain a shadow test follows: mirrored_lights is at most 64.
+const MAX_SHADOW_LEGS: u32 = 65u;
+
+// Whether nothing nearer than x (plus the bias) lies on the ray from `light` towards x in its
+// shadow-map layer. `cos_incidence`: |cos| between the leg and the surface x lies on.
+fn leg_clear(light: Light, x: vec3f, cos_incidence: f32) -> bool {
+    let d = x - light.position;
+    var clip: vec4f;
+    var layer = light.shadow_layer;
+    if (light.plane_count == 0u) {
+        // A cube face: the axis of d's largest component (ties to the lowest axis).
+        let m = abs(d);
+        var a = 2u;
+        if (m.x >= m.y && m.x >= m.z) {
+            a = 0u;
+        } else if (m.y >= m.z) {
+            a = 1u;
+        }
+        let b = (a + 1u) % 3u;
+        let c = (a + 2u) % 3u;
+        layer += 2u * a + select(1u, 0u, d[a] >= 0.0);
+        clip = vec4f(d[b], d[c], 0.0, abs(d[a]));
+    } else {
+        clip = light.shadow_from_world * vec4f(x, 1.0);
+    }
+    if (clip.w <= 0.0) {
+        return true;
+    }
+    let ndc = clip.xy / clip.w;
+    let size = vec2f(textureDimensions(shadow_maps));
+    let texel = vec2i(floor(vec2f(0.5 * ndc.x + 0.5, 0.5 - 0.5 * ndc.y) * size));
+    let clamped = clamp(texel, vec2i(0), vec2i(size) - 1);
+    let stored = textureLoad(shadow_maps, clamped, i32(layer), 0).r;
+    let r = length(d);
+    let cos_i = max(cos_incidence, 0.05);
+    let tan_i = sqrt(max(1.0 - cos_i * cos_i, 0.0)) / cos_i;
+    let bias = frame.shadow_bias + r * light.shadow_texel * min(tan_i, 8.0);
+    return r <= stored + bias;
+}
+
+// Shadows (docs/shading.md): light i reaches p only if every straight leg is clear — p to the
+// light (or image), then for an image each mirror point c back to the real light.
+fn unshadowed(i: u32, p: vec3f, n: vec3f) -> bool {
+    if (frame.shadows == 0u) {
+        return true;
+    }
+    var light = lights[i];
+    var x = p;
+    var cos_i = abs(dot(n, normalize(light.position - p)));
+    for (var leg = 0u; leg < MAX_SHADOW_LEGS; leg++) {
+        if (!leg_clear(light, x, cos_i)) {
+            return false;
+        }
+        if (light.plane_count == 0u) {
+            return true;
+        }
+        // Where the segment x → image meets the image's last mirror (the beam's first plane).
+        let plane = light_planes[light.first_plane];
+        let a = dot(plane, vec4f(x, 1.0));
+        let b = dot(plane, vec4f(light.position, 1.0));
+        x = mix(x, light.position, a / (a - b));
+        light = lights[light.parent];
+        cos_i = abs(dot(plane.xyz, normalize(light.position - x)));
+    }
+    return true;
+}
+
 fn diffuse_radiance(p: vec3f, face_normal: vec3f, to_viewer: vec3f, albedo: vec3f, emission: vec3f) -> vec3f {
     let front = dot(face_normal, to_viewer) >= 0.0;
     let n = select(-face_normal, face_normal, front);
@@ -82,7 +160,7 @@ fn diffuse_radiance(p: vec3f, face_normal: vec3f, to_viewer: vec3f, albedo: vec3
             continue;
         }
         let cos_theta = dot(n, to_light) / sqrt(r2);
-        if (cos_theta > 0.0) {
+        if (cos_theta > 0.0 && unshadowed(i, p, n)) {
             irradiance += lights[i].intensity * (cos_theta / r2);
         }
     }

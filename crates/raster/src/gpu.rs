@@ -77,6 +77,7 @@ fn device_limits(adapter: &wgpu::Limits) -> wgpu::Limits {
     wgpu::Limits {
         max_buffer_size: adapter.max_buffer_size,
         max_storage_buffer_binding_size: adapter.max_storage_buffer_binding_size,
+        max_texture_array_layers: adapter.max_texture_array_layers,
         ..wgpu::Limits::default().using_resolution(adapter.clone())
     }
 }

@@ -33,6 +33,7 @@ pub mod readback;
 pub mod registry;
 pub mod resolve;
 pub mod shading;
+pub mod shadow_maps;
 pub mod symmetry_cells;
 pub mod targets;
 pub mod timing;
@@ -189,6 +190,9 @@ pub fn plan_frame(scene: &Scene, settings: &RenderSettings) -> Result<Planned, P
     let scene = &*lighting::lit_scene(scene, settings.method.params());
     settings.check(scene)?;
     let (w, h) = settings.render_size(scene);
+    if let Some(s) = lighting::shadow_settings(settings.method.params()) {
+        shadow_maps::ShadowPlan::new(scene, s)?;
+    }
     let frame = settings.method.configure().plan(scene, w, h)?;
     Ok(Planned {
         frame,
@@ -220,7 +224,21 @@ pub fn render_planned(
     let target =
         targets::RenderTarget::new(gpu, "view", w, h, wgpu::TextureUsages::TEXTURE_BINDING);
     let resolve = resolve::Resolve::new(gpu, &target, settings.ssaa);
-    let built = planned.frame.build(gpu, scene)?;
+    let shadow_plan = lighting::shadow_settings(settings.method.params())
+        .map(|s| shadow_maps::ShadowPlan::new(scene, s))
+        .transpose()
+        .map_err(plan::PlanError::from)?;
+    let shadows = shadow_maps::ShadowMaps::new(gpu, scene, shadow_plan)?;
+    let mut built = planned.frame.build(gpu, scene, &shadows)?;
+    if shadows.layers() > 0 {
+        built.stats.passes += shadows.layers();
+        built.stats.draws += shadows.layers();
+        built.stats.triangles += shadows.triangles();
+        built.encoder = Box::new(shadow_maps::WithShadowMaps {
+            shadows,
+            method: built.encoder,
+        });
+    }
     gpu.check()?;
     let (image, timing) = timing::run_frames(
         gpu,

@@ -35,3 +35,56 @@ pub fn lit_scene<'a>(scene: &'a Scene, params: &Params) -> Cow<'a, Scene> {
         Cow::Borrowed(scene)
     }
 }
+
+/// `--shadows none|map`.
+pub static SHADOWS: OptionSpec = OptionSpec {
+    name: "shadows",
+    help: "Shadows of the scene's lighting.shadows contract: `none` lights every point its lights \
+           and light images reach geometrically (no occlusion), `map` tests every straight leg \
+           with shadow maps — a cube map per light, one map per light image rendered through its \
+           last mirror (crates/raster/src/shadow_maps.rs).",
+    kind: OptionKind::Choice {
+        values: &["none", "map"],
+    },
+    default: ParamValue::Choice("none"),
+    sweep: None,
+    in_key: true,
+};
+
+/// `--shadow-map-size N`: texels per side of every shadow map layer.
+pub static SHADOW_MAP_SIZE: OptionSpec = OptionSpec {
+    name: "shadow-map-size",
+    help: "Texels per side of each shadow map (with --shadows map).",
+    kind: OptionKind::Count { min: 16, max: 4096 },
+    default: ParamValue::Count(1024),
+    sweep: None,
+    in_key: true,
+};
+
+/// `--shadow-bias B`: the constant part of the depth bias, in scene units.
+pub static SHADOW_BIAS: OptionSpec = OptionSpec {
+    name: "shadow-bias",
+    help: "Constant depth bias of the shadow test, scene units (with --shadows map); a slope term \
+           of one texel's footprint is added to it.",
+    kind: OptionKind::Real {
+        min: 0.0,
+        min_open: false,
+        max: Some(1.0),
+    },
+    default: ParamValue::Real(DEFAULT_SHADOW_BIAS),
+    sweep: None,
+    in_key: true,
+};
+
+/// The default constant bias (scene units; the bundled scenes are a few units across).
+pub const DEFAULT_SHADOW_BIAS: f32 = 0.005;
+
+/// What a method's `--shadows` options ask for: `None` without shadow maps.
+pub fn shadow_settings(params: &Params) -> Option<crate::shadow_maps::ShadowSettings> {
+    (params.get(&SHADOWS)? == ParamValue::Choice("map")).then(|| {
+        crate::shadow_maps::ShadowSettings {
+            size: params.count(&SHADOW_MAP_SIZE),
+            bias: params.real(&SHADOW_BIAS),
+        }
+    })
+}

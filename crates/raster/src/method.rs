@@ -92,7 +92,12 @@ pub trait RasterMethod {
 
 /// A planned frame, ready to become GPU resources.
 pub trait PlannedFrame {
-    fn build(self: Box<Self>, gpu: &Gpu, scene: &Scene) -> Result<BuiltFrame, RasterError>;
+    fn build(
+        self: Box<Self>,
+        gpu: &Gpu,
+        scene: &Scene,
+        shadows: &crate::shadow_maps::ShadowMaps,
+    ) -> Result<BuiltFrame, RasterError>;
 }
 
 /// A method's GPU resources for one frame, what it draws, and what it cannot promise.

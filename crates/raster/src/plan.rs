@@ -136,6 +136,9 @@ pub enum PlanError {
     /// outside the scene extent).
     #[error("the split-and-mirror bake: {0}")]
     Bake(String),
+    /// `--shadows map` would need more layers than the shadow-map budget.
+    #[error(transparent)]
+    ShadowMaps(#[from] crate::shadow_maps::TooManyShadowLayers),
     /// A render setting out of range (`--ssaa`, `--frames`, `--warmup`, the render size).
     #[error(transparent)]
     Setting(#[from] mirrorbox_scene::limits::SettingError),

@@ -13,10 +13,11 @@ pub fn gpu_structs() -> Vec<crate::wgsl::HostLayout> {
             albedo, kind, emission, mirror, reflectance, _pad0, back_albedo, _pad1
         }),
         crate::host_layout!(GpuLight as "Light" {
-            position, first_plane, intensity, plane_count
+            position, first_plane, intensity, plane_count, shadow_from_world, shadow_layer,
+            parent, shadow_texel, _pad
         }),
         crate::host_layout!(GpuFrame as "Frame" {
-            ambient, light_count, background, _pad0, terminal, _pad1
+            ambient, light_count, background, shadow_bias, terminal, shadows
         }),
     ]
 }
@@ -41,6 +42,15 @@ struct GpuLight {
     first_plane: u32,
     intensity: [f32; 3],
     plane_count: u32,
+    /// Light images with shadow maps: their layer's clip-from-world.
+    shadow_from_world: [[f32; 4]; 4],
+    /// First shadow-map layer (a real light's six cube faces start here).
+    shadow_layer: u32,
+    /// Light images: the light the chain's previous leg leads to (its index in this list).
+    parent: u32,
+    /// The layer's texel size in tangent units (slope bias).
+    shadow_texel: f32,
+    _pad: u32,
 }
 
 #[repr(C)]
@@ -49,9 +59,11 @@ struct GpuFrame {
     ambient: [f32; 3],
     light_count: u32,
     background: [f32; 3],
-    _pad0: u32,
+    /// `--shadow-bias` (scene units).
+    shadow_bias: f32,
     terminal: [f32; 3],
-    _pad1: u32,
+    /// 1: every leg is tested against the shadow maps; 0: nothing occludes.
+    shadows: u32,
 }
 
 /// One vertex: position, the triangle's face normal (the same f32 values the tracer uses)
@@ -72,6 +84,31 @@ pub const VERTEX_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferL
 
 /// The scene on the GPU: vertices (objects first, then each mirror's two triangles) and the
 /// group-0 bind group of `shading.wgsl`.
+/// Every triangle of `scene` (objects and mirrors) as one vertex buffer, and its vertex
+/// count: what a shadow map draws.
+pub fn all_vertices(device: &wgpu::Device, scene: &Scene) -> (wgpu::Buffer, u32) {
+    let g = &scene.geometry;
+    let mut vertices: Vec<Vertex> = Vec::with_capacity(3 * g.triangles.len());
+    for i in 0..g.triangles.len() {
+        let normal = g.face_normal(i).to_array();
+        vertices.extend(g.triangles[i].map(|p| Vertex {
+            position: p.to_array(),
+            normal,
+            surface: g.surface_of[i],
+        }));
+    }
+    let count = vertices.len() as u32;
+    if vertices.is_empty() {
+        vertices.push(Zeroable::zeroed()); // a buffer may not be empty
+    }
+    let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("shadow map vertices"),
+        contents: bytemuck::cast_slice(&vertices),
+        usage: wgpu::BufferUsages::VERTEX,
+    });
+    (buffer, count)
+}
+
 pub struct SceneBuffers {
     pub vertices: wgpu::Buffer,
     /// Vertex range of all non-mirror triangles.
@@ -111,8 +148,12 @@ impl SceneBuffers {
         gpu.check_buffer("light plane", planes as u64 * 16, true)
     }
 
-    pub fn new(device: &wgpu::Device, scene: &Scene) -> Self {
-        Self::for_geometry(device, scene, &scene.geometry)
+    pub fn new(
+        device: &wgpu::Device,
+        scene: &Scene,
+        shadows: &crate::shadow_maps::ShadowMaps,
+    ) -> Self {
+        Self::for_geometry(device, scene, &scene.geometry, shadows)
     }
 
     /// `scene`'s buffers drawing `g` (its mirror surfaces index `scene.mirrors`) instead of
@@ -122,6 +163,7 @@ impl SceneBuffers {
         device: &wgpu::Device,
         scene: &Scene,
         g: &mirrorbox_scene::Geometry,
+        shadows: &crate::shadow_maps::ShadowMaps,
     ) -> Self {
         let vertex = |i: usize| {
             let n = g.face_normal(i).to_array();
@@ -194,24 +236,38 @@ impl SceneBuffers {
             })
             .collect();
         // The real lights, then their images with their beams' planes.
-        let mut lights: Vec<GpuLight> = scene
-            .lighting
-            .lights
-            .iter()
-            .map(|l| GpuLight {
+        let plan = shadows.plan.as_ref();
+        // The shadow facts of entry `i` of the list (real lights, then images).
+        let shadow_of = |i: usize, light: &mut GpuLight| {
+            if let Some(s) = plan.map(|p| p.lights[i]) {
+                light.shadow_from_world = s.clip_from_world.to_cols_array_2d();
+                light.shadow_layer = s.layer;
+                light.shadow_texel = s.texel;
+            }
+        };
+        let real = scene.lighting.lights.len();
+        let mut lights: Vec<GpuLight> = Vec::new();
+        for (i, l) in scene.lighting.lights.iter().enumerate() {
+            let mut light = GpuLight {
                 position: l.position.to_array(),
                 intensity: l.intensity.to_array(),
                 ..Zeroable::zeroed()
-            })
-            .collect();
+            };
+            shadow_of(i, &mut light);
+            lights.push(light);
+        }
         let mut planes: Vec<[f32; 4]> = Vec::new();
-        for image in &scene.lighting.images.images {
-            lights.push(GpuLight {
+        for (j, image) in scene.lighting.images.images.iter().enumerate() {
+            let mut light = GpuLight {
                 position: image.position.to_array(),
                 first_plane: planes.len() as u32,
                 intensity: image.intensity.to_array(),
                 plane_count: image.beam.len() as u32,
-            });
+                parent: image.parent.map_or(image.light, |p| real + p) as u32,
+                ..Zeroable::zeroed()
+            };
+            shadow_of(real + j, &mut light);
+            lights.push(light);
             planes.extend(image.beam.iter().map(|p| p.to_array()));
         }
         if planes.is_empty() {
@@ -228,8 +284,9 @@ impl SceneBuffers {
             ambient: scene.lighting.ambient.to_array(),
             light_count,
             background: scene.background.to_array(),
+            shadow_bias: plan.map_or(0.0, |p| p.settings.bias),
             terminal: scene.terminal.to_array(),
-            ..Zeroable::zeroed()
+            shadows: u32::from(plan.is_some()),
         };
         let init = |label, contents: &[u8], usage| {
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -288,6 +345,14 @@ impl SceneBuffers {
                 entry(1, storage),
                 entry(2, storage),
                 entry(3, storage),
+                entry(
+                    4,
+                    wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                        view_dimension: wgpu::TextureViewDimension::D2Array,
+                        multisampled: false,
+                    },
+                ),
             ],
         });
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -309,6 +374,10 @@ impl SceneBuffers {
                 wgpu::BindGroupEntry {
                     binding: 3,
                     resource: planes_buf.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: wgpu::BindingResource::TextureView(&shadows.array_view),
                 },
             ],
         });

@@ -125,7 +125,10 @@ mod tests {
     use crate::methods::METHODS;
 
     fn every_source() -> Vec<(&'static str, &'static WgslSource)> {
-        let mut all = vec![("resolve", &RESOLVE)];
+        let mut all = vec![
+            ("resolve", &RESOLVE),
+            ("shadow maps", &crate::shadow_maps::SHADER),
+        ];
         for e in METHODS {
             assert!(!e.shaders.is_empty(), "{} lists no shader", e.name);
             all.extend(e.shaders.iter().map(|s| (e.name, *s)));
@@ -192,6 +195,11 @@ mod tests {
             .into_iter()
             .map(|l| (l, every.clone()))
             .collect();
+        layouts.extend(
+            crate::shadow_maps::gpu_structs()
+                .into_iter()
+                .map(|l| (l, vec![&crate::shadow_maps::SHADER])),
+        );
         for e in METHODS {
             layouts.extend(
                 (e.gpu_structs)()

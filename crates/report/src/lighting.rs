@@ -2,8 +2,9 @@
 //! raster lighting variant leaves against a truth lit the same way, and its cost, against the
 //! depth k of the mirrored lights (`lighting.mirrored_lights`).
 //!
-//! A point's lighting variant is read from its method options (`lights=…`): the report knows
-//! the option's name, not the rasterizer. No raster variant draws shadows yet.
+//! A point's lighting variant is read from its method options (`lights=…`, `shadows=…`,
+//! `shadow-map-size=…`, `shadow-bias=…`): the report knows the options' names, not the
+//! rasterizer.
 
 use crate::Record;
 use crate::plot::{Chart, Series};
@@ -12,9 +13,21 @@ use crate::write::{Block, f, ms_cell, sci};
 /// The raster option that chooses direct or mirrored lights.
 pub const LIGHTS_OPTION: &str = "lights";
 
+/// The raster options of a lighting variant (crates/raster/src/lighting.rs).
+const LIGHTING_OPTIONS: [&str; 4] = [LIGHTS_OPTION, "shadows", "shadow-map-size", "shadow-bias"];
+
+/// The value of option `name` among a record's non-default options.
+fn option<'a>(r: &'a Record, name: &str) -> Option<&'a str> {
+    r.method_options.split_whitespace().find_map(|w| {
+        w.split_once('=')
+            .filter(|(n, _)| *n == name)
+            .map(|(_, v)| v)
+    })
+}
+
 fn is_lighting_word(word: &str) -> bool {
     word.split_once('=')
-        .is_some_and(|(name, _)| name == LIGHTS_OPTION)
+        .is_some_and(|(name, _)| LIGHTING_OPTIONS.contains(&name))
 }
 
 /// The method a point measured, without its lighting options: `auxiliary n=2`,
@@ -36,16 +49,22 @@ pub fn method_of(r: &Record) -> String {
     words.join(" ")
 }
 
-/// The point's lighting variant in words: `direct only, no shadows` or `mirrored, no
-/// shadows`. An option at its default is absent from the record: mirrored lights (what the
-/// scene asks for).
+/// The point's lighting variant in words: `direct only, no shadows`, `mirrored, no
+/// shadows`, `mirrored, shadow maps 1024²` (`, bias 0.01` where not the default). An option at
+/// its default is absent from the record: mirrored lights (what the scene asks for), no
+/// shadows, maps of 1024², the default bias.
 pub fn lighting_of(r: &Record) -> String {
-    let direct = r
-        .method_options
-        .split_whitespace()
-        .any(|w| w == format!("{LIGHTS_OPTION}=direct"));
-    let lights = if direct { "direct only" } else { "mirrored" };
-    format!("{lights}, no shadows")
+    let lights = if option(r, LIGHTS_OPTION) == Some("direct") {
+        "direct only"
+    } else {
+        "mirrored"
+    };
+    if option(r, "shadows") != Some("map") {
+        return format!("{lights}, no shadows");
+    }
+    let size = option(r, "shadow-map-size").unwrap_or("1024");
+    let bias = option(r, "shadow-bias").map_or(String::new(), |b| format!(", bias {b}"));
+    format!("{lights}, shadow maps {size}²{bias}")
 }
 
 /// The points of a mirrored-lights sweep.
@@ -175,8 +194,9 @@ pub(crate) fn lighting_section(records: &[Record]) -> Vec<Block> {
         Block::Paragraph(format!(
             "The truth lights every diffuse point through the lights' images in chains of up to \
              k mirrors (the point's k), with the scene's shadows; each raster point uses the \
-             lighting variant named beside its method, without shadows (no raster variant \
-             draws them yet). The plots take k = {k_max}."
+             lighting variant named beside its method: without shadows, or with shadow maps of \
+             the size named (a cube map per light, one map per light image through its last \
+             mirror, nearest texel). The plots take k = {k_max}."
         )),
         Block::Chart(
             "plot_lighting_error_vs_ms.svg".into(),
@@ -305,6 +325,19 @@ mod tests {
             lighting_of(&record("portal", "", 0, 0.1)),
             "mirrored, no shadows"
         );
+        let r = record("unrolled", "shadows=map shadow-map-size=256", 8, 0.1);
+        assert_eq!(method_of(&r), "unrolled depth=64");
+        assert_eq!(lighting_of(&r), "mirrored, shadow maps 256²");
+        let r = record(
+            "portal",
+            "lights=direct shadows=map shadow-bias=0.02",
+            8,
+            0.1,
+        );
+        assert_eq!(lighting_of(&r), "direct only, shadow maps 1024², bias 0.02");
+        // `shadows=none` is the default and never in a key; a stray one reads as no shadows.
+        let r = record("portal", "shadows=none", 8, 0.1);
+        assert_eq!(lighting_of(&r), "mirrored, no shadows");
     }
 
     #[test]

@@ -50,6 +50,9 @@ pub static PORTAL: MethodEntry = MethodEntry {
         &MIN_PORTAL_AREA,
         &MIN_ATTENUATION,
         &crate::lighting::LIGHTS,
+        &crate::lighting::SHADOWS,
+        &crate::lighting::SHADOW_MAP_SIZE,
+        &crate::lighting::SHADOW_BIAS,
     ],
     swept: Some(&DEPTH),
     optional_features: wgpu::Features::CLIP_DISTANCES.union(wgpu::Features::DEPTH32FLOAT_STENCIL8),
@@ -91,8 +94,13 @@ struct PlannedPortal {
 }
 
 impl PlannedFrame for PlannedPortal {
-    fn build(self: Box<Self>, gpu: &Gpu, scene: &Scene) -> Result<BuiltFrame, RasterError> {
-        let m = PortalStencil::new(gpu, scene, &self.planned, self.ops)?;
+    fn build(
+        self: Box<Self>,
+        gpu: &Gpu,
+        scene: &Scene,
+        shadows: &crate::shadow_maps::ShadowMaps,
+    ) -> Result<BuiltFrame, RasterError> {
+        let m = PortalStencil::new(gpu, scene, shadows, &self.planned, self.ops)?;
         let depth_format = m.stats.depth_format;
         let mut warnings = Vec::new();
         if depth_format != DEPTH_STENCIL_FORMAT {
@@ -235,12 +243,13 @@ impl PortalStencil {
     fn new(
         gpu: &Gpu,
         scene: &Scene,
+        shadows: &crate::shadow_maps::ShadowMaps,
         planned: &PlannedPaths,
         ops: Vec<Op>,
     ) -> Result<Self, RasterError> {
         let device = &gpu.device;
         let (paths, projection) = (&planned.paths, planned.projection);
-        let scene_buffers = SceneBuffers::new(device, scene);
+        let scene_buffers = SceneBuffers::new(device, scene, shadows);
         let size = glam::Vec2::new(planned.width as f32, planned.height as f32);
         let mut arena = UniformArena::new(device);
         let mut offsets = Vec::with_capacity(paths.paths.len());

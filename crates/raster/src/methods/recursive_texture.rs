@@ -40,7 +40,14 @@ pub static NAIVE: MethodEntry = MethodEntry {
     name: "naive",
     help: "The paper's Algorithm 1: recursive mirror textures, each mirror hidden in its own recursion.",
     exact: false,
-    options: &[&TEXTURE_SCALE, &MAX_PASSES, &crate::lighting::LIGHTS],
+    options: &[
+        &TEXTURE_SCALE,
+        &MAX_PASSES,
+        &crate::lighting::LIGHTS,
+        &crate::lighting::SHADOWS,
+        &crate::lighting::SHADOW_MAP_SIZE,
+        &crate::lighting::SHADOW_BIAS,
+    ],
     swept: None,
     optional_features: wgpu::Features::CLIP_DISTANCES,
     required_features: wgpu::Features::empty(),
@@ -61,6 +68,9 @@ pub static AUXILIARY: MethodEntry = MethodEntry {
         &TEXTURE_SCALE,
         &MAX_PASSES,
         &crate::lighting::LIGHTS,
+        &crate::lighting::SHADOWS,
+        &crate::lighting::SHADOW_MAP_SIZE,
+        &crate::lighting::SHADOW_BIAS,
     ],
     swept: Some(&AUXILIARY_MIRRORS),
     optional_features: wgpu::Features::CLIP_DISTANCES,
@@ -173,8 +183,13 @@ struct PlannedTextures {
 }
 
 impl PlannedFrame for PlannedTextures {
-    fn build(self: Box<Self>, gpu: &Gpu, scene: &Scene) -> Result<BuiltFrame, RasterError> {
-        let m = RecursiveTexture::new(gpu, scene, &self.plan, self.texture_scale)?;
+    fn build(
+        self: Box<Self>,
+        gpu: &Gpu,
+        scene: &Scene,
+        shadows: &crate::shadow_maps::ShadowMaps,
+    ) -> Result<BuiltFrame, RasterError> {
+        let m = RecursiveTexture::new(gpu, scene, shadows, &self.plan, self.texture_scale)?;
         Ok(BuiltFrame {
             stats: m.stats,
             encoder: Box::new(m),
@@ -402,11 +417,12 @@ impl RecursiveTexture {
     pub fn new(
         gpu: &Gpu,
         scene: &Scene,
+        shadows: &crate::shadow_maps::ShadowMaps,
         plan: &Plan,
         texture_scale: f32,
     ) -> Result<Self, RasterError> {
         let device = &gpu.device;
-        let scene_buffers = SceneBuffers::new(device, scene);
+        let scene_buffers = SceneBuffers::new(device, scene, shadows);
         let mut b = Builder {
             scene,
             plan,

@@ -66,6 +66,9 @@ pub static SYMMETRY: MethodEntry = MethodEntry {
         &FRAGMENT_CLIPPING,
         &COPY_IDS,
         &crate::lighting::LIGHTS,
+        &crate::lighting::SHADOWS,
+        &crate::lighting::SHADOW_MAP_SIZE,
+        &crate::lighting::SHADOW_BIAS,
     ],
     swept: None,
     optional_features: wgpu::Features::CLIP_DISTANCES,
@@ -479,11 +482,16 @@ pub(crate) fn plan_copies(
 }
 
 impl PlannedFrame for PlannedCopies {
-    fn build(self: Box<Self>, gpu: &Gpu, scene: &Scene) -> Result<BuiltFrame, RasterError> {
+    fn build(
+        self: Box<Self>,
+        gpu: &Gpu,
+        scene: &Scene,
+        shadows: &crate::shadow_maps::ShadowMaps,
+    ) -> Result<BuiltFrame, RasterError> {
         let warnings = copy_id_warning(gpu, self.settings.copy_ids, self.stats.total)
             .into_iter()
             .collect();
-        let frame = CopiesFrame::new(gpu, scene, *self)?;
+        let frame = CopiesFrame::new(gpu, scene, shadows, *self)?;
         Ok(BuiltFrame {
             stats: frame.stats,
             encoder: Box::new(frame),
@@ -564,13 +572,18 @@ struct CopiesFrame {
 }
 
 impl CopiesFrame {
-    fn new(gpu: &Gpu, scene: &Scene, planned: PlannedCopies) -> Result<Self, RasterError> {
+    fn new(
+        gpu: &Gpu,
+        scene: &Scene,
+        shadows: &crate::shadow_maps::ShadowMaps,
+        planned: PlannedCopies,
+    ) -> Result<Self, RasterError> {
         use wgpu::util::DeviceExt;
         let device = &gpu.device;
         SceneBuffers::check_fits_geometry(gpu, scene, &planned.geometry)?;
         let masks_bytes = 4 * planned.masks.len().max(1) as u64;
         gpu.check_buffer("copy mask", masks_bytes, true)?;
-        let scene_buffers = SceneBuffers::for_geometry(device, scene, &planned.geometry);
+        let scene_buffers = SceneBuffers::for_geometry(device, scene, &planned.geometry, shadows);
         let settings = planned.settings;
         let clip_distances = gpu.features.contains(wgpu::Features::CLIP_DISTANCES)
             && planned.plane_count <= MAX_CLIP_DISTANCE_PLANES

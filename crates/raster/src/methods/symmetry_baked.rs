@@ -40,7 +40,13 @@ pub static SYMMETRY_BAKED: MethodEntry = MethodEntry {
     name: "symmetry-baked",
     help: "Seed 001's symmetry planes baked on the CPU (split and mirrored, timed apart as bake_ms), the mesh drawn once.",
     exact: true,
-    options: &[&COPY_IDS, &crate::lighting::LIGHTS],
+    options: &[
+        &COPY_IDS,
+        &crate::lighting::LIGHTS,
+        &crate::lighting::SHADOWS,
+        &crate::lighting::SHADOW_MAP_SIZE,
+        &crate::lighting::SHADOW_BIAS,
+    ],
     swept: None,
     optional_features: wgpu::Features::empty(),
     required_features: wgpu::Features::empty(),
@@ -122,12 +128,17 @@ struct PlannedBake {
 }
 
 impl PlannedFrame for PlannedBake {
-    fn build(self: Box<Self>, gpu: &Gpu, scene: &Scene) -> Result<BuiltFrame, RasterError> {
+    fn build(
+        self: Box<Self>,
+        gpu: &Gpu,
+        scene: &Scene,
+        shadows: &crate::shadow_maps::ShadowMaps,
+    ) -> Result<BuiltFrame, RasterError> {
         let bake_ms = self.bake_ms;
         let warnings = copy_id_warning(gpu, self.copy_of_vertex.is_some(), self.copies.total)
             .into_iter()
             .collect();
-        let frame = BakedFrame::new(gpu, scene, *self)?;
+        let frame = BakedFrame::new(gpu, scene, shadows, *self)?;
         Ok(BuiltFrame {
             stats: frame.stats,
             encoder: Box::new(frame),
@@ -151,11 +162,16 @@ struct BakedFrame {
 }
 
 impl BakedFrame {
-    fn new(gpu: &Gpu, scene: &Scene, planned: PlannedBake) -> Result<Self, RasterError> {
+    fn new(
+        gpu: &Gpu,
+        scene: &Scene,
+        shadows: &crate::shadow_maps::ShadowMaps,
+        planned: PlannedBake,
+    ) -> Result<Self, RasterError> {
         use wgpu::util::DeviceExt;
         let device = &gpu.device;
         SceneBuffers::check_fits_geometry(gpu, scene, &planned.geometry)?;
-        let scene_buffers = SceneBuffers::for_geometry(device, scene, &planned.geometry);
+        let scene_buffers = SceneBuffers::for_geometry(device, scene, &planned.geometry, shadows);
         let frame_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("symmetry-baked frame"),
             contents: bytemuck::bytes_of(&planned.frame),

@@ -66,6 +66,9 @@ pub static UNROLLED: MethodEntry = MethodEntry {
         &MIN_ATTENUATION,
         &FRAGMENT_CLIPPING,
         &crate::lighting::LIGHTS,
+        &crate::lighting::SHADOWS,
+        &crate::lighting::SHADOW_MAP_SIZE,
+        &crate::lighting::SHADOW_BIAS,
     ],
     swept: Some(&DEPTH),
     optional_features: wgpu::Features::CLIP_DISTANCES,
@@ -148,8 +151,13 @@ struct PlannedUnrolled {
 }
 
 impl PlannedFrame for PlannedUnrolled {
-    fn build(self: Box<Self>, gpu: &Gpu, scene: &Scene) -> Result<BuiltFrame, RasterError> {
-        let m = Unrolled::new(gpu, scene, &self.planned, self.fragment_clipping)?;
+    fn build(
+        self: Box<Self>,
+        gpu: &Gpu,
+        scene: &Scene,
+        shadows: &crate::shadow_maps::ShadowMaps,
+    ) -> Result<BuiltFrame, RasterError> {
+        let m = Unrolled::new(gpu, scene, shadows, &self.planned, self.fragment_clipping)?;
         Ok(BuiltFrame {
             stats: m.stats,
             encoder: Box::new(m),
@@ -266,6 +274,7 @@ impl Unrolled {
     fn new(
         gpu: &Gpu,
         scene: &Scene,
+        shadows: &crate::shadow_maps::ShadowMaps,
         planned: &PlannedPaths,
         fragment_clipping: bool,
     ) -> Result<Self, RasterError> {
@@ -275,7 +284,7 @@ impl Unrolled {
         let (width, height) = (planned.width, planned.height);
         let clip_distances =
             gpu.features.contains(wgpu::Features::CLIP_DISTANCES) && !fragment_clipping;
-        let scene_buffers = SceneBuffers::new(device, scene);
+        let scene_buffers = SceneBuffers::new(device, scene, shadows);
         let size = Vec2::new(width as f32, height as f32);
         let planes: Vec<Vec4> = scene
             .mirrors
