@@ -40,9 +40,10 @@ fn vs_shadow(v: ShadowVertex) -> ShadowOut {
 }
 
 @fragment
-fn fs_shadow(in: ShadowOut) -> @location(0) f32 {
+fn fs_shadow(in: ShadowOut) -> @location(0) vec4f {
     if (in.surface == shadow_view.skip_surface || dot(shadow_view.keep, vec4f(in.world, 1.0)) < 0.0) {
         discard;
     }
-    return distance(in.world, shadow_view.origin);
+    // The distance in red; four channels so that half-float RGBA layers (GL) take it too.
+    return vec4f(distance(in.world, shadow_view.origin), 0.0, 0.0, 1.0);
 }

@@ -85,6 +85,15 @@ pub fn swept(name: &str, values: impl IntoIterator<Item = u32>) -> Vec<Method> {
 /// drawing them (the default).
 const LIGHTING_VARIANTS: [&str; 2] = ["lights=direct", ""];
 
+/// The shadow-map sizes the lighting preset measures (`--shadows map`), on the methods of
+/// [`SHADOWED_METHODS`] only: each layer is a scene pass, so they are the preset's dearest
+/// points on a CPU rasterizer.
+const SHADOW_MAP_SIZES: [u32; 3] = [256, 1024, 2048];
+
+/// The methods the lighting preset also measures with shadow maps: the exact method and the
+/// paper's method at its published n = 2.
+const SHADOWED_METHODS: [&str; 2] = ["unrolled depth=64", "auxiliary n=2"];
+
 /// `base` with the options of `words` (`"lights=direct shadow-map=1024"`, or empty) set.
 fn with_options(base: &Method, words: &str) -> Method {
     Method::parse(&format!("{} {words}", base.key())).unwrap_or_else(|e| panic!("preset: {e}"))
@@ -176,6 +185,14 @@ impl SweepConfig {
             for variant in LIGHTING_VARIANTS {
                 methods.push(with_options(base, variant));
             }
+            if SHADOWED_METHODS.contains(&base.key().as_str()) {
+                for size in SHADOW_MAP_SIZES {
+                    methods.push(with_options(
+                        base,
+                        &format!("shadows=map shadow-map-size={size}"),
+                    ));
+                }
+            }
         }
         SweepConfig {
             scene: PathBuf::from("scenes/mirror_box_lit.json"),
@@ -191,12 +208,19 @@ impl SweepConfig {
     /// [`SweepConfig::lighting`]'s mirror-room variant, smaller: the room's light images grow
     /// with k² (477 at k = 8) and its reflection paths branch, so a frame costs ~1 s on a CPU
     /// rasterizer even at 160×90. `unrolled` at depth 12 with α = 0.7 (0.7¹² = 1.4 % left to
-    /// what the cut leaves out), both lighting variants, k = 0, 4, 8.
+    /// what the cut leaves out), both lighting variants and shadow maps of 256² and 512²
+    /// (483 layers at k = 8), k = 0, 4, 8.
     pub fn lighting_room(out: PathBuf) -> Self {
         let mut methods = Vec::new();
         for base in swept("unrolled", [12]) {
             for variant in LIGHTING_VARIANTS {
                 methods.push(with_options(&base, variant));
+            }
+            for size in [256, 512] {
+                methods.push(with_options(
+                    &base,
+                    &format!("shadows=map shadow-map-size={size}"),
+                ));
             }
         }
         SweepConfig {

@@ -34,6 +34,7 @@ pub mod registry;
 pub mod resolve;
 pub mod shading;
 pub mod shadow_maps;
+pub mod shadow_plan;
 pub mod symmetry_cells;
 pub mod targets;
 pub mod timing;
@@ -190,7 +191,7 @@ pub fn plan_frame(scene: &Scene, settings: &RenderSettings) -> Result<Planned, P
     let scene = &*lighting::lit_scene(scene, settings.method.params());
     settings.check(scene)?;
     let (w, h) = settings.render_size(scene);
-    if let Some(s) = lighting::shadow_settings(settings.method.params()) {
+    if let Some(s) = lighting::shadow_settings(scene, settings.method.params()) {
         shadow_maps::ShadowPlan::new(scene, s)?;
     }
     let frame = settings.method.configure().plan(scene, w, h)?;
@@ -224,12 +225,19 @@ pub fn render_planned(
     let target =
         targets::RenderTarget::new(gpu, "view", w, h, wgpu::TextureUsages::TEXTURE_BINDING);
     let resolve = resolve::Resolve::new(gpu, &target, settings.ssaa);
-    let shadow_plan = lighting::shadow_settings(settings.method.params())
+    let shadow_plan = lighting::shadow_settings(scene, settings.method.params())
         .map(|s| shadow_maps::ShadowPlan::new(scene, s))
         .transpose()
         .map_err(plan::PlanError::from)?;
     let shadows = shadow_maps::ShadowMaps::new(gpu, scene, shadow_plan)?;
     let mut built = planned.frame.build(gpu, scene, &shadows)?;
+    if lighting::wants_shadow_maps(settings.method.params()) && !scene.lighting.shadows {
+        built.warnings.push(
+            "--shadows map: the scene has no shadows (lighting.shadows is false), so no shadow \
+             map is drawn"
+                .into(),
+        );
+    }
     if shadows.layers() > 0 {
         built.stats.passes += shadows.layers();
         built.stats.draws += shadows.layers();

@@ -77,12 +77,22 @@ pub static SHADOW_BIAS: OptionSpec = OptionSpec {
 };
 
 /// The default constant bias (scene units; the bundled scenes are a few units across).
-pub const DEFAULT_SHADOW_BIAS: f32 = 0.005;
+pub const DEFAULT_SHADOW_BIAS: f32 = 0.02;
 
-/// What a method's `--shadows` options ask for: `None` without shadow maps.
-pub fn shadow_settings(params: &Params) -> Option<crate::shadow_maps::ShadowSettings> {
-    (params.get(&SHADOWS)? == ParamValue::Choice("map")).then(|| {
-        crate::shadow_maps::ShadowSettings {
+/// Whether a method's options ask for shadow maps.
+pub fn wants_shadow_maps(params: &Params) -> bool {
+    params.get(&SHADOWS) == Some(ParamValue::Choice("map"))
+}
+
+/// The shadow maps a method draws for `scene`: `None` without `--shadows map`, and where the
+/// scene's contract has no shadows (`lighting.shadows` false: nothing occludes, so maps
+/// would only make the image disagree with the truth).
+pub fn shadow_settings(
+    scene: &Scene,
+    params: &Params,
+) -> Option<crate::shadow_plan::ShadowSettings> {
+    (scene.lighting.shadows && wants_shadow_maps(params)).then(|| {
+        crate::shadow_plan::ShadowSettings {
             size: params.count(&SHADOW_MAP_SIZE),
             bias: params.real(&SHADOW_BIAS),
         }

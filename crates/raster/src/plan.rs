@@ -138,7 +138,7 @@ pub enum PlanError {
     Bake(String),
     /// `--shadows map` would need more layers than the shadow-map budget.
     #[error(transparent)]
-    ShadowMaps(#[from] crate::shadow_maps::TooManyShadowLayers),
+    ShadowMaps(#[from] crate::shadow_plan::TooManyShadowLayers),
     /// A render setting out of range (`--ssaa`, `--frames`, `--warmup`, the render size).
     #[error(transparent)]
     Setting(#[from] mirrorbox_scene::limits::SettingError),

@@ -151,7 +151,7 @@ impl SceneBuffers {
     pub fn new(
         device: &wgpu::Device,
         scene: &Scene,
-        shadows: &crate::shadow_maps::ShadowMaps,
+        shadows: crate::shadow_plan::ShadowBinding<'_>,
     ) -> Self {
         Self::for_geometry(device, scene, &scene.geometry, shadows)
     }
@@ -163,7 +163,7 @@ impl SceneBuffers {
         device: &wgpu::Device,
         scene: &Scene,
         g: &mirrorbox_scene::Geometry,
-        shadows: &crate::shadow_maps::ShadowMaps,
+        shadows: crate::shadow_plan::ShadowBinding<'_>,
     ) -> Self {
         let vertex = |i: usize| {
             let n = g.face_normal(i).to_array();
@@ -236,7 +236,7 @@ impl SceneBuffers {
             })
             .collect();
         // The real lights, then their images with their beams' planes.
-        let plan = shadows.plan.as_ref();
+        let plan = shadows.plan;
         // The shadow facts of entry `i` of the list (real lights, then images).
         let shadow_of = |i: usize, light: &mut GpuLight| {
             if let Some(s) = plan.map(|p| p.lights[i]) {
@@ -377,7 +377,7 @@ impl SceneBuffers {
                 },
                 wgpu::BindGroupEntry {
                     binding: 4,
-                    resource: wgpu::BindingResource::TextureView(&shadows.array_view),
+                    resource: wgpu::BindingResource::TextureView(shadows.layers),
                 },
             ],
         });

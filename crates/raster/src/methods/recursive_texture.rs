@@ -422,7 +422,7 @@ impl RecursiveTexture {
         texture_scale: f32,
     ) -> Result<Self, RasterError> {
         let device = &gpu.device;
-        let scene_buffers = SceneBuffers::new(device, scene, shadows);
+        let scene_buffers = SceneBuffers::new(device, scene, shadows.binding());
         let mut b = Builder {
             scene,
             plan,
