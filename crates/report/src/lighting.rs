@@ -67,6 +67,18 @@ pub fn lighting_of(r: &Record) -> String {
     format!("{lights}, shadow maps {size}²{bias}")
 }
 
+/// Where a variant's rows go: direct before mirrored, no shadows before shadow maps, maps by
+/// size (256² before 1024²), then by name.
+fn variant_order(r: &Record) -> (bool, bool, u32, String) {
+    let size = option(r, "shadow-map-size").and_then(|s| s.parse().ok());
+    (
+        option(r, LIGHTS_OPTION) != Some("direct"),
+        option(r, "shadows") == Some("map"),
+        size.unwrap_or(1024),
+        lighting_of(r),
+    )
+}
+
 /// The points of a mirrored-lights sweep.
 fn lit_points(records: &[Record]) -> Vec<&Record> {
     records
@@ -254,13 +266,7 @@ pub(crate) fn lighting_section(records: &[Record]) -> Vec<Block> {
         ));
     }
     let mut rows: Vec<&Record> = points.clone();
-    rows.sort_by(|a, b| {
-        (method_of(a), lighting_of(a), a.mirrored_lights).cmp(&(
-            method_of(b),
-            lighting_of(b),
-            b.mirrored_lights,
-        ))
-    });
+    rows.sort_by_key(|r| (method_of(r), variant_order(r), r.mirrored_lights));
     out.push(Block::Table(
         [
             "method",
