@@ -120,14 +120,15 @@ fn leg_clear(light: Light, x: vec3f, cos_incidence: f32) -> bool {
 }
 
 // Shadows (docs/shading.md): light i reaches p only if every straight leg is clear — p to the
-// light (or image), then for an image each mirror point c back to the real light.
-fn unshadowed(i: u32, p: vec3f, n: vec3f) -> bool {
+// light (or image), then for an image each mirror point c back to the real light. `cos_p`:
+// the first leg's incidence on p's surface (diffuse_radiance has it already).
+fn unshadowed(i: u32, p: vec3f, cos_p: f32) -> bool {
     if (frame.shadows == 0u) {
         return true;
     }
     var light = lights[i];
     var x = p;
-    var cos_i = abs(dot(n, normalize(light.position - p)));
+    var cos_i = cos_p;
     for (var leg = 0u; leg < MAX_SHADOW_LEGS; leg++) {
         if (!leg_clear(light, x, cos_i)) {
             return false;
@@ -160,7 +161,7 @@ fn diffuse_radiance(p: vec3f, face_normal: vec3f, to_viewer: vec3f, albedo: vec3
             continue;
         }
         let cos_theta = dot(n, to_light) / sqrt(r2);
-        if (cos_theta > 0.0 && unshadowed(i, p, n)) {
+        if (cos_theta > 0.0 && unshadowed(i, p, cos_theta)) {
             irradiance += lights[i].intensity * (cos_theta / r2);
         }
     }

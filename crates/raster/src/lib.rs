@@ -181,6 +181,8 @@ impl GpuMemory {
 /// here, before any GPU resource exists.
 pub struct Planned {
     frame: Box<dyn method::PlannedFrame>,
+    /// Its shadow-map layers (`--shadows map` on a scene with shadows).
+    shadows: Option<shadow_plan::ShadowPlan>,
     /// What it was planned for: the method's key and the render size.
     key: String,
     size: (u32, u32),
@@ -191,12 +193,13 @@ pub fn plan_frame(scene: &Scene, settings: &RenderSettings) -> Result<Planned, P
     let scene = &*lighting::lit_scene(scene, settings.method.params());
     settings.check(scene)?;
     let (w, h) = settings.render_size(scene);
-    if let Some(s) = lighting::shadow_settings(scene, settings.method.params()) {
-        shadow_maps::ShadowPlan::new(scene, s)?;
-    }
+    let shadows = lighting::shadow_settings(scene, settings.method.params())
+        .map(|s| shadow_plan::ShadowPlan::new(scene, s))
+        .transpose()?;
     let frame = settings.method.configure().plan(scene, w, h)?;
     Ok(Planned {
         frame,
+        shadows,
         key: settings.method.key(),
         size: (w, h),
     })
@@ -225,11 +228,7 @@ pub fn render_planned(
     let target =
         targets::RenderTarget::new(gpu, "view", w, h, wgpu::TextureUsages::TEXTURE_BINDING);
     let resolve = resolve::Resolve::new(gpu, &target, settings.ssaa);
-    let shadow_plan = lighting::shadow_settings(scene, settings.method.params())
-        .map(|s| shadow_maps::ShadowPlan::new(scene, s))
-        .transpose()
-        .map_err(plan::PlanError::from)?;
-    let shadows = shadow_maps::ShadowMaps::new(gpu, scene, shadow_plan)?;
+    let shadows = shadow_maps::ShadowMaps::new(gpu, scene, planned.shadows)?;
     let mut built = planned.frame.build(gpu, scene, &shadows)?;
     if lighting::wants_shadow_maps(settings.method.params()) && !scene.lighting.shadows {
         built.warnings.push(

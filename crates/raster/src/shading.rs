@@ -82,20 +82,23 @@ pub const VERTEX_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferL
     attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Uint32],
 };
 
-/// The scene on the GPU: vertices (objects first, then each mirror's two triangles) and the
-/// group-0 bind group of `shading.wgsl`.
+/// Triangle `i` of `g` as three vertices sharing its face normal and surface.
+fn triangle_vertices(g: &mirrorbox_scene::Geometry, i: usize) -> [Vertex; 3] {
+    let normal = g.face_normal(i).to_array();
+    g.triangles[i].map(|p| Vertex {
+        position: p.to_array(),
+        normal,
+        surface: g.surface_of[i],
+    })
+}
+
 /// Every triangle of `scene` (objects and mirrors) as one vertex buffer, and its vertex
 /// count: what a shadow map draws.
 pub fn all_vertices(device: &wgpu::Device, scene: &Scene) -> (wgpu::Buffer, u32) {
     let g = &scene.geometry;
     let mut vertices: Vec<Vertex> = Vec::with_capacity(3 * g.triangles.len());
     for i in 0..g.triangles.len() {
-        let normal = g.face_normal(i).to_array();
-        vertices.extend(g.triangles[i].map(|p| Vertex {
-            position: p.to_array(),
-            normal,
-            surface: g.surface_of[i],
-        }));
+        vertices.extend(triangle_vertices(g, i));
     }
     let count = vertices.len() as u32;
     if vertices.is_empty() {
@@ -109,6 +112,8 @@ pub fn all_vertices(device: &wgpu::Device, scene: &Scene) -> (wgpu::Buffer, u32)
     (buffer, count)
 }
 
+/// The scene on the GPU: vertices (objects first, then each mirror's two triangles) and the
+/// group-0 bind group of `shading.wgsl`.
 pub struct SceneBuffers {
     pub vertices: wgpu::Buffer,
     /// Vertex range of all non-mirror triangles.
@@ -165,14 +170,7 @@ impl SceneBuffers {
         g: &mirrorbox_scene::Geometry,
         shadows: crate::shadow_plan::ShadowBinding<'_>,
     ) -> Self {
-        let vertex = |i: usize| {
-            let n = g.face_normal(i).to_array();
-            g.triangles[i].map(|p| Vertex {
-                position: p.to_array(),
-                normal: n,
-                surface: g.surface_of[i],
-            })
-        };
+        let vertex = |i: usize| triangle_vertices(g, i);
         let mut vertices: Vec<Vertex> = Vec::with_capacity(g.triangles.len() * 3);
         let mut mirror_tris = vec![Vec::new(); scene.mirrors.len()];
         for i in 0..g.triangles.len() {

@@ -163,12 +163,7 @@ pub fn cube_face(origin: Vec3, face: u32) -> Mat4 {
         Vec4::new(0.0, 0.0, 0.0, CUBE_NEAR),
         row(e(a) * sign),
     ];
-    Mat4::from_cols_array_2d(&[
-        [rows[0].x, rows[1].x, rows[2].x, rows[3].x],
-        [rows[0].y, rows[1].y, rows[2].y, rows[3].y],
-        [rows[0].z, rows[1].z, rows[2].z, rows[3].z],
-        [rows[0].w, rows[1].w, rows[2].w, rows[3].w],
-    ])
+    Mat4::from_cols(rows[0], rows[1], rows[2], rows[3]).transpose()
 }
 
 /// A perspective from `eye` whose frustum is fitted to the rectangle `corners` (off axis:
@@ -219,12 +214,7 @@ pub fn through_rectangle(eye: Vec3, corners: &[Vec3; 4], size: u32) -> (Mat4, f3
         Vec4::new(0.0, 0.0, 0.0, near),
         row(forward),
     ];
-    let m = Mat4::from_cols_array_2d(&[
-        [rows[0].x, rows[1].x, rows[2].x, rows[3].x],
-        [rows[0].y, rows[1].y, rows[2].y, rows[3].y],
-        [rows[0].z, rows[1].z, rows[2].z, rows[3].z],
-        [rows[0].w, rows[1].w, rows[2].w, rows[3].w],
-    ]);
+    let m = Mat4::from_cols(rows[0], rows[1], rows[2], rows[3]).transpose();
     let texel = (x1 - x0).max(y1 - y0) / size as f32;
     (m, texel)
 }

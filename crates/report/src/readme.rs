@@ -226,18 +226,7 @@ struct TraceLighting {
 
 /// The tracer's median time per scene and k, with the light images and rays behind it.
 fn trace_cost_region(path: &Path) -> Result<String, ReadmeError> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| ReadmeError(format!("{}: {e}", path.display())))?;
-    let mut runs = Vec::new();
-    for (i, line) in text
-        .lines()
-        .enumerate()
-        .filter(|(_, l)| !l.trim().is_empty())
-    {
-        let run: TraceRun = serde_json::from_str(line)
-            .map_err(|e| ReadmeError(format!("{}:{}: {e}", path.display(), i + 1)))?;
-        runs.push(run);
-    }
+    let runs: Vec<TraceRun> = crate::runs::read_lines(path)?;
     let mut groups: Vec<(String, u32)> = Vec::new();
     for r in &runs {
         let g = (r.scene.clone(), r.mirrored_lights);
@@ -246,9 +235,6 @@ fn trace_cost_region(path: &Path) -> Result<String, ReadmeError> {
         }
     }
     groups.sort();
-    if groups.is_empty() {
-        return Err(ReadmeError(format!("{}: no runs to quote", path.display())));
-    }
     let rows = groups
         .iter()
         .map(|(scene, k)| {

@@ -17,7 +17,9 @@ pub const REAL_TIME_MS: f64 = 1000.0 / 60.0;
 const MAX_RUNS_BYTES: u64 = 16 << 20;
 
 /// Reads every non-empty line of `path` as a `T`, naming the line that is not one.
-fn read_lines<T: serde::de::DeserializeOwned>(path: &Path) -> Result<Vec<T>, ReadmeError> {
+pub(crate) fn read_lines<T: serde::de::DeserializeOwned>(
+    path: &Path,
+) -> Result<Vec<T>, ReadmeError> {
     let text = mirrorbox_files::read_bounded_text(path, MAX_RUNS_BYTES, "a JSON-lines file")
         .map_err(|e| ReadmeError(e.to_string()))?;
     let runs = text
