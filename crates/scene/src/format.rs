@@ -69,6 +69,48 @@ pub struct MirrorDesc {
     pub reflectance: Option<Rgb>,
     #[serde(default)]
     pub back_albedo: Option<Rgb>,
+    /// An uneven mirror's shading normal (`crate::bump`); absent: flat.
+    #[serde(default)]
+    pub bump: Option<BumpDesc>,
+}
+
+/// `mirrors[i].bump`: a ripple and/or a normal map (at least one).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BumpDesc {
+    #[serde(default)]
+    pub ripple: Option<RippleDesc>,
+    #[serde(default)]
+    pub normal_map: Option<NormalMapDesc>,
+}
+
+/// A sinusoidal tilt of the normal (`crate::bump`).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RippleDesc {
+    /// Largest tilt of the normal, degrees in [0, 90).
+    pub amplitude_deg: f32,
+    /// Scene units.
+    pub wavelength: f32,
+    /// Direction of travel in the mirror's plane, degrees from its right axis towards up.
+    #[serde(default)]
+    pub direction_deg: Option<f32>,
+    #[serde(default)]
+    pub phase_deg: Option<f32>,
+}
+
+/// A tangent-space normal map PNG (8-bit RGB or RGBA; green = +up).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NormalMapDesc {
+    /// Relative to the scene file's folder.
+    pub path: String,
+    /// Repeats across the mirror's width and height (default [1, 1]).
+    #[serde(default)]
+    pub tiling: Option<[f32; 2]>,
+    /// Scales the tangential components (default 1).
+    #[serde(default)]
+    pub strength: Option<f32>,
 }
 
 /// The kind of an object's shape (the `type` field).

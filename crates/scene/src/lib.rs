@@ -10,6 +10,7 @@
 //! Conventions (see `docs/scene-format.md` and `docs/shading.md`): right-handed world, y up,
 //! lengths in scene units, angles in degrees in files and radians in code, linear RGB.
 
+pub mod bump;
 pub mod camera;
 pub mod error;
 pub mod format;
@@ -86,6 +87,8 @@ pub struct Scene {
     pub source: std::path::PathBuf,
     pub camera: Camera,
     pub mirrors: Vec<Mirror>,
+    /// Per mirror, its uneven shading normal ([`bump`]); `None`: flat.
+    pub bumps: Vec<Option<bump::MirrorBump>>,
     pub lighting: Lighting,
     /// Radiance of a ray that leaves the scene.
     pub background: Vec3,
@@ -124,6 +127,7 @@ impl Scene {
         };
         Scene {
             mirrors: Vec::new(),
+            bumps: Vec::new(),
             geometry,
             lighting,
             ..self.clone()
@@ -215,6 +219,19 @@ impl Scene {
         Ok(())
     }
 
+    /// Sets the steepest tilt of every uneven mirror to `degrees` ([`bump::MirrorBump::set_amplitude`]:
+    /// the ripples' amplitude, the normal maps' strength); flat mirrors stay flat.
+    pub fn set_bump_amplitude(&mut self, degrees: f32) {
+        for b in self.bumps.iter_mut().flatten() {
+            b.set_amplitude(degrees);
+        }
+    }
+
+    /// Whether any mirror is uneven.
+    pub fn has_bumps(&self) -> bool {
+        self.bumps.iter().any(Option::is_some)
+    }
+
     /// (Re)computes [`Lighting::images`] for chains of at most `lighting.mirrored_lights`
     /// mirrors, pruning chains dimmer than `min_throughput` (the tracer's `--min-throughput`;
     /// loading uses [`light_images::DEFAULT_MIN_THROUGHPUT`]).
@@ -258,6 +275,10 @@ impl Scene {
         // a plane's name changes no image.
         if let Some(symmetry) = &self.symmetry {
             let _ = write!(h, "symmetry{:?}", symmetry.plane_list());
+        }
+        // Likewise scenes whose mirrors are all flat.
+        if self.bumps.iter().any(Option::is_some) {
+            let _ = write!(h, "bumps{:?}", self.bumps);
         }
         // Likewise scenes with the default lighting (no shadows, no mirrored lights). The
         // images follow from the rest, but their pruning threshold does not.

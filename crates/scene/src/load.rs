@@ -5,8 +5,12 @@
 //! here panics on any input.
 
 use crate::error::{FieldPath, SceneError};
+use crate::bump::{
+    MAX_AMPLITUDE_DEG, MAX_NORMAL_MAP_FILE_BYTES, MAX_NORMAL_MAP_SIDE, MAX_STRENGTH, MAX_TILING,
+    MirrorBump, NormalMap, Ripple,
+};
 use crate::format::{
-    CameraDesc, LightDesc, MirrorDesc, ObjectDesc, Rgb, Scale, SceneFile, ShapeKind,
+    BumpDesc, CameraDesc, LightDesc, MirrorDesc, ObjectDesc, Rgb, Scale, SceneFile, ShapeKind,
     SymmetryPlaneDesc, TransformDesc, Vec3f,
 };
 use crate::geometry::{Geometry, Surface};
@@ -223,11 +227,16 @@ impl Checker<'_> {
             Some(Symmetry { planes, source })
         };
         let mut mirrors = Vec::with_capacity(file.mirrors.len());
+        let mut bumps = Vec::with_capacity(file.mirrors.len());
         let mirror_paths = FieldPath::root("mirrors");
         for (i, desc) in file.mirrors.iter().enumerate() {
             let mirror_path = mirror_paths.index(i);
             self.triangle_budget(&mirror_path, geometry.triangles.len(), 2)?;
             let mirror = self.mirror(&mirror_path, i, desc)?;
+            bumps.push(match &desc.bump {
+                Some(b) => Some(self.bump(&mirror_path.field("bump"), b)?),
+                None => None,
+            });
             let [a, b, c, d] = mirror.corners();
             geometry.push_part(
                 mirror.name.clone(),
@@ -259,10 +268,18 @@ impl Checker<'_> {
                 ),
             ));
         }
+        if mirrored_lights > 0 && bumps.iter().any(Option::is_some) {
+            return Err(self.invalid(
+                &mirrored_path,
+                "must be 0 in a scene with uneven mirrors (a bump): light images are defined \
+                 for flat mirrors only (docs/shading.md)",
+            ));
+        }
         let mut scene = Scene {
             source: self.file.to_path_buf(),
             camera,
             mirrors,
+            bumps,
             lighting: Lighting {
                 lights,
                 ambient: self.radiance(&FieldPath::root("ambient"), file.ambient)?,
@@ -402,6 +419,123 @@ impl Checker<'_> {
             ));
         }
         Ok(mirror)
+    }
+
+    /// `mirrors[i].bump` (`crate::bump`): each number in its range, the normal map read,
+    /// bounded and decoded here.
+    fn bump(&self, path: &FieldPath, b: &BumpDesc) -> Result<MirrorBump> {
+        if b.ripple.is_none() && b.normal_map.is_none() {
+            return Err(self.invalid(path, "needs a \"ripple\", a \"normal_map\" or both"));
+        }
+        let ripple = match &b.ripple {
+            Some(r) => {
+                let rp = path.field("ripple");
+                let a = self.finite(&rp.field("amplitude_deg"), r.amplitude_deg)?;
+                if !(0.0..MAX_AMPLITUDE_DEG).contains(&a) {
+                    return Err(self.invalid(
+                        &rp.field("amplitude_deg"),
+                        format!("must be in [0, {MAX_AMPLITUDE_DEG}) degrees, got {a}"),
+                    ));
+                }
+                let wavelength = self.positive(&rp.field("wavelength"), r.wavelength)?;
+                let direction =
+                    self.finite(&rp.field("direction_deg"), r.direction_deg.unwrap_or(0.0))?;
+                let phase = self.finite(&rp.field("phase_deg"), r.phase_deg.unwrap_or(0.0))?;
+                Some(Ripple {
+                    amplitude: a.to_radians(),
+                    wavelength,
+                    direction: direction.to_radians(),
+                    phase: phase.to_radians(),
+                })
+            }
+            None => None,
+        };
+        let normal_map = match &b.normal_map {
+            Some(m) => {
+                let mp = path.field("normal_map");
+                let tiling = m.tiling.unwrap_or([1.0, 1.0]);
+                for (k, t) in tiling.into_iter().enumerate() {
+                    let t = self.positive(&mp.field("tiling").index(k), t)?;
+                    if t > MAX_TILING {
+                        return Err(self.invalid(
+                            &mp.field("tiling").index(k),
+                            format!("must be in (0, {MAX_TILING}], got {t}"),
+                        ));
+                    }
+                }
+                let strength = self.finite(&mp.field("strength"), m.strength.unwrap_or(1.0))?;
+                if !(0.0..=MAX_STRENGTH).contains(&strength) {
+                    return Err(self.invalid(
+                        &mp.field("strength"),
+                        format!("must be in [0, {MAX_STRENGTH}], got {strength}"),
+                    ));
+                }
+                let (resolved, width, height, texels) =
+                    self.normal_map_texels(&mp.field("path"), &m.path)?;
+                Some(NormalMap {
+                    path: m.path.clone(),
+                    resolved,
+                    width,
+                    height,
+                    texels: std::sync::Arc::new(texels),
+                    tiling,
+                    strength,
+                })
+            }
+            None => None,
+        };
+        Ok(MirrorBump { ripple, normal_map })
+    }
+
+    /// A normal map PNG, relative to the scene's folder: 8-bit RGB or RGBA (alpha ignored),
+    /// at most [`MAX_NORMAL_MAP_SIDE`] texels a side (checked from the header, before
+    /// decoding), every texel's blue above 127 (its normal points out of the mirror).
+    fn normal_map_texels(
+        &self,
+        path: &FieldPath,
+        rel: &str,
+    ) -> Result<(PathBuf, u32, u32, Vec<[u8; 3]>)> {
+        use image::ImageDecoder;
+        let resolved: PathBuf = self.file.parent().unwrap_or(Path::new(".")).join(rel);
+        let bad = |msg: String| self.invalid(path, format!("\"{rel}\" (at {}): {msg}", resolved.display()));
+        let bytes =
+            mirrorbox_files::read_bounded(&resolved, MAX_NORMAL_MAP_FILE_BYTES, "normal map")
+                .map_err(|e| bad(e.message))?;
+        let decoder = image::codecs::png::PngDecoder::new(std::io::Cursor::new(&bytes))
+            .map_err(|e| bad(format!("not a readable PNG file ({e})")))?;
+        let (w, h) = decoder.dimensions();
+        if w == 0 || h == 0 || w > MAX_NORMAL_MAP_SIDE || h > MAX_NORMAL_MAP_SIDE {
+            return Err(bad(format!(
+                "is {w}×{h} texels; a normal map must be 1 to {MAX_NORMAL_MAP_SIDE} texels a side"
+            )));
+        }
+        let color = decoder.color_type();
+        let channels = match color {
+            image::ColorType::Rgb8 => 3,
+            image::ColorType::Rgba8 => 4,
+            other => {
+                return Err(bad(format!(
+                    "has {other:?} texels; a normal map must be 8-bit RGB or RGBA"
+                )));
+            }
+        };
+        let mut raw = vec![0u8; decoder.total_bytes() as usize];
+        decoder
+            .read_image(&mut raw)
+            .map_err(|e| bad(format!("cannot decode the PNG ({e})")))?;
+        let texels: Vec<[u8; 3]> = raw
+            .chunks_exact(channels)
+            .map(|c| [c[0], c[1], c[2]])
+            .collect();
+        if let Some(k) = texels.iter().position(|t| t[2] <= 127) {
+            let (x, y) = (k as u32 % w, k as u32 / w);
+            return Err(bad(format!(
+                "texel ({x}, {y}) has blue {} ≤ 127: its normal would point into the mirror \
+                 (a tangent-space normal map's blue is above 127)",
+                texels[k][2]
+            )));
+        }
+        Ok((resolved, w, h, texels))
     }
 
     fn light(&self, path: &FieldPath, l: &LightDesc) -> Result<PointLight> {

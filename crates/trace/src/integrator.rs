@@ -39,6 +39,8 @@ pub enum Termination {
     Throughput,
     /// Ended by Russian roulette.
     Roulette,
+    /// Absorbed by an uneven mirror (`docs/shading.md`, "Uneven mirrors").
+    Absorbed,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -68,6 +68,8 @@ pub struct TraceStats {
     pub cut_by_throughput: u64,
     /// Ended by Russian roulette (`path`).
     pub cut_by_roulette: u64,
+    /// Absorbed by an uneven mirror (its reflection would leave behind it).
+    pub absorbed: u64,
     /// Most mirror reflections followed by any path.
     pub deepest: u32,
 }
@@ -83,6 +85,7 @@ impl TraceStats {
             Termination::Depth => self.cut_by_depth += 1,
             Termination::Throughput => self.cut_by_throughput += 1,
             Termination::Roulette => self.cut_by_roulette += 1,
+            Termination::Absorbed => self.absorbed += 1,
         }
     }
     fn merge(mut self, o: TraceStats) -> TraceStats {
@@ -93,6 +96,7 @@ impl TraceStats {
         self.cut_by_depth += o.cut_by_depth;
         self.cut_by_throughput += o.cut_by_throughput;
         self.cut_by_roulette += o.cut_by_roulette;
+        self.absorbed += o.absorbed;
         self.deepest = self.deepest.max(o.deepest);
         self
     }

@@ -264,7 +264,8 @@ fn report(
             "bvh": format!("{:?}", bvh.kind).to_lowercase(), "bvh_build_seconds": bvh.build_time.as_secs_f64(),
             "threads": out.threads,
             "ended": { "diffuse": s.diffuse, "escaped": s.escaped, "max_depth": s.cut_by_depth,
-                       "min_throughput": s.cut_by_throughput, "roulette": s.cut_by_roulette },
+                       "min_throughput": s.cut_by_throughput, "roulette": s.cut_by_roulette,
+                       "absorbed_by_uneven_mirrors": s.absorbed },
             "outputs": written.iter().map(|p| p.display().to_string()).collect::<Vec<_>>(),
             "lighting": { "shadows": scene.lighting.shadows,
                           "mirrored_lights": scene.lighting.mirrored_lights,
@@ -304,6 +305,12 @@ fn report(
             String::new()
         }
     );
+    if scene.has_bumps() {
+        println!(
+            "  {} paths absorbed by uneven mirrors (a reflection that would leave behind the mirror: docs/shading.md)",
+            s.absorbed
+        );
+    }
     println!("  lighting: {}", scene.lighting.describe());
     println!(
         "  {:?} over {} triangles built in {:.1} ms; wrote {}",

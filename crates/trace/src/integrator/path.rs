@@ -188,11 +188,13 @@ impl Integrator for PathTracer<'_> {
                         unreachable!("only mirrors reflect")
                     };
                     beta *= reflectance;
-                    let (origin, dir) = self.mirror_planes.reflect(
+                    let Some((origin, dir)) = self.mirror_planes.reflect(
                         mirror,
                         ray.origin.as_dvec3(),
                         ray.dir.as_dvec3(),
-                    );
+                    ) else {
+                        break Termination::Absorbed;
+                    };
                     ray = Ray {
                         origin: origin.as_vec3(),
                         dir: dir.as_vec3(),

@@ -159,7 +159,10 @@ impl<'a> Whitted<'a> {
                     }
                     throughput = next;
                     bounces += 1;
-                    (origin, dir) = self.mirror_planes.reflect(mirror, origin, dir);
+                    let Some(next_ray) = self.mirror_planes.reflect(mirror, origin, dir) else {
+                        break Termination::Absorbed;
+                    };
+                    (origin, dir) = next_ray;
                     leaving = Some(mirror);
                     on_mirror(bounces, origin, mirror);
                 }
