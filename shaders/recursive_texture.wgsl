@@ -17,6 +17,19 @@ struct Pass {
     // The pass's mirror plane in scene space, front positive ((0, 0, 0, 1) for the camera's
     // pass): the mirror's world is what lies in front of it.
     plane: vec4f,
+    // The pass's camera without the crop (world to the whole screen's clip space) and the
+    // screen's size: where the uneven-mirror tricks project their points.
+    screen_from_world: mat4x4f,
+    screen_size: vec2f,
+    // crates/raster/src/uneven.rs: 0 flat, 1 distort, 2 distort-distance, 3 proxy, 4 march,
+    // 5 normals; the march's samples; the distortion strength; the proxy plane's distance;
+    // the march's reach.
+    bump_mode: u32,
+    march_steps: u32,
+    bump_strength: f32,
+    proxy_distance: f32,
+    march_distance: f32,
+    _pad1: f32,
 }
 
 struct MirrorDraw {
@@ -61,14 +74,131 @@ fn shade_diffuse(in: VertexOut, albedo: vec3f, emission: vec3f) -> vec3f {
     return diffuse_radiance(in.world, in.normal, normalize(pass_.eye - in.world), albedo, emission);
 }
 
+// Alpha: the distance from the pass's eye (a texture's distances, which --bump march reads).
+fn eye_distance(in: VertexOut) -> f32 {
+    return length(in.world - pass_.eye);
+}
+
 fn object_colour(in: VertexOut) -> vec4f {
     let s = surfaces[in.surface];
-    return vec4f(shade_diffuse(in, s.albedo, s.emission), 1.0);
+    return vec4f(shade_diffuse(in, s.albedo, s.emission), eye_distance(in));
 }
 
 fn load_clamped(t: vec2i) -> vec3f {
     let size = vec2i(textureDimensions(mirror_texture));
     return textureLoad(mirror_texture, clamp(t, vec2i(0), size - 1), 0).rgb;
+}
+
+// The applied texture's texel coordinates of a screen position.
+fn texture_position(screen: vec2f) -> vec2f {
+    return (screen - mirror.origin) * mirror.texels_per_pixel;
+}
+
+// Bilinear radiance of the applied texture at screen position `screen`, clamped to its edge
+// (the uneven-mirror tricks' lookups fall between texels).
+fn mirror_sample(screen: vec2f) -> vec3f {
+    let t = texture_position(screen) - 0.5;
+    let i = vec2i(floor(t));
+    let f = t - floor(t);
+    let a = mix(load_clamped(i), load_clamped(i + vec2i(1, 0)), f.x);
+    let b = mix(load_clamped(i + vec2i(0, 1)), load_clamped(i + vec2i(1, 1)), f.x);
+    return mix(a, b, f.y);
+}
+
+// The screen position of world point p seen by the pass's camera.
+fn to_screen(p: vec3f) -> vec2f {
+    let c = pass_.screen_from_world * vec4f(p, 1.0);
+    let ndc = c.xy / c.w;
+    return vec2f(ndc.x + 1.0, 1.0 - ndc.y) * 0.5 * pass_.screen_size;
+}
+
+// Whether a screen position lies on the applied texture.
+fn on_texture(screen: vec2f) -> bool {
+    let local = screen - mirror.origin;
+    return all(local >= vec2f(0.0)) && all(local < mirror.size);
+}
+
+// The distance the applied texture stores at a screen position (nearest texel).
+fn stored_distance(screen: vec2f) -> f32 {
+    let size = vec2i(textureDimensions(mirror_texture));
+    let t = clamp(vec2i(floor(texture_position(screen))), vec2i(0), size - 1);
+    return textureLoad(mirror_texture, t, 0).a;
+}
+
+// --bump march: the reflected ray r from x, mirrored into the texture's world (x + t·r',
+// r' = r reflected in the mirror's plane, seen by this pass's camera exactly where the
+// mirror camera sees x + t·r), sampled at t = T·(i/N)² until its distance from the eye
+// passes the distance stored under it, then bisected 6 times. It stops at the texture's
+// edge: what the mirror camera never rendered cannot be found.
+fn march(x: vec3f, r: vec3f, n: vec3f, fallback: vec2f) -> vec2f {
+    let rv = r - 2.0 * dot(r, n) * n;
+    var miss = 0.0;
+    var last = fallback;
+    let steps = pass_.march_steps;
+    for (var i = 1u; i <= steps; i++) {
+        let f = f32(i) / f32(steps);
+        let t = pass_.march_distance * f * f;
+        let p = x + t * rv;
+        let screen = to_screen(p);
+        if (!on_texture(screen)) {
+            return last;
+        }
+        if (length(p - pass_.eye) >= stored_distance(screen)) {
+            var lo = miss;
+            var hi = t;
+            for (var k = 0; k < 6; k++) {
+                let mid = 0.5 * (lo + hi);
+                let q = x + mid * rv;
+                if (length(q - pass_.eye) >= stored_distance(to_screen(q))) {
+                    hi = mid;
+                } else {
+                    lo = mid;
+                }
+            }
+            return to_screen(x + hi * rv);
+        }
+        miss = t;
+        last = screen;
+    }
+    return last;
+}
+
+// A front hit on an uneven mirror (docs/shading.md, "Uneven mirrors"), read with the pass's
+// trick (crates/raster/src/uneven.rs): black where the contract absorbs the reflection.
+fn uneven_mirror_colour(in: VertexOut, s: Surface, b: MirrorBump) -> vec4f {
+    let n_s = mirror_shading_normal(s.mirror, in.world);
+    let d = normalize(in.world - pass_.eye);
+    let alpha = eye_distance(in);
+    if (pass_.bump_mode == 5u) {
+        return vec4f(n_s * 0.5 + 0.5, alpha);
+    }
+    let r = d - 2.0 * dot(d, n_s) * n_s;
+    if (dot(d, n_s) >= 0.0 || dot(r, b.normal) <= 0.0) {
+        return vec4f(vec3f(0.0), alpha);
+    }
+    if (mirror.has_texture == 0u) {
+        return vec4f(frame.terminal, alpha);
+    }
+    let frag = in.clip.xy;
+    var screen = pass_.origin + frag * pass_.pixels_per_texel;
+    let tangent = vec2f(dot(n_s, b.right), -dot(n_s, b.up));
+    switch pass_.bump_mode {
+        case 1u: {
+            screen += pass_.bump_strength * tangent * pass_.screen_size.y;
+        }
+        case 2u: {
+            screen += pass_.bump_strength * tangent * pass_.screen_size.y / alpha;
+        }
+        case 3u: {
+            let p = in.world + r * (pass_.proxy_distance / max(dot(r, b.normal), 1e-3));
+            screen = to_screen(p - 2.0 * dot(p - b.center, b.normal) * b.normal);
+        }
+        case 4u: {
+            screen = march(in.world, r, b.normal, screen);
+        }
+        default: {}
+    }
+    return vec4f(s.reflectance * mirror_sample(screen), alpha);
 }
 
 // The projective lookup: the radiance the applied texture holds for this screen position.
@@ -90,12 +220,16 @@ fn mirror_colour(in: VertexOut) -> vec4f {
     let s = surfaces[in.surface];
     let front = dot(in.normal, pass_.eye - in.world) > 0.0;
     if (!front) {
-        return vec4f(shade_diffuse(in, s.back_albedo, vec3f(0.0)), 1.0);
+        return vec4f(shade_diffuse(in, s.back_albedo, vec3f(0.0)), eye_distance(in));
+    }
+    let b = mirror_bumps[s.mirror];
+    if (b.flags != 0u && pass_.bump_mode != 0u) {
+        return uneven_mirror_colour(in, s, b);
     }
     if (mirror.has_texture == 0u) {
-        return vec4f(frame.terminal, 1.0);
+        return vec4f(frame.terminal, eye_distance(in));
     }
-    return vec4f(s.reflectance * mirror_lookup(in.clip.xy), 1.0);
+    return vec4f(s.reflectance * mirror_lookup(in.clip.xy), eye_distance(in));
 }
 
 // Entry points fs_object, fs_mirror and their *_discard variants:

@@ -44,6 +44,29 @@ struct Frame {
     shadows: u32,
 }
 
+// A mirror's frame and its bump (docs/shading.md, "Uneven mirrors"; the CPU twin is
+// crates/scene/src/bump.rs): flags bit 0 a ripple, bit 1 a normal map.
+struct MirrorBump {
+    center: vec3f,
+    flags: u32,
+    right: vec3f,
+    width: f32,
+    up: vec3f,
+    height: f32,
+    normal: vec3f,
+    // The ripple: largest tilt (radians), (cos β, sin β), 2π/λ, phase (radians).
+    amplitude: f32,
+    ripple_dir: vec2f,
+    wavenumber: f32,
+    phase: f32,
+    map_offset: u32,
+    map_width: u32,
+    map_height: u32,
+    strength: f32,
+    tiling: vec2f,
+    _pad: vec2f,
+}
+
 // One scene vertex (VERTEX_LAYOUT in crates/raster/src/shading.rs): position, the
 // triangle's face normal and its surface id.
 struct VertexIn {
@@ -58,6 +81,10 @@ struct VertexIn {
 @group(0) @binding(3) var<storage, read> light_planes: array<vec4f>;
 // Distance from each layer's light to the nearest surface, per texel.
 @group(0) @binding(4) var shadow_maps: texture_2d_array<f32>;
+// Per scene mirror, its frame and bump (flat mirrors: flags 0); the normal maps' texels,
+// 8-bit RGB packed in a u32 each, every map from its map_offset, row 0 at the mirror's top.
+@group(0) @binding(5) var<storage, read> mirror_bumps: array<MirrorBump>;
+@group(0) @binding(6) var<storage, read> normal_texels: array<u32>;
 
 const FRAC_1_PI: f32 = 0.31830988618379067;
 const MIN_LIGHT_DISTANCE_SQUARED: f32 = 1e-8;
@@ -167,4 +194,57 @@ fn diffuse_radiance(p: vec3f, face_normal: vec3f, to_viewer: vec3f, albedo: vec3
     }
     let emitted = select(vec3f(0.0), emission, front);
     return emitted + albedo * (irradiance * FRAC_1_PI + frame.ambient);
+}
+
+// Normal map texel (i, j) of mirror bump b, repeated, decoded to [−1, 1]³.
+fn normal_texel(b: MirrorBump, i: i32, j: i32) -> vec3f {
+    let w = i32(b.map_width);
+    let h = i32(b.map_height);
+    let ii = ((i % w) + w) % w;
+    let jj = ((j % h) + h) % h;
+    let t = normal_texels[b.map_offset + u32(jj * w + ii)];
+    let rgb = vec3f(f32(t & 255u), f32((t >> 8u) & 255u), f32((t >> 16u) & 255u));
+    return rgb * (2.0 / 255.0) - 1.0;
+}
+
+// The perturbed normal in the mirror's tangent frame (right, up, normal) at mirror-local
+// (u, v): a ripple tilts by θ = A·sin(k(u cos β + v sin β) + φ) towards (cos β, sin β); a
+// normal map is read bilinearly between texel centres, its tangential part scaled by the
+// strength; with both, their slopes add.
+fn mirror_tangent_normal(b: MirrorBump, u: f32, v: f32) -> vec3f {
+    var r = vec3f(0.0, 0.0, 1.0);
+    let has_ripple = (b.flags & 1u) != 0u;
+    if (has_ripple) {
+        let theta = b.amplitude * sin(b.wavenumber * (u * b.ripple_dir.x + v * b.ripple_dir.y) + b.phase);
+        r = vec3f(sin(theta) * b.ripple_dir, cos(theta));
+    }
+    if ((b.flags & 2u) == 0u) {
+        return r;
+    }
+    let x = (u / b.width + 0.5) * b.tiling.x;
+    let y = (0.5 - v / b.height) * b.tiling.y;
+    let p = vec2f(x * f32(b.map_width) - 0.5, y * f32(b.map_height) - 0.5);
+    let i = floor(p);
+    let f = p - i;
+    let ii = i32(i.x);
+    let jj = i32(i.y);
+    let top = mix(normal_texel(b, ii, jj), normal_texel(b, ii + 1, jj), f.x);
+    let bottom = mix(normal_texel(b, ii, jj + 1), normal_texel(b, ii + 1, jj + 1), f.x);
+    let s = mix(top, bottom, f.y);
+    let m = vec3f(b.strength * s.xy, s.z);
+    if (!has_ripple) {
+        return normalize(m);
+    }
+    return normalize(vec3f(r.xy / r.z + m.xy / m.z, 1.0));
+}
+
+// Mirror `mirror`'s shading normal at point p on it (its plane's normal where it is flat).
+fn mirror_shading_normal(mirror: u32, p: vec3f) -> vec3f {
+    let b = mirror_bumps[mirror];
+    if (b.flags == 0u) {
+        return b.normal;
+    }
+    let d = p - b.center;
+    let t = mirror_tangent_normal(b, dot(d, b.right), dot(d, b.up));
+    return normalize(t.x * b.right + t.y * b.up + t.z * b.normal);
 }

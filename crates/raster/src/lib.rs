@@ -38,6 +38,7 @@ pub mod shadow_plan;
 pub mod symmetry_cells;
 pub mod targets;
 pub mod timing;
+pub mod uneven;
 pub mod wgsl;
 
 pub use adapter::{AdapterError, AdapterReport, SelectedAdapter, select_adapter};

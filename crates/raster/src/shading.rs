@@ -19,7 +19,82 @@ pub fn gpu_structs() -> Vec<crate::wgsl::HostLayout> {
         crate::host_layout!(GpuFrame as "Frame" {
             ambient, light_count, background, shadow_bias, terminal, shadows
         }),
+        crate::host_layout!(GpuMirrorBump as "MirrorBump" {
+            center, flags, right, width, up, height, normal, amplitude, ripple_dir,
+            wavenumber, phase, map_offset, map_width, map_height, strength, tiling, _pad
+        }),
     ]
+}
+
+/// A mirror's frame and bump for `shading.wgsl`'s `mirror_shading_normal`.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct GpuMirrorBump {
+    center: [f32; 3],
+    /// Bit 0: a ripple; bit 1: a normal map.
+    flags: u32,
+    right: [f32; 3],
+    width: f32,
+    up: [f32; 3],
+    height: f32,
+    normal: [f32; 3],
+    amplitude: f32,
+    ripple_dir: [f32; 2],
+    wavenumber: f32,
+    phase: f32,
+    map_offset: u32,
+    map_width: u32,
+    map_height: u32,
+    strength: f32,
+    tiling: [f32; 2],
+    _pad: [f32; 2],
+}
+
+/// The mirrors' frames and bumps, and every normal map's texels packed one u32 each.
+fn mirror_bumps(scene: &Scene) -> (Vec<GpuMirrorBump>, Vec<u32>) {
+    let mut texels: Vec<u32> = Vec::new();
+    let mut bumps = Vec::with_capacity(scene.mirrors.len());
+    for (m, bump) in scene.mirrors.iter().zip(&scene.bumps) {
+        let mut g = GpuMirrorBump {
+            center: m.center.to_array(),
+            right: m.right().to_array(),
+            width: m.width,
+            up: m.up.to_array(),
+            height: m.height,
+            normal: m.normal.to_array(),
+            ..Zeroable::zeroed()
+        };
+        if let Some(b) = bump {
+            if let Some(r) = b.ripple {
+                g.flags |= 1;
+                g.amplitude = r.amplitude;
+                g.ripple_dir = [r.direction.cos(), r.direction.sin()];
+                g.wavenumber = std::f32::consts::TAU / r.wavelength;
+                g.phase = r.phase;
+            }
+            if let Some(map) = &b.normal_map {
+                g.flags |= 2;
+                g.map_offset = texels.len() as u32;
+                g.map_width = map.width;
+                g.map_height = map.height;
+                g.strength = map.strength;
+                g.tiling = map.tiling;
+                texels.extend(
+                    map.texels
+                        .iter()
+                        .map(|t| u32::from(t[0]) | u32::from(t[1]) << 8 | u32::from(t[2]) << 16),
+                );
+            }
+        }
+        bumps.push(g);
+    }
+    if bumps.is_empty() {
+        bumps.push(Zeroable::zeroed()); // a storage buffer may not be empty
+    }
+    if texels.is_empty() {
+        texels.push(0);
+    }
+    (bumps, texels)
 }
 
 #[repr(C)]
@@ -150,7 +225,15 @@ impl SceneBuffers {
             true,
         )?;
         let planes: usize = l.images.images.iter().map(|i| i.beam.len()).sum();
-        gpu.check_buffer("light plane", planes as u64 * 16, true)
+        gpu.check_buffer("light plane", planes as u64 * 16, true)?;
+        let texels: u64 = scene
+            .bumps
+            .iter()
+            .flatten()
+            .filter_map(|b| b.normal_map.as_ref())
+            .map(|m| u64::from(m.width) * u64::from(m.height))
+            .sum();
+        gpu.check_buffer("normal map texel", texels * 4, true)
     }
 
     pub fn new(
@@ -318,6 +401,17 @@ impl SceneBuffers {
             bytemuck::cast_slice(&planes),
             wgpu::BufferUsages::STORAGE,
         );
+        let (bumps, texels) = mirror_bumps(scene);
+        let bumps_buf = init(
+            "mirror bumps",
+            bytemuck::cast_slice(&bumps),
+            wgpu::BufferUsages::STORAGE,
+        );
+        let texels_buf = init(
+            "normal map texels",
+            bytemuck::cast_slice(&texels),
+            wgpu::BufferUsages::STORAGE,
+        );
         let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
             binding,
             visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
@@ -351,6 +445,8 @@ impl SceneBuffers {
                         multisampled: false,
                     },
                 ),
+                entry(5, storage),
+                entry(6, storage),
             ],
         });
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -376,6 +472,14 @@ impl SceneBuffers {
                 wgpu::BindGroupEntry {
                     binding: 4,
                     resource: wgpu::BindingResource::TextureView(shadows.layers),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 5,
+                    resource: bumps_buf.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 6,
+                    resource: texels_buf.as_entire_binding(),
                 },
             ],
         });

@@ -122,6 +122,24 @@ impl RenderTarget {
         self.begin_pass_with(encoder, label, clear, depth, timestamps)
     }
 
+    /// [`RenderTarget::begin_pass`] clearing alpha to `alpha` (a mirror texture whose alpha
+    /// holds distances).
+    pub fn begin_pass_with_alpha<'e>(
+        &self,
+        encoder: &'e mut wgpu::CommandEncoder,
+        label: &str,
+        clear: glam::Vec3,
+        alpha: f32,
+        timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
+    ) -> wgpu::RenderPass<'e> {
+        let depth = DepthClear {
+            view: &self.depth_view,
+            depth: FAR_DEPTH,
+            stencil: None,
+        };
+        self.begin(encoder, label, clear.extend(alpha), depth, timestamps)
+    }
+
     /// Begins a pass that clears colour to `clear` and the depth(-stencil) attachment as
     /// `depth` says. Depth and stencil are not kept after the pass.
     pub fn begin_pass_with<'e>(
@@ -129,6 +147,17 @@ impl RenderTarget {
         encoder: &'e mut wgpu::CommandEncoder,
         label: &str,
         clear: glam::Vec3,
+        depth: DepthClear<'_>,
+        timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
+    ) -> wgpu::RenderPass<'e> {
+        self.begin(encoder, label, clear.extend(1.0), depth, timestamps)
+    }
+
+    fn begin<'e>(
+        &self,
+        encoder: &'e mut wgpu::CommandEncoder,
+        label: &str,
+        clear: glam::Vec4,
         depth: DepthClear<'_>,
         timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
     ) -> wgpu::RenderPass<'e> {
@@ -143,7 +172,7 @@ impl RenderTarget {
                         r: clear.x as f64,
                         g: clear.y as f64,
                         b: clear.z as f64,
-                        a: 1.0,
+                        a: clear.w as f64,
                     }),
                     store: wgpu::StoreOp::Store,
                 },

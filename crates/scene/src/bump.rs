@@ -276,7 +276,12 @@ mod tests {
     #[test]
     fn map_lookups_are_bilinear_between_texel_centres_and_repeat() {
         let mut m = flat_map([128, 128, 255], 1.0);
-        m.texels = Arc::new(vec![[0, 128, 255], [255, 128, 255], [0, 128, 255], [255, 128, 255]]);
+        m.texels = Arc::new(vec![
+            [0, 128, 255],
+            [255, 128, 255],
+            [0, 128, 255],
+            [255, 128, 255],
+        ]);
         // Texel centres: x = 0.25 (left, −1) and 0.75 (right, +1); halfway between them 0.
         assert!((m.sample(0.25, 0.5).x + 1.0).abs() < 1e-12);
         assert!((m.sample(0.75, 0.5).x - 1.0).abs() < 1e-12);

@@ -4,11 +4,11 @@
 //! meaning errors carry the field path (`mirrors[1].normal`) and what is allowed. Nothing
 //! here panics on any input.
 
-use crate::error::{FieldPath, SceneError};
 use crate::bump::{
     MAX_AMPLITUDE_DEG, MAX_NORMAL_MAP_FILE_BYTES, MAX_NORMAL_MAP_SIDE, MAX_STRENGTH, MAX_TILING,
     MirrorBump, NormalMap, Ripple,
 };
+use crate::error::{FieldPath, SceneError};
 use crate::format::{
     BumpDesc, CameraDesc, LightDesc, MirrorDesc, ObjectDesc, Rgb, Scale, SceneFile, ShapeKind,
     SymmetryPlaneDesc, TransformDesc, Vec3f,
@@ -497,7 +497,12 @@ impl Checker<'_> {
     ) -> Result<(PathBuf, u32, u32, Vec<[u8; 3]>)> {
         use image::ImageDecoder;
         let resolved: PathBuf = self.file.parent().unwrap_or(Path::new(".")).join(rel);
-        let bad = |msg: String| self.invalid(path, format!("\"{rel}\" (at {}): {msg}", resolved.display()));
+        let bad = |msg: String| {
+            self.invalid(
+                path,
+                format!("\"{rel}\" (at {}): {msg}", resolved.display()),
+            )
+        };
         let bytes =
             mirrorbox_files::read_bounded(&resolved, MAX_NORMAL_MAP_FILE_BYTES, "normal map")
                 .map_err(|e| bad(e.message))?;

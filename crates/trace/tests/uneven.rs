@@ -90,7 +90,11 @@ fn a_constant_tilt_moves_the_reflection_by_the_closed_form() {
     assert_eq!(hits[0].2, 0);
     assert!(hits[0].1.length() < 1e-12, "{:?}", hits[0]);
     assert_eq!((hits[1].0, hits[1].2), (2, 1));
-    assert!((hits[1].1 - expected).length() < 1e-9, "{:?} vs {expected}", hits[1].1);
+    assert!(
+        (hits[1].1 - expected).length() < 1e-9,
+        "{:?} vs {expected}",
+        hits[1].1
+    );
     assert!(expected.y > 0.3, "a visible move: {expected}");
 }
 
@@ -125,7 +129,11 @@ fn a_grazing_ray_sent_behind_the_mirror_is_absorbed() {
         dir,
     });
     assert_eq!(r.termination, Termination::Absorbed);
-    assert_eq!(r.radiance, Vec3::ZERO, "absorbed: neither terminal nor background");
+    assert_eq!(
+        r.radiance,
+        Vec3::ZERO,
+        "absorbed: neither terminal nor background"
+    );
     // Heading towards −y instead it reflects and escapes.
     let back = whitted.radiance(Ray {
         origin: Vec3::new(0.0, 1.0, 10f32.to_radians().tan()),

@@ -27,10 +27,10 @@ use crate::projection::NEARER_OR_EQUAL;
 use crate::shading::{SceneBuffers, VERTEX_LAYOUT};
 use crate::targets::{DEPTH_FORMAT, RenderTarget, texture_entry};
 use crate::timing::FrameEncoder;
+use crate::uneven::BumpSettings;
 use crate::wgsl::{HostLayout, shader_module};
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec2, Vec3, Vec4};
-use mirrorbox_scene::reflection::ReflectedView;
 use mirrorbox_scene::{Plane, Scene};
 use std::collections::HashMap;
 
@@ -47,6 +47,11 @@ pub static NAIVE: MethodEntry = MethodEntry {
         &crate::lighting::SHADOWS,
         &crate::lighting::SHADOW_MAP_SIZE,
         &crate::lighting::SHADOW_BIAS,
+        crate::uneven::OPTIONS[0],
+        crate::uneven::OPTIONS[1],
+        crate::uneven::OPTIONS[2],
+        crate::uneven::OPTIONS[3],
+        crate::uneven::OPTIONS[4],
     ],
     swept: None,
     optional_features: wgpu::Features::CLIP_DISTANCES,
@@ -71,6 +76,11 @@ pub static AUXILIARY: MethodEntry = MethodEntry {
         &crate::lighting::SHADOWS,
         &crate::lighting::SHADOW_MAP_SIZE,
         &crate::lighting::SHADOW_BIAS,
+        crate::uneven::OPTIONS[0],
+        crate::uneven::OPTIONS[1],
+        crate::uneven::OPTIONS[2],
+        crate::uneven::OPTIONS[3],
+        crate::uneven::OPTIONS[4],
     ],
     swept: Some(&AUXILIARY_MIRRORS),
     optional_features: wgpu::Features::CLIP_DISTANCES,
@@ -94,7 +104,9 @@ crate::mirror_plane_shaders!("recursive texture", ENTRY_POINTS);
 fn gpu_structs() -> Vec<HostLayout> {
     vec![
         crate::host_layout!(PassUniform as "Pass" {
-            clip_from_world, eye, _pad0, origin, pixels_per_texel, plane
+            clip_from_world, eye, _pad0, origin, pixels_per_texel, plane, screen_from_world,
+            screen_size, bump_mode, march_steps, bump_strength, proxy_distance,
+            march_distance, _pad1
         }),
         crate::host_layout!(MirrorUniform as "MirrorDraw" {
             origin, size, texels_per_pixel, exact, has_texture
@@ -150,6 +162,7 @@ struct RecursiveTextureMethod {
     queue: Queue,
     texture_scale: f32,
     max_passes: usize,
+    bump: BumpSettings,
 }
 
 impl RecursiveTextureMethod {
@@ -158,6 +171,7 @@ impl RecursiveTextureMethod {
             queue,
             texture_scale: p.real(&TEXTURE_SCALE),
             max_passes: p.count(&MAX_PASSES) as usize,
+            bump: BumpSettings::from_params(p),
         }
     }
 }
@@ -173,6 +187,7 @@ impl RasterMethod for RecursiveTextureMethod {
         Ok(Box::new(PlannedTextures {
             plan,
             texture_scale: self.texture_scale,
+            bump: self.bump,
         }))
     }
 }
@@ -180,6 +195,7 @@ impl RasterMethod for RecursiveTextureMethod {
 struct PlannedTextures {
     plan: Plan,
     texture_scale: f32,
+    bump: BumpSettings,
 }
 
 impl PlannedFrame for PlannedTextures {
@@ -189,7 +205,14 @@ impl PlannedFrame for PlannedTextures {
         scene: &Scene,
         shadows: &crate::shadow_maps::ShadowMaps,
     ) -> Result<BuiltFrame, RasterError> {
-        let m = RecursiveTexture::new(gpu, scene, shadows, &self.plan, self.texture_scale)?;
+        let m = RecursiveTexture::new(
+            gpu,
+            scene,
+            shadows,
+            &self.plan,
+            self.texture_scale,
+            self.bump,
+        )?;
         Ok(BuiltFrame {
             stats: m.stats,
             encoder: Box::new(m),
@@ -210,6 +233,18 @@ struct PassUniform {
     /// The pass's mirror plane in scene space, front positive; `(0, 0, 0, 1)` for the
     /// camera's pass.
     plane: [f32; 4],
+    /// The pass's camera without the crop: world to the whole screen's clip space (where
+    /// the uneven-mirror tricks project their points).
+    screen_from_world: [[f32; 4]; 4],
+    screen_size: [f32; 2],
+    /// [`BumpSettings`]: the trick and its parameters; the march's longest reach (the
+    /// scene's diagonal).
+    bump_mode: u32,
+    march_steps: u32,
+    bump_strength: f32,
+    proxy_distance: f32,
+    march_distance: f32,
+    _pad1: f32,
 }
 
 #[repr(C)]
@@ -248,14 +283,23 @@ pub struct RecursiveTexture {
     slots: Vec<RenderTarget>,
     passes: Vec<PassSpec>,
     background: Vec3,
+    /// What a texture's alpha holds where nothing was drawn: with `--bump march` the
+    /// distance "nothing", else 1.
+    clear_alpha: f32,
     pub stats: FrameStats,
 }
+
+/// The distance a marched texture stores where it shows the background (within half-float
+/// range, beyond any bundled scene).
+const NO_SURFACE_DISTANCE: f32 = 60_000.0;
 
 /// Builds the uniform records and pass list from the plan.
 struct Builder<'a> {
     scene: &'a Scene,
     plan: &'a Plan,
     texture_scale: f32,
+    bump: BumpSettings,
+    march_distance: f32,
     uniforms: UniformArena,
     /// Free slots by exact texture size.
     free: HashMap<(u32, u32), Vec<usize>>,
@@ -266,6 +310,54 @@ struct Builder<'a> {
 }
 
 impl Builder<'_> {
+    /// A node's texture region: its footprint grown by `--texture-margin` within the screen.
+    fn region(&self, r: Rect) -> Rect {
+        let m = self.bump.margin;
+        let x = r.x.saturating_sub(m);
+        let y = r.y.saturating_sub(m);
+        let right = (r.x + r.w).saturating_add(m).min(self.plan.width);
+        let bottom = (r.y + r.h).saturating_add(m).min(self.plan.height);
+        Rect {
+            x,
+            y,
+            w: right - x,
+            h: bottom - y,
+        }
+    }
+
+    /// The pass uniform of a camera `view` (projection `plan.projection`) drawing into
+    /// `region` of the screen at `size` texels, keeping what lies in front of `plane`.
+    fn pass_uniform(
+        &self,
+        view: Mat4,
+        eye: Vec3,
+        region: Rect,
+        size: (u32, u32),
+        plane: Vec4,
+    ) -> PassUniform {
+        let screen = self.plan.projection * view;
+        PassUniform {
+            clip_from_world: (crop(region, self.plan.width, self.plan.height) * screen)
+                .to_cols_array_2d(),
+            eye: eye.to_array(),
+            _pad0: 0.0,
+            origin: [region.x as f32, region.y as f32],
+            pixels_per_texel: [
+                region.w as f32 / size.0 as f32,
+                region.h as f32 / size.1 as f32,
+            ],
+            plane: plane.to_array(),
+            screen_from_world: screen.to_cols_array_2d(),
+            screen_size: [self.plan.width as f32, self.plan.height as f32],
+            bump_mode: self.bump.mode,
+            march_steps: self.bump.march_steps,
+            bump_strength: self.bump.strength,
+            proxy_distance: self.bump.proxy_distance,
+            march_distance: self.march_distance,
+            _pad1: 0.0,
+        }
+    }
+
     fn texture_size(&self, r: Rect) -> (u32, u32) {
         let s = |v: u32| ((v as f32 * self.texture_scale).round() as u32).max(1);
         (s(r.w), s(r.h))
@@ -283,20 +375,17 @@ impl Builder<'_> {
     fn emit(&mut self, node: &TextureNode) -> usize {
         let children: Vec<(&TextureNode, usize)> =
             node.children.iter().map(|c| (c, self.emit(c))).collect();
-        let size = self.texture_size(node.footprint);
+        let region = self.region(node.footprint);
+        let size = self.texture_size(region);
         let slot = self.alloc(size);
-        let clip = mirror_camera_clip(self.plan, &node.view, node.footprint);
-        let offset = self.uniforms.push(&PassUniform {
-            clip_from_world: clip.to_cols_array_2d(),
-            eye: node.view.eye().to_array(),
-            _pad0: 0.0,
-            origin: [node.footprint.x as f32, node.footprint.y as f32],
-            pixels_per_texel: [
-                node.footprint.w as f32 / size.0 as f32,
-                node.footprint.h as f32 / size.1 as f32,
-            ],
-            plane: node.plane.coefficients().to_array(),
-        });
+        let uniform = self.pass_uniform(
+            node.view.view,
+            node.view.eye(),
+            region,
+            size,
+            node.plane.coefficients(),
+        );
+        let offset = self.uniforms.push(&uniform);
         let draws = self.mirror_draws(&node.hidden, Some(&node.plane), &children);
         self.passes.push(PassSpec {
             target: Target::Slot(slot),
@@ -304,7 +393,7 @@ impl Builder<'_> {
             draws,
         });
         for (c, s) in children {
-            let size = self.texture_size(c.footprint);
+            let size = self.texture_size(self.region(c.footprint));
             self.free.entry(size).or_default().push(s);
         }
         slot
@@ -335,8 +424,8 @@ impl Builder<'_> {
             }
             let binding = match children.iter().find(|(c, _)| c.instance == i) {
                 Some((child, slot)) => {
-                    let (tw, th) = self.texture_size(child.footprint);
-                    let f = child.footprint;
+                    let f = self.region(child.footprint);
+                    let (tw, th) = self.texture_size(f);
                     let texels_per_pixel = [tw as f32 / f.w as f32, th as f32 / f.h as f32];
                     let exact = texels_per_pixel == [1.0, 1.0];
                     let offset = self.uniforms.push(&MirrorUniform {
@@ -359,12 +448,6 @@ impl Builder<'_> {
         }
         draws
     }
-}
-
-/// `crop(footprint) · P · view`: the mirror camera's clip transform (the camera's projection
-/// `P`), with the screen region of its texture mapped onto the whole texture.
-fn mirror_camera_clip(plan: &Plan, view: &ReflectedView, footprint: Rect) -> Mat4 {
-    crop(footprint, plan.width, plan.height) * plan.projection * view.view
 }
 
 /// Maps the NDC rectangle of screen region `r` (of a `w × h` screen) onto [−1, 1]².
@@ -420,13 +503,28 @@ impl RecursiveTexture {
         shadows: &crate::shadow_maps::ShadowMaps,
         plan: &Plan,
         texture_scale: f32,
+        bump: BumpSettings,
     ) -> Result<Self, RasterError> {
         let device = &gpu.device;
         let scene_buffers = SceneBuffers::new(device, scene, shadows.binding());
+        let (lo, hi) = scene
+            .geometry
+            .triangles
+            .iter()
+            .flatten()
+            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(a, b), p| {
+                (a.min(*p), b.max(*p))
+            });
         let mut b = Builder {
             scene,
             plan,
             texture_scale,
+            bump,
+            march_distance: if lo.x <= hi.x {
+                (hi - lo).length()
+            } else {
+                1.0
+            },
             uniforms: UniformArena::new(device),
             free: HashMap::new(),
             slot_sizes: Vec::new(),
@@ -435,14 +533,20 @@ impl RecursiveTexture {
         };
         let roots: Vec<(&TextureNode, usize)> = plan.roots.iter().map(|n| (n, b.emit(n))).collect();
         let camera = scene.camera.with_size(plan.width, plan.height);
-        let main_offset = b.uniforms.push(&PassUniform {
-            clip_from_world: (plan.projection * camera.view()).to_cols_array_2d(),
-            eye: camera.position.to_array(),
-            _pad0: 0.0,
-            origin: [0.0, 0.0],
-            pixels_per_texel: [1.0, 1.0],
-            plane: Vec4::W.to_array(),
-        });
+        let screen = Rect {
+            x: 0,
+            y: 0,
+            w: plan.width,
+            h: plan.height,
+        };
+        let main_uniform = b.pass_uniform(
+            camera.view(),
+            camera.position,
+            screen,
+            (plan.width, plan.height),
+            Vec4::W,
+        );
+        let main_offset = b.uniforms.push(&main_uniform);
         let main_draws = b.mirror_draws(&[], None, &roots);
         b.passes.push(PassSpec {
             target: Target::Main,
@@ -581,6 +685,11 @@ impl RecursiveTexture {
             slots,
             passes: b.passes,
             background: scene.background,
+            clear_alpha: if bump.needs_distances() {
+                NO_SURFACE_DISTANCE
+            } else {
+                1.0
+            },
             stats,
         })
     }
@@ -599,7 +708,13 @@ impl FrameEncoder for RecursiveTexture {
                 Target::Slot(s) => (&self.slots[s], "mirror texture pass"),
                 Target::Main => (main, "main view pass"),
             };
-            let mut pass = target.begin_pass(encoder, label, self.background, first_pass.take());
+            let mut pass = target.begin_pass_with_alpha(
+                encoder,
+                label,
+                self.background,
+                self.clear_alpha,
+                first_pass.take(),
+            );
             pass.set_vertex_buffer(0, self.scene_buffers.vertices.slice(..));
             pass.set_bind_group(0, &self.scene_buffers.bind_group, &[]);
             pass.set_bind_group(1, &self.pass_bind_group, &[spec.offset]);
