@@ -13,7 +13,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 export NODEVICE_SELECT=1
 bin=target/release/mirrorbox
-steps_total=11
+steps_total=12
 step=0
 steps_json=""
 started_at=$(date -u +%Y-%m-%dT%H:%M:%SZ)
@@ -47,6 +47,7 @@ run_step "$bin" table1 --fresh --out reports/table1_repeat
 run_step "$bin" depth-scaling --fresh
 run_step "$bin" symmetry-scaling --fresh
 run_step "$bin" lighting --fresh
+run_step "$bin" bumpy --fresh
 run_step env MIRRORBOX="$bin" scripts/lighting-trace-cost.sh
 cpu=$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//; s/"/'"'"'/g')
 cores=$(nproc)

@@ -166,7 +166,7 @@ fn march(x: vec3f, r: vec3f, n: vec3f, fallback: vec2f) -> vec2f {
 // A front hit on an uneven mirror (docs/shading.md, "Uneven mirrors"), read with the pass's
 // trick (crates/raster/src/uneven.rs): black where the contract absorbs the reflection.
 fn uneven_mirror_colour(in: VertexOut, s: Surface, b: MirrorBump) -> vec4f {
-    let n_s = mirror_shading_normal(s.mirror, in.world);
+    let n_s = mirror_shading_normal(b, in.world);
     let d = normalize(in.world - pass_.eye);
     let alpha = eye_distance(in);
     if (pass_.bump_mode == 5u) {
@@ -222,7 +222,7 @@ fn mirror_colour(in: VertexOut) -> vec4f {
     if (!front) {
         return vec4f(shade_diffuse(in, s.back_albedo, vec3f(0.0)), eye_distance(in));
     }
-    let b = mirror_bumps[s.mirror];
+    let b = s.bump;
     if (b.flags != 0u && pass_.bump_mode != 0u) {
         return uneven_mirror_colour(in, s, b);
     }

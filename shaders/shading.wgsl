@@ -13,6 +13,8 @@ struct Surface {
     _pad0: u32,
     back_albedo: vec3f,
     _pad1: u32,
+    // A mirror's frame and bump (zero for a diffuse surface).
+    bump: MirrorBump,
 }
 
 // A point light, or a light's image through a chain of mirrors (docs/shading.md, "Shadows
@@ -45,7 +47,8 @@ struct Frame {
 }
 
 // A mirror's frame and its bump (docs/shading.md, "Uneven mirrors"; the CPU twin is
-// crates/scene/src/bump.rs): flags bit 0 a ripple, bit 1 a normal map.
+// crates/scene/src/bump.rs): flags bit 0 a ripple, bit 1 a normal map; map_offset is the
+// map's first row in the atlas.
 struct MirrorBump {
     center: vec3f,
     flags: u32,
@@ -81,10 +84,9 @@ struct VertexIn {
 @group(0) @binding(3) var<storage, read> light_planes: array<vec4f>;
 // Distance from each layer's light to the nearest surface, per texel.
 @group(0) @binding(4) var shadow_maps: texture_2d_array<f32>;
-// Per scene mirror, its frame and bump (flat mirrors: flags 0); the normal maps' texels,
-// 8-bit RGB packed in a u32 each, every map from its map_offset, row 0 at the mirror's top.
-@group(0) @binding(5) var<storage, read> mirror_bumps: array<MirrorBump>;
-@group(0) @binding(6) var<storage, read> normal_texels: array<u32>;
+// The normal maps' texels, 8-bit RGB packed in a u32 each: one atlas, every map's rows from
+// its map_offset down, row 0 at the mirror's top (a texture: storage buffers are scarcer).
+@group(0) @binding(5) var normal_texels: texture_2d<u32>;
 
 const FRAC_1_PI: f32 = 0.31830988618379067;
 const MIN_LIGHT_DISTANCE_SQUARED: f32 = 1e-8;
@@ -202,7 +204,7 @@ fn normal_texel(b: MirrorBump, i: i32, j: i32) -> vec3f {
     let h = i32(b.map_height);
     let ii = ((i % w) + w) % w;
     let jj = ((j % h) + h) % h;
-    let t = normal_texels[b.map_offset + u32(jj * w + ii)];
+    let t = textureLoad(normal_texels, vec2i(ii, i32(b.map_offset) + jj), 0).x;
     let rgb = vec3f(f32(t & 255u), f32((t >> 8u) & 255u), f32((t >> 16u) & 255u));
     return rgb * (2.0 / 255.0) - 1.0;
 }
@@ -238,9 +240,8 @@ fn mirror_tangent_normal(b: MirrorBump, u: f32, v: f32) -> vec3f {
     return normalize(vec3f(r.xy / r.z + m.xy / m.z, 1.0));
 }
 
-// Mirror `mirror`'s shading normal at point p on it (its plane's normal where it is flat).
-fn mirror_shading_normal(mirror: u32, p: vec3f) -> vec3f {
-    let b = mirror_bumps[mirror];
+// A mirror's shading normal at point p on it (its plane's normal where it is flat).
+fn mirror_shading_normal(b: MirrorBump, p: vec3f) -> vec3f {
     if (b.flags == 0u) {
         return b.normal;
     }

@@ -447,3 +447,74 @@ fn a_value_listed_twice_is_one_point() {
     let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
     assert_eq!(csv.lines().count(), 1 + 3, "{csv}");
 }
+
+/// Issue 16: an uneven mirror's bump is checked field by field, its normal map read bounded
+/// and decoded before anything renders; every refusal names the field and what is allowed.
+#[test]
+fn bad_bumps_are_refused_naming_the_field() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    // A grey PNG (not RGB), an RGB map whose texel points into the mirror, a text file.
+    let grey = image::GrayImage::from_pixel(4, 4, image::Luma([128]));
+    grey.save(d.join("grey.png")).unwrap();
+    let mut inward = image::RgbImage::from_pixel(4, 4, image::Rgb([128, 128, 255]));
+    inward.put_pixel(2, 1, image::Rgb([128, 128, 100]));
+    inward.save(d.join("inward.png")).unwrap();
+    std::fs::write(d.join("text.png"), "not a png").unwrap();
+    let cases: [(Value, &[&str]); 7] = [
+        (json!({}), &["mirrors[0].bump", "needs a \"ripple\""]),
+        (
+            json!({ "ripple": { "amplitude_deg": 90, "wavelength": 1 } }),
+            &["mirrors[0].bump.ripple.amplitude_deg", "[0, 90)"],
+        ),
+        (
+            json!({ "ripple": { "amplitude_deg": 5, "wavelength": 0 } }),
+            &["mirrors[0].bump.ripple.wavelength", "greater than 0"],
+        ),
+        (
+            json!({ "normal_map": { "path": "missing.png" } }),
+            &["mirrors[0].bump.normal_map.path", "missing.png"],
+        ),
+        (
+            json!({ "normal_map": { "path": "grey.png" } }),
+            &["grey.png", "8-bit RGB or RGBA"],
+        ),
+        (
+            json!({ "normal_map": { "path": "inward.png" } }),
+            &["inward.png", "texel (2, 1)", "blue 100"],
+        ),
+        (
+            json!({ "normal_map": { "path": "text.png", "strength": 2 } }),
+            &["text.png", "not a readable PNG"],
+        ),
+    ];
+    for (k, (bump, fragments)) in cases.iter().enumerate() {
+        let mut s = scene();
+        s["mirrors"][0]["bump"] = bump.clone();
+        let path = write_scene(d, &format!("bump{k}.json"), &s);
+        let out = mirrorbox(&["check", path.to_str().unwrap()], &[]);
+        assert_refused(&["check", path.to_str().unwrap()], &out, fragments);
+    }
+    // Mirrored lights are defined for flat mirrors only.
+    let mut s = scene();
+    s["mirrors"][0]["bump"] = json!({ "ripple": { "amplitude_deg": 5, "wavelength": 1 } });
+    s["lighting"] = json!({ "mirrored_lights": 2 });
+    let path = write_scene(d, "lit_bump.json", &s);
+    let out = mirrorbox(&["check", path.to_str().unwrap()], &[]);
+    assert_refused(
+        &["check"],
+        &out,
+        &["lighting.mirrored_lights", "uneven mirrors"],
+    );
+    // A valid bump loads.
+    std::fs::copy(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/textures/hammered.png"),
+        d.join("hammered.png"),
+    )
+    .unwrap();
+    let mut s = scene();
+    s["mirrors"][1]["bump"] = json!({ "normal_map": { "path": "hammered.png", "tiling": [2, 2] } });
+    let path = write_scene(d, "ok_bump.json", &s);
+    let out = mirrorbox(&["check", path.to_str().unwrap()], &[]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+}

@@ -82,7 +82,11 @@ def define_whitted():
                     Ld += f * intensity
                 Ld += bsdf.eval_diffuse_reflectance(si, diffuse) * self.ambient
                 L += dr.select(diffuse, beta * Ld, 0.0)
-                # Mirror: terminal radiance when it cannot be followed, else reflect.
+                # Mirror: terminal radiance when it cannot be followed, else reflect. An
+                # uneven mirror (normalmap) that sends the ray behind it has weight 0: the
+                # path ends with nothing (docs/shading.md, "Uneven mirrors").
+                absorbed = mirror & (dr.max(weight) == 0.0)
+                mirror &= ~absorbed
                 nxt = beta * weight
                 cut = mirror & ((depth >= self.max_depth) | (dr.max(nxt) < self.min_throughput))
                 L += dr.select(cut, beta * self.terminal, 0.0)

@@ -43,6 +43,8 @@ enum Command {
     SymmetryScaling(commands::sweep::PresetArgs),
     /// The preset sweep of lighting variants (direct, mirrored lights, shadow maps) against mirrored-light depth k on the lit mirror box and room (writes reports/lighting/ and reports/lighting_room/).
     Lighting(commands::sweep::PresetArgs),
+    /// The preset sweep of the uneven-mirror tricks (distort, proxy, march, flat) against the bump's tilt 0…10° on the rippled box and the hammered single mirror (writes reports/uneven_mirrors/ and reports/uneven_mirrors_single/).
+    Bumpy(commands::sweep::PresetArgs),
     /// Export a scene as Mitsuba 3 XML (tools/mitsuba renders and compares it).
     ExportMitsuba(commands::export_mitsuba::Args),
     /// Fill the generated regions of README.md and docs/methods.md from the committed reports (--check: only compare).
@@ -190,6 +192,7 @@ fn main() -> ExitCode {
         Command::DepthScaling(args) => commands::sweep::run_depth_scaling(&args),
         Command::SymmetryScaling(args) => commands::sweep::run_symmetry_scaling(&args),
         Command::Lighting(args) => commands::sweep::run_lighting(&args),
+        Command::Bumpy(args) => commands::sweep::run_bumpy(&args),
         Command::ExportMitsuba(args) => commands::export_mitsuba::run(&args),
         Command::Readme(args) => commands::readme::run(&args),
         Command::Report(args) => commands::report::run(&args),

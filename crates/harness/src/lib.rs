@@ -64,6 +64,11 @@ pub struct SweepConfig {
     /// diffuse surfaces through chains of at most k mirrors (`lighting.mirrored_lights = k`),
     /// for every k listed (`--mirrored-lights`); `None` keeps the scene's own.
     pub mirrored_lights: Option<Vec<u32>>,
+    /// The uneven-mirror axis (issue 16, `docs/shading.md`): each point's scene tilts its
+    /// uneven mirrors' normals by at most this many degrees
+    /// ([`mirrorbox_scene::Scene::set_bump_amplitude`]), for every value listed
+    /// (`--bump-amplitude`); `None` keeps the scene's own.
+    pub bump_amplitudes: Option<Vec<f32>>,
 }
 
 /// The methods `name` at each value of its swept option (`"auxiliary"`, `[0, 1, 2]`), every
@@ -94,6 +99,19 @@ const SHADOW_MAP_SIZES: [u32; 3] = [256, 1024, 2048];
 /// paper's method at its published n = 2.
 const SHADOWED_METHODS: [&str; 2] = ["unrolled depth=64", "auxiliary n=2"];
 
+/// The uneven-mirror tricks the bumpy presets measure (`crates/raster/src/uneven.rs`).
+const BUMP_VARIANTS: [&str; 9] = [
+    "bump=flat",
+    "bump=distort bump-strength=0.25",
+    "bump=distort",
+    "bump=distort bump-strength=1",
+    "bump=distort bump-strength=2",
+    "bump=distort-distance bump-strength=2",
+    "bump=proxy",
+    "bump=march",
+    "bump=march texture-margin=16",
+];
+
 /// `base` with the options of `words` (`"lights=direct shadow-map=1024"`, or empty) set.
 fn with_options(base: &Method, words: &str) -> Method {
     Method::parse(&format!("{} {words}", base.key())).unwrap_or_else(|e| panic!("preset: {e}"))
@@ -118,6 +136,7 @@ impl SweepConfig {
             worker: None,
             symmetry_planes: None,
             mirrored_lights: None,
+            bump_amplitudes: None,
         }
     }
 
@@ -234,6 +253,54 @@ impl SweepConfig {
         }
     }
 
+    /// Uneven mirrors (issue 16) on `bumpy_pair`: the paper's method at its published n = 2
+    /// with every trick of `--bump` (`crates/raster/src/uneven.rs`) — the bump ignored,
+    /// the screen-space distortion at four strengths and its 1/distance form, the proxy plane,
+    /// the march with and without a 16-pixel texture margin — and, beside them, the march at
+    /// n = 4 (two reflections deeper) and the exact `unrolled` at depth 64, which shows the
+    /// mirror flat; against truths whose rippled mirror tilts by 0, 1, 2.5, 5 and 10°;
+    /// 320×180, 6 timed frames after one warm-up.
+    pub fn bumpy(out: PathBuf) -> Self {
+        SweepConfig {
+            scene: PathBuf::from("scenes/bumpy_pair.json"),
+            ..SweepConfig::bumpy_variants(
+                out,
+                "auxiliary n=2",
+                &["auxiliary n=4 bump=march", "unrolled depth=64"],
+            )
+        }
+    }
+
+    /// [`SweepConfig::bumpy`] on `bumpy_single` (one normal-mapped mirror: `naive` is the
+    /// paper's method there, and exact for a flat mirror).
+    pub fn bumpy_single(out: PathBuf) -> Self {
+        SweepConfig {
+            scene: PathBuf::from("scenes/bumpy_single.json"),
+            ..SweepConfig::bumpy_variants(out, "naive", &["unrolled depth=64"])
+        }
+    }
+
+    fn bumpy_variants(out: PathBuf, base: &str, extra: &[&str]) -> Self {
+        let base = Method::parse(base).unwrap_or_else(|e| panic!("preset: {e}"));
+        let mut methods: Vec<Method> = BUMP_VARIANTS
+            .iter()
+            .map(|v| with_options(&base, v))
+            .collect();
+        methods.extend(
+            extra
+                .iter()
+                .map(|m| Method::parse(m).unwrap_or_else(|e| panic!("preset: {e}"))),
+        );
+        SweepConfig {
+            bump_amplitudes: Some(vec![0.0, 1.0, 2.5, 5.0, 10.0]),
+            width: Some(320),
+            height: Some(180),
+            frames: 6,
+            warmup: 1,
+            ..SweepConfig::preset(out, methods, vec![0.9])
+        }
+    }
+
     /// A preset on the paper's scene (mirror_box) with 9 timed frames: enough for a 95 %
     /// interval of each median.
     fn preset(out: PathBuf, methods: Vec<Method>, alphas: Vec<f32>) -> Self {
@@ -291,12 +358,29 @@ impl SweepConfig {
                 .into());
             }
         }
+        let bumps = self.bump_amplitudes.as_ref().map_or(1, Vec::len);
+        if bumps == 0 {
+            return Err(SettingError::new(
+                "--bump-amplitude",
+                "at least one angle in [0, 90) degrees",
+                "none",
+            )
+            .into());
+        }
+        for &a in self.bump_amplitudes.iter().flatten() {
+            if !(0.0..mirrorbox_scene::bump::MAX_AMPLITUDE_DEG).contains(&a) {
+                return Err(
+                    SettingError::new("--bump-amplitude", "each in [0, 90) degrees", a).into(),
+                );
+            }
+        }
         let points = 1 + self
             .methods
             .len()
             .saturating_mul(self.alphas.len())
             .saturating_mul(planes)
-            .saturating_mul(lights);
+            .saturating_mul(lights)
+            .saturating_mul(bumps);
         if points > MAX_POINTS {
             return Err(SettingError::new(
                 "--methods × their axes × --alpha × --symmetry-planes × --mirrored-lights",
@@ -429,6 +513,8 @@ struct Point {
     planes: Option<u32>,
     /// `lighting.mirrored_lights` (a `--mirrored-lights` sweep).
     lights: Option<u32>,
+    /// The uneven mirrors' steepest tilt, degrees (a `--bump-amplitude` sweep).
+    bump: Option<f32>,
     key: String,
     label: String,
     slug: String,
@@ -443,12 +529,14 @@ fn point_key(
     alpha: f32,
     planes: Option<u32>,
     lights: Option<u32>,
+    bump: Option<f32>,
     common: &str,
 ) -> String {
     let planes = planes.map_or(String::new(), |p| format!("|planes={p}"));
     let lights = lights.map_or(String::new(), |k| format!("|mirrored_lights={k}"));
+    let bump = bump.map_or(String::new(), |a| format!("|bump_deg={a}"));
     match method {
-        Some(m) => format!("{}{planes}{lights}|alpha={alpha}|{common}", m.key()),
+        Some(m) => format!("{}{planes}{lights}{bump}|alpha={alpha}|{common}", m.key()),
         None => format!("floor|{common}"),
     }
 }
@@ -463,7 +551,8 @@ fn points(config: &SweepConfig, base_hash: u64, w: u32, h: u32) -> Vec<Point> {
         alpha: 1.0,
         planes: None,
         lights: None,
-        key: point_key(None, 1.0, None, None, &common),
+        bump: None,
+        key: point_key(None, 1.0, None, None, None, &common),
         label: "floor (no mirrors)".into(),
         slug: "floor".into(),
     }];
@@ -475,11 +564,18 @@ fn points(config: &SweepConfig, base_hash: u64, w: u32, h: u32) -> Vec<Point> {
         Some(ks) => ks.iter().map(|&k| Some(k)).collect(),
         None => vec![None],
     };
+    let bump_axis: Vec<Option<f32>> = match &config.bump_amplitudes {
+        Some(a) => a.iter().map(|&a| Some(a)).collect(),
+        None => vec![None],
+    };
     for &alpha in &config.alphas {
         for &planes in &plane_axis {
-            for &lights in &light_axis {
+            for (&lights, &bump) in light_axis
+                .iter()
+                .flat_map(|l| bump_axis.iter().map(move |b| (l, b)))
+            {
                 for method in &config.methods {
-                    let key = point_key(Some(method), alpha, planes, lights, &common);
+                    let key = point_key(Some(method), alpha, planes, lights, bump, &common);
                     // A value listed twice (`--depth 1,1`, `--alpha 0.7,0.7`) is one point.
                     if out.iter().any(|p| p.key == key) {
                         continue;
@@ -490,14 +586,18 @@ fn points(config: &SweepConfig, base_hash: u64, w: u32, h: u32) -> Vec<Point> {
                     let (k_label, k_slug) = lights.map_or((String::new(), String::new()), |k| {
                         (format!(" k={k}"), format!("_k{k}"))
                     });
+                    let (b_label, b_slug) = bump.map_or((String::new(), String::new()), |a| {
+                        (format!(" bump={a}°"), format!("_b{a}"))
+                    });
                     out.push(Point {
                         key,
-                        label: format!("{method}{p_label}{k_label} α={alpha}"),
-                        slug: format!("{}{p_slug}{k_slug}_a{alpha}", method.slug()),
+                        label: format!("{method}{p_label}{k_label}{b_label} α={alpha}"),
+                        slug: format!("{}{p_slug}{k_slug}{b_slug}_a{alpha}", method.slug()),
                         method: Some(method.clone()),
                         alpha,
                         planes,
                         lights,
+                        bump,
                     });
                 }
             }
@@ -631,7 +731,14 @@ fn point_setup(
     p: &Point,
     config: &SweepConfig,
 ) -> Result<(Scene, RenderSettings), HarnessError> {
-    let scene = worker::point_scene(base, p.method.is_none(), p.planes, p.lights, p.alpha)?;
+    let scene = worker::point_scene(
+        base,
+        p.method.is_none(),
+        p.planes,
+        p.lights,
+        p.bump,
+        p.alpha,
+    )?;
     let method = p
         .method
         .clone()
@@ -795,6 +902,7 @@ pub fn run_sweep(
             image: rendered_image(&cache, i),
             symmetry_planes: p.planes,
             mirrored_lights: p.lights,
+            bump_amplitude: p.bump,
         });
     }
     // Interleaved timing: `frames` rounds; in each, every point renders its warm-up frames
@@ -859,9 +967,10 @@ pub fn run_sweep(
             match (&p.method, p.planes, p.lights) {
                 (None, _, _) => "floor".into(),
                 (Some(_), planes, lights) => format!(
-                    "{}{}a{}",
+                    "{}{}{}a{}",
                     planes.map_or(String::new(), |p| format!("p{p}_")),
                     lights.map_or(String::new(), |k| format!("k{k}_")),
+                    p.bump.map_or(String::new(), |a| format!("b{a}_")),
                     p.alpha
                 ),
             }
@@ -892,6 +1001,7 @@ pub fn run_sweep(
                 .map_or(String::new(), Method::variant_options),
             symmetry_planes: p.planes,
             mirrored_lights: p.lights,
+            bump_amplitude_deg: p.bump,
             copies_drawn: s.copies.map(|c| c.drawn),
             copies_total: s.copies.map(|c| c.total),
             bake_ms: s.bake_ms,

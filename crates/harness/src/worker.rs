@@ -45,6 +45,10 @@ pub struct RenderJob {
     /// scene's own.
     #[serde(default)]
     pub mirrored_lights: Option<u32>,
+    /// The uneven mirrors' steepest tilt, degrees (a `--bump-amplitude` sweep); `None`: the
+    /// scene's own.
+    #[serde(default)]
+    pub bump_amplitude: Option<f32>,
 }
 
 /// What a worker measured.
@@ -114,6 +118,7 @@ fn job_scene(job: &RenderJob) -> Result<Scene, HarnessError> {
         job.floor,
         job.symmetry_planes,
         job.mirrored_lights,
+        job.bump_amplitude,
         job.alpha,
     )
 }
@@ -127,6 +132,7 @@ pub(crate) fn point_scene(
     floor: bool,
     planes: Option<u32>,
     mirrored_lights: Option<u32>,
+    bump_amplitude: Option<f32>,
     alpha: f32,
 ) -> Result<Scene, HarnessError> {
     let mut scene = match (floor, planes) {
@@ -136,6 +142,9 @@ pub(crate) fn point_scene(
     };
     if let Some(k) = mirrored_lights {
         scene.lighting.mirrored_lights = k;
+    }
+    if let Some(a) = bump_amplitude {
+        scene.set_bump_amplitude(a);
     }
     let budget = |source| HarnessError::LightImages {
         scene: base.source.clone(),

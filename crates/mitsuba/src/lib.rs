@@ -12,6 +12,13 @@
 //!   emitter (one-sided, like ours);
 //! - mirror → `twosided` with a `conductor` (`material = none`: reflects exactly
 //!   `specular_reflectance` at every angle) in front and a `diffuse` of the back albedo behind;
+//! - an uneven mirror (a `bump`) → its OBJ with texture coordinates and the `conductor`
+//!   wrapped in a `normalmap` BSDF reading an EXR beside the meshes: for a normal map, its
+//!   texels decoded and scaled by the strength, `(s·m.x, s·m.y, m.z)`, stored as
+//!   `(n + 1)/2` (Mitsuba computes `2·texel − 1` and normalizes after bilinear filtering,
+//!   as the contract does, so the export is exact) and tiled by the bitmap's `to_uv`; a
+//!   ripple is baked into a map of 48 texels per wavelength at the texel centres
+//!   (bilinear between them: an approximation of relative size ~(π/48)²/2);
 //! - point light → `point` (intensity in W/sr); background → `constant` emitter.
 //!
 //! What Mitsuba cannot express — the ambient term, the terminal radiance and the exposure —
@@ -29,6 +36,53 @@ use std::path::{Path, PathBuf};
 pub struct ExportSettings {
     /// Samples per pixel; a perfect square (the stratified grid).
     pub spp: u32,
+}
+
+/// Texels per ripple wavelength in a baked normal map.
+const RIPPLE_TEXELS_PER_WAVELENGTH: f32 = 48.0;
+
+/// The normal map Mitsuba's `normalmap` reads for an uneven mirror (texels `(n + 1)/2`, row 0
+/// at the mirror's top) and its tiling: a normal map alone exactly (its texels scaled by
+/// the strength, tiled by `to_uv`), anything with a ripple baked at the texel centres of
+/// [`RIPPLE_TEXELS_PER_WAVELENGTH`] per wavelength (at most 4096 a side).
+fn normal_texture(
+    m: &mirrorbox_scene::Mirror,
+    b: &mirrorbox_scene::bump::MirrorBump,
+) -> (mirrorbox_image::RgbImage, [f32; 2]) {
+    let encode = |n: glam::DVec3| {
+        [
+            (n.x as f32 + 1.0) / 2.0,
+            (n.y as f32 + 1.0) / 2.0,
+            (n.z as f32 + 1.0) / 2.0,
+        ]
+    };
+    match (&b.ripple, &b.normal_map) {
+        (None, Some(map)) => {
+            let image = mirrorbox_image::RgbImage::from_fn(map.width, map.height, |x, y| {
+                let t = map.texels[(y * map.width + x) as usize];
+                let d = |c: u8| f64::from(c) * 2.0 / 255.0 - 1.0;
+                let s = f64::from(map.strength);
+                encode(glam::DVec3::new(s * d(t[0]), s * d(t[1]), d(t[2])))
+            });
+            (image, map.tiling)
+        }
+        (Some(r), _) => {
+            let side = |len: f32| {
+                ((len / r.wavelength * RIPPLE_TEXELS_PER_WAVELENGTH).ceil() as u32).clamp(2, 4096)
+            };
+            let (w, h) = (side(m.width), side(m.height));
+            let image = mirrorbox_image::RgbImage::from_fn(w, h, |x, y| {
+                let u = ((f64::from(x) + 0.5) / f64::from(w) - 0.5) * f64::from(m.width);
+                let v = (0.5 - (f64::from(y) + 0.5) / f64::from(h)) * f64::from(m.height);
+                encode(b.tangent_normal(u, v, f64::from(m.width), f64::from(m.height)))
+            });
+            (image, [1.0, 1.0])
+        }
+        (None, None) => (
+            mirrorbox_image::RgbImage::from_fn(1, 1, |_, _| [0.5, 0.5, 1.0]),
+            [1.0, 1.0],
+        ),
+    }
 }
 
 fn rgb(v: Vec3) -> String {
@@ -116,13 +170,34 @@ pub fn export(
             part.name,
             part.triangles.len()
         );
+        let bumped = match &g.surfaces[part.surface as usize] {
+            Surface::Mirror { mirror, .. } => scene.bumps[*mirror]
+                .as_ref()
+                .map(|b| (&scene.mirrors[*mirror], b)),
+            Surface::Diffuse { .. } => None,
+        };
         for t in &g.triangles[part.triangles.clone()] {
             for v in t {
                 let _ = writeln!(obj, "v {} {} {}", v.x, v.y, v.z);
+                if let Some((m, _)) = bumped {
+                    // OBJ's v grows upwards: (u/width + ½, v/height + ½).
+                    let d = *v - m.center;
+                    let _ = writeln!(
+                        obj,
+                        "vt {} {}",
+                        d.dot(m.right()) / m.width + 0.5,
+                        d.dot(m.up) / m.height + 0.5
+                    );
+                }
             }
         }
         for k in 0..part.triangles.len() {
-            let _ = writeln!(obj, "f {} {} {}", 3 * k + 1, 3 * k + 2, 3 * k + 3);
+            let (a, b, c) = (3 * k + 1, 3 * k + 2, 3 * k + 3);
+            if bumped.is_some() {
+                let _ = writeln!(obj, "f {a}/{a} {b}/{b} {c}/{c}");
+            } else {
+                let _ = writeln!(obj, "f {a} {b} {c}");
+            }
         }
         let path = mesh_dir.join(&file);
         write_atomically(&path, obj.as_bytes())?;
@@ -137,14 +212,44 @@ pub fn export(
                 reflectance,
                 back_albedo,
                 ..
-            } => format!(
-                "    <bsdf type=\"twosided\">\n      <bsdf type=\"conductor\">\n        \
-                 <string name=\"material\" value=\"none\"/>\n        \
-                 <rgb name=\"specular_reflectance\" value=\"{}\"/>\n      </bsdf>\n      \
-                 <bsdf type=\"diffuse\">\n        <rgb name=\"reflectance\" value=\"{}\"/>\n      </bsdf>\n    </bsdf>",
-                rgb(*reflectance),
-                rgb(*back_albedo)
-            ),
+            } => {
+                let conductor = format!(
+                    "<bsdf type=\"conductor\">\n        \
+                     <string name=\"material\" value=\"none\"/>\n        \
+                     <rgb name=\"specular_reflectance\" value=\"{}\"/>\n      </bsdf>",
+                    rgb(*reflectance)
+                );
+                let front = match bumped {
+                    None => conductor,
+                    Some((m, b)) => {
+                        let name = format!("{i:03}_{}_normals.exr", slug(&part.name));
+                        let path = mesh_dir.join(&name);
+                        let (image, tiling) = normal_texture(m, b);
+                        mirrorbox_image::write_exr(&path, &image, &[]).map_err(|e| FileError {
+                            path: path.clone(),
+                            message: e.to_string(),
+                            refused: false,
+                        })?;
+                        written.push(path);
+                        format!(
+                            "<bsdf type=\"normalmap\">\n        \
+                             <texture name=\"normalmap\" type=\"bitmap\">\n          \
+                             <string name=\"filename\" value=\"meshes/{name}\"/>\n          \
+                             <boolean name=\"raw\" value=\"true\"/>\n          \
+                             <string name=\"filter_type\" value=\"bilinear\"/>\n          \
+                             <string name=\"wrap_mode\" value=\"repeat\"/>\n          \
+                             <transform name=\"to_uv\"><scale x=\"{}\" y=\"{}\"/></transform>\n        \
+                             </texture>\n        {conductor}\n      </bsdf>",
+                            tiling[0], tiling[1]
+                        )
+                    }
+                };
+                format!(
+                    "    <bsdf type=\"twosided\">\n      {front}\n      \
+                     <bsdf type=\"diffuse\">\n        <rgb name=\"reflectance\" value=\"{}\"/>\n      </bsdf>\n    </bsdf>",
+                    rgb(*back_albedo)
+                )
+            }
         };
         let emitter = match &g.surfaces[part.surface as usize] {
             Surface::Diffuse { emission, .. } if *emission != Vec3::ZERO => format!(

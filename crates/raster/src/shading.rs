@@ -10,7 +10,7 @@ use wgpu::util::DeviceExt;
 pub fn gpu_structs() -> Vec<crate::wgsl::HostLayout> {
     vec![
         crate::host_layout!(GpuSurface as "Surface" {
-            albedo, kind, emission, mirror, reflectance, _pad0, back_albedo, _pad1
+            albedo, kind, emission, mirror, reflectance, _pad0, back_albedo, _pad1, bump
         }),
         crate::host_layout!(GpuLight as "Light" {
             position, first_plane, intensity, plane_count, shadow_from_world, shadow_layer,
@@ -50,8 +50,17 @@ struct GpuMirrorBump {
     _pad: [f32; 2],
 }
 
-/// The mirrors' frames and bumps, and every normal map's texels packed one u32 each.
-fn mirror_bumps(scene: &Scene) -> (Vec<GpuMirrorBump>, Vec<u32>) {
+/// The mirrors' frames and bumps, and the normal maps' atlas: its width and its texels
+/// packed one u32 each, every map's rows below the previous map's.
+fn mirror_bumps(scene: &Scene) -> (Vec<GpuMirrorBump>, u32, Vec<u32>) {
+    let atlas_width = scene
+        .bumps
+        .iter()
+        .flatten()
+        .filter_map(|b| b.normal_map.as_ref())
+        .map(|m| m.width)
+        .max()
+        .unwrap_or(1);
     let mut texels: Vec<u32> = Vec::new();
     let mut bumps = Vec::with_capacity(scene.mirrors.len());
     for (m, bump) in scene.mirrors.iter().zip(&scene.bumps) {
@@ -74,27 +83,40 @@ fn mirror_bumps(scene: &Scene) -> (Vec<GpuMirrorBump>, Vec<u32>) {
             }
             if let Some(map) = &b.normal_map {
                 g.flags |= 2;
-                g.map_offset = texels.len() as u32;
+                g.map_offset = (texels.len() / atlas_width as usize) as u32;
                 g.map_width = map.width;
                 g.map_height = map.height;
                 g.strength = map.strength;
                 g.tiling = map.tiling;
-                texels.extend(
-                    map.texels
-                        .iter()
-                        .map(|t| u32::from(t[0]) | u32::from(t[1]) << 8 | u32::from(t[2]) << 16),
-                );
+                for row in map.texels.chunks_exact(map.width as usize) {
+                    let start = texels.len();
+                    texels.extend(
+                        row.iter().map(|t| {
+                            u32::from(t[0]) | u32::from(t[1]) << 8 | u32::from(t[2]) << 16
+                        }),
+                    );
+                    texels.resize(start + atlas_width as usize, 0);
+                }
             }
         }
         bumps.push(g);
     }
-    if bumps.is_empty() {
-        bumps.push(Zeroable::zeroed()); // a storage buffer may not be empty
-    }
     if texels.is_empty() {
         texels.push(0);
     }
-    (bumps, texels)
+    (bumps, atlas_width, texels)
+}
+
+/// Rows of the normal-map atlas (every map's height, stacked).
+fn atlas_rows(scene: &Scene) -> u32 {
+    scene
+        .bumps
+        .iter()
+        .flatten()
+        .filter_map(|b| b.normal_map.as_ref())
+        .map(|m| m.height)
+        .sum::<u32>()
+        .max(1)
 }
 
 #[repr(C)]
@@ -108,6 +130,8 @@ pub struct GpuSurface {
     _pad0: u32,
     back_albedo: [f32; 3],
     _pad1: u32,
+    /// A mirror's frame and bump.
+    bump: GpuMirrorBump,
 }
 
 #[repr(C)]
@@ -226,33 +250,40 @@ impl SceneBuffers {
         )?;
         let planes: usize = l.images.images.iter().map(|i| i.beam.len()).sum();
         gpu.check_buffer("light plane", planes as u64 * 16, true)?;
-        let texels: u64 = scene
-            .bumps
-            .iter()
-            .flatten()
-            .filter_map(|b| b.normal_map.as_ref())
-            .map(|m| u64::from(m.width) * u64::from(m.height))
-            .sum();
-        gpu.check_buffer("normal map texel", texels * 4, true)
+        // The atlas is one texture: every map's rows stacked.
+        let rows = atlas_rows(scene);
+        let limit = gpu.device.limits().max_texture_dimension_2d;
+        if rows > limit {
+            return Err(crate::RasterError::ExceedsDevice {
+                what: "the normal-map atlas (every normal map's rows stacked)".into(),
+                needed: format!("{rows} rows"),
+                limit: format!("{limit} rows"),
+                adapter: gpu.report.name.clone(),
+                advice: "; use fewer or smaller normal maps",
+            });
+        }
+        Ok(())
     }
 
     pub fn new(
-        device: &wgpu::Device,
+        gpu: &crate::Gpu,
         scene: &Scene,
         shadows: crate::shadow_plan::ShadowBinding<'_>,
     ) -> Self {
-        Self::for_geometry(device, scene, &scene.geometry, shadows)
+        Self::for_geometry(gpu, scene, &scene.geometry, shadows)
     }
 
     /// `scene`'s buffers drawing `g` (its mirror surfaces index `scene.mirrors`) instead of
     /// `scene.geometry`: the symmetry methods draw the objects before the planes, or a fresh
     /// bake.
     pub fn for_geometry(
-        device: &wgpu::Device,
+        gpu: &crate::Gpu,
         scene: &Scene,
         g: &mirrorbox_scene::Geometry,
         shadows: crate::shadow_plan::ShadowBinding<'_>,
     ) -> Self {
+        let device = &gpu.device;
+        let (bumps, atlas_width, texels) = mirror_bumps(scene);
         let vertex = |i: usize| triangle_vertices(g, i);
         let mut vertices: Vec<Vertex> = Vec::with_capacity(g.triangles.len() * 3);
         let mut mirror_tris = vec![Vec::new(); scene.mirrors.len()];
@@ -312,6 +343,7 @@ impl SceneBuffers {
                     mirror: *mirror as u32,
                     reflectance: reflectance.to_array(),
                     back_albedo: back_albedo.to_array(),
+                    bump: bumps[*mirror],
                     ..Zeroable::zeroed()
                 },
             })
@@ -401,17 +433,27 @@ impl SceneBuffers {
             bytemuck::cast_slice(&planes),
             wgpu::BufferUsages::STORAGE,
         );
-        let (bumps, texels) = mirror_bumps(scene);
-        let bumps_buf = init(
-            "mirror bumps",
-            bytemuck::cast_slice(&bumps),
-            wgpu::BufferUsages::STORAGE,
-        );
-        let texels_buf = init(
-            "normal map texels",
+        let atlas = wgpu::util::DeviceExt::create_texture_with_data(
+            device,
+            &gpu.queue,
+            &wgpu::TextureDescriptor {
+                label: Some("normal map atlas"),
+                size: wgpu::Extent3d {
+                    width: atlas_width,
+                    height: texels.len() as u32 / atlas_width,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: wgpu::TextureFormat::R32Uint,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            },
+            wgpu::util::TextureDataOrder::LayerMajor,
             bytemuck::cast_slice(&texels),
-            wgpu::BufferUsages::STORAGE,
         );
+        let atlas_view = atlas.create_view(&Default::default());
         let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
             binding,
             visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
@@ -445,8 +487,14 @@ impl SceneBuffers {
                         multisampled: false,
                     },
                 ),
-                entry(5, storage),
-                entry(6, storage),
+                entry(
+                    5,
+                    wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Uint,
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                ),
             ],
         });
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -475,11 +523,7 @@ impl SceneBuffers {
                 },
                 wgpu::BindGroupEntry {
                     binding: 5,
-                    resource: bumps_buf.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 6,
-                    resource: texels_buf.as_entire_binding(),
+                    resource: wgpu::BindingResource::TextureView(&atlas_view),
                 },
             ],
         });

@@ -1227,3 +1227,51 @@ fn shadow_maps_approach_the_shadowed_truth() {
             .any(|w| w.contains("no shadow map is drawn"))
     );
 }
+
+/// The WGSL shading normal of an uneven mirror is the CPU's (`crates/scene/src/bump.rs`):
+/// `--bump normals` shows `(n + 1)/2`; at every pixel centre whose camera ray first meets a
+/// bumpy mirror's front, the CPU's normal at that hit point — ripple (`bumpy_pair`) and
+/// normal map (`bumpy_single`), at a steep 10°.
+#[test]
+fn uneven_mirror_normals_match_the_contract() {
+    for name in ["bumpy_pair.json", "bumpy_single.json"] {
+        let mut s = scene(name, 96, 54);
+        s.set_bump_amplitude(10.0);
+        let image = raster(&s, m("naive bump=normals"), 1);
+        let bvh = SceneBvh::build(&s.geometry);
+        let (mut checked, mut off, mut worst) = (0usize, 0usize, 0f32);
+        for y in 0..s.camera.height {
+            for x in 0..s.camera.width {
+                let ray = s.camera.primary_ray(x as f32 + 0.5, y as f32 + 0.5);
+                let Some(hit) = bvh.closest_hit(&ray, 0.0, f32::INFINITY, None) else {
+                    continue;
+                };
+                let mirrorbox_scene::Surface::Mirror { mirror, .. } =
+                    *s.geometry.surface(hit.triangle)
+                else {
+                    continue;
+                };
+                let (Some(bump), m) = (&s.bumps[mirror], &s.mirrors[mirror]) else {
+                    continue;
+                };
+                if m.normal.dot(ray.dir) >= 0.0 {
+                    continue;
+                }
+                let n = mirrorbox_scene::bump::world_normal_f32(m, bump, ray.at(hit.t));
+                let want = n * 0.5 + Vec3::splat(0.5);
+                let got = Vec3::from_array(image.pixels[(y * s.camera.width + x) as usize]);
+                let d = (got - want).abs().max_element();
+                worst = worst.max(d);
+                checked += 1;
+                off += usize::from(d > 2e-3);
+            }
+        }
+        assert!(checked > 500, "{name}: only {checked} mirror pixels");
+        // Pixels on a silhouette may rasterize another triangle than the CPU's ray hits.
+        assert!(
+            off * 200 < checked,
+            "{name}: {off} of {checked} differ by > 2e-3"
+        );
+        assert!(worst < 0.5, "{name}: worst {worst}");
+    }
+}

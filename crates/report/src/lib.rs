@@ -15,6 +15,7 @@ mod runs;
 pub mod stats;
 pub mod symmetry;
 pub mod table1;
+pub mod uneven;
 mod write;
 
 pub use folder::rewrite_report;
@@ -62,6 +63,10 @@ pub struct Record {
     /// `lighting.mirrored_lights` of the point's scene (a `--mirrored-lights` sweep, issue 15).
     #[serde(default)]
     pub mirrored_lights: Option<u32>,
+    /// The steepest tilt of the point's uneven mirrors, degrees (a `--bump-amplitude` sweep,
+    /// issue 16).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bump_amplitude_deg: Option<f32>,
     /// Symmetry methods: copies of the objects drawn, and 2^p.
     #[serde(default)]
     pub copies_drawn: Option<usize>,

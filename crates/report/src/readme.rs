@@ -76,6 +76,16 @@ pub const REGIONS: &[(&str, &str, &str)] = &[
         "the same on the lit mirror room",
     ),
     (
+        "uneven-mirrors",
+        "uneven_mirrors",
+        "uneven mirrors on the rippled box: every trick's error against the tilt, and its cost",
+    ),
+    (
+        "uneven-mirrors-single",
+        "uneven_mirrors_single",
+        "the same on the hammered single mirror",
+    ),
+    (
         "lighting-trace-cost",
         "lighting/trace_cost.jsonl",
         "the tracer's time against the mirrored-light depth k on both lit scenes",
@@ -204,6 +214,21 @@ fn lighting_region(s: &Sweep) -> Result<String, ReadmeError> {
     }
     Ok(markdown(&[
         Block::Paragraph(measured_on(s)),
+        Block::Bullets(sentences),
+    ]))
+}
+
+fn uneven_region(s: &Sweep) -> Result<String, ReadmeError> {
+    let sentences = crate::uneven::sentences(&s.records);
+    if sentences.is_empty() {
+        return Err(ReadmeError(format!(
+            "{}: no bump-amplitude sweep, nothing to quote",
+            s.info.scene
+        )));
+    }
+    Ok(markdown(&[
+        Block::Paragraph(measured_on(s)),
+        crate::uneven::table(&s.records, false),
         Block::Bullets(sentences),
     ]))
 }
@@ -479,6 +504,7 @@ pub fn generate(id: &str, reports: &Path) -> Result<Region, ReadmeError> {
         "symmetry-scaling" => symmetry_region(&load_sweep(&folder(source))?)?,
         "lighting" | "lighting-room" => lighting_region(&load_sweep(&folder(source))?)?,
         "lighting-trace-cost" => trace_cost_region(&folder(source))?,
+        "uneven-mirrors" | "uneven-mirrors-single" => uneven_region(&load_sweep(&folder(source))?)?,
         "gpu-column" => device_column_region(
             &load_sweep(&folder("table1"))?,
             &load_sweep(&folder(source))?,

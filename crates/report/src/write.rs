@@ -760,6 +760,7 @@ fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
     b.extend(depth_scaling(info, records, floor));
     b.extend(symmetry_section(records));
     b.extend(crate::lighting::lighting_section(records));
+    b.extend(crate::uneven::uneven_section(records));
 
     let mut groups: Vec<(String, f32)> = Vec::new();
     for r in &points {
@@ -953,6 +954,7 @@ pub(crate) mod tests {
             method_options: String::new(),
             symmetry_planes: None,
             mirrored_lights: None,
+            bump_amplitude_deg: None,
             copies_drawn: None,
             copies_total: None,
             bake_ms: None,

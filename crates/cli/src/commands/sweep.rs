@@ -67,6 +67,11 @@ pub struct Args {
     /// (`lighting.mirrored_lights`, docs/shading.md), for each k; each 0..=64.
     #[arg(long)]
     mirrored_lights: Option<String>,
+    /// Uneven-mirror tilts in degrees, comma separated: every point is measured on the scene
+    /// with its uneven mirrors' steepest tilt set to each (ripple amplitude; normal-map
+    /// strength, docs/shading.md); each in [0, 90).
+    #[arg(long, value_delimiter = ',')]
+    bump_amplitude: Option<Vec<f32>>,
 }
 
 /// `--symmetry-planes`: `0,2,4` or `0..=10`.
@@ -202,6 +207,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             .as_deref()
             .map(parse_planes)
             .transpose()?,
+        bump_amplitudes: args.bump_amplitude.clone(),
         mirrored_lights: args
             .mirrored_lights
             .as_deref()
@@ -256,6 +262,17 @@ pub fn run_lighting(args: &PresetArgs) -> Result<(), Failure> {
     room.push("_room");
     run_preset(SweepConfig::lighting(out), args)?;
     run_preset(SweepConfig::lighting_room(room.into()), args)
+}
+
+pub fn run_bumpy(args: &PresetArgs) -> Result<(), Failure> {
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| "reports/uneven_mirrors".into());
+    let mut single = out.clone().into_os_string();
+    single.push("_single");
+    run_preset(SweepConfig::bumpy(out), args)?;
+    run_preset(SweepConfig::bumpy_single(single.into()), args)
 }
 
 fn run_preset(mut config: SweepConfig, args: &PresetArgs) -> Result<(), Failure> {

@@ -249,7 +249,7 @@ impl PortalStencil {
     ) -> Result<Self, RasterError> {
         let device = &gpu.device;
         let (paths, projection) = (&planned.paths, planned.projection);
-        let scene_buffers = SceneBuffers::new(device, scene, shadows.binding());
+        let scene_buffers = SceneBuffers::new(gpu, scene, shadows.binding());
         let size = glam::Vec2::new(planned.width as f32, planned.height as f32);
         let mut arena = UniformArena::new(device);
         let mut offsets = Vec::with_capacity(paths.paths.len());

@@ -506,7 +506,7 @@ impl RecursiveTexture {
         bump: BumpSettings,
     ) -> Result<Self, RasterError> {
         let device = &gpu.device;
-        let scene_buffers = SceneBuffers::new(device, scene, shadows.binding());
+        let scene_buffers = SceneBuffers::new(gpu, scene, shadows.binding());
         let (lo, hi) = scene
             .geometry
             .triangles

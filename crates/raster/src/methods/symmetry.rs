@@ -584,7 +584,7 @@ impl CopiesFrame {
         let masks_bytes = 4 * planned.masks.len().max(1) as u64;
         gpu.check_buffer("copy mask", masks_bytes, true)?;
         let scene_buffers =
-            SceneBuffers::for_geometry(device, scene, &planned.geometry, shadows.binding());
+            SceneBuffers::for_geometry(gpu, scene, &planned.geometry, shadows.binding());
         let settings = planned.settings;
         let clip_distances = gpu.features.contains(wgpu::Features::CLIP_DISTANCES)
             && planned.plane_count <= MAX_CLIP_DISTANCE_PLANES

@@ -172,7 +172,7 @@ impl BakedFrame {
         let device = &gpu.device;
         SceneBuffers::check_fits_geometry(gpu, scene, &planned.geometry)?;
         let scene_buffers =
-            SceneBuffers::for_geometry(device, scene, &planned.geometry, shadows.binding());
+            SceneBuffers::for_geometry(gpu, scene, &planned.geometry, shadows.binding());
         let frame_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("symmetry-baked frame"),
             contents: bytemuck::bytes_of(&planned.frame),

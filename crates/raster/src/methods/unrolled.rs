@@ -284,7 +284,7 @@ impl Unrolled {
         let (width, height) = (planned.width, planned.height);
         let clip_distances =
             gpu.features.contains(wgpu::Features::CLIP_DISTANCES) && !fragment_clipping;
-        let scene_buffers = SceneBuffers::new(device, scene, shadows.binding());
+        let scene_buffers = SceneBuffers::new(gpu, scene, shadows.binding());
         let size = Vec2::new(width as f32, height as f32);
         let planes: Vec<Vec4> = scene
             .mirrors
