@@ -710,7 +710,7 @@ fn render_refuses_bad_arguments() {
         ),
         (
             &["--method", "auxiliary", "--depth", "8"],
-            "--depth applies to --method portal or unrolled only",
+            "--depth applies to --method path-textures, portal or unrolled only",
         ),
         (
             &["--method", "portal", "--fragment-clipping"],
@@ -729,7 +729,7 @@ fn render_refuses_bad_arguments() {
         ),
         (
             &["--method", "naive", "--min-attenuation", "0.01"],
-            "--min-attenuation applies to --method portal or unrolled only",
+            "--min-attenuation applies to --method path-textures, portal or unrolled only",
         ),
         (
             &["--method", "portal", "--texture-scale", "2"],
@@ -737,7 +737,7 @@ fn render_refuses_bad_arguments() {
         ),
         (
             &["--method", "naive", "--depth", "0"],
-            "--depth applies to --method portal or unrolled only",
+            "--depth applies to --method path-textures, portal or unrolled only",
         ),
         (
             &["--method", "symmetry", "--symmetry-draws", "bogus"],

@@ -231,9 +231,15 @@ fn uneven_mirrors_agree_with_mitsuba() {
         let sub = dir.path().join(scene.replace('/', "_"));
         let (a, b) = both_of(&py, scene, &sub, "whitted", "16", "10000");
         let (mean, off) = mean_off(&a, &b);
-        println!("{scene}: mean |d| {mean:.3e}, {:.2} % of pixels off by > 1e-2", 100.0 * off);
+        println!(
+            "{scene}: mean |d| {mean:.3e}, {:.2} % of pixels off by > 1e-2",
+            100.0 * off
+        );
         assert!(mean < mean_limit, "{scene}: mean |d| {mean}");
-        assert!(off < off_limit, "{scene}: {off} of the pixels differ by > 1e-2");
+        assert!(
+            off < off_limit,
+            "{scene}: {off} of the pixels differ by > 1e-2"
+        );
         // The same scene with its mirrors flat, traced by us: the bump's own effect.
         let text = std::fs::read_to_string(repo().join(scene)).unwrap();
         let mut flat: serde_json::Value = serde_json::from_str(&text).unwrap();
@@ -249,12 +255,21 @@ fn uneven_mirrors_agree_with_mitsuba() {
         let flat_exr = sub.join("flat.exr");
         let bin = env!("CARGO_BIN_EXE_mirrorbox");
         let out = Command::new(bin)
-            .args(["trace", flat_path.to_str().unwrap(), "-o", flat_exr.to_str().unwrap()])
+            .args([
+                "trace",
+                flat_path.to_str().unwrap(),
+                "-o",
+                flat_exr.to_str().unwrap(),
+            ])
             .args(["--spp", "16", "--width", "64", "--height", "36"])
             .output()
             .unwrap();
         let _ = std::fs::remove_file(&flat_path);
-        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
         let (flat_mean, _) = mean_off(&read_image(&flat_exr).unwrap(), &b);
         println!("{scene}: flat vs Mitsuba's uneven: mean |d| {flat_mean:.3e}");
         assert!(

@@ -257,8 +257,8 @@ impl SweepConfig {
     /// with every trick of `--bump` (`crates/raster/src/uneven.rs`) — the bump ignored,
     /// the screen-space distortion at four strengths and its 1/distance form, the proxy plane,
     /// the march with and without a 16-pixel texture margin — and, beside them, the march at
-    /// n = 4 (two reflections deeper) and the exact `unrolled` at depth 64, which shows the
-    /// mirror flat; against truths whose rippled mirror tilts by 0, 1, 2.5, 5 and 10°;
+    /// n = 4 (two reflections deeper), the exact `unrolled` at depth 64, which shows the
+    /// mirror flat, and the exact `path-textures` at depth 64 with four tricks; against truths whose rippled mirror tilts by 0, 1, 2.5, 5 and 10°;
     /// 320×180, 6 timed frames after one warm-up.
     pub fn bumpy(out: PathBuf) -> Self {
         SweepConfig {
@@ -266,7 +266,14 @@ impl SweepConfig {
             ..SweepConfig::bumpy_variants(
                 out,
                 "auxiliary n=2",
-                &["auxiliary n=4 bump=march", "unrolled depth=64"],
+                &[
+                    "auxiliary n=4 bump=march",
+                    "unrolled depth=64",
+                    "path-textures depth=64 bump=flat",
+                    "path-textures depth=64 bump=distort bump-strength=1",
+                    "path-textures depth=64 bump=proxy",
+                    "path-textures depth=64 bump=march",
+                ],
             )
         }
     }
@@ -1084,6 +1091,15 @@ pub fn run_sweep(
         exact_methods: METHODS
             .iter()
             .filter(|e| e.exact)
+            .map(|e| e.name.to_string())
+            .collect(),
+        bump_methods: METHODS
+            .iter()
+            .filter(|e| {
+                e.options
+                    .iter()
+                    .any(|o| std::ptr::eq(*o, &mirrorbox_raster::uneven::BUMP))
+            })
             .map(|e| e.name.to_string())
             .collect(),
     };

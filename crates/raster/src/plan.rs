@@ -464,6 +464,41 @@ mod tests {
     use super::*;
     use mirrorbox_scene::load::bundled_scene as scene;
 
+    /// `path-textures` on the paper's box: one path per depth (the camera sees one mirror,
+    /// each reflection the other), each texture inside its parent's; the attenuation cut
+    /// ends the chain where the tracer's throughput cut does; a room's branching is refused
+    /// by --max-passes with the numbers.
+    #[test]
+    fn path_textures_plan_one_texture_per_reflection_path() {
+        let s = scene("mirror_box.json");
+        let limits = |depth| PathTextureLimits {
+            depth,
+            min_attenuation: 1e-4,
+        };
+        for depth in [1, 4, 16] {
+            let p = plan_paths(&s, limits(depth), 320, 180, 5000).unwrap();
+            assert_eq!((p.passes, p.depth), (1 + depth as usize, depth as usize));
+            let mut node = &p.roots[0];
+            while let Some(child) = node.children.first() {
+                let (a, b) = (node.footprint, child.footprint);
+                assert!(
+                    b.x >= a.x && b.y >= a.y && b.x + b.w <= a.x + a.w && b.y + b.h <= a.y + a.h
+                );
+                assert_ne!(child.instance, node.instance);
+                node = child;
+            }
+        }
+        // 0.9^k ≥ 1e-4 up to k = 87: a depth of 1000 stops there.
+        let p = plan_paths(&s, limits(1000), 320, 180, 5000).unwrap();
+        assert_eq!(p.depth, 87);
+        let room = scene("mirror_room.json");
+        let e = plan_paths(&room, limits(64), 320, 180, 5000).unwrap_err();
+        assert!(
+            matches!(e, PlanError::TooManyPasses { limit: 5000, .. }),
+            "{e}"
+        );
+    }
+
     /// The pass counts of the paper's auxiliary method on `mirror_box` (see the module docs
     /// for the formula): factorial growth, as in Table 1.
     #[test]
@@ -656,4 +691,122 @@ mod tests {
             assert!(count.chains_visited <= 11, "{name}: {count:?}");
         }
     }
+}
+
+/// The limits of a per-path texture plan ([`plan_paths`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PathTextureLimits {
+    /// Most mirrors along a path (`--depth`).
+    pub depth: u32,
+    /// Paths whose attenuation (largest channel of the reflectances' product) falls below
+    /// this end there (`--min-attenuation`, the tracer's `--min-throughput`).
+    pub min_attenuation: f32,
+}
+
+/// Where two screen rectangles overlap, if they do.
+fn intersect(a: Rect, b: Rect) -> Option<Rect> {
+    let x = a.x.max(b.x);
+    let y = a.y.max(b.y);
+    let right = (a.x + a.w).min(b.x + b.w);
+    let bottom = (a.y + a.h).min(b.y + b.h);
+    (right > x && bottom > y).then(|| Rect {
+        x,
+        y,
+        w: right - x,
+        h: bottom - y,
+    })
+}
+
+impl Planner<'_> {
+    /// The texture of path `…, instance` (seen from `parent` through `parent_plane`, inside
+    /// the screen region `rect`) and, below it, every path extending it by one mirror: any
+    /// mirror but this one (a plane cannot see itself) that its camera sees inside `rect`,
+    /// while the path has fewer than `depth` mirrors and its attenuation stays above the
+    /// limit. `budget` counts the passes left.
+    #[allow(clippy::too_many_arguments)]
+    fn path_node(
+        &self,
+        parent: &ReflectedView,
+        instance: usize,
+        rect: Rect,
+        mirrors: u32,
+        attenuation: f32,
+        limits: PathTextureLimits,
+        budget: &mut usize,
+    ) -> Option<TextureNode> {
+        if *budget == 0 {
+            return None;
+        }
+        *budget -= 1;
+        let plane = self.scene.mirrors[self.instances[instance].mirror].plane();
+        let view = parent.through(&plane);
+        let mut children = Vec::new();
+        if mirrors < limits.depth {
+            for (i, r) in self.visible(&view, Some(&plane), &[instance]) {
+                let next = attenuation * self.scene.mirrors[i].reflectance.max_element();
+                let Some(r) = intersect(r, rect) else {
+                    continue;
+                };
+                if next < limits.min_attenuation {
+                    continue;
+                }
+                children.push(self.path_node(&view, i, r, mirrors + 1, next, limits, budget)?);
+            }
+        }
+        Some(TextureNode {
+            instance,
+            view,
+            plane,
+            footprint: rect,
+            hidden: vec![instance],
+            children,
+        })
+    }
+}
+
+/// Plans one mirror texture per reflection path (`path-textures`, exact to `limits.depth`):
+/// the paper's recursion without its one-use-per-mirror rule — any mirror may follow any
+/// other — each texture cut to the part of the screen its parent's texture covers (a
+/// reflection is only seen through its parent's mirror). Refuses, after at most
+/// `max_passes` nodes, a plan of more scene passes.
+pub fn plan_paths(
+    scene: &Scene,
+    limits: PathTextureLimits,
+    width: u32,
+    height: u32,
+    max_passes: usize,
+) -> Result<Plan, PlanError> {
+    let instances = instances(scene, Queue::SceneMirrors)?;
+    let planner = Planner::new(scene, &instances, width, height);
+    let main = planner.main_view(width, height);
+    let mut budget = max_passes.saturating_sub(1);
+    let mut roots = Vec::new();
+    for (i, rect) in planner.visible(&main, None, &[]) {
+        let attenuation = scene.mirrors[i].reflectance.max_element();
+        if attenuation < limits.min_attenuation {
+            continue;
+        }
+        let Some(node) = planner.path_node(&main, i, rect, 1, attenuation, limits, &mut budget)
+        else {
+            return Err(PlanError::TooManyPasses {
+                predicted: max_passes + 1,
+                limit: max_passes,
+                exceeded_count: true,
+            });
+        };
+        roots.push(node);
+    }
+    fn count(nodes: &[TextureNode]) -> usize {
+        nodes.iter().map(|n| 1 + count(&n.children)).sum()
+    }
+    let depth = depth(&roots);
+    Ok(Plan {
+        projection: planner.projection,
+        instances,
+        width,
+        height,
+        passes: 1 + count(&roots),
+        roots,
+        depth,
+    })
 }

@@ -313,7 +313,7 @@ mod tests {
                 .with(depth, ParamValue::Count(8))
                 .unwrap_err()
                 .to_string(),
-            "--depth applies to --method portal or unrolled only"
+            "--depth applies to --method path-textures, portal or unrolled only"
         );
         let portal = Method::named("portal").unwrap();
         assert_eq!(

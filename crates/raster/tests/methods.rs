@@ -1294,11 +1294,17 @@ fn uneven_mirror_tricks_beat_the_flat_mirror() {
     let distort = flip("naive bump=distort");
     println!("FLIP: flat {flat:.3e}, distort {distort:.3e}, proxy {proxy:.3e}, march {march:.3e}");
     assert!(march < 0.75 * flat, "march {march} vs flat {flat}");
-    assert!(proxy < flat && distort < flat, "proxy {proxy}, distort {distort}, flat {flat}");
+    assert!(
+        proxy < flat && distort < flat,
+        "proxy {proxy}, distort {distort}, flat {flat}"
+    );
     let plain = scene("mirror_box.json", 64, 36);
     let reference = raster(&plain, m("naive"), 1);
     for trick in ["flat", "distort", "proxy", "march", "normals"] {
         let image = raster(&plain, m(&format!("naive bump={trick}")), 1);
-        assert_eq!(image.pixels, reference.pixels, "bump={trick} on flat mirrors");
+        assert_eq!(
+            image.pixels, reference.pixels,
+            "bump={trick} on flat mirrors"
+        );
     }
 }

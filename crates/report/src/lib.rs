@@ -190,6 +190,10 @@ pub struct SweepInfo {
     /// and sets them beside the paper's method).
     #[serde(default)]
     pub exact_methods: Vec<String>,
+    /// The methods that read uneven mirrors with a trick (their `bump` option), from the
+    /// raster registry; the others show an uneven mirror flat (issue 16).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub bump_methods: Vec<String>,
 }
 
 impl SweepInfo {

@@ -219,7 +219,7 @@ fn lighting_region(s: &Sweep) -> Result<String, ReadmeError> {
 }
 
 fn uneven_region(s: &Sweep) -> Result<String, ReadmeError> {
-    let sentences = crate::uneven::sentences(&s.records);
+    let sentences = crate::uneven::sentences(&s.records, &s.info.bump_methods);
     if sentences.is_empty() {
         return Err(ReadmeError(format!(
             "{}: no bump-amplitude sweep, nothing to quote",
@@ -228,7 +228,7 @@ fn uneven_region(s: &Sweep) -> Result<String, ReadmeError> {
     }
     Ok(markdown(&[
         Block::Paragraph(measured_on(s)),
-        crate::uneven::table(&s.records, false),
+        crate::uneven::table(&s.records, &s.info.bump_methods, false),
         Block::Bullets(sentences),
     ]))
 }

@@ -43,11 +43,11 @@ pub fn method_of(r: &Record) -> String {
 
 /// The trick in words, from the options (absent options are at their defaults: `march`,
 /// strength 0.5, proxy at 2, 48 steps, no margin): `distort ×1`, `march, margin 16 px`.
-/// The exact methods (`portal`, `unrolled`: those with a depth) take no `bump` option: they
-/// show an uneven mirror flat.
-pub fn trick_of(r: &Record) -> String {
-    if r.depth.is_some() {
-        return "flat (exact method)".into();
+/// A method not in `bump_methods` (the sweep's registry: those with a `bump` option) shows an
+/// uneven mirror flat: it has no texture to read.
+pub fn trick_of(r: &Record, bump_methods: &[String]) -> String {
+    if !bump_methods.contains(&r.method) {
+        return "flat (no texture to read)".into();
     }
     let option = |name: &str| {
         r.method_options.split_whitespace().find_map(|w| {
@@ -92,12 +92,12 @@ fn main_method(points: &[&Record]) -> String {
 
 /// A point's row and series name: its trick, prefixed with its method where that is not the
 /// main method (`auxiliary n=4: march`).
-fn variant_of(r: &Record, main: &str) -> String {
+fn variant_of(r: &Record, main: &str, bump_methods: &[String]) -> String {
     let m = method_of(r);
     if m == main {
-        trick_of(r)
+        trick_of(r, bump_methods)
     } else {
-        format!("{m}: {}", trick_of(r))
+        format!("{m}: {}", trick_of(r, bump_methods))
     }
 }
 
@@ -125,7 +125,7 @@ fn amplitudes(points: &[&Record]) -> Vec<f32> {
 }
 
 /// Which trick wins at each tilt, by how much, and what the best distortion strength is.
-pub fn sentences(records: &[Record]) -> Vec<String> {
+pub fn sentences(records: &[Record], bump_methods: &[String]) -> Vec<String> {
     let pts = points(records);
     let main = main_method(&pts);
     let mut out = Vec::new();
@@ -144,11 +144,11 @@ pub fn sentences(records: &[Record]) -> Vec<String> {
         let Some(win) = best(&|_| true) else {
             continue;
         };
-        let flat = best(&|r| variant_of(r, &main) == "flat");
-        let distort = best(&|r| variant_of(r, &main).starts_with("distort "));
+        let flat = best(&|r| variant_of(r, &main, bump_methods) == "flat");
+        let distort = best(&|r| variant_of(r, &main, bump_methods).starts_with("distort "));
         let mut s = format!(
             "At {a}°: `{}` is closest to the truth, FLIP mean {} (relMSE {}) at {} ms/frame",
-            variant_of(win, &main),
+            variant_of(win, &main, bump_methods),
             sci(win.metrics.flip_mean),
             sci(win.metrics.relmse),
             ms_cell(win, 1)
@@ -162,7 +162,7 @@ pub fn sentences(records: &[Record]) -> Vec<String> {
         if let Some(d) = distort {
             s.push_str(&format!(
                 "; the best distortion strength is `{}` ({})",
-                trick_of(d),
+                variant_of(d, &main, bump_methods),
                 sci(d.metrics.flip_mean)
             ));
         }
@@ -174,11 +174,11 @@ pub fn sentences(records: &[Record]) -> Vec<String> {
 
 /// Every trick's time and error at every tilt, one row per trick; `relmse` adds the relMSE
 /// columns.
-pub(crate) fn table(records: &[Record], relmse: bool) -> Block {
+pub(crate) fn table(records: &[Record], bump_methods: &[String], relmse: bool) -> Block {
     let pts = points(records);
     let amps = amplitudes(&pts);
     let main = main_method(&pts);
-    let tricks = distinct(pts.iter().map(|r| variant_of(r, &main)));
+    let tricks = distinct(pts.iter().map(|r| variant_of(r, &main, bump_methods)));
     let mut header = vec!["trick".to_string(), "ms/frame median [95 % CI]".into()];
     header.extend(amps.iter().map(|a| format!("FLIP at {a}°")));
     if relmse {
@@ -187,7 +187,7 @@ pub(crate) fn table(records: &[Record], relmse: bool) -> Block {
     let find = |t: &str, a: f32| {
         pts.iter()
             .copied()
-            .find(|r| variant_of(r, &main) == t && r.bump_amplitude_deg == Some(a))
+            .find(|r| variant_of(r, &main, bump_methods) == t && r.bump_amplitude_deg == Some(a))
     };
     let rows = tricks
         .iter()
@@ -212,14 +212,14 @@ pub(crate) fn table(records: &[Record], relmse: bool) -> Block {
 }
 
 /// The report section of a bump-amplitude sweep (empty for any other sweep).
-pub(crate) fn uneven_section(records: &[Record]) -> Vec<Block> {
+pub(crate) fn uneven_section(records: &[Record], bump_methods: &[String]) -> Vec<Block> {
     let pts = points(records);
     if pts.is_empty() {
         return Vec::new();
     }
     let amps = amplitudes(&pts);
     let main = main_method(&pts);
-    let tricks = distinct(pts.iter().map(|r| variant_of(r, &main)));
+    let tricks = distinct(pts.iter().map(|r| variant_of(r, &main, bump_methods)));
     let methods = distinct(pts.iter().map(|r| method_of(r)));
     let mut out = vec![
         Block::Heading(
@@ -244,7 +244,7 @@ pub(crate) fn uneven_section(records: &[Record]) -> Vec<Block> {
             let mut rs: Vec<&Record> = pts
                 .iter()
                 .copied()
-                .filter(|r| &variant_of(r, &main) == t)
+                .filter(|r| &variant_of(r, &main, bump_methods) == t)
                 .collect();
             rs.sort_by(|p, q| {
                 p.bump_amplitude_deg
@@ -281,8 +281,8 @@ pub(crate) fn uneven_section(records: &[Record]) -> Vec<Block> {
         }
         .to_svg(),
     ));
-    out.push(table(records, true));
-    let s = sentences(records);
+    out.push(table(records, bump_methods, true));
+    let s = sentences(records, bump_methods);
     if !s.is_empty() {
         out.push(Block::Bullets(s));
     }
@@ -300,7 +300,9 @@ pub(crate) fn uneven_section(records: &[Record]) -> Vec<Block> {
         let chosen = distinct(
             [
                 at.first().copied(),
-                at.iter().copied().find(|r| variant_of(r, &main) == "flat"),
+                at.iter()
+                    .copied()
+                    .find(|r| variant_of(r, &main, bump_methods) == "flat"),
             ]
             .into_iter()
             .flatten()
@@ -317,12 +319,12 @@ pub(crate) fn uneven_section(records: &[Record]) -> Vec<Block> {
             out.push(Block::Paragraph(format!(
                 "{}, {}, tilt {a}°: FLIP mean {}",
                 method_of(r),
-                trick_of(r),
+                trick_of(r, bump_methods),
                 sci(r.metrics.flip_mean)
             )));
             out.push(Block::Images(vec![
                 (format!("truth ({a}°)"), r.truth_image.clone()),
-                (variant_of(r, &main), r.raster_image.clone()),
+                (variant_of(r, &main, bump_methods), r.raster_image.clone()),
                 ("FLIP error".into(), r.heatmap_image.clone()),
             ]));
         }
@@ -333,6 +335,10 @@ pub(crate) fn uneven_section(records: &[Record]) -> Vec<Block> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn bump() -> Vec<String> {
+        vec!["auxiliary".into(), "path-textures".into()]
+    }
 
     fn record(options: &str, a: f32, flip: f64) -> Record {
         let mut r = crate::write::tests::record(2, 10.0, 1, flip);
@@ -346,19 +352,22 @@ mod tests {
     #[test]
     fn tricks_are_read_from_the_options() {
         let r = record("bump=distort bump-strength=2", 5.0, 0.1);
-        assert_eq!(trick_of(&r), "distort ×2");
+        assert_eq!(trick_of(&r, &bump()), "distort ×2");
         assert_eq!(method_of(&r), "auxiliary n=2");
-        assert_eq!(trick_of(&record("", 5.0, 0.1)), "march");
+        assert_eq!(trick_of(&record("", 5.0, 0.1), &bump()), "march");
         assert_eq!(
-            trick_of(&record("bump=march texture-margin=16", 5.0, 0.1)),
+            trick_of(&record("bump=march texture-margin=16", 5.0, 0.1), &bump()),
             "march, margin 16 px"
         );
-        assert_eq!(trick_of(&record("bump=proxy", 5.0, 0.1)), "proxy at 2");
+        assert_eq!(
+            trick_of(&record("bump=proxy", 5.0, 0.1), &bump()),
+            "proxy at 2"
+        );
         let mut exact = record("", 5.0, 0.1);
         exact.method = "unrolled".into();
         exact.n = None;
         exact.depth = Some(64);
-        assert_eq!(trick_of(&exact), "flat (exact method)");
+        assert_eq!(trick_of(&exact, &bump()), "flat (no texture to read)");
         let main = main_method(&[
             &record("", 5.0, 0.1),
             &record("bump=flat", 5.0, 0.1),
@@ -366,8 +375,8 @@ mod tests {
         ]);
         assert_eq!(main, "auxiliary n=2");
         assert_eq!(
-            variant_of(&exact, &main),
-            "unrolled depth=64: flat (exact method)"
+            variant_of(&exact, &main, &bump()),
+            "unrolled depth=64: flat (no texture to read)"
         );
     }
 
@@ -381,7 +390,7 @@ mod tests {
             record("bump=flat", 0.0, 0.01),
             record("", 0.0, 0.02),
         ];
-        let s = sentences(&records).join("\n");
+        let s = sentences(&records, &bump()).join("\n");
         assert!(s.contains("At 0°: `flat` is closest"), "{s}");
         assert!(
             s.contains("At 5°: `march` is closest to the truth, FLIP mean 5.000e-2"),
@@ -395,9 +404,9 @@ mod tests {
             s.contains("best distortion strength is `distort ×1` (1.500e-1)"),
             "{s}"
         );
-        assert!(uneven_section(&records).len() >= 5);
+        assert!(uneven_section(&records, &bump()).len() >= 5);
         let mut plain = records[0].clone();
         plain.bump_amplitude_deg = None;
-        assert!(uneven_section(&[plain]).is_empty());
+        assert!(uneven_section(&[plain], &bump()).is_empty());
     }
 }

@@ -760,7 +760,7 @@ fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
     b.extend(depth_scaling(info, records, floor));
     b.extend(symmetry_section(records));
     b.extend(crate::lighting::lighting_section(records));
-    b.extend(crate::uneven::uneven_section(records));
+    b.extend(crate::uneven::uneven_section(records, &info.bump_methods));
 
     let mut groups: Vec<(String, f32)> = Vec::new();
     for r in &points {
@@ -1134,6 +1134,7 @@ pub(crate) mod tests {
         let info = SweepInfo {
             scene: "scenes/mirror_box.json".into(),
             exact_methods: vec!["unrolled".into()],
+            bump_methods: Vec::new(),
             ..SweepInfo::default()
         };
         let exact_point = |ms: f64, drift: &dyn Fn(usize) -> f64| {

@@ -17,6 +17,7 @@ use crate::method::MethodEntry;
 pub static METHODS: &[&MethodEntry] = &[
     &recursive_texture::NAIVE,
     &recursive_texture::AUXILIARY,
+    &recursive_texture::PATH_TEXTURES,
     &portal_stencil::PORTAL,
     &unrolled::UNROLLED,
     &symmetry::SYMMETRY,

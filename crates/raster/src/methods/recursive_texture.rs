@@ -97,6 +97,46 @@ pub static AUXILIARY: MethodEntry = MethodEntry {
     },
 };
 
+/// Exact to `--depth`: the paper's mirror textures, one per reflection path — a colour and
+/// distance target per path in screen space, so the uneven-mirror tricks (`--bump`) work at
+/// every depth of an exact method (issue 16). Cost: one scene pass per kept path, like
+/// `portal`, each into a texture no larger than its parent's.
+pub static PATH_TEXTURES: MethodEntry = MethodEntry {
+    name: "path-textures",
+    help: "Exact to --depth: one mirror texture per reflection path (a colour + distance target each), so uneven-mirror tricks apply at every depth.",
+    exact: true,
+    options: &[
+        &crate::exact_paths::DEPTH,
+        &crate::exact_paths::MIN_ATTENUATION,
+        &MAX_PASSES,
+        &crate::lighting::LIGHTS,
+        &crate::lighting::SHADOWS,
+        &crate::lighting::SHADOW_MAP_SIZE,
+        &crate::lighting::SHADOW_BIAS,
+        crate::uneven::OPTIONS[0],
+        crate::uneven::OPTIONS[1],
+        crate::uneven::OPTIONS[2],
+        crate::uneven::OPTIONS[3],
+        crate::uneven::OPTIONS[4],
+    ],
+    swept: Some(&crate::exact_paths::DEPTH),
+    optional_features: wgpu::Features::CLIP_DISTANCES,
+    required_features: wgpu::Features::empty(),
+    shaders: &[&SHADER, &CLIP_DISTANCE_SHADER],
+    gpu_structs,
+    configure: |p| {
+        Box::new(RecursiveTextureMethod {
+            queue: TextureQueue::Paths(crate::plan::PathTextureLimits {
+                depth: p.count(&crate::exact_paths::DEPTH),
+                min_attenuation: p.real(&crate::exact_paths::MIN_ATTENUATION),
+            }),
+            texture_scale: 1.0,
+            max_passes: p.count(&MAX_PASSES) as usize,
+            bump: BumpSettings::from_params(p),
+        })
+    },
+};
+
 const ENTRY_POINTS: &str = include_str!("../../../../shaders/recursive_texture.wgsl");
 
 crate::mirror_plane_shaders!("recursive texture", ENTRY_POINTS);
@@ -157,9 +197,16 @@ pub static MAX_PASSES: OptionSpec = OptionSpec {
     in_key: false,
 };
 
-/// The typed settings of `naive` and `auxiliary`.
+/// What the textures recurse over: the paper's queue, or every reflection path.
+#[derive(Clone, Copy)]
+enum TextureQueue {
+    Paper(Queue),
+    Paths(crate::plan::PathTextureLimits),
+}
+
+/// The typed settings of `naive`, `auxiliary` and `path-textures`.
 struct RecursiveTextureMethod {
-    queue: Queue,
+    queue: TextureQueue,
     texture_scale: f32,
     max_passes: usize,
     bump: BumpSettings,
@@ -168,7 +215,7 @@ struct RecursiveTextureMethod {
 impl RecursiveTextureMethod {
     fn new(queue: Queue, p: &Params) -> Self {
         RecursiveTextureMethod {
-            queue,
+            queue: TextureQueue::Paper(queue),
             texture_scale: p.real(&TEXTURE_SCALE),
             max_passes: p.count(&MAX_PASSES) as usize,
             bump: BumpSettings::from_params(p),
@@ -183,7 +230,12 @@ impl RasterMethod for RecursiveTextureMethod {
         width: u32,
         height: u32,
     ) -> Result<Box<dyn PlannedFrame>, PlanError> {
-        let plan = crate::plan::plan(scene, self.queue, width, height, self.max_passes)?;
+        let plan = match self.queue {
+            TextureQueue::Paper(q) => crate::plan::plan(scene, q, width, height, self.max_passes)?,
+            TextureQueue::Paths(limits) => {
+                crate::plan::plan_paths(scene, limits, width, height, self.max_passes)?
+            }
+        };
         Ok(Box::new(PlannedTextures {
             plan,
             texture_scale: self.texture_scale,
