@@ -95,7 +95,7 @@ fn texture_position(screen: vec2f) -> vec2f {
 }
 
 // Bilinear radiance of the applied texture at screen position `screen`, clamped to its edge
-// (the uneven-mirror tricks' lookups fall between texels).
+// (a resampled texture, and the uneven-mirror tricks' lookups, fall between texels).
 fn mirror_sample(screen: vec2f) -> vec3f {
     let t = texture_position(screen) - 0.5;
     let i = vec2i(floor(t));
@@ -103,6 +103,16 @@ fn mirror_sample(screen: vec2f) -> vec3f {
     let a = mix(load_clamped(i), load_clamped(i + vec2i(1, 0)), f.x);
     let b = mix(load_clamped(i + vec2i(0, 1)), load_clamped(i + vec2i(1, 1)), f.x);
     return mix(a, b, f.y);
+}
+
+// The projective lookup: the radiance the applied texture holds for this screen position
+// (texel for pixel where no resampling is needed).
+fn mirror_lookup(frag: vec2f) -> vec3f {
+    let screen = pass_.origin + frag * pass_.pixels_per_texel;
+    if (mirror.exact == 1u) {
+        return load_clamped(vec2i(floor(texture_position(screen))));
+    }
+    return mirror_sample(screen);
 }
 
 // The screen position of world point p seen by the pass's camera.
@@ -199,21 +209,6 @@ fn uneven_mirror_colour(in: VertexOut, s: Surface, b: MirrorBump) -> vec4f {
         default: {}
     }
     return vec4f(s.reflectance * mirror_sample(screen), alpha);
-}
-
-// The projective lookup: the radiance the applied texture holds for this screen position.
-fn mirror_lookup(frag: vec2f) -> vec3f {
-    let screen = pass_.origin + frag * pass_.pixels_per_texel;
-    let local = (screen - mirror.origin) * mirror.texels_per_pixel;
-    if (mirror.exact == 1u) {
-        return load_clamped(vec2i(floor(local)));
-    }
-    let t = local - 0.5;
-    let i = vec2i(floor(t));
-    let f = t - floor(t);
-    let a = mix(load_clamped(i), load_clamped(i + vec2i(1, 0)), f.x);
-    let b = mix(load_clamped(i + vec2i(0, 1)), load_clamped(i + vec2i(1, 1)), f.x);
-    return mix(a, b, f.y);
 }
 
 fn mirror_colour(in: VertexOut) -> vec4f {

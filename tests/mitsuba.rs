@@ -106,12 +106,7 @@ fn whitted_agrees_with_mitsuba() {
     let (a, b) = both(&py, dir.path(), "whitted", "4", "10000");
     // Deterministic, same sub-pixel grid: only silhouette samples that land on another
     // triangle may differ (measured: 0.03 % of pixels at 160×90, mean |d| 8e-6).
-    let d: Vec<f32> = a
-        .pixels
-        .iter()
-        .zip(&b.pixels)
-        .map(|(p, q)| (0..3).map(|c| (p[c] - q[c]).abs()).fold(0.0, f32::max))
-        .collect();
+    let d = channel_differences(&a, &b);
     let mean = d.iter().sum::<f32>() / d.len() as f32;
     let off = d.iter().filter(|&&x| x > 1e-3).count();
     assert!(mean < 1e-4, "mean |d| {mean}");
@@ -120,6 +115,15 @@ fn whitted_agrees_with_mitsuba() {
         "{off} of {} pixels differ by > 1e-3",
         d.len()
     );
+}
+
+/// Per pixel, the largest |difference| of its three channels.
+fn channel_differences(a: &RgbImage, b: &RgbImage) -> Vec<f32> {
+    a.pixels
+        .iter()
+        .zip(&b.pixels)
+        .map(|(p, q)| (0..3).map(|c| (p[c] - q[c]).abs()).fold(0.0, f32::max))
+        .collect()
 }
 
 /// Block means of the per-pixel difference (k×k blocks, all channels).
@@ -214,12 +218,7 @@ fn uneven_mirrors_agree_with_mitsuba() {
     let Some(py) = python() else { return };
     let dir = tempfile::tempdir().unwrap();
     let mean_off = |a: &RgbImage, b: &RgbImage| {
-        let d: Vec<f32> = a
-            .pixels
-            .iter()
-            .zip(&b.pixels)
-            .map(|(p, q)| (0..3).map(|c| (p[c] - q[c]).abs()).fold(0.0, f32::max))
-            .collect();
+        let d = channel_differences(a, b);
         let mean = d.iter().sum::<f32>() / d.len() as f32;
         let off = d.iter().filter(|&&x| x > 1e-2).count() as f32 / d.len() as f32;
         (mean, off)

@@ -114,12 +114,7 @@ impl RenderTarget {
         clear: glam::Vec3,
         timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
     ) -> wgpu::RenderPass<'e> {
-        let depth = DepthClear {
-            view: &self.depth_view,
-            depth: FAR_DEPTH,
-            stencil: None,
-        };
-        self.begin_pass_with(encoder, label, clear, depth, timestamps)
+        self.begin_pass_with_alpha(encoder, label, clear, 1.0, timestamps)
     }
 
     /// [`RenderTarget::begin_pass`] clearing alpha to `alpha` (a mirror texture whose alpha

@@ -160,6 +160,37 @@ impl Record {
         self.ms_interval
             .map(|[low, high]| stats::Interval { low, high })
     }
+
+    /// The value of raster option `name` among the record's non-default options.
+    pub fn option(&self, name: &str) -> Option<&str> {
+        self.method_options.split_whitespace().find_map(|w| {
+            w.split_once('=')
+                .filter(|(n, _)| *n == name)
+                .map(|(_, v)| v)
+        })
+    }
+
+    /// The method the point measured, with its swept count and its options except those
+    /// named in `omit`: `auxiliary n=2`, `unrolled depth=64`.
+    pub fn method_without(&self, omit: &[&str]) -> String {
+        let mut words = vec![self.method.clone()];
+        if let Some(n) = self.n {
+            words.push(format!("n={n}"));
+        }
+        if let Some(d) = self.depth {
+            words.push(format!("depth={d}"));
+        }
+        words.extend(
+            self.method_options
+                .split_whitespace()
+                .filter(|w| {
+                    !w.split_once('=')
+                        .is_some_and(|(name, _)| omit.contains(&name))
+                })
+                .map(String::from),
+        );
+        words.join(" ")
+    }
 }
 
 /// The colour format of records written before [`Record::color_format`] existed.

@@ -16,37 +16,10 @@ pub const LIGHTS_OPTION: &str = "lights";
 /// The raster options of a lighting variant (crates/raster/src/lighting.rs).
 const LIGHTING_OPTIONS: [&str; 4] = [LIGHTS_OPTION, "shadows", "shadow-map-size", "shadow-bias"];
 
-/// The value of option `name` among a record's non-default options.
-fn option<'a>(r: &'a Record, name: &str) -> Option<&'a str> {
-    r.method_options.split_whitespace().find_map(|w| {
-        w.split_once('=')
-            .filter(|(n, _)| *n == name)
-            .map(|(_, v)| v)
-    })
-}
-
-fn is_lighting_word(word: &str) -> bool {
-    word.split_once('=')
-        .is_some_and(|(name, _)| LIGHTING_OPTIONS.contains(&name))
-}
-
 /// The method a point measured, without its lighting options: `auxiliary n=2`,
 /// `unrolled depth=64`.
 pub fn method_of(r: &Record) -> String {
-    let mut words = vec![r.method.clone()];
-    if let Some(n) = r.n {
-        words.push(format!("n={n}"));
-    }
-    if let Some(d) = r.depth {
-        words.push(format!("depth={d}"));
-    }
-    words.extend(
-        r.method_options
-            .split_whitespace()
-            .filter(|w| !is_lighting_word(w))
-            .map(String::from),
-    );
-    words.join(" ")
+    r.method_without(&LIGHTING_OPTIONS)
 }
 
 /// The point's lighting variant in words: `direct only, no shadows`, `mirrored, no
@@ -54,26 +27,28 @@ pub fn method_of(r: &Record) -> String {
 /// its default is absent from the record: mirrored lights (what the scene asks for), no
 /// shadows, maps of 1024², the default bias.
 pub fn lighting_of(r: &Record) -> String {
-    let lights = if option(r, LIGHTS_OPTION) == Some("direct") {
+    let lights = if r.option(LIGHTS_OPTION) == Some("direct") {
         "direct only"
     } else {
         "mirrored"
     };
-    if option(r, "shadows") != Some("map") {
+    if r.option("shadows") != Some("map") {
         return format!("{lights}, no shadows");
     }
-    let size = option(r, "shadow-map-size").unwrap_or("1024");
-    let bias = option(r, "shadow-bias").map_or(String::new(), |b| format!(", bias {b}"));
+    let size = r.option("shadow-map-size").unwrap_or("1024");
+    let bias = r
+        .option("shadow-bias")
+        .map_or(String::new(), |b| format!(", bias {b}"));
     format!("{lights}, shadow maps {size}²{bias}")
 }
 
 /// Where a variant's rows go: direct before mirrored, no shadows before shadow maps, maps by
 /// size (256² before 1024²), then by name.
 fn variant_order(r: &Record) -> (bool, bool, u32, String) {
-    let size = option(r, "shadow-map-size").and_then(|s| s.parse().ok());
+    let size = r.option("shadow-map-size").and_then(|s| s.parse().ok());
     (
-        option(r, LIGHTS_OPTION) != Some("direct"),
-        option(r, "shadows") == Some("map"),
+        r.option(LIGHTS_OPTION) != Some("direct"),
+        r.option("shadows") == Some("map"),
         size.unwrap_or(1024),
         lighting_of(r),
     )

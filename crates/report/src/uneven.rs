@@ -18,27 +18,9 @@ const TRICK_OPTIONS: [&str; 5] = [
     "texture-margin",
 ];
 
-fn is_trick_word(word: &str) -> bool {
-    word.split_once('=')
-        .is_some_and(|(name, _)| TRICK_OPTIONS.contains(&name))
-}
-
 /// The method a point measured without its trick options: `auxiliary n=2`.
 pub fn method_of(r: &Record) -> String {
-    let mut words = vec![r.method.clone()];
-    if let Some(n) = r.n {
-        words.push(format!("n={n}"));
-    }
-    if let Some(d) = r.depth {
-        words.push(format!("depth={d}"));
-    }
-    words.extend(
-        r.method_options
-            .split_whitespace()
-            .filter(|w| !is_trick_word(w))
-            .map(String::from),
-    );
-    words.join(" ")
+    r.method_without(&TRICK_OPTIONS)
 }
 
 /// The trick in words, from the options (absent options are at their defaults: `march`,
@@ -49,13 +31,7 @@ pub fn trick_of(r: &Record, bump_methods: &[String]) -> String {
     if !bump_methods.contains(&r.method) {
         return "flat (no texture to read)".into();
     }
-    let option = |name: &str| {
-        r.method_options.split_whitespace().find_map(|w| {
-            w.split_once('=')
-                .filter(|(n, _)| *n == name)
-                .map(|(_, v)| v.to_string())
-        })
-    };
+    let option = |name: &str| r.option(name).map(String::from);
     let bump = option("bump").unwrap_or_else(|| "march".into());
     let mut words = match bump.as_str() {
         "distort" | "distort-distance" => {
