@@ -285,8 +285,18 @@ pub fn human_bytes(n: u64) -> String {
 /// leaves a stale lock behind.
 #[derive(Debug)]
 pub struct FolderLock {
-    _file: File,
+    file: File,
     path: PathBuf,
+}
+
+/// Unlocks explicitly before the file closes: a `flock` belongs to the open file description,
+/// which a child forked at that moment shares until its `exec` closes it — closing our copy
+/// alone could leave the folder locked for that instant (seen in the hardening tests, whose
+/// other tests spawn processes all the time).
+impl Drop for FolderLock {
+    fn drop(&mut self) {
+        let _ = self.file.unlock();
+    }
 }
 
 /// The lock file's name inside a locked folder.
@@ -330,7 +340,7 @@ impl FolderLock {
         let _ = file.set_len(0);
         let _ = file.seek(std::io::SeekFrom::Start(0));
         let _ = writeln!(file, "pid {}", std::process::id());
-        Ok(FolderLock { _file: file, path })
+        Ok(FolderLock { file, path })
     }
 
     pub fn path(&self) -> &Path {
