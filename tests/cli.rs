@@ -1474,3 +1474,74 @@ fn report_rewrites_a_sweep_folder_from_its_records() {
     assert_eq!(out.code, 2, "stderr: {}", out.stderr);
     assert!(out.stderr.contains("sweep.json"), "{}", out.stderr);
 }
+
+/// Stereo (issue 17, seed 002): `trace` and `render` with `--ipd 0` give both eyes the mono
+/// image bit for bit; with a real IPD each eye of an exact method matches that eye's truth at
+/// the floor (and not the other eye's), and the side-by-side and anaglyph pictures appear.
+#[test]
+fn stereo_eyes_match_their_own_truth() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let p = |name: &str| d.join(name).to_str().unwrap().to_string();
+    let run = |args: &[&str]| {
+        let mut all: Vec<&str> = args.to_vec();
+        all.extend(["--width", "96", "--height", "54"]);
+        let out = mirrorbox(&all, &[]);
+        assert_eq!(out.code, 0, "{args:?}: {}", out.stderr);
+    };
+    let scene = "scenes/mirror_box.json";
+    let trace = ["trace", scene, "--spp", "1", "--max-depth", "64"];
+    let render = ["render", scene, "--method", "unrolled"];
+    for (name, ipd) in [("mono", None), ("zero", Some("0")), ("eyes", Some("0.1"))] {
+        let stereo: Vec<&str> = ipd.map_or(vec![], |i| vec!["--ipd", i]);
+        let truth = p(&format!("truth_{name}.exr"));
+        let raster = p(&format!("raster_{name}.png"));
+        run(&[&trace[..], &["-o", &truth], &stereo[..]].concat());
+        run(&[&render[..], &["-o", &raster], &stereo[..]].concat());
+    }
+    let img = |name: &str| mirrorbox_image::read_image(&d.join(name)).unwrap();
+    let bytes = |name: &str| std::fs::read(d.join(name)).unwrap();
+    for eye in ["left", "right"] {
+        assert_eq!(
+            img(&format!("truth_zero_{eye}.exr")).pixels,
+            img("truth_mono.exr").pixels,
+            "trace, {eye} eye at IPD 0"
+        );
+        assert_eq!(
+            bytes(&format!("raster_zero_{eye}.png")),
+            bytes("raster_mono.png"),
+            "render, {eye} eye at IPD 0"
+        );
+    }
+    let flip = |a: &str, b: &str| {
+        mirrorbox_image::metrics::compare(&img(a), &img(b), 1.0)
+            .unwrap()
+            .flip_mean
+    };
+    // Measured at 96×54: 1e-4 against its own eye's truth, 3e-2 against the other's.
+    for (eye, other) in [("left", "right"), ("right", "left")] {
+        let raster = format!("raster_eyes_{eye}.exr");
+        let own = flip(&format!("truth_eyes_{eye}.exr"), &raster);
+        let crossed = flip(&format!("truth_eyes_{other}.exr"), &raster);
+        assert!(
+            own < 1e-3 && crossed > 10.0 * own,
+            "{eye}: own {own}, other eye's {crossed}"
+        );
+    }
+    for name in [
+        "truth_eyes_sbs.png",
+        "truth_eyes_anaglyph.png",
+        "raster_eyes_sbs.png",
+        "raster_eyes_anaglyph.png",
+    ] {
+        assert!(d.join(name).is_file(), "{name}");
+    }
+    // A mono camera refuses --stereo without --ipd.
+    let out = mirrorbox(&["trace", scene, "-o", &p("x.exr"), "--stereo"], &[]);
+    assert_eq!(out.code, 2, "{}", out.stderr);
+    assert!(
+        out.stderr.contains("has no camera.stereo"),
+        "{}",
+        out.stderr
+    );
+}

@@ -9,6 +9,7 @@
 pub mod colormap;
 pub mod metrics;
 pub mod srgb;
+pub mod stereo;
 
 pub use mirrorbox_files::StagedFiles;
 use std::path::{Path, PathBuf};

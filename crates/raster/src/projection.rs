@@ -65,6 +65,7 @@ mod tests {
             width: 160,
             height: 90,
             exposure: 1.0,
+            shift_x: 0.0,
         };
         let p = camera.projection(NEAR, 1e4);
         let r = camera_projection(&camera, 160, 90);

@@ -502,6 +502,7 @@ mod tests {
             width: 64,
             height: 48,
             exposure: 1.0,
+            shift_x: 0.0,
         };
         let clip_from_world = crate::projection::camera_projection(&camera, 64, 48) * camera.view();
         // Objects at x in [5, 6]; the plane x = 0 puts the reflection at x in [−6, −5],

@@ -25,7 +25,7 @@ impl Ray {
 }
 
 /// A validated pinhole camera (see `docs/scene-format.md`, `camera`).
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, PartialEq)]
 pub struct Camera {
     pub position: Vec3,
     pub look_at: Vec3,
@@ -37,6 +37,29 @@ pub struct Camera {
     pub height: u32,
     /// Linear multiplier applied to radiance before the sRGB transfer (`docs/shading.md`).
     pub exposure: f32,
+    /// Horizontal lens shift in NDC units: the image's centre looks `shift_x` to the side
+    /// (`ndc_x = projected + shift_x`), the asymmetric frustum of an off-axis stereo eye
+    /// ([`crate::stereo`]); 0 for a centred camera.
+    pub shift_x: f32,
+}
+
+/// As derived, with `shift_x` only where it is not 0: a centred camera prints (and so
+/// hashes, [`crate::Scene::content_hash`]) as it did before lens shifts existed.
+impl std::fmt::Debug for Camera {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let mut d = f.debug_struct("Camera");
+        d.field("position", &self.position)
+            .field("look_at", &self.look_at)
+            .field("up", &self.up)
+            .field("fov_y_deg", &self.fov_y_deg)
+            .field("width", &self.width)
+            .field("height", &self.height)
+            .field("exposure", &self.exposure);
+        if self.shift_x != 0.0 {
+            d.field("shift_x", &self.shift_x);
+        }
+        d.finish()
+    }
 }
 
 impl Camera {
@@ -59,14 +82,19 @@ impl Camera {
         glam::camera::rh::view::look_at_mat4(self.position, self.look_at, self.up)
     }
 
-    /// View → clip transform with depth in `[0, 1]` (WebGPU/DirectX convention).
+    /// View → clip transform with depth in `[0, 1]` (WebGPU/DirectX convention), shifted by
+    /// `shift_x` (`clip_x += −shift_x·z_view`, so `ndc_x` moves by `shift_x`).
     pub fn projection(&self, near: f32, far: f32) -> Mat4 {
-        glam::camera::rh::proj::directx::perspective(
+        let mut m = glam::camera::rh::proj::directx::perspective(
             self.fov_y_deg.to_radians(),
             self.aspect(),
             near,
             far,
-        )
+        );
+        if self.shift_x != 0.0 {
+            m.z_axis.x = -self.shift_x;
+        }
+        m
     }
 
     /// The ray through continuous image position `(px, py)` (pixel convention above).
@@ -87,6 +115,7 @@ impl Camera {
             forward,
             width: self.width as f32,
             height: self.height as f32,
+            shift_x: self.shift_x,
         }
     }
 
@@ -113,14 +142,16 @@ pub struct RayGenerator {
     forward: Vec3,
     width: f32,
     height: f32,
+    shift_x: f32,
 }
 
 impl RayGenerator {
-    /// `d = normalize(forward + ndc_x·tan(fov/2)·aspect·right + ndc_y·tan(fov/2)·up)`,
+    /// `d = normalize(forward + (ndc_x − shift_x)·tan(fov/2)·aspect·right + ndc_y·tan(fov/2)·up)`,
     /// the inverse of [`Camera::projection`] on the plane z_view = −1.
     pub fn ray(&self, px: f32, py: f32) -> Ray {
         let ndc = pixel_to_ndc(Vec2::new(px, py), Vec2::new(self.width, self.height));
-        let dir = (self.forward + self.right * ndc.x + self.up * ndc.y).normalize();
+        let dir =
+            (self.forward + self.right * (ndc.x - self.shift_x) + self.up * ndc.y).normalize();
         Ray {
             origin: self.origin,
             dir,
@@ -187,6 +218,7 @@ mod tests {
             width: 64,
             height: 36,
             exposure: 1.0,
+            shift_x: 0.0,
         }
     }
 

@@ -53,6 +53,23 @@ pub struct CameraDesc {
     pub height: u32,
     #[serde(default)]
     pub exposure: Option<f32>,
+    /// Two eyes instead of one (`crate::stereo`).
+    #[serde(default)]
+    pub stereo: Option<StereoDesc>,
+}
+
+/// `camera.stereo`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StereoDesc {
+    /// Interpupillary distance, scene units.
+    pub ipd: f32,
+    /// `off-axis` (default), `parallel` or `toe-in`.
+    #[serde(default)]
+    pub convergence: Option<String>,
+    /// Default: the distance from `position` to `look_at`.
+    #[serde(default)]
+    pub convergence_distance: Option<f32>,
 }
 
 #[derive(Debug, Deserialize)]

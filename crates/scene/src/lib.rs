@@ -23,6 +23,7 @@ pub mod polygon;
 pub mod reflection;
 pub mod reflection_paths;
 pub mod shading;
+pub mod stereo;
 pub mod symmetry;
 pub mod tessellate;
 
@@ -87,6 +88,8 @@ pub struct Scene {
     pub source: std::path::PathBuf,
     pub camera: Camera,
     pub mirrors: Vec<Mirror>,
+    /// The camera's stereo rig (`camera.stereo`), if any: [`Scene::eye`] gives each eye.
+    pub stereo: Option<stereo::Stereo>,
     /// Per mirror, its uneven shading normal ([`bump`]); `None`: flat.
     pub bumps: Vec<Option<bump::MirrorBump>>,
     pub lighting: Lighting,
@@ -227,6 +230,16 @@ impl Scene {
         }
     }
 
+    /// The scene seen by one eye of `stereo` (the scene's own rig, or another): its camera
+    /// replaced by that eye's ([`stereo::Stereo::eye`]), no rig left.
+    pub fn eye(&self, stereo: &stereo::Stereo, eye: stereo::Eye) -> Scene {
+        Scene {
+            camera: stereo.eye(&self.camera, eye),
+            stereo: None,
+            ..self.clone()
+        }
+    }
+
     /// Whether any mirror is uneven.
     pub fn has_bumps(&self) -> bool {
         self.bumps.iter().any(Option::is_some)
@@ -275,6 +288,10 @@ impl Scene {
         // a plane's name changes no image.
         if let Some(symmetry) = &self.symmetry {
             let _ = write!(h, "symmetry{:?}", symmetry.plane_list());
+        }
+        // Likewise mono cameras.
+        if let Some(s) = &self.stereo {
+            let _ = write!(h, "stereo{s:?}");
         }
         // Likewise scenes whose mirrors are all flat.
         if self.bumps.iter().any(Option::is_some) {

@@ -26,6 +26,9 @@ use crate::{Camera, Mirror, Plane, Scene};
 use glam::{EulerRot, Mat4, Quat, Vec3};
 use std::path::{Path, PathBuf};
 
+/// Largest interpupillary distance, scene units (eyes a scene unit apart are not a head).
+const MAX_IPD: f32 = 1.0;
+
 /// Defaults, documented in `docs/scene-format.md`.
 pub mod defaults {
     pub const CAMERA_UP: [f32; 3] = [0.0, 1.0, 0.0];
@@ -279,6 +282,7 @@ impl Checker<'_> {
             source: self.file.to_path_buf(),
             camera,
             mirrors,
+            stereo: self.stereo(&FieldPath::root("camera").field("stereo"), &file.camera)?,
             bumps,
             lighting: Lighting {
                 lights,
@@ -376,6 +380,7 @@ impl Checker<'_> {
             width: c.width,
             height: c.height,
             exposure,
+            shift_x: 0.0,
         })
     }
 
@@ -419,6 +424,43 @@ impl Checker<'_> {
             ));
         }
         Ok(mirror)
+    }
+
+    /// `camera.stereo` (`crate::stereo`): an IPD in [0, [`MAX_IPD`]] scene units, a known
+    /// convergence and a positive convergence distance.
+    fn stereo(&self, path: &FieldPath, c: &CameraDesc) -> Result<Option<crate::stereo::Stereo>> {
+        use crate::stereo::{Convergence, Stereo};
+        let Some(s) = &c.stereo else {
+            return Ok(None);
+        };
+        let ipd = self.finite(&path.field("ipd"), s.ipd)?;
+        if !(0.0..=MAX_IPD).contains(&ipd) {
+            return Err(self.invalid(
+                &path.field("ipd"),
+                format!("must be in [0, {MAX_IPD}] scene units, got {ipd}"),
+            ));
+        }
+        let convergence = match s.convergence.as_deref() {
+            None | Some("off-axis") => Convergence::OffAxis,
+            Some("parallel") => Convergence::Parallel,
+            Some("toe-in") => Convergence::ToeIn,
+            Some(other) => {
+                return Err(self.invalid(
+                    &path.field("convergence"),
+                    format!("must be \"off-axis\", \"parallel\" or \"toe-in\", got \"{other}\""),
+                ));
+            }
+        };
+        let default = (Vec3::from_array(c.look_at) - Vec3::from_array(c.position)).length();
+        let distance = self.positive(
+            &path.field("convergence_distance"),
+            s.convergence_distance.unwrap_or(default),
+        )?;
+        Ok(Some(Stereo {
+            ipd,
+            convergence,
+            convergence_distance: distance,
+        }))
     }
 
     /// `mirrors[i].bump` (`crate::bump`): each number in its range, the normal map read,
@@ -812,6 +854,49 @@ mod tests {
             Ok(_) => panic!("accepted: {rest}"),
             Err(e) => e.to_string(),
         }
+    }
+
+    #[test]
+    fn a_stereo_camera_is_read_and_checked_field_by_field() {
+        let stereo = |fields: &str| {
+            parse_scene(
+                &format!(
+                    r#"{{ "camera": {{ "position": [0, 1, 3], "look_at": [0, 1, 0], "fov_y_deg": 60,
+                    "width": 32, "height": 24, "stereo": {{ {fields} }} }} }}"#
+                ),
+                Path::new("s.json"),
+            )
+        };
+        let s = stereo(r#""ipd": 0.064"#).unwrap().stereo.unwrap();
+        assert_eq!(s.convergence, crate::stereo::Convergence::OffAxis);
+        assert_eq!(
+            s.convergence_distance, 3.0,
+            "default: the distance to look_at"
+        );
+        let s = stereo(r#""ipd": 0.05, "convergence": "toe-in", "convergence_distance": 2"#)
+            .unwrap()
+            .stereo
+            .unwrap();
+        assert_eq!(
+            (s.convergence, s.convergence_distance),
+            (crate::stereo::Convergence::ToeIn, 2.0)
+        );
+        for (fields, words) in [
+            (r#""ipd": -0.1"#, "camera.stereo.ipd"),
+            (r#""ipd": 2"#, "[0, 1]"),
+            (
+                r#""ipd": 0.1, "convergence": "crossed""#,
+                "camera.stereo.convergence",
+            ),
+            (
+                r#""ipd": 0.1, "convergence_distance": 0"#,
+                "camera.stereo.convergence_distance",
+            ),
+        ] {
+            let e = stereo(fields).unwrap_err().to_string();
+            assert!(e.contains(words), "{fields}: {e}");
+        }
+        assert!(scene_with("").unwrap().stereo.is_none());
     }
 
     #[test]

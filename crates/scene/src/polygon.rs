@@ -108,6 +108,7 @@ mod tests {
             width: 100,
             height: 100,
             exposure: 1.0,
+            shift_x: 0.0,
         };
         let m = cam.projection(0.1, 100.0) * cam.view();
         // A 2×2 quad at distance 5 with a 90° field of view spans 2/10 of the image height.

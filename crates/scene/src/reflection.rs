@@ -170,6 +170,7 @@ mod tests {
             width: 80,
             height: 60,
             exposure: 1.0,
+            shift_x: 0.0,
         }
     }
 

@@ -2,11 +2,13 @@
 //! the registry (`mirrorbox_raster::METHODS`) with wgpu, timed.
 
 use super::method_flags::{RenderOptions, method_value_parser};
+use super::stereo::{eye_path, with_suffix};
 use super::{check_outputs, load, output_path, resize, unit_interval};
 use crate::Failure;
-use mirrorbox_image::{StagedFiles, stage_exr, stage_png};
+use mirrorbox_image::{StagedFiles, stage_exr, stage_png, stage_png_bytes};
 use mirrorbox_raster::methods::recursive_texture::TEXTURE_SCALE;
 use mirrorbox_raster::{Gpu, RenderSettings, plan_frame, render_planned};
+use mirrorbox_scene::stereo::Eye;
 use std::path::PathBuf;
 
 #[derive(clap::Args)]
@@ -45,6 +47,8 @@ pub struct Args {
     /// Output PNG (sRGB); the linear EXR is written beside it.
     #[arg(short, long)]
     output: PathBuf,
+    #[command(flatten)]
+    stereo: super::stereo::StereoArgs,
 }
 
 fn bad(message: String) -> Failure {
@@ -58,8 +62,22 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     unit_interval("--alpha", args.alpha)?;
     let png = output_path("-o", &args.output, "png")?;
     let exr = png.with_extension("exr");
-    check_outputs(&[("-o", png.clone()), ("-o (its EXR)", exr.clone())])?;
     let mut scene = load(&args.scene)?;
+    let rig = args.stereo.rig(&scene)?;
+    let eyes: Vec<Option<Eye>> = match rig {
+        None => vec![None],
+        Some(_) => Eye::BOTH.map(Some).to_vec(),
+    };
+    let mut outputs = Vec::new();
+    for eye in &eyes {
+        outputs.push(("-o", eye_path(&png, *eye)));
+        outputs.push(("-o (its EXR)", eye_path(&exr, *eye)));
+    }
+    if rig.is_some() {
+        outputs.push(("-o (side by side)", with_suffix(&png, "sbs")));
+        outputs.push(("-o (anaglyph)", with_suffix(&png, "anaglyph")));
+    }
+    check_outputs(&outputs)?;
     resize(&mut scene, args.width, args.height)?;
     if let Some(a) = args.alpha {
         scene
@@ -72,44 +90,87 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         frames: args.frames,
         warmup: args.warmup,
     };
-    // Plan first: a refused configuration costs no GPU set-up.
-    let planned = plan_frame(&scene, &settings)?;
-    let gpu = Gpu::new()?;
-    let out = render_planned(&gpu, &scene, planned, &settings)?;
-    let method_text = method.to_string();
-    for w in &out.warnings {
-        eprintln!("warning: {w}");
-    }
     let alpha = args
         .alpha
         .map_or("as in scene".to_string(), |a| a.to_string());
-    let attributes = [
-        ("mirrorbox.version", env!("CARGO_PKG_VERSION").to_string()),
-        ("mirrorbox.scene", args.scene.display().to_string()),
-        (
-            "mirrorbox.scene_hash",
-            format!("{:016x}", scene.content_hash()),
-        ),
-        ("mirrorbox.method", method_text.clone()),
-        ("mirrorbox.alpha", alpha.clone()),
-        ("mirrorbox.ssaa", args.ssaa.to_string()),
-        ("mirrorbox.passes", out.stats.passes.to_string()),
-        ("mirrorbox.adapter", gpu.report.name.clone()),
-        (
-            "mirrorbox.color_format",
-            out.color_format.name().to_string(),
-        ),
-    ];
+    let views = super::stereo::views(&scene, rig);
+    // Plan every view first: a refused configuration costs no GPU set-up.
+    let mut planned = Vec::new();
+    for (_, view) in &views {
+        planned.push(plan_frame(view, &settings)?);
+    }
+    let gpu = Gpu::new()?;
     let write_failed = |e: mirrorbox_image::ImageError| Failure::Other(e.to_string());
     let mut staged = StagedFiles::new();
-    stage_exr(&mut staged, &exr, &out.image, &attributes).map_err(write_failed)?;
-    stage_png(&mut staged, &png, &out.image, scene.camera.exposure).map_err(write_failed)?;
+    let mut rendered = Vec::new();
+    for ((eye, view), planned) in views.into_iter().zip(planned) {
+        let out = render_planned(&gpu, &view, planned, &settings)?;
+        for w in &out.warnings {
+            eprintln!("warning: {w}");
+        }
+        let mut attributes = vec![
+            ("mirrorbox.version", env!("CARGO_PKG_VERSION").to_string()),
+            ("mirrorbox.scene", args.scene.display().to_string()),
+            (
+                "mirrorbox.scene_hash",
+                format!("{:016x}", view.content_hash()),
+            ),
+            ("mirrorbox.method", method.to_string()),
+            ("mirrorbox.alpha", alpha.clone()),
+            ("mirrorbox.ssaa", args.ssaa.to_string()),
+            ("mirrorbox.passes", out.stats.passes.to_string()),
+            ("mirrorbox.adapter", gpu.report.name.clone()),
+            (
+                "mirrorbox.color_format",
+                out.color_format.name().to_string(),
+            ),
+        ];
+        if let Some(e) = eye {
+            attributes.push(("mirrorbox.eye", e.name().to_string()));
+        }
+        let (png, exr) = (eye_path(&png, eye), eye_path(&exr, eye));
+        stage_exr(&mut staged, &exr, &out.image, &attributes).map_err(write_failed)?;
+        stage_png(&mut staged, &png, &out.image, view.camera.exposure).map_err(write_failed)?;
+        rendered.push((eye, view, out, png, exr));
+    }
+    if let [(_, l, left, ..), (_, _, right, ..)] = &rendered[..] {
+        let e = l.camera.exposure;
+        let (a, b) = (left.image.to_srgb8(e), right.image.to_srgb8(e));
+        let (w, h) = (l.camera.width, l.camera.height);
+        let sbs = mirrorbox_image::stereo::side_by_side(&a, &b, w, h);
+        stage_png_bytes(&mut staged, &with_suffix(&png, "sbs"), 2 * w, h, &sbs)
+            .map_err(write_failed)?;
+        let ana = mirrorbox_image::stereo::anaglyph(&a, &b);
+        stage_png_bytes(&mut staged, &with_suffix(&png, "anaglyph"), w, h, &ana)
+            .map_err(write_failed)?;
+    }
     staged.commit().map_err(|e| Failure::Other(e.to_string()))?;
+    for (eye, scene, out, png, exr) in &rendered {
+        summary(args, &method, scene, out, &gpu, png, exr, &alpha, *eye);
+    }
+    Ok(())
+}
+
+/// Prints one view's summary (one JSON object with --json).
+#[allow(clippy::too_many_arguments)]
+fn summary(
+    args: &Args,
+    method: &mirrorbox_raster::Method,
+    scene: &mirrorbox_scene::Scene,
+    out: &mirrorbox_raster::RenderOutput,
+    gpu: &Gpu,
+    png: &std::path::Path,
+    exr: &std::path::Path,
+    alpha: &str,
+    eye: Option<Eye>,
+) {
+    let method_text = method.to_string();
     let s = &out.stats;
     let t = &out.timing;
     if args.json {
         let v = serde_json::json!({
             "scene": args.scene.display().to_string(),
+            "eye": eye.map(|e| e.name()),
             "scene_hash": format!("{:016x}", scene.content_hash()),
             "method": method.name(),
             "key": method.key(),
@@ -149,6 +210,9 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         });
         println!("{v}");
     } else {
+        if let Some(e) = eye {
+            println!("{} eye:", e.name());
+        }
         println!(
             "rendered {} with {method_text}, alpha {alpha}: {}x{}, ssaa {}; {} passes ({} texture renders, {} reflections deep), {} draws per frame; depth {:?}, mirrors clipped by {}",
             args.scene.display(),
@@ -211,7 +275,6 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             exr.display()
         );
     }
-    Ok(())
 }
 
 /// A parameter value as JSON (`null` where the method has no such option).

@@ -81,9 +81,11 @@ pub struct Args {
     /// obvhs hierarchy to traverse.
     #[arg(long, value_enum, default_value_t = Bvh::Cwbvh)]
     bvh: Bvh,
-    /// Print the summary as one JSON object.
+    /// Print the summary as one JSON object (one per eye with --stereo).
     #[arg(long)]
     json: bool,
+    #[command(flatten)]
+    stereo: super::stereo::StereoArgs,
 }
 
 fn check_args(args: &Args) -> Result<(SubpixelGrid, WhittedSettings), Failure> {
@@ -102,6 +104,7 @@ fn write_failed(e: impl ToString) -> Failure {
 }
 
 pub fn run(args: &Args) -> Result<(), Failure> {
+    use super::stereo::{eye_path, views, with_suffix};
     let (grid, whitted) = check_args(args)?;
     let exr_path = output_path("-o", &args.output, "exr")?;
     let bounces_path = args
@@ -109,16 +112,34 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         .as_deref()
         .map(|p| output_path("--bounces", p, "exr"))
         .transpose()?;
-    let mut outputs = vec![
-        ("-o", exr_path.clone()),
-        ("-o (its PNG)", exr_path.with_extension("png")),
-    ];
-    if let Some(b) = &bounces_path {
-        outputs.push(("--bounces", b.clone()));
-        outputs.push(("--bounces (its PNG)", b.with_extension("png")));
+    let mut scene = load(&args.scene)?;
+    let rig = args.stereo.rig(&scene)?;
+    let eyes: Vec<Option<mirrorbox_scene::stereo::Eye>> = match rig {
+        None => vec![None],
+        Some(_) => mirrorbox_scene::stereo::Eye::BOTH.map(Some).to_vec(),
+    };
+    let mut outputs = Vec::new();
+    for &eye in &eyes {
+        let exr = eye_path(&exr_path, eye);
+        outputs.push(("-o", exr.clone()));
+        outputs.push(("-o (its PNG)", exr.with_extension("png")));
+        if let Some(b) = &bounces_path {
+            let b = eye_path(b, eye);
+            outputs.push(("--bounces", b.clone()));
+            outputs.push(("--bounces (its PNG)", b.with_extension("png")));
+        }
+    }
+    if rig.is_some() {
+        outputs.push((
+            "-o (side by side)",
+            with_suffix(&exr_path, "sbs").with_extension("png"),
+        ));
+        outputs.push((
+            "-o (anaglyph)",
+            with_suffix(&exr_path, "anaglyph").with_extension("png"),
+        ));
     }
     check_outputs(&outputs)?;
-    let mut scene = load(&args.scene)?;
     resize(&mut scene, args.width, args.height)?;
     if let Some(r) = args.reflectance {
         scene
@@ -166,17 +187,73 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     let settings = TraceSettings::default()
         .with_sampling(sampling)
         .with_integrator(integrator);
-    let bar = progress_bar(scene.camera.height as u64, "tracing rows");
-    let out = render(&scene, &bvh, &settings, &|rows| {
-        bar.set_position(rows as u64)
-    });
-    bar.finish_and_clear();
+    // Every output appears together, or none does (a failing --bounces leaves no image).
+    let mut staged = StagedFiles::new();
+    let mut traced = Vec::new();
+    for (eye, view) in views(&scene, rig) {
+        let bar = progress_bar(view.camera.height as u64, "tracing rows");
+        let out = render(&view, &bvh, &settings, &|rows| {
+            bar.set_position(rows as u64)
+        });
+        bar.finish_and_clear();
+        let exr = eye_path(&exr_path, eye);
+        let bounces = bounces_path.as_deref().map(|b| eye_path(b, eye));
+        stage_view(
+            args,
+            &view,
+            &out,
+            grid,
+            sampling,
+            whitted,
+            eye,
+            &exr,
+            bounces.as_deref(),
+            &mut staged,
+        )?;
+        traced.push((eye, view, out));
+    }
+    if let [(_, l, left), (_, _, right)] = &traced[..] {
+        let e = l.camera.exposure;
+        let (a, b) = (left.image.to_srgb8(e), right.image.to_srgb8(e));
+        let (w, h) = (l.camera.width, l.camera.height);
+        let sbs = mirrorbox_image::stereo::side_by_side(&a, &b, w, h);
+        let sbs_path = with_suffix(&exr_path, "sbs").with_extension("png");
+        stage_png_bytes(&mut staged, &sbs_path, 2 * w, h, &sbs).map_err(write_failed)?;
+        let ana = mirrorbox_image::stereo::anaglyph(&a, &b);
+        let ana_path = with_suffix(&exr_path, "anaglyph").with_extension("png");
+        stage_png_bytes(&mut staged, &ana_path, w, h, &ana).map_err(write_failed)?;
+    }
+    let written = staged.commit().map_err(write_failed)?;
     let total = started.elapsed();
+    for (eye, view, out) in &traced {
+        if let Some(e) = eye
+            && !args.json
+        {
+            println!("{} eye:", e.name());
+        }
+        report(args, view, &bvh, out, grid, total, &written, *eye);
+    }
+    Ok(())
+}
 
+/// Stages one view's EXR, PNG and bounce outputs with their provenance.
+#[allow(clippy::too_many_arguments)]
+fn stage_view(
+    args: &Args,
+    scene: &mirrorbox_scene::Scene,
+    out: &TraceOutput,
+    grid: SubpixelGrid,
+    sampling: Sampling,
+    whitted: WhittedSettings,
+    eye: Option<mirrorbox_scene::stereo::Eye>,
+    exr_path: &Path,
+    bounces_path: Option<&Path>,
+    staged: &mut StagedFiles,
+) -> Result<(), Failure> {
     let reflectance = args
         .reflectance
         .map_or("as in scene".to_string(), |r| r.to_string());
-    let attributes = [
+    let mut attributes = vec![
         ("mirrorbox.version", env!("CARGO_PKG_VERSION").to_string()),
         ("mirrorbox.scene", args.scene.display().to_string()),
         (
@@ -203,22 +280,25 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         ("mirrorbox.deepest_path", out.stats.deepest.to_string()),
         ("mirrorbox.lighting", scene.lighting.describe()),
     ];
-    // Every output appears together, or none does (a failing --bounces leaves no image).
-    let mut staged = StagedFiles::new();
-    stage_exr(&mut staged, &exr_path, &out.image, &attributes).map_err(write_failed)?;
-    let png_path = exr_path.with_extension("png");
-    stage_png(&mut staged, &png_path, &out.image, scene.camera.exposure).map_err(write_failed)?;
-    if let Some(path) = &bounces_path {
-        stage_bounces(
-            &mut staged,
-            path,
-            &out.bounces,
-            out.stats.deepest,
-            &attributes,
-        )?;
+    if let Some(e) = eye {
+        let c = &scene.camera;
+        attributes.push((
+            "mirrorbox.eye",
+            format!(
+                "{} (position {:?}, look_at {:?}, shift_x {})",
+                e.name(),
+                c.position,
+                c.look_at,
+                c.shift_x
+            ),
+        ));
     }
-    let written = staged.commit().map_err(write_failed)?;
-    report(args, &scene, &bvh, &out, grid, total, &written);
+    stage_exr(staged, exr_path, &out.image, &attributes).map_err(write_failed)?;
+    let png_path = exr_path.with_extension("png");
+    stage_png(staged, &png_path, &out.image, scene.camera.exposure).map_err(write_failed)?;
+    if let Some(path) = bounces_path {
+        stage_bounces(staged, path, &out.bounces, out.stats.deepest, &attributes)?;
+    }
     Ok(())
 }
 
@@ -241,6 +321,7 @@ fn stage_bounces(
     stage_png_bytes(staged, &png, image.width, image.height, &bytes).map_err(write_failed)
 }
 
+#[allow(clippy::too_many_arguments)]
 fn report(
     args: &Args,
     scene: &mirrorbox_scene::Scene,
@@ -249,6 +330,7 @@ fn report(
     grid: SubpixelGrid,
     total: std::time::Duration,
     written: &[PathBuf],
+    eye: Option<mirrorbox_scene::stereo::Eye>,
 ) {
     let s = &out.stats;
     let secs = out.wall.as_secs_f64();
@@ -257,6 +339,7 @@ fn report(
     if args.json {
         let v = serde_json::json!({
             "scene": args.scene.display().to_string(),
+            "eye": eye.map(|e| e.name()),
             "scene_hash": format!("{:016x}", scene.content_hash()),
             "width": w, "height": h, "spp": grid.samples_per_pixel(),
             "paths": s.paths, "rays": s.rays, "mrays_per_s": mrays,
