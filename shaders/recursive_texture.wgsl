@@ -29,6 +29,13 @@ struct Pass {
     bump_strength: f32,
     proxy_distance: f32,
     march_distance: f32,
+    // 1 in the main pass of an eye sharing the head's textures (--stereo-mirrors shared):
+    // lookups project the fragment's world position with lookup_from_world (the head's
+    // camera); the march compares distances from lookup_eye. Elsewhere lookup_from_world is
+    // screen_from_world and lookup_eye is eye.
+    projected_lookup: u32,
+    lookup_from_world: mat4x4f,
+    lookup_eye: vec3f,
     _pad1: f32,
 }
 
@@ -107,7 +114,10 @@ fn mirror_sample(screen: vec2f) -> vec3f {
 
 // The projective lookup: the radiance the applied texture holds for this screen position
 // (texel for pixel where no resampling is needed).
-fn mirror_lookup(frag: vec2f) -> vec3f {
+fn mirror_lookup(frag: vec2f, world: vec3f) -> vec3f {
+    if (pass_.projected_lookup == 1u) {
+        return mirror_sample(to_screen(world));
+    }
     let screen = pass_.origin + frag * pass_.pixels_per_texel;
     if (mirror.exact == 1u) {
         return load_clamped(vec2i(floor(texture_position(screen))));
@@ -115,9 +125,10 @@ fn mirror_lookup(frag: vec2f) -> vec3f {
     return mirror_sample(screen);
 }
 
-// The screen position of world point p seen by the pass's camera.
+// The screen position of world point p in the applied textures' screen space (the pass's
+// camera, or the head's for an eye sharing its textures).
 fn to_screen(p: vec3f) -> vec2f {
-    let c = pass_.screen_from_world * vec4f(p, 1.0);
+    let c = pass_.lookup_from_world * vec4f(p, 1.0);
     let ndc = c.xy / c.w;
     return vec2f(ndc.x + 1.0, 1.0 - ndc.y) * 0.5 * pass_.screen_size;
 }
@@ -153,13 +164,13 @@ fn march(x: vec3f, r: vec3f, n: vec3f, fallback: vec2f) -> vec2f {
         if (!on_texture(screen)) {
             return last;
         }
-        if (length(p - pass_.eye) >= stored_distance(screen)) {
+        if (length(p - pass_.lookup_eye) >= stored_distance(screen)) {
             var lo = miss;
             var hi = t;
             for (var k = 0; k < 6; k++) {
                 let mid = 0.5 * (lo + hi);
                 let q = x + mid * rv;
-                if (length(q - pass_.eye) >= stored_distance(to_screen(q))) {
+                if (length(q - pass_.lookup_eye) >= stored_distance(to_screen(q))) {
                     hi = mid;
                 } else {
                     lo = mid;
@@ -191,6 +202,9 @@ fn uneven_mirror_colour(in: VertexOut, s: Surface, b: MirrorBump) -> vec4f {
     }
     let frag = in.clip.xy;
     var screen = pass_.origin + frag * pass_.pixels_per_texel;
+    if (pass_.projected_lookup == 1u) {
+        screen = to_screen(in.world);
+    }
     let tangent = vec2f(dot(n_s, b.right), -dot(n_s, b.up));
     switch pass_.bump_mode {
         case 1u: {
@@ -224,7 +238,7 @@ fn mirror_colour(in: VertexOut) -> vec4f {
     if (mirror.has_texture == 0u) {
         return vec4f(frame.terminal, eye_distance(in));
     }
-    return vec4f(s.reflectance * mirror_lookup(in.clip.xy), eye_distance(in));
+    return vec4f(s.reflectance * mirror_lookup(in.clip.xy, in.world), eye_distance(in));
 }
 
 // Entry points fs_object, fs_mirror and their *_discard variants:

@@ -35,6 +35,7 @@ pub mod resolve;
 pub mod shading;
 pub mod shadow_maps;
 pub mod shadow_plan;
+pub mod stereo_mirrors;
 pub mod symmetry_cells;
 pub mod targets;
 pub mod timing;

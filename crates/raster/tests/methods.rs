@@ -1308,3 +1308,72 @@ fn uneven_mirror_tricks_beat_the_flat_mirror() {
         );
     }
 }
+
+/// Stereo (issue 17): with per-eye mirror textures each eye of the exact `path-textures`
+/// matches its own eye's truth; with `--stereo-mirrors shared` (the head's textures in both
+/// eyes) the reflections lose their parallax: over the pixels where the left eye sees a
+/// mirror, the two shared eyes differ far less than the two true eyes do (the reflection
+/// sits at the mirror's depth), and each is far from its truth. IPD 0.3 on `mirror_box`,
+/// depth 8, 160×90; the test fails if the shortcut is accidentally per-eye.
+#[test]
+fn shared_stereo_mirrors_flatten_the_reflections() {
+    let head = scene("mirror_box.json", 160, 90);
+    let rig = mirrorbox_scene::stereo::Stereo {
+        ipd: 0.3,
+        convergence: mirrorbox_scene::stereo::Convergence::OffAxis,
+        convergence_distance: (head.camera.look_at - head.camera.position).length(),
+    };
+    let eyes = mirrorbox_scene::stereo::Eye::BOTH.map(|e| head.eye(&rig, e));
+    let truth = eyes.each_ref().map(|s| trace_depth(s, 8));
+    let render_all = |key: &str| eyes.each_ref().map(|s| raster(s, m(key), 1));
+    let per_eye = render_all("path-textures depth=8");
+    let shared = render_all("path-textures depth=8 stereo-mirrors=shared");
+    let flip = |a: &RgbImage, b: &RgbImage| {
+        mirrorbox_image::metrics::compare(a, b, 1.0)
+            .unwrap()
+            .flip_mean
+    };
+    for k in 0..2 {
+        let (own, flat) = (flip(&truth[k], &per_eye[k]), flip(&truth[k], &shared[k]));
+        println!("eye {k}: per-eye FLIP {own:.2e}, shared {flat:.2e}");
+        assert!(own < 1e-3, "per-eye {own}");
+        assert!(flat > 20.0 * own, "shared {flat} vs per-eye {own}");
+    }
+    // Where the left eye sees a mirror: how much the two eyes differ.
+    let s = &eyes[0];
+    let bvh = SceneBvh::build(&s.geometry);
+    let mut mask = Vec::new();
+    for y in 0..s.camera.height {
+        for x in 0..s.camera.width {
+            let ray = s.camera.primary_ray(x as f32 + 0.5, y as f32 + 0.5);
+            let on_mirror = bvh
+                .closest_hit(&ray, 0.0, f32::INFINITY, None)
+                .is_some_and(|h| {
+                    matches!(
+                        s.geometry.surface(h.triangle),
+                        mirrorbox_scene::Surface::Mirror { .. }
+                    )
+                });
+            mask.push(on_mirror);
+        }
+    }
+    let eye_difference = |pair: &[RgbImage; 2]| {
+        let (mut sum, mut n) = (0.0f64, 0usize);
+        for (i, _) in mask.iter().enumerate().filter(|(_, m)| **m) {
+            let (a, b) = (pair[0].pixels[i], pair[1].pixels[i]);
+            sum += (0..3).map(|c| f64::from((a[c] - b[c]).abs())).sum::<f64>();
+            n += 1;
+        }
+        sum / n.max(1) as f64
+    };
+    let (true_parallax, shared_parallax, per_eye_parallax) = (
+        eye_difference(&truth),
+        eye_difference(&shared),
+        eye_difference(&per_eye),
+    );
+    println!(
+        "eyes differ on the mirror by: truth {true_parallax:.4}, per-eye {per_eye_parallax:.4}, shared {shared_parallax:.4}"
+    );
+    assert!((per_eye_parallax - true_parallax).abs() < 0.1 * true_parallax);
+    assert!(shared_parallax < 0.5 * true_parallax);
+}

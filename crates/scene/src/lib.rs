@@ -90,6 +90,9 @@ pub struct Scene {
     pub mirrors: Vec<Mirror>,
     /// The camera's stereo rig (`camera.stereo`), if any: [`Scene::eye`] gives each eye.
     pub stereo: Option<stereo::Stereo>,
+    /// In one eye's scene ([`Scene::eye`]): the head's camera, which a method sharing its
+    /// mirrors between the eyes renders them from (`--stereo-mirrors shared`).
+    pub head: Option<Camera>,
     /// Per mirror, its uneven shading normal ([`bump`]); `None`: flat.
     pub bumps: Vec<Option<bump::MirrorBump>>,
     pub lighting: Lighting,
@@ -236,6 +239,7 @@ impl Scene {
         Scene {
             camera: stereo.eye(&self.camera, eye),
             stereo: None,
+            head: Some(self.camera.clone()),
             ..self.clone()
         }
     }
@@ -292,6 +296,9 @@ impl Scene {
         // Likewise mono cameras.
         if let Some(s) = &self.stereo {
             let _ = write!(h, "stereo{s:?}");
+        }
+        if let Some(c) = &self.head {
+            let _ = write!(h, "head{c:?}");
         }
         // Likewise scenes whose mirrors are all flat.
         if self.bumps.iter().any(Option::is_some) {

@@ -283,6 +283,7 @@ impl Checker<'_> {
             camera,
             mirrors,
             stereo: self.stereo(&FieldPath::root("camera").field("stereo"), &file.camera)?,
+            head: None,
             bumps,
             lighting: Lighting {
                 lights,

@@ -52,6 +52,7 @@ pub static NAIVE: MethodEntry = MethodEntry {
         crate::uneven::OPTIONS[2],
         crate::uneven::OPTIONS[3],
         crate::uneven::OPTIONS[4],
+        &crate::stereo_mirrors::STEREO_MIRRORS,
     ],
     swept: None,
     optional_features: wgpu::Features::CLIP_DISTANCES,
@@ -81,6 +82,7 @@ pub static AUXILIARY: MethodEntry = MethodEntry {
         crate::uneven::OPTIONS[2],
         crate::uneven::OPTIONS[3],
         crate::uneven::OPTIONS[4],
+        &crate::stereo_mirrors::STEREO_MIRRORS,
     ],
     swept: Some(&AUXILIARY_MIRRORS),
     optional_features: wgpu::Features::CLIP_DISTANCES,
@@ -118,6 +120,7 @@ pub static PATH_TEXTURES: MethodEntry = MethodEntry {
         crate::uneven::OPTIONS[2],
         crate::uneven::OPTIONS[3],
         crate::uneven::OPTIONS[4],
+        &crate::stereo_mirrors::STEREO_MIRRORS,
     ],
     swept: Some(&crate::exact_paths::DEPTH),
     optional_features: wgpu::Features::CLIP_DISTANCES,
@@ -133,6 +136,7 @@ pub static PATH_TEXTURES: MethodEntry = MethodEntry {
             texture_scale: 1.0,
             max_passes: p.count(&MAX_PASSES) as usize,
             bump: BumpSettings::from_params(p),
+            shared_mirrors: shared_mirrors(p),
         })
     },
 };
@@ -146,7 +150,7 @@ fn gpu_structs() -> Vec<HostLayout> {
         crate::host_layout!(PassUniform as "Pass" {
             clip_from_world, eye, _pad0, origin, pixels_per_texel, plane, screen_from_world,
             screen_size, bump_mode, march_steps, bump_strength, proxy_distance,
-            march_distance, _pad1
+            march_distance, projected_lookup, lookup_from_world, lookup_eye, _pad1
         }),
         crate::host_layout!(MirrorUniform as "MirrorDraw" {
             origin, size, texels_per_pixel, exact, has_texture
@@ -210,6 +214,12 @@ struct RecursiveTextureMethod {
     texture_scale: f32,
     max_passes: usize,
     bump: BumpSettings,
+    /// `--stereo-mirrors shared`: the textures of an eye's frame come from the head.
+    shared_mirrors: bool,
+}
+
+fn shared_mirrors(p: &Params) -> bool {
+    p.choice(&crate::stereo_mirrors::STEREO_MIRRORS) == "shared"
 }
 
 impl RecursiveTextureMethod {
@@ -219,6 +229,7 @@ impl RecursiveTextureMethod {
             texture_scale: p.real(&TEXTURE_SCALE),
             max_passes: p.count(&MAX_PASSES) as usize,
             bump: BumpSettings::from_params(p),
+            shared_mirrors: shared_mirrors(p),
         }
     }
 }
@@ -230,16 +241,36 @@ impl RasterMethod for RecursiveTextureMethod {
         width: u32,
         height: u32,
     ) -> Result<Box<dyn PlannedFrame>, PlanError> {
+        // Shared mirrors in one eye's frame: the textures are the head's (an eye at the head,
+        // IPD 0, is the head: its own textures, bit for bit the mono frame).
+        let head = scene
+            .head
+            .as_ref()
+            .filter(|h| self.shared_mirrors && **h != scene.camera);
+        let head_scene;
+        let planned_scene = match head {
+            Some(h) => {
+                head_scene = Scene {
+                    camera: h.clone(),
+                    ..scene.clone()
+                };
+                &head_scene
+            }
+            None => scene,
+        };
         let plan = match self.queue {
-            TextureQueue::Paper(q) => crate::plan::plan(scene, q, width, height, self.max_passes)?,
+            TextureQueue::Paper(q) => {
+                crate::plan::plan(planned_scene, q, width, height, self.max_passes)?
+            }
             TextureQueue::Paths(limits) => {
-                crate::plan::plan_paths(scene, limits, width, height, self.max_passes)?
+                crate::plan::plan_paths(planned_scene, limits, width, height, self.max_passes)?
             }
         };
         Ok(Box::new(PlannedTextures {
             plan,
             texture_scale: self.texture_scale,
             bump: self.bump,
+            head: head.cloned(),
         }))
     }
 }
@@ -248,6 +279,8 @@ struct PlannedTextures {
     plan: Plan,
     texture_scale: f32,
     bump: BumpSettings,
+    /// Shared mirrors: the head camera the textures were planned from.
+    head: Option<mirrorbox_scene::Camera>,
 }
 
 impl PlannedFrame for PlannedTextures {
@@ -264,6 +297,7 @@ impl PlannedFrame for PlannedTextures {
             &self.plan,
             self.texture_scale,
             self.bump,
+            self.head.as_ref(),
         )?;
         Ok(BuiltFrame {
             stats: m.stats,
@@ -296,6 +330,14 @@ struct PassUniform {
     bump_strength: f32,
     proxy_distance: f32,
     march_distance: f32,
+    /// 1 in the main pass of an eye sharing the head's textures: mirror lookups project the
+    /// fragment's world position with `lookup_from_world` (the head's camera) instead of
+    /// reading its own screen position; distances compare against `lookup_eye`.
+    projected_lookup: u32,
+    /// Where the applied textures' screen space comes from (= `screen_from_world` but in
+    /// that pass).
+    lookup_from_world: [[f32; 4]; 4],
+    lookup_eye: [f32; 3],
     _pad1: f32,
 }
 
@@ -406,6 +448,9 @@ impl Builder<'_> {
             bump_strength: self.bump.strength,
             proxy_distance: self.bump.proxy_distance,
             march_distance: self.march_distance,
+            projected_lookup: 0,
+            lookup_from_world: screen.to_cols_array_2d(),
+            lookup_eye: eye.to_array(),
             _pad1: 0.0,
         }
     }
@@ -556,6 +601,7 @@ impl RecursiveTexture {
         plan: &Plan,
         texture_scale: f32,
         bump: BumpSettings,
+        head: Option<&mirrorbox_scene::Camera>,
     ) -> Result<Self, RasterError> {
         let device = &gpu.device;
         let scene_buffers = SceneBuffers::new(gpu, scene, shadows.binding());
@@ -591,13 +637,26 @@ impl RecursiveTexture {
             w: plan.width,
             h: plan.height,
         };
-        let main_uniform = b.pass_uniform(
+        let mut main_uniform = b.pass_uniform(
             camera.view(),
             camera.position,
             screen,
             (plan.width, plan.height),
             Vec4::W,
         );
+        if let Some(head) = head {
+            // The eye's own projection (its lens shift) draws the frame; the textures are
+            // looked up where the head sees each mirror point.
+            let eye_clip = crate::projection::camera_projection(&camera, plan.width, plan.height)
+                * camera.view();
+            main_uniform.clip_from_world = eye_clip.to_cols_array_2d();
+            main_uniform.screen_from_world = eye_clip.to_cols_array_2d();
+            main_uniform.projected_lookup = 1;
+            main_uniform.lookup_from_world = (plan.projection
+                * head.with_size(plan.width, plan.height).view())
+            .to_cols_array_2d();
+            main_uniform.lookup_eye = head.position.to_array();
+        }
         let main_offset = b.uniforms.push(&main_uniform);
         let main_draws = b.mirror_draws(&[], None, &roots);
         b.passes.push(PassSpec {
