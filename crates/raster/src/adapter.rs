@@ -28,6 +28,10 @@ pub struct AdapterReport {
     pub timestamp_query_inside_passes: bool,
     /// `clip_distances` in WGSL (the unrolled method clips with them; otherwise it discards).
     pub clip_distances: bool,
+    /// Multiview render passes (`Features::MULTIVIEW`: one pass draws both eyes of a stereo
+    /// pair into a two-layer target). Reported, not used: `--stereo` renders each eye's
+    /// passes one after the other (docs/methods.md, "Stereo").
+    pub multiview: bool,
 }
 
 impl AdapterReport {
@@ -46,6 +50,7 @@ impl AdapterReport {
                     | wgpu::Features::TIMESTAMP_QUERY_INSIDE_PASSES,
             ),
             clip_distances: features.contains(wgpu::Features::CLIP_DISTANCES),
+            multiview: features.contains(wgpu::Features::MULTIVIEW),
         }
     }
 }
@@ -63,7 +68,8 @@ impl fmt::Display for AdapterReport {
             "  inside passes:  {}",
             yes_no(self.timestamp_query_inside_passes)
         )?;
-        write!(f, "clip distances:   {}", yes_no(self.clip_distances))
+        writeln!(f, "clip distances:   {}", yes_no(self.clip_distances))?;
+        write!(f, "multiview:        {}", yes_no(self.multiview))
     }
 }
 

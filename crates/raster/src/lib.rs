@@ -36,6 +36,7 @@ pub mod shading;
 pub mod shadow_maps;
 pub mod shadow_plan;
 pub mod stereo_mirrors;
+pub mod stereo_pair;
 pub mod symmetry_cells;
 pub mod targets;
 pub mod timing;
@@ -143,7 +144,10 @@ impl RenderSettings {
 }
 
 pub struct RenderOutput {
+    /// The view; in a stereo pair's frame ([`stereo_pair::render_pair`]) the left eye.
     pub image: RgbImage,
+    /// A stereo pair's right eye.
+    pub right_eye: Option<RgbImage>,
     pub timing: FrameTiming,
     pub stats: FrameStats,
     /// The format of every colour target and mirror texture it was rendered into (RGBA16F
@@ -207,6 +211,52 @@ pub fn plan_frame(scene: &Scene, settings: &RenderSettings) -> Result<Planned, P
     })
 }
 
+/// The checks every planned frame passes before it is built: the method's required
+/// features, the plan made for these settings (key and size), the render target and the
+/// scene buffers within the device's limits. Returns the render size.
+pub(crate) fn check_planned_frame(
+    gpu: &Gpu,
+    scene: &Scene,
+    settings: &RenderSettings,
+    planned_key: &str,
+    planned_size: (u32, u32),
+) -> Result<(u32, u32), RasterError> {
+    settings.method.entry().check_features(gpu)?;
+    let (w, h) = settings.render_size(scene);
+    assert!(
+        planned_key == settings.method.key() && planned_size == (w, h),
+        "a frame planned for {} at {:?} rendered as {} at {:?}",
+        planned_key,
+        planned_size,
+        settings.method.key(),
+        (w, h)
+    );
+    gpu.check_target(w, h)?;
+    shading::SceneBuffers::check_fits(gpu, scene)?;
+    Ok((w, h))
+}
+
+/// Counts a frame's shadow-map layers as scene passes, and warns when `--shadows map` has
+/// nothing to draw.
+pub(crate) fn add_shadow_maps(
+    stats: &mut FrameStats,
+    warnings: &mut Vec<String>,
+    shadows: &shadow_maps::ShadowMaps,
+    scene: &Scene,
+    settings: &RenderSettings,
+) {
+    if lighting::wants_shadow_maps(settings.method.params()) && !scene.lighting.shadows {
+        warnings.push(
+            "--shadows map: the scene has no shadows (lighting.shadows is false), so no shadow \
+             map is drawn"
+                .into(),
+        );
+    }
+    stats.passes += shadows.layers();
+    stats.draws += shadows.layers();
+    stats.triangles += shadows.triangles();
+}
+
 /// Renders a planned frame at the scene camera's size.
 pub fn render_planned(
     gpu: &Gpu,
@@ -215,34 +265,20 @@ pub fn render_planned(
     settings: &RenderSettings,
 ) -> Result<RenderOutput, RasterError> {
     let scene = &*lighting::lit_scene(scene, settings.method.params());
-    settings.method.entry().check_features(gpu)?;
-    let (w, h) = settings.render_size(scene);
-    assert!(
-        planned.key == settings.method.key() && planned.size == (w, h),
-        "a frame planned for {} at {:?} rendered as {} at {:?}",
-        planned.key,
-        planned.size,
-        settings.method.key(),
-        (w, h)
-    );
-    gpu.check_target(w, h)?;
-    shading::SceneBuffers::check_fits(gpu, scene)?;
+    let (w, h) = check_planned_frame(gpu, scene, settings, &planned.key, planned.size)?;
     let target =
         targets::RenderTarget::new(gpu, "view", w, h, wgpu::TextureUsages::TEXTURE_BINDING);
     let resolve = resolve::Resolve::new(gpu, &target, settings.ssaa);
     let shadows = shadow_maps::ShadowMaps::new(gpu, scene, planned.shadows)?;
     let mut built = planned.frame.build(gpu, scene, &shadows)?;
-    if lighting::wants_shadow_maps(settings.method.params()) && !scene.lighting.shadows {
-        built.warnings.push(
-            "--shadows map: the scene has no shadows (lighting.shadows is false), so no shadow \
-             map is drawn"
-                .into(),
-        );
-    }
+    add_shadow_maps(
+        &mut built.stats,
+        &mut built.warnings,
+        &shadows,
+        scene,
+        settings,
+    );
     if shadows.layers() > 0 {
-        built.stats.passes += shadows.layers();
-        built.stats.draws += shadows.layers();
-        built.stats.triangles += shadows.triangles();
         built.encoder = Box::new(shadow_maps::WithShadowMaps {
             shadows,
             method: built.encoder,
@@ -260,6 +296,7 @@ pub fn render_planned(
     let gpu_memory = GpuMemory::read(gpu);
     Ok(RenderOutput {
         image,
+        right_eye: None,
         timing,
         stats: built.stats,
         color_format: gpu.color_format,

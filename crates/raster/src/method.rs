@@ -88,6 +88,21 @@ pub trait RasterMethod {
         width: u32,
         height: u32,
     ) -> Result<Box<dyn PlannedFrame>, PlanError>;
+
+    /// Plans a stereo pair's frame ([`crate::stereo_pair`]); `eyes` differ only in their
+    /// cameras. By default each eye is planned as its own frame (seed 002's per-eye mirror
+    /// cameras); a method that shares work between the eyes plans them jointly.
+    fn plan_pair(
+        &self,
+        eyes: [&Scene; 2],
+        width: u32,
+        height: u32,
+    ) -> Result<crate::stereo_pair::PlannedPair, PlanError> {
+        Ok(crate::stereo_pair::PlannedPair::Separate([
+            self.plan(eyes[0], width, height)?,
+            self.plan(eyes[1], width, height)?,
+        ]))
+    }
 }
 
 /// A planned frame, ready to become GPU resources.

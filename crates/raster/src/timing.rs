@@ -74,6 +74,29 @@ pub fn run_frames(
     warmup: u32,
     frames: u32,
 ) -> Result<(RgbImage, FrameTiming), RasterError> {
+    let encode = |encoder: &mut wgpu::CommandEncoder,
+                  first_pass: Option<wgpu::RenderPassTimestampWrites<'_>>| {
+        method.encode(encoder, target, first_pass)
+    };
+    let (mut images, timing) = run_frames_of(gpu, &encode, &[resolve], warmup, frames)?;
+    Ok((images.remove(0), timing))
+}
+
+/// What a frame draws before its resolves: its scene passes, the first one carrying the
+/// timestamp write it is given.
+pub type EncodeFrame<'a> =
+    dyn Fn(&mut wgpu::CommandEncoder, Option<wgpu::RenderPassTimestampWrites<'_>>) + 'a;
+
+/// [`run_frames`] for a frame of several views (a stereo pair, [`crate::stereo_pair`]):
+/// `encode` draws every view, then each of `resolves` resolves one; the time runs from the
+/// first pass to the end of the last resolve. Returns each resolve's image, in order.
+pub fn run_frames_of(
+    gpu: &Gpu,
+    encode: &EncodeFrame<'_>,
+    resolves: &[&Resolve],
+    warmup: u32,
+    frames: u32,
+) -> Result<(Vec<RgbImage>, FrameTiming), RasterError> {
     let device = &gpu.device;
     let queries = gpu.timestamps.then(|| {
         let set = device.create_query_set(&wgpu::QuerySetDescriptor {
@@ -110,7 +133,11 @@ pub fn run_frames(
                 beginning_of_pass_write_index: Some(0),
                 end_of_pass_write_index: None,
             });
-        method.encode(&mut encoder, target, begin);
+        encode(&mut encoder, begin);
+        let (last, others) = resolves.split_last().expect("a frame resolves a view");
+        for resolve in others {
+            resolve.encode(&mut encoder, None);
+        }
         let end = queries
             .as_ref()
             .map(|(set, _, _)| wgpu::RenderPassTimestampWrites {
@@ -118,7 +145,7 @@ pub fn run_frames(
                 beginning_of_pass_write_index: None,
                 end_of_pass_write_index: Some(1),
             });
-        resolve.encode(&mut encoder, end);
+        last.encode(&mut encoder, end);
         if let Some((set, resolved, read)) = &queries {
             encoder.resolve_query_set(set, 0..2, resolved, 0);
             encoder.copy_buffer_to_buffer(resolved, 0, read, 0, 16);
@@ -146,9 +173,12 @@ pub fn run_frames(
     } else {
         TimingSource::WallClock
     };
-    let image = read_texture(gpu, &resolve.output)?;
+    let images = resolves
+        .iter()
+        .map(|r| read_texture(gpu, &r.output))
+        .collect::<Result<Vec<_>, _>>()?;
     Ok((
-        image,
+        images,
         FrameTiming {
             source,
             frames_ms,

@@ -36,6 +36,15 @@ fn raster(s: &Scene, method: Method, ssaa: u32) -> RgbImage {
     render(&gpu, s, &settings(method, ssaa)).unwrap().image
 }
 
+/// Both eyes in one frame (`mirrorbox_raster::stereo_pair`).
+fn pair(eyes: &[Scene; 2], method: Method) -> mirrorbox_raster::RenderOutput {
+    use mirrorbox_raster::stereo_pair::{plan_pair, render_pair};
+    let gpu = Gpu::new().unwrap();
+    let settings = settings(method, 1);
+    let planned = plan_pair([&eyes[0], &eyes[1]], &settings).unwrap();
+    render_pair(&gpu, [&eyes[0], &eyes[1]], planned, &settings).unwrap()
+}
+
 fn trace(s: &Scene, per_axis: u32) -> RgbImage {
     let bvh = SceneBvh::build(&s.geometry);
     let settings = TraceSettings::whitted(per_axis);
@@ -1328,6 +1337,27 @@ fn shared_stereo_mirrors_flatten_the_reflections() {
     let render_all = |key: &str| eyes.each_ref().map(|s| raster(s, m(key), 1));
     let per_eye = render_all("path-textures depth=8");
     let shared = render_all("path-textures depth=8 stereo-mirrors=shared");
+    // The pair as one frame gives each eye's own frame bit for bit; shared, it renders the
+    // textures once (half the texture passes of per-eye).
+    for (key, single) in [
+        ("path-textures depth=8", &per_eye),
+        ("path-textures depth=8 stereo-mirrors=shared", &shared),
+    ] {
+        let out = pair(&eyes, m(key));
+        assert_eq!(out.image.pixels, single[0].pixels, "{key}: left eye");
+        assert_eq!(
+            out.right_eye.as_ref().unwrap().pixels,
+            single[1].pixels,
+            "{key}: right eye"
+        );
+    }
+    let passes = |key: &str| pair(&eyes, m(key)).stats;
+    let (own, one) = (
+        passes("path-textures depth=8"),
+        passes("path-textures depth=8 stereo-mirrors=shared"),
+    );
+    assert_eq!(own.texture_renders, 2 * one.texture_renders);
+    assert_eq!(own.passes, 2 * one.passes - 2);
     let flip = |a: &RgbImage, b: &RgbImage| {
         mirrorbox_image::metrics::compare(a, b, 1.0)
             .unwrap()

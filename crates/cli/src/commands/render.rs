@@ -94,20 +94,26 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         .alpha
         .map_or("as in scene".to_string(), |a| a.to_string());
     let views = super::stereo::views(&scene, rig);
-    // Plan every view first: a refused configuration costs no GPU set-up.
-    let mut planned = Vec::new();
-    for (_, view) in &views {
-        planned.push(plan_frame(view, &settings)?);
+    // Plan first: a refused configuration costs no GPU set-up. A stereo pair is one frame
+    // (both eyes, timed together: mirrorbox_raster::stereo_pair).
+    let gpu;
+    let out = if let [(_, left), (_, right)] = &views[..] {
+        let planned = mirrorbox_raster::stereo_pair::plan_pair([left, right], &settings)?;
+        gpu = Gpu::new()?;
+        mirrorbox_raster::stereo_pair::render_pair(&gpu, [left, right], planned, &settings)?
+    } else {
+        let planned = plan_frame(&views[0].1, &settings)?;
+        gpu = Gpu::new()?;
+        render_planned(&gpu, &views[0].1, planned, &settings)?
+    };
+    for w in &out.warnings {
+        eprintln!("warning: {w}");
     }
-    let gpu = Gpu::new()?;
     let write_failed = |e: mirrorbox_image::ImageError| Failure::Other(e.to_string());
     let mut staged = StagedFiles::new();
-    let mut rendered = Vec::new();
-    for ((eye, view), planned) in views.into_iter().zip(planned) {
-        let out = render_planned(&gpu, &view, planned, &settings)?;
-        for w in &out.warnings {
-            eprintln!("warning: {w}");
-        }
+    let images = [Some(&out.image), out.right_eye.as_ref()];
+    let mut written = Vec::new();
+    for ((eye, view), image) in views.iter().zip(images.into_iter().flatten()) {
         let mut attributes = vec![
             ("mirrorbox.version", env!("CARGO_PKG_VERSION").to_string()),
             ("mirrorbox.scene", args.scene.display().to_string()),
@@ -128,30 +134,39 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         if let Some(e) = eye {
             attributes.push(("mirrorbox.eye", e.name().to_string()));
         }
-        let (png, exr) = (eye_path(&png, eye), eye_path(&exr, eye));
-        stage_exr(&mut staged, &exr, &out.image, &attributes).map_err(write_failed)?;
-        stage_png(&mut staged, &png, &out.image, view.camera.exposure).map_err(write_failed)?;
-        rendered.push((eye, view, out, png, exr));
+        let (png, exr) = (eye_path(&png, *eye), eye_path(&exr, *eye));
+        stage_exr(&mut staged, &exr, image, &attributes).map_err(write_failed)?;
+        stage_png(&mut staged, &png, image, view.camera.exposure).map_err(write_failed)?;
+        written.extend([png, exr]);
     }
-    if let [(_, l, left, ..), (_, _, right, ..)] = &rendered[..] {
-        let e = l.camera.exposure;
-        let (a, b) = (left.image.to_srgb8(e), right.image.to_srgb8(e));
-        let (w, h) = (l.camera.width, l.camera.height);
+    if let Some(right) = &out.right_eye {
+        let e = scene.camera.exposure;
+        let (a, b) = (out.image.to_srgb8(e), right.to_srgb8(e));
+        let (w, h) = (scene.camera.width, scene.camera.height);
         let sbs = mirrorbox_image::stereo::side_by_side(&a, &b, w, h);
-        stage_png_bytes(&mut staged, &with_suffix(&png, "sbs"), 2 * w, h, &sbs)
-            .map_err(write_failed)?;
         let ana = mirrorbox_image::stereo::anaglyph(&a, &b);
-        stage_png_bytes(&mut staged, &with_suffix(&png, "anaglyph"), w, h, &ana)
-            .map_err(write_failed)?;
+        for (suffix, w, bytes) in [("sbs", 2 * w, &sbs), ("anaglyph", w, &ana)] {
+            let path = with_suffix(&png, suffix);
+            stage_png_bytes(&mut staged, &path, w, h, bytes).map_err(write_failed)?;
+            written.push(path);
+        }
     }
     staged.commit().map_err(|e| Failure::Other(e.to_string()))?;
-    for (eye, scene, out, png, exr) in &rendered {
-        summary(args, &method, scene, out, &gpu, png, exr, &alpha, *eye);
-    }
+    summary(
+        args,
+        &method,
+        &views[0].1,
+        &out,
+        &gpu,
+        &written,
+        &alpha,
+        rig.is_some(),
+    );
     Ok(())
 }
 
-/// Prints one view's summary (one JSON object with --json).
+/// Prints the frame's summary (one JSON object with --json); a stereo pair's counts and
+/// times are both eyes' (`scene`: the left eye's).
 #[allow(clippy::too_many_arguments)]
 fn summary(
     args: &Args,
@@ -159,10 +174,9 @@ fn summary(
     scene: &mirrorbox_scene::Scene,
     out: &mirrorbox_raster::RenderOutput,
     gpu: &Gpu,
-    png: &std::path::Path,
-    exr: &std::path::Path,
+    written: &[std::path::PathBuf],
     alpha: &str,
-    eye: Option<Eye>,
+    stereo: bool,
 ) {
     let method_text = method.to_string();
     let s = &out.stats;
@@ -170,7 +184,7 @@ fn summary(
     if args.json {
         let v = serde_json::json!({
             "scene": args.scene.display().to_string(),
-            "eye": eye.map(|e| e.name()),
+            "stereo_pair": stereo,
             "scene_hash": format!("{:016x}", scene.content_hash()),
             "method": method.name(),
             "key": method.key(),
@@ -206,12 +220,12 @@ fn summary(
             "warnings": out.warnings,
             "adapter": gpu.report.name, "backend": gpu.report.backend, "device_type": gpu.report.device_type,
             "color_format": out.color_format.name(),
-            "outputs": [png.display().to_string(), exr.display().to_string()],
+            "outputs": written.iter().map(|p| p.display().to_string()).collect::<Vec<_>>(),
         });
         println!("{v}");
     } else {
-        if let Some(e) = eye {
-            println!("{} eye:", e.name());
+        if stereo {
+            println!("stereo pair (both eyes in one frame; counts and times are the pair's):");
         }
         println!(
             "rendered {} with {method_text}, alpha {alpha}: {}x{}, ssaa {}; {} passes ({} texture renders, {} reflections deep), {} draws per frame; depth {:?}, mirrors clipped by {}",
@@ -260,7 +274,7 @@ fn summary(
             );
         }
         println!(
-            "  {:.2} ms/frame median, {:.2} min over {} frames ({}); CPU encode+submit {:.2} ms median; GPU memory {} in buffers, {} in textures; on {} ({}, {} targets); wrote {}, {}",
+            "  {:.2} ms/frame median, {:.2} min over {} frames ({}); CPU encode+submit {:.2} ms median; GPU memory {} in buffers, {} in textures; on {} ({}, {} targets); wrote {}",
             t.median_ms(),
             t.min_ms(),
             t.frames_ms.len(),
@@ -271,8 +285,11 @@ fn summary(
             gpu.report.name,
             gpu.report.backend,
             out.color_format,
-            png.display(),
-            exr.display()
+            written
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
         );
     }
 }

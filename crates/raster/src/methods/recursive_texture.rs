@@ -234,6 +234,18 @@ impl RecursiveTextureMethod {
     }
 }
 
+impl RecursiveTextureMethod {
+    /// The textures seen from `scene`'s camera.
+    fn plan_textures(&self, scene: &Scene, width: u32, height: u32) -> Result<Plan, PlanError> {
+        match self.queue {
+            TextureQueue::Paper(q) => crate::plan::plan(scene, q, width, height, self.max_passes),
+            TextureQueue::Paths(limits) => {
+                crate::plan::plan_paths(scene, limits, width, height, self.max_passes)
+            }
+        }
+    }
+}
+
 impl RasterMethod for RecursiveTextureMethod {
     fn plan(
         &self,
@@ -258,20 +270,89 @@ impl RasterMethod for RecursiveTextureMethod {
             }
             None => scene,
         };
-        let plan = match self.queue {
-            TextureQueue::Paper(q) => {
-                crate::plan::plan(planned_scene, q, width, height, self.max_passes)?
-            }
-            TextureQueue::Paths(limits) => {
-                crate::plan::plan_paths(planned_scene, limits, width, height, self.max_passes)?
-            }
-        };
+        let plan = self.plan_textures(planned_scene, width, height)?;
+        let views = vec![MainView {
+            camera: scene.camera.clone(),
+            lookup: head.cloned(),
+        }];
         Ok(Box::new(PlannedTextures {
             plan,
             texture_scale: self.texture_scale,
             bump: self.bump,
-            head: head.cloned(),
+            views,
         }))
+    }
+
+    /// With `--stereo-mirrors shared` and a real IPD, one set of textures from the head for
+    /// both eyes, then each eye's main pass: the shortcut's saving is in the pair's time.
+    fn plan_pair(
+        &self,
+        eyes: [&Scene; 2],
+        width: u32,
+        height: u32,
+    ) -> Result<crate::stereo_pair::PlannedPair, PlanError> {
+        let head = eyes[0].head.as_ref().filter(|h| {
+            self.shared_mirrors
+                && eyes[1].head.as_ref() == Some(*h)
+                && eyes.iter().all(|e| e.camera != **h)
+        });
+        let Some(head) = head else {
+            return Ok(crate::stereo_pair::PlannedPair::Separate([
+                self.plan(eyes[0], width, height)?,
+                self.plan(eyes[1], width, height)?,
+            ]));
+        };
+        let head_scene = Scene {
+            camera: head.clone(),
+            ..eyes[0].clone()
+        };
+        let plan = self.plan_textures(&head_scene, width, height)?;
+        let views = eyes
+            .iter()
+            .map(|e| MainView {
+                camera: e.camera.clone(),
+                lookup: Some(head.clone()),
+            })
+            .collect();
+        Ok(crate::stereo_pair::PlannedPair::Joint(Box::new(
+            PlannedTextures {
+                plan,
+                texture_scale: self.texture_scale,
+                bump: self.bump,
+                views,
+            },
+        )))
+    }
+}
+
+/// One main pass of a frame: the camera that draws it, and where its mirror textures are
+/// looked up from when they are not its own (`--stereo-mirrors shared`: the head's).
+#[derive(Clone)]
+pub struct MainView {
+    pub camera: mirrorbox_scene::Camera,
+    pub lookup: Option<mirrorbox_scene::Camera>,
+}
+
+impl crate::stereo_pair::PlannedJointPair for PlannedTextures {
+    fn build(
+        self: Box<Self>,
+        gpu: &Gpu,
+        eyes: [&Scene; 2],
+        shadows: &crate::shadow_maps::ShadowMaps,
+    ) -> Result<crate::stereo_pair::BuiltPair, RasterError> {
+        let m = RecursiveTexture::new(
+            gpu,
+            eyes[0],
+            shadows,
+            &self.plan,
+            self.texture_scale,
+            self.bump,
+            &self.views,
+        )?;
+        Ok(crate::stereo_pair::BuiltPair {
+            stats: m.stats,
+            encoder: Box::new(m),
+        })
     }
 }
 
@@ -279,8 +360,8 @@ struct PlannedTextures {
     plan: Plan,
     texture_scale: f32,
     bump: BumpSettings,
-    /// Shared mirrors: the head camera the textures were planned from.
-    head: Option<mirrorbox_scene::Camera>,
+    /// The main passes: one, or a stereo pair's two sharing the head's textures.
+    views: Vec<MainView>,
 }
 
 impl PlannedFrame for PlannedTextures {
@@ -297,7 +378,7 @@ impl PlannedFrame for PlannedTextures {
             &self.plan,
             self.texture_scale,
             self.bump,
-            self.head.as_ref(),
+            &self.views,
         )?;
         Ok(BuiltFrame {
             stats: m.stats,
@@ -353,7 +434,8 @@ struct MirrorUniform {
 
 enum Target {
     Slot(usize),
-    Main,
+    /// The frame's k-th main view (one, or a stereo pair's two).
+    View(usize),
 }
 
 struct MirrorDraw {
@@ -601,7 +683,7 @@ impl RecursiveTexture {
         plan: &Plan,
         texture_scale: f32,
         bump: BumpSettings,
-        head: Option<&mirrorbox_scene::Camera>,
+        views: &[MainView],
     ) -> Result<Self, RasterError> {
         let device = &gpu.device;
         let scene_buffers = SceneBuffers::new(gpu, scene, shadows.binding());
@@ -630,40 +712,43 @@ impl RecursiveTexture {
             mirror_bindings: Vec::new(),
         };
         let roots: Vec<(&TextureNode, usize)> = plan.roots.iter().map(|n| (n, b.emit(n))).collect();
-        let camera = scene.camera.with_size(plan.width, plan.height);
         let screen = Rect {
             x: 0,
             y: 0,
             w: plan.width,
             h: plan.height,
         };
-        let mut main_uniform = b.pass_uniform(
-            camera.view(),
-            camera.position,
-            screen,
-            (plan.width, plan.height),
-            Vec4::W,
-        );
-        if let Some(head) = head {
-            // The eye's own projection (its lens shift) draws the frame; the textures are
-            // looked up where the head sees each mirror point.
-            let eye_clip = crate::projection::camera_projection(&camera, plan.width, plan.height)
-                * camera.view();
-            main_uniform.clip_from_world = eye_clip.to_cols_array_2d();
-            main_uniform.screen_from_world = eye_clip.to_cols_array_2d();
-            main_uniform.projected_lookup = 1;
-            main_uniform.lookup_from_world = (plan.projection
-                * head.with_size(plan.width, plan.height).view())
-            .to_cols_array_2d();
-            main_uniform.lookup_eye = head.position.to_array();
+        for (k, view) in views.iter().enumerate() {
+            let camera = view.camera.with_size(plan.width, plan.height);
+            let mut main_uniform = b.pass_uniform(
+                camera.view(),
+                camera.position,
+                screen,
+                (plan.width, plan.height),
+                Vec4::W,
+            );
+            if let Some(head) = &view.lookup {
+                // The eye's own projection (its lens shift) draws the frame; the textures are
+                // looked up where the head sees each mirror point.
+                let eye_clip =
+                    crate::projection::camera_projection(&camera, plan.width, plan.height)
+                        * camera.view();
+                main_uniform.clip_from_world = eye_clip.to_cols_array_2d();
+                main_uniform.screen_from_world = eye_clip.to_cols_array_2d();
+                main_uniform.projected_lookup = 1;
+                main_uniform.lookup_from_world = (plan.projection
+                    * head.with_size(plan.width, plan.height).view())
+                .to_cols_array_2d();
+                main_uniform.lookup_eye = head.position.to_array();
+            }
+            let main_offset = b.uniforms.push(&main_uniform);
+            let main_draws = b.mirror_draws(&[], None, &roots);
+            b.passes.push(PassSpec {
+                target: Target::View(k),
+                offset: main_offset,
+                draws: main_draws,
+            });
         }
-        let main_offset = b.uniforms.push(&main_uniform);
-        let main_draws = b.mirror_draws(&[], None, &roots);
-        b.passes.push(PassSpec {
-            target: Target::Main,
-            offset: main_offset,
-            draws: main_draws,
-        });
 
         let uniforms = b.uniforms.buffer(device, "recursive texture uniforms");
         let stages = wgpu::ShaderStages::VERTEX_FRAGMENT;
@@ -773,7 +858,7 @@ impl RecursiveTexture {
         let draws: usize = b.passes.iter().map(|p| 1 + p.draws.len()).sum::<usize>() + 1;
         let object_triangles = scene_buffers.objects.len() / 3;
         let stats = FrameStats {
-            passes: plan.passes,
+            passes: plan.passes - 1 + views.len(),
             texture_renders: plan.passes - 1,
             draws,
             depth: plan.depth,
@@ -813,11 +898,34 @@ impl FrameEncoder for RecursiveTexture {
         main: &RenderTarget,
         first_pass: Option<wgpu::RenderPassTimestampWrites<'_>>,
     ) {
+        self.encode_views(encoder, &[main], first_pass);
+    }
+}
+
+impl crate::stereo_pair::PairEncoder for RecursiveTexture {
+    fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        targets: [&RenderTarget; 2],
+        first_pass: Option<wgpu::RenderPassTimestampWrites<'_>>,
+    ) {
+        self.encode_views(encoder, &targets, first_pass);
+    }
+}
+
+impl RecursiveTexture {
+    /// Every texture pass, then each main view into its target.
+    fn encode_views(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        views: &[&RenderTarget],
+        first_pass: Option<wgpu::RenderPassTimestampWrites<'_>>,
+    ) {
         let mut first_pass = first_pass;
         for spec in &self.passes {
             let (target, label) = match spec.target {
                 Target::Slot(s) => (&self.slots[s], "mirror texture pass"),
-                Target::Main => (main, "main view pass"),
+                Target::View(k) => (views[k], "main view pass"),
             };
             let mut pass = target.begin_pass_with_alpha(
                 encoder,
