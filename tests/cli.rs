@@ -1545,3 +1545,87 @@ fn stereo_eyes_match_their_own_truth() {
         out.stderr
     );
 }
+
+/// Issue 17: a stereo sweep renders both eyes as one frame against each eye's truth. At IPD 0
+/// the pair is the mono frame (same error, twice its passes); at IPD 0.3 per-eye mirror
+/// textures put the marker's reflection at the truth's disparity, and the shared shortcut
+/// measurably does not (it paints the reflection at the mirror's depth) — this test fails if
+/// the shortcut is accidentally per-eye.
+#[test]
+fn stereo_sweep_measures_the_shared_shortcuts_disparity() {
+    let dir = tempfile::tempdir().unwrap();
+    let sweep = |name: &str, extra: &[&str]| {
+        let out = dir.path().join(name);
+        let mut args = vec![
+            "sweep",
+            "scenes/stereo_box.json",
+            "--out",
+            out.to_str().unwrap(),
+            "--methods",
+            "naive",
+            "--ipd",
+            "mono,0,0.3",
+            "--marker",
+            "marker",
+            "--alpha",
+            "0.9",
+            "--width",
+            "96",
+            "--height",
+            "54",
+            "--frames",
+            "1",
+            "--warmup",
+            "0",
+        ];
+        args.extend_from_slice(extra);
+        let run = mirrorbox(&args, &[]);
+        assert_eq!(run.code, 0, "{}", run.stderr);
+        let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+        assert!(report.contains("Stereo mirrors: per-eye against shared"));
+        (records(&out), out)
+    };
+    let at = |recs: &[Value], ipd: Option<f64>| -> Value {
+        recs.iter()
+            .find(|r| r["kind"] == "point" && r["stereo"]["ipd"].as_f64() == ipd)
+            .unwrap_or_else(|| panic!("no point at {ipd:?}"))
+            .clone()
+    };
+    // x_right − x_left of the marker's first reflection: the raster's, the truth's.
+    let disparity = |r: &Value| -> (f64, f64) {
+        let eyes = &r["stereo"]["eyes"];
+        let x = |e: usize, field: &str| eyes[e][field]["x"].as_f64().unwrap();
+        (
+            x(1, "marker") - x(0, "marker"),
+            x(1, "truth_marker") - x(0, "truth_marker"),
+        )
+    };
+    let (own, own_dir) = sweep("per_eye", &[]);
+    let (mono, zero) = (at(&own, None), at(&own, Some(0.0)));
+    assert_eq!(zero["metrics"], mono["metrics"], "IPD 0 is the mono frame");
+    assert_eq!(
+        zero["passes"].as_u64(),
+        mono["passes"].as_u64().map(|p| 2 * p)
+    );
+    let (raster, truth) = disparity(&at(&own, Some(0.3)));
+    assert!(
+        truth > 1.5,
+        "the truth's reflection lies behind the mirror: {truth} px"
+    );
+    assert!(
+        (raster - truth).abs() <= 1.0,
+        "per-eye {raster} px vs truth {truth} px"
+    );
+    for image in [
+        "images/naive_ipd0.3_a0.9_anaglyph.png",
+        "images/truth_ipd0.3_a0.9_anaglyph.png",
+    ] {
+        assert!(own_dir.join(image).is_file(), "{image}");
+    }
+    let (shared, _) = sweep("shared", &["--stereo-mirrors", "shared"]);
+    let (raster, truth) = disparity(&at(&shared, Some(0.3)));
+    assert!(
+        raster.abs() < 0.5 * truth,
+        "shared mirrors flatten the reflection: {raster} px vs truth {truth} px"
+    );
+}

@@ -45,6 +45,8 @@ enum Command {
     Lighting(commands::sweep::PresetArgs),
     /// The preset sweep of the uneven-mirror tricks (distort, proxy, march, flat) against the bump's tilt 0…10° on the rippled box and the hammered single mirror (writes reports/uneven_mirrors/ and reports/uneven_mirrors_single/).
     Bumpy(commands::sweep::PresetArgs),
+    /// The preset sweep of stereo mirrors: per-eye mirror textures against the head's shared ones, both eyes as one frame, against each eye's truth at IPD 0…0.1 and mono (writes reports/stereo/).
+    Stereo(commands::sweep::PresetArgs),
     /// Export a scene as Mitsuba 3 XML (tools/mitsuba renders and compares it).
     ExportMitsuba(commands::export_mitsuba::Args),
     /// Fill the generated regions of README.md and docs/methods.md from the committed reports (--check: only compare).
@@ -193,6 +195,7 @@ fn main() -> ExitCode {
         Command::SymmetryScaling(args) => commands::sweep::run_symmetry_scaling(&args),
         Command::Lighting(args) => commands::sweep::run_lighting(&args),
         Command::Bumpy(args) => commands::sweep::run_bumpy(&args),
+        Command::Stereo(args) => commands::sweep::run_stereo(&args),
         Command::ExportMitsuba(args) => commands::export_mitsuba::run(&args),
         Command::Readme(args) => commands::readme::run(&args),
         Command::Report(args) => commands::report::run(&args),

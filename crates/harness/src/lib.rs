@@ -69,6 +69,15 @@ pub struct SweepConfig {
     /// ([`mirrorbox_scene::Scene::set_bump_amplitude`]), for every value listed
     /// (`--bump-amplitude`); `None` keeps the scene's own.
     pub bump_amplitudes: Option<Vec<f32>>,
+    /// The stereo axis (issue 17, seed 002): each point renders both eyes of the scene's rig
+    /// ([`Scene::stereo_rig`]) at each interpupillary distance listed, as one frame
+    /// (`mirrorbox_raster::stereo_pair`), against each eye's truth; `None` in the list is the
+    /// mono frame (`--ipd mono,0,0.05`). `None`: mono only.
+    pub stereo_ipds: Option<Vec<Option<f32>>>,
+    /// The object whose first reflection a stereo point locates in each eye, truth and raster
+    /// alike, to measure its disparity (`--marker NAME`, a diffuse object of the scene; its
+    /// albedo's chromaticity finds it: `mirrorbox_image::stereo::marker_blob`).
+    pub marker: Option<String>,
 }
 
 /// The methods `name` at each value of its swept option (`"auxiliary"`, `[0, 1, 2]`), every
@@ -137,6 +146,8 @@ impl SweepConfig {
             symmetry_planes: None,
             mirrored_lights: None,
             bump_amplitudes: None,
+            stereo_ipds: None,
+            marker: None,
         }
     }
 
@@ -308,6 +319,44 @@ impl SweepConfig {
         }
     }
 
+    /// Stereo mirrors (issue 17, seed 002) on `stereo_box` (the paper's box with a green
+    /// marker on the wall behind the viewer): per-eye mirror textures against the head's
+    /// shared ones (`stereo-mirrors=shared`) for the paper's method at n = 2 and the exact
+    /// `path-textures`, the plain `naive` and the exact geometry method `unrolled` (per eye
+    /// only), each as a stereo pair at IPD 0 … 0.1 and as a mono frame; 320×180, α 0.9,
+    /// 6 timed frames after one warm-up.
+    pub fn stereo(out: PathBuf) -> Self {
+        let methods = [
+            "naive",
+            "naive stereo-mirrors=shared",
+            "auxiliary n=2",
+            "auxiliary n=2 stereo-mirrors=shared",
+            "path-textures depth=64",
+            "path-textures depth=64 stereo-mirrors=shared",
+            "unrolled depth=64",
+        ]
+        .iter()
+        .map(|m| Method::parse(m).unwrap_or_else(|e| panic!("preset: {e}")))
+        .collect();
+        SweepConfig {
+            scene: PathBuf::from("scenes/stereo_box.json"),
+            stereo_ipds: Some(vec![
+                None,
+                Some(0.0),
+                Some(0.025),
+                Some(0.05),
+                Some(0.075),
+                Some(0.1),
+            ]),
+            marker: Some("marker".into()),
+            width: Some(320),
+            height: Some(180),
+            frames: 6,
+            warmup: 1,
+            ..SweepConfig::preset(out, methods, vec![0.9])
+        }
+    }
+
     /// A preset on the paper's scene (mirror_box) with 9 timed frames: enough for a 95 %
     /// interval of each median.
     fn preset(out: PathBuf, methods: Vec<Method>, alphas: Vec<f32>) -> Self {
@@ -381,20 +430,38 @@ impl SweepConfig {
                 );
             }
         }
+        let ipds = self.stereo_ipds.as_ref().map_or(1, Vec::len);
+        if ipds == 0 {
+            return Err(SettingError::new(
+                "--ipd",
+                "at least one interpupillary distance in [0, 1], or mono",
+                "none",
+            )
+            .into());
+        }
+        for &d in self.stereo_ipds.iter().flatten().flatten() {
+            if !(d.is_finite() && (0.0..=1.0).contains(&d)) {
+                return Err(
+                    SettingError::new("--ipd", "each in [0, 1] scene units, or mono", d).into(),
+                );
+            }
+        }
         let points = 1 + self
             .methods
             .len()
             .saturating_mul(self.alphas.len())
             .saturating_mul(planes)
             .saturating_mul(lights)
-            .saturating_mul(bumps);
+            .saturating_mul(bumps)
+            .saturating_mul(ipds);
         if points > MAX_POINTS {
             return Err(SettingError::new(
-                "--methods × their axes × --alpha × --symmetry-planes × --mirrored-lights",
+                "--methods × their axes × --alpha × --symmetry-planes × --mirrored-lights × \
+                 --bump-amplitude × --ipd",
                 format!("at most {MAX_POINTS} points"),
                 format!(
                     "{} configured methods × {} α × {planes} plane counts × {lights} \
-                     mirrored-light depths = {points} points",
+                     mirrored-light depths × {bumps} tilts × {ipds} IPDs = {points} points",
                     self.methods.len(),
                     self.alphas.len()
                 ),
@@ -522,6 +589,8 @@ struct Point {
     lights: Option<u32>,
     /// The uneven mirrors' steepest tilt, degrees (a `--bump-amplitude` sweep).
     bump: Option<f32>,
+    /// A stereo pair's interpupillary distance (an `--ipd` sweep; `None`: mono).
+    ipd: Option<f32>,
     key: String,
     label: String,
     slug: String,
@@ -530,20 +599,26 @@ struct Point {
 /// The resume key of a point: the method's stable [`Method::key`], then the α, size, SSAA,
 /// frames and scene. Frozen: earlier `results.jsonl` files resume by it.
 /// A symmetry-planes sweep adds `|planes=p` after the method, a mirrored-lights sweep
-/// `|mirrored_lights=k` (keys without them are as before).
+/// `|mirrored_lights=k`, a tilt `|bump_deg=a`, a stereo pair `|stereo_ipd=d` (keys without
+/// them are as before; a mono point of an `--ipd` sweep has a plain key).
 fn point_key(
     method: Option<&Method>,
     alpha: f32,
     planes: Option<u32>,
     lights: Option<u32>,
     bump: Option<f32>,
+    ipd: Option<f32>,
     common: &str,
 ) -> String {
     let planes = planes.map_or(String::new(), |p| format!("|planes={p}"));
     let lights = lights.map_or(String::new(), |k| format!("|mirrored_lights={k}"));
     let bump = bump.map_or(String::new(), |a| format!("|bump_deg={a}"));
+    let ipd = ipd.map_or(String::new(), |d| format!("|stereo_ipd={d}"));
     match method {
-        Some(m) => format!("{}{planes}{lights}{bump}|alpha={alpha}|{common}", m.key()),
+        Some(m) => format!(
+            "{}{planes}{lights}{bump}{ipd}|alpha={alpha}|{common}",
+            m.key()
+        ),
         None => format!("floor|{common}"),
     }
 }
@@ -559,7 +634,8 @@ fn points(config: &SweepConfig, base_hash: u64, w: u32, h: u32) -> Vec<Point> {
         planes: None,
         lights: None,
         bump: None,
-        key: point_key(None, 1.0, None, None, None, &common),
+        ipd: None,
+        key: point_key(None, 1.0, None, None, None, None, &common),
         label: "floor (no mirrors)".into(),
         slug: "floor".into(),
     }];
@@ -575,14 +651,20 @@ fn points(config: &SweepConfig, base_hash: u64, w: u32, h: u32) -> Vec<Point> {
         Some(a) => a.iter().map(|&a| Some(a)).collect(),
         None => vec![None],
     };
+    let ipd_axis: Vec<Option<f32>> = config.stereo_ipds.clone().unwrap_or(vec![None]);
     for &alpha in &config.alphas {
         for &planes in &plane_axis {
-            for (&lights, &bump) in light_axis
-                .iter()
-                .flat_map(|l| bump_axis.iter().map(move |b| (l, b)))
-            {
+            let mut settings = Vec::new();
+            for &lights in &light_axis {
+                for &bump in &bump_axis {
+                    for &ipd in &ipd_axis {
+                        settings.push((lights, bump, ipd));
+                    }
+                }
+            }
+            for (lights, bump, ipd) in settings {
                 for method in &config.methods {
-                    let key = point_key(Some(method), alpha, planes, lights, bump, &common);
+                    let key = point_key(Some(method), alpha, planes, lights, bump, ipd, &common);
                     // A value listed twice (`--depth 1,1`, `--alpha 0.7,0.7`) is one point.
                     if out.iter().any(|p| p.key == key) {
                         continue;
@@ -596,15 +678,19 @@ fn points(config: &SweepConfig, base_hash: u64, w: u32, h: u32) -> Vec<Point> {
                     let (b_label, b_slug) = bump.map_or((String::new(), String::new()), |a| {
                         (format!(" bump={a}°"), format!("_b{a}"))
                     });
+                    let (d_label, d_slug) = ipd.map_or((String::new(), String::new()), |d| {
+                        (format!(" stereo IPD {d}"), format!("_ipd{d}"))
+                    });
                     out.push(Point {
                         key,
-                        label: format!("{method}{p_label}{k_label}{b_label} α={alpha}"),
-                        slug: format!("{}{p_slug}{k_slug}{b_slug}_a{alpha}", method.slug()),
+                        label: format!("{method}{p_label}{k_label}{b_label}{d_label} α={alpha}"),
+                        slug: format!("{}{p_slug}{k_slug}{b_slug}{d_slug}_a{alpha}", method.slug()),
                         method: Some(method.clone()),
                         alpha,
                         planes,
                         lights,
                         bump,
+                        ipd,
                     });
                 }
             }
@@ -729,6 +815,122 @@ fn rendered_image(cache: &Path, i: usize) -> PathBuf {
     cache.join(format!(".render-{}-{i}.exr", std::process::id()))
 }
 
+/// The albedo of the sweep's `--marker` object, checked against the scene.
+fn marker_albedo(config: &SweepConfig, scene: &Scene) -> Result<Option<[f32; 3]>, HarnessError> {
+    let Some(name) = &config.marker else {
+        return Ok(None);
+    };
+    match scene.albedo_of(name) {
+        Some(a) => Ok(Some(a.to_array())),
+        None => Err(SettingError::new(
+            "--marker",
+            format!(
+                "the name of a diffuse object of {} (its `name`)",
+                config.scene.display()
+            ),
+            format!("{name:?}"),
+        )
+        .into()),
+    }
+}
+
+/// `images/x.png` → `images/x_anaglyph.png`.
+fn with_suffix(path: &Path, suffix: &str) -> PathBuf {
+    let stem = path.file_stem().unwrap_or_default().to_string_lossy();
+    path.with_file_name(format!("{stem}_{suffix}.png"))
+}
+
+/// Where a point's pictures go: the raster, its FLIP map and its truth (a stereo point: side
+/// by side, with the raster's and the truth's anaglyphs beside them, `_anaglyph`).
+struct ViewFiles {
+    raster: PathBuf,
+    heat: PathBuf,
+    truth: PathBuf,
+}
+
+/// A point's comparison: its metrics (a stereo pair: the mean of both eyes') and, for a pair,
+/// each eye's.
+struct Compared {
+    metrics: MetricValues,
+    eyes: Option<Vec<mirrorbox_report::EyeRecord>>,
+}
+
+/// Compares each view's raster (EXR, `rasters`) with its truth (`truths`: one, or a stereo
+/// pair's two, left first) and writes the pictures of `files`; with `marker` (an albedo),
+/// finds the marker's first reflection in each eye of a pair.
+fn compare_views(
+    truths: &[PathBuf],
+    rasters: &[PathBuf],
+    exposure: f32,
+    marker: Option<[f32; 3]>,
+    files: &ViewFiles,
+) -> Result<Compared, HarnessError> {
+    let mut metrics = Vec::new();
+    let mut pictures: Vec<[Vec<u8>; 3]> = Vec::new();
+    let mut eyes = Vec::new();
+    let (mut w, mut h) = (0, 0);
+    for (eye, (truth_path, raster_path)) in truths.iter().zip(rasters).enumerate() {
+        let truth = read_image(truth_path)?;
+        let raster = read_image(raster_path)?;
+        (w, h) = (raster.width, raster.height);
+        let m = metric_values(&compare(&truth, &raster, exposure)?);
+        let (t8, r8) = (truth.to_srgb8(exposure), raster.to_srgb8(exposure));
+        let heat: Vec<u8> = flip_map(&t8, &r8, w, h)
+            .iter()
+            .flat_map(|&v| colormap::heat(v))
+            .collect();
+        if truths.len() == 1 {
+            // Mono: the raster's PNG from its linear image, the truth's copied from the cache.
+            write_png(&files.raster, &raster, exposure)?;
+            write_png_bytes(&files.heat, w, h, &heat)?;
+            let source = truth_path.with_extension("png");
+            mirrorbox_files::write_atomically_with(&files.truth, |tmp| {
+                std::fs::copy(&source, tmp)
+                    .map(|_| ())
+                    .map_err(|e| format!("cannot copy {}: {e}", source.display()))
+            })?;
+            return Ok(Compared {
+                metrics: m,
+                eyes: None,
+            });
+        }
+        let blob = |img: &RgbImage| {
+            marker.and_then(|a| {
+                mirrorbox_image::stereo::marker_blob(&img.pixels, img.width, a).map(|b| {
+                    mirrorbox_report::MarkerRecord {
+                        x: b.x,
+                        y: b.y,
+                        pixels: b.pixels,
+                    }
+                })
+            })
+        };
+        eyes.push(mirrorbox_report::EyeRecord {
+            eye: mirrorbox_scene::stereo::Eye::BOTH[eye].name().into(),
+            metrics: m.clone(),
+            marker: blob(&raster),
+            truth_marker: blob(&truth),
+        });
+        metrics.push(m);
+        pictures.push([t8, r8, heat]);
+    }
+    let [[t_l, r_l, h_l], [t_r, r_r, h_r]] = &pictures[..] else {
+        unreachable!("a stereo point has two eyes");
+    };
+    let sbs = |a: &[u8], b: &[u8]| mirrorbox_image::stereo::side_by_side(a, b, w, h);
+    write_png_bytes(&files.raster, 2 * w, h, &sbs(r_l, r_r))?;
+    write_png_bytes(&files.heat, 2 * w, h, &sbs(h_l, h_r))?;
+    write_png_bytes(&files.truth, 2 * w, h, &sbs(t_l, t_r))?;
+    for (file, l, r) in [(&files.raster, r_l, r_r), (&files.truth, t_l, t_r)] {
+        let anaglyph = mirrorbox_image::stereo::anaglyph(l, r);
+        write_png_bytes(&with_suffix(file, "anaglyph"), w, h, &anaglyph)?;
+    }
+    Ok(Compared {
+        metrics: MetricValues::mean(&metrics),
+        eyes: Some(eyes),
+    })
+}
+
 /// The method every floor point renders the mirror-free scene with: one scene pass.
 pub const FLOOR_METHOD: &str = "naive";
 
@@ -744,6 +946,7 @@ fn point_setup(
         p.planes,
         p.lights,
         p.bump,
+        p.ipd,
         p.alpha,
     )?;
     let method = p
@@ -792,6 +995,7 @@ fn base_scene(config: &SweepConfig) -> Result<(Scene, u32, u32), HarnessError> {
         warmup: config.warmup,
     }
     .check(&base)?;
+    marker_albedo(config, &base)?;
     let (w, h) = (base.camera.width, base.camera.height);
     Ok((base, w, h))
 }
@@ -855,11 +1059,9 @@ pub fn run_sweep(
     };
     for p in still_to_do(&done_before) {
         let (scene, settings) = point_setup(&base, p, config)?;
-        mirrorbox_raster::plan_frame(&scene, &settings).map_err(|source| {
-            HarnessError::Refused {
-                point: p.label.clone(),
-                source,
-            }
+        worker::plan_point(&scene, &settings).map_err(|source| HarnessError::Refused {
+            point: p.label.clone(),
+            source,
         })?;
     }
     let (images, cache) = (out.join("images"), out.join("cache"));
@@ -894,7 +1096,17 @@ pub fn run_sweep(
     for (i, p) in todo.iter().enumerate() {
         progress(Event::Started { label: &p.label });
         let (scene, settings) = point_setup(&base, p, config)?;
-        truths.push(truth(&scene, config, &cache, &mut summary)?.1);
+        // A stereo point: each eye's truth.
+        let mut paths = Vec::new();
+        match worker::eye_scenes(&scene) {
+            Some(eyes) => {
+                for eye in &eyes {
+                    paths.push(truth(eye, config, &cache, &mut summary)?.1);
+                }
+            }
+            None => paths.push(truth(&scene, config, &cache, &mut summary)?.1),
+        }
+        truths.push(paths);
         jobs.push(RenderJob {
             scene: config.scene.clone(),
             width: w,
@@ -910,6 +1122,7 @@ pub fn run_sweep(
             symmetry_planes: p.planes,
             mirrored_lights: p.lights,
             bump_amplitude: p.bump,
+            stereo_ipd: p.ipd,
         });
     }
     // Interleaved timing: `frames` rounds; in each, every point renders its warm-up frames
@@ -946,55 +1159,42 @@ pub fn run_sweep(
     }
     // Every point shares the base scene's camera, hence its exposure.
     let exposure = base.camera.exposure;
+    let marker = marker_albedo(config, &base)?;
     for (i, p) in todo.iter().enumerate() {
-        let truth_path = &truths[i];
-        let truth_image = &read_image(truth_path)?;
         let report = last[i].take().expect("every point renders in every round");
-        let rendered = Rendered {
-            image: read_image(&jobs[i].image)?,
-            report,
-        };
-        let _ = std::fs::remove_file(&jobs[i].image);
         let frames_ms = std::mem::take(&mut timed[i]);
-        let m = compare(truth_image, &rendered.image, exposure)?;
-        let raster_png = images.join(format!("{}.png", p.slug));
-        write_png(&raster_png, &rendered.image, exposure)?;
-        let map = flip_map(
-            &truth_image.to_srgb8(exposure),
-            &rendered.image.to_srgb8(exposure),
-            w,
-            h,
-        );
-        let heat: Vec<u8> = map.iter().flat_map(|&v| colormap::heat(v)).collect();
-        let heat_png = images.join(format!("{}_flip.png", p.slug));
-        write_png_bytes(&heat_png, w, h, &heat)?;
-        // One truth per α (and per plane count in a symmetry-planes sweep).
-        let truth_png = images.join(format!(
-            "truth_{}.png",
-            match (&p.method, p.planes, p.lights) {
-                (None, _, _) => "floor".into(),
-                (Some(_), planes, lights) => format!(
-                    "{}{}{}a{}",
-                    planes.map_or(String::new(), |p| format!("p{p}_")),
-                    lights.map_or(String::new(), |k| format!("k{k}_")),
-                    p.bump.map_or(String::new(), |a| format!("b{a}_")),
-                    p.alpha
-                ),
-            }
-        ));
-        let truth_source = truth_path.with_extension("png");
-        mirrorbox_files::write_atomically_with(&truth_png, |tmp| {
-            std::fs::copy(&truth_source, tmp)
-                .map(|_| ())
-                .map_err(|e| format!("cannot copy {}: {e}", truth_source.display()))
-        })?;
+        let mut rasters = vec![jobs[i].image.clone()];
+        if p.ipd.is_some() {
+            rasters.push(worker::right_eye_image(&jobs[i].image));
+        }
+        let truth_name = match &p.method {
+            None => "floor".into(),
+            Some(_) => format!(
+                "{}{}{}{}a{}",
+                p.planes.map_or(String::new(), |p| format!("p{p}_")),
+                p.lights.map_or(String::new(), |k| format!("k{k}_")),
+                p.bump.map_or(String::new(), |a| format!("b{a}_")),
+                p.ipd.map_or(String::new(), |d| format!("ipd{d}_")),
+                p.alpha
+            ),
+        };
+        let files = ViewFiles {
+            raster: images.join(format!("{}.png", p.slug)),
+            heat: images.join(format!("{}_flip.png", p.slug)),
+            // One truth per α (and per plane count, light depth, tilt, IPD).
+            truth: images.join(format!("truth_{truth_name}.png")),
+        };
+        let views = compare_views(&truths[i], &rasters, exposure, marker, &files)?;
+        for r in &rasters {
+            let _ = std::fs::remove_file(r);
+        }
         let rel = |q: &Path| {
             q.strip_prefix(out)
                 .unwrap_or(q)
                 .to_string_lossy()
                 .into_owned()
         };
-        let s = &rendered.report;
+        let s = &report;
         let interval = mirrorbox_report::stats::median_interval(&frames_ms);
         let record = Record {
             key: p.key.clone(),
@@ -1038,13 +1238,19 @@ pub fn run_sweep(
             triangles: Some(s.triangles),
             paths: s.paths_kept,
             paths_pruned: s.paths_pruned,
-            metrics: metric_values(&m),
+            metrics: views.metrics,
             adapter: s.adapter.clone(),
             backend: s.backend.clone(),
             color_format: s.color_format.clone(),
-            truth_image: rel(&truth_png),
-            raster_image: rel(&raster_png),
-            heatmap_image: rel(&heat_png),
+            truth_image: rel(&files.truth),
+            raster_image: rel(&files.raster),
+            heatmap_image: rel(&files.heat),
+            stereo: views.eyes.map(|eyes| mirrorbox_report::StereoRecord {
+                ipd: p.ipd.unwrap_or(0.0),
+                eyes,
+                anaglyph_image: rel(&with_suffix(&files.raster, "anaglyph")),
+                truth_anaglyph_image: rel(&with_suffix(&files.truth, "anaglyph")),
+            }),
         };
         let line = serde_json::to_string(&record)?;
         let mut f = std::fs::OpenOptions::new()

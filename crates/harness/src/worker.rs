@@ -49,6 +49,15 @@ pub struct RenderJob {
     /// scene's own.
     #[serde(default)]
     pub bump_amplitude: Option<f32>,
+    /// A stereo pair's interpupillary distance (an `--ipd` sweep): the worker renders both
+    /// eyes as one frame, the left eye to `image`, the right to [`right_eye_image`].
+    #[serde(default)]
+    pub stereo_ipd: Option<f32>,
+}
+
+/// Where a stereo job's right eye goes, beside `image`.
+pub fn right_eye_image(image: &Path) -> PathBuf {
+    image.with_extension("right.exr")
 }
 
 /// What a worker measured.
@@ -93,7 +102,10 @@ pub struct CopyReport {
 
 /// A rendered point: the image and what was measured.
 pub struct Rendered {
+    /// The view (a stereo pair's left eye).
     pub image: RgbImage,
+    /// A stereo pair's right eye.
+    pub right_eye: Option<RgbImage>,
     pub report: RenderReport,
 }
 
@@ -119,6 +131,7 @@ fn job_scene(job: &RenderJob) -> Result<Scene, HarnessError> {
         job.symmetry_planes,
         job.mirrored_lights,
         job.bump_amplitude,
+        job.stereo_ipd,
         job.alpha,
     )
 }
@@ -126,13 +139,16 @@ fn job_scene(job: &RenderJob) -> Result<Scene, HarnessError> {
 /// A point's scene made from the sweep's scene, the one derivation the sweep and its workers
 /// share (the worker's scene hash must equal the sweep's): the floor drops the mirrors, a
 /// symmetry-planes point keeps the first p planes, a mirrored-lights point lights through
-/// chains of at most k mirrors, and every mirror reflects α (the light images follow).
+/// chains of at most k mirrors, and every mirror reflects α (the light images follow). A
+/// stereo point's scene carries its rig at the point's IPD ([`Scene::stereo_rig`]); every
+/// other point's carries none (a mono frame, whatever the file's camera says).
 pub(crate) fn point_scene(
     base: &Scene,
     floor: bool,
     planes: Option<u32>,
     mirrored_lights: Option<u32>,
     bump_amplitude: Option<f32>,
+    stereo_ipd: Option<f32>,
     alpha: f32,
 ) -> Result<Scene, HarnessError> {
     let mut scene = match (floor, planes) {
@@ -146,6 +162,7 @@ pub(crate) fn point_scene(
     if let Some(a) = bump_amplitude {
         scene.set_bump_amplitude(a);
     }
+    scene.stereo = stereo_ipd.map(|d| base.stereo_rig(d));
     let budget = |source| HarnessError::LightImages {
         scene: base.source.clone(),
         source,
@@ -154,6 +171,32 @@ pub(crate) fn point_scene(
     let threshold = scene.lighting.images.min_throughput;
     scene.enumerate_light_images(threshold).map_err(budget)?;
     Ok(scene)
+}
+
+/// The eyes of a stereo point's scene (left, right), or `None` for a mono point.
+pub fn eye_scenes(scene: &Scene) -> Option<[Scene; 2]> {
+    let rig = scene.stereo?;
+    Some(mirrorbox_scene::stereo::Eye::BOTH.map(|e| scene.eye(&rig, e)))
+}
+
+/// Plans a point's frame (a stereo point: its pair) on the CPU, refusing what is over budget.
+pub(crate) fn plan_point(
+    scene: &Scene,
+    settings: &RenderSettings,
+) -> Result<PlannedPoint, mirrorbox_raster::PlanError> {
+    Ok(match eye_scenes(scene) {
+        Some(eyes) => PlannedPoint::Pair(
+            mirrorbox_raster::stereo_pair::plan_pair([&eyes[0], &eyes[1]], settings)?,
+            Box::new(eyes),
+        ),
+        None => PlannedPoint::Mono(mirrorbox_raster::plan_frame(scene, settings)?),
+    })
+}
+
+/// A planned point: one frame, or a stereo pair with its eyes' scenes.
+pub(crate) enum PlannedPoint {
+    Mono(mirrorbox_raster::Planned),
+    Pair(mirrorbox_raster::stereo_pair::Planned, Box<[Scene; 2]>),
 }
 
 /// Runs `job` in this process (the worker's side, or the sweep's when it renders in-process).
@@ -178,9 +221,19 @@ pub fn run_job(job: &RenderJob, gpu: &Gpu) -> Result<Rendered, HarnessError> {
     // Planning is the CPU's share of a frame (reflection paths, the paper's recursion):
     // timed on its own, since GPU timestamps do not see it.
     let started = std::time::Instant::now();
-    let planned = mirrorbox_raster::plan_frame(&scene, &settings).map_err(RasterError::from)?;
+    let planned = plan_point(&scene, &settings).map_err(RasterError::from)?;
     let plan_ms = started.elapsed().as_secs_f64() * 1e3;
-    let out = mirrorbox_raster::render_planned(gpu, &scene, planned, &settings)?;
+    let out = match planned {
+        PlannedPoint::Mono(planned) => {
+            mirrorbox_raster::render_planned(gpu, &scene, planned, &settings)?
+        }
+        PlannedPoint::Pair(planned, eyes) => mirrorbox_raster::stereo_pair::render_pair(
+            gpu,
+            [&eyes[0], &eyes[1]],
+            planned,
+            &settings,
+        )?,
+    };
     let s = &out.stats;
     Ok(Rendered {
         report: RenderReport {
@@ -208,6 +261,7 @@ pub fn run_job(job: &RenderJob, gpu: &Gpu) -> Result<Rendered, HarnessError> {
             bake_ms: out.bake_ms,
         },
         image: out.image,
+        right_eye: out.right_eye,
     })
 }
 
@@ -215,6 +269,9 @@ pub fn run_job(job: &RenderJob, gpu: &Gpu) -> Result<Rendered, HarnessError> {
 pub fn run_job_to_file(job: &RenderJob, gpu: &Gpu) -> Result<RenderReport, HarnessError> {
     let rendered = run_job(job, gpu)?;
     write_exr(&job.image, &rendered.image, &[])?;
+    if let Some(right) = &rendered.right_eye {
+        write_exr(&right_eye_image(&job.image), right, &[])?;
+    }
     Ok(rendered.report)
 }
 

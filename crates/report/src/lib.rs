@@ -13,6 +13,7 @@ pub mod plot;
 pub mod readme;
 mod runs;
 pub mod stats;
+pub mod stereo;
 pub mod symmetry;
 pub mod table1;
 pub mod uneven;
@@ -36,6 +37,62 @@ pub struct MetricValues {
     pub flip_mean: f64,
     pub flip_p95: f64,
     pub flip_p99: f64,
+}
+
+impl MetricValues {
+    /// The mean of each metric over `views` (a stereo pair's eyes); PSNR only where every view
+    /// has one.
+    pub fn mean(views: &[MetricValues]) -> MetricValues {
+        let n = views.len().max(1) as f64;
+        let mean = |f: fn(&MetricValues) -> f64| views.iter().map(f).sum::<f64>() / n;
+        MetricValues {
+            rmse: mean(|m| m.rmse),
+            relmse: mean(|m| m.relmse),
+            smape: mean(|m| m.smape),
+            max_abs: views.iter().map(|m| m.max_abs).fold(0.0, f64::max),
+            psnr: views
+                .iter()
+                .map(|m| m.psnr)
+                .sum::<Option<f64>>()
+                .map(|s| s / n),
+            ssim: mean(|m| m.ssim),
+            flip_mean: mean(|m| m.flip_mean),
+            flip_p95: mean(|m| m.flip_p95),
+            flip_p99: mean(|m| m.flip_p99),
+        }
+    }
+}
+
+/// A stereo point (issue 17): both eyes rendered as one frame, each against its own truth.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StereoRecord {
+    /// Interpupillary distance, scene units.
+    pub ipd: f32,
+    /// Left, then right.
+    pub eyes: Vec<EyeRecord>,
+    /// The raster's and the truth's red–cyan anaglyphs.
+    pub anaglyph_image: String,
+    pub truth_anaglyph_image: String,
+}
+
+/// One eye of a stereo point.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct EyeRecord {
+    pub eye: String,
+    /// Against this eye's truth.
+    pub metrics: MetricValues,
+    /// The sweep's marker (`--marker`) in the raster's and in the truth's picture of this eye:
+    /// its first reflection's centroid, `None` where it is not seen.
+    pub marker: Option<MarkerRecord>,
+    pub truth_marker: Option<MarkerRecord>,
+}
+
+/// Where a marker appears: centroid in pixels (x right, y down) and its size in pixels.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MarkerRecord {
+    pub x: f64,
+    pub y: f64,
+    pub pixels: usize,
 }
 
 fn back_to_back() -> String {
@@ -67,6 +124,10 @@ pub struct Record {
     /// issue 16).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub bump_amplitude_deg: Option<f32>,
+    /// A stereo point (an `--ipd` sweep): the IPD and each eye's comparison; `metrics` is then
+    /// the mean of both eyes', the images are side by side, the time is the pair's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stereo: Option<StereoRecord>,
     /// Symmetry methods: copies of the objects drawn, and 2^p.
     #[serde(default)]
     pub copies_drawn: Option<usize>,

@@ -268,14 +268,14 @@ fn esc(s: &str) -> String {
 fn write_csv(path: &Path, records: &[Record]) -> Result<(), FileError> {
     let mut s = String::from(
         "kind,method,n,depth,alpha,width,height,ssaa,ms_median,ms_ci_low,ms_ci_high,ms_min,timing_order,timing_source,frames,passes,draws,texture_renders,reflections,\
-         rmse,relmse,smape,max_abs,psnr,ssim,flip_mean,flip_p95,flip_p99,adapter,backend,scene,scene_hash,color_format,peak_memory_bytes,plan_ms,encode_ms,gpu_buffer_bytes,gpu_texture_bytes,method_options,symmetry_planes,copies_drawn,copies_total,bake_ms,mirrored_lights\n",
+         rmse,relmse,smape,max_abs,psnr,ssim,flip_mean,flip_p95,flip_p99,adapter,backend,scene,scene_hash,color_format,peak_memory_bytes,plan_ms,encode_ms,gpu_buffer_bytes,gpu_texture_bytes,method_options,symmetry_planes,copies_drawn,copies_total,bake_ms,mirrored_lights,bump_amplitude_deg,stereo_ipd,marker_disparity_px,truth_marker_disparity_px\n",
     );
     for r in records {
         let m = &r.metrics;
         let opt = |v: Option<u32>| v.map_or(String::new(), |x| x.to_string());
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},\"{}\",{},\"{}\",{},{},{},{},{},{},{},\"{}\",{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},\"{}\",{},\"{}\",{},{},{},{},{},{},{},\"{}\",{},{},{},{},{},{},{},{},{}",
             r.kind,
             r.method,
             opt(r.n),
@@ -319,7 +319,14 @@ fn write_csv(path: &Path, records: &[Record]) -> Result<(), FileError> {
             r.copies_drawn.map_or(String::new(), |c| c.to_string()),
             r.copies_total.map_or(String::new(), |c| c.to_string()),
             r.bake_ms.map_or(String::new(), |ms| ms.to_string()),
-            opt(r.mirrored_lights)
+            opt(r.mirrored_lights),
+            r.bump_amplitude_deg
+                .map_or(String::new(), |a| a.to_string()),
+            r.stereo
+                .as_ref()
+                .map_or(String::new(), |st| st.ipd.to_string()),
+            crate::stereo::disparity(r, false).map_or(String::new(), |d| d.to_string()),
+            crate::stereo::disparity(r, true).map_or(String::new(), |d| d.to_string()),
         );
     }
     write_atomically(path, s.as_bytes())
@@ -761,6 +768,7 @@ fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
     b.extend(symmetry_section(records));
     b.extend(crate::lighting::lighting_section(records));
     b.extend(crate::uneven::uneven_section(records, &info.bump_methods));
+    b.extend(crate::stereo::stereo_section(records));
 
     let mut groups: Vec<(String, f32)> = Vec::new();
     for r in &points {
@@ -955,6 +963,7 @@ pub(crate) mod tests {
             symmetry_planes: None,
             mirrored_lights: None,
             bump_amplitude_deg: None,
+            stereo: None,
             copies_drawn: None,
             copies_total: None,
             bake_ms: None,
@@ -1221,13 +1230,14 @@ pub(crate) mod tests {
         let csv = std::fs::read_to_string(dir.path().join("results.csv")).unwrap();
         assert!(csv.lines().next().unwrap().ends_with(
             ",color_format,peak_memory_bytes,plan_ms,encode_ms,gpu_buffer_bytes,gpu_texture_bytes,\
-             method_options,symmetry_planes,copies_drawn,copies_total,bake_ms,mirrored_lights"
+             method_options,symmetry_planes,copies_drawn,copies_total,bake_ms,mirrored_lights,\
+             bump_amplitude_deg,stereo_ipd,marker_disparity_px,truth_marker_disparity_px"
         ));
         assert!(
             csv.lines()
                 .nth(2)
                 .unwrap()
-                .ends_with(",rgba16float,,,,,,\"\",,,,,")
+                .ends_with(",rgba16float,,,,,,\"\",,,,,,,,,")
         );
         // Every row has the header's number of columns (no value here holds a comma).
         let columns = |l: &str| l.split(',').count();

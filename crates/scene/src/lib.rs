@@ -233,6 +233,29 @@ impl Scene {
         }
     }
 
+    /// The rig the scene's stereo renders use at interpupillary distance `ipd`: the camera's
+    /// own `stereo` with that IPD, or else an off-axis rig converging at `look_at`.
+    pub fn stereo_rig(&self, ipd: f32) -> stereo::Stereo {
+        match self.stereo {
+            Some(rig) => stereo::Stereo { ipd, ..rig },
+            None => stereo::Stereo {
+                ipd,
+                convergence: stereo::Convergence::OffAxis,
+                convergence_distance: (self.camera.look_at - self.camera.position).length(),
+            },
+        }
+    }
+
+    /// The albedo of the diffuse object named `name` (a marker a measurement looks for).
+    pub fn albedo_of(&self, name: &str) -> Option<Vec3> {
+        self.geometry.parts.iter().find_map(|p| {
+            match (&self.geometry.surfaces[p.surface as usize], p.name == name) {
+                (Surface::Diffuse { albedo, .. }, true) => Some(*albedo),
+                _ => None,
+            }
+        })
+    }
+
     /// The scene seen by one eye of `stereo` (the scene's own rig, or another): its camera
     /// replaced by that eye's ([`stereo::Stereo::eye`]), no rig left.
     pub fn eye(&self, stereo: &stereo::Stereo, eye: stereo::Eye) -> Scene {

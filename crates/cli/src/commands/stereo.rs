@@ -3,7 +3,7 @@
 
 use crate::Failure;
 use mirrorbox_scene::Scene;
-use mirrorbox_scene::stereo::{Convergence, Eye, Stereo};
+use mirrorbox_scene::stereo::{Eye, Stereo};
 use std::path::{Path, PathBuf};
 
 /// The flags, shared by `trace` and `render`.
@@ -32,15 +32,8 @@ impl StereoArgs {
         }
         match (self.stereo || self.ipd.is_some(), scene.stereo, self.ipd) {
             (false, _, _) => Ok(None),
-            (true, Some(rig), ipd) => Ok(Some(Stereo {
-                ipd: ipd.unwrap_or(rig.ipd),
-                ..rig
-            })),
-            (true, None, Some(ipd)) => Ok(Some(Stereo {
-                ipd,
-                convergence: Convergence::OffAxis,
-                convergence_distance: (scene.camera.look_at - scene.camera.position).length(),
-            })),
+            (true, Some(rig), None) => Ok(Some(rig)),
+            (true, _, Some(ipd)) => Ok(Some(scene.stereo_rig(ipd))),
             (true, None, None) => Err(Failure::BadInput(format!(
                 "--stereo: {} has no camera.stereo; add one (docs/scene-format.md) or give --ipd",
                 scene.source.display()

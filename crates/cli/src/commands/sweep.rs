@@ -72,6 +72,31 @@ pub struct Args {
     /// strength, docs/shading.md); each in [0, 90).
     #[arg(long, value_delimiter = ',')]
     bump_amplitude: Option<Vec<f32>>,
+    /// Stereo pairs: interpupillary distances in scene units, comma separated, each in [0, 1],
+    /// or `mono`: every point renders both eyes of the camera's `stereo` rig (or an off-axis
+    /// rig converging at look_at) as one frame, each eye against its own truth, at each IPD;
+    /// `mono` is the plain frame.
+    #[arg(long, value_delimiter = ',')]
+    ipd: Option<Vec<String>>,
+    /// With --ipd: the name of a diffuse object whose first reflection is located in each eye
+    /// (raster and truth), for the report's disparity check.
+    #[arg(long, requires = "ipd")]
+    marker: Option<String>,
+}
+
+/// `--ipd`: numbers or `mono` (the range is checked with the other settings).
+fn parse_ipds(values: &[String]) -> Result<Vec<Option<f32>>, Failure> {
+    values
+        .iter()
+        .map(|v| match v.trim() {
+            "mono" => Ok(None),
+            t => t.parse::<f32>().map(Some).map_err(|_| {
+                bad(format!(
+                    "--ipd: each value must be a number in [0, 1] or `mono`, got {v:?}"
+                ))
+            }),
+        })
+        .collect()
 }
 
 /// `--symmetry-planes`: `0,2,4` or `0..=10`.
@@ -208,6 +233,8 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             .map(parse_planes)
             .transpose()?,
         bump_amplitudes: args.bump_amplitude.clone(),
+        stereo_ipds: args.ipd.as_deref().map(parse_ipds).transpose()?,
+        marker: args.marker.clone(),
         mirrored_lights: args
             .mirrored_lights
             .as_deref()
@@ -273,6 +300,12 @@ pub fn run_bumpy(args: &PresetArgs) -> Result<(), Failure> {
     single.push("_single");
     run_preset(SweepConfig::bumpy(out), args)?;
     run_preset(SweepConfig::bumpy_single(single.into()), args)
+}
+
+/// Stereo mirrors (`SweepConfig::stereo`), into `reports/stereo/` by default.
+pub fn run_stereo(args: &PresetArgs) -> Result<(), Failure> {
+    let out = args.out.clone().unwrap_or_else(|| "reports/stereo".into());
+    run_preset(SweepConfig::stereo(out), args)
 }
 
 fn run_preset(mut config: SweepConfig, args: &PresetArgs) -> Result<(), Failure> {
