@@ -86,6 +86,11 @@ pub const REGIONS: &[(&str, &str, &str)] = &[
         "the same on the hammered single mirror",
     ),
     (
+        "stereo",
+        "stereo",
+        "stereo mirrors: the pair's cost against mono, per-eye against shared, and the disparity check",
+    ),
+    (
         "lighting-trace-cost",
         "lighting/trace_cost.jsonl",
         "the tracer's time against the mirrored-light depth k on both lit scenes",
@@ -229,6 +234,23 @@ fn uneven_region(s: &Sweep) -> Result<String, ReadmeError> {
     Ok(markdown(&[
         Block::Paragraph(measured_on(s)),
         crate::uneven::table(&s.records, &s.info.bump_methods, false),
+        Block::Bullets(sentences),
+    ]))
+}
+
+fn stereo_region(s: &Sweep) -> Result<String, ReadmeError> {
+    let sentences = crate::stereo::sentences(&s.records);
+    if sentences.is_empty() {
+        return Err(ReadmeError(format!(
+            "{}: no stereo sweep measuring per-eye and shared, nothing to quote",
+            s.info.scene
+        )));
+    }
+    Ok(markdown(&[
+        Block::Paragraph(measured_on(s)),
+        crate::stereo::cost_table(&s.records),
+        crate::stereo::error_table(&s.records),
+        crate::stereo::disparity_table(&s.records),
         Block::Bullets(sentences),
     ]))
 }
@@ -505,6 +527,7 @@ pub fn generate(id: &str, reports: &Path) -> Result<Region, ReadmeError> {
         "lighting" | "lighting-room" => lighting_region(&load_sweep(&folder(source))?)?,
         "lighting-trace-cost" => trace_cost_region(&folder(source))?,
         "uneven-mirrors" | "uneven-mirrors-single" => uneven_region(&load_sweep(&folder(source))?)?,
+        "stereo" => stereo_region(&load_sweep(&folder(source))?)?,
         "gpu-column" => device_column_region(
             &load_sweep(&folder("table1"))?,
             &load_sweep(&folder(source))?,
