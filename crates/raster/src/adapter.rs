@@ -30,7 +30,7 @@ pub struct AdapterReport {
     pub clip_distances: bool,
     /// Multiview render passes (`Features::MULTIVIEW`: one pass draws both eyes of a stereo
     /// pair into a two-layer target). Reported, not used: `--stereo` renders each eye's
-    /// passes one after the other (docs/methods.md, "Stereo").
+    /// passes one after the other (docs/methods.md, "Stereo mirrors").
     pub multiview: bool,
 }
 

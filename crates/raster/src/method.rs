@@ -97,12 +97,60 @@ pub trait RasterMethod {
         eyes: [&Scene; 2],
         width: u32,
         height: u32,
-    ) -> Result<crate::stereo_pair::PlannedPair, PlanError> {
-        Ok(crate::stereo_pair::PlannedPair::Separate([
-            self.plan(eyes[0], width, height)?,
-            self.plan(eyes[1], width, height)?,
-        ]))
+    ) -> Result<PlannedPair, PlanError> {
+        plan_each_eye(self, eyes, width, height)
     }
+}
+
+// ---------------------------------------------------------------------------------------
+// Stereo pairs (rendered by crate::stereo_pair)
+
+/// A frame that draws both eyes' views, each into its own target.
+pub trait PairEncoder {
+    /// `first_pass` carries the timestamp write the frame's first pass must attach.
+    fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        targets: [&crate::targets::RenderTarget; 2],
+        first_pass: Option<wgpu::RenderPassTimestampWrites<'_>>,
+    );
+}
+
+/// A pair planned jointly: one set of GPU resources drawing both eyes.
+pub trait PlannedJointPair {
+    fn build(
+        self: Box<Self>,
+        gpu: &Gpu,
+        eyes: [&Scene; 2],
+        shadows: &crate::shadow_maps::ShadowMaps,
+    ) -> Result<BuiltPair, RasterError>;
+}
+
+/// A jointly planned pair's resources and counts (passes of both eyes).
+pub struct BuiltPair {
+    pub encoder: Box<dyn PairEncoder>,
+    pub stats: FrameStats,
+}
+
+/// How a method plans a stereo pair ([`RasterMethod::plan_pair`]).
+pub enum PlannedPair {
+    /// Each eye its own frame (left, right).
+    Separate([Box<dyn PlannedFrame>; 2]),
+    /// One frame drawing both eyes, sharing what the eyes share.
+    Joint(Box<dyn PlannedJointPair>),
+}
+
+/// Each eye planned as its own frame (the default [`RasterMethod::plan_pair`]).
+pub fn plan_each_eye<M: RasterMethod + ?Sized>(
+    method: &M,
+    eyes: [&Scene; 2],
+    width: u32,
+    height: u32,
+) -> Result<PlannedPair, PlanError> {
+    Ok(PlannedPair::Separate([
+        method.plan(eyes[0], width, height)?,
+        method.plan(eyes[1], width, height)?,
+    ]))
 }
 
 /// A planned frame, ready to become GPU resources.

@@ -11,49 +11,17 @@
 //!   the shortcut's whole point, so it is in the pair's time.
 //! - Shadow maps depend on the lights, not the eye: drawn once per pair.
 //! - Multiview (`Features::MULTIVIEW`, one pass drawing both eyes into a two-layer target) is
-//!   not used: the adapter report says whether a device has it (`mirrorbox info`).
+//!   not used: the adapter report says whether a device has it (`mirrorbox info`), and
+//!   docs/methods.md ("Stereo mirrors") why it did not land.
+
+pub use crate::method::{BuiltPair, PairEncoder, PlannedJointPair, PlannedPair, plan_each_eye};
 
 use crate::gpu::{Gpu, RasterError};
-use crate::method::{FrameStats, PlannedFrame};
+use crate::method::FrameStats;
 use crate::plan::PlanError;
 use crate::targets::RenderTarget;
 use crate::{RenderOutput, RenderSettings};
 use mirrorbox_scene::Scene;
-
-/// A frame that draws both eyes' views, each into its own target.
-pub trait PairEncoder {
-    /// `first_pass` carries the timestamp write the frame's first pass must attach.
-    fn encode(
-        &self,
-        encoder: &mut wgpu::CommandEncoder,
-        targets: [&RenderTarget; 2],
-        first_pass: Option<wgpu::RenderPassTimestampWrites<'_>>,
-    );
-}
-
-/// A pair planned jointly: one set of GPU resources drawing both eyes.
-pub trait PlannedJointPair {
-    fn build(
-        self: Box<Self>,
-        gpu: &Gpu,
-        eyes: [&Scene; 2],
-        shadows: &crate::shadow_maps::ShadowMaps,
-    ) -> Result<BuiltPair, RasterError>;
-}
-
-/// A jointly planned pair's resources and counts (passes of both eyes).
-pub struct BuiltPair {
-    pub encoder: Box<dyn PairEncoder>,
-    pub stats: FrameStats,
-}
-
-/// How a method plans a stereo pair ([`crate::RasterMethod::plan_pair`]).
-pub enum PlannedPair {
-    /// Each eye its own frame (left, right).
-    Separate([Box<dyn PlannedFrame>; 2]),
-    /// One frame drawing both eyes, sharing what the eyes share.
-    Joint(Box<dyn PlannedJointPair>),
-}
 
 /// A stereo pair planned on the CPU (see [`crate::Planned`]).
 pub struct Planned {

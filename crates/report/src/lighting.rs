@@ -62,15 +62,7 @@ fn lit_points(records: &[Record]) -> Vec<&Record> {
         .collect()
 }
 
-fn distinct(values: impl Iterator<Item = String>) -> Vec<String> {
-    let mut out: Vec<String> = Vec::new();
-    for v in values {
-        if !out.contains(&v) {
-            out.push(v);
-        }
-    }
-    out
-}
+use crate::write::distinct;
 
 /// The method the sentences and the error-against-k chart follow: the first exact one
 /// measured (`unrolled`, `portal`), else the first.

@@ -10,7 +10,7 @@
 //! paints it at the mirror's.
 
 use crate::plot::{Chart, Series};
-use crate::write::{Block, f, ms_cell, sci};
+use crate::write::{Block, distinct, f, ms_cell, sci};
 use crate::{MarkerRecord, Record};
 
 /// The method option that chooses shared mirror textures (crates/raster/src/stereo_mirrors.rs).
@@ -33,16 +33,6 @@ fn variant_of(r: &Record) -> String {
         method_of(r),
         if is_shared(r) { "shared" } else { "per-eye" }
     )
-}
-
-fn distinct<T: PartialEq>(values: impl Iterator<Item = T>) -> Vec<T> {
-    let mut out: Vec<T> = Vec::new();
-    for v in values {
-        if !out.contains(&v) {
-            out.push(v);
-        }
-    }
-    out
 }
 
 /// The stereo points, and whether the sweep has any.

@@ -7,7 +7,7 @@
 
 use crate::Record;
 use crate::plot::{Chart, Series};
-use crate::write::{Block, ms_cell, sci};
+use crate::write::{Block, distinct, ms_cell, sci};
 
 /// The raster options of an uneven-mirror trick (crates/raster/src/uneven.rs).
 const TRICK_OPTIONS: [&str; 5] = [
@@ -82,16 +82,6 @@ fn points(records: &[Record]) -> Vec<&Record> {
         .iter()
         .filter(|r| r.kind == "point" && r.bump_amplitude_deg.is_some())
         .collect()
-}
-
-fn distinct<T: PartialEq>(values: impl Iterator<Item = T>) -> Vec<T> {
-    let mut out: Vec<T> = Vec::new();
-    for v in values {
-        if !out.contains(&v) {
-            out.push(v);
-        }
-    }
-    out
 }
 
 fn amplitudes(points: &[&Record]) -> Vec<f32> {

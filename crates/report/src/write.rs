@@ -72,6 +72,17 @@ pub(crate) fn ms(v: f64, digits: usize) -> String {
     f(v, ms_digits(v, digits))
 }
 
+/// `values` without repeats, in first-seen order (a report's rows and series).
+pub(crate) fn distinct<T: PartialEq>(values: impl Iterator<Item = T>) -> Vec<T> {
+    let mut out: Vec<T> = Vec::new();
+    for v in values {
+        if !out.contains(&v) {
+            out.push(v);
+        }
+    }
+    out
+}
+
 pub(crate) fn sci(v: f64) -> String {
     if v.is_finite() {
         format!("{v:.3e}")

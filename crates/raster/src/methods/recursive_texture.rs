@@ -297,10 +297,7 @@ impl RasterMethod for RecursiveTextureMethod {
                 && eyes.iter().all(|e| e.camera != **h)
         });
         let Some(head) = head else {
-            return Ok(crate::stereo_pair::PlannedPair::Separate([
-                self.plan(eyes[0], width, height)?,
-                self.plan(eyes[1], width, height)?,
-            ]));
+            return crate::stereo_pair::plan_each_eye(self, eyes, width, height);
         };
         let head_scene = Scene {
             camera: head.clone(),
