@@ -1629,3 +1629,150 @@ fn stereo_sweep_measures_the_shared_shortcuts_disparity() {
         "shared mirrors flatten the reflection: {raster} px vs truth {truth} px"
     );
 }
+
+/// Issue 20: `sweep --shard I/N` splits the points by key into disjoint shares that together
+/// are the unsharded sweep; shards share a truth cache; `merge` joins them into the same
+/// records (the same images bit for bit, the same errors) and refuses a shard given twice, a
+/// missing shard, and a folder that is not a shard.
+#[test]
+fn shards_merge_into_the_unsharded_sweep() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let p = |name: &str| d.join(name).to_str().unwrap().to_string();
+    let sweep = |out: &str, extra: &[&str], env: &[(&str, &str)]| {
+        let mut args = vec![
+            "sweep",
+            "scenes/mirror_box.json",
+            "--out",
+            out,
+            "--methods",
+            "naive,auxiliary",
+            "--n",
+            "0,1",
+            "--alpha",
+            "0.7,0.9",
+            "--width",
+            "48",
+            "--height",
+            "27",
+            "--frames",
+            "1",
+            "--warmup",
+            "0",
+        ];
+        args.extend_from_slice(extra);
+        let run = mirrorbox(&args, env);
+        assert_eq!(run.code, 0, "{args:?}: {}", run.stderr);
+    };
+    for (shard, message) in [
+        (
+            "3/3",
+            "--shard must be I/N with N in [1, 100000] and I in [0, N)",
+        ),
+        ("x/3", "I must be a whole number"),
+        (
+            "auto",
+            "expected I/N, auto/N, or auto inside a Slurm job array",
+        ),
+        ("auto/3", "auto needs SLURM_ARRAY_TASK_ID"),
+    ] {
+        let r = mirrorbox(
+            &[
+                "sweep",
+                "scenes/mirror_box.json",
+                "--out",
+                &p("bad"),
+                "--shard",
+                shard,
+            ],
+            &[],
+        );
+        assert_eq!(r.code, 2, "{shard}: {}", r.stderr);
+        assert!(r.stderr.contains(message), "{shard}: {}", r.stderr);
+    }
+    sweep(&p("full"), &[], &[]);
+    let cache = p("truths");
+    // Shard 0 as a Slurm array task (ids 1..3), the others by number.
+    sweep(
+        &p("s0"),
+        &["--shard", "auto", "--truth-cache", &cache],
+        &[
+            ("SLURM_ARRAY_TASK_ID", "1"),
+            ("SLURM_ARRAY_TASK_MIN", "1"),
+            ("SLURM_ARRAY_TASK_COUNT", "3"),
+        ],
+    );
+    for i in [1, 2] {
+        sweep(
+            &p(&format!("s{i}")),
+            &["--shard", &format!("{i}/3"), "--truth-cache", &cache],
+            &[],
+        );
+    }
+    let full = records(&d.join("full"));
+    let shard_keys: Vec<Vec<String>> = (0..3)
+        .map(|i| {
+            records(&d.join(format!("s{i}")))
+                .iter()
+                .map(|r| r["key"].as_str().unwrap().to_string())
+                .collect()
+        })
+        .collect();
+    let mut union: Vec<&String> = shard_keys.iter().flatten().collect();
+    assert_eq!(union.len(), full.len(), "every point in exactly one shard");
+    union.sort();
+    let mut keys: Vec<&str> = full.iter().map(|r| r["key"].as_str().unwrap()).collect();
+    keys.sort_unstable();
+    assert_eq!(union, keys);
+    assert!(
+        shard_keys.iter().filter(|k| !k.is_empty()).count() >= 2,
+        "{shard_keys:?}"
+    );
+    // The truths were traced once, into the shared cache.
+    let truths = std::fs::read_dir(&cache).unwrap().count();
+    assert_eq!(
+        truths,
+        2 * 3,
+        "a truth per α and the floor's, EXR and PNG each"
+    );
+
+    let (s0, s1, s2) = (p("s0"), p("s1"), p("s2"));
+    let merged = mirrorbox(&["merge", &p("merged"), &s0, &s1, &s2], &[]);
+    assert_eq!(merged.code, 0, "{}", merged.stderr);
+    let joined = records(&d.join("merged"));
+    assert_eq!(joined.len(), full.len());
+    for r in &joined {
+        let f = full.iter().find(|f| f["key"] == r["key"]).unwrap();
+        for m in ["flip_mean", "rmse", "ssim"] {
+            let (a, b) = (
+                f["metrics"][m].as_f64().unwrap(),
+                r["metrics"][m].as_f64().unwrap(),
+            );
+            assert!((a - b).abs() <= 1e-12 * a.abs().max(1.0), "{m}: {a} vs {b}");
+        }
+        for image in ["raster_image", "truth_image"] {
+            let name = r[image].as_str().unwrap();
+            assert_eq!(
+                std::fs::read(d.join("merged").join(name)).unwrap(),
+                std::fs::read(d.join("full").join(name)).unwrap(),
+                "{name}"
+            );
+        }
+    }
+    let report = std::fs::read_to_string(d.join("merged/report.md")).unwrap();
+    assert!(report.contains("Merged from 3 shards"), "{report}");
+
+    for (args, message) in [
+        (vec![s0.clone(), s0.clone()], "one folder per shard"),
+        (vec![s0.clone(), s1.clone()], "measured by none of them"),
+        (vec![p("full")], "this sweep was not sharded"),
+    ] {
+        let out = p("refused");
+        let mut all = vec!["merge", out.as_str()];
+        all.extend(args.iter().map(String::as_str));
+        let r = mirrorbox(&all, &[]);
+        assert_eq!(r.code, 2, "{all:?}: {}", r.stderr);
+        assert!(r.stderr.contains(message), "{all:?}: {}", r.stderr);
+        assert!(!d.join("refused").exists(), "nothing written on refusal");
+    }
+}

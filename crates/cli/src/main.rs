@@ -53,6 +53,8 @@ enum Command {
     Readme(commands::readme::Args),
     /// Rewrite a sweep folder's report (Markdown, HTML, CSV, plots) from its results.jsonl, without rendering.
     Report(commands::report::Args),
+    /// Join the shards of a sweep (`sweep --shard I/N`, each in its own folder) into one sweep folder and write its reports.
+    Merge(commands::merge::Args),
     /// Internal: one timed render of a sweep, a job as JSON on stdin (see
     /// `mirrorbox_harness::worker`).
     #[command(hide = true)]
@@ -199,6 +201,7 @@ fn main() -> ExitCode {
         Command::ExportMitsuba(args) => commands::export_mitsuba::run(&args),
         Command::Readme(args) => commands::readme::run(&args),
         Command::Report(args) => commands::report::run(&args),
+        Command::Merge(args) => commands::merge::run(&args),
         Command::RenderWorker => {
             mirrorbox_harness::serve(std::io::stdin().lock(), std::io::stdout().lock())
                 .map_err(Failure::from)

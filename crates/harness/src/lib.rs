@@ -16,6 +16,7 @@
 //! - **Floor**: raster vs trace on the scene without its mirrors, the error that is left
 //!   when there is no mirror effect to truncate.
 
+pub mod merge;
 mod worker;
 
 pub use worker::{RenderJob, RenderReport, Rendered, peak_memory_bytes, serve};
@@ -78,6 +79,39 @@ pub struct SweepConfig {
     /// alike, to measure its disparity (`--marker NAME`, a diffuse object of the scene; its
     /// albedo's chromaticity finds it: `mirrorbox_image::stereo::marker_blob`).
     pub marker: Option<String>,
+    /// This run's share of the sweep (`--shard I/N`, issue 20): only the points [`Shard::owns`]
+    /// are measured and reported; `mirrorbox merge` joins the shards. `None`: every point.
+    pub shard: Option<Shard>,
+    /// Where traced truths are cached (`--truth-cache DIR`; default `OUT/cache`): several
+    /// shards may share one, as every truth is written atomically under a content hash.
+    pub truth_cache: Option<PathBuf>,
+}
+
+/// One of `count` disjoint shares of a sweep's points (`--shard index/count`, index from 0).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Shard {
+    pub index: u32,
+    pub count: u32,
+}
+
+/// Most shards of one sweep.
+pub const MAX_SHARDS: u32 = 100_000;
+
+impl Shard {
+    /// Whether the point of resume key `key` belongs to this shard: FNV-1a of the key modulo
+    /// the count — stable across runs, machines and the order points are listed in, and
+    /// spread evenly over the shards.
+    pub fn owns(&self, key: &str) -> bool {
+        let mut h = mirrorbox_scene::hash::Fnv1a::new();
+        let _ = h.write_str(key);
+        h.finish() % u64::from(self.count) == u64::from(self.index)
+    }
+}
+
+impl std::fmt::Display for Shard {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}/{}", self.index, self.count)
+    }
 }
 
 /// The methods `name` at each value of its swept option (`"auxiliary"`, `[0, 1, 2]`), every
@@ -148,6 +182,8 @@ impl SweepConfig {
             bump_amplitudes: None,
             stereo_ipds: None,
             marker: None,
+            shard: None,
+            truth_cache: None,
         }
     }
 
@@ -429,6 +465,16 @@ impl SweepConfig {
                     SettingError::new("--bump-amplitude", "each in [0, 90) degrees", a).into(),
                 );
             }
+        }
+        if let Some(sh) = self.shard
+            && !(sh.count >= 1 && sh.count <= MAX_SHARDS && sh.index < sh.count)
+        {
+            return Err(SettingError::new(
+                "--shard",
+                format!("I/N with N in [1, {MAX_SHARDS}] and I in [0, N)"),
+                sh,
+            )
+            .into());
         }
         let ipds = self.stereo_ipds.as_ref().map_or(1, Vec::len);
         if ipds == 0 {
@@ -1023,10 +1069,23 @@ pub fn run_sweep(
     fresh: bool,
     progress: &mut dyn FnMut(Event),
 ) -> Result<Summary, HarnessError> {
-    let run_started = now_rfc3339();
+    // Points are timed together only within one run (and one shard: shards may start in the
+    // same second on several machines).
+    let run_started = match config.shard {
+        Some(sh) => format!("{} shard {sh}", now_rfc3339()),
+        None => now_rfc3339(),
+    };
     let (base, w, h) = base_scene(config)?;
     let base_hash = base.content_hash();
-    let all = points(config, base_hash, w, h);
+    let every_point = points(config, base_hash, w, h);
+    let point_keys: Vec<String> = match config.shard {
+        Some(_) => every_point.iter().map(|p| p.key.clone()).collect(),
+        None => Vec::new(),
+    };
+    let all: Vec<Point> = every_point
+        .into_iter()
+        .filter(|p| config.shard.is_none_or(|s| s.owns(&p.key)))
+        .collect();
     let out = &config.out;
     // The sweep creates its own folder, inside one that must exist (as every command's
     // outputs): a mistyped path is refused, not created.
@@ -1065,7 +1124,8 @@ pub fn run_sweep(
         })?;
     }
     let (images, cache) = (out.join("images"), out.join("cache"));
-    for d in [out, &images, &cache] {
+    let truth_cache = config.truth_cache.clone().unwrap_or_else(|| cache.clone());
+    for d in [out, &images, &cache, &truth_cache] {
         std::fs::create_dir_all(d).map_err(|source| HarnessError::OutputFolder {
             path: d.to_path_buf(),
             source,
@@ -1101,10 +1161,10 @@ pub fn run_sweep(
         match worker::eye_scenes(&scene) {
             Some(eyes) => {
                 for eye in &eyes {
-                    paths.push(truth(eye, config, &cache, &mut summary)?.1);
+                    paths.push(truth(eye, config, &truth_cache, &mut summary)?.1);
                 }
             }
-            None => paths.push(truth(&scene, config, &cache, &mut summary)?.1),
+            None => paths.push(truth(&scene, config, &truth_cache, &mut summary)?.1),
         }
         truths.push(paths);
         jobs.push(RenderJob {
@@ -1308,6 +1368,9 @@ pub fn run_sweep(
             })
             .map(|e| e.name.to_string())
             .collect(),
+        shard: config.shard.map(|s| s.to_string()),
+        point_keys,
+        shards: Vec::new(),
     };
     write_atomically(
         &out.join("sweep.json"),

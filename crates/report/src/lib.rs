@@ -286,6 +286,30 @@ pub struct SweepInfo {
     /// raster registry; the others show an uneven mirror flat (issue 16).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub bump_methods: Vec<String>,
+    /// A shard of a sweep (`--shard I/N`, issue 20): `"I/N"`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shard: Option<String>,
+    /// A shard's whole sweep: every point's resume key, the floor first (what `merge` checks
+    /// the shards against: the same configuration, every point once).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub point_keys: Vec<String>,
+    /// A merged sweep: where each shard ran and how many points it measured.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub shards: Vec<ShardInfo>,
+}
+
+/// One shard of a merged sweep (`mirrorbox merge`).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct ShardInfo {
+    /// `"I/N"`.
+    pub shard: String,
+    /// The shard's folder, as given to `merge`.
+    pub folder: String,
+    pub date: String,
+    pub cpu: String,
+    /// [`SweepInfo::adapter_description`] of the shard.
+    pub device: String,
+    pub points: usize,
 }
 
 impl SweepInfo {

@@ -180,16 +180,13 @@ pub fn sentences(records: &[Record]) -> Vec<String> {
             continue;
         };
         let saved = own.ms_median - shared.ms_median;
-        let ratio = crate::stats::paired_ratio_interval(&shared.frames_ms, &own.frames_ms).map_or(
-            String::new(),
-            |i| {
-                format!(
-                    " (shared ÷ per-eye: 95 % CI [{}, {}])",
-                    f(i.low, 2),
-                    f(i.high, 2)
-                )
-            },
-        );
+        let ratio = crate::write::paired_ratio(shared, own).map_or(String::new(), |i| {
+            format!(
+                " (shared ÷ per-eye: 95 % CI [{}, {}])",
+                f(i.low, 2),
+                f(i.high, 2)
+            )
+        });
         let mut s = format!(
             "`{m}` at IPD {widest}: sharing the head's mirror textures saves {} ms per stereo \
              pair ({} % of per-eye's {} ms){ratio} and raises FLIP from {} to {}",

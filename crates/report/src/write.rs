@@ -91,9 +91,61 @@ pub(crate) fn sci(v: f64) -> String {
     }
 }
 
+/// A merged sweep (`mirrorbox merge`): which shard ran where, and how to read its timings.
+fn shards_section(info: &SweepInfo) -> Vec<Block> {
+    let mut devices: Vec<String> = Vec::new();
+    for s in &info.shards {
+        let d = format!("{} on {}", s.device, s.cpu);
+        if !devices.contains(&d) {
+            devices.push(d);
+        }
+    }
+    let timing = if devices.len() > 1 {
+        format!(
+            "The shards ran on {} devices: error figures merge freely, but timings compare only \
+             within one device — read each point's time with its shard's device below.",
+            devices.len()
+        )
+    } else {
+        "Every shard ran on the same device; still, each shard interleaved the timing of its own \
+         points only, so no paired ratio is computed across shards."
+            .into()
+    };
+    vec![
+        Block::Heading(2, "Shards".into()),
+        Block::Paragraph(format!(
+            "Merged from {} shards (`sweep --shard I/N`, then `mirrorbox merge`). {timing}",
+            info.shards.len()
+        )),
+        Block::Table(
+            vec![
+                "shard".into(),
+                "points".into(),
+                "device".into(),
+                "CPU".into(),
+                "date".into(),
+                "folder".into(),
+            ],
+            info.shards
+                .iter()
+                .map(|s| {
+                    vec![
+                        s.shard.clone(),
+                        s.points.to_string(),
+                        s.device.clone(),
+                        s.cpu.clone(),
+                        s.date.clone(),
+                        format!("`{}`", s.folder),
+                    ]
+                })
+                .collect(),
+        ),
+    ]
+}
+
 /// The paired 95 % interval of `a`'s median time over `b`'s, where both were timed in the
 /// same interleaved rounds of the same run ([`crate::stats::paired_ratio_interval`]).
-fn paired_ratio(a: &Record, b: &Record) -> Option<crate::stats::Interval> {
+pub(crate) fn paired_ratio(a: &Record, b: &Record) -> Option<crate::stats::Interval> {
     let same_rounds = a.timing_order == "interleaved"
         && b.timing_order == "interleaved"
         && a.run.is_some()
@@ -748,7 +800,14 @@ fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
     let floor = records.iter().find(|r| r.kind == "floor");
     let latest_run = records.iter().filter_map(|r| r.run.as_deref()).max();
     let reused = |r: &Record| latest_run.is_some() && r.run.as_deref() != latest_run;
-    let earlier: Vec<&Record> = records.iter().filter(|r| reused(r)).collect();
+    // A merged sweep's shards are separate runs by design (below).
+    let earlier: Vec<&Record> = records
+        .iter()
+        .filter(|r| info.shards.is_empty() && reused(r))
+        .collect();
+    if !info.shards.is_empty() {
+        b.extend(shards_section(info));
+    }
     if !earlier.is_empty() {
         let mut runs: Vec<&str> = earlier
             .iter()

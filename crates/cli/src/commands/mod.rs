@@ -2,6 +2,7 @@ pub mod check;
 pub mod compare;
 pub mod export_mitsuba;
 pub mod info;
+pub mod merge;
 pub mod method_flags;
 pub mod readme;
 pub mod render;

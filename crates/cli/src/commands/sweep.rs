@@ -4,7 +4,7 @@
 use super::method_flags::SweepOptions;
 use super::progress_bar;
 use crate::Failure;
-use mirrorbox_harness::{Event, SweepConfig, run_sweep};
+use mirrorbox_harness::{Event, Shard, SweepConfig, run_sweep};
 use mirrorbox_raster::registry::{find, names};
 use mirrorbox_trace::WhittedSettings;
 use std::path::PathBuf;
@@ -82,6 +82,78 @@ pub struct Args {
     /// (raster and truth), for the report's disparity check.
     #[arg(long, requires = "ipd")]
     marker: Option<String>,
+    #[command(flatten)]
+    shard: ShardArgs,
+}
+
+/// `--shard` and `--truth-cache`, for `sweep` and the presets (issue 20).
+#[derive(clap::Args, Clone, Debug, Default)]
+pub struct ShardArgs {
+    /// Run one shard of the sweep: `I/N` (I from 0), or `auto/N` / `auto`, taking I from
+    /// SLURM_ARRAY_TASK_ID (less SLURM_ARRAY_TASK_MIN) or JOB_COMPLETION_INDEX (Kubernetes
+    /// Indexed Jobs) and N, with `auto`, from SLURM_ARRAY_TASK_COUNT. The points are split by a
+    /// hash of their keys; `mirrorbox merge` joins the shards' folders.
+    #[arg(long)]
+    shard: Option<String>,
+    /// Folder of the traced truths (default OUT/cache); shards may share one.
+    #[arg(long)]
+    truth_cache: Option<PathBuf>,
+}
+
+impl ShardArgs {
+    fn apply(&self, config: &mut SweepConfig) -> Result<(), Failure> {
+        config.shard = self.shard.as_deref().map(parse_shard).transpose()?;
+        config.truth_cache = self.truth_cache.clone();
+        Ok(())
+    }
+}
+
+/// `--shard I/N`, `auto/N` or `auto` (see [`ShardArgs`]); the ranges are checked with the
+/// other settings.
+fn parse_shard(text: &str) -> Result<Shard, Failure> {
+    let bad = |why: String| bad(format!("--shard {text:?}: {why}"));
+    let number = |s: &str, what: &str| -> Result<u32, Failure> {
+        s.trim()
+            .parse::<u32>()
+            .map_err(|_| bad(format!("{what} must be a whole number, got {s:?}")))
+    };
+    let env = |name: &str| std::env::var(name).ok().filter(|v| !v.trim().is_empty());
+    let (index, count) = text.split_once('/').unwrap_or((text, ""));
+    let count = match (count, env("SLURM_ARRAY_TASK_COUNT")) {
+        ("", Some(c)) if index == "auto" => number(&c, "SLURM_ARRAY_TASK_COUNT")?,
+        ("", _) => {
+            return Err(bad(
+                "expected I/N, auto/N, or auto inside a Slurm job array".into(),
+            ));
+        }
+        (n, _) => number(n, "N")?,
+    };
+    let index = if index == "auto" {
+        match (env("SLURM_ARRAY_TASK_ID"), env("JOB_COMPLETION_INDEX")) {
+            (Some(id), _) => {
+                let min = env("SLURM_ARRAY_TASK_MIN")
+                    .map(|m| number(&m, "SLURM_ARRAY_TASK_MIN"))
+                    .transpose()?
+                    .unwrap_or(0);
+                number(&id, "SLURM_ARRAY_TASK_ID")?
+                    .checked_sub(min)
+                    .ok_or_else(
+                        || bad("SLURM_ARRAY_TASK_ID is below SLURM_ARRAY_TASK_MIN".into()),
+                    )?
+            }
+            (None, Some(i)) => number(&i, "JOB_COMPLETION_INDEX")?,
+            (None, None) => {
+                return Err(bad(
+                    "auto needs SLURM_ARRAY_TASK_ID (a Slurm job array) or JOB_COMPLETION_INDEX \
+                     (a Kubernetes Indexed Job)"
+                        .into(),
+                ));
+            }
+        }
+    } else {
+        number(index, "I")?
+    };
+    Ok(Shard { index, count })
 }
 
 /// `--ipd`: numbers or `mono` (the range is checked with the other settings).
@@ -146,6 +218,8 @@ pub struct PresetArgs {
     /// Discard earlier results and measure every point again (cached truths stay).
     #[arg(long)]
     fresh: bool,
+    #[command(flatten)]
+    shard: ShardArgs,
 }
 
 fn bad(m: String) -> Failure {
@@ -211,7 +285,7 @@ fn command_line() -> String {
 }
 
 pub fn run(args: &Args) -> Result<(), Failure> {
-    let config = SweepConfig {
+    let mut config = SweepConfig {
         scene: args.scene.clone(),
         out: args.out.clone(),
         methods: parse_methods(&args.methods, &args.options)?,
@@ -235,6 +309,8 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         bump_amplitudes: args.bump_amplitude.clone(),
         stereo_ipds: args.ipd.as_deref().map(parse_ipds).transpose()?,
         marker: args.marker.clone(),
+        shard: None,
+        truth_cache: None,
         mirrored_lights: args
             .mirrored_lights
             .as_deref()
@@ -248,6 +324,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             })
             .transpose()?,
     };
+    args.shard.apply(&mut config)?;
     execute(&config, args.fresh)
 }
 
@@ -314,6 +391,7 @@ fn run_preset(mut config: SweepConfig, args: &PresetArgs) -> Result<(), Failure>
     }
     config.command = command_line();
     config.worker = render_worker();
+    args.shard.apply(&mut config)?;
     execute(&config, args.fresh)
 }
 

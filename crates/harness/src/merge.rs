@@ -1,0 +1,254 @@
+//! `mirrorbox merge OUT DIR...` (issue 20): the shards of one sweep (`sweep --shard I/N`, each
+//! in its own folder) joined into one sweep folder — one `results.jsonl`, the pictures its
+//! records name, a `sweep.json` listing where each shard ran — and its reports regenerated.
+//!
+//! Refused, naming the folder: a folder that is not a shard, shards of different sweeps
+//! (their lists of every point's key differ), two shards with one index or count, a point
+//! measured twice, a point no shard measured. Nothing is written before every check passed.
+
+use crate::HarnessError;
+use mirrorbox_files::{FolderLock, write_atomically};
+use mirrorbox_report::{Record, ShardInfo, SweepInfo, read_records, write_report};
+use mirrorbox_scene::limits::SettingError;
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+/// `sweep.json` is a few KB per thousand points; the bound keeps a wrong path from being read
+/// whole.
+const MAX_SWEEP_JSON_BYTES: u64 = 64 << 20;
+
+/// Most shard folders one merge reads.
+pub const MAX_MERGED_SHARDS: usize = 100_000;
+
+fn refused(folder: &Path, what: impl Into<String>) -> HarnessError {
+    HarnessError::Setting(SettingError::new(
+        "merge DIR",
+        what.into(),
+        folder.display().to_string(),
+    ))
+}
+
+struct ShardFolder {
+    dir: PathBuf,
+    info: SweepInfo,
+    records: Vec<Record>,
+}
+
+fn read_shard(dir: &Path) -> Result<ShardFolder, HarnessError> {
+    let info_path = dir.join("sweep.json");
+    let text =
+        mirrorbox_files::read_bounded_text(&info_path, MAX_SWEEP_JSON_BYTES, "a sweep description")
+            .map_err(|e| refused(dir, format!("a shard's folder (sweep.json: {e})")))?;
+    let info: SweepInfo = serde_json::from_str(&text).map_err(|e| {
+        refused(
+            dir,
+            format!("a shard's folder (sweep.json is not one: {e})"),
+        )
+    })?;
+    if info.shard.is_none() || info.point_keys.is_empty() {
+        return Err(refused(
+            dir,
+            "a shard's folder (written by `sweep --shard I/N`; this sweep was not sharded)",
+        ));
+    }
+    let results = dir.join("results.jsonl");
+    let records = read_records(&results).map_err(|source| HarnessError::Io {
+        path: results,
+        source,
+    })?;
+    Ok(ShardFolder {
+        dir: dir.to_path_buf(),
+        info,
+        records,
+    })
+}
+
+/// Every picture a record names, relative to its sweep folder.
+fn pictures(r: &Record) -> Vec<&str> {
+    let mut out = vec![
+        r.truth_image.as_str(),
+        r.raster_image.as_str(),
+        r.heatmap_image.as_str(),
+    ];
+    if let Some(s) = &r.stereo {
+        out.extend([s.anaglyph_image.as_str(), s.truth_anaglyph_image.as_str()]);
+    }
+    out.retain(|p| !p.is_empty());
+    out
+}
+
+/// What a merge did.
+pub struct Merged {
+    pub shards: usize,
+    pub points: usize,
+    /// The distinct devices the shards ran on (timings compare only within one).
+    pub devices: Vec<String>,
+}
+
+/// Merges the shard folders `dirs` into the sweep folder `out` (created inside an existing
+/// folder) and writes its reports; `command` is recorded as the merged sweep's command.
+pub fn merge(out: &Path, dirs: &[PathBuf], command: &str) -> Result<Merged, HarnessError> {
+    if dirs.is_empty() || dirs.len() > MAX_MERGED_SHARDS {
+        return Err(SettingError::new(
+            "merge DIR...",
+            format!("1 to {MAX_MERGED_SHARDS} shard folders"),
+            dirs.len(),
+        )
+        .into());
+    }
+    let shards = dirs
+        .iter()
+        .map(|d| read_shard(d))
+        .collect::<Result<Vec<_>, _>>()?;
+    let first = &shards[0];
+    let mut indices: HashMap<String, &Path> = HashMap::new();
+    for s in &shards {
+        if s.info.point_keys != first.info.point_keys {
+            return Err(refused(
+                &s.dir,
+                format!(
+                    "a shard of the same sweep as {} (its configuration — methods, axes, scene, \
+                     size, frames — gives other points)",
+                    first.dir.display()
+                ),
+            ));
+        }
+        let shard = s.info.shard.clone().unwrap_or_default();
+        let count = |t: &str| t.split('/').nth(1).map(str::to_string);
+        if count(&shard) != count(first.info.shard.as_deref().unwrap_or_default()) {
+            return Err(refused(
+                &s.dir,
+                format!(
+                    "shards split one way (it is shard {shard}, {} is shard {})",
+                    first.dir.display(),
+                    first.info.shard.as_deref().unwrap_or_default()
+                ),
+            ));
+        }
+        if let Some(other) = indices.insert(shard.clone(), &s.dir) {
+            return Err(refused(
+                &s.dir,
+                format!(
+                    "one folder per shard (shard {shard} is also {})",
+                    other.display()
+                ),
+            ));
+        }
+    }
+    // Every point exactly once.
+    let mut seen: HashMap<&str, &Path> = HashMap::new();
+    for s in &shards {
+        for r in &s.records {
+            if let Some(other) = seen.insert(r.key.as_str(), &s.dir) {
+                return Err(refused(
+                    &s.dir,
+                    format!(
+                        "each point in one shard (point {:?} is also in {})",
+                        r.key,
+                        other.display()
+                    ),
+                ));
+            }
+        }
+    }
+    let missing: Vec<&String> = first
+        .info
+        .point_keys
+        .iter()
+        .filter(|k| !seen.contains_key(k.as_str()))
+        .collect();
+    if let Some(k) = missing.first() {
+        return Err(SettingError::new(
+            "merge DIR...",
+            "the folders of every shard, each finished",
+            format!(
+                "{} of {} points measured by none of them (first: {k:?})",
+                missing.len(),
+                first.info.point_keys.len()
+            ),
+        )
+        .into());
+    }
+    // Write: the folder, its pictures, the records in the sweep's order, the description.
+    let parent = out
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    if !parent.is_dir() {
+        return Err(HarnessError::OutputFolder {
+            path: out.to_path_buf(),
+            source: std::io::Error::new(
+                std::io::ErrorKind::NotFound,
+                format!("folder {} does not exist", parent.display()),
+            ),
+        });
+    }
+    std::fs::create_dir_all(out.join("images")).map_err(|source| HarnessError::OutputFolder {
+        path: out.to_path_buf(),
+        source,
+    })?;
+    let _lock = FolderLock::try_acquire(out)?;
+    let mut by_key: HashMap<&str, &Record> = HashMap::new();
+    for s in &shards {
+        for r in &s.records {
+            by_key.insert(r.key.as_str(), r);
+            for picture in pictures(r) {
+                let (from, to) = (s.dir.join(picture), out.join(picture));
+                if !to.exists() {
+                    mirrorbox_files::write_atomically_with(&to, |tmp| {
+                        std::fs::copy(&from, tmp)
+                            .map(|_| ())
+                            .map_err(|e| format!("cannot copy {}: {e}", from.display()))
+                    })?;
+                }
+            }
+        }
+    }
+    let records: Vec<Record> = first
+        .info
+        .point_keys
+        .iter()
+        .map(|k| by_key[k.as_str()].clone())
+        .collect();
+    let mut lines = String::new();
+    for r in &records {
+        lines.push_str(&serde_json::to_string(r)?);
+        lines.push('\n');
+    }
+    write_atomically(&out.join("results.jsonl"), lines.as_bytes())?;
+    let mut info = SweepInfo {
+        command: command.to_string(),
+        date: humantime::format_rfc3339_seconds(std::time::SystemTime::now()).to_string(),
+        shard: None,
+        shards: shards
+            .iter()
+            .map(|s| ShardInfo {
+                shard: s.info.shard.clone().unwrap_or_default(),
+                folder: s.dir.display().to_string(),
+                date: s.info.date.clone(),
+                cpu: s.info.cpu.clone(),
+                device: s.info.adapter_description(),
+                points: s.records.len(),
+            })
+            .collect(),
+        ..first.info.clone()
+    };
+    info.shards.sort_by(|a, b| a.shard.cmp(&b.shard));
+    let mut devices: Vec<String> = Vec::new();
+    for s in &info.shards {
+        let d = format!("{} on {}", s.device, s.cpu);
+        if !devices.contains(&d) {
+            devices.push(d);
+        }
+    }
+    write_atomically(
+        &out.join("sweep.json"),
+        serde_json::to_string_pretty(&info)?.as_bytes(),
+    )?;
+    write_report(out, &info, &records)?;
+    Ok(Merged {
+        shards: shards.len(),
+        points: records.len(),
+        devices,
+    })
+}
