@@ -1,0 +1,167 @@
+//! Issue 20, end to end on a real Slurm: a one-node Slurm on this machine
+//! (`scripts/slurm-local.sh`: slurm-wlm and munge from Debian), a 4-shard job array of a small
+//! sweep submitted with `deploy/slurm/submit.sh` (at most 2 tasks at once) and the merge as a
+//! dependent job; the merged sweep must hold the unsharded sweep's points with the same
+//! images bit for bit and the same errors. The daemons are stopped however the test ends.
+//!
+//! Needs root (to install and run the daemons). Outside CI without root the test says so and
+//! passes; under CI (`CI` set) it must run.
+
+mod common;
+
+use common::{mirrorbox, repo};
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::{Duration, Instant};
+
+fn is_root() -> bool {
+    Command::new("id")
+        .arg("-u")
+        .output()
+        .is_ok_and(|o| String::from_utf8_lossy(&o.stdout).trim() == "0")
+}
+
+/// Stops the local Slurm when dropped (a failed assertion included).
+struct LocalSlurm {
+    state: PathBuf,
+}
+
+impl Drop for LocalSlurm {
+    fn drop(&mut self) {
+        let _ = Command::new(repo().join("scripts/slurm-local.sh"))
+            .arg("stop")
+            .arg(&self.state)
+            .status();
+    }
+}
+
+fn records(dir: &Path) -> Vec<Value> {
+    std::fs::read_to_string(dir.join("results.jsonl"))
+        .unwrap_or_default()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect()
+}
+
+const SWEEP: [&str; 13] = [
+    "scenes/mirror_box.json",
+    "--methods",
+    "naive,auxiliary",
+    "--n",
+    "0,1",
+    "--alpha",
+    "0.7,0.9",
+    "--width",
+    "48",
+    "--height",
+    "27",
+    "--frames",
+    "1",
+];
+
+#[test]
+fn a_sharded_sweep_through_slurm_merges_into_the_unsharded_one() {
+    if !is_root() {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "CI must run the Slurm test as root (scripts/test.sh)"
+        );
+        eprintln!("skipped: the local Slurm needs root (scripts/slurm-local.sh)");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let state = d.join("slurm");
+    let start = Command::new(repo().join("scripts/slurm-local.sh"))
+        .arg("start")
+        .arg(&state)
+        .output()
+        .unwrap();
+    let slurm = LocalSlurm {
+        state: state.clone(),
+    };
+    assert!(
+        start.status.success(),
+        "local Slurm did not start: {}{}",
+        String::from_utf8_lossy(&start.stdout),
+        String::from_utf8_lossy(&start.stderr)
+    );
+    let conf = state.join("slurm.conf");
+
+    let full = d.join("full");
+    let mut args = vec!["sweep", "--out", full.to_str().unwrap(), "--warmup", "0"];
+    args.extend(SWEEP);
+    let run = mirrorbox(&args, &[]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+
+    let runs = d.join("runs");
+    let submit = Command::new(repo().join("deploy/slurm/submit.sh"))
+        .args(["4", "2", runs.to_str().unwrap()])
+        .args(SWEEP)
+        .args(["--warmup", "0"])
+        .env("SLURM_CONF", &conf)
+        .env("MIRRORBOX", env!("CARGO_BIN_EXE_mirrorbox"))
+        .current_dir(repo())
+        .output()
+        .unwrap();
+    assert!(
+        submit.status.success(),
+        "submit: {}{}",
+        String::from_utf8_lossy(&submit.stdout),
+        String::from_utf8_lossy(&submit.stderr)
+    );
+    // Wait for the queue to empty (the merge is the last job).
+    let started = Instant::now();
+    loop {
+        let queue = Command::new("squeue")
+            .args(["-h", "-o", "%i %T"])
+            .env("SLURM_CONF", &conf)
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&queue.stdout).to_string();
+        if queue.status.success() && text.trim().is_empty() {
+            break;
+        }
+        assert!(
+            started.elapsed() < Duration::from_secs(900),
+            "the jobs did not finish in 15 minutes: {text}"
+        );
+        std::thread::sleep(Duration::from_secs(2));
+    }
+    let logs = || -> String {
+        std::fs::read_dir(&runs)
+            .unwrap()
+            .flatten()
+            .filter(|e| e.path().extension().is_some_and(|x| x == "out"))
+            .map(|e| std::fs::read_to_string(e.path()).unwrap_or_default())
+            .collect::<Vec<_>>()
+            .join("\n")
+    };
+    let merged = records(&runs.join("merged"));
+    let unsharded = records(&full);
+    assert_eq!(merged.len(), unsharded.len(), "job logs:\n{}", logs());
+    let shards = (0..4)
+        .filter(|i| !records(&runs.join(format!("shard-{i}"))).is_empty())
+        .count();
+    assert!(shards >= 2, "the points were spread over the shards");
+    for r in &merged {
+        let f = unsharded
+            .iter()
+            .find(|f| f["key"] == r["key"])
+            .unwrap_or_else(|| panic!("{} is not a point of the unsharded sweep", r["key"]));
+        for m in ["flip_mean", "rmse", "ssim"] {
+            let (a, b) = (f["metrics"][m].as_f64().unwrap(), r["metrics"][m].as_f64().unwrap());
+            assert!((a - b).abs() <= 1e-12 * a.abs().max(1.0), "{m}: {a} vs {b}");
+        }
+        let name = r["raster_image"].as_str().unwrap();
+        assert_eq!(
+            std::fs::read(runs.join("merged").join(name)).unwrap(),
+            std::fs::read(full.join(name)).unwrap(),
+            "{name}"
+        );
+    }
+    let report = std::fs::read_to_string(runs.join("merged/report.md")).unwrap();
+    assert!(report.contains("Merged from 4 shards"), "{report}");
+    drop(slurm);
+}
