@@ -1640,26 +1640,8 @@ fn shards_merge_into_the_unsharded_sweep() {
     let d = dir.path();
     let p = |name: &str| d.join(name).to_str().unwrap().to_string();
     let sweep = |out: &str, extra: &[&str], env: &[(&str, &str)]| {
-        let mut args = vec![
-            "sweep",
-            "scenes/mirror_box.json",
-            "--out",
-            out,
-            "--methods",
-            "naive,auxiliary",
-            "--n",
-            "0,1",
-            "--alpha",
-            "0.7,0.9",
-            "--width",
-            "48",
-            "--height",
-            "27",
-            "--frames",
-            "1",
-            "--warmup",
-            "0",
-        ];
+        let mut args = vec!["sweep", "--out", out];
+        args.extend(common::SMALL_SWEEP);
         args.extend_from_slice(extra);
         let run = mirrorbox(&args, env);
         assert_eq!(run.code, 0, "{args:?}: {}", run.stderr);
@@ -1740,25 +1722,7 @@ fn shards_merge_into_the_unsharded_sweep() {
     let merged = mirrorbox(&["merge", &p("merged"), &s0, &s1, &s2], &[]);
     assert_eq!(merged.code, 0, "{}", merged.stderr);
     let joined = records(&d.join("merged"));
-    assert_eq!(joined.len(), full.len());
-    for r in &joined {
-        let f = full.iter().find(|f| f["key"] == r["key"]).unwrap();
-        for m in ["flip_mean", "rmse", "ssim"] {
-            let (a, b) = (
-                f["metrics"][m].as_f64().unwrap(),
-                r["metrics"][m].as_f64().unwrap(),
-            );
-            assert!((a - b).abs() <= 1e-12 * a.abs().max(1.0), "{m}: {a} vs {b}");
-        }
-        for image in ["raster_image", "truth_image"] {
-            let name = r[image].as_str().unwrap();
-            assert_eq!(
-                std::fs::read(d.join("merged").join(name)).unwrap(),
-                std::fs::read(d.join("full").join(name)).unwrap(),
-                "{name}"
-            );
-        }
-    }
+    common::assert_same_points(&full, &d.join("full"), &joined, &d.join("merged"));
     let report = std::fs::read_to_string(d.join("merged/report.md")).unwrap();
     assert!(report.contains("Merged from 3 shards"), "{report}");
 

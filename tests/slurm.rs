@@ -9,9 +9,8 @@
 
 mod common;
 
-use common::{mirrorbox, repo};
-use serde_json::Value;
-use std::path::{Path, PathBuf};
+use common::{SMALL_SWEEP, assert_same_points, mirrorbox, repo, sweep_records as records};
+use std::path::PathBuf;
 use std::process::Command;
 use std::time::{Duration, Instant};
 
@@ -35,30 +34,6 @@ impl Drop for LocalSlurm {
             .status();
     }
 }
-
-fn records(dir: &Path) -> Vec<Value> {
-    std::fs::read_to_string(dir.join("results.jsonl"))
-        .unwrap_or_default()
-        .lines()
-        .map(|l| serde_json::from_str(l).unwrap())
-        .collect()
-}
-
-const SWEEP: [&str; 13] = [
-    "scenes/mirror_box.json",
-    "--methods",
-    "naive,auxiliary",
-    "--n",
-    "0,1",
-    "--alpha",
-    "0.7,0.9",
-    "--width",
-    "48",
-    "--height",
-    "27",
-    "--frames",
-    "1",
-];
 
 #[test]
 fn a_sharded_sweep_through_slurm_merges_into_the_unsharded_one() {
@@ -90,16 +65,15 @@ fn a_sharded_sweep_through_slurm_merges_into_the_unsharded_one() {
     let conf = state.join("slurm.conf");
 
     let full = d.join("full");
-    let mut args = vec!["sweep", "--out", full.to_str().unwrap(), "--warmup", "0"];
-    args.extend(SWEEP);
+    let mut args = vec!["sweep", "--out", full.to_str().unwrap()];
+    args.extend(SMALL_SWEEP);
     let run = mirrorbox(&args, &[]);
     assert_eq!(run.code, 0, "{}", run.stderr);
 
     let runs = d.join("runs");
     let submit = Command::new(repo().join("deploy/slurm/submit.sh"))
         .args(["4", "2", runs.to_str().unwrap()])
-        .args(SWEEP)
-        .args(["--warmup", "0"])
+        .args(SMALL_SWEEP)
         .env("SLURM_CONF", &conf)
         .env("MIRRORBOX", env!("CARGO_BIN_EXE_mirrorbox"))
         .current_dir(repo())
@@ -145,22 +119,7 @@ fn a_sharded_sweep_through_slurm_merges_into_the_unsharded_one() {
         .filter(|i| !records(&runs.join(format!("shard-{i}"))).is_empty())
         .count();
     assert!(shards >= 2, "the points were spread over the shards");
-    for r in &merged {
-        let f = unsharded
-            .iter()
-            .find(|f| f["key"] == r["key"])
-            .unwrap_or_else(|| panic!("{} is not a point of the unsharded sweep", r["key"]));
-        for m in ["flip_mean", "rmse", "ssim"] {
-            let (a, b) = (f["metrics"][m].as_f64().unwrap(), r["metrics"][m].as_f64().unwrap());
-            assert!((a - b).abs() <= 1e-12 * a.abs().max(1.0), "{m}: {a} vs {b}");
-        }
-        let name = r["raster_image"].as_str().unwrap();
-        assert_eq!(
-            std::fs::read(runs.join("merged").join(name)).unwrap(),
-            std::fs::read(full.join(name)).unwrap(),
-            "{name}"
-        );
-    }
+    assert_same_points(&unsharded, &full, &merged, &runs.join("merged"));
     let report = std::fs::read_to_string(runs.join("merged/report.md")).unwrap();
     assert!(report.contains("Merged from 4 shards"), "{report}");
     drop(slurm);

@@ -43,3 +43,59 @@ pub fn valid_scene() -> Value {
         "lights": [ { "position": [0, 2.5, 0], "intensity": [10, 10, 10] } ]
     })
 }
+
+/// A sweep folder's records (`results.jsonl`), none if it has no file.
+pub fn sweep_records(dir: &Path) -> Vec<Value> {
+    std::fs::read_to_string(dir.join("results.jsonl"))
+        .unwrap_or_default()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect()
+}
+
+/// The arguments of the small sweep the shard tests split (mirror_box, 48×27, 7 points).
+pub const SMALL_SWEEP: [&str; 15] = [
+    "scenes/mirror_box.json",
+    "--methods",
+    "naive,auxiliary",
+    "--n",
+    "0,1",
+    "--alpha",
+    "0.7,0.9",
+    "--width",
+    "48",
+    "--height",
+    "27",
+    "--frames",
+    "1",
+    "--warmup",
+    "0",
+];
+
+/// A merged sweep (`merged`, its folder `merged_dir`) holds exactly the points of `full`
+/// (folder `full_dir`), with the same errors (metrics may differ in the last bit: parallel
+/// sums) and the same raster and truth pictures, byte for byte.
+pub fn assert_same_points(full: &[Value], full_dir: &Path, merged: &[Value], merged_dir: &Path) {
+    assert_eq!(merged.len(), full.len(), "points");
+    for r in merged {
+        let f = full
+            .iter()
+            .find(|f| f["key"] == r["key"])
+            .unwrap_or_else(|| panic!("{} is not a point of the unsharded sweep", r["key"]));
+        for m in ["flip_mean", "rmse", "ssim"] {
+            let (a, b) = (
+                f["metrics"][m].as_f64().unwrap(),
+                r["metrics"][m].as_f64().unwrap(),
+            );
+            assert!((a - b).abs() <= 1e-12 * a.abs().max(1.0), "{m}: {a} vs {b}");
+        }
+        for image in ["raster_image", "truth_image"] {
+            let name = r[image].as_str().unwrap();
+            assert_eq!(
+                std::fs::read(merged_dir.join(name)).unwrap(),
+                std::fs::read(full_dir.join(name)).unwrap(),
+                "{name}"
+            );
+        }
+    }
+}

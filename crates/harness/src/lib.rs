@@ -977,6 +977,25 @@ fn compare_views(
     })
 }
 
+/// A sweep (or a merge) creates its own folder `out`, inside one that must exist (as every
+/// command's outputs): a mistyped path is refused, not created.
+pub(crate) fn check_output_parent(out: &Path) -> Result<(), HarnessError> {
+    let parent = out
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    if parent.is_dir() {
+        return Ok(());
+    }
+    Err(HarnessError::OutputFolder {
+        path: out.to_path_buf(),
+        source: std::io::Error::new(
+            std::io::ErrorKind::NotFound,
+            format!("folder {} does not exist", parent.display()),
+        ),
+    })
+}
+
 /// The method every floor point renders the mirror-free scene with: one scene pass.
 pub const FLOOR_METHOD: &str = "naive";
 
@@ -1087,21 +1106,7 @@ pub fn run_sweep(
         .filter(|p| config.shard.is_none_or(|s| s.owns(&p.key)))
         .collect();
     let out = &config.out;
-    // The sweep creates its own folder, inside one that must exist (as every command's
-    // outputs): a mistyped path is refused, not created.
-    let parent = out
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    if !parent.is_dir() {
-        return Err(HarnessError::OutputFolder {
-            path: out.clone(),
-            source: std::io::Error::new(
-                std::io::ErrorKind::NotFound,
-                format!("folder {} does not exist", parent.display()),
-            ),
-        });
-    }
+    check_output_parent(out)?;
     let results = out.join("results.jsonl");
     let still_to_do = |done: &[Record]| -> Vec<&Point> {
         all.iter()

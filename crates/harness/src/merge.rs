@@ -170,19 +170,7 @@ pub fn merge(out: &Path, dirs: &[PathBuf], command: &str) -> Result<Merged, Harn
         .into());
     }
     // Write: the folder, its pictures, the records in the sweep's order, the description.
-    let parent = out
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    if !parent.is_dir() {
-        return Err(HarnessError::OutputFolder {
-            path: out.to_path_buf(),
-            source: std::io::Error::new(
-                std::io::ErrorKind::NotFound,
-                format!("folder {} does not exist", parent.display()),
-            ),
-        });
-    }
+    crate::check_output_parent(out)?;
     std::fs::create_dir_all(out.join("images")).map_err(|source| HarnessError::OutputFolder {
         path: out.to_path_buf(),
         source,
