@@ -43,7 +43,7 @@ start() {
     chown munge:munge /etc/munge/munge.key
     chmod 0400 /etc/munge/munge.key
   fi
-  if ! pgrep -x munged >/dev/null; then
+  if ! { [ -s /run/munge/munged.pid ] && kill -0 "$(cat /run/munge/munged.pid)" 2>/dev/null; }; then
     runuser -u munge -- /usr/sbin/munged
     touch "$dir/munged.ours"
   fi
