@@ -35,15 +35,28 @@ impl FileError {
     }
 }
 
-/// The temporary name of `path` while it is written: `.NAME.PID.tmp` beside it (same
-/// folder, so the final rename is atomic).
+/// The temporary name of `path` while it is written: `.NAME.HOST.PID.N.tmp` beside it (same
+/// folder, so the final rename is atomic). Host, process and a per-process count make it
+/// unique among every writer of a folder shared by several machines (shards filling one truth
+/// cache, issue 20): two writers of the same file never share a temporary.
 fn temporary_path(path: &Path) -> Result<PathBuf, FileError> {
+    static COUNT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
     let file_name = path
         .file_name()
         .ok_or_else(|| FileError::refused(path, "not a file path"))?;
+    let host = std::fs::read_to_string("/proc/sys/kernel/hostname")
+        .map(|h| {
+            h.trim()
+                .chars()
+                .filter(|c| c.is_ascii_alphanumeric() || *c == '-')
+                .take(64)
+                .collect::<String>()
+        })
+        .unwrap_or_default();
+    let n = COUNT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let mut tmp_name = std::ffi::OsString::from(".");
     tmp_name.push(file_name);
-    tmp_name.push(format!(".{}.tmp", std::process::id()));
+    tmp_name.push(format!(".{host}.{}.{n}.tmp", std::process::id()));
     Ok(path.with_file_name(tmp_name))
 }
 
@@ -351,6 +364,29 @@ impl FolderLock {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Writers racing on one file (shards filling one truth cache): the file ends as one
+    /// writer's bytes, whole, and no temporary is left.
+    #[test]
+    fn concurrent_writers_of_one_file_never_mix() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("truth.exr");
+        std::thread::scope(|s| {
+            for k in 0u8..8 {
+                let path = &path;
+                s.spawn(move || {
+                    for _ in 0..20 {
+                        write_atomically(path, &vec![k; 64 * 1024]).unwrap();
+                    }
+                });
+            }
+        });
+        let bytes = std::fs::read(&path).unwrap();
+        assert_eq!(bytes.len(), 64 * 1024);
+        assert!(bytes.iter().all(|&b| b == bytes[0]), "mixed writers");
+        let names: Vec<_> = std::fs::read_dir(dir.path()).unwrap().flatten().collect();
+        assert_eq!(names.len(), 1, "a temporary was left");
+    }
 
     #[test]
     fn a_failed_write_leaves_the_old_file_and_no_temporary() {
