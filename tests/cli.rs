@@ -1723,6 +1723,10 @@ fn shards_merge_into_the_unsharded_sweep() {
     assert_eq!(merged.code, 0, "{}", merged.stderr);
     let joined = records(&d.join("merged"));
     common::assert_same_points(&full, &d.join("full"), &joined, &d.join("merged"));
+    assert!(
+        joined.iter().all(|r| r["device"].is_string()),
+        "a merged record keeps its shard's device"
+    );
     let report = std::fs::read_to_string(d.join("merged/report.md")).unwrap();
     assert!(report.contains("Merged from 3 shards"), "{report}");
 

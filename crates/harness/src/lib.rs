@@ -1310,6 +1310,7 @@ pub fn run_sweep(
             truth_image: rel(&files.truth),
             raster_image: rel(&files.raster),
             heatmap_image: rel(&files.heat),
+            device: None,
             stereo: views.eyes.map(|eyes| mirrorbox_report::StereoRecord {
                 ipd: p.ipd.unwrap_or(0.0),
                 eyes,

@@ -176,10 +176,17 @@ pub fn merge(out: &Path, dirs: &[PathBuf], command: &str) -> Result<Merged, Harn
         source,
     })?;
     let _lock = FolderLock::try_acquire(out)?;
-    let mut by_key: HashMap<&str, &Record> = HashMap::new();
+    let mut by_key: HashMap<&str, Record> = HashMap::new();
     for s in &shards {
+        let device = format!("{} on {}", s.info.adapter_description(), s.info.cpu);
         for r in &s.records {
-            by_key.insert(r.key.as_str(), r);
+            by_key.insert(
+                r.key.as_str(),
+                Record {
+                    device: Some(device.clone()),
+                    ..r.clone()
+                },
+            );
             for picture in pictures(r) {
                 let (from, to) = (s.dir.join(picture), out.join(picture));
                 if !to.exists() {

@@ -128,6 +128,10 @@ pub struct Record {
     /// the mean of both eyes', the images are side by side, the time is the pair's.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub stereo: Option<StereoRecord>,
+    /// In a merged sweep (`mirrorbox merge`): the device its shard ran on (the shard's
+    /// adapter and CPU), so that timings are read per device.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub device: Option<String>,
     /// Symmetry methods: copies of the objects drawn, and 2^p.
     #[serde(default)]
     pub copies_drawn: Option<usize>,

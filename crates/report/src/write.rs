@@ -91,6 +91,46 @@ pub(crate) fn sci(v: f64) -> String {
     }
 }
 
+/// A merged sweep whose shards ran on several devices: each device's points with their
+/// times, one table per device (the time plots, which would mix them, are left out).
+fn timings_by_device(devices: &[String], records: &[Record]) -> Vec<Block> {
+    let mut out = vec![
+        Block::Heading(2, "Timings by device".into()),
+        Block::Paragraph(
+            "The shards ran on different devices, so the times below are grouped by device \
+             and the error-against-time plots are left out; error figures compare across \
+             devices, times only within one table. Sections above or below that set times \
+             side by side (Table 1, cost against depth) mix devices: read their times here."
+                .into(),
+        ),
+    ];
+    for d in devices {
+        out.push(Block::Heading(3, format!("On {d}")));
+        out.push(Block::Table(
+            ["point", "α", "ms/frame median [95 % CI]", "FLIP mean"]
+                .map(String::from)
+                .to_vec(),
+            records
+                .iter()
+                .filter(|r| r.device.as_deref() == Some(d.as_str()))
+                .map(|r| {
+                    vec![
+                        if r.kind == "floor" {
+                            "floor (no mirrors)".into()
+                        } else {
+                            label(r)
+                        },
+                        r.alpha.to_string(),
+                        ms_cell(r, 2),
+                        sci(r.metrics.flip_mean),
+                    ]
+                })
+                .collect(),
+        ));
+    }
+    out
+}
+
 /// A merged sweep (`mirrorbox merge`): which shard ran where, and how to read its timings.
 fn shards_section(info: &SweepInfo) -> Vec<Block> {
     let mut devices: Vec<String> = Vec::new();
@@ -808,6 +848,12 @@ fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
     if !info.shards.is_empty() {
         b.extend(shards_section(info));
     }
+    // A merged sweep timed on several devices: times are read per device, never across.
+    let devices = distinct(records.iter().filter_map(|r| r.device.clone()));
+    let mixed_devices = devices.len() > 1;
+    if mixed_devices {
+        b.extend(timings_by_device(&devices, records));
+    }
     if !earlier.is_empty() {
         let mut runs: Vec<&str> = earlier
             .iter()
@@ -884,7 +930,7 @@ fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
             .map(|fl| vec![("floor (no mirrors)".to_string(), v(fl))])
             .unwrap_or_default()
     };
-    if !points.is_empty() {
+    if !points.is_empty() && !mixed_devices {
         b.push(Block::Heading(2, "Error against time".into()));
         b.push(Block::Chart(
             "plot_flip_vs_ms.svg".into(),
@@ -912,6 +958,8 @@ fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
             }
             .to_svg(),
         ));
+    }
+    if !points.is_empty() {
         b.push(Block::Heading(2, "Error against n".into()));
         b.push(Block::Chart(
             "plot_flip_vs_n.svg".into(),
@@ -1034,6 +1082,7 @@ pub(crate) mod tests {
             mirrored_lights: None,
             bump_amplitude_deg: None,
             stereo: None,
+            device: None,
             copies_drawn: None,
             copies_total: None,
             bake_ms: None,
@@ -1261,6 +1310,26 @@ pub(crate) mod tests {
                 && drifting.contains("not shown apart in time at 95 % on this device (intervals overlap); paired by round the ratio is 1.25× [1.25–1.25×]"),
             "{drifting}"
         );
+    }
+
+    #[test]
+    fn timings_of_several_devices_are_grouped_not_mixed() {
+        let mut a = record(0, 20.0, 3, 0.1);
+        a.device = Some("adapter A on CPU 1".into());
+        let mut b = record(1, 30.0, 5, 0.05);
+        b.device = Some("adapter B on CPU 2".into());
+        let md = markdown(&document(&SweepInfo::default(), &[a.clone(), b.clone()]));
+        assert!(md.contains("## Timings by device"), "{md}");
+        assert!(
+            md.contains("### On adapter A on CPU 1") && md.contains("### On adapter B on CPU 2")
+        );
+        assert!(
+            !md.contains("Error against time"),
+            "no plot mixes the devices"
+        );
+        b.device = a.device.clone();
+        let md = markdown(&document(&SweepInfo::default(), &[a, b]));
+        assert!(!md.contains("Timings by device") && md.contains("Error against time"));
     }
 
     #[test]
