@@ -47,6 +47,9 @@ enum Command {
     Bumpy(commands::sweep::PresetArgs),
     /// The preset sweep of stereo mirrors: per-eye mirror textures against the head's shared ones, both eyes as one frame, against each eye's truth at IPD 0…0.1 and mono (writes reports/stereo/).
     Stereo(commands::sweep::PresetArgs),
+    /// A window: the method live (free camera, every option switchable), the traced truth
+    /// refining beside it, and their error (docs/viewer.md).
+    View(commands::view::Args),
     /// Export a scene as Mitsuba 3 XML (tools/mitsuba renders and compares it).
     ExportMitsuba(commands::export_mitsuba::Args),
     /// Fill the generated regions of README.md and docs/methods.md from the committed reports (--check: only compare).
@@ -198,6 +201,7 @@ fn main() -> ExitCode {
         Command::Lighting(args) => commands::sweep::run_lighting(&args),
         Command::Bumpy(args) => commands::sweep::run_bumpy(&args),
         Command::Stereo(args) => commands::sweep::run_stereo(&args),
+        Command::View(args) => commands::view::run(&args),
         Command::ExportMitsuba(args) => commands::export_mitsuba::run(&args),
         Command::Readme(args) => commands::readme::run(&args),
         Command::Report(args) => commands::report::run(&args),

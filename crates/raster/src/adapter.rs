@@ -88,36 +88,57 @@ pub enum AdapterError {
 }
 
 fn try_backends(backends: wgpu::Backends) -> Option<SelectedAdapter> {
-    let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+    try_backends_presenting(backends, None).map(|(selected, _)| selected)
+}
+
+/// What a window adds to adapter selection (`mirrorbox view`): the display connection the
+/// instance is made with (GL needs it to present; Vulkan ignores it) and the surface the
+/// adapter must be able to present to.
+pub struct PresentTarget<'a> {
+    pub display: &'a dyn Fn() -> Box<dyn wgpu::wgt::WgpuHasDisplayHandle>,
+    pub surface:
+        &'a dyn Fn(&wgpu::Instance) -> Result<wgpu::Surface<'static>, wgpu::CreateSurfaceError>,
+}
+
+fn try_backends_presenting(
+    backends: wgpu::Backends,
+    present: Option<&PresentTarget<'_>>,
+) -> Option<(SelectedAdapter, Option<wgpu::Surface<'static>>)> {
+    let mut desc = match present {
+        Some(p) => wgpu::InstanceDescriptor::new_with_display_handle((p.display)()),
+        None => wgpu::InstanceDescriptor::new_without_display_handle(),
+    };
     desc.backends = backends;
     // Keep validation/debug flags controllable from the environment (WGPU_VALIDATION=1, ...).
     desc.flags = wgpu::InstanceFlags::default().with_env();
     let instance = wgpu::Instance::new(desc);
+    let surface = match present {
+        Some(p) => Some((p.surface)(&instance).ok()?),
+        None => None,
+    };
     let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
         power_preference: wgpu::PowerPreference::HighPerformance,
         force_fallback_adapter: false,
-        compatible_surface: None,
+        compatible_surface: surface.as_ref(),
         ..Default::default()
     }))
     .ok()?;
     let report = AdapterReport::of(&adapter);
-    Some(SelectedAdapter {
-        instance,
-        adapter,
-        report,
-    })
+    Some((
+        SelectedAdapter {
+            instance,
+            adapter,
+            report,
+        },
+        surface,
+    ))
 }
 
-/// Chooses the adapter (see the module docs for the order).
-pub fn select_adapter() -> Result<SelectedAdapter, AdapterError> {
-    select_adapter_from(None)
-}
-
-/// Chooses the adapter among `backends` when given, else as [`select_adapter`] does.
-pub fn select_adapter_from(
+/// The backends to try, in order, each with what chose it.
+fn backend_order(
     backends: Option<wgpu::Backends>,
-) -> Result<SelectedAdapter, AdapterError> {
-    let order: Vec<(&str, wgpu::Backends)> = match (backends, std::env::var("WGPU_BACKEND")) {
+) -> Result<Vec<(&'static str, wgpu::Backends)>, AdapterError> {
+    Ok(match (backends, std::env::var("WGPU_BACKEND")) {
         (Some(backends), _) => vec![("the caller's choice", backends)],
         (None, Ok(value)) => {
             let backends = wgpu::Backends::from_comma_list(&value);
@@ -130,16 +151,48 @@ pub fn select_adapter_from(
             ("Vulkan", wgpu::Backends::VULKAN),
             ("GL", wgpu::Backends::GL),
         ],
-    };
-    for (_, backends) in &order {
-        if let Some(selected) = try_backends(*backends) {
-            return Ok(selected);
-        }
-    }
+    })
+}
+
+fn none_found(order: &[(&str, wgpu::Backends)], what: &str) -> AdapterError {
     let tried = order
         .iter()
         .map(|(name, b)| format!("{name} ({b:?})"))
         .collect::<Vec<_>>()
         .join(", then ");
-    Err(AdapterError::NoneFound { tried })
+    AdapterError::NoneFound {
+        tried: format!("{tried}{what}"),
+    }
+}
+
+/// Chooses the adapter by the same rule as [`select_adapter`], among those that can present
+/// to `present`'s surface; returns it with the surface.
+pub fn select_adapter_presenting(
+    present: &PresentTarget<'_>,
+) -> Result<(SelectedAdapter, wgpu::Surface<'static>), AdapterError> {
+    let order = backend_order(None)?;
+    for (_, backends) in &order {
+        if let Some((selected, Some(surface))) = try_backends_presenting(*backends, Some(present)) {
+            return Ok((selected, surface));
+        }
+    }
+    Err(none_found(&order, " that can present to the window"))
+}
+
+/// Chooses the adapter (see the module docs for the order).
+pub fn select_adapter() -> Result<SelectedAdapter, AdapterError> {
+    select_adapter_from(None)
+}
+
+/// Chooses the adapter among `backends` when given, else as [`select_adapter`] does.
+pub fn select_adapter_from(
+    backends: Option<wgpu::Backends>,
+) -> Result<SelectedAdapter, AdapterError> {
+    let order = backend_order(backends)?;
+    for (_, backends) in &order {
+        if let Some(selected) = try_backends(*backends) {
+            return Ok(selected);
+        }
+    }
+    Err(none_found(&order, ""))
 }

@@ -130,6 +130,16 @@ impl Gpu {
             }
         };
         let selected = select_adapter_from(options.backends)?;
+        Gpu::open_adapter(selected, wanted, forced)
+    }
+
+    /// Opens `selected` (chosen by [`crate::adapter`]'s rule) as [`Gpu::open`] does, with the
+    /// colour format `forced` or the best the adapter has.
+    pub fn open_adapter(
+        selected: crate::SelectedAdapter,
+        wanted: wgpu::Features,
+        forced: Option<ColorFormat>,
+    ) -> Result<Gpu, RasterError> {
         let color_format = ColorFormat::choose(&selected.adapter, forced).map_err(|message| {
             RasterError::Device {
                 adapter: format!("{} ({})", selected.report.name, selected.report.backend),

@@ -257,13 +257,45 @@ pub(crate) fn add_shadow_maps(
     stats.triangles += shadows.triangles();
 }
 
-/// Renders a planned frame at the scene camera's size.
-pub fn render_planned(
+/// A frame built on the device, ready to be drawn any number of times: what `render` times
+/// once, and what `mirrorbox view` draws every frame while the view stays the same (a
+/// method's uniforms hold the camera, so a moved camera needs a new one).
+pub struct BuiltView {
+    target: targets::RenderTarget,
+    resolve: resolve::Resolve,
+    encoder: Box<dyn timing::FrameEncoder>,
+    pub stats: FrameStats,
+    pub warnings: Vec<String>,
+    pub bake_ms: Option<f64>,
+}
+
+impl BuiltView {
+    /// Draws `warmup + frames` frames, times the last `frames` and reads the last back.
+    pub fn run(
+        &self,
+        gpu: &Gpu,
+        warmup: u32,
+        frames: u32,
+    ) -> Result<(RgbImage, FrameTiming), RasterError> {
+        timing::run_frames(
+            gpu,
+            self.encoder.as_ref(),
+            &self.target,
+            &self.resolve,
+            warmup,
+            frames,
+        )
+    }
+}
+
+/// Builds a planned frame's GPU resources (its shadow maps included) at the scene camera's
+/// size.
+pub fn build_planned(
     gpu: &Gpu,
     scene: &Scene,
     planned: Planned,
     settings: &RenderSettings,
-) -> Result<RenderOutput, RasterError> {
+) -> Result<BuiltView, RasterError> {
     let scene = &*lighting::lit_scene(scene, settings.method.params());
     let (w, h) = check_planned_frame(gpu, scene, settings, &planned.key, planned.size)?;
     let target =
@@ -285,14 +317,25 @@ pub fn render_planned(
         });
     }
     gpu.check()?;
-    let (image, timing) = timing::run_frames(
-        gpu,
-        built.encoder.as_ref(),
-        &target,
-        &resolve,
-        settings.warmup,
-        settings.frames,
-    )?;
+    Ok(BuiltView {
+        target,
+        resolve,
+        encoder: built.encoder,
+        stats: built.stats,
+        warnings: built.warnings,
+        bake_ms: built.bake_ms,
+    })
+}
+
+/// Renders a planned frame at the scene camera's size.
+pub fn render_planned(
+    gpu: &Gpu,
+    scene: &Scene,
+    planned: Planned,
+    settings: &RenderSettings,
+) -> Result<RenderOutput, RasterError> {
+    let built = build_planned(gpu, scene, planned, settings)?;
+    let (image, timing) = built.run(gpu, settings.warmup, settings.frames)?;
     let gpu_memory = GpuMemory::read(gpu);
     Ok(RenderOutput {
         image,

@@ -18,6 +18,6 @@ pub mod watertight;
 pub use bvh::{BvhKind, Hit, SceneBvh};
 pub use integrator::{Integrator, IntegratorSettings, PathResult, Termination, path, whitted};
 pub use path::{PathSettings, PathTracer};
-pub use render::{TraceOutput, TraceSettings, TraceStats, render};
+pub use render::{TraceOutput, TraceSettings, TraceStats, render, render_while};
 pub use sampler::Sampling;
 pub use whitted::{Whitted, WhittedSettings};

@@ -124,6 +124,20 @@ pub fn render(
     settings: &TraceSettings,
     progress: &(dyn Fn(u32) + Sync),
 ) -> TraceOutput {
+    render_while(scene, bvh, settings, progress, &|| true)
+        .expect("a render that is never cancelled finishes")
+}
+
+/// [`render`], abandoned (`None`) as soon as `go_on()` is false before a row starts: the
+/// viewer's live truth cancels a view the camera has left. A finished render is the same
+/// image as [`render`]'s, bit for bit.
+pub fn render_while(
+    scene: &Scene,
+    bvh: &SceneBvh,
+    settings: &TraceSettings,
+    progress: &(dyn Fn(u32) + Sync),
+    go_on: &(dyn Fn() -> bool + Sync),
+) -> Option<TraceOutput> {
     let cam = &scene.camera;
     let (w, h) = (cam.width, cam.height);
     let rays = cam.ray_generator();
@@ -132,9 +146,12 @@ pub fn render(
     let spp = settings.sampling.grid().samples_per_pixel() as f32;
     let done = AtomicU32::new(0);
     let start = Instant::now();
-    let rows: Vec<Row> = (0..h)
+    let rows: Option<Vec<Row>> = (0..h)
         .into_par_iter()
         .map(|y| {
+            if !go_on() {
+                return None;
+            }
             let mut offsets = Vec::new();
             let mut stats = TraceStats::default();
             let mut colour = Vec::with_capacity(w as usize);
@@ -158,9 +175,10 @@ pub fn render(
                 depth.push([bounces as f32 / spp; 3]);
             }
             progress(done.fetch_add(1, Ordering::Relaxed) + 1);
-            (colour, depth, stats)
+            Some((colour, depth, stats))
         })
         .collect();
+    let rows = rows?;
     let wall = start.elapsed();
     let mut image = RgbImage::new(w, h);
     let mut bounces = RgbImage::new(w, h);
@@ -172,11 +190,11 @@ pub fn render(
         bounces.pixels.extend(d);
         stats = stats.merge(s);
     }
-    TraceOutput {
+    Some(TraceOutput {
         image,
         bounces,
         stats,
         wall,
         threads: rayon::current_num_threads(),
-    }
+    })
 }

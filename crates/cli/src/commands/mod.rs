@@ -10,6 +10,7 @@ pub mod report;
 pub mod stereo;
 pub mod sweep;
 pub mod trace;
+pub mod view;
 
 use crate::Failure;
 use mirrorbox_scene::{Scene, load_scene};

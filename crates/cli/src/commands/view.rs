@@ -1,0 +1,153 @@
+//! `mirrorbox view SCENE`: a window with the method live, the traced truth refining beside
+//! it and their error (docs/viewer.md). `--script` drives it; `--frames N --screenshot
+//! OUT.png` takes one picture and closes.
+
+use super::method_flags::{RenderOptions, method_value_parser};
+use super::{load, output_path, resize, unit_interval};
+use crate::Failure;
+use mirrorbox_raster::RenderSettings;
+use mirrorbox_viewer::script::{self, Action, Step};
+use mirrorbox_viewer::{ViewError, ViewOptions};
+use std::path::PathBuf;
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Scene file (JSON).
+    scene: PathBuf,
+    /// The raster method to start with (switchable in the window: the panel or keys 1…8).
+    #[arg(long, default_value = "auxiliary", value_parser = method_value_parser())]
+    method: String,
+    #[command(flatten)]
+    options: RenderOptions,
+    /// α: sets every mirror's reflectance, in [0, 1] (default: the scene's).
+    #[arg(long, visible_alias = "reflectance", allow_negative_numbers = true)]
+    alpha: Option<f32>,
+    /// View width in pixels (default: the scene camera's; the vertical field of view kept).
+    #[arg(long)]
+    width: Option<u32>,
+    /// View height in pixels (default: the scene camera's).
+    #[arg(long)]
+    height: Option<u32>,
+    /// Supersampling factor s of the method, 1..4; the live truth uses the same s×s grid.
+    #[arg(long, default_value_t = 1)]
+    ssaa: u32,
+    /// Window size WIDTHxHEIGHT in pixels (default: the panel and four panes of the view).
+    #[arg(long, value_parser = parse_size)]
+    window: Option<(u32, u32)>,
+    /// Timed actions that drive the viewer, one per line (see docs/viewer.md).
+    #[arg(long, conflicts_with_all = ["frames", "screenshot"])]
+    script: Option<PathBuf>,
+    /// Draw N frames, then close (with --screenshot: take it after the N-th frame).
+    #[arg(long)]
+    frames: Option<u32>,
+    /// Save the window (PNG) with the method and truth EXRs beside it, after --frames.
+    #[arg(long, requires = "frames")]
+    screenshot: Option<PathBuf>,
+    /// Write one JSON line per frame (method, passes, draws, GPU ms, truth level, panes) here
+    /// when the viewer closes.
+    #[arg(long)]
+    log: Option<PathBuf>,
+    /// Present without waiting for the display's refresh (default: vsync on).
+    #[arg(long)]
+    no_vsync: bool,
+    /// Folder the screenshot and save-camera keys write into (default: the current folder).
+    #[arg(long, default_value = ".")]
+    out: PathBuf,
+}
+
+fn parse_size(text: &str) -> Result<(u32, u32), String> {
+    let (w, h) = text
+        .split_once('x')
+        .ok_or_else(|| format!("expected WIDTHxHEIGHT, got {text:?}"))?;
+    let side = |s: &str| {
+        s.parse::<u32>()
+            .ok()
+            .filter(|v| (64..=script::MAX_WINDOW_SIDE).contains(v))
+            .ok_or_else(|| {
+                format!(
+                    "each side must be in [64, {}], got {s:?}",
+                    script::MAX_WINDOW_SIDE
+                )
+            })
+    };
+    Ok((side(w)?, side(h)?))
+}
+
+pub fn run(args: &Args) -> Result<(), Failure> {
+    let bad = Failure::BadInput;
+    let entry = mirrorbox_raster::registry::find(&args.method)
+        .ok_or_else(|| bad(format!("unknown method {:?}", args.method)))?;
+    let method = args.options.0.configure(entry)?;
+    let alpha = unit_interval("--alpha", args.alpha)?;
+    if !(1..=4).contains(&args.ssaa) {
+        return Err(bad(format!("--ssaa must be in [1, 4], got {}", args.ssaa)));
+    }
+    let mut scene = load(&args.scene)?;
+    resize(&mut scene, args.width, args.height)?;
+    if let Some(alpha) = alpha {
+        scene
+            .set_reflectance(glam::Vec3::splat(alpha))
+            .map_err(|e| super::light_budget(&scene, "--alpha", e))?;
+    }
+    let settings = RenderSettings {
+        method: method.clone(),
+        ssaa: args.ssaa,
+        frames: 1,
+        warmup: 0,
+    };
+    settings.check(&scene).map_err(super::setting)?;
+    if !args.out.is_dir() {
+        return Err(bad(format!(
+            "--out {}: folder does not exist",
+            args.out.display()
+        )));
+    }
+    let (steps, script_name) = match (&args.script, args.frames) {
+        (Some(path), _) => (
+            Some(script::read_script(path).map_err(|e| bad(e.to_string()))?),
+            path.display().to_string(),
+        ),
+        (None, Some(frames)) => {
+            if !(1..=script::MAX_FRAMES).contains(&frames) {
+                return Err(bad(format!(
+                    "--frames must be in [1, {}], got {frames}",
+                    script::MAX_FRAMES
+                )));
+            }
+            let mut steps = vec![Step {
+                line: 0,
+                action: Action::Frames(frames),
+            }];
+            if let Some(png) = &args.screenshot {
+                let png = output_path("--screenshot", png, "png")?;
+                steps.push(Step {
+                    line: 0,
+                    action: Action::Screenshot(png),
+                });
+            }
+            (Some(steps), "--frames".to_string())
+        }
+        (None, None) => (None, String::new()),
+    };
+    if let Some(log) = &args.log {
+        output_path("--log", log, "jsonl")?;
+    }
+    let size = (scene.camera.width, scene.camera.height);
+    let options = ViewOptions {
+        scene_path: args.scene.clone(),
+        scene,
+        method,
+        ssaa: args.ssaa,
+        size,
+        window: args.window,
+        script: steps,
+        script_name,
+        log: args.log.clone(),
+        vsync: !args.no_vsync,
+        out_dir: args.out.clone(),
+    };
+    mirrorbox_viewer::run(options).map_err(|e| match e {
+        ViewError::Refused(m) => Failure::BadInput(m),
+        ViewError::Failed(m) => Failure::Other(m),
+    })
+}

@@ -1,0 +1,216 @@
+//! Screenshots and the frame log.
+//!
+//! A screenshot `OUT.png` is the window as presented (the same egui paint jobs drawn into a
+//! texture that is read back), with beside it:
+//! - `OUT.method.exr`: the method's linear image (the values `render` writes);
+//! - `OUT.truth.exr`: the truth's linear image, when the truth of the view is complete;
+//! - `OUT.error.png`: the heat map, when there is one;
+//! - `OUT.json`: the method, camera, timings, metrics and each pane's rectangle in the
+//!   window's pixels (so a test can cut the panes out of `OUT.png`).
+
+use crate::ViewOptions;
+use crate::session::Session;
+use mirrorbox_raster::Gpu;
+use serde_json::json;
+use std::path::{Path, PathBuf};
+
+/// An offscreen copy of the window's frame.
+pub struct Capture {
+    texture: wgpu::Texture,
+    pub view: wgpu::TextureView,
+    buffer: wgpu::Buffer,
+    size: (u32, u32),
+    padded_row: u32,
+    bgra: bool,
+}
+
+impl Capture {
+    pub fn new(gpu: &Gpu, format: wgpu::TextureFormat, size: (u32, u32)) -> Capture {
+        let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("screenshot"),
+            size: wgpu::Extent3d {
+                width: size.0,
+                height: size.1,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let view = texture.create_view(&Default::default());
+        let padded_row = (4 * size.0).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
+        let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("screenshot read"),
+            size: u64::from(padded_row) * u64::from(size.1),
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        Capture {
+            texture,
+            view,
+            buffer,
+            size,
+            padded_row,
+            bgra: matches!(
+                format,
+                wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb
+            ),
+        }
+    }
+
+    pub fn copy(&self, encoder: &mut wgpu::CommandEncoder) {
+        encoder.copy_texture_to_buffer(
+            self.texture.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &self.buffer,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(self.padded_row),
+                    rows_per_image: Some(self.size.1),
+                },
+            },
+            wgpu::Extent3d {
+                width: self.size.0,
+                height: self.size.1,
+                depth_or_array_layers: 1,
+            },
+        );
+    }
+
+    /// The frame as RGB bytes, row-major (after the copy was submitted).
+    pub fn read(&self, gpu: &Gpu) -> Result<(u32, u32, Vec<u8>), String> {
+        let slice = self.buffer.slice(..);
+        slice.map_async(wgpu::MapMode::Read, |_| {});
+        gpu.wait().map_err(|e| e.to_string())?;
+        let data = slice.get_mapped_range().map_err(|e| e.to_string())?;
+        let (w, h) = self.size;
+        let mut rgb = Vec::with_capacity((w * h * 3) as usize);
+        for row in data.chunks_exact(self.padded_row as usize).take(h as usize) {
+            for p in row[..(4 * w) as usize].chunks_exact(4) {
+                if self.bgra {
+                    rgb.extend([p[2], p[1], p[0]]);
+                } else {
+                    rgb.extend([p[0], p[1], p[2]]);
+                }
+            }
+        }
+        drop(data);
+        self.buffer.unmap();
+        Ok((w, h, rgb))
+    }
+}
+
+fn with_suffix(path: &Path, suffix: &str) -> PathBuf {
+    let stem = path.with_extension("");
+    PathBuf::from(format!("{}{suffix}", stem.display()))
+}
+
+fn panes_json(panes: &[(&'static str, [u32; 4])]) -> serde_json::Value {
+    panes
+        .iter()
+        .map(|(name, r)| ((*name).to_string(), json!(r)))
+        .collect::<serde_json::Map<_, _>>()
+        .into()
+}
+
+/// One frame of the `--log`: what was shown and what it cost.
+pub fn frame_record(
+    frame: u64,
+    session: &Session,
+    panes: &[(&'static str, [u32; 4])],
+    window: (u32, u32),
+) -> serde_json::Value {
+    let method = session.frame.as_ref();
+    let history = session.history.back();
+    json!({
+        "frame": frame,
+        "method": session.method.key(),
+        "ssaa": session.ssaa,
+        "method_error": session.method_error,
+        "passes": method.map(|f| f.stats.passes),
+        "draws": method.map(|f| f.stats.draws),
+        "reflections": method.map(|f| f.stats.depth),
+        "paths": method.and_then(|f| f.stats.paths.map(|p| p.kept)),
+        "gpu_ms": method.map(|f| f.gpu_ms),
+        "timing": method.map(|f| f.timing_source.clone()),
+        "wall_ms": history.map(|t| t.wall_ms),
+        "build_ms": history.map(|t| t.build_ms),
+        "truth_level": session.truth_shown.as_ref().map(|l| l.level),
+        "truth_complete": session.complete_truth().is_some(),
+        "flip_mean": session.error.as_ref().map(|e| e.metrics.flip_mean),
+        "window": [window.0, window.1],
+        "panes": panes_json(panes),
+    })
+}
+
+/// Writes a screenshot and its companions (see the module docs); every file atomically.
+pub fn save(
+    path: &Path,
+    (w, h, rgb): &(u32, u32, Vec<u8>),
+    session: &Session,
+    panes: &[(&'static str, [u32; 4])],
+    options: &ViewOptions,
+) -> Result<(), String> {
+    let err = |e: mirrorbox_image::ImageError| format!("{}: {e}", path.display());
+    mirrorbox_image::write_png_bytes(path, *w, *h, rgb).map_err(err)?;
+    let camera = session.view_camera();
+    if let Some(frame) = &session.frame {
+        mirrorbox_image::write_exr(
+            &with_suffix(path, ".method.exr"),
+            &frame.image,
+            &[("mirrorbox.method", session.method.key())],
+        )
+        .map_err(err)?;
+    }
+    let truth = session.complete_truth();
+    if let Some(level) = truth {
+        mirrorbox_image::write_exr(
+            &with_suffix(path, ".truth.exr"),
+            &level.image,
+            &[("mirrorbox.spp", (session.ssaa * session.ssaa).to_string())],
+        )
+        .map_err(err)?;
+    }
+    if let Some(e) = &session.error {
+        mirrorbox_image::write_png_bytes(
+            &with_suffix(path, ".error.png"),
+            e.width,
+            e.height,
+            &e.heat_rgb8,
+        )
+        .map_err(err)?;
+    }
+    let frame = session.frame.as_ref();
+    let record = json!({
+        "scene": options.scene_path.display().to_string(),
+        "method": session.method.key(),
+        "ssaa": session.ssaa,
+        "size": [session.size.0, session.size.1],
+        "camera": {
+            "position": camera.position.to_array(),
+            "look_at": camera.look_at.to_array(),
+            "up": camera.up.to_array(),
+            "fov_y_deg": camera.fov_y_deg,
+        },
+        "passes": frame.map(|f| f.stats.passes),
+        "draws": frame.map(|f| f.stats.draws),
+        "gpu_ms": frame.map(|f| f.gpu_ms),
+        "truth_complete": truth.is_some(),
+        "error_map": session.error_mode.name(),
+        "metrics": session.error.as_ref().map(|e| json!({
+            "flip_mean": e.metrics.flip_mean,
+            "relmse": e.metrics.relmse,
+            "psnr": if e.metrics.psnr.is_finite() { json!(e.metrics.psnr) } else { json!(null) },
+            "ssim": e.metrics.ssim,
+        })),
+        "window": [w, h],
+        "panes": panes_json(panes),
+    });
+    let mut text = serde_json::to_string_pretty(&record).map_err(|e| e.to_string())?;
+    text.push('\n');
+    mirrorbox_files::write_atomically(&path.with_extension("json"), text.as_bytes())
+        .map_err(|e| e.to_string())
+}

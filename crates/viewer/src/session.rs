@@ -1,0 +1,416 @@
+//! What the viewer shows, apart from the window: the method's frame (rebuilt when the view
+//! or the settings change, redrawn every frame), the live truth, the error view, the frame
+//! times, and the textures the panes are painted from.
+
+use crate::error_view::{ErrorImage, ErrorMode, error_image};
+use crate::fly_camera::FlyCamera;
+use crate::live_truth::{LiveTruth, TruthLevel, TruthRequest, level_count};
+use mirrorbox_image::RgbImage;
+use mirrorbox_raster::{BuiltView, FrameStats, Gpu, Method, RasterError, RenderSettings};
+use mirrorbox_scene::{Camera, Scene};
+use std::collections::VecDeque;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// Frame times kept for the graph.
+pub const HISTORY: usize = 600;
+
+/// One pane's image on the GPU, as egui paints it: RGBA8 holding the contract's sRGB bytes
+/// (egui's textures are not sRGB-aware; its shader writes them to a non-sRGB target as they
+/// are, so a pane shown 1:1 holds the same bytes as the PNG `render` writes).
+pub struct PaneTexture {
+    pub texture: wgpu::Texture,
+    pub id: Option<egui::TextureId>,
+    pub size: (u32, u32),
+    pub filter: wgpu::FilterMode,
+}
+
+impl PaneTexture {
+    fn new(device: &wgpu::Device, label: &str, size: (u32, u32)) -> Self {
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d {
+                width: size.0,
+                height: size.1,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba8Unorm,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        PaneTexture {
+            texture,
+            id: None,
+            size,
+            filter: wgpu::FilterMode::Nearest,
+        }
+    }
+
+    /// Writes RGB 8-bit sRGB bytes of `size` into the texture, recreating it (and its egui
+    /// registration) when the size changed.
+    pub fn upload(
+        slot: &mut Option<PaneTexture>,
+        gpu: &Gpu,
+        renderer: &mut egui_wgpu::Renderer,
+        label: &str,
+        size: (u32, u32),
+        rgb: &[u8],
+    ) {
+        if slot.as_ref().map(|t| t.size) != Some(size) {
+            if let Some(old) = slot.take().and_then(|t| t.id) {
+                renderer.free_texture(&old);
+            }
+            let mut t = PaneTexture::new(&gpu.device, label, size);
+            let view = t.texture.create_view(&Default::default());
+            t.id = Some(renderer.register_native_texture(&gpu.device, &view, t.filter));
+            *slot = Some(t);
+        }
+        let t = slot.as_ref().expect("texture just made");
+        let rgba: Vec<u8> = rgb
+            .chunks_exact(3)
+            .flat_map(|p| [p[0], p[1], p[2], 255])
+            .collect();
+        gpu.queue.write_texture(
+            wgpu::TexelCopyTextureInfo {
+                texture: &t.texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
+            &rgba,
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(4 * size.0),
+                rows_per_image: Some(size.1),
+            },
+            wgpu::Extent3d {
+                width: size.0,
+                height: size.1,
+                depth_or_array_layers: 1,
+            },
+        );
+    }
+
+    /// Samples nearest when shown 1:1 (the exact bytes), linearly when scaled.
+    pub fn set_filter(
+        &mut self,
+        gpu: &Gpu,
+        renderer: &mut egui_wgpu::Renderer,
+        filter: wgpu::FilterMode,
+    ) {
+        if filter != self.filter
+            && let Some(id) = self.id
+        {
+            self.filter = filter;
+            let view = self.texture.create_view(&Default::default());
+            renderer.update_egui_texture_from_wgpu_texture(&gpu.device, &view, filter, id);
+        }
+    }
+}
+
+/// The method's last frame.
+pub struct MethodFrame {
+    pub image: Arc<RgbImage>,
+    pub stats: FrameStats,
+    /// GPU milliseconds of the frame (timestamps), or the CPU wall time of submit-to-done
+    /// where the adapter has no timestamps.
+    pub gpu_ms: f64,
+    pub timing_source: String,
+    pub warnings: Vec<String>,
+    /// The camera it was drawn from.
+    pub camera: Camera,
+    /// Counts rebuilds: a new value means a new image.
+    pub build: u64,
+}
+
+/// One entry of the frame-time history.
+#[derive(Clone, Copy, Debug)]
+pub struct FrameTime {
+    /// Wall time since the previous frame (what the user sees as the frame rate).
+    pub wall_ms: f64,
+    /// The method's frame on the GPU.
+    pub gpu_ms: f64,
+    /// CPU time spent re-planning and building the method's frame (a moved camera).
+    pub build_ms: f64,
+}
+
+/// A method frame built for one view and setting.
+struct Built {
+    view: BuiltView,
+    key: String,
+    camera: Camera,
+}
+
+pub struct Session {
+    /// The scene, its camera replaced by each view's before planning (the live truth keeps
+    /// its own copy: two in all).
+    pub scene: Scene,
+    pub camera: FlyCamera,
+    pub method: Method,
+    pub ssaa: u32,
+    /// The view's size in pixels (the method's image and the truth's last level).
+    pub size: (u32, u32),
+    built: Option<Built>,
+    builds: u64,
+    /// A refusal or failure of the current settings (shown in the panel; the last good
+    /// image stays).
+    pub method_error: Option<String>,
+    pub frame: Option<MethodFrame>,
+    pub truth_enabled: bool,
+    truth: LiveTruth,
+    pub truth_shown: Option<TruthLevel>,
+    pub error_mode: ErrorMode,
+    pub error_gain: f32,
+    pub error: Option<ErrorImage>,
+    /// (method build, truth generation, mode, gain bits) of the error shown.
+    error_key: Option<(u64, u64, ErrorMode, u32)>,
+    pub history: VecDeque<FrameTime>,
+    last_frame: Option<Instant>,
+    pub method_texture: Option<PaneTexture>,
+    pub truth_texture: Option<PaneTexture>,
+    pub error_texture: Option<PaneTexture>,
+}
+
+impl Session {
+    pub fn new(scene: Scene, method: Method, ssaa: u32, size: (u32, u32)) -> Self {
+        let mut scene = scene;
+        scene.stereo = None;
+        scene.head = None;
+        Session {
+            camera: FlyCamera::new(scene.camera.clone()),
+            truth: LiveTruth::start(Arc::new(scene.clone())),
+            scene,
+            method,
+            ssaa,
+            size,
+            built: None,
+            builds: 0,
+            method_error: None,
+            frame: None,
+            truth_enabled: true,
+            truth_shown: None,
+            error_mode: ErrorMode::Difference,
+            error_gain: 4.0,
+            error: None,
+            error_key: None,
+            history: VecDeque::with_capacity(HISTORY),
+            last_frame: None,
+            method_texture: None,
+            truth_texture: None,
+            error_texture: None,
+        }
+    }
+
+    /// The scene camera of the current view.
+    pub fn view_camera(&self) -> Camera {
+        self.camera.camera(self.size.0, self.size.1)
+    }
+
+    fn settings(&self) -> RenderSettings {
+        RenderSettings {
+            method: self.method.clone(),
+            ssaa: self.ssaa,
+            frames: 1,
+            warmup: 0,
+        }
+    }
+
+    /// Draws the method's frame for the current view (planning and building it first when
+    /// the view or the settings changed), asks the live truth for this view, takes its
+    /// newest level and recomputes the error view when either changed. Uploads what changed.
+    /// A refused setting (too many passes, …) is reported in `method_error`; a device failure
+    /// is returned.
+    pub fn update(
+        &mut self,
+        gpu: &Gpu,
+        renderer: &mut egui_wgpu::Renderer,
+    ) -> Result<(), RasterError> {
+        let now = Instant::now();
+        let wall_ms = self
+            .last_frame
+            .map(|t| now.duration_since(t).as_secs_f64() * 1e3)
+            .unwrap_or(0.0);
+        self.last_frame = Some(now);
+        let camera = self.view_camera();
+        let settings = self.settings();
+        let key = format!(
+            "{} ssaa={} {:?}",
+            settings.method.key(),
+            settings.ssaa,
+            camera
+        );
+        let mut build_ms = 0.0;
+        if self.built.as_ref().map(|b| &b.key) != Some(&key) {
+            let started = Instant::now();
+            self.scene.camera = camera.clone();
+            let scene = &self.scene;
+            match mirrorbox_raster::plan_frame(scene, &settings)
+                .map_err(RasterError::from)
+                .and_then(|planned| mirrorbox_raster::build_planned(gpu, scene, planned, &settings))
+            {
+                Ok(view) => {
+                    self.builds += 1;
+                    self.built = Some(Built {
+                        view,
+                        key,
+                        camera: camera.clone(),
+                    });
+                    self.method_error = None;
+                }
+                Err(e) if e.is_refusal() => {
+                    self.built = None;
+                    self.method_error = Some(e.to_string());
+                }
+                Err(e) => return Err(e),
+            }
+            build_ms = started.elapsed().as_secs_f64() * 1e3;
+        }
+        if let Some(built) = &self.built {
+            let (image, timing) = built.view.run(gpu, 0, 1)?;
+            let rgb = image.to_srgb8(self.scene.camera.exposure);
+            PaneTexture::upload(
+                &mut self.method_texture,
+                gpu,
+                renderer,
+                "method pane",
+                (image.width, image.height),
+                &rgb,
+            );
+            let gpu_ms = timing.median_ms();
+            self.frame = Some(MethodFrame {
+                image: Arc::new(image),
+                stats: built.view.stats,
+                gpu_ms,
+                timing_source: timing.source.name().to_string(),
+                warnings: built.view.warnings.clone(),
+                camera: built.camera.clone(),
+                build: self.builds,
+            });
+            if self.history.len() == HISTORY {
+                self.history.pop_front();
+            }
+            self.history.push_back(FrameTime {
+                wall_ms,
+                gpu_ms,
+                build_ms,
+            });
+        }
+        self.update_truth(gpu, renderer);
+        self.update_error(gpu, renderer);
+        Ok(())
+    }
+
+    fn update_truth(&mut self, gpu: &Gpu, renderer: &mut egui_wgpu::Renderer) {
+        if !self.truth_enabled {
+            return;
+        }
+        self.truth.request(TruthRequest {
+            camera: self.view_camera(),
+            grid_side: self.ssaa,
+        });
+        let newest = self.truth.latest();
+        let shown = self.truth_shown.as_ref().map(|l| (l.generation, l.level));
+        match newest {
+            Some(level) if Some((level.generation, level.level)) != shown => {
+                let rgb = level.image.to_srgb8(self.scene.camera.exposure);
+                PaneTexture::upload(
+                    &mut self.truth_texture,
+                    gpu,
+                    renderer,
+                    "truth pane",
+                    (level.image.width, level.image.height),
+                    &rgb,
+                );
+                self.truth_shown = Some(level);
+            }
+            Some(_) => {}
+            None => {
+                // The view changed and nothing of it is traced yet: keep showing the last
+                // image only while it is of the same view.
+                if self
+                    .truth_shown
+                    .as_ref()
+                    .is_some_and(|l| l.generation != self.truth.generation())
+                {
+                    self.truth_shown = None;
+                }
+            }
+        }
+    }
+
+    /// The complete truth of the view the method's frame shows, if the tracer has it.
+    pub fn complete_truth(&self) -> Option<&TruthLevel> {
+        let level = self.truth_shown.as_ref().filter(|l| l.complete)?;
+        let frame = self.frame.as_ref()?;
+        (level.generation == self.truth.generation() && frame.camera == self.view_camera())
+            .then_some(level)
+    }
+
+    fn update_error(&mut self, gpu: &Gpu, renderer: &mut egui_wgpu::Renderer) {
+        let (Some(truth), Some(frame)) = (self.complete_truth(), self.frame.as_ref()) else {
+            self.error = None;
+            self.error_key = None;
+            return;
+        };
+        let key = (
+            frame.build,
+            truth.generation,
+            self.error_mode,
+            self.error_gain.to_bits(),
+        );
+        if self.error_key == Some(key) {
+            return;
+        }
+        match error_image(
+            &truth.image,
+            &frame.image,
+            self.scene.camera.exposure,
+            self.error_mode,
+            self.error_gain,
+        ) {
+            Ok(e) => {
+                PaneTexture::upload(
+                    &mut self.error_texture,
+                    gpu,
+                    renderer,
+                    "error pane",
+                    (e.width, e.height),
+                    &e.heat_rgb8,
+                );
+                self.error = Some(e);
+            }
+            Err(_) => self.error = None,
+        }
+        self.error_key = Some(key);
+    }
+
+    /// Waits for the current view's complete truth (a script's `wait-truth`).
+    pub fn wait_truth(&self, timeout: Duration) -> bool {
+        self.truth.wait_complete(timeout).is_some()
+    }
+
+    /// Which level the truth pane shows, in words.
+    pub fn truth_progress(&self) -> String {
+        match &self.truth_shown {
+            _ if !self.truth_enabled => "off".into(),
+            Some(l) if l.complete => format!(
+                "complete: {}×{}, {} spp, traced in {:.0} ms",
+                l.image.width,
+                l.image.height,
+                self.ssaa * self.ssaa,
+                l.trace_time.as_secs_f64() * 1e3
+            ),
+            Some(l) => format!(
+                "level {}/{} ({}×{}, 1 spp), refining",
+                l.level + 1,
+                level_count(),
+                l.image.width,
+                l.image.height
+            ),
+            None => "tracing…".into(),
+        }
+    }
+}
