@@ -45,6 +45,8 @@ struct Running {
     /// Screenshots and camera copies the keys ask for, numbered.
     saved: u32,
     pending_screenshot: Option<PathBuf>,
+    /// egui textures to free after the next submitted frame.
+    pending_free: Vec<egui::TextureId>,
 }
 
 pub struct App {
@@ -185,6 +187,7 @@ impl App {
             frames_drawn: 0,
             saved: 0,
             pending_screenshot: None,
+            pending_free: Vec::new(),
         })
     }
 
@@ -238,6 +241,7 @@ impl App {
                 Action::Method(m) => r.session.method = m,
                 Action::Ssaa(s) => r.session.ssaa = s,
                 Action::Error(mode) => r.session.error_mode = mode,
+                Action::Truth(on) => r.session.truth_enabled = on,
                 Action::Walk([f, rt, u]) => r.session.camera.walk(f, rt, u),
                 Action::Turn { yaw, pitch } => r.session.camera.turn(yaw, pitch),
                 Action::Look { position, at } => r
@@ -312,12 +316,17 @@ impl App {
             size_in_pixels: [r.config.width, r.config.height],
             pixels_per_point: ppp,
         };
-        for (id, deltas) in &full_output.textures_delta.set {
+        // egui's texture changes: uploads now; frees once this frame is submitted (or at
+        // the next frame, when this one is skipped).
+        let mut textures = full_output.textures_delta;
+        for (id, deltas) in &textures.set {
             for delta in deltas {
                 r.renderer
                     .update_texture(&r.gpu.device, &r.gpu.queue, *id, delta);
             }
         }
+        r.pending_free.extend(textures.free.drain());
+        textures.clear();
         let frame = match r.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(t)
             | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
@@ -381,8 +390,8 @@ impl App {
             .submit(commands.into_iter().chain([encoder.finish()]));
         r.window.pre_present_notify();
         r.gpu.queue.present(frame);
-        for id in &full_output.textures_delta.free {
-            r.renderer.free_texture(id);
+        for id in r.pending_free.drain(..) {
+            r.renderer.free_texture(&id);
         }
         r.frames_drawn += 1;
         let panes = r.ui.panes_px.clone();

@@ -369,29 +369,46 @@ fn controls(
     }
 }
 
-/// The last seconds of frame times: the method's GPU time and the time between shown frames.
+/// Seconds of frame times the graph spans.
+const GRAPH_SECONDS: f64 = 10.0;
+
+/// The last seconds of frame times, newest on the right: the method's GPU time and the wall
+/// time between shown frames (which adds planning, readback, the truth's share of the CPU
+/// and the window's own work).
 fn frame_graph(ui: &mut egui::Ui, session: &Session) {
     let (rect, _) =
         ui.allocate_exact_size(Vec2::new(ui.available_width(), 70.0), egui::Sense::hover());
     let painter = ui.painter_at(rect);
     painter.rect_filled(rect, 2.0, Color32::from_gray(25));
-    let h = &session.history;
-    if h.len() < 2 {
+    // Newest first, each with its age in ms at its end.
+    let mut age = 0.0;
+    let recent: Vec<(f64, &crate::session::FrameTime)> = session
+        .history
+        .iter()
+        .rev()
+        .map(|t| {
+            let at = age;
+            age += t.wall_ms;
+            (at, t)
+        })
+        .take_while(|(at, _)| *at <= GRAPH_SECONDS * 1e3)
+        .collect();
+    if recent.len() < 2 {
         return;
     }
-    let top = h
+    let top = recent
         .iter()
-        .map(|t| t.wall_ms.max(t.gpu_ms))
+        .map(|(_, t)| t.wall_ms.max(t.gpu_ms))
         .fold(1.0, f64::max)
         * 1.1;
-    let point = |i: usize, v: f64| {
+    let point = |at: f64, v: f64| {
         Pos2::new(
-            rect.left() + rect.width() * i as f32 / (crate::session::HISTORY - 1) as f32,
+            rect.right() - rect.width() * (at / (GRAPH_SECONDS * 1e3)) as f32,
             rect.bottom() - rect.height() * (v / top) as f32,
         )
     };
     let line = |f: &dyn Fn(&crate::session::FrameTime) -> f64, colour: Color32| {
-        let points: Vec<Pos2> = h.iter().enumerate().map(|(i, t)| point(i, f(t))).collect();
+        let points: Vec<Pos2> = recent.iter().map(|(at, t)| point(*at, f(t))).collect();
         painter.add(egui::Shape::line(points, egui::Stroke::new(1.0, colour)));
     };
     line(&|t| t.wall_ms, Color32::from_gray(150));
@@ -399,7 +416,7 @@ fn frame_graph(ui: &mut egui::Ui, session: &Session) {
     painter.text(
         rect.left_top() + Vec2::new(4.0, 2.0),
         egui::Align2::LEFT_TOP,
-        format!("{top:.0} ms — green: GPU, grey: between frames"),
+        format!("last {GRAPH_SECONDS:.0} s, top {top:.0} ms — green: GPU, grey: between frames"),
         egui::FontId::proportional(10.0),
         Color32::from_gray(200),
     );

@@ -8,6 +8,7 @@
 //! | `method NAME [OPTION=VALUE]...` | switch the method, as `sweep` keys name it (`auxiliary n=2`) |
 //! | `ssaa S` | supersampling factor |
 //! | `error difference\|flip` | the error view's map |
+//! | `truth on\|off` | the live truth (off: the method has the CPU to itself, for timing) |
 //! | `walk FORWARD RIGHT UP` | move the camera by these scene units along the view |
 //! | `turn YAW PITCH` | turn by degrees (positive: right, up) |
 //! | `look X Y Z AT X Y Z` | place the camera at a point looking at another |
@@ -35,6 +36,7 @@ pub enum Action {
     Method(Method),
     Ssaa(u32),
     Error(crate::error_view::ErrorMode),
+    Truth(bool),
     Walk([f32; 3]),
     Turn { yaw: f32, pitch: f32 },
     Look { position: [f32; 3], at: [f32; 3] },
@@ -165,6 +167,14 @@ fn parse_action(line: &str) -> Result<Action, String> {
                 format!("the error map is `difference` or `flip`, got {:?}", args[0])
             })?)
         }
+        "truth" => {
+            count(1, "`on` or `off`")?;
+            Action::Truth(match args[0] {
+                "on" => true,
+                "off" => false,
+                other => return Err(format!("`truth` takes `on` or `off`, got {other:?}")),
+            })
+        }
         "walk" => {
             count(3, "three distances (forward, right, up)")?;
             Action::Walk([
@@ -229,8 +239,8 @@ fn parse_action(line: &str) -> Result<Action, String> {
         }
         other => {
             return Err(format!(
-                "unknown action {other:?} (known: frames, wait-truth, method, ssaa, error, walk, \
-                 turn, look, reset-camera, resize, screenshot, save-camera, exit)"
+                "unknown action {other:?} (known: frames, wait-truth, method, ssaa, error, truth, \
+                 walk, turn, look, reset-camera, resize, screenshot, save-camera, exit)"
             ));
         }
     })
@@ -285,6 +295,7 @@ mod tests {
             ("fly", "unknown action \"fly\""),
             ("wait-truth -1", "the timeout must be in (0, 86400]"),
             ("error blur", "`difference` or `flip`"),
+            ("truth maybe", "`truth` takes `on` or `off`"),
         ];
         for (line, expected) in cases {
             let e = parse_script(&format!("frames 1\n{line}\n"), "s.txt").unwrap_err();
