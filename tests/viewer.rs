@@ -154,6 +154,10 @@ fn the_viewer_shows_what_render_and_trace_write_and_survives_switching_and_resiz
          wait-truth 300\n\
          screenshot {b}\n\
          save-camera {bj}\n\
+         # a refused setting is shown, not fatal; then back\n\
+         method auxiliary n=3 max-passes=4\n\
+         frames 2\n\
+         method unrolled depth=8\n\
          error flip\n\
          resize 1100 640\n\
          frames 3\n\
@@ -266,6 +270,17 @@ fn the_viewer_shows_what_render_and_trace_write_and_survives_switching_and_resiz
         aux.iter().all(|&p| p == 3) && unrolled.iter().all(|&p| p == 1),
         "{aux:?} {unrolled:?}"
     );
+    let refused: Vec<&Value> = records
+        .iter()
+        .filter(|r| r["method"] == "auxiliary n=3")
+        .collect();
+    assert!(
+        !refused.is_empty()
+            && refused.iter().all(|r| r["method_error"]
+                .as_str()
+                .is_some_and(|e| e.contains("max-passes"))),
+        "{refused:?}"
+    );
     let last = records.last().unwrap();
     assert_eq!(
         last["window"],
@@ -329,4 +344,120 @@ fn without_a_display_the_viewer_says_what_it_needs() {
         "{stderr}"
     );
     assert!(!stderr.contains("panicked"), "{stderr}");
+}
+
+fn xdotool(display: &str, args: &[&str]) -> String {
+    let out = Command::new("xdotool")
+        .args(args)
+        .env("DISPLAY", display)
+        .output()
+        .expect("xdotool runs");
+    assert!(out.status.success(), "xdotool {args:?}: {}", String::from_utf8_lossy(&out.stderr));
+    String::from_utf8_lossy(&out.stdout).trim().to_string()
+}
+
+fn camera(shot: &Path) -> (glam::Vec3, glam::Vec3) {
+    let meta: Value =
+        serde_json::from_str(&std::fs::read_to_string(shot.with_extension("json")).unwrap())
+            .unwrap();
+    let v = |key: &str| {
+        let a: Vec<f32> = meta["camera"][key]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap() as f32)
+            .collect();
+        glam::Vec3::new(a[0], a[1], a[2])
+    };
+    (v("position"), v("look_at"))
+}
+
+/// Waits for a file the viewer writes (a screenshot's JSON), up to two minutes.
+fn wait_for(path: &Path, viewer: &mut Child) {
+    let start = std::time::Instant::now();
+    while !path.is_file() {
+        if let Ok(Some(status)) = viewer.try_wait() {
+            panic!("the viewer ended ({status}) before writing {}", path.display());
+        }
+        assert!(start.elapsed().as_secs() < 120, "{} never came", path.display());
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+}
+
+/// Real input through the X server (XTEST, as a keyboard and a mouse send it): holding W
+/// walks the camera forward along the view; dragging right on the method pane turns it right.
+#[test]
+fn held_keys_and_a_mouse_drag_move_the_camera() {
+    let Some(x) = display_or_skip() else { return };
+    if Command::new("xdotool").arg("version").output().is_err() {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "xdotool is missing under CI: scripts/install-system-deps.sh installs it"
+        );
+        eprintln!("skipped: xdotool is not installed");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let shot = |name: &str| dir.path().join(name);
+    // The viewer keeps drawing during `seconds`, while the test types and drags.
+    let script = format!(
+        "truth off\nframes 3\nscreenshot {}\nseconds 6\nscreenshot {}\nseconds 6\nscreenshot {}\nexit\n",
+        shot("a.png").display(),
+        shot("b.png").display(),
+        shot("c.png").display()
+    );
+    std::fs::write(shot("input.txt"), script).unwrap();
+    let mut viewer = Command::new(env!("CARGO_BIN_EXE_mirrorbox"))
+        .args(["view", "scenes/mirror_box.json", "--width", "320", "--height", "180"])
+        .args(["--no-vsync", "--script"])
+        .arg(shot("input.txt"))
+        .current_dir(repo())
+        .env("DISPLAY", &x.display)
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    wait_for(&shot("a.json"), &mut viewer);
+    let window = xdotool(&x.display, &["search", "--name", "mirrorbox view"]);
+    let window = window.lines().next().expect("the viewer's window").to_string();
+    // Pointer over the method pane, keyboard focus on the window, then W held for 0.7 s.
+    let meta: Value =
+        serde_json::from_str(&std::fs::read_to_string(shot("a.json")).unwrap()).unwrap();
+    let pane: Vec<u64> = meta["panes"]["method"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_u64().unwrap())
+        .collect();
+    let (cx, cy) = (pane[0] + pane[2] / 2, pane[1] + pane[3] / 2);
+    let at = |dx: u64| [(cx + dx).to_string(), cy.to_string()];
+    let [x0, y0] = at(0);
+    xdotool(&x.display, &["mousemove", "--window", &window, &x0, &y0]);
+    xdotool(&x.display, &["windowfocus", "--sync", &window]);
+    xdotool(&x.display, &["keydown", "w", "sleep", "0.7", "keyup", "w"]);
+    wait_for(&shot("b.json"), &mut viewer);
+    let [x1, y1] = at(80);
+    xdotool(&x.display, &["mousedown", "1"]);
+    xdotool(&x.display, &["mousemove", "--window", &window, &x1, &y1]);
+    xdotool(&x.display, &["mouseup", "1"]);
+    wait_for(&shot("c.json"), &mut viewer);
+    let out = viewer.wait_with_output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+
+    let (pa, la) = camera(&shot("a.png"));
+    let (pb, lb) = camera(&shot("b.png"));
+    let (pc, lc) = camera(&shot("c.png"));
+    let (fa, fb, fc) = (
+        (la - pa).normalize(),
+        (lb - pb).normalize(),
+        (lc - pc).normalize(),
+    );
+    // W: forward along the view, no turn.
+    let walked = pb - pa;
+    assert!(walked.dot(fa) > 0.1, "W did not walk forward: {walked}");
+    assert!(walked.cross(fa).length() < 1e-3 * walked.length().max(1.0), "{walked} vs {fa}");
+    assert!(fb.dot(fa) > 0.9999, "W turned the view: {fa} → {fb}");
+    // The drag: a turn to the right (towards view × up), no move.
+    assert_eq!(pc, pb, "the drag moved the camera");
+    let right = fa.cross(glam::Vec3::Y).normalize();
+    assert!(fc.dot(right) > fb.dot(right) + 0.05, "the drag did not turn right: {fb} → {fc}");
 }

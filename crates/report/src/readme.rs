@@ -91,6 +91,11 @@ pub const REGIONS: &[(&str, &str, &str)] = &[
         "stereo mirrors: the pair's cost against mono, per-eye against shared, and the disparity check",
     ),
     (
+        "viewer-frame-rates",
+        "viewer/frame_rates.md",
+        "`mirrorbox view`'s frame rates per method, still and walking (scripts/viewer-frame-rates.sh)",
+    ),
+    (
         "lighting-trace-cost",
         "lighting/trace_cost.jsonl",
         "the tracer's time against the mirrored-light depth k on both lit scenes",
@@ -272,6 +277,18 @@ struct TraceLighting {
 }
 
 /// The tracer's median time per scene and k, with the light images and rays behind it.
+/// A Markdown report written whole by a script: its text after the title line.
+fn report_body_region(path: &Path) -> Result<String, ReadmeError> {
+    let text = mirrorbox_files::read_bounded_text(path, 1 << 20, "a report")
+        .map_err(|e| ReadmeError(e.to_string()))?;
+    let body = text
+        .lines()
+        .skip_while(|l| l.starts_with("# ") || l.trim().is_empty())
+        .collect::<Vec<_>>()
+        .join("\n");
+    Ok(format!("{}\n", body.trim_end()))
+}
+
 fn trace_cost_region(path: &Path) -> Result<String, ReadmeError> {
     let runs: Vec<TraceRun> = crate::runs::read_lines(path)?;
     let mut groups: Vec<(String, u32)> = Vec::new();
@@ -540,6 +557,7 @@ pub fn generate(id: &str, reports: &Path) -> Result<Region, ReadmeError> {
             crate::runs::threads_region(&folder(source), cpu.trim())?
         }
         "main-job" => main_job_region(&folder(source))?,
+        "viewer-frame-rates" => report_body_region(&folder(source))?,
         _ => unreachable!("every ID in REGIONS has a generator"),
     };
     Ok(Region { id, text })

@@ -59,6 +59,8 @@ pub struct App {
     frames_left: u32,
     /// Deadline of a `wait-truth` step.
     waiting_truth: Option<(Instant, usize)>,
+    /// End of a `seconds` step.
+    drawing_until: Option<Instant>,
     pub log: Vec<serde_json::Value>,
     pub outcome: Result<(), ViewError>,
 }
@@ -74,6 +76,7 @@ impl App {
             next_step: 0,
             frames_left: 0,
             waiting_truth: None,
+            drawing_until: None,
             log: Vec::new(),
             outcome: Ok(()),
         }
@@ -206,6 +209,12 @@ impl App {
                 return true;
             }
         }
+        if let Some(until) = self.drawing_until {
+            if Instant::now() < until {
+                return true;
+            }
+            self.drawing_until = None;
+        }
         if let Some((deadline, line)) = self.waiting_truth {
             if r.session.complete_truth().is_some() {
                 self.waiting_truth = None;
@@ -230,6 +239,10 @@ impl App {
             match step.action {
                 Action::Frames(n) => {
                     self.frames_left = n;
+                    return true;
+                }
+                Action::Seconds(seconds) => {
+                    self.drawing_until = Some(Instant::now() + Duration::from_secs_f64(seconds));
                     return true;
                 }
                 Action::WaitTruth { seconds } => {
@@ -273,7 +286,7 @@ impl App {
                 Action::Exit => return false,
             }
         }
-        self.frames_left > 0 || self.waiting_truth.is_some()
+        self.frames_left > 0 || self.waiting_truth.is_some() || self.drawing_until.is_some()
     }
 
     fn redraw(&mut self, event_loop: &ActiveEventLoop) {
@@ -299,10 +312,12 @@ impl App {
         if !r.egui_ctx.egui_wants_keyboard_input() {
             move_camera(&mut r.session, &r.held, dt, r.ui.speed);
         }
+        let phase_start = Instant::now();
         if let Err(e) = r.session.update(&r.gpu, &mut r.renderer) {
             self.fail(event_loop, ViewError::Failed(e.to_string()));
             return;
         }
+        let updated = Instant::now();
         let raw_input = r.egui_state.take_egui_input(&r.window);
         let mut actions = PanelActions::default();
         let full_output = r.egui_ctx.run_ui(raw_input, |ui| {
@@ -327,6 +342,7 @@ impl App {
         }
         r.pending_free.extend(textures.free.drain());
         textures.clear();
+        let laid_out = Instant::now();
         let frame = match r.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(t)
             | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
@@ -357,6 +373,7 @@ impl App {
                 return;
             }
         };
+        let acquired = Instant::now();
         let view = frame.texture.create_view(&Default::default());
         let mut encoder = r.gpu.device.create_command_encoder(&Default::default());
         let commands = r.renderer.update_buffers(
@@ -390,6 +407,14 @@ impl App {
             .submit(commands.into_iter().chain([encoder.finish()]));
         r.window.pre_present_notify();
         r.gpu.queue.present(frame);
+        let ms = |a: Instant, b: Instant| b.duration_since(a).as_secs_f64() * 1e3;
+        let phases = screenshot::Phases {
+            update: r.session.update_phases,
+            ui: ms(updated, laid_out),
+            acquire: ms(laid_out, acquired),
+            paint_present: ms(acquired, Instant::now()),
+            total: ms(phase_start, Instant::now()),
+        };
         for id in r.pending_free.drain(..) {
             r.renderer.free_texture(&id);
         }
@@ -397,6 +422,7 @@ impl App {
         let panes = r.ui.panes_px.clone();
         self.log.push(screenshot::frame_record(
             r.frames_drawn,
+            &phases,
             &r.session,
             &panes,
             (r.config.width, r.config.height),
@@ -582,7 +608,14 @@ impl ApplicationHandler for App {
             }
             WindowEvent::Focused(false) => r.held.clear(),
             WindowEvent::MouseInput { state, button, .. } => {
-                let over_panes = !r.egui_ctx.egui_wants_pointer_input();
+                let (cx, cy) = r.cursor;
+                let over_panes = !r.egui_ctx.egui_is_using_pointer()
+                    && r.ui.panes_px.iter().any(|(_, [x, y, w, h])| {
+                        cx >= f64::from(*x)
+                            && cy >= f64::from(*y)
+                            && cx < f64::from(x + w)
+                            && cy < f64::from(y + h)
+                    });
                 match (state, button) {
                     (ElementState::Pressed, MouseButton::Right)
                     | (ElementState::Pressed, MouseButton::Left)

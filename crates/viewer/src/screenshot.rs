@@ -116,9 +116,25 @@ fn panes_json(panes: &[(&'static str, [u32; 4])]) -> serde_json::Value {
         .into()
 }
 
+/// Where a frame's CPU time went, in milliseconds.
+pub struct Phases {
+    /// The session's update: building the method's frame (a changed view), drawing it and
+    /// reading it back (the GPU frame and the copy), converting and uploading the panes.
+    pub update: crate::session::UpdatePhases,
+    /// egui: the panel's layout and tessellation.
+    pub ui: f64,
+    /// Waiting for the window's next image.
+    pub acquire: f64,
+    /// Painting the window and presenting it.
+    pub paint_present: f64,
+    /// The whole frame from the update to the present.
+    pub total: f64,
+}
+
 /// One frame of the `--log`: what was shown and what it cost.
 pub fn frame_record(
     frame: u64,
+    phases: &Phases,
     session: &Session,
     panes: &[(&'static str, [u32; 4])],
     window: (u32, u32),
@@ -143,6 +159,15 @@ pub fn frame_record(
         "flip_mean": session.error.as_ref().map(|e| e.metrics.flip_mean),
         "window": [window.0, window.1],
         "panes": panes_json(panes),
+        "phases_ms": {
+            "build": phases.update.build,
+            "draw_and_read_back": phases.update.draw,
+            "panes": phases.update.panes,
+            "ui": phases.ui,
+            "acquire": phases.acquire,
+            "paint_present": phases.paint_present,
+            "total": phases.total,
+        },
     })
 }
 

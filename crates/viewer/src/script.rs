@@ -4,6 +4,7 @@
 //! | action | effect |
 //! |---|---|
 //! | `frames N` | draw N frames |
+//! | `seconds S` | draw frames for S seconds (keys and the mouse work meanwhile) |
 //! | `wait-truth [SECONDS]` | draw frames until the live truth of the current view is complete (default 300 s; past it the viewer fails, exit 1) |
 //! | `method NAME [OPTION=VALUE]...` | switch the method, as `sweep` keys name it (`auxiliary n=2`) |
 //! | `ssaa S` | supersampling factor |
@@ -32,6 +33,7 @@ pub const MAX_SCRIPT_BYTES: u64 = 1 << 20;
 #[derive(Clone, Debug, PartialEq)]
 pub enum Action {
     Frames(u32),
+    Seconds(f64),
     WaitTruth { seconds: f64 },
     Method(Method),
     Ssaa(u32),
@@ -125,6 +127,16 @@ fn parse_action(line: &str) -> Result<Action, String> {
         "frames" => {
             count(1, "one count")?;
             Action::Frames(whole(args[0], "the frame count", 1, MAX_FRAMES)?)
+        }
+        "seconds" => {
+            count(1, "a number of seconds")?;
+            let seconds = f64::from(real(args[0], "the time")?);
+            if !(seconds > 0.0 && seconds <= 86_400.0) {
+                return Err(format!(
+                    "the time must be in (0, 86400] seconds, got {seconds}"
+                ));
+            }
+            Action::Seconds(seconds)
         }
         "wait-truth" => {
             if args.len() > 1 {
@@ -239,7 +251,7 @@ fn parse_action(line: &str) -> Result<Action, String> {
         }
         other => {
             return Err(format!(
-                "unknown action {other:?} (known: frames, wait-truth, method, ssaa, error, truth, \
+                "unknown action {other:?} (known: frames, seconds, wait-truth, method, ssaa, error, truth, \
                  walk, turn, look, reset-camera, resize, screenshot, save-camera, exit)"
             ));
         }
@@ -296,6 +308,7 @@ mod tests {
             ("wait-truth -1", "the timeout must be in (0, 86400]"),
             ("error blur", "`difference` or `flip`"),
             ("truth maybe", "`truth` takes `on` or `off`"),
+            ("seconds 0", "the time must be in (0, 86400]"),
         ];
         for (line, expected) in cases {
             let e = parse_script(&format!("frames 1\n{line}\n"), "s.txt").unwrap_err();

@@ -137,6 +137,17 @@ pub struct FrameTime {
     pub build_ms: f64,
 }
 
+/// Milliseconds of one update's parts (the log's `phases_ms`).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct UpdatePhases {
+    /// Planning and building the method's frame (0 while the view stays).
+    pub build: f64,
+    /// Drawing the frame and reading the image back.
+    pub draw: f64,
+    /// Tone mapping and uploading the panes, the truth's and the error's included.
+    pub panes: f64,
+}
+
 /// A method frame built for one view and setting.
 struct Built {
     view: BuiltView,
@@ -155,9 +166,9 @@ pub struct Session {
     pub size: (u32, u32),
     built: Option<Built>,
     builds: u64,
-    /// A refusal or failure of the current settings (shown in the panel; the last good
-    /// image stays).
+    /// Why the current settings were refused (shown in the panel and the method pane).
     pub method_error: Option<String>,
+    refused_key: Option<String>,
     pub frame: Option<MethodFrame>,
     pub truth_enabled: bool,
     truth: LiveTruth,
@@ -168,6 +179,7 @@ pub struct Session {
     /// (method build, truth generation, mode, gain bits) of the error shown.
     error_key: Option<(u64, u64, ErrorMode, u32)>,
     pub history: VecDeque<FrameTime>,
+    pub update_phases: UpdatePhases,
     last_frame: Option<Instant>,
     pub method_texture: Option<PaneTexture>,
     pub truth_texture: Option<PaneTexture>,
@@ -189,6 +201,7 @@ impl Session {
             built: None,
             builds: 0,
             method_error: None,
+            refused_key: None,
             frame: None,
             truth_enabled: true,
             truth_shown: None,
@@ -197,6 +210,7 @@ impl Session {
             error: None,
             error_key: None,
             history: VecDeque::with_capacity(HISTORY),
+            update_phases: UpdatePhases::default(),
             last_frame: None,
             method_texture: None,
             truth_texture: None,
@@ -243,7 +257,8 @@ impl Session {
             camera
         );
         let mut build_ms = 0.0;
-        if self.built.as_ref().map(|b| &b.key) != Some(&key) {
+        let refused_again = self.method_error.is_some() && self.refused_key.as_ref() == Some(&key);
+        if self.built.as_ref().map(|b| &b.key) != Some(&key) && !refused_again {
             let started = Instant::now();
             self.scene.camera = camera.clone();
             let scene = &self.scene;
@@ -261,15 +276,24 @@ impl Session {
                     self.method_error = None;
                 }
                 Err(e) if e.is_refusal() => {
+                    // The pane says why instead of showing another setting's image.
                     self.built = None;
+                    self.frame = None;
                     self.method_error = Some(e.to_string());
+                    // Not planned again until the view or the settings change.
+                    self.refused_key = Some(key);
                 }
                 Err(e) => return Err(e),
             }
             build_ms = started.elapsed().as_secs_f64() * 1e3;
         }
+        let mut draw_ms = 0.0;
+        let panes_start;
         if let Some(built) = &self.built {
+            let drawing = Instant::now();
             let (image, timing) = built.view.run(gpu, 0, 1)?;
+            draw_ms = drawing.elapsed().as_secs_f64() * 1e3;
+            panes_start = Instant::now();
             let rgb = image.to_srgb8(self.scene.camera.exposure);
             PaneTexture::upload(
                 &mut self.method_texture,
@@ -297,9 +321,16 @@ impl Session {
                 gpu_ms,
                 build_ms,
             });
+        } else {
+            panes_start = Instant::now();
         }
         self.update_truth(gpu, renderer);
         self.update_error(gpu, renderer);
+        self.update_phases = UpdatePhases {
+            build: build_ms,
+            draw: draw_ms,
+            panes: panes_start.elapsed().as_secs_f64() * 1e3,
+        };
         Ok(())
     }
 
