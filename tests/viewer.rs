@@ -352,7 +352,11 @@ fn xdotool(display: &str, args: &[&str]) -> String {
         .env("DISPLAY", display)
         .output()
         .expect("xdotool runs");
-    assert!(out.status.success(), "xdotool {args:?}: {}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "xdotool {args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     String::from_utf8_lossy(&out.stdout).trim().to_string()
 }
 
@@ -377,9 +381,16 @@ fn wait_for(path: &Path, viewer: &mut Child) {
     let start = std::time::Instant::now();
     while !path.is_file() {
         if let Ok(Some(status)) = viewer.try_wait() {
-            panic!("the viewer ended ({status}) before writing {}", path.display());
+            panic!(
+                "the viewer ended ({status}) before writing {}",
+                path.display()
+            );
         }
-        assert!(start.elapsed().as_secs() < 120, "{} never came", path.display());
+        assert!(
+            start.elapsed().as_secs() < 120,
+            "{} never came",
+            path.display()
+        );
         std::thread::sleep(std::time::Duration::from_millis(50));
     }
 }
@@ -408,7 +419,14 @@ fn held_keys_and_a_mouse_drag_move_the_camera() {
     );
     std::fs::write(shot("input.txt"), script).unwrap();
     let mut viewer = Command::new(env!("CARGO_BIN_EXE_mirrorbox"))
-        .args(["view", "scenes/mirror_box.json", "--width", "320", "--height", "180"])
+        .args([
+            "view",
+            "scenes/mirror_box.json",
+            "--width",
+            "320",
+            "--height",
+            "180",
+        ])
         .args(["--no-vsync", "--script"])
         .arg(shot("input.txt"))
         .current_dir(repo())
@@ -418,7 +436,11 @@ fn held_keys_and_a_mouse_drag_move_the_camera() {
         .unwrap();
     wait_for(&shot("a.json"), &mut viewer);
     let window = xdotool(&x.display, &["search", "--name", "mirrorbox view"]);
-    let window = window.lines().next().expect("the viewer's window").to_string();
+    let window = window
+        .lines()
+        .next()
+        .expect("the viewer's window")
+        .to_string();
     // Pointer over the method pane, keyboard focus on the window, then W held for 0.7 s.
     let meta: Value =
         serde_json::from_str(&std::fs::read_to_string(shot("a.json")).unwrap()).unwrap();
@@ -441,7 +463,11 @@ fn held_keys_and_a_mouse_drag_move_the_camera() {
     xdotool(&x.display, &["mouseup", "1"]);
     wait_for(&shot("c.json"), &mut viewer);
     let out = viewer.wait_with_output().unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
 
     let (pa, la) = camera(&shot("a.png"));
     let (pb, lb) = camera(&shot("b.png"));
@@ -454,10 +480,16 @@ fn held_keys_and_a_mouse_drag_move_the_camera() {
     // W: forward along the view, no turn.
     let walked = pb - pa;
     assert!(walked.dot(fa) > 0.1, "W did not walk forward: {walked}");
-    assert!(walked.cross(fa).length() < 1e-3 * walked.length().max(1.0), "{walked} vs {fa}");
+    assert!(
+        walked.cross(fa).length() < 1e-3 * walked.length().max(1.0),
+        "{walked} vs {fa}"
+    );
     assert!(fb.dot(fa) > 0.9999, "W turned the view: {fa} → {fb}");
     // The drag: a turn to the right (towards view × up), no move.
     assert_eq!(pc, pb, "the drag moved the camera");
     let right = fa.cross(glam::Vec3::Y).normalize();
-    assert!(fc.dot(right) > fb.dot(right) + 0.05, "the drag did not turn right: {fb} → {fc}");
+    assert!(
+        fc.dot(right) > fb.dot(right) + 0.05,
+        "the drag did not turn right: {fb} → {fc}"
+    );
 }

@@ -170,7 +170,16 @@ impl App {
                 ..Default::default()
             },
         );
+        // Walking speed: a quarter of the scene's diagonal per second.
+        let speed = o
+            .scene
+            .geometry
+            .bounds()
+            .map_or(1.0, |(lo, hi)| 0.25 * lo.distance(hi))
+            .clamp(0.05, 20.0);
         let session = Session::new(o.scene.clone(), o.method.clone(), o.ssaa, o.size);
+        let mut ui = panel::UiState::new(o.vsync);
+        ui.speed = speed;
         Ok(Running {
             window,
             instance,
@@ -182,7 +191,7 @@ impl App {
             egui_state,
             renderer,
             session,
-            ui: panel::UiState::new(o.vsync),
+            ui,
             held: HashSet::new(),
             looking: None,
             cursor: (0.0, 0.0),
