@@ -96,6 +96,11 @@ pub const REGIONS: &[(&str, &str, &str)] = &[
         "`mirrorbox view`'s frame rates per method, still and walking (scripts/viewer-frame-rates.sh)",
     ),
     (
+        "tracer-bench",
+        "tracer/bench.md",
+        "the tracer against Mitsuba 3 side by side (scripts/bench-tracer.sh)",
+    ),
+    (
         "lighting-trace-cost",
         "lighting/trace_cost.jsonl",
         "the tracer's time against the mirrored-light depth k on both lit scenes",
@@ -557,7 +562,7 @@ pub fn generate(id: &str, reports: &Path) -> Result<Region, ReadmeError> {
             crate::runs::threads_region(&folder(source), cpu.trim())?
         }
         "main-job" => main_job_region(&folder(source))?,
-        "viewer-frame-rates" => report_body_region(&folder(source))?,
+        "viewer-frame-rates" | "tracer-bench" => report_body_region(&folder(source))?,
         _ => unreachable!("every ID in REGIONS has a generator"),
     };
     Ok(Region { id, text })

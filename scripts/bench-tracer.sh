@@ -1,0 +1,84 @@
+#!/usr/bin/env bash
+# The ground truth against Mitsuba 3, side by side in one run (issue 19): `mirrorbox trace`
+# and Mitsuba 3 (`tools/mitsuba`, variant llvm_ad_rgb) on the same exported scenes, same
+# size, spp and depth, alternating the two renderers round by round so that drift of a
+# shared machine falls on both alike.
+#
+# Per scene × integrator and round: one `mirrorbox trace --json` process (its image loop's
+# time, BVH build apart) and one Mitsuba process rendering twice: the first render includes
+# compiling its JIT kernels (each Mitsuba process gets an empty Dr.Jit kernel cache), the
+# second is the compiled kernel's time. Medians over rounds with the range, and the ratios.
+# Writes reports/tracer/bench.md and bench.json with the device.
+#
+# Usage: scripts/bench-tracer.sh [ROUNDS] [SPP]      (defaults: 5 rounds, 16 spp, 640×360)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+rounds=${1:-5}
+spp=${2:-16}
+bin=target/release/mirrorbox
+[ -x "$bin" ] || cargo build --release --locked -p mirrorbox
+tools/mitsuba/setup.sh >&2
+py=tools/mitsuba/.venv/bin/python
+out=reports/tracer
+mkdir -p "$out"
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+scenes="mirror_box mirror_room"
+# Whitted follows mirror chains to 10 000 reflections (cut by the throughput); path traces
+# to 10 segments with Russian roulette from 5, the same in both renderers.
+for s in $scenes; do
+  mkdir -p "$work/$s"
+  "$bin" export-mitsuba "scenes/$s.json" -o "$work/$s/scene.xml" --spp "$spp" >/dev/null
+done
+: > "$work/runs.jsonl"
+for round in $(seq "$rounds"); do
+  for s in $scenes; do
+    for integrator in whitted path; do
+      depth=10000; [ "$integrator" = path ] && depth=10
+      echo "round $round: $s $integrator" >&2
+      "$bin" trace "scenes/$s.json" -o "$work/ours.exr" --spp "$spp" --integrator "$integrator" \
+        --max-depth "$depth" --json 2>/dev/null |
+        python3 -c "import json,sys; r=json.load(sys.stdin); print(json.dumps({'who':'mirrorbox','scene':'$s','integrator':'$integrator','round':$round,'seconds':r['render_seconds'],'rays':r['rays'],'threads':r['threads']}))" >> "$work/runs.jsonl"
+      # A fresh HOME: Dr.Jit's kernel cache (~/.drjit) starts empty, so Mitsuba's first
+      # render compiles its kernels, as a user's first run does.
+      fresh_home="$work/home.$round.$s.$integrator"
+      mkdir -p "$fresh_home"
+      HOME="$fresh_home" "$py" tools/mitsuba/render.py "$work/$s/scene.xml" -o "$work/mitsuba.exr" --integrator "$integrator" \
+        --max-depth "$depth" --runs 1 2>/dev/null |
+        python3 -c "import json,sys; r=json.loads(sys.stdin.read().strip().splitlines()[-1]); print(json.dumps({'who':'mitsuba','scene':'$s','integrator':'$integrator','round':$round,'seconds':r['render_seconds'],'first_seconds':r['first_render_seconds'],'variant':r['variant']}))" >> "$work/runs.jsonl"
+    done
+  done
+done
+mitsuba_version=$("$py" -c 'import mitsuba; print(mitsuba.__version__)')
+python3 - "$work/runs.jsonl" "$out" "$rounds" "$spp" "$mitsuba_version" <<'PY'
+import json, sys, statistics, datetime, os
+runs_path, out, rounds, spp, mver = sys.argv[1:]
+runs = [json.loads(l) for l in open(runs_path)]
+cpu = next((l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.startswith("model name")), "?")
+flags = next((l.split(":", 1)[1].split() for l in open("/proc/cpuinfo") if l.startswith("flags")), [])
+simd = "AVX-512" if "avx512f" in flags else "AVX2" if "avx2" in flags else "SSE"
+def stats(v):
+    v = sorted(v); return statistics.median(v), v[0], v[-1]
+rows, summary = [], {"date": datetime.date.today().isoformat(), "cpu": cpu, "cores": os.cpu_count(), "simd": simd,
+                     "rounds": int(rounds), "spp": int(spp), "mitsuba": mver, "results": []}
+for scene in ["mirror_box", "mirror_room"]:
+    for integ in ["whitted", "path"]:
+        ours = [r["seconds"] for r in runs if r["who"] == "mirrorbox" and r["scene"] == scene and r["integrator"] == integ]
+        mits = [r["seconds"] for r in runs if r["who"] == "mitsuba" and r["scene"] == scene and r["integrator"] == integ]
+        first = [r["first_seconds"] for r in runs if r["who"] == "mitsuba" and r["scene"] == scene and r["integrator"] == integ]
+        rays = next(r["rays"] for r in runs if r["who"] == "mirrorbox" and r["scene"] == scene and r["integrator"] == integ)
+        o, m, f = stats(ours), stats(mits), stats(first)
+        ratio = m[0] / o[0]
+        summary["results"].append({"scene": scene, "integrator": integ, "ours_s": o, "mitsuba_s": m, "mitsuba_first_s": f,
+                                   "rays": rays, "speedup_vs_mitsuba": ratio, "speedup_vs_mitsuba_first": f[0] / o[0]})
+        rows.append(f"| `{scene}` | {integ} | {o[0]:.3f} [{o[1]:.3f}–{o[2]:.3f}] | {rays/o[0]/1e6:.1f} | {m[0]:.3f} [{m[1]:.3f}–{m[2]:.3f}] | {f[0]:.3f} [{f[1]:.3f}–{f[2]:.3f}] | {ratio:.2f}× | {f[0]/o[0]:.2f}× |")
+lines = ["# The tracer against Mitsuba 3", "",
+         f"Measured {summary['date']} with `scripts/bench-tracer.sh {rounds} {spp}` on {cpu} ({simd}), {os.cpu_count()} cores: 640×360, {spp} spp; Mitsuba {mver} `llvm_ad_rgb`; the two renderers alternated, one process each per round; medians over {rounds} rounds [min–max].",
+         "",
+         "| scene | integrator | mirrorbox s | mirrorbox Mrays/s | Mitsuba s (compiled kernel) | Mitsuba s (first render, JIT included) | Mitsuba ÷ mirrorbox | Mitsuba first ÷ mirrorbox |",
+         "|---|---|---|---|---|---|---|---|"] + rows + ["",
+         "A ratio above 1 means mirrorbox is faster. Whitted: mirror chains to 10 000 reflections, cut at a throughput of 1e-4; path: 10 segments, Russian roulette from 5. mirrorbox's time is its image loop (BVH build apart); Mitsuba's is `mi.render` to an evaluated image (scene loading apart). Mitsuba's first render compiles its kernels (each of its processes starts with an empty Dr.Jit kernel cache)."]
+open(f"{out}/bench.md", "w").write("\n".join(lines) + "\n")
+json.dump(summary, open(f"{out}/bench.json", "w"), indent=2)
+print("\n".join(lines))
+PY
