@@ -183,6 +183,37 @@ impl SceneBvh {
     }
 }
 
+impl SceneBvh {
+    /// Whether anything [`SceneBvh::closest_hit_skipping`] would find is there, without
+    /// finding the closest: traversal stops at the first hit (a shadow leg needs only yes or
+    /// no, and gets the same answer).
+    pub fn occluded(
+        &self,
+        ray: &Ray,
+        t_min: f32,
+        t_max: f32,
+        skip_mirror: Option<usize>,
+        skip_triangle: Option<usize>,
+    ) -> bool {
+        let skip = skip_mirror.map_or(NOT_A_MIRROR, |m| m as u32);
+        let skip_tri = skip_triangle.map_or(u32::MAX, |t| t as u32);
+        let wt = WatertightRay::new(ray.origin, ray.dir);
+        let test = |r: &obvhs::ray::Ray, slot: usize| {
+            let s = &self.slots[slot];
+            if (s.mirror == skip && skip != NOT_A_MIRROR) || self.original[slot] == skip_tri {
+                return f32::INFINITY;
+            }
+            wt.intersect(s.v[0], s.v[1], s.v[2], r.tmin, r.tmax)
+        };
+        let r = obvhs::ray::Ray::new(Vec3A::from(ray.origin), Vec3A::from(ray.dir), t_min, t_max);
+        match &self.hierarchy {
+            Hierarchy::Empty => false,
+            Hierarchy::Cw(bvh) => !bvh.ray_traverse_miss(r, test),
+            Hierarchy::Binary(bvh) => !bvh.ray_traverse_miss(r, test),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -278,6 +309,37 @@ mod tests {
                     "({px},{py}) → {back}"
                 );
             }
+        }
+    }
+
+    /// The any-hit query answers exactly as the closest-hit one, for both hierarchies,
+    /// segments of every length and both kinds of skip.
+    #[test]
+    fn occluded_agrees_with_closest_hit() {
+        let scene = parse_scene(SCENE, Path::new("inline.json")).unwrap();
+        let mut rng = crate::sampler::SplitMix64::for_pixel(7, 0);
+        let mut r = || rng.next_unit();
+        for kind in [BvhKind::Cwbvh, BvhKind::Bvh2] {
+            let bvh = SceneBvh::build_with(&scene.geometry, kind);
+            let (mut hits, mut misses) = (0, 0);
+            for i in 0..4000 {
+                let origin = Vec3::new(r() * 4.0 - 2.0, r() * 2.5, r() * 4.0 - 2.0);
+                let dir = Vec3::new(r() - 0.5, r() - 0.5, r() - 0.5).normalize_or(Vec3::Y);
+                let ray = Ray { origin, dir };
+                let t_max = [0.5, 2.0, f32::INFINITY][i % 3];
+                let skip_mirror = (i % 5 == 0).then_some(0);
+                let skip_triangle = (i % 7 == 0).then_some(i % scene.geometry.triangles.len());
+                let closest =
+                    bvh.closest_hit_skipping(&ray, 0.0, t_max, skip_mirror, skip_triangle);
+                let any = bvh.occluded(&ray, 0.0, t_max, skip_mirror, skip_triangle);
+                assert_eq!(
+                    any,
+                    closest.is_some(),
+                    "{kind:?} ray {i}: {ray:?} to {t_max}"
+                );
+                if any { hits += 1 } else { misses += 1 }
+            }
+            assert!(hits > 500 && misses > 500, "{hits} hits, {misses} misses");
         }
     }
 

@@ -90,9 +90,9 @@ impl<'a> Whitted<'a> {
             dir: d / length,
         };
         let skip_triangle = if a_mirror.is_none() { Some(from) } else { None };
-        self.bvh
-            .closest_hit_skipping(&ray, 0.0, length * (1.0 - 1e-4), a_mirror, skip_triangle)
-            .is_none()
+        !self
+            .bvh
+            .occluded(&ray, 0.0, length * (1.0 - 1e-4), a_mirror, skip_triangle)
     }
 
     /// Radiance along `ray` (what [`Integrator::radiance`] returns; no random numbers).
