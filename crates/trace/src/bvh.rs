@@ -43,6 +43,40 @@ enum Hierarchy {
     Binary(Bvh2),
 }
 
+/// Runs `$body` with `$test`, the closure obvhs calls per primitive slot: the skips, then
+/// the watertight test specialised for the ray's axis permutation (six monomorphised
+/// traversals instead of indexing vectors by a run-time axis for every triangle).
+macro_rules! with_triangle_test {
+    ($bvh:expr, $wt:expr, $skip_mirror:expr, $skip_triangle:expr, |$test:ident| $body:expr) => {{
+        let skip = $skip_mirror.map_or(NOT_A_MIRROR, |m| m as u32);
+        let skip_tri = $skip_triangle.map_or(u32::MAX, |t| t as u32);
+        let slots = &$bvh.slots;
+        let original = &$bvh.original;
+        let wt = &$wt;
+        macro_rules! run {
+            ($kx:literal, $ky:literal, $kz:literal) => {{
+                let $test = |r: &obvhs::ray::Ray, slot: usize| {
+                    let s = &slots[slot];
+                    if (s.mirror == skip && skip != NOT_A_MIRROR) || original[slot] == skip_tri {
+                        return f32::INFINITY;
+                    }
+                    wt.intersect_axes::<$kx, $ky, $kz>(s.v[0], s.v[1], s.v[2], r.tmin, r.tmax)
+                };
+                $body
+            }};
+        }
+        match wt.axes() {
+            (1, 2, 0) => run!(1, 2, 0),
+            (2, 1, 0) => run!(2, 1, 0),
+            (2, 0, 1) => run!(2, 0, 1),
+            (0, 2, 1) => run!(0, 2, 1),
+            (0, 1, 2) => run!(0, 1, 2),
+            (1, 0, 2) => run!(1, 0, 2),
+            other => unreachable!("not an axis permutation: {other:?}"),
+        }
+    }};
+}
+
 /// Marks a slot whose triangle is not on a mirror.
 const NOT_A_MIRROR: u32 = u32::MAX;
 
@@ -159,23 +193,16 @@ impl SceneBvh {
         skip_mirror: Option<usize>,
         skip_triangle: Option<usize>,
     ) -> Option<Hit> {
-        let skip = skip_mirror.map_or(NOT_A_MIRROR, |m| m as u32);
-        let skip_tri = skip_triangle.map_or(u32::MAX, |t| t as u32);
         let wt = WatertightRay::new(ray.origin, ray.dir);
-        let test = |r: &obvhs::ray::Ray, slot: usize| {
-            let s = &self.slots[slot];
-            if (s.mirror == skip && skip != NOT_A_MIRROR) || self.original[slot] == skip_tri {
-                return f32::INFINITY;
-            }
-            wt.intersect(s.v[0], s.v[1], s.v[2], r.tmin, r.tmax)
-        };
         let r = obvhs::ray::Ray::new(Vec3A::from(ray.origin), Vec3A::from(ray.dir), t_min, t_max);
         let mut hit = RayHit::none();
-        let found = match &self.hierarchy {
-            Hierarchy::Empty => false,
-            Hierarchy::Cw(bvh) => bvh.ray_traverse(r, &mut hit, test),
-            Hierarchy::Binary(bvh) => bvh.ray_traverse(r, &mut hit, test),
-        };
+        let found = with_triangle_test!(self, wt, skip_mirror, skip_triangle, |test| {
+            match &self.hierarchy {
+                Hierarchy::Empty => false,
+                Hierarchy::Cw(bvh) => bvh.ray_traverse(r, &mut hit, test),
+                Hierarchy::Binary(bvh) => bvh.ray_traverse(r, &mut hit, test),
+            }
+        });
         found.then(|| Hit {
             t: hit.t,
             triangle: self.original[hit.primitive_id as usize] as usize,
@@ -195,22 +222,15 @@ impl SceneBvh {
         skip_mirror: Option<usize>,
         skip_triangle: Option<usize>,
     ) -> bool {
-        let skip = skip_mirror.map_or(NOT_A_MIRROR, |m| m as u32);
-        let skip_tri = skip_triangle.map_or(u32::MAX, |t| t as u32);
         let wt = WatertightRay::new(ray.origin, ray.dir);
-        let test = |r: &obvhs::ray::Ray, slot: usize| {
-            let s = &self.slots[slot];
-            if (s.mirror == skip && skip != NOT_A_MIRROR) || self.original[slot] == skip_tri {
-                return f32::INFINITY;
-            }
-            wt.intersect(s.v[0], s.v[1], s.v[2], r.tmin, r.tmax)
-        };
         let r = obvhs::ray::Ray::new(Vec3A::from(ray.origin), Vec3A::from(ray.dir), t_min, t_max);
-        match &self.hierarchy {
-            Hierarchy::Empty => false,
-            Hierarchy::Cw(bvh) => !bvh.ray_traverse_miss(r, test),
-            Hierarchy::Binary(bvh) => !bvh.ray_traverse_miss(r, test),
-        }
+        with_triangle_test!(self, wt, skip_mirror, skip_triangle, |test| {
+            match &self.hierarchy {
+                Hierarchy::Empty => false,
+                Hierarchy::Cw(bvh) => !bvh.ray_traverse_miss(r, test),
+                Hierarchy::Binary(bvh) => !bvh.ray_traverse_miss(r, test),
+            }
+        })
     }
 }
 

@@ -50,11 +50,48 @@ impl WatertightRay {
         }
     }
 
+    /// The axis permutation `(kx, ky, kz)` of this ray: one of the six, for
+    /// [`WatertightRay::intersect_axes`].
+    pub fn axes(&self) -> (usize, usize, usize) {
+        (self.kx, self.ky, self.kz)
+    }
+
     /// Distance `t` to the triangle if hit with `t_min ≤ t ≤ t_max`, else `f32::INFINITY`.
     /// Two-sided.
     #[inline]
     pub fn intersect(&self, v0: Vec3, v1: Vec3, v2: Vec3, t_min: f32, t_max: f32) -> f32 {
-        let (kx, ky, kz) = (self.kx, self.ky, self.kz);
+        self.intersect_with(self.kx, self.ky, self.kz, v0, v1, v2, t_min, t_max)
+    }
+
+    /// [`WatertightRay::intersect`] with the permutation known at compile time (it must be
+    /// [`WatertightRay::axes`]): the same arithmetic, the same bits, without indexing
+    /// vectors by a run-time axis in the innermost loop.
+    #[inline(always)]
+    pub fn intersect_axes<const KX: usize, const KY: usize, const KZ: usize>(
+        &self,
+        v0: Vec3,
+        v1: Vec3,
+        v2: Vec3,
+        t_min: f32,
+        t_max: f32,
+    ) -> f32 {
+        debug_assert_eq!(self.axes(), (KX, KY, KZ));
+        self.intersect_with(KX, KY, KZ, v0, v1, v2, t_min, t_max)
+    }
+
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn intersect_with(
+        &self,
+        kx: usize,
+        ky: usize,
+        kz: usize,
+        v0: Vec3,
+        v1: Vec3,
+        v2: Vec3,
+        t_min: f32,
+        t_max: f32,
+    ) -> f32 {
         let a = v0 - self.origin;
         let b = v1 - self.origin;
         let c = v2 - self.origin;
