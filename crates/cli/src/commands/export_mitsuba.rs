@@ -1,6 +1,6 @@
 //! `mirrorbox export-mitsuba SCENE -o DIR/scene.xml`: the scene as Mitsuba 3 XML.
 
-use super::{grid_side, load, output_path, resize, unit_interval};
+use super::{grid_side, load, output_path, unit_interval};
 use crate::Failure;
 use mirrorbox_mitsuba::{ExportSettings, export};
 use std::path::PathBuf;
@@ -12,12 +12,8 @@ pub struct Args {
     /// Output XML; meshes go to meshes/ beside it, with mirrorbox.json (what Mitsuba cannot express).
     #[arg(short, long)]
     output: PathBuf,
-    /// Image width in pixels, 1..16384 (default: the scene camera's).
-    #[arg(long)]
-    width: Option<u32>,
-    /// Image height in pixels, 1..16384 (default: the scene camera's).
-    #[arg(long)]
-    height: Option<u32>,
+    #[command(flatten)]
+    size: super::SizeArgs,
     /// Samples per pixel (a perfect square: Mitsuba's unjittered stratified grid = ours).
     #[arg(long, default_value_t = 16)]
     spp: u32,
@@ -37,7 +33,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     // silently creates folders); the export creates only its own `meshes/` inside it.
     let xml = output_path("-o", &args.output, "xml")?;
     let mut scene = load(&args.scene)?;
-    resize(&mut scene, args.width, args.height)?;
+    args.size.apply(&mut scene)?;
     if let Some(r) = args.reflectance {
         scene
             .set_reflectance(glam::Vec3::splat(r))

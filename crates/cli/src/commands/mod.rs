@@ -34,9 +34,24 @@ pub fn unit_interval(flag: &str, value: Option<f32>) -> Result<Option<f32>, Fail
         .map_err(setting)
 }
 
-/// Applies `--width/--height` overrides ([`Scene::resize`]).
-pub fn resize(scene: &mut Scene, width: Option<u32>, height: Option<u32>) -> Result<(), Failure> {
-    scene.resize(width, height).map_err(setting)
+/// `--width` / `--height`: the image size, where it differs from the scene camera's (every
+/// command that renders or exports a view).
+#[derive(clap::Args, Clone, Copy, Debug, Default)]
+pub struct SizeArgs {
+    /// Image width in pixels, 1..16384 (default: the scene camera's; the vertical field of
+    /// view is kept).
+    #[arg(long)]
+    pub width: Option<u32>,
+    /// Image height in pixels, 1..16384 (default: the scene camera's).
+    #[arg(long)]
+    pub height: Option<u32>,
+}
+
+impl SizeArgs {
+    /// Applies the overrides ([`Scene::resize`]); a size out of range is exit 2.
+    pub fn apply(&self, scene: &mut Scene) -> Result<(), Failure> {
+        scene.resize(self.width, self.height).map_err(setting)
+    }
 }
 
 /// A setting out of its range is the user's input (exit 2).

@@ -3,7 +3,7 @@
 
 use super::method_flags::{RenderOptions, method_value_parser};
 use super::stereo::{eye_path, with_suffix};
-use super::{check_outputs, load, output_path, resize, unit_interval};
+use super::{check_outputs, load, output_path, unit_interval};
 use crate::Failure;
 use mirrorbox_image::{StagedFiles, stage_exr, stage_png, stage_png_bytes};
 use mirrorbox_raster::methods::recursive_texture::TEXTURE_SCALE;
@@ -25,13 +25,8 @@ pub struct Args {
     /// `--reflectance` is the same flag.
     #[arg(long, visible_alias = "reflectance", allow_negative_numbers = true)]
     alpha: Option<f32>,
-    /// Image width in pixels, 1..16384 (default: the scene camera's; the vertical field of
-    /// view is kept).
-    #[arg(long)]
-    width: Option<u32>,
-    /// Image height in pixels, 1..16384 (default: the scene camera's).
-    #[arg(long)]
-    height: Option<u32>,
+    #[command(flatten)]
+    size: super::SizeArgs,
     /// Supersampling factor s: renders at s× and box-filters down, the tracer's `--spp s²` grid.
     #[arg(long, default_value_t = 1)]
     ssaa: u32,
@@ -78,7 +73,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         outputs.push(("-o (anaglyph)", with_suffix(&png, "anaglyph")));
     }
     check_outputs(&outputs)?;
-    resize(&mut scene, args.width, args.height)?;
+    args.size.apply(&mut scene)?;
     if let Some(a) = args.alpha {
         scene
             .set_reflectance(glam::Vec3::splat(a))

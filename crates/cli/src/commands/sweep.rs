@@ -32,13 +32,8 @@ pub struct Args {
         allow_hyphen_values = true
     )]
     alpha: String,
-    /// Image width in pixels, 1..16384 (default: the scene camera's; the vertical field of
-    /// view is kept).
-    #[arg(long)]
-    width: Option<u32>,
-    /// Image height in pixels, 1..16384 (default: the scene camera's).
-    #[arg(long)]
-    height: Option<u32>,
+    #[command(flatten)]
+    size: super::SizeArgs,
     /// Supersampling s of the raster (the truth uses the same s×s sub-pixel grid).
     #[arg(long, default_value_t = 1)]
     ssaa: u32,
@@ -290,8 +285,8 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         out: args.out.clone(),
         methods: parse_methods(&args.methods, &args.options)?,
         alphas: parse_alphas(&args.alpha)?,
-        width: args.width,
-        height: args.height,
+        width: args.size.width,
+        height: args.size.height,
         ssaa: args.ssaa,
         frames: args.frames,
         warmup: args.warmup,

@@ -1,8 +1,6 @@
 //! `mirrorbox trace SCENE -o OUT.exr`: the ground truth, rendered on the CPU with obvhs.
 
-use super::{
-    check_outputs, grid_side, load, output_path, progress_bar, resize, setting, unit_interval,
-};
+use super::{check_outputs, grid_side, load, output_path, progress_bar, setting, unit_interval};
 use crate::Failure;
 use mirrorbox_image::{RgbImage, StagedFiles, colormap, stage_exr, stage_png, stage_png_bytes};
 use mirrorbox_scene::SubpixelGrid;
@@ -33,12 +31,8 @@ pub struct Args {
     /// Output EXR (linear float32 RGB); an sRGB PNG is written beside it.
     #[arg(short, long)]
     output: PathBuf,
-    /// Image width in pixels (overrides the scene's).
-    #[arg(long)]
-    width: Option<u32>,
-    /// Image height in pixels (overrides the scene's).
-    #[arg(long)]
-    height: Option<u32>,
+    #[command(flatten)]
+    size: super::SizeArgs,
     /// Samples per pixel: a perfect square s², taken as the s×s sub-pixel grid the
     /// rasterizer reproduces with --ssaa s.
     #[arg(long, default_value_t = 16)]
@@ -140,7 +134,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         ));
     }
     check_outputs(&outputs)?;
-    resize(&mut scene, args.width, args.height)?;
+    args.size.apply(&mut scene)?;
     if let Some(r) = args.reflectance {
         scene
             .set_reflectance(glam::Vec3::splat(r))

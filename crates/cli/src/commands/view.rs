@@ -3,7 +3,7 @@
 //! OUT.png` takes one picture and closes.
 
 use super::method_flags::{RenderOptions, method_value_parser};
-use super::{load, output_path, resize, unit_interval};
+use super::{load, output_path, unit_interval};
 use crate::Failure;
 use mirrorbox_raster::RenderSettings;
 use mirrorbox_viewer::script::{self, Action, Step};
@@ -22,12 +22,8 @@ pub struct Args {
     /// α: sets every mirror's reflectance, in [0, 1] (default: the scene's).
     #[arg(long, visible_alias = "reflectance", allow_negative_numbers = true)]
     alpha: Option<f32>,
-    /// View width in pixels (default: the scene camera's; the vertical field of view kept).
-    #[arg(long)]
-    width: Option<u32>,
-    /// View height in pixels (default: the scene camera's).
-    #[arg(long)]
-    height: Option<u32>,
+    #[command(flatten)]
+    size: super::SizeArgs,
     /// Supersampling factor s of the method, 1..4; the live truth uses the same s×s grid.
     #[arg(long, default_value_t = 1)]
     ssaa: u32,
@@ -83,7 +79,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         return Err(bad(format!("--ssaa must be in [1, 4], got {}", args.ssaa)));
     }
     let mut scene = load(&args.scene)?;
-    resize(&mut scene, args.width, args.height)?;
+    args.size.apply(&mut scene)?;
     if let Some(alpha) = alpha {
         scene
             .set_reflectance(glam::Vec3::splat(alpha))
