@@ -1744,3 +1744,54 @@ fn shards_merge_into_the_unsharded_sweep() {
         assert!(!d.join("refused").exists(), "nothing written on refusal");
     }
 }
+
+/// `--time` places the camera on the scene's `camera.path`: at a key's time, `render` and
+/// `trace` give exactly the images of the same scene with that key as its still camera;
+/// between keys the view is another one; a bad time is exit 2.
+#[test]
+fn time_on_a_camera_path_renders_the_keyed_view() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
+    let walk = "scenes/mirror_box_walk.json";
+    let mut still: Value =
+        serde_json::from_str(&std::fs::read_to_string(repo().join(walk)).unwrap()).unwrap();
+    let key = still["camera"]["path"][1].clone();
+    let camera = still["camera"].as_object_mut().unwrap();
+    camera.remove("path");
+    camera.insert("position".into(), key["position"].clone());
+    camera.insert("look_at".into(), key["look_at"].clone());
+    std::fs::write(d("still.json"), still.to_string()).unwrap();
+    let size = ["--width", "96", "--height", "54"];
+    let run = |args: &[&str]| {
+        let out = mirrorbox(args, &[]);
+        assert_eq!(out.code, 0, "{args:?}: {}", out.stderr);
+    };
+    let bytes = |p: &str| std::fs::read(p).unwrap();
+    for (scene, time, name) in [
+        (walk, Some("2"), "at_key"),
+        (&d("still.json") as &str, None, "still"),
+        (walk, Some("1"), "between"),
+    ] {
+        let (png, exr) = (d(&format!("{name}_r.png")), d(&format!("{name}_t.exr")));
+        let mut render = vec!["render", scene, "--method", "unrolled", "-o", &png];
+        let mut trace = vec!["trace", scene, "--spp", "1", "-o", &exr];
+        render.extend(size);
+        trace.extend(size);
+        if let Some(t) = time {
+            render.extend(["--time", t]);
+            trace.extend(["--time", t]);
+        }
+        run(&render);
+        run(&trace);
+    }
+    assert_eq!(bytes(&d("at_key_r.png")), bytes(&d("still_r.png")));
+    assert_eq!(bytes(&d("at_key_t.png")), bytes(&d("still_t.png")));
+    assert_ne!(bytes(&d("between_r.png")), bytes(&d("at_key_r.png")));
+    let out = mirrorbox(&["trace", walk, "--time", "nan", "-o", &d("x.exr")], &[]);
+    assert_eq!(out.code, 2, "{}", out.stderr);
+    assert!(
+        out.stderr.contains("--time must be a finite number"),
+        "{}",
+        out.stderr
+    );
+}

@@ -56,6 +56,25 @@ pub struct CameraDesc {
     /// Two eyes instead of one (`crate::stereo`).
     #[serde(default)]
     pub stereo: Option<StereoDesc>,
+    /// Keyframes of a moving camera (`crate::camera_path`).
+    #[serde(default)]
+    pub path: Option<Vec<CameraKeyDesc>>,
+}
+
+/// One key of `camera.path`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraKeyDesc {
+    /// Seconds.
+    pub time: f64,
+    pub position: Vec3f,
+    pub look_at: Vec3f,
+    /// Default: the camera's `up`.
+    #[serde(default)]
+    pub up: Option<Vec3f>,
+    /// Default: the camera's `fov_y_deg`.
+    #[serde(default)]
+    pub fov_y_deg: Option<f32>,
 }
 
 /// `camera.stereo`.

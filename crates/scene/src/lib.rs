@@ -12,6 +12,7 @@
 
 pub mod bump;
 pub mod camera;
+pub mod camera_path;
 pub mod error;
 pub mod format;
 pub mod geometry;
@@ -90,6 +91,9 @@ pub struct Scene {
     pub mirrors: Vec<Mirror>,
     /// The camera's stereo rig (`camera.stereo`), if any: [`Scene::eye`] gives each eye.
     pub stereo: Option<stereo::Stereo>,
+    /// Keyframes of a moving camera (`camera.path`), if any: [`Scene::at_time`] places the
+    /// camera on it. `camera` stays the file's still view.
+    pub camera_path: Option<camera_path::CameraPath>,
     /// In one eye's scene ([`Scene::eye`]): the head's camera, which a method sharing its
     /// mirrors between the eyes renders them from (`--stereo-mirrors shared`).
     pub head: Option<Camera>,
@@ -253,6 +257,19 @@ impl Scene {
                 (Surface::Diffuse { albedo, .. }, true) => Some(*albedo),
                 _ => None,
             }
+        })
+    }
+
+    /// The scene at `time` seconds along its camera path: the camera placed by the path (its
+    /// size, exposure and stereo rig kept). A scene without a path is still: any time gives
+    /// the scene itself.
+    pub fn at_time(&self, time: f64) -> Result<Scene, camera_path::DegenerateView> {
+        let Some(path) = &self.camera_path else {
+            return Ok(self.clone());
+        };
+        Ok(Scene {
+            camera: path.camera_at(&self.camera, time)?,
+            ..self.clone()
         })
     }
 

@@ -278,11 +278,17 @@ impl Checker<'_> {
                  for flat mirrors only (docs/shading.md)",
             ));
         }
+        let camera_path = self.camera_path(
+            &FieldPath::root("camera").field("path"),
+            &file.camera,
+            &camera,
+        )?;
         let mut scene = Scene {
             source: self.file.to_path_buf(),
             camera,
             mirrors,
             stereo: self.stereo(&FieldPath::root("camera").field("stereo"), &file.camera)?,
+            camera_path,
             head: None,
             bumps,
             lighting: Lighting {
@@ -383,6 +389,89 @@ impl Checker<'_> {
             exposure,
             shift_x: 0.0,
         })
+    }
+
+    /// `camera.path`: 1 to [`MAX_KEYS`](crate::camera_path::MAX_KEYS) keys, times finite
+    /// and strictly increasing, each key a valid view (its own `up` and `fov_y_deg`, or the
+    /// camera's).
+    fn camera_path(
+        &self,
+        path: &FieldPath,
+        c: &CameraDesc,
+        camera: &Camera,
+    ) -> Result<Option<crate::camera_path::CameraPath>> {
+        use crate::camera_path::{CameraKey, CameraPath, MAX_KEYS};
+        let Some(keys) = &c.path else {
+            return Ok(None);
+        };
+        if keys.is_empty() || keys.len() > MAX_KEYS {
+            return Err(self.invalid(
+                path,
+                format!("must hold 1 to {MAX_KEYS} keys, got {}", keys.len()),
+            ));
+        }
+        let mut checked: Vec<CameraKey> = Vec::with_capacity(keys.len());
+        for (i, k) in keys.iter().enumerate() {
+            let at = path.index(i);
+            let time_path = at.field("time");
+            if !k.time.is_finite() || k.time.abs() > 1e9 {
+                return Err(self.invalid(
+                    &time_path,
+                    format!(
+                        "must be a finite number of seconds within ±1e9, got {}",
+                        k.time
+                    ),
+                ));
+            }
+            if let Some(before) = checked.last()
+                && k.time <= before.time
+            {
+                return Err(self.invalid(
+                    &time_path,
+                    format!(
+                        "must be later than the key before it ({} s), got {} s",
+                        before.time, k.time
+                    ),
+                ));
+            }
+            let position = self.position(&at.field("position"), k.position)?;
+            let look_at = self.position(&at.field("look_at"), k.look_at)?;
+            let forward = (look_at - position).try_normalize().ok_or_else(|| {
+                self.invalid(&at.field("look_at"), "must differ from the key's position")
+            })?;
+            let up = match k.up {
+                Some(up) => self.direction(&at.field("up"), up)?,
+                None => camera.up,
+            };
+            if forward.cross(up).length() < 1e-4 {
+                return Err(self.invalid(
+                    &at.field("up"),
+                    "must not be parallel to the key's view direction (look_at − position)",
+                ));
+            }
+            let fov_y_deg = match k.fov_y_deg {
+                Some(fov) => {
+                    let fov_path = at.field("fov_y_deg");
+                    let fov = self.finite(&fov_path, fov)?;
+                    if !(fov > 0.0 && fov < 180.0) {
+                        return Err(self.invalid(
+                            &fov_path,
+                            format!("must be in (0, 180) degrees, got {fov}"),
+                        ));
+                    }
+                    fov
+                }
+                None => camera.fov_y_deg,
+            };
+            checked.push(CameraKey {
+                time: k.time,
+                position,
+                look_at,
+                up,
+                fov_y_deg,
+            });
+        }
+        Ok(Some(CameraPath::new(checked)))
     }
 
     fn mirror(&self, path: &FieldPath, index: usize, m: &MirrorDesc) -> Result<Mirror> {
@@ -854,6 +943,67 @@ mod tests {
         match scene_with(rest) {
             Ok(_) => panic!("accepted: {rest}"),
             Err(e) => e.to_string(),
+        }
+    }
+
+    #[test]
+    fn a_camera_path_is_read_and_checked_key_by_key() {
+        let with_path = |keys: &str| {
+            parse_scene(
+                &format!(
+                    r#"{{ "camera": {{ "position": [0, 1, 3], "look_at": [0, 1, 0], "fov_y_deg": 60,
+                    "width": 32, "height": 24, "path": [ {keys} ] }} }}"#
+                ),
+                Path::new("s.json"),
+            )
+        };
+        let scene = with_path(
+            r#"{ "time": 0, "position": [0, 1, 3], "look_at": [0, 1, 0] },
+               { "time": 2, "position": [1, 1, 2], "look_at": [0, 1, 0], "fov_y_deg": 50 }"#,
+        )
+        .unwrap();
+        let path = scene.camera_path.as_ref().unwrap();
+        assert_eq!(path.keys().len(), 2);
+        assert_eq!(path.keys()[0].fov_y_deg, 60.0, "default: the camera's");
+        let at_end = scene.at_time(5.0).unwrap();
+        assert_eq!(at_end.camera.position, glam::Vec3::new(1.0, 1.0, 2.0));
+        assert_eq!(at_end.camera.fov_y_deg, 50.0);
+        assert_eq!((at_end.camera.width, at_end.camera.height), (32, 24));
+        // No path: any time is the scene itself.
+        let still = scene_with("").unwrap();
+        assert_eq!(still.at_time(3.0).unwrap().camera, still.camera);
+        let key = |time: &str, extra: &str| {
+            format!(r#"{{ "time": {time}, "position": [0, 1, 3], "look_at": [0, 1, 0]{extra} }}"#)
+        };
+        for (keys, words) in [
+            (
+                String::new(),
+                "camera.path: must hold 1 to 10000 keys, got 0",
+            ),
+            (
+                format!("{}, {}", key("1", ""), key("1", "")),
+                "camera.path[1].time: must be later than the key before it (1 s), got 1 s",
+            ),
+            (
+                key("1e12", ""),
+                "camera.path[0].time: must be a finite number",
+            ),
+            (
+                r#"{ "time": 0, "position": [0, 1, 3], "look_at": [0, 1, 3] }"#.to_string(),
+                "camera.path[0].look_at: must differ from the key's position",
+            ),
+            (
+                key("0", r#", "up": [0, 0, 1]"#),
+                "camera.path[0].up: must not be parallel",
+            ),
+            (
+                key("0", r#", "fov_y_deg": 180"#),
+                "camera.path[0].fov_y_deg: must be in (0, 180)",
+            ),
+            (key("0", r#", "roll": 3"#), "roll"),
+        ] {
+            let e = with_path(&keys).unwrap_err().to_string();
+            assert!(e.contains("s.json") && e.contains(words), "{keys}: {e}");
         }
     }
 

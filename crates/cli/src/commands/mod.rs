@@ -54,6 +54,38 @@ impl SizeArgs {
     }
 }
 
+/// `--time T`: the scene's camera placed by its `camera.path` at T seconds.
+#[derive(clap::Args, Clone, Copy, Debug, Default)]
+pub struct TimeArgs {
+    /// Seconds along the scene's camera path (`camera.path`, docs/scene-format.md): the
+    /// camera where the path puts it then (held before the first key and after the last).
+    /// Without a path the scene is still and every time is the same view.
+    #[arg(long, allow_negative_numbers = true)]
+    pub time: Option<f64>,
+}
+
+impl TimeArgs {
+    /// The scene at `--time` (itself without the flag); a bad time is exit 2.
+    pub fn apply(&self, scene: Scene) -> Result<Scene, Failure> {
+        let Some(time) = self.time else {
+            return Ok(scene);
+        };
+        if !time.is_finite() || time.abs() > 1e9 {
+            return Err(Failure::BadInput(format!(
+                "--time must be a finite number of seconds within ±1e9, got {time}"
+            )));
+        }
+        scene
+            .at_time(time)
+            .map_err(|e| Failure::BadInput(format!("{}: camera.path: {e}", scene.source.display())))
+    }
+
+    /// The provenance attribute of an output, when a time was given.
+    pub fn attribute(&self) -> Option<(&'static str, String)> {
+        self.time.map(|t| ("mirrorbox.time", t.to_string()))
+    }
+}
+
 /// A setting out of its range is the user's input (exit 2).
 /// A flag (`--alpha`, `--reflectance`, `--min-throughput`) that makes `scene`'s light images
 /// exceed their budget (exit 2).

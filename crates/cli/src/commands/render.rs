@@ -27,6 +27,8 @@ pub struct Args {
     alpha: Option<f32>,
     #[command(flatten)]
     size: super::SizeArgs,
+    #[command(flatten)]
+    time: super::TimeArgs,
     /// Supersampling factor s: renders at s× and box-filters down, the tracer's `--spp s²` grid.
     #[arg(long, default_value_t = 1)]
     ssaa: u32,
@@ -57,7 +59,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     unit_interval("--alpha", args.alpha)?;
     let png = output_path("-o", &args.output, "png")?;
     let exr = png.with_extension("exr");
-    let mut scene = load(&args.scene)?;
+    let mut scene = args.time.apply(load(&args.scene)?)?;
     let rig = args.stereo.rig(&scene)?;
     let eyes: Vec<Option<Eye>> = match rig {
         None => vec![None],
@@ -129,6 +131,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         if let Some(e) = eye {
             attributes.push(("mirrorbox.eye", e.name().to_string()));
         }
+        attributes.extend(args.time.attribute());
         let (png, exr) = (eye_path(&png, *eye), eye_path(&exr, *eye));
         stage_exr(&mut staged, &exr, image, &attributes).map_err(write_failed)?;
         stage_png(&mut staged, &png, image, view.camera.exposure).map_err(write_failed)?;

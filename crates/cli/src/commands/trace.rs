@@ -33,6 +33,8 @@ pub struct Args {
     output: PathBuf,
     #[command(flatten)]
     size: super::SizeArgs,
+    #[command(flatten)]
+    time: super::TimeArgs,
     /// Samples per pixel: a perfect square s², taken as the s×s sub-pixel grid the
     /// rasterizer reproduces with --ssaa s.
     #[arg(long, default_value_t = 16)]
@@ -106,7 +108,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         .as_deref()
         .map(|p| output_path("--bounces", p, "exr"))
         .transpose()?;
-    let mut scene = load(&args.scene)?;
+    let mut scene = args.time.apply(load(&args.scene)?)?;
     let rig = args.stereo.rig(&scene)?;
     let eyes: Vec<Option<mirrorbox_scene::stereo::Eye>> = match rig {
         None => vec![None],
@@ -274,6 +276,7 @@ fn stage_view(
         ("mirrorbox.deepest_path", out.stats.deepest.to_string()),
         ("mirrorbox.lighting", scene.lighting.describe()),
     ];
+    attributes.extend(args.time.attribute());
     if let Some(e) = eye {
         let c = &scene.camera;
         attributes.push((

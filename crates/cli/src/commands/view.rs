@@ -24,6 +24,8 @@ pub struct Args {
     alpha: Option<f32>,
     #[command(flatten)]
     size: super::SizeArgs,
+    #[command(flatten)]
+    time: super::TimeArgs,
     /// Supersampling factor s of the method, 1..4; the live truth uses the same s×s grid.
     #[arg(long, default_value_t = 1)]
     ssaa: u32,
@@ -78,7 +80,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     if !(1..=4).contains(&args.ssaa) {
         return Err(bad(format!("--ssaa must be in [1, 4], got {}", args.ssaa)));
     }
-    let mut scene = load(&args.scene)?;
+    let mut scene = args.time.apply(load(&args.scene)?)?;
     args.size.apply(&mut scene)?;
     if let Some(alpha) = alpha {
         scene
