@@ -29,8 +29,18 @@ pub fn run(args: &Args) -> Result<(), Failure> {
                         s.copy_count()
                     ),
                 };
+                let camera_path = match &scene.camera_path {
+                    None => String::new(),
+                    Some(p) => {
+                        let (t0, t1) = p.span();
+                        format!(
+                            ", a camera path of {} over {t0}–{t1} s",
+                            count(p.keys().len(), "key")
+                        )
+                    }
+                };
                 println!(
-                    "{}: ok: {}, {} ({} on mirrors), {}, {}x{}{dropped}{symmetry}",
+                    "{}: ok: {}, {} ({} on mirrors), {}, {}x{}{dropped}{symmetry}{camera_path}",
                     path.display(),
                     count(scene.mirrors.len(), "mirror"),
                     count(g.triangles.len(), "triangle"),
