@@ -1,0 +1,80 @@
+//! The traversal kernel alone on fixed ray sets (issue 19): closest hits per second for the
+//! camera rays of `mirror_box` at 640×360 (one per pixel centre), for the rays leaving the
+//! first mirror those hit, and for the rays leaving their tenth mirror — the coherence a
+//! packet kernel would exploit falls from set to set (planar mirrors keep neighbours
+//! neighbours; edges and the sphere scatter them). Today's kernel traces one ray at a time
+//! through obvhs' CWBVH; a packet kernel must beat these figures on the same sets.
+//! Run: `cargo bench -p mirrorbox-trace --bench ray_sets`.
+
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use mirrorbox_scene::{Ray, Scene, Surface};
+use mirrorbox_trace::SceneBvh;
+use mirrorbox_trace::mirror_bounce::MirrorPlanes;
+
+/// A ray with the mirror it leaves (skipped by the query, as the integrators do).
+type Leaving = (Ray, Option<usize>);
+
+/// The camera rays, then per bounce the rays leaving the mirror the previous set hit.
+fn ray_sets(scene: &Scene, bvh: &SceneBvh, bounces: usize) -> Vec<Vec<Leaving>> {
+    let cam = &scene.camera;
+    let rays = cam.ray_generator();
+    let planes = MirrorPlanes::new(scene);
+    let mut sets = vec![
+        (0..cam.height)
+            .flat_map(|y| (0..cam.width).map(move |x| (x, y)))
+            .map(|(x, y)| (rays.ray(x as f32 + 0.5, y as f32 + 0.5), None))
+            .collect::<Vec<Leaving>>(),
+    ];
+    for _ in 0..bounces {
+        let next = sets
+            .last()
+            .expect("a set")
+            .iter()
+            .filter_map(|(ray, leaving)| {
+                let hit = bvh.closest_hit(ray, 0.0, f32::INFINITY, *leaving)?;
+                let Surface::Mirror { mirror, .. } = *scene.geometry.surface(hit.triangle) else {
+                    return None;
+                };
+                let (o, d) = planes.reflect(mirror, ray.origin.as_dvec3(), ray.dir.as_dvec3())?;
+                Some((
+                    Ray {
+                        origin: o.as_vec3(),
+                        dir: d.as_vec3(),
+                    },
+                    Some(mirror),
+                ))
+            })
+            .collect();
+        sets.push(next);
+    }
+    sets
+}
+
+fn bench(c: &mut Criterion) {
+    let mut scene = mirrorbox_scene::load::bundled_scene("mirror_box.json");
+    scene.camera = scene.camera.with_size(640, 360);
+    let bvh = SceneBvh::build(&scene.geometry);
+    let sets = ray_sets(&scene, &bvh, 10);
+    let mut group = c.benchmark_group("closest_hit_mirror_box_640x360");
+    group.sample_size(10);
+    for (name, set) in [
+        ("primary", &sets[0]),
+        ("after_1_bounce", &sets[1]),
+        ("after_10_bounces", &sets[10]),
+    ] {
+        group.throughput(Throughput::Elements(set.len() as u64));
+        group.bench_function(format!("{name} ({} rays)", set.len()), |b| {
+            b.iter(|| {
+                set.iter()
+                    .filter(|(ray, leaving)| {
+                        bvh.closest_hit(ray, 0.0, f32::INFINITY, *leaving).is_some()
+                    })
+                    .count()
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
