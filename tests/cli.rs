@@ -1787,6 +1787,22 @@ fn time_on_a_camera_path_renders_the_keyed_view() {
     assert_eq!(bytes(&d("at_key_r.png")), bytes(&d("still_r.png")));
     assert_eq!(bytes(&d("at_key_t.png")), bytes(&d("still_t.png")));
     assert_ne!(bytes(&d("between_r.png")), bytes(&d("at_key_r.png")));
+    // A sequence: frame k at --time + k / --fps, into OUT_k; frame 1 here is time 2.
+    let seq = d("seq.png");
+    let mut render = vec!["render", walk, "--method", "unrolled", "-o", &seq];
+    render.extend(size);
+    render.extend(["--sequence", "3", "--fps", "1", "--time", "1"]);
+    run(&render);
+    assert_eq!(bytes(&d("seq_0001.png")), bytes(&d("at_key_r.png")));
+    assert_eq!(bytes(&d("seq_0000.png")), bytes(&d("between_r.png")));
+    assert!(dir.path().join("seq_0002.png").is_file() && !dir.path().join("seq_0003.png").exists());
+    let out = mirrorbox(&["trace", walk, "--sequence", "0", "-o", &d("x.exr")], &[]);
+    assert_eq!(out.code, 2, "{}", out.stderr);
+    assert!(
+        out.stderr.contains("--sequence must be in [1, 10000]"),
+        "{}",
+        out.stderr
+    );
     let out = mirrorbox(&["trace", walk, "--time", "nan", "-o", &d("x.exr")], &[]);
     assert_eq!(out.code, 2, "{}", out.stderr);
     assert!(

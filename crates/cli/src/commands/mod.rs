@@ -54,7 +54,11 @@ impl SizeArgs {
     }
 }
 
-/// `--time T`: the scene's camera placed by its `camera.path` at T seconds.
+/// Most frames of a `--sequence`.
+pub const MAX_SEQUENCE: u32 = 10_000;
+
+/// `--time T`: the scene's camera placed by its `camera.path` at T seconds; `--sequence N
+/// --fps F`: N frames along it.
 #[derive(clap::Args, Clone, Copy, Debug, Default)]
 pub struct TimeArgs {
     /// Seconds along the scene's camera path (`camera.path`, docs/scene-format.md): the
@@ -62,9 +66,50 @@ pub struct TimeArgs {
     /// Without a path the scene is still and every time is the same view.
     #[arg(long, allow_negative_numbers = true)]
     pub time: Option<f64>,
+    /// Render N frames along the camera path, frame k at --time (default 0) + k / --fps, into
+    /// OUT_0000, OUT_0001, … (1..10000).
+    #[arg(long)]
+    pub sequence: Option<u32>,
+    /// Frames per second of a --sequence, in (0, 1000].
+    #[arg(long, default_value_t = 30.0, requires = "sequence")]
+    pub fps: f64,
 }
 
 impl TimeArgs {
+    /// The frames of a `--sequence`: each frame's time and output suffix; `None` without
+    /// the flag. Bad values are exit 2.
+    pub fn sequence(&self) -> Result<Option<Vec<(f64, String)>>, Failure> {
+        let Some(n) = self.sequence else {
+            return Ok(None);
+        };
+        if !(1..=MAX_SEQUENCE).contains(&n) {
+            return Err(Failure::BadInput(format!(
+                "--sequence must be in [1, {MAX_SEQUENCE}] frames, got {n}"
+            )));
+        }
+        if !(self.fps.is_finite() && self.fps > 0.0 && self.fps <= 1000.0) {
+            return Err(Failure::BadInput(format!(
+                "--fps must be in (0, 1000], got {}",
+                self.fps
+            )));
+        }
+        let start = self.time.unwrap_or(0.0);
+        Ok(Some(
+            (0..n)
+                .map(|k| (start + f64::from(k) / self.fps, format!("{k:04}")))
+                .collect(),
+        ))
+    }
+
+    /// One frame of a sequence: `--time` set to its time, no sequence left.
+    pub fn frame(&self, time: f64) -> TimeArgs {
+        TimeArgs {
+            time: Some(time),
+            sequence: None,
+            ..*self
+        }
+    }
+
     /// The scene at `--time` (itself without the flag); a bad time is exit 2.
     pub fn apply(&self, scene: Scene) -> Result<Scene, Failure> {
         let Some(time) = self.time else {

@@ -11,7 +11,7 @@ use mirrorbox_raster::{Gpu, RenderSettings, plan_frame, render_planned};
 use mirrorbox_scene::stereo::Eye;
 use std::path::PathBuf;
 
-#[derive(clap::Args)]
+#[derive(clap::Args, Clone)]
 pub struct Args {
     /// Scene file (JSON).
     scene: PathBuf,
@@ -52,7 +52,22 @@ fn bad(message: String) -> Failure {
     Failure::BadInput(message)
 }
 
+/// One frame, or with `--sequence` one frame per time step (each written whole before the
+/// next starts; frame k into OUT_k).
 pub fn run(args: &Args) -> Result<(), Failure> {
+    let Some(frames) = args.time.sequence()? else {
+        return run_frame(args);
+    };
+    for (time, suffix) in frames {
+        let mut frame = args.clone();
+        frame.time = args.time.frame(time);
+        frame.output = super::stereo::with_suffix(&args.output, &suffix);
+        run_frame(&frame)?;
+    }
+    Ok(())
+}
+
+fn run_frame(args: &Args) -> Result<(), Failure> {
     let entry = mirrorbox_raster::registry::find(&args.method)
         .ok_or_else(|| bad(format!("unknown method {:?}", args.method)))?;
     let method = args.options.0.configure(entry)?;

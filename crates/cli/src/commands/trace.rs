@@ -24,7 +24,7 @@ pub enum Integrator {
     Path,
 }
 
-#[derive(clap::Args)]
+#[derive(clap::Args, Clone)]
 pub struct Args {
     /// Scene file (JSON).
     scene: PathBuf,
@@ -99,7 +99,22 @@ fn write_failed(e: impl ToString) -> Failure {
     Failure::Other(e.to_string())
 }
 
+/// One frame, or with `--sequence` one frame per time step (each written whole before the
+/// next starts; frame k into OUT_k).
 pub fn run(args: &Args) -> Result<(), Failure> {
+    let Some(frames) = args.time.sequence()? else {
+        return run_frame(args);
+    };
+    for (time, suffix) in frames {
+        let mut frame = args.clone();
+        frame.time = args.time.frame(time);
+        frame.output = super::stereo::with_suffix(&args.output, &suffix);
+        run_frame(&frame)?;
+    }
+    Ok(())
+}
+
+fn run_frame(args: &Args) -> Result<(), Failure> {
     use super::stereo::{eye_path, views, with_suffix};
     let (grid, whitted) = check_args(args)?;
     let exr_path = output_path("-o", &args.output, "exr")?;

@@ -24,8 +24,9 @@ pub struct Args {
     alpha: Option<f32>,
     #[command(flatten)]
     size: super::SizeArgs,
-    #[command(flatten)]
-    time: super::TimeArgs,
+    /// Start at the camera the scene's `camera.path` gives at this many seconds.
+    #[arg(long, allow_negative_numbers = true)]
+    time: Option<f64>,
     /// Supersampling factor s of the method, 1..4; the live truth uses the same s×s grid.
     #[arg(long, default_value_t = 1)]
     ssaa: u32,
@@ -80,7 +81,11 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     if !(1..=4).contains(&args.ssaa) {
         return Err(bad(format!("--ssaa must be in [1, 4], got {}", args.ssaa)));
     }
-    let mut scene = args.time.apply(load(&args.scene)?)?;
+    let at = super::TimeArgs {
+        time: args.time,
+        ..Default::default()
+    };
+    let mut scene = at.apply(load(&args.scene)?)?;
     args.size.apply(&mut scene)?;
     if let Some(alpha) = alpha {
         scene
