@@ -412,7 +412,7 @@ fn held_keys_and_a_mouse_drag_move_the_camera() {
     let shot = |name: &str| dir.path().join(name);
     // The viewer keeps drawing during `seconds`, while the test types and drags.
     let script = format!(
-        "truth off\nframes 3\nscreenshot {}\nseconds 6\nscreenshot {}\nseconds 6\nscreenshot {}\nexit\n",
+        "truth off\nframes 3\nscreenshot {}\nseconds 8\nscreenshot {}\nseconds 8\nscreenshot {}\nexit\n",
         shot("a.png").display(),
         shot("b.png").display(),
         shot("c.png").display()
@@ -441,7 +441,7 @@ fn held_keys_and_a_mouse_drag_move_the_camera() {
         .next()
         .expect("the viewer's window")
         .to_string();
-    // Pointer over the method pane, keyboard focus on the window, then W held for 0.7 s.
+    // Pointer over the method pane, keyboard focus on the window, then W held for 1.5 s (several frames even on a loaded machine).
     let meta: Value =
         serde_json::from_str(&std::fs::read_to_string(shot("a.json")).unwrap()).unwrap();
     let pane: Vec<u64> = meta["panes"]["method"]
@@ -455,7 +455,7 @@ fn held_keys_and_a_mouse_drag_move_the_camera() {
     let [x0, y0] = at(0);
     xdotool(&x.display, &["mousemove", "--window", &window, &x0, &y0]);
     xdotool(&x.display, &["windowfocus", "--sync", &window]);
-    xdotool(&x.display, &["keydown", "w", "sleep", "0.7", "keyup", "w"]);
+    xdotool(&x.display, &["keydown", "w", "sleep", "1.5", "keyup", "w"]);
     wait_for(&shot("b.json"), &mut viewer);
     let [x1, y1] = at(80);
     xdotool(&x.display, &["mousedown", "1"]);
