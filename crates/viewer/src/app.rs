@@ -148,7 +148,11 @@ impl App {
             height: size.height.max(1),
             present_mode: present_mode(o.vsync),
             desired_maximum_frame_latency: 2,
-            alpha_mode: caps.alpha_modes[0],
+            alpha_mode: caps
+                .alpha_modes
+                .first()
+                .copied()
+                .unwrap_or(wgpu::CompositeAlphaMode::Auto),
             color_space: wgpu::SurfaceColorSpace::Auto,
             view_formats: vec![],
         };
