@@ -26,10 +26,11 @@ pub struct Capture {
 
 impl Capture {
     pub fn new(gpu: &Gpu, format: wgpu::TextureFormat, size: (u32, u32)) -> Capture {
-        let texture = crate::session::texture_2d(
+        let texture = mirrorbox_raster::targets::texture_2d(
             &gpu.device,
             "screenshot",
-            size,
+            size.0,
+            size.1,
             format,
             wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
         );

@@ -25,36 +25,13 @@ pub struct PaneTexture {
     pub filter: wgpu::FilterMode,
 }
 
-/// A plain 2D texture of one mip level (the panes' images, the screenshot's copy).
-pub(crate) fn texture_2d(
-    device: &wgpu::Device,
-    label: &str,
-    size: (u32, u32),
-    format: wgpu::TextureFormat,
-    usage: wgpu::TextureUsages,
-) -> wgpu::Texture {
-    device.create_texture(&wgpu::TextureDescriptor {
-        label: Some(label),
-        size: wgpu::Extent3d {
-            width: size.0,
-            height: size.1,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format,
-        usage,
-        view_formats: &[],
-    })
-}
-
 impl PaneTexture {
     fn new(device: &wgpu::Device, label: &str, size: (u32, u32)) -> Self {
-        let texture = texture_2d(
+        let texture = mirrorbox_raster::targets::texture_2d(
             device,
             label,
-            size,
+            size.0,
+            size.1,
             wgpu::TextureFormat::Rgba8Unorm,
             wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
         );

@@ -101,13 +101,27 @@ impl TimeArgs {
         ))
     }
 
-    /// One frame of a sequence: `--time` set to its time, no sequence left.
-    pub fn frame(&self, time: f64) -> TimeArgs {
-        TimeArgs {
-            time: Some(time),
-            sequence: None,
-            ..*self
+    /// Runs `run_frame` once, or with `--sequence` once per frame: `with_frame(args, time,
+    /// suffix)` gives that frame's arguments (its `--time`, its output `OUT_suffix`). Each
+    /// frame is written whole before the next starts.
+    pub fn run<A>(
+        &self,
+        args: &A,
+        with_frame: impl Fn(&A, TimeArgs, &str) -> A,
+        run_frame: impl Fn(&A) -> Result<(), Failure>,
+    ) -> Result<(), Failure> {
+        let Some(frames) = self.sequence()? else {
+            return run_frame(args);
+        };
+        for (time, suffix) in frames {
+            let frame = TimeArgs {
+                time: Some(time),
+                sequence: None,
+                ..*self
+            };
+            run_frame(&with_frame(args, frame, &suffix))?;
         }
+        Ok(())
     }
 
     /// The scene at `--time` (itself without the flag); a bad time is exit 2.

@@ -102,16 +102,15 @@ fn write_failed(e: impl ToString) -> Failure {
 /// One frame, or with `--sequence` one frame per time step (each written whole before the
 /// next starts; frame k into OUT_k).
 pub fn run(args: &Args) -> Result<(), Failure> {
-    let Some(frames) = args.time.sequence()? else {
-        return run_frame(args);
-    };
-    for (time, suffix) in frames {
-        let mut frame = args.clone();
-        frame.time = args.time.frame(time);
-        frame.output = super::stereo::with_suffix(&args.output, &suffix);
-        run_frame(&frame)?;
-    }
-    Ok(())
+    args.time.run(
+        args,
+        |args, time, suffix| Args {
+            time,
+            output: super::stereo::with_suffix(&args.output, suffix),
+            ..args.clone()
+        },
+        run_frame,
+    )
 }
 
 fn run_frame(args: &Args) -> Result<(), Failure> {
