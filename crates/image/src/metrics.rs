@@ -53,6 +53,26 @@ pub fn compare(
     test: &RgbImage,
     exposure: f32,
 ) -> Result<Metrics, MetricsError> {
+    compare_detailed(reference, test, exposure).map(|c| c.metrics)
+}
+
+/// [`compare`] with what it computed on the way: both tone-mapped images and FLIP's map (an
+/// error view paints them without computing them again).
+pub struct Comparison {
+    pub metrics: Metrics,
+    /// RGB 8-bit sRGB after the contract's tone mapping, row-major.
+    pub reference_srgb8: Vec<u8>,
+    pub test_srgb8: Vec<u8>,
+    /// FLIP's per-pixel error, row-major, in [0, 1].
+    pub flip_map: Vec<f32>,
+}
+
+/// [`compare`], keeping the tone-mapped images and the FLIP map ([`Comparison`]).
+pub fn compare_detailed(
+    reference: &RgbImage,
+    test: &RgbImage,
+    exposure: f32,
+) -> Result<Comparison, MetricsError> {
     if (reference.width, reference.height) != (test.width, test.height) {
         return Err(MetricsError::SizeMismatch(
             reference.width,
@@ -78,8 +98,9 @@ pub fn compare(
     let n = (reference.pixels.len() * 3) as f64;
     let r8 = reference.to_srgb8(exposure);
     let t8 = test.to_srgb8(exposure);
-    let (flip_mean, flip_p95, flip_p99) = flip(&r8, &t8, reference.width, reference.height);
-    Ok(Metrics {
+    let flip_map = flip_map(&r8, &t8, reference.width, reference.height);
+    let (flip_mean, flip_p95, flip_p99) = flip_stats(&flip_map);
+    let metrics = Metrics {
         rmse: (se / n).sqrt(),
         relmse: rel / n,
         smape: smape / n,
@@ -94,6 +115,12 @@ pub fn compare(
         flip_mean,
         flip_p95,
         flip_p99,
+    };
+    Ok(Comparison {
+        metrics,
+        reference_srgb8: r8,
+        test_srgb8: t8,
+        flip_map,
     })
 }
 
@@ -175,8 +202,12 @@ pub fn ssim(a: &[u8], b: &[u8], w: usize, h: usize) -> f64 {
 
 /// FLIP mean, 95th and 99th percentile (nearest rank) of two interleaved RGB 8-bit images.
 pub fn flip(reference: &[u8], test: &[u8], w: u32, h: u32) -> (f64, f64, f64) {
-    let map = flip_map(reference, test, w, h);
-    let mut v = map;
+    flip_stats(&flip_map(reference, test, w, h))
+}
+
+/// Mean, 95th and 99th percentile (nearest rank) of a FLIP map.
+fn flip_stats(map: &[f32]) -> (f64, f64, f64) {
+    let mut v = map.to_vec();
     let mean = v.iter().map(|&x| x as f64).sum::<f64>() / v.len() as f64;
     v.sort_by(f32::total_cmp);
     let rank =

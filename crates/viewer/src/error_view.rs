@@ -50,26 +50,24 @@ pub fn error_image(
     mode: ErrorMode,
     gain: f32,
 ) -> Result<ErrorImage, MetricsError> {
-    let metrics = metrics::compare(truth, method, exposure)?;
-    let (w, h) = (truth.width, truth.height);
-    let reference = truth.to_srgb8(exposure);
-    let test = method.to_srgb8(exposure);
+    let c = metrics::compare_detailed(truth, method, exposure)?;
     let values: Vec<f32> = match mode {
-        ErrorMode::Difference => reference
+        ErrorMode::Difference => c
+            .reference_srgb8
             .chunks_exact(3)
-            .zip(test.chunks_exact(3))
+            .zip(c.test_srgb8.chunks_exact(3))
             .map(|(a, b)| {
                 let sum: u32 = (0..3).map(|c| u32::from(a[c].abs_diff(b[c]))).sum();
                 sum as f32 / (3.0 * 255.0) * gain
             })
             .collect(),
-        ErrorMode::Flip => metrics::flip_map(&reference, &test, w, h),
+        ErrorMode::Flip => c.flip_map,
     };
     Ok(ErrorImage {
-        width: w,
-        height: h,
+        width: truth.width,
+        height: truth.height,
         heat_rgb8: values.iter().flat_map(|&v| colormap::heat(v)).collect(),
-        metrics,
+        metrics: c.metrics,
     })
 }
 
