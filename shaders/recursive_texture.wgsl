@@ -47,6 +47,13 @@ struct MirrorDraw {
     // 1 when texel (x, y) is exactly screen pixel origin + (x, y): no resampling.
     exact: u32,
     has_texture: u32,
+    // With projected = 1 (feedback): the camera the texture was rendered from; a fragment
+    // is looked up where that camera saw its world position.
+    lookup_from_world: mat4x4f,
+    projected: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 @group(1) @binding(0) var<uniform> pass_: Pass;
@@ -115,6 +122,11 @@ fn mirror_sample(screen: vec2f) -> vec3f {
 // The projective lookup: the radiance the applied texture holds for this screen position
 // (texel for pixel where no resampling is needed).
 fn mirror_lookup(frag: vec2f, world: vec3f) -> vec3f {
+    if (mirror.projected == 1u) {
+        let c = mirror.lookup_from_world * vec4f(world, 1.0);
+        let ndc = c.xy / c.w;
+        return mirror_sample(vec2f(ndc.x + 1.0, 1.0 - ndc.y) * 0.5 * pass_.screen_size);
+    }
     if (pass_.projected_lookup == 1u) {
         return mirror_sample(to_screen(world));
     }

@@ -52,7 +52,7 @@ pub use method::{
 };
 pub use plan::PlanError;
 pub use registry::{METHODS, Method};
-pub use timing::{FrameTiming, TimingSource};
+pub use timing::{FrameHistory, FrameTiming, TimingSource};
 
 use mirrorbox_image::RgbImage;
 use mirrorbox_scene::Scene;
@@ -160,6 +160,9 @@ pub struct RenderOutput {
     /// CPU milliseconds of baking geometry while planning (`symmetry-baked`), apart from the
     /// frame time ([`method::BuiltFrame::bake_ms`]).
     pub bake_ms: Option<f64>,
+    /// What a stateful method (`feedback`) leaves for the next frame of a sequence
+    /// ([`render_planned_after`]); `None` for the others.
+    pub history: Option<FrameHistory>,
 }
 
 /// Bytes of GPU memory held by the device's buffers and textures (wgpu's internal counters:
@@ -192,6 +195,14 @@ pub struct Planned {
     /// What it was planned for: the method's key and the render size.
     key: String,
     size: (u32, u32),
+}
+
+impl Planned {
+    /// Makes a stateful method (`feedback`) continue from the previous frame's `history`
+    /// instead of starting afresh (and drawing its `--history` pre-roll).
+    pub fn continue_from(&mut self, history: FrameHistory) {
+        self.frame.continue_from(history);
+    }
 }
 
 /// Plans `settings.method` for `scene` at render resolution, without a GPU.
@@ -286,6 +297,17 @@ impl BuiltView {
             frames,
         )
     }
+
+    /// Commits the frame last drawn as the state of a stateful method (`feedback`): the next
+    /// [`BuiltView::run`] draws the frame after it. What `mirrorbox view` does every frame.
+    pub fn advance(&self) {
+        self.encoder.advance();
+    }
+
+    /// The state a frame of the next view continues from ([`Planned::continue_from`]).
+    pub fn history(&self) -> Option<FrameHistory> {
+        self.encoder.history()
+    }
 }
 
 /// Builds a planned frame's GPU resources (its shadow maps included) at the scene camera's
@@ -317,6 +339,7 @@ pub fn build_planned(
         });
     }
     gpu.check()?;
+    timing::preroll(gpu, built.encoder.as_ref(), &target)?;
     Ok(BuiltView {
         target,
         resolve,
@@ -334,8 +357,27 @@ pub fn render_planned(
     planned: Planned,
     settings: &RenderSettings,
 ) -> Result<RenderOutput, RasterError> {
+    render_planned_after(gpu, scene, planned, settings, None)
+}
+
+/// [`render_planned`] for a frame of a sequence: a stateful method (`feedback`) continues
+/// from the previous frame's `history` (one more frame of its recursion, from this frame's
+/// camera), and the output's `history` is what the next frame continues from. Every timed
+/// frame draws this same frame from the same state; the frame is committed once, after.
+pub fn render_planned_after(
+    gpu: &Gpu,
+    scene: &Scene,
+    mut planned: Planned,
+    settings: &RenderSettings,
+    history: Option<FrameHistory>,
+) -> Result<RenderOutput, RasterError> {
+    if let Some(h) = history {
+        planned.continue_from(h);
+    }
     let built = build_planned(gpu, scene, planned, settings)?;
     let (image, timing) = built.run(gpu, settings.warmup, settings.frames)?;
+    built.advance();
+    let history = built.history();
     let gpu_memory = GpuMemory::read(gpu);
     Ok(RenderOutput {
         image,
@@ -346,6 +388,7 @@ pub fn render_planned(
         warnings: built.warnings,
         gpu_memory,
         bake_ms: built.bake_ms,
+        history,
     })
 }
 

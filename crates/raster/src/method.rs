@@ -155,6 +155,11 @@ pub fn plan_each_eye<M: RasterMethod + ?Sized>(
 
 /// A planned frame, ready to become GPU resources.
 pub trait PlannedFrame {
+    /// A stateful method (`feedback`) continues from `history`, the state the previous frame
+    /// of a sequence left ([`crate::timing::FrameEncoder::history`]), instead of starting
+    /// afresh. Stateless methods ignore it.
+    fn continue_from(&mut self, _history: crate::timing::FrameHistory) {}
+
     fn build(
         self: Box<Self>,
         gpu: &Gpu,

@@ -459,6 +459,64 @@ pub fn plan(
     })
 }
 
+/// One mirror's camera in a `feedback` frame ([`feedback_cameras`]).
+#[derive(Clone, Debug)]
+pub struct MirrorCamera {
+    /// The scene mirror whose texture it renders.
+    pub mirror: usize,
+    /// The mirror camera: the view that first sees the mirror, composed with its reflection.
+    pub view: ReflectedView,
+    /// The mirror's plane (front kept).
+    pub plane: Plane,
+    /// Screen region of the texture: the mirror's footprint seen from the parent view.
+    pub footprint: Rect,
+}
+
+/// The cameras of a `feedback` frame: one per mirror the camera can reach, from the view
+/// that reaches it first. Breadth first: the mirrors the camera sees (through no mirror),
+/// then those seen through one of them, and so on; a mirror seen from several views of the
+/// same level takes the one where its footprint is largest (the first in scene order on a
+/// tie). A mirror behind the camera (the paper's box, looking into one mirror) is reached
+/// through the mirror in front. Mirrors no chain reaches have no camera.
+pub fn feedback_cameras(scene: &Scene, width: u32, height: u32) -> (Mat4, Vec<MirrorCamera>) {
+    let instances: Vec<MirrorInstance> = (0..scene.mirrors.len())
+        .map(|i| MirrorInstance {
+            mirror: i,
+            label: format!("mirror {}", i + 1),
+        })
+        .collect();
+    let planner = Planner::new(scene, &instances, width, height);
+    let mut cameras: Vec<MirrorCamera> = Vec::new();
+    let mut frontier: Vec<(ReflectedView, Option<Plane>)> =
+        vec![(planner.main_view(width, height), None)];
+    while !frontier.is_empty() {
+        let mut level: Vec<Option<MirrorCamera>> = vec![None; scene.mirrors.len()];
+        for (view, near) in &frontier {
+            let reached: Vec<usize> = cameras.iter().map(|c| c.mirror).collect();
+            for (mirror, rect) in planner.visible(view, near.as_ref(), &reached) {
+                let area = |r: &Rect| u64::from(r.w) * u64::from(r.h);
+                if level[mirror]
+                    .as_ref()
+                    .is_some_and(|c| area(&c.footprint) >= area(&rect))
+                {
+                    continue;
+                }
+                let plane = scene.mirrors[mirror].plane();
+                level[mirror] = Some(MirrorCamera {
+                    mirror,
+                    view: view.through(&plane),
+                    plane,
+                    footprint: rect,
+                });
+            }
+        }
+        let new: Vec<MirrorCamera> = level.into_iter().flatten().collect();
+        frontier = new.iter().map(|c| (c.view, Some(c.plane))).collect();
+        cameras.extend(new);
+    }
+    (planner.projection, cameras)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -321,4 +321,16 @@ impl crate::timing::FrameEncoder for WithShadowMaps {
         self.shadows.encode(encoder, first_pass);
         self.method.encode(encoder, target, None);
     }
+
+    fn preroll_frames(&self) -> u32 {
+        self.method.preroll_frames()
+    }
+
+    fn advance(&self) {
+        self.method.advance()
+    }
+
+    fn history(&self) -> Option<crate::timing::FrameHistory> {
+        self.method.history()
+    }
 }

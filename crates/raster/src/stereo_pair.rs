@@ -142,6 +142,15 @@ pub fn render_pair(
                         warnings.push(w);
                     }
                 }
+                // A stateful method's pre-roll (`feedback --history`), each eye its own, after
+                // the shadow maps it reads.
+                if a.encoder.preroll_frames() + b.encoder.preroll_frames() > 0 {
+                    let mut e = gpu.device.create_command_encoder(&Default::default());
+                    shadows.encode(&mut e, None);
+                    gpu.queue.submit([e.finish()]);
+                    crate::timing::preroll(gpu, a.encoder.as_ref(), &targets[0])?;
+                    crate::timing::preroll(gpu, b.encoder.as_ref(), &targets[1])?;
+                }
                 let bake = match (a.bake_ms, b.bake_ms) {
                     (Some(x), Some(y)) => Some(x + y),
                     (x, y) => x.or(y),
@@ -188,5 +197,6 @@ pub fn render_pair(
         warnings,
         gpu_memory: crate::GpuMemory::read(gpu),
         bake_ms,
+        history: None,
     })
 }

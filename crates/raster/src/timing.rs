@@ -19,6 +19,55 @@ pub trait FrameEncoder {
         target: &RenderTarget,
         first_pass: Option<wgpu::RenderPassTimestampWrites<'_>>,
     );
+
+    /// Frames a stateful method draws and commits ([`FrameEncoder::advance`]) from this view
+    /// before the frame that is timed and read back (`feedback --history`); 0 for the others.
+    fn preroll_frames(&self) -> u32 {
+        0
+    }
+
+    /// Commits the frame last encoded as the state the next one starts from. Without it a
+    /// stateful method redraws the same frame from the same state every time (so timed
+    /// frames are all the same frame); stateless methods have nothing to commit.
+    fn advance(&self) {}
+
+    /// The state the next frame of a sequence continues from (after [`FrameEncoder::advance`]).
+    fn history(&self) -> Option<FrameHistory> {
+        None
+    }
+}
+
+/// Draws and commits a stateful method's pre-roll frames ([`FrameEncoder::preroll_frames`])
+/// into `target`, one submission each, waiting for each (no frame queue builds up).
+pub fn preroll(
+    gpu: &Gpu,
+    method: &dyn FrameEncoder,
+    target: &RenderTarget,
+) -> Result<(), RasterError> {
+    for _ in 0..method.preroll_frames() {
+        let mut encoder = gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("pre-roll frame"),
+            });
+        method.encode(&mut encoder, target, None);
+        gpu.queue.submit([encoder.finish()]);
+        method.advance();
+        gpu.wait()?;
+    }
+    gpu.check()
+}
+
+/// What a stateful method's frame leaves for the next frame of a sequence (`feedback`: its
+/// mirror textures and the cameras they were rendered from). Opaque: only the method that
+/// made it reads it; another method, or a frame of another size, starts afresh.
+#[derive(Clone)]
+pub struct FrameHistory(pub(crate) std::sync::Arc<dyn std::any::Any + Send + Sync>);
+
+impl std::fmt::Debug for FrameHistory {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("FrameHistory")
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -1407,3 +1407,58 @@ fn shared_stereo_mirrors_flatten_the_reflections() {
     assert!((per_eye_parallax - true_parallax).abs() < 0.1 * true_parallax);
     assert!(shared_parallax < 0.5 * true_parallax);
 }
+
+/// `feedback` on a still camera, frame by frame (docs/methods.md, "Previous-frame
+/// feedback"): frame 0 shows one reflection and equals the exact methods at depth 1; frame
+/// 1 reads textures rendered for exactly the cameras that look at them on the two-mirror
+/// box and equals them at depth 2; from frame 2 on each frame adds one reflection, drawn
+/// from reused (wrong-parallax) textures — the error the method measures — and the frames
+/// converge: what a frame changes shrinks towards nothing. A sequence carrying the state
+/// from frame to frame (`render_planned_after`) draws the same frames as `--history k`.
+#[test]
+fn feedback_converges_frame_by_frame() {
+    use mirrorbox_raster::{plan_frame, render_planned_after};
+    let s = scene("mirror_box.json", 160, 90);
+    let gpu = Gpu::new().unwrap();
+    let render = |key: &str| render(&gpu, &s, &settings(m(key), 1)).unwrap().image;
+    let max_diff = |a: &RgbImage, b: &RgbImage| differences(a, b).into_iter().fold(0.0, f32::max);
+    let frames: Vec<RgbImage> = (0..=20)
+        .map(|k| render(&format!("feedback history={k}")))
+        .collect();
+    for depth in [1, 2] {
+        let exact = render(&format!("unrolled depth={depth}"));
+        let d = max_diff(&frames[depth - 1], &exact);
+        assert!(
+            d < 1e-4,
+            "frame {} against the exact methods at depth {depth}: max |d| {d}",
+            depth - 1
+        );
+    }
+    let exact3 = render("unrolled depth=3");
+    let parallax = max_diff(&frames[2], &exact3);
+    assert!(
+        parallax > 0.05,
+        "frame 2 reuses textures from other viewpoints, yet equals depth 3 (max |d| {parallax})"
+    );
+    let changes: Vec<f32> = frames.windows(2).map(|w| max_diff(&w[0], &w[1])).collect();
+    eprintln!("feedback frame-to-frame max |d|: {changes:?}; frame 2 vs depth 3 {parallax}");
+    assert!(
+        changes.iter().all(|&c| c > 0.0) || changes[19] < 1e-6,
+        "{changes:?}"
+    );
+    assert!(
+        changes[19] < 0.01 * changes[1],
+        "frames do not converge: {changes:?}"
+    );
+
+    // The same frames, carried from one frame to the next as a sequence does.
+    let settings = settings(m("feedback history=0"), 1);
+    let mut history = None;
+    for (k, expected) in frames.iter().take(4).enumerate() {
+        let planned = plan_frame(&s, &settings).unwrap();
+        let out = render_planned_after(&gpu, &s, planned, &settings, history.take()).unwrap();
+        assert_eq!(out.stats.depth, k + 1);
+        assert_eq!(max_diff(&out.image, expected), 0.0, "sequence frame {k}");
+        history = out.history;
+    }
+}

@@ -7,8 +7,9 @@ use super::{check_outputs, load, output_path, unit_interval};
 use crate::Failure;
 use mirrorbox_image::{StagedFiles, stage_exr, stage_png, stage_png_bytes};
 use mirrorbox_raster::methods::recursive_texture::TEXTURE_SCALE;
-use mirrorbox_raster::{Gpu, RenderSettings, plan_frame, render_planned};
+use mirrorbox_raster::{FrameHistory, Gpu, RenderSettings, plan_frame, render_planned_after};
 use mirrorbox_scene::stereo::Eye;
+use std::cell::RefCell;
 use std::path::PathBuf;
 
 #[derive(clap::Args, Clone)]
@@ -53,8 +54,10 @@ fn bad(message: String) -> Failure {
 }
 
 /// One frame, or with `--sequence` one frame per time step (each written whole before the
-/// next starts; frame k into OUT_k).
+/// next starts; frame k into OUT_k). A sequence opens the adapter once, and a stateful
+/// method (`feedback`) continues each frame from the one before, as in an engine.
 pub fn run(args: &Args) -> Result<(), Failure> {
+    let carry = RefCell::new(Carry::default());
     args.time.run(
         args,
         |args, time, suffix| Args {
@@ -62,11 +65,18 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             output: super::stereo::with_suffix(&args.output, suffix),
             ..args.clone()
         },
-        run_frame,
+        |args| run_frame(args, &mut carry.borrow_mut()),
     )
 }
 
-fn run_frame(args: &Args) -> Result<(), Failure> {
+/// What a sequence's frame hands the next: the adapter and a stateful method's history.
+#[derive(Default)]
+struct Carry {
+    gpu: Option<Gpu>,
+    history: Option<FrameHistory>,
+}
+
+fn run_frame(args: &Args, carry: &mut Carry) -> Result<(), Failure> {
     let entry = mirrorbox_raster::registry::find(&args.method)
         .ok_or_else(|| bad(format!("unknown method {:?}", args.method)))?;
     let method = args.options.0.configure(entry)?;
@@ -107,16 +117,31 @@ fn run_frame(args: &Args) -> Result<(), Failure> {
     let views = super::stereo::views(&scene, rig);
     // Plan first: a refused configuration costs no GPU set-up. A stereo pair is one frame
     // (both eyes, timed together: mirrorbox_raster::stereo_pair).
-    let gpu;
-    let out = if let [(_, left), (_, right)] = &views[..] {
-        let planned = mirrorbox_raster::stereo_pair::plan_pair([left, right], &settings)?;
-        gpu = Gpu::new()?;
-        mirrorbox_raster::stereo_pair::render_pair(&gpu, [left, right], planned, &settings)?
-    } else {
-        let planned = plan_frame(&views[0].1, &settings)?;
-        gpu = Gpu::new()?;
-        render_planned(&gpu, &views[0].1, planned, &settings)?
+    let planned = match &views[..] {
+        [(_, left), (_, right)] => Err(mirrorbox_raster::stereo_pair::plan_pair(
+            [left, right],
+            &settings,
+        )?),
+        _ => Ok(plan_frame(&views[0].1, &settings)?),
     };
+    if carry.gpu.is_none() {
+        carry.gpu = Some(Gpu::new()?);
+    }
+    let gpu = carry.gpu.as_ref().expect("the adapter was just opened");
+    // One view (Ok), or a stereo pair (Err) with each eye's scene.
+    let mut out = match planned {
+        Ok(one) => {
+            let history = carry.history.take();
+            render_planned_after(gpu, &views[0].1, one, &settings, history)?
+        }
+        Err(pair) => mirrorbox_raster::stereo_pair::render_pair(
+            gpu,
+            [&views[0].1, &views[1].1],
+            pair,
+            &settings,
+        )?,
+    };
+    carry.history = out.history.take();
     for w in &out.warnings {
         eprintln!("warning: {w}");
     }

@@ -4,6 +4,7 @@
 //! configures), its WGSL in `shaders/`, one `mod` line and one row below, its golden image,
 //! a paragraph in `docs/methods.md` — see `CONTRIBUTING.md`.
 
+pub mod feedback;
 pub mod portal_stencil;
 pub mod recursive_texture;
 pub mod symmetry;
@@ -18,6 +19,7 @@ pub static METHODS: &[&MethodEntry] = &[
     &recursive_texture::NAIVE,
     &recursive_texture::AUXILIARY,
     &recursive_texture::PATH_TEXTURES,
+    &feedback::FEEDBACK,
     &portal_stencil::PORTAL,
     &unrolled::UNROLLED,
     &symmetry::SYMMETRY,

@@ -57,7 +57,7 @@ pub static NAIVE: MethodEntry = MethodEntry {
     swept: None,
     optional_features: wgpu::Features::CLIP_DISTANCES,
     required_features: wgpu::Features::empty(),
-    shaders: &[&SHADER, &CLIP_DISTANCE_SHADER],
+    shaders: SHADERS,
     gpu_structs,
     configure: |p| Box::new(RecursiveTextureMethod::new(Queue::SceneMirrors, p)),
 };
@@ -87,7 +87,7 @@ pub static AUXILIARY: MethodEntry = MethodEntry {
     swept: Some(&AUXILIARY_MIRRORS),
     optional_features: wgpu::Features::CLIP_DISTANCES,
     required_features: wgpu::Features::empty(),
-    shaders: &[&SHADER, &CLIP_DISTANCE_SHADER],
+    shaders: SHADERS,
     gpu_structs,
     configure: |p| {
         Box::new(RecursiveTextureMethod::new(
@@ -125,7 +125,7 @@ pub static PATH_TEXTURES: MethodEntry = MethodEntry {
     swept: Some(&crate::exact_paths::DEPTH),
     optional_features: wgpu::Features::CLIP_DISTANCES,
     required_features: wgpu::Features::empty(),
-    shaders: &[&SHADER, &CLIP_DISTANCE_SHADER],
+    shaders: SHADERS,
     gpu_structs,
     configure: |p| {
         Box::new(RecursiveTextureMethod {
@@ -145,7 +145,10 @@ const ENTRY_POINTS: &str = include_str!("../../../../shaders/recursive_texture.w
 
 crate::mirror_plane_shaders!("recursive texture", ENTRY_POINTS);
 
-fn gpu_structs() -> Vec<HostLayout> {
+/// The shader variants of every texture method (this file's and `feedback`'s).
+pub(crate) static SHADERS: &[&crate::wgsl::WgslSource] = &[&SHADER, &CLIP_DISTANCE_SHADER];
+
+pub(crate) fn gpu_structs() -> Vec<HostLayout> {
     vec![
         crate::host_layout!(PassUniform as "Pass" {
             clip_from_world, eye, _pad0, origin, pixels_per_texel, plane, screen_from_world,
@@ -153,7 +156,8 @@ fn gpu_structs() -> Vec<HostLayout> {
             march_distance, projected_lookup, lookup_from_world, lookup_eye, _pad1
         }),
         crate::host_layout!(MirrorUniform as "MirrorDraw" {
-            origin, size, texels_per_pixel, exact, has_texture
+            origin, size, texels_per_pixel, exact, has_texture, lookup_from_world, projected,
+            _pad0, _pad1, _pad2
         }),
     ]
 }
@@ -388,7 +392,7 @@ impl PlannedFrame for PlannedTextures {
 
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
-struct PassUniform {
+pub(crate) struct PassUniform {
     clip_from_world: [[f32; 4]; 4],
     eye: [f32; 3],
     _pad0: f32,
@@ -421,12 +425,34 @@ struct PassUniform {
 
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
-struct MirrorUniform {
-    origin: [f32; 2],
-    size: [f32; 2],
-    texels_per_pixel: [f32; 2],
-    exact: u32,
-    has_texture: u32,
+pub(crate) struct MirrorUniform {
+    pub origin: [f32; 2],
+    pub size: [f32; 2],
+    pub texels_per_pixel: [f32; 2],
+    pub exact: u32,
+    pub has_texture: u32,
+    /// With `projected`: the camera the applied texture was rendered from (world to the
+    /// whole screen's clip space); the mirror looks a fragment up where that camera saw it
+    /// (`feedback`, whose textures come from other cameras than the pass's).
+    pub lookup_from_world: [[f32; 4]; 4],
+    pub projected: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+    pub _pad2: u32,
+}
+
+impl MirrorUniform {
+    /// A mirror drawn with texture region `region` applied at one texel per pixel.
+    pub(crate) fn textured(region: Rect) -> Self {
+        MirrorUniform {
+            origin: [region.x as f32, region.y as f32],
+            size: [region.w as f32, region.h as f32],
+            texels_per_pixel: [1.0, 1.0],
+            exact: 1,
+            has_texture: 1,
+            ..Zeroable::zeroed()
+        }
+    }
 }
 
 enum Target {
@@ -449,8 +475,7 @@ struct PassSpec {
 
 pub struct RecursiveTexture {
     scene_buffers: SceneBuffers,
-    objects_pipeline: wgpu::RenderPipeline,
-    mirror_pipeline: wgpu::RenderPipeline,
+    pipelines: TexturePipelines,
     pass_bind_group: wgpu::BindGroup,
     mirror_bind_groups: Vec<wgpu::BindGroup>,
     slots: Vec<RenderTarget>,
@@ -508,29 +533,18 @@ impl Builder<'_> {
         size: (u32, u32),
         plane: Vec4,
     ) -> PassUniform {
-        let screen = self.plan.projection * view;
+        let screen = ScreenSpace {
+            projection: self.plan.projection,
+            width: self.plan.width,
+            height: self.plan.height,
+        };
         PassUniform {
-            clip_from_world: (crop(region, self.plan.width, self.plan.height) * screen)
-                .to_cols_array_2d(),
-            eye: eye.to_array(),
-            _pad0: 0.0,
-            origin: [region.x as f32, region.y as f32],
-            pixels_per_texel: [
-                region.w as f32 / size.0 as f32,
-                region.h as f32 / size.1 as f32,
-            ],
-            plane: plane.to_array(),
-            screen_from_world: screen.to_cols_array_2d(),
-            screen_size: [self.plan.width as f32, self.plan.height as f32],
             bump_mode: self.bump.mode,
             march_steps: self.bump.march_steps,
             bump_strength: self.bump.strength,
             proxy_distance: self.bump.proxy_distance,
             march_distance: self.march_distance,
-            projected_lookup: 0,
-            lookup_from_world: screen.to_cols_array_2d(),
-            lookup_eye: eye.to_array(),
-            _pad1: 0.0,
+            ..screen.pass_uniform(view, eye, region, size, plane)
         }
     }
 
@@ -605,11 +619,9 @@ impl Builder<'_> {
                     let texels_per_pixel = [tw as f32 / f.w as f32, th as f32 / f.h as f32];
                     let exact = texels_per_pixel == [1.0, 1.0];
                     let offset = self.uniforms.push(&MirrorUniform {
-                        origin: [f.x as f32, f.y as f32],
-                        size: [f.w as f32, f.h as f32],
                         texels_per_pixel,
                         exact: exact as u32,
-                        has_texture: 1,
+                        ..MirrorUniform::textured(f)
                     });
                     (offset, Some(*slot))
                 }
@@ -623,6 +635,51 @@ impl Builder<'_> {
             });
         }
         draws
+    }
+}
+
+/// The screen every texture of a frame shares: the camera's projection at render size.
+#[derive(Clone, Copy)]
+pub(crate) struct ScreenSpace {
+    pub projection: Mat4,
+    pub width: u32,
+    pub height: u32,
+}
+
+impl ScreenSpace {
+    /// The pass uniform of a camera `view` drawing into `region` of the screen at `size`
+    /// texels, keeping what lies in front of `plane` (flat mirrors: no uneven-mirror trick).
+    pub(crate) fn pass_uniform(
+        &self,
+        view: Mat4,
+        eye: Vec3,
+        region: Rect,
+        size: (u32, u32),
+        plane: Vec4,
+    ) -> PassUniform {
+        let screen = self.projection * view;
+        PassUniform {
+            clip_from_world: (crop(region, self.width, self.height) * screen).to_cols_array_2d(),
+            eye: eye.to_array(),
+            _pad0: 0.0,
+            origin: [region.x as f32, region.y as f32],
+            pixels_per_texel: [
+                region.w as f32 / size.0 as f32,
+                region.h as f32 / size.1 as f32,
+            ],
+            plane: plane.to_array(),
+            screen_from_world: screen.to_cols_array_2d(),
+            screen_size: [self.width as f32, self.height as f32],
+            bump_mode: 0,
+            march_steps: 0,
+            bump_strength: 0.0,
+            proxy_distance: 0.0,
+            march_distance: 1.0,
+            projected_lookup: 0,
+            lookup_from_world: screen.to_cols_array_2d(),
+            lookup_eye: eye.to_array(),
+            _pad1: 0.0,
+        }
     }
 }
 
@@ -648,7 +705,7 @@ pub const MAX_MIRROR_TEXTURE_BYTES: u64 = 2_000_000_000;
 
 /// Refuses mirror textures larger than the device's largest texture, or more of them in
 /// bytes than [`MAX_MIRROR_TEXTURE_BYTES`], before any is created.
-fn check_mirror_textures(gpu: &Gpu, sizes: &[(u32, u32)]) -> Result<(), RasterError> {
+pub(crate) fn check_mirror_textures(gpu: &Gpu, sizes: &[(u32, u32)]) -> Result<(), RasterError> {
     for &(w, h) in sizes {
         gpu.check_target(w, h)?;
     }
@@ -748,23 +805,8 @@ impl RecursiveTexture {
         }
 
         let uniforms = b.uniforms.buffer(device, "recursive texture uniforms");
-        let stages = wgpu::ShaderStages::VERTEX_FRAGMENT;
-        let pass_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("pass"),
-            entries: &[dynamic_uniform_entry(0, stages)],
-        });
-        let mirror_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("mirror"),
-            entries: &[dynamic_uniform_entry(0, stages), texture_entry(1)],
-        });
-        let pass_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("pass"),
-            layout: &pass_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: record_binding::<PassUniform>(&uniforms),
-            }],
-        });
+        let pipelines = TexturePipelines::new(gpu, &scene_buffers);
+        let pass_bind_group = pipelines.pass_bind_group(gpu, &uniforms);
         check_mirror_textures(gpu, &b.slot_sizes)?;
         let slots: Vec<RenderTarget> = b
             .slot_sizes
@@ -791,67 +833,10 @@ impl RecursiveTexture {
             .iter()
             .map(|(_, slot)| {
                 let view = slot.map_or(&none.color_view, |s| &slots[s].color_view);
-                device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("mirror"),
-                    layout: &mirror_layout,
-                    entries: &[
-                        wgpu::BindGroupEntry {
-                            binding: 0,
-                            resource: record_binding::<MirrorUniform>(&uniforms),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 1,
-                            resource: wgpu::BindingResource::TextureView(view),
-                        },
-                    ],
-                })
+                pipelines.mirror_bind_group(gpu, &uniforms, view)
             })
             .collect();
-
-        let clipping = Clipping::for_features(gpu.features);
-        let (shader, vertex, fs_object, fs_mirror) = match clipping {
-            Clipping::ClipDistances => (
-                shader_module(device, &CLIP_DISTANCE_SHADER),
-                "vs_clip_distances",
-                "fs_object",
-                "fs_mirror",
-            ),
-            Clipping::FragmentDiscard | Clipping::None => (
-                shader_module(device, &SHADER),
-                "vs_main",
-                "fs_object_discard",
-                "fs_mirror_discard",
-            ),
-        };
-        let sl = &scene_buffers.layout;
-        let pipeline = |label: &str, layout: &wgpu::PipelineLayout, fragment: &str| {
-            ScenePipeline {
-                label,
-                layout,
-                module: &shader,
-                vertex,
-                fragment,
-                buffers: &[Some(VERTEX_LAYOUT)],
-                // Of coincident mirror instances the last drawn wins, deterministically.
-                depth_stencil: depth_state(DEPTH_FORMAT, true, NEARER_OR_EQUAL, Default::default()),
-                color_writes: wgpu::ColorWrites::ALL,
-            }
-            .build(gpu)
-        };
-        let objects_pipeline = pipeline(
-            "recursive texture objects",
-            &pipeline_layout(device, "recursive texture objects", &[sl, &pass_layout]),
-            fs_object,
-        );
-        let mirror_pipeline = pipeline(
-            "recursive texture mirrors",
-            &pipeline_layout(
-                device,
-                "recursive texture mirrors",
-                &[sl, &pass_layout, &mirror_layout],
-            ),
-            fs_mirror,
-        );
+        let clipping = pipelines.clipping;
         let draws: usize = b.passes.iter().map(|p| 1 + p.draws.len()).sum::<usize>() + 1;
         let object_triangles = scene_buffers.objects.len() / 3;
         let stats = FrameStats {
@@ -871,8 +856,7 @@ impl RecursiveTexture {
         };
         Ok(RecursiveTexture {
             scene_buffers,
-            objects_pipeline,
-            mirror_pipeline,
+            pipelines,
             pass_bind_group,
             mirror_bind_groups,
             slots,
@@ -931,17 +915,154 @@ impl RecursiveTexture {
                 self.clear_alpha,
                 first_pass.take(),
             );
-            pass.set_vertex_buffer(0, self.scene_buffers.vertices.slice(..));
-            pass.set_bind_group(0, &self.scene_buffers.bind_group, &[]);
-            pass.set_bind_group(1, &self.pass_bind_group, &[spec.offset]);
-            pass.set_pipeline(&self.objects_pipeline);
-            pass.draw(self.scene_buffers.objects.clone(), 0..1);
-            if !spec.draws.is_empty() {
-                pass.set_pipeline(&self.mirror_pipeline);
-                for d in &spec.draws {
-                    pass.set_bind_group(2, &self.mirror_bind_groups[d.bind_group], &[d.offset]);
-                    pass.draw(self.scene_buffers.mirrors[d.mirror].clone(), 0..1);
-                }
+            let draws = spec
+                .draws
+                .iter()
+                .map(|d| (d.mirror, &self.mirror_bind_groups[d.bind_group], d.offset));
+            self.pipelines.draw(
+                &mut pass,
+                &self.scene_buffers,
+                &self.pass_bind_group,
+                spec.offset,
+                draws,
+            );
+        }
+    }
+}
+
+/// The two pipelines of a texture method's scene pass (objects, then mirrors with their
+/// applied textures) and their bind-group layouts: pass uniform at group 1, mirror uniform
+/// and texture at group 2.
+pub(crate) struct TexturePipelines {
+    objects: wgpu::RenderPipeline,
+    mirrors: wgpu::RenderPipeline,
+    pass_layout: wgpu::BindGroupLayout,
+    mirror_layout: wgpu::BindGroupLayout,
+    /// Hardware clip distances where the adapter has them, else per-fragment discard.
+    pub clipping: Clipping,
+}
+
+impl TexturePipelines {
+    pub(crate) fn new(gpu: &Gpu, scene_buffers: &SceneBuffers) -> Self {
+        let device = &gpu.device;
+        let stages = wgpu::ShaderStages::VERTEX_FRAGMENT;
+        let pass_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("pass"),
+            entries: &[dynamic_uniform_entry(0, stages)],
+        });
+        let mirror_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("mirror"),
+            entries: &[dynamic_uniform_entry(0, stages), texture_entry(1)],
+        });
+        let clipping = Clipping::for_features(gpu.features);
+        let (shader, vertex, fs_object, fs_mirror) = match clipping {
+            Clipping::ClipDistances => (
+                shader_module(device, &CLIP_DISTANCE_SHADER),
+                "vs_clip_distances",
+                "fs_object",
+                "fs_mirror",
+            ),
+            Clipping::FragmentDiscard | Clipping::None => (
+                shader_module(device, &SHADER),
+                "vs_main",
+                "fs_object_discard",
+                "fs_mirror_discard",
+            ),
+        };
+        let sl = &scene_buffers.layout;
+        let pipeline = |label: &str, layout: &wgpu::PipelineLayout, fragment: &str| {
+            ScenePipeline {
+                label,
+                layout,
+                module: &shader,
+                vertex,
+                fragment,
+                buffers: &[Some(VERTEX_LAYOUT)],
+                // Of coincident mirror instances the last drawn wins, deterministically.
+                depth_stencil: depth_state(DEPTH_FORMAT, true, NEARER_OR_EQUAL, Default::default()),
+                color_writes: wgpu::ColorWrites::ALL,
+            }
+            .build(gpu)
+        };
+        let objects = pipeline(
+            "texture pass objects",
+            &pipeline_layout(device, "texture pass objects", &[sl, &pass_layout]),
+            fs_object,
+        );
+        let mirrors = pipeline(
+            "texture pass mirrors",
+            &pipeline_layout(
+                device,
+                "texture pass mirrors",
+                &[sl, &pass_layout, &mirror_layout],
+            ),
+            fs_mirror,
+        );
+        TexturePipelines {
+            objects,
+            mirrors,
+            pass_layout,
+            mirror_layout,
+            clipping,
+        }
+    }
+
+    /// The pass uniforms' bind group over the frame's uniform arena.
+    pub(crate) fn pass_bind_group(&self, gpu: &Gpu, uniforms: &wgpu::Buffer) -> wgpu::BindGroup {
+        gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("pass"),
+            layout: &self.pass_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: record_binding::<PassUniform>(uniforms),
+            }],
+        })
+    }
+
+    /// A mirror draw's bind group: its uniform (at a dynamic offset) and applied texture.
+    pub(crate) fn mirror_bind_group(
+        &self,
+        gpu: &Gpu,
+        uniforms: &wgpu::Buffer,
+        texture: &wgpu::TextureView,
+    ) -> wgpu::BindGroup {
+        gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("mirror"),
+            layout: &self.mirror_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: record_binding::<MirrorUniform>(uniforms),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(texture),
+                },
+            ],
+        })
+    }
+
+    /// One scene pass: the objects with the pass uniform at `offset`, then each mirror
+    /// `(scene mirror, bind group, uniform offset)`.
+    pub(crate) fn draw<'a>(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        scene_buffers: &SceneBuffers,
+        pass_bind_group: &wgpu::BindGroup,
+        offset: u32,
+        mirrors: impl Iterator<Item = (usize, &'a wgpu::BindGroup, u32)>,
+    ) {
+        pass.set_vertex_buffer(0, scene_buffers.vertices.slice(..));
+        pass.set_bind_group(0, &scene_buffers.bind_group, &[]);
+        pass.set_bind_group(1, pass_bind_group, &[offset]);
+        pass.set_pipeline(&self.objects);
+        pass.draw(scene_buffers.objects.clone(), 0..1);
+        let mut mirrors = mirrors.peekable();
+        if mirrors.peek().is_some() {
+            pass.set_pipeline(&self.mirrors);
+            for (mirror, bind_group, offset) in mirrors {
+                pass.set_bind_group(2, bind_group, &[offset]);
+                pass.draw(scene_buffers.mirrors[mirror].clone(), 0..1);
             }
         }
     }
