@@ -256,9 +256,17 @@ impl Session {
             let started = Instant::now();
             self.scene.camera = camera.clone();
             let scene = &self.scene;
+            // A stateful method (`feedback`) continues from the frame drawn last, as in an
+            // engine: a moved camera reads the textures of where it was.
+            let history = self.built.as_ref().and_then(|b| b.view.history());
             match mirrorbox_raster::plan_frame(scene, &settings)
                 .map_err(RasterError::from)
-                .and_then(|planned| mirrorbox_raster::build_planned(gpu, scene, planned, &settings))
+                .and_then(|mut planned| {
+                    if let Some(h) = history {
+                        planned.continue_from(h);
+                    }
+                    mirrorbox_raster::build_planned(gpu, scene, planned, &settings)
+                })
             {
                 Ok(view) => {
                     self.builds += 1;
@@ -286,6 +294,8 @@ impl Session {
         if let Some(built) = &self.built {
             let drawing = Instant::now();
             let (image, timing) = built.view.run(gpu, 0, 1)?;
+            // Every drawn frame is committed: feedback's row grows by one per frame.
+            built.view.advance();
             draw_ms = drawing.elapsed().as_secs_f64() * 1e3;
             panes_start = Instant::now();
             let rgb = image.to_srgb8(self.scene.camera.exposure);
