@@ -493,3 +493,61 @@ fn held_keys_and_a_mouse_drag_move_the_camera() {
         "the drag did not turn right: {fb} → {fc}"
     );
 }
+
+/// `feedback` in the viewer carries from frame to frame as in an engine: a still view's
+/// reflections grow by one per drawn frame, and the frame shown is `render --history K`'s
+/// bit for bit (K + 1 its reflections).
+#[test]
+fn feedback_grows_one_reflection_per_frame_in_the_viewer() {
+    let Some(x) = display_or_skip() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let p = |name: &str| d.join(name).to_str().unwrap().to_string();
+    std::fs::write(
+        d.join("still.txt"),
+        format!("frames 5\nscreenshot {}\nexit\n", p("f.png")),
+    )
+    .unwrap();
+    let scene = "scenes/mirror_box.json";
+    let size = ["--width", "320", "--height", "180"];
+    let (script, log) = (p("still.txt"), p("log.jsonl"));
+    let mut view = vec!["view", scene, "--method", "feedback", "--no-vsync"];
+    view.extend(size);
+    view.extend(["--script", &script, "--log", &log]);
+    run_ok(&view, &[("DISPLAY", x.display.as_str())]);
+    let reflections: Vec<u64> = std::fs::read_to_string(&log)
+        .unwrap()
+        .lines()
+        .filter_map(|l| serde_json::from_str::<Value>(l).ok()?["reflections"].as_u64())
+        .collect();
+    assert!(reflections.len() >= 5, "{reflections:?}");
+    assert!(
+        reflections.windows(2).all(|w| w[1] == w[0] + 1) && reflections[0] == 1,
+        "one more reflection per frame: {reflections:?}"
+    );
+    let meta: Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("f.json")).unwrap()).unwrap();
+    let shown = meta["reflections"]
+        .as_u64()
+        .expect("the screenshot's reflections");
+    let history = (shown - 1).to_string();
+    let out = p("render.png");
+    let mut render = vec![
+        "render",
+        scene,
+        "--method",
+        "feedback",
+        "--history",
+        &history,
+        "-o",
+        &out,
+    ];
+    render.extend(size);
+    run_ok(&render, &[]);
+    let exr = |path: &str| mirrorbox_image::read_image(Path::new(path)).unwrap().pixels;
+    assert_eq!(
+        exr(&p("f.method.exr")),
+        exr(&p("render.exr")),
+        "the viewer's frame with {shown} reflections is render --history {history}"
+    );
+}

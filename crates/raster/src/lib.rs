@@ -304,6 +304,15 @@ impl BuiltView {
         self.encoder.advance();
     }
 
+    /// The counts of the frame last drawn (a stateful method's reflections change as its
+    /// frames advance).
+    pub fn drawn_stats(&self) -> FrameStats {
+        FrameStats {
+            depth: self.encoder.drawn_depth().unwrap_or(self.stats.depth),
+            ..self.stats
+        }
+    }
+
     /// The state a frame of the next view continues from ([`Planned::continue_from`]).
     pub fn history(&self) -> Option<FrameHistory> {
         self.encoder.history()

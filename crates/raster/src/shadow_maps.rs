@@ -330,6 +330,10 @@ impl crate::timing::FrameEncoder for WithShadowMaps {
         self.method.advance()
     }
 
+    fn drawn_depth(&self) -> Option<usize> {
+        self.method.drawn_depth()
+    }
+
     fn history(&self) -> Option<crate::timing::FrameHistory> {
         self.method.history()
     }

@@ -31,6 +31,12 @@ pub trait FrameEncoder {
     /// frames are all the same frame); stateless methods have nothing to commit.
     fn advance(&self) {}
 
+    /// The reflections the frame last encoded shows, where that changes from frame to frame
+    /// (`feedback`); `None` where [`crate::FrameStats::depth`] holds for every frame.
+    fn drawn_depth(&self) -> Option<usize> {
+        None
+    }
+
     /// The state the next frame of a sequence continues from (after [`FrameEncoder::advance`]).
     fn history(&self) -> Option<FrameHistory> {
         None

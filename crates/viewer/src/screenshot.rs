@@ -216,6 +216,7 @@ pub fn save(
         },
         "passes": frame.map(|f| f.stats.passes),
         "draws": frame.map(|f| f.stats.draws),
+        "reflections": frame.map(|f| f.stats.depth),
         "gpu_ms": frame.map(|f| f.gpu_ms),
         "truth_complete": truth.is_some(),
         "error_map": session.error_mode.name(),

@@ -266,8 +266,7 @@ impl Session {
                         planned.continue_from(h);
                     }
                     mirrorbox_raster::build_planned(gpu, scene, planned, &settings)
-                })
-            {
+                }) {
                 Ok(view) => {
                     self.builds += 1;
                     self.built = Some(Built {
@@ -294,6 +293,7 @@ impl Session {
         if let Some(built) = &self.built {
             let drawing = Instant::now();
             let (image, timing) = built.view.run(gpu, 0, 1)?;
+            let stats = built.view.drawn_stats();
             // Every drawn frame is committed: feedback's row grows by one per frame.
             built.view.advance();
             draw_ms = drawing.elapsed().as_secs_f64() * 1e3;
@@ -310,7 +310,7 @@ impl Session {
             let gpu_ms = timing.median_ms();
             self.frame = Some(MethodFrame {
                 image: Arc::new(image),
-                stats: built.view.stats,
+                stats,
                 gpu_ms,
                 timing_source: timing.source.name().to_string(),
                 warnings: built.view.warnings.clone(),

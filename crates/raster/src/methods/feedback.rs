@@ -209,6 +209,8 @@ struct FeedbackFrame {
     /// What the next frame reads, and the reflections each own set holds.
     read: Cell<Source>,
     own_levels: [Cell<usize>; 2],
+    /// The set the frame last encoded wrote.
+    drawn: Cell<usize>,
     preroll: u32,
     size: (u32, u32),
     stats: FrameStats,
@@ -429,6 +431,7 @@ impl FeedbackFrame {
             background: scene.background,
             read: Cell::new(read),
             own_levels: [Cell::new(0), Cell::new(0)],
+            drawn: Cell::new(0),
             preroll: if read == Source::Carried { 0 } else { history },
             size: (w, h),
             stats,
@@ -466,6 +469,7 @@ impl FrameEncoder for FeedbackFrame {
         let read = self.read.get();
         let write = read.written();
         self.own_levels[write].set(self.levels(read) + 1);
+        self.drawn.set(write);
         let mut first_pass = first_pass;
         for (k, texture) in self.own[write].iter().enumerate() {
             let mut pass = texture.begin_pass_with_alpha(
@@ -506,6 +510,10 @@ impl FrameEncoder for FeedbackFrame {
 
     fn advance(&self) {
         self.read.set(Source::Own(self.read.get().written()));
+    }
+
+    fn drawn_depth(&self) -> Option<usize> {
+        Some(self.own_levels[self.drawn.get()].get())
     }
 
     fn history(&self) -> Option<FrameHistory> {
