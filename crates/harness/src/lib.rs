@@ -17,6 +17,7 @@
 //!   when there is no mirror effect to truncate.
 
 pub mod merge;
+pub mod sequence;
 mod worker;
 
 pub use worker::{RenderJob, RenderReport, Rendered, peak_memory_bytes, serve};
@@ -551,6 +552,9 @@ pub enum HarnessError {
     /// An output file could not be written, or the output folder is in use.
     #[error(transparent)]
     File(#[from] FileError),
+    /// A sequence sweep's setting out of range.
+    #[error("{0}")]
+    Sequence(String),
     /// A render worker could not be run or failed.
     #[error("render worker: {0}")]
     Worker(String),
@@ -578,7 +582,8 @@ impl HarnessError {
             | HarnessError::WorkerRefused(_)
             | HarnessError::SymmetryPlanes(_)
             | HarnessError::LightImages { .. }
-            | HarnessError::OutputFolder { .. } => true,
+            | HarnessError::OutputFolder { .. }
+            | HarnessError::Sequence(_) => true,
             HarnessError::Raster(e) => e.is_refusal(),
             HarnessError::File(e) => e.refused,
             _ => false,
@@ -745,7 +750,7 @@ fn points(config: &SweepConfig, base_hash: u64, w: u32, h: u32) -> Vec<Point> {
     out
 }
 
-fn cpu_description() -> String {
+pub(crate) fn cpu_description() -> String {
     let model = std::fs::read_to_string("/proc/cpuinfo")
         .ok()
         .and_then(|t| {
@@ -1079,7 +1084,7 @@ pub fn point_keys(config: &SweepConfig) -> Result<Vec<String>, HarnessError> {
 /// in `results.jsonl` first (cached truths stay). The output folder is locked for the whole
 /// run: a second sweep into it is refused at once, naming the process that holds it.
 /// The current UTC time, RFC 3339 to the second.
-fn now_rfc3339() -> String {
+pub(crate) fn now_rfc3339() -> String {
     humantime::format_rfc3339_seconds(std::time::SystemTime::now()).to_string()
 }
 

@@ -9,6 +9,7 @@
 pub mod exact;
 mod folder;
 pub mod lighting;
+pub mod motion;
 pub mod plot;
 pub mod readme;
 mod runs;

@@ -4,6 +4,7 @@
 use super::method_flags::SweepOptions;
 use super::progress_bar;
 use crate::Failure;
+use mirrorbox_harness::sequence::{Scenario, SequenceConfig};
 use mirrorbox_harness::{Event, Shard, SweepConfig, run_sweep};
 use mirrorbox_raster::registry::{find, names};
 use mirrorbox_trace::WhittedSettings;
@@ -77,6 +78,28 @@ pub struct Args {
     /// (raster and truth), for the report's disparity check.
     #[arg(long, requires = "ipd")]
     marker: Option<String>,
+    /// A sequence sweep (issue 22): render every method and the truth along the scene's
+    /// camera path for N frames (frame k at --time + k / --fps), each method's frames in
+    /// order in one process (so `feedback` carries its state), each frame against its own
+    /// truth; writes frames.jsonl, report.md, a plot of FLIP against frame and a filmstrip
+    /// of feedback's worst frames. 1..1000.
+    #[arg(
+        long,
+        value_name = "N",
+        conflicts_with_all = ["symmetry_planes", "mirrored_lights", "bump_amplitude", "ipd", "alpha", "shard", "truth_cache"]
+    )]
+    path: Option<u32>,
+    /// Frames per second of path time for --path, in (0, 1000].
+    #[arg(long, default_value_t = 30.0, requires = "path")]
+    fps: f64,
+    /// Path time of --path's first frame, seconds.
+    #[arg(
+        long,
+        default_value_t = 0.0,
+        requires = "path",
+        allow_negative_numbers = true
+    )]
+    time: f64,
     #[command(flatten)]
     shard: ShardArgs,
 }
@@ -280,6 +303,29 @@ fn command_line() -> String {
 }
 
 pub fn run(args: &Args) -> Result<(), Failure> {
+    if let Some(frames) = args.path {
+        let methods = parse_methods(&args.methods, &args.options)?;
+        let config = SequenceConfig {
+            out: args.out.clone(),
+            scenarios: vec![Scenario {
+                name: "path".into(),
+                description: "The camera follows the path of".into(),
+                scene: args.scene.clone(),
+                start: args.time,
+                fps: args.fps,
+                frames,
+                methods,
+            }],
+            width: args.size.width,
+            height: args.size.height,
+            warmup: args.warmup,
+            timed: args.frames,
+            exe: render_worker()
+                .ok_or_else(|| Failure::Other("cannot find this executable".into()))?,
+            command: command_line(),
+        };
+        return run_sequences(&config);
+    }
     let mut config = SweepConfig {
         scene: args.scene.clone(),
         out: args.out.clone(),
@@ -378,6 +424,46 @@ pub fn run_bumpy(args: &PresetArgs) -> Result<(), Failure> {
 pub fn run_stereo(args: &PresetArgs) -> Result<(), Failure> {
     let out = args.out.clone().unwrap_or_else(|| "reports/stereo".into());
     run_preset(SweepConfig::stereo(out), args)
+}
+
+/// `mirrorbox motion`'s options.
+#[derive(clap::Args, Clone, Debug)]
+pub struct MotionArgs {
+    /// Output folder of the committed report (default reports/motion).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Frames per scenario (default 24), 1..1000.
+    #[arg(long)]
+    frames: Option<u32>,
+}
+
+/// Error over time (`SequenceConfig::motion`): a still camera and three walking speeds on
+/// the paper's box, into `reports/motion/` by default.
+pub fn run_motion(args: &MotionArgs) -> Result<(), Failure> {
+    let out = args.out.clone().unwrap_or_else(|| "reports/motion".into());
+    let exe =
+        render_worker().ok_or_else(|| Failure::Other("cannot find this executable".into()))?;
+    let mut config = SequenceConfig::motion(out, exe, command_line());
+    if let Some(n) = args.frames {
+        for s in &mut config.scenarios {
+            s.frames = n;
+        }
+    }
+    run_sequences(&config)
+}
+
+fn run_sequences(config: &SequenceConfig) -> Result<(), Failure> {
+    let started = std::time::Instant::now();
+    let records = mirrorbox_harness::sequence::run_sequences(config, &mut |line| {
+        eprintln!("sequence: {line}");
+    })?;
+    eprintln!(
+        "sequence sweep: {} frames compared in {:.0} s; report in {}",
+        records.len(),
+        started.elapsed().as_secs_f64(),
+        config.out.join("report.md").display()
+    );
+    Ok(())
 }
 
 fn run_preset(mut config: SweepConfig, args: &PresetArgs) -> Result<(), Failure> {

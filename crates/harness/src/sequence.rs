@@ -1,0 +1,434 @@
+//! Sequence sweeps (issue 22): every method and the truth rendered frame by frame along a
+//! camera path, each frame compared with the truth of that frame
+//! (`mirrorbox sweep --path`, and the `mirrorbox motion` preset).
+//!
+//! Each sequence runs in a child process of this executable — `trace --sequence` for the
+//! truth, `render --sequence` per method — so a stateful method (`feedback`) carries its
+//! state from frame to frame as an engine would, and whatever lavapipe leaves behind per
+//! frame (see [`crate::worker`]) goes back to the system when the sequence's process exits.
+//! The frames land in `OUT/cache/<scenario>/` (not kept in git); the records, plots and the
+//! filmstrips of the worst frames in `OUT/`.
+
+use crate::HarnessError;
+use mirrorbox_image::{RgbImage, read_image};
+use mirrorbox_raster::Method;
+use mirrorbox_report::motion::{FrameRecord, MotionInfo, ScenarioInfo, write_motion_report};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// Most frames of one sequence (a sequence sweep keeps every frame's images on disk).
+pub const MAX_SEQUENCE_FRAMES: u32 = 1000;
+
+/// One camera run: a scene (its `camera.path`, or a still camera), where it starts, how
+/// fast path time passes per frame, and the methods rendered along it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scenario {
+    /// A file-name-safe name (`still`, `slow`).
+    pub name: String,
+    /// One sentence for the report, ending before the scene's name.
+    pub description: String,
+    pub scene: PathBuf,
+    /// Path time of frame 0, seconds.
+    pub start: f64,
+    /// Frames per second of path time: frame k is at `start + k / fps`.
+    pub fps: f64,
+    pub frames: u32,
+    pub methods: Vec<Method>,
+}
+
+/// A sequence sweep.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SequenceConfig {
+    pub out: PathBuf,
+    pub scenarios: Vec<Scenario>,
+    /// Image size (default: each scene camera's), as `--width` / `--height` give it.
+    pub width: Option<u32>,
+    pub height: Option<u32>,
+    /// Untimed and timed redraws of each frame (a frame's time is their median).
+    pub warmup: u32,
+    pub timed: u32,
+    /// This executable (`mirrorbox`), run as the sequences' child processes.
+    pub exe: PathBuf,
+    pub command: String,
+}
+
+impl SequenceConfig {
+    /// The `mirrorbox motion` preset: the paper's box, a still camera (`feedback`'s
+    /// convergence from its first frame) and the camera walking `mirror_box_walk`'s path at
+    /// three speeds (`feedback` starting from 16 frames at the first view, as if it had been
+    /// showing it), beside `auxiliary` n = 0…4 and an exact method at depth 64.
+    pub fn motion(out: PathBuf, exe: PathBuf, command: String) -> Self {
+        let stateless: Vec<Method> = (0..=4)
+            .map(|n| Method::parse(&format!("auxiliary n={n}")))
+            .chain([Method::parse("unrolled depth=64")])
+            .collect::<Result<_, _>>()
+            .expect("the preset's methods are registered");
+        let with_feedback = |history: u32| {
+            let mut m =
+                vec![Method::parse(&format!("feedback history={history}")).expect("feedback")];
+            m.extend(stateless.iter().cloned());
+            m
+        };
+        let walk = |name: &str, fps: f64, words: &str| Scenario {
+            name: name.into(),
+            description: format!("The camera walks the path of {words}"),
+            scene: "scenes/mirror_box_walk.json".into(),
+            start: 0.0,
+            fps,
+            frames: 24,
+            methods: with_feedback(16),
+        };
+        SequenceConfig {
+            out,
+            scenarios: vec![
+                Scenario {
+                    name: "still".into(),
+                    description:
+                        "A still camera (the paper's view), `feedback` from its first frame:".into(),
+                    scene: "scenes/mirror_box.json".into(),
+                    start: 0.0,
+                    fps: 30.0,
+                    frames: 24,
+                    methods: with_feedback(0),
+                },
+                walk("slow", 120.0, "a quarter of real time:"),
+                walk("medium", 30.0, "real time (30 frames per second):"),
+                walk("fast", 10.0, "three times real time:"),
+            ],
+            width: Some(320),
+            height: Some(180),
+            warmup: 1,
+            timed: 3,
+            exe,
+            command,
+        }
+    }
+
+    /// Checks the sizes and counts before any work (exit 2 for the CLI).
+    pub fn validate(&self) -> Result<(), HarnessError> {
+        let bad = |m: String| Err(HarnessError::Sequence(m));
+        if self.scenarios.is_empty() {
+            return bad("no scenario to render".into());
+        }
+        for s in &self.scenarios {
+            if !(1..=MAX_SEQUENCE_FRAMES).contains(&s.frames) {
+                return bad(format!(
+                    "--path must be in [1, {MAX_SEQUENCE_FRAMES}] frames, got {}",
+                    s.frames
+                ));
+            }
+            if !(s.fps.is_finite() && s.fps > 0.0 && s.fps <= 1000.0) {
+                return bad(format!("--fps must be in (0, 1000], got {}", s.fps));
+            }
+            if s.methods.is_empty() {
+                return bad(format!("scenario {}: no method", s.name));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The command-line flags of a configured method: `auxiliary n=2` → `--method auxiliary --n 2`.
+fn method_flags(method: &Method) -> Vec<String> {
+    let key = method.key();
+    let mut words = key.split_whitespace();
+    let mut flags = vec![
+        "--method".to_string(),
+        words.next().unwrap_or("").to_string(),
+    ];
+    for w in words {
+        match w.split_once('=') {
+            None => flags.push(format!("--{w}")),
+            Some((_, "false")) => {}
+            Some((name, "true")) => flags.push(format!("--{name}")),
+            Some((name, value)) => flags.extend([format!("--{name}"), value.to_string()]),
+        }
+    }
+    flags
+}
+
+/// Runs `exe args`, returning its standard output; a failure names the command and its
+/// standard error.
+fn run(exe: &Path, args: &[String]) -> Result<String, HarnessError> {
+    let out = Command::new(exe)
+        .args(args)
+        .output()
+        .map_err(|e| HarnessError::Worker(format!("cannot start {}: {e}", exe.display())))?;
+    if !out.status.success() {
+        return Err(HarnessError::Worker(format!(
+            "mirrorbox {} failed ({}): {}",
+            args.join(" "),
+            out.status,
+            String::from_utf8_lossy(&out.stderr).trim()
+        )));
+    }
+    Ok(String::from_utf8_lossy(&out.stdout).into_owned())
+}
+
+/// Frame `k` of a sequence written to `base` (`truth.exr` → `truth_0003.exr`).
+fn frame_path(base: &Path, k: u32) -> PathBuf {
+    let stem = base.file_stem().unwrap_or_default().to_string_lossy();
+    base.with_file_name(format!("{stem}_{k:04}.exr"))
+}
+
+/// The sequence flags every child shares.
+fn sequence_flags(config: &SequenceConfig, s: &Scenario) -> Vec<String> {
+    let mut flags = vec![
+        s.scene.display().to_string(),
+        "--sequence".into(),
+        s.frames.to_string(),
+        "--fps".into(),
+        s.fps.to_string(),
+        "--time".into(),
+        s.start.to_string(),
+    ];
+    for (flag, v) in [("--width", config.width), ("--height", config.height)] {
+        if let Some(v) = v {
+            flags.extend([flag.to_string(), v.to_string()]);
+        }
+    }
+    flags
+}
+
+/// The median distance the camera moves per frame along `s`.
+fn camera_step(s: &Scenario) -> Result<f64, HarnessError> {
+    let scene = mirrorbox_scene::load_scene(&s.scene)?;
+    let mut steps = Vec::new();
+    let mut last = None;
+    for k in 0..s.frames {
+        let t = s.start + f64::from(k) / s.fps;
+        let at = scene
+            .at_time(t)
+            .map_err(|e| HarnessError::Sequence(format!("{}: {e}", s.scene.display())))?;
+        let p = at.camera.position;
+        if let Some(q) = last {
+            steps.push(f64::from(p.distance(q)));
+        }
+        last = Some(p);
+    }
+    Ok(if steps.is_empty() {
+        0.0
+    } else {
+        mirrorbox_report::stats::median(&steps)
+    })
+}
+
+/// Runs every scenario, writes the report into `config.out`, and returns the records.
+/// `progress` hears one line per finished sequence.
+pub fn run_sequences(
+    config: &SequenceConfig,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Vec<FrameRecord>, HarnessError> {
+    config.validate()?;
+    crate::check_output_parent(&config.out)?;
+    let io = |path: &Path| {
+        let path = path.to_path_buf();
+        move |source| HarnessError::Io { path, source }
+    };
+    std::fs::create_dir_all(&config.out).map_err(io(&config.out))?;
+    let mut records = Vec::new();
+    let mut scenarios = Vec::new();
+    let mut device = String::new();
+    let mut size = (0, 0);
+    for s in &config.scenarios {
+        let dir = config.out.join("cache").join(&s.name);
+        std::fs::create_dir_all(&dir).map_err(io(&dir))?;
+        let truth_base = dir.join("truth.exr");
+        let mut args = vec!["trace".to_string()];
+        args.extend(sequence_flags(config, s));
+        args.extend(["--spp".into(), "1".into(), "-o".into()]);
+        args.push(truth_base.display().to_string());
+        run(&config.exe, &args)?;
+        let truths: Vec<RgbImage> = (0..s.frames)
+            .map(|k| read_image(&frame_path(&truth_base, k)))
+            .collect::<Result<_, _>>()?;
+        size = (truths[0].width, truths[0].height);
+        let exposure = mirrorbox_scene::load_scene(&s.scene)?.camera.exposure;
+        progress(&format!("{}: truth of {} frames", s.name, s.frames));
+        let mut strip_frames: Vec<(f64, u32)> = Vec::new();
+        for method in &s.methods {
+            let base = dir.join(format!("{}.png", method.slug()));
+            let mut args = vec!["render".to_string()];
+            args.extend(sequence_flags(config, s));
+            args.extend(method_flags(method));
+            args.extend([
+                "--warmup".into(),
+                config.warmup.to_string(),
+                "--frames".into(),
+                config.timed.to_string(),
+                "--json".into(),
+                "-o".into(),
+                base.display().to_string(),
+            ]);
+            let stdout = run(&config.exe, &args)?;
+            let summaries: Vec<serde_json::Value> = stdout
+                .lines()
+                .filter_map(|l| serde_json::from_str(l).ok())
+                .collect();
+            if summaries.len() != s.frames as usize {
+                return Err(HarnessError::Worker(format!(
+                    "render --sequence {} printed {} frame summaries",
+                    s.frames,
+                    summaries.len()
+                )));
+            }
+            let is_feedback = method.name() == "feedback";
+            for (k, summary) in (0..s.frames).zip(&summaries) {
+                let image = read_image(&frame_path(&base, k).with_extension("exr"))?;
+                let m = mirrorbox_image::metrics::compare(&truths[k as usize], &image, exposure)?;
+                device = summary["adapter"].as_str().unwrap_or("").to_string();
+                records.push(FrameRecord {
+                    scenario: s.name.clone(),
+                    method: method.key(),
+                    exact: method.entry().exact,
+                    frame: k,
+                    time: s.start + f64::from(k) / s.fps,
+                    flip_mean: m.flip_mean,
+                    flip_p95: m.flip_p95,
+                    relmse: m.relmse,
+                    psnr: m.psnr,
+                    ms: summary["ms_per_frame_median"].as_f64().unwrap_or(f64::NAN),
+                    passes: summary["passes"].as_u64().unwrap_or(0) as usize,
+                    reflections: summary["depth"].as_u64().unwrap_or(0) as usize,
+                });
+                if is_feedback {
+                    strip_frames.push((m.flip_mean, k));
+                }
+            }
+            progress(&format!(
+                "{}: {} over {} frames",
+                s.name,
+                method.key(),
+                s.frames
+            ));
+        }
+        let filmstrip = if strip_frames.is_empty() {
+            None
+        } else {
+            let name = format!("filmstrip_{}.png", s.name);
+            let feedback = s
+                .methods
+                .iter()
+                .find(|m| m.name() == "feedback")
+                .expect("a feedback frame was recorded");
+            strip_frames.sort_by(|a, b| b.0.total_cmp(&a.0));
+            let mut picked: Vec<u32> = strip_frames.iter().take(3).map(|f| f.1).collect();
+            picked.sort_unstable();
+            let base = dir.join(format!("{}.png", feedback.slug()));
+            let rows: Vec<(RgbImage, RgbImage)> = picked
+                .iter()
+                .map(|&k| {
+                    Ok((
+                        truths[k as usize].clone(),
+                        read_image(&frame_path(&base, k).with_extension("exr"))?,
+                    ))
+                })
+                .collect::<Result<_, HarnessError>>()?;
+            write_filmstrip(&config.out.join(&name), &rows, exposure)?;
+            Some(name)
+        };
+        scenarios.push(ScenarioInfo {
+            name: s.name.clone(),
+            description: s.description.clone(),
+            scene: s.scene.display().to_string(),
+            frames: s.frames,
+            fps: s.fps,
+            step: camera_step(s)?,
+            filmstrip,
+        });
+    }
+    let info = MotionInfo {
+        command: config.command.clone(),
+        date: crate::now_rfc3339(),
+        device,
+        cpu: crate::cpu_description(),
+        width: size.0,
+        height: size.1,
+        truth: "mirrorbox trace (Whitted, its default depth and threshold), 1 spp at pixel centres"
+            .into(),
+        scenarios,
+    };
+    write_motion_report(&config.out, &info, &records)?;
+    Ok(records)
+}
+
+/// One row per frame: truth | method | FLIP heat map (the three side by side, 8-bit sRGB).
+fn write_filmstrip(
+    path: &Path,
+    rows: &[(RgbImage, RgbImage)],
+    exposure: f32,
+) -> Result<(), HarnessError> {
+    let Some((first, _)) = rows.first() else {
+        return Ok(());
+    };
+    let (w, h) = (first.width as usize, first.height as usize);
+    let width = 3 * w;
+    let mut bytes = vec![0u8; width * h * rows.len() * 3];
+    for (r, (truth, method)) in rows.iter().enumerate() {
+        let c = mirrorbox_image::metrics::compare_detailed(truth, method, exposure)?;
+        let heat: Vec<u8> = c
+            .flip_map
+            .iter()
+            .flat_map(|&v| mirrorbox_image::colormap::heat(v))
+            .collect();
+        for (i, pane) in [&c.reference_srgb8, &c.test_srgb8, &heat]
+            .into_iter()
+            .enumerate()
+        {
+            for y in 0..h {
+                let src = &pane[y * w * 3..(y + 1) * w * 3];
+                let dst = ((r * h + y) * width + i * w) * 3;
+                bytes[dst..dst + w * 3].copy_from_slice(src);
+            }
+        }
+    }
+    let mut staged = mirrorbox_files::StagedFiles::new();
+    mirrorbox_image::stage_png_bytes(
+        &mut staged,
+        path,
+        width as u32,
+        (h * rows.len()) as u32,
+        &bytes,
+    )?;
+    staged.commit()?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn methods_become_their_command_line_flags() {
+        let m = |k: &str| method_flags(&Method::parse(k).unwrap());
+        assert_eq!(m("auxiliary n=2"), ["--method", "auxiliary", "--n", "2"]);
+        assert_eq!(
+            m("feedback history=16"),
+            ["--method", "feedback", "--history", "16"]
+        );
+        assert_eq!(
+            m("unrolled depth=8 fragment-clipping=true"),
+            [
+                "--method",
+                "unrolled",
+                "--depth",
+                "8",
+                "--fragment-clipping"
+            ]
+        );
+        assert_eq!(m("naive"), ["--method", "naive"]);
+    }
+
+    #[test]
+    fn the_motion_preset_is_valid_and_bad_counts_are_refused() {
+        let c = SequenceConfig::motion("out".into(), "mirrorbox".into(), String::new());
+        c.validate().unwrap();
+        assert_eq!(c.scenarios.len(), 4);
+        let mut bad = c.clone();
+        bad.scenarios[0].frames = 0;
+        assert!(bad.validate().unwrap_err().to_string().contains("--path"));
+        let mut bad = c;
+        bad.scenarios[1].fps = f64::NAN;
+        assert!(bad.validate().unwrap_err().to_string().contains("--fps"));
+    }
+}

@@ -1,0 +1,354 @@
+//! Error over time (issue 22): each method rendered frame by frame along a camera path (or a
+//! still camera) against the truth of every frame — `feedback`'s convergence for a still
+//! camera, its lag under motion, beside the stateless methods. The records come from a
+//! sequence sweep (`mirrorbox_harness::sequence`); this module only reads and writes them.
+
+use crate::plot::{Chart, Series};
+use crate::stats::median;
+use mirrorbox_files::{FileError, write_atomically_with};
+use serde::{Deserialize, Serialize};
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// One frame of one method in one scenario.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FrameRecord {
+    pub scenario: String,
+    /// The method's key (`feedback history=16`, `auxiliary n=2`).
+    pub method: String,
+    /// Whether the method claims to match the truth (registry `exact`).
+    pub exact: bool,
+    pub frame: u32,
+    /// Seconds along the camera path.
+    pub time: f64,
+    pub flip_mean: f64,
+    pub flip_p95: f64,
+    pub relmse: f64,
+    pub psnr: f64,
+    /// GPU milliseconds of the frame (median of its timed redraws).
+    pub ms: f64,
+    pub passes: usize,
+    /// Reflections the frame shows (`feedback`'s grow frame by frame).
+    pub reflections: usize,
+}
+
+/// A scenario as the report describes it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ScenarioInfo {
+    pub name: String,
+    pub description: String,
+    pub scene: String,
+    pub frames: u32,
+    pub fps: f64,
+    /// Median distance the camera moves per frame, scene units (0 for a still camera).
+    pub step: f64,
+    /// Filmstrip image of the scenario's worst `feedback` frames, if written.
+    pub filmstrip: Option<String>,
+}
+
+/// What every frame of a motion sweep shares.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MotionInfo {
+    pub command: String,
+    pub date: String,
+    pub device: String,
+    pub cpu: String,
+    pub width: u32,
+    pub height: u32,
+    pub truth: String,
+    pub scenarios: Vec<ScenarioInfo>,
+}
+
+/// The frames of `method` in `scenario`, in frame order.
+fn frames<'a>(records: &'a [FrameRecord], scenario: &str, method: &str) -> Vec<&'a FrameRecord> {
+    let mut v: Vec<&FrameRecord> = records
+        .iter()
+        .filter(|r| r.scenario == scenario && r.method == method)
+        .collect();
+    v.sort_by_key(|r| r.frame);
+    v
+}
+
+/// The methods of a scenario, in first-seen order.
+fn methods<'a>(records: &'a [FrameRecord], scenario: &str) -> Vec<&'a str> {
+    let mut out: Vec<&str> = Vec::new();
+    for r in records.iter().filter(|r| r.scenario == scenario) {
+        if !out.contains(&r.method.as_str()) {
+            out.push(&r.method);
+        }
+    }
+    out
+}
+
+fn sci(v: f64) -> String {
+    format!("{v:.3e}")
+}
+
+/// The first frame from which `flips` stays within `tolerance` (relative) of its last value:
+/// where a converging method has settled.
+pub fn settled_after(flips: &[f64], tolerance: f64) -> Option<usize> {
+    let last = *flips.last()?;
+    let within = |v: f64| (v - last).abs() <= tolerance * last.abs().max(1e-12);
+    (0..flips.len()).find(|&k| flips[k..].iter().all(|&v| within(v)))
+}
+
+/// The report's markdown.
+pub fn document(info: &MotionInfo, records: &[FrameRecord]) -> String {
+    let mut md = String::new();
+    let _ = writeln!(
+        md,
+        "# Error over time: moving cameras and previous-frame feedback\n"
+    );
+    let _ = writeln!(
+        md,
+        "Every method and the truth rendered frame by frame along the same camera path \
+         (issue 22, docs/methods.md \"Previous-frame feedback\"); each frame compared with the \
+         truth of that frame. `feedback` carries its textures from frame to frame as an engine \
+         would; the other methods have no state.\n"
+    );
+    let _ = writeln!(
+        md,
+        "- Device: {} (CPU: {})\n- Size: {}×{}, SSAA 1 against the truth at 1 spp (the same \
+         sample positions)\n- Truth: {}\n- Date: {}\n- Command: `{}`\n",
+        info.device, info.cpu, info.width, info.height, info.truth, info.date, info.command
+    );
+    for s in &info.scenarios {
+        let _ = writeln!(md, "## {}\n", s.name);
+        let _ = writeln!(
+            md,
+            "{} `{}`, {} frames at {} frames per second of path time; the camera moves {:.4} \
+             scene units per frame (median).\n",
+            s.description, s.scene, s.frames, s.fps, s.step
+        );
+        let _ = writeln!(
+            md,
+            "| method | FLIP frame 0 | FLIP last frame | FLIP mean over frames | worst frame (FLIP) | reflections, last frame | ms/frame (median) |\n|---|---|---|---|---|---|---|"
+        );
+        for m in methods(records, &s.name) {
+            let f = frames(records, &s.name, m);
+            let flips: Vec<f64> = f.iter().map(|r| r.flip_mean).collect();
+            let worst = f
+                .iter()
+                .max_by(|a, b| a.flip_mean.total_cmp(&b.flip_mean))
+                .map(|r| format!("{} ({})", r.frame, sci(r.flip_mean)))
+                .unwrap_or_default();
+            let ms: Vec<f64> = f.iter().map(|r| r.ms).collect();
+            let _ = writeln!(
+                md,
+                "| {m}{} | {} | {} | {} | {} | {} | {:.1} |",
+                if f.first().is_some_and(|r| r.exact) {
+                    " (exact)"
+                } else {
+                    ""
+                },
+                flips.first().map_or(String::new(), |v| sci(*v)),
+                flips.last().map_or(String::new(), |v| sci(*v)),
+                sci(flips.iter().sum::<f64>() / flips.len().max(1) as f64),
+                worst,
+                f.last().map_or(0, |r| r.reflections),
+                median(&ms),
+            );
+        }
+        let _ = writeln!(md);
+        for line in findings(records, &s.name, s.step == 0.0) {
+            let _ = writeln!(md, "- {line}");
+        }
+        let _ = writeln!(md, "\n![FLIP against frame, {0}](plot_{0}.svg)\n", s.name);
+        if let Some(strip) = &s.filmstrip {
+            let _ = writeln!(
+                md,
+                "Worst `feedback` frames (truth | feedback | FLIP error, brighter is worse):\n\n![{0}]({0})\n",
+                strip
+            );
+        }
+    }
+    md
+}
+
+/// What a scenario shows about `feedback`: when it settles, against the exact methods and
+/// each `auxiliary` n, in words with the measured numbers.
+fn findings(records: &[FrameRecord], scenario: &str, still: bool) -> Vec<String> {
+    let mut out = Vec::new();
+    let ms = methods(records, scenario);
+    let Some(fb) = ms.iter().find(|m| m.starts_with("feedback")) else {
+        return out;
+    };
+    let fb_flips: Vec<f64> = frames(records, scenario, fb)
+        .iter()
+        .map(|r| r.flip_mean)
+        .collect();
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
+    if !still {
+        out.push(format!(
+            "`{fb}` over the walk: mean FLIP {}, last frame {}.",
+            sci(mean(&fb_flips)),
+            sci(*fb_flips.last().unwrap_or(&0.0))
+        ));
+    } else if let Some(k) = settled_after(&fb_flips, 0.05) {
+        out.push(format!(
+            "`{fb}` settles (FLIP within 5 % of its last frame's, {}) from frame {k} on; its mean over the frames is {}.",
+            sci(*fb_flips.last().unwrap_or(&0.0)),
+            sci(mean(&fb_flips))
+        ));
+    }
+    for m in &ms {
+        if m == fb {
+            continue;
+        }
+        let other: Vec<f64> = frames(records, scenario, m)
+            .iter()
+            .map(|r| r.flip_mean)
+            .collect();
+        let first_below = (0..fb_flips.len().min(other.len())).find(|&k| fb_flips[k] <= other[k]);
+        let exact = frames(records, scenario, m)
+            .first()
+            .is_some_and(|r| r.exact);
+        let verdict = match first_below {
+            Some(k) => format!("at or below it from frame {k}"),
+            None => "above it in every frame".to_string(),
+        };
+        out.push(format!(
+            "against `{m}`{} (mean FLIP {}): `{fb}` is {verdict}; mean ratio {:.2}×.",
+            if exact { ", exact" } else { "" },
+            sci(mean(&other)),
+            mean(&fb_flips) / mean(&other).max(1e-12)
+        ));
+    }
+    out
+}
+
+/// FLIP against frame, one series per method (log y).
+pub fn chart(records: &[FrameRecord], scenario: &str) -> Chart {
+    Chart {
+        title: format!("FLIP against frame: {scenario}"),
+        x_label: "frame".into(),
+        y_label: "FLIP mean (log)".into(),
+        x_log: false,
+        y_log: true,
+        series: methods(records, scenario)
+            .into_iter()
+            .map(|m| Series {
+                name: m.to_string(),
+                points: frames(records, scenario, m)
+                    .iter()
+                    .map(|r| (f64::from(r.frame), r.flip_mean.max(1e-6)))
+                    .collect(),
+                labels: Vec::new(),
+                x_intervals: Vec::new(),
+                y_intervals: Vec::new(),
+            })
+            .collect(),
+        reference_lines: Vec::new(),
+    }
+}
+
+fn write_text(path: &Path, text: &str) -> Result<(), FileError> {
+    write_atomically_with(path, |tmp| {
+        std::fs::write(tmp, text).map_err(|e| e.to_string())
+    })
+}
+
+/// Writes `frames.jsonl` (the records), `motion.json` (the info), `report.md` and one
+/// `plot_<scenario>.svg` per scenario into `dir`, each atomically.
+pub fn write_motion_report(
+    dir: &Path,
+    info: &MotionInfo,
+    records: &[FrameRecord],
+) -> Result<(), FileError> {
+    let mut lines = String::new();
+    for r in records {
+        let _ = writeln!(
+            lines,
+            "{}",
+            serde_json::to_string(r).expect("a frame record encodes")
+        );
+    }
+    write_text(&dir.join("frames.jsonl"), &lines)?;
+    write_text(
+        &dir.join("motion.json"),
+        &serde_json::to_string_pretty(info).expect("the motion info encodes"),
+    )?;
+    for s in &info.scenarios {
+        write_text(
+            &dir.join(format!("plot_{}.svg", s.name)),
+            &chart(records, &s.name).to_svg(),
+        )?;
+    }
+    write_text(&dir.join("report.md"), &document(info, records))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn record(scenario: &str, method: &str, frame: u32, flip: f64) -> FrameRecord {
+        FrameRecord {
+            scenario: scenario.into(),
+            method: method.into(),
+            exact: method.starts_with("unrolled"),
+            frame,
+            time: 0.0,
+            flip_mean: flip,
+            flip_p95: flip,
+            relmse: flip,
+            psnr: 30.0,
+            ms: 1.0,
+            passes: 3,
+            reflections: frame as usize + 1,
+        }
+    }
+
+    #[test]
+    fn settling_is_the_first_frame_that_stays_near_the_last() {
+        assert_eq!(settled_after(&[0.5, 0.2, 0.11, 0.1, 0.1], 0.05), Some(3));
+        assert_eq!(settled_after(&[0.1, 0.5, 0.1], 0.05), Some(2));
+        assert_eq!(settled_after(&[0.3], 0.05), Some(0));
+        assert_eq!(settled_after(&[], 0.05), None);
+    }
+
+    #[test]
+    fn findings_compare_feedback_frame_by_frame() {
+        let mut r = Vec::new();
+        for (k, f) in [0.4, 0.2, 0.05, 0.05].into_iter().enumerate() {
+            r.push(record("still", "feedback history=0", k as u32, f));
+            r.push(record("still", "auxiliary n=0", k as u32, 0.1));
+            r.push(record("still", "unrolled depth=64", k as u32, 0.01));
+        }
+        let f = findings(&r, "still", true);
+        assert!(f[0].contains("from frame 2"), "{f:?}");
+        assert!(
+            f[1].contains("auxiliary n=0") && f[1].contains("from frame 2"),
+            "{f:?}"
+        );
+        assert!(
+            f[2].contains("exact") && f[2].contains("above it in every frame"),
+            "{f:?}"
+        );
+        let md = document(
+            &MotionInfo {
+                command: "mirrorbox motion".into(),
+                date: "today".into(),
+                device: "test".into(),
+                cpu: "test".into(),
+                width: 8,
+                height: 8,
+                truth: "whitted".into(),
+                scenarios: vec![ScenarioInfo {
+                    name: "still".into(),
+                    description: "A still camera:".into(),
+                    scene: "scenes/mirror_box.json".into(),
+                    frames: 4,
+                    fps: 30.0,
+                    step: 0.0,
+                    filmstrip: None,
+                }],
+            },
+            &r,
+        );
+        assert!(
+            md.contains("| feedback history=0 | 4.000e-1 | 5.000e-2 |"),
+            "{md}"
+        );
+        assert!(md.contains("unrolled depth=64 (exact)"), "{md}");
+    }
+}
