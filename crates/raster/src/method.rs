@@ -29,6 +29,11 @@ pub struct MethodEntry {
     /// Whether the method claims to match the traced truth (up to its depth cap and edge
     /// samples); reports group exact methods by depth.
     pub exact: bool,
+    /// Whether its error (beyond the exact methods' floor) is the reflections it stops short
+    /// of: the registry test then holds it nearer the truth at its depth than one shallower.
+    /// False for `cubemap`, whose error is parallax at every depth (that test instead holds
+    /// it to the truth wherever no mirror is seen).
+    pub depth_limited: bool,
     /// The options it accepts, in key order.
     pub options: &'static [&'static OptionSpec],
     /// The option a sweep varies for this method (named in every resume key), if any.

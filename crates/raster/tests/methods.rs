@@ -153,8 +153,19 @@ fn every_registered_method_matches_its_golden_and_the_truth_at_its_depth() {
         );
         let ok = if entry.exact {
             off * 200 <= n && flip <= 1e-3
-        } else {
+        } else if entry.depth_limited {
             off < off_other && flip < flip_other
+        } else {
+            // Parallax (`cubemap`): wrong only where a mirror is seen — a pixel off the truth
+            // is one whose truth changes when mirrors reflect nothing (depth 0), but for a
+            // few where mirror edges cover pixel centres differently (≤ 0.1 %).
+            let mirrorless = differences(&trace_depth(&s, 0), &truth);
+            let diff = differences(&out.image, &truth);
+            let stray = (0..n)
+                .filter(|&i| diff[i] > 1e-3 && mirrorless[i] == 0.0)
+                .count();
+            println!("{method}: {stray} pixels off the truth where no mirror is seen");
+            off > 0 && stray * 1000 <= n
         };
         if !ok {
             let where_ = dump(&format!("registry_{}", entry.name), &out.image, &truth);
@@ -1459,6 +1470,94 @@ fn feedback_converges_frame_by_frame() {
         let out = render_planned_after(&gpu, &s, planned, &settings, history.take()).unwrap();
         assert_eq!(out.stats.depth, k + 1);
         assert_eq!(max_diff(&out.image, expected), 0.0, "sequence frame {k}");
+        history = out.history;
+    }
+}
+
+/// `cubemap` (docs/methods.md, "Cube-map reflections"): every front-mirror pixel shows what
+/// the method defines — the radiance the tracer finds from the mirror's centre along the
+/// reflected direction (so the cube faces, their cameras and the lookup agree) — which is
+/// not the truth (parallax: thousands of pixels off the exact methods); its cubes carry
+/// from frame to frame like `feedback`'s textures (a sequence draws what `--history k`
+/// draws).
+#[test]
+fn cubemap_shows_the_radiance_at_its_centre_and_carries_its_cubes() {
+    use mirrorbox_raster::{plan_frame, render_planned_after};
+    let s = scene("mirror_box.json", 320, 180);
+    let gpu = Gpu::new().unwrap();
+    let render = |key: &str| render(&gpu, &s, &settings(m(key), 1)).unwrap().image;
+    let cube = render("cubemap cube-size=1024");
+    let exact = render("unrolled depth=1");
+    // What the method means to show at each pixel of the front mirror: the radiance
+    // arriving at the mirror's centre from the reflected view direction (mirrors reflecting
+    // nothing, as in its first frame), times the reflectance.
+    let bvh = SceneBvh::build(&s.geometry);
+    let at_centre = mirrorbox_trace::whitted::Whitted::new(
+        &s,
+        &bvh,
+        WhittedSettings {
+            max_depth: 0,
+            min_throughput: 1e-4,
+        },
+    );
+    let front = &s.mirrors[0];
+    let (n, c) = (front.normal, front.center);
+    let mut lookup_errors = Vec::new();
+    for y in 0..180u32 {
+        for x in 0..320u32 {
+            let ray = s.camera.primary_ray(x as f32 + 0.5, y as f32 + 0.5);
+            let t = (c - ray.origin).dot(n) / ray.dir.dot(n);
+            let p = ray.at(t);
+            let local = p - c;
+            let inside = local.dot(front.right()).abs() < 0.45 * front.width
+                && local.dot(front.up).abs() < 0.45 * front.height;
+            if !(t > 0.0 && inside) {
+                continue;
+            }
+            let r = ray.dir - 2.0 * ray.dir.dot(n) * n;
+            let expected = at_centre
+                .radiance(mirrorbox_scene::camera::Ray {
+                    origin: c + 1e-4 * n,
+                    dir: r,
+                })
+                .radiance
+                * front.reflectance;
+            let got = cube.pixels[(y * 320 + x) as usize];
+            lookup_errors.push(
+                (0..3)
+                    .map(|k| (got[k] - expected[k]).abs())
+                    .fold(0.0, f32::max),
+            );
+        }
+    }
+    lookup_errors.sort_by(f32::total_cmp);
+    let q = |f: f64| lookup_errors[((lookup_errors.len() - 1) as f64 * f) as usize];
+    eprintln!(
+        "{} front-mirror pixels: lookup error median {}, p95 {}, max {}",
+        lookup_errors.len(),
+        q(0.5),
+        q(0.95),
+        q(1.0)
+    );
+    assert!(lookup_errors.len() > 5000 && q(0.5) < 1e-3 && q(0.95) < 0.05);
+    let diff = differences(&cube, &exact);
+    let off = diff.iter().filter(|&&v| v > 0.05).count();
+    assert!(off > 1000, "parallax shows nowhere: {off} pixels off");
+
+    let settings = settings(m("cubemap cube-size=64"), 1);
+    let mut history = None;
+    for k in 0..3 {
+        let expected = render(&format!("cubemap cube-size=64 history={k}"));
+        let planned = plan_frame(&s, &settings).unwrap();
+        let out = render_planned_after(&gpu, &s, planned, &settings, history.take()).unwrap();
+        assert_eq!(out.stats.depth, k + 1);
+        assert_eq!(
+            differences(&out.image, &expected)
+                .iter()
+                .fold(0.0, |a: f32, &b| a.max(b)),
+            0.0,
+            "frame {k}"
+        );
         history = out.history;
     }
 }

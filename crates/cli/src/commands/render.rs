@@ -194,7 +194,7 @@ fn run_frame(args: &Args, carry: &mut Carry) -> Result<(), Failure> {
         &method,
         &views[0].1,
         &out,
-        &gpu,
+        gpu,
         &written,
         &alpha,
         rig.is_some(),

@@ -42,6 +42,7 @@ pub static FEEDBACK: MethodEntry = MethodEntry {
     name: "feedback",
     help: "Previous-frame feedback: one texture per mirror per frame from its mirror camera, the mirrors inside it textured with last frame's (one more reflection each frame).",
     exact: false,
+    depth_limited: true,
     options: &[
         &HISTORY,
         &crate::lighting::LIGHTS,
@@ -64,7 +65,7 @@ pub static FEEDBACK: MethodEntry = MethodEntry {
 /// `--history K`: frames drawn from the same view before the one shown.
 pub static HISTORY: OptionSpec = OptionSpec {
     name: "history",
-    help: "feedback: frames drawn from the same (still) view before the one shown; frame K shows K + 1 reflections.",
+    help: "feedback, cubemap: frames drawn from the same (still) view before the one shown; frame K shows K + 1 reflections.",
     kind: OptionKind::Count { min: 0, max: 1024 },
     default: ParamValue::Count(0),
     sweep: Some(SweepAxis {

@@ -4,6 +4,7 @@
 //! configures), its WGSL in `shaders/`, one `mod` line and one row below, its golden image,
 //! a paragraph in `docs/methods.md` — see `CONTRIBUTING.md`.
 
+pub mod cubemap;
 pub mod feedback;
 pub mod portal_stencil;
 pub mod recursive_texture;
@@ -20,6 +21,7 @@ pub static METHODS: &[&MethodEntry] = &[
     &recursive_texture::AUXILIARY,
     &recursive_texture::PATH_TEXTURES,
     &feedback::FEEDBACK,
+    &cubemap::CUBEMAP,
     &portal_stencil::PORTAL,
     &unrolled::UNROLLED,
     &symmetry::SYMMETRY,

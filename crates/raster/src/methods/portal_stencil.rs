@@ -45,6 +45,7 @@ pub static PORTAL: MethodEntry = MethodEntry {
     name: "portal",
     help: "Exact: stencil recursion over the reflection paths, one pass, cost linear in depth.",
     exact: true,
+    depth_limited: true,
     options: &[
         &DEPTH,
         &MIN_PORTAL_AREA,

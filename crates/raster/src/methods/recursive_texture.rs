@@ -40,6 +40,7 @@ pub static NAIVE: MethodEntry = MethodEntry {
     name: "naive",
     help: "The paper's Algorithm 1: recursive mirror textures, each mirror hidden in its own recursion.",
     exact: false,
+    depth_limited: true,
     options: &[
         &TEXTURE_SCALE,
         &MAX_PASSES,
@@ -69,6 +70,7 @@ pub static AUXILIARY: MethodEntry = MethodEntry {
     name: "auxiliary",
     help: "The paper's §3.1–3.2: n auxiliary mirrors per facing pair (n + 2 in the queue for two mirrors), attenuation α^k.",
     exact: false,
+    depth_limited: true,
     options: &[
         &AUXILIARY_MIRRORS,
         &TEXTURE_SCALE,
@@ -107,6 +109,7 @@ pub static PATH_TEXTURES: MethodEntry = MethodEntry {
     name: "path-textures",
     help: "Exact to --depth: one mirror texture per reflection path (a colour + distance target each), so uneven-mirror tricks apply at every depth.",
     exact: true,
+    depth_limited: true,
     options: &[
         &crate::exact_paths::DEPTH,
         &crate::exact_paths::MIN_ATTENUATION,

@@ -61,6 +61,7 @@ pub static SYMMETRY: MethodEntry = MethodEntry {
     name: "symmetry",
     help: "Seed 001's symmetry planes: the objects drawn 2^p times, each copy an instance clipped to its cell; even and odd copies with opposite front faces.",
     exact: true,
+    depth_limited: true,
     options: &[
         &SYMMETRY_DRAWS,
         &FRAGMENT_CLIPPING,

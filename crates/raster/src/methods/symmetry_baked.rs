@@ -40,6 +40,7 @@ pub static SYMMETRY_BAKED: MethodEntry = MethodEntry {
     name: "symmetry-baked",
     help: "Seed 001's symmetry planes baked on the CPU (split and mirrored, timed apart as bake_ms), the mesh drawn once.",
     exact: true,
+    depth_limited: true,
     options: &[
         &COPY_IDS,
         &crate::lighting::LIGHTS,

@@ -25,6 +25,7 @@ pub static SYMMETRY_PRUNED: MethodEntry = MethodEntry {
     name: "symmetry-pruned",
     help: "Seed 001's symmetry planes as `symmetry`, leaving out copies whose cell is empty or outside the view.",
     exact: true,
+    depth_limited: true,
     options: &[
         &SYMMETRY_DRAWS,
         &FRAGMENT_CLIPPING,

@@ -60,6 +60,7 @@ pub static UNROLLED: MethodEntry = MethodEntry {
     name: "unrolled",
     help: "Exact: every reflection path an instance of the scene, clipped to its cell; a handful of draws.",
     exact: true,
+    depth_limited: true,
     options: &[
         &DEPTH,
         &MIN_PORTAL_AREA,

@@ -1,0 +1,655 @@
+//! `cubemap`: cube-map reflections, the other trick real-time demos ship (issue 22;
+//! docs/methods.md, "Cube-map reflections").
+//!
+//! Every frame renders a cube map — six 90° faces from one point — per mirror at the
+//! mirror's centre (keeping what lies in front of it), or one for the scene at the centre of
+//! its bounds (`--cube-centre scene`). A mirror fragment shows its cube looked up by the
+//! reflected view direction r: the radiance arriving at the cube's centre from direction r,
+//! as if everything reflected were infinitely far away. Exact only at the centre itself;
+//! anything near the mirror is displaced (parallax), which is what the method's error
+//! measures. The cube's own mirrors show the previous frame's cube maps (two sets,
+//! ping-pong; the recursive variant), so the reflections deepen by one per frame as with
+//! `feedback` (`--history K` pre-rolls K frames; a sequence carries the cubes, which do not
+//! depend on the camera). The first frame's cubes show the depth cap in their mirrors.
+
+use crate::gpu::{Gpu, RasterError};
+use crate::method::{
+    BuiltFrame, FrameStats, MethodEntry, OptionKind, OptionSpec, ParamValue, PlannedFrame,
+    RasterMethod, SweepAxis,
+};
+use crate::methods::feedback::HISTORY;
+use crate::methods::recursive_texture::check_mirror_textures;
+use crate::pipeline::{
+    ScenePipeline, UniformArena, depth_state, dynamic_uniform_entry, pipeline_layout,
+    record_binding,
+};
+use crate::plan::PlanError;
+use crate::projection::{NEARER_OR_EQUAL, camera_projection};
+use crate::shading::{SceneBuffers, VERTEX_LAYOUT};
+use crate::targets::{DEPTH_FORMAT, RenderTarget, texture_entry};
+use crate::timing::{FrameEncoder, FrameHistory};
+use crate::wgsl::{HostLayout, shader_module};
+use bytemuck::{Pod, Zeroable};
+use glam::{Mat4, Vec3, Vec4};
+use mirrorbox_scene::{Camera, Plane, Scene};
+use std::cell::Cell;
+use std::sync::Arc;
+
+/// Cube-map reflections (issue 22).
+pub static CUBEMAP: MethodEntry = MethodEntry {
+    name: "cubemap",
+    help: "Cube-map reflections: a cube map per mirror (or one for the scene) rendered every frame, looked up by the reflected direction (parallax-wrong near the mirror); its mirrors show last frame's cube maps.",
+    exact: false,
+    depth_limited: false,
+    options: &[
+        &CUBE_SIZE,
+        &CUBE_CENTRE,
+        &HISTORY,
+        &crate::lighting::LIGHTS,
+        &crate::lighting::SHADOWS,
+        &crate::lighting::SHADOW_MAP_SIZE,
+        &crate::lighting::SHADOW_BIAS,
+    ],
+    swept: Some(&CUBE_SIZE),
+    optional_features: wgpu::Features::CLIP_DISTANCES,
+    required_features: wgpu::Features::empty(),
+    shaders: &[&SHADER, &CLIP_DISTANCE_SHADER],
+    gpu_structs,
+    configure: |p| {
+        Box::new(Cubemap {
+            size: p.count(&CUBE_SIZE),
+            per_mirror: p.choice(&CUBE_CENTRE) == "mirror",
+            history: p.count(&HISTORY),
+        })
+    },
+};
+
+const ENTRY_POINTS: &str = include_str!("../../../../shaders/cubemap.wgsl");
+
+crate::mirror_plane_shaders!("cubemap", ENTRY_POINTS);
+
+fn gpu_structs() -> Vec<HostLayout> {
+    vec![
+        crate::host_layout!(PassUniform as "Pass" { clip_from_world, eye, _pad0, plane }),
+        crate::host_layout!(CubeUniform as "CubeDraw" {
+            faces, centre, has_cube, face_size, _pad0, _pad1, _pad2
+        }),
+    ]
+}
+
+/// `--cube-size N`: texels per side of each cube face.
+pub static CUBE_SIZE: OptionSpec = OptionSpec {
+    name: "cube-size",
+    help: "cubemap: texels per side of each cube face.",
+    kind: OptionKind::Count { min: 8, max: 2048 },
+    default: ParamValue::Count(256),
+    sweep: Some(SweepAxis {
+        default: "64,128,256,512",
+        range_example: "64..66",
+        list_example: "64,256,1024",
+        noun: "face sizes",
+    }),
+    in_key: true,
+};
+
+/// `--cube-centre mirror|scene`: where the cube maps are rendered from.
+pub static CUBE_CENTRE: OptionSpec = OptionSpec {
+    name: "cube-centre",
+    help: "cubemap: one cube per mirror at its centre (mirror), or one at the centre of the scene's bounds (scene).",
+    kind: OptionKind::Choice {
+        values: &["mirror", "scene"],
+    },
+    default: ParamValue::Choice("mirror"),
+    sweep: None,
+    in_key: true,
+};
+
+struct Cubemap {
+    size: u32,
+    per_mirror: bool,
+    history: u32,
+}
+
+/// One cube map: where it is rendered from, what it keeps, and its faces' cameras.
+#[derive(Clone, Debug)]
+struct Cube {
+    centre: Vec3,
+    /// The owning mirror's plane (front kept) for a per-mirror cube.
+    plane: Option<Plane>,
+    /// Face k's camera, world to clip space (+X, −X, +Y, −Y, +Z, −Z).
+    faces: [Mat4; 6],
+}
+
+/// The six faces' cameras at `centre`: 90° square views along ±X, ±Y, ±Z.
+fn face_cameras(centre: Vec3, size: u32, exposure: f32) -> [Mat4; 6] {
+    let axes = [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z];
+    axes.map(|a| {
+        let up = if a.y != 0.0 { Vec3::Z } else { Vec3::Y };
+        let camera = Camera {
+            position: centre,
+            look_at: centre + a,
+            up,
+            fov_y_deg: 90.0,
+            width: size,
+            height: size,
+            exposure,
+            shift_x: 0.0,
+        };
+        camera_projection(&camera, size, size) * camera.view()
+    })
+}
+
+/// The cube maps of `scene`: one per mirror at its centre, or one at the centre of the
+/// bounds of everything in the scene.
+fn cubes(scene: &Scene, size: u32, per_mirror: bool) -> Vec<Cube> {
+    let exposure = scene.camera.exposure;
+    if per_mirror {
+        scene
+            .mirrors
+            .iter()
+            .map(|m| Cube {
+                centre: m.center,
+                plane: Some(m.plane()),
+                faces: face_cameras(m.center, size, exposure),
+            })
+            .collect()
+    } else {
+        let (lo, hi) = scene
+            .geometry
+            .triangles
+            .iter()
+            .flatten()
+            .chain(
+                scene
+                    .mirrors
+                    .iter()
+                    .flat_map(|m| m.corners())
+                    .collect::<Vec<_>>()
+                    .iter(),
+            )
+            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(a, b), p| {
+                (a.min(*p), b.max(*p))
+            });
+        let centre = if lo.x <= hi.x {
+            0.5 * (lo + hi)
+        } else {
+            Vec3::ZERO
+        };
+        vec![Cube {
+            centre,
+            plane: None,
+            faces: face_cameras(centre, size, exposure),
+        }]
+    }
+}
+
+impl RasterMethod for Cubemap {
+    fn plan(
+        &self,
+        scene: &Scene,
+        width: u32,
+        height: u32,
+    ) -> Result<Box<dyn PlannedFrame>, PlanError> {
+        Ok(Box::new(PlannedCubes {
+            cubes: cubes(scene, self.size, self.per_mirror),
+            size: self.size,
+            per_mirror: self.per_mirror,
+            history: self.history,
+            view: (width, height),
+            carried: None,
+        }))
+    }
+}
+
+struct PlannedCubes {
+    cubes: Vec<Cube>,
+    size: u32,
+    per_mirror: bool,
+    history: u32,
+    view: (u32, u32),
+    carried: Option<Arc<CubeHistory>>,
+}
+
+/// One set of cube maps (six faces each).
+type CubeSet = Vec<[RenderTarget; 6]>;
+
+/// What a frame leaves for the next: its cube maps. They do not depend on the camera.
+struct CubeHistory {
+    cubes: Arc<CubeSet>,
+    /// Face size and centre choice (another configuration starts afresh).
+    config: (u32, bool),
+    levels: usize,
+}
+
+impl PlannedFrame for PlannedCubes {
+    fn continue_from(&mut self, history: FrameHistory) {
+        let config = (self.size, self.per_mirror);
+        self.carried = history
+            .0
+            .downcast::<CubeHistory>()
+            .ok()
+            .filter(|h| h.config == config && h.cubes.len() == self.cubes.len());
+    }
+
+    fn build(
+        self: Box<Self>,
+        gpu: &Gpu,
+        scene: &Scene,
+        shadows: &crate::shadow_maps::ShadowMaps,
+    ) -> Result<BuiltFrame, RasterError> {
+        let frame = CubeFrame::new(gpu, scene, shadows, *self)?;
+        Ok(BuiltFrame {
+            stats: frame.stats,
+            encoder: Box::new(frame),
+            warnings: Vec::new(),
+            bake_ms: None,
+        })
+    }
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct PassUniform {
+    clip_from_world: [[f32; 4]; 4],
+    eye: [f32; 3],
+    _pad0: f32,
+    plane: [f32; 4],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct CubeUniform {
+    faces: [[[f32; 4]; 4]; 6],
+    centre: [f32; 3],
+    has_cube: u32,
+    face_size: f32,
+    _pad0: f32,
+    _pad1: f32,
+    _pad2: f32,
+}
+
+/// The cube sets a pass reads: none yet, the carried one, or this frame's set 0 or 1.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Source {
+    Nothing,
+    Carried,
+    Own(usize),
+}
+
+impl Source {
+    fn written(self) -> usize {
+        match self {
+            Source::Own(0) => 1,
+            _ => 0,
+        }
+    }
+}
+
+struct CubeFrame {
+    scene_buffers: SceneBuffers,
+    objects: wgpu::RenderPipeline,
+    mirrors: wgpu::RenderPipeline,
+    pass_bind_group: wgpu::BindGroup,
+    /// Per (source set, cube): the bind group of a mirror reading that cube; index 0 is "no
+    /// cube" ([`CubeFrame::bind_group`]).
+    bind_groups: Vec<wgpu::BindGroup>,
+    own: [Arc<CubeSet>; 2],
+    carried: Option<Arc<CubeHistory>>,
+    /// Per cube and face, its pass uniform; then the main view's.
+    face_offsets: Vec<[u32; 6]>,
+    main_offset: u32,
+    /// Per cube, the scene mirrors its passes draw (not those in its own plane).
+    cube_mirrors: Vec<Vec<usize>>,
+    /// The cube each scene mirror reads (per mirror: its own; scene: the one).
+    reads: Vec<usize>,
+    /// Per cube, its uniform's offset; and the "no cube" uniform's.
+    cube_uniforms: Vec<u32>,
+    no_cube_uniform: u32,
+    all_mirrors: Vec<usize>,
+    cube_count: usize,
+    background: Vec3,
+    config: (u32, bool),
+    read: Cell<Source>,
+    own_levels: [Cell<usize>; 2],
+    drawn: Cell<usize>,
+    preroll: u32,
+    stats: FrameStats,
+}
+
+impl CubeFrame {
+    fn new(
+        gpu: &Gpu,
+        scene: &Scene,
+        shadows: &crate::shadow_maps::ShadowMaps,
+        planned: PlannedCubes,
+    ) -> Result<Self, RasterError> {
+        let PlannedCubes {
+            cubes,
+            size,
+            per_mirror,
+            history,
+            view: (w, h),
+            carried,
+        } = planned;
+        let device = &gpu.device;
+        let faces = 2 * 6 * cubes.len();
+        check_mirror_textures(gpu, &vec![(size, size); faces])?;
+        let scene_buffers = SceneBuffers::new(gpu, scene, shadows.binding());
+        let own = [0, 1].map(|_| {
+            Arc::new(
+                cubes
+                    .iter()
+                    .map(|_| {
+                        [0, 1, 2, 3, 4, 5].map(|_| {
+                            RenderTarget::new(
+                                gpu,
+                                "cube face",
+                                size,
+                                size,
+                                wgpu::TextureUsages::TEXTURE_BINDING,
+                            )
+                        })
+                    })
+                    .collect::<CubeSet>(),
+            )
+        });
+
+        let mut uniforms = UniformArena::new(device);
+        let pass = |clip: Mat4, eye: Vec3, plane: Vec4| PassUniform {
+            clip_from_world: clip.to_cols_array_2d(),
+            eye: eye.to_array(),
+            _pad0: 0.0,
+            plane: plane.to_array(),
+        };
+        let face_offsets: Vec<[u32; 6]> = cubes
+            .iter()
+            .map(|c| {
+                let plane = c.plane.map_or(Vec4::W, |p| p.coefficients());
+                c.faces.map(|f| uniforms.push(&pass(f, c.centre, plane)))
+            })
+            .collect();
+        let camera = scene.camera.with_size(w, h);
+        let main_offset = uniforms.push(&pass(
+            camera_projection(&camera, w, h) * camera.view(),
+            camera.position,
+            Vec4::W,
+        ));
+        // One uniform per cube (the same for every set: the cubes do not move), and "none".
+        let cube_uniforms: Vec<u32> = cubes
+            .iter()
+            .map(|c| {
+                uniforms.push(&CubeUniform {
+                    faces: c.faces.map(|f| f.to_cols_array_2d()),
+                    centre: c.centre.to_array(),
+                    has_cube: 1,
+                    face_size: size as f32,
+                    ..Zeroable::zeroed()
+                })
+            })
+            .collect();
+        let no_cube_uniform = uniforms.push(&CubeUniform {
+            face_size: 1.0,
+            ..Zeroable::zeroed()
+        });
+        let cube_mirrors: Vec<Vec<usize>> = cubes
+            .iter()
+            .map(|c| {
+                (0..scene.mirrors.len())
+                    .filter(|&j| {
+                        c.plane.is_none_or(|p| {
+                            !scene.mirrors[j]
+                                .corners()
+                                .iter()
+                                .all(|x| p.signed_distance(*x).abs() < 1e-5)
+                        })
+                    })
+                    .collect()
+            })
+            .collect();
+        let reads: Vec<usize> = (0..scene.mirrors.len())
+            .map(|j| if per_mirror { j } else { 0 })
+            .collect();
+
+        let buffer = uniforms.buffer(device, "cubemap uniforms");
+        let stages = wgpu::ShaderStages::VERTEX_FRAGMENT;
+        let pass_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("cubemap pass"),
+            entries: &[dynamic_uniform_entry(0, stages)],
+        });
+        let mut cube_entries = vec![dynamic_uniform_entry(0, stages)];
+        cube_entries.extend((1..=6).map(texture_entry));
+        let cube_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("cubemap cube"),
+            entries: &cube_entries,
+        });
+        let pass_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("cubemap pass"),
+            layout: &pass_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: record_binding::<PassUniform>(&buffer),
+            }],
+        });
+        let none = RenderTarget::new(gpu, "no cube", 1, 1, wgpu::TextureUsages::TEXTURE_BINDING);
+        let bind_group = |faces: [&wgpu::TextureView; 6]| {
+            let mut entries = vec![wgpu::BindGroupEntry {
+                binding: 0,
+                resource: record_binding::<CubeUniform>(&buffer),
+            }];
+            entries.extend(faces.iter().enumerate().map(|(k, v)| wgpu::BindGroupEntry {
+                binding: k as u32 + 1,
+                resource: wgpu::BindingResource::TextureView(v),
+            }));
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("cubemap cube"),
+                layout: &cube_layout,
+                entries: &entries,
+            })
+        };
+        // 0: no cube; then own set 0's cubes, own set 1's, the carried set's.
+        let mut bind_groups = vec![bind_group([&none.color_view; 6])];
+        for set in own.iter().chain(carried.iter().map(|c| &c.cubes)) {
+            for cube in set.iter() {
+                bind_groups.push(bind_group(cube.each_ref().map(|t| &t.color_view)));
+            }
+        }
+
+        let clipping = crate::method::Clipping::for_features(gpu.features);
+        let (shader, vertex, fs_object, fs_mirror) = match clipping {
+            crate::method::Clipping::ClipDistances => (
+                shader_module(device, &CLIP_DISTANCE_SHADER),
+                "vs_clip_distances",
+                "fs_object",
+                "fs_mirror",
+            ),
+            _ => (
+                shader_module(device, &SHADER),
+                "vs_main",
+                "fs_object_discard",
+                "fs_mirror_discard",
+            ),
+        };
+        let sl = &scene_buffers.layout;
+        let pipeline = |label: &str, layout: &wgpu::PipelineLayout, fragment: &str| {
+            ScenePipeline {
+                label,
+                layout,
+                module: &shader,
+                vertex,
+                fragment,
+                buffers: &[Some(VERTEX_LAYOUT)],
+                depth_stencil: depth_state(DEPTH_FORMAT, true, NEARER_OR_EQUAL, Default::default()),
+                color_writes: wgpu::ColorWrites::ALL,
+            }
+            .build(gpu)
+        };
+        let objects = pipeline(
+            "cubemap objects",
+            &pipeline_layout(device, "cubemap objects", &[sl, &pass_layout]),
+            fs_object,
+        );
+        let mirrors = pipeline(
+            "cubemap mirrors",
+            &pipeline_layout(device, "cubemap mirrors", &[sl, &pass_layout, &cube_layout]),
+            fs_mirror,
+        );
+
+        let (read, levels) = match &carried {
+            Some(c) => (Source::Carried, c.levels + 1),
+            None => (Source::Nothing, history as usize + 1),
+        };
+        let passes = 6 * cubes.len() + 1;
+        let mirror_draws: usize =
+            6 * cube_mirrors.iter().map(Vec::len).sum::<usize>() + scene.mirrors.len();
+        let object_triangles = scene_buffers.objects.len() / 3;
+        let stats = FrameStats {
+            passes,
+            texture_renders: 6 * cubes.len(),
+            draws: passes + mirror_draws + 1,
+            depth: levels,
+            triangles: passes * object_triangles + 2 * mirror_draws,
+            paths: None,
+            clipping,
+            depth_format: DEPTH_FORMAT,
+            copies: None,
+        };
+        Ok(CubeFrame {
+            scene_buffers,
+            objects,
+            mirrors,
+            pass_bind_group,
+            bind_groups,
+            own,
+            carried,
+            face_offsets,
+            main_offset,
+            cube_mirrors,
+            reads,
+            cube_uniforms,
+            no_cube_uniform,
+            all_mirrors: (0..scene.mirrors.len()).collect(),
+            cube_count: cubes.len(),
+            background: scene.background,
+            config: (size, per_mirror),
+            read: Cell::new(read),
+            own_levels: [Cell::new(0), Cell::new(0)],
+            drawn: Cell::new(0),
+            preroll: if read == Source::Carried { 0 } else { history },
+            stats,
+        })
+    }
+
+    /// Reflections the cubes of `source` hold.
+    fn levels(&self, source: Source) -> usize {
+        match source {
+            Source::Nothing => 0,
+            Source::Carried => self.carried.as_ref().map_or(0, |c| c.levels),
+            Source::Own(i) => self.own_levels[i].get(),
+        }
+    }
+
+    /// The bind group and uniform offset of scene mirror `j` reading the cubes of `source`.
+    fn mirror_binding(&self, source: Source, j: usize) -> (&wgpu::BindGroup, u32) {
+        let cube = self.reads[j];
+        let first = match source {
+            Source::Nothing => return (&self.bind_groups[0], self.no_cube_uniform),
+            Source::Own(i) => 1 + i * self.cube_count,
+            Source::Carried => 1 + 2 * self.cube_count,
+        };
+        (&self.bind_groups[first + cube], self.cube_uniforms[cube])
+    }
+
+    /// One scene pass: the objects, then `mirrors` showing the cubes of `source`.
+    fn draw(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        offset: u32,
+        mirrors: &[usize],
+        source: Source,
+    ) {
+        let b = &self.scene_buffers;
+        pass.set_vertex_buffer(0, b.vertices.slice(..));
+        pass.set_bind_group(0, &b.bind_group, &[]);
+        pass.set_bind_group(1, &self.pass_bind_group, &[offset]);
+        pass.set_pipeline(&self.objects);
+        pass.draw(b.objects.clone(), 0..1);
+        pass.set_pipeline(&self.mirrors);
+        for &j in mirrors {
+            let (group, offset) = self.mirror_binding(source, j);
+            pass.set_bind_group(2, group, &[offset]);
+            pass.draw(b.mirrors[j].clone(), 0..1);
+        }
+    }
+}
+
+impl FrameEncoder for CubeFrame {
+    /// Every cube's six faces into the set the frame writes (their mirrors reading the
+    /// other set, or the carried one), then the main view reading the cubes just drawn.
+    fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &RenderTarget,
+        first_pass: Option<wgpu::RenderPassTimestampWrites<'_>>,
+    ) {
+        let read = self.read.get();
+        let write = read.written();
+        self.own_levels[write].set(self.levels(read) + 1);
+        self.drawn.set(write);
+        let mut first_pass = first_pass;
+        for (c, cube) in self.own[write].iter().enumerate() {
+            for (k, face) in cube.iter().enumerate() {
+                let mut pass = face.begin_pass_with_alpha(
+                    encoder,
+                    "cube face pass",
+                    self.background,
+                    1.0,
+                    first_pass.take(),
+                );
+                self.draw(
+                    &mut pass,
+                    self.face_offsets[c][k],
+                    &self.cube_mirrors[c],
+                    read,
+                );
+            }
+        }
+        let mut pass = target.begin_pass_with_alpha(
+            encoder,
+            "main view pass",
+            self.background,
+            1.0,
+            first_pass.take(),
+        );
+        self.draw(
+            &mut pass,
+            self.main_offset,
+            &self.all_mirrors,
+            Source::Own(write),
+        );
+    }
+
+    fn preroll_frames(&self) -> u32 {
+        self.preroll
+    }
+
+    fn advance(&self) {
+        self.read.set(Source::Own(self.read.get().written()));
+    }
+
+    fn drawn_depth(&self) -> Option<usize> {
+        Some(self.own_levels[self.drawn.get()].get())
+    }
+
+    fn history(&self) -> Option<FrameHistory> {
+        let h = match self.read.get() {
+            Source::Nothing => return None,
+            Source::Carried => self.carried.clone()? as Arc<dyn std::any::Any + Send + Sync>,
+            Source::Own(i) => Arc::new(CubeHistory {
+                cubes: self.own[i].clone(),
+                config: self.config,
+                levels: self.own_levels[i].get(),
+            }),
+        };
+        Some(FrameHistory(h))
+    }
+}
