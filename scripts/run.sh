@@ -7,14 +7,15 @@
 # planes in reports/symmetry_scaling/, the lighting variants (shadows, mirrored lights) in
 # reports/lighting/ and reports/lighting_room/ with the tracer's cost against the mirrored-light
 # depth in reports/lighting/trace_cost.jsonl, the uneven-mirror tricks in reports/uneven_mirrors*/
-# and stereo mirrors (per-eye against shared) in reports/stereo/ (measuring every point again; cached ground truths are
+# stereo mirrors (per-eye against shared) in reports/stereo/ and error over time (feedback, cube maps; still and
+# walking) in reports/motion/ (measuring every point again; cached ground truths are
 # reused when present). It records each step's time and peak memory in
 # reports/main_job.json and fills the README's generated regions from the reports.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 export NODEVICE_SELECT=1
 bin=target/release/mirrorbox
-steps_total=13
+steps_total=14
 step=0
 steps_json=""
 started_at=$(date -u +%Y-%m-%dT%H:%M:%SZ)
@@ -50,6 +51,7 @@ run_step "$bin" symmetry-scaling --fresh
 run_step "$bin" lighting --fresh
 run_step "$bin" bumpy --fresh
 run_step "$bin" stereo --fresh
+run_step "$bin" motion
 run_step env MIRRORBOX="$bin" scripts/lighting-trace-cost.sh
 cpu=$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//; s/"/'"'"'/g')
 cores=$(nproc)

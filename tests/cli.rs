@@ -1811,3 +1811,83 @@ fn time_on_a_camera_path_renders_the_keyed_view() {
         out.stderr
     );
 }
+
+/// `sweep --path` (issue 22): every method and the truth along the camera path, each frame
+/// against its own truth; `feedback` carries its state (one more reflection per frame);
+/// the report, plot and filmstrip are written; bad counts and flags that do not apply to a
+/// sequence are refused (exit 2) before any work.
+#[test]
+fn a_sequence_sweep_compares_every_frame_with_its_truth() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("seq");
+    let out_s = out.to_str().unwrap();
+    let walk = "scenes/mirror_box_walk.json";
+    let size = [
+        "--width", "96", "--height", "54", "--frames", "1", "--warmup", "0",
+    ];
+    let mut args = vec![
+        "sweep",
+        walk,
+        "--out",
+        out_s,
+        "--methods",
+        "feedback,unrolled",
+        "--history",
+        "0",
+        "--depth",
+        "4",
+        "--path",
+        "3",
+        "--fps",
+        "4",
+    ];
+    args.extend(size);
+    let run = mirrorbox(&args, &[]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let records: Vec<Value> = std::fs::read_to_string(out.join("frames.jsonl"))
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(records.len(), 6, "two methods × three frames");
+    let of = |m: &str, field: &str| -> Vec<f64> {
+        records
+            .iter()
+            .filter(|r| r["method"] == m)
+            .map(|r| r[field].as_f64().unwrap())
+            .collect()
+    };
+    assert_eq!(of("feedback history=0", "reflections"), [1.0, 2.0, 3.0]);
+    assert_eq!(of("unrolled depth=4", "reflections"), [4.0, 4.0, 4.0]);
+    assert_eq!(of("unrolled depth=4", "time"), [0.0, 0.25, 0.5]);
+    assert!(
+        of("unrolled depth=4", "flip_mean")
+            .iter()
+            .all(|&f| f < 0.05)
+    );
+    for f in [
+        "report.md",
+        "plot_path.svg",
+        "filmstrip_path_feedback.png",
+        "motion.json",
+    ] {
+        assert!(out.join(f).is_file(), "{f} missing");
+    }
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(report.contains("| feedback history=0 |"), "{report}");
+
+    for (bad, expected) in [
+        (vec!["--path", "0"], "--path must be in [1, 1000]"),
+        (
+            vec!["--path", "2", "--fps", "0"],
+            "--fps must be in (0, 1000]",
+        ),
+        (vec!["--path", "2", "--alpha", "0.5"], "cannot be used with"),
+    ] {
+        let mut args = vec!["sweep", walk, "--out", out_s, "--methods", "unrolled"];
+        args.extend(bad);
+        let run = mirrorbox(&args, &[]);
+        assert_eq!(run.code, 2, "{args:?}: {}", run.stderr);
+        assert!(run.stderr.contains(expected), "{args:?}: {}", run.stderr);
+    }
+}

@@ -53,10 +53,13 @@ pub struct SequenceConfig {
 }
 
 impl SequenceConfig {
-    /// The `mirrorbox motion` preset: the paper's box, a still camera (`feedback`'s
-    /// convergence from its first frame) and the camera walking `mirror_box_walk`'s path at
-    /// three speeds (`feedback` starting from 16 frames at the first view, as if it had been
-    /// showing it), beside `auxiliary` n = 0…4 and an exact method at depth 64.
+    /// The `mirrorbox motion` preset: the paper's box, a still camera (`feedback`'s and
+    /// `cubemap`'s convergence from their first frame) and the camera walking
+    /// `mirror_box_walk`'s path at three speeds (the stateful methods starting from 16
+    /// frames at the first view, as if they had been showing it), beside `auxiliary`
+    /// n = 0…4 and an exact method at depth 64. Each frame is drawn once untimed and once
+    /// timed (its time: one GPU-timestamped frame; the report gives the median over the
+    /// sequence's frames).
     pub fn motion(out: PathBuf, exe: PathBuf, command: String) -> Self {
         let stateless: Vec<Method> = (0..=4)
             .map(|n| Method::parse(&format!("auxiliary n={n}")))
@@ -64,8 +67,13 @@ impl SequenceConfig {
             .collect::<Result<_, _>>()
             .expect("the preset's methods are registered");
         let with_feedback = |history: u32| {
-            let mut m =
-                vec![Method::parse(&format!("feedback history={history}")).expect("feedback")];
+            let mut m: Vec<Method> = [
+                format!("feedback history={history}"),
+                format!("cubemap cube-size=256 history={history}"),
+            ]
+            .iter()
+            .map(|k| Method::parse(k).expect("registered"))
+            .collect();
             m.extend(stateless.iter().cloned());
             m
         };
@@ -98,7 +106,7 @@ impl SequenceConfig {
             width: Some(320),
             height: Some(180),
             warmup: 1,
-            timed: 3,
+            timed: 1,
             exe,
             command,
         }
@@ -245,7 +253,7 @@ pub fn run_sequences(
         size = (truths[0].width, truths[0].height);
         let exposure = mirrorbox_scene::load_scene(&s.scene)?.camera.exposure;
         progress(&format!("{}: truth of {} frames", s.name, s.frames));
-        let mut strip_frames: Vec<(f64, u32)> = Vec::new();
+        let mut filmstrips = Vec::new();
         for method in &s.methods {
             let base = dir.join(format!("{}.png", method.slug()));
             let mut args = vec!["render".to_string()];
@@ -272,7 +280,11 @@ pub fn run_sequences(
                     summaries.len()
                 )));
             }
-            let is_feedback = method.name() == "feedback";
+            // A stateful method's worst frames go into a filmstrip.
+            let stateful = method
+                .entry()
+                .accepts(&mirrorbox_raster::methods::feedback::HISTORY);
+            let mut flips: Vec<(f64, u32)> = Vec::new();
             for (k, summary) in (0..s.frames).zip(&summaries) {
                 let image = read_image(&frame_path(&base, k).with_extension("exr"))?;
                 let m = mirrorbox_image::metrics::compare(&truths[k as usize], &image, exposure)?;
@@ -291,9 +303,24 @@ pub fn run_sequences(
                     passes: summary["passes"].as_u64().unwrap_or(0) as usize,
                     reflections: summary["depth"].as_u64().unwrap_or(0) as usize,
                 });
-                if is_feedback {
-                    strip_frames.push((m.flip_mean, k));
-                }
+                flips.push((m.flip_mean, k));
+            }
+            if stateful {
+                let name = format!("filmstrip_{}_{}.png", s.name, method.name());
+                flips.sort_by(|a, b| b.0.total_cmp(&a.0));
+                let mut worst: Vec<u32> = flips.iter().take(3).map(|f| f.1).collect();
+                worst.sort_unstable();
+                let rows: Vec<(RgbImage, RgbImage)> = worst
+                    .iter()
+                    .map(|&k| {
+                        Ok((
+                            truths[k as usize].clone(),
+                            read_image(&frame_path(&base, k).with_extension("exr"))?,
+                        ))
+                    })
+                    .collect::<Result<_, HarnessError>>()?;
+                write_filmstrip(&config.out.join(&name), &rows, exposure)?;
+                filmstrips.push((method.key(), name, worst));
             }
             progress(&format!(
                 "{}: {} over {} frames",
@@ -302,31 +329,6 @@ pub fn run_sequences(
                 s.frames
             ));
         }
-        let filmstrip = if strip_frames.is_empty() {
-            None
-        } else {
-            let name = format!("filmstrip_{}.png", s.name);
-            let feedback = s
-                .methods
-                .iter()
-                .find(|m| m.name() == "feedback")
-                .expect("a feedback frame was recorded");
-            strip_frames.sort_by(|a, b| b.0.total_cmp(&a.0));
-            let mut picked: Vec<u32> = strip_frames.iter().take(3).map(|f| f.1).collect();
-            picked.sort_unstable();
-            let base = dir.join(format!("{}.png", feedback.slug()));
-            let rows: Vec<(RgbImage, RgbImage)> = picked
-                .iter()
-                .map(|&k| {
-                    Ok((
-                        truths[k as usize].clone(),
-                        read_image(&frame_path(&base, k).with_extension("exr"))?,
-                    ))
-                })
-                .collect::<Result<_, HarnessError>>()?;
-            write_filmstrip(&config.out.join(&name), &rows, exposure)?;
-            Some(name)
-        };
         scenarios.push(ScenarioInfo {
             name: s.name.clone(),
             description: s.description.clone(),
@@ -334,7 +336,7 @@ pub fn run_sequences(
             frames: s.frames,
             fps: s.fps,
             step: camera_step(s)?,
-            filmstrip,
+            filmstrips,
         });
     }
     let info = MotionInfo {

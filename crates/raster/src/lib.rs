@@ -8,6 +8,7 @@
 //!   parameters, frame stats; [`registry`]: the table looked up, configured [`Method`]s and
 //!   their keys.
 //! - [`exact_paths`]: the exact methods' options and reflection-path planning.
+//! - [`ping_pong`]: the frame-to-frame state of the stateful methods (`feedback`, `cubemap`).
 //! - [`culling`]: footprint rectangles and parts against a path's portal.
 //! - [`symmetry_cells`]: seed 001's symmetry cascade on the CPU — copy transforms, cells,
 //!   which copies a frame can leave out.
@@ -26,6 +27,7 @@ pub mod gpu;
 pub mod lighting;
 pub mod method;
 pub mod methods;
+pub mod ping_pong;
 pub mod pipeline;
 pub mod plan;
 pub mod projection;

@@ -42,8 +42,8 @@ pub struct ScenarioInfo {
     pub fps: f64,
     /// Median distance the camera moves per frame, scene units (0 for a still camera).
     pub step: f64,
-    /// Filmstrip image of the scenario's worst `feedback` frames, if written.
-    pub filmstrip: Option<String>,
+    /// Filmstrips of the stateful methods' worst frames: (method, image, frames shown).
+    pub filmstrips: Vec<(String, String, Vec<u32>)>,
 }
 
 /// What every frame of a motion sweep shares.
@@ -154,11 +154,10 @@ pub fn document(info: &MotionInfo, records: &[FrameRecord]) -> String {
             let _ = writeln!(md, "- {line}");
         }
         let _ = writeln!(md, "\n![FLIP against frame, {0}](plot_{0}.svg)\n", s.name);
-        if let Some(strip) = &s.filmstrip {
+        for (method, strip, worst) in &s.filmstrips {
             let _ = writeln!(
                 md,
-                "Worst `feedback` frames (truth | feedback | FLIP error, brighter is worse):\n\n![{0}]({0})\n",
-                strip
+                "`{method}`, its worst frames {worst:?} (truth | {method} | FLIP error, brighter is worse):\n\n![{strip}]({strip})\n"
             );
         }
     }
@@ -277,6 +276,108 @@ pub fn write_motion_report(
     write_text(&dir.join("report.md"), &document(info, records))
 }
 
+/// Reads a motion report's records and info (bounded: a report folder is the user's).
+pub fn read_motion(dir: &Path) -> Result<(MotionInfo, Vec<FrameRecord>), String> {
+    let text = |name: &str, what: &str| {
+        mirrorbox_files::read_bounded_text(&dir.join(name), 64 << 20, what)
+            .map_err(|e| e.to_string())
+    };
+    let info: MotionInfo = serde_json::from_str(&text("motion.json", "a motion report's info")?)
+        .map_err(|e| format!("{}: {e}", dir.join("motion.json").display()))?;
+    let records = text("frames.jsonl", "a motion report's frames")?
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty())
+        .map(|(i, l)| {
+            serde_json::from_str(l)
+                .map_err(|e| format!("{}:{}: {e}", dir.join("frames.jsonl").display(), i + 1))
+        })
+        .collect::<Result<_, _>>()?;
+    Ok((info, records))
+}
+
+/// The README's summary: per scenario, each method's mean and last-frame FLIP and its
+/// median time, and `feedback`'s settling frame on the still camera.
+pub fn readme_region(info: &MotionInfo, records: &[FrameRecord]) -> String {
+    let mut md = format!(
+        "Measured by `mirrorbox motion` ({}, {}×{}, {}; report: [`reports/motion/report.md`](reports/motion/report.md)). FLIP mean against each frame's truth:\n\n",
+        info.device, info.width, info.height, info.date
+    );
+    let mut head = String::from("| method |");
+    let mut rule = String::from("|---|");
+    for s in &info.scenarios {
+        let _ = write!(head, " {} ({:.3}/frame): mean, last |", s.name, s.step);
+        rule.push_str("---|");
+    }
+    head.push_str(" ms/frame (median, still) |");
+    rule.push_str("---|");
+    let _ = writeln!(md, "{head}\n{rule}");
+    let Some(first) = info.scenarios.first() else {
+        return md;
+    };
+    // Rows by method family (stateful methods' history differs between scenarios).
+    let family = |m: &str| match m.split_once(" history=") {
+        Some((base, _)) => base.to_string(),
+        None => m.to_string(),
+    };
+    let mut rows: Vec<String> = Vec::new();
+    for r in records {
+        let f = family(&r.method);
+        if !rows.contains(&f) {
+            rows.push(f);
+        }
+    }
+    for row in rows {
+        let _ = write!(md, "| {row} |");
+        for s in &info.scenarios {
+            let f: Vec<&FrameRecord> = methods(records, &s.name)
+                .into_iter()
+                .filter(|m| family(m) == row)
+                .flat_map(|m| frames(records, &s.name, m))
+                .collect();
+            let flips: Vec<f64> = f.iter().map(|r| r.flip_mean).collect();
+            if flips.is_empty() {
+                md.push_str(" – |");
+            } else {
+                let _ = write!(
+                    md,
+                    " {}, {} |",
+                    sci(flips.iter().sum::<f64>() / flips.len() as f64),
+                    sci(*flips.last().unwrap_or(&0.0))
+                );
+            }
+        }
+        let ms: Vec<f64> = methods(records, &first.name)
+            .into_iter()
+            .filter(|m| family(m) == row)
+            .flat_map(|m| frames(records, &first.name, m))
+            .map(|r| r.ms)
+            .collect();
+        let _ = writeln!(md, " {:.1} |", median(&ms));
+    }
+    md.push('\n');
+    for s in info.scenarios.iter().filter(|s| s.step == 0.0) {
+        for m in methods(records, &s.name) {
+            if !m.contains("history=") {
+                continue;
+            }
+            let flips: Vec<f64> = frames(records, &s.name, m)
+                .iter()
+                .map(|r| r.flip_mean)
+                .collect();
+            if let Some(k) = settled_after(&flips, 0.05) {
+                let _ = writeln!(
+                    md,
+                    "- {}: `{m}` settles from frame {k} (FLIP within 5 % of its last frame's, {}).",
+                    s.name,
+                    sci(*flips.last().unwrap_or(&0.0))
+                );
+            }
+        }
+    }
+    md
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -340,7 +441,7 @@ mod tests {
                     frames: 4,
                     fps: 30.0,
                     step: 0.0,
-                    filmstrip: None,
+                    filmstrips: Vec::new(),
                 }],
             },
             &r,

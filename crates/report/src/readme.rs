@@ -101,6 +101,11 @@ pub const REGIONS: &[(&str, &str, &str)] = &[
         "the tracer against Mitsuba 3 side by side (scripts/bench-tracer.sh)",
     ),
     (
+        "motion",
+        "motion",
+        "error over time: feedback, cubemap, auxiliary and an exact method, still and walking (mirrorbox motion)",
+    ),
+    (
         "lighting-trace-cost",
         "lighting/trace_cost.jsonl",
         "the tracer's time against the mirrored-light depth k on both lit scenes",
@@ -562,6 +567,11 @@ pub fn generate(id: &str, reports: &Path) -> Result<Region, ReadmeError> {
             crate::runs::threads_region(&folder(source), cpu.trim())?
         }
         "main-job" => main_job_region(&folder(source))?,
+        "motion" => {
+            let (info, records) =
+                crate::motion::read_motion(&folder(source)).map_err(ReadmeError)?;
+            crate::motion::readme_region(&info, &records)
+        }
         "viewer-frame-rates" | "tracer-bench" => report_body_region(&folder(source))?,
         _ => unreachable!("every ID in REGIONS has a generator"),
     };

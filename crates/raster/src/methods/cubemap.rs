@@ -19,6 +19,7 @@ use crate::method::{
 };
 use crate::methods::feedback::HISTORY;
 use crate::methods::recursive_texture::check_mirror_textures;
+use crate::ping_pong::{Carried, PingPong, Source};
 use crate::pipeline::{
     ScenePipeline, UniformArena, depth_state, dynamic_uniform_entry, pipeline_layout,
     record_binding,
@@ -32,7 +33,6 @@ use crate::wgsl::{HostLayout, shader_module};
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3, Vec4};
 use mirrorbox_scene::{Camera, Plane, Scene};
-use std::cell::Cell;
 use std::sync::Arc;
 
 /// Cube-map reflections (issue 22).
@@ -207,7 +207,7 @@ struct PlannedCubes {
     per_mirror: bool,
     history: u32,
     view: (u32, u32),
-    carried: Option<Arc<CubeHistory>>,
+    carried: Option<Carried<CubeHistory>>,
 }
 
 /// One set of cube maps (six faces each).
@@ -218,17 +218,15 @@ struct CubeHistory {
     cubes: Arc<CubeSet>,
     /// Face size and centre choice (another configuration starts afresh).
     config: (u32, bool),
-    levels: usize,
 }
 
 impl PlannedFrame for PlannedCubes {
     fn continue_from(&mut self, history: FrameHistory) {
         let config = (self.size, self.per_mirror);
-        self.carried = history
-            .0
-            .downcast::<CubeHistory>()
-            .ok()
-            .filter(|h| h.config == config && h.cubes.len() == self.cubes.len());
+        let cubes = self.cubes.len();
+        self.carried = PingPong::carried_from(history, |h: &CubeHistory| {
+            h.config == config && h.cubes.len() == cubes
+        });
     }
 
     fn build(
@@ -268,23 +266,6 @@ struct CubeUniform {
     _pad2: f32,
 }
 
-/// The cube sets a pass reads: none yet, the carried one, or this frame's set 0 or 1.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Source {
-    Nothing,
-    Carried,
-    Own(usize),
-}
-
-impl Source {
-    fn written(self) -> usize {
-        match self {
-            Source::Own(0) => 1,
-            _ => 0,
-        }
-    }
-}
-
 struct CubeFrame {
     scene_buffers: SceneBuffers,
     objects: wgpu::RenderPipeline,
@@ -294,7 +275,7 @@ struct CubeFrame {
     /// cube" ([`CubeFrame::bind_group`]).
     bind_groups: Vec<wgpu::BindGroup>,
     own: [Arc<CubeSet>; 2],
-    carried: Option<Arc<CubeHistory>>,
+    state: PingPong<CubeHistory>,
     /// Per cube and face, its pass uniform; then the main view's.
     face_offsets: Vec<[u32; 6]>,
     main_offset: u32,
@@ -309,10 +290,6 @@ struct CubeFrame {
     cube_count: usize,
     background: Vec3,
     config: (u32, bool),
-    read: Cell<Source>,
-    own_levels: [Cell<usize>; 2],
-    drawn: Cell<usize>,
-    preroll: u32,
     stats: FrameStats,
 }
 
@@ -331,6 +308,7 @@ impl CubeFrame {
             view: (w, h),
             carried,
         } = planned;
+        let state = PingPong::new(carried, history);
         let device = &gpu.device;
         let faces = 2 * 6 * cubes.len();
         check_mirror_textures(gpu, &vec![(size, size); faces])?;
@@ -448,7 +426,7 @@ impl CubeFrame {
         };
         // 0: no cube; then own set 0's cubes, own set 1's, the carried set's.
         let mut bind_groups = vec![bind_group([&none.color_view; 6])];
-        for set in own.iter().chain(carried.iter().map(|c| &c.cubes)) {
+        for set in own.iter().chain(state.carried().map(|c| &c.cubes)) {
             for cube in set.iter() {
                 bind_groups.push(bind_group(cube.each_ref().map(|t| &t.color_view)));
             }
@@ -494,10 +472,6 @@ impl CubeFrame {
             fs_mirror,
         );
 
-        let (read, levels) = match &carried {
-            Some(c) => (Source::Carried, c.levels + 1),
-            None => (Source::Nothing, history as usize + 1),
-        };
         let passes = 6 * cubes.len() + 1;
         let mirror_draws: usize =
             6 * cube_mirrors.iter().map(Vec::len).sum::<usize>() + scene.mirrors.len();
@@ -506,7 +480,7 @@ impl CubeFrame {
             passes,
             texture_renders: 6 * cubes.len(),
             draws: passes + mirror_draws + 1,
-            depth: levels,
+            depth: state.first_depth(),
             triangles: passes * object_triangles + 2 * mirror_draws,
             paths: None,
             clipping,
@@ -520,7 +494,7 @@ impl CubeFrame {
             pass_bind_group,
             bind_groups,
             own,
-            carried,
+            state,
             face_offsets,
             main_offset,
             cube_mirrors,
@@ -531,21 +505,8 @@ impl CubeFrame {
             cube_count: cubes.len(),
             background: scene.background,
             config: (size, per_mirror),
-            read: Cell::new(read),
-            own_levels: [Cell::new(0), Cell::new(0)],
-            drawn: Cell::new(0),
-            preroll: if read == Source::Carried { 0 } else { history },
             stats,
         })
-    }
-
-    /// Reflections the cubes of `source` hold.
-    fn levels(&self, source: Source) -> usize {
-        match source {
-            Source::Nothing => 0,
-            Source::Carried => self.carried.as_ref().map_or(0, |c| c.levels),
-            Source::Own(i) => self.own_levels[i].get(),
-        }
     }
 
     /// The bind group and uniform offset of scene mirror `j` reading the cubes of `source`.
@@ -591,10 +552,7 @@ impl FrameEncoder for CubeFrame {
         target: &RenderTarget,
         first_pass: Option<wgpu::RenderPassTimestampWrites<'_>>,
     ) {
-        let read = self.read.get();
-        let write = read.written();
-        self.own_levels[write].set(self.levels(read) + 1);
-        self.drawn.set(write);
+        let (read, write) = self.state.begin_frame();
         let mut first_pass = first_pass;
         for (c, cube) in self.own[write].iter().enumerate() {
             for (k, face) in cube.iter().enumerate() {
@@ -629,27 +587,23 @@ impl FrameEncoder for CubeFrame {
     }
 
     fn preroll_frames(&self) -> u32 {
-        self.preroll
+        self.state.preroll()
     }
 
     fn advance(&self) {
-        self.read.set(Source::Own(self.read.get().written()));
+        self.state.advance()
     }
 
     fn drawn_depth(&self) -> Option<usize> {
-        Some(self.own_levels[self.drawn.get()].get())
+        Some(self.state.drawn_depth())
     }
 
     fn history(&self) -> Option<FrameHistory> {
-        let h = match self.read.get() {
-            Source::Nothing => return None,
-            Source::Carried => self.carried.clone()? as Arc<dyn std::any::Any + Send + Sync>,
-            Source::Own(i) => Arc::new(CubeHistory {
+        self.state.history(|i| {
+            Arc::new(CubeHistory {
                 cubes: self.own[i].clone(),
                 config: self.config,
-                levels: self.own_levels[i].get(),
-            }),
-        };
-        Some(FrameHistory(h))
+            })
+        })
     }
 }

@@ -26,6 +26,7 @@ use crate::method::{
 use crate::methods::recursive_texture::{
     MirrorUniform, SHADERS, ScreenSpace, TexturePipelines, check_mirror_textures, gpu_structs,
 };
+use crate::ping_pong::{Carried, PingPong, Source};
 use crate::pipeline::UniformArena;
 use crate::plan::{MirrorCamera, PlanError, Rect};
 use crate::shading::SceneBuffers;
@@ -34,7 +35,6 @@ use crate::timing::{FrameEncoder, FrameHistory};
 use bytemuck::Zeroable;
 use glam::{Mat4, Vec3, Vec4};
 use mirrorbox_scene::Scene;
-use std::cell::Cell;
 use std::sync::Arc;
 
 /// Previous-frame feedback (issue 22): one texture per mirror per frame.
@@ -106,7 +106,7 @@ struct PlannedFeedback {
     screen: ScreenSpace,
     cameras: Vec<MirrorCamera>,
     history: u32,
-    carried: Option<Arc<FeedbackHistory>>,
+    carried: Option<Carried<FeedbackHistory>>,
 }
 
 /// One texture of a set: which mirror, the screen region it covers, and the camera it was
@@ -124,18 +124,12 @@ struct FeedbackHistory {
     cameras: Arc<Vec<TextureCamera>>,
     /// The render size they were drawn at (another size starts afresh).
     size: (u32, u32),
-    /// Reflections the textures hold (a mirror's own reflection counted).
-    levels: usize,
 }
 
 impl PlannedFrame for PlannedFeedback {
     fn continue_from(&mut self, history: FrameHistory) {
         let size = (self.screen.width, self.screen.height);
-        self.carried = history
-            .0
-            .downcast::<FeedbackHistory>()
-            .ok()
-            .filter(|h| h.size == size);
+        self.carried = PingPong::carried_from(history, |h: &FeedbackHistory| h.size == size);
     }
 
     fn build(
@@ -151,35 +145,6 @@ impl PlannedFrame for PlannedFeedback {
             warnings: Vec::new(),
             bake_ms: None,
         })
-    }
-}
-
-/// The textures a pass reads.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Source {
-    /// None yet (the first frame): inner mirrors show the depth cap.
-    Nothing,
-    /// The previous view's (a sequence's previous frame).
-    Carried,
-    /// This view's set 0 or 1.
-    Own(usize),
-}
-
-impl Source {
-    fn index(self) -> usize {
-        match self {
-            Source::Nothing => 0,
-            Source::Carried => 1,
-            Source::Own(i) => 2 + i,
-        }
-    }
-
-    /// The set a frame reading `self` writes.
-    fn written(self) -> usize {
-        match self {
-            Source::Own(0) => 1,
-            _ => 0,
-        }
     }
 }
 
@@ -199,20 +164,14 @@ struct FeedbackFrame {
     /// This view's two texture sets (one per camera each).
     own: [Arc<Vec<RenderTarget>>; 2],
     cameras: Arc<Vec<TextureCamera>>,
-    carried: Option<Arc<FeedbackHistory>>,
-    /// Per read source ([`Source::index`]), each camera pass's mirror draws.
+    state: PingPong<FeedbackHistory>,
+    /// Per read source ([`source_index`]), each camera pass's mirror draws.
     camera_draws: [Vec<Vec<Draw>>; 4],
     camera_offsets: Vec<u32>,
     /// The main pass's draws applying own set 0 or 1.
     main_draws: [Vec<Draw>; 2],
     main_offset: u32,
     background: Vec3,
-    /// What the next frame reads, and the reflections each own set holds.
-    read: Cell<Source>,
-    own_levels: [Cell<usize>; 2],
-    /// The set the frame last encoded wrote.
-    drawn: Cell<usize>,
-    preroll: u32,
     size: (u32, u32),
     stats: FrameStats,
 }
@@ -231,6 +190,7 @@ impl FeedbackFrame {
             carried,
         } = planned;
         let (w, h) = (screen.width, screen.height);
+        let state = PingPong::new(carried, history);
         let device = &gpu.device;
         let scene_buffers = SceneBuffers::new(gpu, scene, shadows.binding());
         let cameras: Vec<TextureCamera> = mirror_cameras
@@ -301,7 +261,7 @@ impl FeedbackFrame {
         let own_base = [1, 1 + cameras.len()];
         views.extend(own.iter().flat_map(|set| set.iter().map(|t| &t.color_view)));
         let carried_base = views.len();
-        if let Some(c) = &carried {
+        if let Some(c) = state.carried() {
             views.extend(c.textures.iter().map(|t| &t.color_view));
         }
 
@@ -311,7 +271,7 @@ impl FeedbackFrame {
         let mut draws_reading = |source: Source, plane: Option<&mirrorbox_scene::Plane>| {
             let set: Option<(&[TextureCamera], usize)> = match source {
                 Source::Nothing => None,
-                Source::Carried => carried.as_ref().map(|c| (&c.cameras[..], carried_base)),
+                Source::Carried => state.carried().map(|c| (&c.cameras[..], carried_base)),
                 Source::Own(i) => Some((&cameras[..], own_base[i])),
             };
             let mut draws = Vec::new();
@@ -395,12 +355,13 @@ impl FeedbackFrame {
             .map(|v| pipelines.mirror_bind_group(gpu, &buffer, v))
             .collect();
 
-        let (read, levels) = match &carried {
-            Some(c) => (Source::Carried, c.levels + 1),
-            None => (Source::Nothing, history as usize + 1),
+        let read = if state.carried().is_some() {
+            Source::Carried
+        } else {
+            Source::Nothing
         };
         let passes = cameras.len() + 1;
-        let mirror_draws = camera_draws[read.index()]
+        let mirror_draws = camera_draws[source_index(read)]
             .iter()
             .map(Vec::len)
             .sum::<usize>()
@@ -410,7 +371,7 @@ impl FeedbackFrame {
             passes,
             texture_renders: cameras.len(),
             draws: passes + mirror_draws + 1,
-            depth: levels,
+            depth: state.first_depth(),
             triangles: passes * object_triangles + 2 * mirror_draws,
             paths: None,
             clipping: pipelines.clipping,
@@ -424,28 +385,15 @@ impl FeedbackFrame {
             bind_groups,
             own,
             cameras: Arc::new(cameras),
-            carried,
+            state,
             camera_draws,
             camera_offsets,
             main_draws,
             main_offset,
             background: scene.background,
-            read: Cell::new(read),
-            own_levels: [Cell::new(0), Cell::new(0)],
-            drawn: Cell::new(0),
-            preroll: if read == Source::Carried { 0 } else { history },
             size: (w, h),
             stats,
         })
-    }
-
-    /// Reflections the textures of `source` hold.
-    fn levels(&self, source: Source) -> usize {
-        match source {
-            Source::Nothing => 0,
-            Source::Carried => self.carried.as_ref().map_or(0, |c| c.levels),
-            Source::Own(i) => self.own_levels[i].get(),
-        }
     }
 
     fn draws<'a>(
@@ -467,10 +415,7 @@ impl FrameEncoder for FeedbackFrame {
         target: &RenderTarget,
         first_pass: Option<wgpu::RenderPassTimestampWrites<'_>>,
     ) {
-        let read = self.read.get();
-        let write = read.written();
-        self.own_levels[write].set(self.levels(read) + 1);
-        self.drawn.set(write);
+        let (read, write) = self.state.begin_frame();
         let mut first_pass = first_pass;
         for (k, texture) in self.own[write].iter().enumerate() {
             let mut pass = texture.begin_pass_with_alpha(
@@ -480,7 +425,7 @@ impl FrameEncoder for FeedbackFrame {
                 1.0,
                 first_pass.take(),
             );
-            let draws = self.draws(&self.camera_draws[read.index()][k]);
+            let draws = self.draws(&self.camera_draws[source_index(read)][k]);
             self.pipelines.draw(
                 &mut pass,
                 &self.scene_buffers,
@@ -506,28 +451,33 @@ impl FrameEncoder for FeedbackFrame {
     }
 
     fn preroll_frames(&self) -> u32 {
-        self.preroll
+        self.state.preroll()
     }
 
     fn advance(&self) {
-        self.read.set(Source::Own(self.read.get().written()));
+        self.state.advance()
     }
 
     fn drawn_depth(&self) -> Option<usize> {
-        Some(self.own_levels[self.drawn.get()].get())
+        Some(self.state.drawn_depth())
     }
 
     fn history(&self) -> Option<FrameHistory> {
-        let h = match self.read.get() {
-            Source::Nothing => return None,
-            Source::Carried => self.carried.clone()? as Arc<dyn std::any::Any + Send + Sync>,
-            Source::Own(i) => Arc::new(FeedbackHistory {
+        self.state.history(|i| {
+            Arc::new(FeedbackHistory {
                 textures: self.own[i].clone(),
                 cameras: self.cameras.clone(),
                 size: self.size,
-                levels: self.own_levels[i].get(),
-            }),
-        };
-        Some(FrameHistory(h))
+            })
+        })
+    }
+}
+
+/// The index of a read source in [`FeedbackFrame::camera_draws`].
+fn source_index(source: Source) -> usize {
+    match source {
+        Source::Nothing => 0,
+        Source::Carried => 1,
+        Source::Own(i) => 2 + i,
     }
 }
