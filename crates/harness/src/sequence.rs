@@ -6,8 +6,8 @@
 //! truth, `render --sequence` per method — so a stateful method (`feedback`) carries its
 //! state from frame to frame as an engine would, and whatever lavapipe leaves behind per
 //! frame (see [`crate::worker`]) goes back to the system when the sequence's process exits.
-//! The frames land in `OUT/cache/<scenario>/` (not kept in git); the records, plots and the
-//! filmstrips of the worst frames in `OUT/`.
+//! The frames land in `OUT/cache/<scenario>/` and are removed once compared; the records,
+//! plots and the filmstrips of the stateful methods' worst frames stay in `OUT/`.
 
 use crate::HarnessError;
 use mirrorbox_image::{RgbImage, read_image};
@@ -180,15 +180,16 @@ fn frame_path(base: &Path, k: u32) -> PathBuf {
 }
 
 /// The sequence flags every child shares.
-fn sequence_flags(config: &SequenceConfig, s: &Scenario) -> Vec<String> {
+/// The flags of frames `first .. first + count` of `s`.
+fn sequence_flags(config: &SequenceConfig, s: &Scenario, first: u32, count: u32) -> Vec<String> {
     let mut flags = vec![
         s.scene.display().to_string(),
         "--sequence".into(),
-        s.frames.to_string(),
+        count.to_string(),
         "--fps".into(),
         s.fps.to_string(),
         "--time".into(),
-        s.start.to_string(),
+        (s.start + f64::from(first) / s.fps).to_string(),
     ];
     for (flag, v) in [("--width", config.width), ("--height", config.height)] {
         if let Some(v) = v {
@@ -221,6 +222,71 @@ fn camera_step(s: &Scenario) -> Result<f64, HarnessError> {
     })
 }
 
+/// Scene passes one child process may execute (frames × draws × passes per frame): Mesa
+/// 22.3's lavapipe keeps about 4 MB per executed pass until the process exits (measured:
+/// `auxiliary n=4`, 139 passes, 560 MB per frame), so a stateless method's sequence is split
+/// into processes of at most this many passes, about 2.4 GB each. A stateful method's
+/// sequence stays in one process (its state lives there); it draws few passes per frame.
+pub const MAX_PASSES_PER_PROCESS: u64 = 600;
+
+/// Renders `method`'s frames of `s` in child processes: one per sequence for a stateful
+/// method, chunks within [`MAX_PASSES_PER_PROCESS`] for the others (sized by the first
+/// frame's pass count). Returns each frame's summary and its EXR.
+fn render_sequence(
+    config: &SequenceConfig,
+    s: &Scenario,
+    method: &Method,
+    dir: &Path,
+) -> Result<(Vec<serde_json::Value>, Vec<PathBuf>), HarnessError> {
+    let stateful = method
+        .entry()
+        .accepts(&mirrorbox_raster::methods::feedback::HISTORY);
+    let draws = u64::from(config.warmup + config.timed);
+    let mut summaries: Vec<serde_json::Value> = Vec::new();
+    let mut images = Vec::new();
+    let mut first = 0;
+    while first < s.frames {
+        let count = match summaries.first() {
+            _ if stateful => s.frames,
+            None => 1,
+            Some(one) => {
+                let passes = one["passes"].as_u64().unwrap_or(1).max(1);
+                (MAX_PASSES_PER_PROCESS / (passes * draws.max(1))).clamp(1, u64::from(s.frames))
+                    as u32
+            }
+        }
+        .min(s.frames - first);
+        let base = dir.join(format!("{}_{first:04}.png", method.slug()));
+        let mut args = vec!["render".to_string()];
+        args.extend(sequence_flags(config, s, first, count));
+        args.extend(method_flags(method));
+        args.extend([
+            "--warmup".into(),
+            config.warmup.to_string(),
+            "--frames".into(),
+            config.timed.to_string(),
+            "--json".into(),
+            "-o".into(),
+            base.display().to_string(),
+        ]);
+        let stdout = run(&config.exe, &args)?;
+        let printed: Vec<serde_json::Value> = stdout
+            .lines()
+            .filter_map(|l| serde_json::from_str(l).ok())
+            .collect();
+        if printed.len() != count as usize {
+            return Err(HarnessError::Worker(format!(
+                "render --sequence {count} printed {} frame summaries",
+                printed.len()
+            )));
+        }
+        summaries.extend(printed);
+        images.extend((0..count).map(|j| frame_path(&base, j)));
+        first += count;
+    }
+    Ok((summaries, images))
+}
+
 /// Runs every scenario, writes the report into `config.out`, and returns the records.
 /// `progress` hears one line per finished sequence.
 pub fn run_sequences(
@@ -243,7 +309,7 @@ pub fn run_sequences(
         std::fs::create_dir_all(&dir).map_err(io(&dir))?;
         let truth_base = dir.join("truth.exr");
         let mut args = vec!["trace".to_string()];
-        args.extend(sequence_flags(config, s));
+        args.extend(sequence_flags(config, s, 0, s.frames));
         args.extend(["--spp".into(), "1".into(), "-o".into()]);
         args.push(truth_base.display().to_string());
         run(&config.exe, &args)?;
@@ -255,38 +321,14 @@ pub fn run_sequences(
         progress(&format!("{}: truth of {} frames", s.name, s.frames));
         let mut filmstrips = Vec::new();
         for method in &s.methods {
-            let base = dir.join(format!("{}.png", method.slug()));
-            let mut args = vec!["render".to_string()];
-            args.extend(sequence_flags(config, s));
-            args.extend(method_flags(method));
-            args.extend([
-                "--warmup".into(),
-                config.warmup.to_string(),
-                "--frames".into(),
-                config.timed.to_string(),
-                "--json".into(),
-                "-o".into(),
-                base.display().to_string(),
-            ]);
-            let stdout = run(&config.exe, &args)?;
-            let summaries: Vec<serde_json::Value> = stdout
-                .lines()
-                .filter_map(|l| serde_json::from_str(l).ok())
-                .collect();
-            if summaries.len() != s.frames as usize {
-                return Err(HarnessError::Worker(format!(
-                    "render --sequence {} printed {} frame summaries",
-                    s.frames,
-                    summaries.len()
-                )));
-            }
+            let (summaries, images) = render_sequence(config, s, method, &dir)?;
             // A stateful method's worst frames go into a filmstrip.
             let stateful = method
                 .entry()
                 .accepts(&mirrorbox_raster::methods::feedback::HISTORY);
             let mut flips: Vec<(f64, u32)> = Vec::new();
             for (k, summary) in (0..s.frames).zip(&summaries) {
-                let image = read_image(&frame_path(&base, k).with_extension("exr"))?;
+                let image = read_image(&images[k as usize])?;
                 let m = mirrorbox_image::metrics::compare(&truths[k as usize], &image, exposure)?;
                 device = summary["adapter"].as_str().unwrap_or("").to_string();
                 records.push(FrameRecord {
@@ -312,12 +354,7 @@ pub fn run_sequences(
                 worst.sort_unstable();
                 let rows: Vec<(RgbImage, RgbImage)> = worst
                     .iter()
-                    .map(|&k| {
-                        Ok((
-                            truths[k as usize].clone(),
-                            read_image(&frame_path(&base, k).with_extension("exr"))?,
-                        ))
-                    })
+                    .map(|&k| Ok((truths[k as usize].clone(), read_image(&images[k as usize])?)))
                     .collect::<Result<_, HarnessError>>()?;
                 write_filmstrip(&config.out.join(&name), &rows, exposure)?;
                 filmstrips.push((method.key(), name, worst));
@@ -329,6 +366,9 @@ pub fn run_sequences(
                 s.frames
             ));
         }
+        // The frames are compared and the filmstrips drawn: their images go (a scenario's
+        // are ~150 MB at the preset's size).
+        std::fs::remove_dir_all(&dir).map_err(io(&dir))?;
         scenarios.push(ScenarioInfo {
             name: s.name.clone(),
             description: s.description.clone(),
@@ -339,6 +379,8 @@ pub fn run_sequences(
             filmstrips,
         });
     }
+    // The cache folder held only the scenarios' frames.
+    let _ = std::fs::remove_dir(config.out.join("cache"));
     let info = MotionInfo {
         command: config.command.clone(),
         date: crate::now_rfc3339(),

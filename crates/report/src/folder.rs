@@ -44,6 +44,13 @@ pub(crate) fn load_sweep(dir: &Path) -> Result<Sweep, ReadmeError> {
 /// Rewrites `results.csv`, `report.md`, `report.html` and the plots of the sweep folder `dir`
 /// from its `sweep.json` and `results.jsonl`; returns the number of records reported.
 pub fn rewrite_report(dir: &Path) -> Result<usize, ReadmeError> {
+    // A sequence sweep's folder (`mirrorbox motion`, `sweep --path`) has its own files.
+    if dir.join("motion.json").is_file() && !dir.join("sweep.json").exists() {
+        let (info, records) = crate::motion::read_motion(dir).map_err(ReadmeError)?;
+        crate::motion::write_motion_report(dir, &info, &records)
+            .map_err(|e| ReadmeError(e.to_string()))?;
+        return Ok(records.len());
+    }
     let sweep = load_sweep(dir)?;
     write_report(dir, &sweep.info, &sweep.records).map_err(|e| ReadmeError(e.to_string()))?;
     Ok(sweep.records.len())

@@ -97,14 +97,17 @@ pub fn document(info: &MotionInfo, records: &[FrameRecord]) -> String {
     let mut md = String::new();
     let _ = writeln!(
         md,
-        "# Error over time: moving cameras and previous-frame feedback\n"
+        "# Error over time: moving cameras, previous-frame feedback and cube maps\n"
     );
     let _ = writeln!(
         md,
         "Every method and the truth rendered frame by frame along the same camera path \
-         (issue 22, docs/methods.md \"Previous-frame feedback\"); each frame compared with the \
-         truth of that frame. `feedback` carries its textures from frame to frame as an engine \
-         would; the other methods have no state.\n"
+         (issue 22; docs/methods.md, \"Previous-frame feedback\" and \"Cube-map \
+         reflections\"); each frame compared with the truth of that frame. The stateful \
+         methods (`feedback`, `cubemap`) carry their textures from frame to frame as an \
+         engine would (`history=16`: they start from 16 frames drawn at the first view); \
+         the other methods have no state. Times: one GPU-timestamped draw per frame after \
+         one untimed draw; the table gives the median over the frames.\n"
     );
     let _ = writeln!(
         md,

@@ -1,13 +1,15 @@
 //! `mirrorbox report DIR...`: remakes each sweep folder's `results.csv`, `report.md`,
-//! `report.html` and plots from its `sweep.json` and `results.jsonl`, without rendering — for a
-//! report measured elsewhere (a GPU machine, a cluster) after the report's text changed.
+//! `report.html` and plots from its `sweep.json` and `results.jsonl` (a sequence sweep's
+//! `report.md` and plots from its `motion.json` and `frames.jsonl`), without rendering — for
+//! a report measured elsewhere (a GPU machine, a cluster) after the report's text changed.
 
 use crate::Failure;
 use std::path::PathBuf;
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// Sweep folders (each with the `sweep.json` and `results.jsonl` a sweep wrote).
+    /// Sweep folders (each with the `sweep.json` and `results.jsonl` a sweep wrote, or a
+    /// sequence sweep's `motion.json` and `frames.jsonl`).
     #[arg(required = true)]
     dirs: Vec<PathBuf>,
 }
