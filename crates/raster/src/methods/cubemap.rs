@@ -18,18 +18,15 @@ use crate::method::{
     RasterMethod, SweepAxis,
 };
 use crate::methods::feedback::HISTORY;
-use crate::methods::recursive_texture::check_mirror_textures;
+use crate::methods::recursive_texture::{TexturePipelines, check_mirror_textures};
 use crate::ping_pong::{Carried, PingPong, Source};
-use crate::pipeline::{
-    ScenePipeline, UniformArena, depth_state, dynamic_uniform_entry, pipeline_layout,
-    record_binding,
-};
+use crate::pipeline::{UniformArena, dynamic_uniform_entry, record_binding};
 use crate::plan::PlanError;
-use crate::projection::{NEARER_OR_EQUAL, camera_projection};
-use crate::shading::{SceneBuffers, VERTEX_LAYOUT};
+use crate::projection::camera_projection;
+use crate::shading::SceneBuffers;
 use crate::targets::{DEPTH_FORMAT, RenderTarget, texture_entry};
 use crate::timing::{FrameEncoder, FrameHistory};
-use crate::wgsl::{HostLayout, shader_module};
+use crate::wgsl::HostLayout;
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3, Vec4};
 use mirrorbox_scene::{Camera, Plane, Scene};
@@ -268,8 +265,7 @@ struct CubeUniform {
 
 struct CubeFrame {
     scene_buffers: SceneBuffers,
-    objects: wgpu::RenderPipeline,
-    mirrors: wgpu::RenderPipeline,
+    pipelines: TexturePipelines,
     pass_bind_group: wgpu::BindGroup,
     /// Per (source set, cube): the bind group of a mirror reading that cube; index 0 is "no
     /// cube" ([`CubeFrame::bind_group`]).
@@ -390,24 +386,15 @@ impl CubeFrame {
 
         let buffer = uniforms.buffer(device, "cubemap uniforms");
         let stages = wgpu::ShaderStages::VERTEX_FRAGMENT;
-        let pass_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("cubemap pass"),
-            entries: &[dynamic_uniform_entry(0, stages)],
-        });
         let mut cube_entries = vec![dynamic_uniform_entry(0, stages)];
         cube_entries.extend((1..=6).map(texture_entry));
-        let cube_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("cubemap cube"),
-            entries: &cube_entries,
-        });
-        let pass_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("cubemap pass"),
-            layout: &pass_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: record_binding::<PassUniform>(&buffer),
-            }],
-        });
+        let pipelines = TexturePipelines::with(
+            gpu,
+            &scene_buffers,
+            [&SHADER, &CLIP_DISTANCE_SHADER],
+            &cube_entries,
+        );
+        let pass_bind_group = pipelines.pass_bind_group::<PassUniform>(gpu, &buffer);
         let none = RenderTarget::new(gpu, "no cube", 1, 1, wgpu::TextureUsages::TEXTURE_BINDING);
         let bind_group = |faces: [&wgpu::TextureView; 6]| {
             let mut entries = vec![wgpu::BindGroupEntry {
@@ -418,11 +405,7 @@ impl CubeFrame {
                 binding: k as u32 + 1,
                 resource: wgpu::BindingResource::TextureView(v),
             }));
-            device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("cubemap cube"),
-                layout: &cube_layout,
-                entries: &entries,
-            })
+            pipelines.mirror_group(gpu, &entries)
         };
         // 0: no cube; then own set 0's cubes, own set 1's, the carried set's.
         let mut bind_groups = vec![bind_group([&none.color_view; 6])];
@@ -432,45 +415,7 @@ impl CubeFrame {
             }
         }
 
-        let clipping = crate::method::Clipping::for_features(gpu.features);
-        let (shader, vertex, fs_object, fs_mirror) = match clipping {
-            crate::method::Clipping::ClipDistances => (
-                shader_module(device, &CLIP_DISTANCE_SHADER),
-                "vs_clip_distances",
-                "fs_object",
-                "fs_mirror",
-            ),
-            _ => (
-                shader_module(device, &SHADER),
-                "vs_main",
-                "fs_object_discard",
-                "fs_mirror_discard",
-            ),
-        };
-        let sl = &scene_buffers.layout;
-        let pipeline = |label: &str, layout: &wgpu::PipelineLayout, fragment: &str| {
-            ScenePipeline {
-                label,
-                layout,
-                module: &shader,
-                vertex,
-                fragment,
-                buffers: &[Some(VERTEX_LAYOUT)],
-                depth_stencil: depth_state(DEPTH_FORMAT, true, NEARER_OR_EQUAL, Default::default()),
-                color_writes: wgpu::ColorWrites::ALL,
-            }
-            .build(gpu)
-        };
-        let objects = pipeline(
-            "cubemap objects",
-            &pipeline_layout(device, "cubemap objects", &[sl, &pass_layout]),
-            fs_object,
-        );
-        let mirrors = pipeline(
-            "cubemap mirrors",
-            &pipeline_layout(device, "cubemap mirrors", &[sl, &pass_layout, &cube_layout]),
-            fs_mirror,
-        );
+        let clipping = pipelines.clipping;
 
         let passes = 6 * cubes.len() + 1;
         let mirror_draws: usize =
@@ -489,8 +434,7 @@ impl CubeFrame {
         };
         Ok(CubeFrame {
             scene_buffers,
-            objects,
-            mirrors,
+            pipelines,
             pass_bind_group,
             bind_groups,
             own,
@@ -528,18 +472,17 @@ impl CubeFrame {
         mirrors: &[usize],
         source: Source,
     ) {
-        let b = &self.scene_buffers;
-        pass.set_vertex_buffer(0, b.vertices.slice(..));
-        pass.set_bind_group(0, &b.bind_group, &[]);
-        pass.set_bind_group(1, &self.pass_bind_group, &[offset]);
-        pass.set_pipeline(&self.objects);
-        pass.draw(b.objects.clone(), 0..1);
-        pass.set_pipeline(&self.mirrors);
-        for &j in mirrors {
+        let mirrors = mirrors.iter().map(|&j| {
             let (group, offset) = self.mirror_binding(source, j);
-            pass.set_bind_group(2, group, &[offset]);
-            pass.draw(b.mirrors[j].clone(), 0..1);
-        }
+            (j, group, offset)
+        });
+        self.pipelines.draw(
+            pass,
+            &self.scene_buffers,
+            &self.pass_bind_group,
+            offset,
+            mirrors,
+        );
     }
 }
 

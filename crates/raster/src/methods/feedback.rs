@@ -349,7 +349,8 @@ impl FeedbackFrame {
 
         let buffer = uniforms.buffer(device, "feedback uniforms");
         let pipelines = TexturePipelines::new(gpu, &scene_buffers);
-        let pass_bind_group = pipelines.pass_bind_group(gpu, &buffer);
+        let pass_bind_group = pipelines
+            .pass_bind_group::<crate::methods::recursive_texture::PassUniform>(gpu, &buffer);
         let bind_groups = views
             .iter()
             .map(|v| pipelines.mirror_bind_group(gpu, &buffer, v))

@@ -809,7 +809,7 @@ impl RecursiveTexture {
 
         let uniforms = b.uniforms.buffer(device, "recursive texture uniforms");
         let pipelines = TexturePipelines::new(gpu, &scene_buffers);
-        let pass_bind_group = pipelines.pass_bind_group(gpu, &uniforms);
+        let pass_bind_group = pipelines.pass_bind_group::<PassUniform>(gpu, &uniforms);
         check_mirror_textures(gpu, &b.slot_sizes)?;
         let slots: Vec<RenderTarget> = b
             .slot_sizes
@@ -946,7 +946,26 @@ pub(crate) struct TexturePipelines {
 }
 
 impl TexturePipelines {
+    /// The pipelines of this file's shaders: a mirror's group holds its uniform and one
+    /// texture.
     pub(crate) fn new(gpu: &Gpu, scene_buffers: &SceneBuffers) -> Self {
+        let stages = wgpu::ShaderStages::VERTEX_FRAGMENT;
+        Self::with(
+            gpu,
+            scene_buffers,
+            [&SHADER, &CLIP_DISTANCE_SHADER],
+            &[dynamic_uniform_entry(0, stages), texture_entry(1)],
+        )
+    }
+
+    /// The pipelines of a method whose shaders follow `mirror_plane_shaders!` (`shaders`:
+    /// its plain and clip-distance variants), the mirror group laid out as `mirror_entries`.
+    pub(crate) fn with(
+        gpu: &Gpu,
+        scene_buffers: &SceneBuffers,
+        shaders: [&crate::wgsl::WgslSource; 2],
+        mirror_entries: &[wgpu::BindGroupLayoutEntry],
+    ) -> Self {
         let device = &gpu.device;
         let stages = wgpu::ShaderStages::VERTEX_FRAGMENT;
         let pass_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -955,18 +974,18 @@ impl TexturePipelines {
         });
         let mirror_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("mirror"),
-            entries: &[dynamic_uniform_entry(0, stages), texture_entry(1)],
+            entries: mirror_entries,
         });
         let clipping = Clipping::for_features(gpu.features);
         let (shader, vertex, fs_object, fs_mirror) = match clipping {
             Clipping::ClipDistances => (
-                shader_module(device, &CLIP_DISTANCE_SHADER),
+                shader_module(device, shaders[1]),
                 "vs_clip_distances",
                 "fs_object",
                 "fs_mirror",
             ),
             Clipping::FragmentDiscard | Clipping::None => (
-                shader_module(device, &SHADER),
+                shader_module(device, shaders[0]),
                 "vs_main",
                 "fs_object_discard",
                 "fs_mirror_discard",
@@ -1010,15 +1029,29 @@ impl TexturePipelines {
         }
     }
 
-    /// The pass uniforms' bind group over the frame's uniform arena.
-    pub(crate) fn pass_bind_group(&self, gpu: &Gpu, uniforms: &wgpu::Buffer) -> wgpu::BindGroup {
+    /// The pass uniforms' bind group over the frame's uniform arena (records of `P`).
+    pub(crate) fn pass_bind_group<P>(&self, gpu: &Gpu, uniforms: &wgpu::Buffer) -> wgpu::BindGroup {
         gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("pass"),
             layout: &self.pass_layout,
             entries: &[wgpu::BindGroupEntry {
                 binding: 0,
-                resource: record_binding::<PassUniform>(uniforms),
+                resource: record_binding::<P>(uniforms),
             }],
+        })
+    }
+
+    /// A mirror draw's bind group of `entries` (its uniform and textures), in the layout
+    /// [`TexturePipelines::with`] was given.
+    pub(crate) fn mirror_group(
+        &self,
+        gpu: &Gpu,
+        entries: &[wgpu::BindGroupEntry<'_>],
+    ) -> wgpu::BindGroup {
+        gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("mirror"),
+            layout: &self.mirror_layout,
+            entries,
         })
     }
 
@@ -1029,10 +1062,9 @@ impl TexturePipelines {
         uniforms: &wgpu::Buffer,
         texture: &wgpu::TextureView,
     ) -> wgpu::BindGroup {
-        gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("mirror"),
-            layout: &self.mirror_layout,
-            entries: &[
+        self.mirror_group(
+            gpu,
+            &[
                 wgpu::BindGroupEntry {
                     binding: 0,
                     resource: record_binding::<MirrorUniform>(uniforms),
@@ -1042,7 +1074,7 @@ impl TexturePipelines {
                     resource: wgpu::BindingResource::TextureView(texture),
                 },
             ],
-        })
+        )
     }
 
     /// One scene pass: the objects with the pass uniform at `offset`, then each mirror
