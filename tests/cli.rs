@@ -1876,6 +1876,41 @@ fn a_sequence_sweep_compares_every_frame_with_its_truth() {
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
     assert!(report.contains("| feedback history=0 |"), "{report}");
 
+    // Supersampling reaches both sides: the raster's s×s grid is the truth's s² samples
+    // (an exact method stays at the floor).
+    let ssaa = dir.path().join("ssaa");
+    let mut args = vec![
+        "sweep",
+        walk,
+        "--out",
+        ssaa.to_str().unwrap(),
+        "--methods",
+        "unrolled",
+        "--depth",
+        "4",
+        "--path",
+        "1",
+        "--ssaa",
+        "2",
+    ];
+    args.extend(size);
+    let run = mirrorbox(&args, &[]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let record: Value = serde_json::from_str(
+        std::fs::read_to_string(ssaa.join("frames.jsonl"))
+            .unwrap()
+            .lines()
+            .next()
+            .unwrap(),
+    )
+    .unwrap();
+    assert!(record["flip_mean"].as_f64().unwrap() < 0.05, "{record}");
+    let info = std::fs::read_to_string(ssaa.join("motion.json")).unwrap();
+    assert!(
+        info.contains("4 spp on the raster's 2×2 SSAA grid"),
+        "{info}"
+    );
+
     for (bad, expected) in [
         (vec!["--path", "0"], "--path must be in [1, 1000]"),
         (

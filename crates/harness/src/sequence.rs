@@ -11,7 +11,7 @@
 
 use crate::HarnessError;
 use mirrorbox_image::{RgbImage, read_image};
-use mirrorbox_raster::Method;
+use mirrorbox_raster::{Method, ParamValue};
 use mirrorbox_report::motion::{FrameRecord, MotionInfo, ScenarioInfo, write_motion_report};
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -44,6 +44,10 @@ pub struct SequenceConfig {
     /// Image size (default: each scene camera's), as `--width` / `--height` give it.
     pub width: Option<u32>,
     pub height: Option<u32>,
+    /// Supersampling of the raster (the truth traces the same s×s grid, `--spp s²`).
+    pub ssaa: u32,
+    /// The truth's depth and throughput cut (`trace --max-depth`, `--min-throughput`).
+    pub truth: mirrorbox_trace::WhittedSettings,
     /// Untimed and timed redraws of each frame (a frame's time is their median).
     pub warmup: u32,
     pub timed: u32,
@@ -105,6 +109,8 @@ impl SequenceConfig {
             ],
             width: Some(320),
             height: Some(180),
+            ssaa: 1,
+            truth: mirrorbox_trace::WhittedSettings::default(),
             warmup: 1,
             timed: 1,
             exe,
@@ -136,20 +142,17 @@ impl SequenceConfig {
     }
 }
 
-/// The command-line flags of a configured method: `auxiliary n=2` → `--method auxiliary --n 2`.
+/// The command-line flags of a configured method, every option not at its default:
+/// `auxiliary n=2` → `--method auxiliary --n 2`.
 fn method_flags(method: &Method) -> Vec<String> {
-    let key = method.key();
-    let mut words = key.split_whitespace();
-    let mut flags = vec![
-        "--method".to_string(),
-        words.next().unwrap_or("").to_string(),
-    ];
-    for w in words {
-        match w.split_once('=') {
-            None => flags.push(format!("--{w}")),
-            Some((_, "false")) => {}
-            Some((name, "true")) => flags.push(format!("--{name}")),
-            Some((name, value)) => flags.extend([format!("--{name}"), value.to_string()]),
+    let entry = method.entry();
+    let mut flags = vec!["--method".to_string(), entry.name.to_string()];
+    for (o, v) in entry.options.iter().zip(method.params().values()) {
+        match v {
+            _ if *v == o.default => {}
+            ParamValue::Switch(true) => flags.push(format!("--{}", o.name)),
+            ParamValue::Switch(false) => {}
+            v => flags.extend([format!("--{}", o.name), v.to_string()]),
         }
     }
     flags
@@ -261,6 +264,8 @@ fn render_sequence(
         args.extend(sequence_flags(config, s, first, count));
         args.extend(method_flags(method));
         args.extend([
+            "--ssaa".into(),
+            config.ssaa.to_string(),
             "--warmup".into(),
             config.warmup.to_string(),
             "--frames".into(),
@@ -310,7 +315,15 @@ pub fn run_sequences(
         let truth_base = dir.join("truth.exr");
         let mut args = vec!["trace".to_string()];
         args.extend(sequence_flags(config, s, 0, s.frames));
-        args.extend(["--spp".into(), "1".into(), "-o".into()]);
+        args.extend([
+            "--spp".into(),
+            (config.ssaa * config.ssaa).to_string(),
+            "--max-depth".into(),
+            config.truth.max_depth.to_string(),
+            "--min-throughput".into(),
+            config.truth.min_throughput.to_string(),
+            "-o".into(),
+        ]);
         args.push(truth_base.display().to_string());
         run(&config.exe, &args)?;
         let truths: Vec<RgbImage> = (0..s.frames)
@@ -388,8 +401,14 @@ pub fn run_sequences(
         cpu: crate::cpu_description(),
         width: size.0,
         height: size.1,
-        truth: "mirrorbox trace (Whitted, its default depth and threshold), 1 spp at pixel centres"
-            .into(),
+        truth: format!(
+            "mirrorbox trace (Whitted, at most {} reflections, throughput cut {}), {} spp on the raster's {}×{} SSAA grid",
+            config.truth.max_depth,
+            config.truth.min_throughput,
+            config.ssaa * config.ssaa,
+            config.ssaa,
+            config.ssaa
+        ),
         scenarios,
     };
     write_motion_report(&config.out, &info, &records)?;
@@ -461,6 +480,11 @@ mod tests {
             ]
         );
         assert_eq!(m("naive"), ["--method", "naive"]);
+        assert_eq!(
+            m("auxiliary n=1 max-passes=100"),
+            ["--method", "auxiliary", "--n", "1", "--max-passes", "100"],
+            "options outside the key are passed too"
+        );
     }
 
     #[test]

@@ -111,8 +111,7 @@ pub fn document(info: &MotionInfo, records: &[FrameRecord]) -> String {
     );
     let _ = writeln!(
         md,
-        "- Device: {} (CPU: {})\n- Size: {}×{}, SSAA 1 against the truth at 1 spp (the same \
-         sample positions)\n- Truth: {}\n- Date: {}\n- Command: `{}`\n",
+        "- Device: {} (CPU: {})\n- Size: {}×{}\n- Truth: {}\n- Date: {}\n- Command: `{}`\n",
         info.device, info.cpu, info.width, info.height, info.truth, info.date, info.command
     );
     for s in &info.scenarios {

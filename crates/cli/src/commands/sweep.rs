@@ -318,6 +318,11 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             }],
             width: args.size.width,
             height: args.size.height,
+            ssaa: args.ssaa,
+            truth: WhittedSettings {
+                max_depth: args.max_depth,
+                min_throughput: args.min_throughput,
+            },
             warmup: args.warmup,
             timed: args.frames,
             exe: render_worker()
