@@ -12,6 +12,26 @@ use crate::timing::FrameHistory;
 use std::cell::Cell;
 use std::sync::Arc;
 
+/// The `FrameEncoder` methods of a frame that keeps its [`PingPong`] in `self.state`:
+/// pre-roll, advance and the reflections of the frame drawn (`history` is the method's: it
+/// names what its sets hold).
+#[macro_export]
+macro_rules! ping_pong_frame {
+    () => {
+        fn preroll_frames(&self) -> u32 {
+            self.state.preroll()
+        }
+
+        fn advance(&self) {
+            self.state.advance()
+        }
+
+        fn drawn_depth(&self) -> Option<usize> {
+            Some(self.state.drawn_depth())
+        }
+    };
+}
+
 /// The textures a frame reads.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Source {

@@ -529,17 +529,7 @@ impl FrameEncoder for CubeFrame {
         );
     }
 
-    fn preroll_frames(&self) -> u32 {
-        self.state.preroll()
-    }
-
-    fn advance(&self) {
-        self.state.advance()
-    }
-
-    fn drawn_depth(&self) -> Option<usize> {
-        Some(self.state.drawn_depth())
-    }
+    crate::ping_pong_frame!();
 
     fn history(&self) -> Option<FrameHistory> {
         self.state.history(|i| {
