@@ -8,6 +8,8 @@
 //!
 //! Triangles are tested with [`crate::watertight`], not obvhs' own test (see there why).
 
+pub mod packet;
+
 use crate::watertight::WatertightRay;
 use glam::{Vec3, Vec3A};
 use mirrorbox_scene::limits::{MAX_COORDINATE, within_extent};
@@ -17,6 +19,8 @@ use obvhs::bvh2::Bvh2;
 use obvhs::cwbvh::CwBvh;
 use obvhs::ray::RayHit;
 use obvhs::triangle::Triangle;
+use packet::{LANES, LaneMask, PacketBvh, RayPacket};
+use std::sync::OnceLock;
 use std::time::Duration;
 
 /// A closest hit.
@@ -93,6 +97,10 @@ pub struct SceneBvh {
     /// Time obvhs spent building the hierarchy.
     pub build_time: Duration,
     pub kind: BvhKind,
+    /// Whether [`SceneBvh::closest_hits`] traces packets (else one ray at a time).
+    packets: bool,
+    /// The binary hierarchy of the packet kernel, built at its first use.
+    packet_bvh: OnceLock<PacketBvh>,
 }
 
 impl SceneBvh {
@@ -167,10 +175,25 @@ impl SceneBvh {
             original,
             build_time,
             kind,
+            packets: true,
+            packet_bvh: OnceLock::new(),
         }
     }
 
-    /// The closest triangle hit by `ray` with `t` in `[t_min, t_max]`, ignoring the triangles
+    /// This hierarchy with the packet kernel on (the default) or off: off,
+    /// [`SceneBvh::closest_hits`] asks [`SceneBvh::closest_hit`] lane by lane (the
+    /// benchmark's baseline; the answers are the same).
+    pub fn with_packets(self, packets: bool) -> Self {
+        SceneBvh { packets, ..self }
+    }
+
+    /// Whether packets are traced.
+    pub fn packets(&self) -> bool {
+        self.packets
+    }
+
+    /// The closest triangle hit by `ray` with `t` in `[t_min, t_max]` (of equally close
+    /// ones, the lowest index in the scene's numbering), ignoring the triangles
     /// of mirror `skip_mirror` (the planar mirror a reflected ray is leaving cannot be hit
     /// again by it, so skipping it replaces any self-intersection epsilon).
     pub fn closest_hit(
@@ -196,16 +219,75 @@ impl SceneBvh {
         let wt = WatertightRay::new(ray.origin, ray.dir);
         let r = obvhs::ray::Ray::new(Vec3A::from(ray.origin), Vec3A::from(ray.dir), t_min, t_max);
         let mut hit = RayHit::none();
+        // obvhs keeps the first of equally distant hits; `best` keeps the lowest triangle
+        // index among them instead, so the answer does not depend on the visiting order
+        // (the packet kernel's rule too).
+        let mut best = u32::MAX;
         let found = with_triangle_test!(self, wt, skip_mirror, skip_triangle, |test| {
+            let original = &self.original;
+            let keep_lowest = |r: &obvhs::ray::Ray, slot: usize| {
+                let t = test(r, slot);
+                let tie =
+                    t == r.tmax && best != u32::MAX && original[slot] < original[best as usize];
+                if t < r.tmax || tie {
+                    best = slot as u32;
+                }
+                t
+            };
             match &self.hierarchy {
                 Hierarchy::Empty => false,
-                Hierarchy::Cw(bvh) => bvh.ray_traverse(r, &mut hit, test),
-                Hierarchy::Binary(bvh) => bvh.ray_traverse(r, &mut hit, test),
+                Hierarchy::Cw(bvh) => bvh.ray_traverse(r, &mut hit, keep_lowest),
+                Hierarchy::Binary(bvh) => bvh.ray_traverse(r, &mut hit, keep_lowest),
             }
         });
         found.then(|| Hit {
             t: hit.t,
-            triangle: self.original[hit.primitive_id as usize] as usize,
+            triangle: self.original[best as usize] as usize,
+        })
+    }
+}
+
+impl SceneBvh {
+    /// The closest hit of every lane of `active` in `packet` (what
+    /// [`SceneBvh::closest_hit`] answers for each lane's ray and skipped mirror) into `out`;
+    /// lanes outside `active` are left as they are. Traced together through the packet
+    /// kernel ([`packet`]) unless it is off or cannot hold this hierarchy.
+    pub fn closest_hits(
+        &self,
+        packet: &RayPacket,
+        active: LaneMask,
+        out: &mut [Option<Hit>; LANES],
+    ) {
+        if self.packets {
+            let bvh = self.packet_bvh.get_or_init(|| self.build_packet_bvh());
+            if bvh.usable() {
+                return bvh.closest_hits(packet, active, out);
+            }
+        }
+        for lane in packet::lanes(active) {
+            let (ray, skip) = packet.lane(lane);
+            out[lane] = self.closest_hit(&ray, 0.0, f32::INFINITY, skip);
+        }
+    }
+
+    fn build_packet_bvh(&self) -> PacketBvh {
+        let mut by_index = vec![self.slots.first().copied(); self.slots.len()];
+        for (slot, &i) in self.slots.iter().zip(&self.original) {
+            by_index[i as usize] = Some(*slot);
+        }
+        let tris: Vec<Triangle> = by_index
+            .iter()
+            .map(|s| {
+                let v = s.expect("every triangle has a slot").v;
+                Triangle {
+                    v0: Vec3A::from(v[0]),
+                    v1: Vec3A::from(v[1]),
+                    v2: Vec3A::from(v[2]),
+                }
+            })
+            .collect();
+        PacketBvh::build(&tris, |i| {
+            by_index[i as usize].expect("every triangle has a slot")
         })
     }
 }
@@ -361,6 +443,140 @@ mod tests {
             }
             assert!(hits > 500 && misses > 500, "{hits} hits, {misses} misses");
         }
+    }
+
+    /// Every lane of `rays` (in packets of [`LANES`], with every lane active or only some)
+    /// gets from the packet kernel exactly the single-ray answer: the same distance bits and
+    /// the same triangle. Returns how many lanes hit something.
+    fn assert_packets_answer_as_single_rays(
+        bvh: &SceneBvh,
+        rays: &[(Ray, Option<usize>)],
+    ) -> usize {
+        let mut hits = 0;
+        for (c, chunk) in rays.chunks(LANES).enumerate() {
+            let mut packet = RayPacket::default();
+            for (lane, (ray, skip)) in chunk.iter().enumerate() {
+                packet.set(lane, ray, *skip);
+            }
+            let all: LaneMask = (1 << chunk.len()) - 1;
+            for active in [all, all & 0x5555, all & 0xf0f0] {
+                let mut out = [None; LANES];
+                bvh.closest_hits(&packet, active, &mut out);
+                for lane in 0..chunk.len() {
+                    let (ray, skip) = &chunk[lane];
+                    if active >> lane & 1 == 0 {
+                        assert_eq!(out[lane], None, "lane {lane} not asked about");
+                        continue;
+                    }
+                    let want = bvh.closest_hit(ray, 0.0, f32::INFINITY, *skip);
+                    assert_eq!(
+                        out[lane].map(|h| h.t.to_bits()),
+                        want.map(|h| h.t.to_bits()),
+                        "packet {c} lane {lane}: {ray:?} skipping {skip:?}"
+                    );
+                    assert_eq!(
+                        out[lane].map(|h| h.triangle),
+                        want.map(|h| h.triangle),
+                        "packet {c} lane {lane}: {ray:?} skipping {skip:?}"
+                    );
+                    hits += (active == all && want.is_some()) as usize;
+                }
+            }
+        }
+        hits
+    }
+
+    /// Coherent packets (each pixel's 4×4 sub-pixel grid, and the same rays after their
+    /// first reflection) and incoherent ones (random origins and directions, random skips).
+    #[test]
+    fn packets_answer_as_single_rays() {
+        let scene = parse_scene(SCENE, Path::new("inline.json")).unwrap();
+        for kind in [BvhKind::Cwbvh, BvhKind::Bvh2] {
+            let bvh = SceneBvh::build_with(&scene.geometry, kind);
+            let cam = &scene.camera;
+            let grid = mirrorbox_scene::SubpixelGrid::new(4);
+            let planes = crate::mirror_bounce::MirrorPlanes::new(&scene);
+            let mut coherent = Vec::new();
+            let mut reflected = Vec::new();
+            for y in 0..cam.height {
+                for x in 0..cam.width {
+                    for o in grid.offsets() {
+                        let ray = cam.primary_ray(x as f32 + o.x, y as f32 + o.y);
+                        coherent.push((ray, None));
+                        let Some(hit) = bvh.closest_hit(&ray, 0.0, f32::INFINITY, None) else {
+                            continue;
+                        };
+                        if let Surface::Mirror { mirror, .. } =
+                            *scene.geometry.surface(hit.triangle)
+                        {
+                            let (o, d) = planes
+                                .reflect(mirror, ray.origin.as_dvec3(), ray.dir.as_dvec3())
+                                .expect("a flat mirror reflects");
+                            let ray = Ray {
+                                origin: o.as_vec3(),
+                                dir: d.as_vec3(),
+                            };
+                            reflected.push((ray, Some(mirror)));
+                        }
+                    }
+                }
+            }
+            let mut rng = crate::sampler::SplitMix64::for_pixel(11, 0);
+            let mut r = || rng.next_unit();
+            let scattered: Vec<_> = (0..4000)
+                .map(|i| {
+                    let origin = Vec3::new(r() * 4.0 - 2.0, r() * 2.5, r() * 4.0 - 2.0);
+                    let dir = Vec3::new(r() - 0.5, r() - 0.5, r() - 0.5).normalize_or(Vec3::Y);
+                    (Ray { origin, dir }, (i % 3 == 0).then_some(0))
+                })
+                .collect();
+            let n = coherent.len();
+            assert!(
+                assert_packets_answer_as_single_rays(&bvh, &coherent) > n / 2,
+                "{kind:?}"
+            );
+            let reflected_hits = assert_packets_answer_as_single_rays(&bvh, &reflected);
+            assert!(
+                reflected.len() > 1000 && reflected_hits > reflected.len() / 4,
+                "{reflected_hits} of {} reflected rays hit",
+                reflected.len()
+            );
+            assert!(assert_packets_answer_as_single_rays(&bvh, &scattered) > 1000);
+        }
+    }
+
+    /// Rays aimed at the mirror's diagonal seam (and at its corner) from many origins, as
+    /// packets: none leaks through, and each gets the single-ray answer.
+    #[test]
+    fn packets_do_not_leak_through_a_seam() {
+        let scene = parse_scene(SCENE, Path::new("inline.json")).unwrap();
+        let bvh = SceneBvh::build(&scene.geometry);
+        let mirror: Vec<usize> = (0..scene.geometry.triangles.len())
+            .filter(|&i| matches!(scene.geometry.surface(i), Surface::Mirror { .. }))
+            .collect();
+        assert_eq!(mirror.len(), 2, "the mirror is one quad");
+        // The vertex the two triangles do not share with the other lies off the diagonal.
+        let [a, b] = [mirror[0], mirror[1]].map(|i| scene.geometry.triangles[i]);
+        let shared: Vec<Vec3> = a.iter().copied().filter(|p| b.contains(p)).collect();
+        assert_eq!(shared.len(), 2, "two triangles share the diagonal");
+        let mut rng = crate::sampler::SplitMix64::for_pixel(3, 0);
+        let mut r = || rng.next_unit();
+        let rays: Vec<_> = (0..1600)
+            .map(|i| {
+                let f = (i % 100) as f32 / 100.0;
+                let target = shared[0] + (shared[1] - shared[0]) * f;
+                let origin = Vec3::new(r() * 3.0 - 1.5, r() * 2.0 + 0.2, r() * 2.0 + 0.5);
+                (
+                    Ray {
+                        origin,
+                        dir: (target - origin).normalize(),
+                    },
+                    None,
+                )
+            })
+            .collect();
+        let hits = assert_packets_answer_as_single_rays(&bvh, &rays);
+        assert_eq!(hits, rays.len(), "a ray through the seam leaked");
     }
 
     #[test]

@@ -24,6 +24,14 @@ pub trait Integrator: Sync {
     /// stream (seeded by [`IntegratorSettings::seed`] and the pixel index, shared by the
     /// pixel's samples in order); a deterministic integrator ignores it.
     fn radiance(&self, ray: Ray, rng: &mut SplitMix64) -> PathResult;
+
+    /// The radiance of each of a pixel's camera rays `rays`, in order, into `out` (cleared
+    /// first): exactly what [`Integrator::radiance`] returns for each in turn with the same
+    /// `rng`. An integrator may trace them together (`whitted` traces packets).
+    fn radiance_all(&self, rays: &[Ray], rng: &mut SplitMix64, out: &mut Vec<PathResult>) {
+        out.clear();
+        out.extend(rays.iter().map(|&ray| self.radiance(ray, rng)));
+    }
 }
 
 /// How a path ended.

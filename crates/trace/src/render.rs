@@ -153,6 +153,8 @@ pub fn render_while(
                 return None;
             }
             let mut offsets = Vec::new();
+            let mut camera_rays = Vec::new();
+            let mut results = Vec::new();
             let mut stats = TraceStats::default();
             let mut colour = Vec::with_capacity(w as usize);
             let mut depth = Vec::with_capacity(w as usize);
@@ -164,9 +166,14 @@ pub fn render_while(
                 let mut bounces = 0u64;
                 let pixel = y as u64 * w as u64 + x as u64;
                 let mut rng = SplitMix64::for_pixel(seed, pixel);
-                for o in &offsets {
-                    let ray = rays.ray(x as f32 + o.x, y as f32 + o.y);
-                    let r = integrator.radiance(ray, &mut rng);
+                camera_rays.clear();
+                camera_rays.extend(
+                    offsets
+                        .iter()
+                        .map(|o| rays.ray(x as f32 + o.x, y as f32 + o.y)),
+                );
+                integrator.radiance_all(&camera_rays, &mut rng, &mut results);
+                for r in &results {
                     sum += r.radiance;
                     bounces += r.bounces as u64;
                     stats.record(r.bounces, r.termination, r.rays);

@@ -56,6 +56,11 @@ impl WatertightRay {
         (self.kx, self.ky, self.kz)
     }
 
+    /// The shear constants `(sx, sy, sz)`: the packet kernel tests with exactly these.
+    pub fn shear(&self) -> [f32; 3] {
+        [self.sx, self.sy, self.sz]
+    }
+
     /// Distance `t` to the triangle if hit with `t_min ≤ t ≤ t_max`, else `f32::INFINITY`.
     /// Two-sided.
     #[inline]

@@ -16,6 +16,15 @@ pub enum Bvh {
     Bvh2,
 }
 
+/// How `whitted` asks the BVH for closest hits (the same answers either way).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Kernel {
+    /// A pixel's samples traced together through a binary BVH, SIMD across rays (docs/tracer-performance.md).
+    Packet,
+    /// One ray at a time through the --bvh hierarchy.
+    Single,
+}
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Integrator {
     /// Perfect mirror chains, the contract's lighting at the first diffuse hit.
@@ -77,6 +86,9 @@ pub struct Args {
     /// obvhs hierarchy to traverse.
     #[arg(long, value_enum, default_value_t = Bvh::Cwbvh)]
     bvh: Bvh,
+    /// Closest-hit kernel of `whitted` (`path` traces one ray at a time).
+    #[arg(long, value_enum, default_value_t = Kernel::Packet)]
+    kernel: Kernel,
     /// Print the summary as one JSON object (one per eye with --stereo).
     #[arg(long)]
     json: bool,
@@ -184,7 +196,8 @@ fn run_frame(args: &Args) -> Result<(), Failure> {
         Bvh::Bvh2 => BvhKind::Bvh2,
     };
     let started = Instant::now();
-    let bvh = SceneBvh::build_with(&scene.geometry, kind);
+    let bvh =
+        SceneBvh::build_with(&scene.geometry, kind).with_packets(args.kernel == Kernel::Packet);
     let integrator: mirrorbox_trace::IntegratorSettings = match args.integrator {
         Integrator::Path => mirrorbox_trace::PathSettings {
             max_depth: args.max_depth,
@@ -356,6 +369,7 @@ fn report(
             "paths": s.paths, "rays": s.rays, "mrays_per_s": mrays,
             "deepest_path": s.deepest, "render_seconds": secs, "total_seconds": total.as_secs_f64(),
             "bvh": format!("{:?}", bvh.kind).to_lowercase(), "bvh_build_seconds": bvh.build_time.as_secs_f64(),
+            "kernel": format!("{:?}", args.kernel).to_lowercase(),
             "threads": out.threads,
             "ended": { "diffuse": s.diffuse, "escaped": s.escaped, "max_depth": s.cut_by_depth,
                        "min_throughput": s.cut_by_throughput, "roulette": s.cut_by_roulette,
