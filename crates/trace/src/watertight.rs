@@ -56,7 +56,7 @@ impl WatertightRay {
         (self.kx, self.ky, self.kz)
     }
 
-    /// The shear constants `(sx, sy, sz)`: the packet kernel tests with exactly these.
+    /// The shear constants `(sx, sy, sz)` (the packet kernel computes the same, tested).
     pub fn shear(&self) -> [f32; 3] {
         [self.sx, self.sy, self.sz]
     }

@@ -58,29 +58,20 @@ pub(super) struct PacketBvh {
     fits_stack: bool,
 }
 
-/// Up to [`LANES`] rays, structure of arrays, with what the tests need per lane.
+/// Up to [`LANES`] rays, structure of arrays, each with the mirror it skips.
 #[derive(Clone)]
 pub struct RayPacket {
     origin: [Lanes; 3],
     dir: [Lanes; 3],
-    /// obvhs' safe reciprocal of the direction (no infinities: no `0 × ∞` in a box test).
-    inv: [Lanes; 3],
-    /// The watertight shear constants `sx, sy, sz` of [`WatertightRay`].
-    shear: [Lanes; 3],
     skip: [u32; LANES],
-    rays: [WatertightRay; LANES],
 }
 
 impl Default for RayPacket {
     fn default() -> Self {
-        let idle = WatertightRay::new(Vec3::ZERO, Vec3::Z);
         RayPacket {
             origin: [[0.0; LANES]; 3],
-            dir: [[0.0; LANES]; 3],
-            inv: [[0.0; LANES]; 3],
-            shear: [[0.0; LANES]; 3],
+            dir: [[0.0; LANES], [0.0; LANES], [1.0; LANES]],
             skip: [SKIP_NOTHING; LANES],
-            rays: [idle; LANES],
         }
     }
 }
@@ -89,29 +80,91 @@ impl RayPacket {
     /// Lane `lane` asks for the closest hit of `ray` in `[0, ∞)`, skipping mirror
     /// `skip_mirror` (what [`super::SceneBvh::closest_hit`] asks).
     pub fn set(&mut self, lane: usize, ray: &Ray, skip_mirror: Option<usize>) {
-        let wt = WatertightRay::new(ray.origin, ray.dir);
-        let shear = wt.shear();
-        for (k, shear) in shear.into_iter().enumerate() {
+        for k in 0..3 {
             self.origin[k][lane] = ray.origin[k];
             self.dir[k][lane] = ray.dir[k];
-            self.inv[k][lane] = safe_inverse(ray.dir[k]);
-            self.shear[k][lane] = shear;
         }
         self.skip[lane] = skip_mirror.map_or(SKIP_NOTHING, |m| m as u32);
-        self.rays[lane] = wt;
     }
 
     /// The ray and skipped mirror of lane `lane`, as [`RayPacket::set`] was given them.
     pub fn lane(&self, lane: usize) -> (Ray, Option<usize>) {
-        let v = |a: &[Lanes; 3]| Vec3::new(a[0][lane], a[1][lane], a[2][lane]);
         let skip = (self.skip[lane] != SKIP_NOTHING).then_some(self.skip[lane] as usize);
         (
             Ray {
-                origin: v(&self.origin),
-                dir: v(&self.dir),
+                origin: lane_vec(&self.origin, lane),
+                dir: lane_vec(&self.dir, lane),
             },
             skip,
         )
+    }
+}
+
+fn lane_vec(a: &[Lanes; 3], lane: usize) -> Vec3 {
+    Vec3::new(a[0][lane], a[1][lane], a[2][lane])
+}
+
+/// What the tests need per lane, computed for all lanes at once: the reciprocal direction
+/// of the box test and the watertight shear (exactly [`WatertightRay::new`]'s arithmetic).
+struct Prepared {
+    inv: [Lanes; 3],
+    /// `sx, sy, sz`.
+    shear: [Lanes; 3],
+    /// The axis permutation, as `kz · 2 + (1 if kx and ky are swapped)`.
+    axes: [u32; LANES],
+}
+
+impl Prepared {
+    #[inline(always)]
+    fn new(p: &RayPacket) -> Self {
+        let mut inv = [[0.0; LANES]; 3];
+        let mut shear = [[0.0; LANES]; 3];
+        let mut axes = [0; LANES];
+        for i in 0..LANES {
+            let d = [p.dir[0][i], p.dir[1][i], p.dir[2][i]];
+            for k in 0..3 {
+                inv[k][i] = safe_inverse(d[k]);
+            }
+            let a = d.map(f32::abs);
+            let kz = if a[0] >= a[1] && a[0] >= a[2] {
+                0
+            } else if a[1] >= a[2] {
+                1
+            } else {
+                2
+            };
+            let pick = |k: u32| {
+                if k == 0 {
+                    d[0]
+                } else if k == 1 {
+                    d[1]
+                } else {
+                    d[2]
+                }
+            };
+            let dz = pick(kz);
+            let swap = dz < 0.0;
+            let (mut kx, mut ky) = ((kz + 1) % 3, (kz + 2) % 3);
+            if swap {
+                (kx, ky) = (ky, kx);
+            }
+            shear[0][i] = pick(kx) / dz;
+            shear[1][i] = pick(ky) / dz;
+            shear[2][i] = 1.0 / dz;
+            axes[i] = kz * 2 + swap as u32;
+        }
+        Prepared { inv, shear, axes }
+    }
+}
+
+/// The `(kx, ky, kz)` of a [`Prepared::axes`] code.
+fn axes_of(code: u32) -> (usize, usize, usize) {
+    let kz = (code / 2) as usize;
+    let (kx, ky) = ((kz + 1) % 3, (kz + 2) % 3);
+    if code % 2 == 1 {
+        (ky, kx, kz)
+    } else {
+        (kx, ky, kz)
     }
 }
 
@@ -235,24 +288,25 @@ impl PacketBvh {
     ) {
         let mut best_t = [f32::INFINITY; LANES];
         let mut best_slot = [u32::MAX; LANES];
+        let prepared = Prepared::new(packet);
         let mut left = active;
         while left != 0 {
-            let axes = packet.rays[left.trailing_zeros() as usize].axes();
+            let code = prepared.axes[left.trailing_zeros() as usize];
             let mut group = 0;
             for lane in lanes(left) {
-                if packet.rays[lane].axes() == axes {
+                if prepared.axes[lane] == code {
                     group |= 1 << lane;
                 }
             }
             left &= !group;
-            let (t, s) = (&mut best_t, &mut best_slot);
-            match axes {
-                (1, 2, 0) => self.traverse::<1, 2, 0>(packet, group, t, s),
-                (2, 1, 0) => self.traverse::<2, 1, 0>(packet, group, t, s),
-                (2, 0, 1) => self.traverse::<2, 0, 1>(packet, group, t, s),
-                (0, 2, 1) => self.traverse::<0, 2, 1>(packet, group, t, s),
-                (0, 1, 2) => self.traverse::<0, 1, 2>(packet, group, t, s),
-                (1, 0, 2) => self.traverse::<1, 0, 2>(packet, group, t, s),
+            let (p, q, t, s) = (packet, &prepared, &mut best_t, &mut best_slot);
+            match axes_of(code) {
+                (1, 2, 0) => self.traverse::<1, 2, 0>(p, q, group, t, s),
+                (2, 1, 0) => self.traverse::<2, 1, 0>(p, q, group, t, s),
+                (2, 0, 1) => self.traverse::<2, 0, 1>(p, q, group, t, s),
+                (0, 2, 1) => self.traverse::<0, 2, 1>(p, q, group, t, s),
+                (0, 1, 2) => self.traverse::<0, 1, 2>(p, q, group, t, s),
+                (1, 0, 2) => self.traverse::<1, 0, 2>(p, q, group, t, s),
                 other => unreachable!("not an axis permutation: {other:?}"),
             }
         }
@@ -271,6 +325,7 @@ impl PacketBvh {
     fn traverse<const KX: usize, const KY: usize, const KZ: usize>(
         &self,
         p: &RayPacket,
+        q: &Prepared,
         group: LaneMask,
         best_t: &mut Lanes,
         best_slot: &mut [u32; LANES],
@@ -283,7 +338,7 @@ impl PacketBvh {
         let mut index = 0usize;
         loop {
             let node = &self.nodes[index];
-            let hit = box_hits(node, p, best_t, &in_group);
+            let hit = box_hits(node, p, q, best_t, &in_group);
             if any(&hit) {
                 if node.count == 0 {
                     let (a, b) = (node.first as usize, node.first as usize + 1);
@@ -298,7 +353,7 @@ impl PacketBvh {
                     continue;
                 }
                 for slot in node.first..node.first + node.count {
-                    self.triangle::<KX, KY, KZ>(slot, p, &hit, best_t, best_slot);
+                    self.triangle::<KX, KY, KZ>(slot, p, q, &hit, best_t, best_slot);
                 }
             }
             if sp == 0 {
@@ -317,6 +372,7 @@ impl PacketBvh {
         &self,
         slot: u32,
         p: &RayPacket,
+        q: &Prepared,
         hit: &Mask,
         best_t: &mut Lanes,
         best_slot: &mut [u32; LANES],
@@ -328,7 +384,7 @@ impl PacketBvh {
         let mut tie = [false; LANES];
         for i in 0..LANES {
             let o = [p.origin[0][i], p.origin[1][i], p.origin[2][i]];
-            let (sx, sy, sz) = (p.shear[0][i], p.shear[1][i], p.shear[2][i]);
+            let (sx, sy, sz) = (q.shear[0][i], q.shear[1][i], q.shear[2][i]);
             let (a_x, a_y, a_z) = (v0[KX] - o[KX], v0[KY] - o[KY], v0[KZ] - o[KZ]);
             let (b_x, b_y, b_z) = (v1[KX] - o[KX], v1[KY] - o[KY], v1[KZ] - o[KZ]);
             let (c_x, c_y, c_z) = (v2[KX] - o[KX], v2[KY] - o[KY], v2[KZ] - o[KZ]);
@@ -360,7 +416,8 @@ impl PacketBvh {
             // The scalar test's f64 re-evaluation of exact zeros.
             let (v0, v1, v2) = (Vec3::from(v0), Vec3::from(v1), Vec3::from(v2));
             for i in (0..LANES).filter(|&i| zero[i]) {
-                let t = p.rays[i].intersect_axes::<KX, KY, KZ>(v0, v1, v2, 0.0, best_t[i]);
+                let ray = WatertightRay::new(lane_vec(&p.origin, i), lane_vec(&p.dir, i));
+                let t = ray.intersect_axes::<KX, KY, KZ>(v0, v1, v2, 0.0, best_t[i]);
                 if t < best_t[i] {
                     best_t[i] = t;
                     best_slot[i] = slot;
@@ -393,12 +450,12 @@ fn any(mask: &Mask) -> bool {
 
 /// The lanes of `group` whose ray meets the node's box no farther than their best hit.
 #[inline(always)]
-fn box_hits(node: &Node, p: &RayPacket, best_t: &Lanes, group: &Mask) -> Mask {
+fn box_hits(node: &Node, p: &RayPacket, q: &Prepared, best_t: &Lanes, group: &Mask) -> Mask {
     let mut mask = [false; LANES];
     for i in 0..LANES {
         let slab = |k: usize| {
-            let t0 = (node.min[k] - p.origin[k][i]) * p.inv[k][i];
-            let t1 = (node.max[k] - p.origin[k][i]) * p.inv[k][i];
+            let t0 = (node.min[k] - p.origin[k][i]) * q.inv[k][i];
+            let t1 = (node.max[k] - p.origin[k][i]) * q.inv[k][i];
             (min(t0, t1), max(t0, t1))
         };
         let (n0, f0) = slab(0);
@@ -447,3 +504,46 @@ fn depth(nodes: &[Node], index: usize) -> usize {
 }
 
 const _: () = assert!(NOT_A_MIRROR != SKIP_NOTHING);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The lane-parallel shear and permutation are [`WatertightRay::new`]'s, bit for bit,
+    /// for directions of every kind: random, axis-aligned, with ties between components,
+    /// signed zeros.
+    #[test]
+    fn prepared_lanes_match_the_single_ray_shear() {
+        let mut rng = crate::sampler::SplitMix64::for_pixel(5, 0);
+        let mut dirs: Vec<Vec3> = (0..4000)
+            .map(|_| {
+                let v = Vec3::new(rng.next_unit(), rng.next_unit(), rng.next_unit()) - 0.5;
+                v.normalize_or(Vec3::X)
+            })
+            .collect();
+        for a in [-1.0f32, -0.0, 0.0, 1.0] {
+            for b in [-1.0f32, -0.0, 0.0, 1.0] {
+                for c in [-1.0f32, 1.0] {
+                    dirs.extend([Vec3::new(a, b, c), Vec3::new(c, a, b), Vec3::new(b, c, a)]);
+                }
+            }
+        }
+        for chunk in dirs.chunks(LANES) {
+            let mut packet = RayPacket::default();
+            for (lane, &dir) in chunk.iter().enumerate() {
+                let ray = Ray {
+                    origin: Vec3::ZERO,
+                    dir,
+                };
+                packet.set(lane, &ray, None);
+            }
+            let q = Prepared::new(&packet);
+            for (lane, &dir) in chunk.iter().enumerate() {
+                let wt = WatertightRay::new(Vec3::ZERO, dir);
+                assert_eq!(axes_of(q.axes[lane]), wt.axes(), "{dir}");
+                let shear = [0, 1, 2].map(|k| q.shear[k][lane].to_bits());
+                assert_eq!(shear, wt.shear().map(f32::to_bits), "{dir}");
+            }
+        }
+    }
+}
