@@ -2,13 +2,14 @@
 //! camera rays of `mirror_box` at 640×360 (one per pixel centre), for the rays leaving the
 //! first mirror those hit, and for the rays leaving their tenth mirror — the coherence a
 //! packet kernel would exploit falls from set to set (planar mirrors keep neighbours
-//! neighbours; edges and the sphere scatter them). Today's kernel traces one ray at a time
-//! through obvhs' CWBVH; a packet kernel must beat these figures on the same sets.
+//! neighbours; edges and the sphere scatter them): the single-ray kernel (obvhs' CWBVH) and
+//! the packet kernel (`bvh::packet`) on the same sets.
 //! Run: `cargo bench -p mirrorbox-trace --bench ray_sets`.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use mirrorbox_scene::{Ray, Scene, Surface};
 use mirrorbox_trace::SceneBvh;
+use mirrorbox_trace::bvh::packet::{LANES, LaneMask, RayPacket};
 use mirrorbox_trace::mirror_bounce::MirrorPlanes;
 
 /// A ray with the mirror it leaves (skipped by the query, as the integrators do).
@@ -70,6 +71,30 @@ fn bench(c: &mut Criterion) {
                         bvh.closest_hit(ray, 0.0, f32::INFINITY, *leaving).is_some()
                     })
                     .count()
+            })
+        });
+        // The packet kernel on the same rays, 16 consecutive ones per packet (neighbouring
+        // pixels of a row; the image loop packs a pixel's 16 samples, more coherent still).
+        let packets: Vec<RayPacket> = set
+            .chunks(LANES)
+            .map(|chunk| {
+                let mut packet = RayPacket::default();
+                for (lane, (ray, leaving)) in chunk.iter().enumerate() {
+                    packet.set(lane, ray, *leaving);
+                }
+                packet
+            })
+            .collect();
+        group.bench_function(format!("{name} packets ({} rays)", set.len()), |b| {
+            b.iter(|| {
+                let mut hits = [None; LANES];
+                let mut found = 0;
+                for (packet, chunk) in packets.iter().zip(set.chunks(LANES)) {
+                    let active: LaneMask = (1 << chunk.len()) - 1;
+                    bvh.closest_hits(packet, active, &mut hits);
+                    found += hits[..chunk.len()].iter().flatten().count();
+                }
+                found
             })
         });
     }
