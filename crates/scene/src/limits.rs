@@ -18,7 +18,11 @@ pub const MAX_TRIANGLES: usize = 1 << 22;
 /// Peak bytes per triangle of a scene, measured: `mirrorbox trace --spp 1` of twelve spheres
 /// at subdivision level 7 (3.93 M triangles) peaked at 1.25 GB resident on the development
 /// machine (geometry, CWBVH build, the tracer's slots): 318 bytes each; `render --method
-/// naive` of it peaked at 0.98 GB. Used to say what a refused scene would have needed.
+/// naive` of it peaked at 0.98 GB. Since the packet kernel (2026-11-25) the default
+/// hierarchy is the BVH2, which the packets share: `trace --spp 4` of the same scene peaked
+/// at 1.16 GB (295 bytes each); the non-default `--bvh cwbvh` builds a second hierarchy for
+/// the packets and peaked at 1.75 GB (444 bytes each). Used to say what a refused scene
+/// would have needed with the defaults.
 pub const MEMORY_PER_TRIANGLE: u64 = 320;
 /// Every position in a scene (vertices after their transform, mirror corners, camera, lights)
 /// lies within `±MAX_COORDINATE` scene units on every axis, so that every triangle, its

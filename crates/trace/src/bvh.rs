@@ -32,12 +32,13 @@ pub struct Hit {
     pub triangle: usize,
 }
 
-/// Which obvhs hierarchy to traverse. CWBVH (8-wide, compressed) is the default: it measured
-/// faster on `mirror_box` here (see `benches/trace.rs` and the README).
+/// Which obvhs hierarchy the single-ray queries traverse. BVH2 is the default: obvhs' CWBVH
+/// traversal (8-wide, compressed; ~7–10 % faster) misses some hits a few 10⁻⁵ from a mirror
+/// corner (docs/tracer-performance.md), and the packet kernel shares the BVH2 (one build).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum BvhKind {
-    #[default]
     Cwbvh,
+    #[default]
     Bvh2,
 }
 
@@ -271,6 +272,10 @@ impl SceneBvh {
     }
 
     fn build_packet_bvh(&self) -> PacketBvh {
+        if let Hierarchy::Binary(bvh) = &self.hierarchy {
+            // The packet kernel traverses this very hierarchy, slots in the same order.
+            return PacketBvh::from_bvh2(bvh, self.slots.clone(), self.original.clone());
+        }
         let mut by_index = vec![self.slots.first().copied(); self.slots.len()];
         for (slot, &i) in self.slots.iter().zip(&self.original) {
             by_index[i as usize] = Some(*slot);

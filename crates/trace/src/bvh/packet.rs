@@ -188,15 +188,11 @@ fn max(a: f32, b: f32) -> f32 {
 }
 
 impl PacketBvh {
-    /// The hierarchy over `slots_of(original)`: obvhs' binary build, flattened.
+    /// A binary hierarchy built over `tris` (the scene's triangles in its numbering), with
+    /// `slot_of(i)` the slot of triangle `i`.
     pub(super) fn build(tris: &[obvhs::triangle::Triangle], slot_of: impl Fn(u32) -> Slot) -> Self {
         if tris.is_empty() {
-            return PacketBvh {
-                nodes: Vec::new(),
-                slots: Vec::new(),
-                original: Vec::new(),
-                fits_stack: true,
-            };
+            return PacketBvh::from_parts(Vec::new(), Vec::new(), Vec::new());
         }
         let mut build_time = std::time::Duration::ZERO;
         let bvh = obvhs::bvh2::builder::build_bvh2_from_tris(
@@ -204,7 +200,15 @@ impl PacketBvh {
             obvhs::BvhBuildParams::medium_build(),
             &mut build_time,
         );
-        let nodes: Vec<Node> = bvh
+        let original = bvh.primitive_indices.clone();
+        let slots = original.iter().map(|&i| slot_of(i)).collect();
+        PacketBvh::from_bvh2(&bvh, slots, original)
+    }
+
+    /// The kernel's view of obvhs' `bvh`, whose leaves index `slots` (and `original`, the
+    /// scene's triangle of each slot) in its primitive order.
+    pub(super) fn from_bvh2(bvh: &obvhs::bvh2::Bvh2, slots: Vec<Slot>, original: Vec<u32>) -> Self {
+        let nodes = bvh
             .nodes
             .iter()
             .map(|n| Node {
@@ -214,8 +218,10 @@ impl PacketBvh {
                 first: n.first_index,
             })
             .collect();
-        let original = bvh.primitive_indices.clone();
-        let slots = original.iter().map(|&i| slot_of(i)).collect();
+        PacketBvh::from_parts(nodes, slots, original)
+    }
+
+    fn from_parts(nodes: Vec<Node>, slots: Vec<Slot>, original: Vec<u32>) -> Self {
         let fits_stack = nodes.is_empty() || depth(&nodes, 0) < STACK;
         PacketBvh {
             nodes,
