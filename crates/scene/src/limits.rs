@@ -15,15 +15,14 @@ pub const MAX_OBJ_FILE_BYTES: u64 = 256 << 20;
 /// Most triangles in a scene, objects and mirrors together (2²², e.g. twelve spheres at
 /// subdivision level 7). See [`MEMORY_PER_TRIANGLE`].
 pub const MAX_TRIANGLES: usize = 1 << 22;
-/// Peak bytes per triangle of a scene, measured: `mirrorbox trace --spp 1` of twelve spheres
-/// at subdivision level 7 (3.93 M triangles) peaked at 1.25 GB resident on the development
-/// machine (geometry, CWBVH build, the tracer's slots): 318 bytes each; `render --method
-/// naive` of it peaked at 0.98 GB. Since the packet kernel (2026-11-25) the default
-/// hierarchy is the BVH2, which the packets share: `trace --spp 4` of the same scene peaked
-/// at 1.16 GB (295 bytes each); the non-default `--bvh cwbvh` builds a second hierarchy for
-/// the packets and peaked at 1.75 GB (444 bytes each). Used to say what a refused scene
-/// would have needed with the defaults.
-pub const MEMORY_PER_TRIANGLE: u64 = 320;
+/// Peak bytes per triangle of a scene, measured: `mirrorbox trace` of twelve spheres at
+/// subdivision level 7 (3.93 M triangles) on the development machine. With the packet kernel
+/// (2026-11-25; `--spp 4`) it peaked at 1.75 GB resident (geometry, the CWBVH of the
+/// single-ray queries, the BVH2 of the packets, the slots of each): 444 bytes each; with
+/// `--bvh bvh2` (one hierarchy for both) 1.16 GB; before the packet kernel 1.25 GB.
+/// `render --method naive` of it peaked at 0.98 GB. Used to say what a refused scene would
+/// have needed.
+pub const MEMORY_PER_TRIANGLE: u64 = 450;
 /// Every position in a scene (vertices after their transform, mirror corners, camera, lights)
 /// lies within `±MAX_COORDINATE` scene units on every axis, so that every triangle, its
 /// bounds, the BVH and the products the intersection tests form stay finite in f32 (their

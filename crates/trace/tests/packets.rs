@@ -1,11 +1,11 @@
 //! The packet kernel (issue 19) changes the speed of the truth, not the truth: `whitted`
-//! renders every bundled scene to the same bits with packets as one ray at a time (through
-//! the default hierarchy, the BVH2 the packets share), at the
+//! renders every bundled scene to the same bits with packets as one ray at a time through
+//! the BVH2 (the packets' hierarchy; the CWBVH misses some corner hits: see `bvh.rs`), at the
 //! command line's 4×4 grid and at a 2×2 grid (packets of 4), with shadow legs, uneven
 //! mirrors, symmetry planes and stereo rigs' scenes among them.
 
 use mirrorbox_scene::load::bundled_scene;
-use mirrorbox_trace::{SceneBvh, TraceSettings, render};
+use mirrorbox_trace::{BvhKind, SceneBvh, TraceSettings, render};
 
 #[test]
 fn whitted_renders_every_bundled_scene_to_the_same_bits_with_packets() {
@@ -24,8 +24,8 @@ fn whitted_renders_every_bundled_scene_to_the_same_bits_with_packets() {
         scene.camera = scene.camera.with_size(48, 27);
         for grid in [4, 2] {
             let settings = TraceSettings::whitted(grid);
-            let single = SceneBvh::build(&scene.geometry).with_packets(false);
-            let packets = SceneBvh::build(&scene.geometry);
+            let single = SceneBvh::build_with(&scene.geometry, BvhKind::Bvh2).with_packets(false);
+            let packets = SceneBvh::build_with(&scene.geometry, BvhKind::Bvh2);
             assert!(packets.packets() && !single.packets());
             let a = render(&scene, &single, &settings, &|_| {});
             let b = render(&scene, &packets, &settings, &|_| {});

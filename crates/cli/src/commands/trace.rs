@@ -83,8 +83,8 @@ pub struct Args {
     /// How paths are followed: the contract's Whitted chains, or physically based paths.
     #[arg(long, value_enum, default_value_t = Integrator::Whitted)]
     integrator: Integrator,
-    /// obvhs hierarchy of the single-ray queries (cwbvh: faster, but misses some hits at mirror corners).
-    #[arg(long, value_enum, default_value_t = Bvh::Bvh2)]
+    /// obvhs hierarchy of the single-ray queries (shadow legs, `path`, --kernel single): cwbvh is faster, bvh2 does not miss some hits at mirror corners that cwbvh does.
+    #[arg(long, value_enum, default_value_t = Bvh::Cwbvh)]
     bvh: Bvh,
     /// Closest-hit kernel of `whitted` (`path` traces one ray at a time).
     #[arg(long, value_enum, default_value_t = Kernel::Packet)]
