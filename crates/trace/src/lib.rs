@@ -1,6 +1,7 @@
 //! The obvhs ray tracer: mirrorbox's ground truth.
 //!
-//! - [`bvh`]: one obvhs hierarchy over all the scene's triangles, watertight triangle tests.
+//! - [`bvh`]: one obvhs hierarchy over all the scene's triangles, watertight triangle tests;
+//!   [`bvh::packet`]: the packet kernel (a pixel's rays through a binary BVH together).
 //! - [`integrator`]: the [`Integrator`] trait and its implementations, chosen by
 //!   [`IntegratorSettings`]:
 //!   - [`whitted`]: the integrator that follows the shading contract to deep bounce counts;

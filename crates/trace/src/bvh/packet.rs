@@ -7,13 +7,13 @@
 //! four SSE or two AVX or one AVX-512 operation per line) replace sixteen traversals.
 //!
 //! **The same answer as the single-ray query.** Each lane runs exactly the arithmetic of
-//! [`WatertightRay::intersect`] (the shear constants come from it; no fused multiply-add;
-//! lanes with an exact zero edge function are re-evaluated by the scalar test in f64), and a
-//! hit is kept if `0 ≤ t < best`, and of hits at exactly the same distance the one with the
-//! lowest triangle index is kept, the single-ray query's rule: the answer (distance bits and
-//! triangle) does not depend on the visiting order, which differs. Box tests only prune, conservatively: the
-//! far distance is widened by `1 + 2γ₃` (Ize, "Robust BVH Ray Traversal", JCGT 2013), so a
-//! box is never skipped by a rounding error.
+//! [`WatertightRay::intersect`]: the same shear constants (computed for all lanes at once,
+//! bit-identical, tested), no fused multiply-add, and lanes with an exact zero edge function
+//! finished by the scalar test's f64 re-evaluation. A hit is kept if `0 ≤ t < best`; of hits
+//! at exactly the same distance the lowest triangle index is kept, the single-ray query's
+//! rule, so the answer (distance bits and triangle) does not depend on the visiting order,
+//! which differs. Box tests only prune, conservatively: the far distance is widened by
+//! `1 + 2γ₃` (Ize, "Robust BVH Ray Traversal", JCGT 2013), so rounding never skips a box.
 
 use super::{Hit, NOT_A_MIRROR, Slot};
 use crate::watertight::WatertightRay;
