@@ -279,24 +279,19 @@ impl SceneBvh {
             // The packet kernel traverses this very hierarchy, slots in the same order.
             return PacketBvh::from_bvh2(bvh, self.slots.clone(), self.original.clone());
         }
-        let mut by_index = vec![self.slots.first().copied(); self.slots.len()];
-        for (slot, &i) in self.slots.iter().zip(&self.original) {
-            by_index[i as usize] = Some(*slot);
+        // The slot of each triangle, by the scene's numbering: the input order of the build.
+        let mut slot_of = vec![0u32; self.slots.len()];
+        for (slot, &i) in self.original.iter().enumerate() {
+            slot_of[i as usize] = slot as u32;
         }
-        let tris: Vec<Triangle> = by_index
-            .iter()
-            .map(|s| {
-                let v = s.expect("every triangle has a slot").v;
-                Triangle {
-                    v0: Vec3A::from(v[0]),
-                    v1: Vec3A::from(v[1]),
-                    v2: Vec3A::from(v[2]),
-                }
+        let slot = |i: u32| self.slots[slot_of[i as usize] as usize];
+        let tris: Vec<Triangle> = (0..self.slots.len() as u32)
+            .map(|i| {
+                let [v0, v1, v2] = slot(i).v.map(Vec3A::from);
+                Triangle { v0, v1, v2 }
             })
             .collect();
-        PacketBvh::build(&tris, |i| {
-            by_index[i as usize].expect("every triangle has a slot")
-        })
+        PacketBvh::build(&tris, slot)
     }
 }
 

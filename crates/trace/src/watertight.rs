@@ -23,30 +23,65 @@ pub struct WatertightRay {
     sz: f32,
 }
 
+/// The shear of a ray with direction `dir`: its axis permutation, coded as
+/// `kz · 2 + (1 if kx and ky are swapped)` (see [`axes_of`]), and `(sx, sy, sz)`. `kz` is the
+/// dominant axis; kx and ky are swapped when looking down −kz, to keep the winding of the
+/// projected triangle. Branch free in effect (selects), so that the packet kernel computes it
+/// for all its lanes at once with exactly these operations.
+#[inline(always)]
+pub(crate) fn shear_of(d: [f32; 3]) -> (u32, [f32; 3]) {
+    let a = d.map(f32::abs);
+    let kz = if a[0] >= a[1] && a[0] >= a[2] {
+        0
+    } else if a[1] >= a[2] {
+        1
+    } else {
+        2
+    };
+    let pick = |k: u32| {
+        if k == 0 {
+            d[0]
+        } else if k == 1 {
+            d[1]
+        } else {
+            d[2]
+        }
+    };
+    let dz = pick(kz);
+    let swap = dz < 0.0;
+    let (mut kx, mut ky) = ((kz + 1) % 3, (kz + 2) % 3);
+    if swap {
+        (kx, ky) = (ky, kx);
+    }
+    (
+        kz * 2 + swap as u32,
+        [pick(kx) / dz, pick(ky) / dz, 1.0 / dz],
+    )
+}
+
+/// The `(kx, ky, kz)` of a [`shear_of`] permutation code.
+pub(crate) fn axes_of(code: u32) -> (usize, usize, usize) {
+    let kz = (code / 2) as usize;
+    let (kx, ky) = ((kz + 1) % 3, (kz + 2) % 3);
+    if code % 2 == 1 {
+        (ky, kx, kz)
+    } else {
+        (kx, ky, kz)
+    }
+}
+
 impl WatertightRay {
     pub fn new(origin: Vec3, dir: Vec3) -> Self {
-        let a = dir.abs();
-        let kz = if a.x >= a.y && a.x >= a.z {
-            0
-        } else if a.y >= a.z {
-            1
-        } else {
-            2
-        };
-        let mut kx = (kz + 1) % 3;
-        let mut ky = (kx + 1) % 3;
-        // Keep the winding of the projected triangle: swap when looking down −kz.
-        if dir[kz] < 0.0 {
-            std::mem::swap(&mut kx, &mut ky);
-        }
+        let (code, [sx, sy, sz]) = shear_of(dir.to_array());
+        let (kx, ky, kz) = axes_of(code);
         WatertightRay {
             origin,
             kx,
             ky,
             kz,
-            sx: dir[kx] / dir[kz],
-            sy: dir[ky] / dir[kz],
-            sz: 1.0 / dir[kz],
+            sx,
+            sy,
+            sz,
         }
     }
 
@@ -56,7 +91,7 @@ impl WatertightRay {
         (self.kx, self.ky, self.kz)
     }
 
-    /// The shear constants `(sx, sy, sz)` (the packet kernel computes the same, tested).
+    /// The shear constants `(sx, sy, sz)`.
     pub fn shear(&self) -> [f32; 3] {
         [self.sx, self.sy, self.sz]
     }

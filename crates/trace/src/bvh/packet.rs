@@ -16,9 +16,10 @@
 //! `1 + 2γ₃` (Ize, "Robust BVH Ray Traversal", JCGT 2013), so rounding never skips a box.
 
 use super::{Hit, NOT_A_MIRROR, Slot};
-use crate::watertight::WatertightRay;
+use crate::watertight::{WatertightRay, axes_of, shear_of};
 use glam::Vec3;
 use mirrorbox_scene::Ray;
+use obvhs::ray::safe_inverse;
 
 /// Rays per packet: a pixel's 4×4 sub-pixel grid.
 pub const LANES: usize = 16;
@@ -105,12 +106,13 @@ fn lane_vec(a: &[Lanes; 3], lane: usize) -> Vec3 {
 }
 
 /// What the tests need per lane, computed for all lanes at once: the reciprocal direction
-/// of the box test and the watertight shear (exactly [`WatertightRay::new`]'s arithmetic).
+/// of the box test (obvhs' `safe_inverse`: no infinities, so no `0 × ∞` in a box test) and
+/// the watertight shear ([`shear_of`], as [`WatertightRay::new`]).
 struct Prepared {
     inv: [Lanes; 3],
     /// `sx, sy, sz`.
     shear: [Lanes; 3],
-    /// The axis permutation, as `kz · 2 + (1 if kx and ky are swapped)`.
+    /// The axis permutation, coded as [`shear_of`] codes it.
     axes: [u32; LANES],
 }
 
@@ -125,55 +127,15 @@ impl Prepared {
             for k in 0..3 {
                 inv[k][i] = safe_inverse(d[k]);
             }
-            let a = d.map(f32::abs);
-            let kz = if a[0] >= a[1] && a[0] >= a[2] {
-                0
-            } else if a[1] >= a[2] {
-                1
-            } else {
-                2
-            };
-            let pick = |k: u32| {
-                if k == 0 {
-                    d[0]
-                } else if k == 1 {
-                    d[1]
-                } else {
-                    d[2]
-                }
-            };
-            let dz = pick(kz);
-            let swap = dz < 0.0;
-            let (mut kx, mut ky) = ((kz + 1) % 3, (kz + 2) % 3);
-            if swap {
-                (kx, ky) = (ky, kx);
-            }
-            shear[0][i] = pick(kx) / dz;
-            shear[1][i] = pick(ky) / dz;
-            shear[2][i] = 1.0 / dz;
-            axes[i] = kz * 2 + swap as u32;
+            // Keep the reciprocals' loop apart from the shear's stores: writing both in one
+            // loop over k measured 12 % slower on `mirror_box` (the lane loop stayed scalar).
+            let (code, s) = shear_of(d);
+            shear[0][i] = s[0];
+            shear[1][i] = s[1];
+            shear[2][i] = s[2];
+            axes[i] = code;
         }
         Prepared { inv, shear, axes }
-    }
-}
-
-/// The `(kx, ky, kz)` of a [`Prepared::axes`] code.
-fn axes_of(code: u32) -> (usize, usize, usize) {
-    let kz = (code / 2) as usize;
-    let (kx, ky) = ((kz + 1) % 3, (kz + 2) % 3);
-    if code % 2 == 1 {
-        (ky, kx, kz)
-    } else {
-        (kx, ky, kz)
-    }
-}
-
-/// obvhs' reciprocal (`ray::safe_inverse`): ±1/ε for components within ε of zero.
-fn safe_inverse(x: f32) -> f32 {
-    if x.abs() <= f32::EPSILON {
-        x.signum() / f32::EPSILON
-    } else {
-        1.0 / x
     }
 }
 

@@ -125,11 +125,10 @@ impl<'a> Whitted<'a> {
     /// the results are the same.
     pub fn radiance_packet(&self, rays: &[Ray], out: &mut Vec<PathResult>) {
         for chunk in rays.chunks(LANES) {
-            let mut walks: [Walk; LANES] = std::array::from_fn(|_| Walk::new(chunk[0]));
+            // Lanes past the chunk's end repeat its last ray and are never active.
+            let mut walks: [Walk; LANES] =
+                std::array::from_fn(|lane| Walk::new(chunk[lane.min(chunk.len() - 1)]));
             let mut ends = [Termination::Escaped; LANES];
-            for (walk, &ray) in walks.iter_mut().zip(chunk) {
-                *walk = Walk::new(ray);
-            }
             let mut active: LaneMask = (1 << chunk.len()) - 1;
             let mut packet = RayPacket::default();
             let mut queries = [chunk[0]; LANES];
