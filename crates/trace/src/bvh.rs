@@ -10,6 +10,7 @@
 
 pub mod packet;
 
+use crate::cpu_features::{Vectorised, widest};
 use crate::watertight::WatertightRay;
 use glam::{Vec3, Vec3A};
 use mirrorbox_scene::limits::{MAX_COORDINATE, within_extent};
@@ -262,10 +263,41 @@ impl SceneBvh {
         active: LaneMask,
         out: &mut [Option<Hit>; LANES],
     ) {
+        struct Kernel<'a> {
+            bvh: &'a SceneBvh,
+            packet: &'a RayPacket,
+            active: LaneMask,
+            out: &'a mut [Option<Hit>; LANES],
+        }
+        impl Vectorised for Kernel<'_> {
+            type Output = ();
+            #[inline(always)]
+            fn run(self) {
+                self.bvh
+                    .closest_hits_inline(self.packet, self.active, self.out)
+            }
+        }
+        widest(Kernel {
+            bvh: self,
+            packet,
+            active,
+            out,
+        })
+    }
+
+    /// [`SceneBvh::closest_hits`] for callers already compiled for this CPU
+    /// ([`crate::cpu_features::widest`]): the kernel is inlined into them.
+    #[inline(always)]
+    pub(crate) fn closest_hits_inline(
+        &self,
+        packet: &RayPacket,
+        active: LaneMask,
+        out: &mut [Option<Hit>; LANES],
+    ) {
         if self.packets {
             let bvh = self.packet_bvh.get_or_init(|| self.build_packet_bvh());
             if bvh.usable() {
-                return bvh.closest_hits(packet, active, out);
+                return bvh.closest_hits_inline(packet, active, out);
             }
         }
         for lane in packet::lanes(active) {

@@ -10,6 +10,7 @@
 //! - [`render`](mod@render): the parallel image loop and its statistics.
 
 pub mod bvh;
+pub mod cpu_features;
 pub mod integrator;
 pub mod mirror_bounce;
 pub mod render;

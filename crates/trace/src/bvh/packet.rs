@@ -85,6 +85,23 @@ impl RayPacket {
             self.origin[k][lane] = ray.origin[k];
             self.dir[k][lane] = ray.dir[k];
         }
+        self.set_skip(lane, skip_mirror);
+    }
+
+    /// Every lane's ray, from f64 lanes rounded to f32 (as `DVec3::as_vec3` rounds); the
+    /// skipped mirrors stay as they are. One loop over the lanes per component: vectorised.
+    #[inline(always)]
+    pub fn set_rays_f64(&mut self, origin: &[[f64; LANES]; 3], dir: &[[f64; LANES]; 3]) {
+        for k in 0..3 {
+            for i in 0..LANES {
+                self.origin[k][i] = origin[k][i] as f32;
+                self.dir[k][i] = dir[k][i] as f32;
+            }
+        }
+    }
+
+    /// Lane `lane` skips mirror `skip_mirror` from now on.
+    pub fn set_skip(&mut self, lane: usize, skip_mirror: Option<usize>) {
         self.skip[lane] = skip_mirror.map_or(SKIP_NOTHING, |m| m as u32);
     }
 
@@ -201,54 +218,12 @@ impl PacketBvh {
     /// The closest hit of every lane in `active`, into `out` (lanes outside `active` are
     /// left as they are). The lanes are traversed in groups sharing an axis permutation of
     /// the watertight test (a pixel's samples nearly always share one).
-    pub(super) fn closest_hits(
-        &self,
-        packet: &RayPacket,
-        active: LaneMask,
-        out: &mut [Option<Hit>; LANES],
-    ) {
-        #[cfg(target_arch = "x86_64")]
-        {
-            if *x86::AVX512 {
-                // SAFETY: the CPU has AVX-512F (detected at run time).
-                return unsafe { self.closest_hits_avx512(packet, active, out) };
-            }
-            if *x86::AVX2 {
-                // SAFETY: the CPU has AVX2 (detected at run time).
-                return unsafe { self.closest_hits_avx2(packet, active, out) };
-            }
-        }
-        self.closest_hits_inline(packet, active, out)
-    }
-
-    /// [`PacketBvh::closest_hits`] compiled for AVX-512: one instruction per lane loop line.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx512f")]
-    fn closest_hits_avx512(
-        &self,
-        packet: &RayPacket,
-        active: LaneMask,
-        out: &mut [Option<Hit>; LANES],
-    ) {
-        self.closest_hits_inline(packet, active, out)
-    }
-
-    /// [`PacketBvh::closest_hits`] compiled for AVX2: two instructions per lane loop line.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn closest_hits_avx2(
-        &self,
-        packet: &RayPacket,
-        active: LaneMask,
-        out: &mut [Option<Hit>; LANES],
-    ) {
-        self.closest_hits_inline(packet, active, out)
-    }
-
-    /// The kernel, inlined into each entry point so that each compiles it for its CPU
-    /// features (the same arithmetic, hence the same bits, in every one).
+    ///
+    /// Inlined into its caller so that it is compiled for the caller's CPU
+    /// features ([`crate::cpu_features::widest`]; the same arithmetic, hence the same bits,
+    /// in every build).
     #[inline(always)]
-    fn closest_hits_inline(
+    pub(super) fn closest_hits_inline(
         &self,
         packet: &RayPacket,
         active: LaneMask,
@@ -445,15 +420,6 @@ pub fn lanes(mut mask: LaneMask) -> impl Iterator<Item = usize> {
             lane
         })
     })
-}
-
-/// The CPU features the kernel is compiled for, detected once.
-#[cfg(target_arch = "x86_64")]
-mod x86 {
-    use std::sync::LazyLock;
-    pub static AVX512: LazyLock<bool> =
-        LazyLock::new(|| std::arch::is_x86_feature_detected!("avx512f"));
-    pub static AVX2: LazyLock<bool> = LazyLock::new(|| std::arch::is_x86_feature_detected!("avx2"));
 }
 
 /// Nodes on the longest root-to-leaf path below `index`.

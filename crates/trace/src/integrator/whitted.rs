@@ -13,7 +13,8 @@
 use super::{Integrator, PathResult, Termination, face_normals};
 use crate::bvh::packet::{LANES, LaneMask, RayPacket, lanes};
 use crate::bvh::{Hit, SceneBvh};
-use crate::mirror_bounce::MirrorPlanes;
+use crate::cpu_features::{Vectorised, widest};
+use crate::mirror_bounce::{MirrorPlanes, reflect_on_plane};
 use crate::sampler::SplitMix64;
 use glam::{DVec3, Vec3};
 use mirrorbox_scene::shading::{Interaction, interaction};
@@ -107,67 +108,137 @@ impl<'a> Whitted<'a> {
     /// Radiance along `ray`, calling `on_mirror(k, point, mirror)` at the k-th reflection
     /// (k from 1) with the exact hit point (tests and diagnostics; the closure inlines away).
     pub fn trace(&self, ray: Ray, mut on_mirror: impl FnMut(u32, DVec3, usize)) -> PathResult {
-        let mut walk = Walk::new(ray);
+        let (mut origin, mut dir) = (ray.origin.as_dvec3(), ray.dir.as_dvec3());
+        let mut leaving = None;
+        let mut carried = Carried::START;
         loop {
-            let query = walk.query();
-            let hit = self
-                .bvh
-                .closest_hit(&query, 0.0, f32::INFINITY, walk.leaving);
-            if let Some(end) = self.step(&mut walk, &query, hit, &mut on_mirror) {
-                return walk.result(end);
-            }
+            let query = Ray {
+                origin: origin.as_vec3(),
+                dir: dir.as_vec3(),
+            };
+            let hit = self.bvh.closest_hit(&query, 0.0, f32::INFINITY, leaving);
+            let mirror = match self.step(&mut carried, &query, hit) {
+                Next::End(end) => return carried.result(end),
+                Next::Reflect(mirror) => mirror,
+            };
+            let Some(next) = self.mirror_planes.reflect(mirror, origin, dir) else {
+                return carried.result(Termination::Absorbed);
+            };
+            (origin, dir) = next;
+            leaving = Some(mirror);
+            on_mirror(carried.bounces, origin, mirror);
         }
     }
 
     /// [`Whitted::radiance`] of each of `rays`, in order, into `out`: the rays walk their
     /// paths side by side, and each round's closest-hit queries go to the BVH together as
     /// one packet ([`SceneBvh::closest_hits`]). Every path takes the same steps as alone, so
-    /// the results are the same.
+    /// the results are the same. Compiled for the CPU's widest vectors
+    /// ([`crate::cpu_features`]), kernel included.
     pub fn radiance_packet(&self, rays: &[Ray], out: &mut Vec<PathResult>) {
+        struct Work<'w, 'a> {
+            whitted: &'w Whitted<'a>,
+            rays: &'w [Ray],
+            out: &'w mut Vec<PathResult>,
+        }
+        impl Vectorised for Work<'_, '_> {
+            type Output = ();
+            #[inline(always)]
+            fn run(self) {
+                self.whitted.radiance_packet_inline(self.rays, self.out)
+            }
+        }
+        widest(Work {
+            whitted: self,
+            rays,
+            out,
+        })
+    }
+
+    /// [`Whitted::radiance_packet`]'s work. The walks are kept as structure of arrays: the
+    /// packet's rays are rounded to f32 in one lane loop, and the round's bounces off flat
+    /// mirrors are computed in another ([`reflect_on_plane`], f64); the shading of each
+    /// lane's hit stays one lane at a time.
+    #[inline(always)]
+    fn radiance_packet_inline(&self, rays: &[Ray], out: &mut Vec<PathResult>) {
         for chunk in rays.chunks(LANES) {
             // Lanes past the chunk's end repeat its last ray and are never active.
-            let mut walks: [Walk; LANES] =
-                std::array::from_fn(|lane| Walk::new(chunk[lane.min(chunk.len() - 1)]));
+            let ray = |lane: usize| chunk[lane.min(chunk.len() - 1)];
+            let mut origin: [[f64; LANES]; 3] =
+                std::array::from_fn(|k| std::array::from_fn(|lane| ray(lane).origin[k] as f64));
+            let mut dir: [[f64; LANES]; 3] =
+                std::array::from_fn(|k| std::array::from_fn(|lane| ray(lane).dir[k] as f64));
+            let mut carried = [Carried::START; LANES];
             let mut ends = [Termination::Escaped; LANES];
             let mut active: LaneMask = (1 << chunk.len()) - 1;
             let mut packet = RayPacket::default();
-            let mut queries = [chunk[0]; LANES];
             let mut hits = [None; LANES];
             while active != 0 {
+                packet.set_rays_f64(&origin, &dir);
+                self.bvh.closest_hits_inline(&packet, active, &mut hits);
+                // The round's bounces off flat mirrors: which lanes, and their planes.
+                let mut flat = [false; LANES];
+                let mut normal = [[0.0f64; LANES]; 3];
+                let mut offset = [0.0f64; LANES];
                 for lane in lanes(active) {
-                    queries[lane] = walks[lane].query();
-                    packet.set(lane, &queries[lane], walks[lane].leaving);
-                }
-                self.bvh.closest_hits(&packet, active, &mut hits);
-                for lane in lanes(active) {
-                    let walk = &mut walks[lane];
-                    if let Some(end) =
-                        self.step(walk, &queries[lane], hits[lane], &mut |_, _, _| {})
-                    {
-                        ends[lane] = end;
+                    let (query, _) = packet.lane(lane);
+                    let mirror = match self.step(&mut carried[lane], &query, hits[lane]) {
+                        Next::End(end) => {
+                            ends[lane] = end;
+                            active &= !(1 << lane);
+                            continue;
+                        }
+                        Next::Reflect(mirror) => mirror,
+                    };
+                    packet.set_skip(lane, Some(mirror));
+                    if let Some((n, off)) = self.mirror_planes.flat_plane(mirror) {
+                        flat[lane] = true;
+                        for k in 0..3 {
+                            normal[k][lane] = n[k];
+                        }
+                        offset[lane] = off;
+                        continue;
+                    }
+                    let o = DVec3::new(origin[0][lane], origin[1][lane], origin[2][lane]);
+                    let d = DVec3::new(dir[0][lane], dir[1][lane], dir[2][lane]);
+                    let Some((o, d)) = self.mirror_planes.reflect(mirror, o, d) else {
+                        ends[lane] = Termination::Absorbed;
                         active &= !(1 << lane);
+                        continue;
+                    };
+                    for k in 0..3 {
+                        origin[k][lane] = o[k];
+                        dir[k][lane] = d[k];
+                    }
+                }
+                if flat.iter().any(|&f| f) {
+                    // Branch free over all lanes; lanes without a flat bounce keep their ray.
+                    for i in 0..LANES {
+                        let n = [normal[0][i], normal[1][i], normal[2][i]];
+                        let o = [origin[0][i], origin[1][i], origin[2][i]];
+                        let d = [dir[0][i], dir[1][i], dir[2][i]];
+                        let (hit, r) = reflect_on_plane(n, offset[i], o, d);
+                        for k in 0..3 {
+                            origin[k][i] = if flat[i] { hit[k] } else { origin[k][i] };
+                            dir[k][i] = if flat[i] { r[k] } else { dir[k][i] };
+                        }
                     }
                 }
             }
-            out.extend((0..chunk.len()).map(|lane| walks[lane].result(ends[lane])));
+            out.extend((0..chunk.len()).map(|lane| carried[lane].result(ends[lane])));
         }
     }
 
-    /// One step of a path: `hit` is the closest hit of `query` (the walk's current ray);
-    /// shades it or reflects the walk there. `Some` when the path ends.
+    /// One step of a path: `hit` is the closest hit of `query` (the path's current ray).
+    /// Shades it (the path ends) or, at a mirror, takes its reflectance and asks for the
+    /// bounce, which the caller computes.
     #[inline(always)]
-    fn step(
-        &self,
-        walk: &mut Walk,
-        query: &Ray,
-        hit: Option<Hit>,
-        on_mirror: &mut impl FnMut(u32, DVec3, usize),
-    ) -> Option<Termination> {
+    fn step(&self, carried: &mut Carried, query: &Ray, hit: Option<Hit>) -> Next {
         let scene = self.scene;
-        walk.rays += 1;
+        carried.rays += 1;
         let Some(hit) = hit else {
-            walk.radiance += walk.throughput * scene.background;
-            return Some(Termination::Escaped);
+            carried.radiance += carried.throughput * scene.background;
+            return Next::End(Termination::Escaped);
         };
         let normal = self.face_normals[hit.triangle];
         let front = normal.dot(query.dir) < 0.0;
@@ -187,16 +258,16 @@ impl<'a> Whitted<'a> {
                         self.leg_unoccluded(a, a_mirror, hit.triangle, b)
                     },
                 );
-                walk.rays += legs;
-                walk.radiance += walk.throughput * shaded;
-                Some(Termination::Diffuse)
+                carried.rays += legs;
+                carried.radiance += carried.throughput * shaded;
+                Next::End(Termination::Diffuse)
             }
             Interaction::Reflect { reflectance } => {
                 let mirrorbox_scene::Surface::Mirror { mirror, .. } = *surface else {
                     unreachable!("only mirrors reflect")
                 };
-                let next = walk.throughput * reflectance;
-                let cut = if walk.bounces >= self.settings.max_depth {
+                let next = carried.throughput * reflectance;
+                let cut = if carried.bounces >= self.settings.max_depth {
                     Some(Termination::Depth)
                 } else if next.max_element() < self.settings.min_throughput {
                     Some(Termination::Throughput)
@@ -204,57 +275,34 @@ impl<'a> Whitted<'a> {
                     None
                 };
                 if let Some(reason) = cut {
-                    walk.radiance += walk.throughput * scene.terminal;
-                    return Some(reason);
+                    carried.radiance += carried.throughput * scene.terminal;
+                    return Next::End(reason);
                 }
-                walk.throughput = next;
-                walk.bounces += 1;
-                let Some(next_ray) = self.mirror_planes.reflect(mirror, walk.origin, walk.dir)
-                else {
-                    return Some(Termination::Absorbed);
-                };
-                (walk.origin, walk.dir) = next_ray;
-                walk.leaving = Some(mirror);
-                on_mirror(walk.bounces, walk.origin, mirror);
-                None
+                carried.throughput = next;
+                carried.bounces += 1;
+                Next::Reflect(mirror)
             }
         }
     }
 }
 
-/// A path in progress: its ray (in f64, for plane-exact bounces), what it carries so far
-/// and the mirror it leaves.
+/// What a path carries from step to step (its ray is kept by the caller: in f64, for
+/// plane-exact bounces).
 #[derive(Clone, Copy)]
-struct Walk {
-    origin: DVec3,
-    dir: DVec3,
+struct Carried {
     throughput: Vec3,
     radiance: Vec3,
     bounces: u32,
     rays: u32,
-    leaving: Option<usize>,
 }
 
-impl Walk {
-    fn new(ray: Ray) -> Self {
-        Walk {
-            origin: ray.origin.as_dvec3(),
-            dir: ray.dir.as_dvec3(),
-            throughput: Vec3::ONE,
-            radiance: Vec3::ZERO,
-            bounces: 0,
-            rays: 0,
-            leaving: None,
-        }
-    }
-
-    /// The ray the BVH is asked about next.
-    fn query(&self) -> Ray {
-        Ray {
-            origin: self.origin.as_vec3(),
-            dir: self.dir.as_vec3(),
-        }
-    }
+impl Carried {
+    const START: Carried = Carried {
+        throughput: Vec3::ONE,
+        radiance: Vec3::ZERO,
+        bounces: 0,
+        rays: 0,
+    };
 
     fn result(&self, termination: Termination) -> PathResult {
         PathResult {
@@ -264,6 +312,13 @@ impl Walk {
             rays: self.rays,
         }
     }
+}
+
+/// What [`Whitted::step`] decided.
+enum Next {
+    End(Termination),
+    /// Reflect off this mirror (the throughput already includes its reflectance).
+    Reflect(usize),
 }
 
 impl Integrator for Whitted<'_> {

@@ -1,0 +1,73 @@
+//! One binary, the CPU's widest vectors: code run through [`widest`] is compiled three
+//! times — for AVX-512, for AVX2 and for the x86-64 baseline (SSE2) — and the CPU's best
+//! is chosen at run time (`is_x86_feature_detected`, once). No `target-cpu=native`.
+//!
+//! Why it is safe for the answers: Rust never contracts `a * b + c` into a fused
+//! multiply-add, and every vector instruction of add, multiply, divide and square root
+//! rounds each lane as its scalar form does, so all three builds give the same bits.
+//!
+//! How it works: the work is a [`Vectorised`] value whose `run` is `#[inline(always)]`; it
+//! is called from a function carrying `#[target_feature]`, and `run` and everything forced
+//! inline into it are compiled with those features. (A closure does not do: it stays a
+//! function of its own, compiled for the baseline, and the wrapper only jumps to it.) The
+//! lane loops inside (`for i in 0..LANES`, branch free over structure-of-arrays data) are
+//! what the wider vectors speed up.
+
+/// Work to compile for each CPU: implement `run` with `#[inline(always)]`, and mark
+/// `#[inline(always)]` what it calls that should be compiled with it.
+pub trait Vectorised {
+    type Output;
+    fn run(self) -> Self::Output;
+}
+
+/// Runs `work` compiled for the widest vector instructions this CPU has.
+#[inline(always)]
+pub fn widest<W: Vectorised>(work: W) -> W::Output {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if *x86::AVX512 {
+            // SAFETY: the CPU has AVX-512F (detected at run time).
+            return unsafe { x86::avx512(work) };
+        }
+        if *x86::AVX2 {
+            // SAFETY: the CPU has AVX2 (detected at run time).
+            return unsafe { x86::avx2(work) };
+        }
+    }
+    work.run()
+}
+
+/// The name of the build [`widest`] runs on this CPU (reports, `--json`).
+pub fn widest_name() -> &'static str {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if *x86::AVX512 {
+            return "avx512";
+        }
+        if *x86::AVX2 {
+            return "avx2";
+        }
+    }
+    "baseline"
+}
+
+#[cfg(target_arch = "x86_64")]
+mod x86 {
+    use std::sync::LazyLock;
+
+    pub static AVX512: LazyLock<bool> =
+        LazyLock::new(|| std::arch::is_x86_feature_detected!("avx512f"));
+    pub static AVX2: LazyLock<bool> = LazyLock::new(|| std::arch::is_x86_feature_detected!("avx2"));
+
+    use super::Vectorised;
+
+    #[target_feature(enable = "avx512f")]
+    pub fn avx512<W: Vectorised>(work: W) -> W::Output {
+        work.run()
+    }
+
+    #[target_feature(enable = "avx2")]
+    pub fn avx2<W: Vectorised>(work: W) -> W::Output {
+        work.run()
+    }
+}
