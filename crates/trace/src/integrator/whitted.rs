@@ -119,6 +119,10 @@ impl<'a> Whitted<'a> {
             let hit = self.bvh.closest_hit(&query, 0.0, f32::INFINITY, leaving);
             let mirror = match self.step(&mut carried, &query, hit) {
                 Next::End(end) => return carried.result(end),
+                Next::Diffuse(d) => {
+                    let end = self.shade(&mut carried, &d);
+                    return carried.result(end);
+                }
                 Next::Reflect(mirror) => mirror,
             };
             let Some(next) = self.mirror_planes.reflect(mirror, origin, dir) else {
@@ -156,11 +160,16 @@ impl<'a> Whitted<'a> {
     }
 
     /// [`Whitted::radiance_packet`]'s work. The walks are kept as structure of arrays: the
-    /// packet's rays are rounded to f32 in one lane loop, and the round's bounces off flat
-    /// mirrors are computed in another ([`reflect_on_plane`], f64); the shading of each
-    /// lane's hit stays one lane at a time.
+    /// packet's rays are rounded to f32 in one lane loop, the round's bounces off flat
+    /// mirrors are computed in another ([`reflect_on_plane`], f64), and its diffuse hits are
+    /// shaded in a third where there are no shadow legs or light images
+    /// ([`mirrorbox_scene::Lighting::direct_radiance_lanes`]); the rest (the step's
+    /// decisions, bumps, shadow legs) stays one lane at a time.
     #[inline(always)]
     fn radiance_packet_inline(&self, rays: &[Ray], out: &mut Vec<PathResult>) {
+        let lighting = &self.scene.lighting;
+        // Without shadow legs, a round's diffuse hits are shaded side by side.
+        let lanes_shade = lighting.lanes_apply();
         for chunk in rays.chunks(LANES) {
             // Lanes past the chunk's end repeat its last ray and are never active.
             let ray = |lane: usize| chunk[lane.min(chunk.len() - 1)];
@@ -180,12 +189,31 @@ impl<'a> Whitted<'a> {
                 let mut flat = [false; LANES];
                 let mut normal = [[0.0f64; LANES]; 3];
                 let mut offset = [0.0f64; LANES];
+                // The round's diffuse hits, shaded together where the lighting allows.
+                let mut diffuse = [false; LANES];
+                let mut shading = [[[0.0f32; LANES]; 3]; 5];
                 for lane in lanes(active) {
                     let (query, _) = packet.lane(lane);
                     let mirror = match self.step(&mut carried[lane], &query, hits[lane]) {
                         Next::End(end) => {
                             ends[lane] = end;
                             active &= !(1 << lane);
+                            continue;
+                        }
+                        Next::Diffuse(d) => {
+                            ends[lane] = Termination::Diffuse;
+                            active &= !(1 << lane);
+                            if !lanes_shade {
+                                self.shade(&mut carried[lane], &d);
+                                continue;
+                            }
+                            diffuse[lane] = true;
+                            let values = [d.p, d.normal, d.to_viewer, d.albedo, d.emission];
+                            for (a, value) in shading.iter_mut().zip(values) {
+                                for k in 0..3 {
+                                    a[k][lane] = value[k];
+                                }
+                            }
                             continue;
                         }
                         Next::Reflect(mirror) => mirror,
@@ -211,6 +239,15 @@ impl<'a> Whitted<'a> {
                         dir[k][lane] = d[k];
                     }
                 }
+                if diffuse.iter().any(|&f| f) {
+                    let [p, n, to_viewer, albedo, emission] = &shading;
+                    let shaded = lighting.direct_radiance_lanes(p, n, to_viewer, albedo, emission);
+                    for lane in (0..LANES).filter(|&lane| diffuse[lane]) {
+                        let c = &mut carried[lane];
+                        let l = Vec3::new(shaded[0][lane], shaded[1][lane], shaded[2][lane]);
+                        c.radiance += c.throughput * l;
+                    }
+                }
                 if flat.iter().any(|&f| f) {
                     // Branch free over all lanes; lanes without a flat bounce keep their ray.
                     for i in 0..LANES {
@@ -229,9 +266,31 @@ impl<'a> Whitted<'a> {
         }
     }
 
+    /// The radiance a diffuse hit sends back along the path, shadow legs traced (the
+    /// contract's [`mirrorbox_scene::Lighting::diffuse_radiance_with`]); ends the path.
+    #[inline(always)]
+    fn shade(&self, carried: &mut Carried, d: &DiffuseHit) -> Termination {
+        let mut legs = 0;
+        let shaded = self.scene.lighting.diffuse_radiance_with(
+            d.p,
+            d.normal,
+            d.to_viewer,
+            d.albedo,
+            d.emission,
+            |a, a_mirror, b, _| {
+                legs += 1;
+                self.leg_unoccluded(a, a_mirror, d.triangle, b)
+            },
+        );
+        carried.rays += legs;
+        carried.radiance += carried.throughput * shaded;
+        Termination::Diffuse
+    }
+
     /// One step of a path: `hit` is the closest hit of `query` (the path's current ray).
-    /// Shades it (the path ends) or, at a mirror, takes its reflectance and asks for the
-    /// bounce, which the caller computes.
+    /// Ends it (escaped, or cut at a mirror), asks for the shading of a diffuse hit, or,
+    /// at a mirror, takes its reflectance and asks for the bounce; the caller computes
+    /// those two.
     #[inline(always)]
     fn step(&self, carried: &mut Carried, query: &Ray, hit: Option<Hit>) -> Next {
         let scene = self.scene;
@@ -244,24 +303,14 @@ impl<'a> Whitted<'a> {
         let front = normal.dot(query.dir) < 0.0;
         let surface = scene.geometry.surface(hit.triangle);
         match interaction(surface, front) {
-            Interaction::Diffuse { albedo, emission } => {
-                let p = query.at(hit.t);
-                let mut legs = 0;
-                let shaded = scene.lighting.diffuse_radiance_with(
-                    p,
-                    normal,
-                    -query.dir,
-                    albedo,
-                    emission,
-                    |a, a_mirror, b, _| {
-                        legs += 1;
-                        self.leg_unoccluded(a, a_mirror, hit.triangle, b)
-                    },
-                );
-                carried.rays += legs;
-                carried.radiance += carried.throughput * shaded;
-                Next::End(Termination::Diffuse)
-            }
+            Interaction::Diffuse { albedo, emission } => Next::Diffuse(DiffuseHit {
+                p: query.at(hit.t),
+                normal,
+                to_viewer: -query.dir,
+                albedo,
+                emission,
+                triangle: hit.triangle,
+            }),
             Interaction::Reflect { reflectance } => {
                 let mirrorbox_scene::Surface::Mirror { mirror, .. } = *surface else {
                     unreachable!("only mirrors reflect")
@@ -314,9 +363,21 @@ impl Carried {
     }
 }
 
+/// A diffuse hit to shade: what the contract's shading needs.
+struct DiffuseHit {
+    p: Vec3,
+    normal: Vec3,
+    to_viewer: Vec3,
+    albedo: Vec3,
+    emission: Vec3,
+    triangle: usize,
+}
+
 /// What [`Whitted::step`] decided.
 enum Next {
     End(Termination),
+    /// Shade this diffuse hit ([`Whitted::shade`]); the path ends there.
+    Diffuse(DiffuseHit),
     /// Reflect off this mirror (the throughput already includes its reflectance).
     Reflect(usize),
 }
