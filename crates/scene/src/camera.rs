@@ -162,9 +162,11 @@ impl RayGenerator {
     pub fn rays_at_offsets(&self, x: f32, y: f32, offsets: &[Vec2], out: &mut Vec<Ray>) {
         const LANES: usize = 16;
         for chunk in offsets.chunks(LANES) {
-            let offset = |i: usize| chunk[i.min(chunk.len() - 1)];
-            let px: [f32; LANES] = std::array::from_fn(|i| x + offset(i).x);
-            let py: [f32; LANES] = std::array::from_fn(|i| y + offset(i).y);
+            let (mut px, mut py) = ([0.0f32; LANES], [0.0f32; LANES]);
+            for i in 0..LANES {
+                let o = chunk[i.min(chunk.len() - 1)];
+                (px[i], py[i]) = (x + o.x, y + o.y);
+            }
             let mut dir = [[0.0f32; LANES]; 3];
             for i in 0..LANES {
                 let d = self.dir(px[i], py[i]);

@@ -149,9 +149,14 @@ impl Vectorised for RowWork<'_> {
         let mut stats = TraceStats::default();
         let mut colour = Vec::with_capacity(w as usize);
         let mut depth = Vec::with_capacity(w as usize);
+        // The grid's offsets are the same in every pixel.
+        let per_pixel = matches!(sampling, Sampling::Jittered { .. });
+        sampling.offsets(y as u64 * w as u64, &mut offsets);
         for x in 0..w {
             let pixel = y as u64 * w as u64 + x as u64;
-            sampling.offsets(pixel, &mut offsets);
+            if per_pixel {
+                sampling.offsets(pixel, &mut offsets);
+            }
             let mut sum = glam::Vec3::ZERO;
             let mut bounces = 0u64;
             let mut rng = SplitMix64::for_pixel(seed, pixel);

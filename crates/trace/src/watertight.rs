@@ -30,7 +30,7 @@ pub struct WatertightRay {
 /// for all its lanes at once with exactly these operations.
 #[inline(always)]
 pub(crate) fn shear_of(d: [f32; 3]) -> (u32, [f32; 3]) {
-    let a = d.map(f32::abs);
+    let a = [d[0].abs(), d[1].abs(), d[2].abs()];
     let kz = if a[0] >= a[1] && a[0] >= a[2] {
         0
     } else if a[1] >= a[2] {

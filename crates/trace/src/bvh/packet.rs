@@ -273,7 +273,10 @@ impl PacketBvh {
         best_t: &mut Lanes,
         best_slot: &mut [u32; LANES],
     ) {
-        let in_group: Mask = std::array::from_fn(|i| group >> i & 1 == 1);
+        let mut in_group: Mask = [false; LANES];
+        for (i, lane) in in_group.iter_mut().enumerate() {
+            *lane = group >> i & 1 == 1;
+        }
         let lead = group.trailing_zeros() as usize;
         let lead_dir = [p.dir[0][lead], p.dir[1][lead], p.dir[2][lead]];
         let mut stack = [0u32; STACK];

@@ -171,12 +171,17 @@ impl<'a> Whitted<'a> {
         // Without shadow legs, a round's diffuse hits are shaded side by side.
         let lanes_shade = lighting.lanes_apply();
         for chunk in rays.chunks(LANES) {
-            // Lanes past the chunk's end repeat its last ray and are never active.
-            let ray = |lane: usize| chunk[lane.min(chunk.len() - 1)];
-            let mut origin: [[f64; LANES]; 3] =
-                std::array::from_fn(|k| std::array::from_fn(|lane| ray(lane).origin[k] as f64));
-            let mut dir: [[f64; LANES]; 3] =
-                std::array::from_fn(|k| std::array::from_fn(|lane| ray(lane).dir[k] as f64));
+            // Lanes past the chunk's end repeat its last ray and are never active. (Plain
+            // loops: `std::array::from_fn` here stayed calls, not inlined, a few per cent.)
+            let mut origin = [[0.0f64; LANES]; 3];
+            let mut dir = [[0.0f64; LANES]; 3];
+            for lane in 0..LANES {
+                let ray = &chunk[lane.min(chunk.len() - 1)];
+                for k in 0..3 {
+                    origin[k][lane] = ray.origin[k] as f64;
+                    dir[k][lane] = ray.dir[k] as f64;
+                }
+            }
             let mut carried = [Carried::START; LANES];
             let mut ends = [Termination::Escaped; LANES];
             let mut active: LaneMask = (1 << chunk.len()) - 1;
