@@ -104,8 +104,9 @@ pub struct SceneBvh {
     pub kind: BvhKind,
     /// Whether [`SceneBvh::closest_hits`] traces packets (else one ray at a time).
     packets: bool,
-    /// The binary hierarchy of the packet kernel, built at its first use.
-    packet_bvh: OnceLock<PacketBvh>,
+    /// The binary hierarchy of the packet kernel, built at its first use or by
+    /// [`SceneBvh::prepare_packets`], and the time its build took.
+    packet_bvh: OnceLock<(PacketBvh, Duration)>,
 }
 
 impl SceneBvh {
@@ -295,7 +296,7 @@ impl SceneBvh {
         out: &mut [Option<Hit>; LANES],
     ) {
         if self.packets {
-            let bvh = self.packet_bvh.get_or_init(|| self.build_packet_bvh());
+            let bvh = self.packet_bvh();
             if bvh.usable() {
                 return bvh.closest_hits_inline(packet, active, out);
             }
@@ -304,6 +305,32 @@ impl SceneBvh {
             let (ray, skip) = packet.lane(lane);
             out[lane] = self.closest_hit(&ray, 0.0, f32::INFINITY, skip);
         }
+    }
+
+    /// Builds the packet kernel's hierarchy now if packets are on (an integrator that
+    /// traces packets calls it when it is created, so that the build is not part of the
+    /// image loop's time, as the single-ray hierarchy's is not).
+    pub fn prepare_packets(&self) {
+        if self.packets {
+            self.packet_bvh();
+        }
+    }
+
+    /// Time spent building the packet kernel's hierarchy, if it was built (beside
+    /// [`SceneBvh::build_time`]; zero when the kernel reuses the BVH2 of `--bvh bvh2`).
+    pub fn packet_build_time(&self) -> Option<Duration> {
+        self.packet_bvh.get().map(|(_, time)| *time)
+    }
+
+    fn packet_bvh(&self) -> &PacketBvh {
+        &self
+            .packet_bvh
+            .get_or_init(|| {
+                let start = std::time::Instant::now();
+                let bvh = self.build_packet_bvh();
+                (bvh, start.elapsed())
+            })
+            .0
     }
 
     fn build_packet_bvh(&self) -> PacketBvh {

@@ -370,6 +370,8 @@ fn report(
             "deepest_path": s.deepest, "render_seconds": secs, "total_seconds": total.as_secs_f64(),
             "bvh": format!("{:?}", bvh.kind).to_lowercase(), "bvh_build_seconds": bvh.build_time.as_secs_f64(),
             "kernel": format!("{:?}", args.kernel).to_lowercase(),
+            "packet_bvh_build_seconds": bvh.packet_build_time().map(|t| t.as_secs_f64()),
+            "simd": mirrorbox_trace::cpu_features::widest_name(),
             "threads": out.threads,
             "ended": { "diffuse": s.diffuse, "escaped": s.escaped, "max_depth": s.cut_by_depth,
                        "min_throughput": s.cut_by_throughput, "roulette": s.cut_by_roulette,
@@ -420,11 +422,19 @@ fn report(
         );
     }
     println!("  lighting: {}", scene.lighting.describe());
+    let packet_build = match bvh.packet_build_time() {
+        Some(t) => format!(
+            " (+ {:.1} ms for the packet kernel's BVH2)",
+            t.as_secs_f64() * 1e3
+        ),
+        None => String::new(),
+    };
     println!(
-        "  {:?} over {} triangles built in {:.1} ms; wrote {}",
+        "  {:?} over {} triangles built in {:.1} ms{packet_build}; {} vectors; wrote {}",
         bvh.kind,
         scene.geometry.triangles.len(),
         bvh.build_time.as_secs_f64() * 1e3,
+        mirrorbox_trace::cpu_features::widest_name(),
         written
             .iter()
             .map(|p| p.display().to_string())

@@ -67,6 +67,7 @@ impl<'a> Whitted<'a> {
     pub fn new(scene: &'a Scene, bvh: &'a SceneBvh, settings: WhittedSettings) -> Self {
         let face_normals = face_normals(&scene.geometry);
         let mirror_planes = MirrorPlanes::new(scene);
+        bvh.prepare_packets();
         Whitted {
             scene,
             bvh,
