@@ -9,7 +9,7 @@
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use mirrorbox_scene::{Ray, Scene, Surface};
 use mirrorbox_trace::SceneBvh;
-use mirrorbox_trace::bvh::packet::{LANES, LaneMask, RayPacket};
+use mirrorbox_trace::bvh::packet::{LANES, RayPacket, first_lanes};
 use mirrorbox_trace::mirror_bounce::MirrorPlanes;
 
 /// A ray with the mirror it leaves (skipped by the query, as the integrators do).
@@ -73,8 +73,8 @@ fn bench(c: &mut Criterion) {
                     .count()
             })
         });
-        // The packet kernel on the same rays, 16 consecutive ones per packet (neighbouring
-        // pixels of a row; the image loop packs a pixel's 16 samples, more coherent still).
+        // The packet kernel on the same rays, LANES consecutive ones per packet (neighbouring
+        // pixels of a row; the image loop packs two pixels' 16 samples, more coherent still).
         let packets: Vec<RayPacket> = set
             .chunks(LANES)
             .map(|chunk| {
@@ -90,7 +90,7 @@ fn bench(c: &mut Criterion) {
                 let mut hits = [None; LANES];
                 let mut found = 0;
                 for (packet, chunk) in packets.iter().zip(set.chunks(LANES)) {
-                    let active: LaneMask = (1 << chunk.len()) - 1;
+                    let active = first_lanes(chunk.len());
                     bvh.closest_hits(packet, active, &mut hits);
                     found += hits[..chunk.len()].iter().flatten().count();
                 }

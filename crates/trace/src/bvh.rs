@@ -520,8 +520,8 @@ mod tests {
             for (lane, (ray, skip)) in chunk.iter().enumerate() {
                 packet.set(lane, ray, *skip);
             }
-            let all: LaneMask = (1 << chunk.len()) - 1;
-            for active in [all, all & 0x5555, all & 0xf0f0] {
+            let all = packet::first_lanes(chunk.len());
+            for active in [all, all & 0x5555_5555, all & 0xf0f0_f0f0, all & 0xffff_0000] {
                 let mut out = [None; LANES];
                 bvh.closest_hits(&packet, active, &mut out);
                 for lane in 0..chunk.len() {

@@ -32,6 +32,15 @@ pub trait Integrator: Sync {
         out.clear();
         out.extend(rays.iter().map(|&ray| self.radiance(ray, rng)));
     }
+
+    /// How many neighbouring pixels of a row the image loop may hand to one
+    /// [`Integrator::radiance_all`] call, their rays pixel after pixel, given
+    /// `samples_per_pixel`. The default, 1, is the only value for an integrator that draws
+    /// random numbers: a call gets one pixel's stream (that of its first pixel).
+    fn pixels_per_call(&self, samples_per_pixel: usize) -> usize {
+        let _ = samples_per_pixel;
+        1
+    }
 }
 
 /// How a path ended.

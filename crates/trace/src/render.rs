@@ -119,7 +119,8 @@ pub struct TraceOutput {
 type Row = (Vec<[f32; 3]>, Vec<[f32; 3]>, TraceStats);
 
 /// One image row: every pixel's camera rays (generated sixteen at a time) through the
-/// integrator, their results summed in order. Compiled for the CPU's widest vectors.
+/// integrator, as many pixels per call as it takes ([`Integrator::pixels_per_call`]), each
+/// pixel's results summed in order. Compiled for the CPU's widest vectors.
 struct RowWork<'a> {
     y: u32,
     width: u32,
@@ -142,7 +143,9 @@ impl Vectorised for RowWork<'_> {
             integrator,
             seed,
         } = self;
-        let spp = sampling.grid().samples_per_pixel() as f32;
+        let samples = sampling.grid().samples_per_pixel() as usize;
+        let spp = samples as f32;
+        let batch = integrator.pixels_per_call(samples).max(1) as u32;
         let mut offsets = Vec::new();
         let mut camera_rays = Vec::new();
         let mut results = Vec::new();
@@ -152,24 +155,30 @@ impl Vectorised for RowWork<'_> {
         // The grid's offsets are the same in every pixel.
         let per_pixel = matches!(sampling, Sampling::Jittered { .. });
         sampling.offsets(y as u64 * w as u64, &mut offsets);
-        for x in 0..w {
-            let pixel = y as u64 * w as u64 + x as u64;
-            if per_pixel {
-                sampling.offsets(pixel, &mut offsets);
-            }
-            let mut sum = glam::Vec3::ZERO;
-            let mut bounces = 0u64;
-            let mut rng = SplitMix64::for_pixel(seed, pixel);
+        let pixel_index = |x: u32| y as u64 * w as u64 + x as u64;
+        for first in (0..w).step_by(batch as usize) {
+            // The camera rays of pixels first.. (as many as the integrator takes per call),
+            // pixel after pixel; the first pixel's random stream.
             camera_rays.clear();
-            rays.rays_at_offsets(x as f32, y as f32, &offsets, &mut camera_rays);
-            integrator.radiance_all(&camera_rays, &mut rng, &mut results);
-            for r in &results {
-                sum += r.radiance;
-                bounces += r.bounces as u64;
-                stats.record(r.bounces, r.termination, r.rays);
+            for x in first..(first + batch).min(w) {
+                if per_pixel {
+                    sampling.offsets(pixel_index(x), &mut offsets);
+                }
+                rays.rays_at_offsets(x as f32, y as f32, &offsets, &mut camera_rays);
             }
-            colour.push((sum / spp).to_array());
-            depth.push([bounces as f32 / spp; 3]);
+            let mut rng = SplitMix64::for_pixel(seed, pixel_index(first));
+            integrator.radiance_all(&camera_rays, &mut rng, &mut results);
+            for pixel in results.chunks(samples) {
+                let mut sum = glam::Vec3::ZERO;
+                let mut bounces = 0u64;
+                for r in pixel {
+                    sum += r.radiance;
+                    bounces += r.bounces as u64;
+                    stats.record(r.bounces, r.termination, r.rays);
+                }
+                colour.push((sum / spp).to_array());
+                depth.push([bounces as f32 / spp; 3]);
+            }
         }
         (colour, depth, stats)
     }

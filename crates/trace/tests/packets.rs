@@ -1,7 +1,8 @@
 //! The packet kernel (issue 19) changes the speed of the truth, not the truth: `whitted`
 //! renders every bundled scene to the same bits with packets as one ray at a time through
 //! the BVH2 (the packets' hierarchy; the CWBVH misses some corner hits: see `bvh.rs`), at the
-//! command line's 4×4 grid and at a 2×2 grid (packets of 4), with shadow legs, uneven
+//! command line's 4×4 grid (two pixels per packet), at 3×3, 2×2 and 1×1 (3, 8 and 32
+//! pixels per packet; rows of 48 pixels end in part-filled packets), with shadow legs, uneven
 //! mirrors, symmetry planes and stereo rigs' scenes among them.
 
 use mirrorbox_scene::load::bundled_scene;
@@ -22,7 +23,7 @@ fn whitted_renders_every_bundled_scene_to_the_same_bits_with_packets() {
     for name in &names {
         let mut scene = bundled_scene(name);
         scene.camera = scene.camera.with_size(48, 27);
-        for grid in [4, 2] {
+        for grid in [4, 3, 2, 1] {
             let settings = TraceSettings::whitted(grid);
             let single = SceneBvh::build_with(&scene.geometry, BvhKind::Bvh2).with_packets(false);
             let packets = SceneBvh::build_with(&scene.geometry, BvhKind::Bvh2);

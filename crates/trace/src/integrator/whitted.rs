@@ -11,7 +11,7 @@
 //! they leave ([`crate::mirror_bounce`]).
 
 use super::{Integrator, PathResult, Termination, face_normals};
-use crate::bvh::packet::{LANES, LaneMask, RayPacket, lanes};
+use crate::bvh::packet::{LANES, LaneMask, RayPacket, first_lanes, lanes};
 use crate::bvh::{Hit, SceneBvh};
 use crate::cpu_features::{Vectorised, widest};
 use crate::mirror_bounce::{MirrorPlanes, reflect_on_plane};
@@ -185,7 +185,7 @@ impl<'a> Whitted<'a> {
             }
             let mut carried = [Carried::START; LANES];
             let mut ends = [Termination::Escaped; LANES];
-            let mut active: LaneMask = (1 << chunk.len()) - 1;
+            let mut active: LaneMask = first_lanes(chunk.len());
             let mut packet = RayPacket::default();
             let mut hits = [None; LANES];
             while active != 0 {
@@ -391,6 +391,15 @@ enum Next {
 impl Integrator for Whitted<'_> {
     fn radiance(&self, ray: Ray, _rng: &mut SplitMix64) -> PathResult {
         Whitted::radiance(self, ray)
+    }
+
+    /// Enough pixels to fill a packet when packets are traced (no random numbers are used).
+    fn pixels_per_call(&self, samples_per_pixel: usize) -> usize {
+        if self.bvh.packets() {
+            (LANES / samples_per_pixel.max(1)).max(1)
+        } else {
+            1
+        }
     }
 
     /// As packets when the BVH traces them and there are enough rays to fill some lanes.
