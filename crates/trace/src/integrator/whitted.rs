@@ -171,6 +171,12 @@ impl<'a> Whitted<'a> {
         let lighting = &self.scene.lighting;
         // Without shadow legs, a round's diffuse hits are shaded side by side.
         let lanes_shade = lighting.lanes_apply();
+        // A round's flat-mirror planes and diffuse hits, per lane; set for the lanes that
+        // have one, read (past values in the others, never used) by whole-packet loops.
+        // Kept across rounds and chunks: zeroing them every round cost 2 % (memset).
+        let mut normal = [[0.0f64; LANES]; 3];
+        let mut offset = [0.0f64; LANES];
+        let mut shading = [[[0.0f32; LANES]; 3]; 5];
         for chunk in rays.chunks(LANES) {
             // Lanes past the chunk's end repeat its last ray and are never active. (Plain
             // loops: `std::array::from_fn` here stayed calls, not inlined, a few per cent.)
@@ -191,13 +197,10 @@ impl<'a> Whitted<'a> {
             while active != 0 {
                 packet.set_rays_f64(&origin, &dir);
                 self.bvh.closest_hits_inline(&packet, active, &mut hits);
-                // The round's bounces off flat mirrors: which lanes, and their planes.
+                // The lanes bouncing off a flat mirror this round, and those hitting a
+                // diffuse surface to shade together (where the lighting allows).
                 let mut flat = [false; LANES];
-                let mut normal = [[0.0f64; LANES]; 3];
-                let mut offset = [0.0f64; LANES];
-                // The round's diffuse hits, shaded together where the lighting allows.
                 let mut diffuse = [false; LANES];
-                let mut shading = [[[0.0f32; LANES]; 3]; 5];
                 for lane in lanes(active) {
                     let (query, _) = packet.lane(lane);
                     let mirror = match self.step(&mut carried[lane], &query, hits[lane]) {
