@@ -3,13 +3,14 @@
 //! the BVH2 (the packets' hierarchy; the CWBVH misses some corner hits: see `bvh.rs`), at the
 //! command line's 4×4 grid (two pixels per packet), at 3×3, 2×2 and 1×1 (3, 8 and 32
 //! pixels per packet; rows of 48 pixels end in part-filled packets), with shadow legs, uneven
-//! mirrors, symmetry planes and stereo rigs' scenes among them.
+//! mirrors, symmetry planes and stereo rigs' scenes among them. So does `path`, whose
+//! mirror chains the packets trace ahead of its samples.
 
 use mirrorbox_scene::load::bundled_scene;
-use mirrorbox_trace::{BvhKind, SceneBvh, TraceSettings, render};
+use mirrorbox_trace::{BvhKind, PathSettings, SceneBvh, TraceSettings, render};
 
-#[test]
-fn whitted_renders_every_bundled_scene_to_the_same_bits_with_packets() {
+/// The bundled scenes, by file name.
+fn bundled_names() -> Vec<String> {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
     let mut names: Vec<String> = std::fs::read_dir(&dir)
         .unwrap()
@@ -20,7 +21,12 @@ fn whitted_renders_every_bundled_scene_to_the_same_bits_with_packets() {
         .collect();
     names.sort();
     assert!(names.len() >= 10, "{names:?}");
-    for name in &names {
+    names
+}
+
+#[test]
+fn whitted_renders_every_bundled_scene_to_the_same_bits_with_packets() {
+    for name in &bundled_names() {
         let mut scene = bundled_scene(name);
         scene.camera = scene.camera.with_size(48, 27);
         for grid in [4, 3, 2, 1] {
@@ -41,6 +47,39 @@ fn whitted_renders_every_bundled_scene_to_the_same_bits_with_packets() {
             assert_eq!(a.bounces.pixels, b.bounces.pixels, "{name}");
             assert_eq!(a.stats, b.stats, "{name}");
             assert!(a.stats.rays > 0);
+        }
+    }
+}
+
+/// `path` takes the hits of its deterministic mirror chains from packets traced ahead of its
+/// samples; its random streams and every other query are unchanged, so its images are the
+/// same bits as one ray at a time through the same hierarchy.
+#[test]
+fn path_renders_every_bundled_scene_to_the_same_bits_with_packets() {
+    for name in &bundled_names() {
+        let mut scene = bundled_scene(name);
+        scene.camera = scene.camera.with_size(32, 18);
+        for (grid, max_depth) in [(4, 10), (2, 66)] {
+            let settings = TraceSettings::path(
+                grid,
+                PathSettings {
+                    max_depth,
+                    ..Default::default()
+                },
+            );
+            let single = SceneBvh::build_with(&scene.geometry, BvhKind::Bvh2).with_packets(false);
+            let packets = SceneBvh::build_with(&scene.geometry, BvhKind::Bvh2);
+            let a = render(&scene, &single, &settings, &|_| {});
+            let b = render(&scene, &packets, &settings, &|_| {});
+            let differing = a
+                .image
+                .pixels
+                .iter()
+                .zip(&b.image.pixels)
+                .filter(|(p, q)| p.map(f32::to_bits) != q.map(f32::to_bits))
+                .count();
+            assert_eq!(differing, 0, "{name}, {grid}×{grid} grid: pixels differ");
+            assert_eq!(a.stats, b.stats, "{name}");
         }
     }
 }

@@ -17,7 +17,8 @@
 //! term of the contract is not physical and is not used here.
 
 use super::{Integrator, PathResult, Termination, face_normals};
-use crate::bvh::SceneBvh;
+use crate::bvh::packet::{LANES, RayPacket, first_lanes, lanes};
+use crate::bvh::{Hit, SceneBvh};
 use crate::mirror_bounce::MirrorPlanes;
 use crate::sampler::SplitMix64;
 use glam::Vec3;
@@ -107,6 +108,7 @@ impl<'a> PathTracer<'a> {
             area_pdf[e.triangle] = w / total / e.area;
         }
         let mirror_planes = MirrorPlanes::new(scene);
+        bvh.prepare_packets();
         PathTracer {
             scene,
             bvh,
@@ -119,7 +121,9 @@ impl<'a> PathTracer<'a> {
         }
     }
 
-    /// Whether the segment from `p` (on triangle `from`) to `q` is unblocked.
+    /// Whether the segment from `p` (on triangle `from`) to `q` is unblocked; `q` lies on
+    /// triangle `to`, or is a point light (`None`: then any hit blocks it, and the any-hit
+    /// query answers without looking for the closest).
     fn visible(&self, p: Vec3, from: usize, q: Vec3, to: Option<usize>) -> bool {
         let d = q - p;
         let dist = d.length();
@@ -127,6 +131,11 @@ impl<'a> PathTracer<'a> {
             origin: p,
             dir: d / dist,
         };
+        if to.is_none() {
+            return !self
+                .bvh
+                .occluded(&ray, 0.0, dist * (1.0 - 1e-4), None, Some(from));
+        }
         match self
             .bvh
             .closest_hit_skipping(&ray, 0.0, dist * (1.0 - 1e-4), None, Some(from))
@@ -137,9 +146,86 @@ impl<'a> PathTracer<'a> {
     }
 }
 
-impl Integrator for PathTracer<'_> {
-    /// Radiance along `ray`, random numbers from `rng`.
-    fn radiance(&self, ray: Ray, rng: &mut SplitMix64) -> PathResult {
+/// The closest hit of one query of a path, found ahead of the path (by a packet).
+#[derive(Clone, Copy)]
+struct Hinted {
+    ray: Ray,
+    skip_mirror: Option<usize>,
+    hit: Option<Hit>,
+}
+
+/// Fewest rays of a pixel whose mirror chains are traced as packets.
+const MIN_PACKET: usize = 4;
+
+impl PathTracer<'_> {
+    /// The deterministic start of each of `rays`' paths (at most [`LANES`] rays) — the
+    /// camera ray and the chain of front-facing mirror reflections after it, which draw no
+    /// random numbers (Russian roulette may end the path there, but does not change the next
+    /// ray) — traced side by side: every round's closest-hit queries go to the BVH as one
+    /// packet. `rounds[k][i]` gets the k-th query of ray `i`'s path with its hit, for
+    /// [`PathTracer::radiance_hinted`]. The chain's rays are computed as the path computes
+    /// them (f32 rays, the bounce in f64).
+    fn mirror_chains(&self, rays: &[Ray], rounds: &mut Vec<[Option<Hinted>; LANES]>) {
+        let g = &self.scene.geometry;
+        rounds.clear();
+        let mut ray = [Ray {
+            origin: Vec3::ZERO,
+            dir: Vec3::Z,
+        }; LANES];
+        ray[..rays.len()].copy_from_slice(rays);
+        let mut skip = [None; LANES];
+        let mut active = first_lanes(rays.len());
+        let mut packet = RayPacket::default();
+        let mut hits = [None; LANES];
+        while active != 0 {
+            for lane in lanes(active) {
+                packet.set(lane, &ray[lane], skip[lane]);
+            }
+            self.bvh.closest_hits(&packet, active, &mut hits);
+            let mut round = [None; LANES];
+            for lane in lanes(active) {
+                round[lane] = Some(Hinted {
+                    ray: ray[lane],
+                    skip_mirror: skip[lane],
+                    hit: hits[lane],
+                });
+            }
+            rounds.push(round);
+            // The path follows a front-facing mirror to its next query, unless that query
+            // would be past the depth limit.
+            let deeper = (rounds.len() as u32) < self.settings.max_depth;
+            for lane in lanes(active) {
+                let next = hits[lane].filter(|_| deeper).and_then(|hit| {
+                    let front = self.normals[hit.triangle].dot(ray[lane].dir) < 0.0;
+                    let Surface::Mirror { mirror, .. } = *g.surface(hit.triangle) else {
+                        return None;
+                    };
+                    let (o, d) = (ray[lane].origin.as_dvec3(), ray[lane].dir.as_dvec3());
+                    let (o, d) = self.mirror_planes.reflect(mirror, o, d).filter(|_| front)?;
+                    let next = Ray {
+                        origin: o.as_vec3(),
+                        dir: d.as_vec3(),
+                    };
+                    Some((next, mirror))
+                });
+                match next {
+                    Some((r, mirror)) => (ray[lane], skip[lane]) = (r, Some(mirror)),
+                    None => active &= !(1 << lane),
+                }
+            }
+        }
+    }
+
+    /// Radiance along `ray`, random numbers from `rng`; the closest hit of the path's k-th
+    /// query is taken from `rounds[k][lane]` when that is the same query (ray bits and
+    /// skips), else asked of the BVH. With no rounds, [`Integrator::radiance`].
+    fn radiance_hinted(
+        &self,
+        ray: Ray,
+        rng: &mut SplitMix64,
+        rounds: &[[Option<Hinted>; LANES]],
+        lane: usize,
+    ) -> PathResult {
         let scene = self.scene;
         let g = &scene.geometry;
         let mut ray = ray;
@@ -154,10 +240,25 @@ impl Integrator for PathTracer<'_> {
         let mut depth = 0u32;
         let termination = loop {
             rays += 1;
-            let Some(hit) =
-                self.bvh
-                    .closest_hit_skipping(&ray, 0.0, f32::INFINITY, from_mirror, from_triangle)
-            else {
+            let hinted = rounds.get(depth as usize).and_then(|r| r[lane].as_ref());
+            let hinted = hinted.filter(|h| {
+                from_triangle.is_none()
+                    && h.skip_mirror == from_mirror
+                    && h.ray.origin == ray.origin
+                    && h.ray.dir == ray.dir
+            });
+            let was_hinted = hinted.is_some();
+            let hit = match hinted {
+                Some(h) => h.hit,
+                None => self.bvh.closest_hit_skipping(
+                    &ray,
+                    0.0,
+                    f32::INFINITY,
+                    from_mirror,
+                    from_triangle,
+                ),
+            };
+            let Some(hit) = hit else {
                 radiance += beta * scene.background;
                 break Termination::Escaped;
             };
@@ -188,17 +289,27 @@ impl Integrator for PathTracer<'_> {
                         unreachable!("only mirrors reflect")
                     };
                     beta *= reflectance;
-                    let Some((origin, dir)) = self.mirror_planes.reflect(
-                        mirror,
-                        ray.origin.as_dvec3(),
-                        ray.dir.as_dvec3(),
-                    ) else {
-                        break Termination::Absorbed;
-                    };
-                    ray = Ray {
-                        origin: origin.as_vec3(),
-                        dir: dir.as_vec3(),
-                    };
+                    // After a hinted query, the chain's next query is this very bounce
+                    // (computed from the same ray and hit, the same way): take its ray.
+                    let chained = rounds
+                        .get(depth as usize + 1)
+                        .and_then(|r| r[lane].as_ref())
+                        .filter(|h| was_hinted && h.skip_mirror == Some(mirror));
+                    if let Some(next) = chained {
+                        ray = next.ray;
+                    } else {
+                        let Some((origin, dir)) = self.mirror_planes.reflect(
+                            mirror,
+                            ray.origin.as_dvec3(),
+                            ray.dir.as_dvec3(),
+                        ) else {
+                            break Termination::Absorbed;
+                        };
+                        ray = Ray {
+                            origin: origin.as_vec3(),
+                            dir: dir.as_vec3(),
+                        };
+                    }
                     bsdf_pdf = None;
                     from_mirror = Some(mirror);
                     from_triangle = None;
@@ -270,6 +381,35 @@ impl Integrator for PathTracer<'_> {
             bounces,
             termination,
             rays,
+        }
+    }
+}
+
+impl Integrator for PathTracer<'_> {
+    /// Radiance along `ray`, random numbers from `rng`.
+    fn radiance(&self, ray: Ray, rng: &mut SplitMix64) -> PathResult {
+        self.radiance_hinted(ray, rng, &[], 0)
+    }
+
+    /// One ray at a time in order, sharing `rng`, as [`Integrator::radiance`]; when the BVH
+    /// traces packets, the deterministic mirror chains at the start of the paths are traced
+    /// first, side by side ([`PathTracer::mirror_chains`]), and each path takes its hits
+    /// from there.
+    fn radiance_all(&self, rays: &[Ray], rng: &mut SplitMix64, out: &mut Vec<PathResult>) {
+        out.clear();
+        if !self.bvh.packets() || rays.len() < MIN_PACKET {
+            out.extend(
+                rays.iter()
+                    .map(|&ray| self.radiance_hinted(ray, rng, &[], 0)),
+            );
+            return;
+        }
+        let mut rounds = Vec::new();
+        for chunk in rays.chunks(LANES) {
+            self.mirror_chains(chunk, &mut rounds);
+            for (lane, &ray) in chunk.iter().enumerate() {
+                out.push(self.radiance_hinted(ray, rng, &rounds, lane));
+            }
         }
     }
 }
