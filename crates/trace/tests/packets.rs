@@ -1,8 +1,9 @@
 //! The packet kernel (issue 19) changes the speed of the truth, not the truth: `whitted`
 //! renders every bundled scene to the same bits with packets as one ray at a time through
 //! the BVH2 (the packets' hierarchy; the CWBVH misses some corner hits: see `bvh.rs`), at the
-//! command line's 4×4 grid (two pixels per packet), at 3×3, 2×2 and 1×1 (3, 8 and 32
-//! pixels per packet; rows of 48 pixels end in part-filled packets), with shadow legs, uneven
+//! command line's 4×4 grid (two pixels per packet), at 3×3 and 2×2 (3 and 8 pixels per
+//! packet; rows of 48 pixels end in part-filled packets) and 1×1 (one ray at a time), with
+//! shadow legs, uneven
 //! mirrors, symmetry planes and stereo rigs' scenes among them. So does `path`, whose
 //! mirror chains the packets trace ahead of its samples.
 
