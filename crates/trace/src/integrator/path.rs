@@ -19,7 +19,8 @@
 use super::{Integrator, PathResult, Termination, face_normals};
 use crate::bvh::packet::{LANES, RayPacket, first_lanes, lanes};
 use crate::bvh::{Hit, SceneBvh};
-use crate::mirror_bounce::MirrorPlanes;
+use crate::cpu_features::{Vectorised, widest};
+use crate::mirror_bounce::{MirrorPlanes, reflect_on_plane};
 use crate::sampler::SplitMix64;
 use glam::Vec3;
 use mirrorbox_scene::shading::{Interaction, interaction};
@@ -165,52 +166,114 @@ impl PathTracer<'_> {
     /// packet. `rounds[k][i]` gets the k-th query of ray `i`'s path with its hit, for
     /// [`PathTracer::radiance_hinted`]. The chain's rays are computed as the path computes
     /// them (f32 rays, the bounce in f64).
+    ///
+    /// Compiled for the CPU's widest vectors ([`crate::cpu_features`], kernel inlined); the
+    /// bounces off flat mirrors are computed in one lane loop ([`reflect_on_plane`]).
     fn mirror_chains(&self, rays: &[Ray], rounds: &mut Vec<[Option<Hinted>; LANES]>) {
+        struct Work<'w, 'a> {
+            path: &'w PathTracer<'a>,
+            rays: &'w [Ray],
+            rounds: &'w mut Vec<[Option<Hinted>; LANES]>,
+        }
+        impl Vectorised for Work<'_, '_> {
+            type Output = ();
+            #[inline(always)]
+            fn run(self) {
+                self.path.mirror_chains_inline(self.rays, self.rounds)
+            }
+        }
+        widest(Work {
+            path: self,
+            rays,
+            rounds,
+        })
+    }
+
+    #[inline(always)]
+    fn mirror_chains_inline(&self, rays: &[Ray], rounds: &mut Vec<[Option<Hinted>; LANES]>) {
         let g = &self.scene.geometry;
         rounds.clear();
-        let mut ray = [Ray {
-            origin: Vec3::ZERO,
-            dir: Vec3::Z,
-        }; LANES];
-        ray[..rays.len()].copy_from_slice(rays);
-        let mut skip = [None; LANES];
+        // The chains' rays: f32 values (as the path holds them) in f64 lanes (the bounce's
+        // input); lanes past the end repeat the last ray and are never active.
+        let mut origin = [[0.0f64; LANES]; 3];
+        let mut dir = [[0.0f64; LANES]; 3];
+        for lane in 0..LANES {
+            let ray = &rays[lane.min(rays.len() - 1)];
+            for k in 0..3 {
+                origin[k][lane] = ray.origin[k] as f64;
+                dir[k][lane] = ray.dir[k] as f64;
+            }
+        }
+        let mut normal = [[0.0f64; LANES]; 3];
+        let mut offset = [0.0f64; LANES];
         let mut active = first_lanes(rays.len());
         let mut packet = RayPacket::default();
         let mut hits = [None; LANES];
         while active != 0 {
-            for lane in lanes(active) {
-                packet.set(lane, &ray[lane], skip[lane]);
-            }
-            self.bvh.closest_hits(&packet, active, &mut hits);
-            let mut round = [None; LANES];
-            for lane in lanes(active) {
-                round[lane] = Some(Hinted {
-                    ray: ray[lane],
-                    skip_mirror: skip[lane],
-                    hit: hits[lane],
-                });
-            }
-            rounds.push(round);
+            packet.set_rays_f64(&origin, &dir);
+            self.bvh.closest_hits_inline(&packet, active, &mut hits);
+            rounds.push([None; LANES]);
             // The path follows a front-facing mirror to its next query, unless that query
             // would be past the depth limit.
             let deeper = (rounds.len() as u32) < self.settings.max_depth;
+            let round = rounds.last_mut().expect("just pushed");
+            let mut flat = [false; LANES];
             for lane in lanes(active) {
-                let next = hits[lane].filter(|_| deeper).and_then(|hit| {
-                    let front = self.normals[hit.triangle].dot(ray[lane].dir) < 0.0;
-                    let Surface::Mirror { mirror, .. } = *g.surface(hit.triangle) else {
-                        return None;
-                    };
-                    let (o, d) = (ray[lane].origin.as_dvec3(), ray[lane].dir.as_dvec3());
-                    let (o, d) = self.mirror_planes.reflect(mirror, o, d).filter(|_| front)?;
-                    let next = Ray {
-                        origin: o.as_vec3(),
-                        dir: d.as_vec3(),
-                    };
-                    Some((next, mirror))
+                let (ray, skip_mirror) = packet.lane(lane);
+                round[lane] = Some(Hinted {
+                    ray,
+                    skip_mirror,
+                    hit: hits[lane],
                 });
-                match next {
-                    Some((r, mirror)) => (ray[lane], skip[lane]) = (r, Some(mirror)),
-                    None => active &= !(1 << lane),
+                let mirror = hits[lane].filter(|_| deeper).and_then(|hit| {
+                    let front = self.normals[hit.triangle].dot(ray.dir) < 0.0;
+                    match *g.surface(hit.triangle) {
+                        Surface::Mirror { mirror, .. } if front => Some(mirror),
+                        _ => None,
+                    }
+                });
+                let Some(mirror) = mirror else {
+                    active &= !(1 << lane);
+                    continue;
+                };
+                packet.set_skip(lane, Some(mirror));
+                if let Some((n, off)) = self.mirror_planes.flat_plane(mirror) {
+                    flat[lane] = true;
+                    for k in 0..3 {
+                        normal[k][lane] = n[k];
+                    }
+                    offset[lane] = off;
+                    continue;
+                }
+                let (o, d) = (ray.origin.as_dvec3(), ray.dir.as_dvec3());
+                let Some((o, d)) = self.mirror_planes.reflect(mirror, o, d) else {
+                    active &= !(1 << lane);
+                    continue;
+                };
+                for k in 0..3 {
+                    origin[k][lane] = o[k] as f32 as f64;
+                    dir[k][lane] = d[k] as f32 as f64;
+                }
+            }
+            if flat.iter().any(|&f| f) {
+                for i in 0..LANES {
+                    let n = [normal[0][i], normal[1][i], normal[2][i]];
+                    let o = [origin[0][i], origin[1][i], origin[2][i]];
+                    let d = [dir[0][i], dir[1][i], dir[2][i]];
+                    let (hit, r) = reflect_on_plane(n, offset[i], o, d);
+                    for k in 0..3 {
+                        // Rounded to f32, as the path holds its rays.
+                        origin[k][i] = if flat[i] {
+                            hit[k] as f32 as f64
+                        } else {
+                            origin[k][i]
+                        };
+                        dir[k][i] = if flat[i] {
+                            r[k] as f32 as f64
+                        } else {
+                            dir[k][i]
+                        };
+                    }
                 }
             }
         }
