@@ -136,6 +136,7 @@ impl Lighting {
     /// operations in the same order (the same bits); written as loops over the lanes, innermost
     /// and branch free, so that they vectorise (inline: compiled for the caller's CPU).
     #[inline(always)]
+    #[allow(clippy::needless_range_loop)] // lane loops index several arrays by lane
     pub fn direct_radiance_lanes<const L: usize>(
         &self,
         p: &[[f32; L]; 3],
@@ -193,7 +194,9 @@ fn point_irradiance(p: Vec3, n: Vec3, source: Vec3, intensity: Vec3) -> Vec3 {
     let to_light = source - p;
     let r2 = to_light.length_squared();
     let cos = n.dot(to_light) / r2.sqrt();
-    let lit = !(r2 < MIN_LIGHT_DISTANCE_SQUARED) & (cos > 0.0);
+    // As the early return it replaces: only `r2 < min` is dropped (a NaN is not).
+    let touching = r2 < MIN_LIGHT_DISTANCE_SQUARED;
+    let lit = !touching & (cos > 0.0);
     let e = intensity * (cos / r2);
     if lit { e } else { Vec3::ZERO }
 }

@@ -83,10 +83,10 @@ pub struct Args {
     /// How paths are followed: the contract's Whitted chains, or physically based paths.
     #[arg(long, value_enum, default_value_t = Integrator::Whitted)]
     integrator: Integrator,
-    /// obvhs hierarchy of the single-ray queries (shadow legs, `path`, --kernel single): cwbvh is faster, bvh2 does not miss some hits at mirror corners that cwbvh does.
+    /// obvhs hierarchy of the single-ray queries (shadow legs, `path` after a diffuse bounce, --kernel single): cwbvh is faster, bvh2 does not miss some hits at mirror corners that cwbvh does.
     #[arg(long, value_enum, default_value_t = Bvh::Cwbvh)]
     bvh: Bvh,
-    /// Closest-hit kernel of `whitted` (`path` traces one ray at a time).
+    /// Closest-hit kernel: packets (`whitted`'s paths, and the mirror chains that start `path`'s, traced as 32-ray packets through a BVH2) or single (one ray at a time).
     #[arg(long, value_enum, default_value_t = Kernel::Packet)]
     kernel: Kernel,
     /// Print the summary as one JSON object (one per eye with --stereo).
