@@ -87,6 +87,36 @@ pub fn reflect_on_plane(
     )
 }
 
+/// A packet's bounces off flat mirrors, side by side: every lane with `flat[i]` has its ray
+/// `(origin, dir)` (f64 lanes) replaced by the bounce off the plane `(normal, offset)`
+/// ([`reflect_on_plane`]), rounded to f32 when `ROUND_TO_F32` (the `path` integrator holds
+/// its rays in f32); other lanes keep their ray. Branch free over all lanes: it vectorises
+/// (inline: compiled for the caller's CPU features).
+#[inline(always)]
+pub fn bounce_flat_lanes<const L: usize, const ROUND_TO_F32: bool>(
+    flat: &[bool; L],
+    normal: &[[f64; L]; 3],
+    offset: &[f64; L],
+    origin: &mut [[f64; L]; 3],
+    dir: &mut [[f64; L]; 3],
+) {
+    for i in 0..L {
+        let n = [normal[0][i], normal[1][i], normal[2][i]];
+        let o = [origin[0][i], origin[1][i], origin[2][i]];
+        let d = [dir[0][i], dir[1][i], dir[2][i]];
+        let (hit, r) = reflect_on_plane(n, offset[i], o, d);
+        for k in 0..3 {
+            let (h, r) = if ROUND_TO_F32 {
+                (hit[k] as f32 as f64, r[k] as f32 as f64)
+            } else {
+                (hit[k], r[k])
+            };
+            origin[k][i] = if flat[i] { h } else { origin[k][i] };
+            dir[k][i] = if flat[i] { r } else { dir[k][i] };
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

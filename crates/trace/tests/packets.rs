@@ -8,7 +8,32 @@
 //! mirror chains the packets trace ahead of its samples.
 
 use mirrorbox_scene::load::bundled_scene;
-use mirrorbox_trace::{BvhKind, PathSettings, SceneBvh, TraceSettings, render};
+use mirrorbox_trace::{BvhKind, PathSettings, SceneBvh, TraceSettings, WhittedSettings, render};
+
+/// Renders `scene` through the BVH2 with packets and one ray at a time, and asserts the
+/// same bits in every pixel, the same bounce counts and the same statistics.
+fn same_with_and_without_packets(
+    scene: &mirrorbox_scene::Scene,
+    settings: &TraceSettings,
+    what: &str,
+) {
+    let single = SceneBvh::build_with(&scene.geometry, BvhKind::Bvh2).with_packets(false);
+    let packets = SceneBvh::build_with(&scene.geometry, BvhKind::Bvh2);
+    assert!(packets.packets() && !single.packets());
+    let a = render(scene, &single, settings, &|_| {});
+    let b = render(scene, &packets, settings, &|_| {});
+    let differing = a
+        .image
+        .pixels
+        .iter()
+        .zip(&b.image.pixels)
+        .filter(|(p, q)| p.map(f32::to_bits) != q.map(f32::to_bits))
+        .count();
+    assert_eq!(differing, 0, "{what}: pixels differ");
+    assert_eq!(a.bounces.pixels, b.bounces.pixels, "{what}");
+    assert_eq!(a.stats, b.stats, "{what}");
+    assert!(a.stats.rays > 0, "{what}");
+}
 
 /// The bundled scenes, by file name.
 fn bundled_names() -> Vec<String> {
@@ -31,24 +56,15 @@ fn whitted_renders_every_bundled_scene_to_the_same_bits_with_packets() {
         let mut scene = bundled_scene(name);
         scene.camera = scene.camera.with_size(48, 27);
         for grid in [4, 3, 2, 1] {
-            let settings = TraceSettings::whitted(grid);
-            let single = SceneBvh::build_with(&scene.geometry, BvhKind::Bvh2).with_packets(false);
-            let packets = SceneBvh::build_with(&scene.geometry, BvhKind::Bvh2);
-            assert!(packets.packets() && !single.packets());
-            let a = render(&scene, &single, &settings, &|_| {});
-            let b = render(&scene, &packets, &settings, &|_| {});
-            let differing = a
-                .image
-                .pixels
-                .iter()
-                .zip(&b.image.pixels)
-                .filter(|(p, q)| p.map(f32::to_bits) != q.map(f32::to_bits))
-                .count();
-            assert_eq!(differing, 0, "{name}, {grid}×{grid} grid: pixels differ");
-            assert_eq!(a.bounces.pixels, b.bounces.pixels, "{name}");
-            assert_eq!(a.stats, b.stats, "{name}");
-            assert!(a.stats.rays > 0);
+            let what = format!("whitted, {name}, {grid}×{grid} grid");
+            same_with_and_without_packets(&scene, &TraceSettings::whitted(grid), &what);
         }
+        // Paths cut at a depth of 2 (the default never cuts a bundled scene by depth).
+        let shallow = TraceSettings::whitted(4).with_integrator(WhittedSettings {
+            max_depth: 2,
+            ..Default::default()
+        });
+        same_with_and_without_packets(&scene, &shallow, &format!("whitted, {name}, depth 2"));
     }
 }
 
@@ -68,19 +84,8 @@ fn path_renders_every_bundled_scene_to_the_same_bits_with_packets() {
                     ..Default::default()
                 },
             );
-            let single = SceneBvh::build_with(&scene.geometry, BvhKind::Bvh2).with_packets(false);
-            let packets = SceneBvh::build_with(&scene.geometry, BvhKind::Bvh2);
-            let a = render(&scene, &single, &settings, &|_| {});
-            let b = render(&scene, &packets, &settings, &|_| {});
-            let differing = a
-                .image
-                .pixels
-                .iter()
-                .zip(&b.image.pixels)
-                .filter(|(p, q)| p.map(f32::to_bits) != q.map(f32::to_bits))
-                .count();
-            assert_eq!(differing, 0, "{name}, {grid}×{grid} grid: pixels differ");
-            assert_eq!(a.stats, b.stats, "{name}");
+            let what = format!("path, {name}, {grid}×{grid} grid, depth {max_depth}");
+            same_with_and_without_packets(&scene, &settings, &what);
         }
     }
 }

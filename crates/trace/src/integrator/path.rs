@@ -20,7 +20,7 @@ use super::{Integrator, PathResult, Termination, face_normals};
 use crate::bvh::packet::{LANES, RayPacket, first_lanes, lanes};
 use crate::bvh::{Hit, SceneBvh};
 use crate::cpu_features::{Vectorised, widest};
-use crate::mirror_bounce::{MirrorPlanes, reflect_on_plane};
+use crate::mirror_bounce::{MirrorPlanes, bounce_flat_lanes};
 use crate::sampler::SplitMix64;
 use glam::Vec3;
 use mirrorbox_scene::shading::{Interaction, interaction};
@@ -171,7 +171,7 @@ impl PathTracer<'_> {
     /// them (f32 rays, the bounce in f64).
     ///
     /// Compiled for the CPU's widest vectors ([`crate::cpu_features`], kernel inlined); the
-    /// bounces off flat mirrors are computed in one lane loop ([`reflect_on_plane`]).
+    /// bounces off flat mirrors are computed in one lane loop ([`bounce_flat_lanes`]).
     fn mirror_chains(&self, rays: &[Ray], rounds: &mut Vec<[Option<Hinted>; LANES]>) {
         struct Work<'w, 'a> {
             path: &'w PathTracer<'a>,
@@ -265,25 +265,7 @@ impl PathTracer<'_> {
                 }
             }
             if flat.iter().any(|&f| f) {
-                for i in 0..LANES {
-                    let n = [normal[0][i], normal[1][i], normal[2][i]];
-                    let o = [origin[0][i], origin[1][i], origin[2][i]];
-                    let d = [dir[0][i], dir[1][i], dir[2][i]];
-                    let (hit, r) = reflect_on_plane(n, offset[i], o, d);
-                    for k in 0..3 {
-                        // Rounded to f32, as the path holds its rays.
-                        origin[k][i] = if flat[i] {
-                            hit[k] as f32 as f64
-                        } else {
-                            origin[k][i]
-                        };
-                        dir[k][i] = if flat[i] {
-                            r[k] as f32 as f64
-                        } else {
-                            dir[k][i]
-                        };
-                    }
-                }
+                bounce_flat_lanes::<LANES, true>(&flat, &normal, &offset, &mut origin, &mut dir);
             }
         }
     }
@@ -316,8 +298,10 @@ impl PathTracer<'_> {
             let hinted = hinted.filter(|h| {
                 from_triangle.is_none()
                     && h.skip_mirror == from_mirror
-                    && h.ray.origin == ray.origin
-                    && h.ray.dir == ray.dir
+                    && h.ray.origin.to_array().map(f32::to_bits)
+                        == ray.origin.to_array().map(f32::to_bits)
+                    && h.ray.dir.to_array().map(f32::to_bits)
+                        == ray.dir.to_array().map(f32::to_bits)
             });
             let was_hinted = hinted.is_some();
             let hit = match hinted {

@@ -14,7 +14,7 @@ use super::{Integrator, PathResult, Termination, face_normals};
 use crate::bvh::packet::{LANES, LaneMask, RayPacket, first_lanes, lanes};
 use crate::bvh::{Hit, SceneBvh};
 use crate::cpu_features::{Vectorised, widest};
-use crate::mirror_bounce::{MirrorPlanes, reflect_on_plane};
+use crate::mirror_bounce::{MirrorPlanes, bounce_flat_lanes};
 use crate::sampler::SplitMix64;
 use glam::{DVec3, Vec3};
 use mirrorbox_scene::shading::{Interaction, interaction};
@@ -162,7 +162,7 @@ impl<'a> Whitted<'a> {
 
     /// [`Whitted::radiance_packet`]'s work. The walks are kept as structure of arrays: the
     /// packet's rays are rounded to f32 in one lane loop, the round's bounces off flat
-    /// mirrors are computed in another ([`reflect_on_plane`], f64), and its diffuse hits are
+    /// mirrors are computed in another ([`bounce_flat_lanes`], f64), and its diffuse hits are
     /// shaded in a third where there are no shadow legs or light images
     /// ([`mirrorbox_scene::Lighting::direct_radiance_lanes`]); the rest (the step's
     /// decisions, bumps, shadow legs) stays one lane at a time.
@@ -258,17 +258,13 @@ impl<'a> Whitted<'a> {
                     }
                 }
                 if flat.iter().any(|&f| f) {
-                    // Branch free over all lanes; lanes without a flat bounce keep their ray.
-                    for i in 0..LANES {
-                        let n = [normal[0][i], normal[1][i], normal[2][i]];
-                        let o = [origin[0][i], origin[1][i], origin[2][i]];
-                        let d = [dir[0][i], dir[1][i], dir[2][i]];
-                        let (hit, r) = reflect_on_plane(n, offset[i], o, d);
-                        for k in 0..3 {
-                            origin[k][i] = if flat[i] { hit[k] } else { origin[k][i] };
-                            dir[k][i] = if flat[i] { r[k] } else { dir[k][i] };
-                        }
-                    }
+                    bounce_flat_lanes::<LANES, false>(
+                        &flat,
+                        &normal,
+                        &offset,
+                        &mut origin,
+                        &mut dir,
+                    );
                 }
             }
             out.extend((0..chunk.len()).map(|lane| carried[lane].result(ends[lane])));
