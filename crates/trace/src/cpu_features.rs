@@ -20,45 +20,53 @@ pub trait Vectorised {
     fn run(self) -> Self::Output;
 }
 
+/// The builds [`widest`] chooses from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Build {
+    Avx512,
+    Avx2,
+    Baseline,
+}
+
+/// This CPU's widest build, detected once.
+static BUILD: std::sync::LazyLock<Build> = std::sync::LazyLock::new(|| {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::arch::is_x86_feature_detected!("avx512f") {
+            return Build::Avx512;
+        }
+        if std::arch::is_x86_feature_detected!("avx2") {
+            return Build::Avx2;
+        }
+    }
+    Build::Baseline
+});
+
 /// Runs `work` compiled for the widest vector instructions this CPU has.
 #[inline(always)]
 pub fn widest<W: Vectorised>(work: W) -> W::Output {
-    #[cfg(target_arch = "x86_64")]
-    {
-        if *x86::AVX512 {
-            // SAFETY: the CPU has AVX-512F (detected at run time).
-            return unsafe { x86::avx512(work) };
-        }
-        if *x86::AVX2 {
-            // SAFETY: the CPU has AVX2 (detected at run time).
-            return unsafe { x86::avx2(work) };
-        }
+    match *BUILD {
+        // SAFETY: the CPU has AVX-512F (detected at run time).
+        #[cfg(target_arch = "x86_64")]
+        Build::Avx512 => unsafe { x86::avx512(work) },
+        // SAFETY: the CPU has AVX2 (detected at run time).
+        #[cfg(target_arch = "x86_64")]
+        Build::Avx2 => unsafe { x86::avx2(work) },
+        _ => work.run(),
     }
-    work.run()
 }
 
 /// The name of the build [`widest`] runs on this CPU (reports, `--json`).
 pub fn widest_name() -> &'static str {
-    #[cfg(target_arch = "x86_64")]
-    {
-        if *x86::AVX512 {
-            return "avx512";
-        }
-        if *x86::AVX2 {
-            return "avx2";
-        }
+    match *BUILD {
+        Build::Avx512 => "avx512",
+        Build::Avx2 => "avx2",
+        Build::Baseline => "baseline",
     }
-    "baseline"
 }
 
 #[cfg(target_arch = "x86_64")]
 mod x86 {
-    use std::sync::LazyLock;
-
-    pub static AVX512: LazyLock<bool> =
-        LazyLock::new(|| std::arch::is_x86_feature_detected!("avx512f"));
-    pub static AVX2: LazyLock<bool> = LazyLock::new(|| std::arch::is_x86_feature_detected!("avx2"));
-
     use super::Vectorised;
 
     #[target_feature(enable = "avx512f")]

@@ -197,16 +197,8 @@ impl PathTracer<'_> {
         let g = &self.scene.geometry;
         rounds.clear();
         // The chains' rays: f32 values (as the path holds them) in f64 lanes (the bounce's
-        // input); lanes past the end repeat the last ray and are never active.
-        let mut origin = [[0.0f64; LANES]; 3];
-        let mut dir = [[0.0f64; LANES]; 3];
-        for lane in 0..LANES {
-            let ray = &rays[lane.min(rays.len() - 1)];
-            for k in 0..3 {
-                origin[k][lane] = ray.origin[k] as f64;
-                dir[k][lane] = ray.dir[k] as f64;
-            }
-        }
+        // input).
+        let (mut origin, mut dir) = RayPacket::f64_lanes(rays);
         let mut normal = [[0.0f64; LANES]; 3];
         let mut offset = [0.0f64; LANES];
         let mut active = first_lanes(rays.len());

@@ -178,17 +178,7 @@ impl<'a> Whitted<'a> {
         let mut offset = [0.0f64; LANES];
         let mut shading = [[[0.0f32; LANES]; 3]; 5];
         for chunk in rays.chunks(LANES) {
-            // Lanes past the chunk's end repeat its last ray and are never active. (Plain
-            // loops: `std::array::from_fn` here stayed calls, not inlined, a few per cent.)
-            let mut origin = [[0.0f64; LANES]; 3];
-            let mut dir = [[0.0f64; LANES]; 3];
-            for lane in 0..LANES {
-                let ray = &chunk[lane.min(chunk.len() - 1)];
-                for k in 0..3 {
-                    origin[k][lane] = ray.origin[k] as f64;
-                    dir[k][lane] = ray.dir[k] as f64;
-                }
-            }
+            let (mut origin, mut dir) = RayPacket::f64_lanes(chunk);
             let mut carried = [Carried::START; LANES];
             let mut ends = [Termination::Escaped; LANES];
             let mut active: LaneMask = first_lanes(chunk.len());
