@@ -50,6 +50,16 @@ const STACK: usize = 128;
 /// A lane that skips no mirror (never equal to a slot's mirror or to [`NOT_A_MIRROR`]).
 const SKIP_NOTHING: u32 = u32::MAX - 1;
 
+/// No triangle: what a lane that skips none holds in an any-hit query's skipped triangles.
+pub const NO_TRIANGLE: u32 = u32::MAX;
+
+/// The closest-hit queries' skipped triangles: none.
+const NO_TRIANGLES: [u32; LANES] = [NO_TRIANGLE; LANES];
+
+/// An any-hit lane's `best_t` once it has hit something: below every box's near distance
+/// (never negative), so its box tests fail from then on.
+const STOPPED: f32 = -1.0;
+
 /// `1 + 2γ₃` with `γₙ = nε/(1 − nε)`, ε = 2⁻²⁴: the robust far-distance factor.
 const FAR_WIDENING: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
 
@@ -262,6 +272,50 @@ impl PacketBvh {
     ) {
         let mut best_t = [f32::INFINITY; LANES];
         let mut best_slot = [u32::MAX; LANES];
+        self.trace_lanes::<false>(packet, active, &mut best_t, &mut best_slot, &NO_TRIANGLES);
+        for lane in lanes(active) {
+            out[lane] = (best_slot[lane] != u32::MAX).then(|| Hit {
+                t: best_t[lane],
+                triangle: self.original[best_slot[lane] as usize] as usize,
+            });
+        }
+    }
+
+    /// The lanes of `active` whose segment is blocked: whose ray hits a triangle at
+    /// `0 ≤ t < t_max[lane]` other than its skipped mirror's and `skip_triangle[lane]` (the
+    /// scene's numbering; [`NO_TRIANGLE`] for none) — what
+    /// [`super::SceneBvh::occluded`] answers. A lane stops at its first such hit (any hit
+    /// will do), and so does the traversal once every lane has stopped.
+    #[inline(always)]
+    pub(super) fn occluded_lanes_inline(
+        &self,
+        packet: &RayPacket,
+        active: LaneMask,
+        t_max: &[f32; LANES],
+        skip_triangle: &[u32; LANES],
+    ) -> LaneMask {
+        let mut best_t = *t_max;
+        let mut best_slot = [u32::MAX; LANES];
+        self.trace_lanes::<true>(packet, active, &mut best_t, &mut best_slot, skip_triangle);
+        lanes(active)
+            .filter(|&lane| best_slot[lane] != u32::MAX)
+            .fold(0, |blocked, lane| blocked | 1 << lane)
+    }
+
+    /// The traversal of every lane in `active`, grouped by the watertight test's axis
+    /// permutation: closest hits (`ANY_HIT` false) or blocked segments (`ANY_HIT` true, see
+    /// [`PacketBvh::occluded_lanes_inline`]; a lane's `best_t` becomes [`STOPPED`] at its
+    /// first hit). Two monomorphised kernels, so that the any-hit mode costs the closest-hit
+    /// one nothing.
+    #[inline(always)]
+    fn trace_lanes<const ANY_HIT: bool>(
+        &self,
+        packet: &RayPacket,
+        active: LaneMask,
+        best_t: &mut Lanes,
+        best_slot: &mut [u32; LANES],
+        skip_triangle: &[u32; LANES],
+    ) {
         let prepared = Prepared::new(packet);
         let mut left = active;
         while left != 0 {
@@ -273,22 +327,22 @@ impl PacketBvh {
                 }
             }
             left &= !group;
-            let (p, q, t, s) = (packet, &prepared, &mut best_t, &mut best_slot);
+            let (p, q, t, s, k) = (
+                packet,
+                &prepared,
+                &mut *best_t,
+                &mut *best_slot,
+                skip_triangle,
+            );
             match axes_of(code) {
-                (1, 2, 0) => self.traverse::<1, 2, 0>(p, q, group, t, s),
-                (2, 1, 0) => self.traverse::<2, 1, 0>(p, q, group, t, s),
-                (2, 0, 1) => self.traverse::<2, 0, 1>(p, q, group, t, s),
-                (0, 2, 1) => self.traverse::<0, 2, 1>(p, q, group, t, s),
-                (0, 1, 2) => self.traverse::<0, 1, 2>(p, q, group, t, s),
-                (1, 0, 2) => self.traverse::<1, 0, 2>(p, q, group, t, s),
+                (1, 2, 0) => self.traverse::<1, 2, 0, ANY_HIT>(p, q, group, t, s, k),
+                (2, 1, 0) => self.traverse::<2, 1, 0, ANY_HIT>(p, q, group, t, s, k),
+                (2, 0, 1) => self.traverse::<2, 0, 1, ANY_HIT>(p, q, group, t, s, k),
+                (0, 2, 1) => self.traverse::<0, 2, 1, ANY_HIT>(p, q, group, t, s, k),
+                (0, 1, 2) => self.traverse::<0, 1, 2, ANY_HIT>(p, q, group, t, s, k),
+                (1, 0, 2) => self.traverse::<1, 0, 2, ANY_HIT>(p, q, group, t, s, k),
                 other => unreachable!("not an axis permutation: {other:?}"),
             }
-        }
-        for lane in lanes(active) {
-            out[lane] = (best_slot[lane] != u32::MAX).then(|| Hit {
-                t: best_t[lane],
-                triangle: self.original[best_slot[lane] as usize] as usize,
-            });
         }
     }
 
@@ -296,13 +350,14 @@ impl PacketBvh {
     /// a node is entered when any of them hits its box before its closest hit so far; the
     /// nearer child (along the group's first lane's direction) first.
     #[inline(always)]
-    fn traverse<const KX: usize, const KY: usize, const KZ: usize>(
+    fn traverse<const KX: usize, const KY: usize, const KZ: usize, const ANY_HIT: bool>(
         &self,
         p: &RayPacket,
         q: &Prepared,
         group: LaneMask,
         best_t: &mut Lanes,
         best_slot: &mut [u32; LANES],
+        skip_triangle: &[u32; LANES],
     ) {
         let mut in_group: Mask = [false; LANES];
         for (i, lane) in in_group.iter_mut().enumerate() {
@@ -330,7 +385,21 @@ impl PacketBvh {
                     continue;
                 }
                 for slot in node.first..node.first + node.count {
-                    self.triangle::<KX, KY, KZ>(slot, p, q, &hit, best_t, best_slot);
+                    self.triangle::<KX, KY, KZ, ANY_HIT>(
+                        slot,
+                        p,
+                        q,
+                        &hit,
+                        best_t,
+                        best_slot,
+                        skip_triangle,
+                    );
+                }
+                // Any hit: done once every lane has stopped (a stopped lane's box tests
+                // fail, but the stack would still be walked).
+                if ANY_HIT && !(0..LANES).fold(false, |a, i| a | (in_group[i] & (best_t[i] >= 0.0)))
+                {
+                    break;
                 }
             }
             if sp == 0 {
@@ -343,9 +412,11 @@ impl PacketBvh {
 
     /// The watertight test of slot `slot` for the lanes of `hit`, keeping `0 ≤ t < best`.
     /// Branch free over the lanes (the compiler vectorises it); the rare lanes with an
-    /// exact zero edge function or an exact tie are finished one by one.
+    /// exact zero edge function or an exact tie are finished one by one. `ANY_HIT`: lanes
+    /// also skip `skip_triangle`, and a hit stops the lane (`best` becomes [`STOPPED`]).
     #[inline(always)]
-    fn triangle<const KX: usize, const KY: usize, const KZ: usize>(
+    #[allow(clippy::too_many_arguments)]
+    fn triangle<const KX: usize, const KY: usize, const KZ: usize, const ANY_HIT: bool>(
         &self,
         slot: u32,
         p: &RayPacket,
@@ -353,8 +424,14 @@ impl PacketBvh {
         hit: &Mask,
         best_t: &mut Lanes,
         best_slot: &mut [u32; LANES],
+        skip_triangle: &[u32; LANES],
     ) {
         let s = &self.slots[slot as usize];
+        let triangle = if ANY_HIT {
+            self.original[slot as usize]
+        } else {
+            NO_TRIANGLE
+        };
         let [v0, v1, v2] = s.v;
         let (v0, v1, v2) = (v0.to_array(), v1.to_array(), v2.to_array());
         let mut zero = [false; LANES];
@@ -381,12 +458,14 @@ impl PacketBvh {
             let bz = sz * b_z;
             let cz = sz * c_z;
             let t = (u * az + v * bz + w * cz) / det;
-            let asked = hit[i] & (s.mirror != p.skip[i]);
+            let asked =
+                hit[i] & (s.mirror != p.skip[i]) & (!ANY_HIT || triangle != skip_triangle[i]);
             zero[i] = asked & exact_zero;
             let valid = asked & !exact_zero & !outside & (det != 0.0) & (t >= 0.0);
             let take = valid & (t < best_t[i]);
-            tie[i] = valid & (t == best_t[i]);
-            best_t[i] = if take { t } else { best_t[i] };
+            tie[i] = !ANY_HIT & valid & (t == best_t[i]);
+            let kept = if ANY_HIT { STOPPED } else { t };
+            best_t[i] = if take { kept } else { best_t[i] };
             best_slot[i] = if take { slot } else { best_slot[i] };
         }
         if any(&zero) {
@@ -396,9 +475,9 @@ impl PacketBvh {
                 let ray = WatertightRay::new(lane_vec(&p.origin, i), lane_vec(&p.dir, i));
                 let t = ray.intersect_axes::<KX, KY, KZ>(v0, v1, v2, 0.0, best_t[i]);
                 if t < best_t[i] {
-                    best_t[i] = t;
+                    best_t[i] = if ANY_HIT { STOPPED } else { t };
                     best_slot[i] = slot;
-                } else if t == best_t[i] {
+                } else if t == best_t[i] && !ANY_HIT {
                     tie[i] = true;
                 }
             }

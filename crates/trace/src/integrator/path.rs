@@ -17,7 +17,7 @@
 //! term of the contract is not physical and is not used here.
 
 use super::{Integrator, PathResult, Termination, face_normals};
-use crate::bvh::packet::{LANES, RayPacket, first_lanes, lanes};
+use crate::bvh::packet::{LANES, LaneMask, NO_TRIANGLE, RayPacket, first_lanes, lanes};
 use crate::bvh::{Hit, SceneBvh};
 use crate::cpu_features::{Vectorised, widest};
 use crate::mirror_bounce::{MirrorPlanes, bounce_flat_lanes};
@@ -126,25 +126,42 @@ impl<'a> PathTracer<'a> {
     /// triangle `to`, or is a point light (`None`: then any hit blocks it, and the any-hit
     /// query answers without looking for the closest).
     fn visible(&self, p: Vec3, from: usize, q: Vec3, to: Option<usize>) -> bool {
-        let d = q - p;
-        let dist = d.length();
-        let ray = Ray {
-            origin: p,
-            dir: d / dist,
-        };
+        let (ray, t_max) = segment(p, q);
         if to.is_none() {
-            return !self
-                .bvh
-                .occluded(&ray, 0.0, dist * (1.0 - 1e-4), None, Some(from));
+            return !self.bvh.occluded(&ray, 0.0, t_max, None, Some(from));
         }
         match self
             .bvh
-            .closest_hit_skipping(&ray, 0.0, dist * (1.0 - 1e-4), None, Some(from))
+            .closest_hit_skipping(&ray, 0.0, t_max, None, Some(from))
         {
             None => true,
             Some(h) => Some(h.triangle) == to,
         }
     }
+}
+
+/// The shadow ray from `p` towards `q` and its far limit: hits nearer than `q` by a
+/// relative 10⁻⁴ block it (`q` itself lies on a surface, or is a light).
+#[inline(always)]
+fn segment(p: Vec3, q: Vec3) -> (Ray, f32) {
+    let d = q - p;
+    let dist = d.length();
+    let ray = Ray {
+        origin: p,
+        dir: d / dist,
+    };
+    (ray, dist * (1.0 - 1e-4))
+}
+
+/// Whether a point light at `light` lights a diffuse point `p` with normal `n` from its
+/// side (before its shadow ray is asked), and the cosine and squared distance of its
+/// contribution.
+#[inline(always)]
+fn faces_light(p: Vec3, n: Vec3, light: Vec3) -> (bool, f32, f32) {
+    let to = light - p;
+    let r2 = to.length_squared();
+    let cos = n.dot(to) / r2.sqrt();
+    (cos > 0.0 && r2 > 1e-8, cos, r2)
 }
 
 /// The closest hit of one query of a path, found ahead of the path (by a packet).
@@ -153,6 +170,31 @@ struct Hinted {
     ray: Ray,
     skip_mirror: Option<usize>,
     hit: Option<Hit>,
+}
+
+/// What the paths of up to [`LANES`] rays know before they draw a random number
+/// ([`PathTracer::mirror_chains`]): each query of their mirror chains with its hit, and
+/// where a chain ends on a diffuse surface, whether each point light lights that point.
+#[derive(Default)]
+struct Ahead {
+    /// `rounds[k][i]`: the k-th query of ray `i`'s path and its closest hit.
+    rounds: Vec<[Option<Hinted>; LANES]>,
+    /// Per lane, the round whose hit (diffuse) ends its chain: its first diffuse vertex;
+    /// `u32::MAX` where the chain ends otherwise.
+    diffuse_round: [u32; LANES],
+    /// Per point light, the lanes whose shadow ray from their first diffuse vertex was
+    /// traced, and of those, the lanes it found unblocked.
+    traced: Vec<LaneMask>,
+    lit: Vec<LaneMask>,
+}
+
+impl Ahead {
+    /// Whether the shadow ray from lane `lane`'s diffuse vertex in round `round` to light
+    /// `light` is unblocked, if it was traced ahead.
+    fn lit(&self, lane: usize, round: u32, light: usize) -> Option<bool> {
+        (self.diffuse_round[lane] == round && self.traced[light] >> lane & 1 == 1)
+            .then(|| self.lit[light] >> lane & 1 == 1)
+    }
 }
 
 /// Fewest rays of a pixel whose mirror chains are traced as packets.
@@ -166,36 +208,43 @@ impl PathTracer<'_> {
     /// camera ray and the chain of front-facing mirror reflections after it, which draw no
     /// random numbers (Russian roulette may end the path there, but does not change the next
     /// ray) — traced side by side: every round's closest-hit queries go to the BVH as one
-    /// packet. `rounds[k][i]` gets the k-th query of ray `i`'s path with its hit, for
+    /// packet. `ahead.rounds[k][i]` gets the k-th query of ray `i`'s path with its hit, for
     /// [`PathTracer::radiance_hinted`]. The chain's rays are computed as the path computes
-    /// them (f32 rays, the bounce in f64).
+    /// them (f32 rays, the bounce in f64). Where a chain ends on a diffuse surface, the
+    /// shadow rays from there to the point lights are deterministic too: traced as any-hit
+    /// packets, one per light, into `ahead.lit`.
     ///
     /// Compiled for the CPU's widest vectors ([`crate::cpu_features`], kernel inlined); the
     /// bounces off flat mirrors are computed in one lane loop ([`bounce_flat_lanes`]).
-    fn mirror_chains(&self, rays: &[Ray], rounds: &mut Vec<[Option<Hinted>; LANES]>) {
+    fn mirror_chains(&self, rays: &[Ray], ahead: &mut Ahead) {
         struct Work<'w, 'a> {
             path: &'w PathTracer<'a>,
             rays: &'w [Ray],
-            rounds: &'w mut Vec<[Option<Hinted>; LANES]>,
+            ahead: &'w mut Ahead,
         }
         impl Vectorised for Work<'_, '_> {
             type Output = ();
             #[inline(always)]
             fn run(self) {
-                self.path.mirror_chains_inline(self.rays, self.rounds)
+                self.path.mirror_chains_inline(self.rays, self.ahead)
             }
         }
         widest(Work {
             path: self,
             rays,
-            rounds,
+            ahead,
         })
     }
 
     #[inline(always)]
-    fn mirror_chains_inline(&self, rays: &[Ray], rounds: &mut Vec<[Option<Hinted>; LANES]>) {
+    fn mirror_chains_inline(&self, rays: &[Ray], ahead: &mut Ahead) {
         let g = &self.scene.geometry;
+        let rounds = &mut ahead.rounds;
         rounds.clear();
+        ahead.diffuse_round = [u32::MAX; LANES];
+        // The first diffuse vertices: point and normal on the side the path arrives from.
+        let mut vertex = [(Vec3::ZERO, Vec3::ZERO); LANES];
+        let mut on_triangle = [NO_TRIANGLE; LANES];
         // The chains' rays: f32 values (as the path holds them) in f64 lanes (the bounce's
         // input).
         let (mut origin, mut dir) = RayPacket::f64_lanes(rays);
@@ -217,6 +266,7 @@ impl PathTracer<'_> {
             // The path follows a front-facing mirror to its next query, unless that query
             // would be past the depth limit.
             let deeper = (rounds.len() as u32) < chain_limit;
+            let index = rounds.len() as u32 - 1;
             let round = rounds.last_mut().expect("just pushed");
             let mut flat = [false; LANES];
             for lane in lanes(active) {
@@ -226,14 +276,24 @@ impl PathTracer<'_> {
                     skip_mirror,
                     hit: hits[lane],
                 });
-                let mirror = hits[lane].filter(|_| deeper).and_then(|hit| {
-                    let front = self.normals[hit.triangle].dot(ray.dir) < 0.0;
-                    match *g.surface(hit.triangle) {
-                        Surface::Mirror { mirror, .. } if front => Some(mirror),
-                        _ => None,
+                let Some(hit) = hits[lane] else {
+                    active &= !(1 << lane);
+                    continue;
+                };
+                let n_f = self.normals[hit.triangle];
+                let front = n_f.dot(ray.dir) < 0.0;
+                let mirror = match *g.surface(hit.triangle) {
+                    Surface::Mirror { mirror, .. } if front => Some(mirror),
+                    _ => None,
+                };
+                let Some(mirror) = mirror.filter(|_| deeper) else {
+                    // The path shades a diffuse hit unless it is at the depth limit.
+                    if mirror.is_none() && index + 1 < self.settings.max_depth {
+                        ahead.diffuse_round[lane] = index;
+                        let n = if front { n_f } else { -n_f };
+                        vertex[lane] = (ray.at(hit.t), n);
+                        on_triangle[lane] = hit.triangle as u32;
                     }
-                });
-                let Some(mirror) = mirror else {
                     active &= !(1 << lane);
                     continue;
                 };
@@ -260,18 +320,48 @@ impl PathTracer<'_> {
                 bounce_flat_lanes::<LANES, true>(&flat, &normal, &offset, &mut origin, &mut dir);
             }
         }
+        // The first diffuse vertices' shadow rays, as the path asks them
+        // (`PathTracer::visible` towards a point light).
+        let diffuse = lanes(first_lanes(rays.len()))
+            .filter(|&lane| ahead.diffuse_round[lane] != u32::MAX)
+            .fold(0, |mask: LaneMask, lane| mask | 1 << lane);
+        ahead.traced.clear();
+        ahead.lit.clear();
+        let mut t_max = [0.0f32; LANES];
+        for light in &self.scene.lighting.lights {
+            let mut traced: LaneMask = 0;
+            for lane in lanes(diffuse) {
+                let (p, n) = vertex[lane];
+                if faces_light(p, n, light.position).0 {
+                    let (ray, far) = segment(p, light.position);
+                    packet.set(lane, &ray, None);
+                    t_max[lane] = far;
+                    traced |= 1 << lane;
+                }
+            }
+            let blocked = if traced == 0 {
+                0
+            } else {
+                self.bvh
+                    .occluded_lanes_inline(&packet, traced, &t_max, &on_triangle)
+            };
+            ahead.traced.push(traced);
+            ahead.lit.push(traced & !blocked);
+        }
     }
 
     /// Radiance along `ray`, random numbers from `rng`; the closest hit of the path's k-th
-    /// query is taken from `rounds[k][lane]` when that is the same query (ray bits and
-    /// skips), else asked of the BVH. With no rounds, [`Integrator::radiance`].
+    /// query is taken from `ahead.rounds[k][lane]` when that is the same query (ray bits
+    /// and skips), else asked of the BVH, and so are the point lights' shadow rays from
+    /// the diffuse hit that ends the chain. With nothing ahead, [`Integrator::radiance`].
     fn radiance_hinted(
         &self,
         ray: Ray,
         rng: &mut SplitMix64,
-        rounds: &[[Option<Hinted>; LANES]],
+        ahead: Option<&Ahead>,
         lane: usize,
     ) -> PathResult {
+        let rounds = ahead.map_or(&[][..], |a| &a.rounds[..]);
         let scene = self.scene;
         let g = &scene.geometry;
         let mut ray = ray;
@@ -366,13 +456,17 @@ impl PathTracer<'_> {
                 Interaction::Diffuse { albedo, .. } => {
                     let n = if front { n_f } else { -n_f };
                     let f = albedo * std::f32::consts::FRAC_1_PI;
-                    for light in &scene.lighting.lights {
-                        let to = light.position - p;
-                        let r2 = to.length_squared();
-                        let cos = n.dot(to) / r2.sqrt();
-                        if cos > 0.0
-                            && r2 > 1e-8
-                            && self.visible(p, hit.triangle, light.position, None)
+                    for (l, light) in scene.lighting.lights.iter().enumerate() {
+                        let (faces, cos, r2) = faces_light(p, n, light.position);
+                        // Traced ahead where this is the hinted diffuse hit that ends
+                        // the mirror chain (the same point, so the same shadow ray).
+                        let ahead_lit = ahead
+                            .filter(|_| was_hinted)
+                            .and_then(|a| a.lit(lane, depth, l));
+                        if faces
+                            && ahead_lit.unwrap_or_else(|| {
+                                self.visible(p, hit.triangle, light.position, None)
+                            })
                         {
                             rays += 1;
                             radiance += beta * f * light.intensity * (cos / r2);
@@ -436,7 +530,7 @@ impl PathTracer<'_> {
 impl Integrator for PathTracer<'_> {
     /// Radiance along `ray`, random numbers from `rng`.
     fn radiance(&self, ray: Ray, rng: &mut SplitMix64) -> PathResult {
-        self.radiance_hinted(ray, rng, &[], 0)
+        self.radiance_hinted(ray, rng, None, 0)
     }
 
     /// One ray at a time in order, sharing `rng`, as [`Integrator::radiance`]; when the BVH
@@ -448,7 +542,7 @@ impl Integrator for PathTracer<'_> {
         if !self.bvh.packets() || rays.len() < MIN_PACKET {
             out.extend(
                 rays.iter()
-                    .map(|&ray| self.radiance_hinted(ray, rng, &[], 0)),
+                    .map(|&ray| self.radiance_hinted(ray, rng, None, 0)),
             );
             return;
         }
@@ -456,14 +550,13 @@ impl Integrator for PathTracer<'_> {
         // 2 KB per round and `max_depth` rounds, went to `mmap` and page faults (5 % at the
         // default depth of 66).
         thread_local! {
-            static ROUNDS: std::cell::RefCell<Vec<[Option<Hinted>; LANES]>> =
-                const { std::cell::RefCell::new(Vec::new()) };
+            static AHEAD: std::cell::RefCell<Ahead> = std::cell::RefCell::new(Ahead::default());
         }
-        ROUNDS.with_borrow_mut(|rounds| {
+        AHEAD.with_borrow_mut(|ahead| {
             for chunk in rays.chunks(LANES) {
-                self.mirror_chains(chunk, rounds);
+                self.mirror_chains(chunk, ahead);
                 for (lane, &ray) in chunk.iter().enumerate() {
-                    out.push(self.radiance_hinted(ray, rng, rounds, lane));
+                    out.push(self.radiance_hinted(ray, rng, Some(ahead), lane));
                 }
             }
         });
