@@ -81,6 +81,9 @@ pub(super) struct PacketBvh {
     original: Vec<u32>,
     /// Whether every root-to-leaf path fits the traversal stack.
     fits_stack: bool,
+    /// Per node, the mirror every triangle below it belongs to ([`NOT_A_MIRROR`] where
+    /// they are not all on one mirror): a ray leaving that mirror skips the whole subtree.
+    node_mirror: Vec<u32>,
 }
 
 /// Up to [`LANES`] rays, structure of arrays, each with the mirror it skips.
@@ -243,11 +246,13 @@ impl PacketBvh {
 
     fn from_parts(nodes: Vec<Node>, slots: Vec<Slot>, original: Vec<u32>) -> Self {
         let fits_stack = nodes.is_empty() || depth(&nodes, 0) < STACK;
+        let node_mirror = subtree_mirrors(&nodes, &slots);
         PacketBvh {
             nodes,
             slots,
             original,
             fits_stack,
+            node_mirror,
         }
     }
 
@@ -370,7 +375,7 @@ impl PacketBvh {
         let mut index = 0usize;
         loop {
             let node = &self.nodes[index];
-            let hit = box_hits(node, p, q, best_t, &in_group);
+            let hit = box_hits(node, self.node_mirror[index], p, q, best_t, &in_group);
             if any(&hit) {
                 if node.count == 0 {
                     let (a, b) = (node.first as usize, node.first as usize + 1);
@@ -504,9 +509,19 @@ fn any(mask: &Mask) -> bool {
     mask.iter().fold(false, |a, &b| a | b)
 }
 
-/// The lanes of `group` whose ray meets the node's box no farther than their best hit.
+/// The lanes of `group` whose ray meets the node's box no farther than their best hit,
+/// and does not skip `mirror`, the one mirror all of the node's triangles are on (if any):
+/// a ray leaving a mirror starts inside its boxes and would otherwise enter them all, to
+/// skip every triangle there (`mirror_room`: a quarter of the triangle tests).
 #[inline(always)]
-fn box_hits(node: &Node, p: &RayPacket, q: &Prepared, best_t: &Lanes, group: &Mask) -> Mask {
+fn box_hits(
+    node: &Node,
+    mirror: u32,
+    p: &RayPacket,
+    q: &Prepared,
+    best_t: &Lanes,
+    group: &Mask,
+) -> Mask {
     let mut mask = [false; LANES];
     for i in 0..LANES {
         let slab = |k: usize| {
@@ -519,7 +534,7 @@ fn box_hits(node: &Node, p: &RayPacket, q: &Prepared, best_t: &Lanes, group: &Ma
         let (n2, f2) = slab(2);
         let near = max(max(0.0, n0), max(n1, n2));
         let far = min(min(f0, f1), f2) * FAR_WIDENING;
-        mask[i] = group[i] & (near <= far) & (near <= best_t[i]);
+        mask[i] = group[i] & (near <= far) & (near <= best_t[i]) & (mirror != p.skip[i]);
     }
     mask
 }
@@ -533,6 +548,36 @@ pub fn lanes(mut mask: LaneMask) -> impl Iterator<Item = usize> {
             lane
         })
     })
+}
+
+/// Per node, the mirror all the triangles below it are on, or [`NOT_A_MIRROR`] (children
+/// before parents: an explicit post-order walk from the root).
+fn subtree_mirrors(nodes: &[Node], slots: &[Slot]) -> Vec<u32> {
+    let mut mirror = vec![NOT_A_MIRROR; nodes.len()];
+    if nodes.is_empty() {
+        return mirror;
+    }
+    let mut stack = vec![(0usize, false)];
+    while let Some((i, children_done)) = stack.pop() {
+        let n = &nodes[i];
+        if n.count > 0 {
+            let leaf = &slots[n.first as usize..(n.first + n.count) as usize];
+            let first = leaf[0].mirror;
+            mirror[i] = if leaf.iter().all(|s| s.mirror == first) {
+                first
+            } else {
+                NOT_A_MIRROR
+            };
+        } else if children_done {
+            let (a, b) = (mirror[n.first as usize], mirror[n.first as usize + 1]);
+            mirror[i] = if a == b { a } else { NOT_A_MIRROR };
+        } else {
+            stack.push((i, true));
+            stack.push((n.first as usize, false));
+            stack.push((n.first as usize + 1, false));
+        }
+    }
+    mirror
 }
 
 /// Nodes on the longest root-to-leaf path below `index`.
@@ -555,6 +600,76 @@ const _: () = assert!(NOT_A_MIRROR != SKIP_NOTHING);
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bvh::{NOT_A_MIRROR, Slot};
+
+    /// Every node records the mirror all triangles below it are on, exactly: a subtree of
+    /// one mirror's triangles has it (so rays leaving that mirror skip it), a mixed one
+    /// has none.
+    #[test]
+    fn subtree_mirrors_are_the_mirror_of_every_triangle_below() {
+        let quad = |z: f32, x0: f32| {
+            let [a, b, c, d] = [
+                Vec3::new(x0, 0.0, z),
+                Vec3::new(x0 + 1.0, 0.0, z),
+                Vec3::new(x0 + 1.0, 1.0, z),
+                Vec3::new(x0, 1.0, z),
+            ];
+            [[a, b, c], [a, c, d]]
+        };
+        // Two mirrors of two quads each, far apart, and diffuse quads between them.
+        let mut triangles = Vec::new();
+        let mut mirrors = Vec::new();
+        for (z, mirror) in [(-5.0, 0), (5.0, 1)] {
+            for x0 in [0.0, 1.0] {
+                triangles.extend(quad(z, x0));
+                mirrors.extend([mirror; 2]);
+            }
+        }
+        for z in [-1.0, 0.0, 1.0] {
+            triangles.extend(quad(z, 0.5));
+            mirrors.extend([NOT_A_MIRROR; 2]);
+        }
+        let tris: Vec<_> = triangles
+            .iter()
+            .map(|t| obvhs::triangle::Triangle {
+                v0: t[0].into(),
+                v1: t[1].into(),
+                v2: t[2].into(),
+            })
+            .collect();
+        let bvh = PacketBvh::build(&tris, |i| Slot {
+            v: triangles[i as usize],
+            mirror: mirrors[i as usize],
+        });
+        let below = |index: usize| {
+            let mut found = Vec::new();
+            let mut stack = vec![index];
+            while let Some(i) = stack.pop() {
+                let n = &bvh.nodes[i];
+                if n.count > 0 {
+                    found
+                        .extend((n.first..n.first + n.count).map(|s| bvh.slots[s as usize].mirror));
+                } else {
+                    stack.extend([n.first as usize, n.first as usize + 1]);
+                }
+            }
+            found
+        };
+        let mut on_one = [0; 2];
+        for index in 0..bvh.nodes.len() {
+            let mirrors = below(index);
+            let want = if mirrors.iter().all(|&m| m == mirrors[0]) {
+                mirrors[0]
+            } else {
+                NOT_A_MIRROR
+            };
+            assert_eq!(bvh.node_mirror[index], want, "node {index}: {mirrors:?}");
+            if want != NOT_A_MIRROR {
+                on_one[want as usize] += 1;
+            }
+        }
+        assert!(on_one[0] > 0 && on_one[1] > 0, "{on_one:?}");
+    }
 
     /// The lane-parallel shear and permutation are [`WatertightRay::new`]'s, bit for bit,
     /// for directions of every kind: random, axis-aligned, with ties between components,
