@@ -1,5 +1,6 @@
-//! Coherent ray packets (issue 19): up to [`LANES`] closest-hit queries traced together
-//! through one binary BVH, each box and triangle test evaluated for every lane at once.
+//! Coherent ray packets (issue 19): up to [`LANES`] closest-hit queries — or any-hit
+//! shadow queries ([`PacketBvh::occluded_lanes_inline`]) — traced together through one
+//! binary BVH, each box and triangle test evaluated for every lane at once.
 //!
 //! Why packets: planar mirrors keep neighbouring rays neighbours, so the sub-pixel samples
 //! of neighbouring pixels visit nearly the same nodes and triangles at every bounce. One node
