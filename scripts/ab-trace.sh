@@ -16,7 +16,7 @@ fi
 rounds=$1 scene=$2 a=$3 b=$4
 shift 4
 [ "${1:-}" = "--" ] && shift
-case $rounds in '' | *[!0-9]*) echo "ROUNDS must be a positive whole number, not '$rounds'" >&2; exit 2 ;; esac
+case $rounds in '' | *[!0-9]* | 0*) echo "ROUNDS must be a positive whole number, not '$rounds'" >&2; exit 2 ;; esac
 [ -f "scenes/$scene.json" ] || { echo "no scene scenes/$scene.json" >&2; exit 2; }
 for bin in "$a" "$b"; do
   [ -x "$bin" ] || { echo "not an executable: $bin" >&2; exit 2; }
