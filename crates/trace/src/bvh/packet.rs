@@ -387,11 +387,12 @@ impl PacketBvh {
         let mut stack = [0u32; STACK];
         let mut sp = 0;
         let mut index = 0usize;
+        let mut warm = lead / BOX_CHUNK;
         loop {
             let node = &self.nodes[index];
-            let hit = box_hits(node, self.node_mirror[index], p, q, best_t, &in_group);
-            if any(&hit) {
-                if node.count == 0 {
+            let mirror = self.node_mirror[index];
+            if node.count == 0 {
+                if box_any(node, mirror, p, q, best_t, &in_group, group, &mut warm) {
                     let (a, b) = (node.first as usize, node.first as usize + 1);
                     let (na, nb) = (&self.nodes[a], &self.nodes[b]);
                     let along = (0..3)
@@ -403,22 +404,27 @@ impl PacketBvh {
                     index = near;
                     continue;
                 }
-                for slot in node.first..node.first + node.count {
-                    self.triangle::<KX, KY, KZ, ANY_HIT>(
-                        slot,
-                        p,
-                        q,
-                        &hit,
-                        best_t,
-                        best_slot,
-                        skip_triangle,
-                    );
-                }
-                // Any hit: done once every lane has stopped (a stopped lane's box tests
-                // fail, but the stack would still be walked).
-                if ANY_HIT && !(0..LANES).fold(false, |a, i| a | (in_group[i] & (best_t[i] >= 0.0)))
-                {
-                    break;
+            } else {
+                let hit = box_hits(node, mirror, p, q, best_t, &in_group);
+                if any(&hit) {
+                    for slot in node.first..node.first + node.count {
+                        self.triangle::<KX, KY, KZ, ANY_HIT>(
+                            slot,
+                            p,
+                            q,
+                            &hit,
+                            best_t,
+                            best_slot,
+                            skip_triangle,
+                        );
+                    }
+                    // Any hit: done once every lane has stopped (a stopped lane's box tests
+                    // fail, but the stack would still be walked).
+                    if ANY_HIT
+                        && !(0..LANES).fold(false, |a, i| a | (in_group[i] & (best_t[i] >= 0.0)))
+                    {
+                        break;
+                    }
                 }
             }
             if sp == 0 {
@@ -455,9 +461,13 @@ impl PacketBvh {
         let (v0, v1, v2) = (v0.to_array(), v1.to_array(), v2.to_array());
         let mut zero = [false; LANES];
         let mut tie = [false; LANES];
+        // First the edge functions: in most tests no lane is inside the triangle, and the
+        // distance (a division per lane) is not needed.
+        let mut edges = [[0.0f32; LANES]; 3];
+        let mut inside = [false; LANES];
         for i in 0..LANES {
             let o = [p.origin[0][i], p.origin[1][i], p.origin[2][i]];
-            let (sx, sy, sz) = (q.shear[0][i], q.shear[1][i], q.shear[2][i]);
+            let (sx, sy) = (q.shear[0][i], q.shear[1][i]);
             let (a_x, a_y, a_z) = (v0[KX] - o[KX], v0[KY] - o[KY], v0[KZ] - o[KZ]);
             let (b_x, b_y, b_z) = (v1[KX] - o[KX], v1[KY] - o[KY], v1[KZ] - o[KZ]);
             let (c_x, c_y, c_z) = (v2[KX] - o[KX], v2[KY] - o[KY], v2[KZ] - o[KZ]);
@@ -473,19 +483,31 @@ impl PacketBvh {
             let exact_zero = (u == 0.0) | (v == 0.0) | (w == 0.0);
             let outside = ((u < 0.0) | (v < 0.0) | (w < 0.0)) & ((u > 0.0) | (v > 0.0) | (w > 0.0));
             let det = u + v + w;
-            let az = sz * a_z;
-            let bz = sz * b_z;
-            let cz = sz * c_z;
-            let t = (u * az + v * bz + w * cz) / det;
             let asked =
                 hit[i] & (s.mirror != p.skip[i]) & (!ANY_HIT || triangle != skip_triangle[i]);
             zero[i] = asked & exact_zero;
-            let valid = asked & !exact_zero & !outside & (det != 0.0) & (t >= 0.0);
-            let take = valid & (t < best_t[i]);
-            tie[i] = !ANY_HIT & valid & (t == best_t[i]);
-            let kept = if ANY_HIT { STOPPED } else { t };
-            best_t[i] = if take { kept } else { best_t[i] };
-            best_slot[i] = if take { slot } else { best_slot[i] };
+            inside[i] = asked & !exact_zero & !outside & (det != 0.0);
+            edges[0][i] = u;
+            edges[1][i] = v;
+            edges[2][i] = w;
+        }
+        if any(&inside) {
+            for i in 0..LANES {
+                let o_z = p.origin[KZ][i];
+                let sz = q.shear[2][i];
+                let [u, v, w] = [edges[0][i], edges[1][i], edges[2][i]];
+                let det = u + v + w;
+                let az = sz * (v0[KZ] - o_z);
+                let bz = sz * (v1[KZ] - o_z);
+                let cz = sz * (v2[KZ] - o_z);
+                let t = (u * az + v * bz + w * cz) / det;
+                let valid = inside[i] & (t >= 0.0);
+                let take = valid & (t < best_t[i]);
+                tie[i] = !ANY_HIT & valid & (t == best_t[i]);
+                let kept = if ANY_HIT { STOPPED } else { t };
+                best_t[i] = if take { kept } else { best_t[i] };
+                best_slot[i] = if take { slot } else { best_slot[i] };
+            }
         }
         if any(&zero) {
             // The scalar test's f64 re-evaluation of exact zeros.
@@ -537,20 +559,73 @@ fn box_hits(
     group: &Mask,
 ) -> Mask {
     let mut mask = [false; LANES];
-    for i in 0..LANES {
-        let slab = |k: usize| {
-            let t0 = (node.min[k] - p.origin[k][i]) * q.inv[k][i];
-            let t1 = (node.max[k] - p.origin[k][i]) * q.inv[k][i];
-            (min(t0, t1), max(t0, t1))
-        };
-        let (n0, f0) = slab(0);
-        let (n1, f1) = slab(1);
-        let (n2, f2) = slab(2);
-        let near = max(max(0.0, n0), max(n1, n2));
-        let far = min(min(f0, f1), f2) * FAR_WIDENING;
-        mask[i] = group[i] & (near <= far) & (near <= best_t[i]) & (mirror != p.skip[i]);
+    for (i, lane) in mask.iter_mut().enumerate() {
+        *lane = box_hit_lane(node, mirror, p, q, best_t, group, i);
     }
     mask
+}
+
+/// Lanes per step of [`box_any`]: one AVX2 vector of f32.
+const BOX_CHUNK: usize = 8;
+
+/// Whether any lane of `group` (also given as bits, `group_bits`) meets the node's box as
+/// [`box_hits`] decides, with the same arithmetic, [`BOX_CHUNK`] lanes at a time: an inner
+/// node needs only this answer, and in a coherent packet the first chunk tried usually
+/// gives it. Starts at chunk `warm`, the last chunk that hit, and leaves it there.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn box_any(
+    node: &Node,
+    mirror: u32,
+    p: &RayPacket,
+    q: &Prepared,
+    best_t: &Lanes,
+    group: &Mask,
+    group_bits: LaneMask,
+    warm: &mut usize,
+) -> bool {
+    const CHUNKS: usize = LANES / BOX_CHUNK;
+    for step in 0..CHUNKS {
+        let c = (*warm + step) % CHUNKS;
+        let base = c * BOX_CHUNK;
+        if (group_bits >> base) & ((1 << BOX_CHUNK) - 1) == 0 {
+            continue;
+        }
+        let mut hit = false;
+        for i in base..base + BOX_CHUNK {
+            hit |= box_hit_lane(node, mirror, p, q, best_t, group, i);
+        }
+        if hit {
+            *warm = c;
+            return true;
+        }
+    }
+    false
+}
+
+/// Whether lane `i` meets the node's box no farther than its best hit (and is in the group
+/// and does not skip `mirror`): [`box_hits`]'s test of one lane.
+#[inline(always)]
+fn box_hit_lane(
+    node: &Node,
+    mirror: u32,
+    p: &RayPacket,
+    q: &Prepared,
+    best_t: &Lanes,
+    group: &Mask,
+    i: usize,
+) -> bool {
+    let slab = |k: usize| {
+        let t0 = (node.min[k] - p.origin[k][i]) * q.inv[k][i];
+        let t1 = (node.max[k] - p.origin[k][i]) * q.inv[k][i];
+        (min(t0, t1), max(t0, t1))
+    };
+    let (n0, f0) = slab(0);
+    let (n1, f1) = slab(1);
+    let (n2, f2) = slab(2);
+    let near = max(max(0.0, n0), max(n1, n2));
+    let far = min(min(f0, f1), f2) * FAR_WIDENING;
+    group[i] & (near <= far) & (near <= best_t[i]) & (mirror != p.skip[i])
 }
 
 /// The lanes set in `mask`, lowest first.
