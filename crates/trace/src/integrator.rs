@@ -25,22 +25,32 @@ pub trait Integrator: Sync {
     /// pixel's samples in order); a deterministic integrator ignores it.
     fn radiance(&self, ray: Ray, rng: &mut SplitMix64) -> PathResult;
 
-    /// The radiance of each of a pixel's camera rays `rays`, in order, into `out` (cleared
-    /// first): exactly what [`Integrator::radiance`] returns for each in turn with the same
-    /// `rng`. An integrator may trace them together (`whitted` traces packets).
-    fn radiance_all(&self, rays: &[Ray], rng: &mut SplitMix64, out: &mut Vec<PathResult>) {
+    /// The radiance of each of `rngs.len()` pixels' camera rays `rays` (pixel after pixel,
+    /// equally many each), in order, into `out` (cleared first): exactly what
+    /// [`Integrator::radiance`] returns for each in turn, a pixel's rays sharing that
+    /// pixel's stream `rngs[p]` in order. An integrator may trace them together (`whitted`
+    /// and `path` trace packets).
+    fn radiance_all(&self, rays: &[Ray], rngs: &mut [SplitMix64], out: &mut Vec<PathResult>) {
         out.clear();
-        out.extend(rays.iter().map(|&ray| self.radiance(ray, rng)));
+        for (pixel, rng) in rays.chunks(rays_per_pixel(rays, rngs)).zip(rngs) {
+            out.extend(pixel.iter().map(|&ray| self.radiance(ray, rng)));
+        }
     }
 
     /// How many neighbouring pixels of a row the image loop may hand to one
     /// [`Integrator::radiance_all`] call, their rays pixel after pixel, given
-    /// `samples_per_pixel`. The default, 1, is the only value for an integrator that draws
-    /// random numbers: a call gets one pixel's stream (that of its first pixel).
+    /// `samples_per_pixel` (each with its own random stream). Default 1.
     fn pixels_per_call(&self, samples_per_pixel: usize) -> usize {
         let _ = samples_per_pixel;
         1
     }
+}
+
+/// The rays of one pixel in a [`Integrator::radiance_all`] call: `rays` holds `rngs.len()`
+/// pixels' rays, equally many each.
+fn rays_per_pixel(rays: &[Ray], rngs: &[SplitMix64]) -> usize {
+    debug_assert!(!rngs.is_empty() && rays.len().is_multiple_of(rngs.len()));
+    (rays.len() / rngs.len().max(1)).max(1)
 }
 
 /// How a path ended.

@@ -149,6 +149,7 @@ impl Vectorised for RowWork<'_> {
         let mut offsets = Vec::new();
         let mut camera_rays = Vec::new();
         let mut results = Vec::new();
+        let mut rngs = Vec::new();
         let mut stats = TraceStats::default();
         let mut colour = Vec::with_capacity(w as usize);
         let mut depth = Vec::with_capacity(w as usize);
@@ -158,16 +159,17 @@ impl Vectorised for RowWork<'_> {
         let pixel_index = |x: u32| y as u64 * w as u64 + x as u64;
         for first in (0..w).step_by(batch as usize) {
             // The camera rays of pixels first.. (as many as the integrator takes per call),
-            // pixel after pixel; the first pixel's random stream.
+            // pixel after pixel, and each pixel's random stream.
             camera_rays.clear();
+            rngs.clear();
             for x in first..(first + batch).min(w) {
                 if per_pixel {
                     sampling.offsets(pixel_index(x), &mut offsets);
                 }
                 rays.rays_at_offsets(x as f32, y as f32, &offsets, &mut camera_rays);
+                rngs.push(SplitMix64::for_pixel(seed, pixel_index(x)));
             }
-            let mut rng = SplitMix64::for_pixel(seed, pixel_index(first));
-            integrator.radiance_all(&camera_rays, &mut rng, &mut results);
+            integrator.radiance_all(&camera_rays, &mut rngs, &mut results);
             for pixel in results.chunks(samples) {
                 let mut sum = glam::Vec3::ZERO;
                 let mut bounces = 0u64;

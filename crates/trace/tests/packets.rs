@@ -69,14 +69,16 @@ fn whitted_renders_every_bundled_scene_to_the_same_bits_with_packets() {
 }
 
 /// `path` takes the hits of its deterministic mirror chains from packets traced ahead of its
-/// samples; its random streams and every other query are unchanged, so its images are the
-/// same bits as one ray at a time through the same hierarchy.
+/// samples, several pixels' at once (2, 3 and 8 pixels per call at these grids), each pixel
+/// drawing from its own random stream; its streams and every other query are unchanged, so
+/// its images are the same bits as one ray at a time, one pixel per call, through the same
+/// hierarchy.
 #[test]
 fn path_renders_every_bundled_scene_to_the_same_bits_with_packets() {
     for name in &bundled_names() {
         let mut scene = bundled_scene(name);
         scene.camera = scene.camera.with_size(32, 18);
-        for (grid, max_depth) in [(4, 10), (2, 66)] {
+        for (grid, max_depth) in [(4, 10), (3, 10), (2, 66)] {
             let settings = TraceSettings::path(
                 grid,
                 PathSettings {

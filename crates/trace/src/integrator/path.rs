@@ -533,17 +533,33 @@ impl Integrator for PathTracer<'_> {
         self.radiance_hinted(ray, rng, None, 0)
     }
 
-    /// One ray at a time in order, sharing `rng`, as [`Integrator::radiance`]; when the BVH
-    /// traces packets, the deterministic mirror chains at the start of the paths are traced
-    /// first, side by side ([`PathTracer::mirror_chains`]), and each path takes its hits
-    /// from there.
-    fn radiance_all(&self, rays: &[Ray], rng: &mut SplitMix64, out: &mut Vec<PathResult>) {
+    /// Enough pixels to fill a packet's lanes with their mirror chains when packets are
+    /// traced and a pixel has enough samples to make one ([`MIN_PACKET`]); each pixel keeps
+    /// its own stream, so the images do not change.
+    fn pixels_per_call(&self, samples_per_pixel: usize) -> usize {
+        if self.bvh.packets() && samples_per_pixel >= MIN_PACKET {
+            LANES / samples_per_pixel
+        } else {
+            1
+        }
+    }
+
+    /// One ray at a time in order, each pixel's rays sharing its stream, as
+    /// [`Integrator::radiance`]; when the BVH traces packets, the deterministic mirror chains
+    /// at the start of the paths are traced first, [`LANES`] rays side by side (two pixels'
+    /// at 16 samples: [`Integrator::pixels_per_call`]), and each path takes its hits from
+    /// there.
+    fn radiance_all(&self, rays: &[Ray], rngs: &mut [SplitMix64], out: &mut Vec<PathResult>) {
         out.clear();
+        let per_pixel = super::rays_per_pixel(rays, rngs);
         if !self.bvh.packets() || rays.len() < MIN_PACKET {
-            out.extend(
-                rays.iter()
-                    .map(|&ray| self.radiance_hinted(ray, rng, None, 0)),
-            );
+            for (pixel, rng) in rays.chunks(per_pixel).zip(rngs) {
+                out.extend(
+                    pixel
+                        .iter()
+                        .map(|&ray| self.radiance_hinted(ray, rng, None, 0)),
+                );
+            }
             return;
         }
         // One buffer per thread, kept from pixel to pixel: a fresh one per pixel, up to
@@ -553,9 +569,10 @@ impl Integrator for PathTracer<'_> {
             static AHEAD: std::cell::RefCell<Ahead> = std::cell::RefCell::new(Ahead::default());
         }
         AHEAD.with_borrow_mut(|ahead| {
-            for chunk in rays.chunks(LANES) {
+            for (chunk_index, chunk) in rays.chunks(LANES).enumerate() {
                 self.mirror_chains(chunk, ahead);
                 for (lane, &ray) in chunk.iter().enumerate() {
+                    let rng = &mut rngs[(chunk_index * LANES + lane) / per_pixel];
                     out.push(self.radiance_hinted(ray, rng, Some(ahead), lane));
                 }
             }

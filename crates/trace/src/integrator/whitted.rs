@@ -395,7 +395,7 @@ impl Integrator for Whitted<'_> {
     }
 
     /// As packets when the BVH traces them and there are enough rays to fill some lanes.
-    fn radiance_all(&self, rays: &[Ray], _rng: &mut SplitMix64, out: &mut Vec<PathResult>) {
+    fn radiance_all(&self, rays: &[Ray], _rngs: &mut [SplitMix64], out: &mut Vec<PathResult>) {
         out.clear();
         if self.bvh.packets() && rays.len() >= MIN_PACKET {
             self.radiance_packet(rays, out);
