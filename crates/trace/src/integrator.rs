@@ -27,8 +27,8 @@ pub trait Integrator: Sync {
 
     /// The radiance of each of `rngs.len()` pixels' camera rays `rays` (pixel after pixel,
     /// equally many each), in order, into `out` (cleared first): exactly what
-    /// [`Integrator::radiance`] returns for each in turn, a pixel's rays sharing that
-    /// pixel's stream `rngs[p]` in order. An integrator may trace them together (`whitted`
+    /// [`Integrator::radiance`] returns for each in turn, the rays of the call's p-th pixel
+    /// sharing that pixel's stream `rngs[p]` in order. An integrator may trace them together (`whitted`
     /// and `path` trace packets).
     fn radiance_all(&self, rays: &[Ray], rngs: &mut [SplitMix64], out: &mut Vec<PathResult>) {
         out.clear();
@@ -39,18 +39,24 @@ pub trait Integrator: Sync {
 
     /// How many neighbouring pixels of a row the image loop may hand to one
     /// [`Integrator::radiance_all`] call, their rays pixel after pixel, given
-    /// `samples_per_pixel` (each with its own random stream). Default 1.
+    /// `samples_per_pixel` (each with its own random stream). Default 1; 0 is taken as 1.
     fn pixels_per_call(&self, samples_per_pixel: usize) -> usize {
         let _ = samples_per_pixel;
         1
     }
 }
 
-/// The rays of one pixel in a [`Integrator::radiance_all`] call: `rays` holds `rngs.len()`
-/// pixels' rays, equally many each.
+/// How many rays each pixel has in a [`Integrator::radiance_all`] call: `rays` must hold
+/// `rngs.len()` pixels' rays, equally many each (the image loop's contract; a mismatch
+/// would pair rays with the wrong streams, so it is checked).
 fn rays_per_pixel(rays: &[Ray], rngs: &[SplitMix64]) -> usize {
-    debug_assert!(!rngs.is_empty() && rays.len().is_multiple_of(rngs.len()));
-    (rays.len() / rngs.len().max(1)).max(1)
+    assert!(
+        !rngs.is_empty() && rays.len().is_multiple_of(rngs.len()),
+        "{} rays for {} pixels",
+        rays.len(),
+        rngs.len()
+    );
+    (rays.len() / rngs.len()).max(1)
 }
 
 /// How a path ended.

@@ -1,6 +1,7 @@
 //! Coherent ray packets (issue 19): up to [`LANES`] closest-hit queries — or any-hit
 //! shadow queries ([`PacketBvh::occluded_lanes_inline`]) — traced together through one
-//! binary BVH, each box and triangle test evaluated for every lane at once.
+//! binary BVH, each box and triangle test evaluated for all lanes side by side (an inner
+//! node's box [`BOX_CHUNK`] lanes at a time, until one lane meets it).
 //!
 //! Why packets: planar mirrors keep neighbouring rays neighbours, so the sub-pixel samples
 //! of neighbouring pixels visit nearly the same nodes and triangles at every bounce. One node
@@ -436,7 +437,8 @@ impl PacketBvh {
     }
 
     /// The watertight test of slot `slot` for the lanes of `hit`, keeping `0 ≤ t < best`.
-    /// Branch free over the lanes (the compiler vectorises it); the rare lanes with an
+    /// Two loops branch free over the lanes (the compiler vectorises them): the edge
+    /// functions, then, only if some lane is inside the edges, the distance; the rare lanes with an
     /// exact zero edge function or an exact tie are finished one by one. `ANY_HIT`: lanes
     /// also skip `skip_triangle`, and a hit stops the lane (`best` becomes [`STOPPED`]).
     #[inline(always)]
@@ -568,10 +570,13 @@ fn box_hits(
 /// Lanes per step of [`box_any`]: one AVX2 vector of f32.
 const BOX_CHUNK: usize = 8;
 
+// Every lane is in some chunk: a lane left out would never enter an inner node.
+const _: () = assert!(LANES.is_multiple_of(BOX_CHUNK));
+
 /// Whether any lane of `group` (also given as bits, `group_bits`) meets the node's box as
 /// [`box_hits`] decides, with the same arithmetic, [`BOX_CHUNK`] lanes at a time: an inner
 /// node needs only this answer, and in a coherent packet the first chunk tried usually
-/// gives it. Starts at chunk `warm`, the last chunk that hit, and leaves it there.
+/// gives it. Starts at chunk `warm`, and sets `warm` to the chunk that hit.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn box_any(

@@ -534,11 +534,11 @@ impl Integrator for PathTracer<'_> {
     }
 
     /// Enough pixels to fill a packet's lanes with their mirror chains when packets are
-    /// traced and a pixel has enough samples to make one ([`MIN_PACKET`]); each pixel keeps
-    /// its own stream, so the images do not change.
+    /// traced and a pixel has enough samples to make one ([`MIN_PACKET`]), at least one;
+    /// each pixel keeps its own stream, so the images do not change.
     fn pixels_per_call(&self, samples_per_pixel: usize) -> usize {
         if self.bvh.packets() && samples_per_pixel >= MIN_PACKET {
-            LANES / samples_per_pixel
+            (LANES / samples_per_pixel).max(1)
         } else {
             1
         }

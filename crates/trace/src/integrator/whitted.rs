@@ -382,13 +382,13 @@ impl Integrator for Whitted<'_> {
         Whitted::radiance(self, ray)
     }
 
-    /// Enough pixels to fill a packet when packets are traced (no random numbers are used)
-    /// and a pixel has enough samples to make one ([`MIN_PACKET`]). Fewer samples stay one
+    /// Enough pixels to fill a packet when packets are traced and a pixel has enough samples
+    /// to make one ([`MIN_PACKET`]); at least one. Fewer samples stay one
     /// ray at a time through the default hierarchy, as before the packets: the sweeps'
     /// truths are traced at 1 spp, and their bits do not change.
     fn pixels_per_call(&self, samples_per_pixel: usize) -> usize {
         if self.bvh.packets() && samples_per_pixel >= MIN_PACKET {
-            LANES / samples_per_pixel
+            (LANES / samples_per_pixel).max(1)
         } else {
             1
         }
