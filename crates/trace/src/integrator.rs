@@ -46,6 +46,17 @@ pub trait Integrator: Sync {
     }
 }
 
+/// Pixels per [`Integrator::radiance_all`] call for an integrator that traces packets:
+/// as many as fill a packet's lanes (at least one) when `bvh` traces packets and a pixel has
+/// at least `min_packet` samples; else one.
+fn packet_pixels(bvh: &SceneBvh, samples_per_pixel: usize, min_packet: usize) -> usize {
+    if bvh.packets() && samples_per_pixel >= min_packet {
+        (crate::bvh::packet::LANES / samples_per_pixel).max(1)
+    } else {
+        1
+    }
+}
+
 /// How many rays each pixel has in a [`Integrator::radiance_all`] call: `rays` must hold
 /// `rngs.len()` pixels' rays, equally many each (the image loop's contract; a mismatch
 /// would pair rays with the wrong streams, so it is checked).

@@ -537,11 +537,7 @@ impl Integrator for PathTracer<'_> {
     /// traced and a pixel has enough samples to make one ([`MIN_PACKET`]), at least one;
     /// each pixel keeps its own stream, so the images do not change.
     fn pixels_per_call(&self, samples_per_pixel: usize) -> usize {
-        if self.bvh.packets() && samples_per_pixel >= MIN_PACKET {
-            (LANES / samples_per_pixel).max(1)
-        } else {
-            1
-        }
+        super::packet_pixels(self.bvh, samples_per_pixel, MIN_PACKET)
     }
 
     /// One ray at a time in order, each pixel's rays sharing its stream, as

@@ -387,11 +387,7 @@ impl Integrator for Whitted<'_> {
     /// ray at a time through the default hierarchy, as before the packets: the sweeps'
     /// truths are traced at 1 spp, and their bits do not change.
     fn pixels_per_call(&self, samples_per_pixel: usize) -> usize {
-        if self.bvh.packets() && samples_per_pixel >= MIN_PACKET {
-            (LANES / samples_per_pixel).max(1)
-        } else {
-            1
-        }
+        super::packet_pixels(self.bvh, samples_per_pixel, MIN_PACKET)
     }
 
     /// As packets when the BVH traces them and there are enough rays to fill some lanes.
