@@ -96,6 +96,10 @@ pub(super) struct PacketBvh {
     /// Per node, the mirror every triangle below it belongs to ([`NOT_A_MIRROR`] where
     /// they are not all on one mirror): a ray leaving that mirror skips the whole subtree.
     node_mirror: Vec<u32>,
+    /// Per inner node, twice the step from its first child's box centre to its second's
+    /// ([`children_gap`]): which child is nearer along a direction, without reading the
+    /// children's boxes.
+    child_gap: Vec<[f32; 4]>,
 }
 
 /// Up to [`LANES`] rays, structure of arrays, each with the mirror it skips.
@@ -262,12 +266,14 @@ impl PacketBvh {
     fn from_parts(nodes: Vec<Node>, slots: Vec<Slot>, original: Vec<u32>) -> Self {
         let fits_stack = nodes.is_empty() || depth(&nodes, 0) < STACK;
         let node_mirror = subtree_mirrors(&nodes, &slots);
+        let child_gap = nodes.iter().map(|n| children_gap(&nodes, n)).collect();
         PacketBvh {
             nodes,
             slots,
             original,
             fits_stack,
             node_mirror,
+            child_gap,
         }
     }
 
@@ -340,12 +346,11 @@ impl PacketBvh {
         let mut left = active;
         while left != 0 {
             let code = prepared.axes[left.trailing_zeros() as usize];
-            let mut group = 0;
-            for lane in lanes(left) {
-                if prepared.axes[lane] == code {
-                    group |= 1 << lane;
-                }
-            }
+            // Over all lanes, then masked: a loop without branches (vectorised).
+            let same = (0..LANES).fold(0, |m: LaneMask, i| {
+                m | ((prepared.axes[i] == code) as LaneMask) << i
+            });
+            let group = same & left;
             left &= !group;
             let (p, q, t, s, k) = (
                 packet,
@@ -393,12 +398,10 @@ impl PacketBvh {
             let node = &self.nodes[index];
             let mirror = self.node_mirror[index];
             if node.count == 0 {
-                if box_any(node, mirror, p, q, best_t, &in_group, group, &mut warm) {
+                if box_any(node, mirror, p, q, best_t, group, &mut warm) {
                     let (a, b) = (node.first as usize, node.first as usize + 1);
-                    let (na, nb) = (&self.nodes[a], &self.nodes[b]);
-                    let along = (0..3)
-                        .map(|k| (nb.min[k] + nb.max[k] - na.min[k] - na.max[k]) * lead_dir[k])
-                        .sum::<f32>();
+                    let gap = &self.child_gap[index];
+                    let along = (0..3).map(|k| gap[k] * lead_dir[k]).sum::<f32>();
                     let (near, far) = if along < 0.0 { (b, a) } else { (a, b) };
                     stack[sp] = far as u32;
                     sp += 1;
@@ -406,14 +409,14 @@ impl PacketBvh {
                     continue;
                 }
             } else {
-                let hit = box_hits(node, mirror, p, q, best_t, &in_group);
-                if any(&hit) {
+                let hit = box_hits(node, mirror, p, q, best_t, group);
+                if hit != 0 {
                     for slot in node.first..node.first + node.count {
                         self.triangle::<KX, KY, KZ, ANY_HIT>(
                             slot,
                             p,
                             q,
-                            &hit,
+                            hit,
                             best_t,
                             best_slot,
                             skip_triangle,
@@ -448,7 +451,7 @@ impl PacketBvh {
         slot: u32,
         p: &RayPacket,
         q: &Prepared,
-        hit: &Mask,
+        hit: LaneMask,
         best_t: &mut Lanes,
         best_slot: &mut [u32; LANES],
         skip_triangle: &[u32; LANES],
@@ -483,12 +486,16 @@ impl PacketBvh {
             let v = ax * cy - ay * cx;
             let w = bx * ay - by * ax;
             let exact_zero = (u == 0.0) | (v == 0.0) | (w == 0.0);
-            let outside = ((u < 0.0) | (v < 0.0) | (w < 0.0)) & ((u > 0.0) | (v > 0.0) | (w > 0.0));
-            let det = u + v + w;
-            let asked =
-                hit[i] & (s.mirror != p.skip[i]) & (!ANY_HIT || triangle != skip_triangle[i]);
+            // Inside: all three edge functions of one sign, none zero. (The scalar test's
+            // "no zero, not of both signs, determinant not zero": the same lanes, since
+            // three non-zero values of one sign never sum to zero.)
+            let all_positive = min(min(u, v), w) > 0.0;
+            let all_negative = max(max(u, v), w) < 0.0;
+            let asked = (hit >> i & 1 == 1)
+                & (s.mirror != p.skip[i])
+                & (!ANY_HIT || triangle != skip_triangle[i]);
             zero[i] = asked & exact_zero;
-            inside[i] = asked & !exact_zero & !outside & (det != 0.0);
+            inside[i] = asked & (all_positive | all_negative);
             edges[0][i] = u;
             edges[1][i] = v;
             edges[2][i] = w;
@@ -558,13 +565,15 @@ fn box_hits(
     p: &RayPacket,
     q: &Prepared,
     best_t: &Lanes,
-    group: &Mask,
-) -> Mask {
-    let mut mask = [false; LANES];
-    for (i, lane) in mask.iter_mut().enumerate() {
-        *lane = box_hit_lane(node, mirror, p, q, best_t, group, i);
+    group: LaneMask,
+) -> LaneMask {
+    // As bits, one `movmsk` per chunk: cheaper than a flag per lane, and the group is
+    // applied to the bits.
+    let mut meets: LaneMask = 0;
+    for i in 0..LANES {
+        meets |= (box_meets_lane(node, mirror, p, q, best_t, i) as LaneMask) << i;
     }
-    mask
+    meets & group
 }
 
 /// Lanes per step of [`box_any`]: one AVX2 vector of f32.
@@ -573,8 +582,7 @@ const BOX_CHUNK: usize = 8;
 // Every lane is in some chunk: a lane left out would never enter an inner node.
 const _: () = assert!(LANES.is_multiple_of(BOX_CHUNK));
 
-/// Whether any lane of `group` (also given as bits, `group_bits`) meets the node's box as
-/// [`box_hits`] decides, with the same arithmetic, [`BOX_CHUNK`] lanes at a time: an inner
+/// Whether any lane of `group` meets the node's box as [`box_hits`] decides, with the same arithmetic, [`BOX_CHUNK`] lanes at a time: an inner
 /// node needs only this answer, and in a coherent packet the first chunk tried usually
 /// gives it. Starts at chunk `warm`, and sets `warm` to the chunk that hit.
 #[inline(always)]
@@ -585,22 +593,22 @@ fn box_any(
     p: &RayPacket,
     q: &Prepared,
     best_t: &Lanes,
-    group: &Mask,
-    group_bits: LaneMask,
+    group: LaneMask,
     warm: &mut usize,
 ) -> bool {
     const CHUNKS: usize = LANES / BOX_CHUNK;
     for step in 0..CHUNKS {
         let c = (*warm + step) % CHUNKS;
         let base = c * BOX_CHUNK;
-        if (group_bits >> base) & ((1 << BOX_CHUNK) - 1) == 0 {
+        if (group >> base) & ((1 << BOX_CHUNK) - 1) == 0 {
             continue;
         }
-        let mut hit = false;
-        for i in base..base + BOX_CHUNK {
-            hit |= box_hit_lane(node, mirror, p, q, best_t, group, i);
+        // The chunk's answers as bits (one `movmsk`), the group applied to the bits.
+        let mut meets: LaneMask = 0;
+        for j in 0..BOX_CHUNK {
+            meets |= (box_meets_lane(node, mirror, p, q, best_t, base + j) as LaneMask) << j;
         }
-        if hit {
+        if meets & (group >> base) != 0 {
             *warm = c;
             return true;
         }
@@ -608,16 +616,16 @@ fn box_any(
     false
 }
 
-/// Whether lane `i` meets the node's box no farther than its best hit (and is in the group
-/// and does not skip `mirror`): [`box_hits`]'s test of one lane.
+/// Whether lane `i` meets the node's box no farther than its best hit and does not skip
+/// `mirror` (whether it is in the traversed group or not is the caller's business):
+/// [`box_hits`]'s and [`box_any`]'s test of one lane.
 #[inline(always)]
-fn box_hit_lane(
+fn box_meets_lane(
     node: &Node,
     mirror: u32,
     p: &RayPacket,
     q: &Prepared,
     best_t: &Lanes,
-    group: &Mask,
     i: usize,
 ) -> bool {
     let slab = |k: usize| {
@@ -630,7 +638,8 @@ fn box_hit_lane(
     let (n2, f2) = slab(2);
     let near = max(max(0.0, n0), max(n1, n2));
     let far = min(min(f0, f1), f2) * FAR_WIDENING;
-    group[i] & (near <= far) & (near <= best_t[i]) & (mirror != p.skip[i])
+    // `near ≤ far` and `near ≤ best`, in one comparison.
+    (near <= min(far, best_t[i])) & (mirror != p.skip[i])
 }
 
 /// The lanes set in `mask`, lowest first.
@@ -642,6 +651,18 @@ pub fn lanes(mut mask: LaneMask) -> impl Iterator<Item = usize> {
             lane
         })
     })
+}
+
+/// For an inner node, `b.min + b.max − a.min − a.max` per axis (children `a`, `b`): the
+/// second child lies farther along a direction `d` than the first when the gap's dot
+/// product with `d` is positive. Zero for a leaf.
+fn children_gap(nodes: &[Node], node: &Node) -> [f32; 4] {
+    if node.count > 0 {
+        return [0.0; 4];
+    }
+    let (a, b) = (&nodes[node.first as usize], &nodes[node.first as usize + 1]);
+    let gap = |k: usize| b.min[k] + b.max[k] - a.min[k] - a.max[k];
+    [gap(0), gap(1), gap(2), 0.0]
 }
 
 /// Per node, the mirror all the triangles below it are on, or [`NOT_A_MIRROR`] (children
