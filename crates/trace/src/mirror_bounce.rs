@@ -20,6 +20,9 @@ pub struct MirrorPlanes {
     planes: Vec<(DVec3, f64)>,
     /// Per mirror: the mirror and its bump, where it has one.
     bumps: Vec<Option<(mirrorbox_scene::Mirror, MirrorBump)>>,
+    /// Per mirror: its plane where it is flat (what [`MirrorPlanes::flat_plane`] answers,
+    /// kept apart from the large bump records so that a bounce reads one small entry).
+    flat: Vec<Option<(DVec3, f64)>>,
 }
 
 impl MirrorPlanes {
@@ -28,14 +31,23 @@ impl MirrorPlanes {
             .mirrors
             .iter()
             .map(mirrorbox_scene::Mirror::plane_f64)
-            .collect();
+            .collect::<Vec<_>>();
         let bumps = scene
             .mirrors
             .iter()
             .zip(&scene.bumps)
             .map(|(m, b)| b.clone().map(|b| (m.clone(), b)))
+            .collect::<Vec<_>>();
+        let flat = planes
+            .iter()
+            .zip(&bumps)
+            .map(|(&plane, bump)| bump.is_none().then_some(plane))
             .collect();
-        MirrorPlanes { planes, bumps }
+        MirrorPlanes {
+            planes,
+            bumps,
+            flat,
+        }
     }
 
     /// The ray `origin + t·dir` reflected at mirror `mirror`: (hit point, reflected
@@ -59,8 +71,9 @@ impl MirrorPlanes {
 
     /// The plane (unit normal, offset) of mirror `mirror` when it is flat; `None` when it
     /// is uneven (its bounce needs [`MirrorPlanes::reflect`]).
+    #[inline(always)]
     pub fn flat_plane(&self, mirror: usize) -> Option<(DVec3, f64)> {
-        self.bumps[mirror].is_none().then(|| self.planes[mirror])
+        self.flat[mirror]
     }
 }
 
