@@ -20,7 +20,7 @@ use obvhs::bvh2::Bvh2;
 use obvhs::cwbvh::CwBvh;
 use obvhs::ray::RayHit;
 use obvhs::triangle::Triangle;
-use packet::{LANES, LaneMask, PacketBvh, RayPacket};
+use packet::{LANES, LaneHits, LaneMask, PacketBvh, RayPacket};
 use std::sync::OnceLock;
 use std::time::Duration;
 
@@ -304,6 +304,28 @@ impl SceneBvh {
         for lane in packet::lanes(active) {
             let (ray, skip) = packet.lane(lane);
             out[lane] = self.closest_hit(&ray, 0.0, f32::INFINITY, skip);
+        }
+    }
+
+    /// [`SceneBvh::closest_hits_inline`] as structure of arrays ([`LaneHits`], what the
+    /// kernel keeps): every lane is written, those outside `active` with no hit.
+    #[inline(always)]
+    pub(crate) fn closest_hit_lanes_inline(
+        &self,
+        packet: &RayPacket,
+        active: LaneMask,
+        out: &mut LaneHits,
+    ) {
+        if self.packets {
+            let bvh = self.packet_bvh();
+            if bvh.usable() {
+                return bvh.closest_hit_lanes_inline(packet, active, out);
+            }
+        }
+        *out = LaneHits::default();
+        for lane in packet::lanes(active) {
+            let (ray, skip) = packet.lane(lane);
+            out.set(lane, self.closest_hit(&ray, 0.0, f32::INFINITY, skip));
         }
     }
 

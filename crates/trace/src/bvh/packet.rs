@@ -102,6 +102,43 @@ pub(super) struct PacketBvh {
     child_gap: Vec<[f32; 4]>,
 }
 
+/// The closest hits of a packet's lanes, structure of arrays: lane `i` hit triangle
+/// `triangle[i]` (the scene's numbering) at distance `t[i]`, or nothing where `triangle[i]`
+/// is [`NO_TRIANGLE`].
+#[derive(Clone)]
+pub struct LaneHits {
+    pub t: [f32; LANES],
+    pub triangle: [u32; LANES],
+}
+
+impl Default for LaneHits {
+    fn default() -> Self {
+        LaneHits {
+            t: [f32::INFINITY; LANES],
+            triangle: [NO_TRIANGLE; LANES],
+        }
+    }
+}
+
+impl LaneHits {
+    /// Lane `lane`'s hit, as [`super::SceneBvh::closest_hit`] answers it.
+    #[inline(always)]
+    pub fn get(&self, lane: usize) -> Option<Hit> {
+        (self.triangle[lane] != NO_TRIANGLE).then(|| Hit {
+            t: self.t[lane],
+            triangle: self.triangle[lane] as usize,
+        })
+    }
+
+    /// Lane `lane` hit `hit`.
+    pub fn set(&mut self, lane: usize, hit: Option<Hit>) {
+        (self.t[lane], self.triangle[lane]) = match hit {
+            Some(h) => (h.t, h.triangle as u32),
+            None => (f32::INFINITY, NO_TRIANGLE),
+        };
+    }
+}
+
 /// Up to [`LANES`] rays, structure of arrays, each with the mirror it skips.
 #[derive(Clone)]
 pub struct RayPacket {
@@ -296,15 +333,24 @@ impl PacketBvh {
         active: LaneMask,
         out: &mut [Option<Hit>; LANES],
     ) {
-        let mut best_t = [f32::INFINITY; LANES];
-        let mut best_slot = [u32::MAX; LANES];
-        self.trace_lanes::<false>(packet, active, &mut best_t, &mut best_slot, &NO_TRIANGLES);
+        let mut hits = LaneHits::default();
+        self.closest_hit_lanes_inline(packet, active, &mut hits);
         for lane in lanes(active) {
-            out[lane] = (best_slot[lane] != u32::MAX).then(|| Hit {
-                t: best_t[lane],
-                triangle: self.original[best_slot[lane] as usize] as usize,
-            });
+            out[lane] = hits.get(lane);
         }
+    }
+
+    /// [`PacketBvh::closest_hits_inline`] as structure of arrays, which the traversal
+    /// keeps anyway: every lane of `out` is written, those outside `active` with no hit.
+    #[inline(always)]
+    pub(super) fn closest_hit_lanes_inline(
+        &self,
+        packet: &RayPacket,
+        active: LaneMask,
+        out: &mut LaneHits,
+    ) {
+        *out = LaneHits::default();
+        self.trace_lanes::<false>(packet, active, &mut out.t, &mut out.triangle, &NO_TRIANGLES);
     }
 
     /// The lanes of `active` whose segment is blocked: whose ray hits a triangle at
@@ -321,10 +367,16 @@ impl PacketBvh {
         skip_triangle: &[u32; LANES],
     ) -> LaneMask {
         let mut best_t = *t_max;
-        let mut best_slot = [u32::MAX; LANES];
-        self.trace_lanes::<true>(packet, active, &mut best_t, &mut best_slot, skip_triangle);
+        let mut best_triangle = [NO_TRIANGLE; LANES];
+        self.trace_lanes::<true>(
+            packet,
+            active,
+            &mut best_t,
+            &mut best_triangle,
+            skip_triangle,
+        );
         lanes(active)
-            .filter(|&lane| best_slot[lane] != u32::MAX)
+            .filter(|&lane| best_triangle[lane] != NO_TRIANGLE)
             .fold(0, |blocked, lane| blocked | 1 << lane)
     }
 
@@ -339,7 +391,7 @@ impl PacketBvh {
         packet: &RayPacket,
         active: LaneMask,
         best_t: &mut Lanes,
-        best_slot: &mut [u32; LANES],
+        best_triangle: &mut [u32; LANES],
         skip_triangle: &[u32; LANES],
     ) {
         let prepared = Prepared::new(packet);
@@ -356,7 +408,7 @@ impl PacketBvh {
                 packet,
                 &prepared,
                 &mut *best_t,
-                &mut *best_slot,
+                &mut *best_triangle,
                 skip_triangle,
             );
             match axes_of(code) {
@@ -381,7 +433,7 @@ impl PacketBvh {
         q: &Prepared,
         group: LaneMask,
         best_t: &mut Lanes,
-        best_slot: &mut [u32; LANES],
+        best_triangle: &mut [u32; LANES],
         skip_triangle: &[u32; LANES],
     ) {
         let mut in_group: Mask = [false; LANES];
@@ -418,7 +470,7 @@ impl PacketBvh {
                             q,
                             hit,
                             best_t,
-                            best_slot,
+                            best_triangle,
                             skip_triangle,
                         );
                     }
@@ -453,15 +505,11 @@ impl PacketBvh {
         q: &Prepared,
         hit: LaneMask,
         best_t: &mut Lanes,
-        best_slot: &mut [u32; LANES],
+        best_triangle: &mut [u32; LANES],
         skip_triangle: &[u32; LANES],
     ) {
         let s = &self.slots[slot as usize];
-        let triangle = if ANY_HIT {
-            self.original[slot as usize]
-        } else {
-            NO_TRIANGLE
-        };
+        let triangle = self.original[slot as usize];
         let [v0, v1, v2] = s.v;
         let (v0, v1, v2) = (v0.to_array(), v1.to_array(), v2.to_array());
         let mut zero = [false; LANES];
@@ -515,7 +563,7 @@ impl PacketBvh {
                 tie[i] = !ANY_HIT & valid & (t == best_t[i]);
                 let kept = if ANY_HIT { STOPPED } else { t };
                 best_t[i] = if take { kept } else { best_t[i] };
-                best_slot[i] = if take { slot } else { best_slot[i] };
+                best_triangle[i] = if take { triangle } else { best_triangle[i] };
             }
         }
         if any(&zero) {
@@ -526,7 +574,7 @@ impl PacketBvh {
                 let t = ray.intersect_axes::<KX, KY, KZ>(v0, v1, v2, 0.0, best_t[i]);
                 if t < best_t[i] {
                     best_t[i] = if ANY_HIT { STOPPED } else { t };
-                    best_slot[i] = slot;
+                    best_triangle[i] = triangle;
                 } else if t == best_t[i] && !ANY_HIT {
                     tie[i] = true;
                 }
@@ -536,9 +584,11 @@ impl PacketBvh {
             // Equally distant hits: the lowest triangle index wins, whatever the visiting
             // order (the single-ray query's rule).
             for i in (0..LANES).filter(|&i| tie[i]) {
-                let best = best_slot[i];
-                if best != u32::MAX && self.original[slot as usize] < self.original[best as usize] {
-                    best_slot[i] = slot;
+                // (A miss of the f64 re-evaluation is an infinite distance, equal to that of
+                // a lane with no hit yet: no hit to compare with.)
+                let best = best_triangle[i];
+                if best != NO_TRIANGLE && triangle < best {
+                    best_triangle[i] = triangle;
                 }
             }
         }

@@ -11,7 +11,7 @@
 //! they leave ([`crate::mirror_bounce`]).
 
 use super::{Integrator, PathResult, Termination, face_normals};
-use crate::bvh::packet::{LANES, LaneMask, RayPacket, first_lanes, lanes};
+use crate::bvh::packet::{LANES, LaneHits, LaneMask, RayPacket, first_lanes, lanes};
 use crate::bvh::{Hit, SceneBvh};
 use crate::cpu_features::{Vectorised, widest};
 use crate::mirror_bounce::{MirrorPlanes, bounce_flat_lanes};
@@ -183,17 +183,18 @@ impl<'a> Whitted<'a> {
             let mut ends = [Termination::Escaped; LANES];
             let mut active: LaneMask = first_lanes(chunk.len());
             let mut packet = RayPacket::default();
-            let mut hits = [None; LANES];
+            let mut hits = LaneHits::default();
             while active != 0 {
                 packet.set_rays_f64(&origin, &dir);
-                self.bvh.closest_hits_inline(&packet, active, &mut hits);
+                self.bvh
+                    .closest_hit_lanes_inline(&packet, active, &mut hits);
                 // The lanes bouncing off a flat mirror this round, and those hitting a
                 // diffuse surface to shade together (where the lighting allows).
                 let mut flat = [false; LANES];
                 let mut diffuse = [false; LANES];
                 for lane in lanes(active) {
                     let (query, _) = packet.lane(lane);
-                    let mirror = match self.step(&mut carried[lane], &query, hits[lane]) {
+                    let mirror = match self.step(&mut carried[lane], &query, hits.get(lane)) {
                         Next::End(end) => {
                             ends[lane] = end;
                             active &= !(1 << lane);
