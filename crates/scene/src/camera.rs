@@ -162,9 +162,10 @@ impl RayGenerator {
     pub fn rays_at_offsets(&self, x: f32, y: f32, offsets: &[Vec2], out: &mut Vec<Ray>) {
         const LANES: usize = 16;
         for chunk in offsets.chunks(LANES) {
-            let (mut px, mut py) = ([0.0f32; LANES], [0.0f32; LANES]);
-            for i in 0..LANES {
-                let o = chunk[i.min(chunk.len() - 1)];
+            // Lanes past the chunk's end keep the pixel's corner (never emitted). A lane
+            // loop with a clamped index stayed scalar.
+            let (mut px, mut py) = ([x; LANES], [y; LANES]);
+            for (i, o) in chunk.iter().enumerate() {
                 (px[i], py[i]) = (x + o.x, y + o.y);
             }
             let mut dir = [[0.0f32; LANES]; 3];
