@@ -295,15 +295,10 @@ impl SceneBvh {
         active: LaneMask,
         out: &mut [Option<Hit>; LANES],
     ) {
-        if self.packets {
-            let bvh = self.packet_bvh();
-            if bvh.usable() {
-                return bvh.closest_hits_inline(packet, active, out);
-            }
-        }
+        let mut hits = LaneHits::default();
+        self.closest_hit_lanes_inline(packet, active, &mut hits);
         for lane in packet::lanes(active) {
-            let (ray, skip) = packet.lane(lane);
-            out[lane] = self.closest_hit(&ray, 0.0, f32::INFINITY, skip);
+            out[lane] = hits.get(lane);
         }
     }
 
@@ -641,8 +636,13 @@ mod tests {
     #[test]
     fn packets_answer_as_single_rays() {
         let scene = parse_scene(SCENE, Path::new("inline.json")).unwrap();
-        for kind in [BvhKind::Cwbvh, BvhKind::Bvh2] {
-            let bvh = SceneBvh::build_with(&scene.geometry, kind);
+        // Packets off too: the same queries answered lane by lane (the fallback).
+        for (kind, packets) in [
+            (BvhKind::Cwbvh, true),
+            (BvhKind::Bvh2, true),
+            (BvhKind::Cwbvh, false),
+        ] {
+            let bvh = SceneBvh::build_with(&scene.geometry, kind).with_packets(packets);
             let cam = &scene.camera;
             let grid = mirrorbox_scene::SubpixelGrid::new(4);
             let planes = crate::mirror_bounce::MirrorPlanes::new(&scene);

@@ -20,8 +20,9 @@ pub struct MirrorPlanes {
     planes: Vec<(DVec3, f64)>,
     /// Per mirror: the mirror and its bump, where it has one.
     bumps: Vec<Option<(mirrorbox_scene::Mirror, MirrorBump)>>,
-    /// Per mirror: its plane where it is flat (what [`MirrorPlanes::flat_plane`] answers,
-    /// kept apart from the large bump records so that a bounce reads one small entry).
+    /// Per mirror: its plane where it is flat (what [`MirrorPlanes::flat_plane`] answers;
+    /// a copy of `planes` and `bumps` together, kept apart from the large bump records so
+    /// that a bounce reads one small entry).
     flat: Vec<Option<(DVec3, f64)>>,
 }
 

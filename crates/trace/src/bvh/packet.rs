@@ -319,29 +319,14 @@ impl PacketBvh {
         self.fits_stack && !self.nodes.is_empty()
     }
 
-    /// The closest hit of every lane in `active`, into `out` (lanes outside `active` are
-    /// left as they are). The lanes are traversed in groups sharing an axis permutation of
-    /// the watertight test (a pixel's samples nearly always share one).
+    /// The closest hit of every lane in `active`, into `out` as structure of arrays (what
+    /// the traversal keeps anyway): every lane is written, those outside `active` with no
+    /// hit. The lanes are traversed in groups sharing an axis permutation of the watertight
+    /// test (a pixel's samples nearly always share one).
     ///
     /// Inlined into its caller so that it is compiled for the caller's CPU
     /// features ([`crate::cpu_features::widest`]; the same arithmetic, hence the same bits,
     /// in every build).
-    #[inline(always)]
-    pub(super) fn closest_hits_inline(
-        &self,
-        packet: &RayPacket,
-        active: LaneMask,
-        out: &mut [Option<Hit>; LANES],
-    ) {
-        let mut hits = LaneHits::default();
-        self.closest_hit_lanes_inline(packet, active, &mut hits);
-        for lane in lanes(active) {
-            out[lane] = hits.get(lane);
-        }
-    }
-
-    /// [`PacketBvh::closest_hits_inline`] as structure of arrays, which the traversal
-    /// keeps anyway: every lane of `out` is written, those outside `active` with no hit.
     #[inline(always)]
     pub(super) fn closest_hit_lanes_inline(
         &self,
@@ -436,10 +421,6 @@ impl PacketBvh {
         best_triangle: &mut [u32; LANES],
         skip_triangle: &[u32; LANES],
     ) {
-        let mut in_group: Mask = [false; LANES];
-        for (i, lane) in in_group.iter_mut().enumerate() {
-            *lane = group >> i & 1 == 1;
-        }
         let lead = group.trailing_zeros() as usize;
         let lead_dir = [p.dir[0][lead], p.dir[1][lead], p.dir[2][lead]];
         let mut stack = [0u32; STACK];
@@ -477,7 +458,10 @@ impl PacketBvh {
                     // Any hit: done once every lane has stopped (a stopped lane's box tests
                     // fail, but the stack would still be walked).
                     if ANY_HIT
-                        && !(0..LANES).fold(false, |a, i| a | (in_group[i] & (best_t[i] >= 0.0)))
+                        && (0..LANES).fold(0, |m: LaneMask, i| {
+                            m | ((best_t[i] >= 0.0) as LaneMask) << i
+                        }) & group
+                            == 0
                     {
                         break;
                     }
@@ -536,7 +520,9 @@ impl PacketBvh {
             let exact_zero = (u == 0.0) | (v == 0.0) | (w == 0.0);
             // Inside: all three edge functions of one sign, none zero. (The scalar test's
             // "no zero, not of both signs, determinant not zero": the same lanes, since
-            // three non-zero values of one sign never sum to zero.)
+            // three non-zero values of one sign never sum to zero. A lane with a NaN edge
+            // function may be flagged otherwise here, but its distance is NaN then and
+            // `t >= 0` drops it, as the scalar test does.)
             let all_positive = min(min(u, v), w) > 0.0;
             let all_negative = max(max(u, v), w) < 0.0;
             let asked = (hit >> i & 1 == 1)
@@ -632,11 +618,11 @@ const BOX_CHUNK: usize = 8;
 // Every lane is in some chunk: a lane left out would never enter an inner node.
 const _: () = assert!(LANES.is_multiple_of(BOX_CHUNK));
 
-/// Whether any lane of `group` meets the node's box as [`box_hits`] decides, with the same arithmetic, [`BOX_CHUNK`] lanes at a time: an inner
-/// node needs only this answer, and in a coherent packet the first chunk tried usually
-/// gives it. Starts at chunk `warm`, and sets `warm` to the chunk that hit.
+/// Whether any lane of `group` meets the node's box as [`box_hits`] decides, with the
+/// same arithmetic, [`BOX_CHUNK`] lanes at a time: an inner node needs only this answer,
+/// and in a coherent packet the first chunk tried usually gives it. Starts at chunk
+/// `warm`, and sets `warm` to the chunk that hit.
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
 fn box_any(
     node: &Node,
     mirror: u32,
@@ -688,7 +674,9 @@ fn box_meets_lane(
     let (n2, f2) = slab(2);
     let near = max(max(0.0, n0), max(n1, n2));
     let far = min(min(f0, f1), f2) * FAR_WIDENING;
-    // `near ≤ far` and `near ≤ best`, in one comparison.
+    // `near ≤ far` and `near ≤ best`, in one comparison (the same answer for all values
+    // but a NaN `far`, which finite boxes and `safe_inverse` never give; with one, `min`
+    // returns `best` and the box is entered: pruning less, never more).
     (near <= min(far, best_t[i])) & (mirror != p.skip[i])
 }
 
