@@ -314,7 +314,7 @@ impl PacketBvh {
         }
     }
 
-    /// Whether [`PacketBvh::closest_hits`] can trace this hierarchy.
+    /// Whether [`PacketBvh::closest_hit_lanes_inline`] can trace this hierarchy.
     pub(super) fn usable(&self) -> bool {
         self.fits_stack && !self.nodes.is_empty()
     }
@@ -475,11 +475,12 @@ impl PacketBvh {
         }
     }
 
-    /// The watertight test of slot `slot` for the lanes of `hit`, keeping `0 ≤ t < best`.
-    /// Two loops branch free over the lanes (the compiler vectorises them): the edge
-    /// functions, then, only if some lane is inside the edges, the distance; the rare lanes with an
-    /// exact zero edge function or an exact tie are finished one by one. `ANY_HIT`: lanes
-    /// also skip `skip_triangle`, and a hit stops the lane (`best` becomes [`STOPPED`]).
+    /// The watertight test of slot `slot` for the lanes of `hit`, keeping `0 ≤ t < best`
+    /// and recording the scene's index of the triangle hit. Two loops branch free over the
+    /// lanes (the compiler vectorises them): the edge functions, then, only if some lane is
+    /// inside the edges, the distance; the rare lanes with an exact zero edge function or
+    /// an exact tie are finished one by one. `ANY_HIT`: lanes also skip `skip_triangle`, and
+    /// a hit stops the lane (`best` becomes [`STOPPED`]).
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     fn triangle<const KX: usize, const KY: usize, const KZ: usize, const ANY_HIT: bool>(
