@@ -99,7 +99,7 @@ pub(super) struct PacketBvh {
     /// Per inner node, twice the step from its first child's box centre to its second's
     /// ([`children_gap`]): which child is nearer along a direction, without reading the
     /// children's boxes.
-    child_gap: Vec<[f32; 4]>,
+    child_gap: Vec<[f32; 3]>,
 }
 
 /// The closest hits of a packet's lanes, structure of arrays: lane `i` hit triangle
@@ -695,13 +695,13 @@ pub fn lanes(mut mask: LaneMask) -> impl Iterator<Item = usize> {
 /// For an inner node, `b.min + b.max − a.min − a.max` per axis (children `a`, `b`): the
 /// second child lies farther along a direction `d` than the first when the gap's dot
 /// product with `d` is positive. Zero for a leaf.
-fn children_gap(nodes: &[Node], node: &Node) -> [f32; 4] {
+fn children_gap(nodes: &[Node], node: &Node) -> [f32; 3] {
     if node.count > 0 {
-        return [0.0; 4];
+        return [0.0; 3];
     }
     let (a, b) = (&nodes[node.first as usize], &nodes[node.first as usize + 1]);
     let gap = |k: usize| b.min[k] + b.max[k] - a.min[k] - a.max[k];
-    [gap(0), gap(1), gap(2), 0.0]
+    [gap(0), gap(1), gap(2)]
 }
 
 /// Per node, the mirror all the triangles below it are on, or [`NOT_A_MIRROR`] (children
