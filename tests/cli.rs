@@ -1,9 +1,8 @@
 //! End-to-end tests of the `mirrorbox` command line: real processes, real files, exit codes
 //! and messages as a user sees them.
 
-mod common;
-
-use common::{Output, mirrorbox, repo, valid_scene};
+use crate::common;
+use crate::common::{Output, mirrorbox, repo, valid_scene};
 use serde_json::{Value, json};
 use std::path::Path;
 
@@ -885,6 +884,23 @@ fn compare_reports_metrics_and_refuses_mismatched_sizes() {
     let out = mirrorbox(&["compare", a.to_str().unwrap(), "nowhere.exr"], &[]);
     assert_eq!(out.code, 2);
     assert!(out.stderr.contains("nowhere.exr"), "{}", out.stderr);
+    // The same size on another sub-pixel grid (4 spp against the centre): refused, since the
+    // difference would be sampling, not the method.
+    let centre = dir.path().join("centre.exr");
+    let mut centre_args = trace_args(centre.to_str().unwrap(), &[]);
+    *centre_args.last_mut().unwrap() = "1";
+    let out = mirrorbox(&centre_args, &[]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let out = mirrorbox(
+        &["compare", a.to_str().unwrap(), centre.to_str().unwrap()],
+        &[],
+    );
+    assert_eq!(out.code, 2, "{}", out.stdout);
+    assert!(
+        out.stderr.contains("4 samples per pixel") && out.stderr.contains("with 1"),
+        "{}",
+        out.stderr
+    );
 }
 
 fn sweep(out: &Path) -> Output {

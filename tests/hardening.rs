@@ -2,9 +2,8 @@
 //! half a file. Every case runs the real binary; each must end with a clear message and exit 2
 //! (or just work), never a panic (101), an abort (134) or a signal.
 
-mod common;
-
-use common::{Output, mirrorbox};
+use crate::common;
+use crate::common::{Output, mirrorbox};
 use serde_json::{Value, json};
 use std::path::{Path, PathBuf};
 

@@ -2,8 +2,7 @@
 //! region of `README.md` and `docs/methods.md` must be what `mirrorbox readme` makes from
 //! `reports/` (issue #13).
 
-mod common;
-use common::{mirrorbox, repo};
+use crate::common::{mirrorbox, repo};
 
 #[test]
 fn the_readme_agrees_with_the_committed_reports() {

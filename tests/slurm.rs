@@ -7,9 +7,7 @@
 //! Needs root (to install and run the daemons). Outside CI without root the test says so and
 //! passes; under CI (`CI` set) it must run.
 
-mod common;
-
-use common::{SMALL_SWEEP, assert_same_points, mirrorbox, repo, sweep_records as records};
+use crate::common::{SMALL_SWEEP, assert_same_points, mirrorbox, repo, sweep_records as records};
 use std::path::PathBuf;
 use std::process::Command;
 use std::time::{Duration, Instant};

@@ -12,9 +12,7 @@
 //! so and pass, except under CI (`CI` set), where they must run.
 //! `MIRRORBOX_VIEWER_SCREENSHOT=PATH` keeps the last screenshot (the README's picture).
 
-mod common;
-
-use common::{mirrorbox, repo};
+use crate::common::{mirrorbox, repo};
 use serde_json::Value;
 use std::io::{BufRead, BufReader};
 use std::path::Path;

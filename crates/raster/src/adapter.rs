@@ -32,9 +32,59 @@ pub struct AdapterReport {
     /// pair into a two-layer target). Reported, not used: `--stereo` renders each eye's
     /// passes one after the other (docs/methods.md, "Stereo mirrors").
     pub multiview: bool,
+    /// Ray queries in shaders (`Features::EXPERIMENTAL_RAY_QUERY`; Mesa ≥ 25's lavapipe has
+    /// them). Reported for the methods that will trace on the GPU.
+    pub ray_query: bool,
+}
+
+/// The oldest Mesa whose lavapipe mirrorbox supports: Mesa 22.3's keeps the memory of every
+/// executed render pass until the process exits (a 32×18 `auxiliary --n 2` render of
+/// `mirror_room` peaked at 18.3 GB there, 235 MB on 25.0.7, the same image bit for bit).
+pub const MIN_MESA: (u32, u32) = (25, 0);
+
+/// The Mesa version `(major, minor, patch)` named in a driver description such as
+/// `Mesa 25.0.7-2~bpo12+1 (LLVM 19.1.7)`; `None` when it names no Mesa.
+pub fn mesa_version(driver_info: &str) -> Option<(u32, u32, u32)> {
+    let rest = &driver_info[driver_info.find("Mesa ")? + 5..];
+    let token: String = rest
+        .chars()
+        .take_while(|c| c.is_ascii_digit() || *c == '.')
+        .collect();
+    let mut parts = token.split('.').map(|p| p.parse::<u32>().ok());
+    let major = parts.next()??;
+    let minor = parts.next().flatten().unwrap_or(0);
+    let patch = parts.next().flatten().unwrap_or(0);
+    Some((major, minor, patch))
 }
 
 impl AdapterReport {
+    /// Whether this is Mesa's CPU rasterizer (lavapipe on Vulkan, llvmpipe on GL).
+    pub fn is_llvmpipe(&self) -> bool {
+        self.name.contains("llvmpipe")
+    }
+
+    /// A warning when the adapter is a Mesa CPU driver older than [`MIN_MESA`], naming the
+    /// fix; `None` otherwise.
+    pub fn platform_warning(&self) -> Option<String> {
+        if !self.is_llvmpipe() {
+            return None;
+        }
+        let found = mesa_version(&format!("{} {}", self.driver, self.driver_info));
+        let old = found.is_none_or(|(major, minor, _)| (major, minor) < MIN_MESA);
+        old.then(|| {
+            let version = found.map_or_else(
+                || "an unknown Mesa".to_string(),
+                |(a, b, c)| format!("Mesa {a}.{b}.{c}"),
+            );
+            format!(
+                "{} runs on {version}; mirrorbox needs Mesa >= {}.{} (older lavapipe keeps \
+                 the memory of every render pass: gigabytes for a small render). Install it \
+                 with scripts/install-system-deps.sh (Debian 12: bookworm-backports).",
+                self.name, MIN_MESA.0, MIN_MESA.1
+            )
+        })
+    }
+
     fn of(adapter: &wgpu::Adapter) -> Self {
         let info = adapter.get_info();
         let features = adapter.features();
@@ -51,6 +101,7 @@ impl AdapterReport {
             ),
             clip_distances: features.contains(wgpu::Features::CLIP_DISTANCES),
             multiview: features.contains(wgpu::Features::MULTIVIEW),
+            ray_query: features.contains(wgpu::Features::EXPERIMENTAL_RAY_QUERY),
         }
     }
 }
@@ -69,7 +120,8 @@ impl fmt::Display for AdapterReport {
             yes_no(self.timestamp_query_inside_passes)
         )?;
         writeln!(f, "clip distances:   {}", yes_no(self.clip_distances))?;
-        write!(f, "multiview:        {}", yes_no(self.multiview))
+        writeln!(f, "multiview:        {}", yes_no(self.multiview))?;
+        write!(f, "ray query:        {}", yes_no(self.ray_query))
     }
 }
 
@@ -195,4 +247,56 @@ pub fn select_adapter_from(
         }
     }
     Err(none_found(&order, ""))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn lavapipe(driver_info: &str) -> AdapterReport {
+        AdapterReport {
+            name: "llvmpipe (LLVM 19.1.7, 256 bits)".into(),
+            backend: "vulkan".into(),
+            device_type: "Cpu".into(),
+            driver: "llvmpipe".into(),
+            driver_info: driver_info.into(),
+            timestamp_query: true,
+            timestamp_query_inside_passes: true,
+            clip_distances: true,
+            multiview: true,
+            ray_query: false,
+        }
+    }
+
+    #[test]
+    fn mesa_versions_are_read_from_driver_descriptions() {
+        assert_eq!(
+            mesa_version("Mesa 25.0.7-2~bpo12+1 (LLVM 19.1.7)"),
+            Some((25, 0, 7))
+        );
+        assert_eq!(mesa_version("Mesa 22.3.6 (LLVM 15.0.6)"), Some((22, 3, 6)));
+        assert_eq!(
+            mesa_version("4.5 (Core Profile) Mesa 25.2"),
+            Some((25, 2, 0))
+        );
+        assert_eq!(mesa_version("NVIDIA 550.54"), None);
+        assert_eq!(mesa_version("Mesa x"), None);
+    }
+
+    #[test]
+    fn old_lavapipe_is_warned_about_and_a_current_one_is_not() {
+        let old = lavapipe("Mesa 22.3.6 (LLVM 15.0.6)").platform_warning();
+        assert!(old.is_some_and(|w| w.contains("Mesa 22.3.6") && w.contains(">= 25.0")));
+        assert_eq!(
+            lavapipe("Mesa 25.0.7 (LLVM 19.1.7)").platform_warning(),
+            None
+        );
+        assert!(lavapipe("unknown").platform_warning().is_some());
+        let gpu = AdapterReport {
+            name: "NVIDIA H100".into(),
+            driver_info: "550.54".into(),
+            ..lavapipe("")
+        };
+        assert_eq!(gpu.platform_warning(), None);
+    }
 }

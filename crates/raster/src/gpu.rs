@@ -140,6 +140,11 @@ impl Gpu {
         wanted: wgpu::Features,
         forced: Option<ColorFormat>,
     ) -> Result<Gpu, RasterError> {
+        // Once per process: an old lavapipe still renders, but may need gigabytes.
+        static WARNED: std::sync::Once = std::sync::Once::new();
+        if let Some(warning) = selected.report.platform_warning() {
+            WARNED.call_once(|| eprintln!("warning: {warning}"));
+        }
         let color_format = ColorFormat::choose(&selected.adapter, forced).map_err(|message| {
             RasterError::Device {
                 adapter: format!("{} ({})", selected.report.name, selected.report.backend),

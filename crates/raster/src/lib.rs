@@ -45,7 +45,9 @@ pub mod timing;
 pub mod uneven;
 pub mod wgsl;
 
-pub use adapter::{AdapterError, AdapterReport, SelectedAdapter, select_adapter};
+pub use adapter::{
+    AdapterError, AdapterReport, MIN_MESA, SelectedAdapter, mesa_version, select_adapter,
+};
 pub use color_format::ColorFormat;
 pub use gpu::{Gpu, GpuOptions, RasterError};
 pub use method::{

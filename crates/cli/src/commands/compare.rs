@@ -33,6 +33,34 @@ pub fn metrics_json(m: &Metrics) -> serde_json::Value {
     })
 }
 
+/// The samples per pixel an image written by `trace` (`mirrorbox.spp`) or `render`
+/// (`mirrorbox.ssaa`, an s×s grid) was taken with; `None` for other images.
+fn samples_per_pixel(path: &std::path::Path) -> Option<u64> {
+    let attributes = mirrorbox_image::read_exr_attributes(path).ok()?;
+    let value = |key: &str| {
+        attributes
+            .iter()
+            .find(|(k, _)| k == key)
+            .and_then(|(_, v)| v.parse::<u64>().ok())
+    };
+    value("mirrorbox.spp").or_else(|| value("mirrorbox.ssaa").map(|s| s * s))
+}
+
+/// Refuses images sampled on different sub-pixel grids: a 4×4 box average and a pixel-centre
+/// sample differ wherever the image curves, and that difference would be read as the
+/// method's error (the shading contract: never from mismatched sampling).
+fn check_same_grid(reference: &std::path::Path, test: &std::path::Path) -> Result<(), Failure> {
+    match (samples_per_pixel(reference), samples_per_pixel(test)) {
+        (Some(a), Some(b)) if a != b => Err(Failure::BadInput(format!(
+            "{} was taken with {a} samples per pixel and {} with {b}: compare images of the \
+             same sub-pixel grid (trace --spp s² against render --ssaa s)",
+            reference.display(),
+            test.display()
+        ))),
+        _ => Ok(()),
+    }
+}
+
 pub fn run(args: &Args) -> Result<(), Failure> {
     if !(args.exposure > 0.0 && args.exposure.is_finite()) {
         return Err(Failure::BadInput(format!(
@@ -63,6 +91,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             args.test.display()
         ))
     })?;
+    check_same_grid(&args.reference, &args.test)?;
     if let Some(path) = &heatmap {
         let map = flip_map(
             &r.to_srgb8(args.exposure),

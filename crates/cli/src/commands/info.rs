@@ -31,12 +31,18 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             "timestamp_query": r.timestamp_query,
             "timestamp_query_inside_passes": r.timestamp_query_inside_passes,
             "clip_distances": r.clip_distances,
+            "ray_query": r.ray_query,
+            "mesa": mirrorbox_raster::mesa_version(&r.driver_info).map(|(a, b, c)| format!("{a}.{b}.{c}")),
+            "warning": r.platform_warning(),
             "color_format": color_format.as_ref().ok().map(|f| f.name()),
             "color_format_error": color_format.as_ref().err(),
         });
         println!("{value}");
     } else {
         println!("{r}");
+        if let Some(warning) = r.platform_warning() {
+            eprintln!("warning: {warning}");
+        }
         match &color_format {
             Ok(f) => println!("colour targets:   {f}"),
             Err(why) => println!("colour targets:   none: {why}"),

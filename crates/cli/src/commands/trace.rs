@@ -45,8 +45,11 @@ pub struct Args {
     #[command(flatten)]
     time: super::TimeArgs,
     /// Samples per pixel: a perfect square s², taken as the s×s sub-pixel grid the
-    /// rasterizer reproduces with --ssaa s.
-    #[arg(long, default_value_t = 16)]
+    /// rasterizer reproduces with --ssaa s. The default, 1, is the pixel centre, as
+    /// `render`'s default --ssaa 1: at their defaults the two commands sample the same points
+    /// (a 4×4 box average differs from the centre value by the image's curvature: up to
+    /// 1.8e-4 relative at the steep edges of a mirrored light's falloff).
+    #[arg(long, default_value_t = 1)]
     spp: u32,
     /// α: override every mirror's reflectance (the attenuation per reflection being measured),
     /// in [0, 1]. `--reflectance` is the same flag.

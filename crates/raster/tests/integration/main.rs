@@ -1,0 +1,8 @@
+//! The crate's integration tests, one binary (one link) for all of them; each module is
+//! one concern.
+
+mod device_limits;
+mod methods;
+mod mirrored_lights_closed_form;
+mod scene_fuzz;
+mod structure;

@@ -1,0 +1,11 @@
+//! mirrorbox end to end: the CLI as a user runs it. One test binary (one link) for every
+//! concern; each module is one of them.
+
+mod common;
+
+mod cli;
+mod hardening;
+mod mitsuba;
+mod readme;
+mod slurm;
+mod viewer;
