@@ -5,6 +5,7 @@ mod common;
 
 mod cli;
 mod hardening;
+mod memory;
 mod mitsuba;
 mod readme;
 mod slurm;

@@ -95,3 +95,33 @@ pub fn plan_paths(
         projection,
     })
 }
+
+/// Host bytes a path set holds: each path's record, mirror list, portal, visible pieces and
+/// children (a memory estimate's "the reflection paths", [`crate::memory`]).
+pub fn paths_host_bytes(paths: &PathSet) -> u64 {
+    use mirrorbox_scene::reflection_paths::ReflectionPath;
+    let vec2 = std::mem::size_of::<glam::Vec2>();
+    let vec_header = std::mem::size_of::<Vec<u8>>();
+    paths
+        .paths
+        .iter()
+        .map(|p| {
+            std::mem::size_of::<ReflectionPath>()
+                + 8 * (p.mirrors.len() + p.children.len())
+                + vec2 * p.portal.len()
+                + p.visible
+                    .iter()
+                    .map(|v| vec_header + vec2 * v.len())
+                    .sum::<usize>()
+        })
+        .sum::<usize>() as u64
+}
+
+/// The paths' part of a memory estimate: their records on the host.
+pub fn paths_memory(e: &mut crate::memory::MemoryEstimate, paths: &PathSet) {
+    e.host(
+        "the reflection paths",
+        "--depth, or raise --min-portal-area or --min-attenuation",
+        paths_host_bytes(paths),
+    );
+}

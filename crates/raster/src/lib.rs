@@ -25,6 +25,7 @@ pub mod culling;
 pub mod exact_paths;
 pub mod gpu;
 pub mod lighting;
+pub mod memory;
 pub mod method;
 pub mod methods;
 pub mod ping_pong;
@@ -50,6 +51,7 @@ pub use adapter::{
 };
 pub use color_format::ColorFormat;
 pub use gpu::{Gpu, GpuOptions, RasterError};
+pub use memory::{DEFAULT_MEMORY_BUDGET, MemoryEstimate, OverMemoryBudget, parse_memory_size};
 pub use method::{
     Clipping, CopyCounts, FrameStats, MethodEntry, OptionSpec, ParamError, ParamValue, PathCounts,
     RasterMethod,
@@ -207,6 +209,97 @@ impl Planned {
     pub fn continue_from(&mut self, history: FrameHistory) {
         self.frame.continue_from(history);
     }
+
+    /// The memory this frame will need when built and rendered for `scene` with `settings`
+    /// (those it was planned with), computed from the plan before any GPU resource exists
+    /// ([`memory`] gives the formula):
+    ///
+    /// `gpu = target(W·s, H·s) + resolve(W, H) + readback(W, H) + shadow maps + wgpu's own +
+    /// method` and `host = driver + 48·W·H + method`, where `target` is colour (16 bytes a
+    /// texel, RGBA32F) + depth (4), the shadow maps `layers × size² × 4` + one depth layer +
+    /// a vertex buffer of every triangle, and `method` is
+    /// [`PlannedFrame::memory`](method::PlannedFrame::memory) (its scene buffers, mirror
+    /// textures, uniforms, instance buffers, …).
+    pub fn memory_estimate(&self, scene: &Scene, settings: &RenderSettings) -> MemoryEstimate {
+        let scene = &*lighting::lit_scene(scene, settings.method.params());
+        let color = u64::from(ColorFormat::Rgba32Float.texel_bytes());
+        let mut estimate = frame_memory(scene, settings, self.shadows.as_ref(), 1);
+        estimate.merge(self.frame.memory(scene, color));
+        estimate
+    }
+
+    /// [`Planned::memory_estimate`], refused above `budget` bytes
+    /// ([`PlanError::OverMemoryBudget`], exit 2: the estimate, the budget and what to lower).
+    /// What `render`, `view` and a sweep's points call after planning and before building.
+    pub fn check_memory(
+        &self,
+        scene: &Scene,
+        settings: &RenderSettings,
+        budget: u64,
+    ) -> Result<MemoryEstimate, PlanError> {
+        let estimate = self.memory_estimate(scene, settings);
+        estimate.check(budget)?;
+        Ok(estimate)
+    }
+}
+
+/// The memory every frame has whatever its method, for `views` views (a stereo pair: 2):
+/// the render targets at the SSAA size, the resolves' outputs and readback buffers at the
+/// image size, the shadow maps (or their 1×1 placeholder), wgpu's own buffers, the driver,
+/// and the images' copies on the CPU.
+pub(crate) fn frame_memory(
+    scene: &Scene,
+    settings: &RenderSettings,
+    shadows: Option<&shadow_plan::ShadowPlan>,
+    views: u64,
+) -> MemoryEstimate {
+    use memory::{buffer_bytes, target_bytes, texture_bytes, uniform_arena_bytes};
+    let color = u64::from(ColorFormat::Rgba32Float.texel_bytes());
+    let (w, h) = settings.render_size(scene);
+    let (ow, oh) = (scene.camera.width, scene.camera.height);
+    let image = "the image size (--width/--height)";
+    let mut e = MemoryEstimate::new();
+    e.gpu(
+        "the render target",
+        "the image size (--width/--height) or --ssaa",
+        views * target_bytes(w, h, color),
+    );
+    let readback_row = (u64::from(ow) * color).next_multiple_of(256);
+    e.gpu(
+        "the resolve and readback",
+        image,
+        views
+            * (texture_bytes(ow, oh, color)
+                + buffer_bytes(16)
+                + buffer_bytes(readback_row * u64::from(oh))),
+    );
+    let shadow_bytes = match shadows {
+        None => texture_bytes(1, 1, 4),
+        Some(plan) => {
+            let size = plan.settings.size;
+            // R32F layers (RGBA16F, 8 bytes, on a device whose colours are RGBA16F).
+            let layer = texture_bytes(size, size, if color >= 16 { 4 } else { 8 });
+            let layers = (plan.views.len() as u64).max(1);
+            let triangles = scene.geometry.triangles.len() as u64;
+            layers * layer
+                + texture_bytes(size, size, memory::DEPTH_BYTES)
+                + uniform_arena_bytes(plan.views.len() as u64)
+                + buffer_bytes(3 * triangles.max(1) * std::mem::size_of::<shading::Vertex>() as u64)
+        }
+    };
+    e.gpu(
+        "the shadow maps",
+        "--shadow-map-size or lighting.mirrored_lights (--mirrored-lights)",
+        shadow_bytes,
+    );
+    e.gpu("wgpu's own buffers", "", memory::WGPU_DEVICE_BYTES);
+    e.host("the driver", "", memory::DRIVER_HOST_BYTES);
+    e.host(
+        "the image's copies",
+        image,
+        views * u64::from(ow) * u64::from(oh) * memory::HOST_BYTES_PER_PIXEL,
+    );
+    e
 }
 
 /// Plans `settings.method` for `scene` at render resolution, without a GPU.

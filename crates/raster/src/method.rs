@@ -16,6 +16,7 @@
 //! values. Its `Method::key` is the stable identity sweeps resume by.
 
 use crate::gpu::{Gpu, RasterError};
+use crate::memory::MemoryEstimate;
 use crate::plan::PlanError;
 use mirrorbox_scene::Scene;
 use std::fmt;
@@ -123,6 +124,9 @@ pub trait PairEncoder {
 
 /// A pair planned jointly: one set of GPU resources drawing both eyes.
 pub trait PlannedJointPair {
+    /// The pair's memory, as [`PlannedFrame::memory`] (both eyes' main passes).
+    fn memory(&self, eyes: [&Scene; 2], color_bytes_per_texel: u64) -> MemoryEstimate;
+
     fn build(
         self: Box<Self>,
         gpu: &Gpu,
@@ -164,6 +168,14 @@ pub trait PlannedFrame {
     /// of a sequence left ([`crate::timing::FrameEncoder::history`]), instead of starting
     /// afresh. Stateless methods ignore it.
     fn continue_from(&mut self, _history: crate::timing::FrameHistory) {}
+
+    /// The memory the method's own resources will take when built for `scene`, from the
+    /// plan alone (no GPU): its scene buffers, mirror textures and depth targets, uniform
+    /// and instance buffers (GPU), and what it keeps on the CPU (host), with colour texels of
+    /// `color_bytes_per_texel`. The frame's render target, resolve, readback, shadow maps
+    /// and the driver are added by [`crate::Planned::memory_estimate`]. An upper bound of
+    /// what `build` creates (wgpu's counters are checked against it in the tests).
+    fn memory(&self, scene: &Scene, color_bytes_per_texel: u64) -> MemoryEstimate;
 
     fn build(
         self: Box<Self>,

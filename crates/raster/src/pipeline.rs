@@ -140,10 +140,21 @@ pub struct UniformArena {
 
 impl UniformArena {
     pub fn new(device: &wgpu::Device) -> Self {
+        Self::with_alignment(device.limits().min_uniform_buffer_offset_alignment as usize)
+    }
+
+    /// An arena with records `alignment` bytes apart, without a device: a memory estimate
+    /// ([`crate::memory`]) lays the records out at the largest alignment a device may ask.
+    pub fn with_alignment(alignment: usize) -> Self {
         UniformArena {
-            alignment: device.limits().min_uniform_buffer_offset_alignment as usize,
+            alignment,
             bytes: Vec::new(),
         }
+    }
+
+    /// The size of the buffer [`UniformArena::buffer`] would create.
+    pub fn buffer_size(&self) -> u64 {
+        self.bytes.len().max(self.alignment.max(16)) as u64
     }
 
     /// Appends `value`; returns its dynamic offset.

@@ -142,6 +142,15 @@ pub enum PlanError {
     /// A render setting out of range (`--ssaa`, `--frames`, `--warmup`, the render size).
     #[error(transparent)]
     Setting(#[from] mirrorbox_scene::limits::SettingError),
+    /// The plan's memory estimate exceeds `--memory-budget` ([`crate::memory`]).
+    #[error(transparent)]
+    OverMemoryBudget(Box<crate::memory::OverMemoryBudget>),
+}
+
+impl From<crate::memory::OverMemoryBudget> for PlanError {
+    fn from(e: crate::memory::OverMemoryBudget) -> Self {
+        PlanError::OverMemoryBudget(Box::new(e))
+    }
 }
 
 /// The mirror whose copies alternate with mirror `i`'s (§3.1: "an auxiliary mirror at the

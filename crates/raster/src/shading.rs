@@ -226,6 +226,34 @@ pub struct SceneBuffers {
 }
 
 impl SceneBuffers {
+    /// GPU bytes of `scene`'s buffers drawing `g` ([`SceneBuffers::for_geometry`]), before
+    /// any is created: the vertex buffer (3 × 28 bytes a triangle), the frame uniform, the
+    /// surface, light and light-plane storage buffers, and the normal-map atlas (4 bytes a
+    /// texel), each at [`crate::memory`]'s granularity.
+    pub fn memory_bytes(scene: &Scene, g: &mirrorbox_scene::Geometry) -> u64 {
+        use crate::memory::{buffer_bytes, texture_bytes};
+        let size = |n: usize, each: usize| buffer_bytes((n.max(1) * each) as u64);
+        let l = &scene.lighting;
+        let planes: usize = l.images.images.iter().map(|i| i.beam.len()).sum();
+        let atlas_width = scene
+            .bumps
+            .iter()
+            .flatten()
+            .filter_map(|b| b.normal_map.as_ref())
+            .map(|m| m.width)
+            .max()
+            .unwrap_or(1);
+        size(3 * g.triangles.len(), std::mem::size_of::<Vertex>())
+            + size(1, std::mem::size_of::<GpuFrame>())
+            + size(g.surfaces.len(), std::mem::size_of::<GpuSurface>())
+            + size(
+                l.lights.len() + l.images.images.len(),
+                std::mem::size_of::<GpuLight>(),
+            )
+            + size(planes, 16)
+            + texture_bytes(atlas_width, atlas_rows(scene), 4)
+    }
+
     /// Refuses a scene whose buffers this device cannot hold, before any is created.
     pub fn check_fits(gpu: &crate::Gpu, scene: &Scene) -> Result<(), crate::RasterError> {
         Self::check_fits_geometry(gpu, scene, &scene.geometry)

@@ -56,6 +56,45 @@ pub fn plan_pair(eyes: [&Scene; 2], settings: &RenderSettings) -> Result<Planned
     })
 }
 
+impl Planned {
+    /// The pair's memory ([`crate::Planned::memory_estimate`]): two render targets,
+    /// resolves and images, one set of shadow maps, and each eye's frame (or the joint
+    /// frame's resources once).
+    pub fn memory_estimate(
+        &self,
+        eyes: [&Scene; 2],
+        settings: &RenderSettings,
+    ) -> crate::memory::MemoryEstimate {
+        let params = settings.method.params();
+        let lit = eyes.map(|s| crate::lighting::lit_scene(s, params));
+        let [left, right] = [&*lit[0], &*lit[1]];
+        let color = u64::from(crate::ColorFormat::Rgba32Float.texel_bytes());
+        let mut estimate = crate::frame_memory(left, settings, self.shadows.as_ref(), 2);
+        match &self.pair {
+            PlannedPair::Separate([l, r]) => {
+                estimate.merge(l.memory(left, color));
+                estimate.merge(r.memory(right, color));
+            }
+            PlannedPair::Joint(pair) => {
+                estimate.merge(pair.memory([left, right], color));
+            }
+        }
+        estimate
+    }
+
+    /// [`Planned::memory_estimate`] refused above `budget` bytes (exit 2).
+    pub fn check_memory(
+        &self,
+        eyes: [&Scene; 2],
+        settings: &RenderSettings,
+        budget: u64,
+    ) -> Result<crate::memory::MemoryEstimate, PlanError> {
+        let estimate = self.memory_estimate(eyes, settings);
+        estimate.check(budget)?;
+        Ok(estimate)
+    }
+}
+
 /// The counts of two frames drawn one after the other: passes, draws, triangles and paths
 /// add; the depth is the deeper one's.
 pub fn both(a: &FrameStats, b: &FrameStats) -> FrameStats {

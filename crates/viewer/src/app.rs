@@ -181,7 +181,8 @@ impl App {
             .bounds()
             .map_or(1.0, |(lo, hi)| 0.25 * lo.distance(hi))
             .clamp(0.05, 20.0);
-        let session = Session::new(o.scene.clone(), o.method.clone(), o.ssaa, o.size);
+        let mut session = Session::new(o.scene.clone(), o.method.clone(), o.ssaa, o.size);
+        session.memory_budget = o.memory_budget;
         let mut ui = panel::UiState::new(o.vsync);
         ui.speed = speed;
         Ok(Running {

@@ -36,6 +36,9 @@ pub struct ViewOptions {
     pub scene: Scene,
     pub method: Method,
     pub ssaa: u32,
+    /// `--memory-budget` in bytes: a method or option whose plan's memory estimate exceeds
+    /// it is refused (the method pane says why) instead of built.
+    pub memory_budget: u64,
     /// The view's size in pixels (the scene camera's unless `--size` says otherwise).
     pub size: (u32, u32),
     /// The window's inner size; by default the panel and four panes of `size`.

@@ -158,6 +158,9 @@ pub struct Session {
     pub ssaa: u32,
     /// The view's size in pixels (the method's image and the truth's last level).
     pub size: (u32, u32),
+    /// `--memory-budget`: a plan whose estimate exceeds it is refused like any other
+    /// refused setting (its message in the method pane), before any GPU resource.
+    pub memory_budget: u64,
     built: Option<Built>,
     builds: u64,
     /// Why the current settings were refused (shown in the panel and the method pane).
@@ -192,6 +195,7 @@ impl Session {
             method,
             ssaa,
             size,
+            memory_budget: mirrorbox_raster::DEFAULT_MEMORY_BUDGET,
             built: None,
             builds: 0,
             method_error: None,
@@ -259,14 +263,18 @@ impl Session {
             // A stateful method (`feedback`) continues from the frame drawn last, as in an
             // engine: a moved camera reads the textures of where it was.
             let history = self.built.as_ref().and_then(|b| b.view.history());
+            let budget = self.memory_budget;
             match mirrorbox_raster::plan_frame(scene, &settings)
-                .map_err(RasterError::from)
                 .and_then(|mut planned| {
                     if let Some(h) = history {
                         planned.continue_from(h);
                     }
-                    mirrorbox_raster::build_planned(gpu, scene, planned, &settings)
-                }) {
+                    planned.check_memory(scene, &settings, budget)?;
+                    Ok(planned)
+                })
+                .map_err(RasterError::from)
+                .and_then(|planned| mirrorbox_raster::build_planned(gpu, scene, planned, &settings))
+            {
                 Ok(view) => {
                     self.builds += 1;
                     self.built = Some(Built {

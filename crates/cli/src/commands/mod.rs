@@ -54,6 +54,35 @@ impl SizeArgs {
     }
 }
 
+/// `--memory-budget SIZE`: a plan whose estimated GPU + host memory
+/// (`mirrorbox_raster::Planned::memory_estimate`) is above it is refused before any GPU work
+/// (exit 2, naming the estimate and what to lower).
+#[derive(clap::Args, Clone, Copy, Debug)]
+pub struct MemoryBudgetArgs {
+    /// Refuse a frame whose estimated GPU + host memory exceeds SIZE (before any GPU work):
+    /// 2G, 512M, 1.5GB or plain bytes (K, M, G, T are powers of 1024), 1M..1T.
+    #[arg(
+        long = "memory-budget",
+        value_name = "SIZE",
+        default_value = "2G",
+        value_parser = parse_memory_budget
+    )]
+    pub memory_budget: u64,
+}
+
+impl Default for MemoryBudgetArgs {
+    fn default() -> Self {
+        MemoryBudgetArgs {
+            memory_budget: mirrorbox_raster::DEFAULT_MEMORY_BUDGET,
+        }
+    }
+}
+
+/// The one parser of `--memory-budget` values (clap reports its error with exit 2).
+pub fn parse_memory_budget(text: &str) -> Result<u64, String> {
+    mirrorbox_raster::parse_memory_size("--memory-budget", text)
+}
+
 /// Most frames of a `--sequence`.
 pub const MAX_SEQUENCE: u32 = 10_000;
 

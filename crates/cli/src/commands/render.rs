@@ -47,6 +47,8 @@ pub struct Args {
     output: PathBuf,
     #[command(flatten)]
     stereo: super::stereo::StereoArgs,
+    #[command(flatten)]
+    memory: super::MemoryBudgetArgs,
 }
 
 fn bad(message: String) -> Failure {
@@ -124,16 +126,27 @@ fn run_frame(args: &Args, carry: &mut Carry) -> Result<(), Failure> {
         )?),
         _ => Ok(plan_frame(&views[0].1, &settings)?),
     };
+    // A stateful method continues from the previous frame of a sequence: its carried
+    // textures count in this frame's memory.
+    let planned = planned.map(|mut one| {
+        if let Some(history) = carry.history.take() {
+            one.continue_from(history);
+        }
+        one
+    });
+    // Refused above --memory-budget before the adapter is opened.
+    let budget = args.memory.memory_budget;
+    let estimate = match &planned {
+        Ok(one) => one.check_memory(&views[0].1, &settings, budget)?,
+        Err(pair) => pair.check_memory([&views[0].1, &views[1].1], &settings, budget)?,
+    };
     if carry.gpu.is_none() {
         carry.gpu = Some(Gpu::new()?);
     }
     let gpu = carry.gpu.as_ref().expect("the adapter was just opened");
     // One view (Ok), or a stereo pair (Err) with each eye's scene.
     let mut out = match planned {
-        Ok(one) => {
-            let history = carry.history.take();
-            render_planned_after(gpu, &views[0].1, one, &settings, history)?
-        }
+        Ok(one) => render_planned_after(gpu, &views[0].1, one, &settings, None)?,
         Err(pair) => mirrorbox_raster::stereo_pair::render_pair(
             gpu,
             [&views[0].1, &views[1].1],
@@ -198,6 +211,7 @@ fn run_frame(args: &Args, carry: &mut Carry) -> Result<(), Failure> {
         &written,
         &alpha,
         rig.is_some(),
+        &estimate,
     );
     Ok(())
 }
@@ -214,7 +228,10 @@ fn summary(
     written: &[std::path::PathBuf],
     alpha: &str,
     stereo: bool,
+    estimate: &mirrorbox_raster::MemoryEstimate,
 ) {
+    // This process's peak resident memory so far (VmHWM), next to the plan's estimate.
+    let peak_rss = mirrorbox_harness::peak_memory_bytes();
     let method_text = method.to_string();
     let s = &out.stats;
     let t = &out.timing;
@@ -238,6 +255,11 @@ fn summary(
             "frames_ms": t.frames_ms, "timing_source": t.source.name(),
             "encode_ms": t.encode_ms,
             "gpu_buffer_bytes": out.gpu_memory.buffer_bytes, "gpu_texture_bytes": out.gpu_memory.texture_bytes,
+            "memory_estimate": {
+                "gpu_bytes": estimate.gpu_bytes, "host_bytes": estimate.host_bytes,
+                "budget_bytes": args.memory.memory_budget,
+            },
+            "peak_rss_bytes": peak_rss,
             "passes": s.passes, "texture_renders": s.texture_renders, "draws": s.draws, "depth": s.depth,
             "triangles": s.triangles,
             "paths": s.paths.map(|c| serde_json::json!({
@@ -310,6 +332,11 @@ fn summary(
                 "  split-and-mirror bake: {ms:.2} ms on the CPU while planning (not in the frame time)"
             );
         }
+        println!(
+            "  memory: estimate {estimate} (budget {}); peak resident {}",
+            mirrorbox_raster::memory::format_bytes(args.memory.memory_budget),
+            peak_rss.map_or("unknown".into(), mirrorbox_raster::memory::format_bytes)
+        );
         println!(
             "  {:.2} ms/frame median, {:.2} min over {} frames ({}); CPU encode+submit {:.2} ms median; GPU memory {} in buffers, {} in textures; on {} ({}, {} targets); wrote {}",
             t.median_ms(),

@@ -52,6 +52,8 @@ pub struct Args {
     /// Folder the screenshot and save-camera keys write into (default: the current folder).
     #[arg(long, default_value = ".")]
     out: PathBuf,
+    #[command(flatten)]
+    memory: super::MemoryBudgetArgs,
 }
 
 fn parse_size(text: &str) -> Result<(u32, u32), String> {
@@ -99,6 +101,11 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         warmup: 0,
     };
     settings.check(&scene).map_err(super::setting)?;
+    // The starting method over --memory-budget is refused before the window opens (a method
+    // chosen in the window is refused in its pane, as is a starting plan refused otherwise).
+    if let Ok(planned) = mirrorbox_raster::plan_frame(&scene, &settings) {
+        planned.check_memory(&scene, &settings, args.memory.memory_budget)?;
+    }
     if !args.out.is_dir() {
         return Err(bad(format!(
             "--out {}: folder does not exist",
@@ -141,6 +148,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         scene,
         method,
         ssaa: args.ssaa,
+        memory_budget: args.memory.memory_budget,
         size,
         window: args.window,
         script: steps,

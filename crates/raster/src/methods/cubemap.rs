@@ -218,6 +218,33 @@ struct CubeHistory {
 }
 
 impl PlannedFrame for PlannedCubes {
+    /// Two sets (and a sequence's carried one) of six `--cube-size`² colour + depth faces
+    /// per cube, the "no cube" 1×1 target, the scene buffers, and the uniform records: one
+    /// per face pass, the main pass, one per cube and "no cube".
+    fn memory(&self, scene: &Scene, color_bytes_per_texel: u64) -> crate::memory::MemoryEstimate {
+        use crate::memory::{target_bytes, uniform_arena_bytes};
+        let cubes = self.cubes.len() as u64;
+        let sets = 2 + u64::from(self.carried.is_some());
+        let face = target_bytes(self.size, self.size, color_bytes_per_texel);
+        let mut e = crate::memory::MemoryEstimate::new();
+        e.gpu(
+            "the cube maps",
+            "--cube-size (or --cube-centre scene)",
+            sets * 6 * cubes * face + target_bytes(1, 1, color_bytes_per_texel),
+        );
+        e.gpu(
+            "the scene buffers",
+            "the scene's triangles",
+            SceneBuffers::memory_bytes(scene, &scene.geometry),
+        );
+        e.gpu(
+            "the uniforms",
+            "the scene's mirrors",
+            uniform_arena_bytes(6 * cubes + 2 + cubes),
+        );
+        e
+    }
+
     fn continue_from(&mut self, history: FrameHistory) {
         let config = (self.size, self.per_mirror);
         let cubes = self.cubes.len();

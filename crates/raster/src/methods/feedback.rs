@@ -127,6 +127,47 @@ struct FeedbackHistory {
 }
 
 impl PlannedFrame for PlannedFeedback {
+    /// Two sets of one colour + depth target per mirror camera (its footprint), the carried
+    /// set a sequence's previous frame left, the "no texture" 1×1 target, the scene buffers,
+    /// and the uniform records: one per camera pass and the main pass, "no texture", and a
+    /// mirror draw per (read source, camera pass, mirror) and per (set, mirror) in the main
+    /// pass.
+    fn memory(&self, scene: &Scene, color_bytes_per_texel: u64) -> crate::memory::MemoryEstimate {
+        use crate::memory::{target_bytes, uniform_arena_bytes};
+        let target = |w, h| target_bytes(w, h, color_bytes_per_texel);
+        let set: u64 = self
+            .cameras
+            .iter()
+            .map(|c| target(c.footprint.w, c.footprint.h))
+            .sum();
+        let carried: u64 = self.carried.as_ref().map_or(0, |c| {
+            c.history
+                .textures
+                .iter()
+                .map(|t| target(t.width, t.height))
+                .sum()
+        });
+        let (cameras, mirrors) = (self.cameras.len() as u64, scene.mirrors.len() as u64);
+        let records = cameras + 2 + 4 * cameras * mirrors + 2 * mirrors;
+        let mut e = crate::memory::MemoryEstimate::new();
+        e.gpu(
+            "the mirror textures",
+            "the image size (--width/--height, --ssaa)",
+            2 * set + carried + target(1, 1),
+        );
+        e.gpu(
+            "the scene buffers",
+            "the scene's triangles",
+            SceneBuffers::memory_bytes(scene, &scene.geometry),
+        );
+        e.gpu(
+            "the uniforms",
+            "the scene's mirrors",
+            uniform_arena_bytes(records),
+        );
+        e
+    }
+
     fn continue_from(&mut self, history: FrameHistory) {
         let size = (self.screen.width, self.screen.height);
         self.carried = PingPong::carried_from(history, |h: &FeedbackHistory| h.size == size);

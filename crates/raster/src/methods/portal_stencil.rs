@@ -95,6 +95,36 @@ struct PlannedPortal {
 }
 
 impl PlannedFrame for PlannedPortal {
+    /// The scene buffers, one depth-stencil target at the render size (counted at 8 bytes a
+    /// texel), one uniform record per path; on the host the paths and the frame's steps.
+    fn memory(&self, scene: &Scene, _color_bytes_per_texel: u64) -> crate::memory::MemoryEstimate {
+        use crate::memory::{DEPTH_STENCIL_BYTES, texture_bytes, uniform_arena_bytes};
+        let paths = self.planned.paths.paths.len() as u64;
+        let mut e = crate::memory::MemoryEstimate::new();
+        e.gpu(
+            "the depth-stencil target",
+            "the image size (--width/--height) or --ssaa",
+            texture_bytes(self.planned.width, self.planned.height, DEPTH_STENCIL_BYTES),
+        );
+        e.gpu(
+            "the scene buffers",
+            "the scene's triangles",
+            SceneBuffers::memory_bytes(scene, &scene.geometry),
+        );
+        e.gpu(
+            "the path uniforms",
+            "--depth, or raise --min-portal-area or --min-attenuation",
+            uniform_arena_bytes(paths),
+        );
+        crate::exact_paths::paths_memory(&mut e, &self.planned.paths);
+        e.host(
+            "the reflection paths",
+            "--depth, or raise --min-portal-area or --min-attenuation",
+            (self.ops.len() * std::mem::size_of::<Op>()) as u64,
+        );
+        e
+    }
+
     fn build(
         self: Box<Self>,
         gpu: &Gpu,

@@ -338,6 +338,14 @@ pub struct MainView {
 }
 
 impl crate::stereo_pair::PlannedJointPair for PlannedTextures {
+    fn memory(
+        &self,
+        eyes: [&Scene; 2],
+        color_bytes_per_texel: u64,
+    ) -> crate::memory::MemoryEstimate {
+        texture_memory(eyes[0], self, color_bytes_per_texel)
+    }
+
     fn build(
         self: Box<Self>,
         gpu: &Gpu,
@@ -369,6 +377,10 @@ struct PlannedTextures {
 }
 
 impl PlannedFrame for PlannedTextures {
+    fn memory(&self, scene: &Scene, color_bytes_per_texel: u64) -> crate::memory::MemoryEstimate {
+        texture_memory(scene, self, color_bytes_per_texel)
+    }
+
     fn build(
         self: Box<Self>,
         gpu: &Gpu,
@@ -744,69 +756,14 @@ impl RecursiveTexture {
     ) -> Result<Self, RasterError> {
         let device = &gpu.device;
         let scene_buffers = SceneBuffers::new(gpu, scene, shadows.binding());
-        let (lo, hi) = scene
-            .geometry
-            .triangles
-            .iter()
-            .flatten()
-            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(a, b), p| {
-                (a.min(*p), b.max(*p))
-            });
-        let mut b = Builder {
+        let b = schedule(
             scene,
             plan,
             texture_scale,
             bump,
-            march_distance: if lo.x <= hi.x {
-                (hi - lo).length()
-            } else {
-                1.0
-            },
-            uniforms: UniformArena::new(device),
-            free: HashMap::new(),
-            slot_sizes: Vec::new(),
-            passes: Vec::new(),
-            mirror_bindings: Vec::new(),
-        };
-        let roots: Vec<(&TextureNode, usize)> = plan.roots.iter().map(|n| (n, b.emit(n))).collect();
-        let screen = Rect {
-            x: 0,
-            y: 0,
-            w: plan.width,
-            h: plan.height,
-        };
-        for (k, view) in views.iter().enumerate() {
-            let camera = view.camera.with_size(plan.width, plan.height);
-            let mut main_uniform = b.pass_uniform(
-                camera.view(),
-                camera.position,
-                screen,
-                (plan.width, plan.height),
-                Vec4::W,
-            );
-            if let Some(head) = &view.lookup {
-                // The eye's own projection (its lens shift) draws the frame; the textures are
-                // looked up where the head sees each mirror point.
-                let eye_clip =
-                    crate::projection::camera_projection(&camera, plan.width, plan.height)
-                        * camera.view();
-                main_uniform.clip_from_world = eye_clip.to_cols_array_2d();
-                main_uniform.screen_from_world = eye_clip.to_cols_array_2d();
-                main_uniform.projected_lookup = 1;
-                main_uniform.lookup_from_world = (plan.projection
-                    * head.with_size(plan.width, plan.height).view())
-                .to_cols_array_2d();
-                main_uniform.lookup_eye = head.position.to_array();
-            }
-            let main_offset = b.uniforms.push(&main_uniform);
-            let main_draws = b.mirror_draws(&[], None, &roots);
-            b.passes.push(PassSpec {
-                target: Target::View(k),
-                offset: main_offset,
-                draws: main_draws,
-            });
-        }
-
+            views,
+            UniformArena::new(device),
+        );
         let uniforms = b.uniforms.buffer(device, "recursive texture uniforms");
         let pipelines = TexturePipelines::new(gpu, &scene_buffers);
         let pass_bind_group = pipelines.pass_bind_group::<PassUniform>(gpu, &uniforms);
@@ -874,6 +831,131 @@ impl RecursiveTexture {
         })
     }
 }
+
+/// Lays out a frame's passes, texture slots and uniform records from `plan`, on the CPU:
+/// what [`RecursiveTexture::new`] creates, and what [`PlannedFrame::memory`] counts.
+fn schedule<'a>(
+    scene: &'a Scene,
+    plan: &'a Plan,
+    texture_scale: f32,
+    bump: BumpSettings,
+    views: &[MainView],
+    uniforms: UniformArena,
+) -> Builder<'a> {
+    let (lo, hi) = scene
+        .geometry
+        .triangles
+        .iter()
+        .flatten()
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(a, b), p| {
+            (a.min(*p), b.max(*p))
+        });
+    let mut b = Builder {
+        scene,
+        plan,
+        texture_scale,
+        bump,
+        march_distance: if lo.x <= hi.x {
+            (hi - lo).length()
+        } else {
+            1.0
+        },
+        uniforms,
+        free: HashMap::new(),
+        slot_sizes: Vec::new(),
+        passes: Vec::new(),
+        mirror_bindings: Vec::new(),
+    };
+    let roots: Vec<(&TextureNode, usize)> = plan.roots.iter().map(|n| (n, b.emit(n))).collect();
+    let screen = Rect {
+        x: 0,
+        y: 0,
+        w: plan.width,
+        h: plan.height,
+    };
+    for (k, view) in views.iter().enumerate() {
+        let camera = view.camera.with_size(plan.width, plan.height);
+        let mut main_uniform = b.pass_uniform(
+            camera.view(),
+            camera.position,
+            screen,
+            (plan.width, plan.height),
+            Vec4::W,
+        );
+        if let Some(head) = &view.lookup {
+            // The eye's own projection (its lens shift) draws the frame; the textures are
+            // looked up where the head sees each mirror point.
+            let eye_clip = crate::projection::camera_projection(&camera, plan.width, plan.height)
+                * camera.view();
+            main_uniform.clip_from_world = eye_clip.to_cols_array_2d();
+            main_uniform.screen_from_world = eye_clip.to_cols_array_2d();
+            main_uniform.projected_lookup = 1;
+            main_uniform.lookup_from_world = (plan.projection
+                * head.with_size(plan.width, plan.height).view())
+            .to_cols_array_2d();
+            main_uniform.lookup_eye = head.position.to_array();
+        }
+        let main_offset = b.uniforms.push(&main_uniform);
+        let main_draws = b.mirror_draws(&[], None, &roots);
+        b.passes.push(PassSpec {
+            target: Target::View(k),
+            offset: main_offset,
+            draws: main_draws,
+        });
+    }
+
+    b
+}
+
+/// The GPU and host bytes of a planned texture frame: its scene buffers, one colour +
+/// depth target per texture slot (slots are recycled by size, as built) and the "no
+/// texture" 1×1 one, the uniform records at the largest alignment, and the plan's nodes.
+fn texture_memory(
+    scene: &Scene,
+    planned: &PlannedTextures,
+    color_bytes_per_texel: u64,
+) -> crate::memory::MemoryEstimate {
+    use crate::memory::{MAX_UNIFORM_ALIGNMENT, buffer_bytes, target_bytes};
+    let b = schedule(
+        scene,
+        &planned.plan,
+        planned.texture_scale,
+        planned.bump,
+        &planned.views,
+        UniformArena::with_alignment(MAX_UNIFORM_ALIGNMENT as usize),
+    );
+    let textures: u64 = b
+        .slot_sizes
+        .iter()
+        .map(|&(w, h)| target_bytes(w, h, color_bytes_per_texel))
+        .sum::<u64>()
+        + target_bytes(1, 1, color_bytes_per_texel);
+    let mut e = crate::memory::MemoryEstimate::new();
+    e.gpu(
+        "the mirror textures",
+        "--texture-scale, --n, --depth or the image size (--width/--height, --ssaa)",
+        textures,
+    );
+    e.gpu(
+        "the scene buffers",
+        "the scene's triangles",
+        SceneBuffers::memory_bytes(scene, &scene.geometry),
+    );
+    e.gpu(
+        "the uniforms",
+        "--max-passes, --n or --depth",
+        buffer_bytes(b.uniforms.buffer_size()),
+    );
+    e.host(
+        "the plan",
+        "--max-passes, --n or --depth",
+        planned.plan.passes as u64 * PLAN_BYTES_PER_PASS,
+    );
+    e
+}
+
+/// Host bytes a plan keeps per texture render (its node, camera, hidden list and pass).
+const PLAN_BYTES_PER_PASS: u64 = 1024;
 
 impl FrameEncoder for RecursiveTexture {
     fn encode(

@@ -482,7 +482,40 @@ pub(crate) fn plan_copies(
     }))
 }
 
+/// Host bytes of a geometry copy a plan keeps: each triangle's corners and surface id.
+pub(crate) fn geometry_host_bytes(g: &Geometry) -> u64 {
+    g.triangles.len() as u64 * (std::mem::size_of::<[glam::Vec3; 3]>() + 4) as u64
+}
+
 impl PlannedFrame for PlannedCopies {
+    /// The scene buffers of the objects before the planes and the mirrors, the frame
+    /// uniform, the copies' masks (4 bytes each) and copy records (one, or one per copy with
+    /// `--symmetry-draws per-copy`); on the host the geometry and the masks.
+    fn memory(&self, scene: &Scene, _color_bytes_per_texel: u64) -> crate::memory::MemoryEstimate {
+        use crate::memory::{buffer_bytes, uniform_arena_bytes};
+        let copies = self.masks.len() as u64;
+        let records = if self.settings.per_copy { copies } else { 1 };
+        let mut e = crate::memory::MemoryEstimate::new();
+        e.gpu(
+            "the scene buffers",
+            "the scene's triangles",
+            SceneBuffers::memory_bytes(scene, &self.geometry),
+        );
+        e.gpu(
+            "the copies",
+            "the scene's symmetry planes, or use --method symmetry-pruned",
+            buffer_bytes(std::mem::size_of::<SymmetryFrame>() as u64)
+                + buffer_bytes(4 * copies.max(1))
+                + uniform_arena_bytes(records),
+        );
+        e.host(
+            "the copies",
+            "the scene's symmetry planes, or use --method symmetry-pruned",
+            geometry_host_bytes(&self.geometry) + 4 * copies,
+        );
+        e
+    }
+
     fn build(
         self: Box<Self>,
         gpu: &Gpu,

@@ -129,6 +129,32 @@ struct PlannedBake {
 }
 
 impl PlannedFrame for PlannedBake {
+    /// The baked mesh's scene buffers (every copy's split triangles and the mirrors), the
+    /// frame uniform and, with `--copy-ids`, one id per vertex; on the host the baked mesh.
+    fn memory(&self, scene: &Scene, _color_bytes_per_texel: u64) -> crate::memory::MemoryEstimate {
+        use crate::memory::buffer_bytes;
+        let ids = self.copy_of_vertex.as_ref().map_or(0, |v| v.len() as u64);
+        let lower = "the scene's symmetry planes, or use --method symmetry-pruned";
+        let mut e = crate::memory::MemoryEstimate::new();
+        e.gpu(
+            "the baked mesh",
+            lower,
+            SceneBuffers::memory_bytes(scene, &self.geometry)
+                + buffer_bytes(std::mem::size_of::<SymmetryFrame>() as u64)
+                + if self.copy_of_vertex.is_some() {
+                    buffer_bytes(4 * ids.max(1))
+                } else {
+                    0
+                },
+        );
+        e.host(
+            "the baked mesh",
+            lower,
+            crate::methods::symmetry::geometry_host_bytes(&self.geometry) + 4 * ids,
+        );
+        e
+    }
+
     fn build(
         self: Box<Self>,
         gpu: &Gpu,

@@ -152,6 +152,45 @@ struct PlannedUnrolled {
 }
 
 impl PlannedFrame for PlannedUnrolled {
+    /// The scene buffers, a depth target at the render size, and the instance storage
+    /// buffers at their largest: per visible piece of every path one `CellPiece`, its edges
+    /// (one per polygon vertex), one id per drawn item (every diffuse part and mirror at
+    /// most) and its background triangles; on the host the paths.
+    fn memory(&self, scene: &Scene, _color_bytes_per_texel: u64) -> crate::memory::MemoryEstimate {
+        use crate::memory::{DEPTH_BYTES, buffer_bytes, texture_bytes};
+        let paths = &self.planned.paths.paths;
+        let pieces: u64 = paths.iter().map(|p| p.visible.len() as u64).sum();
+        let corners: u64 = paths
+            .iter()
+            .flat_map(|p| &p.visible)
+            .map(|v| v.len() as u64)
+            .sum();
+        let items = (scene.geometry.parts.len() + scene.mirrors.len()) as u64;
+        let instances = buffer_bytes(pieces * std::mem::size_of::<CellPiece>() as u64)
+            + buffer_bytes(corners * 16)
+            + buffer_bytes(pieces * items * 4)
+            + buffer_bytes(scene.mirrors.len() as u64 * std::mem::size_of::<MirrorRect>() as u64)
+            + buffer_bytes(3 * corners * std::mem::size_of::<BackgroundVertex>() as u64);
+        let mut e = crate::memory::MemoryEstimate::new();
+        e.gpu(
+            "the depth target",
+            "the image size (--width/--height) or --ssaa",
+            texture_bytes(self.planned.width, self.planned.height, DEPTH_BYTES),
+        );
+        e.gpu(
+            "the scene buffers",
+            "the scene's triangles",
+            SceneBuffers::memory_bytes(scene, &scene.geometry),
+        );
+        e.gpu(
+            "the path instances",
+            "--depth, or raise --min-portal-area or --min-attenuation",
+            instances,
+        );
+        crate::exact_paths::paths_memory(&mut e, &self.planned.paths);
+        e
+    }
+
     fn build(
         self: Box<Self>,
         gpu: &Gpu,

@@ -328,18 +328,15 @@ fn no_scene_that_loads_crashes_the_tracer_or_a_raster_method() {
     if let Ok(chunk) = std::env::var("MIRRORBOX_FUZZ_CHUNK") {
         return fuzz_chunk(chunk.parse().expect("a chunk index"));
     }
+    // libtest's name of this test: the module path without the crate, then the function.
+    let module = module_path!().split_once("::").map_or("", |(_, m)| m);
+    let this_test = format!("{module}::no_scene_that_loads_crashes_the_tracer_or_a_raster_method");
     let mutants = env_number("MIRRORBOX_FUZZ_MUTANTS", 1000) as usize;
     let total = 3 + mutants;
     let mut tally = Tally::default();
     for chunk in 0..total.div_ceil(MUTANTS_PER_CHILD) {
         let out = std::process::Command::new(std::env::current_exe().unwrap())
-            .args([
-                "--exact",
-                "no_scene_that_loads_crashes_the_tracer_or_a_raster_method",
-                "--nocapture",
-                "--test-threads",
-                "1",
-            ])
+            .args(["--exact", &this_test, "--nocapture", "--test-threads", "1"])
             .env("MIRRORBOX_FUZZ_CHUNK", chunk.to_string())
             .output()
             .expect("run a fuzz chunk");
