@@ -10,12 +10,13 @@
 # stereo mirrors (per-eye against shared) in reports/stereo/ and error over time (feedback, cube maps; still and
 # walking) in reports/motion/ (measuring every point again; cached ground truths are
 # reused when present). It records each step's time and peak memory in
-# reports/main_job.json and fills the README's generated regions from the reports.
+# reports/main_job.json and fills the README's generated regions from the reports. Last, the
+# peak memory of every bundled scene × method in reports/memory/peaks.md.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 export NODEVICE_SELECT=1
 bin=target/release/mirrorbox
-steps_total=14
+steps_total=15
 step=0
 steps_json=""
 started_at=$(date -u +%Y-%m-%dT%H:%M:%SZ)
@@ -41,7 +42,8 @@ run_step() {
   steps_json+="${steps_json:+,}{\"name\":\"$name\",\"seconds\":$took,\"peak_kb\":$peak}"
 }
 run_step scripts/install-system-deps.sh
-run_step cargo build --release --locked -p mirrorbox
+# --timings: target/cargo-timings/cargo-timing.html says which crates the build's time goes to.
+run_step cargo build --release --locked -p mirrorbox --timings
 run_step "$bin" check scenes/*.json
 run_step "$bin" info
 run_step "$bin" table1 --fresh
@@ -53,6 +55,7 @@ run_step "$bin" bumpy --fresh
 run_step "$bin" stereo --fresh
 run_step "$bin" motion
 run_step env MIRRORBOX="$bin" scripts/lighting-trace-cost.sh
+run_step scripts/memory-peaks.sh
 cpu=$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//; s/"/'"'"'/g')
 cores=$(nproc)
 tmp=$(mktemp reports/.main_job.XXXXXX)

@@ -58,6 +58,10 @@ pub struct SweepConfig {
     /// (`EXE render-worker`, [`worker`]), so that the driver's per-frame memory is returned
     /// after each and every point's peak memory is its own; `None` renders in this process.
     pub worker: Option<PathBuf>,
+    /// A point whose frame's estimated GPU + host memory
+    /// (`mirrorbox_raster::Planned::memory_estimate`) exceeds this many bytes is refused
+    /// before any work (`--memory-budget`, default 2 GiB).
+    pub memory_budget: u64,
     /// The symmetry planes axis (seed 001): each point's scene keeps the first p of the
     /// scene's `symmetry_planes`, for every p listed (`--symmetry-planes`); `None` keeps the
     /// scene as it is.
@@ -178,6 +182,7 @@ impl SweepConfig {
             truth: WhittedSettings::default(),
             command: String::new(),
             worker: None,
+            memory_budget: mirrorbox_raster::DEFAULT_MEMORY_BUDGET,
             symmetry_planes: None,
             mirrored_lights: None,
             bump_amplitudes: None,
@@ -1128,10 +1133,12 @@ pub fn run_sweep(
     };
     for p in still_to_do(&done_before) {
         let (scene, settings) = point_setup(&base, p, config)?;
-        worker::plan_point(&scene, &settings).map_err(|source| HarnessError::Refused {
-            point: p.label.clone(),
-            source,
-        })?;
+        worker::plan_point(&scene, &settings)
+            .and_then(|planned| planned.check_memory(&scene, &settings, config.memory_budget))
+            .map_err(|source| HarnessError::Refused {
+                point: p.label.clone(),
+                source,
+            })?;
     }
     let (images, cache) = (out.join("images"), out.join("cache"));
     let truth_cache = config.truth_cache.clone().unwrap_or_else(|| cache.clone());

@@ -1,6 +1,7 @@
-//! Timed renders in a child process (`mirrorbox render-worker`), one per point and round.
+//! One timed render of a sweep point: in the sweep's own process (the default), or in a child
+//! process (`mirrorbox render-worker`, `sweep --isolate-renders`), one per point and round.
 //!
-//! Why: on lavapipe (Mesa 22.3, Vulkan) every executed frame leaves memory behind in the
+//! Why children existed: on lavapipe (Mesa 22.3, Vulkan) every executed frame leaves memory behind in the
 //! process — a few hundred MB per frame of `portal` at depth 512, freed neither when the
 //! frame's resources nor when the device are dropped (measured: `render --frames 16` peaked
 //! at 5.2 GB where one frame peaks at 0.47 GB; wgpu's GL backend does not grow). A sweep that
@@ -199,6 +200,23 @@ pub(crate) enum PlannedPoint {
     Pair(mirrorbox_raster::stereo_pair::Planned, Box<[Scene; 2]>),
 }
 
+impl PlannedPoint {
+    /// Refuses the point when its frame's estimated memory is above `budget` bytes.
+    pub(crate) fn check_memory(
+        &self,
+        scene: &Scene,
+        settings: &RenderSettings,
+        budget: u64,
+    ) -> Result<(), mirrorbox_raster::PlanError> {
+        match self {
+            PlannedPoint::Mono(p) => p.check_memory(scene, settings, budget).map(|_| ()),
+            PlannedPoint::Pair(p, eyes) => p
+                .check_memory([&eyes[0], &eyes[1]], settings, budget)
+                .map(|_| ()),
+        }
+    }
+}
+
 /// Runs `job` in this process (the worker's side, or the sweep's when it renders in-process).
 pub fn run_job(job: &RenderJob, gpu: &Gpu) -> Result<Rendered, HarnessError> {
     let scene = job_scene(job)?;
@@ -218,6 +236,8 @@ pub fn run_job(job: &RenderJob, gpu: &Gpu) -> Result<Rendered, HarnessError> {
         frames: job.frames,
         warmup: job.warmup,
     };
+    // The point's own peak, when several points render in one process (the sweep's default).
+    reset_peak_memory();
     // Planning is the CPU's share of a frame (reflection paths, the paper's recursion):
     // timed on its own, since GPU timestamps do not see it.
     let started = std::time::Instant::now();
@@ -332,6 +352,14 @@ pub fn render_in_worker(
         });
     }
     Ok(serde_json::from_slice(&out.stdout)?)
+}
+
+/// Starts this process's peak resident memory afresh (Linux: `5` written to
+/// `/proc/self/clear_refs` sets `VmHWM` to the current resident size), so that the peak read
+/// after a render is that render's, the sweep's own resident memory included. Returns
+/// whether the kernel took it; elsewhere the peak stays the process's so far.
+pub fn reset_peak_memory() -> bool {
+    std::fs::write("/proc/self/clear_refs", "5").is_ok()
 }
 
 /// This process's peak resident memory so far (Linux `VmHWM`), bytes.

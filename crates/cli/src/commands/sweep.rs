@@ -102,6 +102,13 @@ pub struct Args {
     time: f64,
     #[command(flatten)]
     shard: ShardArgs,
+    /// Render every timed frame in its own child process (`mirrorbox render-worker`), as the
+    /// sweeps did for Mesa 22.3's lavapipe, which kept the memory of every executed pass; by
+    /// default the sweep renders in its own process on one device (docs/budgets.md).
+    #[arg(long)]
+    isolate_renders: bool,
+    #[command(flatten)]
+    memory: super::MemoryBudgetArgs,
 }
 
 /// `--shard` and `--truth-cache`, for `sweep` and the presets (issue 20).
@@ -238,6 +245,13 @@ pub struct PresetArgs {
     fresh: bool,
     #[command(flatten)]
     shard: ShardArgs,
+    /// Render every timed frame in its own child process (`mirrorbox render-worker`), as the
+    /// sweeps did for Mesa 22.3's lavapipe, which kept the memory of every executed pass; by
+    /// default the sweep renders in its own process on one device (docs/budgets.md).
+    #[arg(long)]
+    isolate_renders: bool,
+    #[command(flatten)]
+    memory: super::MemoryBudgetArgs,
 }
 
 fn bad(m: String) -> Failure {
@@ -285,8 +299,8 @@ fn parse_methods(
     Ok(methods)
 }
 
-/// This executable, run as `render-worker` for every timed render of a sweep (see
-/// `mirrorbox_harness::worker`: lavapipe keeps memory from every frame a process executes).
+/// This executable, run as `render-worker` for every timed render of a sweep with
+/// `--isolate-renders` (see `mirrorbox_harness::worker`), and for the sequences of `motion`.
 /// On Linux `/proc/self/exe`, which stays this very binary even if the file is rebuilt
 /// during the sweep.
 fn render_worker() -> Option<PathBuf> {
@@ -346,7 +360,8 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             min_throughput: args.min_throughput,
         },
         command: command_line(),
-        worker: render_worker(),
+        worker: args.isolate_renders.then(render_worker).flatten(),
+        memory_budget: args.memory.memory_budget,
         symmetry_planes: args
             .symmetry_planes
             .as_deref()
@@ -476,7 +491,8 @@ fn run_preset(mut config: SweepConfig, args: &PresetArgs) -> Result<(), Failure>
         config.frames = frames;
     }
     config.command = command_line();
-    config.worker = render_worker();
+    config.worker = args.isolate_renders.then(render_worker).flatten();
+    config.memory_budget = args.memory.memory_budget;
     args.shard.apply(&mut config)?;
     execute(&config, args.fresh)
 }
