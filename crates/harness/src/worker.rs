@@ -217,7 +217,8 @@ impl PlannedPoint {
     }
 }
 
-/// Runs `job` in this process (the worker's side, or the sweep's when it renders in-process).
+/// Runs `job` in a worker process: builds its scene from the file and checks that it is the
+/// sweep's (content hash), then [`render_scene`].
 pub fn run_job(job: &RenderJob, gpu: &Gpu) -> Result<Rendered, HarnessError> {
     let scene = job_scene(job)?;
     if scene.content_hash() != job.scene_hash {
@@ -228,6 +229,11 @@ pub fn run_job(job: &RenderJob, gpu: &Gpu) -> Result<Rendered, HarnessError> {
             job.scene_hash
         )));
     }
+    render_scene(job, &scene, gpu)
+}
+
+/// Renders `job` on `scene` (the point's scene, made once by the sweep or by the worker).
+pub fn render_scene(job: &RenderJob, scene: &Scene, gpu: &Gpu) -> Result<Rendered, HarnessError> {
     let method = Method::parse(&job.method)
         .map_err(|e| HarnessError::Worker(format!("{}: {e}", job.method)))?;
     let settings = RenderSettings {
@@ -241,11 +247,11 @@ pub fn run_job(job: &RenderJob, gpu: &Gpu) -> Result<Rendered, HarnessError> {
     // Planning is the CPU's share of a frame (reflection paths, the paper's recursion):
     // timed on its own, since GPU timestamps do not see it.
     let started = std::time::Instant::now();
-    let planned = plan_point(&scene, &settings).map_err(RasterError::from)?;
+    let planned = plan_point(scene, &settings).map_err(RasterError::from)?;
     let plan_ms = started.elapsed().as_secs_f64() * 1e3;
     let out = match planned {
         PlannedPoint::Mono(planned) => {
-            mirrorbox_raster::render_planned(gpu, &scene, planned, &settings)?
+            mirrorbox_raster::render_planned(gpu, scene, planned, &settings)?
         }
         PlannedPoint::Pair(planned, eyes) => mirrorbox_raster::stereo_pair::render_pair(
             gpu,
@@ -287,7 +293,12 @@ pub fn run_job(job: &RenderJob, gpu: &Gpu) -> Result<Rendered, HarnessError> {
 
 /// Runs `job` in this process and writes its image to `job.image`, as a worker would.
 pub fn run_job_to_file(job: &RenderJob, gpu: &Gpu) -> Result<RenderReport, HarnessError> {
-    let rendered = run_job(job, gpu)?;
+    write_images(job, run_job(job, gpu)?)
+}
+
+/// Writes a render's image (and a stereo pair's right eye) where `job` says; returns its
+/// report.
+pub fn write_images(job: &RenderJob, rendered: Rendered) -> Result<RenderReport, HarnessError> {
     write_exr(&job.image, &rendered.image, &[])?;
     if let Some(right) = &rendered.right_eye {
         write_exr(&right_eye_image(&job.image), right, &[])?;

@@ -69,6 +69,8 @@ pub struct Gpu {
     /// a registered method needs or can use that the adapter has.
     pub features: wgpu::Features,
     errors: Arc<Mutex<Vec<String>>>,
+    /// Shader modules compiled on this device, by source ([`Gpu::shader_module`]).
+    modules: Mutex<std::collections::HashMap<usize, wgpu::ShaderModule>>,
 }
 
 /// wgpu's defaults, raised to what the adapter offers for image sizes and buffer sizes (the
@@ -178,7 +180,21 @@ impl Gpu {
             timestamps,
             features,
             errors,
+            modules: Mutex::default(),
         })
+    }
+
+    /// `shader` compiled on this device, once: every build of a frame asks for its modules,
+    /// and a sweep, the viewer and the tests build many frames on one device; naga's parse,
+    /// validation and SPIR-V output run once per source (keyed by the static's address,
+    /// every [`crate::wgsl::WgslSource`] being a `static`).
+    pub fn shader_module(&self, shader: &'static crate::wgsl::WgslSource) -> wgpu::ShaderModule {
+        let key = std::ptr::from_ref(shader) as usize;
+        let mut modules = self.modules.lock().unwrap_or_else(|e| e.into_inner());
+        modules
+            .entry(key)
+            .or_insert_with(|| crate::wgsl::shader_module(&self.device, shader))
+            .clone()
     }
 
     /// Fails with the first error wgpu reported since the last check.

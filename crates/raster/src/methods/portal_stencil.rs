@@ -34,7 +34,7 @@ use crate::projection::{FAR_DEPTH, NEARER_OR_EQUAL};
 use crate::shading::{SceneBuffers, VERTEX_LAYOUT};
 use crate::targets::{DEPTH_STENCIL_FORMAT, DepthClear, RenderTarget, depth_stencil_format};
 use crate::timing::FrameEncoder;
-use crate::wgsl::{HostLayout, shader_module};
+use crate::wgsl::HostLayout;
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec3, Vec4};
 use mirrorbox_scene::Scene;
@@ -333,13 +333,10 @@ impl PortalStencil {
         let layout = pipeline_layout(device, "portal", &[&scene_buffers.layout, &path_layout]);
         let clipping = Clipping::for_features(gpu.features);
         let depth_format = depth_stencil_format(gpu.features);
-        let shader = shader_module(
-            device,
-            match clipping {
-                Clipping::ClipDistances => &CLIP_DISTANCE_SHADER,
-                Clipping::FragmentDiscard | Clipping::None => &SHADER,
-            },
-        );
+        let shader = gpu.shader_module(match clipping {
+            Clipping::ClipDistances => &CLIP_DISTANCE_SHADER,
+            Clipping::FragmentDiscard | Clipping::None => &SHADER,
+        });
         // Scene draws clip at the path's last mirror: by clip distance, or per fragment.
         let (scene_vertex, fs_object, fs_mirror, fs_mark) = match clipping {
             Clipping::ClipDistances => ("vs_clip_distances", "fs_object", "fs_mirror", "fs_none"),

@@ -28,7 +28,7 @@ use crate::shading::{SceneBuffers, VERTEX_LAYOUT};
 use crate::targets::{DEPTH_FORMAT, RenderTarget, texture_entry};
 use crate::timing::FrameEncoder;
 use crate::uneven::BumpSettings;
-use crate::wgsl::{HostLayout, shader_module};
+use crate::wgsl::HostLayout;
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use mirrorbox_scene::{Plane, Scene};
@@ -1045,7 +1045,7 @@ impl TexturePipelines {
     pub(crate) fn with(
         gpu: &Gpu,
         scene_buffers: &SceneBuffers,
-        shaders: [&crate::wgsl::WgslSource; 2],
+        shaders: [&'static crate::wgsl::WgslSource; 2],
         mirror_entries: &[wgpu::BindGroupLayoutEntry],
     ) -> Self {
         let device = &gpu.device;
@@ -1061,13 +1061,13 @@ impl TexturePipelines {
         let clipping = Clipping::for_features(gpu.features);
         let (shader, vertex, fs_object, fs_mirror) = match clipping {
             Clipping::ClipDistances => (
-                shader_module(device, shaders[1]),
+                gpu.shader_module(shaders[1]),
                 "vs_clip_distances",
                 "fs_object",
                 "fs_mirror",
             ),
             Clipping::FragmentDiscard | Clipping::None => (
-                shader_module(device, shaders[0]),
+                gpu.shader_module(shaders[0]),
                 "vs_main",
                 "fs_object_discard",
                 "fs_mirror_discard",

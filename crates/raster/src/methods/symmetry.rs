@@ -48,7 +48,7 @@ use crate::shading::{SceneBuffers, VERTEX_LAYOUT};
 use crate::symmetry_cells::{CopySelection, copy_count, reverses_winding};
 use crate::targets::{DEPTH_FORMAT, RenderTarget};
 use crate::timing::FrameEncoder;
-use crate::wgsl::{HostLayout, WgslSource, shader_module};
+use crate::wgsl::{HostLayout, WgslSource};
 use bytemuck::{Pod, Zeroable};
 use glam::{DVec3, Mat4, Vec3};
 use mirrorbox_scene::{Geometry, Plane, Scene, Surface};
@@ -675,14 +675,11 @@ impl CopiesFrame {
         });
         let pipeline_layout =
             pipeline_layout(device, "symmetry", &[&scene_buffers.layout, &layout]);
-        let module = shader_module(
-            device,
-            if clip_distances {
-                &CLIP_DISTANCE_SHADER
-            } else {
-                &SHADER
-            },
-        );
+        let module = gpu.shader_module(if clip_distances {
+            &CLIP_DISTANCE_SHADER
+        } else {
+            &SHADER
+        });
         let vertex = match (settings.per_copy, clip_distances) {
             (false, false) => "vs_instanced",
             (true, false) => "vs_per_copy",

@@ -28,7 +28,6 @@ use crate::shading::{SceneBuffers, VERTEX_LAYOUT};
 use crate::symmetry_cells::copy_count;
 use crate::targets::{DEPTH_FORMAT, RenderTarget};
 use crate::timing::FrameEncoder;
-use crate::wgsl::shader_module;
 use glam::Vec3;
 use mirrorbox_scene::symmetry::split_and_mirror_with_origins;
 use mirrorbox_scene::{Geometry, Scene};
@@ -230,7 +229,7 @@ impl BakedFrame {
         });
         let pipeline_layout =
             pipeline_layout(device, "symmetry-baked", &[&scene_buffers.layout, &layout]);
-        let module = shader_module(device, &SHADER);
+        let module = gpu.shader_module(&SHADER);
         const COPY_ID_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
             array_stride: 4,
             step_mode: wgpu::VertexStepMode::Vertex,

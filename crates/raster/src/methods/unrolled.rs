@@ -46,7 +46,7 @@ use crate::projection::{FAR_DEPTH, NEARER};
 use crate::shading::{SceneBuffers, VERTEX_LAYOUT};
 use crate::targets::{DEPTH_FORMAT, DepthClear, RenderTarget};
 use crate::timing::FrameEncoder;
-use crate::wgsl::{HostLayout, WgslSource, shader_module};
+use crate::wgsl::{HostLayout, WgslSource};
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3, Vec4};
 use mirrorbox_scene::Scene;
@@ -538,8 +538,8 @@ impl Unrolled {
                 .collect::<Vec<_>>(),
         });
         let layout = pipeline_layout(device, "unrolled", &[&scene_buffers.layout, &layout]);
-        let guarded_module = shader_module(device, &GUARDED_SHADER);
-        let clipped_module = clip_distances.then(|| shader_module(device, &CLIP_DISTANCE_SHADER));
+        let guarded_module = gpu.shader_module(&GUARDED_SHADER);
+        let clipped_module = clip_distances.then(|| gpu.shader_module(&CLIP_DISTANCE_SHADER));
         let background_layout = wgpu::VertexBufferLayout {
             array_stride: std::mem::size_of::<BackgroundVertex>() as u64,
             step_mode: wgpu::VertexStepMode::Vertex,

@@ -315,11 +315,12 @@ fn env_number(name: &str, default: u64) -> u64 {
         .unwrap_or(default)
 }
 
-/// Mutants per child process: lavapipe keeps memory from every frame a process executes
-/// (see `mirrorbox_harness::worker`), so the renders are spread over child processes of this
-/// test, each bounded (1 000 mutants in one process peaked at 4.8 GB; 5 000 were killed for
-/// memory at 24 GB).
-const MUTANTS_PER_CHILD: usize = 125;
+/// Mutants per child process of this test. On Mesa 22.3's lavapipe, which kept the memory of
+/// every executed pass, 1 000 mutants in one process peaked at 4.8 GB, so they were spread over
+/// children of 125; on Mesa 25 all 1 003 in one child peak at 306 MB and take 93 s where nine
+/// children took 108 s (docs/budgets.md). One child is kept so that a driver abort is reported
+/// with the chunk's output instead of ending the whole test binary.
+const MUTANTS_PER_CHILD: usize = 2000;
 
 /// The reproducers, then random mutants of every bundled scene, in chunks of
 /// [`MUTANTS_PER_CHILD`], each in a child process of this test binary.
