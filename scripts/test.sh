@@ -43,10 +43,20 @@ if [ -n "$clippy_driver" ]; then
 else
   echo "test.sh: no clippy-driver (rustup component add clippy); building without lints" >&2
 fi
+# A fresh clone's build has nothing to reuse: incremental compilation only writes files.
+export CARGO_INCREMENTAL=${CARGO_INCREMENTAL:-0}
 # Every target (benches included) built and linted; then every test run. The workspace has
-# no doc tests, so rustdoc is not asked to look for them.
-timed cargo test --workspace --locked --all-targets --no-run
-timed cargo test --workspace --locked --no-fail-fast --lib --bins --tests
+# no doc tests, so rustdoc is not asked to look for them. --timings: where the build's time
+# goes, per crate (target/cargo-timings/cargo-timing.html).
+timed cargo test --workspace --locked --all-targets --no-run --timings
+# cargo-nextest, where installed (it is on the project's machines), schedules every test of
+# every binary in one pool: the long tests (the scene fuzz) overlap the other binaries'
+# instead of running after them (docs/budgets.md, measured). Otherwise cargo's own runner.
+if cargo nextest --version >/dev/null 2>&1; then
+  timed cargo nextest run --workspace --locked --no-fail-fast --lib --bins --tests
+else
+  timed cargo test --workspace --locked --no-fail-fast --lib --bins --tests
+fi
 cpu=$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//; s/"/'"'"'/g')
 mkdir -p target
 printf '{"date":"%s","cpu":"%s, %s cores","seconds":%s,"steps":[%s]}\n' \

@@ -76,29 +76,6 @@ fn quiet_mesa_device_select() {
     }
 }
 
-/// Asks glibc to hand freed heap memory back to the kernel at once (`M_TRIM_THRESHOLD` 0)
-/// instead of keeping up to its dynamic threshold. lavapipe allocates and frees a few hundred
-/// KB per draw as it executes a frame; kept by the heap, that piled up to 4.0 GB resident for
-/// `render --method portal --depth 1024` on mirror_box over 7 frames (the peak of the main
-/// job), 2.6 GB with this (measured on the development machine, issue #12). Speed, two
-/// interleaved rounds on the busy machine: trace 9.5, 9.3 Mrays/s without, 11.1, 8.7 with;
-/// `auxiliary --n 2` 148, 144 ms/frame without, 152, 151 with (within the noise there). A
-/// `MALLOC_TRIM_THRESHOLD_` set by the user wins.
-fn release_freed_memory_promptly() {
-    #[cfg(all(target_os = "linux", target_env = "gnu"))]
-    if std::env::var_os("MALLOC_TRIM_THRESHOLD_").is_none() {
-        const M_TRIM_THRESHOLD: std::ffi::c_int = -1;
-        unsafe extern "C" {
-            fn mallopt(param: std::ffi::c_int, value: std::ffi::c_int) -> std::ffi::c_int;
-        }
-        // SAFETY: called first thing in `main`, before any other thread exists; mallopt only
-        // changes when glibc returns free memory to the kernel.
-        unsafe {
-            mallopt(M_TRIM_THRESHOLD, 0);
-        }
-    }
-}
-
 /// Printing into a closed pipe (`mirrorbox check … | head`) ends the process quietly, as Unix
 /// tools do, instead of Rust's "failed printing to stdout: Broken pipe" panic: restore the
 /// default action of SIGPIPE, which Rust's runtime sets to ignore.
@@ -184,7 +161,6 @@ impl Failure {
 
 fn main() -> ExitCode {
     quiet_mesa_device_select();
-    release_freed_memory_promptly();
     die_quietly_on_closed_pipe();
     // A repeated flag: the last one wins, as in most command lines (scripts append overrides).
     let command = Cli::command().mut_subcommands(|s| s.args_override_self(true));

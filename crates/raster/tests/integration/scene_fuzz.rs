@@ -315,32 +315,43 @@ fn env_number(name: &str, default: u64) -> u64 {
         .unwrap_or(default)
 }
 
-/// Mutants per child process of this test. On Mesa 22.3's lavapipe, which kept the memory of
-/// every executed pass, 1 000 mutants in one process peaked at 4.8 GB, so they were spread over
-/// children of 125; on Mesa 25 all 1 003 in one child peak at 306 MB and take 93 s where nine
-/// children took 108 s (docs/budgets.md). One child is kept so that a driver abort is reported
-/// with the chunk's output instead of ending the whole test binary.
-const MUTANTS_PER_CHILD: usize = 2000;
+/// Mutants per child process of this test: the mutants are split over [`CHILDREN`] children
+/// that run at the same time, one per core of the 2-core machines the budgets are set for (a
+/// child renders tiny images, which lavapipe draws on one thread). On Mesa 22.3's lavapipe,
+/// which kept the memory of every executed pass, 1 000 mutants in one process peaked at
+/// 4.8 GB, so they ran in children of 125, one after another; on Mesa 25 all 1 003 in one
+/// child peak at 306 MB and take 93 s, where those nine took 108 s (docs/budgets.md).
+/// Children, not threads, so that a driver abort is reported with its chunk's output instead
+/// of ending the whole test binary.
+const CHILDREN: usize = 2;
 
-/// The reproducers, then random mutants of every bundled scene, in chunks of
-/// [`MUTANTS_PER_CHILD`], each in a child process of this test binary.
+/// The reproducers, then random mutants of every bundled scene, split over
+/// [`CHILDREN`] child processes of this test binary running side by side.
 #[test]
 fn no_scene_that_loads_crashes_the_tracer_or_a_raster_method() {
+    let mutants = env_number("MIRRORBOX_FUZZ_MUTANTS", 1000) as usize;
+    let total = 3 + mutants;
+    let per_child = total.div_ceil(CHILDREN);
     if let Ok(chunk) = std::env::var("MIRRORBOX_FUZZ_CHUNK") {
-        return fuzz_chunk(chunk.parse().expect("a chunk index"));
+        return fuzz_chunk(chunk.parse().expect("a chunk index"), per_child);
     }
     // libtest's name of this test: the module path without the crate, then the function.
     let module = module_path!().split_once("::").map_or("", |(_, m)| m);
     let this_test = format!("{module}::no_scene_that_loads_crashes_the_tracer_or_a_raster_method");
-    let mutants = env_number("MIRRORBOX_FUZZ_MUTANTS", 1000) as usize;
-    let total = 3 + mutants;
+    let children: Vec<_> = (0..CHILDREN)
+        .map(|chunk| {
+            std::process::Command::new(std::env::current_exe().unwrap())
+                .args(["--exact", &this_test, "--nocapture", "--test-threads", "1"])
+                .env("MIRRORBOX_FUZZ_CHUNK", chunk.to_string())
+                .stdout(std::process::Stdio::piped())
+                .stderr(std::process::Stdio::piped())
+                .spawn()
+                .expect("start a fuzz chunk")
+        })
+        .collect();
     let mut tally = Tally::default();
-    for chunk in 0..total.div_ceil(MUTANTS_PER_CHILD) {
-        let out = std::process::Command::new(std::env::current_exe().unwrap())
-            .args(["--exact", &this_test, "--nocapture", "--test-threads", "1"])
-            .env("MIRRORBOX_FUZZ_CHUNK", chunk.to_string())
-            .output()
-            .expect("run a fuzz chunk");
+    for (chunk, child) in children.into_iter().enumerate() {
+        let out = child.wait_with_output().expect("run a fuzz chunk");
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert!(
             out.status.success(),
@@ -368,9 +379,9 @@ fn no_scene_that_loads_crashes_the_tracer_or_a_raster_method() {
     );
 }
 
-/// Mutants `chunk·MUTANTS_PER_CHILD ..` of the whole sequence (every chunk generates the same
+/// Mutants `chunk·per_child ..` of the whole sequence (every chunk generates the same
 /// sequence from the seed and takes its slice).
-fn fuzz_chunk(chunk: usize) {
+fn fuzz_chunk(chunk: usize, per_child: usize) {
     let gpu = Gpu::new().expect("a wgpu adapter (scripts/install-system-deps.sh)");
     let mutants = env_number("MIRRORBOX_FUZZ_MUTANTS", 1000) as usize;
     let mut rng = Rng(env_number("MIRRORBOX_FUZZ_SEED", 12));
@@ -401,8 +412,8 @@ fn fuzz_chunk(chunk: usize) {
         (path, mutant)
     });
     let all: Vec<(PathBuf, Value)> = reproducers.into_iter().chain(random).collect();
-    let start = chunk * MUTANTS_PER_CHILD;
-    for (i, (path, mutant)) in all.iter().enumerate().skip(start).take(MUTANTS_PER_CHILD) {
+    let start = chunk * per_child;
+    for (i, (path, mutant)) in all.iter().enumerate().skip(start).take(per_child) {
         tally.tried += 1;
         let text = serde_json::to_string(mutant).unwrap();
         match load(&text, path) {
