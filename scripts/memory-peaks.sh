@@ -27,6 +27,8 @@ mb() { awk -v b="$1" 'BEGIN { printf "%.0f", b / 1e6 }'; }
   echo "GPU + host estimate (docs/memory.md), the number \`--memory-budget\` (default 2 GiB) is"
   echo "checked against. Refused: the CLI's reason (exit 2)."
   echo
+  echo "Measured $(date -u +%Y-%m-%d) on $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//'), $(nproc) cores: $("$bin" info | sed -n 's/^driver: *//p')."
+  echo
   echo "| scene | method | peak RSS (MB) | estimate (MB) |"
   echo "|---|---|---:|---:|"
   for scene in scenes/*.json; do
