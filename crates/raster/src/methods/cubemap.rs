@@ -226,16 +226,11 @@ impl PlannedFrame for PlannedCubes {
         let cubes = self.cubes.len() as u64;
         let sets = 2 + u64::from(self.carried.is_some());
         let face = target_bytes(self.size, self.size, color_bytes_per_texel);
-        let mut e = crate::memory::MemoryEstimate::new();
+        let mut e = crate::memory::MemoryEstimate::with_scene_buffers(scene, &scene.geometry);
         e.gpu(
             "the cube maps",
             "--cube-size (or --cube-centre scene)",
             sets * 6 * cubes * face + target_bytes(1, 1, color_bytes_per_texel),
-        );
-        e.gpu(
-            "the scene buffers",
-            "the scene's triangles",
-            SceneBuffers::memory_bytes(scene, &scene.geometry),
         );
         e.gpu(
             "the uniforms",

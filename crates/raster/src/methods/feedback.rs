@@ -149,16 +149,11 @@ impl PlannedFrame for PlannedFeedback {
         });
         let (cameras, mirrors) = (self.cameras.len() as u64, scene.mirrors.len() as u64);
         let records = cameras + 2 + 4 * cameras * mirrors + 2 * mirrors;
-        let mut e = crate::memory::MemoryEstimate::new();
+        let mut e = crate::memory::MemoryEstimate::with_scene_buffers(scene, &scene.geometry);
         e.gpu(
             "the mirror textures",
             "the image size (--width/--height, --ssaa)",
             2 * set + carried + target(1, 1),
-        );
-        e.gpu(
-            "the scene buffers",
-            "the scene's triangles",
-            SceneBuffers::memory_bytes(scene, &scene.geometry),
         );
         e.gpu(
             "the uniforms",

@@ -930,16 +930,11 @@ fn texture_memory(
         .map(|&(w, h)| target_bytes(w, h, color_bytes_per_texel))
         .sum::<u64>()
         + target_bytes(1, 1, color_bytes_per_texel);
-    let mut e = crate::memory::MemoryEstimate::new();
+    let mut e = crate::memory::MemoryEstimate::with_scene_buffers(scene, &scene.geometry);
     e.gpu(
         "the mirror textures",
         "--texture-scale, --n, --depth or the image size (--width/--height, --ssaa)",
         textures,
-    );
-    e.gpu(
-        "the scene buffers",
-        "the scene's triangles",
-        SceneBuffers::memory_bytes(scene, &scene.geometry),
     );
     e.gpu(
         "the uniforms",
