@@ -101,7 +101,7 @@ trace_threads() {
   tmp=$(mktemp reports/gpu/.trace.XXXXXX)
   for round in 1 2 3; do
     for t in $(printf '%s\n' 1 2 4 8 16 | shuf --random-source=<(yes "$round")); do
-      RAYON_NUM_THREADS=$t "$bin" trace scenes/mirror_room.json --width 960 --height 540 --json \
+      RAYON_NUM_THREADS=$t "$bin" trace scenes/mirror_room.json --width 960 --height 540 --spp 16 --json \
         -o /tmp/trace.exr | sed "s/^{/{\"round\":$round,/" >>"$tmp"
     done
   done

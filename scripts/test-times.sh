@@ -8,6 +8,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 export NODEVICE_SELECT=1
+export CARGO_INCREMENTAL=${CARGO_INCREMENTAL:-0}   # as scripts/test.sh builds, so nothing is rebuilt
 clippy_driver=$(rustup which clippy-driver 2>/dev/null || command -v clippy-driver || true)
 if [ -n "$clippy_driver" ]; then
   export RUSTC_WORKSPACE_WRAPPER="$clippy_driver"
@@ -52,7 +53,7 @@ print("# Where the test time goes")
 print()
 print(f"Made by `scripts/test-times.sh` on {datetime.date.today()}, {cpu}, {cores} cores: every test run")
 print(f"alone, one after the other ({len(rows)} tests, {total:.0f} s in all; `scripts/test.sh` runs")
-print("them in parallel, two threads per binary). Per binary, then the 25 slowest tests.")
+print("them in parallel: cargo-nextest, one pool over every binary). Per binary, then the 25 slowest tests.")
 print()
 print("| test binary | tests | seconds alone |")
 print("|---|---:|---:|")
