@@ -104,21 +104,6 @@ impl MemoryEstimate {
         Self::default()
     }
 
-    /// An estimate that starts with the scene buffers every method uploads for `geometry`
-    /// (the scene's, or a method's own baked copy): `SceneBuffers::memory_bytes`.
-    pub fn with_scene_buffers(
-        scene: &mirrorbox_scene::Scene,
-        geometry: &mirrorbox_scene::Geometry,
-    ) -> Self {
-        let mut e = Self::new();
-        e.gpu(
-            "the scene buffers",
-            "the scene's triangles",
-            crate::shading::SceneBuffers::memory_bytes(scene, geometry),
-        );
-        e
-    }
-
     fn part(&mut self, what: &'static str, lower: &'static str) -> &mut MemoryPart {
         let i = match self.parts.iter().position(|p| p.what == what) {
             Some(i) => i,

@@ -226,6 +226,21 @@ pub struct SceneBuffers {
 }
 
 impl SceneBuffers {
+    /// A frame's memory estimate that starts with these buffers for `g` (the scene's
+    /// geometry, or a method's own baked copy): every method uploads them.
+    pub fn memory_estimate(
+        scene: &Scene,
+        g: &mirrorbox_scene::Geometry,
+    ) -> crate::memory::MemoryEstimate {
+        let mut e = crate::memory::MemoryEstimate::new();
+        e.gpu(
+            "the scene buffers",
+            "the scene's triangles",
+            SceneBuffers::memory_bytes(scene, g),
+        );
+        e
+    }
+
     /// GPU bytes of `scene`'s buffers drawing `g` ([`SceneBuffers::for_geometry`]), before
     /// any is created: the vertex buffer (3 × 28 bytes a triangle), the frame uniform, the
     /// surface, light and light-plane storage buffers, and the normal-map atlas (4 bytes a

@@ -226,7 +226,7 @@ impl PlannedFrame for PlannedCubes {
         let cubes = self.cubes.len() as u64;
         let sets = 2 + u64::from(self.carried.is_some());
         let face = target_bytes(self.size, self.size, color_bytes_per_texel);
-        let mut e = crate::memory::MemoryEstimate::with_scene_buffers(scene, &scene.geometry);
+        let mut e = SceneBuffers::memory_estimate(scene, &scene.geometry);
         e.gpu(
             "the cube maps",
             "--cube-size (or --cube-centre scene)",

@@ -149,7 +149,7 @@ impl PlannedFrame for PlannedFeedback {
         });
         let (cameras, mirrors) = (self.cameras.len() as u64, scene.mirrors.len() as u64);
         let records = cameras + 2 + 4 * cameras * mirrors + 2 * mirrors;
-        let mut e = crate::memory::MemoryEstimate::with_scene_buffers(scene, &scene.geometry);
+        let mut e = SceneBuffers::memory_estimate(scene, &scene.geometry);
         e.gpu(
             "the mirror textures",
             "the image size (--width/--height, --ssaa)",

@@ -100,7 +100,7 @@ impl PlannedFrame for PlannedPortal {
     fn memory(&self, scene: &Scene, _color_bytes_per_texel: u64) -> crate::memory::MemoryEstimate {
         use crate::memory::{DEPTH_STENCIL_BYTES, texture_bytes, uniform_arena_bytes};
         let paths = self.planned.paths.paths.len() as u64;
-        let mut e = crate::memory::MemoryEstimate::with_scene_buffers(scene, &scene.geometry);
+        let mut e = SceneBuffers::memory_estimate(scene, &scene.geometry);
         e.gpu(
             "the depth-stencil target",
             "the image size (--width/--height) or --ssaa",

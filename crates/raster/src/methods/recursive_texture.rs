@@ -930,7 +930,7 @@ fn texture_memory(
         .map(|&(w, h)| target_bytes(w, h, color_bytes_per_texel))
         .sum::<u64>()
         + target_bytes(1, 1, color_bytes_per_texel);
-    let mut e = crate::memory::MemoryEstimate::with_scene_buffers(scene, &scene.geometry);
+    let mut e = SceneBuffers::memory_estimate(scene, &scene.geometry);
     e.gpu(
         "the mirror textures",
         "--texture-scale, --n, --depth or the image size (--width/--height, --ssaa)",

@@ -495,7 +495,7 @@ impl PlannedFrame for PlannedCopies {
         use crate::memory::{buffer_bytes, uniform_arena_bytes};
         let copies = self.masks.len() as u64;
         let records = if self.settings.per_copy { copies } else { 1 };
-        let mut e = crate::memory::MemoryEstimate::with_scene_buffers(scene, &self.geometry);
+        let mut e = SceneBuffers::memory_estimate(scene, &self.geometry);
         e.gpu(
             "the copies",
             "the scene's symmetry planes, or use --method symmetry-pruned",

@@ -171,7 +171,7 @@ impl PlannedFrame for PlannedUnrolled {
             + buffer_bytes(pieces * items * 4)
             + buffer_bytes(scene.mirrors.len() as u64 * std::mem::size_of::<MirrorRect>() as u64)
             + buffer_bytes(3 * corners * std::mem::size_of::<BackgroundVertex>() as u64);
-        let mut e = crate::memory::MemoryEstimate::with_scene_buffers(scene, &scene.geometry);
+        let mut e = SceneBuffers::memory_estimate(scene, &scene.geometry);
         e.gpu(
             "the depth target",
             "the image size (--width/--height) or --ssaa",
