@@ -50,17 +50,22 @@ struct GpuMirrorBump {
     _pad: [f32; 2],
 }
 
-/// The mirrors' frames and bumps, and the normal maps' atlas: its width and its texels
-/// packed one u32 each, every map's rows below the previous map's.
-fn mirror_bumps(scene: &Scene) -> (Vec<GpuMirrorBump>, u32, Vec<u32>) {
-    let atlas_width = scene
+/// The normal maps' atlas width: the widest map's (1 when there is none).
+fn atlas_width(scene: &Scene) -> u32 {
+    scene
         .bumps
         .iter()
         .flatten()
         .filter_map(|b| b.normal_map.as_ref())
         .map(|m| m.width)
         .max()
-        .unwrap_or(1);
+        .unwrap_or(1)
+}
+
+/// The mirrors' frames and bumps, and the normal maps' atlas: its width and its texels
+/// packed one u32 each, every map's rows below the previous map's.
+fn mirror_bumps(scene: &Scene) -> (Vec<GpuMirrorBump>, u32, Vec<u32>) {
+    let atlas_width = atlas_width(scene);
     let mut texels: Vec<u32> = Vec::new();
     let mut bumps = Vec::with_capacity(scene.mirrors.len());
     for (m, bump) in scene.mirrors.iter().zip(&scene.bumps) {
@@ -250,14 +255,7 @@ impl SceneBuffers {
         let size = |n: usize, each: usize| buffer_bytes((n.max(1) * each) as u64);
         let l = &scene.lighting;
         let planes: usize = l.images.images.iter().map(|i| i.beam.len()).sum();
-        let atlas_width = scene
-            .bumps
-            .iter()
-            .flatten()
-            .filter_map(|b| b.normal_map.as_ref())
-            .map(|m| m.width)
-            .max()
-            .unwrap_or(1);
+        let atlas_width = atlas_width(scene);
         size(3 * g.triangles.len(), std::mem::size_of::<Vertex>())
             + size(1, std::mem::size_of::<GpuFrame>())
             + size(g.surfaces.len(), std::mem::size_of::<GpuSurface>())
