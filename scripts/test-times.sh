@@ -7,13 +7,7 @@
 # parallel run takes; the ranking is what it is for.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-export NODEVICE_SELECT=1
-export CARGO_INCREMENTAL=${CARGO_INCREMENTAL:-0}   # as scripts/test.sh builds, so nothing is rebuilt
-clippy_driver=$(rustup which clippy-driver 2>/dev/null || command -v clippy-driver || true)
-if [ -n "$clippy_driver" ]; then
-  export RUSTC_WORKSPACE_WRAPPER="$clippy_driver"
-  export CLIPPY_ARGS="-D__CLIPPY_HACKERY__warnings__CLIPPY_HACKERY__"
-fi
+. scripts/test-build-env.sh   # as scripts/test.sh builds, so nothing is rebuilt
 export MIRRORBOX_MITSUBA_PYTHON="${MIRRORBOX_MITSUBA_PYTHON:-$PWD/tools/mitsuba/.venv/bin/python}"
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT

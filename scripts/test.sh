@@ -12,7 +12,6 @@
 # warnings` reports the same lints.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-export NODEVICE_SELECT=1          # quiet Mesa's device-select layer on headless machines
 steps_json=""
 timed() {
   echo "== $*"
@@ -35,16 +34,7 @@ fi
 timed scripts/check-deploy.sh
 
 timed cargo fmt --all -- --check
-clippy_driver=$(rustup which clippy-driver 2>/dev/null || command -v clippy-driver || true)
-if [ -n "$clippy_driver" ]; then
-  export RUSTC_WORKSPACE_WRAPPER="$clippy_driver"
-  # cargo-clippy's own way of passing `-- -D warnings` to clippy-driver.
-  export CLIPPY_ARGS="-D__CLIPPY_HACKERY__warnings__CLIPPY_HACKERY__"
-else
-  echo "test.sh: no clippy-driver (rustup component add clippy); building without lints" >&2
-fi
-# A fresh clone's build has nothing to reuse: incremental compilation only writes files.
-export CARGO_INCREMENTAL=${CARGO_INCREMENTAL:-0}
+. scripts/test-build-env.sh
 # Every target (benches included) built and linted; then every test run. The workspace has
 # no doc tests, so rustdoc is not asked to look for them. --timings: where the build's time
 # goes, per crate (target/cargo-timings/cargo-timing.html).
