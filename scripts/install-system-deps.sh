@@ -84,6 +84,8 @@ command -v Xvfb >/dev/null 2>&1 || missing+=(xvfb)
 command -v xauth >/dev/null 2>&1 || missing+=(xauth)
 command -v xdotool >/dev/null 2>&1 || missing+=(xdotool)
 command -v /usr/bin/time >/dev/null 2>&1 || missing+=(time)
+# The reports test opens every HTML report in headless Chromium (issue 38).
+command -v chromium-headless-shell >/dev/null 2>&1 || missing+=(chromium-headless-shell)
 
 if [ ${#missing[@]} -eq 0 ]; then
   [ ${#mesa_old[@]} -gt 0 ] || echo "install-system-deps: Mesa $(deb_version mesa-vulkan-drivers), X11 libraries and Xvfb present; nothing to install."

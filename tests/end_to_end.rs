@@ -8,5 +8,6 @@ mod hardening;
 mod memory;
 mod mitsuba;
 mod readme;
+mod reports_html;
 mod slurm;
 mod viewer;

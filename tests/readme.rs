@@ -1,33 +1,84 @@
-//! The README's and the docs' numbers are the committed reports' numbers: every generated
-//! region of `README.md` and `docs/methods.md` must be what `mirrorbox readme` makes from
-//! `reports/` (issue #13).
+//! The README's, the book's and the docs' numbers are the committed reports' numbers: every
+//! generated region of `README.md`, `docs/methods.md` and the book's chapters
+//! (`docs/book/src/*.md`) must be what `mirrorbox readme` makes from `reports/` (issue #13),
+//! and the command-line reference (`docs/book/src/cli.md`) what the program's own `--help`
+//! says. The README stays a front door, and every relative link of the README, the book and
+//! the docs points at a file (and heading) that exists.
 
 use crate::common::{mirrorbox, repo};
+use std::path::{Path, PathBuf};
+
+/// The book's chapters, in name order.
+fn book_chapters() -> Vec<PathBuf> {
+    let dir = repo().join("docs/book/src");
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "md"))
+        .collect();
+    files.sort();
+    files
+}
+
+/// Every file `mirrorbox readme` fills by default.
+fn filled_files() -> Vec<PathBuf> {
+    let mut files = vec![repo().join("README.md"), repo().join("docs/methods.md")];
+    files.extend(book_chapters());
+    files
+}
+
+fn read(path: &Path) -> String {
+    std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
 
 #[test]
 fn the_readme_agrees_with_the_committed_reports() {
     let out = mirrorbox(&["readme", "--check"], &[]);
     assert_eq!(
         out.code, 0,
-        "{}{}\n(after changing a report, run `mirrorbox readme` and commit README.md)",
+        "{}{}\n(after changing a report or a flag, run `mirrorbox readme` and commit README.md, \
+         docs/methods.md and docs/book/src/)",
         out.stdout, out.stderr
     );
+    // The book's chapters are checked too, each by name.
+    for chapter in book_chapters() {
+        let name = chapter.strip_prefix(repo()).unwrap().display().to_string();
+        assert!(
+            out.stdout
+                .contains(&format!("{name}: every generated region agrees")),
+            "{name} was not checked:\n{}",
+            out.stdout
+        );
+    }
     // Every region the generator knows is used, so no report figure is quoted by hand.
-    let text: String = ["README.md", "docs/methods.md"]
-        .iter()
-        .map(|f| std::fs::read_to_string(repo().join(f)).unwrap())
-        .collect();
+    let text: String = filled_files().iter().map(|f| read(f)).collect();
     for (id, _, _) in mirrorbox_report::readme::REGIONS {
         assert!(
             text.contains(&format!("<!-- generated: {id} -->")),
-            "neither README.md nor docs/methods.md has the generated region {id:?}"
+            "none of README.md, docs/methods.md and docs/book/src/*.md has the generated region {id:?}"
         );
     }
+    // The command-line reference is generated from the program's own `--help`.
+    let cli = read(&repo().join("docs/book/src/cli.md"));
+    assert!(
+        cli.contains("<!-- generated: cli -->"),
+        "cli.md has no `cli` region"
+    );
+    for command in ["check", "trace", "render", "sweep", "readme", "view"] {
+        assert!(
+            cli.contains(&format!("## `mirrorbox {command}`")),
+            "cli.md has no section for `mirrorbox {command}`"
+        );
+    }
+    assert!(
+        !cli.contains("## `mirrorbox render-worker`"),
+        "the hidden internal subcommand is not documented"
+    );
 }
 
 #[test]
 fn a_changed_figure_in_a_region_is_caught_and_named() {
-    let readme = std::fs::read_to_string(repo().join("README.md")).unwrap();
+    let readme = read(&repo().join("README.md"));
     // Change the first digit inside the first region.
     let start = readme.find("<!-- generated: ").expect("a region");
     let body = start + readme[start..].find('\n').unwrap();
@@ -68,4 +119,173 @@ fn a_changed_figure_in_a_region_is_caught_and_named() {
     );
     assert_eq!(out.code, 0, "{}", out.stderr);
     assert_eq!(std::fs::read_to_string(&copy).unwrap(), readme);
+}
+
+#[test]
+fn a_changed_command_line_reference_is_caught_and_named() {
+    let cli = read(&repo().join("docs/book/src/cli.md"));
+    // A flag documented by hand that the program does not have.
+    let usage = cli
+        .find("Usage: mirrorbox render")
+        .expect("render's usage line");
+    let mut changed = cli.clone();
+    changed.insert_str(usage, "      --no-such-flag  typed by hand\n");
+    let dir = tempfile::tempdir().unwrap();
+    let copy = dir.path().join("cli.md");
+    std::fs::write(&copy, changed).unwrap();
+    let out = mirrorbox(&["readme", "--check", copy.to_str().unwrap()], &[]);
+    assert_eq!(out.code, 1, "{}{}", out.stdout, out.stderr);
+    assert!(
+        out.stderr.contains("in 1 region") && out.stderr.contains("region \"cli\""),
+        "{}",
+        out.stderr
+    );
+    assert!(out.stderr.contains("--no-such-flag"), "{}", out.stderr);
+    // Filling it restores the page exactly.
+    let out = mirrorbox(&["readme", copy.to_str().unwrap()], &[]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    assert_eq!(std::fs::read_to_string(&copy).unwrap(), cli);
+}
+
+#[test]
+fn the_readme_is_a_front_door() {
+    let lines = read(&repo().join("README.md")).lines().count();
+    assert!(
+        lines <= 200,
+        "README.md has {lines} lines: at most 200 (an experiment's text goes in its book chapter)"
+    );
+    // Every chapter is in the book's table of contents.
+    let summary = read(&repo().join("docs/book/src/SUMMARY.md"));
+    for chapter in book_chapters() {
+        let name = chapter.file_name().unwrap().to_str().unwrap();
+        if name != "SUMMARY.md" {
+            assert!(
+                summary.contains(&format!("]({name})")),
+                "docs/book/src/SUMMARY.md does not list {name}"
+            );
+        }
+    }
+}
+
+/// The relative link targets of a Markdown text with their line numbers: `[label](target)`
+/// and `![alt](target)`, outside fenced code blocks; targets with a scheme are left out.
+fn relative_links(text: &str) -> Vec<(usize, String)> {
+    let mut links = Vec::new();
+    let mut fenced = false;
+    for (i, line) in text.lines().enumerate() {
+        if line.trim_start().starts_with("```") {
+            fenced = !fenced;
+            continue;
+        }
+        if fenced {
+            continue;
+        }
+        let mut rest = line;
+        while let Some(at) = rest.find("](") {
+            let after = &rest[at + 2..];
+            let Some(end) = after.find(')') else { break };
+            let target = &after[..end];
+            if !target.is_empty()
+                && !target.contains(' ')
+                && !target.contains("://")
+                && !target.starts_with("mailto:")
+            {
+                links.push((i + 1, target.to_string()));
+            }
+            rest = &after[end..];
+        }
+    }
+    links
+}
+
+/// A heading's anchor as GitHub and mdBook make it: lower case, spaces to hyphens, other
+/// punctuation dropped.
+fn anchor(heading: &str) -> String {
+    heading
+        .trim()
+        .to_lowercase()
+        .chars()
+        .filter_map(|c| match c {
+            ' ' => Some('-'),
+            c if c.is_alphanumeric() || c == '-' || c == '_' => Some(c),
+            _ => None,
+        })
+        .collect()
+}
+
+fn anchors(markdown: &str) -> Vec<String> {
+    let mut fenced = false;
+    let mut out = Vec::new();
+    for line in markdown.lines() {
+        if line.trim_start().starts_with("```") {
+            fenced = !fenced;
+        } else if !fenced && line.starts_with('#') {
+            out.push(anchor(line.trim_start_matches('#')));
+        }
+    }
+    out
+}
+
+#[test]
+fn every_relative_link_points_at_a_file_that_exists() {
+    let mut files = vec![repo().join("README.md"), repo().join("CONTRIBUTING.md")];
+    files.extend(book_chapters());
+    let docs = repo().join("docs");
+    for entry in std::fs::read_dir(&docs).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|x| x == "md") {
+            files.push(path);
+        }
+    }
+    let mut broken = Vec::new();
+    for file in &files {
+        let text = read(file);
+        let dir = file.parent().unwrap();
+        for (line, target) in relative_links(&text) {
+            let (path, fragment) = match target.split_once('#') {
+                Some((p, f)) => (p, Some(f)),
+                None => (target.as_str(), None),
+            };
+            let resolved = if path.is_empty() {
+                file.clone()
+            } else {
+                dir.join(path)
+            };
+            let name = file.strip_prefix(repo()).unwrap().display().to_string();
+            if !resolved.exists() {
+                broken.push(format!("{name}:{line}: {target} (no such file)"));
+                continue;
+            }
+            if let Some(fragment) = fragment
+                && resolved.extension().is_some_and(|x| x == "md")
+                && !anchors(&read(&resolved)).iter().any(|a| a == fragment)
+            {
+                broken.push(format!("{name}:{line}: {target} (no such heading)"));
+            }
+        }
+    }
+    assert!(
+        broken.is_empty(),
+        "broken relative links:\n  {}",
+        broken.join("\n  ")
+    );
+}
+
+#[test]
+fn links_and_anchors_are_read_as_markdown_writes_them() {
+    let text = "See [`a.md`](a.md#x) and ![i](../b.png), not [w](https://e.org).\n\
+                ```\n[c](in-code.md)\n```\n[d](c.md) [e](f g)\n";
+    assert_eq!(
+        relative_links(text),
+        vec![
+            (1, "a.md#x".to_string()),
+            (1, "../b.png".to_string()),
+            (5, "c.md".to_string())
+        ]
+    );
+    assert_eq!(
+        anchor(" Colour targets: RGBA32F, or RGBA16F"),
+        "colour-targets-rgba32f-or-rgba16f"
+    );
+    assert_eq!(anchor(" The `cli` region"), "the-cli-region");
 }

@@ -23,7 +23,7 @@ mod worker;
 pub use worker::{RenderJob, RenderReport, Rendered, peak_memory_bytes, serve};
 
 use mirrorbox_files::{FileError, FolderLock, write_atomically};
-use mirrorbox_image::metrics::{MetricsError, compare, flip_map};
+use mirrorbox_image::metrics::{MetricsError, compare_detailed};
 use mirrorbox_image::{
     ImageError, RgbImage, StagedFiles, colormap, read_image, stage_exr, stage_png, write_png,
     write_png_bytes,
@@ -795,6 +795,11 @@ fn truth(
         && let Ok(img) = read_image(&path)
     {
         summary.truths_cached += 1;
+        if !mask_path(&path).is_file() {
+            // A truth cached before masks were kept.
+            let bvh = SceneBvh::build(&scene.geometry);
+            write_mask(scene, &bvh, config, &path)?;
+        }
         return Ok((img, path));
     }
     // Light images are pruned at the truth's own threshold, as its eye paths are.
@@ -831,8 +836,44 @@ fn truth(
         scene.camera.exposure,
     )?;
     staged.commit()?;
+    write_mask(scene, &bvh, config, &path)?;
     summary.truths_traced += 1;
     Ok((out.image, path))
+}
+
+/// Where the mirror mask of the cached truth `truth` is kept: white where a pixel shows a
+/// mirror ([`mirrorbox_trace::mirror_mask`]).
+fn mask_path(truth: &Path) -> PathBuf {
+    truth.with_extension("mask.png")
+}
+
+/// Writes the mirror mask of `scene`'s truth on the sweep's sub-pixel grid beside `truth`.
+fn write_mask(
+    scene: &Scene,
+    bvh: &SceneBvh,
+    config: &SweepConfig,
+    truth: &Path,
+) -> Result<(), HarnessError> {
+    let grid = mirrorbox_scene::camera::SubpixelGrid::new(config.ssaa);
+    let mask = mirrorbox_trace::mirror_mask(scene, bvh, grid);
+    let bytes: Vec<u8> = mask
+        .iter()
+        .flat_map(|&m| [if m { 255 } else { 0 }; 3])
+        .collect();
+    write_png_bytes(
+        &mask_path(truth),
+        scene.camera.width,
+        scene.camera.height,
+        &bytes,
+    )?;
+    Ok(())
+}
+
+/// The mirror mask kept beside a cached truth, one flag per pixel; `None` when it is missing
+/// or unreadable (the point then has no mirror-pixel error).
+fn read_mask(truth: &Path) -> Option<Vec<bool>> {
+    let img = read_image(&mask_path(truth)).ok()?;
+    Some(img.pixels.iter().map(|p| p[0] > 0.5).collect())
 }
 
 fn metric_values(m: &mirrorbox_image::metrics::Metrics) -> MetricValues {
@@ -910,6 +951,9 @@ struct ViewFiles {
 /// each eye's.
 struct Compared {
     metrics: MetricValues,
+    /// Over the mirror pixels (mono points with a mask that has any).
+    mirror_metrics: Option<MetricValues>,
+    mirror_pixel_share: Option<f64>,
     eyes: Option<Vec<mirrorbox_report::EyeRecord>>,
 }
 
@@ -931,13 +975,22 @@ fn compare_views(
         let truth = read_image(truth_path)?;
         let raster = read_image(raster_path)?;
         (w, h) = (raster.width, raster.height);
-        let m = metric_values(&compare(&truth, &raster, exposure)?);
-        let (t8, r8) = (truth.to_srgb8(exposure), raster.to_srgb8(exposure));
-        let heat: Vec<u8> = flip_map(&t8, &r8, w, h)
+        let comparison = compare_detailed(&truth, &raster, exposure)?;
+        let m = metric_values(&comparison.metrics);
+        let heat: Vec<u8> = comparison
+            .flip_map
             .iter()
             .flat_map(|&v| colormap::heat(v))
             .collect();
         if truths.len() == 1 {
+            let mask = read_mask(truth_path).filter(|m| m.len() == raster.pixels.len());
+            let mirror_metrics = mask
+                .as_ref()
+                .and_then(|mask| comparison.masked(&truth, &raster, mask))
+                .map(|m| metric_values(&m));
+            let mirror_pixel_share = mask
+                .as_ref()
+                .map(|m| m.iter().filter(|v| **v).count() as f64 / m.len().max(1) as f64);
             // Mono: the raster's PNG from its linear image, the truth's copied from the cache.
             write_png(&files.raster, &raster, exposure)?;
             write_png_bytes(&files.heat, w, h, &heat)?;
@@ -949,6 +1002,8 @@ fn compare_views(
             })?;
             return Ok(Compared {
                 metrics: m,
+                mirror_metrics,
+                mirror_pixel_share,
                 eyes: None,
             });
         }
@@ -970,7 +1025,7 @@ fn compare_views(
             truth_marker: blob(&truth),
         });
         metrics.push(m);
-        pictures.push([t8, r8, heat]);
+        pictures.push([comparison.reference_srgb8, comparison.test_srgb8, heat]);
     }
     let [[t_l, r_l, h_l], [t_r, r_r, h_r]] = &pictures[..] else {
         unreachable!("a stereo point has two eyes");
@@ -985,6 +1040,8 @@ fn compare_views(
     }
     Ok(Compared {
         metrics: MetricValues::mean(&metrics),
+        mirror_metrics: None,
+        mirror_pixel_share: None,
         eyes: Some(eyes),
     })
 }
@@ -1332,6 +1389,8 @@ pub fn run_sweep(
             paths: s.paths_kept,
             paths_pruned: s.paths_pruned,
             metrics: views.metrics,
+            mirror_metrics: views.mirror_metrics,
+            mirror_pixel_share: views.mirror_pixel_share,
             adapter: s.adapter.clone(),
             backend: s.backend.clone(),
             color_format: s.color_format.clone(),
@@ -1375,6 +1434,8 @@ pub fn run_sweep(
         driver: format!("{} {}", gpu.report.driver, gpu.report.driver_info)
             .trim()
             .to_string(),
+        commit: source_commit(),
+        records_commit: String::new(),
         versions: format!(
             "mirrorbox {}, wgpu 30.0.1, obvhs 0.4.0",
             env!("CARGO_PKG_VERSION")
@@ -1412,4 +1473,25 @@ pub fn run_sweep(
     )?;
     write_report(out, &info, &records)?;
     Ok(summary)
+}
+
+/// The commit of the checkout the running binary was built in (`git describe --always
+/// --dirty`, run beside the executable): what a report's figures name as the code that
+/// measured them. Empty outside a git checkout.
+pub fn source_commit() -> String {
+    let Some(dir) = std::env::current_exe()
+        .ok()
+        .and_then(|e| e.parent().map(Path::to_path_buf))
+    else {
+        return String::new();
+    };
+    std::process::Command::new("git")
+        .arg("-C")
+        .arg(dir)
+        .args(["describe", "--always", "--dirty", "--abbrev=10"])
+        .output()
+        .ok()
+        .filter(|o| o.status.success())
+        .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+        .unwrap_or_default()
 }

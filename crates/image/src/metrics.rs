@@ -14,6 +14,11 @@
 //!   `gaussian_weights=True, sigma=1.5, use_sample_covariance=False, data_range=1`;
 //! - FLIP (NVIDIA's LDR-FLIP through the `nv-flip` crate) at [`FLIP_PIXELS_PER_DEGREE`]: mean
 //!   and the 95th/99th percentiles (nearest rank) of the per-pixel error map.
+//!
+//! [`compare_masked`] gives the same metrics over a subset of the pixels (a mirror mask): the
+//! sums run over the masked pixels only; FLIP's map and SSIM's windows are computed on the
+//! whole images (their filters see the neighbours) and averaged over the masked pixels (SSIM:
+//! the valid windows centred on one).
 
 use crate::RgbImage;
 
@@ -73,6 +78,40 @@ pub fn compare_detailed(
     test: &RgbImage,
     exposure: f32,
 ) -> Result<Comparison, MetricsError> {
+    check_sizes(reference, test)?;
+    let r8 = reference.to_srgb8(exposure);
+    let t8 = test.to_srgb8(exposure);
+    let flip_map = flip_map(&r8, &t8, reference.width, reference.height);
+    let metrics = metrics_over(reference, test, &r8, &t8, &flip_map, None)
+        .expect("an unmasked image has pixels");
+    Ok(Comparison {
+        metrics,
+        reference_srgb8: r8,
+        test_srgb8: t8,
+        flip_map,
+    })
+}
+
+impl Comparison {
+    /// The metrics over the pixels where `mask` (row-major, one per pixel) is true, from the
+    /// images this comparison was made of; `None` when no pixel is, or the mask is not one per
+    /// pixel.
+    pub fn masked(&self, reference: &RgbImage, test: &RgbImage, mask: &[bool]) -> Option<Metrics> {
+        if mask.len() != reference.pixels.len() || reference.pixels.len() != test.pixels.len() {
+            return None;
+        }
+        metrics_over(
+            reference,
+            test,
+            &self.reference_srgb8,
+            &self.test_srgb8,
+            &self.flip_map,
+            Some(mask),
+        )
+    }
+}
+
+fn check_sizes(reference: &RgbImage, test: &RgbImage) -> Result<(), MetricsError> {
     if (reference.width, reference.height) != (test.width, test.height) {
         return Err(MetricsError::SizeMismatch(
             reference.width,
@@ -84,8 +123,26 @@ pub fn compare_detailed(
     if reference.width < MIN_SIDE || reference.height < MIN_SIDE {
         return Err(MetricsError::TooSmall(reference.width, reference.height));
     }
+    Ok(())
+}
+
+/// Every metric over the pixels `mask` keeps (all without one); `None` when it keeps none.
+fn metrics_over(
+    reference: &RgbImage,
+    test: &RgbImage,
+    r8: &[u8],
+    t8: &[u8],
+    flip_map: &[f32],
+    mask: Option<&[bool]>,
+) -> Option<Metrics> {
+    let kept = |i: usize| mask.is_none_or(|m| m[i]);
     let (mut se, mut rel, mut smape, mut max_abs) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
-    for (y, x) in reference.pixels.iter().zip(&test.pixels) {
+    let mut pixels = 0usize;
+    for (i, (y, x)) in reference.pixels.iter().zip(&test.pixels).enumerate() {
+        if !kept(i) {
+            continue;
+        }
+        pixels += 1;
         for c in 0..3 {
             let (x, y) = (x[c] as f64, y[c] as f64);
             let d = x - y;
@@ -95,32 +152,38 @@ pub fn compare_detailed(
             max_abs = max_abs.max(d.abs());
         }
     }
-    let n = (reference.pixels.len() * 3) as f64;
-    let r8 = reference.to_srgb8(exposure);
-    let t8 = test.to_srgb8(exposure);
-    let flip_map = flip_map(&r8, &t8, reference.width, reference.height);
-    let (flip_mean, flip_p95, flip_p99) = flip_stats(&flip_map);
-    let metrics = Metrics {
+    if pixels == 0 {
+        return None;
+    }
+    let n = (pixels * 3) as f64;
+    let bytes = |img: &[u8]| -> Vec<u8> {
+        img.chunks_exact(3)
+            .enumerate()
+            .filter(|(i, _)| kept(*i))
+            .flat_map(|(_, p)| p.iter().copied())
+            .collect()
+    };
+    let flips: Vec<f32> = flip_map
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| kept(*i))
+        .map(|(_, v)| *v)
+        .collect();
+    let (flip_mean, flip_p95, flip_p99) = flip_stats(&flips);
+    let (w, h) = (reference.width as usize, reference.height as usize);
+    Some(Metrics {
         rmse: (se / n).sqrt(),
         relmse: rel / n,
         smape: smape / n,
         max_abs,
-        psnr: psnr(&r8, &t8),
-        ssim: ssim(
-            &r8,
-            &t8,
-            reference.width as usize,
-            reference.height as usize,
-        ),
+        psnr: match mask {
+            None => psnr(r8, t8),
+            Some(_) => psnr(&bytes(r8), &bytes(t8)),
+        },
+        ssim: ssim_over(r8, t8, w, h, mask),
         flip_mean,
         flip_p95,
         flip_p99,
-    };
-    Ok(Comparison {
-        metrics,
-        reference_srgb8: r8,
-        test_srgb8: t8,
-        flip_map,
     })
 }
 
@@ -153,6 +216,12 @@ fn gaussian_11() -> [f64; 11] {
 /// Mean SSIM of two interleaved RGB 8-bit images (values taken as /255), averaged over the
 /// channels, on the valid region.
 pub fn ssim(a: &[u8], b: &[u8], w: usize, h: usize) -> f64 {
+    ssim_over(a, b, w, h, None)
+}
+
+/// [`ssim`] averaged over the valid windows centred on a pixel `mask` keeps (all without
+/// one); NaN where it keeps none of them.
+fn ssim_over(a: &[u8], b: &[u8], w: usize, h: usize, mask: Option<&[bool]>) -> f64 {
     let k = gaussian_11();
     let (c1, c2) = ((0.01f64).powi(2), (0.03f64).powi(2));
     let (vw, vh) = (w - 10, h - 10);
@@ -188,14 +257,20 @@ pub fn ssim(a: &[u8], b: &[u8], w: usize, h: usize) -> f64 {
             filter(&yy),
             filter(&xy),
         );
-        let mut sum = 0.0;
+        let (mut sum, mut windows) = (0.0, 0usize);
         for i in 0..vw * vh {
+            // The window's centre pixel.
+            let centre = (i / vw + 5) * w + i % vw + 5;
+            if mask.is_some_and(|m| !m[centre]) {
+                continue;
+            }
             let (ux, uy) = (mx[i], my[i]);
             let (vx, vy, cxy) = (mxx[i] - ux * ux, myy[i] - uy * uy, mxy[i] - ux * uy);
             sum += ((2.0 * ux * uy + c1) * (2.0 * cxy + c2))
                 / ((ux * ux + uy * uy + c1) * (vx + vy + c2));
+            windows += 1;
         }
-        total += sum / (vw * vh) as f64;
+        total += sum / windows as f64;
     }
     total / 3.0
 }
@@ -225,6 +300,35 @@ pub fn flip_map(reference: &[u8], test: &[u8], w: u32, h: u32) -> Vec<f32> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_mask_restricts_the_error_to_its_pixels() {
+        // Identical images but for the left half: the error over the right half is zero,
+        // over the left half larger than over the whole image.
+        let (w, h) = (32, 24);
+        let reference = pattern(w, h, 1);
+        let mut test = reference.clone();
+        for y in 0..h {
+            for x in 0..w / 2 {
+                test.pixels[(y * w + x) as usize] = [0.9, 0.1, 0.1];
+            }
+        }
+        let c = compare_detailed(&reference, &test, 1.0).unwrap();
+        let left: Vec<bool> = (0..w * h).map(|i| i % w < w / 2).collect();
+        let right: Vec<bool> = left.iter().map(|l| !l).collect();
+        let l = c.masked(&reference, &test, &left).unwrap();
+        let r = c.masked(&reference, &test, &right).unwrap();
+        assert!(l.rmse > c.metrics.rmse && c.metrics.rmse > 0.0);
+        assert_eq!(r.rmse, 0.0);
+        assert!(l.flip_mean > c.metrics.flip_mean);
+        assert!(r.ssim > l.ssim);
+        // Whole image = pixel-weighted mean of the halves (for the mean-type metrics).
+        assert!((c.metrics.flip_mean - (l.flip_mean + r.flip_mean) / 2.0).abs() < 1e-9);
+        assert!(
+            c.masked(&reference, &test, &vec![false; (w * h) as usize])
+                .is_none()
+        );
+    }
 
     fn constant(w: u32, h: u32, v: [f32; 3]) -> RgbImage {
         RgbImage::from_fn(w, h, |_, _| v)

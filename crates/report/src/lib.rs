@@ -10,6 +10,7 @@ pub mod exact;
 mod folder;
 pub mod lighting;
 pub mod motion;
+pub mod overview;
 pub mod plot;
 pub mod readme;
 mod runs;
@@ -207,6 +208,14 @@ pub struct Record {
     #[serde(default)]
     pub paths_pruned: Option<usize>,
     pub metrics: MetricValues,
+    /// The same metrics over the mirror pixels only (the pixels whose primary hit in the truth
+    /// is a mirror, from the tracer's own object ids): where a method's error lives, undiluted
+    /// by the pixels every method gets right. Absent in older records and for stereo points.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mirror_metrics: Option<MetricValues>,
+    /// The share of the image's pixels that are mirror pixels, in [0, 1].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mirror_pixel_share: Option<f64>,
     pub adapter: String,
     pub backend: String,
     /// The colour format of the raster targets (`rgba32float`, or `rgba16float` where the
@@ -283,6 +292,15 @@ pub struct SweepInfo {
     pub scene: String,
     pub resolution: String,
     pub truth: String,
+    /// The commit of the mirrorbox that measured the sweep (`git describe`-style, `-dirty`
+    /// when the tree had changes); empty in sweeps written before it was recorded, where the
+    /// report names the commit that committed the records instead (`records_commit`).
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub commit: String,
+    /// For a sweep without [`SweepInfo::commit`]: the commit that last committed its records,
+    /// found by `mirrorbox report` (not stored).
+    #[serde(skip)]
+    pub records_commit: String,
     /// The exact methods' names, from the raster registry (the report groups them by depth
     /// and sets them beside the paper's method).
     #[serde(default)]
@@ -318,6 +336,24 @@ pub struct ShardInfo {
 }
 
 impl SweepInfo {
+    /// The footer of every chart: scene, size, device, date, commit — what a figure printed
+    /// alone must say about where its numbers come from.
+    pub fn footer(&self) -> String {
+        let size = self.resolution.split(',').next().unwrap_or_default().trim();
+        let date = self.date.get(..10).unwrap_or(&self.date);
+        let commit = if !self.commit.is_empty() {
+            format!("commit {}", self.commit)
+        } else if !self.records_commit.is_empty() {
+            format!("records committed in {}", self.records_commit)
+        } else {
+            "commit not recorded".to_string()
+        };
+        format!(
+            "{} · {size} · {} ({}) on {} · {date} · {commit}",
+            self.scene, self.adapter, self.backend, self.cpu
+        )
+    }
+
     /// "adapter NAME (backend, type[, driver D])": the device a sweep's timings belong to.
     pub fn adapter_description(&self) -> String {
         let driver = if self.driver.trim().is_empty() {

@@ -7,7 +7,7 @@
 //! rasterizer.
 
 use crate::Record;
-use crate::plot::{Chart, Series};
+use crate::plot::{Chart, Series, method_style};
 use crate::write::{Block, f, ms_cell, sci};
 
 /// The raster option that chooses direct or mirrored lights.
@@ -148,26 +148,51 @@ pub(crate) fn lighting_section(records: &[Record]) -> Vec<Block> {
         .max()
         .unwrap_or(0);
     let variants = distinct(points.iter().map(|r| lighting_of(r)));
-    let error_vs_ms: Vec<Series> = variants
-        .iter()
-        .map(|v| {
-            let at_k: Vec<&Record> = points
+    // One series per method and lighting variant at k_max, joined along the method's swept
+    // count (auxiliary's n) — the one variable that varies within a series; a method with
+    // one setting is one marker.
+    let kinds = distinct(points.iter().map(|r| r.method.clone()));
+    let mut error_vs_ms: Vec<Series> = Vec::new();
+    for kind in &kinds {
+        let mut mine: Vec<&Record> = points
+            .iter()
+            .copied()
+            .filter(|r| &r.method == kind && r.mirrored_lights == Some(k_max))
+            .collect();
+        mine.sort_by_key(|r| variant_order(r));
+        for (k, v) in distinct(mine.iter().map(|r| lighting_of(r)))
+            .iter()
+            .enumerate()
+        {
+            let mut at: Vec<&Record> = mine
                 .iter()
                 .copied()
-                .filter(|r| &lighting_of(r) == v && r.mirrored_lights == Some(k_max))
+                .filter(|r| &lighting_of(r) == v)
                 .collect();
-            Series {
-                name: v.clone(),
-                points: at_k
-                    .iter()
+            at.sort_by_key(|r| (r.n, r.depth));
+            let counts = distinct(at.iter().map(|r| method_of(r)));
+            let name = if counts.len() == 1 {
+                format!("{}, {v}", counts[0])
+            } else {
+                format!("{kind}, {v}")
+            };
+            let mut s = Series::new(
+                name,
+                method_style(kind).variant(k),
+                at.iter()
                     .map(|r| (r.ms_median, r.metrics.flip_mean))
                     .collect(),
-                labels: at_k.iter().map(|r| method_of(r)).collect(),
-                x_intervals: at_k.iter().map(|r| r.ms_interval).collect(),
-                y_intervals: Vec::new(),
+            );
+            if counts.len() > 1 {
+                s.labels = at
+                    .iter()
+                    .map(|r| r.n.map_or(String::new(), |n| format!("n={n}")))
+                    .collect();
             }
-        })
-        .collect();
+            s.x_intervals = at.iter().map(|r| r.ms_interval).collect();
+            error_vs_ms.push(s);
+        }
+    }
     let mut out = vec![
         Block::Heading(2, "Lighting: shadows and mirrored lights".into()),
         Block::Paragraph(format!(
@@ -179,32 +204,34 @@ pub(crate) fn lighting_section(records: &[Record]) -> Vec<Block> {
         )),
         Block::Chart(
             "plot_lighting_error_vs_ms.svg".into(),
-            Chart {
-                title: format!("FLIP mean vs ms/frame by lighting variant, k = {k_max}"),
-                x_label: "ms/frame (median, 95 % CI bars)".into(),
-                y_label: "FLIP mean".into(),
+            Box::new(Chart {
                 x_log: true,
                 y_log: true,
                 series: error_vs_ms,
-                reference_lines: Vec::new(),
-            }
-            .to_svg(),
+                ..Chart::new(
+                    format!("Error vs cost of each lighting variant, k = {k_max}"),
+                    "ms/frame (median, 95 % CI bars)",
+                    "FLIP mean over the image",
+                )
+            }),
         ),
     ];
     if let Some(method) = reference_method(&points) {
+        let base = method.split_whitespace().next().unwrap_or_default();
         let series: Vec<Series> = variants
             .iter()
-            .map(|v| {
+            .enumerate()
+            .map(|(i, v)| {
                 let mut pts: Vec<&Record> = points
                     .iter()
                     .copied()
                     .filter(|r| &lighting_of(r) == v && method_of(r) == method)
                     .collect();
                 pts.sort_by_key(|r| r.mirrored_lights);
-                Series {
-                    name: v.clone(),
-                    points: pts
-                        .iter()
+                Series::new(
+                    v.clone(),
+                    method_style(base).variant(i),
+                    pts.iter()
                         .map(|r| {
                             (
                                 f64::from(r.mirrored_lights.unwrap_or(0)),
@@ -212,24 +239,21 @@ pub(crate) fn lighting_section(records: &[Record]) -> Vec<Block> {
                             )
                         })
                         .collect(),
-                    labels: Vec::new(),
-                    x_intervals: Vec::new(),
-                    y_intervals: Vec::new(),
-                }
+                )
             })
             .collect();
         out.push(Block::Chart(
             "plot_lighting_error_vs_k.svg".into(),
-            Chart {
-                title: format!("FLIP mean vs mirrored-light depth k, {method}"),
-                x_label: "k (most mirrors between a light and a surface)".into(),
-                y_label: "FLIP mean".into(),
-                x_log: false,
+            Box::new(Chart {
                 y_log: true,
                 series,
-                reference_lines: Vec::new(),
-            }
-            .to_svg(),
+                x_ticks_at_data: true,
+                ..Chart::new(
+                    format!("Error vs mirrored-light depth k, {method}"),
+                    "k (most mirrors between a light and a surface)",
+                    "FLIP mean over the image",
+                )
+            }),
         ));
     }
     let mut rows: Vec<&Record> = points.clone();

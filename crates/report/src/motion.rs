@@ -3,7 +3,7 @@
 //! camera, its lag under motion, beside the stateless methods. The records come from a
 //! sequence sweep (`mirrorbox_harness::sequence`); this module only reads and writes them.
 
-use crate::plot::{Chart, Series};
+use crate::plot::{Chart, Series, styles_for};
 use crate::stats::median;
 use mirrorbox_files::{FileError, write_atomically_with};
 use serde::{Deserialize, Serialize};
@@ -220,26 +220,34 @@ fn findings(records: &[FrameRecord], scenario: &str, still: bool) -> Vec<String>
 
 /// FLIP against frame, one series per method (log y).
 pub fn chart(records: &[FrameRecord], scenario: &str) -> Chart {
+    let methods = methods(records, scenario);
+    let styles = styles_for(
+        &methods
+            .iter()
+            .map(|m| m.split_whitespace().next().unwrap_or_default())
+            .collect::<Vec<_>>(),
+    );
     Chart {
-        title: format!("FLIP against frame: {scenario}"),
-        x_label: "frame".into(),
-        y_label: "FLIP mean (log)".into(),
-        x_log: false,
         y_log: true,
-        series: methods(records, scenario)
-            .into_iter()
-            .map(|m| Series {
-                name: m.to_string(),
-                points: frames(records, scenario, m)
-                    .iter()
-                    .map(|r| (f64::from(r.frame), r.flip_mean.max(1e-6)))
-                    .collect(),
-                labels: Vec::new(),
-                x_intervals: Vec::new(),
-                y_intervals: Vec::new(),
+        series: methods
+            .iter()
+            .zip(styles)
+            .map(|(m, style)| {
+                Series::new(
+                    m.to_string(),
+                    style,
+                    frames(records, scenario, m)
+                        .iter()
+                        .map(|r| (f64::from(r.frame), r.flip_mean.max(1e-6)))
+                        .collect(),
+                )
             })
             .collect(),
-        reference_lines: Vec::new(),
+        ..Chart::new(
+            format!("Error per frame: {scenario}"),
+            "frame",
+            "FLIP mean over the image (log)",
+        )
     }
 }
 
@@ -272,7 +280,19 @@ pub fn write_motion_report(
     for s in &info.scenarios {
         write_text(
             &dir.join(format!("plot_{}.svg", s.name)),
-            &chart(records, &s.name).to_svg(),
+            &Chart {
+                footer: format!(
+                    "{} · {}x{} · {} on {} · {}",
+                    s.scene,
+                    info.width,
+                    info.height,
+                    info.device,
+                    info.cpu,
+                    info.date.get(..10).unwrap_or(&info.date)
+                ),
+                ..chart(records, &s.name)
+            }
+            .to_svg(),
         )?;
     }
     write_text(&dir.join("report.md"), &document(info, records))

@@ -1,18 +1,169 @@
-//! Small SVG line charts (log or linear axes, markers, legend, horizontal reference lines).
-//! Hand-written to keep the report free of font and rendering dependencies.
+//! The reports' SVG charts: one question per chart, one fixed style per method.
+//!
+//! Rules every chart follows (issue 38), enforced here rather than by each report section:
+//! - a method has one colour and one marker in every report ([`method_style`]); a variant of a
+//!   method (its options, α, a lighting or stereo variant) keeps them and changes the dash and
+//!   the marker's fill ([`Style::variant`]); the colours are Okabe and Ito's colour-blind-safe set;
+//! - a series is joined by a line only when its points are one variable swept
+//!   ([`Series::joined`]); otherwise it is markers only;
+//! - log axes are tight to the data (not rounded out to whole decades); the comparison's floor
+//!   is an annotation (a shaded band, or a note when it lies far below the data), never a
+//!   reason to stretch the axis;
+//! - reference curves (2^p, one full-scene pass) are dashed grey and named "reference: …";
+//! - point labels never overprint: a label that would touch another is left out;
+//! - markers of series that coincide are drawn as rings around each other, and the legend says
+//!   which series it coincides with;
+//! - a footer names the scene, size, device, date and commit ([`Chart::footer`]);
+//! - a chart with fewer than two distinct x is not drawn at all ([`Chart::is_drawable`]).
+//!
+//! Hand-written rather than `plotters`: these rules are most of the code either way, the
+//! text needs no font files (plotters' SVG backend measures text with a font backend or not
+//! at all), and the test build's budget (≤ 10 min on 2 cores) has no room for another
+//! dependency tree.
 
 use std::fmt::Write;
+
+/// Okabe & Ito's palette without its yellow (too light on white), plus a dark grey.
+const COLORS: [&str; 7] = [
+    "#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#333333",
+];
+/// Reference curves and floors.
+const REFERENCE_GREY: &str = "#888888";
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Marker {
+    Circle,
+    Square,
+    TriangleUp,
+    Diamond,
+    TriangleDown,
+    Cross,
+    Plus,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Style {
+    pub color: &'static str,
+    pub marker: Marker,
+    /// SVG `stroke-dasharray` of the series' line; empty for solid.
+    pub dash: &'static str,
+    /// Hollow markers (a method's variants after its first).
+    pub hollow: bool,
+}
+
+const DASHES: [&str; 4] = ["", "7 4", "2 3", "8 3 2 3"];
+
+impl Style {
+    /// The `k`-th variant of a method: same colour and marker, another dash, hollow markers
+    /// from the second variant on.
+    pub fn variant(self, k: usize) -> Style {
+        Style {
+            dash: DASHES[k % DASHES.len()],
+            // Eight distinct (dash, fill) pairs before one repeats.
+            hollow: (k + k / DASHES.len()) % 2 == 1,
+            ..self
+        }
+    }
+}
+
+/// The fixed style of every raster method (and the truth), the same in every report. A name
+/// not in the table (a method added later) gets a style from its name's hash, in grey's place
+/// never: the table is the place to give a new method its own.
+pub fn method_style(method: &str) -> Style {
+    use Marker::*;
+    let (color, marker) = match method {
+        "naive" => (COLORS[4], TriangleDown),
+        "auxiliary" => (COLORS[1], Circle),
+        "path-textures" => (COLORS[3], Diamond),
+        "portal" => (COLORS[2], Square),
+        "unrolled" => (COLORS[0], Plus),
+        "symmetry" => (COLORS[5], Circle),
+        "symmetry-pruned" => (COLORS[3], TriangleUp),
+        "symmetry-baked" => (COLORS[4], Square),
+        "feedback" => (COLORS[5], Diamond),
+        "cubemap" => (COLORS[3], Cross),
+        "ssr" => (COLORS[1], Square),
+        "ray-query" => (COLORS[2], TriangleUp),
+        "truth" => (COLORS[6], Cross),
+        other => {
+            let h = other
+                .bytes()
+                .fold(0u32, |h, b| h.wrapping_mul(31).wrapping_add(u32::from(b)));
+            let markers = [
+                Circle,
+                Square,
+                TriangleUp,
+                Diamond,
+                TriangleDown,
+                Cross,
+                Plus,
+            ];
+            (
+                COLORS[h as usize % 6],
+                markers[(h / 7) as usize % markers.len()],
+            )
+        }
+    };
+    Style {
+        color,
+        marker,
+        dash: "",
+        hollow: false,
+    }
+}
+
+/// The styles of a chart's series, given each series' method in order: the method's style,
+/// its `k`-th variant for the `k`-th series of the same method.
+pub fn styles_for(methods: &[&str]) -> Vec<Style> {
+    methods
+        .iter()
+        .enumerate()
+        .map(|(i, m)| {
+            let k = methods[..i].iter().filter(|o| *o == m).count();
+            method_style(m).variant(k)
+        })
+        .collect()
+}
 
 pub struct Series {
     pub name: String,
     pub points: Vec<(f64, f64)>,
-    /// A short label drawn beside each point (e.g. "n=2"); empty for none.
+    /// A short label drawn beside each point (e.g. "n=2"); empty for none. Left out where it
+    /// would touch another label.
     pub labels: Vec<String>,
     /// An interval around each point's x (e.g. a 95 % confidence interval of a median time),
     /// drawn as a horizontal error bar; empty, or `None` for a point without one.
     pub x_intervals: Vec<Option<[f64; 2]>>,
     /// The same for y, drawn as a vertical error bar.
     pub y_intervals: Vec<Option<[f64; 2]>>,
+    pub style: Style,
+    /// Joined by a line, in the order given: only when the points are one variable swept
+    /// (n, depth, p, tilt, IPD), never across methods or unrelated settings.
+    pub joined: bool,
+}
+
+impl Series {
+    /// A joined series in `style` with no labels and no error bars.
+    pub fn new(name: impl Into<String>, style: Style, points: Vec<(f64, f64)>) -> Series {
+        Series {
+            name: name.into(),
+            points,
+            labels: Vec::new(),
+            x_intervals: Vec::new(),
+            y_intervals: Vec::new(),
+            style,
+            joined: true,
+        }
+    }
+}
+
+/// A reference the data are read against — not a measurement: drawn dashed grey, named
+/// "reference: …" in the legend.
+pub enum Reference {
+    /// A horizontal line across the plot.
+    Level(String, f64),
+    /// A curve through points (e.g. 2^p × a base time).
+    Curve(String, Vec<(f64, f64)>),
 }
 
 pub struct Chart {
@@ -22,31 +173,86 @@ pub struct Chart {
     pub x_log: bool,
     pub y_log: bool,
     pub series: Vec<Series>,
-    /// Dashed horizontal lines: (name, y).
-    pub reference_lines: Vec<(String, f64)>,
+    pub references: Vec<Reference>,
+    /// The comparison's floor (raster vs trace without mirrors): errors at or below it are not
+    /// resolved. Shaded from the bottom of the plot up to it, or noted under the plot when it
+    /// lies below the axis.
+    pub floor: Option<f64>,
+    /// Ticks at the data's distinct x (n, depth, p) instead of round numbers.
+    pub x_ticks_at_data: bool,
+    /// Scene, size, device, date and commit; set by the report writer for every chart.
+    pub footer: String,
 }
 
-const PALETTE: [&str; 8] = [
-    "#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#e377c2", "#17becf",
-];
+impl Chart {
+    /// A chart with no series yet, log axes as given, no footer.
+    pub fn new(
+        title: impl Into<String>,
+        x_label: impl Into<String>,
+        y_label: impl Into<String>,
+    ) -> Chart {
+        Chart {
+            title: title.into(),
+            x_label: x_label.into(),
+            y_label: y_label.into(),
+            x_log: false,
+            y_log: false,
+            series: Vec::new(),
+            references: Vec::new(),
+            floor: None,
+            x_ticks_at_data: false,
+            footer: String::new(),
+        }
+    }
+
+    /// The distinct drawable x of the chart's series.
+    fn distinct_x(&self) -> Vec<f64> {
+        let mut xs: Vec<f64> = self
+            .series
+            .iter()
+            .flat_map(|s| s.points.iter())
+            .filter(|(x, y)| drawable(*x, self.x_log) && drawable(*y, self.y_log))
+            .map(|p| p.0)
+            .collect();
+        xs.sort_by(f64::total_cmp);
+        xs.dedup();
+        xs
+    }
+
+    /// A chart answers a question about a variable only where the variable takes two values:
+    /// one x draws a vertical stack of points, which says nothing the table does not.
+    pub fn is_drawable(&self) -> bool {
+        self.distinct_x().len() >= 2
+    }
+}
+
 /// Width of the plot area; the legend's column is added to its right, as wide as its longest
 /// entry needs.
 const PLOT_W: f64 = 450.0;
-const H: f64 = 420.0;
+const PLOT_H: f64 = 330.0;
 const LEFT: f64 = 80.0;
 /// Approximate advance of one character of the 12 px sans-serif legend text.
 const LEGEND_CHAR_W: f64 = 7.0;
+/// Approximate advance of one character of the 10 px label and footer text.
+const SMALL_CHAR_W: f64 = 6.2;
 /// The legend column: its margin, the sample line and the gap before the text.
 const LEGEND_PAD: f64 = 14.0 + 28.0 + 10.0;
+const LEGEND_ROW: f64 = 18.0;
 const TOP: f64 = 40.0;
+/// Below the plot: tick labels, the axis label, the floor note and the footer.
+const BOTTOM: f64 = 92.0;
 /// Half-length of an error bar's end caps, px.
 const ERROR_CAP: f64 = 4.0;
-const BOTTOM: f64 = 50.0;
+const MARKER_R: f64 = 4.0;
 
 fn esc(s: &str) -> String {
     s.replace('&', "&amp;")
         .replace('<', "&lt;")
         .replace('>', "&gt;")
+}
+
+fn drawable(v: f64, log: bool) -> bool {
+    v.is_finite() && (!log || v > 0.0)
 }
 
 struct Axis {
@@ -56,24 +262,31 @@ struct Axis {
 }
 
 impl Axis {
+    /// Tight to the values: a log axis pads 4 % of its span in decades on each side (at least a
+    /// factor 1.15), a linear one 6 %, starting at 0 where the values are non-negative and
+    /// close to it.
     fn new(values: impl Iterator<Item = f64>, log: bool) -> Axis {
-        let v: Vec<f64> = values
-            .filter(|x| x.is_finite() && (!log || *x > 0.0))
-            .collect();
-        let (mut lo, mut hi) = v
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+        let (mut lo, mut hi) = values
+            .filter(|x| drawable(*x, log))
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
                 (a.min(x), b.max(x))
             });
         if !lo.is_finite() {
             (lo, hi) = if log { (0.1, 10.0) } else { (0.0, 1.0) };
         }
         if log {
-            lo = 10f64.powf(lo.log10().floor());
-            hi = 10f64.powf(hi.log10().ceil().max(lo.log10() + 1.0));
+            let (a, b) = (lo.log10(), hi.log10());
+            let pad = ((b - a) * 0.04).max(0.06);
+            lo = 10f64.powf(a - pad);
+            hi = 10f64.powf(b + pad);
         } else {
-            let pad = ((hi - lo) * 0.08).max(1e-12);
-            lo = if lo >= 0.0 && lo - pad < 0.0 {
+            let span = hi - lo;
+            let pad = if span > 0.0 {
+                span * 0.06
+            } else {
+                lo.abs().max(1.0) * 0.1
+            };
+            lo = if lo >= 0.0 && lo - pad < 0.0 || (lo > 0.0 && lo < span * 0.25) {
                 0.0
             } else {
                 lo - pad
@@ -89,13 +302,31 @@ impl Axis {
             (x - self.lo) / (self.hi - self.lo)
         }
     }
+    fn contains(&self, v: f64) -> bool {
+        drawable(v, self.log) && (-1e-9..=1.0 + 1e-9).contains(&self.t(v))
+    }
     fn ticks(&self) -> Vec<f64> {
         if self.log {
+            // Decades; where fewer than two fall inside, the 2× and 5× steps as well.
             let (a, b) = (
-                self.lo.log10().round() as i32,
-                self.hi.log10().round() as i32,
+                self.lo.log10().floor() as i32,
+                self.hi.log10().ceil() as i32,
             );
-            (a..=b).map(|e| 10f64.powi(e)).collect()
+            let decades: Vec<f64> = (a..=b)
+                .map(|e| 10f64.powi(e))
+                .filter(|&v| self.contains(v))
+                .collect();
+            if decades.len() >= 2 {
+                return decades;
+            }
+            let mut out: Vec<f64> = (a..=b)
+                .flat_map(|e| [1.0, 2.0, 5.0].map(|m| m * 10f64.powi(e)))
+                .filter(|&v| self.contains(v))
+                .collect();
+            if out.len() < 2 {
+                out = vec![self.lo * 1.02, (self.lo * self.hi).sqrt(), self.hi / 1.02];
+            }
+            out
         } else {
             let raw = (self.hi - self.lo) / 5.0;
             let mag = 10f64.powf(raw.log10().floor());
@@ -115,76 +346,283 @@ impl Axis {
     }
 }
 
-fn fmt_tick(v: f64) -> String {
+/// A tick or annotation value, with as few digits as it needs.
+pub fn fmt_tick(v: f64) -> String {
     if v == 0.0 {
         "0".into()
-    } else if v.abs() >= 1e4 || v.abs() < 1e-3 {
-        format!("{v:.0e}")
+    } else if v.abs() >= 1e4 || v.abs() < 1e-2 {
+        let s = format!("{v:.1e}");
+        s.replace(".0e", "e")
     } else {
-        let s = format!("{v:.4}");
+        let s = format!("{v:.3}");
         s.trim_end_matches('0').trim_end_matches('.').to_string()
     }
 }
 
+/// An axis-aligned box in pixels, for keeping labels apart.
+#[derive(Clone, Copy)]
+struct Rect {
+    x0: f64,
+    y0: f64,
+    x1: f64,
+    y1: f64,
+}
+
+impl Rect {
+    fn overlaps(&self, o: &Rect) -> bool {
+        self.x0 < o.x1 && o.x0 < self.x1 && self.y0 < o.y1 && o.y0 < self.y1
+    }
+}
+
+fn marker_svg(s: &mut String, style: &Style, x: f64, y: f64, r: f64, hollow: bool) {
+    let c = style.color;
+    let (fill, stroke) = if hollow {
+        (
+            "white".to_string(),
+            format!(r#"stroke="{c}" stroke-width="1.6""#),
+        )
+    } else {
+        (c.to_string(), format!(r#"stroke="{c}" stroke-width="1""#))
+    };
+    let _ = match style.marker {
+        Marker::Circle => writeln!(
+            s,
+            r#"<circle cx="{x:.1}" cy="{y:.1}" r="{r:.1}" fill="{fill}" {stroke}/>"#
+        ),
+        Marker::Square => writeln!(
+            s,
+            r#"<rect x="{:.1}" y="{:.1}" width="{:.1}" height="{:.1}" fill="{fill}" {stroke}/>"#,
+            x - r * 0.9,
+            y - r * 0.9,
+            r * 1.8,
+            r * 1.8
+        ),
+        Marker::TriangleUp | Marker::TriangleDown | Marker::Diamond => {
+            let k = r * 1.25;
+            let pts = match style.marker {
+                Marker::TriangleUp => {
+                    [(x, y - k), (x + k, y + k * 0.8), (x - k, y + k * 0.8)].to_vec()
+                }
+                Marker::TriangleDown => {
+                    [(x, y + k), (x + k, y - k * 0.8), (x - k, y - k * 0.8)].to_vec()
+                }
+                _ => [(x, y - k), (x + k, y), (x, y + k), (x - k, y)].to_vec(),
+            };
+            let p: Vec<String> = pts.iter().map(|(a, b)| format!("{a:.1},{b:.1}")).collect();
+            writeln!(
+                s,
+                r#"<polygon points="{}" fill="{fill}" {stroke}/>"#,
+                p.join(" ")
+            )
+        }
+        Marker::Cross | Marker::Plus => {
+            let k = r * 1.1;
+            let d = if style.marker == Marker::Cross {
+                format!(
+                    "M{:.1},{:.1}L{:.1},{:.1}M{:.1},{:.1}L{:.1},{:.1}",
+                    x - k,
+                    y - k,
+                    x + k,
+                    y + k,
+                    x - k,
+                    y + k,
+                    x + k,
+                    y - k
+                )
+            } else {
+                format!(
+                    "M{:.1},{y:.1}H{:.1}M{x:.1},{:.1}V{:.1}",
+                    x - k * 1.2,
+                    x + k * 1.2,
+                    y - k * 1.2,
+                    y + k * 1.2
+                )
+            };
+            writeln!(
+                s,
+                r#"<path d="{d}" stroke="{c}" stroke-width="{}" fill="none"/>"#,
+                if hollow { 1.4 } else { 2.2 }
+            )
+        }
+    };
+}
+
+/// Splits `text` into lines of at most `max` characters at spaces.
+fn wrap(text: &str, max: usize) -> Vec<String> {
+    let mut lines = vec![String::new()];
+    for word in text.split(' ') {
+        let last = lines.last_mut().expect("one line");
+        if !last.is_empty() && last.chars().count() + 1 + word.chars().count() > max {
+            lines.push(word.to_string());
+        } else {
+            if !last.is_empty() {
+                last.push(' ');
+            }
+            last.push_str(word);
+        }
+    }
+    lines
+}
+
 impl Chart {
     pub fn to_svg(&self) -> String {
-        // The axes span the points and their error bars.
+        // The axes span the points, their error bars and the reference curves' points that
+        // lie within the data's x (a reference never widens x).
         let bounds = |i: &[Option<[f64; 2]>]| -> Vec<f64> {
             i.iter().flatten().flatten().copied().collect()
         };
-        let xs = self
+        let xs: Vec<f64> = self
             .series
             .iter()
-            .flat_map(|s| s.points.iter().map(|p| p.0).chain(bounds(&s.x_intervals)));
-        let ys = self
+            .flat_map(|s| s.points.iter().map(|p| p.0).chain(bounds(&s.x_intervals)))
+            .collect();
+        let ax = Axis::new(xs.iter().copied(), self.x_log);
+        let ys: Vec<f64> = self
             .series
             .iter()
             .flat_map(|s| s.points.iter().map(|p| p.1).chain(bounds(&s.y_intervals)))
-            .chain(self.reference_lines.iter().map(|r| r.1));
-        let (ax, ay) = (Axis::new(xs, self.x_log), Axis::new(ys, self.y_log));
-        let legend_chars = self
-            .series
+            .collect();
+        let data_lo = ys
             .iter()
-            .map(|s| s.name.chars().count())
-            .chain(
-                self.reference_lines
+            .copied()
+            .filter(|v| drawable(*v, self.y_log))
+            .fold(f64::INFINITY, f64::min);
+        // The floor joins the y range only when it is near the data (within a factor 10 on a
+        // log axis); otherwise it is a note under the plot.
+        let floor_near = self.floor.filter(|&f| {
+            drawable(f, self.y_log) && (!self.y_log || !data_lo.is_finite() || f >= data_lo / 10.0)
+        });
+        let ay = Axis::new(
+            ys.iter().copied().chain(floor_near).chain(
+                self.references
                     .iter()
-                    .map(|(n, y)| n.chars().count() + 3 + fmt_tick(*y).len() + " (off axis)".len()),
+                    .flat_map(|r| match r {
+                        Reference::Level(_, y) => vec![*y],
+                        Reference::Curve(_, pts) => pts
+                            .iter()
+                            .filter(|p| ax.contains(p.0))
+                            .map(|p| p.1)
+                            .collect(),
+                    })
+                    .filter(|y| !data_lo.is_finite() || !self.y_log || *y >= data_lo / 100.0),
+            ),
+            self.y_log,
+        );
+
+        // Legend entries: series (with a note where one coincides with an earlier one), then
+        // references.
+        let px_of = |x: f64| LEFT + ax.t(x) * PLOT_W;
+        let py_of = |y: f64| TOP + (1.0 - ay.t(y)) * PLOT_H;
+        let key = |(x, y): (f64, f64)| {
+            (
+                (px_of(x) / 2.0).round() as i64,
+                (py_of(y) / 2.0).round() as i64,
             )
+        };
+        let visible = |s: &Series| -> Vec<(f64, f64)> {
+            s.points
+                .iter()
+                .copied()
+                .filter(|(x, y)| drawable(*x, ax.log) && drawable(*y, ay.log))
+                .collect()
+        };
+        let mut legend: Vec<(String, Option<&Series>)> = Vec::new();
+        for (i, series) in self.series.iter().enumerate() {
+            let mine: Vec<_> = visible(series).into_iter().map(key).collect();
+            let same = self.series[..i].iter().find(|o| {
+                let theirs: Vec<_> = visible(o).into_iter().map(key).collect();
+                !mine.is_empty() && mine.iter().all(|k| theirs.contains(k))
+            });
+            let name = match same {
+                Some(o) => format!("{} (on {})", series.name, o.name),
+                None => series.name.clone(),
+            };
+            legend.push((name, Some(series)));
+        }
+        for r in &self.references {
+            let name = match r {
+                Reference::Level(n, _) | Reference::Curve(n, _) => format!("reference: {n}"),
+            };
+            legend.push((name, None));
+        }
+        let legend_chars = legend
+            .iter()
+            .map(|(n, _)| n.chars().count())
             .max()
             .unwrap_or(0);
-        let (pw, ph) = (PLOT_W, H - TOP - BOTTOM);
-        let w = (LEFT + pw + LEGEND_PAD + LEGEND_CHAR_W * legend_chars as f64).ceil();
-        let px = |x: f64| LEFT + ax.t(x) * pw;
-        let py = |y: f64| TOP + (1.0 - ay.t(y)) * ph;
+        let w = (LEFT + PLOT_W + LEGEND_PAD + LEGEND_CHAR_W * legend_chars as f64)
+            .ceil()
+            .max(LEFT + PLOT_W + 40.0);
+        let footer_lines = wrap(&self.footer, ((w - 20.0) / SMALL_CHAR_W) as usize);
+        let legend_bottom = TOP + 10.0 + LEGEND_ROW * legend.len() as f64;
+        let h = (TOP + PLOT_H + BOTTOM + 12.0 * footer_lines.len().saturating_sub(1) as f64)
+            .max(legend_bottom + 20.0)
+            .ceil();
+
         let mut s = String::new();
         let _ = writeln!(
             s,
-            r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{H}" viewBox="0 0 {w} {H}" font-family="sans-serif" font-size="12">"#
+            r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" viewBox="0 0 {w} {h}" font-family="sans-serif" font-size="12">"#
         );
-        let _ = writeln!(s, r#"<rect width="{w}" height="{H}" fill="white"/>"#);
+        let _ = writeln!(s, r#"<rect width="{w}" height="{h}" fill="white"/>"#);
         let _ = writeln!(
             s,
             r#"<text x="{}" y="22" text-anchor="middle" font-size="15">{}</text>"#,
-            LEFT + pw / 2.0,
+            LEFT + PLOT_W / 2.0,
             esc(&self.title)
         );
-        for t in ax.ticks() {
-            let x = px(t);
+        // The floor band first, under everything.
+        let mut floor_note = None;
+        if let Some(f) = self.floor.filter(|f| drawable(*f, ay.log)) {
+            if ay.t(f) > 0.0 {
+                let yf = py_of(f.min(ay.hi));
+                let _ = writeln!(
+                    s,
+                    r##"<rect x="{LEFT}" y="{yf:.1}" width="{PLOT_W}" height="{:.1}" fill="#000" fill-opacity="0.07"/>"##,
+                    TOP + PLOT_H - yf
+                );
+                let _ = writeln!(
+                    s,
+                    r##"<text x="{:.1}" y="{:.1}" font-size="10" fill="#555" text-anchor="end">floor (no mirrors) {}: not resolved below</text>"##,
+                    LEFT + PLOT_W - 4.0,
+                    (yf + 11.0).min(TOP + PLOT_H - 3.0),
+                    fmt_tick(f)
+                );
+            } else {
+                floor_note = Some(format!(
+                    "floor of the comparison (no mirrors): {}, below the axis",
+                    fmt_tick(f)
+                ));
+            }
+        }
+        let x_ticks: Vec<f64> = if self.x_ticks_at_data {
+            // Thinned so that labels ~40 px apart never touch.
+            let mut out: Vec<f64> = Vec::new();
+            for x in self.distinct_x() {
+                if out.last().is_none_or(|&l| px_of(x) - px_of(l) >= 28.0) {
+                    out.push(x);
+                }
+            }
+            out
+        } else {
+            ax.ticks()
+        };
+        for t in x_ticks {
+            let x = px_of(t);
             let _ = writeln!(
                 s,
                 r##"<line x1="{x:.1}" y1="{TOP}" x2="{x:.1}" y2="{:.1}" stroke="#e5e5e5"/><text x="{x:.1}" y="{:.1}" text-anchor="middle">{}</text>"##,
-                TOP + ph,
-                TOP + ph + 16.0,
+                TOP + PLOT_H,
+                TOP + PLOT_H + 16.0,
                 fmt_tick(t)
             );
         }
         for t in ay.ticks() {
-            let y = py(t);
+            let y = py_of(t);
             let _ = writeln!(
                 s,
                 r##"<line x1="{LEFT}" y1="{y:.1}" x2="{:.1}" y2="{y:.1}" stroke="#e5e5e5"/><text x="{:.1}" y="{:.1}" text-anchor="end">{}</text>"##,
-                LEFT + pw,
+                LEFT + PLOT_W,
                 LEFT - 6.0,
                 y + 4.0,
                 fmt_tick(t)
@@ -192,82 +630,102 @@ impl Chart {
         }
         let _ = writeln!(
             s,
-            r#"<rect x="{LEFT}" y="{TOP}" width="{pw}" height="{ph}" fill="none" stroke="black"/>"#
+            r#"<rect x="{LEFT}" y="{TOP}" width="{PLOT_W}" height="{PLOT_H}" fill="none" stroke="black"/>"#
         );
         let _ = writeln!(
             s,
             r#"<text x="{:.1}" y="{:.1}" text-anchor="middle">{}</text>"#,
-            LEFT + pw / 2.0,
-            H - 12.0,
+            LEFT + PLOT_W / 2.0,
+            TOP + PLOT_H + 36.0,
             esc(&self.x_label)
         );
         let _ = writeln!(
             s,
             r#"<text x="18" y="{:.1}" text-anchor="middle" transform="rotate(-90 18 {:.1})">{}</text>"#,
-            TOP + ph / 2.0,
-            TOP + ph / 2.0,
+            TOP + PLOT_H / 2.0,
+            TOP + PLOT_H / 2.0,
             esc(&self.y_label)
         );
-        let mut legend_y = TOP + 10.0;
-        let lx = LEFT + pw + 14.0;
-        for (name, y) in &self.reference_lines {
-            if !(y.is_finite() && (!ay.log || *y > 0.0)) {
-                // Not drawable (e.g. 0 on a log axis): say so in the legend.
+        let mut below = TOP + PLOT_H + 54.0;
+        if let Some(note) = floor_note {
+            let _ = writeln!(
+                s,
+                r##"<text x="{LEFT}" y="{below:.1}" font-size="10" fill="#555">{}</text>"##,
+                esc(&note)
+            );
+        }
+        below += 16.0;
+        for line in &footer_lines {
+            let _ = writeln!(
+                s,
+                r##"<text x="10" y="{below:.1}" font-size="10" fill="#777">{}</text>"##,
+                esc(line)
+            );
+            below += 12.0;
+        }
+
+        // Clip the data to the plot area.
+        let _ = writeln!(
+            s,
+            r#"<clipPath id="plot"><rect x="{LEFT}" y="{TOP}" width="{PLOT_W}" height="{PLOT_H}"/></clipPath><g clip-path="url(#plot)">"#
+        );
+        for r in &self.references {
+            let pts: Vec<(f64, f64)> = match r {
+                Reference::Level(_, y) if drawable(*y, ay.log) => {
+                    vec![(ax.lo, *y), (ax.hi, *y)]
+                }
+                Reference::Level(..) => Vec::new(),
+                Reference::Curve(_, pts) => pts
+                    .iter()
+                    .copied()
+                    .filter(|(x, y)| drawable(*x, ax.log) && drawable(*y, ay.log))
+                    .collect(),
+            };
+            if pts.len() >= 2 {
+                let p: Vec<String> = pts
+                    .iter()
+                    .map(|&(x, y)| format!("{:.1},{:.1}", px_of(x), py_of(y)))
+                    .collect();
                 let _ = writeln!(
                     s,
-                    r##"<text x="{lx}" y="{}">{} = {} (off axis)</text>"##,
-                    legend_y + 4.0,
-                    esc(name),
-                    fmt_tick(*y)
+                    r#"<polyline points="{}" fill="none" stroke="{REFERENCE_GREY}" stroke-width="1.5" stroke-dasharray="5 4"/>"#,
+                    p.join(" ")
                 );
-                legend_y += 18.0;
-                continue;
             }
-            let yy = py(*y);
-            let _ = writeln!(
-                s,
-                r##"<line x1="{LEFT}" y1="{yy:.1}" x2="{:.1}" y2="{yy:.1}" stroke="#555" stroke-dasharray="6 4"/>"##,
-                LEFT + pw
-            );
-            let _ = writeln!(
-                s,
-                r##"<line x1="{lx}" y1="{legend_y}" x2="{}" y2="{legend_y}" stroke="#555" stroke-dasharray="6 4"/><text x="{}" y="{}">{}</text>"##,
-                lx + 22.0,
-                lx + 28.0,
-                legend_y + 4.0,
-                esc(name)
-            );
-            legend_y += 18.0;
         }
-        for (i, series) in self.series.iter().enumerate() {
-            let color = PALETTE[i % PALETTE.len()];
-            let pts: Vec<(f64, f64)> = series
-                .points
-                .iter()
-                .copied()
-                .filter(|(x, y)| {
-                    x.is_finite() && y.is_finite() && (!ax.log || *x > 0.0) && (!ay.log || *y > 0.0)
-                })
-                .collect();
-            let path: Vec<String> = pts
-                .iter()
-                .map(|&(x, y)| format!("{:.1},{:.1}", px(x), py(y)))
-                .collect();
-            let _ = writeln!(
-                s,
-                r#"<polyline points="{}" fill="none" stroke="{color}" stroke-width="2"/>"#,
-                path.join(" ")
-            );
+        // Lines, then error bars, then markers (rings where an earlier marker sits), then
+        // labels that touch no other.
+        for series in &self.series {
+            let pts = visible(series);
+            if series.joined && pts.len() >= 2 {
+                let p: Vec<String> = pts
+                    .iter()
+                    .map(|&(x, y)| format!("{:.1},{:.1}", px_of(x), py_of(y)))
+                    .collect();
+                let dash = if series.style.dash.is_empty() {
+                    String::new()
+                } else {
+                    format!(r#" stroke-dasharray="{}""#, series.style.dash)
+                };
+                let _ = writeln!(
+                    s,
+                    r#"<polyline points="{}" fill="none" stroke="{}" stroke-width="1.8"{dash}/>"#,
+                    p.join(" "),
+                    series.style.color
+                );
+            }
+        }
+        for series in &self.series {
+            let color = series.style.color;
             for (k, &(x, y)) in series.points.iter().enumerate() {
-                if !pts.contains(&(x, y)) {
+                if !(drawable(x, ax.log) && drawable(y, ay.log)) {
                     continue;
                 }
-                let drawable = |v: f64, log: bool| v.is_finite() && (!log || v > 0.0);
                 if let Some([lo, hi]) = series.x_intervals.get(k).copied().flatten()
                     && drawable(lo, ax.log)
                     && drawable(hi, ax.log)
                 {
-                    let (x0, x1, yy) = (px(lo), px(hi), py(y));
+                    let (x0, x1, yy) = (px_of(lo), px_of(hi), py_of(y));
                     let _ = writeln!(
                         s,
                         r#"<path d="M{x0:.1},{yy:.1}H{x1:.1}M{x0:.1},{:.1}V{:.1}M{x1:.1},{:.1}V{:.1}" stroke="{color}" stroke-width="1.2" fill="none"/>"#,
@@ -281,7 +739,7 @@ impl Chart {
                     && drawable(lo, ay.log)
                     && drawable(hi, ay.log)
                 {
-                    let (y0, y1, xx) = (py(lo), py(hi), px(x));
+                    let (y0, y1, xx) = (py_of(lo), py_of(hi), px_of(x));
                     let _ = writeln!(
                         s,
                         r#"<path d="M{xx:.1},{y0:.1}V{y1:.1}M{:.1},{y0:.1}H{:.1}M{:.1},{y1:.1}H{:.1}" stroke="{color}" stroke-width="1.2" fill="none"/>"#,
@@ -291,31 +749,131 @@ impl Chart {
                         xx + ERROR_CAP
                     );
                 }
-                let _ = writeln!(
-                    s,
-                    r#"<circle cx="{:.1}" cy="{:.1}" r="3.5" fill="{color}"/>"#,
-                    px(x),
-                    py(y)
-                );
-                if let Some(label) = series.labels.get(k).filter(|l| !l.is_empty()) {
+            }
+        }
+        let mut occupied: Vec<((i64, i64), usize)> = Vec::new();
+        let mut taken: Vec<Rect> = Vec::new();
+        let mut label_queue: Vec<(f64, f64, f64, &str, &'static str)> = Vec::new();
+        for series in &self.series {
+            for (k, &(x, y)) in series.points.iter().enumerate() {
+                if !(drawable(x, ax.log) && drawable(y, ay.log)) {
+                    continue;
+                }
+                let spot = key((x, y));
+                let under = match occupied.iter_mut().find(|(p, _)| *p == spot) {
+                    Some((_, n)) => {
+                        *n += 1;
+                        *n - 1
+                    }
+                    None => {
+                        occupied.push((spot, 1));
+                        0
+                    }
+                };
+                let r = MARKER_R + 2.6 * under as f64;
+                // A marker over an earlier one is a ring around it, so both show.
+                let (xx, yy) = (px_of(x), py_of(y));
+                if under > 0 {
                     let _ = writeln!(
                         s,
-                        r#"<text x="{:.1}" y="{:.1}" font-size="10" fill="{color}">{}</text>"#,
-                        px(x) + 5.0,
-                        py(y) - 5.0,
-                        esc(label)
+                        r#"<circle cx="{xx:.1}" cy="{yy:.1}" r="{:.1}" fill="none" stroke="{}" stroke-width="1.6"/>"#,
+                        r + 1.5,
+                        series.style.color
+                    );
+                } else {
+                    marker_svg(&mut s, &series.style, xx, yy, r, series.style.hollow);
+                }
+                taken.push(Rect {
+                    x0: xx - r,
+                    y0: yy - r,
+                    x1: xx + r,
+                    y1: yy + r,
+                });
+                if let Some(label) = series.labels.get(k).filter(|l| !l.is_empty()) {
+                    label_queue.push((xx, yy, r, label, series.style.color));
+                }
+            }
+        }
+        for (xx, yy, r, label, color) in label_queue {
+            let lw = SMALL_CHAR_W * label.chars().count() as f64;
+            let candidates = [
+                (xx + r + 2.0, yy - r - 1.0),
+                (xx + r + 2.0, yy + r + 9.0),
+                (xx - r - 2.0 - lw, yy - r - 1.0),
+                (xx - r - 2.0 - lw, yy + r + 9.0),
+            ];
+            let place = candidates.iter().find_map(|&(lx, ly)| {
+                let rect = Rect {
+                    x0: lx,
+                    y0: ly - 9.0,
+                    x1: lx + lw,
+                    y1: ly + 1.0,
+                };
+                let inside = rect.x0 >= LEFT
+                    && rect.x1 <= LEFT + PLOT_W
+                    && rect.y0 >= TOP
+                    && rect.y1 <= TOP + PLOT_H;
+                let own = Rect {
+                    x0: xx - r,
+                    y0: yy - r,
+                    x1: xx + r,
+                    y1: yy + r,
+                };
+                (inside
+                    && !taken
+                        .iter()
+                        .any(|t| t.overlaps(&rect) && !(t.x0 == own.x0 && t.y0 == own.y0)))
+                .then_some((lx, ly, rect))
+            });
+            if let Some((lx, ly, rect)) = place {
+                taken.push(rect);
+                let _ = writeln!(
+                    s,
+                    r#"<text x="{lx:.1}" y="{ly:.1}" font-size="10" fill="{color}">{}</text>"#,
+                    esc(label)
+                );
+            }
+        }
+        s.push_str("</g>\n");
+
+        // The legend.
+        let lx = LEFT + PLOT_W + 14.0;
+        let mut ly = TOP + 10.0;
+        for (name, series) in &legend {
+            match series {
+                Some(series) => {
+                    let st = &series.style;
+                    if series.joined {
+                        let dash = if st.dash.is_empty() {
+                            String::new()
+                        } else {
+                            format!(r#" stroke-dasharray="{}""#, st.dash)
+                        };
+                        let _ = writeln!(
+                            s,
+                            r#"<line x1="{lx}" y1="{ly}" x2="{}" y2="{ly}" stroke="{}" stroke-width="1.8"{dash}/>"#,
+                            lx + 24.0,
+                            st.color
+                        );
+                    }
+                    marker_svg(&mut s, st, lx + 12.0, ly, MARKER_R, st.hollow);
+                }
+                None => {
+                    let _ = writeln!(
+                        s,
+                        r#"<line x1="{lx}" y1="{ly}" x2="{}" y2="{ly}" stroke="{REFERENCE_GREY}" stroke-width="1.5" stroke-dasharray="5 4"/>"#,
+                        lx + 24.0
                     );
                 }
             }
             let _ = writeln!(
                 s,
-                r#"<line x1="{lx}" y1="{legend_y}" x2="{}" y2="{legend_y}" stroke="{color}" stroke-width="2"/><text x="{}" y="{}">{}</text>"#,
-                lx + 22.0,
-                lx + 28.0,
-                legend_y + 4.0,
-                esc(&series.name)
+                r#"<text x="{}" y="{}">{}</text>"#,
+                lx + 30.0,
+                ly + 4.0,
+                esc(name)
             );
-            legend_y += 18.0;
+            ly += LEGEND_ROW;
         }
         s.push_str("</svg>\n");
         s
@@ -326,54 +884,149 @@ impl Chart {
 mod tests {
     use super::*;
 
-    #[test]
-    fn chart_places_points_inside_the_plot_area() {
-        let c = Chart {
-            title: "t".into(),
-            x_label: "ms".into(),
-            y_label: "err".into(),
+    fn chart(series: Vec<Series>) -> Chart {
+        Chart {
             x_log: true,
-            y_log: false,
-            series: vec![Series {
-                name: "a <b>".into(),
-                points: vec![(10.0, 0.5), (1000.0, 0.1)],
-                labels: vec!["n=0".into(), "n=4".into()],
-                x_intervals: vec![Some([8.0, 12.0]), None],
-                y_intervals: vec![None, Some([0.05, 0.2])],
-            }],
-            reference_lines: vec![("floor (no mirrors)".into(), 0.05)],
-        };
-        let svg = c.to_svg();
-        assert!(svg.starts_with("<svg") && svg.ends_with("</svg>\n"));
-        assert!(svg.contains("a &lt;b&gt;"), "names are escaped");
-        assert_eq!(svg.matches("<circle").count(), 2);
-        for cap in svg.split("<circle cx=\"").skip(1) {
-            let cx: f64 = cap.split('"').next().unwrap().parse().unwrap();
-            assert!((LEFT..=LEFT + PLOT_W).contains(&cx), "{cx}");
+            series,
+            references: vec![Reference::Level("one full-scene pass".into(), 0.05)],
+            floor: Some(0.01),
+            footer: "scenes/mirror_box.json · 640x360 · llvmpipe · 2026-11-26 · commit abc".into(),
+            ..Chart::new("t", "ms", "err")
         }
-        assert!(svg.contains("stroke-dasharray"));
-        // One horizontal and one vertical error bar, each with its caps, inside the plot:
-        // the x axis reaches down to the interval's 8 ms, below the lowest point.
-        let bars: Vec<&str> = svg.split("<path d=\"M").skip(1).collect();
-        assert_eq!(bars.len(), 2);
-        let first_x: f64 = bars[0].split(',').next().unwrap().parse().unwrap();
-        assert!((LEFT..=LEFT + PLOT_W).contains(&first_x), "{first_x}");
-        assert!(bars[0].contains('H') && bars[1].starts_with(|c: char| c.is_ascii_digit()));
-        // The legend's column is wide enough for its longest entry.
-        let width: f64 = svg
-            .split("width=\"")
+    }
+
+    fn width(svg: &str) -> f64 {
+        svg.split("width=\"")
             .nth(1)
             .unwrap()
             .split('"')
             .next()
             .unwrap()
             .parse()
-            .unwrap();
-        assert!(
-            width
-                >= LEFT
-                    + PLOT_W
-                    + LEGEND_CHAR_W * "floor (no mirrors) = 0.05 (off axis)".len() as f64
+            .unwrap()
+    }
+
+    #[test]
+    fn chart_places_points_inside_the_plot_area() {
+        let mut s = Series::new(
+            "a <b>",
+            method_style("auxiliary"),
+            vec![(10.0, 0.5), (1000.0, 0.1)],
         );
+        s.labels = vec!["n=0".into(), "n=4".into()];
+        s.x_intervals = vec![Some([8.0, 12.0]), None];
+        s.y_intervals = vec![None, Some([0.05, 0.2])];
+        let svg = chart(vec![s]).to_svg();
+        assert!(svg.starts_with("<svg") && svg.ends_with("</svg>\n"));
+        assert!(svg.contains("a &lt;b&gt;"), "names are escaped");
+        // Two markers in the plot, one in the legend.
+        assert_eq!(svg.matches("<circle").count(), 3);
+        for cap in svg.split("<circle cx=\"").skip(1).take(2) {
+            let cx: f64 = cap.split('"').next().unwrap().parse().unwrap();
+            assert!((LEFT..=LEFT + PLOT_W).contains(&cx), "{cx}");
+        }
+        assert!(svg.contains("reference: one full-scene pass"));
+        assert!(svg.contains("commit abc"), "the footer is drawn");
+        // One horizontal and one vertical error bar, each with its caps, inside the plot:
+        // the x axis reaches down to the interval's 8 ms, below the lowest point.
+        let bars: Vec<&str> = svg.split("<path d=\"M").skip(1).collect();
+        assert_eq!(bars.len(), 2);
+        let first_x: f64 = bars[0].split(',').next().unwrap().parse().unwrap();
+        assert!((LEFT..=LEFT + PLOT_W).contains(&first_x), "{first_x}");
+        // The legend's column is wide enough for its longest entry.
+        assert!(
+            width(&svg)
+                >= LEFT + PLOT_W + LEGEND_CHAR_W * "reference: one full-scene pass".len() as f64
+        );
+    }
+
+    #[test]
+    fn a_log_axis_is_tight_and_a_far_floor_is_a_note() {
+        let s = Series::new(
+            "m",
+            method_style("portal"),
+            vec![(900.0, 2e-3), (1800.0, 3e-3)],
+        );
+        let mut c = chart(vec![s]);
+        c.y_log = true;
+        c.floor = Some(1e-14);
+        c.references.clear();
+        let svg = c.to_svg();
+        assert!(svg.contains("below the axis"), "{svg}");
+        // No tick at 1e4 (the data stop at 1.8e3) nor at 1e-14.
+        assert!(!svg.contains(">1e4<") && !svg.contains("e-14<"), "{svg}");
+    }
+
+    #[test]
+    fn one_distinct_x_is_not_a_chart() {
+        let s = Series::new("m", method_style("portal"), vec![(64.0, 1.0), (64.0, 2.0)]);
+        assert!(!chart(vec![s]).is_drawable());
+        let s = Series::new("m", method_style("portal"), vec![(1.0, 1.0), (64.0, 2.0)]);
+        assert!(chart(vec![s]).is_drawable());
+    }
+
+    #[test]
+    fn coinciding_series_both_show_and_the_legend_says_so() {
+        let pts = vec![(1.0, 1.0), (2.0, 2.0)];
+        let a = Series::new("unrolled", method_style("unrolled"), pts.clone());
+        let b = Series::new("portal", method_style("portal"), pts);
+        let svg = chart(vec![a, b]).to_svg();
+        assert!(svg.contains("portal (on unrolled)"), "{svg}");
+        // Each of portal's points is a ring around unrolled's marker.
+        assert_eq!(
+            svg.matches("fill=\"none\" stroke=\"#009E73\"").count(),
+            2 + 1
+        );
+    }
+
+    #[test]
+    fn labels_that_would_overprint_are_left_out() {
+        let mut s = Series::new(
+            "m",
+            method_style("auxiliary"),
+            vec![(10.0, 1.0), (10.01, 1.0), (10.02, 1.0), (100.0, 2.0)],
+        );
+        s.labels = vec![
+            "first".into(),
+            "second".into(),
+            "third".into(),
+            "far".into(),
+        ];
+        s.joined = false;
+        let svg = chart(vec![s]).to_svg();
+        let drawn = ["first", "second", "third"]
+            .iter()
+            .filter(|l| svg.contains(&format!(">{l}</text>")))
+            .count();
+        assert!(drawn < 3, "{svg}");
+        assert!(svg.contains(">far</text>"));
+    }
+
+    #[test]
+    fn every_method_has_its_own_style() {
+        let methods = [
+            "naive",
+            "auxiliary",
+            "path-textures",
+            "portal",
+            "unrolled",
+            "symmetry",
+            "symmetry-pruned",
+            "symmetry-baked",
+            "feedback",
+            "cubemap",
+            "ssr",
+            "ray-query",
+            "truth",
+        ];
+        for (i, a) in methods.iter().enumerate() {
+            for b in &methods[..i] {
+                let (sa, sb) = (method_style(a), method_style(b));
+                assert!(
+                    (sa.color, sa.marker) != (sb.color, sb.marker),
+                    "{a} and {b} share a style"
+                );
+            }
+        }
     }
 }

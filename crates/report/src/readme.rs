@@ -1,9 +1,12 @@
-//! The figures the README and the docs quote, generated from the committed reports.
+//! The figures the README, the book and the docs quote, generated from the committed reports.
 //!
-//! A region of `README.md` (or `docs/methods.md`) between `<!-- generated: ID -->` and `<!-- end generated: ID -->`
-//! is written by [`fill`] from the report folder its ID names (its `results.jsonl` and
-//! `sweep.json`), with the same sentences and tables the report itself prints — so the prose
-//! cannot drift from the numbers. `mirrorbox readme` rewrites the regions; `mirrorbox readme
+//! A region of `README.md`, `docs/methods.md` or a chapter of the book (`docs/book/src/*.md`)
+//! between `<!-- generated: ID -->` and `<!-- end generated: ID -->` is written by [`fill`]
+//! from the report folder its ID names (its `results.jsonl` and `sweep.json`), with the same
+//! sentences and tables the report itself prints — so the prose cannot drift from the
+//! numbers. Regions made elsewhere (the command-line reference, which the CLI crate renders
+//! from its argument parser) are passed in by the caller ([`fill_with`],
+//! [`stale_regions_with`]). `mirrorbox readme` rewrites the regions; `mirrorbox readme
 //! --check` (run by the tests) fails when a region differs from what the reports give.
 //! Everything outside the regions is left alone, byte for byte.
 
@@ -44,6 +47,11 @@ pub const REGIONS: &[(&str, &str, &str)] = &[
         "table1",
         "table1",
         "the reproduction of Table 1, the exact methods beside it, the floor",
+    ),
+    (
+        "table1-summary",
+        "table1",
+        "Table 1's methods at one glance: ms/frame, passes, reflections and error of each point",
     ),
     (
         "table1-repeat",
@@ -140,6 +148,11 @@ pub const REGIONS: &[(&str, &str, &str)] = &[
         "main_job.json",
         "the main job's steps: time and peak memory",
     ),
+    (
+        "job-costs",
+        "main_job.json",
+        "what the two commands cost: the last recorded scripts/test.sh and scripts/run.sh",
+    ),
 ];
 
 /// "Measured DATE on DEVICE: adapter …, `COMMAND`." The date is the latest run that measured
@@ -186,6 +199,26 @@ fn table1_region(s: &Sweep) -> Result<String, ReadmeError> {
         )));
     }
     blocks.extend(section);
+    if let Some(fl) = s.records.iter().find(|r| r.kind == "floor") {
+        blocks.push(floor_paragraph(fl));
+    }
+    Ok(markdown(&blocks))
+}
+
+/// The short form of [`table1_region`]: the device, the table of every method's point (the
+/// paper's auxiliary n = 0…4 and the exact methods) and the floor.
+fn table1_summary_region(s: &Sweep) -> Result<String, ReadmeError> {
+    let table = prose(table1_section(&s.info, &s.records))
+        .into_iter()
+        .rfind(|b| matches!(b, Block::Table(..)))
+        .ok_or_else(|| {
+            ReadmeError(format!(
+                "{}: not the paper's experiment (every n of Table 1 on {}), nothing to quote",
+                s.info.scene,
+                table1::PAPER_SCENE
+            ))
+        })?;
+    let mut blocks = vec![Block::Paragraph(measured_on(s)), table];
     if let Some(fl) = s.records.iter().find(|r| r.kind == "floor") {
         blocks.push(floor_paragraph(fl));
     }
@@ -528,6 +561,60 @@ fn main_job_region(path: &Path) -> Result<String, ReadmeError> {
     Ok(markdown(&blocks))
 }
 
+/// `scripts/test.sh`'s own record (`target/test-timing.json`, committed as
+/// `reports/tests/test_timing.json`): the same shape as the main job's, without memory.
+const TEST_JOB: &str = "tests/test_timing.json";
+
+/// One line per command: its last recorded run's total, date and machine, and its two
+/// longest steps (the rest summed), read from `main_job.json` and `tests/test_timing.json`.
+fn job_costs_region(reports: &Path) -> Result<String, ReadmeError> {
+    let read = |name: &str| -> Result<MainJob, ReadmeError> {
+        let path = reports.join(name);
+        let text = mirrorbox_files::read_bounded_text(&path, 1 << 20, "a job record")
+            .map_err(|e| ReadmeError(e.to_string()))?;
+        serde_json::from_str(&text).map_err(|e| ReadmeError(format!("{}: {e}", path.display())))
+    };
+    let row = |command: &str, what: &str, job: &MainJob| {
+        let mut steps: Vec<&Step> = job.steps.iter().collect();
+        steps.sort_by_key(|s| std::cmp::Reverse(s.seconds));
+        let mut parts: Vec<String> = steps
+            .iter()
+            .take(2)
+            .map(|s| format!("`{}` {} s", s.name, s.seconds))
+            .collect();
+        if steps.len() > 2 {
+            let rest: u64 = steps[2..].iter().map(|s| s.seconds).sum();
+            parts.push(format!("{} other steps {rest} s", steps.len() - 2));
+        }
+        vec![
+            format!("`{command}`"),
+            what.to_string(),
+            format!(
+                "{}, {}",
+                job.date.split('T').next().unwrap_or(&job.date),
+                job.cpu
+            ),
+            format!("**{}**", job.seconds),
+            parts.join("; "),
+        ]
+    };
+    Ok(markdown(&[Block::Table(
+        [
+            "command",
+            "what",
+            "last recorded run",
+            "seconds",
+            "where the time went",
+        ]
+        .map(String::from)
+        .to_vec(),
+        vec![
+            row("scripts/test.sh", "the tests", &read(TEST_JOB)?),
+            row("scripts/run.sh", "the main job", &read("main_job.json")?),
+        ],
+    )]))
+}
+
 /// Generates the region `id` from the reports under `reports`.
 pub fn generate(id: &str, reports: &Path) -> Result<Region, ReadmeError> {
     let (id, source, _) = REGIONS
@@ -542,6 +629,8 @@ pub fn generate(id: &str, reports: &Path) -> Result<Region, ReadmeError> {
     let folder = |name: &str| -> PathBuf { reports.join(name) };
     let text = match *id {
         "table1" | "gpu-table1" => table1_region(&load_sweep(&folder(source))?)?,
+        "table1-summary" => table1_summary_region(&load_sweep(&folder(source))?)?,
+        "job-costs" => job_costs_region(reports)?,
         "table1-repeat" => repeat_region(
             &load_sweep(&folder("table1"))?,
             &load_sweep(&folder(source))?,
@@ -575,7 +664,47 @@ pub fn generate(id: &str, reports: &Path) -> Result<Region, ReadmeError> {
         "viewer-frame-rates" | "tracer-bench" => report_body_region(&folder(source))?,
         _ => unreachable!("every ID in REGIONS has a generator"),
     };
-    Ok(Region { id, text })
+    Ok(Region {
+        id,
+        text: without_relative_links(&text),
+    })
+}
+
+/// `text` with every Markdown link to a relative target replaced by its label: a region is
+/// quoted in files at different depths (the README, `docs/`, the book's chapters), where one
+/// relative link cannot be right for all of them. Links with a scheme (`https://…`) stay.
+fn without_relative_links(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let mut rest = text;
+    while let Some(open) = rest.find('[') {
+        out.push_str(&rest[..open]);
+        let after = &rest[open + 1..];
+        // `[label](target)` on one line, the label without brackets.
+        let link = after.find("](").and_then(|close| {
+            let label = &after[..close];
+            let target_start = close + 2;
+            let target_len = after[target_start..].find(')')?;
+            let target = &after[target_start..target_start + target_len];
+            let plain = |t: &str| !t.contains(['[', ']', '\n']);
+            (plain(label) && plain(target) && !target.contains(' ')).then_some((
+                label,
+                target,
+                target_start + target_len + 1,
+            ))
+        });
+        match link {
+            Some((label, target, len)) if !target.contains("://") => {
+                out.push_str(label);
+                rest = &after[len..];
+            }
+            _ => {
+                out.push('[');
+                rest = after;
+            }
+        }
+    }
+    out.push_str(rest);
+    out
 }
 
 /// A region found in the README: its ID and the byte range of its content (between the
@@ -636,14 +765,40 @@ fn find_regions(readme: &str) -> Result<Vec<Found>, ReadmeError> {
     Ok(found)
 }
 
+/// The text of region `id`: one of `extra` (regions made by the caller) if it has that ID,
+/// else generated from the reports.
+fn region_text(id: &str, reports: &Path, extra: &[Region]) -> Result<String, ReadmeError> {
+    match extra.iter().find(|r| r.id == id) {
+        Some(r) => Ok(r.text.clone()),
+        None if extra.is_empty() || REGIONS.iter().any(|r| r.0 == id) => {
+            generate(id, reports).map(|r| r.text)
+        }
+        None => Err(ReadmeError(format!(
+            "unknown generated region {id:?} (known: {})",
+            REGIONS
+                .iter()
+                .map(|r| r.0)
+                .chain(extra.iter().map(|r| r.id))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ))),
+    }
+}
+
 /// The README with every region replaced by its generated text.
 pub fn fill(readme: &str, reports: &Path) -> Result<String, ReadmeError> {
+    fill_with(readme, reports, &[])
+}
+
+/// [`fill`], with the regions of `extra` (made by the caller, e.g. from the CLI's argument
+/// parser) filled from `extra` instead of the reports.
+pub fn fill_with(readme: &str, reports: &Path, extra: &[Region]) -> Result<String, ReadmeError> {
     let mut out = String::with_capacity(readme.len());
     let mut at = 0;
     for f in find_regions(readme)? {
-        let region = generate(&f.id, reports)?;
+        let text = region_text(&f.id, reports, extra)?;
         out.push_str(&readme[at..f.content.start]);
-        out.push_str(&region.text);
+        out.push_str(&text);
         at = f.content.end;
     }
     out.push_str(&readme[at..]);
@@ -656,16 +811,25 @@ pub fn stale_regions(
     readme: &str,
     reports: &Path,
 ) -> Result<Vec<(String, String, String)>, ReadmeError> {
+    stale_regions_with(readme, reports, &[])
+}
+
+/// [`stale_regions`], with the regions of `extra` compared against `extra`'s text.
+pub fn stale_regions_with(
+    readme: &str,
+    reports: &Path,
+    extra: &[Region],
+) -> Result<Vec<(String, String, String)>, ReadmeError> {
     let mut stale = Vec::new();
     for f in find_regions(readme)? {
-        let region = generate(&f.id, reports)?;
+        let generated = region_text(&f.id, reports, extra)?;
         let current = &readme[f.content.clone()];
-        if current != region.text {
+        if current != generated {
             let (have, want) = current
                 .lines()
                 .map(Some)
                 .chain(std::iter::repeat(None))
-                .zip(region.text.lines().map(Some).chain(std::iter::repeat(None)))
+                .zip(generated.lines().map(Some).chain(std::iter::repeat(None)))
                 .take_while(|(a, b)| a.is_some() || b.is_some())
                 .find(|(a, b)| a != b)
                 .unwrap_or((None, None));
@@ -738,5 +902,72 @@ mod tests {
             err("<!-- generated: table1 -->\n<!-- end generated: table1 -->\n")
                 .contains("table1/sweep.json")
         );
+    }
+
+    #[test]
+    fn relative_links_become_their_labels() {
+        let text = "report: [`reports/m/report.md`](reports/m/report.md), \
+                    [site](https://example.org/a) [x] [a](b c) [[n]](t) end\n";
+        assert_eq!(
+            without_relative_links(text),
+            "report: `reports/m/report.md`, [site](https://example.org/a) [x] [a](b c) [[n]](t) end\n"
+        );
+    }
+
+    #[test]
+    fn regions_made_by_the_caller_are_filled_and_checked() {
+        let dir = tempfile::tempdir().unwrap();
+        main_job(dir.path(), 5);
+        let extra = [Region {
+            id: "cli",
+            text: "usage\n".into(),
+        }];
+        let text = "<!-- generated: cli -->\nold\n<!-- end generated: cli -->\n\
+                    <!-- generated: main-job -->\n<!-- end generated: main-job -->\n";
+        let filled = fill_with(text, dir.path(), &extra).unwrap();
+        assert!(
+            filled.starts_with("<!-- generated: cli -->\nusage\n<!-- end generated: cli -->\n")
+        );
+        assert!(filled.contains("took 5 s"));
+        assert!(
+            stale_regions_with(&filled, dir.path(), &extra)
+                .unwrap()
+                .is_empty()
+        );
+        let stale = stale_regions_with(text, dir.path(), &extra).unwrap();
+        assert_eq!(stale[0], ("cli".into(), "old".into(), "usage".into()));
+        // Without the caller's region the ID is unknown; with it, the message lists it.
+        assert!(
+            fill(text, dir.path())
+                .unwrap_err()
+                .0
+                .contains("unknown generated region \"cli\"")
+        );
+        let other = "<!-- generated: nonsense -->\n<!-- end generated: nonsense -->\n";
+        assert!(
+            fill_with(other, dir.path(), &extra)
+                .unwrap_err()
+                .0
+                .contains(", cli)")
+        );
+    }
+
+    #[test]
+    fn job_costs_name_both_commands_and_their_longest_steps() {
+        let dir = tempfile::tempdir().unwrap();
+        main_job(dir.path(), 300);
+        std::fs::create_dir(dir.path().join("tests")).unwrap();
+        std::fs::write(
+            dir.path().join(TEST_JOB),
+            r#"{"date":"2026-11-23T10:00:00Z","cpu":"a test CPU","seconds":60,
+               "steps":[{"name":"a","seconds":5},{"name":"build","seconds":40},
+                        {"name":"b","seconds":3},{"name":"tests","seconds":12}]}"#,
+        )
+        .unwrap();
+        let text = generate("job-costs", dir.path()).unwrap().text;
+        assert!(text.contains(
+            "| `scripts/test.sh` | the tests | 2026-11-23, a test CPU | **60** | `build` 40 s; `tests` 12 s; 2 other steps 8 s |"
+        ), "{text}");
+        assert!(text.contains("| `scripts/run.sh` | the main job | 2026-11-22, a test CPU | **300** | `cargo build` 300 s |"), "{text}");
     }
 }

@@ -9,7 +9,7 @@
 //! the mirror, so its true disparity is larger than the mirror surface's; the shared shortcut
 //! paints it at the mirror's.
 
-use crate::plot::{Chart, Series};
+use crate::plot::{Chart, Series, method_style, styles_for};
 use crate::write::{Block, distinct, f, ms_cell, sci};
 use crate::{MarkerRecord, Record};
 
@@ -226,25 +226,33 @@ fn chart(records: &[Record], name: &str, title: &str, y_label: &str, y_log: bool
             disparity(r, false)
         }
     };
-    let mut series: Vec<Series> = distinct(pts.iter().map(|r| variant_of(r)))
+    let variants = distinct(pts.iter().map(|r| variant_of(r)));
+    let methods: Vec<String> = variants
         .iter()
         .map(|v| {
+            pts.iter()
+                .find(|r| &variant_of(r) == v)
+                .map_or(String::new(), |r| r.method.clone())
+        })
+        .collect();
+    let styles = styles_for(&methods.iter().map(String::as_str).collect::<Vec<_>>());
+    let mut series: Vec<Series> = variants
+        .iter()
+        .zip(styles)
+        .map(|(v, style)| {
             let mut rs: Vec<&Record> = pts
                 .iter()
                 .copied()
                 .filter(|r| &variant_of(r) == v)
                 .collect();
             rs.sort_by(|p, q| ipd(p).total_cmp(&ipd(q)));
-            Series {
-                name: v.clone(),
-                points: rs
-                    .iter()
+            Series::new(
+                v.clone(),
+                style,
+                rs.iter()
                     .filter_map(|r| Some((f64::from(ipd(r)), value(r)?)))
                     .collect(),
-                labels: Vec::new(),
-                x_intervals: Vec::new(),
-                y_intervals: Vec::new(),
-            }
+            )
         })
         .collect();
     if !y_log {
@@ -256,30 +264,17 @@ fn chart(records: &[Record], name: &str, title: &str, y_label: &str, y_log: bool
             })
             .collect();
         truth.sort_by(|a, b| a.0.total_cmp(&b.0));
-        series.insert(
-            0,
-            Series {
-                name: "truth".into(),
-                points: truth,
-                labels: Vec::new(),
-                x_intervals: Vec::new(),
-                y_intervals: Vec::new(),
-            },
-        );
+        series.insert(0, Series::new("truth", method_style("truth"), truth));
     }
     series.retain(|s| !s.points.is_empty());
     Block::Chart(
         name.into(),
-        Chart {
-            title: title.into(),
-            x_label: "interpupillary distance (scene units)".into(),
-            y_label: y_label.into(),
-            x_log: false,
+        Box::new(Chart {
             y_log,
             series,
-            reference_lines: Vec::new(),
-        }
-        .to_svg(),
+            x_ticks_at_data: true,
+            ..Chart::new(title, "interpupillary distance (scene units)", y_label)
+        }),
     )
 }
 

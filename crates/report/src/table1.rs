@@ -82,6 +82,13 @@ pub fn is_papers_sweep(scene: &str, rows: &[Row]) -> bool {
     on_papers_scene && rows.len() == PAPER_MS.len()
 }
 
+/// `[low, high]` with the decimals the interval can tell apart (two significant digits of its
+/// width, at least two decimals): a narrow interval must not print as "[0.47, 0.47]".
+fn bracket(low: f64, high: f64) -> String {
+    let d = crate::write::interval_digits(low, high).max(2);
+    format!("[{low:.d$}, {high:.d$}]")
+}
+
 /// The 95 % bootstrap interval of our exponent: every row's frames resampled with
 /// replacement, its median taken, the power law fitted again. `None` without frames.
 pub fn exponent_interval(rows: &[Row]) -> Option<crate::stats::Interval> {
@@ -153,16 +160,15 @@ pub fn growth_sentence(rows: &[Row]) -> String {
     let interval = exponent_interval(rows);
     let verdict = match interval {
         Some(i) if i.contains(p) => format!(
-            "matches: the paper's exponent {p:.2} lies inside our 95 % interval [{:.2}, {:.2}] \
+            "matches: the paper's exponent {p:.2} lies inside our 95 % interval {} \
              (bootstrap over frames)",
-            i.low, i.high
+            bracket(i.low, i.high)
         ),
         Some(i) => format!(
             "does not match: the paper's exponent {p:.2} lies {:.2} outside our 95 % interval \
-             [{:.2}, {:.2}] (bootstrap over frames)",
+             {} (bootstrap over frames)",
             (p - i.low).abs().min((p - i.high).abs()),
-            i.low,
-            i.high
+            bracket(i.low, i.high)
         ),
         None => format!(
             "cannot be judged: these records keep no frames to bound our exponent with \

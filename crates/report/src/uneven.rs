@@ -6,8 +6,8 @@
 //! `march-steps`, `texture-margin`), not the rasterizer.
 
 use crate::Record;
-use crate::plot::{Chart, Series};
-use crate::write::{Block, distinct, ms_cell, sci};
+use crate::plot::{Chart, Series, method_style};
+use crate::write::{Block, distinct, join_words, lowest_with_ties, ms_cell, sci};
 
 /// The raster options of an uneven-mirror trick (crates/raster/src/uneven.rs).
 const TRICK_OPTIONS: [&str; 5] = [
@@ -101,36 +101,60 @@ pub fn sentences(records: &[Record], bump_methods: &[String]) -> Vec<String> {
             .copied()
             .filter(|r| r.bump_amplitude_deg == Some(a))
             .collect();
-        let best = |filter: &dyn Fn(&Record) -> bool| {
-            at.iter()
-                .copied()
-                .filter(|r| filter(r))
-                .min_by(|p, q| p.metrics.flip_mean.total_cmp(&q.metrics.flip_mean))
-        };
-        let Some(win) = best(&|_| true) else {
+        let flip = |r: &Record| r.metrics.flip_mean;
+        let name = |r: &Record| format!("`{}`", variant_of(r, &main, bump_methods));
+        // Winners within 2 % of the lowest error are a tie, said as one.
+        let winners = lowest_with_ties(at.iter().copied(), flip);
+        let Some(win) = winners.first().copied() else {
             continue;
         };
-        let flat = best(&|r| variant_of(r, &main, bump_methods) == "flat");
-        let distort = best(&|r| variant_of(r, &main, bump_methods).starts_with("distort "));
-        let mut s = format!(
-            "At {a}°: `{}` is closest to the truth, FLIP mean {} (relMSE {}) at {} ms/frame",
-            variant_of(win, &main, bump_methods),
-            sci(win.metrics.flip_mean),
-            sci(win.metrics.relmse),
-            ms_cell(win, 1)
-        );
+        let flat = at
+            .iter()
+            .copied()
+            .find(|r| variant_of(r, &main, bump_methods) == "flat");
+        let mut s = if winners.len() == 1 {
+            format!(
+                "At {a}°: {} is closest to the truth, FLIP mean {} (relMSE {}) at {} ms/frame",
+                name(win),
+                sci(win.metrics.flip_mean),
+                sci(win.metrics.relmse),
+                ms_cell(win, 1)
+            )
+        } else {
+            format!(
+                "At {a}°: {} tie for closest to the truth (FLIP mean {}–{}, within 2 %)",
+                join_words(&winners.iter().map(|r| name(r)).collect::<Vec<_>>()),
+                sci(winners
+                    .iter()
+                    .map(|r| flip(r))
+                    .fold(f64::INFINITY, f64::min)),
+                sci(winners.iter().map(|r| flip(r)).fold(0.0, f64::max))
+            )
+        };
         if let Some(f) = flat {
             s.push_str(&format!(
                 "; ignoring the bump (`{main}`) gives {}",
                 sci(f.metrics.flip_mean)
             ));
         }
-        if let Some(d) = distort {
-            s.push_str(&format!(
-                "; the best distortion strength is `{}` ({})",
-                variant_of(d, &main, bump_methods),
-                sci(d.metrics.flip_mean)
-            ));
+        let distorts = lowest_with_ties(
+            at.iter()
+                .copied()
+                .filter(|r| variant_of(r, &main, bump_methods).starts_with("distort ")),
+            flip,
+        );
+        match distorts.len() {
+            0 => {}
+            1 => s.push_str(&format!(
+                "; the best distortion strength is {} ({})",
+                name(distorts[0]),
+                sci(distorts[0].metrics.flip_mean)
+            )),
+            n => s.push_str(&format!(
+                "; {n} distortion strengths tie ({}, within 2 % of {})",
+                join_words(&distorts.iter().map(|r| name(r)).collect::<Vec<_>>()),
+                sci(distorts[0].metrics.flip_mean.min(flip(distorts[n - 1])))
+            )),
         }
         s.push('.');
         out.push(s);
@@ -185,7 +209,6 @@ pub(crate) fn uneven_section(records: &[Record], bump_methods: &[String]) -> Vec
     }
     let amps = amplitudes(&pts);
     let main = main_method(&pts);
-    let tricks = distinct(pts.iter().map(|r| variant_of(r, &main, bump_methods)));
     let methods = distinct(pts.iter().map(|r| method_of(r)));
     let mut out = vec![
         Block::Heading(
@@ -204,49 +227,96 @@ pub(crate) fn uneven_section(records: &[Record], bump_methods: &[String]) -> Vec
             methods.join(", ")
         )),
     ];
-    let series: Vec<Series> = tricks
+    // One chart per method that reads the bump: its trick families (flat, distort, proxy,
+    // march), each at its setting with the lowest mean error over the tilts (the table lists
+    // every setting), beside the methods that show the mirror flat. The question: which trick
+    // errs least as the tilt grows.
+    let family = |t: &str| t.split([' ', ',']).next().unwrap_or_default().to_string();
+    let tilt = |r: &Record| f64::from(r.bump_amplitude_deg.unwrap_or(0.0));
+    let curve = |rs: &[&Record]| -> Vec<(f64, f64)> {
+        let mut p: Vec<(f64, f64)> = rs.iter().map(|r| (tilt(r), r.metrics.flip_mean)).collect();
+        p.sort_by(|a, b| a.0.total_cmp(&b.0));
+        p
+    };
+    let flat_only: Vec<String> = methods
         .iter()
-        .map(|t| {
-            let mut rs: Vec<&Record> = pts
-                .iter()
-                .copied()
-                .filter(|r| &variant_of(r, &main, bump_methods) == t)
-                .collect();
-            rs.sort_by(|p, q| {
-                p.bump_amplitude_deg
-                    .unwrap_or(0.0)
-                    .total_cmp(&q.bump_amplitude_deg.unwrap_or(0.0))
-            });
-            Series {
-                name: t.clone(),
-                points: rs
-                    .iter()
-                    .map(|r| {
-                        (
-                            f64::from(r.bump_amplitude_deg.unwrap_or(0.0)),
-                            r.metrics.flip_mean,
-                        )
-                    })
-                    .collect(),
-                labels: Vec::new(),
-                x_intervals: Vec::new(),
-                y_intervals: Vec::new(),
-            }
+        .filter(|m| {
+            pts.iter()
+                .filter(|r| &&method_of(r) == m)
+                .all(|r| !bump_methods.contains(&r.method))
         })
+        .cloned()
         .collect();
-    out.push(Block::Chart(
-        "plot_uneven_error_vs_tilt.svg".into(),
-        Chart {
-            title: "FLIP mean vs the bump's steepest tilt, by trick".into(),
-            x_label: "steepest tilt (degrees)".into(),
-            y_label: "FLIP mean".into(),
-            x_log: false,
-            y_log: true,
-            series,
-            reference_lines: Vec::new(),
+    for (chart_index, m) in methods
+        .iter()
+        .filter(|m| !flat_only.contains(m))
+        .enumerate()
+    {
+        let mine: Vec<&Record> = pts.iter().copied().filter(|r| &method_of(r) == m).collect();
+        let base = mine.first().map_or(String::new(), |r| r.method.clone());
+        let mut series = Vec::new();
+        for (k, fam) in distinct(mine.iter().map(|r| family(&trick_of(r, bump_methods))))
+            .iter()
+            .enumerate()
+        {
+            let settings = distinct(
+                mine.iter()
+                    .filter(|r| &family(&trick_of(r, bump_methods)) == fam)
+                    .map(|r| trick_of(r, bump_methods)),
+            );
+            let of = |t: &String| -> Vec<&Record> {
+                mine.iter()
+                    .copied()
+                    .filter(|r| &trick_of(r, bump_methods) == t)
+                    .collect()
+            };
+            let mean = |t: &String| {
+                let e: Vec<f64> = of(t).iter().map(|r| r.metrics.flip_mean).collect();
+                e.iter().sum::<f64>() / e.len().max(1) as f64
+            };
+            let Some(best) = settings.iter().min_by(|a, b| mean(a).total_cmp(&mean(b))) else {
+                continue;
+            };
+            let name = if settings.len() > 1 {
+                format!("{best} (best of {} settings)", settings.len())
+            } else {
+                best.clone()
+            };
+            series.push(Series::new(
+                name,
+                method_style(&base).variant(k),
+                curve(&of(best)),
+            ));
         }
-        .to_svg(),
-    ));
+        for f in &flat_only {
+            let rs: Vec<&Record> = pts.iter().copied().filter(|r| &method_of(r) == f).collect();
+            let style = rs
+                .first()
+                .map_or(method_style(f), |r| method_style(&r.method));
+            series.push(Series::new(format!("{f}: flat"), style, curve(&rs)));
+        }
+        let file = if chart_index == 0 {
+            "plot_uneven_error_vs_tilt.svg".to_string()
+        } else {
+            format!(
+                "plot_uneven_error_vs_tilt_{}.svg",
+                m.replace([' ', '='], "_")
+            )
+        };
+        out.push(Block::Chart(
+            file,
+            Box::new(Chart {
+                y_log: true,
+                series,
+                x_ticks_at_data: true,
+                ..Chart::new(
+                    format!("Error vs tilt: {m}'s tricks, each at its best setting"),
+                    "the bump's steepest tilt (degrees)",
+                    "FLIP mean over the image",
+                )
+            }),
+        ));
+    }
     out.push(table(records, bump_methods, true));
     let s = sentences(records, bump_methods);
     if !s.is_empty() {

@@ -1,7 +1,7 @@
 //! Writing the sweep's files. Markdown and HTML are rendered from one document model, so
 //! they always say the same thing.
 
-use crate::plot::{Chart, Series};
+use crate::plot::{Chart, Reference, Series};
 use crate::{Record, SweepInfo};
 use crate::{exact, table1};
 use base64::Engine;
@@ -42,8 +42,9 @@ pub(crate) enum Block {
     Table(Vec<String>, Vec<Vec<String>>),
     /// Images side by side: (caption, path relative to the report).
     Images(Vec<(String, String)>),
-    /// An SVG chart, written to `file` and embedded in the HTML.
-    Chart(String, String),
+    /// An SVG chart, written to `file` and embedded in the HTML — only where it is drawable
+    /// ([`Chart::is_drawable`]); the writer adds its footer.
+    Chart(String, Box<Chart>),
 }
 
 /// Bytes in a mebibyte (the tables' memory unit).
@@ -197,28 +198,80 @@ pub(crate) fn paired_ratio(a: &Record, b: &Record) -> Option<crate::stats::Inter
 
 /// "median [low–high]" (older records: "median (min m)"), all with the median's decimals.
 pub(crate) fn ms_cell(r: &Record, digits: usize) -> String {
-    let digits = ms_digits(r.ms_median, digits);
     match r.ms_interval {
-        Some([low, high]) => format!(
-            "{} [{}–{}]",
-            f(r.ms_median, digits),
-            f(low, digits),
-            f(high, digits)
-        ),
-        None => format!("{} (min {})", f(r.ms_median, digits), f(r.ms_min, digits)),
+        Some([low, high]) => {
+            let digits = interval_digits(low, high);
+            format!(
+                "{} [{}–{}]",
+                f(r.ms_median, digits),
+                f(low, digits),
+                f(high, digits)
+            )
+        }
+        None => {
+            let digits = ms_digits(r.ms_median, digits);
+            format!("{} (min {})", f(r.ms_median, digits), f(r.ms_min, digits))
+        }
     }
 }
 
+/// Decimals for a value printed with its interval `[low, high]`: two significant digits of
+/// the interval's width — what the interval can tell apart, and no more (an interval from six
+/// frames does not know a fourth digit). A zero-width interval gets three significant digits
+/// of its value.
+pub(crate) fn interval_digits(low: f64, high: f64) -> usize {
+    let width = (high - low).abs();
+    let basis = if width > 0.0 && width.is_finite() {
+        width
+    } else {
+        low.abs().max(1e-12) / 10.0
+    };
+    (1.0 - basis.log10().floor()).clamp(0.0, 8.0) as usize
+}
+
+/// Those of `candidates` within [`TIE_TOLERANCE`] of the lowest `value`: one winner, or a tie.
+pub(crate) fn lowest_with_ties<'a>(
+    candidates: impl Iterator<Item = &'a Record>,
+    value: impl Fn(&Record) -> f64,
+) -> Vec<&'a Record> {
+    let all: Vec<&Record> = candidates.collect();
+    let Some(best) = all.iter().map(|r| value(r)).min_by(f64::total_cmp) else {
+        return Vec::new();
+    };
+    all.into_iter()
+        .filter(|r| value(r) <= best * (1.0 + TIE_TOLERANCE) + f64::EPSILON)
+        .collect()
+}
+
+/// `a`, `a and b`, `a, b and c`.
+pub(crate) fn join_words(words: &[String]) -> String {
+    match words {
+        [] => String::new(),
+        [one] => one.clone(),
+        [rest @ .., last] => format!("{} and {last}", rest.join(", ")),
+    }
+}
+
+/// Two errors within 2 % of each other are a tie: the spread of one method's error between
+/// runs of the same sweep is of that order.
+pub(crate) const TIE_TOLERANCE: f64 = 0.02;
+
 /// A Table 1 row's cell: "median [low–high]", or "median [min m]" for older records.
 pub(crate) fn row_cell(r: &table1::Row) -> String {
-    let digits = ms_digits(r.ms_median, 1);
+    let digits = match crate::stats::median_interval(&r.frames_ms) {
+        Some(i) => interval_digits(i.low, i.high),
+        None => ms_digits(r.ms_median, 1),
+    };
     format!("{} [{}]", f(r.ms_median, digits), row_interval(r, digits))
 }
 
 /// A Table 1 row's interval, "low–high", or "min m" for older records.
 fn row_interval(r: &table1::Row, digits: usize) -> String {
     match crate::stats::median_interval(&r.frames_ms) {
-        Some(i) => format!("{}–{}", f(i.low, digits), f(i.high, digits)),
+        Some(i) => {
+            let d = interval_digits(i.low, i.high);
+            format!("{}–{}", f(i.low, d), f(i.high, d))
+        }
         None => format!("min {}", f(r.ms_min, digits)),
     }
 }
@@ -237,6 +290,16 @@ pub(crate) fn label(r: &Record) -> String {
     }
 }
 
+/// A point's error counts as at the floor up to this multiple of the floor's FLIP mean: the
+/// floor itself varies by that much between renders of the same scene.
+pub(crate) const FLOOR_FACTOR: f64 = 1.5;
+
+/// Whether `r`'s whole-image FLIP mean is at or under the floor `fl` (within [`FLOOR_FACTOR`]):
+/// not resolved by the comparison, so not ranked.
+pub(crate) fn at_or_under_floor(r: &Record, fl: &Record) -> bool {
+    r.metrics.flip_mean <= FLOOR_FACTOR * fl.metrics.flip_mean
+}
+
 /// A point's place on its method's axis: n, the depth, or the symmetry planes p.
 fn setting(r: &Record) -> f64 {
     r.n.or(r.depth).or(r.symmetry_planes).map_or(0.0, f64::from)
@@ -247,13 +310,22 @@ fn setting(r: &Record) -> f64 {
 /// none, and names the file.
 pub fn write_report(dir: &Path, info: &SweepInfo, records: &[Record]) -> Result<(), FileError> {
     write_csv(&dir.join("results.csv"), records)?;
-    let blocks = document(info, records);
+    let mut blocks = document(info, records);
+    let footer = info.footer();
+    for b in &mut blocks {
+        if let Block::Chart(_, chart) = b {
+            chart.footer = footer.clone();
+        }
+    }
     let mut html = String::from(
         "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>mirrorbox report</title><style>\
          body{font-family:sans-serif;max-width:1100px;margin:2em auto;padding:0 1em}\
+         .scroll{overflow-x:auto;max-width:100%}\
          table{border-collapse:collapse;margin:1em 0}td,th{border:1px solid #ccc;padding:3px 8px;text-align:right}\
-         th{background:#f3f3f3}figure{display:inline-block;margin:4px}figcaption{font-size:12px}\
-         img{max-width:340px}</style></head><body>\n",
+         td{white-space:nowrap}th{background:#f3f3f3}\
+         figure{display:inline-block;margin:4px;vertical-align:top}figcaption{font-size:12px;max-width:340px}\
+         img{max-width:340px}.chart svg{max-width:100%;height:auto}\
+         p,li{overflow-wrap:break-word}</style></head><body>\n",
     );
     for b in &blocks {
         match b {
@@ -261,7 +333,7 @@ pub fn write_report(dir: &Path, info: &SweepInfo, records: &[Record]) -> Result<
                 let _ = writeln!(html, "<h{level}>{}</h{level}>", esc(t));
             }
             Block::Paragraph(t) => {
-                let _ = writeln!(html, "<p>{}</p>", esc(t));
+                let _ = writeln!(html, "<p>{}</p>", inline(t));
             }
             Block::Bullets(items) => {
                 let _ = writeln!(
@@ -269,14 +341,14 @@ pub fn write_report(dir: &Path, info: &SweepInfo, records: &[Record]) -> Result<
                     "<ul>{}</ul>",
                     items
                         .iter()
-                        .map(|i| format!("<li>{}</li>", esc(i)))
+                        .map(|i| format!("<li>{}</li>", inline(i)))
                         .collect::<String>()
                 );
             }
             Block::Table(head, rows) => {
                 let _ = write!(
                     html,
-                    "<table><tr>{}</tr>",
+                    "<div class=\"scroll\"><table><tr>{}</tr>",
                     head.iter()
                         .map(|h| format!("<th>{}</th>", esc(h)))
                         .collect::<String>()
@@ -286,11 +358,11 @@ pub fn write_report(dir: &Path, info: &SweepInfo, records: &[Record]) -> Result<
                         html,
                         "<tr>{}</tr>",
                         r.iter()
-                            .map(|c| format!("<td>{}</td>", esc(c)))
+                            .map(|c| format!("<td>{}</td>", inline(c)))
                             .collect::<String>()
                     );
                 }
-                html.push_str("</table>\n");
+                html.push_str("</table></div>\n");
             }
             Block::Images(images) => {
                 html.push_str("<div>");
@@ -310,15 +382,51 @@ pub fn write_report(dir: &Path, info: &SweepInfo, records: &[Record]) -> Result<
                 }
                 html.push_str("</div>\n");
             }
-            Block::Chart(file, svg) => {
-                write_atomically(&dir.join(file), svg.as_bytes())?;
-                let _ = writeln!(html, "<div>{svg}</div>");
+            Block::Chart(file, chart) => {
+                let path = dir.join(file);
+                if chart.is_drawable() {
+                    let svg = chart.to_svg();
+                    write_atomically(&path, svg.as_bytes())?;
+                    let _ = writeln!(html, "<div class=\"chart\">{svg}</div>");
+                }
             }
         }
     }
     html.push_str("</body></html>\n");
+    // Charts an earlier report of this folder drew and this one does not (a section that no
+    // longer applies, a chart with one x): a stale figure must not pass for a current one.
+    let drawn: Vec<&str> = blocks
+        .iter()
+        .filter_map(|b| match b {
+            Block::Chart(file, chart) if chart.is_drawable() => Some(file.as_str()),
+            _ => None,
+        })
+        .collect();
+    if let Ok(entries) = std::fs::read_dir(dir) {
+        for e in entries.flatten() {
+            let name = e.file_name().to_string_lossy().into_owned();
+            if name.starts_with("plot_")
+                && name.ends_with(".svg")
+                && !drawn.contains(&name.as_str())
+            {
+                remove_stale(&e.path())?;
+            }
+        }
+    }
     write_atomically(&dir.join("report.md"), markdown(&blocks).as_bytes())?;
     write_atomically(&dir.join("report.html"), html.as_bytes())
+}
+
+/// Removes `path` if it exists: a file an earlier report wrote that this one does not.
+pub(crate) fn remove_stale(path: &Path) -> Result<(), FileError> {
+    match std::fs::remove_file(path) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(FileError {
+            path: path.to_path_buf(),
+            message: format!("could not remove the stale file: {e}"),
+            refused: false,
+        }),
+        _ => Ok(()),
+    }
 }
 
 /// The blocks as Markdown (charts and images as links to their files).
@@ -353,12 +461,31 @@ pub(crate) fn markdown(blocks: &[Block]) -> String {
                     .collect();
                 let _ = writeln!(md, "{}\n", line.join(" "));
             }
-            Block::Chart(file, _) => {
-                let _ = writeln!(md, "![{file}]({file})\n");
+            Block::Chart(file, chart) => {
+                if chart.is_drawable() {
+                    let _ = writeln!(md, "![{file}]({file})\n");
+                }
             }
         }
     }
     md
+}
+
+/// Escaped text with Markdown's inline code (`x`) as `<code>`: the report's sentences are
+/// written once, for both files.
+fn inline(s: &str) -> String {
+    let mut out = String::new();
+    for (i, part) in s.split('`').enumerate() {
+        if i % 2 == 1 && s.matches('`').count().is_multiple_of(2) {
+            let _ = write!(out, "<code>{}</code>", esc(part));
+        } else {
+            if i % 2 == 1 {
+                out.push('`');
+            }
+            out.push_str(&esc(part));
+        }
+    }
+    out
 }
 
 fn esc(s: &str) -> String {
@@ -565,30 +692,43 @@ pub(crate) fn depth_scaling(
     }
     let mut out = vec![
         Block::Heading(2, "Exact methods: cost against depth".into()),
-        Block::Chart(
-            "plot_ms_vs_depth.svg".into(),
-            Chart {
-                title: "ms/frame vs depth cap".into(),
-                x_label: "depth cap (most mirrors along a path)".into(),
-                y_label: "ms/frame (median, 95 % CI bars)".into(),
+        Block::Chart("plot_ms_vs_depth.svg".into(), {
+            let styles = crate::plot::styles_for(
+                &groups.iter().map(|g| g.method.as_str()).collect::<Vec<_>>(),
+            );
+            let alphas = distinct(groups.iter().map(|g| g.alpha.to_bits()));
+            Box::new(Chart {
                 x_log: true,
                 y_log: true,
+                x_ticks_at_data: true,
                 series: groups
                     .iter()
-                    .map(|g| Series {
-                        name: format!("{}, α={}", g.method, g.alpha),
-                        points: g.points.iter().map(|r| (setting(r), r.ms_median)).collect(),
-                        labels: Vec::new(),
-                        x_intervals: Vec::new(),
-                        y_intervals: g.points.iter().map(|r| r.ms_interval).collect(),
+                    .zip(styles)
+                    .map(|(g, style)| {
+                        let name = if alphas.len() > 1 {
+                            format!("{}, α={}", g.method, g.alpha)
+                        } else {
+                            g.method.clone()
+                        };
+                        let mut s = Series::new(
+                            name,
+                            style,
+                            g.points.iter().map(|r| (setting(r), r.ms_median)).collect(),
+                        );
+                        s.y_intervals = g.points.iter().map(|r| r.ms_interval).collect();
+                        s
                     })
                     .collect(),
-                reference_lines: floor
-                    .map(|fl| vec![("one full-scene pass".to_string(), fl.ms_median)])
+                references: floor
+                    .map(|fl| vec![Reference::Level("one full-scene pass".into(), fl.ms_median)])
                     .unwrap_or_default(),
-            }
-            .to_svg(),
-        ),
+                ..Chart::new(
+                    "Cost of the exact methods vs depth cap",
+                    "depth cap (most mirrors along a path)",
+                    "ms/frame (median, 95 % CI bars)",
+                )
+            })
+        }),
         Block::Table(
             [
                 "method",
@@ -699,53 +839,54 @@ pub(crate) fn symmetry_section(records: &[Record]) -> Vec<Block> {
     if groups.is_empty() {
         return Vec::new();
     }
-    let mut series: Vec<Series> = groups
+    let styles =
+        crate::plot::styles_for(&groups.iter().map(|g| g.method.as_str()).collect::<Vec<_>>());
+    let series: Vec<Series> = groups
         .iter()
-        .map(|g| Series {
-            name: g.name.clone(),
-            points: g.points.iter().map(|r| (setting(r), r.ms_median)).collect(),
-            labels: Vec::new(),
-            x_intervals: Vec::new(),
-            y_intervals: g.points.iter().map(|r| r.ms_interval).collect(),
+        .zip(styles)
+        .map(|(g, style)| {
+            let mut s = Series::new(
+                g.name.clone(),
+                style,
+                g.points.iter().map(|r| (setting(r), r.ms_median)).collect(),
+            );
+            s.y_intervals = g.points.iter().map(|r| r.ms_interval).collect();
+            s
         })
         .collect();
     // The seed's worst case: 2^p times the cost of one copy (the first method's p = 0 time).
+    let mut references = Vec::new();
     if let Some(base) = groups[0]
         .points
         .first()
         .filter(|r| r.symmetry_planes == Some(0))
     {
-        let ps: Vec<u32> = groups[0]
-            .points
-            .iter()
-            .filter_map(|r| r.symmetry_planes)
-            .collect();
-        series.push(Series {
-            name: format!("2^p × {}'s p = 0 time", groups[0].name),
-            points: ps
+        references.push(Reference::Curve(
+            format!("2^p × {}'s p = 0 time", groups[0].name),
+            groups[0]
+                .points
                 .iter()
-                .map(|&p| (f64::from(p), base.ms_median * f64::from(1u32 << p.min(31))))
+                .filter_map(|r| r.symmetry_planes)
+                .map(|p| (f64::from(p), base.ms_median * f64::from(1u32 << p.min(31))))
                 .collect(),
-            labels: Vec::new(),
-            x_intervals: Vec::new(),
-            y_intervals: Vec::new(),
-        });
+        ));
     }
     let opt = |v: Option<usize>| v.map_or("–".into(), |x| x.to_string());
     let mut out = vec![
         Block::Heading(2, "Symmetry planes: cost against p".into()),
         Block::Chart(
             "plot_ms_vs_planes.svg".into(),
-            Chart {
-                title: "ms/frame vs symmetry planes p".into(),
-                x_label: "symmetry planes p".into(),
-                y_label: "ms/frame (median, 95 % CI bars)".into(),
-                x_log: false,
+            Box::new(Chart {
                 y_log: true,
                 series,
-                reference_lines: Vec::new(),
-            }
-            .to_svg(),
+                references,
+                x_ticks_at_data: true,
+                ..Chart::new(
+                    "Cost of the symmetry methods vs planes p",
+                    "symmetry planes p",
+                    "ms/frame (median, 95 % CI bars)",
+                )
+            }),
         ),
         Block::Table(
             [
@@ -893,87 +1034,175 @@ fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
             groups.push(group);
         }
     }
-    // `ms_on_x`: x is the median time, drawn with its 95 % interval as an error bar.
-    let series =
-        |x: &dyn Fn(&Record) -> f64, y: &dyn Fn(&Record) -> f64, ms_on_x: bool| -> Vec<Series> {
-            groups
-                .iter()
-                .map(|(m, a)| {
-                    let mut pts: Vec<&&Record> = points
-                        .iter()
-                        .filter(|r| &crate::symmetry::variant(r) == m && r.alpha == *a)
-                        .collect();
-                    pts.sort_by(|p, q| setting(p).total_cmp(&setting(q)));
-                    Series {
-                        name: format!("{m}, α={a}"),
-                        points: pts.iter().map(|r| (x(r), y(r))).collect(),
-                        labels: pts
-                            .iter()
-                            .map(|r| {
-                                r.n.map(|n| format!("n={n}"))
-                                    .or(r.depth.map(|d| format!("d={d}")))
-                                    .unwrap_or_default()
-                            })
-                            .collect(),
-                        x_intervals: if ms_on_x {
-                            pts.iter().map(|r| r.ms_interval).collect()
-                        } else {
-                            Vec::new()
-                        },
-                        y_intervals: Vec::new(),
-                    }
-                })
-                .collect()
-        };
-    let floor_line = |v: fn(&Record) -> f64| {
-        floor
-            .map(|fl| vec![("floor (no mirrors)".to_string(), v(fl))])
-            .unwrap_or_default()
+    // One series per method variant and α, joined along its one swept setting (n or depth);
+    // a sweep with a scene axis (lighting, tilt, IPD) draws its own charts in its section:
+    // joining its points here would join unrelated settings.
+    let has_scene_axis = points.iter().any(|r| {
+        r.mirrored_lights.is_some() || r.bump_amplitude_deg.is_some() || r.stereo.is_some()
+    });
+    let alphas = distinct(points.iter().map(|r| r.alpha.to_bits()));
+    let styles = crate::plot::styles_for(
+        &groups
+            .iter()
+            .map(|(m, _)| m.split_whitespace().next().unwrap_or_default())
+            .collect::<Vec<_>>(),
+    );
+    // `keep`: which of a group's points the chart shows; `ms_on_x`: x is the median time,
+    // drawn with its 95 % interval as an error bar.
+    let series = |keep: &dyn Fn(&Record) -> bool,
+                  x: &dyn Fn(&Record) -> f64,
+                  y: &dyn Fn(&Record) -> Option<f64>,
+                  ms_on_x: bool|
+     -> Vec<Series> {
+        groups
+            .iter()
+            .zip(&styles)
+            .filter_map(|((m, a), style)| {
+                let mut pts: Vec<&&Record> = points
+                    .iter()
+                    .filter(|r| &crate::symmetry::variant(r) == m && r.alpha == *a && keep(r))
+                    .filter(|r| y(r).is_some())
+                    .collect();
+                if pts.is_empty() {
+                    return None;
+                }
+                pts.sort_by(|p, q| setting(p).total_cmp(&setting(q)));
+                let name = if alphas.len() > 1 {
+                    format!("{m}, α={a}")
+                } else {
+                    m.clone()
+                };
+                let mut s = Series::new(
+                    name,
+                    *style,
+                    pts.iter()
+                        .map(|r| (x(r), y(r).unwrap_or(f64::NAN)))
+                        .collect(),
+                );
+                s.labels = pts
+                    .iter()
+                    .map(|r| {
+                        r.n.map(|n| format!("n={n}"))
+                            .or(r.depth.map(|d| format!("d={d}")))
+                            .unwrap_or_default()
+                    })
+                    .collect();
+                if ms_on_x {
+                    s.x_intervals = pts.iter().map(|r| r.ms_interval).collect();
+                }
+                Some(s)
+            })
+            .collect()
     };
-    if !points.is_empty() && !mixed_devices {
+    let alpha_note = if alphas.len() == 1 {
+        format!(", α = {}", points.first().map_or(0.0, |r| r.alpha))
+    } else {
+        String::new()
+    };
+    let any = |_: &Record| true;
+    // Errors at the floor are not resolved: a chart of them would rank noise.
+    let at_floor = |r: &Record| floor.is_some_and(|fl| at_or_under_floor(r, fl));
+    let all_at_floor = !points.is_empty() && points.iter().all(|r| at_floor(r));
+    if all_at_floor && let Some(fl) = floor {
         b.push(Block::Heading(2, "Error against time".into()));
+        b.push(Block::Paragraph(format!(
+            "Every point's error is at the comparison's floor (FLIP mean ≤ {FLOOR_FACTOR}× the \
+             floor's {}): the methods are exact on this scene, and their errors are not \
+             compared or charted. Their cost is.",
+            sci(fl.metrics.flip_mean)
+        )));
+    }
+    let flip = |r: &Record| Some(r.metrics.flip_mean);
+    let mirror_flip = |r: &Record| r.mirror_metrics.as_ref().map(|m| m.flip_mean);
+    if !points.is_empty() && !mixed_devices && !has_scene_axis && !all_at_floor {
+        b.push(Block::Heading(2, "Error against time".into()));
+        b.push(Block::Paragraph(
+            "Each method's points joined along its swept setting (n or the depth cap, labelled); \
+             the shaded band is the comparison's floor (raster vs trace without mirrors)."
+                .into(),
+        ));
         b.push(Block::Chart(
             "plot_flip_vs_ms.svg".into(),
-            Chart {
-                title: "FLIP mean vs ms/frame".into(),
-                x_label: "ms/frame (median, 95 % CI bars)".into(),
-                y_label: "FLIP mean (lower is better)".into(),
+            Box::new(Chart {
                 x_log: true,
                 y_log: true,
-                series: series(&|r| r.ms_median, &|r| r.metrics.flip_mean, true),
-                reference_lines: floor_line(|r| r.metrics.flip_mean),
-            }
-            .to_svg(),
+                series: series(&any, &|r| r.ms_median, &flip, true),
+                floor: floor.map(|fl| fl.metrics.flip_mean),
+                ..Chart::new(
+                    format!("Whole-image error vs cost{alpha_note}"),
+                    "ms/frame (median, 95 % CI bars)",
+                    "FLIP mean over the image (lower is better)",
+                )
+            }),
+        ));
+        b.push(Block::Chart(
+            "plot_mirror_flip_vs_ms.svg".into(),
+            Box::new(Chart {
+                x_log: true,
+                y_log: true,
+                series: series(&any, &|r| r.ms_median, &mirror_flip, true),
+                ..Chart::new(
+                    format!("Error over the mirror pixels vs cost{alpha_note}"),
+                    "ms/frame (median, 95 % CI bars)",
+                    "FLIP mean over the mirror pixels",
+                )
+            }),
         ));
         b.push(Block::Chart(
             "plot_relmse_vs_ms.svg".into(),
-            Chart {
-                title: "relMSE (linear radiance) vs ms/frame".into(),
-                x_label: "ms/frame (median, 95 % CI bars)".into(),
-                y_label: "relMSE".into(),
+            Box::new(Chart {
                 x_log: true,
                 y_log: true,
-                series: series(&|r| r.ms_median, &|r| r.metrics.relmse, true),
-                reference_lines: floor_line(|r| r.metrics.relmse),
-            }
-            .to_svg(),
+                series: series(&any, &|r| r.ms_median, &|r| Some(r.metrics.relmse), true),
+                floor: floor.map(|fl| fl.metrics.relmse),
+                ..Chart::new(
+                    format!("relMSE (linear radiance) vs cost{alpha_note}"),
+                    "ms/frame (median, 95 % CI bars)",
+                    "relMSE over the image",
+                )
+            }),
+        ));
+    }
+    if !points.is_empty() && !has_scene_axis && !all_at_floor {
+        let with_n = |r: &Record| r.n.is_some();
+        let with_depth = |r: &Record| r.depth.is_some();
+        b.push(Block::Heading(2, "Error against the swept setting".into()));
+        b.push(Block::Chart(
+            "plot_flip_vs_n.svg".into(),
+            Box::new(Chart {
+                y_log: true,
+                series: series(&with_n, &|r| f64::from(r.n.unwrap_or(0)), &flip, false),
+                floor: floor.map(|fl| fl.metrics.flip_mean),
+                x_ticks_at_data: true,
+                ..Chart::new(
+                    format!("Error vs auxiliary mirrors n{alpha_note}"),
+                    "n (auxiliary mirrors)",
+                    "FLIP mean over the image",
+                )
+            }),
+        ));
+        b.push(Block::Chart(
+            "plot_flip_vs_depth.svg".into(),
+            Box::new(Chart {
+                x_log: true,
+                y_log: true,
+                series: series(
+                    &with_depth,
+                    &|r| f64::from(r.depth.unwrap_or(0)),
+                    &flip,
+                    false,
+                ),
+                floor: floor.map(|fl| fl.metrics.flip_mean),
+                x_ticks_at_data: true,
+                ..Chart::new(
+                    format!("Error vs depth cap{alpha_note}"),
+                    "depth cap (most mirrors along a path)",
+                    "FLIP mean over the image",
+                )
+            }),
         ));
     }
     if !points.is_empty() {
-        b.push(Block::Heading(2, "Error against n".into()));
-        b.push(Block::Chart(
-            "plot_flip_vs_n.svg".into(),
-            Chart {
-                title: "FLIP mean vs n (auxiliary mirrors) or depth".into(),
-                x_label: "n".into(),
-                y_label: "FLIP mean".into(),
-                x_log: false,
-                y_log: true,
-                series: series(&setting, &|r| r.metrics.flip_mean, false),
-                reference_lines: floor_line(|r| r.metrics.flip_mean),
-            }
-            .to_svg(),
-        ));
         b.push(Block::Heading(2, "All points".into()));
         b.push(Block::Table(
             [
@@ -1123,6 +1352,8 @@ pub(crate) mod tests {
                 flip_p95: flip,
                 flip_p99: flip,
             },
+            mirror_metrics: None,
+            mirror_pixel_share: None,
             adapter: "test".into(),
             backend: "vulkan".into(),
             color_format: "rgba32float".into(),

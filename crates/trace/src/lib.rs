@@ -13,12 +13,14 @@ pub mod bvh;
 pub mod cpu_features;
 pub mod integrator;
 pub mod mirror_bounce;
+pub mod mirror_mask;
 pub mod render;
 pub mod sampler;
 pub mod watertight;
 
 pub use bvh::{BvhKind, Hit, SceneBvh};
 pub use integrator::{Integrator, IntegratorSettings, PathResult, Termination, path, whitted};
+pub use mirror_mask::mirror_mask;
 pub use path::{PathSettings, PathTracer};
 pub use render::{TraceOutput, TraceSettings, TraceStats, render, render_while};
 pub use sampler::Sampling;

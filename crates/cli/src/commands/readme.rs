@@ -1,9 +1,11 @@
-//! `mirrorbox readme [--check]`: fills the README's generated regions (`<!-- generated: ID
-//! -->` … `<!-- end generated: ID -->`) from the committed reports, so every figure its prose
-//! quotes is the report's own (`mirrorbox_report::readme`).
+//! `mirrorbox readme [--check]`: fills the generated regions (`<!-- generated: ID -->` …
+//! `<!-- end generated: ID -->`) of the README, `docs/methods.md` and the book's chapters
+//! (`docs/book/src/*.md`) from the committed reports, so every figure their prose quotes is
+//! the report's own (`mirrorbox_report::readme`), and the region `cli` from this command
+//! line's own argument parser, so the command-line reference is the `--help` users see.
 
 use crate::Failure;
-use mirrorbox_report::readme::{REGIONS, fill, stale_regions};
+use mirrorbox_report::readme::{REGIONS, Region, fill_with, stale_regions_with};
 use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
@@ -11,20 +13,41 @@ pub struct Args {
     /// Do not write: exit 1 if a region differs from what the reports give, naming it.
     #[arg(long)]
     check: bool,
-    /// The Markdown files to fill (their regions name the reports they quote).
-    #[arg(default_values = ["README.md", "docs/methods.md"])]
+    /// The Markdown files to fill (their regions name the reports they quote). Default:
+    /// README.md, docs/methods.md and every docs/book/src/*.md.
     files: Vec<PathBuf>,
     /// The folder of the committed reports.
     #[arg(long, default_value = "reports")]
     reports: PathBuf,
 }
 
+/// The files filled when none is named, relative to the repository root.
+const DEFAULT_FILES: [&str; 2] = ["README.md", "docs/methods.md"];
+/// The book's chapters: every `*.md` directly in this folder is filled too.
+pub const BOOK_SOURCE: &str = "docs/book/src";
+
+/// The region that holds the command-line reference (`docs/book/src/cli.md`).
+pub const CLI_REGION: &str = "cli";
+
+/// The width clap lays the help out for, fixed so the reference does not depend on the
+/// terminal that runs `mirrorbox readme`.
+const HELP_WIDTH: usize = 100;
+
 pub fn run(args: &Args) -> Result<(), Failure> {
+    let files = if args.files.is_empty() {
+        default_files()?
+    } else {
+        args.files.clone()
+    };
+    let extra = [Region {
+        id: CLI_REGION,
+        text: cli_reference(),
+    }];
     // Every file is tried; bad input (a malformed region, a missing report) decides exit 2
     // over a stale region's exit 1.
     let (mut messages, mut bad_input) = (Vec::new(), false);
-    for file in &args.files {
-        match one(file, args) {
+    for file in &files {
+        match one(file, args, &extra) {
             Ok(()) => {}
             Err(Failure::BadInput(m)) => {
                 bad_input = true;
@@ -33,6 +56,17 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             Err(Failure::Other(m)) => messages.push(m),
         }
     }
+    if !args.check {
+        println!(
+            "regions known: {}",
+            REGIONS
+                .iter()
+                .map(|r| r.0)
+                .chain(extra.iter().map(|r| r.id))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
     match (messages.is_empty(), bad_input) {
         (true, _) => Ok(()),
         (false, true) => Err(Failure::BadInput(messages.join("\n"))),
@@ -40,13 +74,67 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     }
 }
 
+/// README.md, docs/methods.md and the book's chapters in name order (run from the
+/// repository root).
+fn default_files() -> Result<Vec<PathBuf>, Failure> {
+    let mut files: Vec<PathBuf> = DEFAULT_FILES.iter().map(PathBuf::from).collect();
+    let book = Path::new(BOOK_SOURCE);
+    let entries = std::fs::read_dir(book).map_err(|e| {
+        Failure::BadInput(format!(
+            "{}: {e} (run `mirrorbox readme` from the repository root, or name the files)",
+            book.display()
+        ))
+    })?;
+    let mut chapters = Vec::new();
+    for entry in entries {
+        let path = entry
+            .map_err(|e| Failure::Other(format!("{}: {e}", book.display())))?
+            .path();
+        if path.extension().is_some_and(|x| x == "md") && path.is_file() {
+            chapters.push(path);
+        }
+    }
+    chapters.sort();
+    files.extend(chapters);
+    Ok(files)
+}
+
+/// The command-line reference: `mirrorbox --help`, then every visible subcommand's `--help`
+/// under its own heading, as clap renders it at [`HELP_WIDTH`] columns, without styling.
+pub fn cli_reference() -> String {
+    let mut cli = <crate::Cli as clap::CommandFactory>::command().term_width(HELP_WIDTH);
+    cli.build();
+    let mut out = String::new();
+    let mut section = |title: &str, help: String| {
+        out.push_str(&format!("## `{title}`\n\n```text\n"));
+        for line in help.trim_end().lines() {
+            out.push_str(line.trim_end());
+            out.push('\n');
+        }
+        out.push_str("```\n\n");
+    };
+    let top = cli.render_long_help().to_string();
+    section("mirrorbox", top);
+    let name = cli.get_name().to_string();
+    for sub in cli.get_subcommands_mut() {
+        if sub.is_hide_set() || sub.get_name() == "help" {
+            continue;
+        }
+        let title = format!("{name} {}", sub.get_name());
+        let mut sub = sub.clone().term_width(HELP_WIDTH);
+        let help = sub.render_long_help().to_string();
+        section(&title, help);
+    }
+    format!("{}\n", out.trim_end())
+}
+
 /// Fills (or checks) one file; a malformed region or a missing report is bad input (exit 2).
-fn one(file: &Path, args: &Args) -> Result<(), Failure> {
+fn one(file: &Path, args: &Args, extra: &[Region]) -> Result<(), Failure> {
     let bad = |e: &dyn std::fmt::Display| Failure::BadInput(format!("{}: {e}", file.display()));
     let text = mirrorbox_files::read_bounded_text(file, MAX_README_BYTES, "a Markdown file")
         .map_err(|e| bad(&e))?;
     if args.check {
-        let stale = stale_regions(&text, &args.reports).map_err(|e| bad(&e))?;
+        let stale = stale_regions_with(&text, &args.reports, extra).map_err(|e| bad(&e))?;
         if stale.is_empty() {
             println!(
                 "{}: every generated region agrees with {}",
@@ -68,13 +156,13 @@ fn one(file: &Path, args: &Args) -> Result<(), Failure> {
             lines.join("\n  ")
         )));
     }
-    let filled = fill(&text, &args.reports).map_err(|e| bad(&e))?;
+    let filled = fill_with(&text, &args.reports, extra).map_err(|e| bad(&e))?;
     if filled != text {
         mirrorbox_files::write_atomically(file, filled.as_bytes())
             .map_err(|e| Failure::Other(e.to_string()))?;
     }
     println!(
-        "{}: {} from {} (regions known: {})",
+        "{}: {} from {}",
         file.display(),
         if filled != text {
             "generated regions filled"
@@ -82,7 +170,6 @@ fn one(file: &Path, args: &Args) -> Result<(), Failure> {
             "generated regions already up to date"
         },
         args.reports.display(),
-        REGIONS.iter().map(|r| r.0).collect::<Vec<_>>().join(", ")
     );
     Ok(())
 }

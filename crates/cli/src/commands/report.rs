@@ -10,13 +10,26 @@ use std::path::PathBuf;
 pub struct Args {
     /// Sweep folders (each with the `sweep.json` and `results.jsonl` a sweep wrote, or a
     /// sequence sweep's `motion.json` and `frames.jsonl`).
-    #[arg(required = true)]
+    #[arg(required_unless_present = "index")]
     dirs: Vec<PathBuf>,
+    /// Write the overview of every report under this folder (normally `reports`):
+    /// `index.html`, `README.md` and the cross-method frontier charts `frontier_*.svg`.
+    #[arg(long, value_name = "REPORTS")]
+    index: Option<PathBuf>,
 }
 
 pub fn run(args: &Args) -> Result<(), Failure> {
+    if let Some(reports) = &args.index {
+        let n = mirrorbox_report::overview::write_overview(reports, &records_commit)
+            .map_err(|e| Failure::BadInput(format!("{}: {e}", reports.display())))?;
+        println!(
+            "{}: index.html and README.md list {}",
+            reports.display(),
+            crate::count(n, "report")
+        );
+    }
     for dir in &args.dirs {
-        let n = mirrorbox_report::rewrite_report(dir)
+        let n = mirrorbox_report::rewrite_report(dir, &records_commit(dir))
             .map_err(|e| Failure::BadInput(format!("{}: {e}", dir.display())))?;
         println!(
             "{}: report rewritten from {}",
@@ -25,4 +38,26 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         );
     }
     Ok(())
+}
+
+/// The commit that last committed `dir/results.jsonl` (for the figures' footers of a sweep
+/// that did not record the commit that measured it); empty outside a git checkout.
+fn records_commit(dir: &std::path::Path) -> String {
+    if !dir.is_dir() {
+        return String::new();
+    }
+    std::process::Command::new("git")
+        .arg("-C")
+        .arg(dir)
+        .args(["log", "-1", "--format=%h", "--"])
+        .arg(if dir.join("results.jsonl").is_file() {
+            "results.jsonl"
+        } else {
+            "."
+        })
+        .output()
+        .ok()
+        .filter(|o| o.status.success())
+        .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+        .unwrap_or_default()
 }

@@ -1,0 +1,449 @@
+//! The overview of every committed report (issue 38): `reports/index.html` and
+//! `reports/README.md`, headed by the harness's first question — across every method, what
+//! error does each millisecond buy? — as one frontier chart per scene and device, then one row
+//! per report with its scene, device, date and commit.
+//!
+//! The frontier takes every point of every sweep on the scene (no scene axis: lighting, tilt
+//! and stereo sweeps answer their own questions), groups them by device, size and α, and draws
+//! each method at its sweep points (markers, the method's fixed style) with the Pareto front
+//! (the points no other point beats in both time and error) as a grey step line. Its error is
+//! the FLIP mean over the mirror pixels where every point has it (the error a method makes,
+//! undiluted by the pixels every method gets right), else over the image.
+
+use crate::folder::{Sweep, load_sweep};
+use crate::plot::{Chart, Reference, Series, styles_for};
+use crate::readme::ReadmeError;
+use crate::write::{distinct, remove_stale};
+use crate::{Record, SweepInfo};
+use mirrorbox_files::write_atomically;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// The scenes the overview draws a frontier for: the two bundled mirror scenes.
+pub const FRONTIER_SCENES: [&str; 2] = ["mirror_box", "mirror_room"];
+
+/// One report folder under `reports/`.
+struct Entry {
+    /// Relative to `reports/`.
+    folder: String,
+    /// The file a reader opens (relative to `reports/`).
+    link: String,
+    title: String,
+    scene: String,
+    device: String,
+    date: String,
+    commit: String,
+}
+
+/// A frontier panel's key: device slug, device, size, α's bits.
+type GroupKey = (String, String, String, u32);
+
+/// A chart of the overview: its file name (in `reports/`) and the chart.
+pub struct Frontier {
+    pub file: String,
+    pub chart: Chart,
+}
+
+fn scene_stem(scene: &str) -> &str {
+    Path::new(scene)
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or(scene)
+}
+
+/// A device's short name for file names: `lavapipe`, `h100`, or the adapter's first word.
+fn device_slug(info: &SweepInfo) -> String {
+    let a = info.adapter.to_lowercase();
+    if a.contains("llvmpipe") {
+        "lavapipe".into()
+    } else if let Some(i) = a.find("h100") {
+        a[i..i + 4].to_string()
+    } else {
+        a.split_whitespace()
+            .next()
+            .unwrap_or("device")
+            .chars()
+            .filter(char::is_ascii_alphanumeric)
+            .collect()
+    }
+}
+
+/// The sweep folders under `reports` (one level, and one below for `gpu/`), sorted.
+fn sweep_folders(reports: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    let mut visit = |dir: &Path| {
+        if let Ok(entries) = std::fs::read_dir(dir) {
+            for e in entries.flatten() {
+                let p = e.path();
+                if p.join("sweep.json").is_file() {
+                    out.push(p);
+                }
+            }
+        }
+    };
+    visit(reports);
+    visit(&reports.join("gpu"));
+    out.sort();
+    out
+}
+
+/// The report's first Markdown heading, without its `#`s.
+fn first_heading(path: &Path) -> Option<String> {
+    let text = mirrorbox_files::read_bounded_text(path, 8 << 20, "a report").ok()?;
+    text.lines()
+        .find(|l| l.starts_with('#'))
+        .map(|l| l.trim_start_matches('#').trim().replace('`', ""))
+}
+
+/// What a point's series in the frontier is: its method and non-default options.
+fn series_name(r: &Record) -> String {
+    crate::symmetry::variant(r)
+}
+
+/// The setting a point was swept at, for labels on the front: `n=2`, `d=64`.
+fn setting_label(r: &Record) -> String {
+    let mut words = Vec::new();
+    if let Some(n) = r.n {
+        words.push(format!("n={n}"));
+    }
+    if let Some(d) = r.depth {
+        words.push(format!("d={d}"));
+    }
+    for w in r.method_options.split_whitespace() {
+        words.push(w.to_string());
+    }
+    words.join(" ")
+}
+
+/// Points of a chart: (ms/frame, error).
+type Points = Vec<(f64, f64)>;
+
+/// The Pareto front of `(ms, error)` points: sorted by time, each point kept if no faster one
+/// has an error as low; returned with the step line through the kept points.
+pub fn pareto_steps(points: &[(f64, f64)]) -> (Points, Points) {
+    let mut sorted: Vec<(f64, f64)> = points
+        .iter()
+        .copied()
+        .filter(|(x, y)| x.is_finite() && y.is_finite() && *x > 0.0 && *y > 0.0)
+        .collect();
+    sorted.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    let mut front: Vec<(f64, f64)> = Vec::new();
+    for p in sorted {
+        if front.last().is_none_or(|l| p.1 < l.1) {
+            front.push(p);
+        }
+    }
+    let mut steps = Vec::new();
+    for (i, p) in front.iter().enumerate() {
+        if i > 0 {
+            steps.push((p.0, front[i - 1].1));
+        }
+        steps.push(*p);
+    }
+    (front, steps)
+}
+
+/// The frontier charts of the sweeps in `sweeps`: per scene of [`FRONTIER_SCENES`], per device,
+/// size and α with at least two methods. The lavapipe chart with the most points of a scene is
+/// `frontier_<scene>.svg`; the others are named by device, size and α.
+pub(crate) fn frontiers(sweeps: &[(String, Sweep)]) -> Vec<Frontier> {
+    let mut out = Vec::new();
+    for scene in FRONTIER_SCENES {
+        // (device slug, device text, size, α) → records.
+        let mut groups: Vec<(GroupKey, Vec<&Record>, &SweepInfo)> = Vec::new();
+        for (_, sweep) in sweeps {
+            if scene_stem(&sweep.info.scene) != scene {
+                continue;
+            }
+            for r in sweep.records.iter().filter(|r| {
+                r.kind == "point"
+                    && r.mirrored_lights.is_none()
+                    && r.bump_amplitude_deg.is_none()
+                    && r.stereo.is_none()
+                    && r.device.is_none()
+            }) {
+                let key = (
+                    device_slug(&sweep.info),
+                    format!("{} ({})", sweep.info.adapter, sweep.info.backend),
+                    format!("{}x{}", r.width, r.height),
+                    r.alpha.to_bits(),
+                );
+                match groups.iter_mut().find(|g| g.0 == key) {
+                    Some(g) => g.1.push(r),
+                    None => groups.push((key, vec![r], &sweep.info)),
+                }
+            }
+        }
+        groups.retain(|g| distinct(g.1.iter().map(|r| r.method.clone())).len() >= 2);
+        let headline = groups
+            .iter()
+            .enumerate()
+            .filter(|(_, g)| g.0.0 == "lavapipe")
+            .max_by_key(|(_, g)| g.1.len())
+            .map(|(i, _)| i);
+        for (i, ((slug, device, size, alpha), records, info)) in groups.iter().enumerate() {
+            let alpha = f32::from_bits(*alpha);
+            let file = if Some(i) == headline {
+                format!("frontier_{scene}.svg")
+            } else {
+                format!("frontier_{scene}_{slug}_{size}_a{alpha}.svg")
+            };
+            out.push(Frontier {
+                file,
+                chart: frontier_chart(scene, device, size, alpha, records, info),
+            });
+        }
+    }
+    out
+}
+
+fn frontier_chart(
+    scene: &str,
+    device: &str,
+    size: &str,
+    alpha: f32,
+    records: &[&Record],
+    info: &SweepInfo,
+) -> Chart {
+    let mirror = records.iter().all(|r| r.mirror_metrics.is_some());
+    let error = |r: &Record| match (&r.mirror_metrics, mirror) {
+        (Some(m), true) => m.flip_mean,
+        _ => r.metrics.flip_mean,
+    };
+    let names = distinct(records.iter().map(|r| series_name(r)));
+    let bases: Vec<String> = names
+        .iter()
+        .map(|n| n.split_whitespace().next().unwrap_or_default().to_string())
+        .collect();
+    let styles = styles_for(&bases.iter().map(String::as_str).collect::<Vec<_>>());
+    let all: Vec<(f64, f64)> = records.iter().map(|r| (r.ms_median, error(r))).collect();
+    let (front, steps) = pareto_steps(&all);
+    let on_front = |r: &Record| front.contains(&(r.ms_median, error(r)));
+    let series: Vec<Series> = names
+        .iter()
+        .zip(styles)
+        .map(|(name, style)| {
+            let mut pts: Vec<&&Record> =
+                records.iter().filter(|r| &series_name(r) == name).collect();
+            pts.sort_by(|a, b| a.ms_median.total_cmp(&b.ms_median));
+            let mut s = Series::new(
+                name.clone(),
+                style,
+                pts.iter().map(|r| (r.ms_median, error(r))).collect(),
+            );
+            s.joined = false;
+            s.x_intervals = pts.iter().map(|r| r.ms_interval).collect();
+            s.labels = pts
+                .iter()
+                .map(|r| {
+                    if on_front(r) {
+                        setting_label(r)
+                    } else {
+                        String::new()
+                    }
+                })
+                .collect();
+            s
+        })
+        .collect();
+    let mut chart = Chart {
+        x_log: true,
+        y_log: true,
+        series,
+        references: vec![Reference::Curve("Pareto front".into(), steps)],
+        ..Chart::new(
+            format!("What each millisecond buys: {scene}, α = {alpha}"),
+            "ms/frame (median, 95 % CI bars)",
+            if mirror {
+                "FLIP mean over the mirror pixels"
+            } else {
+                "FLIP mean over the image"
+            },
+        )
+    };
+    let date = info.date.get(..10).unwrap_or(&info.date);
+    let commit = if info.commit.is_empty() {
+        format!("records committed in {}", info.records_commit)
+    } else {
+        format!("commit {}", info.commit)
+    };
+    chart.footer = format!(
+        "{scene} · {size} · {device} on {} · {date} · {commit}",
+        info.cpu
+    );
+    chart
+}
+
+/// Writes `reports/index.html`, `reports/README.md` and the frontier SVGs from every report
+/// under `reports`; `commit_of(folder)` names the commit of a sweep that did not record the
+/// one that measured it (the commit that committed its records). Returns the number of
+/// reports listed.
+pub fn write_overview(
+    reports: &Path,
+    commit_of: &dyn Fn(&Path) -> String,
+) -> Result<usize, ReadmeError> {
+    let rel = |p: &Path| {
+        p.strip_prefix(reports)
+            .unwrap_or(p)
+            .to_string_lossy()
+            .into_owned()
+    };
+    let mut sweeps: Vec<(String, Sweep)> = Vec::new();
+    let mut entries: Vec<Entry> = Vec::new();
+    for dir in sweep_folders(reports) {
+        let mut sweep = load_sweep(&dir)?;
+        if sweep.info.commit.is_empty() {
+            sweep.info.records_commit = commit_of(&dir);
+        }
+        let folder = rel(&dir);
+        entries.push(Entry {
+            link: format!("{folder}/report.html"),
+            title: first_heading(&dir.join("report.md")).unwrap_or_else(|| folder.clone()),
+            scene: sweep.info.scene.clone(),
+            device: format!("{} ({})", sweep.info.adapter, sweep.info.backend),
+            date: sweep
+                .info
+                .date
+                .get(..10)
+                .unwrap_or(&sweep.info.date)
+                .to_string(),
+            commit: if sweep.info.commit.is_empty() {
+                format!("records in {}", sweep.info.records_commit)
+            } else {
+                sweep.info.commit.clone()
+            },
+            folder: folder.clone(),
+        });
+        sweeps.push((folder, sweep));
+    }
+    // The other reports: a sequence sweep, benches and one-off measurements.
+    for (file, scene) in [
+        ("motion/report.md", "scenes/mirror_box_walk.json"),
+        (
+            "tracer/bench.md",
+            "scenes/mirror_box.json, scenes/mirror_room.json",
+        ),
+        ("viewer/frame_rates.md", "scenes/mirror_box.json"),
+        ("memory/peaks.md", "every bundled scene"),
+        ("tests/test_times.md", "–"),
+        ("gpu/README.md", "–"),
+    ] {
+        let path = reports.join(file);
+        if !path.is_file() {
+            continue;
+        }
+        let folder = Path::new(file)
+            .parent()
+            .map_or(String::new(), |p| p.to_string_lossy().into_owned());
+        entries.push(Entry {
+            link: file.to_string(),
+            title: first_heading(&path).unwrap_or_else(|| file.to_string()),
+            scene: scene.into(),
+            device: "see the report".into(),
+            date: "see the report".into(),
+            commit: format!("records in {}", commit_of(&reports.join(&folder))),
+            folder,
+        });
+    }
+
+    let charts = frontiers(&sweeps);
+    // Frontier files of an earlier overview that this one does not draw.
+    if let Ok(dir) = std::fs::read_dir(reports) {
+        for e in dir.flatten() {
+            let name = e.file_name().to_string_lossy().into_owned();
+            if name.starts_with("frontier_")
+                && name.ends_with(".svg")
+                && !charts
+                    .iter()
+                    .any(|c| c.file == name && c.chart.is_drawable())
+            {
+                remove_stale(&e.path()).map_err(|e| ReadmeError(e.to_string()))?;
+            }
+        }
+    }
+    let mut md = String::from(
+        "# mirrorbox reports\n\nGenerated by `mirrorbox report --index reports` from the committed \
+         records; every figure names its scene, size, device and date.\n\n## What each millisecond buys\n\n\
+         Every method at its sweep points on the bundled mirror scenes, error against ms/frame \
+         (log–log, lower left is better); the grey step line is the Pareto front, labelled with \
+         the settings on it. One chart per device, size and α.\n\n",
+    );
+    let mut html = String::from(
+        "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>mirrorbox reports</title>\
+         <meta name=\"viewport\" content=\"width=device-width\"><style>\
+         body{font-family:sans-serif;max-width:1100px;margin:2em auto;padding:0 1em}\
+         .chart svg{max-width:100%;height:auto}\
+         .scroll{overflow-x:auto}table{border-collapse:collapse;margin:1em 0}\
+         td,th{border:1px solid #ccc;padding:3px 8px;text-align:left;vertical-align:top}\
+         th{background:#f3f3f3}td{overflow-wrap:anywhere}\
+         </style></head><body>\n<h1>mirrorbox reports</h1>\n<p>Generated by <code>mirrorbox report \
+         --index reports</code> from the committed records; every figure names its scene, size, \
+         device and date.</p>\n<h2>What each millisecond buys</h2>\n<p>Every method at its sweep \
+         points on the bundled mirror scenes, error against ms/frame (log–log, lower left is \
+         better); the grey step line is the Pareto front, labelled with the settings on it. One \
+         chart per device, size and α.</p>\n",
+    );
+    for c in charts.iter().filter(|c| c.chart.is_drawable()) {
+        let svg = c.chart.to_svg();
+        write_atomically(&reports.join(&c.file), svg.as_bytes())
+            .map_err(|e| ReadmeError(e.to_string()))?;
+        let _ = writeln!(md, "![{}]({})\n", c.chart.title, c.file);
+        let _ = writeln!(html, "<div class=\"chart\">{svg}</div>");
+    }
+    md.push_str("## Every report\n\n| report | what | scene | device | date | commit |\n|---|---|---|---|---|---|\n");
+    html.push_str(
+        "<h2>Every report</h2>\n<div class=\"scroll\"><table><tr><th>report</th><th>what</th>\
+         <th>scene</th><th>device</th><th>date</th><th>commit</th></tr>\n",
+    );
+    let esc = |s: &str| {
+        s.replace('&', "&amp;")
+            .replace('<', "&lt;")
+            .replace('>', "&gt;")
+    };
+    for e in &entries {
+        let md_link = if e.link.ends_with("report.html") {
+            e.link.replace("report.html", "report.md")
+        } else {
+            e.link.clone()
+        };
+        let _ = writeln!(
+            md,
+            "| [{}]({md_link}) | {} | {} | {} | {} | {} |",
+            e.folder, e.title, e.scene, e.device, e.date, e.commit
+        );
+        let _ = writeln!(
+            html,
+            "<tr><td><a href=\"{}\">{}</a></td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+            esc(&e.link),
+            esc(&e.folder),
+            esc(&e.title),
+            esc(&e.scene),
+            esc(&e.device),
+            esc(&e.date),
+            esc(&e.commit)
+        );
+    }
+    html.push_str("</table></div>\n</body></html>\n");
+    write_atomically(&reports.join("README.md"), md.as_bytes())
+        .map_err(|e| ReadmeError(e.to_string()))?;
+    write_atomically(&reports.join("index.html"), html.as_bytes())
+        .map_err(|e| ReadmeError(e.to_string()))?;
+    Ok(entries.len())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_pareto_front_keeps_only_points_nothing_beats() {
+        let pts = [(1.0, 10.0), (2.0, 5.0), (3.0, 7.0), (4.0, 1.0), (5.0, 1.0)];
+        let (front, steps) = pareto_steps(&pts);
+        assert_eq!(front, vec![(1.0, 10.0), (2.0, 5.0), (4.0, 1.0)]);
+        // A step line: each later point reached first horizontally.
+        assert_eq!(
+            steps,
+            vec![(1.0, 10.0), (2.0, 10.0), (2.0, 5.0), (4.0, 5.0), (4.0, 1.0)]
+        );
+    }
+}
