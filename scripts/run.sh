@@ -8,15 +8,17 @@
 # reports/lighting/ and reports/lighting_room/ with the tracer's cost against the mirrored-light
 # depth in reports/lighting/trace_cost.jsonl, the uneven-mirror tricks in reports/uneven_mirrors*/
 # stereo mirrors (per-eye against shared) in reports/stereo/ and error over time (feedback, cube maps; still and
-# walking) in reports/motion/ (measuring every point again; cached ground truths are
-# reused when present). It records each step's time and peak memory in
+# walking) in reports/motion/, and the cross-method frontier sweeps of every method on
+# mirror_box and mirror_room in reports/frontier_box/ and reports/frontier_room/ (measuring
+# every point again; cached ground truths are reused when present), then the overview
+# reports/index.html and reports/README.md (`report --index`). It records each step's time and peak memory in
 # reports/main_job.json and fills the README's generated regions from the reports. Last, the
 # peak memory of every bundled scene × method in reports/memory/peaks.md.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 export NODEVICE_SELECT=1
 bin=target/release/mirrorbox
-steps_total=15
+steps_total=18
 step=0
 steps_json=""
 started_at=$(date -u +%Y-%m-%dT%H:%M:%SZ)
@@ -54,6 +56,18 @@ run_step "$bin" lighting --fresh
 run_step "$bin" bumpy --fresh
 run_step "$bin" stereo --fresh
 run_step "$bin" motion
+# The frontier (issue 38): every method at a few settings on both bundled mirror scenes, at
+# 320×180 and α = 1. The room leaves out path-textures (over 5 000 passes past depth 4) and
+# auxiliary n ≥ 2 (3 761 passes, 2.9 s/frame), and caps the depth at 16 (unrolled's 8 M
+# triangle bound).
+run_step "$bin" sweep scenes/mirror_box.json --out reports/frontier_box --fresh \
+  --methods naive,auxiliary,path-textures,portal,unrolled,feedback,cubemap \
+  --n 0,1,2,3 --depth 1,4,16,64 --history 16 --cube-size 128,512 --alpha 1 \
+  --width 320 --height 180 --frames 5 --warmup 1
+run_step "$bin" sweep scenes/mirror_room.json --out reports/frontier_room --fresh \
+  --methods naive,auxiliary,portal,unrolled,feedback,cubemap \
+  --n 0,1 --depth 1,2,4,8,16 --history 16 --cube-size 128,512 --alpha 1 \
+  --width 320 --height 180 --frames 5 --warmup 1
 run_step env MIRRORBOX="$bin" scripts/lighting-trace-cost.sh
 run_step scripts/memory-peaks.sh
 cpu=$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//; s/"/'"'"'/g')
@@ -62,5 +76,6 @@ tmp=$(mktemp reports/.main_job.XXXXXX)
 printf '{"date":"%s","cpu":"%s, %s cores","seconds":%s,"steps":[%s]}\n' \
   "$started_at" "$cpu" "$cores" "$SECONDS" "$steps_json" >"$tmp"
 mv "$tmp" reports/main_job.json
+run_step "$bin" report --index reports
 run_step "$bin" readme
 echo "== main job done in $SECONDS s"

@@ -54,7 +54,7 @@ enum Command {
     View(commands::view::Args),
     /// Export a scene as Mitsuba 3 XML (tools/mitsuba renders and compares it).
     ExportMitsuba(commands::export_mitsuba::Args),
-    /// Fill the generated regions of README.md and docs/methods.md from the committed reports (--check: only compare).
+    /// Fill the generated regions of README.md, docs/methods.md and the book (docs/book/src/*.md) from the committed reports and the CLI's own help (--check: only compare).
     Readme(commands::readme::Args),
     /// Rewrite a sweep folder's report (Markdown, HTML, CSV, plots) from its results.jsonl, without rendering.
     Report(commands::report::Args),

@@ -87,7 +87,7 @@ fn slope_interval(points: &[Record]) -> Option<crate::stats::Interval> {
     )
 }
 
-use crate::write::{ms, ms_digits};
+use crate::document::{ms, ms_digits};
 
 /// A sentence on the cost of one more bounce against one full-scene pass (`pass_ms`).
 pub fn bounce_sentence(g: &DepthScaling, pass_ms: Option<f64>) -> String {

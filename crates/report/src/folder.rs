@@ -4,7 +4,7 @@
 //! no GPU: a report measured on another machine is regenerated here after a change to the
 //! report's text.
 
-use crate::readme::ReadmeError;
+use crate::error::ReadmeError;
 use crate::{Record, SweepInfo, read_records, write_report};
 use std::path::Path;
 

@@ -6,6 +6,8 @@
 //!   plots, including the reproduction of the seed paper's Table 1 ([`table1`]).
 //! - [`readme`]: the README's figures, generated from the committed reports.
 
+mod document;
+mod error;
 pub mod exact;
 mod folder;
 pub mod lighting;
@@ -379,4 +381,84 @@ pub fn linear_fit(points: &[(f64, f64)]) -> Option<(f64, f64)> {
     let sxx: f64 = points.iter().map(|p| (p.0 - mx).powi(2)).sum();
     let sxy: f64 = points.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
     (sxx > 0.0).then(|| (my - sxy / sxx * mx, sxy / sxx))
+}
+
+#[cfg(test)]
+mod structure {
+    /// The modules of this crate and the sibling modules each one names (`crate::x`).
+    fn imports() -> Vec<(String, Vec<String>)> {
+        let src = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+        let modules: Vec<String> = std::fs::read_dir(&src)
+            .unwrap()
+            .flatten()
+            .filter_map(|e| {
+                let name = e.file_name().to_string_lossy().into_owned();
+                name.strip_suffix(".rs")
+                    .filter(|n| *n != "lib")
+                    .map(String::from)
+            })
+            .collect();
+        modules
+            .iter()
+            .map(|m| {
+                let text = std::fs::read_to_string(src.join(format!("{m}.rs"))).unwrap();
+                let mut used: Vec<String> = text
+                    .split("crate::")
+                    .skip(1)
+                    .filter_map(|rest| {
+                        let name: String = rest
+                            .chars()
+                            .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+                            .collect();
+                        // `crate::{a, b}` names root items and modules alike.
+                        (modules.contains(&name) && name != *m).then_some(name)
+                    })
+                    .collect();
+                used.sort();
+                used.dedup();
+                (m.clone(), used)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_report_modules_import_each_other_without_a_circle() {
+        let graph = imports();
+        // Depth-first search for a back edge; the path to it is the circle.
+        fn visit(
+            m: &str,
+            graph: &[(String, Vec<String>)],
+            path: &mut Vec<String>,
+            done: &mut Vec<String>,
+        ) -> Option<Vec<String>> {
+            if let Some(i) = path.iter().position(|p| p == m) {
+                let mut circle = path[i..].to_vec();
+                circle.push(m.to_string());
+                return Some(circle);
+            }
+            if done.iter().any(|d| d == m) {
+                return None;
+            }
+            path.push(m.to_string());
+            let next = graph.iter().find(|(n, _)| n == m).map(|(_, u)| u.clone());
+            for u in next.unwrap_or_default() {
+                if let Some(c) = visit(&u, graph, path, done) {
+                    return Some(c);
+                }
+            }
+            path.pop();
+            done.push(m.to_string());
+            None
+        }
+        let (mut path, mut done) = (Vec::new(), Vec::new());
+        for (m, _) in &graph {
+            if let Some(circle) = visit(m, &graph, &mut path, &mut done) {
+                panic!("import circle in crates/report/src: {}", circle.join(" → "));
+            }
+        }
+        // The writer imports the sections; the document model imports none of them.
+        let uses = |m: &str| graph.iter().find(|(n, _)| n == m).unwrap().1.clone();
+        assert!(uses("write").contains(&"lighting".to_string()));
+        assert!(!uses("document").contains(&"write".to_string()));
+    }
 }

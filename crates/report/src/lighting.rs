@@ -7,8 +7,8 @@
 //! rasterizer.
 
 use crate::Record;
+use crate::document::{Block, f, ms_cell, sci};
 use crate::plot::{Chart, Series, method_style};
-use crate::write::{Block, f, ms_cell, sci};
 
 /// The raster option that chooses direct or mirrored lights.
 pub const LIGHTS_OPTION: &str = "lights";
@@ -62,7 +62,7 @@ fn lit_points(records: &[Record]) -> Vec<&Record> {
         .collect()
 }
 
-use crate::write::distinct;
+use crate::document::distinct;
 
 /// The method the sentences and the error-against-k chart follow: the first exact one
 /// measured (`unrolled`, `portal`), else the first.
@@ -298,7 +298,7 @@ mod tests {
     use super::*;
 
     fn record(method: &str, options: &str, k: u32, flip: f64) -> Record {
-        let mut r = crate::write::tests::record(0, 10.0, 1, flip);
+        let mut r = crate::document::fixtures::record(0, 10.0, 1, flip);
         r.method = method.into();
         r.n = None;
         r.method_options = options.into();

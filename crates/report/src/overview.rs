@@ -10,10 +10,10 @@
 //! the FLIP mean over the mirror pixels where every point has it (the error a method makes,
 //! undiluted by the pixels every method gets right), else over the image.
 
+use crate::document::{distinct, remove_stale};
+use crate::error::ReadmeError;
 use crate::folder::{Sweep, load_sweep};
 use crate::plot::{Chart, Reference, Series, styles_for};
-use crate::readme::ReadmeError;
-use crate::write::{distinct, remove_stale};
 use crate::{Record, SweepInfo};
 use mirrorbox_files::write_atomically;
 use std::fmt::Write as _;

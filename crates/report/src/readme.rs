@@ -10,11 +10,9 @@
 //! --check` (run by the tests) fails when a region differs from what the reports give.
 //! Everything outside the regions is left alone, byte for byte.
 
+use crate::document::{Block, markdown, ms_cell};
 use crate::folder::{Sweep, load_sweep};
-use crate::write::{
-    Block, depth_scaling, floor_paragraph, markdown, ms_cell, row_cell, symmetry_section,
-    table1_section,
-};
+use crate::write::{depth_scaling, floor_paragraph, row_cell, symmetry_section, table1_section};
 use crate::{stats, table1};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -23,15 +21,7 @@ const BEGIN: &str = "<!-- generated: ";
 const END: &str = "<!-- end generated: ";
 const CLOSE: &str = " -->";
 
-/// Why the README's regions could not be generated or filled.
-#[derive(Debug, PartialEq)]
-pub struct ReadmeError(pub String);
-
-impl std::fmt::Display for ReadmeError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.0)
-    }
-}
+pub use crate::error::ReadmeError;
 
 /// One generated region: its ID and its Markdown.
 #[derive(Clone, Debug, PartialEq)]
@@ -402,7 +392,7 @@ fn device_column_region(first: &Sweep, second: &Sweep) -> Result<String, ReadmeE
         let name = if a.kind == "floor" {
             "floor (no mirrors)".to_string()
         } else {
-            crate::write::label(a)
+            crate::document::label(a)
         };
         rows.push(vec![
             name,
@@ -410,8 +400,8 @@ fn device_column_region(first: &Sweep, second: &Sweep) -> Result<String, ReadmeE
             ms_cell(a, 1),
             ms_cell(b, 1),
             format!("{:.0}×", a.ms_median / b.ms_median),
-            crate::write::sci(a.metrics.flip_mean),
-            crate::write::sci(b.metrics.flip_mean),
+            crate::document::sci(a.metrics.flip_mean),
+            crate::document::sci(b.metrics.flip_mean),
         ]);
     }
     if rows.is_empty() {

@@ -3,9 +3,9 @@
 //! mirror room at 1920×1080 against depth, and the tracer against its thread count
 //! (`scripts/gpu-measure.sh`, steps `room` and `trace`).
 
-use crate::readme::ReadmeError;
+use crate::document::{Block, markdown, ms};
+use crate::error::ReadmeError;
 use crate::stats;
-use crate::write::{Block, markdown, ms};
 use std::collections::BTreeMap;
 use std::path::Path;
 

@@ -9,8 +9,8 @@
 //! the mirror, so its true disparity is larger than the mirror surface's; the shared shortcut
 //! paints it at the mirror's.
 
+use crate::document::{Block, distinct, f, ms_cell, sci};
 use crate::plot::{Chart, Series, method_style, styles_for};
-use crate::write::{Block, distinct, f, ms_cell, sci};
 use crate::{MarkerRecord, Record};
 
 /// The method option that chooses shared mirror textures (crates/raster/src/stereo_mirrors.rs).
@@ -180,7 +180,7 @@ pub fn sentences(records: &[Record]) -> Vec<String> {
             continue;
         };
         let saved = own.ms_median - shared.ms_median;
-        let ratio = crate::write::paired_ratio(shared, own).map_or(String::new(), |i| {
+        let ratio = crate::document::paired_ratio(shared, own).map_or(String::new(), |i| {
             format!(
                 " (shared ÷ per-eye: 95 % CI [{}, {}])",
                 f(i.low, 2),
@@ -374,7 +374,7 @@ mod tests {
     use crate::{EyeRecord, StereoRecord};
 
     fn eye(name: &str, flip: f64, x: f64, truth_x: f64) -> EyeRecord {
-        let mut metrics = crate::write::tests::record(2, 1.0, 1, flip).metrics;
+        let mut metrics = crate::document::fixtures::record(2, 1.0, 1, flip).metrics;
         metrics.flip_mean = flip;
         let at = |x| {
             Some(MarkerRecord {
@@ -392,7 +392,7 @@ mod tests {
     }
 
     fn pair(options: &str, d: f32, ms: f64, flip: f64, x_right: f64) -> Record {
-        let mut r = crate::write::tests::record(2, ms, 30, flip);
+        let mut r = crate::document::fixtures::record(2, ms, 30, flip);
         r.key = format!("{options} {d}");
         r.method_options = options.into();
         r.frames_ms = vec![ms; 6];
@@ -410,7 +410,7 @@ mod tests {
 
     #[test]
     fn sharing_is_weighed_by_its_saving_error_and_disparity() {
-        let mut mono = crate::write::tests::record(2, 50.0, 15, 0.01);
+        let mut mono = crate::document::fixtures::record(2, 50.0, 15, 0.01);
         mono.key = "mono".into();
         let records = vec![
             pair("", 0.1, 110.0, 0.01, 97.0),

@@ -3,7 +3,7 @@
 //! empty or out of view, and the CPU's split-and-mirror mesh is drawn once.
 
 use crate::Record;
-use crate::write::ms;
+use crate::document::ms;
 
 /// The method that draws the CPU-baked mesh once; the others are compared with it.
 pub const BAKED_METHOD: &str = "symmetry-baked";
@@ -23,13 +23,7 @@ pub struct PlaneScaling {
 }
 
 /// The method and its options as a report names them.
-pub fn variant(r: &Record) -> String {
-    if r.method_options.is_empty() {
-        r.method.clone()
-    } else {
-        format!("{} {}", r.method, r.method_options)
-    }
-}
+pub use crate::document::variant;
 
 /// Groups the points that carry a plane count by method variant, each in p order.
 pub fn plane_scaling(records: &[Record]) -> Vec<PlaneScaling> {
@@ -120,7 +114,7 @@ mod tests {
     use super::*;
 
     fn point(method: &str, p: u32, ms: f64, drawn: usize) -> Record {
-        let mut r = crate::write::tests::record(0, ms, 1, 0.0);
+        let mut r = crate::document::fixtures::record(0, ms, 1, 0.0);
         r.method = method.into();
         r.n = None;
         r.symmetry_planes = Some(p);

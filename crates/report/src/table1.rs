@@ -85,7 +85,7 @@ pub fn is_papers_sweep(scene: &str, rows: &[Row]) -> bool {
 /// `[low, high]` with the decimals the interval can tell apart (two significant digits of its
 /// width, at least two decimals): a narrow interval must not print as "[0.47, 0.47]".
 fn bracket(low: f64, high: f64) -> String {
-    let d = crate::write::interval_digits(low, high).max(2);
+    let d = crate::document::interval_digits(low, high).max(2);
     format!("[{low:.d$}, {high:.d$}]")
 }
 
@@ -138,7 +138,7 @@ pub fn growth_sentence(rows: &[Row]) -> String {
         let (lo, hi) = v
             .iter()
             .fold((f64::INFINITY, 0.0f64), |(a, b), &x| (a.min(x), b.max(x)));
-        let digits = crate::write::ms_digits(lo, 1);
+        let digits = crate::document::ms_digits(lo, 1);
         (format!("{lo:.digits$}–{hi:.digits$}"), hi / lo)
     };
     let ((ours_range, ours_ratio), (paper_range, paper_ratio)) =
@@ -149,8 +149,8 @@ pub fn growth_sentence(rows: &[Row]) -> String {
         crate::linear_fit(&pts).map_or("–".into(), |(a, b)| {
             format!(
                 "a = {} ms, b = {} ms",
-                crate::write::ms(a, 1),
-                crate::write::ms(b, 1)
+                crate::document::ms(a, 1),
+                crate::document::ms(b, 1)
             )
         })
     };

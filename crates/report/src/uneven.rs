@@ -6,8 +6,8 @@
 //! `march-steps`, `texture-margin`), not the rasterizer.
 
 use crate::Record;
+use crate::document::{Block, distinct, join_words, lowest_with_ties, ms_cell, sci};
 use crate::plot::{Chart, Series, method_style};
-use crate::write::{Block, distinct, join_words, lowest_with_ties, ms_cell, sci};
 
 /// The raster options of an uneven-mirror trick (crates/raster/src/uneven.rs).
 const TRICK_OPTIONS: [&str; 5] = [
@@ -377,7 +377,7 @@ mod tests {
     }
 
     fn record(options: &str, a: f32, flip: f64) -> Record {
-        let mut r = crate::write::tests::record(2, 10.0, 1, flip);
+        let mut r = crate::document::fixtures::record(2, 10.0, 1, flip);
         r.key = format!("{options} {a}");
         r.method_options = options.into();
         r.bump_amplitude_deg = Some(a);

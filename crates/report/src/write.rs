@@ -1,6 +1,10 @@
 //! Writing the sweep's files. Markdown and HTML are rendered from one document model, so
 //! they always say the same thing.
 
+use crate::document::{
+    Block, FLOOR_FACTOR, MIB, at_or_under_floor, distinct, f, interval_digits, label, markdown, ms,
+    ms_cell, ms_digits, paired_ratio, remove_stale, sci,
+};
 use crate::plot::{Chart, Reference, Series};
 use crate::{Record, SweepInfo};
 use crate::{exact, table1};
@@ -33,63 +37,6 @@ pub fn read_records(path: &Path) -> std::io::Result<Vec<Record>> {
         }
     }
     Ok(records)
-}
-
-pub(crate) enum Block {
-    Heading(u8, String),
-    Paragraph(String),
-    Bullets(Vec<String>),
-    Table(Vec<String>, Vec<Vec<String>>),
-    /// Images side by side: (caption, path relative to the report).
-    Images(Vec<(String, String)>),
-    /// An SVG chart, written to `file` and embedded in the HTML — only where it is drawable
-    /// ([`Chart::is_drawable`]); the writer adds its footer.
-    Chart(String, Box<Chart>),
-}
-
-/// Bytes in a mebibyte (the tables' memory unit).
-const MIB: f64 = 1024.0 * 1024.0;
-
-pub(crate) fn f(v: f64, digits: usize) -> String {
-    if v.is_finite() {
-        format!("{v:.digits$}")
-    } else {
-        "–".into()
-    }
-}
-
-/// Decimals for a time: at least `digits`, and enough for three significant digits below 100
-/// (a GPU frame of 0.403 ms must not print as "0.4"), at most six.
-pub(crate) fn ms_digits(v: f64, digits: usize) -> usize {
-    if !(v.is_finite() && v > 0.0) || v >= 100.0 {
-        return digits;
-    }
-    let needed = (2.0 - v.log10().floor()).max(0.0) as usize;
-    digits.max(needed.min(6))
-}
-
-/// A time in ms with [`ms_digits`] decimals.
-pub(crate) fn ms(v: f64, digits: usize) -> String {
-    f(v, ms_digits(v, digits))
-}
-
-/// `values` without repeats, in first-seen order (a report's rows and series).
-pub(crate) fn distinct<T: PartialEq>(values: impl Iterator<Item = T>) -> Vec<T> {
-    let mut out: Vec<T> = Vec::new();
-    for v in values {
-        if !out.contains(&v) {
-            out.push(v);
-        }
-    }
-    out
-}
-
-pub(crate) fn sci(v: f64) -> String {
-    if v.is_finite() {
-        format!("{v:.3e}")
-    } else {
-        "–".into()
-    }
 }
 
 /// A merged sweep whose shards ran on several devices: each device's points with their
@@ -184,78 +131,6 @@ fn shards_section(info: &SweepInfo) -> Vec<Block> {
     ]
 }
 
-/// The paired 95 % interval of `a`'s median time over `b`'s, where both were timed in the
-/// same interleaved rounds of the same run ([`crate::stats::paired_ratio_interval`]).
-pub(crate) fn paired_ratio(a: &Record, b: &Record) -> Option<crate::stats::Interval> {
-    let same_rounds = a.timing_order == "interleaved"
-        && b.timing_order == "interleaved"
-        && a.run.is_some()
-        && a.run == b.run;
-    same_rounds
-        .then(|| crate::stats::paired_ratio_interval(&a.frames_ms, &b.frames_ms))
-        .flatten()
-}
-
-/// "median [low–high]" (older records: "median (min m)"), all with the median's decimals.
-pub(crate) fn ms_cell(r: &Record, digits: usize) -> String {
-    match r.ms_interval {
-        Some([low, high]) => {
-            let digits = interval_digits(low, high);
-            format!(
-                "{} [{}–{}]",
-                f(r.ms_median, digits),
-                f(low, digits),
-                f(high, digits)
-            )
-        }
-        None => {
-            let digits = ms_digits(r.ms_median, digits);
-            format!("{} (min {})", f(r.ms_median, digits), f(r.ms_min, digits))
-        }
-    }
-}
-
-/// Decimals for a value printed with its interval `[low, high]`: two significant digits of
-/// the interval's width — what the interval can tell apart, and no more (an interval from six
-/// frames does not know a fourth digit). A zero-width interval gets three significant digits
-/// of its value.
-pub(crate) fn interval_digits(low: f64, high: f64) -> usize {
-    let width = (high - low).abs();
-    let basis = if width > 0.0 && width.is_finite() {
-        width
-    } else {
-        low.abs().max(1e-12) / 10.0
-    };
-    (1.0 - basis.log10().floor()).clamp(0.0, 8.0) as usize
-}
-
-/// Those of `candidates` within [`TIE_TOLERANCE`] of the lowest `value`: one winner, or a tie.
-pub(crate) fn lowest_with_ties<'a>(
-    candidates: impl Iterator<Item = &'a Record>,
-    value: impl Fn(&Record) -> f64,
-) -> Vec<&'a Record> {
-    let all: Vec<&Record> = candidates.collect();
-    let Some(best) = all.iter().map(|r| value(r)).min_by(f64::total_cmp) else {
-        return Vec::new();
-    };
-    all.into_iter()
-        .filter(|r| value(r) <= best * (1.0 + TIE_TOLERANCE) + f64::EPSILON)
-        .collect()
-}
-
-/// `a`, `a and b`, `a, b and c`.
-pub(crate) fn join_words(words: &[String]) -> String {
-    match words {
-        [] => String::new(),
-        [one] => one.clone(),
-        [rest @ .., last] => format!("{} and {last}", rest.join(", ")),
-    }
-}
-
-/// Two errors within 2 % of each other are a tie: the spread of one method's error between
-/// runs of the same sweep is of that order.
-pub(crate) const TIE_TOLERANCE: f64 = 0.02;
-
 /// A Table 1 row's cell: "median [low–high]", or "median [min m]" for older records.
 pub(crate) fn row_cell(r: &table1::Row) -> String {
     let digits = match crate::stats::median_interval(&r.frames_ms) {
@@ -274,30 +149,6 @@ fn row_interval(r: &table1::Row, digits: usize) -> String {
         }
         None => format!("min {}", f(r.ms_min, digits)),
     }
-}
-
-pub(crate) fn label(r: &Record) -> String {
-    let name = crate::symmetry::variant(r);
-    let at = match (r.n, r.depth, r.symmetry_planes) {
-        (Some(n), _, _) => format!("{name} n={n}"),
-        (None, Some(d), _) => format!("{name} depth={d}"),
-        (None, None, Some(p)) => format!("{name} p={p}"),
-        _ => name,
-    };
-    match r.mirrored_lights {
-        Some(k) => format!("{at} k={k}"),
-        None => at,
-    }
-}
-
-/// A point's error counts as at the floor up to this multiple of the floor's FLIP mean: the
-/// floor itself varies by that much between renders of the same scene.
-pub(crate) const FLOOR_FACTOR: f64 = 1.5;
-
-/// Whether `r`'s whole-image FLIP mean is at or under the floor `fl` (within [`FLOOR_FACTOR`]):
-/// not resolved by the comparison, so not ranked.
-pub(crate) fn at_or_under_floor(r: &Record, fl: &Record) -> bool {
-    r.metrics.flip_mean <= FLOOR_FACTOR * fl.metrics.flip_mean
 }
 
 /// A point's place on its method's axis: n, the depth, or the symmetry planes p.
@@ -415,60 +266,6 @@ pub fn write_report(dir: &Path, info: &SweepInfo, records: &[Record]) -> Result<
     }
     write_atomically(&dir.join("report.md"), markdown(&blocks).as_bytes())?;
     write_atomically(&dir.join("report.html"), html.as_bytes())
-}
-
-/// Removes `path` if it exists: a file an earlier report wrote that this one does not.
-pub(crate) fn remove_stale(path: &Path) -> Result<(), FileError> {
-    match std::fs::remove_file(path) {
-        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(FileError {
-            path: path.to_path_buf(),
-            message: format!("could not remove the stale file: {e}"),
-            refused: false,
-        }),
-        _ => Ok(()),
-    }
-}
-
-/// The blocks as Markdown (charts and images as links to their files).
-pub(crate) fn markdown(blocks: &[Block]) -> String {
-    let mut md = String::new();
-    for b in blocks {
-        match b {
-            Block::Heading(level, t) => {
-                let _ = writeln!(md, "{} {t}\n", "#".repeat(*level as usize));
-            }
-            Block::Paragraph(t) => {
-                let _ = writeln!(md, "{t}\n");
-            }
-            Block::Bullets(items) => {
-                for i in items {
-                    let _ = writeln!(md, "- {i}");
-                }
-                md.push('\n');
-            }
-            Block::Table(head, rows) => {
-                let _ = writeln!(md, "| {} |", head.join(" | "));
-                let _ = writeln!(md, "|{}", "---|".repeat(head.len()));
-                for r in rows {
-                    let _ = writeln!(md, "| {} |", r.join(" | "));
-                }
-                md.push('\n');
-            }
-            Block::Images(images) => {
-                let line: Vec<String> = images
-                    .iter()
-                    .map(|(cap, p)| format!("![{cap}]({p})"))
-                    .collect();
-                let _ = writeln!(md, "{}\n", line.join(" "));
-            }
-            Block::Chart(file, chart) => {
-                if chart.is_drawable() {
-                    let _ = writeln!(md, "![{file}]({file})\n");
-                }
-            }
-        }
-    }
-    md
 }
 
 /// Escaped text with Markdown's inline code (`x`) as `<code>`: the report's sentences are
@@ -1297,71 +1094,7 @@ fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
-    use crate::MetricValues;
-
-    pub(crate) fn record(n: u32, ms: f64, passes: usize, flip: f64) -> Record {
-        Record {
-            key: format!("auxiliary n={n}"),
-            kind: "point".into(),
-            scene: "s.json".into(),
-            scene_hash: "00".into(),
-            method: "auxiliary".into(),
-            method_options: String::new(),
-            symmetry_planes: None,
-            mirrored_lights: None,
-            bump_amplitude_deg: None,
-            stereo: None,
-            device: None,
-            copies_drawn: None,
-            copies_total: None,
-            bake_ms: None,
-            n: Some(n),
-            depth: None,
-            alpha: 0.7,
-            width: 16,
-            height: 16,
-            ssaa: 1,
-            ms_median: ms,
-            ms_interval: None,
-            frames_ms: Vec::new(),
-            timing_order: "back-to-back".into(),
-            run: None,
-            peak_memory_bytes: None,
-            plan_ms: None,
-            encode_ms: None,
-            gpu_buffer_bytes: None,
-            gpu_texture_bytes: None,
-            ms_min: ms,
-            timing_source: "gpu-timestamps".into(),
-            frames: 1,
-            passes,
-            draws: 2 * passes,
-            texture_renders: passes - 1,
-            reflections: n as usize + 2,
-            triangles: None,
-            paths: None,
-            paths_pruned: None,
-            metrics: MetricValues {
-                rmse: flip,
-                relmse: flip,
-                smape: flip,
-                max_abs: flip,
-                psnr: Some(30.0),
-                ssim: 0.9,
-                flip_mean: flip,
-                flip_p95: flip,
-                flip_p99: flip,
-            },
-            mirror_metrics: None,
-            mirror_pixel_share: None,
-            adapter: "test".into(),
-            backend: "vulkan".into(),
-            color_format: "rgba32float".into(),
-            truth_image: "t.png".into(),
-            raster_image: "r.png".into(),
-            heatmap_image: "h.png".into(),
-        }
-    }
+    use crate::document::fixtures::record;
 
     #[test]
     fn report_files_hold_the_table_and_the_points() {
