@@ -1240,8 +1240,8 @@ fn sweep_measures_the_symmetry_methods_by_plane_count() {
     // refused before anything is written.
     for (planes, says) in [
         ("4", "--symmetry-planes"),
-        ("17", "0..=16"),
-        ("2..=1", "0..=16"),
+        ("17", "each in [0, 16], whole numbers, got 17"),
+        ("2..=1", "each in [0, 16], whole numbers, got \"2..=1\""),
     ] {
         let refused = run(planes);
         assert_eq!(refused.code, 2, "{planes}: {}", refused.stderr);
@@ -1259,11 +1259,11 @@ fn sweep_measures_the_symmetry_methods_by_plane_count() {
         let recs: Vec<&Value> = all.iter().filter(|r| r["method"] == method).collect();
         let planes: Vec<u64> = recs
             .iter()
-            .map(|r| r["symmetry_planes"].as_u64().unwrap())
+            .map(|r| r["axes"]["planes"].as_f64().unwrap() as u64)
             .collect();
         assert_eq!(planes, vec![0, 1, 2, 3], "{method}");
         for r in &recs {
-            let p = r["symmetry_planes"].as_u64().unwrap();
+            let p = r["axes"]["planes"].as_f64().unwrap() as u64;
             assert_eq!(r["copies_total"].as_u64(), Some(1 << p), "{method}");
             assert!(
                 r["key"]
@@ -1276,12 +1276,12 @@ fn sweep_measures_the_symmetry_methods_by_plane_count() {
     // The seed's six-pointed star: the pruned method keeps 6 of the 8 copies at p = 3.
     let pruned = all
         .iter()
-        .find(|r| r["method"] == "symmetry-pruned" && r["symmetry_planes"] == 3)
+        .find(|r| r["method"] == "symmetry-pruned" && r["axes"]["planes"] == 3.0)
         .unwrap();
     assert_eq!(pruned["copies_drawn"].as_u64(), Some(6), "{pruned}");
     let baked = all
         .iter()
-        .find(|r| r["method"] == "symmetry-baked" && r["symmetry_planes"] == 3)
+        .find(|r| r["method"] == "symmetry-baked" && r["axes"]["planes"] == 3.0)
         .unwrap();
     assert!(baked["bake_ms"].as_f64().is_some());
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
@@ -1730,8 +1730,8 @@ fn shards_merge_into_the_unsharded_sweep() {
     let truths = std::fs::read_dir(&cache).unwrap().count();
     assert_eq!(
         truths,
-        2 * 3,
-        "a truth per α and the floor's, EXR and PNG each"
+        3 * 3,
+        "a truth per α and the floor's: EXR, PNG and mirror mask each"
     );
 
     let (s0, s1, s2) = (p("s0"), p("s1"), p("s2"));

@@ -206,7 +206,9 @@ fn edge_cases_are_refused_with_a_clear_message_and_nothing_written() {
         (sweep(&["--ssaa", "9"]), vec!["--ssaa must be in [1, 8]"]),
         (
             sweep(&["--mirrored-lights", "0,65"]),
-            vec!["--mirrored-lights \"0,65\": must be mirror counts in 0..=64"],
+            vec![
+                "--mirrored-lights must be mirrored-light depths each in [0, 64], whole numbers, got 65",
+            ],
         ),
         (
             own(&["trace", &deep_lights, "-o", exr]),

@@ -16,10 +16,12 @@
 //! - **Floor**: raster vs trace on the scene without its mirrors, the error that is left
 //!   when there is no mirror effect to truncate.
 
+pub mod axes;
 pub mod merge;
 pub mod sequence;
 mod worker;
 
+pub use axes::{AxisSpec, AxisValues, PointAxes};
 pub use worker::{RenderJob, RenderReport, Rendered, peak_memory_bytes, serve};
 
 use mirrorbox_files::{FileError, FolderLock, write_atomically};
@@ -30,13 +32,20 @@ use mirrorbox_image::{
 };
 use mirrorbox_raster::{Gpu, METHODS, Method, PlanError, RasterError, RenderSettings};
 use mirrorbox_report::{MetricValues, Record, SweepInfo, read_records, write_report};
-use mirrorbox_scene::light_images::MAX_MIRRORED_LIGHTS;
 use mirrorbox_scene::limits::{SettingError, unit_interval};
 use mirrorbox_scene::{Scene, SceneError, load_scene};
 use mirrorbox_trace::{SceneBvh, TraceSettings, WhittedSettings};
 use std::fmt::Write as _;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
+
+/// An axis along `values` (each applied; see [`AxisValues`] for `None`).
+pub fn along(axis: &'static AxisSpec, values: impl IntoIterator<Item = f64>) -> AxisValues {
+    AxisValues {
+        axis,
+        values: values.into_iter().map(Some).collect(),
+    }
+}
 
 #[derive(Clone, Debug)]
 pub struct SweepConfig {
@@ -62,24 +71,10 @@ pub struct SweepConfig {
     /// (`mirrorbox_raster::Planned::memory_estimate`) exceeds this many bytes is refused
     /// before any work (`--memory-budget`, default 2 GiB).
     pub memory_budget: u64,
-    /// The symmetry planes axis (seed 001): each point's scene keeps the first p of the
-    /// scene's `symmetry_planes`, for every p listed (`--symmetry-planes`); `None` keeps the
-    /// scene as it is.
-    pub symmetry_planes: Option<Vec<u32>>,
-    /// The mirrored-lights axis (issue 15, `docs/shading.md`): each point's scene lights its
-    /// diffuse surfaces through chains of at most k mirrors (`lighting.mirrored_lights = k`),
-    /// for every k listed (`--mirrored-lights`); `None` keeps the scene's own.
-    pub mirrored_lights: Option<Vec<u32>>,
-    /// The uneven-mirror axis (issue 16, `docs/shading.md`): each point's scene tilts its
-    /// uneven mirrors' normals by at most this many degrees
-    /// ([`mirrorbox_scene::Scene::set_bump_amplitude`]), for every value listed
-    /// (`--bump-amplitude`); `None` keeps the scene's own.
-    pub bump_amplitudes: Option<Vec<f32>>,
-    /// The stereo axis (issue 17, seed 002): each point renders both eyes of the scene's rig
-    /// ([`Scene::stereo_rig`]) at each interpupillary distance listed, as one frame
-    /// (`mirrorbox_raster::stereo_pair`), against each eye's truth; `None` in the list is the
-    /// mono frame (`--ipd mono,0,0.05`). `None`: mono only.
-    pub stereo_ipds: Option<Vec<Option<f32>>>,
+    /// The scene axes the sweep varies beside the methods and α ([`axes::AXES`]: symmetry
+    /// planes, mirrored-light depth, uneven-mirror tilt, stereo IPD), each with its values;
+    /// every combination is a point (of every method, at every α). Empty: the scene as it is.
+    pub axes: Vec<AxisValues>,
     /// The object whose first reflection a stereo point locates in each eye, truth and raster
     /// alike, to measure its disparity (`--marker NAME`, a diffuse object of the scene; its
     /// albedo's chromaticity finds it: `mirrorbox_image::stereo::marker_blob`).
@@ -185,10 +180,7 @@ impl SweepConfig {
             command: String::new(),
             worker: None,
             memory_budget: mirrorbox_raster::DEFAULT_MEMORY_BUDGET,
-            symmetry_planes: None,
-            mirrored_lights: None,
-            bump_amplitudes: None,
-            stereo_ipds: None,
+            axes: Vec::new(),
             marker: None,
             shard: None,
             truth_cache: None,
@@ -238,7 +230,7 @@ impl SweepConfig {
         // one warm-up keep the preset within minutes.
         SweepConfig {
             scene: PathBuf::from("scenes/symmetry_many.json"),
-            symmetry_planes: Some((0..=10).collect()),
+            axes: vec![along(&axes::SYMMETRY_PLANES, (0..=10).map(f64::from))],
             frames: 6,
             warmup: 1,
             ..SweepConfig::preset(out, methods, vec![1.0])
@@ -270,7 +262,7 @@ impl SweepConfig {
         }
         SweepConfig {
             scene: PathBuf::from("scenes/mirror_box_lit.json"),
-            mirrored_lights: Some(vec![0, 1, 2, 4, 8]),
+            axes: vec![along(&axes::MIRRORED_LIGHTS, [0.0, 1.0, 2.0, 4.0, 8.0])],
             width: Some(320),
             height: Some(180),
             frames: 6,
@@ -299,7 +291,7 @@ impl SweepConfig {
         }
         SweepConfig {
             scene: PathBuf::from("scenes/mirror_room_lit.json"),
-            mirrored_lights: Some(vec![0, 4, 8]),
+            axes: vec![along(&axes::MIRRORED_LIGHTS, [0.0, 4.0, 8.0])],
             width: Some(160),
             height: Some(90),
             frames: 6,
@@ -354,7 +346,7 @@ impl SweepConfig {
                 .map(|m| Method::parse(m).unwrap_or_else(|e| panic!("preset: {e}"))),
         );
         SweepConfig {
-            bump_amplitudes: Some(vec![0.0, 1.0, 2.5, 5.0, 10.0]),
+            axes: vec![along(&axes::BUMP_AMPLITUDE, [0.0, 1.0, 2.5, 5.0, 10.0])],
             width: Some(320),
             height: Some(180),
             frames: 6,
@@ -384,14 +376,17 @@ impl SweepConfig {
         .collect();
         SweepConfig {
             scene: PathBuf::from("scenes/stereo_box.json"),
-            stereo_ipds: Some(vec![
-                None,
-                Some(0.0),
-                Some(0.025),
-                Some(0.05),
-                Some(0.075),
-                Some(0.1),
-            ]),
+            axes: vec![AxisValues {
+                axis: &axes::STEREO_IPD,
+                values: vec![
+                    None,
+                    Some(0.0),
+                    Some(0.025),
+                    Some(0.05),
+                    Some(0.075),
+                    Some(0.1),
+                ],
+            }],
             marker: Some("marker".into()),
             width: Some(320),
             height: Some(180),
@@ -436,42 +431,10 @@ impl SweepConfig {
             unit_interval("--alpha", a)?;
         }
         self.truth.check()?;
-        let planes = self.symmetry_planes.as_ref().map_or(1, Vec::len);
-        if planes == 0 {
-            return Err(
-                SettingError::new("--symmetry-planes", "at least one plane count", "none").into(),
-            );
-        }
-        let lights = self.mirrored_lights.as_ref().map_or(1, Vec::len);
-        if lights == 0 {
-            return Err(
-                SettingError::new("--mirrored-lights", "at least one depth", "none").into(),
-            );
-        }
-        for &k in self.mirrored_lights.iter().flatten() {
-            if k > MAX_MIRRORED_LIGHTS {
-                return Err(SettingError::new(
-                    "--mirrored-lights",
-                    format!("each in [0, {MAX_MIRRORED_LIGHTS}]"),
-                    k,
-                )
-                .into());
-            }
-        }
-        let bumps = self.bump_amplitudes.as_ref().map_or(1, Vec::len);
-        if bumps == 0 {
-            return Err(SettingError::new(
-                "--bump-amplitude",
-                "at least one angle in [0, 90) degrees",
-                "none",
-            )
-            .into());
-        }
-        for &a in self.bump_amplitudes.iter().flatten() {
-            if !(0.0..mirrorbox_scene::bump::MAX_AMPLITUDE_DEG).contains(&a) {
-                return Err(
-                    SettingError::new("--bump-amplitude", "each in [0, 90) degrees", a).into(),
-                );
+        for (i, a) in self.axes.iter().enumerate() {
+            a.axis.check(&a.values)?;
+            if self.axes[..i].iter().any(|o| o.axis.name == a.axis.name) {
+                return Err(SettingError::new(a.axis.flag, "one list", "two").into());
             }
         }
         if let Some(sh) = self.shard
@@ -484,38 +447,26 @@ impl SweepConfig {
             )
             .into());
         }
-        let ipds = self.stereo_ipds.as_ref().map_or(1, Vec::len);
-        if ipds == 0 {
-            return Err(SettingError::new(
-                "--ipd",
-                "at least one interpupillary distance in [0, 1], or mono",
-                "none",
-            )
-            .into());
-        }
-        for &d in self.stereo_ipds.iter().flatten().flatten() {
-            if !(d.is_finite() && (0.0..=1.0).contains(&d)) {
-                return Err(
-                    SettingError::new("--ipd", "each in [0, 1] scene units, or mono", d).into(),
-                );
-            }
-        }
-        let points = 1 + self
-            .methods
-            .len()
-            .saturating_mul(self.alphas.len())
-            .saturating_mul(planes)
-            .saturating_mul(lights)
-            .saturating_mul(bumps)
-            .saturating_mul(ipds);
+        let points = 1 + self.axes.iter().fold(
+            self.methods.len().saturating_mul(self.alphas.len()),
+            |n, a| n.saturating_mul(a.values.len()),
+        );
         if points > MAX_POINTS {
+            let flags: String = self
+                .axes
+                .iter()
+                .map(|a| format!(" × {}", a.axis.flag))
+                .collect();
+            let counts: String = self
+                .axes
+                .iter()
+                .map(|a| format!(" × {} {}", a.values.len(), a.axis.what))
+                .collect();
             return Err(SettingError::new(
-                "--methods × their axes × --alpha × --symmetry-planes × --mirrored-lights × \
-                 --bump-amplitude × --ipd",
+                &format!("--methods × their axes × --alpha{flags}"),
                 format!("at most {MAX_POINTS} points"),
                 format!(
-                    "{} configured methods × {} α × {planes} plane counts × {lights} \
-                     mirrored-light depths × {bumps} tilts × {ipds} IPDs = {points} points",
+                    "{} configured methods × {} α{counts} = {points} points",
                     self.methods.len(),
                     self.alphas.len()
                 ),
@@ -641,14 +592,9 @@ pub struct Summary {
 struct Point {
     method: Option<Method>,
     alpha: f32,
-    /// Symmetry planes kept (a `--symmetry-planes` sweep).
-    planes: Option<u32>,
-    /// `lighting.mirrored_lights` (a `--mirrored-lights` sweep).
-    lights: Option<u32>,
-    /// The uneven mirrors' steepest tilt, degrees (a `--bump-amplitude` sweep).
-    bump: Option<f32>,
-    /// A stereo pair's interpupillary distance (an `--ipd` sweep; `None`: mono).
-    ipd: Option<f32>,
+    /// The point's setting of the sweep's scene axes (none for the floor, nor for the
+    /// stereo axis' `mono`).
+    axes: PointAxes,
     key: String,
     label: String,
     slug: String,
@@ -659,24 +605,13 @@ struct Point {
 /// A symmetry-planes sweep adds `|planes=p` after the method, a mirrored-lights sweep
 /// `|mirrored_lights=k`, a tilt `|bump_deg=a`, a stereo pair `|stereo_ipd=d` (keys without
 /// them are as before; a mono point of an `--ipd` sweep has a plain key).
-fn point_key(
-    method: Option<&Method>,
-    alpha: f32,
-    planes: Option<u32>,
-    lights: Option<u32>,
-    bump: Option<f32>,
-    ipd: Option<f32>,
-    common: &str,
-) -> String {
-    let planes = planes.map_or(String::new(), |p| format!("|planes={p}"));
-    let lights = lights.map_or(String::new(), |k| format!("|mirrored_lights={k}"));
-    let bump = bump.map_or(String::new(), |a| format!("|bump_deg={a}"));
-    let ipd = ipd.map_or(String::new(), |d| format!("|stereo_ipd={d}"));
+fn point_key(method: Option<&Method>, alpha: f32, axes: &PointAxes, common: &str) -> String {
+    let fragments: String = axes
+        .iter()
+        .map(|(a, v)| format!("|{}={}", a.name, a.text(*v)))
+        .collect();
     match method {
-        Some(m) => format!(
-            "{}{planes}{lights}{bump}{ipd}|alpha={alpha}|{common}",
-            m.key()
-        ),
+        Some(m) => format!("{}{fragments}|alpha={alpha}|{common}", m.key()),
         None => format!("floor|{common}"),
     }
 }
@@ -689,68 +624,54 @@ fn points(config: &SweepConfig, base_hash: u64, w: u32, h: u32) -> Vec<Point> {
     let mut out = vec![Point {
         method: None,
         alpha: 1.0,
-        planes: None,
-        lights: None,
-        bump: None,
-        ipd: None,
-        key: point_key(None, 1.0, None, None, None, None, &common),
+        axes: Vec::new(),
+        key: point_key(None, 1.0, &Vec::new(), &common),
         label: "floor (no mirrors)".into(),
         slug: "floor".into(),
     }];
-    let plane_axis: Vec<Option<u32>> = match &config.symmetry_planes {
-        Some(ps) => ps.iter().map(|&p| Some(p)).collect(),
-        None => vec![None],
-    };
-    let light_axis: Vec<Option<u32>> = match &config.mirrored_lights {
-        Some(ks) => ks.iter().map(|&k| Some(k)).collect(),
-        None => vec![None],
-    };
-    let bump_axis: Vec<Option<f32>> = match &config.bump_amplitudes {
-        Some(a) => a.iter().map(|&a| Some(a)).collect(),
-        None => vec![None],
-    };
-    let ipd_axis: Vec<Option<f32>> = config.stereo_ipds.clone().unwrap_or(vec![None]);
+    // Every combination of the axes' values, the first axis (in AXES order) outermost.
+    let mut settings: Vec<PointAxes> = vec![Vec::new()];
+    for spec in axes::AXES {
+        let Some(a) = config.axes.iter().find(|a| a.axis.name == spec.name) else {
+            continue;
+        };
+        settings = settings
+            .iter()
+            .flat_map(|s| {
+                a.values.iter().map(move |v| {
+                    let mut s = s.clone();
+                    if let Some(v) = v {
+                        s.push((spec, *v));
+                    }
+                    s
+                })
+            })
+            .collect();
+    }
     for &alpha in &config.alphas {
-        for &planes in &plane_axis {
-            let mut settings = Vec::new();
-            for &lights in &light_axis {
-                for &bump in &bump_axis {
-                    for &ipd in &ipd_axis {
-                        settings.push((lights, bump, ipd));
-                    }
+        for setting in &settings {
+            for method in &config.methods {
+                let key = point_key(Some(method), alpha, setting, &common);
+                // A value listed twice (`--depth 1,1`, `--alpha 0.7,0.7`) is one point.
+                if out.iter().any(|p| p.key == key) {
+                    continue;
                 }
-            }
-            for (lights, bump, ipd) in settings {
-                for method in &config.methods {
-                    let key = point_key(Some(method), alpha, planes, lights, bump, ipd, &common);
-                    // A value listed twice (`--depth 1,1`, `--alpha 0.7,0.7`) is one point.
-                    if out.iter().any(|p| p.key == key) {
-                        continue;
-                    }
-                    let (p_label, p_slug) = planes.map_or((String::new(), String::new()), |p| {
-                        (format!(" p={p}"), format!("_p{p}"))
-                    });
-                    let (k_label, k_slug) = lights.map_or((String::new(), String::new()), |k| {
-                        (format!(" k={k}"), format!("_k{k}"))
-                    });
-                    let (b_label, b_slug) = bump.map_or((String::new(), String::new()), |a| {
-                        (format!(" bump={a}°"), format!("_b{a}"))
-                    });
-                    let (d_label, d_slug) = ipd.map_or((String::new(), String::new()), |d| {
-                        (format!(" stereo IPD {d}"), format!("_ipd{d}"))
-                    });
-                    out.push(Point {
-                        key,
-                        label: format!("{method}{p_label}{k_label}{b_label}{d_label} α={alpha}"),
-                        slug: format!("{}{p_slug}{k_slug}{b_slug}{d_slug}_a{alpha}", method.slug()),
-                        method: Some(method.clone()),
-                        alpha,
-                        planes,
-                        lights,
-                        bump,
-                        ipd,
-                    });
-                }
+                let label: String = setting
+                    .iter()
+                    .map(|(a, v)| format!("{}{}{}", a.label, a.text(*v), a.unit))
+                    .collect();
+                let slug: String = setting
+                    .iter()
+                    .map(|(a, v)| format!("_{}{}", a.slug, a.text(*v)))
+                    .collect();
+                out.push(Point {
+                    key,
+                    label: format!("{method}{label} α={alpha}"),
+                    slug: format!("{}{slug}_a{alpha}", method.slug()),
+                    method: Some(method.clone()),
+                    alpha,
+                    axes: setting.clone(),
+                });
             }
         }
     }
@@ -1074,15 +995,7 @@ fn point_setup(
     p: &Point,
     config: &SweepConfig,
 ) -> Result<(Scene, RenderSettings), HarnessError> {
-    let scene = worker::point_scene(
-        base,
-        p.method.is_none(),
-        p.planes,
-        p.lights,
-        p.bump,
-        p.ipd,
-        p.alpha,
-    )?;
+    let scene = worker::point_scene(base, p.method.is_none(), &p.axes, p.alpha)?;
     let method = p
         .method
         .clone()
@@ -1258,10 +1171,11 @@ pub fn run_sweep(
             warmup: config.warmup,
             scene_hash: scene.content_hash(),
             image: rendered_image(&cache, i),
-            symmetry_planes: p.planes,
-            mirrored_lights: p.lights,
-            bump_amplitude: p.bump,
-            stereo_ipd: p.ipd,
+            axes: p
+                .axes
+                .iter()
+                .map(|(a, v)| (a.name.to_string(), *v))
+                .collect(),
         });
         if config.worker.is_none() {
             scenes.push(scene);
@@ -1314,19 +1228,24 @@ pub fn run_sweep(
         let report = last[i].take().expect("every point renders in every round");
         let frames_ms = std::mem::take(&mut timed[i]);
         let mut rasters = vec![jobs[i].image.clone()];
-        if p.ipd.is_some() {
+        let ipd = p
+            .axes
+            .iter()
+            .find(|(a, _)| a.name == axes::STEREO_IPD.name)
+            .map(|(_, d)| *d as f32);
+        if ipd.is_some() {
             rasters.push(worker::right_eye_image(&jobs[i].image));
         }
         let truth_name = match &p.method {
             None => "floor".into(),
-            Some(_) => format!(
-                "{}{}{}{}a{}",
-                p.planes.map_or(String::new(), |p| format!("p{p}_")),
-                p.lights.map_or(String::new(), |k| format!("k{k}_")),
-                p.bump.map_or(String::new(), |a| format!("b{a}_")),
-                p.ipd.map_or(String::new(), |d| format!("ipd{d}_")),
-                p.alpha
-            ),
+            Some(_) => {
+                let axes: String = p
+                    .axes
+                    .iter()
+                    .map(|(a, v)| format!("{}{}_", a.slug, a.text(*v)))
+                    .collect();
+                format!("{axes}a{}", p.alpha)
+            }
         };
         let files = ViewFiles {
             raster: images.join(format!("{}.png", p.slug)),
@@ -1356,9 +1275,14 @@ pub fn run_sweep(
                 .method
                 .as_ref()
                 .map_or(String::new(), Method::variant_options),
-            symmetry_planes: p.planes,
-            mirrored_lights: p.lights,
-            bump_amplitude_deg: p.bump,
+            axes: p
+                .axes
+                .iter()
+                .map(|(a, v)| (a.name.to_string(), *v))
+                .collect(),
+            symmetry_planes: None,
+            mirrored_lights: None,
+            bump_amplitude_deg: None,
             copies_drawn: s.copies.map(|c| c.drawn),
             copies_total: s.copies.map(|c| c.total),
             bake_ms: s.bake_ms,
@@ -1399,7 +1323,7 @@ pub fn run_sweep(
             heatmap_image: rel(&files.heat),
             device: None,
             stereo: views.eyes.map(|eyes| mirrorbox_report::StereoRecord {
-                ipd: p.ipd.unwrap_or(0.0),
+                ipd: ipd.unwrap_or(0.0),
                 eyes,
                 anaglyph_image: rel(&with_suffix(&files.raster, "anaglyph")),
                 truth_anaglyph_image: rel(&with_suffix(&files.truth, "anaglyph")),

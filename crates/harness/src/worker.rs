@@ -16,6 +16,7 @@ use crate::HarnessError;
 use glam::Vec3;
 use mirrorbox_image::{RgbImage, write_exr};
 use mirrorbox_raster::{Gpu, Method, RasterError, RenderSettings};
+use mirrorbox_scene::limits::SettingError;
 use mirrorbox_scene::{Scene, load_scene};
 use serde::{Deserialize, Serialize};
 use std::io::Write as _;
@@ -39,21 +40,9 @@ pub struct RenderJob {
     pub scene_hash: u64,
     /// Where the worker writes the rendered image (linear EXR).
     pub image: PathBuf,
-    /// The symmetry planes the scene keeps (a `--symmetry-planes` sweep); `None`: all.
+    /// The point's scene axes (`crate::axes`), by name: `[["planes", 3]]`.
     #[serde(default)]
-    pub symmetry_planes: Option<u32>,
-    /// `lighting.mirrored_lights` of the scene (a `--mirrored-lights` sweep); `None`: the
-    /// scene's own.
-    #[serde(default)]
-    pub mirrored_lights: Option<u32>,
-    /// The uneven mirrors' steepest tilt, degrees (a `--bump-amplitude` sweep); `None`: the
-    /// scene's own.
-    #[serde(default)]
-    pub bump_amplitude: Option<f32>,
-    /// A stereo pair's interpupillary distance (an `--ipd` sweep): the worker renders both
-    /// eyes as one frame, the left eye to `image`, the right to [`right_eye_image`].
-    #[serde(default)]
-    pub stereo_ipd: Option<f32>,
+    pub axes: Vec<(String, f64)>,
 }
 
 /// Where a stereo job's right eye goes, beside `image`.
@@ -126,15 +115,20 @@ pub fn method_text(method: &Method) -> String {
 fn job_scene(job: &RenderJob) -> Result<Scene, HarnessError> {
     let mut scene = load_scene(&job.scene)?;
     scene.resize(Some(job.width), Some(job.height))?;
-    point_scene(
-        &scene,
-        job.floor,
-        job.symmetry_planes,
-        job.mirrored_lights,
-        job.bump_amplitude,
-        job.stereo_ipd,
-        job.alpha,
-    )
+    let axes = job
+        .axes
+        .iter()
+        .map(|(name, v)| {
+            crate::axes::axis(name).map(|a| (a, *v)).ok_or_else(|| {
+                HarnessError::Setting(SettingError::new(
+                    "a render job's axes",
+                    "the names of crate::axes::AXES",
+                    name,
+                ))
+            })
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    point_scene(&scene, job.floor, &axes, job.alpha)
 }
 
 /// A point's scene made from the sweep's scene, the one derivation the sweep and its workers
@@ -146,24 +140,10 @@ fn job_scene(job: &RenderJob) -> Result<Scene, HarnessError> {
 pub(crate) fn point_scene(
     base: &Scene,
     floor: bool,
-    planes: Option<u32>,
-    mirrored_lights: Option<u32>,
-    bump_amplitude: Option<f32>,
-    stereo_ipd: Option<f32>,
+    axes: &[(&'static crate::axes::AxisSpec, f64)],
     alpha: f32,
 ) -> Result<Scene, HarnessError> {
-    let mut scene = match (floor, planes) {
-        (true, _) => base.without_mirrors(),
-        (false, Some(p)) => base.with_symmetry_planes(p as usize)?,
-        (false, None) => base.clone(),
-    };
-    if let Some(k) = mirrored_lights {
-        scene.lighting.mirrored_lights = k;
-    }
-    if let Some(a) = bump_amplitude {
-        scene.set_bump_amplitude(a);
-    }
-    scene.stereo = stereo_ipd.map(|d| base.stereo_rig(d));
+    let mut scene = crate::axes::apply_axes(base, floor, axes)?;
     let budget = |source| HarnessError::LightImages {
         scene: base.source.clone(),
         source,

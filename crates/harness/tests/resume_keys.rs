@@ -58,3 +58,61 @@ fn the_paper_method_is_registered() {
         .expect("Table 1's method is in the raster registry");
     assert!(m.swept.is_some_and(|o| o.name == "n"));
 }
+
+/// The committed reports of the presets with scene axes: this code's keys are the keys in
+/// their `results.jsonl` (a resumed sweep measures nothing again), and every record read back
+/// carries its axes in the map, the ones written before the map included.
+#[test]
+fn the_axis_presets_resume_from_the_committed_reports() {
+    for (config, folder, axis) in [
+        (
+            SweepConfig::symmetry_scaling("unused".into()),
+            "symmetry_scaling",
+            "planes",
+        ),
+        (
+            SweepConfig::lighting("unused".into()),
+            "lighting",
+            "mirrored_lights",
+        ),
+        (
+            SweepConfig::lighting_room("unused".into()),
+            "lighting_room",
+            "mirrored_lights",
+        ),
+        (
+            SweepConfig::bumpy("unused".into()),
+            "uneven_mirrors",
+            "bump_deg",
+        ),
+        (
+            SweepConfig::bumpy_single("unused".into()),
+            "uneven_mirrors_single",
+            "bump_deg",
+        ),
+        (SweepConfig::stereo("unused".into()), "stereo", "stereo_ipd"),
+    ] {
+        let now = keys_of(config);
+        let path = root().join("reports").join(folder).join("results.jsonl");
+        let records = mirrorbox_report::read_records(&path).unwrap();
+        let committed: BTreeSet<String> = records.iter().map(|r| r.key.clone()).collect();
+        assert_eq!(now, committed, "{folder}");
+        for r in records.iter().filter(|r| r.kind == "point") {
+            let fragment = format!("|{axis}=");
+            if r.key.contains(&fragment) {
+                let v = r
+                    .axis(axis)
+                    .unwrap_or_else(|| panic!("{folder}: {} has no {axis}", r.key));
+                let text = r
+                    .key
+                    .split(&fragment)
+                    .nth(1)
+                    .unwrap()
+                    .split('|')
+                    .next()
+                    .unwrap();
+                assert_eq!(text.parse::<f64>().unwrap(), v, "{folder}: {}", r.key);
+            }
+        }
+    }
+}

@@ -140,13 +140,13 @@ pub(crate) const TIE_TOLERANCE: f64 = 0.02;
 
 pub(crate) fn label(r: &Record) -> String {
     let name = variant(r);
-    let at = match (r.n, r.depth, r.symmetry_planes) {
+    let at = match (r.n, r.depth, r.planes()) {
         (Some(n), _, _) => format!("{name} n={n}"),
         (None, Some(d), _) => format!("{name} depth={d}"),
         (None, None, Some(p)) => format!("{name} p={p}"),
         _ => name,
     };
-    match r.mirrored_lights {
+    match r.lights_depth() {
         Some(k) => format!("{at} k={k}"),
         None => at,
     }
@@ -236,6 +236,7 @@ pub(crate) mod fixtures {
             scene_hash: "00".into(),
             method: "auxiliary".into(),
             method_options: String::new(),
+            axes: Default::default(),
             symmetry_planes: None,
             mirrored_lights: None,
             bump_amplitude_deg: None,

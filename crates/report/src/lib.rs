@@ -118,15 +118,20 @@ pub struct Record {
     /// own series in the report. Empty in older records.
     #[serde(default)]
     pub method_options: String,
-    /// Symmetry planes p the point's scene kept (a `--symmetry-planes` sweep, seed 001).
-    #[serde(default)]
+    /// The point's scene axes (the harness's `axes::AXES`), by name: `planes` (symmetry
+    /// planes p kept, seed 001), `mirrored_lights` (k, issue 15), `bump_deg` (the uneven
+    /// mirrors' steepest tilt, issue 16), `stereo_ipd` (issue 17). Records older than the map
+    /// kept them in fields of their own; [`read_records`] moves those here.
+    #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    pub axes: std::collections::BTreeMap<String, f64>,
+    /// Older records' symmetry planes (now `axes["planes"]`); read, never written.
+    #[serde(default, skip_serializing)]
     pub symmetry_planes: Option<u32>,
-    /// `lighting.mirrored_lights` of the point's scene (a `--mirrored-lights` sweep, issue 15).
-    #[serde(default)]
+    /// Older records' mirrored-light depth (now `axes["mirrored_lights"]`).
+    #[serde(default, skip_serializing)]
     pub mirrored_lights: Option<u32>,
-    /// The steepest tilt of the point's uneven mirrors, degrees (a `--bump-amplitude` sweep,
-    /// issue 16).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    /// Older records' tilt (now `axes["bump_deg"]`).
+    #[serde(default, skip_serializing)]
     pub bump_amplitude_deg: Option<f32>,
     /// A stereo point (an `--ipd` sweep): the IPD and each eye's comparison; `metrics` is then
     /// the mean of both eyes', the images are side by side, the time is the pair's.
@@ -231,7 +236,64 @@ pub struct Record {
     pub heatmap_image: String,
 }
 
+/// The names of the scene axes in [`Record::axes`].
+pub mod axis {
+    pub const PLANES: &str = "planes";
+    pub const MIRRORED_LIGHTS: &str = "mirrored_lights";
+    pub const BUMP_DEG: &str = "bump_deg";
+    pub const STEREO_IPD: &str = "stereo_ipd";
+}
+
 impl Record {
+    /// The value of scene axis `name` ([`axis`]) at this point.
+    pub fn axis(&self, name: &str) -> Option<f64> {
+        self.axes.get(name).copied()
+    }
+
+    /// Symmetry planes p the point's scene kept (a `--symmetry-planes` sweep, seed 001).
+    pub fn planes(&self) -> Option<u32> {
+        self.axis(axis::PLANES).map(|v| v as u32)
+    }
+
+    /// `lighting.mirrored_lights` of the point's scene (a `--mirrored-lights` sweep).
+    pub fn lights_depth(&self) -> Option<u32> {
+        self.axis(axis::MIRRORED_LIGHTS).map(|v| v as u32)
+    }
+
+    /// The steepest tilt of the point's uneven mirrors, degrees (a `--bump-amplitude` sweep).
+    pub fn tilt_deg(&self) -> Option<f32> {
+        self.axis(axis::BUMP_DEG).map(|v| v as f32)
+    }
+
+    /// Moves the axes of a record older than [`Record::axes`] into the map.
+    pub fn migrate_axes(&mut self) {
+        let legacy = [
+            (axis::PLANES, self.symmetry_planes.take().map(f64::from)),
+            (
+                axis::MIRRORED_LIGHTS,
+                self.mirrored_lights.take().map(f64::from),
+            ),
+            // The f32 as its shortest decimal, as the key wrote it.
+            (
+                axis::BUMP_DEG,
+                self.bump_amplitude_deg
+                    .take()
+                    .map(|a| a.to_string().parse().unwrap_or(f64::from(a))),
+            ),
+            (
+                axis::STEREO_IPD,
+                self.stereo
+                    .as_ref()
+                    .map(|s| s.ipd.to_string().parse().unwrap_or(f64::from(s.ipd))),
+            ),
+        ];
+        for (name, value) in legacy {
+            if let Some(v) = value {
+                self.axes.entry(name.to_string()).or_insert(v);
+            }
+        }
+    }
+
     /// The 95 % interval of the median time, if the record has one.
     pub fn ms_ci(&self) -> Option<stats::Interval> {
         self.ms_interval

@@ -58,7 +58,7 @@ fn variant_order(r: &Record) -> (bool, bool, u32, String) {
 fn lit_points(records: &[Record]) -> Vec<&Record> {
     records
         .iter()
-        .filter(|r| r.kind == "point" && r.mirrored_lights.is_some())
+        .filter(|r| r.kind == "point" && r.lights_depth().is_some())
         .collect()
 }
 
@@ -81,12 +81,12 @@ pub fn sentences(records: &[Record]) -> Vec<String> {
     let Some(method) = reference_method(&points) else {
         return Vec::new();
     };
-    let Some(k) = points.iter().filter_map(|r| r.mirrored_lights).max() else {
+    let Some(k) = points.iter().filter_map(|r| r.lights_depth()).max() else {
         return Vec::new();
     };
     let at = |lighting: &str| {
         points.iter().copied().find(|r| {
-            method_of(r) == method && r.mirrored_lights == Some(k) && lighting_of(r) == lighting
+            method_of(r) == method && r.lights_depth() == Some(k) && lighting_of(r) == lighting
         })
     };
     let variants = distinct(points.iter().map(|r| lighting_of(r)));
@@ -118,19 +118,19 @@ pub fn sentences(records: &[Record]) -> Vec<String> {
             .copied()
             .filter(|r| method_of(r) == method && lighting_of(r) == "direct only, no shadows")
             .collect();
-        d.sort_by_key(|r| r.mirrored_lights);
+        d.sort_by_key(|r| r.lights_depth());
         d
     };
     if let (Some(first), Some(last)) = (direct.first(), direct.last())
-        && first.mirrored_lights != last.mirrored_lights
+        && first.lights_depth() != last.lights_depth()
     {
         out.push(format!(
             "The error of ignoring mirrored light grows with the truth's depth: FLIP mean {} at \
              k = {} to {} at k = {}.",
             sci(first.metrics.flip_mean),
-            first.mirrored_lights.unwrap_or(0),
+            first.lights_depth().unwrap_or(0),
             sci(last.metrics.flip_mean),
-            last.mirrored_lights.unwrap_or(0)
+            last.lights_depth().unwrap_or(0)
         ));
     }
     out
@@ -144,7 +144,7 @@ pub(crate) fn lighting_section(records: &[Record]) -> Vec<Block> {
     }
     let k_max = points
         .iter()
-        .filter_map(|r| r.mirrored_lights)
+        .filter_map(|r| r.lights_depth())
         .max()
         .unwrap_or(0);
     let variants = distinct(points.iter().map(|r| lighting_of(r)));
@@ -157,7 +157,7 @@ pub(crate) fn lighting_section(records: &[Record]) -> Vec<Block> {
         let mut mine: Vec<&Record> = points
             .iter()
             .copied()
-            .filter(|r| &r.method == kind && r.mirrored_lights == Some(k_max))
+            .filter(|r| &r.method == kind && r.lights_depth() == Some(k_max))
             .collect();
         mine.sort_by_key(|r| variant_order(r));
         for (k, v) in distinct(mine.iter().map(|r| lighting_of(r)))
@@ -227,14 +227,14 @@ pub(crate) fn lighting_section(records: &[Record]) -> Vec<Block> {
                     .copied()
                     .filter(|r| &lighting_of(r) == v && method_of(r) == method)
                     .collect();
-                pts.sort_by_key(|r| r.mirrored_lights);
+                pts.sort_by_key(|r| r.lights_depth());
                 Series::new(
                     v.clone(),
                     method_style(base).variant(i),
                     pts.iter()
                         .map(|r| {
                             (
-                                f64::from(r.mirrored_lights.unwrap_or(0)),
+                                f64::from(r.lights_depth().unwrap_or(0)),
                                 r.metrics.flip_mean,
                             )
                         })
@@ -257,7 +257,7 @@ pub(crate) fn lighting_section(records: &[Record]) -> Vec<Block> {
         ));
     }
     let mut rows: Vec<&Record> = points.clone();
-    rows.sort_by_key(|r| (method_of(r), variant_order(r), r.mirrored_lights));
+    rows.sort_by_key(|r| (method_of(r), variant_order(r), r.lights_depth()));
     out.push(Block::Table(
         [
             "method",
@@ -276,7 +276,7 @@ pub(crate) fn lighting_section(records: &[Record]) -> Vec<Block> {
                 vec![
                     method_of(r),
                     lighting_of(r),
-                    r.mirrored_lights.map_or("–".into(), |k| k.to_string()),
+                    r.lights_depth().map_or("–".into(), |k| k.to_string()),
                     ms_cell(r, 2),
                     r.passes.to_string(),
                     sci(r.metrics.flip_mean),
@@ -302,7 +302,8 @@ mod tests {
         r.method = method.into();
         r.n = None;
         r.method_options = options.into();
-        r.mirrored_lights = Some(k);
+        r.axes
+            .insert(crate::axis::MIRRORED_LIGHTS.into(), f64::from(k));
         r.metrics.flip_mean = flip;
         if method == "unrolled" {
             r.depth = Some(64);
@@ -359,7 +360,7 @@ mod tests {
         assert!(lighting_section(&records).len() >= 5);
         // Not a mirrored-lights sweep: no section.
         let mut plain = records[0].clone();
-        plain.mirrored_lights = None;
+        plain.axes.remove(crate::axis::MIRRORED_LIGHTS);
         assert!(lighting_section(&[plain]).is_empty());
     }
 }

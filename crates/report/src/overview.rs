@@ -157,8 +157,8 @@ pub(crate) fn frontiers(sweeps: &[(String, Sweep)]) -> Vec<Frontier> {
             }
             for r in sweep.records.iter().filter(|r| {
                 r.kind == "point"
-                    && r.mirrored_lights.is_none()
-                    && r.bump_amplitude_deg.is_none()
+                    && r.lights_depth().is_none()
+                    && r.tilt_deg().is_none()
                     && r.stereo.is_none()
                     && r.device.is_none()
             }) {

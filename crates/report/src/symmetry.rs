@@ -30,7 +30,7 @@ pub fn plane_scaling(records: &[Record]) -> Vec<PlaneScaling> {
     let mut out: Vec<PlaneScaling> = Vec::new();
     for r in records
         .iter()
-        .filter(|r| r.kind == "point" && r.symmetry_planes.is_some())
+        .filter(|r| r.kind == "point" && r.planes().is_some())
     {
         let name = variant(r);
         match out.iter_mut().find(|g| g.name == name) {
@@ -43,7 +43,7 @@ pub fn plane_scaling(records: &[Record]) -> Vec<PlaneScaling> {
         }
     }
     for g in &mut out {
-        g.points.sort_by_key(|r| r.symmetry_planes);
+        g.points.sort_by_key(|r| r.planes());
     }
     out
 }
@@ -56,8 +56,8 @@ pub fn crossover_sentence(baked: &PlaneScaling, other: &PlaneScaling) -> String 
         .points
         .iter()
         .filter_map(|b| {
-            let p = b.symmetry_planes?;
-            let o = other.points.iter().find(|o| o.symmetry_planes == Some(p))?;
+            let p = b.planes()?;
+            let o = other.points.iter().find(|o| o.planes() == Some(p))?;
             Some((p, b, o))
         })
         .collect();
@@ -100,7 +100,7 @@ pub fn crossover_sentence(baked: &PlaneScaling, other: &PlaneScaling) -> String 
 /// How many of the 2^p copies pruning keeps, at the largest p measured.
 pub fn pruning_sentence(pruned: &PlaneScaling) -> Option<String> {
     let r = pruned.points.last()?;
-    let (p, drawn, total) = (r.symmetry_planes?, r.copies_drawn?, r.copies_total?);
+    let (p, drawn, total) = (r.planes()?, r.copies_drawn?, r.copies_total?);
     Some(format!(
         "`{}` draws {drawn} of the 2^{p} = {total} copies at p = {p} ({:.1} %: the rest have an \
          empty cell or lie outside the view).",
@@ -117,7 +117,7 @@ mod tests {
         let mut r = crate::document::fixtures::record(0, ms, 1, 0.0);
         r.method = method.into();
         r.n = None;
-        r.symmetry_planes = Some(p);
+        r.axes.insert(crate::axis::PLANES.into(), f64::from(p));
         r.copies_drawn = Some(drawn);
         r.copies_total = Some(1 << p);
         // A tight interval: ±1 %.

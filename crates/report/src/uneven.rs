@@ -80,12 +80,12 @@ fn variant_of(r: &Record, main: &str, bump_methods: &[String]) -> String {
 fn points(records: &[Record]) -> Vec<&Record> {
     records
         .iter()
-        .filter(|r| r.kind == "point" && r.bump_amplitude_deg.is_some())
+        .filter(|r| r.kind == "point" && r.tilt_deg().is_some())
         .collect()
 }
 
 fn amplitudes(points: &[&Record]) -> Vec<f32> {
-    let mut a = distinct(points.iter().filter_map(|r| r.bump_amplitude_deg));
+    let mut a = distinct(points.iter().filter_map(|r| r.tilt_deg()));
     a.sort_by(f32::total_cmp);
     a
 }
@@ -99,7 +99,7 @@ pub fn sentences(records: &[Record], bump_methods: &[String]) -> Vec<String> {
         let at: Vec<&Record> = pts
             .iter()
             .copied()
-            .filter(|r| r.bump_amplitude_deg == Some(a))
+            .filter(|r| r.tilt_deg() == Some(a))
             .collect();
         let flip = |r: &Record| r.metrics.flip_mean;
         let name = |r: &Record| format!("`{}`", variant_of(r, &main, bump_methods));
@@ -177,7 +177,7 @@ pub(crate) fn table(records: &[Record], bump_methods: &[String], relmse: bool) -
     let find = |t: &str, a: f32| {
         pts.iter()
             .copied()
-            .find(|r| variant_of(r, &main, bump_methods) == t && r.bump_amplitude_deg == Some(a))
+            .find(|r| variant_of(r, &main, bump_methods) == t && r.tilt_deg() == Some(a))
     };
     let rows = tricks
         .iter()
@@ -232,7 +232,7 @@ pub(crate) fn uneven_section(records: &[Record], bump_methods: &[String]) -> Vec
     // every setting), beside the methods that show the mirror flat. The question: which trick
     // errs least as the tilt grows.
     let family = |t: &str| t.split([' ', ',']).next().unwrap_or_default().to_string();
-    let tilt = |r: &Record| f64::from(r.bump_amplitude_deg.unwrap_or(0.0));
+    let tilt = |r: &Record| f64::from(r.tilt_deg().unwrap_or(0.0));
     let curve = |rs: &[&Record]| -> Vec<(f64, f64)> {
         let mut p: Vec<(f64, f64)> = rs.iter().map(|r| (tilt(r), r.metrics.flip_mean)).collect();
         p.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -330,7 +330,7 @@ pub(crate) fn uneven_section(records: &[Record], bump_methods: &[String]) -> Vec
         let mut at: Vec<&Record> = pts
             .iter()
             .copied()
-            .filter(|r| r.bump_amplitude_deg == Some(a))
+            .filter(|r| r.tilt_deg() == Some(a))
             .collect();
         at.sort_by(|p, q| p.metrics.flip_mean.total_cmp(&q.metrics.flip_mean));
         let chosen = distinct(
@@ -380,7 +380,7 @@ mod tests {
         let mut r = crate::document::fixtures::record(2, 10.0, 1, flip);
         r.key = format!("{options} {a}");
         r.method_options = options.into();
-        r.bump_amplitude_deg = Some(a);
+        r.axes.insert(crate::axis::BUMP_DEG.into(), f64::from(a));
         r.metrics.flip_mean = flip;
         r
     }
@@ -442,7 +442,7 @@ mod tests {
         );
         assert!(uneven_section(&records, &bump()).len() >= 5);
         let mut plain = records[0].clone();
-        plain.bump_amplitude_deg = None;
+        plain.axes.remove(crate::axis::BUMP_DEG);
         assert!(uneven_section(&[plain], &bump()).is_empty());
     }
 }

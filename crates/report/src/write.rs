@@ -24,10 +24,11 @@ pub fn read_records(path: &Path) -> std::io::Result<Vec<Record>> {
     };
     let mut records: Vec<Record> = Vec::new();
     let mut index = std::collections::HashMap::new();
-    for record in text
+    for mut record in text
         .lines()
         .filter_map(|l| serde_json::from_str::<Record>(l).ok())
     {
+        record.migrate_axes();
         match index.get(&record.key) {
             Some(&i) => records[i] = record,
             None => {
@@ -153,7 +154,7 @@ fn row_interval(r: &table1::Row, digits: usize) -> String {
 
 /// A point's place on its method's axis: n, the depth, or the symmetry planes p.
 fn setting(r: &Record) -> f64 {
-    r.n.or(r.depth).or(r.symmetry_planes).map_or(0.0, f64::from)
+    r.n.or(r.depth).or(r.planes()).map_or(0.0, f64::from)
 }
 
 /// Writes `results.csv`, `report.md`, `report.html` and the `plot_*.svg` files into `dir`.
@@ -342,13 +343,12 @@ fn write_csv(path: &Path, records: &[Record]) -> Result<(), FileError> {
             r.gpu_buffer_bytes.map_or(String::new(), |b| b.to_string()),
             r.gpu_texture_bytes.map_or(String::new(), |b| b.to_string()),
             r.method_options,
-            opt(r.symmetry_planes),
+            opt(r.planes()),
             r.copies_drawn.map_or(String::new(), |c| c.to_string()),
             r.copies_total.map_or(String::new(), |c| c.to_string()),
             r.bake_ms.map_or(String::new(), |ms| ms.to_string()),
-            opt(r.mirrored_lights),
-            r.bump_amplitude_deg
-                .map_or(String::new(), |a| a.to_string()),
+            opt(r.lights_depth()),
+            r.tilt_deg().map_or(String::new(), |a| a.to_string()),
             r.stereo
                 .as_ref()
                 .map_or(String::new(), |st| st.ipd.to_string()),
@@ -653,17 +653,13 @@ pub(crate) fn symmetry_section(records: &[Record]) -> Vec<Block> {
         .collect();
     // The seed's worst case: 2^p times the cost of one copy (the first method's p = 0 time).
     let mut references = Vec::new();
-    if let Some(base) = groups[0]
-        .points
-        .first()
-        .filter(|r| r.symmetry_planes == Some(0))
-    {
+    if let Some(base) = groups[0].points.first().filter(|r| r.planes() == Some(0)) {
         references.push(Reference::Curve(
             format!("2^p × {}'s p = 0 time", groups[0].name),
             groups[0]
                 .points
                 .iter()
-                .filter_map(|r| r.symmetry_planes)
+                .filter_map(|r| r.planes())
                 .map(|p| (f64::from(p), base.ms_median * f64::from(1u32 << p.min(31))))
                 .collect(),
         ));
@@ -703,7 +699,7 @@ pub(crate) fn symmetry_section(records: &[Record]) -> Vec<Block> {
                 .map(|r| {
                     vec![
                         crate::symmetry::variant(r),
-                        opt(r.symmetry_planes.map(|p| p as usize)),
+                        opt(r.planes().map(|p| p as usize)),
                         format!("{} / {}", opt(r.copies_drawn), opt(r.copies_total)),
                         opt(r.triangles),
                         r.bake_ms.map_or("–".into(), |ms| f(ms, 2)),
@@ -834,9 +830,9 @@ fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
     // One series per method variant and α, joined along its one swept setting (n or depth);
     // a sweep with a scene axis (lighting, tilt, IPD) draws its own charts in its section:
     // joining its points here would join unrelated settings.
-    let has_scene_axis = points.iter().any(|r| {
-        r.mirrored_lights.is_some() || r.bump_amplitude_deg.is_some() || r.stereo.is_some()
-    });
+    let has_scene_axis = points
+        .iter()
+        .any(|r| r.lights_depth().is_some() || r.tilt_deg().is_some() || r.stereo.is_some());
     let alphas = distinct(points.iter().map(|r| r.alpha.to_bits()));
     let styles = crate::plot::styles_for(
         &groups

@@ -5,7 +5,7 @@ use super::method_flags::SweepOptions;
 use super::progress_bar;
 use crate::Failure;
 use mirrorbox_harness::sequence::{Scenario, SequenceConfig};
-use mirrorbox_harness::{Event, Shard, SweepConfig, run_sweep};
+use mirrorbox_harness::{AxisValues, Event, Shard, SweepConfig, run_sweep};
 use mirrorbox_raster::registry::{find, names};
 use mirrorbox_trace::WhittedSettings;
 use std::path::PathBuf;
@@ -66,14 +66,14 @@ pub struct Args {
     /// Uneven-mirror tilts in degrees, comma separated: every point is measured on the scene
     /// with its uneven mirrors' steepest tilt set to each (ripple amplitude; normal-map
     /// strength, docs/shading.md); each in [0, 90).
-    #[arg(long, value_delimiter = ',')]
-    bump_amplitude: Option<Vec<f32>>,
+    #[arg(long)]
+    bump_amplitude: Option<String>,
     /// Stereo pairs: interpupillary distances in scene units, comma separated, each in [0, 1],
     /// or `mono`: every point renders both eyes of the camera's `stereo` rig (or an off-axis
     /// rig converging at look_at) as one frame, each eye against its own truth, at each IPD;
     /// `mono` is the plain frame.
-    #[arg(long, value_delimiter = ',')]
-    ipd: Option<Vec<String>>,
+    #[arg(long)]
+    ipd: Option<String>,
     /// With --ipd: the name of a diffuse object whose first reflection is located in each eye
     /// (raster and truth), for the report's disparity check.
     #[arg(long, requires = "ipd")]
@@ -179,55 +179,6 @@ fn parse_shard(text: &str) -> Result<Shard, Failure> {
         number(index, "I")?
     };
     Ok(Shard { index, count })
-}
-
-/// `--ipd`: numbers or `mono` (the range is checked with the other settings).
-fn parse_ipds(values: &[String]) -> Result<Vec<Option<f32>>, Failure> {
-    values
-        .iter()
-        .map(|v| match v.trim() {
-            "mono" => Ok(None),
-            t => t.parse::<f32>().map(Some).map_err(|_| {
-                bad(format!(
-                    "--ipd: each value must be a number in [0, 1] or `mono`, got {v:?}"
-                ))
-            }),
-        })
-        .collect()
-}
-
-/// `--symmetry-planes`: `0,2,4` or `0..=10`.
-fn parse_planes(text: &str) -> Result<Vec<u32>, Failure> {
-    parse_counts(
-        "--symmetry-planes",
-        "plane counts",
-        mirrorbox_scene::symmetry::MAX_SYMMETRY_PLANES as u32,
-        text,
-    )
-}
-
-/// A list of counts each in `0..=max`: `0,2,4` or `0..=10` (`flag` and `what` for the error).
-fn parse_counts(flag: &str, what: &str, max: u32, text: &str) -> Result<Vec<u32>, Failure> {
-    let bad = || {
-        Failure::BadInput(format!(
-            "{flag} {text:?}: must be {what} in 0..={max}, comma separated or a range a..=b"
-        ))
-    };
-    let count = |s: &str| -> Result<u32, Failure> {
-        let p: u32 = s.trim().parse().map_err(|_| bad())?;
-        if p > max {
-            return Err(bad());
-        }
-        Ok(p)
-    };
-    if let Some((a, b)) = text.split_once("..=") {
-        let (a, b) = (count(a)?, count(b)?);
-        if a > b {
-            return Err(bad());
-        }
-        return Ok((a..=b).collect());
-    }
-    text.split(',').map(count).collect()
 }
 
 /// The options of the preset sweeps (`table1`, `depth-scaling`).
@@ -362,31 +313,33 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         command: command_line(),
         worker: args.isolate_renders.then(render_worker).flatten(),
         memory_budget: args.memory.memory_budget,
-        symmetry_planes: args
-            .symmetry_planes
-            .as_deref()
-            .map(parse_planes)
-            .transpose()?,
-        bump_amplitudes: args.bump_amplitude.clone(),
-        stereo_ipds: args.ipd.as_deref().map(parse_ipds).transpose()?,
+        axes: scene_axes(args)?,
         marker: args.marker.clone(),
         shard: None,
         truth_cache: None,
-        mirrored_lights: args
-            .mirrored_lights
-            .as_deref()
-            .map(|t| {
-                parse_counts(
-                    "--mirrored-lights",
-                    "mirror counts",
-                    mirrorbox_scene::light_images::MAX_MIRRORED_LIGHTS,
-                    t,
-                )
-            })
-            .transpose()?,
     };
     args.shard.apply(&mut config)?;
     execute(&config, args.fresh)
+}
+
+/// The scene axes given on the command line, each parsed and bounded by its
+/// [`mirrorbox_harness::AxisSpec`].
+fn scene_axes(args: &Args) -> Result<Vec<AxisValues>, Failure> {
+    use mirrorbox_harness::axes;
+    [
+        (&axes::SYMMETRY_PLANES, &args.symmetry_planes),
+        (&axes::MIRRORED_LIGHTS, &args.mirrored_lights),
+        (&axes::BUMP_AMPLITUDE, &args.bump_amplitude),
+        (&axes::STEREO_IPD, &args.ipd),
+    ]
+    .into_iter()
+    .filter_map(|(axis, text)| text.as_deref().map(|t| (axis, t)))
+    .map(|(axis, text)| {
+        axis.parse(text)
+            .map(|values| AxisValues { axis, values })
+            .map_err(|e| Failure::BadInput(e.to_string()))
+    })
+    .collect()
 }
 
 /// Table 1 of the seed paper (`SweepConfig::table1`), into `reports/table1/` by default.

@@ -1,0 +1,289 @@
+//! Scene axes: a setting of a point's scene that a sweep varies beside the methods and α —
+//! the twin of the raster registry's `OptionSpec` for the scene instead of the method.
+//!
+//! An [`AxisSpec`] says everything the harness needs of an axis: its name (in a record's
+//! `axes` map and in the resume key, `|name=value`: frozen), its flag and bounds (parsed and
+//! checked here for every axis alike), how a point's label, image names and truth name show a
+//! value, and how a value is applied to the point's scene. The sweep, the worker, the resume
+//! keys and the records read the [`AXES`] table; adding an axis is one entry here (and its
+//! flag on `mirrorbox sweep`).
+
+use crate::HarnessError;
+use mirrorbox_scene::Scene;
+use mirrorbox_scene::limits::SettingError;
+
+/// One scene axis (see the module doc).
+pub struct AxisSpec {
+    /// The name in a record's `axes` map and in the resume key: frozen, earlier
+    /// `results.jsonl` files resume by it.
+    pub name: &'static str,
+    /// The `mirrorbox sweep` flag that lists its values.
+    pub flag: &'static str,
+    /// What one value is, for errors: "symmetry plane counts".
+    pub what: &'static str,
+    /// Allowed values: `[min, max]` (`[min, max)` when `max_open`), whole numbers when
+    /// `integer`.
+    pub min: f64,
+    pub max: f64,
+    pub max_open: bool,
+    pub integer: bool,
+    /// The word a list may hold for "this axis not applied" (the stereo axis' `mono`).
+    pub none_word: Option<&'static str>,
+    /// A point's label shows a value as `{label}{value}{unit}` (` p=3`, ` bump=2.5°`).
+    pub label: &'static str,
+    pub unit: &'static str,
+    /// Image and truth file names show it as `{slug}{value}`.
+    pub slug: &'static str,
+    /// Sets the value on a point's scene; `base` is the sweep's scene as loaded (an axis that
+    /// rebuilds the scene from it, as the symmetry planes do, comes first in [`AXES`]).
+    pub apply: fn(base: &Scene, scene: &mut Scene, value: f64) -> Result<(), HarnessError>,
+}
+
+/// Symmetry planes p (seed 001): the point's scene keeps the first p of the scene's
+/// `symmetry_planes`.
+pub const SYMMETRY_PLANES: AxisSpec = AxisSpec {
+    name: "planes",
+    flag: "--symmetry-planes",
+    what: "symmetry plane counts",
+    min: 0.0,
+    max: mirrorbox_scene::symmetry::MAX_SYMMETRY_PLANES as f64,
+    max_open: false,
+    integer: true,
+    none_word: None,
+    label: " p=",
+    unit: "",
+    slug: "p",
+    apply: |base, scene, p| {
+        *scene = base.with_symmetry_planes(p as usize)?;
+        Ok(())
+    },
+};
+
+/// Mirrored-light depth k (issue 15, docs/shading.md): surfaces lit through chains of at most
+/// k mirrors (`lighting.mirrored_lights`).
+pub const MIRRORED_LIGHTS: AxisSpec = AxisSpec {
+    name: "mirrored_lights",
+    flag: "--mirrored-lights",
+    what: "mirrored-light depths",
+    min: 0.0,
+    max: mirrorbox_scene::light_images::MAX_MIRRORED_LIGHTS as f64,
+    max_open: false,
+    integer: true,
+    none_word: None,
+    label: " k=",
+    unit: "",
+    slug: "k",
+    apply: |_, scene, k| {
+        scene.lighting.mirrored_lights = k as u32;
+        Ok(())
+    },
+};
+
+/// The uneven mirrors' steepest tilt, degrees (issue 16, docs/shading.md).
+pub const BUMP_AMPLITUDE: AxisSpec = AxisSpec {
+    name: "bump_deg",
+    flag: "--bump-amplitude",
+    what: "tilts in degrees",
+    min: 0.0,
+    max: mirrorbox_scene::bump::MAX_AMPLITUDE_DEG as f64,
+    max_open: true,
+    integer: false,
+    none_word: None,
+    label: " bump=",
+    unit: "°",
+    slug: "b",
+    apply: |_, scene, a| {
+        scene.set_bump_amplitude(a as f32);
+        Ok(())
+    },
+};
+
+/// A stereo pair's interpupillary distance, scene units (issue 17, seed 002): the point
+/// renders both eyes of the scene's rig; `mono` is the plain frame.
+pub const STEREO_IPD: AxisSpec = AxisSpec {
+    name: "stereo_ipd",
+    flag: "--ipd",
+    what: "interpupillary distances in scene units",
+    min: 0.0,
+    max: 1.0,
+    max_open: false,
+    integer: false,
+    none_word: Some("mono"),
+    label: " stereo IPD ",
+    unit: "",
+    slug: "ipd",
+    apply: |base, scene, d| {
+        scene.stereo = Some(base.stereo_rig(d as f32));
+        Ok(())
+    },
+};
+
+/// Every scene axis, in the order a point's scene applies them and its key names them.
+pub const AXES: [&AxisSpec; 4] = [
+    &SYMMETRY_PLANES,
+    &MIRRORED_LIGHTS,
+    &BUMP_AMPLITUDE,
+    &STEREO_IPD,
+];
+
+/// The axis named `name`.
+pub fn axis(name: &str) -> Option<&'static AxisSpec> {
+    AXES.iter().copied().find(|a| a.name == name)
+}
+
+impl AxisSpec {
+    /// A value as keys, labels and file names show it: a whole number, or the shortest
+    /// decimal of its `f32` (as the keys of earlier sweeps, which held `f32`s).
+    pub fn text(&self, v: f64) -> String {
+        if self.integer {
+            format!("{}", v as u64)
+        } else {
+            format!("{}", v as f32)
+        }
+    }
+
+    /// The values' range in words: `each 0..=16, whole numbers`.
+    pub fn allowed(&self) -> String {
+        let close = if self.max_open { ")" } else { "]" };
+        let kind = if self.integer { ", whole numbers" } else { "" };
+        let none = self
+            .none_word
+            .map_or(String::new(), |w| format!(", or {w}"));
+        format!(
+            "{} each in [{}, {}{close}{kind}{none}",
+            self.what,
+            self.text(self.min),
+            self.text(self.max)
+        )
+    }
+
+    /// Whether `v` is an allowed value.
+    pub fn allows(&self, v: f64) -> bool {
+        v.is_finite()
+            && v >= self.min
+            && (v < self.max || (!self.max_open && v == self.max))
+            && (!self.integer || v.fract() == 0.0)
+    }
+
+    /// Checks a list of values (`None`: the axis' none word).
+    pub fn check(&self, values: &[Option<f64>]) -> Result<(), SettingError> {
+        if values.is_empty() {
+            return Err(SettingError::new(self.flag, self.allowed(), "none"));
+        }
+        for v in values {
+            match v {
+                None if self.none_word.is_none() => {
+                    return Err(SettingError::new(self.flag, self.allowed(), "none"));
+                }
+                Some(x) if !self.allows(*x) => {
+                    return Err(SettingError::new(self.flag, self.allowed(), x));
+                }
+                _ => {}
+            }
+        }
+        Ok(())
+    }
+
+    /// Parses a flag's text: values comma separated, a whole-number axis also `a..=b`, the
+    /// none word where the axis has one; each checked.
+    pub fn parse(&self, text: &str) -> Result<Vec<Option<f64>>, SettingError> {
+        let bad = |got: &str| SettingError::new(self.flag, self.allowed(), format!("{got:?}"));
+        let mut out = Vec::new();
+        for part in text.split(',').map(str::trim) {
+            if Some(part) == self.none_word {
+                out.push(None);
+            } else if let Some((a, b)) = part.split_once("..=").filter(|_| self.integer) {
+                let (a, b): (u64, u64) = (
+                    a.trim().parse().map_err(|_| bad(part))?,
+                    b.trim().parse().map_err(|_| bad(part))?,
+                );
+                if b < a || b - a > 10_000 {
+                    return Err(bad(part));
+                }
+                out.extend((a..=b).map(|v| Some(v as f64)));
+            } else {
+                out.push(Some(part.parse::<f64>().map_err(|_| bad(part))?));
+            }
+        }
+        self.check(&out)?;
+        Ok(out)
+    }
+}
+
+/// One axis of a sweep and the values it takes (`None`: the axis not applied, e.g. `mono`).
+#[derive(Clone)]
+pub struct AxisValues {
+    pub axis: &'static AxisSpec,
+    pub values: Vec<Option<f64>>,
+}
+
+impl std::fmt::Debug for AxisValues {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}={:?}", self.axis.name, self.values)
+    }
+}
+
+/// A point's setting of the axes it has, in [`AXES`] order.
+pub type PointAxes = Vec<(&'static AxisSpec, f64)>;
+
+/// The point's scene: the floor's without mirrors, or the base scene with each axis applied
+/// in [`AXES`] order.
+pub(crate) fn apply_axes(
+    base: &Scene,
+    floor: bool,
+    axes: &[(&'static AxisSpec, f64)],
+) -> Result<Scene, HarnessError> {
+    let mut scene = if floor {
+        base.without_mirrors()
+    } else {
+        base.clone()
+    };
+    // A mono point renders one frame, whatever the file's camera says.
+    scene.stereo = None;
+    for spec in AXES {
+        if let Some((_, v)) = axes.iter().find(|(a, _)| a.name == spec.name) {
+            (spec.apply)(base, &mut scene, *v)?;
+        }
+    }
+    Ok(scene)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn values_are_parsed_and_bounded_alike_for_every_axis() {
+        assert_eq!(
+            SYMMETRY_PLANES.parse("0..=2,5").unwrap(),
+            vec![Some(0.0), Some(1.0), Some(2.0), Some(5.0)]
+        );
+        assert!(SYMMETRY_PLANES.parse("17").is_err());
+        assert!(SYMMETRY_PLANES.parse("1.5").is_err());
+        assert!(
+            BUMP_AMPLITUDE.parse("90").is_err(),
+            "90° is outside [0, 90)"
+        );
+        assert_eq!(BUMP_AMPLITUDE.parse("2.5").unwrap(), vec![Some(2.5)]);
+        assert_eq!(
+            STEREO_IPD.parse("mono,0.05").unwrap(),
+            vec![None, Some(0.05)]
+        );
+        assert!(MIRRORED_LIGHTS.parse("mono").is_err());
+        let e = MIRRORED_LIGHTS.parse("x").unwrap_err().to_string();
+        assert!(e.contains("--mirrored-lights"), "{e}");
+    }
+
+    #[test]
+    fn a_value_reads_as_the_keys_of_earlier_sweeps_did() {
+        // Earlier keys formatted the f32 the flag parsed: `|bump_deg=2.5`, `|stereo_ipd=0.025`.
+        assert_eq!(STEREO_IPD.text(0.025), "0.025");
+        assert_eq!(BUMP_AMPLITUDE.text(2.5), "2.5");
+        assert_eq!(SYMMETRY_PLANES.text(3.0), "3");
+        let names: Vec<&str> = AXES.iter().map(|a| a.name).collect();
+        assert_eq!(
+            names,
+            ["planes", "mirrored_lights", "bump_deg", "stereo_ipd"]
+        );
+    }
+}
