@@ -9,7 +9,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 width=${1:-32}
 height=${2:-18}
-bin=target/release/mirrorbox
+bin=${MIRRORBOX:-target/release/mirrorbox}
 [ -x "$bin" ] || cargo build --release -p mirrorbox
 export NODEVICE_SELECT=1
 tmp=$(mktemp -d)

@@ -35,6 +35,8 @@ enum Command {
     Compare(commands::compare::Args),
     /// Sweep methods, n and α: time, compare with cached truths, write reports (resumable).
     Sweep(commands::sweep::Args),
+    /// Run an experiment of the registry (crates/experiments): its sweeps, sequences or script, into its report folder (`--list` lists them).
+    Experiment(commands::sweep::ExperimentArgs),
     /// The preset sweep reproducing the paper's Table 1, exact methods beside it (writes reports/table1/).
     Table1(commands::sweep::PresetArgs),
     /// The preset sweep of the exact methods' cost against depth 1…1024 (writes reports/depth_scaling/).
@@ -173,12 +175,15 @@ fn main() -> ExitCode {
         Command::Render(args) => commands::render::run(&args),
         Command::Compare(args) => commands::compare::run(&args),
         Command::Sweep(args) => commands::sweep::run(&args),
-        Command::Table1(args) => commands::sweep::run_table1(&args),
-        Command::DepthScaling(args) => commands::sweep::run_depth_scaling(&args),
-        Command::SymmetryScaling(args) => commands::sweep::run_symmetry_scaling(&args),
-        Command::Lighting(args) => commands::sweep::run_lighting(&args),
-        Command::Bumpy(args) => commands::sweep::run_bumpy(&args),
-        Command::Stereo(args) => commands::sweep::run_stereo(&args),
+        Command::Experiment(args) => commands::sweep::run_experiment_command(&args),
+        Command::Table1(args) => commands::sweep::run_experiment("table1", &args),
+        Command::DepthScaling(args) => commands::sweep::run_experiment("depth-scaling", &args),
+        Command::SymmetryScaling(args) => {
+            commands::sweep::run_experiment("symmetry-scaling", &args)
+        }
+        Command::Lighting(args) => commands::sweep::run_experiment("lighting", &args),
+        Command::Bumpy(args) => commands::sweep::run_experiment("bumpy", &args),
+        Command::Stereo(args) => commands::sweep::run_experiment("stereo", &args),
         Command::Motion(args) => commands::sweep::run_motion(&args),
         Command::View(args) => commands::view::run(&args),
         Command::ExportMitsuba(args) => commands::export_mitsuba::run(&args),

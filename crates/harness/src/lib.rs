@@ -75,6 +75,9 @@ pub struct SweepConfig {
     /// planes, mirrored-light depth, uneven-mirror tilt, stereo IPD), each with its values;
     /// every combination is a point (of every method, at every α). Empty: the scene as it is.
     pub axes: Vec<AxisValues>,
+    /// The experiments' report sections the report offers its records (the registry's, from
+    /// `mirrorbox-experiments`); none: the sections every sweep report has.
+    pub sections: Vec<mirrorbox_report::Section>,
     /// The object whose first reflection a stereo point locates in each eye, truth and raster
     /// alike, to measure its disparity (`--marker NAME`, a diffuse object of the scene; its
     /// albedo's chromaticity finds it: `mirrorbox_image::stereo::marker_blob`).
@@ -129,34 +132,8 @@ pub fn swept(name: &str, values: impl IntoIterator<Item = u32>) -> Vec<Method> {
         .collect()
 }
 
-/// The raster lighting variants the lighting presets measure: ignoring the light images, and
-/// drawing them (the default).
-const LIGHTING_VARIANTS: [&str; 2] = ["lights=direct", ""];
-
-/// The shadow-map sizes the lighting preset measures (`--shadows map`), on the methods of
-/// [`SHADOWED_METHODS`] only: each layer is a scene pass, so they are the preset's dearest
-/// points on a CPU rasterizer.
-const SHADOW_MAP_SIZES: [u32; 3] = [256, 1024, 2048];
-
-/// The methods the lighting preset also measures with shadow maps: the exact method and the
-/// paper's method at its published n = 2.
-const SHADOWED_METHODS: [&str; 2] = ["unrolled depth=64", "auxiliary n=2"];
-
-/// The uneven-mirror tricks the bumpy presets measure (`crates/raster/src/uneven.rs`).
-const BUMP_VARIANTS: [&str; 9] = [
-    "bump=flat",
-    "bump=distort bump-strength=0.25",
-    "bump=distort",
-    "bump=distort bump-strength=1",
-    "bump=distort bump-strength=2",
-    "bump=distort-distance bump-strength=2",
-    "bump=proxy",
-    "bump=march",
-    "bump=march texture-margin=16",
-];
-
 /// `base` with the options of `words` (`"lights=direct shadow-map=1024"`, or empty) set.
-fn with_options(base: &Method, words: &str) -> Method {
+pub fn with_options(base: &Method, words: &str) -> Method {
     Method::parse(&format!("{} {words}", base.key())).unwrap_or_else(|e| panic!("preset: {e}"))
 }
 
@@ -181,224 +158,16 @@ impl SweepConfig {
             worker: None,
             memory_budget: mirrorbox_raster::DEFAULT_MEMORY_BUDGET,
             axes: Vec::new(),
+            sections: Vec::new(),
             marker: None,
             shard: None,
             truth_cache: None,
         }
     }
 
-    /// Table 1 of the seed paper: the auxiliary method for n = 0…4 on mirror_box at α = 1 and
-    /// the paper's 0.7, with the exact methods at depth 64 beside it; 9 timed frames.
-    pub fn table1(out: PathBuf) -> Self {
-        let mut methods = swept(mirrorbox_report::table1::PAPER_METHOD, 0..=4);
-        // A preset is a fixed experiment: its methods are named, not taken from the table.
-        for m in ["portal", "unrolled"] {
-            methods.extend(swept(m, [64]));
-        }
-        SweepConfig::preset(out, methods, vec![1.0, 0.7])
-    }
-
-    /// The exact methods' cost against depth, 1 to 1024, on mirror_box with perfect mirrors
-    /// (α = 1: no path ends by attenuation, only when its portal holds no pixel centre).
-    pub fn depth_scaling(out: PathBuf) -> Self {
-        let methods = ["portal", "unrolled"]
-            .into_iter()
-            .flat_map(|m| swept(m, (0..=10).map(|k| 1 << k)))
-            .collect();
-        SweepConfig::preset(out, methods, vec![1.0])
-    }
-
-    /// Symmetry planes (seed 001): the seed's method (instanced, and one draw per copy), the
-    /// pruned copies and the CPU-baked mesh for p = 0…10 of `symmetry_many`'s ten planes; no
-    /// mirrors, so one α.
-    pub fn symmetry_scaling(out: PathBuf) -> Self {
-        let named = |name: &str| Method::named(name).unwrap_or_else(|e| panic!("preset: {e}"));
-        let per_copy = named("symmetry")
-            .with_text(
-                &mirrorbox_raster::methods::symmetry::SYMMETRY_DRAWS,
-                "per-copy",
-            )
-            .unwrap_or_else(|e| panic!("preset: {e}"));
-        let methods = vec![
-            named("symmetry"),
-            per_copy,
-            named("symmetry-pruned"),
-            named("symmetry-baked"),
-        ];
-        // The seed's method takes seconds per frame at p = 10 on a CPU rasterizer (2^10
-        // copies of 5 708 triangles): 6 timed frames (the fewest that give an interval) after
-        // one warm-up keep the preset within minutes.
-        SweepConfig {
-            scene: PathBuf::from("scenes/symmetry_many.json"),
-            axes: vec![along(&axes::SYMMETRY_PLANES, (0..=10).map(f64::from))],
-            frames: 6,
-            warmup: 1,
-            ..SweepConfig::preset(out, methods, vec![1.0])
-        }
-    }
-
-    /// Shadows and mirrored lights (issue 15) on `mirror_box_lit`: the paper's auxiliary
-    /// method n = 0…4 and the exact methods at depth 64, each ignoring mirrored light
-    /// (`lights=direct`) and with the light images (no raster variant draws shadows yet),
-    /// against truths lit through k = 0, 1, 2, 4, 8 mirrors, with shadows; at 320×180 (70
-    /// points), 6 timed frames after one warm-up.
-    pub fn lighting(out: PathBuf) -> Self {
-        let mut methods = Vec::new();
-        let mut bases = swept(mirrorbox_report::table1::PAPER_METHOD, 0..=4);
-        bases.extend(swept("unrolled", [64]));
-        bases.extend(swept("portal", [64]));
-        for base in &bases {
-            for variant in LIGHTING_VARIANTS {
-                methods.push(with_options(base, variant));
-            }
-            if SHADOWED_METHODS.contains(&base.key().as_str()) {
-                for size in SHADOW_MAP_SIZES {
-                    methods.push(with_options(
-                        base,
-                        &format!("shadows=map shadow-map-size={size}"),
-                    ));
-                }
-            }
-        }
-        SweepConfig {
-            scene: PathBuf::from("scenes/mirror_box_lit.json"),
-            axes: vec![along(&axes::MIRRORED_LIGHTS, [0.0, 1.0, 2.0, 4.0, 8.0])],
-            width: Some(320),
-            height: Some(180),
-            frames: 6,
-            warmup: 1,
-            ..SweepConfig::preset(out, methods, vec![0.9])
-        }
-    }
-
-    /// [`SweepConfig::lighting`]'s mirror-room variant, smaller: the room's light images grow
-    /// with k² (477 at k = 8) and its reflection paths branch, so a frame costs ~1 s on a CPU
-    /// rasterizer even at 160×90. `unrolled` at depth 12 with α = 0.7 (0.7¹² = 1.4 % left to
-    /// what the cut leaves out), both lighting variants and shadow maps of 256² and 512²
-    /// (483 layers at k = 8), k = 0, 4, 8.
-    pub fn lighting_room(out: PathBuf) -> Self {
-        let mut methods = Vec::new();
-        for base in swept("unrolled", [12]) {
-            for variant in LIGHTING_VARIANTS {
-                methods.push(with_options(&base, variant));
-            }
-            for size in [256, 512] {
-                methods.push(with_options(
-                    &base,
-                    &format!("shadows=map shadow-map-size={size}"),
-                ));
-            }
-        }
-        SweepConfig {
-            scene: PathBuf::from("scenes/mirror_room_lit.json"),
-            axes: vec![along(&axes::MIRRORED_LIGHTS, [0.0, 4.0, 8.0])],
-            width: Some(160),
-            height: Some(90),
-            frames: 6,
-            warmup: 1,
-            ..SweepConfig::preset(out, methods, vec![0.7])
-        }
-    }
-
-    /// Uneven mirrors (issue 16) on `bumpy_pair`: the paper's method at its published n = 2
-    /// with every trick of `--bump` (`crates/raster/src/uneven.rs`) — the bump ignored,
-    /// the screen-space distortion at four strengths and its 1/distance form, the proxy plane,
-    /// the march with and without a 16-pixel texture margin — and, beside them, the march at
-    /// n = 4 (two reflections deeper), the exact `unrolled` at depth 64, which shows the
-    /// mirror flat, and the exact `path-textures` at depth 64 with four tricks; against truths whose rippled mirror tilts by 0, 1, 2.5, 5 and 10°;
-    /// 320×180, 6 timed frames after one warm-up.
-    pub fn bumpy(out: PathBuf) -> Self {
-        SweepConfig {
-            scene: PathBuf::from("scenes/bumpy_pair.json"),
-            ..SweepConfig::bumpy_variants(
-                out,
-                "auxiliary n=2",
-                &[
-                    "auxiliary n=4 bump=march",
-                    "unrolled depth=64",
-                    "path-textures depth=64 bump=flat",
-                    "path-textures depth=64 bump=distort bump-strength=1",
-                    "path-textures depth=64 bump=proxy",
-                    "path-textures depth=64 bump=march",
-                ],
-            )
-        }
-    }
-
-    /// [`SweepConfig::bumpy`] on `bumpy_single` (one normal-mapped mirror: `naive` is the
-    /// paper's method there, and exact for a flat mirror).
-    pub fn bumpy_single(out: PathBuf) -> Self {
-        SweepConfig {
-            scene: PathBuf::from("scenes/bumpy_single.json"),
-            ..SweepConfig::bumpy_variants(out, "naive", &["unrolled depth=64"])
-        }
-    }
-
-    fn bumpy_variants(out: PathBuf, base: &str, extra: &[&str]) -> Self {
-        let base = Method::parse(base).unwrap_or_else(|e| panic!("preset: {e}"));
-        let mut methods: Vec<Method> = BUMP_VARIANTS
-            .iter()
-            .map(|v| with_options(&base, v))
-            .collect();
-        methods.extend(
-            extra
-                .iter()
-                .map(|m| Method::parse(m).unwrap_or_else(|e| panic!("preset: {e}"))),
-        );
-        SweepConfig {
-            axes: vec![along(&axes::BUMP_AMPLITUDE, [0.0, 1.0, 2.5, 5.0, 10.0])],
-            width: Some(320),
-            height: Some(180),
-            frames: 6,
-            warmup: 1,
-            ..SweepConfig::preset(out, methods, vec![0.9])
-        }
-    }
-
-    /// Stereo mirrors (issue 17, seed 002) on `stereo_box` (the paper's box with a green
-    /// marker on the wall behind the viewer): per-eye mirror textures against the head's
-    /// shared ones (`stereo-mirrors=shared`) for the paper's method at n = 2 and the exact
-    /// `path-textures`, the plain `naive` and the exact geometry method `unrolled` (per eye
-    /// only), each as a stereo pair at IPD 0 … 0.1 and as a mono frame; 320×180, α 0.9,
-    /// 6 timed frames after one warm-up.
-    pub fn stereo(out: PathBuf) -> Self {
-        let methods = [
-            "naive",
-            "naive stereo-mirrors=shared",
-            "auxiliary n=2",
-            "auxiliary n=2 stereo-mirrors=shared",
-            "path-textures depth=64",
-            "path-textures depth=64 stereo-mirrors=shared",
-            "unrolled depth=64",
-        ]
-        .iter()
-        .map(|m| Method::parse(m).unwrap_or_else(|e| panic!("preset: {e}")))
-        .collect();
-        SweepConfig {
-            scene: PathBuf::from("scenes/stereo_box.json"),
-            axes: vec![AxisValues {
-                axis: &axes::STEREO_IPD,
-                values: vec![
-                    None,
-                    Some(0.0),
-                    Some(0.025),
-                    Some(0.05),
-                    Some(0.075),
-                    Some(0.1),
-                ],
-            }],
-            marker: Some("marker".into()),
-            width: Some(320),
-            height: Some(180),
-            frames: 6,
-            warmup: 1,
-            ..SweepConfig::preset(out, methods, vec![0.9])
-        }
-    }
-
     /// A preset on the paper's scene (mirror_box) with 9 timed frames: enough for a 95 %
-    /// interval of each median.
-    fn preset(out: PathBuf, methods: Vec<Method>, alphas: Vec<f32>) -> Self {
+    /// interval of each median (the experiments' presets start from it).
+    pub fn preset(out: PathBuf, methods: Vec<Method>, alphas: Vec<f32>) -> Self {
         SweepConfig {
             frames: 9,
             ..SweepConfig::new(
@@ -1395,7 +1164,7 @@ pub fn run_sweep(
         &out.join("sweep.json"),
         serde_json::to_string_pretty(&info)?.as_bytes(),
     )?;
-    write_report(out, &info, &records)?;
+    write_report(out, &info, &records, &config.sections)?;
     Ok(summary)
 }
 

@@ -87,7 +87,13 @@ pub struct Merged {
 
 /// Merges the shard folders `dirs` into the sweep folder `out` (created inside an existing
 /// folder) and writes its reports; `command` is recorded as the merged sweep's command.
-pub fn merge(out: &Path, dirs: &[PathBuf], command: &str) -> Result<Merged, HarnessError> {
+/// `sections`: the experiments' report sections (the registry's) for the merged report.
+pub fn merge(
+    out: &Path,
+    dirs: &[PathBuf],
+    command: &str,
+    sections: &[mirrorbox_report::Section],
+) -> Result<Merged, HarnessError> {
     if dirs.is_empty() || dirs.len() > MAX_MERGED_SHARDS {
         return Err(SettingError::new(
             "merge DIR...",
@@ -240,7 +246,7 @@ pub fn merge(out: &Path, dirs: &[PathBuf], command: &str) -> Result<Merged, Harn
         &out.join("sweep.json"),
         serde_json::to_string_pretty(&info)?.as_bytes(),
     )?;
-    write_report(out, &info, &records)?;
+    write_report(out, &info, &records, sections)?;
     Ok(Merged {
         shards: shards.len(),
         points: records.len(),

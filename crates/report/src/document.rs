@@ -2,6 +2,8 @@
 //! alike — and the formatting rules its sentences and tables share (digits scaled to an
 //! interval, ties said as ties, errors at the floor not ranked). Report sections import this
 //! module; none imports the writer (`write.rs`), which imports them: no import circle.
+//! An experiment's own report section (`mirrorbox-experiments`) is written in it too: a
+//! [`Section`] returns blocks, the writer places them.
 
 use crate::Record;
 use crate::plot::Chart;
@@ -9,7 +11,11 @@ use mirrorbox_files::FileError;
 use std::fmt::Write as _;
 use std::path::Path;
 
-pub(crate) enum Block {
+/// A report section: the blocks it adds to a sweep's report, or none where the sweep's
+/// records are not its experiment's (every section is offered every sweep).
+pub type Section = fn(&crate::SweepInfo, &[Record]) -> Vec<Block>;
+
+pub enum Block {
     Heading(u8, String),
     Paragraph(String),
     Bullets(Vec<String>),
@@ -24,7 +30,7 @@ pub(crate) enum Block {
 /// Bytes in a mebibyte (the tables' memory unit).
 pub(crate) const MIB: f64 = 1024.0 * 1024.0;
 
-pub(crate) fn f(v: f64, digits: usize) -> String {
+pub fn f(v: f64, digits: usize) -> String {
     if v.is_finite() {
         format!("{v:.digits$}")
     } else {
@@ -34,7 +40,7 @@ pub(crate) fn f(v: f64, digits: usize) -> String {
 
 /// Decimals for a time: at least `digits`, and enough for three significant digits below 100
 /// (a GPU frame of 0.403 ms must not print as "0.4"), at most six.
-pub(crate) fn ms_digits(v: f64, digits: usize) -> usize {
+pub fn ms_digits(v: f64, digits: usize) -> usize {
     if !(v.is_finite() && v > 0.0) || v >= 100.0 {
         return digits;
     }
@@ -43,12 +49,12 @@ pub(crate) fn ms_digits(v: f64, digits: usize) -> usize {
 }
 
 /// A time in ms with [`ms_digits`] decimals.
-pub(crate) fn ms(v: f64, digits: usize) -> String {
+pub fn ms(v: f64, digits: usize) -> String {
     f(v, ms_digits(v, digits))
 }
 
 /// `values` without repeats, in first-seen order (a report's rows and series).
-pub(crate) fn distinct<T: PartialEq>(values: impl Iterator<Item = T>) -> Vec<T> {
+pub fn distinct<T: PartialEq>(values: impl Iterator<Item = T>) -> Vec<T> {
     let mut out: Vec<T> = Vec::new();
     for v in values {
         if !out.contains(&v) {
@@ -58,7 +64,7 @@ pub(crate) fn distinct<T: PartialEq>(values: impl Iterator<Item = T>) -> Vec<T> 
     out
 }
 
-pub(crate) fn sci(v: f64) -> String {
+pub fn sci(v: f64) -> String {
     if v.is_finite() {
         format!("{v:.3e}")
     } else {
@@ -79,7 +85,7 @@ pub(crate) fn paired_ratio(a: &Record, b: &Record) -> Option<crate::stats::Inter
 }
 
 /// "median [low–high]" (older records: "median (min m)"), all with the median's decimals.
-pub(crate) fn ms_cell(r: &Record, digits: usize) -> String {
+pub fn ms_cell(r: &Record, digits: usize) -> String {
     match r.ms_interval {
         Some([low, high]) => {
             let digits = interval_digits(low, high);
@@ -101,7 +107,7 @@ pub(crate) fn ms_cell(r: &Record, digits: usize) -> String {
 /// the interval's width — what the interval can tell apart, and no more (an interval from six
 /// frames does not know a fourth digit). A zero-width interval gets three significant digits
 /// of its value.
-pub(crate) fn interval_digits(low: f64, high: f64) -> usize {
+pub fn interval_digits(low: f64, high: f64) -> usize {
     let width = (high - low).abs();
     let basis = if width > 0.0 && width.is_finite() {
         width
@@ -112,7 +118,7 @@ pub(crate) fn interval_digits(low: f64, high: f64) -> usize {
 }
 
 /// Those of `candidates` within [`TIE_TOLERANCE`] of the lowest `value`: one winner, or a tie.
-pub(crate) fn lowest_with_ties<'a>(
+pub fn lowest_with_ties<'a>(
     candidates: impl Iterator<Item = &'a Record>,
     value: impl Fn(&Record) -> f64,
 ) -> Vec<&'a Record> {
@@ -126,7 +132,7 @@ pub(crate) fn lowest_with_ties<'a>(
 }
 
 /// `a`, `a and b`, `a, b and c`.
-pub(crate) fn join_words(words: &[String]) -> String {
+pub fn join_words(words: &[String]) -> String {
     match words {
         [] => String::new(),
         [one] => one.clone(),
@@ -136,9 +142,9 @@ pub(crate) fn join_words(words: &[String]) -> String {
 
 /// Two errors within 2 % of each other are a tie: the spread of one method's error between
 /// runs of the same sweep is of that order.
-pub(crate) const TIE_TOLERANCE: f64 = 0.02;
+pub const TIE_TOLERANCE: f64 = 0.02;
 
-pub(crate) fn label(r: &Record) -> String {
+pub fn label(r: &Record) -> String {
     let name = variant(r);
     let at = match (r.n, r.depth, r.planes()) {
         (Some(n), _, _) => format!("{name} n={n}"),
@@ -154,11 +160,11 @@ pub(crate) fn label(r: &Record) -> String {
 
 /// A point's error counts as at the floor up to this multiple of the floor's FLIP mean: the
 /// floor itself varies by that much between renders of the same scene.
-pub(crate) const FLOOR_FACTOR: f64 = 1.5;
+pub const FLOOR_FACTOR: f64 = 1.5;
 
 /// Whether `r`'s whole-image FLIP mean is at or under the floor `fl` (within [`FLOOR_FACTOR`]):
 /// not resolved by the comparison, so not ranked.
-pub(crate) fn at_or_under_floor(r: &Record, fl: &Record) -> bool {
+pub fn at_or_under_floor(r: &Record, fl: &Record) -> bool {
     r.metrics.flip_mean <= FLOOR_FACTOR * fl.metrics.flip_mean
 }
 
@@ -175,7 +181,7 @@ pub(crate) fn remove_stale(path: &Path) -> Result<(), FileError> {
 }
 
 /// The blocks as Markdown (charts and images as links to their files).
-pub(crate) fn markdown(blocks: &[Block]) -> String {
+pub fn markdown(blocks: &[Block]) -> String {
     let mut md = String::new();
     for b in blocks {
         match b {

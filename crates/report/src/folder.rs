@@ -45,7 +45,12 @@ pub(crate) fn load_sweep(dir: &Path) -> Result<Sweep, ReadmeError> {
 /// from its `sweep.json` and `results.jsonl`; returns the number of records reported.
 /// `records_commit`: the commit that committed the records, named in the figures' footers of
 /// a sweep that did not record the commit that measured it (empty: unknown).
-pub fn rewrite_report(dir: &Path, records_commit: &str) -> Result<usize, ReadmeError> {
+/// `sections`: the experiments' report sections (the registry's).
+pub fn rewrite_report(
+    dir: &Path,
+    records_commit: &str,
+    sections: &[crate::Section],
+) -> Result<usize, ReadmeError> {
     // A sequence sweep's folder (`mirrorbox motion`, `sweep --path`) has its own files.
     if dir.join("motion.json").is_file() && !dir.join("sweep.json").exists() {
         let (info, records) = crate::motion::read_motion(dir).map_err(ReadmeError)?;
@@ -55,7 +60,8 @@ pub fn rewrite_report(dir: &Path, records_commit: &str) -> Result<usize, ReadmeE
     }
     let mut sweep = load_sweep(dir)?;
     sweep.info.records_commit = records_commit.to_string();
-    write_report(dir, &sweep.info, &sweep.records).map_err(|e| ReadmeError(e.to_string()))?;
+    write_report(dir, &sweep.info, &sweep.records, sections)
+        .map_err(|e| ReadmeError(e.to_string()))?;
     Ok(sweep.records.len())
 }
 
@@ -66,10 +72,14 @@ mod tests {
     #[test]
     fn a_folder_without_a_sweep_description_is_named_in_the_error() {
         let dir = tempfile::tempdir().unwrap();
-        let e = rewrite_report(dir.path(), "").err().unwrap();
+        let e = rewrite_report(dir.path(), "", &crate::TEST_SECTIONS)
+            .err()
+            .unwrap();
         assert!(e.0.contains("sweep.json"), "{e}");
         std::fs::write(dir.path().join("sweep.json"), "[1, 2]").unwrap();
-        let e = rewrite_report(dir.path(), "").err().unwrap();
+        let e = rewrite_report(dir.path(), "", &crate::TEST_SECTIONS)
+            .err()
+            .unwrap();
         assert!(e.0.contains("not a sweep description"), "{e}");
     }
 
@@ -82,7 +92,7 @@ mod tests {
         for f in ["sweep.json", "results.jsonl"] {
             std::fs::copy(root.join(f), dir.path().join(f)).unwrap();
         }
-        assert!(rewrite_report(dir.path(), "").unwrap() > 0);
+        assert!(rewrite_report(dir.path(), "", &crate::TEST_SECTIONS).unwrap() > 0);
         let want = std::fs::read_to_string(root.join("report.md")).unwrap();
         let have = std::fs::read_to_string(dir.path().join("report.md")).unwrap();
         assert_eq!(have, want);

@@ -6,7 +6,7 @@
 //!   plots, including the reproduction of the seed paper's Table 1 ([`table1`]).
 //! - [`readme`]: the README's figures, generated from the committed reports.
 
-mod document;
+pub mod document;
 mod error;
 pub mod exact;
 mod folder;
@@ -16,6 +16,7 @@ pub mod overview;
 pub mod plot;
 pub mod readme;
 mod runs;
+pub mod sections;
 pub mod stats;
 pub mod stereo;
 pub mod symmetry;
@@ -23,6 +24,18 @@ pub mod table1;
 pub mod uneven;
 mod write;
 
+pub use document::{Block, Section};
+
+/// Every section of [`sections`], for this crate's tests (the registry offers the real ones).
+#[cfg(test)]
+pub(crate) const TEST_SECTIONS: [Section; 6] = [
+    sections::table1,
+    sections::depth_scaling,
+    sections::symmetry_scaling,
+    sections::lighting,
+    sections::uneven_mirrors,
+    sections::stereo,
+];
 pub use folder::rewrite_report;
 pub use write::{read_records, write_report};
 

@@ -2,8 +2,8 @@
 //! they always say the same thing.
 
 use crate::document::{
-    Block, FLOOR_FACTOR, MIB, at_or_under_floor, distinct, f, interval_digits, label, markdown, ms,
-    ms_cell, ms_digits, paired_ratio, remove_stale, sci,
+    Block, FLOOR_FACTOR, MIB, Section, at_or_under_floor, distinct, f, interval_digits, label,
+    markdown, ms, ms_cell, ms_digits, paired_ratio, remove_stale, sci,
 };
 use crate::plot::{Chart, Reference, Series};
 use crate::{Record, SweepInfo};
@@ -160,9 +160,14 @@ fn setting(r: &Record) -> f64 {
 /// Writes `results.csv`, `report.md`, `report.html` and the `plot_*.svg` files into `dir`.
 /// Each file is written atomically: a failure (a full disk) leaves the previous file or
 /// none, and names the file.
-pub fn write_report(dir: &Path, info: &SweepInfo, records: &[Record]) -> Result<(), FileError> {
+pub fn write_report(
+    dir: &Path,
+    info: &SweepInfo,
+    records: &[Record],
+    sections: &[Section],
+) -> Result<(), FileError> {
     write_csv(&dir.join("results.csv"), records)?;
-    let mut blocks = document(info, records);
+    let mut blocks = document(info, records, sections);
     let footer = info.footer();
     for b in &mut blocks {
         if let Block::Chart(_, chart) = b {
@@ -753,7 +758,7 @@ fn color_formats(records: &[Record]) -> String {
     }
 }
 
-fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
+fn document(info: &SweepInfo, records: &[Record], sections: &[Section]) -> Vec<Block> {
     let mut b = vec![
         Block::Heading(1, format!("mirrorbox sweep: {}", info.scene)),
         Block::Bullets(vec![
@@ -807,18 +812,14 @@ fn document(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
         )));
     }
 
-    b.extend(table1_section(info, records));
-
     if let Some(fl) = floor {
         b.push(Block::Heading(2, "Floor of the comparison".into()));
         b.push(floor_paragraph(fl));
     }
-
-    b.extend(depth_scaling(info, records, floor));
-    b.extend(symmetry_section(records));
-    b.extend(crate::lighting::lighting_section(records));
-    b.extend(crate::uneven::uneven_section(records, &info.bump_methods));
-    b.extend(crate::stereo::stereo_section(records));
+    // The experiments' own sections (the registry's), each empty for another's records.
+    for section in sections {
+        b.extend(section(info, records));
+    }
 
     let mut groups: Vec<(String, f32)> = Vec::new();
     for r in &points {
@@ -1106,7 +1107,13 @@ pub(crate) mod tests {
             scene: scene.into(),
             ..Default::default()
         };
-        write_report(dir.path(), &info("scenes/mirror_box.json"), &records).unwrap();
+        write_report(
+            dir.path(),
+            &info("scenes/mirror_box.json"),
+            &records,
+            &crate::TEST_SECTIONS,
+        )
+        .unwrap();
         let md = std::fs::read_to_string(dir.path().join("report.md")).unwrap();
         assert!(md.contains("Reproduction of the paper's Table 1"));
         assert!(md.contains("| 2 | 142 | 100.0 [min 100.0] | 15 |"), "{md}");
@@ -1120,7 +1127,13 @@ pub(crate) mod tests {
             ("scenes/mirror_box.json", 3),
         ] {
             let other = tempfile::tempdir().unwrap();
-            write_report(other.path(), &info(scene), &records[..points]).unwrap();
+            write_report(
+                other.path(),
+                &info(scene),
+                &records[..points],
+                &crate::TEST_SECTIONS,
+            )
+            .unwrap();
             let md = std::fs::read_to_string(other.path().join("report.md")).unwrap();
             assert!(!md.contains("Table 1"), "{scene}, {points} points: {md}");
         }
@@ -1175,7 +1188,13 @@ pub(crate) mod tests {
         // A folder where the report file should go: the rename fails, like a full disk would.
         std::fs::create_dir(dir.path().join("report.md")).unwrap();
         std::fs::write(dir.path().join("report.md").join("x"), "").unwrap();
-        let e = write_report(dir.path(), &SweepInfo::default(), &records).unwrap_err();
+        let e = write_report(
+            dir.path(),
+            &SweepInfo::default(),
+            &records,
+            &crate::TEST_SECTIONS,
+        )
+        .unwrap_err();
         assert!(e.to_string().contains("report.md"), "{e}");
         let leftovers: Vec<String> = std::fs::read_dir(dir.path())
             .unwrap()
@@ -1194,7 +1213,7 @@ pub(crate) mod tests {
         for file in [
             "reports/table1/results.jsonl",
             "reports/depth_scaling/results.jsonl",
-            "crates/harness/tests/data/table1_results_session2.jsonl",
+            "crates/experiments/tests/data/table1_results_session2.jsonl",
         ] {
             let path = root.join(file);
             let lines = std::fs::read_to_string(&path).unwrap().lines().count();
@@ -1249,7 +1268,7 @@ pub(crate) mod tests {
                 .collect();
             records.push(exact_point(unrolled_ms, drift));
             let dir = tempfile::tempdir().unwrap();
-            write_report(dir.path(), &info, &records).unwrap();
+            write_report(dir.path(), &info, &records, &crate::TEST_SECTIONS).unwrap();
             let md = std::fs::read_to_string(dir.path().join("report.md")).unwrap();
             md.lines()
                 .find(|l| l.starts_with("- unrolled depth=64 shows"))
@@ -1278,7 +1297,11 @@ pub(crate) mod tests {
         a.device = Some("adapter A on CPU 1".into());
         let mut b = record(1, 30.0, 5, 0.05);
         b.device = Some("adapter B on CPU 2".into());
-        let md = markdown(&document(&SweepInfo::default(), &[a.clone(), b.clone()]));
+        let md = markdown(&document(
+            &SweepInfo::default(),
+            &[a.clone(), b.clone()],
+            &crate::TEST_SECTIONS,
+        ));
         assert!(md.contains("## Timings by device"), "{md}");
         assert!(
             md.contains("### On adapter A on CPU 1") && md.contains("### On adapter B on CPU 2")
@@ -1288,7 +1311,11 @@ pub(crate) mod tests {
             "no plot mixes the devices"
         );
         b.device = a.device.clone();
-        let md = markdown(&document(&SweepInfo::default(), &[a, b]));
+        let md = markdown(&document(
+            &SweepInfo::default(),
+            &[a, b],
+            &crate::TEST_SECTIONS,
+        ));
         assert!(!md.contains("Timings by device") && md.contains("Error against time"));
     }
 
@@ -1299,13 +1326,25 @@ pub(crate) mod tests {
         old.run = Some("2026-11-20T10:00:00Z".into());
         let mut new = record(0, 20.0, 3, 0.1);
         new.run = Some("2026-11-22T10:00:00Z".into());
-        write_report(dir.path(), &SweepInfo::default(), &[new.clone(), old]).unwrap();
+        write_report(
+            dir.path(),
+            &SweepInfo::default(),
+            &[new.clone(), old],
+            &crate::TEST_SECTIONS,
+        )
+        .unwrap();
         let md = std::fs::read_to_string(dir.path().join("report.md")).unwrap();
         assert!(md.contains("† 1 of 2 points were reused"), "{md}");
         assert!(md.contains("| auxiliary n=1 † |"), "{md}");
         assert!(!md.contains("auxiliary n=0 †"), "{md}");
         // All from one run: nothing marked.
-        write_report(dir.path(), &SweepInfo::default(), &[new]).unwrap();
+        write_report(
+            dir.path(),
+            &SweepInfo::default(),
+            &[new],
+            &crate::TEST_SECTIONS,
+        )
+        .unwrap();
         let md = std::fs::read_to_string(dir.path().join("report.md")).unwrap();
         assert!(!md.contains('†'), "{md}");
     }
@@ -1319,6 +1358,7 @@ pub(crate) mod tests {
             dir.path(),
             &SweepInfo::default(),
             &[record(0, 20.0, 3, 0.1), half],
+            &crate::TEST_SECTIONS,
         )
         .unwrap();
         let md = std::fs::read_to_string(dir.path().join("report.md")).unwrap();

@@ -15,7 +15,12 @@ pub struct Args {
 
 pub fn run(args: &Args) -> Result<(), Failure> {
     let command = std::env::args().collect::<Vec<_>>().join(" ");
-    let merged = mirrorbox_harness::merge::merge(&args.out, &args.dirs, &command)?;
+    let merged = mirrorbox_harness::merge::merge(
+        &args.out,
+        &args.dirs,
+        &command,
+        &mirrorbox_experiments::sections(),
+    )?;
     println!(
         "merged {} shards, {} points, into {}; devices: {}",
         merged.shards,

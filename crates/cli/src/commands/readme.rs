@@ -2,7 +2,9 @@
 //! `<!-- end generated: ID -->`) of the README, `docs/methods.md` and the book's chapters
 //! (`docs/book/src/*.md`) from the committed reports, so every figure their prose quotes is
 //! the report's own (`mirrorbox_report::readme`), and the region `cli` from this command
-//! line's own argument parser, so the command-line reference is the `--help` users see.
+//! line's own argument parser, so the command-line reference is the `--help` users see, and
+//! each experiment's region `experiment-NAME` from its row of the registry
+//! (`mirrorbox-experiments`), whose chapter must hold it.
 
 use crate::Failure;
 use mirrorbox_report::readme::{REGIONS, Region, fill_with, stale_regions_with};
@@ -39,10 +41,20 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     } else {
         args.files.clone()
     };
-    let extra = [Region {
+    let mut extra = vec![Region {
         id: CLI_REGION,
         text: cli_reference(),
     }];
+    // Each experiment's region in its chapter, from its row of the registry.
+    for e in mirrorbox_experiments::EXPERIMENTS {
+        extra.push(Region {
+            id: Box::leak(e.region_id().into_boxed_str()),
+            text: e.region_text(),
+        });
+    }
+    if args.files.is_empty() {
+        check_chapters()?;
+    }
     // Every file is tried; bad input (a malformed region, a missing report) decides exit 2
     // over a stale region's exit 1.
     let (mut messages, mut bad_input) = (Vec::new(), false);
@@ -71,6 +83,46 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         (true, _) => Ok(()),
         (false, true) => Err(Failure::BadInput(messages.join("\n"))),
         (false, false) => Err(Failure::Other(messages.join("\n"))),
+    }
+}
+
+/// Every experiment of the registry has its chapter in the book, listed in its `SUMMARY.md`,
+/// holding the experiment's region: an experiment cannot be added without its chapter.
+fn check_chapters() -> Result<(), Failure> {
+    let book = Path::new(BOOK_SOURCE);
+    let summary = std::fs::read_to_string(book.join("SUMMARY.md"))
+        .map_err(|e| Failure::BadInput(format!("{}/SUMMARY.md: {e}", book.display())))?;
+    let mut missing = Vec::new();
+    for e in mirrorbox_experiments::EXPERIMENTS {
+        let chapter = book.join(e.chapter);
+        let marker = format!("<!-- generated: {} -->", e.region_id());
+        match std::fs::read_to_string(&chapter) {
+            Err(_) => missing.push(format!(
+                "experiment {}: its chapter {} does not exist",
+                e.name,
+                chapter.display()
+            )),
+            Ok(text) if !text.contains(&marker) => missing.push(format!(
+                "experiment {}: {} lacks its region (add `{marker}` and `<!-- end generated: {} -->`)",
+                e.name,
+                chapter.display(),
+                e.region_id()
+            )),
+            Ok(_) => {}
+        }
+        if !summary.contains(&format!("]({})", e.chapter)) {
+            missing.push(format!(
+                "experiment {}: {}/SUMMARY.md does not list its chapter {}",
+                e.name,
+                book.display(),
+                e.chapter
+            ));
+        }
+    }
+    if missing.is_empty() {
+        Ok(())
+    } else {
+        Err(Failure::BadInput(missing.join("\n")))
     }
 }
 

@@ -29,8 +29,12 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         );
     }
     for dir in &args.dirs {
-        let n = mirrorbox_report::rewrite_report(dir, &records_commit(dir))
-            .map_err(|e| Failure::BadInput(format!("{}: {e}", dir.display())))?;
+        let n = mirrorbox_report::rewrite_report(
+            dir,
+            &records_commit(dir),
+            &mirrorbox_experiments::sections(),
+        )
+        .map_err(|e| Failure::BadInput(format!("{}: {e}", dir.display())))?;
         println!(
             "{}: report rewritten from {}",
             dir.display(),

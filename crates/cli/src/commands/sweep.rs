@@ -181,14 +181,16 @@ fn parse_shard(text: &str) -> Result<Shard, Failure> {
     Ok(Shard { index, count })
 }
 
-/// The options of the preset sweeps (`table1`, `depth-scaling`).
-#[derive(clap::Args)]
+/// The options of the experiments (`experiment NAME`, and the preset commands `table1`,
+/// `depth-scaling` …).
+#[derive(clap::Args, Default)]
 pub struct PresetArgs {
     /// Output folder of the committed report (default: the preset's folder in reports/).
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Timed frames per point, one per interleaved round (default: 9, symmetry-scaling 6; 6 or more give each
-    /// median a 95 % interval).
+    /// Timed frames per point, one per interleaved round (default: the experiment's, 9 for
+    /// Table 1; 6 or more give each median a 95 % interval); a sequence experiment (motion):
+    /// frames per scenario.
     #[arg(long)]
     frames: Option<u32>,
     /// Discard earlier results and measure every point again (cached truths stay).
@@ -314,6 +316,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         worker: args.isolate_renders.then(render_worker).flatten(),
         memory_budget: args.memory.memory_budget,
         axes: scene_axes(args)?,
+        sections: mirrorbox_experiments::sections(),
         marker: args.marker.clone(),
         shard: None,
         truth_cache: None,
@@ -342,61 +345,94 @@ fn scene_axes(args: &Args) -> Result<Vec<AxisValues>, Failure> {
     .collect()
 }
 
-/// Table 1 of the seed paper (`SweepConfig::table1`), into `reports/table1/` by default.
-pub fn run_table1(args: &PresetArgs) -> Result<(), Failure> {
-    let out = args.out.clone().unwrap_or_else(|| "reports/table1".into());
-    run_preset(SweepConfig::table1(out), args)
+/// `mirrorbox experiment NAME`: an experiment of the registry (`mirrorbox-experiments`).
+#[derive(clap::Args)]
+pub struct ExperimentArgs {
+    /// The experiment: one of the registry's (crates/experiments/src/lib.rs, `EXPERIMENTS`).
+    #[arg(value_parser = experiment_names(), required_unless_present_any = ["list", "main_job"])]
+    name: Option<String>,
+    /// List every experiment with what it measures, and exit.
+    #[arg(long)]
+    list: bool,
+    /// Print the names of the experiments the main job runs, one per line, in its order
+    /// (`scripts/run.sh` reads them), and exit.
+    #[arg(long, conflicts_with = "list")]
+    main_job: bool,
+    #[command(flatten)]
+    preset: PresetArgs,
 }
 
-/// The exact methods' cost against depth (`SweepConfig::depth_scaling`), into
-/// `reports/depth_scaling/` by default.
-pub fn run_depth_scaling(args: &PresetArgs) -> Result<(), Failure> {
-    let out = args
-        .out
-        .clone()
-        .unwrap_or_else(|| "reports/depth_scaling".into());
-    run_preset(SweepConfig::depth_scaling(out), args)
+/// The registry's names, each with what it measures (clap lists them in the help).
+fn experiment_names() -> clap::builder::PossibleValuesParser {
+    clap::builder::PossibleValuesParser::new(
+        mirrorbox_experiments::EXPERIMENTS
+            .iter()
+            .map(|e| clap::builder::PossibleValue::new(e.name).help(e.about)),
+    )
 }
 
-/// Symmetry planes' cost against p (`SweepConfig::symmetry_scaling`), into
-/// `reports/symmetry_scaling/` by default.
-pub fn run_symmetry_scaling(args: &PresetArgs) -> Result<(), Failure> {
-    let out = args
-        .out
-        .clone()
-        .unwrap_or_else(|| "reports/symmetry_scaling".into());
-    run_preset(SweepConfig::symmetry_scaling(out), args)
+pub fn run_experiment_command(args: &ExperimentArgs) -> Result<(), Failure> {
+    use mirrorbox_experiments::EXPERIMENTS;
+    if args.list || args.main_job {
+        for e in EXPERIMENTS.iter().filter(|e| args.list || e.main_job) {
+            if args.list {
+                println!("{:<20} {}", e.name, e.about);
+            } else {
+                println!("{}", e.name);
+            }
+        }
+        return Ok(());
+    }
+    let name = args.name.as_deref().unwrap_or_default();
+    run_experiment(name, &args.preset)
 }
 
-/// Lighting variants against mirrored-light depth (`SweepConfig::lighting`): the lit mirror
-/// box into `reports/lighting/` and the lit mirror room into `reports/lighting_room/` (with
-/// `--out DIR`: `DIR` and `DIR_room`).
-pub fn run_lighting(args: &PresetArgs) -> Result<(), Failure> {
-    let out = args
-        .out
-        .clone()
-        .unwrap_or_else(|| "reports/lighting".into());
-    let mut room = out.clone().into_os_string();
-    room.push("_room");
-    run_preset(SweepConfig::lighting(out), args)?;
-    run_preset(SweepConfig::lighting_room(room.into()), args)
-}
-
-pub fn run_bumpy(args: &PresetArgs) -> Result<(), Failure> {
-    let out = args
-        .out
-        .clone()
-        .unwrap_or_else(|| "reports/uneven_mirrors".into());
-    let mut single = out.clone().into_os_string();
-    single.push("_single");
-    run_preset(SweepConfig::bumpy(out), args)?;
-    run_preset(SweepConfig::bumpy_single(single.into()), args)
-}
-
-/// Stereo mirrors (`SweepConfig::stereo`), into `reports/stereo/` by default.
-pub fn run_stereo(args: &PresetArgs) -> Result<(), Failure> {
-    let out = args.out.clone().unwrap_or_else(|| "reports/stereo".into());
-    run_preset(SweepConfig::stereo(out), args)
+/// Runs the registry's experiment `name` with the preset options (the older preset commands,
+/// `mirrorbox table1` and the like, are this with their experiment's name).
+pub fn run_experiment(name: &str, args: &PresetArgs) -> Result<(), Failure> {
+    use mirrorbox_experiments::Measure;
+    let e = mirrorbox_experiments::find(name)
+        .ok_or_else(|| bad(format!("no experiment named {name:?} in the registry")))?;
+    let out = args.out.clone().unwrap_or_else(|| e.default_out());
+    match &e.measure {
+        Measure::Sweeps(configs) => {
+            for config in configs(&out) {
+                run_preset(config, args)?;
+            }
+            Ok(())
+        }
+        Measure::Sequences(sequences) => {
+            let exe = render_worker()
+                .ok_or_else(|| Failure::Other("cannot find this executable".into()))?;
+            let mut config = sequences(&out, exe, command_line());
+            if let Some(n) = args.frames {
+                for s in &mut config.scenarios {
+                    s.frames = n;
+                }
+            }
+            run_sequences(&config)
+        }
+        Measure::Script(script, script_args) => {
+            if !std::path::Path::new(script).is_file() {
+                return Err(bad(format!(
+                    "experiment {name}: {script} not found; run it from the repository root"
+                )));
+            }
+            let exe = std::env::current_exe()
+                .map_err(|e| Failure::Other(format!("cannot find this executable: {e}")))?;
+            let status = std::process::Command::new("bash")
+                .arg(script)
+                .args(*script_args)
+                .env("MIRRORBOX", exe)
+                .status()
+                .map_err(|e| Failure::Other(format!("cannot run {script}: {e}")))?;
+            if status.success() {
+                Ok(())
+            } else {
+                Err(Failure::Other(format!("{script} failed ({status})")))
+            }
+        }
+    }
 }
 
 /// `mirrorbox motion`'s options.
@@ -410,19 +446,17 @@ pub struct MotionArgs {
     frames: Option<u32>,
 }
 
-/// Error over time (`SequenceConfig::motion`): a still camera and three walking speeds on
-/// the paper's box, into `reports/motion/` by default.
+/// Error over time (the registry's `motion`): a still camera and three walking speeds on the
+/// paper's box, into `reports/motion/` by default.
 pub fn run_motion(args: &MotionArgs) -> Result<(), Failure> {
-    let out = args.out.clone().unwrap_or_else(|| "reports/motion".into());
-    let exe =
-        render_worker().ok_or_else(|| Failure::Other("cannot find this executable".into()))?;
-    let mut config = SequenceConfig::motion(out, exe, command_line());
-    if let Some(n) = args.frames {
-        for s in &mut config.scenarios {
-            s.frames = n;
-        }
-    }
-    run_sequences(&config)
+    run_experiment(
+        "motion",
+        &PresetArgs {
+            out: args.out.clone(),
+            frames: args.frames,
+            ..PresetArgs::default()
+        },
+    )
 }
 
 fn run_sequences(config: &SequenceConfig) -> Result<(), Failure> {
@@ -440,6 +474,7 @@ fn run_sequences(config: &SequenceConfig) -> Result<(), Failure> {
 }
 
 fn run_preset(mut config: SweepConfig, args: &PresetArgs) -> Result<(), Failure> {
+    config.sections = mirrorbox_experiments::sections();
     if let Some(frames) = args.frames {
         config.frames = frames;
     }

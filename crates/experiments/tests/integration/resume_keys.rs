@@ -3,6 +3,7 @@
 //! `tests/data/` from `reports/` at commit 83da7cf), or every earlier sweep would be measured
 //! again from scratch.
 
+use mirrorbox_experiments::{bumpy, depth_scaling, lighting, stereo, symmetry_scaling, table1};
 use mirrorbox_harness::{SweepConfig, point_keys};
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
@@ -31,7 +32,7 @@ fn keys_of(mut config: SweepConfig) -> BTreeSet<String> {
 
 #[test]
 fn table1_keys_are_those_of_earlier_sweeps() {
-    let now = keys_of(SweepConfig::table1("unused".into()));
+    let now = keys_of(table1::sweep("unused".as_ref()));
     let before = keys_in("tests/data/table1_results_session2.jsonl");
     assert_eq!(now, before);
     assert_eq!(now.len(), 1 + 2 * (5 + 2));
@@ -41,7 +42,7 @@ fn table1_keys_are_those_of_earlier_sweeps() {
 /// interval per median); at the earlier frame count the keys are the earlier ones.
 #[test]
 fn depth_scaling_keys_are_those_of_earlier_sweeps() {
-    let preset = SweepConfig::depth_scaling("unused".into());
+    let preset = depth_scaling::sweep("unused".as_ref());
     assert_eq!(preset.frames, 9);
     let now = keys_of(SweepConfig {
         frames: 5,
@@ -66,31 +67,31 @@ fn the_paper_method_is_registered() {
 fn the_axis_presets_resume_from_the_committed_reports() {
     for (config, folder, axis) in [
         (
-            SweepConfig::symmetry_scaling("unused".into()),
+            symmetry_scaling::sweep("unused".as_ref()),
             "symmetry_scaling",
             "planes",
         ),
         (
-            SweepConfig::lighting("unused".into()),
+            lighting::sweep("unused".as_ref()),
             "lighting",
             "mirrored_lights",
         ),
         (
-            SweepConfig::lighting_room("unused".into()),
+            lighting::room_sweep("unused".as_ref()),
             "lighting_room",
             "mirrored_lights",
         ),
         (
-            SweepConfig::bumpy("unused".into()),
+            bumpy::sweep("unused".as_ref()),
             "uneven_mirrors",
             "bump_deg",
         ),
         (
-            SweepConfig::bumpy_single("unused".into()),
+            bumpy::single_sweep("unused".as_ref()),
             "uneven_mirrors_single",
             "bump_deg",
         ),
-        (SweepConfig::stereo("unused".into()), "stereo", "stereo_ipd"),
+        (stereo::sweep("unused".as_ref()), "stereo", "stereo_ipd"),
     ] {
         let now = keys_of(config);
         let path = root().join("reports").join(folder).join("results.jsonl");

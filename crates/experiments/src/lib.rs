@@ -1,0 +1,154 @@
+//! The experiment registry, the twin of the raster method table: every experiment mirrorbox
+//! measures is one module here — its sweeps (or sequence, or script), its report section when
+//! it has one of its own, its book chapter — and one row of [`EXPERIMENTS`]. From the table
+//! follow the CLI (`mirrorbox experiment NAME`, and the older preset commands), the main job
+//! (`scripts/run.sh` runs `mirrorbox experiment --main-job`), the report writer (every
+//! sweep's report is offered every experiment's section) and the book (`mirrorbox readme`
+//! fills each chapter's `experiment-NAME` region, and fails when a chapter lacks it).
+//! CONTRIBUTING.md, "Adding an experiment", says how to add one.
+
+use mirrorbox_harness::SweepConfig;
+use mirrorbox_harness::sequence::SequenceConfig;
+use mirrorbox_report::Section;
+use std::path::{Path, PathBuf};
+
+pub mod bumpy;
+pub mod depth_scaling;
+pub mod frontier;
+pub mod lighting;
+pub mod motion;
+pub mod scripts;
+pub mod stereo;
+pub mod symmetry_scaling;
+pub mod table1;
+
+/// How an experiment is measured.
+pub enum Measure {
+    /// Sweeps, each writing one report folder, made from the experiment's output folder
+    /// (default `reports/<folder>`; an experiment of several sweeps names the others after it).
+    Sweeps(fn(&Path) -> Vec<SweepConfig>),
+    /// Sequence sweeps along camera paths, from the output folder, this executable (each
+    /// method's frames run in one child process) and the command line.
+    Sequences(fn(&Path, PathBuf, String) -> SequenceConfig),
+    /// A script of the repository (`scripts/…`) with its arguments, run from the repository
+    /// root with `MIRRORBOX` set to this executable: measurements that are not sweeps.
+    Script(&'static str, &'static [&'static str]),
+}
+
+/// One experiment (see the crate doc).
+pub struct Experiment {
+    /// `mirrorbox experiment NAME`.
+    pub name: &'static str,
+    /// What it measures, in one line (the CLI's help, the book's region).
+    pub about: &'static str,
+    /// Its report folder under `reports/`.
+    pub folder: &'static str,
+    pub measure: Measure,
+    /// Its own report section, offered every sweep's records (the sections of the report
+    /// crate, or one in the experiment's module); `None`: the report every sweep has.
+    pub section: Option<Section>,
+    /// Its chapter of the book, under `docs/book/src/`; the chapter holds the generated region
+    /// `experiment-NAME`.
+    pub chapter: &'static str,
+    /// Run by the main job (`scripts/run.sh`), in the table's order.
+    pub main_job: bool,
+}
+
+/// Every experiment, in the main job's order.
+pub const EXPERIMENTS: &[&Experiment] = &[
+    &table1::TABLE1,
+    &table1::TABLE1_REPEAT,
+    &depth_scaling::DEPTH_SCALING,
+    &symmetry_scaling::SYMMETRY_SCALING,
+    &lighting::LIGHTING,
+    &bumpy::BUMPY,
+    &stereo::STEREO,
+    &motion::MOTION,
+    &frontier::FRONTIER,
+    &scripts::LIGHTING_TRACE_COST,
+    &scripts::MEMORY_PEAKS,
+    &scripts::TRACER_BENCH,
+    &scripts::VIEWER_FRAME_RATES,
+    &scripts::CLUSTER,
+    &scripts::GPU,
+];
+
+/// The experiment named `name`.
+pub fn find(name: &str) -> Option<&'static Experiment> {
+    EXPERIMENTS.iter().copied().find(|e| e.name == name)
+}
+
+/// Every experiment's own report section, once each, in the table's order: what every sweep's
+/// report is offered.
+pub fn sections() -> Vec<Section> {
+    let mut out: Vec<Section> = Vec::new();
+    for s in EXPERIMENTS.iter().filter_map(|e| e.section) {
+        if !out.iter().any(|o| std::ptr::fn_addr_eq(*o, s)) {
+            out.push(s);
+        }
+    }
+    out
+}
+
+/// `out` with `suffix` appended to its last component (`reports/lighting` →
+/// `reports/lighting_room`): the second sweep of an experiment.
+pub fn beside(out: &Path, suffix: &str) -> PathBuf {
+    let mut s = out.as_os_str().to_os_string();
+    s.push(suffix);
+    s.into()
+}
+
+impl Experiment {
+    /// Its default output folder, `reports/<folder>`.
+    pub fn default_out(&self) -> PathBuf {
+        Path::new("reports").join(self.folder)
+    }
+
+    /// The region of its chapter that `mirrorbox readme` fills from this row.
+    pub fn region_id(&self) -> String {
+        format!("experiment-{}", self.name)
+    }
+
+    /// The region's Markdown: what the experiment measures, the command that runs it, where it
+    /// writes, whether the main job runs it (no links: a region may sit at any depth).
+    pub fn region_text(&self) -> String {
+        let how = match &self.measure {
+            Measure::Sweeps(configs) => {
+                let folders: Vec<String> = configs(&self.default_out())
+                    .iter()
+                    .map(|c| format!("`{}/`", c.out.display()))
+                    .collect();
+                format!(
+                    "{} sweep{} into {}",
+                    folders.len(),
+                    if folders.len() == 1 { "" } else { "s" },
+                    folders.join(" and ")
+                )
+            }
+            Measure::Sequences(_) => format!(
+                "sequence sweeps along camera paths into `{}/`",
+                self.default_out().display()
+            ),
+            Measure::Script(script, args) => {
+                let args = if args.is_empty() {
+                    String::new()
+                } else {
+                    format!(" {}", args.join(" "))
+                };
+                format!(
+                    "`{script}{args}`, writing under `{}/`",
+                    self.default_out().display()
+                )
+            }
+        };
+        format!(
+            "**Experiment `{}`** — {}.\n\n- Run: `mirrorbox experiment {}` — {how}.\n- Main job \
+             (`scripts/run.sh`): {}.\n- Report section of its own: {}.\n",
+            self.name,
+            self.about,
+            self.name,
+            if self.main_job { "yes" } else { "no" },
+            if self.section.is_some() { "yes" } else { "no" }
+        )
+    }
+}

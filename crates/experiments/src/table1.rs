@@ -1,0 +1,38 @@
+//! The seed paper's Table 1 (seed 000): its auxiliary-mirror method at n = 0…4, with the exact
+//! methods at depth 64 beside it — run twice by the main job, the second run into its own
+//! folder, so that two consecutive runs stand side by side.
+
+use crate::{Experiment, Measure};
+use mirrorbox_harness::{SweepConfig, swept};
+use std::path::Path;
+
+/// The auxiliary method for n = 0…4 on mirror_box at α = 1 and the paper's 0.7, with
+/// `portal` and `unrolled` at depth 64 beside it; 9 timed frames.
+pub fn sweep(out: &Path) -> SweepConfig {
+    let mut methods = swept(mirrorbox_report::table1::PAPER_METHOD, 0..=4);
+    // A preset is a fixed experiment: its methods are named, not taken from the table.
+    for m in ["portal", "unrolled"] {
+        methods.extend(swept(m, [64]));
+    }
+    SweepConfig::preset(out.to_path_buf(), methods, vec![1.0, 0.7])
+}
+
+pub const TABLE1: Experiment = Experiment {
+    name: "table1",
+    about: "the paper's Table 1: its auxiliary mirrors at n = 0…4 against the truth, with the exact methods beside it",
+    folder: "table1",
+    measure: Measure::Sweeps(|out| vec![sweep(out)]),
+    section: Some(mirrorbox_report::sections::table1),
+    chapter: "table1.md",
+    main_job: true,
+};
+
+pub const TABLE1_REPEAT: Experiment = Experiment {
+    name: "table1-repeat",
+    about: "Table 1 measured again right after the first run: how much two runs differ",
+    folder: "table1_repeat",
+    measure: Measure::Sweeps(|out| vec![sweep(out)]),
+    section: Some(mirrorbox_report::sections::table1),
+    chapter: "table1.md",
+    main_job: true,
+};

@@ -1,0 +1,4 @@
+//! The experiment registry's tests, one binary (CONTRIBUTING, "Where tests go").
+
+mod registry;
+mod resume_keys;
