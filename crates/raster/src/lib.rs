@@ -27,6 +27,7 @@ pub mod gpu;
 pub mod lighting;
 pub mod memory;
 pub mod method;
+mod method_options;
 pub mod methods;
 pub mod ping_pong;
 pub mod pipeline;

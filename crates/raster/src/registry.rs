@@ -213,6 +213,26 @@ mod tests {
     use super::*;
 
     #[test]
+    fn every_method_takes_the_shared_options() {
+        // `method_options!` appends them; an entry that lists its options by hand must too.
+        for e in METHODS {
+            for shared in [
+                &crate::lighting::LIGHTS,
+                &crate::lighting::SHADOWS,
+                &crate::lighting::SHADOW_MAP_SIZE,
+                &crate::lighting::SHADOW_BIAS,
+            ] {
+                assert!(
+                    e.options.iter().any(|o| o.name == shared.name),
+                    "{} lacks --{}: build its options with method_options!",
+                    e.name,
+                    shared.name
+                );
+            }
+        }
+    }
+
+    #[test]
     fn names_are_unique_and_options_consistent() {
         for (i, e) in METHODS.iter().enumerate() {
             assert!(

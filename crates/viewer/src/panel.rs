@@ -78,7 +78,8 @@ const HELP: &[(&str, &str)] = &[
     ("Shift", "move four times faster"),
     ("drag (left on the images, or right)", "look around"),
     ("R", "reset to the scene's camera"),
-    ("1 … 8", "method by its place in the list"),
+    ("1 … 9, 0", "method by its place in the list (0: the tenth)"),
+    ("M", "next method, through every one in the list"),
     ("Tab", "layout: grid, method, truth, error"),
     ("T", "live truth on / off"),
     ("F", "error map: difference / FLIP"),
@@ -91,6 +92,16 @@ const HELP: &[(&str, &str)] = &[
     ("H or F1", "this help"),
     ("Esc", "quit"),
 ];
+
+/// The method after `current` in the registry's list, the first after the last: `M` reaches
+/// every method however many the list holds (the number keys reach ten).
+fn next_method(current: &Method) -> &'static mirrorbox_raster::MethodEntry {
+    let i = METHODS
+        .iter()
+        .position(|e| e.name == current.entry().name)
+        .map_or(0, |i| (i + 1) % METHODS.len());
+    METHODS[i]
+}
 
 /// A key press not taken by egui.
 pub fn key_pressed(code: KeyCode, session: &mut Session, ui: &mut UiState) -> PanelActions {
@@ -113,6 +124,7 @@ pub fn key_pressed(code: KeyCode, session: &mut Session, ui: &mut UiState) -> Pa
         KeyCode::KeyC => actions.save_camera = true,
         KeyCode::KeyH | KeyCode::F1 => ui.help = !ui.help,
         KeyCode::Escape => actions.quit = true,
+        KeyCode::KeyM => session.method = Method::defaults(next_method(&session.method)),
         _ => {
             let digits = [
                 KeyCode::Digit1,
@@ -124,6 +136,7 @@ pub fn key_pressed(code: KeyCode, session: &mut Session, ui: &mut UiState) -> Pa
                 KeyCode::Digit7,
                 KeyCode::Digit8,
                 KeyCode::Digit9,
+                KeyCode::Digit0,
             ];
             if let Some(i) = digits.iter().position(|&d| d == code)
                 && let Some(entry) = METHODS.get(i)
@@ -533,4 +546,28 @@ fn panes(
     // Mouse drags on the panes turn the camera (handled by the window); egui only needs to
     // know the area is not its own.
     let _ = ui.allocate_rect(area, egui::Sense::hover());
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_m_key_reaches_every_method() {
+        let mut m = Method::defaults(METHODS[0]);
+        let mut seen = vec![m.entry().name];
+        for _ in 1..METHODS.len() {
+            m = Method::defaults(next_method(&m));
+            seen.push(m.entry().name);
+        }
+        let mut all: Vec<&str> = METHODS.iter().map(|e| e.name).collect();
+        seen.sort_unstable();
+        all.sort_unstable();
+        assert_eq!(seen, all);
+        assert_eq!(
+            next_method(&m).name,
+            METHODS[0].name,
+            "after the last, the first"
+        );
+    }
 }

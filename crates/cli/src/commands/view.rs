@@ -14,7 +14,7 @@ use std::path::PathBuf;
 pub struct Args {
     /// Scene file (JSON).
     scene: PathBuf,
-    /// The raster method to start with (switchable in the window: the panel or keys 1…8).
+    /// The raster method to start with (switchable in the window: the panel, keys 1…9 and 0, or M for the next).
     #[arg(long, default_value = "auxiliary", value_parser = method_value_parser())]
     method: String,
     #[command(flatten)]

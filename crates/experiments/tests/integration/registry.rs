@@ -83,3 +83,44 @@ fn every_report_section_belongs_to_an_experiment() {
         );
     }
 }
+
+/// An experiment's module without its row (or a row's module without its `pub mod` line)
+/// would be silently left out: every `pub const X: Experiment` of `src/*.rs` is in the table.
+#[test]
+fn every_experiment_module_has_its_row() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let lib = std::fs::read_to_string(src.join("lib.rs")).unwrap();
+    let table = lib
+        .split("pub const EXPERIMENTS")
+        .nth(1)
+        .and_then(|t| t.split("];").next())
+        .unwrap();
+    let mut consts = 0;
+    for entry in std::fs::read_dir(&src).unwrap().flatten() {
+        let file = entry.file_name().to_string_lossy().into_owned();
+        let Some(module) = file.strip_suffix(".rs").filter(|m| *m != "lib") else {
+            continue;
+        };
+        assert!(
+            lib.contains(&format!("pub mod {module};")),
+            "src/{file} is not a module of the crate: add `pub mod {module};`"
+        );
+        let text = std::fs::read_to_string(entry.path()).unwrap();
+        for line in text
+            .lines()
+            .filter(|l| l.ends_with(": Experiment = Experiment {"))
+        {
+            let name = line
+                .trim_start_matches("pub const ")
+                .split(':')
+                .next()
+                .unwrap();
+            consts += 1;
+            assert!(
+                table.contains(&format!("&{module}::{name},")),
+                "{module}::{name} is not in EXPERIMENTS"
+            );
+        }
+    }
+    assert_eq!(consts, EXPERIMENTS.len(), "one const per row");
+}

@@ -61,15 +61,11 @@ pub static UNROLLED: MethodEntry = MethodEntry {
     help: "Exact: every reflection path an instance of the scene, clipped to its cell; a handful of draws.",
     exact: true,
     depth_limited: true,
-    options: &[
+    options: crate::method_options![
         &DEPTH,
         &MIN_PORTAL_AREA,
         &MIN_ATTENUATION,
-        &FRAGMENT_CLIPPING,
-        &crate::lighting::LIGHTS,
-        &crate::lighting::SHADOWS,
-        &crate::lighting::SHADOW_MAP_SIZE,
-        &crate::lighting::SHADOW_BIAS,
+        &FRAGMENT_CLIPPING
     ],
     swept: Some(&DEPTH),
     optional_features: wgpu::Features::CLIP_DISTANCES,

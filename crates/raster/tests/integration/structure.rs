@@ -124,3 +124,30 @@ fn every_declared_method_has_its_row_in_the_table() {
     }
     assert_eq!(declared.len(), mirrorbox_raster::METHODS.len());
 }
+
+/// A method's documentation is part of adding it (CONTRIBUTING, step 5): every registered
+/// method has a heading of its own in `docs/methods.md` (its name in backticks), and every
+/// WGSL file under `shaders/` its row in `shaders/README.md`.
+#[test]
+fn every_method_and_shader_is_documented() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let methods = std::fs::read_to_string(root.join("docs/methods.md")).unwrap();
+    let headings: Vec<&str> = methods.lines().filter(|l| l.starts_with('#')).collect();
+    for e in mirrorbox_raster::METHODS {
+        let name = format!("`{}`", e.name);
+        assert!(
+            headings.iter().any(|h| h.contains(&name)),
+            "docs/methods.md has no heading naming {name}: add its paragraph (CONTRIBUTING, step 5)"
+        );
+    }
+    let readme = std::fs::read_to_string(root.join("shaders/README.md")).unwrap();
+    for entry in std::fs::read_dir(root.join("shaders")).unwrap().flatten() {
+        let file = entry.file_name().to_string_lossy().into_owned();
+        if file.ends_with(".wgsl") {
+            assert!(
+                readme.contains(&format!("| `{file}` |")),
+                "shaders/README.md has no row for {file} (CONTRIBUTING, step 5)"
+            );
+        }
+    }
+}
