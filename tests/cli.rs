@@ -1472,6 +1472,14 @@ fn report_rewrites_a_sweep_folder_from_its_records() {
     for f in ["sweep.json", "results.jsonl"] {
         std::fs::copy(from.join(f), dir.path().join(f)).unwrap();
     }
+    // The rows' images (their insets are made again from them).
+    std::fs::create_dir(dir.path().join("images")).unwrap();
+    for e in std::fs::read_dir(from.join("images")).unwrap().flatten() {
+        let name = e.file_name().to_string_lossy().into_owned();
+        if !name.ends_with("_inset.png") {
+            std::fs::copy(e.path(), dir.path().join("images").join(&name)).unwrap();
+        }
+    }
     let out = mirrorbox(&["report", dir.path().to_str().unwrap()], &[]);
     assert_eq!(out.code, 0, "stderr: {}", out.stderr);
     assert!(out.stdout.contains("from 15 records"), "{}", out.stdout);

@@ -168,6 +168,15 @@ pub fn at_or_under_floor(r: &Record, fl: &Record) -> bool {
     r.metrics.flip_mean <= FLOOR_FACTOR * fl.metrics.flip_mean
 }
 
+/// Whether an image block is a truth | raster | FLIP row (its last caption names FLIP).
+pub fn is_flip_row(images: &[(String, String)]) -> bool {
+    images.len() == 3 && images[2].0.starts_with("FLIP")
+}
+
+/// The Markdown line under a FLIP row: the ramp its map is painted with.
+pub const COLOUR_BAR_MD: &str =
+    "FLIP per pixel: black 0 → purple → red → orange → yellow → white 1.";
+
 /// Removes `path` if it exists: a file an earlier report wrote that this one does not.
 pub(crate) fn remove_stale(path: &Path) -> Result<(), FileError> {
     match std::fs::remove_file(path) {
@@ -211,6 +220,14 @@ pub fn markdown(blocks: &[Block]) -> String {
                     .map(|(cap, p)| format!("![{cap}]({p})"))
                     .collect();
                 let _ = writeln!(md, "{}\n", line.join(" "));
+                if is_flip_row(images) {
+                    let _ = writeln!(md, "{}\n", COLOUR_BAR_MD);
+                }
+                if let [(cap, _)] = &images[..]
+                    && cap.contains("inset")
+                {
+                    let _ = writeln!(md, "{cap}\n");
+                }
             }
             Block::Chart(file, chart) => {
                 if chart.is_drawable() {

@@ -92,6 +92,14 @@ mod tests {
         for f in ["sweep.json", "results.jsonl"] {
             std::fs::copy(root.join(f), dir.path().join(f)).unwrap();
         }
+        // The rows' images (their insets are made again from them).
+        std::fs::create_dir(dir.path().join("images")).unwrap();
+        for e in std::fs::read_dir(root.join("images")).unwrap().flatten() {
+            let name = e.file_name().to_string_lossy().into_owned();
+            if !name.ends_with("_inset.png") {
+                std::fs::copy(e.path(), dir.path().join("images").join(&name)).unwrap();
+            }
+        }
         assert!(rewrite_report(dir.path(), "", &crate::TEST_SECTIONS).unwrap() > 0);
         let want = std::fs::read_to_string(root.join("report.md")).unwrap();
         let have = std::fs::read_to_string(dir.path().join("report.md")).unwrap();

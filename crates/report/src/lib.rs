@@ -10,6 +10,7 @@ pub mod document;
 mod error;
 pub mod exact;
 mod folder;
+mod image_rows;
 pub mod lighting;
 pub mod motion;
 pub mod overview;

@@ -167,7 +167,20 @@ pub fn write_report(
     sections: &[Section],
 ) -> Result<(), FileError> {
     write_csv(&dir.join("results.csv"), records)?;
-    let mut blocks = document(info, records, sections);
+    let blocks = document(info, records, sections);
+    // Each truth | raster | FLIP row is followed by its 4× inset where its images are there.
+    let mut with_insets = Vec::with_capacity(blocks.len());
+    for b in blocks {
+        let inset = match &b {
+            Block::Images(images) if crate::document::is_flip_row(images) => {
+                crate::image_rows::inset(dir, &images[0].1, &images[1].1)
+            }
+            _ => None,
+        };
+        with_insets.push(b);
+        with_insets.extend(inset);
+    }
+    let mut blocks = with_insets;
     let footer = info.footer();
     for b in &mut blocks {
         if let Block::Chart(_, chart) = b {
@@ -180,8 +193,10 @@ pub fn write_report(
          .scroll{overflow-x:auto;max-width:100%}\
          table{border-collapse:collapse;margin:1em 0}td,th{border:1px solid #ccc;padding:3px 8px;text-align:right}\
          td{white-space:nowrap}th{background:#f3f3f3}\
-         figure{display:inline-block;margin:4px;vertical-align:top}figcaption{font-size:12px;max-width:340px}\
-         img{max-width:340px}.chart svg{max-width:100%;height:auto}\
+         table.images td,table.images th{border:0;padding:2px 4px;text-align:left;vertical-align:top;white-space:normal;font-weight:normal;font-size:12px;background:none;max-width:340px}\
+         table.images img{max-width:340px;display:block}table.inset img{max-width:1040px}table.inset th{max-width:none}\
+         .bar{max-width:340px;margin-top:2px}.ticks{display:flex;justify-content:space-between;font-size:11px}\
+         .chart svg{max-width:100%;height:auto}\
          p,li{overflow-wrap:break-word}</style></head><body>\n",
     );
     for b in &blocks {
@@ -222,7 +237,18 @@ pub fn write_report(
                 html.push_str("</table></div>\n");
             }
             Block::Images(images) => {
-                html.push_str("<div>");
+                // A row of images with its captions as column headers; a FLIP map gets the
+                // colour bar of its ramp; an inset spans the page.
+                let inset = images.len() == 1 && images[0].0.contains("inset");
+                html.push_str(if inset {
+                    "<div class=\"scroll\"><table class=\"images inset\"><tr>"
+                } else {
+                    "<div class=\"scroll\"><table class=\"images\"><tr>"
+                });
+                for (cap, _) in images {
+                    let _ = write!(html, "<th>{}</th>", inline(cap));
+                }
+                html.push_str("</tr><tr>");
                 for (cap, p) in images {
                     let src = match std::fs::read(dir.join(p)) {
                         Ok(bytes) => format!(
@@ -231,13 +257,18 @@ pub fn write_report(
                         ),
                         Err(_) => p.clone(),
                     };
+                    let bar = if cap.starts_with("FLIP") || cap.contains(": FLIP") {
+                        crate::image_rows::colour_bar_html()
+                    } else {
+                        String::new()
+                    };
                     let _ = write!(
                         html,
-                        "<figure><img src=\"{src}\" alt=\"{0}\"><figcaption>{0}</figcaption></figure>",
+                        "<td><img src=\"{src}\" alt=\"{}\">{bar}</td>",
                         esc(cap)
                     );
                 }
-                html.push_str("</div>\n");
+                html.push_str("</tr></table></div>\n");
             }
             Block::Chart(file, chart) => {
                 let path = dir.join(file);
