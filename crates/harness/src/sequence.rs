@@ -334,6 +334,8 @@ pub fn run_sequences(
     // The cache folder held only the scenarios' frames.
     let _ = std::fs::remove_dir(config.out.join("cache"));
     let info = MotionInfo {
+        commit: crate::source_commit(),
+        records_commit: String::new(),
         command: config.command.clone(),
         date: crate::now_rfc3339(),
         device,

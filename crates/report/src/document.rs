@@ -168,6 +168,25 @@ pub fn at_or_under_floor(r: &Record, fl: &Record) -> bool {
     r.metrics.flip_mean <= FLOOR_FACTOR * fl.metrics.flip_mean
 }
 
+/// The setting a point's method was swept at, for a chart's point labels: `n=2`, `d=64`, or
+/// the swept option read from the point's key (`cube-size=128`); empty for a method with none.
+pub fn swept_label(r: &Record) -> String {
+    if let Some(n) = r.n {
+        return format!("n={n}");
+    }
+    if let Some(d) = r.depth {
+        return format!("d={d}");
+    }
+    let method = r.key.split('|').next().unwrap_or_default();
+    let options: Vec<&str> = r.method_options.split_whitespace().collect();
+    method
+        .split_whitespace()
+        .skip(1)
+        .filter(|w| !options.contains(w))
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
 /// Whether an image block is a truth | raster | FLIP row (its last caption names FLIP).
 pub fn is_flip_row(images: &[(String, String)]) -> bool {
     images.len() == 3 && images[2].0.starts_with("FLIP")

@@ -53,7 +53,8 @@ pub fn rewrite_report(
 ) -> Result<usize, ReadmeError> {
     // A sequence sweep's folder (`mirrorbox motion`, `sweep --path`) has its own files.
     if dir.join("motion.json").is_file() && !dir.join("sweep.json").exists() {
-        let (info, records) = crate::motion::read_motion(dir).map_err(ReadmeError)?;
+        let (mut info, records) = crate::motion::read_motion(dir).map_err(ReadmeError)?;
+        info.records_commit = records_commit.to_string();
         crate::motion::write_motion_report(dir, &info, &records)
             .map_err(|e| ReadmeError(e.to_string()))?;
         return Ok(records.len());

@@ -57,6 +57,13 @@ pub struct MotionInfo {
     pub height: u32,
     pub truth: String,
     pub scenarios: Vec<ScenarioInfo>,
+    /// The commit that measured it (`git describe`, as [`crate::SweepInfo::commit`]); empty
+    /// in older reports, whose figures name the commit that committed their frames instead.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub commit: String,
+    /// For a report without [`MotionInfo::commit`]: the commit that last committed it.
+    #[serde(skip)]
+    pub records_commit: String,
 }
 
 /// The frames of `method` in `scenario`, in frame order.
@@ -282,13 +289,20 @@ pub fn write_motion_report(
             &dir.join(format!("plot_{}.svg", s.name)),
             &Chart {
                 footer: format!(
-                    "{} · {}x{} · {} on {} · {}",
+                    "{} · {}x{} · {} on {} · {} · {}",
                     s.scene,
                     info.width,
                     info.height,
                     info.device,
                     info.cpu,
-                    info.date.get(..10).unwrap_or(&info.date)
+                    info.date.get(..10).unwrap_or(&info.date),
+                    if !info.commit.is_empty() {
+                        format!("commit {}", info.commit)
+                    } else if !info.records_commit.is_empty() {
+                        format!("records committed in {}", info.records_commit)
+                    } else {
+                        "commit not recorded".to_string()
+                    }
                 ),
                 ..chart(records, &s.name)
             }
@@ -449,6 +463,8 @@ mod tests {
         );
         let md = document(
             &MotionInfo {
+                commit: String::new(),
+                records_commit: String::new(),
                 command: "mirrorbox motion".into(),
                 date: "today".into(),
                 device: "test".into(),

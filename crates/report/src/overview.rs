@@ -100,21 +100,6 @@ fn series_name(r: &Record) -> String {
     crate::symmetry::variant(r)
 }
 
-/// The setting a point was swept at, for labels on the front: `n=2`, `d=64`.
-fn setting_label(r: &Record) -> String {
-    let mut words = Vec::new();
-    if let Some(n) = r.n {
-        words.push(format!("n={n}"));
-    }
-    if let Some(d) = r.depth {
-        words.push(format!("d={d}"));
-    }
-    for w in r.method_options.split_whitespace() {
-        words.push(w.to_string());
-    }
-    words.join(" ")
-}
-
 /// Points of a chart: (ms/frame, error).
 type Points = Vec<(f64, f64)>;
 
@@ -173,6 +158,19 @@ pub(crate) fn frontiers(sweeps: &[(String, Sweep)]) -> Vec<Frontier> {
                     None => groups.push((key, vec![r], &sweep.info)),
                 }
             }
+        }
+        // A point measured in several sweeps (Table 1 and its repeat) is shown once: its
+        // latest measurement.
+        for g in &mut groups {
+            let mut kept: Vec<&Record> = Vec::new();
+            for r in g.1.drain(..) {
+                match kept.iter_mut().find(|k| k.key == r.key) {
+                    Some(k) if r.run > k.run => *k = r,
+                    Some(_) => {}
+                    None => kept.push(r),
+                }
+            }
+            g.1 = kept;
         }
         groups.retain(|g| distinct(g.1.iter().map(|r| r.method.clone())).len() >= 2);
         let headline = groups
@@ -237,7 +235,7 @@ fn frontier_chart(
                 .iter()
                 .map(|r| {
                     if on_front(r) {
-                        setting_label(r)
+                        crate::document::swept_label(r)
                     } else {
                         String::new()
                     }

@@ -41,6 +41,18 @@ pub enum Marker {
     Plus,
 }
 
+impl Marker {
+    pub const ALL: [Marker; 7] = [
+        Marker::Circle,
+        Marker::Square,
+        Marker::TriangleUp,
+        Marker::Diamond,
+        Marker::TriangleDown,
+        Marker::Cross,
+        Marker::Plus,
+    ];
+}
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Style {
     pub color: &'static str,
@@ -51,7 +63,7 @@ pub struct Style {
     pub hollow: bool,
 }
 
-const DASHES: [&str; 4] = ["", "7 4", "2 3", "8 3 2 3"];
+const DASHES: [&str; 6] = ["", "7 4", "2 3", "8 3 2 3", "12 3", "2 2 6 2"];
 
 impl Style {
     /// The `k`-th variant of a method: same colour and marker, another dash, hollow markers
@@ -89,15 +101,7 @@ pub fn method_style(method: &str) -> Style {
             let h = other
                 .bytes()
                 .fold(0u32, |h, b| h.wrapping_mul(31).wrapping_add(u32::from(b)));
-            let markers = [
-                Circle,
-                Square,
-                TriangleUp,
-                Diamond,
-                TriangleDown,
-                Cross,
-                Plus,
-            ];
+            let markers = Marker::ALL;
             (
                 COLORS[h as usize % 6],
                 markers[(h / 7) as usize % markers.len()],
@@ -234,7 +238,7 @@ const LEFT: f64 = 80.0;
 /// Approximate advance of one character of the 12 px sans-serif legend text.
 const LEGEND_CHAR_W: f64 = 7.0;
 /// Approximate advance of one character of the 10 px label and footer text.
-const SMALL_CHAR_W: f64 = 6.2;
+const SMALL_CHAR_W: f64 = 6.8;
 /// The legend column: its margin, the sample line and the gap before the text.
 const LEGEND_PAD: f64 = 14.0 + 28.0 + 10.0;
 const LEGEND_ROW: f64 = 18.0;
@@ -324,26 +328,36 @@ impl Axis {
                 .filter(|&v| self.contains(v))
                 .collect();
             if out.len() < 2 {
-                out = vec![self.lo * 1.02, (self.lo * self.hi).sqrt(), self.hi / 1.02];
+                // Less than a factor 2.5 of range: round linear steps inside it.
+                out = linear_ticks(self.lo, self.hi)
+                    .into_iter()
+                    .filter(|&v| v > 0.0 && self.contains(v))
+                    .collect();
             }
             out
         } else {
-            let raw = (self.hi - self.lo) / 5.0;
-            let mag = 10f64.powf(raw.log10().floor());
-            let step = [1.0, 2.0, 5.0, 10.0]
-                .iter()
-                .map(|m| m * mag)
-                .find(|s| *s >= raw)
-                .unwrap_or(raw);
-            let mut t = (self.lo / step).ceil() * step;
-            let mut out = Vec::new();
-            while t <= self.hi + 1e-12 {
-                out.push(t);
-                t += step;
-            }
-            out
+            linear_ticks(self.lo, self.hi)
         }
     }
+}
+
+/// About five round ticks (1, 2 or 5 × a power of ten apart) from `lo` to `hi`.
+fn linear_ticks(lo: f64, hi: f64) -> Vec<f64> {
+    let raw = (hi - lo) / 5.0;
+    let mag = 10f64.powf(raw.log10().floor());
+    let step = [1.0, 2.0, 5.0, 10.0]
+        .iter()
+        .map(|m| m * mag)
+        .find(|s| *s >= raw)
+        .unwrap_or(raw);
+    let mut t = (lo / step).ceil() * step;
+    let mut out = Vec::new();
+    while t <= hi + 1e-12 * hi.abs().max(1.0) {
+        // Snap to the step's decimals (0.1 + 0.2 is not 0.3 in binary).
+        out.push((t / step).round() * step);
+        t += step;
+    }
+    out
 }
 
 /// A tick or annotation value, with as few digits as it needs.
@@ -572,7 +586,12 @@ impl Chart {
             esc(&self.title)
         );
         // The floor band first, under everything.
-        let mut floor_note = None;
+        let mut floor_note = self.floor.filter(|f| !drawable(*f, ay.log)).map(|f| {
+            format!(
+                "floor of the comparison (no mirrors): {}, every difference above it is the method's",
+                fmt_tick(f)
+            )
+        });
         if let Some(f) = self.floor.filter(|f| drawable(*f, ay.log)) {
             if ay.t(f) > 0.0 {
                 let yf = py_of(f.min(ay.hi));

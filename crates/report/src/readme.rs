@@ -605,6 +605,17 @@ fn job_costs_region(reports: &Path) -> Result<String, ReadmeError> {
     )]))
 }
 
+/// Every region ID there is: the reports' ([`REGIONS`]), then the caller's `extra`, comma
+/// separated.
+pub fn known_regions(extra: &[Region]) -> String {
+    REGIONS
+        .iter()
+        .map(|r| r.0)
+        .chain(extra.iter().map(|r| r.id))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
 /// Generates the region `id` from the reports under `reports`.
 pub fn generate(id: &str, reports: &Path) -> Result<Region, ReadmeError> {
     let (id, source, _) = REGIONS
@@ -765,12 +776,7 @@ fn region_text(id: &str, reports: &Path, extra: &[Region]) -> Result<String, Rea
         }
         None => Err(ReadmeError(format!(
             "unknown generated region {id:?} (known: {})",
-            REGIONS
-                .iter()
-                .map(|r| r.0)
-                .chain(extra.iter().map(|r| r.id))
-                .collect::<Vec<_>>()
-                .join(", ")
+            known_regions(extra)
         ))),
     }
 }

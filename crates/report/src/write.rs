@@ -906,11 +906,7 @@ fn document(info: &SweepInfo, records: &[Record], sections: &[Section]) -> Vec<B
                 );
                 s.labels = pts
                     .iter()
-                    .map(|r| {
-                        r.n.map(|n| format!("n={n}"))
-                            .or(r.depth.map(|d| format!("d={d}")))
-                            .unwrap_or_default()
-                    })
+                    .map(|r| crate::document::swept_label(r))
                     .collect();
                 if ms_on_x {
                     s.x_intervals = pts.iter().map(|r| r.ms_interval).collect();

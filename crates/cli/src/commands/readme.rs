@@ -7,7 +7,7 @@
 //! (`mirrorbox-experiments`), whose chapter must hold it.
 
 use crate::Failure;
-use mirrorbox_report::readme::{REGIONS, Region, fill_with, stale_regions_with};
+use mirrorbox_report::readme::{Region, fill_with, known_regions, stale_regions_with};
 use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
@@ -69,15 +69,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         }
     }
     if !args.check {
-        println!(
-            "regions known: {}",
-            REGIONS
-                .iter()
-                .map(|r| r.0)
-                .chain(extra.iter().map(|r| r.id))
-                .collect::<Vec<_>>()
-                .join(", ")
-        );
+        println!("regions known: {}", known_regions(&extra));
     }
     match (messages.is_empty(), bad_input) {
         (true, _) => Ok(()),
