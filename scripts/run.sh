@@ -47,8 +47,10 @@ run_step "$bin" check scenes/*.json
 run_step "$bin" info
 # Every experiment of the registry the main job runs, in its order (crates/experiments:
 # `mirrorbox experiment --list` says what each measures).
+# One truth cache for all of them: Table 1's repeat and the depth scaling trace the truths
+# Table 1 traced (the cache is keyed by the scene's content and the truth's settings).
 for experiment in $("$bin" experiment --main-job); do
-  run_step "$bin" experiment "$experiment" --fresh
+  run_step "$bin" experiment "$experiment" --fresh --truth-cache target/truth-cache
 done
 cpu=$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//; s/"/'"'"'/g')
 cores=$(nproc)

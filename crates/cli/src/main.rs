@@ -49,7 +49,7 @@ enum Command {
     Bumpy(commands::sweep::PresetArgs),
     /// The preset sweep of stereo mirrors: per-eye mirror textures against the head's shared ones, both eyes as one frame, against each eye's truth at IPD 0…0.1 and mono (writes reports/stereo/).
     Stereo(commands::sweep::PresetArgs),
-    /// Error over time: feedback's convergence for a still camera and its lag at three walking speeds on the paper's box, beside auxiliary n = 0…4 and an exact method, frame by frame against the truth (writes reports/motion/).
+    /// Error over time: feedback's convergence for a still camera and its lag walking at real time and three times it on the paper's box, beside auxiliary n = 0…4 and an exact method, frame by frame against the truth (writes reports/motion/).
     Motion(commands::sweep::MotionArgs),
     /// A window: the method live (free camera, every option switchable), the traced truth
     /// refining beside it, and their error (docs/viewer.md).

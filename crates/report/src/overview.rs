@@ -250,7 +250,10 @@ fn frontier_chart(
         series,
         references: vec![Reference::Curve("Pareto front".into(), steps)],
         ..Chart::new(
-            format!("What each millisecond buys: {scene}, α = {alpha}"),
+            format!(
+                "What each millisecond buys: {scene}, {}, {size}, α = {alpha}",
+                device.split(" (").next().unwrap_or(device)
+            ),
             "ms/frame (median, 95 % CI bars)",
             if mirror {
                 "FLIP mean over the mirror pixels"
@@ -276,9 +279,12 @@ fn frontier_chart(
 /// under `reports`; `commit_of(folder)` names the commit of a sweep that did not record the
 /// one that measured it (the commit that committed its records). Returns the number of
 /// reports listed.
+/// `about(folder)`: what the experiment that writes `folder` (relative to `reports`)
+/// measures, from the experiment registry, where it knows the folder.
 pub fn write_overview(
     reports: &Path,
     commit_of: &dyn Fn(&Path) -> String,
+    about: &dyn Fn(&str) -> Option<String>,
 ) -> Result<usize, ReadmeError> {
     let rel = |p: &Path| {
         p.strip_prefix(reports)
@@ -296,7 +302,9 @@ pub fn write_overview(
         let folder = rel(&dir);
         entries.push(Entry {
             link: format!("{folder}/report.html"),
-            title: first_heading(&dir.join("report.md")).unwrap_or_else(|| folder.clone()),
+            title: about(&folder)
+                .or_else(|| first_heading(&dir.join("report.md")))
+                .unwrap_or_else(|| folder.clone()),
             scene: sweep.info.scene.clone(),
             device: format!("{} ({})", sweep.info.adapter, sweep.info.backend),
             date: sweep
@@ -335,7 +343,9 @@ pub fn write_overview(
             .map_or(String::new(), |p| p.to_string_lossy().into_owned());
         entries.push(Entry {
             link: file.to_string(),
-            title: first_heading(&path).unwrap_or_else(|| file.to_string()),
+            title: about(&folder)
+                .or_else(|| first_heading(&path))
+                .unwrap_or_else(|| file.to_string()),
             scene: scene.into(),
             device: "see the report".into(),
             date: "see the report".into(),

@@ -121,14 +121,19 @@ pub fn sentences(records: &[Record], bump_methods: &[String]) -> Vec<String> {
                 ms_cell(win, 1)
             )
         } else {
+            let lo = sci(winners
+                .iter()
+                .map(|r| flip(r))
+                .fold(f64::INFINITY, f64::min));
+            let hi = sci(winners.iter().map(|r| flip(r)).fold(0.0, f64::max));
+            let range = if lo == hi {
+                format!("FLIP mean {lo} each")
+            } else {
+                format!("FLIP mean {lo}–{hi}, within 2 %")
+            };
             format!(
-                "At {a}°: {} tie for closest to the truth (FLIP mean {}–{}, within 2 %)",
-                join_words(&winners.iter().map(|r| name(r)).collect::<Vec<_>>()),
-                sci(winners
-                    .iter()
-                    .map(|r| flip(r))
-                    .fold(f64::INFINITY, f64::min)),
-                sci(winners.iter().map(|r| flip(r)).fold(0.0, f64::max))
+                "At {a}°: {} tie for closest to the truth ({range})",
+                join_words(&winners.iter().map(|r| name(r)).collect::<Vec<_>>())
             )
         };
         if let Some(f) = flat {

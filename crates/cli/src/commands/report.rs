@@ -20,7 +20,7 @@ pub struct Args {
 
 pub fn run(args: &Args) -> Result<(), Failure> {
     if let Some(reports) = &args.index {
-        let n = mirrorbox_report::overview::write_overview(reports, &records_commit)
+        let n = mirrorbox_report::overview::write_overview(reports, &records_commit, &about)
             .map_err(|e| Failure::BadInput(format!("{}: {e}", reports.display())))?;
         println!(
             "{}: index.html and README.md list {}",
@@ -64,4 +64,26 @@ fn records_commit(dir: &std::path::Path) -> String {
         .filter(|o| o.status.success())
         .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
         .unwrap_or_default()
+}
+
+/// What the registry's experiment writing the report folder `folder` (under `reports/`)
+/// measures.
+fn about(folder: &str) -> Option<String> {
+    use mirrorbox_experiments::{EXPERIMENTS, Measure};
+    EXPERIMENTS.iter().find_map(|e| {
+        let folders: Vec<std::path::PathBuf> = match &e.measure {
+            Measure::Sweeps(configs) => configs(&e.default_out())
+                .into_iter()
+                .map(|c| c.out)
+                .collect(),
+            _ => vec![e.default_out()],
+        };
+        folders
+            .iter()
+            .any(|f| {
+                f.strip_prefix("reports")
+                    .is_ok_and(|f| f == std::path::Path::new(folder))
+            })
+            .then(|| format!("{} (`{}`)", e.about, e.name))
+    })
 }

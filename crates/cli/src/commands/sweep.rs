@@ -441,12 +441,12 @@ pub struct MotionArgs {
     /// Output folder of the committed report (default reports/motion).
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Frames per scenario (default 24), 1..1000.
+    /// Frames per scenario (default 12), 1..1000.
     #[arg(long)]
     frames: Option<u32>,
 }
 
-/// Error over time (the registry's `motion`): a still camera and three walking speeds on the
+/// Error over time (the registry's `motion`): a still camera and two walking speeds on the
 /// paper's box, into `reports/motion/` by default.
 pub fn run_motion(args: &MotionArgs) -> Result<(), Failure> {
     run_experiment(
