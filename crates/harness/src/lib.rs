@@ -1168,9 +1168,10 @@ pub fn run_sweep(
     Ok(summary)
 }
 
-/// The commit of the checkout the running binary was built in (`git describe --always
-/// --dirty`, run beside the executable): what a report's figures name as the code that
-/// measured them. Empty outside a git checkout.
+/// The commit of the checkout the running binary was built in (`git describe --always`, run
+/// beside the executable), with `-dirty` when its code differs from that commit — the sources,
+/// shaders, scenes, scripts and tools, not `reports/`, which a main job rewrites as it goes:
+/// what a report's figures name as the code that measured them. Empty outside a git checkout.
 pub fn source_commit() -> String {
     let Some(dir) = std::env::current_exe()
         .ok()
@@ -1178,13 +1179,32 @@ pub fn source_commit() -> String {
     else {
         return String::new();
     };
-    std::process::Command::new("git")
-        .arg("-C")
-        .arg(dir)
-        .args(["describe", "--always", "--dirty", "--abbrev=10"])
-        .output()
-        .ok()
-        .filter(|o| o.status.success())
-        .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
-        .unwrap_or_default()
+    let git = |args: &[&str]| {
+        std::process::Command::new("git")
+            .arg("-C")
+            .arg(&dir)
+            .args(args)
+            .output()
+            .ok()
+            .filter(|o| o.status.success())
+            .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+    };
+    let Some(commit) = git(&["describe", "--always", "--abbrev=10"]) else {
+        return String::new();
+    };
+    let code = [
+        ":/crates",
+        ":/shaders",
+        ":/scenes",
+        ":/scripts",
+        ":/tools",
+        ":/Cargo.toml",
+        ":/Cargo.lock",
+    ];
+    let mut status = vec!["status", "--porcelain", "--"];
+    status.extend(code);
+    match git(&status) {
+        Some(changes) if !changes.is_empty() => format!("{commit}-dirty"),
+        _ => commit,
+    }
 }
