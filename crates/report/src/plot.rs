@@ -579,10 +579,12 @@ impl Chart {
             r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" viewBox="0 0 {w} {h}" font-family="sans-serif" font-size="12">"#
         );
         let _ = writeln!(s, r#"<rect width="{w}" height="{h}" fill="white"/>"#);
+        // Centred over the plot, moved right as far as a long title needs to stay inside.
+        let title_w = 8.5 * self.title.chars().count() as f64;
         let _ = writeln!(
             s,
-            r#"<text x="{}" y="22" text-anchor="middle" font-size="15">{}</text>"#,
-            LEFT + PLOT_W / 2.0,
+            r#"<text x="{:.1}" y="22" text-anchor="middle" font-size="15">{}</text>"#,
+            (LEFT + PLOT_W / 2.0).max(title_w / 2.0 + 8.0),
             esc(&self.title)
         );
         // The floor band first, under everything.
