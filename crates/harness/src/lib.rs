@@ -1179,16 +1179,7 @@ pub fn source_commit() -> String {
     else {
         return String::new();
     };
-    let git = |args: &[&str]| {
-        std::process::Command::new("git")
-            .arg("-C")
-            .arg(&dir)
-            .args(args)
-            .output()
-            .ok()
-            .filter(|o| o.status.success())
-            .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
-    };
+    let git = |args: &[&str]| git_output(&dir, args);
     let Some(commit) = git(&["describe", "--always", "--abbrev=10"]) else {
         return String::new();
     };
@@ -1207,4 +1198,17 @@ pub fn source_commit() -> String {
         Some(changes) if !changes.is_empty() => format!("{commit}-dirty"),
         _ => commit,
     }
+}
+
+/// The trimmed standard output of `git -C dir ARGS`, or `None` where git fails (not a
+/// checkout, no git): what the reports' commits are read with.
+pub fn git_output(dir: &Path, args: &[&str]) -> Option<String> {
+    std::process::Command::new("git")
+        .arg("-C")
+        .arg(dir)
+        .args(args)
+        .output()
+        .ok()
+        .filter(|o| o.status.success())
+        .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
 }

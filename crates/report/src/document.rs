@@ -187,6 +187,14 @@ pub fn swept_label(r: &Record) -> String {
         .join(" ")
 }
 
+/// Text for HTML, in an element or an attribute: `&`, `<`, `>` and `"` escaped.
+pub fn escape_html(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
 /// Whether an image block is a truth | raster | FLIP row (its last caption names FLIP).
 pub fn is_flip_row(images: &[(String, String)]) -> bool {
     images.len() == 3 && images[2].0.starts_with("FLIP")

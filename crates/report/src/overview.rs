@@ -276,7 +276,7 @@ fn frontier_chart(
 }
 
 /// Writes `reports/index.html`, `reports/README.md` and the frontier SVGs from every report
-/// under `reports`; `commit_of(folder)` names the commit of a sweep that did not record the
+/// under `reports`; `commit_of(path)` (a sweep folder, or a measurement's file) names the commit of one that did not record the
 /// one that measured it (the commit that committed its records). Returns the number of
 /// reports listed.
 /// `about(folder)`: what the experiment that writes `folder` (relative to `reports`)
@@ -323,16 +323,27 @@ pub fn write_overview(
         sweeps.push((folder, sweep));
     }
     // The other reports: a sequence sweep, benches and one-off measurements.
-    for (file, scene) in [
-        ("motion/report.md", "scenes/mirror_box_walk.json"),
+    // Each with the file of its measurements, whose commit the table names (the report
+    // beside it is rewritten with every change of the report's text).
+    for (file, data, scene) in [
+        (
+            "motion/report.md",
+            "motion/frames.jsonl",
+            "scenes/mirror_box_walk.json",
+        ),
         (
             "tracer/bench.md",
+            "tracer/bench.json",
             "scenes/mirror_box.json, scenes/mirror_room.json",
         ),
-        ("viewer/frame_rates.md", "scenes/mirror_box.json"),
-        ("memory/peaks.md", "every bundled scene"),
-        ("tests/test_times.md", "–"),
-        ("gpu/README.md", "–"),
+        (
+            "viewer/frame_rates.md",
+            "viewer/frame_rates.json",
+            "scenes/mirror_box.json",
+        ),
+        ("memory/peaks.md", "memory/peaks.md", "every bundled scene"),
+        ("tests/test_times.md", "tests/test_times.md", "–"),
+        ("gpu/README.md", "gpu/info.json", "–"),
     ] {
         let path = reports.join(file);
         if !path.is_file() {
@@ -349,7 +360,7 @@ pub fn write_overview(
             scene: scene.into(),
             device: "see the report".into(),
             date: "see the report".into(),
-            commit: format!("records in {}", commit_of(&reports.join(&folder))),
+            commit: format!("records in {}", commit_of(&reports.join(data))),
             folder,
         });
     }
@@ -403,11 +414,7 @@ pub fn write_overview(
         "<h2>Every report</h2>\n<div class=\"scroll\"><table><tr><th>report</th><th>what</th>\
          <th>scene</th><th>device</th><th>date</th><th>commit</th></tr>\n",
     );
-    let esc = |s: &str| {
-        s.replace('&', "&amp;")
-            .replace('<', "&lt;")
-            .replace('>', "&gt;")
-    };
+    let esc = crate::document::escape_html;
     for e in &entries {
         let md_link = if e.link.ends_with("report.html") {
             e.link.replace("report.html", "report.md")

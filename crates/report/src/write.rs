@@ -2,8 +2,8 @@
 //! they always say the same thing.
 
 use crate::document::{
-    Block, FLOOR_FACTOR, MIB, Section, at_or_under_floor, distinct, f, interval_digits, label,
-    markdown, ms, ms_cell, ms_digits, paired_ratio, remove_stale, sci,
+    Block, FLOOR_FACTOR, MIB, Section, at_or_under_floor, distinct, escape_html, f,
+    interval_digits, label, markdown, ms, ms_cell, ms_digits, paired_ratio, remove_stale, sci,
 };
 use crate::plot::{Chart, Reference, Series};
 use crate::{Record, SweepInfo};
@@ -202,7 +202,7 @@ pub fn write_report(
     for b in &blocks {
         match b {
             Block::Heading(level, t) => {
-                let _ = writeln!(html, "<h{level}>{}</h{level}>", esc(t));
+                let _ = writeln!(html, "<h{level}>{}</h{level}>", escape_html(t));
             }
             Block::Paragraph(t) => {
                 let _ = writeln!(html, "<p>{}</p>", inline(t));
@@ -222,7 +222,7 @@ pub fn write_report(
                     html,
                     "<div class=\"scroll\"><table><tr>{}</tr>",
                     head.iter()
-                        .map(|h| format!("<th>{}</th>", esc(h)))
+                        .map(|h| format!("<th>{}</th>", escape_html(h)))
                         .collect::<String>()
                 );
                 for r in rows {
@@ -265,7 +265,7 @@ pub fn write_report(
                     let _ = write!(
                         html,
                         "<td><img src=\"{src}\" alt=\"{}\">{bar}</td>",
-                        esc(cap)
+                        escape_html(cap)
                     );
                 }
                 html.push_str("</tr></table></div>\n");
@@ -311,22 +311,15 @@ fn inline(s: &str) -> String {
     let mut out = String::new();
     for (i, part) in s.split('`').enumerate() {
         if i % 2 == 1 && s.matches('`').count().is_multiple_of(2) {
-            let _ = write!(out, "<code>{}</code>", esc(part));
+            let _ = write!(out, "<code>{}</code>", escape_html(part));
         } else {
             if i % 2 == 1 {
                 out.push('`');
             }
-            out.push_str(&esc(part));
+            out.push_str(&escape_html(part));
         }
     }
     out
-}
-
-fn esc(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-        .replace('"', "&quot;")
 }
 
 fn write_csv(path: &Path, records: &[Record]) -> Result<(), FileError> {

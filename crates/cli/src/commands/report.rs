@@ -44,25 +44,29 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     Ok(())
 }
 
-/// The commit that last committed `dir/results.jsonl` (for the figures' footers of a sweep
-/// that did not record the commit that measured it); empty outside a git checkout.
-fn records_commit(dir: &std::path::Path) -> String {
-    if !dir.is_dir() {
+/// The commit that last committed `path` — a measurement's file, or a sweep folder's
+/// `results.jsonl` — for the figures and the overview of reports that did not record the
+/// commit that measured them; empty outside a git checkout.
+fn records_commit(path: &std::path::Path) -> String {
+    // A measurement's file, or a sweep folder's records.
+    let (dir, file) = if path.is_file() {
+        match (path.parent(), path.file_name()) {
+            (Some(d), Some(f)) => (d.to_path_buf(), f.to_string_lossy().into_owned()),
+            _ => return String::new(),
+        }
+    } else if path.join("results.jsonl").is_file() {
+        (path.to_path_buf(), "results.jsonl".into())
+    } else if path.is_dir() {
+        (path.to_path_buf(), ".".into())
+    } else {
         return String::new();
-    }
-    std::process::Command::new("git")
-        .arg("-C")
-        .arg(dir)
-        .args(["log", "-1", "--format=%h", "--"])
-        .arg(if dir.join("results.jsonl").is_file() {
-            "results.jsonl"
-        } else {
-            "."
-        })
-        .output()
-        .ok()
-        .filter(|o| o.status.success())
-        .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+    };
+    let dir = if dir.as_os_str().is_empty() {
+        std::path::PathBuf::from(".")
+    } else {
+        dir
+    };
+    mirrorbox_harness::git_output(&dir, &["log", "-1", "--format=%h", "--", &file])
         .unwrap_or_default()
 }
 
