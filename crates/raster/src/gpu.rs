@@ -75,13 +75,23 @@ pub struct Gpu {
 
 /// wgpu's defaults, raised to what the adapter offers for image sizes and buffer sizes (the
 /// default 256 MiB buffer holds only 3 M triangles; the scene limit is 4 M).
-fn device_limits(adapter: &wgpu::Limits) -> wgpu::Limits {
-    wgpu::Limits {
+/// With ray queries (`ray-query`), the adapter's acceleration-structure limits too (wgpu's
+/// defaults are 0).
+fn device_limits(adapter: &wgpu::Limits, features: wgpu::Features) -> wgpu::Limits {
+    let mut limits = wgpu::Limits {
         max_buffer_size: adapter.max_buffer_size,
         max_storage_buffer_binding_size: adapter.max_storage_buffer_binding_size,
         max_texture_array_layers: adapter.max_texture_array_layers,
         ..wgpu::Limits::default().using_resolution(adapter.clone())
+    };
+    if features.contains(wgpu::Features::EXPERIMENTAL_RAY_QUERY) {
+        limits.max_blas_primitive_count = adapter.max_blas_primitive_count;
+        limits.max_blas_geometry_count = adapter.max_blas_geometry_count;
+        limits.max_tlas_instance_count = adapter.max_tlas_instance_count;
+        limits.max_acceleration_structures_per_shader_stage =
+            adapter.max_acceleration_structures_per_shader_stage;
     }
+    limits
 }
 
 impl Gpu {
@@ -159,7 +169,16 @@ impl Gpu {
             pollster::block_on(selected.adapter.request_device(&wgpu::DeviceDescriptor {
                 label: Some("mirrorbox"),
                 required_features: features,
-                required_limits: device_limits(&selected.adapter.limits()),
+                required_limits: device_limits(&selected.adapter.limits(), features),
+                // wgpu's ray queries are experimental: they must be opted into
+                // (`ray-query`, `trace --device gpu`; issue 39 records what was checked).
+                experimental_features: if features.contains(wgpu::Features::EXPERIMENTAL_RAY_QUERY) {
+                    // SAFETY: only the ray-query method and the GPU truth use the feature,
+                    // and their images are tested against the CPU truth.
+                    unsafe { wgpu::ExperimentalFeatures::enabled() }
+                } else {
+                    wgpu::ExperimentalFeatures::disabled()
+                },
                 ..Default::default()
             }))
             .map_err(|e| RasterError::Device {

@@ -14,7 +14,7 @@ pub fn gpu_structs() -> Vec<crate::wgsl::HostLayout> {
         }),
         crate::host_layout!(GpuLight as "Light" {
             position, first_plane, intensity, plane_count, shadow_from_world, shadow_layer,
-            parent, shadow_texel, _pad
+            parent, shadow_texel, mirror
         }),
         crate::host_layout!(GpuFrame as "Frame" {
             ambient, light_count, background, shadow_bias, terminal, shadows
@@ -154,7 +154,8 @@ struct GpuLight {
     parent: u32,
     /// The layer's texel size in tangent units (slope bias).
     shadow_texel: f32,
-    _pad: u32,
+    /// Light images: the chain's last mirror (a shadow leg from it skips it).
+    mirror: u32,
 }
 
 #[repr(C)]
@@ -418,6 +419,7 @@ impl SceneBuffers {
                 intensity: image.intensity.to_array(),
                 plane_count: image.beam.len() as u32,
                 parent: image.parent.map_or(image.light, |p| real + p) as u32,
+                mirror: image.mirror as u32,
                 ..Zeroable::zeroed()
             };
             shadow_of(real + j, &mut light);

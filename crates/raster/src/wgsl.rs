@@ -11,8 +11,17 @@
 //! [`MethodEntry::shaders`]: crate::method::MethodEntry::shaders
 //! [`MethodEntry::gpu_structs`]: crate::method::MethodEntry::gpu_structs
 
-/// `shaders/shading.wgsl`: the shading contract and the scene bindings (group 0).
-pub const SHADING: &str = include_str!("../../../shaders/shading.wgsl");
+/// `shaders/shading.wgsl` then `shaders/shadow_map_legs.wgsl`: the shading contract and the
+/// scene bindings (group 0), with shadows tested in the shadow maps (every raster method).
+pub const SHADING: &str = concat!(
+    include_str!("../../../shaders/shading.wgsl"),
+    "\n",
+    include_str!("../../../shaders/shadow_map_legs.wgsl")
+);
+
+/// `shaders/shading.wgsl` alone: the contract without a shadow test, for a shader that brings
+/// its own `unshadowed` (`ray-query`: a ray query per leg).
+pub const SHADING_CONTRACT: &str = include_str!("../../../shaders/shading.wgsl");
 
 /// `shaders/mirror_plane_clip_distances.wgsl`: the clip-distance vertex stage of the methods
 /// that clip a mirror's world at the mirror's plane (`portal`, `naive`, `auxiliary`); it

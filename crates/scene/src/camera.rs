@@ -146,6 +146,12 @@ pub struct RayGenerator {
 }
 
 impl RayGenerator {
+    /// The frame a GPU twin needs to make the same rays: (forward, right·tan(fov/2)·aspect,
+    /// up·tan(fov/2), shift_x) — `ray-query --primary rays`.
+    pub fn frame(&self) -> (Vec3, Vec3, Vec3, f32) {
+        (self.forward, self.right, self.up, self.shift_x)
+    }
+
     /// `d = normalize(forward + (ndc_x − shift_x)·tan(fov/2)·aspect·right + ndc_y·tan(fov/2)·up)`,
     /// the inverse of [`Camera::projection`] on the plane z_view = −1.
     pub fn ray(&self, px: f32, py: f32) -> Ray {

@@ -328,9 +328,12 @@ fn summary(
             );
         }
         if let Some(ms) = out.bake_ms {
-            println!(
-                "  split-and-mirror bake: {ms:.2} ms on the CPU while planning (not in the frame time)"
-            );
+            let what = if method.name() == "ray-query" {
+                "acceleration structures (a BLAS per mesh, a TLAS) built on the device"
+            } else {
+                "split-and-mirror bake on the CPU while planning"
+            };
+            println!("  {what}: {ms:.2} ms (not in the frame time)");
         }
         println!(
             "  memory: estimate {estimate} (budget {}); peak resident {}",

@@ -26,6 +26,14 @@ pub enum Kernel {
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Device {
+    /// The CPU tracer (obvhs BVH, rayon threads).
+    Cpu,
+    /// wgpu ray queries (`whitted` only).
+    Gpu,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Integrator {
     /// Perfect mirror chains, the contract's lighting at the first diffuse hit.
     Whitted,
@@ -95,6 +103,11 @@ pub struct Args {
     /// Print the summary as one JSON object (one per eye with --stereo).
     #[arg(long)]
     json: bool,
+    /// Where to trace: cpu (obvhs, rayon; the reference of every report) or gpu (`whitted`
+    /// by wgpu ray queries, `ray-query --primary rays`: the same paths in f32 on an adapter
+    /// with EXPERIMENTAL_RAY_QUERY; grid sampling only, at most 64 spp and 4096 reflections).
+    #[arg(long, value_enum, default_value_t = Device::Cpu)]
+    device: Device,
     #[command(flatten)]
     stereo: super::stereo::StereoArgs,
 }
@@ -185,6 +198,9 @@ fn run_frame(args: &Args) -> Result<(), Failure> {
         scene
             .enumerate_light_images(whitted.min_throughput)
             .map_err(|e| super::light_budget(&scene, "--min-throughput", e))?;
+    }
+    if args.device == Device::Gpu {
+        return trace_on_gpu(args, &scene, rig, grid, whitted, &exr_path);
     }
     let sampling = if args.jitter {
         Sampling::Jittered {
@@ -444,4 +460,111 @@ fn report(
             .collect::<Vec<_>>()
             .join(", ")
     );
+}
+
+/// `trace --device gpu`: every view traced by `ray-query --primary rays` (the tracer's
+/// `whitted` in WGSL), written as the CPU truth is.
+fn trace_on_gpu(
+    args: &Args,
+    scene: &mirrorbox_scene::Scene,
+    rig: Option<mirrorbox_scene::stereo::Stereo>,
+    grid: SubpixelGrid,
+    whitted: WhittedSettings,
+    exr_path: &Path,
+) -> Result<(), Failure> {
+    use super::stereo::{eye_path, views};
+    let refuse = |flag: &str, why: &str| {
+        Failure::BadInput(format!("--device gpu: {flag} {why}"))
+    };
+    if args.integrator != Integrator::Whitted {
+        return Err(refuse("--integrator path", "is CPU only (the GPU traces whitted)"));
+    }
+    if args.jitter {
+        return Err(refuse("--jitter", "is CPU only (the GPU samples the fixed grid)"));
+    }
+    if args.bounces.is_some() {
+        return Err(refuse("--bounces", "is CPU only"));
+    }
+    let per_axis = (grid.samples_per_pixel() as f64).sqrt().round() as u32;
+    if per_axis > mirrorbox_raster::MAX_SSAA {
+        let max = mirrorbox_raster::MAX_SSAA;
+        return Err(refuse(
+            "--spp",
+            &format!("must be at most {} (a {max}×{max} grid), got {}", max * max, args.spp),
+        ));
+    }
+    let depth_cap = mirrorbox_raster::methods::ray_query::MAX_GPU_TRUTH_DEPTH;
+    let settings = mirrorbox_raster::methods::ray_query::gpu_truth_settings(
+        per_axis,
+        whitted.max_depth,
+        whitted.min_throughput,
+    )?;
+    let gpu = mirrorbox_raster::Gpu::new()?;
+    let started = Instant::now();
+    let mut staged = StagedFiles::new();
+    let mut done = Vec::new();
+    for (eye, view) in views(scene, rig) {
+        let out = mirrorbox_raster::render(&gpu, &view, &settings)?;
+        let exr = eye_path(exr_path, eye);
+        let attributes = vec![
+            ("mirrorbox.version", env!("CARGO_PKG_VERSION").to_string()),
+            ("mirrorbox.scene", args.scene.display().to_string()),
+            ("mirrorbox.scene_hash", format!("{:016x}", view.content_hash())),
+            ("mirrorbox.integrator", "whitted (gpu ray queries)".to_string()),
+            ("mirrorbox.spp", grid.samples_per_pixel().to_string()),
+            ("mirrorbox.max_depth", whitted.max_depth.min(depth_cap).to_string()),
+            ("mirrorbox.min_throughput", whitted.min_throughput.to_string()),
+            ("mirrorbox.adapter", gpu.report.name.clone()),
+            ("mirrorbox.lighting", view.lighting.describe()),
+        ];
+        stage_exr(&mut staged, &exr, &out.image, &attributes).map_err(write_failed)?;
+        stage_png(&mut staged, &exr.with_extension("png"), &out.image, view.camera.exposure)
+            .map_err(write_failed)?;
+        done.push((eye, view, out));
+    }
+    let written = staged.commit().map_err(write_failed)?;
+    let total = started.elapsed().as_secs_f64();
+    for (eye, view, out) in &done {
+        let (w, h) = (view.camera.width, view.camera.height);
+        let gpu_ms = out.timing.median_ms();
+        let build_ms = out.bake_ms.unwrap_or(0.0);
+        if args.json {
+            let v = serde_json::json!({
+                "scene": args.scene.display().to_string(),
+                "eye": eye.map(|e| e.name()),
+                "device": "gpu", "adapter": gpu.report.name, "backend": gpu.report.backend,
+                "width": w, "height": h, "spp": grid.samples_per_pixel(),
+                "max_depth": whitted.max_depth.min(depth_cap),
+                "trace_ms": gpu_ms, "timing": out.timing.source.name(),
+                "acceleration_build_ms": build_ms, "total_seconds": total,
+                "outputs": written.iter().map(|p| p.display().to_string()).collect::<Vec<_>>(),
+            });
+            println!("{v}");
+            continue;
+        }
+        if let Some(e) = eye {
+            println!("{} eye:", e.name());
+        }
+        println!(
+            "traced {} on the GPU ({}, {}): {w}x{h}, {} spp (the {per_axis}×{per_axis} grid), \
+             whitted to {} reflections, min throughput {}",
+            args.scene.display(),
+            gpu.report.name,
+            gpu.report.backend,
+            grid.samples_per_pixel(),
+            whitted.max_depth.min(depth_cap),
+            whitted.min_throughput,
+        );
+        if whitted.max_depth > depth_cap {
+            println!("  (the GPU follows at most {depth_cap} reflections; --max-depth {} was capped)", whitted.max_depth);
+        }
+        println!(
+            "  lighting: {}\n  trace {gpu_ms:.2} ms ({}); acceleration structures {build_ms:.2} ms; \
+             {total:.2} s in all; wrote {}",
+            view.lighting.describe(),
+            out.timing.source.name(),
+            written.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ")
+        );
+    }
+    Ok(())
 }

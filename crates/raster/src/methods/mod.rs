@@ -7,6 +7,7 @@
 pub mod cubemap;
 pub mod feedback;
 pub mod portal_stencil;
+pub mod ray_query;
 pub mod recursive_texture;
 pub mod symmetry;
 pub mod symmetry_baked;
@@ -24,6 +25,7 @@ pub static METHODS: &[&MethodEntry] = &[
     &cubemap::CUBEMAP,
     &portal_stencil::PORTAL,
     &unrolled::UNROLLED,
+    &ray_query::RAY_QUERY,
     &symmetry::SYMMETRY,
     &symmetry_pruned::SYMMETRY_PRUNED,
     &symmetry_baked::SYMMETRY_BAKED,
