@@ -172,7 +172,8 @@ impl Gpu {
                 required_limits: device_limits(&selected.adapter.limits(), features),
                 // wgpu's ray queries are experimental: they must be opted into
                 // (`ray-query`, `trace --device gpu`; issue 39 records what was checked).
-                experimental_features: if features.contains(wgpu::Features::EXPERIMENTAL_RAY_QUERY) {
+                experimental_features: if features.contains(wgpu::Features::EXPERIMENTAL_RAY_QUERY)
+                {
                     // SAFETY: only the ray-query method and the GPU truth use the feature,
                     // and their images are tested against the CPU truth.
                     unsafe { wgpu::ExperimentalFeatures::enabled() }

@@ -333,7 +333,7 @@ mod tests {
                 .with(depth, ParamValue::Count(8))
                 .unwrap_err()
                 .to_string(),
-            "--depth applies to --method path-textures, portal or unrolled only"
+            "--depth applies to --method path-textures, portal, unrolled or ray-query only"
         );
         let portal = Method::named("portal").unwrap();
         assert_eq!(

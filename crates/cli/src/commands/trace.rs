@@ -473,14 +473,18 @@ fn trace_on_gpu(
     exr_path: &Path,
 ) -> Result<(), Failure> {
     use super::stereo::{eye_path, views};
-    let refuse = |flag: &str, why: &str| {
-        Failure::BadInput(format!("--device gpu: {flag} {why}"))
-    };
+    let refuse = |flag: &str, why: &str| Failure::BadInput(format!("--device gpu: {flag} {why}"));
     if args.integrator != Integrator::Whitted {
-        return Err(refuse("--integrator path", "is CPU only (the GPU traces whitted)"));
+        return Err(refuse(
+            "--integrator path",
+            "is CPU only (the GPU traces whitted)",
+        ));
     }
     if args.jitter {
-        return Err(refuse("--jitter", "is CPU only (the GPU samples the fixed grid)"));
+        return Err(refuse(
+            "--jitter",
+            "is CPU only (the GPU samples the fixed grid)",
+        ));
     }
     if args.bounces.is_some() {
         return Err(refuse("--bounces", "is CPU only"));
@@ -490,7 +494,11 @@ fn trace_on_gpu(
         let max = mirrorbox_raster::MAX_SSAA;
         return Err(refuse(
             "--spp",
-            &format!("must be at most {} (a {max}×{max} grid), got {}", max * max, args.spp),
+            &format!(
+                "must be at most {} (a {max}×{max} grid), got {}",
+                max * max,
+                args.spp
+            ),
         ));
     }
     let depth_cap = mirrorbox_raster::methods::ray_query::MAX_GPU_TRUTH_DEPTH;
@@ -509,17 +517,34 @@ fn trace_on_gpu(
         let attributes = vec![
             ("mirrorbox.version", env!("CARGO_PKG_VERSION").to_string()),
             ("mirrorbox.scene", args.scene.display().to_string()),
-            ("mirrorbox.scene_hash", format!("{:016x}", view.content_hash())),
-            ("mirrorbox.integrator", "whitted (gpu ray queries)".to_string()),
+            (
+                "mirrorbox.scene_hash",
+                format!("{:016x}", view.content_hash()),
+            ),
+            (
+                "mirrorbox.integrator",
+                "whitted (gpu ray queries)".to_string(),
+            ),
             ("mirrorbox.spp", grid.samples_per_pixel().to_string()),
-            ("mirrorbox.max_depth", whitted.max_depth.min(depth_cap).to_string()),
-            ("mirrorbox.min_throughput", whitted.min_throughput.to_string()),
+            (
+                "mirrorbox.max_depth",
+                whitted.max_depth.min(depth_cap).to_string(),
+            ),
+            (
+                "mirrorbox.min_throughput",
+                whitted.min_throughput.to_string(),
+            ),
             ("mirrorbox.adapter", gpu.report.name.clone()),
             ("mirrorbox.lighting", view.lighting.describe()),
         ];
         stage_exr(&mut staged, &exr, &out.image, &attributes).map_err(write_failed)?;
-        stage_png(&mut staged, &exr.with_extension("png"), &out.image, view.camera.exposure)
-            .map_err(write_failed)?;
+        stage_png(
+            &mut staged,
+            &exr.with_extension("png"),
+            &out.image,
+            view.camera.exposure,
+        )
+        .map_err(write_failed)?;
         done.push((eye, view, out));
     }
     let written = staged.commit().map_err(write_failed)?;
@@ -556,14 +581,21 @@ fn trace_on_gpu(
             whitted.min_throughput,
         );
         if whitted.max_depth > depth_cap {
-            println!("  (the GPU follows at most {depth_cap} reflections; --max-depth {} was capped)", whitted.max_depth);
+            println!(
+                "  (the GPU follows at most {depth_cap} reflections; --max-depth {} was capped)",
+                whitted.max_depth
+            );
         }
         println!(
             "  lighting: {}\n  trace {gpu_ms:.2} ms ({}); acceleration structures {build_ms:.2} ms; \
              {total:.2} s in all; wrote {}",
             view.lighting.describe(),
             out.timing.source.name(),
-            written.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ")
+            written
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
         );
     }
     Ok(())

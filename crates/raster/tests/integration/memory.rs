@@ -77,8 +77,18 @@ fn gpu_estimate_bounds_wgpus_counters_for_every_method() {
                     estimate.parts
                 );
                 let bound = (LOOSENESS * measured as f64) as u64 + SLACK;
+                // wgpu's counters do not see acceleration structures (`ray-query`): the rest
+                // of the estimate is held to them.
+                let unseen: u64 = estimate
+                    .parts
+                    .iter()
+                    .filter(|p| {
+                        p.what == mirrorbox_raster::methods::ray_query::ACCELERATION_STRUCTURES
+                    })
+                    .map(|p| p.gpu_bytes)
+                    .sum();
                 assert!(
-                    estimate.gpu_bytes <= bound,
+                    estimate.gpu_bytes - unseen <= bound,
                     "{key}: the estimate's GPU part {} is loose: above {LOOSENESS} × {measured} + {SLACK} ({:?})",
                     estimate.gpu_bytes,
                     estimate.parts
