@@ -9,6 +9,7 @@ pub mod feedback;
 pub mod portal_stencil;
 pub mod ray_query;
 pub mod recursive_texture;
+pub mod screen_space_reflections;
 pub mod symmetry;
 pub mod symmetry_baked;
 pub mod symmetry_pruned;
@@ -23,6 +24,7 @@ pub static METHODS: &[&MethodEntry] = &[
     &recursive_texture::PATH_TEXTURES,
     &feedback::FEEDBACK,
     &cubemap::CUBEMAP,
+    &screen_space_reflections::SSR,
     &portal_stencil::PORTAL,
     &unrolled::UNROLLED,
     &ray_query::RAY_QUERY,
