@@ -4,7 +4,8 @@
 //
 // 1. vs_scene / fs_base: the scene drawn once; a diffuse surface (or a mirror's back) shaded
 //    by the contract, a mirror's front marked: alpha holds its surface + 1 (0 elsewhere).
-// 2. ssr_depth_pyramid.wgsl: the depth buffer's pyramid, each texel the nearest depth below.
+// 2. ssr_depth_pyramid.wgsl: the depth pyramid above that pass's depth, each texel the
+//    nearest depth below.
 // 3. vs_fullscreen / fs_reflect: every mirror pixel marches its reflected ray through the
 //    pyramid; a hit on a non-mirror pixel shows that pixel's colour × the reflectance; a miss
 //    (off screen, behind a surface thicker than --ssr-thickness, out of steps, or a mirror hit:
@@ -48,24 +49,36 @@ fn vs_scene(v: VertexIn) -> SceneOut {
     return out;
 }
 
+// The scene pass's two targets: the contract's radiance with the mirror mark in alpha, and the
+// reversed depth's f32 bits — the depth pyramid's level 0 (ssr_depth_pyramid.wgsl says why
+// bits: R32Uint renders on every backend, and depth textures cannot be read on GL).
+struct BaseOut {
+    @location(0) colour: vec4f,
+    @location(1) depth: vec4u,
+}
+
 // The scene pass: the contract's radiance, and which mirror (if any) shows its front here.
 @fragment
-fn fs_base(in: SceneOut) -> @location(0) vec4f {
+fn fs_base(in: SceneOut) -> BaseOut {
     let s = surfaces[in.surface];
     let to_eye = normalize(ssr.eye - in.world);
     let front = dot(in.normal, to_eye) > 0.0;
+    var out: BaseOut;
+    out.depth = vec4u(bitcast<u32>(max(in.clip.z, 0.0)), 0u, 0u, 0u);
     if (s.kind == 1u && front) {
-        return vec4f(s.reflectance * frame.terminal, f32(in.surface + 1u));
+        out.colour = vec4f(s.reflectance * frame.terminal, f32(in.surface + 1u));
+    } else if (s.kind == 1u) {
+        out.colour = vec4f(diffuse_radiance(in.world, in.normal, to_eye, s.back_albedo, vec3f(0.0)), 0.0);
+    } else {
+        out.colour = vec4f(diffuse_radiance(in.world, in.normal, to_eye, s.albedo, s.emission), 0.0);
     }
-    if (s.kind == 1u) {
-        return vec4f(diffuse_radiance(in.world, in.normal, to_eye, s.back_albedo, vec3f(0.0)), 0.0);
-    }
-    return vec4f(diffuse_radiance(in.world, in.normal, to_eye, s.albedo, s.emission), 0.0);
+    return out;
 }
 
 @group(1) @binding(1) var base_colour: texture_2d<f32>;
 @group(1) @binding(2) var fallback_colour: texture_2d<f32>;
-@group(1) @binding(3) var depth_pyramid: texture_2d<f32>;
+// The pyramid's depths as f32 bits (ssr_depth_pyramid.wgsl).
+@group(1) @binding(3) var depth_pyramid: texture_2d<u32>;
 
 struct FullscreenOut {
     @builtin(position) clip: vec4f,
@@ -93,7 +106,7 @@ fn to_screen(x: vec3f) -> vec3f {
 fn pyramid(cell: vec2i, level: u32) -> f32 {
     let dims = max(vec2i(textureDimensions(depth_pyramid, 0u)) >> vec2u(level), vec2i(1));
     let c = clamp(cell, vec2i(0), dims - 1);
-    return textureLoad(depth_pyramid, c, i32(level)).r;
+    return bitcast<f32>(textureLoad(depth_pyramid, c, i32(level)).r);
 }
 
 // The pixel a reflected ray from x along r hits in the depth buffer, or (-1, -1) on a miss.

@@ -1,10 +1,12 @@
 // The depth pyramid of screen-space reflections (crates/raster/src/methods/
-// screen_space_reflections.rs): level 0 is the scene pass's reversed depth, each texel of a
+// screen_space_reflections.rs): level 0 is the scene pass's reversed depth (written by that
+// pass, screen_space_reflections.wgsl's fs_base), each texel of a
 // coarser level the largest — nearest — of the (up to 3×3, at odd sizes) texels it covers, so
-// that a ray in front of a cell's value is in front of everything in it. Stands alone.
+// that a ray in front of a cell's value is in front of everything in it. Depths are kept as
+// their f32 bits in R32Uint (renderable everywhere, wgpu's GL backend included, where R32Float
+// is not); for depths ≥ 0 the bits order as the floats do. Stands alone.
 
-@group(0) @binding(0) var scene_depth: texture_depth_2d;
-@group(0) @binding(1) var finer: texture_2d<f32>;
+@group(0) @binding(0) var finer: texture_2d<u32>;
 
 struct FullscreenOut {
     @builtin(position) clip: vec4f,
@@ -18,18 +20,13 @@ fn vs_fullscreen(@builtin(vertex_index) i: u32) -> FullscreenOut {
     return out;
 }
 
-@fragment
-fn fs_copy_depth(in: FullscreenOut) -> @location(0) vec4f {
-    return vec4f(textureLoad(scene_depth, vec2i(floor(in.clip.xy)), 0), 0.0, 0.0, 0.0);
-}
-
 // A coarser texel: the nearest of the finer level's texels it covers (a cell of an odd-sized
 // level also takes the row or column the halving drops).
 @fragment
-fn fs_reduce(in: FullscreenOut) -> @location(0) vec4f {
+fn fs_reduce(in: FullscreenOut) -> @location(0) vec4u {
     let dims = vec2i(textureDimensions(finer));
     let base = 2 * vec2i(floor(in.clip.xy));
-    var nearest = 0.0;
+    var nearest = 0u;
     for (var j = 0; j < 3; j++) {
         for (var i = 0; i < 3; i++) {
             let t = base + vec2i(i, j);
@@ -42,5 +39,5 @@ fn fs_reduce(in: FullscreenOut) -> @location(0) vec4f {
             nearest = max(nearest, textureLoad(finer, t, 0).r);
         }
     }
-    return vec4f(nearest, 0.0, 0.0, 0.0);
+    return vec4u(nearest, 0u, 0u, 0u);
 }

@@ -32,8 +32,9 @@ pub struct MethodEntry {
     pub exact: bool,
     /// Whether its error (beyond the exact methods' floor) is the reflections it stops short
     /// of: the registry test then holds it nearer the truth at its depth than one shallower.
-    /// False for `cubemap`, whose error is parallax at every depth (that test instead holds
-    /// it to the truth wherever no mirror is seen).
+    /// False for `cubemap`, whose error is parallax at every depth, and `ssr`, whose error is
+    /// what the screen does not hold (that test instead holds them to the truth wherever no
+    /// mirror is seen).
     pub depth_limited: bool,
     /// The options it accepts, in key order.
     pub options: &'static [&'static OptionSpec],

@@ -36,7 +36,8 @@ pub static SSR: MethodEntry = MethodEntry {
            pixel's reflected ray marched through a hierarchical depth buffer (one bounce); \
            misses show --ssr-fallback.",
     exact: false,
-    depth_limited: true,
+    // Its error is what the screen does not hold, at every depth (as `cubemap`'s parallax).
+    depth_limited: false,
     options: crate::method_options![&FALLBACK, &STEPS, &THICKNESS],
     swept: None,
     optional_features: wgpu::Features::empty(),
@@ -190,6 +191,7 @@ impl PlannedFrame for PlannedSsr {
             "the image size (--width/--height) or --ssaa",
             texture_bytes(w, h, color_bytes_per_texel)
                 + texture_bytes(w, h, DEPTH_BYTES)
+                // The pyramid: 4 bytes a texel, levels summing to under 4/3 of level 0.
                 + 2 * texture_bytes(w, h, 4)
                 + buffer_bytes(std::mem::size_of::<Params>() as u64),
         );
@@ -285,10 +287,9 @@ struct SsrFrame {
     base_group: wgpu::BindGroup,
     base_colour: wgpu::TextureView,
     depth: wgpu::TextureView,
-    /// Level views of the pyramid, and each level's pipeline input.
+    /// Level views of the pyramid, and each coarser level's input (the level below).
     pyramid_levels: Vec<wgpu::TextureView>,
     pyramid_groups: Vec<wgpu::BindGroup>,
-    copy_depth: wgpu::RenderPipeline,
     reduce: wgpu::RenderPipeline,
     reflect_pipeline: wgpu::RenderPipeline,
     reflect_group: wgpu::BindGroup,
@@ -378,9 +379,15 @@ impl SsrFrame {
             sampled,
         )
         .create_view(&Default::default());
-        let depth =
-            crate::targets::texture_2d(device, "ssr depth", width, height, DEPTH_FORMAT, sampled)
-                .create_view(&Default::default());
+        let depth = crate::targets::texture_2d(
+            device,
+            "ssr depth",
+            width,
+            height,
+            DEPTH_FORMAT,
+            wgpu::TextureUsages::RENDER_ATTACHMENT,
+        )
+        .create_view(&Default::default());
         let pyramid = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("ssr depth pyramid"),
             size: wgpu::Extent3d {
@@ -391,7 +398,7 @@ impl SsrFrame {
             mip_level_count: levels,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::R32Float,
+            format: wgpu::TextureFormat::R32Uint,
             usage: sampled,
             view_formats: &[],
         });
@@ -404,22 +411,37 @@ impl SsrFrame {
         };
         let pyramid_levels: Vec<wgpu::TextureView> = (0..levels).map(level_view).collect();
         let module = gpu.shader_module(&SHADER);
-        let base_pipeline = ScenePipeline {
-            label: "ssr scene pass",
-            layout: &pipeline_layout(
-                device,
-                "ssr scene pass",
-                &[&scene_buffers.layout, &base_layout],
-            ),
-            module: &module,
-            vertex: "vs_scene",
-            fragment: "fs_base",
-            buffers: &[Some(VERTEX_LAYOUT)],
-            depth_stencil: depth_state(DEPTH_FORMAT, true, NEARER, Default::default()),
-            color_writes: wgpu::ColorWrites::ALL,
-        }
-        .build(gpu);
-        // The pyramid: level 0 from the depth buffer, each next level reduced from the last.
+        let base_layout_all = pipeline_layout(
+            device,
+            "ssr scene pass",
+            &[&scene_buffers.layout, &base_layout],
+        );
+        // Two targets: the colour (mirror marks in alpha) and the pyramid's level 0.
+        let base_pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("ssr scene pass"),
+            layout: Some(&base_layout_all),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_scene"),
+                compilation_options: Default::default(),
+                buffers: &[Some(VERTEX_LAYOUT)],
+            },
+            primitive: Default::default(),
+            depth_stencil: Some(depth_state(DEPTH_FORMAT, true, NEARER, Default::default())),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_base"),
+                compilation_options: Default::default(),
+                targets: &[
+                    Some(colour_format.into()),
+                    Some(wgpu::TextureFormat::R32Uint.into()),
+                ],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        // The pyramid: level 0 written by the scene pass, each next level reduced from the last.
         let pyramid_module = gpu.shader_module(&PYRAMID_SHADER);
         let fullscreen = |label: &str, fragment: &str| {
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
@@ -438,32 +460,25 @@ impl SsrFrame {
                     module: &pyramid_module,
                     entry_point: Some(fragment),
                     compilation_options: Default::default(),
-                    targets: &[Some(wgpu::TextureFormat::R32Float.into())],
+                    targets: &[Some(wgpu::TextureFormat::R32Uint.into())],
                 }),
                 multiview_mask: None,
                 cache: None,
             })
         };
-        let copy_depth = fullscreen("ssr pyramid level 0", "fs_copy_depth");
         let reduce = fullscreen("ssr pyramid level", "fs_reduce");
-        let mut pyramid_groups = vec![device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("ssr pyramid level 0"),
-            layout: &copy_depth.get_bind_group_layout(0),
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::TextureView(&depth),
-            }],
-        })];
-        for level in 1..levels as usize {
-            pyramid_groups.push(device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("ssr pyramid level"),
-                layout: &reduce.get_bind_group_layout(0),
-                entries: &[wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::TextureView(&pyramid_levels[level - 1]),
-                }],
-            }));
-        }
+        let pyramid_groups: Vec<wgpu::BindGroup> = (1..levels as usize)
+            .map(|level| {
+                device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("ssr pyramid level"),
+                    layout: &reduce.get_bind_group_layout(0),
+                    entries: &[wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: wgpu::BindingResource::TextureView(&pyramid_levels[level - 1]),
+                    }],
+                })
+            })
+            .collect();
         let whole_pyramid = pyramid.create_view(&Default::default());
         let reflect_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("ssr reflect"),
@@ -471,7 +486,16 @@ impl SsrFrame {
                 uniform,
                 texture_entry(1),
                 texture_entry(2),
-                texture_entry(3),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 3,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Uint,
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
             ],
         });
         let fallback_view = fallback
@@ -531,12 +555,13 @@ impl SsrFrame {
                 .filter(|r| !r.is_empty())
                 .cloned(),
         );
+        // The scene pass, the pyramid's coarser levels, the reflect pass.
         let stats = FrameStats {
-            passes: 2 + levels as usize,
+            passes: 1 + levels as usize,
             texture_renders: 0,
-            draws: draws.len() + levels as usize + 2,
+            draws: draws.len() + levels as usize,
             depth: 1,
-            triangles: scene.geometry.triangles.len() + 1 + levels as usize,
+            triangles: scene.geometry.triangles.len() + levels as usize,
             paths: None,
             clipping: Clipping::None,
             depth_format: DEPTH_FORMAT,
@@ -552,7 +577,6 @@ impl SsrFrame {
             depth,
             pyramid_levels,
             pyramid_groups,
-            copy_depth,
             reduce,
             reflect_pipeline,
             reflect_group,
@@ -578,25 +602,37 @@ impl FrameEncoder for SsrFrame {
             let bg = self.background;
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("ssr scene pass"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &self.base_colour,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color {
-                            r: bg.x as f64,
-                            g: bg.y as f64,
-                            b: bg.z as f64,
-                            a: 0.0,
-                        }),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
+                color_attachments: &[
+                    Some(wgpu::RenderPassColorAttachment {
+                        view: &self.base_colour,
+                        depth_slice: None,
+                        resolve_target: None,
+                        ops: wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(wgpu::Color {
+                                r: bg.x as f64,
+                                g: bg.y as f64,
+                                b: bg.z as f64,
+                                a: 0.0,
+                            }),
+                            store: wgpu::StoreOp::Store,
+                        },
+                    }),
+                    // Far everywhere nothing is drawn: reversed depth 0.
+                    Some(wgpu::RenderPassColorAttachment {
+                        view: &self.pyramid_levels[0],
+                        depth_slice: None,
+                        resolve_target: None,
+                        ops: wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                            store: wgpu::StoreOp::Store,
+                        },
+                    }),
+                ],
                 depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                     view: &self.depth,
                     depth_ops: Some(wgpu::Operations {
                         load: wgpu::LoadOp::Clear(FAR_DEPTH),
-                        store: wgpu::StoreOp::Store,
+                        store: wgpu::StoreOp::Discard,
                     }),
                     stencil_ops: None,
                 }),
@@ -612,7 +648,7 @@ impl FrameEncoder for SsrFrame {
                 pass.draw(r.clone(), 0..1);
             }
         }
-        for (level, view) in self.pyramid_levels.iter().enumerate() {
+        for (view, group) in self.pyramid_levels[1..].iter().zip(&self.pyramid_groups) {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("ssr depth pyramid"),
                 color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -629,12 +665,8 @@ impl FrameEncoder for SsrFrame {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            pass.set_pipeline(if level == 0 {
-                &self.copy_depth
-            } else {
-                &self.reduce
-            });
-            pass.set_bind_group(0, &self.pyramid_groups[level], &[]);
+            pass.set_pipeline(&self.reduce);
+            pass.set_bind_group(0, group, &[]);
             pass.draw(0..3, 0..1);
         }
         let mut pass = target.begin_pass(encoder, "ssr reflect", self.background, None);
