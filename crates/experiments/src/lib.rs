@@ -14,6 +14,7 @@ use std::path::{Path, PathBuf};
 
 pub mod bumpy;
 pub mod depth_scaling;
+pub mod engine_reflections;
 pub mod frontier;
 pub mod lighting;
 pub mod motion;
@@ -65,6 +66,8 @@ pub const EXPERIMENTS: &[&Experiment] = &[
     &stereo::STEREO,
     &motion::MOTION,
     &frontier::FRONTIER,
+    &engine_reflections::ENGINE_REFLECTIONS,
+    &scripts::GPU_TRUTH,
     &scripts::LIGHTING_TRACE_COST,
     &scripts::MEMORY_PEAKS,
     &scripts::TRACER_BENCH,

@@ -34,6 +34,16 @@ pub const TRACER_BENCH: Experiment = Experiment {
     main_job: false,
 };
 
+pub const GPU_TRUTH: Experiment = Experiment {
+    name: "gpu-truth",
+    about: "the truth traced on the GPU by ray queries against the CPU truth: time and largest difference at 640×360×16",
+    folder: "gpu_truth",
+    measure: Measure::Script("scripts/gpu-truth-bench.sh", &["5"]),
+    section: None,
+    chapter: "engine-reflections.md",
+    main_job: false,
+};
+
 pub const VIEWER_FRAME_RATES: Experiment = Experiment {
     name: "viewer-frame-rates",
     about: "the viewer's milliseconds between frames, standing and walking, per method",

@@ -118,12 +118,36 @@ pub const STEREO_IPD: AxisSpec = AxisSpec {
     },
 };
 
+/// The camera turned about the scene's up axis through its position, degrees, positive to
+/// the left (issue 39): the same scene seen with more or less of what its mirrors reflect on
+/// screen — the share screen-space reflections depend on.
+pub const CAMERA_YAW: AxisSpec = AxisSpec {
+    name: "yaw_deg",
+    flag: "--camera-yaw",
+    what: "camera turns in degrees",
+    min: -180.0,
+    max: 180.0,
+    max_open: false,
+    integer: false,
+    none_word: None,
+    label: " yaw=",
+    unit: "°",
+    slug: "yaw",
+    apply: |_, scene, deg| {
+        let c = &mut scene.camera;
+        let turn = glam::Quat::from_axis_angle(c.up.normalize(), (deg as f32).to_radians());
+        c.look_at = c.position + turn * (c.look_at - c.position);
+        Ok(())
+    },
+};
+
 /// Every scene axis, in the order a point's scene applies them and its key names them.
-pub const AXES: [&AxisSpec; 4] = [
+pub const AXES: [&AxisSpec; 5] = [
     &SYMMETRY_PLANES,
     &MIRRORED_LIGHTS,
     &BUMP_AMPLITUDE,
     &STEREO_IPD,
+    &CAMERA_YAW,
 ];
 
 /// The axis named `name`.

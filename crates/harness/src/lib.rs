@@ -531,13 +531,15 @@ fn truth(
     Ok((out.image, path))
 }
 
-/// Where the mirror mask of the cached truth `truth` is kept: white where a pixel shows a
-/// mirror ([`mirrorbox_trace::mirror_mask`]).
+/// Where the mirror masks of the cached truth `truth` are kept: red where a pixel shows a
+/// mirror ([`mirrorbox_trace::mirror_mask`]), green where most of its mirror samples reflect
+/// something off screen ([`mirrorbox_trace::reflections_off_screen`]). (`.mask.png`, red only,
+/// was the name before the green channel: a cache holding only that one gets the new file.)
 fn mask_path(truth: &Path) -> PathBuf {
-    truth.with_extension("mask.png")
+    truth.with_extension("mirrors.png")
 }
 
-/// Writes the mirror mask of `scene`'s truth on the sweep's sub-pixel grid beside `truth`.
+/// Writes the mirror masks of `scene`'s truth on the sweep's sub-pixel grid beside `truth`.
 fn write_mask(
     scene: &Scene,
     bvh: &SceneBvh,
@@ -546,9 +548,11 @@ fn write_mask(
 ) -> Result<(), HarnessError> {
     let grid = mirrorbox_scene::camera::SubpixelGrid::new(config.ssaa);
     let mask = mirrorbox_trace::mirror_mask(scene, bvh, grid);
+    let off = mirrorbox_trace::reflections_off_screen(scene, bvh, grid);
     let bytes: Vec<u8> = mask
         .iter()
-        .flat_map(|&m| [if m { 255 } else { 0 }; 3])
+        .zip(&off)
+        .flat_map(|(&m, &o)| [if m { 255 } else { 0 }, if o { 255 } else { 0 }, 0])
         .collect();
     write_png_bytes(
         &mask_path(truth),
@@ -559,11 +563,10 @@ fn write_mask(
     Ok(())
 }
 
-/// The mirror mask kept beside a cached truth, one flag per pixel; `None` when it is missing
-/// or unreadable (the point then has no mirror-pixel error).
-fn read_mask(truth: &Path) -> Option<Vec<bool>> {
+/// The mirror masks beside a cached truth (mirror pixels, reflections off screen), if kept.
+fn read_mask(truth: &Path) -> Option<(Vec<bool>, Vec<bool>)> {
     let img = read_image(&mask_path(truth)).ok()?;
-    Some(img.pixels.iter().map(|p| p[0] > 0.5).collect())
+    Some(img.pixels.iter().map(|p| (p[0] > 0.5, p[1] > 0.5)).unzip())
 }
 
 fn metric_values(m: &mirrorbox_image::metrics::Metrics) -> MetricValues {
@@ -644,6 +647,7 @@ struct Compared {
     /// Over the mirror pixels (mono points with a mask that has any).
     mirror_metrics: Option<MetricValues>,
     mirror_pixel_share: Option<f64>,
+    reflection_offscreen_share: Option<f64>,
     eyes: Option<Vec<mirrorbox_report::EyeRecord>>,
 }
 
@@ -673,7 +677,12 @@ fn compare_views(
             .flat_map(|&v| colormap::heat(v))
             .collect();
         if truths.len() == 1 {
-            let mask = read_mask(truth_path).filter(|m| m.len() == raster.pixels.len());
+            let masks = read_mask(truth_path).filter(|(m, _)| m.len() == raster.pixels.len());
+            let mask = masks.as_ref().map(|(m, _)| m.clone());
+            let reflection_offscreen_share = masks.as_ref().and_then(|(m, off)| {
+                let mirrors = m.iter().filter(|v| **v).count();
+                (mirrors > 0).then(|| off.iter().filter(|v| **v).count() as f64 / mirrors as f64)
+            });
             let mirror_metrics = mask
                 .as_ref()
                 .and_then(|mask| comparison.masked(&truth, &raster, mask))
@@ -694,6 +703,7 @@ fn compare_views(
                 metrics: m,
                 mirror_metrics,
                 mirror_pixel_share,
+                reflection_offscreen_share,
                 eyes: None,
             });
         }
@@ -732,6 +742,7 @@ fn compare_views(
         metrics: MetricValues::mean(&metrics),
         mirror_metrics: None,
         mirror_pixel_share: None,
+        reflection_offscreen_share: None,
         eyes: Some(eyes),
     })
 }
@@ -1084,6 +1095,7 @@ pub fn run_sweep(
             metrics: views.metrics,
             mirror_metrics: views.mirror_metrics,
             mirror_pixel_share: views.mirror_pixel_share,
+            reflection_offscreen_share: views.reflection_offscreen_share,
             adapter: s.adapter.clone(),
             backend: s.backend.clone(),
             color_format: s.color_format.clone(),

@@ -7,6 +7,7 @@
 //! - [`readme`]: the README's figures, generated from the committed reports.
 
 pub mod document;
+pub mod engine_reflections;
 mod error;
 pub mod exact;
 mod folder;
@@ -237,6 +238,10 @@ pub struct Record {
     /// The share of the image's pixels that are mirror pixels, in [0, 1].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mirror_pixel_share: Option<f64>,
+    /// The share of the mirror pixels whose first reflection is off screen (behind the camera
+    /// or outside the image), in [0, 1]: what screen-space reflections cannot show (issue 39).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reflection_offscreen_share: Option<f64>,
     pub adapter: String,
     pub backend: String,
     /// The colour format of the raster targets (`rgba32float`, or `rgba16float` where the

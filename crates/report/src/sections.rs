@@ -36,3 +36,9 @@ pub fn uneven_mirrors(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
 pub fn stereo(_: &SweepInfo, records: &[Record]) -> Vec<Block> {
     crate::stereo::stereo_section(records)
 }
+
+/// Screen-space and ray-query reflections beside the exact methods
+/// ([`crate::engine_reflections`]).
+pub fn engine_reflections(_: &SweepInfo, records: &[Record]) -> Vec<Block> {
+    crate::engine_reflections::engine_reflections_section(records)
+}

@@ -20,7 +20,7 @@ pub mod watertight;
 
 pub use bvh::{BvhKind, Hit, SceneBvh};
 pub use integrator::{Integrator, IntegratorSettings, PathResult, Termination, path, whitted};
-pub use mirror_mask::mirror_mask;
+pub use mirror_mask::{mirror_mask, reflections_off_screen};
 pub use path::{PathSettings, PathTracer};
 pub use render::{TraceOutput, TraceSettings, TraceStats, render, render_while};
 pub use sampler::Sampling;

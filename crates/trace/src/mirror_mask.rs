@@ -38,6 +38,64 @@ pub fn mirror_mask(scene: &Scene, bvh: &SceneBvh, grid: SubpixelGrid) -> Vec<boo
         .collect()
 }
 
+/// One flag per pixel, row-major: true where most of the pixel's samples that first hit a
+/// mirror's front see, in that mirror, something off screen — their reflected ray's first hit
+/// (or, where it escapes, a point far along it) projects behind the camera or outside the
+/// image. What screen-space reflections cannot show, whatever their march (issue 39); the
+/// report plots `ssr`'s error against the share of mirror pixels flagged.
+pub fn reflections_off_screen(scene: &Scene, bvh: &SceneBvh, grid: SubpixelGrid) -> Vec<bool> {
+    let camera = &scene.camera;
+    let (w, h) = (camera.width, camera.height);
+    let rays = camera.ray_generator();
+    let geometry = &scene.geometry;
+    let planes = crate::mirror_bounce::MirrorPlanes::new(scene);
+    let offsets: Vec<_> = grid.offsets().collect();
+    let size = camera.size();
+    let off_screen = |q: glam::Vec3| {
+        camera
+            .project_to_pixel(q)
+            .is_none_or(|p| p.x < 0.0 || p.y < 0.0 || p.x >= size.x || p.y >= size.y)
+    };
+    (0..h)
+        .into_par_iter()
+        .flat_map_iter(|y| {
+            let offsets = &offsets;
+            let planes = &planes;
+            (0..w).map(move |x| {
+                let (mut mirrored, mut away) = (0, 0);
+                for o in offsets {
+                    let ray = rays.ray(x as f32 + o.x, y as f32 + o.y);
+                    let Some(hit) = bvh.closest_hit(&ray, 0.0, f32::INFINITY, None) else {
+                        continue;
+                    };
+                    let Surface::Mirror { mirror, .. } = *geometry.surface(hit.triangle) else {
+                        continue;
+                    };
+                    if geometry.face_normal(hit.triangle).dot(ray.dir) >= 0.0 {
+                        continue;
+                    }
+                    mirrored += 1;
+                    let Some((at, dir)) =
+                        planes.reflect(mirror, ray.origin.as_dvec3(), ray.dir.as_dvec3())
+                    else {
+                        continue;
+                    };
+                    let reflected = mirrorbox_scene::Ray {
+                        origin: at.as_vec3(),
+                        dir: dir.as_vec3(),
+                    };
+                    let seen = match bvh.closest_hit(&reflected, 0.0, f32::INFINITY, Some(mirror)) {
+                        Some(h) => reflected.at(h.t),
+                        None => reflected.at(1e4),
+                    };
+                    away += usize::from(off_screen(seen));
+                }
+                mirrored > 0 && 2 * away > mirrored
+            })
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -74,6 +74,11 @@ pub struct Args {
     /// `mono` is the plain frame.
     #[arg(long)]
     ipd: Option<String>,
+    /// Camera turns in degrees, comma separated, each in [-180, 180]: every point is measured
+    /// with the camera turned about the scene's up axis through its position (positive to the
+    /// left) — how much of what the mirrors reflect is on screen (`ssr`'s question).
+    #[arg(long, allow_negative_numbers = true)]
+    camera_yaw: Option<String>,
     /// With --ipd: the name of a diffuse object whose first reflection is located in each eye
     /// (raster and truth), for the report's disparity check.
     #[arg(long, requires = "ipd")]
@@ -86,7 +91,7 @@ pub struct Args {
     #[arg(
         long,
         value_name = "N",
-        conflicts_with_all = ["symmetry_planes", "mirrored_lights", "bump_amplitude", "ipd", "alpha", "shard", "truth_cache"]
+        conflicts_with_all = ["symmetry_planes", "mirrored_lights", "bump_amplitude", "ipd", "camera_yaw", "alpha", "shard", "truth_cache"]
     )]
     path: Option<u32>,
     /// Frames per second of path time for --path, in (0, 1000].
@@ -334,6 +339,7 @@ fn scene_axes(args: &Args) -> Result<Vec<AxisValues>, Failure> {
         (&axes::MIRRORED_LIGHTS, &args.mirrored_lights),
         (&axes::BUMP_AMPLITUDE, &args.bump_amplitude),
         (&axes::STEREO_IPD, &args.ipd),
+        (&axes::CAMERA_YAW, &args.camera_yaw),
     ]
     .into_iter()
     .filter_map(|(axis, text)| text.as_deref().map(|t| (axis, t)))

@@ -910,7 +910,11 @@ fn assert_gl_matches_vulkan(
     // `ssr`'s hit tests are knife edges: a reflected ray grazing a depth one rounding apart
     // between the backends hits or misses a pixel, so its reflections' edges and grazing floor
     // samples may differ on up to 2 % of pixels (201 of 14 400 measured on mirror_box).
-    let allowed = if method.name() == "ssr" { n / 50 } else { n / 200 };
+    let allowed = if method.name() == "ssr" {
+        n / 50
+    } else {
+        n / 200
+    };
     if off > allowed {
         let where_ = dump(&format!("gl_{dump_name}"), &out.image, &expected.image);
         panic!("{what} on GL: {off} of {n} pixels differ from Vulkan's; {where_}");

@@ -1,0 +1,340 @@
+//! What engines ship (issue 39) in a report: screen-space reflections (`ssr`) and ray-query
+//! reflections (`ray-query`) beside the exact raster methods and the paper's `auxiliary n=2`.
+//! Two questions, each answered where the sweep's records hold it:
+//!
+//! - **Depth**: error and ms/frame against the depth cap for the depth-swept methods
+//!   (`ray-query`, `unrolled`, `portal`), the one-setting methods drawn at the depth they
+//!   show; the cost of one more bounce per method (least squares over the depths).
+//! - **The screen**: `ssr`'s error over the mirror pixels against the share of them whose
+//!   first reflection is off screen (`reflection_offscreen_share`, from the camera turns of
+//!   `yaw_deg`), one series per fallback, and what each fallback buys.
+//!
+//! The report knows the methods' names and options (`ssr-fallback`), not the rasterizer.
+
+use crate::Record;
+use crate::document::{Block, distinct, f, ms_cell, sci};
+use crate::plot::{Chart, Series, method_style};
+
+/// The yaw axis' name in a record's `axes` (the harness's `CAMERA_YAW`).
+const YAW: &str = "yaw_deg";
+/// The exact methods whose depth is swept here.
+const DEPTH_SWEPT: [&str; 3] = ["ray-query", "unrolled", "portal"];
+
+fn points(records: &[Record]) -> Vec<&Record> {
+    records.iter().filter(|r| r.kind == "point").collect()
+}
+
+/// `ssr`'s fallback (`cubemap` where the key leaves it at its default).
+fn fallback(r: &Record) -> String {
+    r.option("ssr-fallback").unwrap_or("cubemap").to_string()
+}
+
+/// A point's name in a legend or a row: the method, with `ssr`'s fallback and `auxiliary`'s n.
+fn name(r: &Record) -> String {
+    match r.method.as_str() {
+        "ssr" => format!("ssr, fallback {}", fallback(r)),
+        "auxiliary" => format!("auxiliary n={}", r.n.unwrap_or(0)),
+        m => m.to_string(),
+    }
+}
+
+/// The error a point is judged by: FLIP over the mirror pixels where the mask was kept, else
+/// over the image.
+fn mirror_flip(r: &Record) -> f64 {
+    r.mirror_metrics
+        .as_ref()
+        .map_or(r.metrics.flip_mean, |m| m.flip_mean)
+}
+
+/// Least-squares slope of `(x, y)`: ms per extra bounce.
+fn slope(points: &[(f64, f64)]) -> Option<f64> {
+    let n = points.len() as f64;
+    if points.len() < 2 {
+        return None;
+    }
+    let (mx, my) = points
+        .iter()
+        .fold((0.0, 0.0), |(a, b), (x, y)| (a + x / n, b + y / n));
+    let sxx: f64 = points.iter().map(|(x, _)| (x - mx) * (x - mx)).sum();
+    let sxy: f64 = points.iter().map(|(x, y)| (x - mx) * (y - my)).sum();
+    (sxx > 0.0).then(|| sxy / sxx)
+}
+
+/// Spearman's rank correlation of `(x, y)` (ties at their mean rank).
+fn spearman(points: &[(f64, f64)]) -> Option<f64> {
+    let ranks = |v: Vec<f64>| -> Vec<f64> {
+        let mut idx: Vec<usize> = (0..v.len()).collect();
+        idx.sort_by(|&a, &b| v[a].total_cmp(&v[b]));
+        let mut r = vec![0.0; v.len()];
+        let mut i = 0;
+        while i < idx.len() {
+            let mut j = i;
+            while j + 1 < idx.len() && v[idx[j + 1]] == v[idx[i]] {
+                j += 1;
+            }
+            for k in i..=j {
+                r[idx[k]] = (i + j) as f64 / 2.0;
+            }
+            i = j + 1;
+        }
+        r
+    };
+    let xs = ranks(points.iter().map(|p| p.0).collect());
+    let ys = ranks(points.iter().map(|p| p.1).collect());
+    let pairs: Vec<(f64, f64)> = xs.into_iter().zip(ys).collect();
+    let n = pairs.len() as f64;
+    if pairs.len() < 3 {
+        return None;
+    }
+    let (mx, my) = pairs
+        .iter()
+        .fold((0.0, 0.0), |(a, b), (x, y)| (a + x / n, b + y / n));
+    let cov: f64 = pairs.iter().map(|(x, y)| (x - mx) * (y - my)).sum();
+    let vx: f64 = pairs.iter().map(|(x, _)| (x - mx).powi(2)).sum();
+    let vy: f64 = pairs.iter().map(|(_, y)| (y - my).powi(2)).sum();
+    (vx > 0.0 && vy > 0.0).then(|| cov / (vx * vy).sqrt())
+}
+
+/// The section: nothing where the sweep measured neither `ssr` nor `ray-query`.
+pub fn engine_reflections_section(records: &[Record]) -> Vec<Block> {
+    let pts = points(records);
+    if !pts
+        .iter()
+        .any(|r| r.method == "ssr" || r.method == "ray-query")
+    {
+        return Vec::new();
+    }
+    let mut out = vec![Block::Heading(
+        2,
+        "What engines ship: screen-space and ray-query reflections".into(),
+    )];
+    if pts.iter().any(|r| r.axis(YAW).is_some()) {
+        out.extend(screen_blocks(&pts));
+    } else {
+        out.extend(depth_blocks(&pts));
+    }
+    out
+}
+
+/// Error and cost against the depth cap.
+fn depth_blocks(pts: &[&Record]) -> Vec<Block> {
+    let mut out = Vec::new();
+    let mut error = Chart::new(
+        "Error over the mirror pixels against the depth cap",
+        "depth cap (reflections followed)",
+        "FLIP mean over the mirror pixels",
+    );
+    error.x_log = true;
+    error.y_log = true;
+    error.x_ticks_at_data = true;
+    let mut cost = Chart::new(
+        "Cost against the depth cap",
+        "depth cap (reflections followed)",
+        "ms/frame (median)",
+    );
+    cost.x_log = true;
+    cost.y_log = true;
+    cost.x_ticks_at_data = true;
+    let mut sentences = Vec::new();
+    for m in DEPTH_SWEPT {
+        let mut of: Vec<&Record> = pts
+            .iter()
+            .copied()
+            .filter(|r| r.method == m && r.depth.is_some())
+            .collect();
+        of.sort_by_key(|r| r.depth);
+        if of.is_empty() {
+            continue;
+        }
+        let d = |r: &Record| f64::from(r.depth.unwrap_or(0));
+        let style = method_style(m);
+        error.series.push(Series::new(
+            m,
+            style,
+            of.iter().map(|r| (d(r), mirror_flip(r))).collect(),
+        ));
+        let mut s = Series::new(m, style, of.iter().map(|r| (d(r), r.ms_median)).collect());
+        s.y_intervals = of.iter().map(|r| r.ms_interval).collect();
+        cost.series.push(s);
+        let ms: Vec<(f64, f64)> = of.iter().map(|r| (d(r), r.ms_median)).collect();
+        if let (Some(k), Some(first), Some(last)) = (slope(&ms), of.first(), of.last()) {
+            sentences.push(format!(
+                "`{m}`: {} ms/frame at depth {} and {} at depth {}; least squares over the \
+                 depths: {} ms per extra reflection.",
+                ms_cell(first, 2),
+                first.depth.unwrap_or(0),
+                ms_cell(last, 2),
+                last.depth.unwrap_or(0),
+                f(k, 4)
+            ));
+        }
+    }
+    // The one-setting methods, each a point at the depth it shows (not joined: no variable
+    // is swept).
+    for r in pts
+        .iter()
+        .copied()
+        .filter(|r| !DEPTH_SWEPT.contains(&r.method.as_str()))
+    {
+        let depth = r.reflections.max(1) as f64;
+        let style = method_style(&r.method).variant(if r.method == "ssr" {
+            ["none", "cubemap", "planar"]
+                .iter()
+                .position(|f| *f == fallback(r))
+                .unwrap_or(0)
+        } else {
+            0
+        });
+        for (chart, y) in [(&mut error, mirror_flip(r)), (&mut cost, r.ms_median)] {
+            let mut s = Series::new(name(r), style, vec![(depth, y)]);
+            s.joined = false;
+            chart.series.push(s);
+        }
+    }
+    out.push(Block::Paragraph(
+        "`ray-query` follows every mirror pixel's chain on the GPU; `unrolled` and `portal` \
+         draw every reflection path of the scene as raster work; `auxiliary n=2` is the \
+         paper's; `ssr` shows one bounce, what is on screen, and its fallback elsewhere. The \
+         one-setting methods are single points at the reflections they show."
+            .into(),
+    ));
+    out.push(Block::Chart(
+        "engine_error_depth.svg".into(),
+        Box::new(error),
+    ));
+    out.push(Block::Chart("engine_ms_depth.svg".into(), Box::new(cost)));
+    if !sentences.is_empty() {
+        out.push(Block::Bullets(sentences));
+    }
+    out.push(table(pts, false));
+    out
+}
+
+/// `ssr` against the share of reflections off screen, per fallback.
+fn screen_blocks(pts: &[&Record]) -> Vec<Block> {
+    let mut out = Vec::new();
+    let ssr: Vec<&Record> = pts
+        .iter()
+        .copied()
+        .filter(|r| r.method == "ssr" && r.reflection_offscreen_share.is_some())
+        .collect();
+    let mut chart = Chart::new(
+        "ssr: error over the mirror pixels against the reflections off screen",
+        "share of mirror pixels whose first reflection is off screen",
+        "FLIP mean over the mirror pixels",
+    );
+    let fallbacks = distinct(ssr.iter().map(|r| fallback(r)));
+    let mut bullets = Vec::new();
+    for (k, fb) in ["none", "cubemap", "planar"]
+        .iter()
+        .filter(|f| fallbacks.iter().any(|g| g == *f))
+        .enumerate()
+    {
+        let mut of: Vec<&Record> = ssr.iter().copied().filter(|r| fallback(r) == *fb).collect();
+        of.sort_by(|a, b| {
+            a.reflection_offscreen_share
+                .unwrap_or(0.0)
+                .total_cmp(&b.reflection_offscreen_share.unwrap_or(0.0))
+        });
+        let xy: Vec<(f64, f64)> = of
+            .iter()
+            .map(|r| (r.reflection_offscreen_share.unwrap_or(0.0), mirror_flip(r)))
+            .collect();
+        let mut s = Series::new(
+            format!("ssr, fallback {fb}"),
+            method_style("ssr").variant(k),
+            xy.clone(),
+        );
+        // Each point is a camera turn: x is not a swept variable, so no line.
+        s.joined = false;
+        s.labels = of
+            .iter()
+            .map(|r| format!("{}°", r.axis(YAW).unwrap_or(0.0)))
+            .collect();
+        chart.series.push(s);
+        let median = |mut v: Vec<f64>| {
+            v.sort_by(f64::total_cmp);
+            v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
+        };
+        let rho = spearman(&xy).map_or("–".into(), |r| f(r, 2));
+        bullets.push(format!(
+            "fallback `{fb}`: FLIP over the mirror pixels from {} to {} over {} camera turns \
+             (median {}); Spearman's ρ against the off-screen share {rho}; median {} ms/frame.",
+            sci(xy.iter().map(|p| p.1).fold(f64::INFINITY, f64::min)),
+            sci(xy.iter().map(|p| p.1).fold(0.0, f64::max)),
+            xy.len(),
+            sci(median(xy.iter().map(|p| p.1).collect())),
+            f(median(of.iter().map(|r| r.ms_median).collect()), 2),
+        ));
+    }
+    out.push(Block::Paragraph(
+        "Each point is one camera turn (`yaw_deg`, labelled): the same scene with more or less \
+         of what its mirrors reflect on screen. Screen-space reflections cannot show what is \
+         off screen; where the share grows, the fallback carries the image."
+            .into(),
+    ));
+    out.push(Block::Chart("ssr_offscreen.svg".into(), Box::new(chart)));
+    out.push(Block::Bullets(bullets));
+    out.push(table(pts, true));
+    out
+}
+
+/// Every point: method, depth, errors, cost (and the turn and off-screen share).
+fn table(pts: &[&Record], screen: bool) -> Block {
+    let mut header = vec!["method".to_string()];
+    if screen {
+        header.push("yaw".into());
+        header.push("off screen".into());
+    } else {
+        header.push("reflections".into());
+    }
+    for h in [
+        "FLIP mean",
+        "FLIP, mirror pixels",
+        "ms/frame (95 % CI)",
+        "passes",
+    ] {
+        header.push(h.into());
+    }
+    let rows = pts
+        .iter()
+        .map(|r| {
+            let mut row = vec![format!("`{}`", name(r))];
+            if screen {
+                row.push(r.axis(YAW).map_or("–".into(), |y| format!("{y}°")));
+                row.push(
+                    r.reflection_offscreen_share
+                        .map_or("–".into(), |s| format!("{} %", f(100.0 * s, 1))),
+                );
+            } else {
+                row.push(r.depth.unwrap_or(r.reflections as u32).to_string());
+            }
+            row.push(sci(r.metrics.flip_mean));
+            row.push(
+                r.mirror_metrics
+                    .as_ref()
+                    .map_or("–".into(), |m| sci(m.flip_mean)),
+            );
+            row.push(ms_cell(r, 2));
+            row.push(r.passes.to_string());
+            row
+        })
+        .collect();
+    Block::Table(header, rows)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn slope_and_rank_correlation() {
+        assert_eq!(slope(&[(1.0, 3.0), (2.0, 5.0), (4.0, 9.0)]), Some(2.0));
+        assert_eq!(slope(&[(1.0, 3.0)]), None);
+        let rising = [(0.1, 1.0), (0.2, 4.0), (0.5, 9.0), (0.9, 20.0)];
+        assert!((spearman(&rising).unwrap() - 1.0).abs() < 1e-12);
+        let falling: Vec<(f64, f64)> = rising.iter().map(|&(x, y)| (x, -y)).collect();
+        assert!((spearman(&falling).unwrap() + 1.0).abs() < 1e-12);
+        assert_eq!(spearman(&rising[..2]), None);
+    }
+}
