@@ -9,6 +9,7 @@ use crate::{Experiment, Measure, beside};
 use mirrorbox_harness::axes::{AxisValues, CAMERA_YAW};
 use mirrorbox_harness::{SweepConfig, swept};
 use mirrorbox_raster::Method;
+use mirrorbox_trace::WhittedSettings;
 use std::path::{Path, PathBuf};
 
 fn parse(m: &str) -> Method {
@@ -50,18 +51,28 @@ fn depth_sweep(scene: &str, out: &Path, deepest: u32, raster_deepest: u32) -> Sw
     sweep(scene, out, methods, Vec::new())
 }
 
-/// `ssr` with each fallback, the camera turned from −90° to 90° in steps of 22.5°.
+/// `ssr` with each fallback, the camera turned from −90° to 90° in steps of 22.5°, against
+/// the **one-bounce** truth (`--max-depth 1`): `ssr` shows one bounce, so what remains is what
+/// the screen lacks (and its march's artefacts), not the deeper reflections no one-bounce
+/// method shows (those are the depth sweeps' question). `planar` is exact at one bounce: its
+/// error is the march's alone.
 fn screen_sweep(scene: &str, out: &Path) -> SweepConfig {
     let yaws = (-4..=4).map(|k| Some(22.5 * f64::from(k))).collect();
-    sweep(
-        scene,
-        out,
-        ssr_methods(),
-        vec![AxisValues {
-            axis: &CAMERA_YAW,
-            values: yaws,
-        }],
-    )
+    SweepConfig {
+        truth: WhittedSettings {
+            max_depth: 1,
+            ..WhittedSettings::default()
+        },
+        ..sweep(
+            scene,
+            out,
+            ssr_methods(),
+            vec![AxisValues {
+                axis: &CAMERA_YAW,
+                values: yaws,
+            }],
+        )
+    }
 }
 
 pub const ENGINE_REFLECTIONS: Experiment = Experiment {

@@ -4,7 +4,7 @@
 //!
 //! - **Depth**: error and ms/frame against the depth cap for the depth-swept methods
 //!   (`ray-query`, `unrolled`, `portal`), the one-setting methods drawn at the depth they
-//!   show; the cost of one more bounce per method (least squares over the depths).
+//!   show; how each method's cost grows (the last doubling of the depth's factor).
 //! - **The screen**: `ssr`'s error over the mirror pixels against the share of them whose
 //!   first reflection is off screen (`reflection_offscreen_share`, from the camera turns of
 //!   `yaw_deg`), one series per fallback, and what each fallback buys.
@@ -29,6 +29,20 @@ fn fallback(r: &Record) -> String {
     r.option("ssr-fallback").unwrap_or("cubemap").to_string()
 }
 
+/// `ssr`'s style with one marker per fallback (single points show no dash): square for
+/// `none`, hollow square for `cubemap`, diamond for `planar`.
+fn ssr_style(fallback: &str) -> crate::plot::Style {
+    let base = method_style("ssr");
+    match fallback {
+        "cubemap" => base.variant(1),
+        "planar" => crate::plot::Style {
+            marker: crate::plot::Marker::Diamond,
+            ..base.variant(2)
+        },
+        _ => base,
+    }
+}
+
 /// A point's name in a legend or a row: the method, with `ssr`'s fallback and `auxiliary`'s n.
 fn name(r: &Record) -> String {
     match r.method.as_str() {
@@ -44,20 +58,6 @@ fn mirror_flip(r: &Record) -> f64 {
     r.mirror_metrics
         .as_ref()
         .map_or(r.metrics.flip_mean, |m| m.flip_mean)
-}
-
-/// Least-squares slope of `(x, y)`: ms per extra bounce.
-fn slope(points: &[(f64, f64)]) -> Option<f64> {
-    let n = points.len() as f64;
-    if points.len() < 2 {
-        return None;
-    }
-    let (mx, my) = points
-        .iter()
-        .fold((0.0, 0.0), |(a, b), (x, y)| (a + x / n, b + y / n));
-    let sxx: f64 = points.iter().map(|(x, _)| (x - mx) * (x - mx)).sum();
-    let sxy: f64 = points.iter().map(|(x, y)| (x - mx) * (y - my)).sum();
-    (sxx > 0.0).then(|| sxy / sxx)
 }
 
 /// Spearman's rank correlation of `(x, y)` (ties at their mean rank).
@@ -96,7 +96,8 @@ fn spearman(points: &[(f64, f64)]) -> Option<f64> {
 }
 
 /// The section: nothing where the sweep measured neither `ssr` nor `ray-query`.
-pub fn engine_reflections_section(records: &[Record]) -> Vec<Block> {
+/// `truth`: the sweep's truth in words (the screen sweeps compare with the one-bounce truth).
+pub fn engine_reflections_section(records: &[Record], truth: &str) -> Vec<Block> {
     let pts = points(records);
     if !pts
         .iter()
@@ -109,7 +110,7 @@ pub fn engine_reflections_section(records: &[Record]) -> Vec<Block> {
         "What engines ship: screen-space and ray-query reflections".into(),
     )];
     if pts.iter().any(|r| r.axis(YAW).is_some()) {
-        out.extend(screen_blocks(&pts));
+        out.extend(screen_blocks(&pts, truth));
     } else {
         out.extend(depth_blocks(&pts));
     }
@@ -156,16 +157,22 @@ fn depth_blocks(pts: &[&Record]) -> Vec<Block> {
         let mut s = Series::new(m, style, of.iter().map(|r| (d(r), r.ms_median)).collect());
         s.y_intervals = of.iter().map(|r| r.ms_interval).collect();
         cost.series.push(s);
-        let ms: Vec<(f64, f64)> = of.iter().map(|r| (d(r), r.ms_median)).collect();
-        if let (Some(k), Some(first), Some(last)) = (slope(&ms), of.first(), of.last()) {
+        // The last doubling's factor says how the cost grows: near 1 where a bounce costs
+        // little beside the frame, near 2 where it grows linearly with the depth, far above
+        // where the paths branch (the room).
+        if let [.., prev, last] = &of[..]
+            && let Some(first) = of.first()
+        {
             sentences.push(format!(
-                "`{m}`: {} ms/frame at depth {} and {} at depth {}; least squares over the \
-                 depths: {} ms per extra reflection.",
+                "`{m}`: {} ms/frame at depth {} and {} at depth {}; the last doubling of the \
+                 depth ({} → {}) took the time ×{}.",
                 ms_cell(first, 2),
                 first.depth.unwrap_or(0),
                 ms_cell(last, 2),
                 last.depth.unwrap_or(0),
-                f(k, 4)
+                prev.depth.unwrap_or(0),
+                last.depth.unwrap_or(0),
+                f(last.ms_median / prev.ms_median, 2)
             ));
         }
     }
@@ -177,14 +184,11 @@ fn depth_blocks(pts: &[&Record]) -> Vec<Block> {
         .filter(|r| !DEPTH_SWEPT.contains(&r.method.as_str()))
     {
         let depth = r.reflections.max(1) as f64;
-        let style = method_style(&r.method).variant(if r.method == "ssr" {
-            ["none", "cubemap", "planar"]
-                .iter()
-                .position(|f| *f == fallback(r))
-                .unwrap_or(0)
+        let style = if r.method == "ssr" {
+            ssr_style(&fallback(r))
         } else {
-            0
-        });
+            method_style(&r.method)
+        };
         for (chart, y) in [(&mut error, mirror_flip(r)), (&mut cost, r.ms_median)] {
             let mut s = Series::new(name(r), style, vec![(depth, y)]);
             s.joined = false;
@@ -211,7 +215,7 @@ fn depth_blocks(pts: &[&Record]) -> Vec<Block> {
 }
 
 /// `ssr` against the share of reflections off screen, per fallback.
-fn screen_blocks(pts: &[&Record]) -> Vec<Block> {
+fn screen_blocks(pts: &[&Record], truth: &str) -> Vec<Block> {
     let mut out = Vec::new();
     let ssr: Vec<&Record> = pts
         .iter()
@@ -225,10 +229,9 @@ fn screen_blocks(pts: &[&Record]) -> Vec<Block> {
     );
     let fallbacks = distinct(ssr.iter().map(|r| fallback(r)));
     let mut bullets = Vec::new();
-    for (k, fb) in ["none", "cubemap", "planar"]
+    for fb in ["none", "cubemap", "planar"]
         .iter()
         .filter(|f| fallbacks.iter().any(|g| g == *f))
-        .enumerate()
     {
         let mut of: Vec<&Record> = ssr.iter().copied().filter(|r| fallback(r) == *fb).collect();
         of.sort_by(|a, b| {
@@ -240,11 +243,7 @@ fn screen_blocks(pts: &[&Record]) -> Vec<Block> {
             .iter()
             .map(|r| (r.reflection_offscreen_share.unwrap_or(0.0), mirror_flip(r)))
             .collect();
-        let mut s = Series::new(
-            format!("ssr, fallback {fb}"),
-            method_style("ssr").variant(k),
-            xy.clone(),
-        );
+        let mut s = Series::new(format!("ssr, fallback {fb}"), ssr_style(fb), xy.clone());
         // Each point is a camera turn: x is not a swept variable, so no line.
         s.joined = false;
         s.labels = of
@@ -267,12 +266,13 @@ fn screen_blocks(pts: &[&Record]) -> Vec<Block> {
             f(median(of.iter().map(|r| r.ms_median).collect()), 2),
         ));
     }
-    out.push(Block::Paragraph(
+    out.push(Block::Paragraph(format!(
         "Each point is one camera turn (`yaw_deg`, labelled): the same scene with more or less \
-         of what its mirrors reflect on screen. Screen-space reflections cannot show what is \
-         off screen; where the share grows, the fallback carries the image."
-            .into(),
-    ));
+         of what its mirrors reflect on screen, against the truth `{truth}` — one bounce, what \
+         `ssr` shows at best, so the error left is what the screen lacks and the march's \
+         artefacts, not the deeper reflections. Where the share grows the fallback carries the \
+         image; `planar` is exact at one bounce, so its error is the march's alone."
+    )));
     out.push(Block::Chart("ssr_offscreen.svg".into(), Box::new(chart)));
     out.push(Block::Bullets(bullets));
     out.push(table(pts, true));
@@ -288,12 +288,7 @@ fn table(pts: &[&Record], screen: bool) -> Block {
     } else {
         header.push("reflections".into());
     }
-    for h in [
-        "FLIP mean",
-        "FLIP, mirror pixels",
-        "ms/frame (95 % CI)",
-        "passes",
-    ] {
+    for h in ["FLIP mean", "FLIP, mirror pixels", "ms/frame", "passes"] {
         header.push(h.into());
     }
     let rows = pts
@@ -328,9 +323,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn slope_and_rank_correlation() {
-        assert_eq!(slope(&[(1.0, 3.0), (2.0, 5.0), (4.0, 9.0)]), Some(2.0));
-        assert_eq!(slope(&[(1.0, 3.0)]), None);
+    fn rank_correlation() {
         let rising = [(0.1, 1.0), (0.2, 4.0), (0.5, 9.0), (0.9, 20.0)];
         assert!((spearman(&rising).unwrap() - 1.0).abs() < 1e-12);
         let falling: Vec<(f64, f64)> = rising.iter().map(|&(x, y)| (x, -y)).collect();

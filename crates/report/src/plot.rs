@@ -94,8 +94,8 @@ pub fn method_style(method: &str) -> Style {
         "symmetry-baked" => (COLORS[4], Square),
         "feedback" => (COLORS[5], Diamond),
         "cubemap" => (COLORS[3], Cross),
-        "ssr" => (COLORS[1], Square),
-        "ray-query" => (COLORS[2], TriangleUp),
+        "ssr" => (COLORS[5], Square),
+        "ray-query" => (COLORS[6], TriangleUp),
         "truth" => (COLORS[6], Cross),
         other => {
             let h = other

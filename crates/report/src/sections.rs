@@ -39,6 +39,6 @@ pub fn stereo(_: &SweepInfo, records: &[Record]) -> Vec<Block> {
 
 /// Screen-space and ray-query reflections beside the exact methods
 /// ([`crate::engine_reflections`]).
-pub fn engine_reflections(_: &SweepInfo, records: &[Record]) -> Vec<Block> {
-    crate::engine_reflections::engine_reflections_section(records)
+pub fn engine_reflections(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
+    crate::engine_reflections::engine_reflections_section(records, &info.truth)
 }

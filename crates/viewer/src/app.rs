@@ -181,7 +181,16 @@ impl App {
             .bounds()
             .map_or(1.0, |(lo, hi)| 0.25 * lo.distance(hi))
             .clamp(0.05, 20.0);
-        let mut session = Session::new(o.scene.clone(), o.method.clone(), o.ssaa, o.size);
+        let truth_device = o
+            .truth_device
+            .unwrap_or_else(|| crate::live_truth::TruthDevice::auto(&gpu.report, gpu.features));
+        let mut session = Session::new(
+            o.scene.clone(),
+            o.method.clone(),
+            o.ssaa,
+            o.size,
+            truth_device,
+        );
         session.memory_budget = o.memory_budget;
         let mut ui = panel::UiState::new(o.vsync);
         ui.speed = speed;

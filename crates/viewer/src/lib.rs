@@ -51,6 +51,8 @@ pub struct ViewOptions {
     pub vsync: bool,
     /// Where the screenshot key writes.
     pub out_dir: PathBuf,
+    /// Where the live truth is traced; `None`: [`live_truth::TruthDevice::auto`].
+    pub truth_device: Option<live_truth::TruthDevice>,
 }
 
 #[derive(Debug, thiserror::Error)]

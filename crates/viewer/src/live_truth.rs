@@ -11,6 +11,12 @@
 //! One worker thread owns the BVH (built once: the camera does not change the geometry) and
 //! traces with rayon; a new request bumps a generation counter that the running render
 //! checks before every row, so a stale view is abandoned within one row per thread.
+//!
+//! On the GPU ([`TruthDevice::Gpu`], issue 39) the worker opens a device of its own and
+//! traces each level with `ray-query --primary rays` (`trace --device gpu`: the same paths
+//! in f32, equal to the CPU truth within float precision); a level is one frame, so a stale
+//! view is abandoned between levels. Where no adapter has ray queries it says so and traces
+//! on the CPU. The CPU truth stays the reference of every report.
 
 use mirrorbox_image::RgbImage;
 use mirrorbox_scene::{Camera, Scene};
@@ -22,6 +28,36 @@ use std::time::{Duration, Instant};
 
 /// Downscale factors of the coarse levels, before the full-size level.
 pub const COARSE_LEVELS: [u32; 3] = [8, 4, 2];
+
+/// Where the live truth is traced.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TruthDevice {
+    /// The CPU tracer (obvhs, rayon).
+    Cpu,
+    /// wgpu ray queries on a device of the worker's own.
+    Gpu,
+}
+
+impl TruthDevice {
+    /// `--truth auto`: the GPU where the viewer's adapter has ray queries and is a real GPU;
+    /// on a CPU adapter (lavapipe) the GPU truth runs on the same cores as the CPU tracer and
+    /// was measured slower than it (`reports/gpu_truth/report.md`), so the CPU traces.
+    pub fn auto(report: &mirrorbox_raster::AdapterReport, features: wgpu::Features) -> Self {
+        if features.contains(wgpu::Features::EXPERIMENTAL_RAY_QUERY) && report.device_type != "Cpu"
+        {
+            TruthDevice::Gpu
+        } else {
+            TruthDevice::Cpu
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            TruthDevice::Cpu => "CPU tracer",
+            TruthDevice::Gpu => "GPU ray queries",
+        }
+    }
+}
 
 /// What to trace: the camera (its size is the view's) and the sub-pixel grid side.
 #[derive(Clone, Debug, PartialEq)]
@@ -68,6 +104,8 @@ struct Shared {
     latest: Mutex<Option<TruthLevel>>,
     /// Set when the viewer closes.
     closing: std::sync::atomic::AtomicBool,
+    /// Where the worker traces (the GPU asked for, and the CPU where that failed).
+    device: Mutex<(TruthDevice, Option<String>)>,
 }
 
 /// The background tracer. Dropping it stops the worker (after its current row).
@@ -78,14 +116,16 @@ pub struct LiveTruth {
 }
 
 impl LiveTruth {
-    /// Starts the worker for `scene` (the camera of each request replaces the scene's).
-    pub fn start(scene: Arc<Scene>) -> Self {
+    /// Starts the worker for `scene` (the camera of each request replaces the scene's),
+    /// tracing on `device`.
+    pub fn start(scene: Arc<Scene>, device: TruthDevice) -> Self {
         let shared = Arc::new(Shared {
             request: Mutex::new(None),
             wake: Condvar::new(),
             generation: AtomicU64::new(0),
             latest: Mutex::new(None),
             closing: Default::default(),
+            device: Mutex::new((device, None)),
         });
         let for_worker = shared.clone();
         let worker = std::thread::Builder::new()
@@ -108,6 +148,11 @@ impl LiveTruth {
         let generation = self.shared.generation.fetch_add(1, Ordering::SeqCst) + 1;
         *self.shared.request.lock().expect("truth request") = Some((generation, request));
         self.shared.wake.notify_all();
+    }
+
+    /// Where the truth is traced, and why not on the GPU where that was asked for and failed.
+    pub fn device(&self) -> (TruthDevice, Option<String>) {
+        self.shared.device.lock().expect("truth device").clone()
     }
 
     /// The generation of the current request.
@@ -147,7 +192,31 @@ impl Drop for LiveTruth {
     }
 }
 
+/// The GPU of the worker, where it traces on one: a device of its own with ray queries, or
+/// why not (then it traces on the CPU).
+fn open_gpu(shared: &Shared) -> Option<mirrorbox_raster::Gpu> {
+    if shared.device.lock().expect("truth device").0 != TruthDevice::Gpu {
+        return None;
+    }
+    let failed = |why: String| {
+        *shared.device.lock().expect("truth device") = (TruthDevice::Cpu, Some(why));
+        None
+    };
+    match mirrorbox_raster::Gpu::new() {
+        Ok(gpu)
+            if gpu
+                .features
+                .contains(wgpu::Features::EXPERIMENTAL_RAY_QUERY) =>
+        {
+            Some(gpu)
+        }
+        Ok(gpu) => failed(format!("{} has no ray queries", gpu.report.name)),
+        Err(e) => failed(e.to_string()),
+    }
+}
+
 fn work(scene: &Scene, shared: &Shared) {
+    let gpu = open_gpu(shared);
     let bvh = SceneBvh::build(&scene.geometry);
     // One mono copy whose camera each level replaces.
     let mut view = scene.clone();
@@ -171,18 +240,23 @@ fn work(scene: &Scene, shared: &Shared) {
         for level in 0..level_count() {
             let (camera, grid_side) = level_setup(&request, level);
             view.camera = camera;
-            let settings = TraceSettings::whitted(grid_side);
-            let Some(out) =
-                mirrorbox_trace::render_while(&view, &bvh, &settings, &|_| {}, &current)
-            else {
+            let traced = match &gpu {
+                Some(gpu) => trace_on_gpu(gpu, &view, grid_side),
+                None => {
+                    let settings = TraceSettings::whitted(grid_side);
+                    mirrorbox_trace::render_while(&view, &bvh, &settings, &|_| {}, &current)
+                        .map(|out| (out.image, out.wall))
+                }
+            };
+            let Some((image, trace_time)) = traced else {
                 break;
             };
             let finished = TruthLevel {
                 generation,
                 level,
                 complete: level + 1 == level_count(),
-                image: Arc::new(out.image),
-                trace_time: out.wall,
+                image: Arc::new(image),
+                trace_time,
             };
             if !current() {
                 break;
@@ -191,6 +265,26 @@ fn work(scene: &Scene, shared: &Shared) {
         }
         done_generation = generation;
     }
+}
+
+/// One level on the GPU: `trace --device gpu` of `view` on the `grid_side²` grid, to the
+/// CPU truth's depth and throughput cut (the depth capped at the GPU's 4096). `None` where the
+/// device fails (the level is not shown).
+fn trace_on_gpu(
+    gpu: &mirrorbox_raster::Gpu,
+    view: &Scene,
+    grid_side: u32,
+) -> Option<(RgbImage, Duration)> {
+    let truth = mirrorbox_trace::WhittedSettings::default();
+    let settings = mirrorbox_raster::methods::ray_query::gpu_truth_settings(
+        grid_side,
+        truth.max_depth,
+        truth.min_throughput,
+    )
+    .ok()?;
+    let start = Instant::now();
+    let out = mirrorbox_raster::render(gpu, view, &settings).ok()?;
+    Some((out.image, start.elapsed()))
 }
 
 #[cfg(test)]
@@ -209,7 +303,7 @@ mod tests {
     #[test]
     fn the_last_level_is_the_offline_trace_bit_for_bit() {
         let scene = small_scene();
-        let mut truth = LiveTruth::start(Arc::new(scene.clone()));
+        let mut truth = LiveTruth::start(Arc::new(scene.clone()), TruthDevice::Cpu);
         truth.request(TruthRequest {
             camera: scene.camera.clone(),
             grid_side: 2,
@@ -227,7 +321,7 @@ mod tests {
     #[test]
     fn a_new_view_replaces_the_old_one_and_levels_grow() {
         let scene = small_scene();
-        let mut truth = LiveTruth::start(Arc::new(scene.clone()));
+        let mut truth = LiveTruth::start(Arc::new(scene.clone()), TruthDevice::Cpu);
         let first = TruthRequest {
             camera: scene.camera.clone(),
             grid_side: 1,

@@ -302,7 +302,8 @@ fn controls(
     ui.separator();
 
     // Truth and error.
-    ui.checkbox(&mut session.truth_enabled, "live truth (CPU tracer)");
+    ui.checkbox(&mut session.truth_enabled, "live truth");
+    ui.small(session.truth_device());
     ui.small(session.truth_progress());
     ui.horizontal(|ui| {
         ui.label("error map");

@@ -4,7 +4,7 @@
 
 use crate::error_view::{ErrorImage, ErrorMode, error_image};
 use crate::fly_camera::FlyCamera;
-use crate::live_truth::{LiveTruth, TruthLevel, TruthRequest, level_count};
+use crate::live_truth::{LiveTruth, TruthDevice, TruthLevel, TruthRequest, level_count};
 use mirrorbox_image::RgbImage;
 use mirrorbox_raster::{BuiltView, FrameStats, Gpu, Method, RasterError, RenderSettings};
 use mirrorbox_scene::{Camera, Scene};
@@ -184,13 +184,19 @@ pub struct Session {
 }
 
 impl Session {
-    pub fn new(scene: Scene, method: Method, ssaa: u32, size: (u32, u32)) -> Self {
+    pub fn new(
+        scene: Scene,
+        method: Method,
+        ssaa: u32,
+        size: (u32, u32),
+        truth_device: TruthDevice,
+    ) -> Self {
         let mut scene = scene;
         scene.stereo = None;
         scene.head = None;
         Session {
             camera: FlyCamera::new(scene.camera.clone()),
-            truth: LiveTruth::start(Arc::new(scene.clone())),
+            truth: LiveTruth::start(Arc::new(scene.clone()), truth_device),
             scene,
             method,
             ssaa,
@@ -436,6 +442,14 @@ impl Session {
     }
 
     /// Which level the truth pane shows, in words.
+    /// Where the live truth is traced, in words (and why not on the GPU, where that failed).
+    pub fn truth_device(&self) -> String {
+        match self.truth.device() {
+            (device, None) => device.name().into(),
+            (device, Some(why)) => format!("{} (GPU truth unavailable: {why})", device.name()),
+        }
+    }
+
     pub fn truth_progress(&self) -> String {
         match &self.truth_shown {
             _ if !self.truth_enabled => "off".into(),

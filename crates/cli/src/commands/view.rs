@@ -52,8 +52,20 @@ pub struct Args {
     /// Folder the screenshot and save-camera keys write into (default: the current folder).
     #[arg(long, default_value = ".")]
     out: PathBuf,
+    /// Where the live truth is traced: cpu (the tracer), gpu (ray queries on the adapter,
+    /// `trace --device gpu`), or auto: the GPU where the adapter has ray queries and is not a
+    /// CPU (on lavapipe the GPU truth runs on the same cores and is slower than the tracer).
+    #[arg(long, value_enum, default_value_t = TruthDeviceArg::Auto)]
+    truth: TruthDeviceArg,
     #[command(flatten)]
     memory: super::MemoryBudgetArgs,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum TruthDeviceArg {
+    Auto,
+    Cpu,
+    Gpu,
 }
 
 fn parse_size(text: &str) -> Result<(u32, u32), String> {
@@ -156,6 +168,11 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         log: args.log.clone(),
         vsync: !args.no_vsync,
         out_dir: args.out.clone(),
+        truth_device: match args.truth {
+            TruthDeviceArg::Auto => None,
+            TruthDeviceArg::Cpu => Some(mirrorbox_viewer::live_truth::TruthDevice::Cpu),
+            TruthDeviceArg::Gpu => Some(mirrorbox_viewer::live_truth::TruthDevice::Gpu),
+        },
     };
     mirrorbox_viewer::run(options).map_err(|e| match e {
         ViewError::Refused(m) => Failure::BadInput(m),
