@@ -709,7 +709,7 @@ fn render_refuses_bad_arguments() {
         ),
         (
             &["--method", "auxiliary", "--depth", "8"],
-            "--depth applies to --method path-textures, portal or unrolled only",
+            "--depth applies to --method path-textures, portal, unrolled or ray-query only",
         ),
         (
             &["--method", "portal", "--fragment-clipping"],
@@ -728,7 +728,7 @@ fn render_refuses_bad_arguments() {
         ),
         (
             &["--method", "naive", "--min-attenuation", "0.01"],
-            "--min-attenuation applies to --method path-textures, portal or unrolled only",
+            "--min-attenuation applies to --method path-textures, portal, unrolled or ray-query only",
         ),
         (
             &["--method", "portal", "--texture-scale", "2"],
@@ -736,7 +736,7 @@ fn render_refuses_bad_arguments() {
         ),
         (
             &["--method", "naive", "--depth", "0"],
-            "--depth applies to --method path-textures, portal or unrolled only",
+            "--depth applies to --method path-textures, portal, unrolled or ray-query only",
         ),
         (
             &["--method", "symmetry", "--symmetry-draws", "bogus"],

@@ -305,9 +305,39 @@ mod tests {
         assert_eq!(BUMP_AMPLITUDE.text(2.5), "2.5");
         assert_eq!(SYMMETRY_PLANES.text(3.0), "3");
         let names: Vec<&str> = AXES.iter().map(|a| a.name).collect();
+        // Frozen: an axis is appended, never renamed (issue 39 added `yaw_deg`).
         assert_eq!(
             names,
-            ["planes", "mirrored_lights", "bump_deg", "stereo_ipd"]
+            [
+                "planes",
+                "mirrored_lights",
+                "bump_deg",
+                "stereo_ipd",
+                "yaw_deg"
+            ]
         );
+        assert_eq!(CAMERA_YAW.text(-22.5), "-22.5");
+    }
+
+    #[test]
+    fn a_camera_turn_looks_left_for_positive_degrees_and_keeps_the_position() {
+        let base = mirrorbox_scene::load::bundled_scene("mirror_box.json");
+        let mut scene = base.clone();
+        (CAMERA_YAW.apply)(&base, &mut scene, 90.0).unwrap();
+        let (c0, c1) = (&base.camera, &scene.camera);
+        assert_eq!(c0.position, c1.position);
+        let (f0, f1) = (c0.look_at - c0.position, c1.look_at - c1.position);
+        assert!((f0.length() - f1.length()).abs() < 1e-4);
+        // About the up axis: the part along it kept, the rest turned a quarter.
+        let up = c0.up.normalize();
+        let flat = |f: glam::Vec3| f - up * f.dot(up);
+        assert!((f0.dot(up) - f1.dot(up)).abs() < 1e-4);
+        assert!(
+            flat(f0).dot(flat(f1)).abs() < 1e-4 * f0.length_squared(),
+            "a quarter turn"
+        );
+        // Left of the old view: along −right = up × forward.
+        let left = c0.up.cross(f0);
+        assert!(f1.dot(left) > 0.0, "{f0} → {f1}");
     }
 }

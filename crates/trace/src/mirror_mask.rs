@@ -121,4 +121,33 @@ mod tests {
                 .any(|m| *m)
         );
     }
+
+    /// The paper's box, seen towards one mirror: most of what it reflects lies behind the
+    /// camera (off screen); only mirror pixels are flagged, and a scene without mirrors has
+    /// none.
+    #[test]
+    fn reflections_behind_the_camera_are_off_screen() {
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/mirror_box.json");
+        let mut scene = mirrorbox_scene::load::load_scene(&path).unwrap();
+        scene.camera.width = 64;
+        scene.camera.height = 36;
+        let bvh = SceneBvh::build(&scene.geometry);
+        let grid = SubpixelGrid::new(1);
+        let mask = mirror_mask(&scene, &bvh, grid);
+        let off = reflections_off_screen(&scene, &bvh, grid);
+        assert!(
+            off.iter().zip(&mask).all(|(o, m)| !o || *m),
+            "only mirror pixels"
+        );
+        let mirrors = mask.iter().filter(|m| **m).count();
+        let away = off.iter().filter(|o| **o).count();
+        assert!(
+            2 * away > mirrors,
+            "{away} of {mirrors} mirror pixels off screen"
+        );
+        let bare = scene.without_mirrors();
+        let bvh = SceneBvh::build(&bare.geometry);
+        assert!(!reflections_off_screen(&bare, &bvh, grid).contains(&true));
+    }
 }
