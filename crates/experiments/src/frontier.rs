@@ -18,6 +18,12 @@ fn sweep(scene: &str, out: &Path, n: &[u32], depths: &[u32], path_textures: bool
     }
     methods.extend(swept("portal", depths.iter().copied()));
     methods.extend(swept("unrolled", depths.iter().copied()));
+    // What engines ship (issue 39): ray queries at the same depths, screen-space reflections
+    // with each fallback.
+    methods.extend(swept("ray-query", depths.iter().copied()));
+    for fallback in ["none", "cubemap", "planar"] {
+        methods.push(parse(&format!("ssr ssr-fallback={fallback}")));
+    }
     methods.push(parse("feedback history=16"));
     for size in [128, 512] {
         methods.push(parse(&format!("cubemap cube-size={size} history=16")));

@@ -140,12 +140,10 @@ pub(crate) fn frontiers(sweeps: &[(String, Sweep)]) -> Vec<Frontier> {
             if scene_stem(&sweep.info.scene) != scene {
                 continue;
             }
+            // The scene as its file has it: a point with a scene axis (mirrored lights, a
+            // tilt, a camera turn, …) or a stereo pair is another scene.
             for r in sweep.records.iter().filter(|r| {
-                r.kind == "point"
-                    && r.lights_depth().is_none()
-                    && r.tilt_deg().is_none()
-                    && r.stereo.is_none()
-                    && r.device.is_none()
+                r.kind == "point" && r.axes.is_empty() && r.stereo.is_none() && r.device.is_none()
             }) {
                 let key = (
                     device_slug(&sweep.info),
