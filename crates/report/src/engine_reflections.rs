@@ -29,16 +29,13 @@ fn fallback(r: &Record) -> String {
     r.option("ssr-fallback").unwrap_or("cubemap").to_string()
 }
 
-/// `ssr`'s style with one marker per fallback (single points show no dash): square for
-/// `none`, hollow square for `cubemap`, diamond for `planar`.
+/// `ssr`'s style per fallback, the variants the overview gives them in key order (`none`,
+/// the default `cubemap`, `planar`): square, hollow square, triangle.
 fn ssr_style(fallback: &str) -> crate::plot::Style {
     let base = method_style("ssr");
     match fallback {
         "cubemap" => base.variant(1),
-        "planar" => crate::plot::Style {
-            marker: crate::plot::Marker::Diamond,
-            ..base.variant(2)
-        },
+        "planar" => base.variant(2),
         _ => base,
     }
 }

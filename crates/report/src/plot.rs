@@ -66,13 +66,19 @@ pub struct Style {
 const DASHES: [&str; 6] = ["", "7 4", "2 3", "8 3 2 3", "12 3", "2 2 6 2"];
 
 impl Style {
-    /// The `k`-th variant of a method: same colour and marker, another dash, hollow markers
-    /// from the second variant on.
+    /// The `k`-th variant of a method: same colour, another dash, hollow markers for odd
+    /// `k`, and from the third variant on the next markers of [`Marker::ALL`] (so that
+    /// variants drawn as points alone, where no dash shows, stay apart: `ssr`'s fallbacks).
     pub fn variant(self, k: usize) -> Style {
+        let at = Marker::ALL
+            .iter()
+            .position(|m| *m == self.marker)
+            .unwrap_or(0);
         Style {
             dash: DASHES[k % DASHES.len()],
             // Eight distinct (dash, fill) pairs before one repeats.
             hollow: (k + k / DASHES.len()) % 2 == 1,
+            marker: Marker::ALL[(at + k / 2) % Marker::ALL.len()],
             ..self
         }
     }
