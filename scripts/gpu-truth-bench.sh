@@ -6,7 +6,8 @@
 # reports/gpu_truth/runs.jsonl (one `trace --json` line per run, with round and device) and
 # reports/gpu_truth/report.md: per scene and device the median and range of the render time
 # (CPU: render_seconds; GPU: the frame's trace_ms, acceleration structures apart), and the
-# largest |Δ| between the two images and their FLIP mean.
+# largest |Δ| between the two images and their FLIP mean, with each scene's FLIP map
+# (reports/gpu_truth/mirror_SCENE_flip.png: where they differ).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bin=${MIRRORBOX:-target/release/mirrorbox}
@@ -27,7 +28,8 @@ for round in $(seq 1 "$rounds"); do
 done
 mv "$tmp" "$dir/runs.jsonl"
 for scene in box room; do
-  "$bin" compare "$work/${scene}_gpu.exr" "$work/${scene}_cpu.exr" --json >"$work/$scene.compare.json"
+  "$bin" compare "$work/${scene}_cpu.exr" "$work/${scene}_gpu.exr" --json \
+    --heatmap "$dir/mirror_${scene}_flip.png" >"$work/$scene.compare.json"
 done
 adapter=$("$bin" info 2>/dev/null | sed -n 's/^adapter: *//p' | head -1)
 python3 - "$dir" "$work" "$adapter" <<'PY'
@@ -62,6 +64,7 @@ lines += ["", "| scene | max abs. difference, GPU vs CPU | FLIP mean |", "|---|-
 for scene in ["box", "room"]:
     c = json.load(open(f"{work}/{scene}.compare.json"))
     lines.append(f"| mirror_{scene} | {c['max_abs']:.2e} | {c['flip_mean']:.2e} |")
+lines += ["", "Where they differ: the FLIP maps `mirror_box_flip.png`, `mirror_room_flip.png` beside this file."]
 open(f"{out}/report.md", "w").write("\n".join(lines) + "\n")
 print("\n".join(lines))
 PY
