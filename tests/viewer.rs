@@ -549,3 +549,55 @@ fn feedback_grows_one_reflection_per_frame_in_the_viewer() {
         "the viewer's frame with {shown} reflections is render --history {history}"
     );
 }
+
+/// `view --truth gpu` (issue 39): the live truth traced by ray queries on the viewer's own
+/// device is `trace --device gpu`'s image bit for bit, and within float precision of the CPU
+/// truth; the method pane is `ray-query`'s `render`.
+#[test]
+fn the_gpu_live_truth_is_trace_on_the_gpu() {
+    let Some(x) = display_or_skip() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let p = |name: &str| d.join(name).to_str().unwrap().to_string();
+    std::fs::write(
+        d.join("truth.txt"),
+        format!("wait-truth 300\nscreenshot {}\nexit\n", p("g.png")),
+    )
+    .unwrap();
+    let scene = "scenes/mirror_box.json";
+    let size = ["--width", "160", "--height", "90"];
+    let script = p("truth.txt");
+    let mut view = vec![
+        "view",
+        scene,
+        "--method",
+        "ray-query",
+        "--truth",
+        "gpu",
+        "--no-vsync",
+        "--script",
+        &script,
+    ];
+    view.extend(size);
+    run_ok(&view, &[("DISPLAY", x.display.as_str())]);
+    let (gpu, cpu, render) = (p("gpu.exr"), p("cpu.exr"), p("render.png"));
+    let mut trace_gpu = vec!["trace", scene, "--device", "gpu", "-o", &gpu];
+    trace_gpu.extend(size);
+    run_ok(&trace_gpu, &[]);
+    let mut trace_cpu = vec!["trace", scene, "-o", &cpu];
+    trace_cpu.extend(size);
+    run_ok(&trace_cpu, &[]);
+    let mut render_cmd = vec!["render", scene, "--method", "ray-query", "-o", &render];
+    render_cmd.extend(size);
+    run_ok(&render_cmd, &[]);
+    let exr = |path: &str| mirrorbox_image::read_image(Path::new(path)).unwrap().pixels;
+    let truth = exr(&p("g.truth.exr"));
+    assert_eq!(truth, exr(&gpu), "the GPU live truth is trace --device gpu");
+    let worst = truth
+        .iter()
+        .zip(exr(&cpu))
+        .flat_map(|(a, b)| (0..3).map(move |c| (a[c] - b[c]).abs()))
+        .fold(0.0f32, f32::max);
+    assert!(worst <= 1e-4, "GPU and CPU truth differ by {worst}");
+    assert_eq!(exr(&p("g.method.exr")), exr(&p("render.exr")));
+}
