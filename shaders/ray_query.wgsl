@@ -15,20 +15,12 @@
 // the depth cap or the attenuation cut the terminal radiance.
 
 struct RayQueryParams {
-    clip_from_world: mat4x4f,
-    eye: vec3f,
+    camera: CameraRays,
     max_depth: u32,
-    // The camera's frame for primary rays: forward, right·tan(fov/2)·aspect, up·tan(fov/2).
-    forward: vec3f,
     min_attenuation: f32,
-    right: vec3f,
-    shift_x: f32,
-    up: vec3f,
     // 1: shadow legs are traced (the scene's lighting.shadows).
     shadows: u32,
-    // The render target's size in pixels.
-    size: vec2f,
-    _pad: vec2f,
+    _pad: u32,
 }
 
 // Triangle i of the scene's geometry: its face normal, its plane's offset n·v0 and surface.
@@ -250,7 +242,7 @@ struct VertexOut {
 @vertex
 fn vs_main(v: VertexIn) -> VertexOut {
     var out: VertexOut;
-    out.clip = params.clip_from_world * vec4f(v.position, 1.0);
+    out.clip = params.camera.clip_from_world * vec4f(v.position, 1.0);
     out.world = v.position;
     out.normal = v.normal;
     out.surface = v.surface;
@@ -264,7 +256,7 @@ fn fs_depth(in: VertexOut) {
 // The pixel's nearest surface, from the rasterizer; everything after it by ray queries.
 @fragment
 fn fs_main(in: VertexOut) -> @location(0) vec4f {
-    let d = normalize(in.world - params.eye);
+    let d = normalize(in.world - params.camera.eye);
     let s = surfaces[in.surface];
     let front = dot(in.normal, d) < 0.0;
     if (s.kind != 1u || !front) {
@@ -277,34 +269,19 @@ fn fs_main(in: VertexOut) -> @location(0) vec4f {
     // A front mirror: the path from the eye, its first hit at the mirror's plane.
     var first: Hit;
     first.found = true;
-    first.t = dot(s.bump.normal, s.bump.center - params.eye) / dot(s.bump.normal, d);
+    first.t = dot(s.bump.normal, s.bump.center - params.camera.eye) / dot(s.bump.normal, d);
     first.normal = in.normal;
     first.surface = in.surface;
-    return vec4f(follow(params.eye, d, first), 1.0);
+    return vec4f(follow(params.camera.eye, d, first), 1.0);
 }
 
 // --- Primary rays (the GPU truth)
-
-struct FullscreenOut {
-    @builtin(position) clip: vec4f,
-}
-
-@vertex
-fn vs_fullscreen(@builtin(vertex_index) i: u32) -> FullscreenOut {
-    let uv = vec2f(f32((i << 1u) & 2u), f32(i & 2u));
-    var out: FullscreenOut;
-    out.clip = vec4f(uv * vec2f(2.0, -2.0) + vec2f(-1.0, 1.0), 0.0, 1.0);
-    return out;
-}
 
 // The camera's ray through this render-target pixel's centre: pixel (X, Y) of an s× target
 // is the sub-pixel position (x + (i+½)/s, y + (j+½)/s) of the output, the tracer's grid.
 @fragment
 fn fs_primary_rays(in: FullscreenOut) -> @location(0) vec4f {
-    let px = in.clip.xy;
-    let ndc = vec2f(2.0 * px.x / params.size.x - 1.0, 1.0 - 2.0 * px.y / params.size.y);
-    let a = ndc.x - params.shift_x;
-    let v = params.forward + params.right * a + params.up * ndc.y;
-    let d = v * (1.0 / sqrt(dot(v, v)));
-    return vec4f(follow(params.eye, d, closest_hit(params.eye, d, NO_MIRROR)), 1.0);
+    let d = camera_ray(params.camera, in.clip.xy);
+    let eye = params.camera.eye;
+    return vec4f(follow(eye, d, closest_hit(eye, d, NO_MIRROR)), 1.0);
 }

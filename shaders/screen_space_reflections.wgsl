@@ -12,20 +12,13 @@
 //    one bounce only) shows the fallback's pixel.
 
 struct SsrParams {
-    clip_from_world: mat4x4f,
-    eye: vec3f,
+    camera: CameraRays,
     // Most pyramid steps a ray takes (--ssr-steps).
     steps: u32,
-    forward: vec3f,
     // How far behind the depth buffer's surface a ray may pass and still hit it (scene units).
     thickness: f32,
-    right: vec3f,
-    shift_x: f32,
-    up: vec3f,
     // 1: misses show the fallback target's pixel; 0: the terminal radiance.
     fallback: u32,
-    size: vec2f,
-    near: f32,
     // Mip levels of the depth pyramid.
     levels: u32,
 }
@@ -42,7 +35,7 @@ struct SceneOut {
 @vertex
 fn vs_scene(v: VertexIn) -> SceneOut {
     var out: SceneOut;
-    out.clip = ssr.clip_from_world * vec4f(v.position, 1.0);
+    out.clip = ssr.camera.clip_from_world * vec4f(v.position, 1.0);
     out.world = v.position;
     out.normal = v.normal;
     out.surface = v.surface;
@@ -61,7 +54,7 @@ struct BaseOut {
 @fragment
 fn fs_base(in: SceneOut) -> BaseOut {
     let s = surfaces[in.surface];
-    let to_eye = normalize(ssr.eye - in.world);
+    let to_eye = normalize(ssr.camera.eye - in.world);
     let front = dot(in.normal, to_eye) > 0.0;
     var out: BaseOut;
     out.depth = vec4u(bitcast<u32>(max(in.clip.z, 0.0)), 0u, 0u, 0u);
@@ -79,25 +72,6 @@ fn fs_base(in: SceneOut) -> BaseOut {
 @group(1) @binding(2) var fallback_colour: texture_2d<f32>;
 // The pyramid's depths as f32 bits (ssr_depth_pyramid.wgsl).
 @group(1) @binding(3) var depth_pyramid: texture_2d<u32>;
-
-struct FullscreenOut {
-    @builtin(position) clip: vec4f,
-}
-
-@vertex
-fn vs_fullscreen(@builtin(vertex_index) i: u32) -> FullscreenOut {
-    let uv = vec2f(f32((i << 1u) & 2u), f32(i & 2u));
-    var out: FullscreenOut;
-    out.clip = vec4f(uv * vec2f(2.0, -2.0) + vec2f(-1.0, 1.0), 0.0, 1.0);
-    return out;
-}
-
-// A world point in render-target pixels (x right, y down) and reversed depth near/w.
-fn to_screen(x: vec3f) -> vec3f {
-    let c = ssr.clip_from_world * vec4f(x, 1.0);
-    let ndc = c.xyz / c.w;
-    return vec3f((ndc.x + 1.0) * 0.5 * ssr.size.x, (1.0 - ndc.y) * 0.5 * ssr.size.y, ndc.z);
-}
 
 // The nearest depth (largest reversed depth) of pyramid cell `cell` at `level`. The level's
 // size is level 0's halved `level` times: `textureDimensions(t, level)` with a level known
@@ -117,14 +91,15 @@ fn pyramid(cell: vec2i, level: u32) -> f32 {
 // behind its surface by at most the thickness.
 fn march(x: vec3f, r: vec3f) -> vec2i {
     // Keep the segment in front of the camera: at most `reach` long, ending before the near plane.
-    let w0 = dot(x - ssr.eye, ssr.forward);
-    let towards = dot(r, ssr.forward);
+    let c = ssr.camera;
+    let w0 = dot(x - c.eye, c.forward);
+    let towards = dot(r, c.forward);
     var reach = 1.0e4;
     if (towards < 0.0) {
-        reach = min(reach, (w0 - 2.0 * ssr.near) / -towards);
+        reach = min(reach, (w0 - 2.0 * c.near) / -towards);
     }
-    let p0 = to_screen(x);
-    let p1 = to_screen(x + r * reach);
+    let p0 = camera_to_screen(c, x);
+    let p1 = camera_to_screen(c, x + r * reach);
     let delta = p1 - p0;
     let length_px = length(delta.xy);
     if (length_px < 1e-3) {
@@ -134,7 +109,7 @@ fn march(x: vec3f, r: vec3f) -> vec2i {
     var s_end = 1.0;
     for (var k = 0; k < 2; k++) {
         if (delta[k] > 0.0) {
-            s_end = min(s_end, (ssr.size[k] - p0[k]) / delta[k]);
+            s_end = min(s_end, (c.size[k] - p0[k]) / delta[k]);
         } else if (delta[k] < 0.0) {
             s_end = min(s_end, -p0[k] / delta[k]);
         }
@@ -175,8 +150,8 @@ fn march(x: vec3f, r: vec3f) -> vec2i {
         // Level 0: the ray reaches this pixel's surface depth. It hits if it crosses the
         // surface inside the pixel (in front of it on entry), or enters behind it by at most
         // the thickness (view depth w = near / z).
-        let w_surface = ssr.near / nearest;
-        let w_entry = ssr.near / z_entry;
+        let w_surface = c.near / nearest;
+        let w_entry = c.near / z_entry;
         if (z_entry >= nearest || w_entry - w_surface <= ssr.thickness) {
             return cell;
         }
@@ -201,11 +176,10 @@ fn fs_reflect(in: FullscreenOut) -> @location(0) vec4f {
         missed = textureLoad(fallback_colour, pixel, 0).rgb;
     }
     // The camera's ray through this pixel's centre, met at the mirror's plane.
-    let ndc = vec2f(2.0 * in.clip.x / ssr.size.x - 1.0, 1.0 - 2.0 * in.clip.y / ssr.size.y);
-    let v = ssr.forward + ssr.right * (ndc.x - ssr.shift_x) + ssr.up * ndc.y;
-    let d = v * (1.0 / sqrt(dot(v, v)));
+    let d = camera_ray(ssr.camera, in.clip.xy);
+    let eye = ssr.camera.eye;
     let n = s.bump.normal;
-    let x = ssr.eye + d * (dot(n, s.bump.center - ssr.eye) / dot(n, d));
+    let x = eye + d * (dot(n, s.bump.center - eye) / dot(n, d));
     var r: vec3f;
     if (s.bump.flags == 0u) {
         r = normalize(d - 2.0 * dot(d, n) * n);

@@ -20,6 +20,7 @@
 //!   [`resolve`] (SSAA), [`timing`] (GPU timestamps), [`readback`].
 
 pub mod adapter;
+pub mod camera_rays;
 pub mod color_format;
 pub mod culling;
 pub mod exact_paths;

@@ -82,6 +82,7 @@ static SHADER: WgslSource = WgslSource {
     enable: &["wgpu_ray_query"],
     parts: &[
         crate::wgsl::SHADING_CONTRACT,
+        crate::camera_rays::WGSL,
         include_str!("../../../../shaders/ray_query.wgsl"),
     ],
 };
@@ -89,9 +90,9 @@ static SHADER: WgslSource = WgslSource {
 fn gpu_structs() -> Vec<HostLayout> {
     vec![
         crate::host_layout!(Params as "RayQueryParams" {
-            clip_from_world, eye, max_depth, forward, min_attenuation, right, shift_x, up,
-            shadows, size, _pad
+            camera, max_depth, min_attenuation, shadows, _pad
         }),
+        crate::camera_rays::CameraRays::layout(),
         crate::host_layout!(TriangleRecord as "TriangleRecord" {
             normal, surface, offset, _pad0, _pad1, _pad2
         }),
@@ -214,17 +215,11 @@ impl PlannedFrame for PlannedRayQuery {
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 struct Params {
-    clip_from_world: [[f32; 4]; 4],
-    eye: [f32; 3],
+    camera: crate::camera_rays::CameraRays,
     max_depth: u32,
-    forward: [f32; 3],
     min_attenuation: f32,
-    right: [f32; 3],
-    shift_x: f32,
-    up: [f32; 3],
     shadows: u32,
-    size: [f32; 2],
-    _pad: [f32; 2],
+    _pad: u32,
 }
 
 #[repr(C)]
@@ -394,22 +389,13 @@ impl RayQueryFrame {
         let build_ms = start.elapsed().as_secs_f64() * 1e3;
         drop(entries);
 
-        let camera = &scene.camera;
         let (w, h) = (planned.width, planned.height);
-        let (forward, right, up, shift_x) = camera.with_size(w, h).ray_generator().frame();
-        let clip = crate::projection::camera_projection(camera, w, h) * camera.view();
         let params = Params {
-            clip_from_world: clip.to_cols_array_2d(),
-            eye: camera.position.to_array(),
+            camera: crate::camera_rays::CameraRays::new(&scene.camera, w, h),
             max_depth: planned.settings.max_depth,
-            forward: forward.to_array(),
             min_attenuation: planned.settings.min_attenuation,
-            right: right.to_array(),
-            shift_x,
-            up: up.to_array(),
             shadows: u32::from(scene.lighting.shadows),
-            size: [w as f32, h as f32],
-            _pad: [0.0; 2],
+            _pad: 0,
         };
         let params_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("ray query parameters"),

@@ -20,7 +20,7 @@ use crate::method::{
 };
 use crate::pipeline::{ScenePipeline, depth_state, pipeline_layout};
 use crate::plan::PlanError;
-use crate::projection::{FAR_DEPTH, NEAR, NEARER};
+use crate::projection::{FAR_DEPTH, NEARER};
 use crate::shading::{SceneBuffers, VERTEX_LAYOUT};
 use crate::targets::{DEPTH_FORMAT, RenderTarget, texture_entry};
 use crate::timing::FrameEncoder;
@@ -101,6 +101,7 @@ static SHADER: WgslSource = WgslSource {
     enable: &[],
     parts: &[
         crate::wgsl::SHADING,
+        crate::camera_rays::WGSL,
         include_str!("../../../../shaders/screen_space_reflections.wgsl"),
     ],
 };
@@ -112,10 +113,12 @@ static PYRAMID_SHADER: WgslSource = WgslSource {
 };
 
 fn gpu_structs() -> Vec<HostLayout> {
-    vec![crate::host_layout!(Params as "SsrParams" {
-        clip_from_world, eye, steps, forward, thickness, right, shift_x, up, fallback, size,
-        near, levels
-    })]
+    vec![
+        crate::host_layout!(Params as "SsrParams" {
+            camera, steps, thickness, fallback, levels
+        }),
+        crate::camera_rays::CameraRays::layout(),
+    ]
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -266,17 +269,10 @@ impl PlannedFrame for PlannedSsr {
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 struct Params {
-    clip_from_world: [[f32; 4]; 4],
-    eye: [f32; 3],
+    camera: crate::camera_rays::CameraRays,
     steps: u32,
-    forward: [f32; 3],
     thickness: f32,
-    right: [f32; 3],
-    shift_x: f32,
-    up: [f32; 3],
     fallback: u32,
-    size: [f32; 2],
-    near: f32,
     levels: u32,
 }
 
@@ -323,22 +319,12 @@ impl SsrFrame {
             });
         }
         let scene_buffers = SceneBuffers::new(gpu, scene, shadows.binding());
-        let camera = &scene.camera;
-        let (forward, right, up, shift_x) = camera.with_size(width, height).ray_generator().frame();
-        let clip = crate::projection::camera_projection(camera, width, height) * camera.view();
         let levels = pyramid_levels(width, height);
         let params = Params {
-            clip_from_world: clip.to_cols_array_2d(),
-            eye: camera.position.to_array(),
+            camera: crate::camera_rays::CameraRays::new(&scene.camera, width, height),
             steps,
-            forward: forward.to_array(),
             thickness,
-            right: right.to_array(),
-            shift_x,
-            up: up.to_array(),
             fallback: u32::from(fallback.is_some()),
-            size: [width as f32, height as f32],
-            near: NEAR,
             levels,
         };
         let params_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
