@@ -318,6 +318,47 @@ mod tests {
         assert_eq!(level.image.pixels, offline.pixels);
     }
 
+    /// `--truth gpu` (issue 39): the last level is `trace --device gpu` of the view bit for
+    /// bit, and within float precision of the CPU truth; the worker says it traces on the GPU.
+    #[test]
+    fn the_gpu_last_level_is_trace_on_the_gpu() {
+        let scene = small_scene();
+        let mut truth = LiveTruth::start(Arc::new(scene.clone()), TruthDevice::Gpu);
+        truth.request(TruthRequest {
+            camera: scene.camera.clone(),
+            grid_side: 2,
+        });
+        let level = truth
+            .wait_complete(Duration::from_secs(120))
+            .expect("the truth completes");
+        assert_eq!(
+            truth.device(),
+            (TruthDevice::Gpu, None),
+            "lavapipe has ray queries"
+        );
+        let gpu = mirrorbox_raster::Gpu::new().unwrap();
+        let d = mirrorbox_trace::WhittedSettings::default();
+        let settings = mirrorbox_raster::methods::ray_query::gpu_truth_settings(
+            2,
+            d.max_depth,
+            d.min_throughput,
+        )
+        .unwrap();
+        let offline = mirrorbox_raster::render(&gpu, &scene, &settings)
+            .unwrap()
+            .image;
+        assert_eq!(level.image.pixels, offline.pixels);
+        let bvh = SceneBvh::build(&scene.geometry);
+        let cpu = mirrorbox_trace::render(&scene, &bvh, &TraceSettings::whitted(2), &|_| {}).image;
+        let worst = cpu
+            .pixels
+            .iter()
+            .zip(&level.image.pixels)
+            .flat_map(|(a, b)| (0..3).map(move |c| (a[c] - b[c]).abs()))
+            .fold(0.0f32, f32::max);
+        assert!(worst <= 1e-4, "GPU and CPU truth differ by {worst}");
+    }
+
     #[test]
     fn a_new_view_replaces_the_old_one_and_levels_grow() {
         let scene = small_scene();
