@@ -268,6 +268,14 @@ impl SceneBuffers {
             + texture_bytes(atlas_width, atlas_rows(scene), 4)
     }
 
+    /// The vertex range of every mesh drawn as it is: each non-mirror part, then each mirror
+    /// (the methods that draw the scene once: `ray-query`, `ssr`).
+    pub fn draw_ranges(&self) -> Vec<std::ops::Range<u32>> {
+        let parts = self.parts.iter().map(|(r, _, _)| r.clone());
+        let mirrors = self.mirrors.iter().filter(|r| !r.is_empty()).cloned();
+        parts.chain(mirrors).collect()
+    }
+
     /// Refuses a scene whose buffers this device cannot hold, before any is created.
     pub fn check_fits(gpu: &crate::Gpu, scene: &Scene) -> Result<(), crate::RasterError> {
         Self::check_fits_geometry(gpu, scene, &scene.geometry)

@@ -518,18 +518,7 @@ impl RayQueryFrame {
             wgpu::TextureUsages::RENDER_ATTACHMENT,
         )
         .create_view(&Default::default());
-        let mut draws: Vec<std::ops::Range<u32>> = scene_buffers
-            .parts
-            .iter()
-            .map(|(r, _, _)| r.clone())
-            .collect();
-        draws.extend(
-            scene_buffers
-                .mirrors
-                .iter()
-                .filter(|r| !r.is_empty())
-                .cloned(),
-        );
+        let draws = scene_buffers.draw_ranges();
         let triangles = g.triangles.len();
         let stats = FrameStats {
             passes: 1,

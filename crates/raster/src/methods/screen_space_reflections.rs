@@ -529,18 +529,7 @@ impl SsrFrame {
             color_writes: wgpu::ColorWrites::ALL,
         }
         .build(gpu);
-        let mut draws: Vec<std::ops::Range<u32>> = scene_buffers
-            .parts
-            .iter()
-            .map(|(r, _, _)| r.clone())
-            .collect();
-        draws.extend(
-            scene_buffers
-                .mirrors
-                .iter()
-                .filter(|r| !r.is_empty())
-                .cloned(),
-        );
+        let draws = scene_buffers.draw_ranges();
         // The scene pass, the pyramid's coarser levels, the reflect pass.
         let stats = FrameStats {
             passes: 1 + levels as usize,
