@@ -86,6 +86,8 @@ command -v xdotool >/dev/null 2>&1 || missing+=(xdotool)
 command -v /usr/bin/time >/dev/null 2>&1 || missing+=(time)
 # The reports test opens every HTML report in headless Chromium (issue 38).
 command -v chromium-headless-shell >/dev/null 2>&1 || missing+=(chromium-headless-shell)
+# Public test assets nobody here wrote (issue 40): the OBJ corpus test loads every OBJ file.
+[ -d /usr/share/assimp/models/OBJ ] || missing+=(assimp-testmodels)
 
 if [ ${#missing[@]} -eq 0 ]; then
   [ ${#mesa_old[@]} -gt 0 ] || echo "install-system-deps: Mesa $(deb_version mesa-vulkan-drivers), X11 libraries and Xvfb present; nothing to install."

@@ -274,7 +274,9 @@ fn malformed_obj_file_names_the_line() {
     assert_rejected_with_files(
         |s| s["objects"] = json!([{ "type": "mesh", "path": "bad.obj" }]),
         &[("bad.obj", obj)],
-        &["objects[0].path: malformed OBJ file \"bad.obj\" at line 3: position parse error"],
+        &[
+            "objects[0].path: malformed OBJ file \"bad.obj\" at line 3 (`v 1 zero 0`): position parse error",
+        ],
     );
     let out_of_range = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n";
     assert_rejected_with_files(

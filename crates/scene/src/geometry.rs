@@ -42,6 +42,10 @@ pub struct Geometry {
     pub parts: Vec<Part>,
     /// Triangles dropped at load because they had (near) zero area.
     pub degenerate_dropped: usize,
+    /// What loading the OBJ files passed over, one line each (`objects[2].path: line 233:
+    /// an empty material name, ignored`): material statements are never read (the scene gives
+    /// each object its albedo), so a broken one does not refuse the file.
+    pub obj_notes: Vec<String>,
 }
 
 /// Twice the area below which a triangle is considered degenerate and dropped, relative to

@@ -201,6 +201,7 @@ impl Scene {
             );
         }
         geometry.degenerate_dropped = self.geometry.degenerate_dropped;
+        geometry.obj_notes = self.geometry.obj_notes.clone();
         Ok(Scene {
             geometry,
             symmetry: (planes > 0).then(|| Symmetry {

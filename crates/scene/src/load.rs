@@ -738,7 +738,11 @@ impl Checker<'_> {
                     .path
                     .as_deref()
                     .ok_or_else(|| self.invalid(&mesh_path, "is required for a \"mesh\" object (an OBJ file, relative to the scene file)"))?;
-                self.obj(&mesh_path, rel, geometry.triangles.len())?
+                let (tris, notes) = self.obj(&mesh_path, rel, geometry.triangles.len())?;
+                geometry
+                    .obj_notes
+                    .extend(notes.into_iter().map(|n| format!("{mesh_path}: {n}")));
+                tris
             }
         };
         self.triangle_budget(path, geometry.triangles.len(), local.len() as u64)?;
@@ -818,8 +822,14 @@ impl Checker<'_> {
         ))
     }
 
-    /// Triangles of an OBJ file, relative to the scene file's folder.
-    fn obj(&self, path: &FieldPath, rel: &str, have: usize) -> Result<Vec<[Vec3; 3]>> {
+    /// Triangles of an OBJ file, relative to the scene file's folder, and what loading it
+    /// passed over ([`obj_text`]).
+    fn obj(
+        &self,
+        path: &FieldPath,
+        rel: &str,
+        have: usize,
+    ) -> Result<(Vec<[Vec3; 3]>, Vec<String>)> {
         let resolved: PathBuf = self.file.parent().unwrap_or(Path::new(".")).join(rel);
         let bytes = mirrorbox_files::read_bounded(&resolved, MAX_OBJ_FILE_BYTES, "OBJ file")
             .map_err(|e| {
@@ -828,9 +838,19 @@ impl Checker<'_> {
                     format!("\"{rel}\" (at {}): {}", resolved.display(), e.message),
                 )
             })?;
+        let (bytes, notes) = obj_text(&bytes)
+            .map_err(|why| self.invalid(path, format!("OBJ file \"{rel}\": {why}")))?;
         self.triangle_budget(path, have, obj_triangle_count(&bytes))?;
         let models = parse_obj(&bytes).map_err(|(line, e)| {
-            let at = line.map(|l| format!(" at line {l}")).unwrap_or_default();
+            // The line itself, so that a user can see what the parser could not read.
+            let text = |l: usize| {
+                let t = String::from_utf8_lossy(bytes.split(|&b| b == b'\n').nth(l - 1)?);
+                let t: String = t.trim().chars().take(60).collect();
+                (!t.is_empty()).then(|| format!(" (`{t}`)"))
+            };
+            let at = line
+                .map(|l| format!(" at line {l}{}", text(l).unwrap_or_default()))
+                .unwrap_or_default();
             self.invalid(path, format!("malformed OBJ file \"{rel}\"{at}: {e}"))
         })?;
         let mut tris = Vec::new();
@@ -851,10 +871,81 @@ impl Checker<'_> {
             ));
         }
         if tris.is_empty() {
-            return Err(self.invalid(path, format!("OBJ file \"{rel}\" contains no faces")));
+            return Err(self.invalid(
+                path,
+                format!(
+                    "OBJ file \"{rel}\" contains no faces (points and lines are not drawn; a \
+                     mesh needs `f` statements)"
+                ),
+            ));
         }
-        Ok(tris)
+        Ok((tris, notes))
     }
+}
+
+/// An OBJ file's bytes as the parser reads them, and what was passed over:
+/// - UTF-16 text (a byte-order mark, as some exporters write) is decoded to UTF-8;
+/// - bytes that are not UTF-8 (a material or group name in another encoding) become U+FFFD:
+///   only names can hold them, and no name is read;
+/// - material statements (`mtllib`, `usemtl`) are blanked, keeping the line count for error
+///   positions: the scene gives each object its albedo, so a broken one (an empty name) must
+///   not refuse the geometry; each broken one is noted.
+fn obj_text(bytes: &[u8]) -> std::result::Result<(Vec<u8>, Vec<String>), String> {
+    let mut notes = Vec::new();
+    let utf16 = |big_endian: bool| -> std::result::Result<String, String> {
+        let units = bytes[2..].chunks(2).map(|c| {
+            let pair = [c[0], *c.get(1).unwrap_or(&0)];
+            if big_endian {
+                u16::from_be_bytes(pair)
+            } else {
+                u16::from_le_bytes(pair)
+            }
+        });
+        char::decode_utf16(units)
+            .collect::<std::result::Result<String, _>>()
+            .map_err(|_| {
+                "is UTF-16 text (it starts with a byte-order mark) that does not decode; save it \
+                 as UTF-8 or ASCII"
+                    .to_string()
+            })
+    };
+    let text: String = match bytes {
+        [0xFE, 0xFF, ..] => {
+            notes.push("UTF-16 (big-endian) text, decoded".to_string());
+            utf16(true)?
+        }
+        [0xFF, 0xFE, ..] => {
+            notes.push("UTF-16 (little-endian) text, decoded".to_string());
+            utf16(false)?
+        }
+        _ => {
+            let text = String::from_utf8_lossy(bytes);
+            if let std::borrow::Cow::Owned(_) = text {
+                notes.push("bytes that are not UTF-8 (in names, which are not read)".to_string());
+            }
+            text.into_owned()
+        }
+    };
+    let mut out = String::with_capacity(text.len());
+    for (i, line) in text.split_inclusive('\n').enumerate() {
+        let mut words = line.split_whitespace();
+        let keyword = words.next();
+        if matches!(keyword, Some("usemtl" | "mtllib")) {
+            if words.next().is_none() {
+                notes.push(format!(
+                    "line {}: `{}` without a name, ignored",
+                    i + 1,
+                    keyword.unwrap_or_default()
+                ));
+            }
+            if line.ends_with('\n') {
+                out.push('\n');
+            }
+        } else {
+            out.push_str(line);
+        }
+    }
+    Ok((out.into_bytes(), notes))
 }
 
 fn obj_options() -> tobj::LoadOptions {
@@ -944,6 +1035,33 @@ mod tests {
             Ok(_) => panic!("accepted: {rest}"),
             Err(e) => e.to_string(),
         }
+    }
+
+    /// OBJ text as the parser reads it: UTF-16 decoded, stray bytes replaced, material
+    /// statements blanked with their lines kept, a nameless one noted.
+    #[test]
+    fn obj_text_passes_over_what_the_scene_never_reads() {
+        let plain = b"v 0 0 0\nusemtl red\nmtllib a.mtl\nusemtl \nf 1 2 3\n";
+        let (text, notes) = obj_text(plain).unwrap();
+        assert_eq!(
+            text, b"v 0 0 0\n\n\n\nf 1 2 3\n",
+            "lines kept, statements blanked"
+        );
+        assert_eq!(notes, ["line 4: `usemtl` without a name, ignored"]);
+        let mut be = vec![0xFE, 0xFF];
+        let mut le = vec![0xFF, 0xFE];
+        for u in "v 1 2 3\n".encode_utf16() {
+            be.extend(u.to_be_bytes());
+            le.extend(u.to_le_bytes());
+        }
+        assert_eq!(obj_text(&be).unwrap().0, b"v 1 2 3\n");
+        assert_eq!(obj_text(&le).unwrap().0, b"v 1 2 3\n");
+        let (text, notes) = obj_text(b"g caf\xe9\nv 0 0 0\n").unwrap();
+        assert!(text.ends_with(b"v 0 0 0\n"));
+        assert_eq!(notes.len(), 1, "{notes:?}");
+        // An unpaired surrogate does not decode: refused with what to do.
+        let e = obj_text(&[0xFE, 0xFF, 0xD8, 0x00]).unwrap_err();
+        assert!(e.contains("save it as UTF-8"), "{e}");
     }
 
     #[test]

@@ -170,6 +170,7 @@ pub fn split_and_mirror_with_origins(
         surfaces: source.surfaces.clone(),
         parts: Vec::with_capacity(source.parts.len()),
         degenerate_dropped: source.degenerate_dropped,
+        obj_notes: source.obj_notes.clone(),
     };
     let mut origins = Vec::with_capacity(total);
     for (part, pieces) in source.parts.iter().zip(by_part) {

@@ -49,6 +49,9 @@ pub fn run(args: &Args) -> Result<(), Failure> {
                     scene.camera.width,
                     scene.camera.height,
                 );
+                for note in &g.obj_notes {
+                    println!("  note: {note}");
+                }
             }
             Err(e) => {
                 eprintln!("error: {}", e.message());

@@ -5,5 +5,6 @@ mod device_limits;
 mod memory;
 mod methods;
 mod mirrored_lights_closed_form;
+mod obj_corpus;
 mod scene_fuzz;
 mod structure;
