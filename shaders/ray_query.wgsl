@@ -209,21 +209,12 @@ fn follow(origin: vec3f, direction: vec3f, first: Hit) -> vec3f {
         let n = s.bump.normal;
         let t = dot(n, s.bump.center - o) / dot(n, d);
         let x = o + d * t;
-        var r: vec3f;
-        if (s.bump.flags == 0u) {
-            r = normalize(d - 2.0 * dot(d, n) * n);
-        } else {
-            let ns = mirror_shading_normal(s.bump, x);
-            if (dot(d, ns) >= 0.0) {
-                return vec3f(0.0);
-            }
-            r = normalize(d - 2.0 * dot(d, ns) * ns);
-            if (dot(r, n) <= 0.0) {
-                return vec3f(0.0);
-            }
+        let r = mirror_reflection(s.bump, d, x);
+        if (r.w == 0.0) {
+            return vec3f(0.0);
         }
         o = x;
-        d = r;
+        d = r.xyz;
         hit = closest_hit(o, d, s.mirror);
     }
     return vec3f(0.0);

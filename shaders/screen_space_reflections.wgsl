@@ -180,21 +180,12 @@ fn fs_reflect(in: FullscreenOut) -> @location(0) vec4f {
     let eye = ssr.camera.eye;
     let n = s.bump.normal;
     let x = eye + d * (dot(n, s.bump.center - eye) / dot(n, d));
-    var r: vec3f;
-    if (s.bump.flags == 0u) {
-        r = normalize(d - 2.0 * dot(d, n) * n);
-    } else {
-        // The contract's uneven-mirror rule: reflected about the bumped normal, or nothing.
-        let ns = mirror_shading_normal(s.bump, x);
-        if (dot(d, ns) >= 0.0) {
-            return vec4f(0.0, 0.0, 0.0, 1.0);
-        }
-        r = normalize(d - 2.0 * dot(d, ns) * ns);
-        if (dot(r, n) <= 0.0) {
-            return vec4f(0.0, 0.0, 0.0, 1.0);
-        }
+    // The contract's reflection, the uneven-mirror rule included (absorbed: nothing).
+    let r = mirror_reflection(s.bump, d, x);
+    if (r.w == 0.0) {
+        return vec4f(0.0, 0.0, 0.0, 1.0);
     }
-    let hit = march(x, r);
+    let hit = march(x, r.xyz);
     if (hit.x < 0) {
         return vec4f(missed, 1.0);
     }

@@ -186,3 +186,22 @@ fn mirror_shading_normal(b: MirrorBump, p: vec3f) -> vec3f {
     let t = mirror_tangent_normal(b, dot(d, b.right), dot(d, b.up));
     return normalize(t.x * b.right + t.y * b.up + t.z * b.normal);
 }
+
+// The reflection of direction d at point x on a mirror's front (docs/shading.md): about its
+// plane's normal, or about its bumped normal — and then nothing where the contract's rule
+// absorbs it (d · n_s ≥ 0, or r · n_f ≤ 0). (r, 1), or (0, 0, 0, 0) where absorbed.
+fn mirror_reflection(b: MirrorBump, d: vec3f, x: vec3f) -> vec4f {
+    let n = b.normal;
+    if (b.flags == 0u) {
+        return vec4f(normalize(d - 2.0 * dot(d, n) * n), 1.0);
+    }
+    let ns = mirror_shading_normal(b, x);
+    if (dot(d, ns) >= 0.0) {
+        return vec4f(0.0);
+    }
+    let r = normalize(d - 2.0 * dot(d, ns) * ns);
+    if (dot(r, n) <= 0.0) {
+        return vec4f(0.0);
+    }
+    return vec4f(r, 1.0);
+}
