@@ -5,37 +5,55 @@
 //! by every method (the comparison's floor).
 
 use crate::bvh::SceneBvh;
-use mirrorbox_scene::Scene;
 use mirrorbox_scene::camera::SubpixelGrid;
 use mirrorbox_scene::geometry::Surface;
+use mirrorbox_scene::{Ray, Scene};
 use rayon::prelude::*;
 
-/// One flag per pixel, row-major: true where a sample's primary ray first hits the front of
-/// a mirror of `scene`, seen from its camera on the sub-pixel grid `grid`.
-pub fn mirror_mask(scene: &Scene, bvh: &SceneBvh, grid: SubpixelGrid) -> Vec<bool> {
+/// The mirror whose front `ray` first hits, if its first hit is one.
+fn front_mirror(scene: &Scene, bvh: &SceneBvh, ray: &Ray) -> Option<usize> {
+    let g = &scene.geometry;
+    let hit = bvh.closest_hit(ray, 0.0, f32::INFINITY, None)?;
+    let [a, b, c] = g.triangles[hit.triangle];
+    let front = (b - a).cross(c - a).dot(ray.dir) < 0.0;
+    match *g.surface(hit.triangle) {
+        Surface::Mirror { mirror, .. } if front => Some(mirror),
+        _ => None,
+    }
+}
+
+/// One flag per pixel of `scene`'s camera, row-major, in parallel: `flag` of the pixel's
+/// primary rays on the sub-pixel grid `grid`.
+fn per_pixel(
+    scene: &Scene,
+    grid: SubpixelGrid,
+    flag: impl Fn(&mut dyn Iterator<Item = Ray>) -> bool + Sync,
+) -> Vec<bool> {
     let camera = &scene.camera;
     let (w, h) = (camera.width, camera.height);
     let rays = camera.ray_generator();
-    let geometry = &scene.geometry;
     let offsets: Vec<_> = grid.offsets().collect();
     (0..h)
         .into_par_iter()
         .flat_map_iter(|y| {
-            let offsets = &offsets;
+            let (offsets, flag) = (&offsets, &flag);
             (0..w).map(move |x| {
-                offsets.iter().any(|o| {
-                    let ray = rays.ray(x as f32 + o.x, y as f32 + o.y);
-                    bvh.closest_hit(&ray, 0.0, f32::INFINITY, None)
-                        .is_some_and(|hit| {
-                            let surface = geometry.surface_of[hit.triangle] as usize;
-                            let [a, b, c] = geometry.triangles[hit.triangle];
-                            let front = (b - a).cross(c - a).dot(ray.dir) < 0.0;
-                            front && matches!(geometry.surfaces[surface], Surface::Mirror { .. })
-                        })
-                })
+                let mut samples = offsets
+                    .iter()
+                    .map(|o| rays.ray(x as f32 + o.x, y as f32 + o.y));
+                flag(&mut samples)
             })
         })
         .collect()
+}
+
+/// One flag per pixel, row-major: true where a sample's primary ray first hits the front of
+/// a mirror of `scene`, seen from its camera on the sub-pixel grid `grid`.
+pub fn mirror_mask(scene: &Scene, bvh: &SceneBvh, grid: SubpixelGrid) -> Vec<bool> {
+    per_pixel(scene, grid, |samples| {
+        let mut samples = samples;
+        Iterator::any(&mut samples, |ray| front_mirror(scene, bvh, &ray).is_some())
+    })
 }
 
 /// One flag per pixel, row-major: true where most of the pixel's samples that first hit a
@@ -45,55 +63,36 @@ pub fn mirror_mask(scene: &Scene, bvh: &SceneBvh, grid: SubpixelGrid) -> Vec<boo
 /// report plots `ssr`'s error against the share of mirror pixels flagged.
 pub fn reflections_off_screen(scene: &Scene, bvh: &SceneBvh, grid: SubpixelGrid) -> Vec<bool> {
     let camera = &scene.camera;
-    let (w, h) = (camera.width, camera.height);
-    let rays = camera.ray_generator();
-    let geometry = &scene.geometry;
     let planes = crate::mirror_bounce::MirrorPlanes::new(scene);
-    let offsets: Vec<_> = grid.offsets().collect();
     let size = camera.size();
     let off_screen = |q: glam::Vec3| {
         camera
             .project_to_pixel(q)
             .is_none_or(|p| p.x < 0.0 || p.y < 0.0 || p.x >= size.x || p.y >= size.y)
     };
-    (0..h)
-        .into_par_iter()
-        .flat_map_iter(|y| {
-            let offsets = &offsets;
-            let planes = &planes;
-            (0..w).map(move |x| {
-                let (mut mirrored, mut away) = (0, 0);
-                for o in offsets {
-                    let ray = rays.ray(x as f32 + o.x, y as f32 + o.y);
-                    let Some(hit) = bvh.closest_hit(&ray, 0.0, f32::INFINITY, None) else {
-                        continue;
-                    };
-                    let Surface::Mirror { mirror, .. } = *geometry.surface(hit.triangle) else {
-                        continue;
-                    };
-                    if geometry.face_normal(hit.triangle).dot(ray.dir) >= 0.0 {
-                        continue;
-                    }
-                    mirrored += 1;
-                    let Some((at, dir)) =
-                        planes.reflect(mirror, ray.origin.as_dvec3(), ray.dir.as_dvec3())
-                    else {
-                        continue;
-                    };
-                    let reflected = mirrorbox_scene::Ray {
-                        origin: at.as_vec3(),
-                        dir: dir.as_vec3(),
-                    };
-                    let seen = match bvh.closest_hit(&reflected, 0.0, f32::INFINITY, Some(mirror)) {
-                        Some(h) => reflected.at(h.t),
-                        None => reflected.at(1e4),
-                    };
-                    away += usize::from(off_screen(seen));
-                }
-                mirrored > 0 && 2 * away > mirrored
-            })
-        })
-        .collect()
+    per_pixel(scene, grid, |samples| {
+        let (mut mirrored, mut away) = (0, 0);
+        for ray in samples {
+            let Some(mirror) = front_mirror(scene, bvh, &ray) else {
+                continue;
+            };
+            mirrored += 1;
+            let Some((at, dir)) = planes.reflect(mirror, ray.origin.as_dvec3(), ray.dir.as_dvec3())
+            else {
+                continue;
+            };
+            let reflected = Ray {
+                origin: at.as_vec3(),
+                dir: dir.as_vec3(),
+            };
+            let seen = match bvh.closest_hit(&reflected, 0.0, f32::INFINITY, Some(mirror)) {
+                Some(h) => reflected.at(h.t),
+                None => reflected.at(1e4),
+            };
+            away += usize::from(off_screen(seen));
+        }
+        mirrored > 0 && 2 * away > mirrored
+    })
 }
 
 #[cfg(test)]
