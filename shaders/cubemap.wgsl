@@ -42,6 +42,7 @@ struct VertexOut {
     @location(1) @interpolate(flat) normal: vec3f,
     @location(2) @interpolate(flat) surface: u32,
     @location(3) plane_distance: f32,
+    @location(8) uv: vec2f,
 }
 
 fn scene_vertex(v: VertexIn) -> VertexOut {
@@ -50,6 +51,7 @@ fn scene_vertex(v: VertexIn) -> VertexOut {
     out.world = v.position;
     out.normal = v.normal;
     out.surface = v.surface;
+    out.uv = v.uv;
     out.plane_distance = dot(pass_.plane, vec4f(v.position, 1.0));
     return out;
 }
@@ -65,7 +67,7 @@ fn shade_diffuse(in: VertexOut, albedo: vec3f, emission: vec3f) -> vec3f {
 
 fn object_colour(in: VertexOut) -> vec4f {
     let s = surfaces[in.surface];
-    return vec4f(shade_diffuse(in, s.albedo, s.emission), 1.0);
+    return vec4f(shade_diffuse(in, surface_albedo(s, in.uv), surface_emission(s, in.uv)), 1.0);
 }
 
 fn face_texel(k: u32, t: vec2i) -> vec3f {

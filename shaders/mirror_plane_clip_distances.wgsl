@@ -13,6 +13,7 @@ struct ClippedVertexOut {
     @location(1) @interpolate(flat) normal: vec3f,
     @location(2) @interpolate(flat) surface: u32,
     @location(3) plane_distance: f32,
+    @location(8) uv: vec2f,
 }
 
 @vertex
@@ -25,5 +26,6 @@ fn vs_clip_distances(v: VertexIn) -> ClippedVertexOut {
     out.normal = o.normal;
     out.surface = o.surface;
     out.plane_distance = o.plane_distance;
+    out.uv = o.uv;
     return out;
 }

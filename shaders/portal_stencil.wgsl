@@ -26,6 +26,7 @@ struct VertexOut {
     @location(2) @interpolate(flat) surface: u32,
     // Signed distance to the path's last mirror plane (scene units).
     @location(3) plane_distance: f32,
+    @location(8) uv: vec2f,
 }
 
 fn scene_vertex(v: VertexIn) -> VertexOut {
@@ -34,6 +35,7 @@ fn scene_vertex(v: VertexIn) -> VertexOut {
     out.world = v.position;
     out.normal = v.normal;
     out.surface = v.surface;
+    out.uv = v.uv;
     out.plane_distance = dot(path.plane, vec4f(v.position, 1.0));
     return out;
 }
@@ -49,7 +51,7 @@ fn shade(in: VertexOut, albedo: vec3f, emission: vec3f) -> vec3f {
 
 fn object_colour(in: VertexOut) -> vec4f {
     let s = surfaces[in.surface];
-    return vec4f(shade(in, s.albedo, s.emission), 1.0);
+    return vec4f(shade(in, surface_albedo(s, in.uv), surface_emission(s, in.uv)), 1.0);
 }
 
 // A mirror in a path's world: its front shows the terminal radiance (overwritten by the

@@ -23,14 +23,16 @@ struct RayQueryParams {
     _pad: u32,
 }
 
-// Triangle i of the scene's geometry: its face normal, its plane's offset n·v0 and surface.
+// Triangle i of the scene's geometry: its face normal, its plane's offset n·v0, surface and
+// its corners' texture coordinates.
 struct TriangleRecord {
     normal: vec3f,
     surface: u32,
     offset: f32,
     _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
+    uv0: vec2f,
+    uv1: vec2f,
+    uv2: vec2f,
 }
 
 @group(1) @binding(0) var acc: acceleration_structure;
@@ -54,6 +56,8 @@ struct Hit {
     normal: vec3f,
     offset: f32,
     surface: u32,
+    // Texture coordinates at the hit (the query's barycentrics).
+    uv: vec2f,
 }
 
 // The first committed hit of o + t·d at t ≥ tmin (every mesh is opaque).
@@ -70,6 +74,8 @@ fn first_hit(o: vec3f, d: vec3f, tmin: f32, tmax: f32) -> Hit {
         hit.normal = r.normal;
         hit.offset = r.offset;
         hit.surface = r.surface;
+        let b = h.barycentrics;
+        hit.uv = r.uv0 + (r.uv1 - r.uv0) * b.x + (r.uv2 - r.uv0) * b.y;
     }
     return hit;
 }
@@ -196,7 +202,7 @@ fn follow(origin: vec3f, direction: vec3f, first: Hit) -> vec3f {
             if (s.kind == 1u) {
                 return throughput * diffuse_radiance(p, hit.normal, -d, s.back_albedo, vec3f(0.0));
             }
-            return throughput * diffuse_radiance(p, hit.normal, -d, s.albedo, s.emission);
+            return throughput * diffuse_radiance(p, hit.normal, -d, surface_albedo(s, hit.uv), surface_emission(s, hit.uv));
         }
         let next = throughput * s.reflectance;
         if (bounces >= params.max_depth || max3(next) < params.min_attenuation) {
@@ -228,6 +234,7 @@ struct VertexOut {
     @location(0) world: vec3f,
     @location(1) @interpolate(flat) normal: vec3f,
     @location(2) @interpolate(flat) surface: u32,
+    @location(8) uv: vec2f,
 }
 
 @vertex
@@ -237,6 +244,7 @@ fn vs_main(v: VertexIn) -> VertexOut {
     out.world = v.position;
     out.normal = v.normal;
     out.surface = v.surface;
+    out.uv = v.uv;
     return out;
 }
 
@@ -255,7 +263,7 @@ fn fs_main(in: VertexOut) -> @location(0) vec4f {
         if (s.kind == 1u) {
             return vec4f(diffuse_radiance(in.world, in.normal, -d, s.back_albedo, vec3f(0.0)), 1.0);
         }
-        return vec4f(diffuse_radiance(in.world, in.normal, -d, s.albedo, s.emission), 1.0);
+        return vec4f(diffuse_radiance(in.world, in.normal, -d, surface_albedo(s, in.uv), surface_emission(s, in.uv)), 1.0);
     }
     // A front mirror: the path from the eye, its first hit at the mirror's plane.
     var first: Hit;

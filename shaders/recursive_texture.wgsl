@@ -67,6 +67,7 @@ struct VertexOut {
     @location(2) @interpolate(flat) surface: u32,
     // Signed distance to the pass's mirror plane (scene units).
     @location(3) plane_distance: f32,
+    @location(8) uv: vec2f,
 }
 
 fn scene_vertex(v: VertexIn) -> VertexOut {
@@ -75,6 +76,7 @@ fn scene_vertex(v: VertexIn) -> VertexOut {
     out.world = v.position;
     out.normal = v.normal;
     out.surface = v.surface;
+    out.uv = v.uv;
     out.plane_distance = dot(pass_.plane, vec4f(v.position, 1.0));
     return out;
 }
@@ -95,7 +97,7 @@ fn eye_distance(in: VertexOut) -> f32 {
 
 fn object_colour(in: VertexOut) -> vec4f {
     let s = surfaces[in.surface];
-    return vec4f(shade_diffuse(in, s.albedo, s.emission), eye_distance(in));
+    return vec4f(shade_diffuse(in, surface_albedo(s, in.uv), surface_emission(s, in.uv)), eye_distance(in));
 }
 
 fn load_clamped(t: vec2i) -> vec3f {

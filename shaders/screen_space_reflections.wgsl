@@ -30,6 +30,7 @@ struct SceneOut {
     @location(0) world: vec3f,
     @location(1) @interpolate(flat) normal: vec3f,
     @location(2) @interpolate(flat) surface: u32,
+    @location(8) uv: vec2f,
 }
 
 @vertex
@@ -39,6 +40,7 @@ fn vs_scene(v: VertexIn) -> SceneOut {
     out.world = v.position;
     out.normal = v.normal;
     out.surface = v.surface;
+    out.uv = v.uv;
     return out;
 }
 
@@ -63,7 +65,7 @@ fn fs_base(in: SceneOut) -> BaseOut {
     } else if (s.kind == 1u) {
         out.colour = vec4f(diffuse_radiance(in.world, in.normal, to_eye, s.back_albedo, vec3f(0.0)), 0.0);
     } else {
-        out.colour = vec4f(diffuse_radiance(in.world, in.normal, to_eye, s.albedo, s.emission), 0.0);
+        out.colour = vec4f(diffuse_radiance(in.world, in.normal, to_eye, surface_albedo(s, in.uv), surface_emission(s, in.uv)), 0.0);
     }
     return out;
 }

@@ -15,6 +15,21 @@ struct Surface {
     _pad1: u32,
     // A mirror's frame and bump (zero for a diffuse surface).
     bump: MirrorBump,
+    // A diffuse surface's textures (docs/shading.md, "Textures"); `present` 0: none.
+    albedo_map: TextureMap,
+    emission_map: TextureMap,
+}
+
+// A texture as a surface reads it (the CPU twin is crates/scene/src/texture.rs): the 2×3
+// transform of its coordinates as two rows, its wrap modes (u in bits 0–3, v in 4–7: 0
+// repeat, 1 clamp to edge, 2 mirrored repeat) and its rectangle in the colour atlas.
+struct TextureMap {
+    row_u: vec3f,
+    present: u32,
+    row_v: vec3f,
+    wrap: u32,
+    origin: vec2u,
+    size: vec2u,
 }
 
 // A point light, or a light's image through a chain of mirrors (docs/shading.md, "Shadows
@@ -72,11 +87,14 @@ struct MirrorBump {
 }
 
 // One scene vertex (VERTEX_LAYOUT in crates/raster/src/shading.rs): position, the
-// triangle's face normal and its surface id.
+// triangle's face normal, its surface id and its texture coordinates (location 5; every
+// method passes them on to its fragments at location 8, interpolated perspective-correct,
+// which is the tracer's barycentric interpolation at the sample's point).
 struct VertexIn {
     @location(0) position: vec3f,
     @location(1) normal: vec3f,
     @location(2) surface: u32,
+    @location(5) uv: vec2f,
 }
 
 @group(0) @binding(0) var<uniform> frame: Frame;
@@ -88,6 +106,10 @@ struct VertexIn {
 // The normal maps' texels, 8-bit RGB packed in a u32 each: one atlas, every map's rows from
 // its map_offset down, row 0 at the mirror's top (a texture: storage buffers are scarcer).
 @group(0) @binding(5) var normal_texels: texture_2d<u32>;
+// The colour textures' texels, sRGB RGBA8 packed in a u32 each, every texture at its
+// TextureMap's origin in one atlas (read texel by texel: the contract's bilinear rule is
+// evaluated here, not by a sampler, so both renderers weigh the same texels alike).
+@group(0) @binding(6) var colour_texels: texture_2d<u32>;
 
 const FRAC_1_PI: f32 = 0.31830988618379067;
 const MIN_LIGHT_DISTANCE_SQUARED: f32 = 1e-8;
@@ -133,6 +155,74 @@ fn diffuse_radiance(p: vec3f, face_normal: vec3f, to_viewer: vec3f, albedo: vec3
     }
     let emitted = select(vec3f(0.0), emission, front);
     return emitted + albedo * (irradiance * FRAC_1_PI + frame.ambient);
+}
+
+// The sRGB transfer function's inverse for an 8-bit value (texture.rs's srgb_to_linear).
+fn srgb_to_linear(value: u32) -> f32 {
+    let c = f32(value) / 255.0;
+    if (c <= 0.04045) {
+        return c / 12.92;
+    }
+    return pow((c + 0.055) / 1.055, 2.4);
+}
+
+// Texel index i of an axis of n texels brought back by wrap mode `mode` (texture.rs's
+// Wrap::index).
+fn wrap_index(mode: u32, i: i32, n: i32) -> i32 {
+    if (mode == 1u) {
+        return clamp(i, 0, n - 1);
+    }
+    if (mode == 2u) {
+        let m = ((i % (2 * n)) + 2 * n) % (2 * n);
+        return select(m, 2 * n - 1 - m, m >= n);
+    }
+    return ((i % n) + n) % n;
+}
+
+fn colour_texel(m: TextureMap, i: i32, j: i32) -> vec3f {
+    let t = textureLoad(colour_texels, vec2i(m.origin) + vec2i(i, j), 0).r;
+    return vec3f(srgb_to_linear(t & 255u), srgb_to_linear((t >> 8u) & 255u), srgb_to_linear((t >> 16u) & 255u));
+}
+
+// The contract's texture lookup (texture.rs's TextureMap::sample, the same f32 steps).
+fn texture_sample(m: TextureMap, uv: vec2f) -> vec3f {
+    let t = vec2f(
+        m.row_u.x * uv.x + m.row_u.y * uv.y + m.row_u.z,
+        m.row_v.x * uv.x + m.row_v.y * uv.y + m.row_v.z,
+    );
+    let size = vec2i(m.size);
+    let xy = clamp(t * vec2f(m.size) - 0.5, vec2f(-16777216.0), vec2f(16777216.0));
+    let base = floor(xy);
+    let f = xy - base;
+    let ij = vec2i(base);
+    let wu = m.wrap & 15u;
+    let wv = (m.wrap >> 4u) & 15u;
+    let i0 = wrap_index(wu, ij.x, size.x);
+    let i1 = wrap_index(wu, ij.x + 1, size.x);
+    let j0 = wrap_index(wv, ij.y, size.y);
+    let j1 = wrap_index(wv, ij.y + 1, size.y);
+    let a = colour_texel(m, i0, j0);
+    let b = colour_texel(m, i1, j0);
+    let c = colour_texel(m, i0, j1);
+    let d = colour_texel(m, i1, j1);
+    let top = a + (b - a) * f.x;
+    let bottom = c + (d - c) * f.x;
+    return top + (bottom - top) * f.y;
+}
+
+// A diffuse surface's albedo and emission at texture coordinates uv: factor × texture.
+fn surface_albedo(s: Surface, uv: vec2f) -> vec3f {
+    if (s.albedo_map.present == 0u) {
+        return s.albedo;
+    }
+    return s.albedo * texture_sample(s.albedo_map, uv);
+}
+
+fn surface_emission(s: Surface, uv: vec2f) -> vec3f {
+    if (s.emission_map.present == 0u) {
+        return s.emission;
+    }
+    return s.emission * texture_sample(s.emission_map, uv);
 }
 
 // Normal map texel (i, j) of mirror bump b, repeated, decoded to [−1, 1]³.

@@ -81,6 +81,7 @@ struct CopyOut {
     @location(5) d1: vec4f,
     @location(6) d2: vec4f,
     @location(7) d3: vec4f,
+    @location(8) uv: vec2f,
 }
 
 fn copy_out(v: VertexIn, mask: u32) -> CopyOut {
@@ -91,6 +92,7 @@ fn copy_out(v: VertexIn, mask: u32) -> CopyOut {
     out.normal = c.normal;
     out.surface = v.surface;
     out.copy = mask;
+    out.uv = v.uv;
     out.d0 = c.d0;
     out.d1 = c.d1;
     out.d2 = c.d2;
@@ -113,9 +115,9 @@ fn behind_a_plane(in: CopyOut) -> bool {
         || any(in.d3 < vec4f(0.0));
 }
 
-fn object_colour(world: vec3f, normal: vec3f, surface: u32) -> vec4f {
+fn object_colour(world: vec3f, normal: vec3f, surface: u32, uv: vec2f) -> vec4f {
     let s = surfaces[surface];
-    return vec4f(diffuse_radiance(world, normal, normalize(symmetry.eye - world), s.albedo, s.emission), 1.0);
+    return vec4f(diffuse_radiance(world, normal, normalize(symmetry.eye - world), surface_albedo(s, uv), surface_emission(s, uv)), 1.0);
 }
 
 // The debug output of `--copy-ids`: which copy a pixel shows, as copy mask + 1 (0: none).
@@ -128,7 +130,7 @@ fn fs_object_discard(in: CopyOut) -> @location(0) vec4f {
     if (behind_a_plane(in)) {
         discard;
     }
-    return object_colour(in.world, in.normal, in.surface);
+    return object_colour(in.world, in.normal, in.surface, in.uv);
 }
 
 @fragment
@@ -145,6 +147,7 @@ struct UnmovedOut {
     @location(0) world: vec3f,
     @location(1) @interpolate(flat) normal: vec3f,
     @location(2) @interpolate(flat) surface: u32,
+    @location(8) uv: vec2f,
 }
 
 @vertex
@@ -154,6 +157,7 @@ fn vs_unmoved(v: VertexIn) -> UnmovedOut {
     out.world = v.position;
     out.normal = v.normal;
     out.surface = v.surface;
+    out.uv = v.uv;
     return out;
 }
 
@@ -175,7 +179,7 @@ fn fs_mirror_copy_id(in: UnmovedOut) -> @location(0) vec4f {
 
 @fragment
 fn fs_unmoved_object(in: UnmovedOut) -> @location(0) vec4f {
-    return object_colour(in.world, in.normal, in.surface);
+    return object_colour(in.world, in.normal, in.surface, in.uv);
 }
 
 // The baked mesh under `--copy-ids`: each vertex carries the copy its triangle came from

@@ -11,6 +11,7 @@ struct ClippedCopyOut {
     @location(1) @interpolate(flat) normal: vec3f,
     @location(2) @interpolate(flat) surface: u32,
     @location(3) @interpolate(flat) copy: u32,
+    @location(8) uv: vec2f,
 }
 
 struct ClippedCopyIn {
@@ -19,6 +20,7 @@ struct ClippedCopyIn {
     @location(1) @interpolate(flat) normal: vec3f,
     @location(2) @interpolate(flat) surface: u32,
     @location(3) @interpolate(flat) copy: u32,
+    @location(8) uv: vec2f,
 }
 
 fn clipped_copy_out(v: VertexIn, mask: u32) -> ClippedCopyOut {
@@ -31,6 +33,7 @@ fn clipped_copy_out(v: VertexIn, mask: u32) -> ClippedCopyOut {
     out.normal = c.normal;
     out.surface = v.surface;
     out.copy = mask;
+    out.uv = v.uv;
     return out;
 }
 
@@ -46,7 +49,7 @@ fn vs_per_copy_clipped(v: VertexIn) -> ClippedCopyOut {
 
 @fragment
 fn fs_object_clipped(in: ClippedCopyIn) -> @location(0) vec4f {
-    return object_colour(in.world, in.normal, in.surface);
+    return object_colour(in.world, in.normal, in.surface, in.uv);
 }
 
 @fragment

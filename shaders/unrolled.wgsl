@@ -49,6 +49,7 @@ struct GuardedOut {
     @location(3) @interpolate(flat) piece: u32,
     // Clip-space x, y, w: affine in the world position, so interpolated exactly.
     @location(4) clip_xyw: vec3f,
+    @location(8) uv: vec2f,
 }
 
 // Without clip distances every test happens per fragment.
@@ -61,6 +62,7 @@ fn vs_guarded(v: VertexIn, @builtin(instance_index) instance: u32) -> GuardedOut
     out.normal = v.normal;
     out.surface = v.surface;
     out.piece = id;
+    out.uv = v.uv;
     out.clip_xyw = out.clip.xyw;
     return out;
 }
@@ -111,10 +113,10 @@ fn in_cell(id: u32, x: vec3f, clip_xyw: vec3f) -> bool {
 // Scene-space tolerance of the guard (the scene loader's coordinates are metres).
 const GUARD_EPSILON: f32 = 1e-5;
 
-fn object_colour(id: u32, world: vec3f, normal: vec3f, surface: u32) -> vec4f {
+fn object_colour(id: u32, world: vec3f, normal: vec3f, surface: u32, uv: vec2f) -> vec4f {
     let p = pieces[id];
     let s = surfaces[surface];
-    return vec4f(p.attenuation * diffuse_radiance(world, normal, normalize(p.eye - world), s.albedo, s.emission), 1.0);
+    return vec4f(p.attenuation * diffuse_radiance(world, normal, normalize(p.eye - world), surface_albedo(s, uv), surface_emission(s, uv)), 1.0);
 }
 
 // A mirror in a path's world whose own path was not kept (pruned or past the depth cap):
@@ -134,7 +136,7 @@ fn fs_object_guarded(in: GuardedOut) -> @location(0) vec4f {
     if (!in_cell(in.piece, in.world, in.clip_xyw)) {
         discard;
     }
-    return object_colour(in.piece, in.world, in.normal, in.surface);
+    return object_colour(in.piece, in.world, in.normal, in.surface, in.uv);
 }
 
 @fragment

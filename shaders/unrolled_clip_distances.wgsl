@@ -12,6 +12,7 @@ struct ClippedOut {
     @location(1) @interpolate(flat) normal: vec3f,
     @location(2) @interpolate(flat) surface: u32,
     @location(3) @interpolate(flat) piece: u32,
+    @location(8) uv: vec2f,
 }
 
 struct ClippedIn {
@@ -20,6 +21,7 @@ struct ClippedIn {
     @location(1) @interpolate(flat) normal: vec3f,
     @location(2) @interpolate(flat) surface: u32,
     @location(3) @interpolate(flat) piece: u32,
+    @location(8) uv: vec2f,
 }
 
 @vertex
@@ -40,12 +42,13 @@ fn vs_clipped(v: VertexIn, @builtin(instance_index) instance: u32) -> ClippedOut
     out.normal = v.normal;
     out.surface = v.surface;
     out.piece = id;
+    out.uv = v.uv;
     return out;
 }
 
 @fragment
 fn fs_object_clipped(in: ClippedIn) -> @location(0) vec4f {
-    return object_colour(in.piece, in.world, in.normal, in.surface);
+    return object_colour(in.piece, in.world, in.normal, in.surface, in.uv);
 }
 
 @fragment

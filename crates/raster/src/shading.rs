@@ -10,7 +10,11 @@ use wgpu::util::DeviceExt;
 pub fn gpu_structs() -> Vec<crate::wgsl::HostLayout> {
     vec![
         crate::host_layout!(GpuSurface as "Surface" {
-            albedo, kind, emission, mirror, reflectance, _pad0, back_albedo, _pad1, bump
+            albedo, kind, emission, mirror, reflectance, _pad0, back_albedo, _pad1, bump,
+            albedo_map, emission_map
+        }),
+        crate::host_layout!(GpuTextureMap as "TextureMap" {
+            row_u, present, row_v, wrap, origin, size
         }),
         crate::host_layout!(GpuLight as "Light" {
             position, first_plane, intensity, plane_count, shadow_from_world, shadow_layer,
@@ -124,6 +128,104 @@ fn atlas_rows(scene: &Scene) -> u32 {
         .max(1)
 }
 
+/// A texture as a surface reads it, for `shading.wgsl`'s `texture_sample`.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct GpuTextureMap {
+    row_u: [f32; 3],
+    /// 1 where the surface has this texture.
+    present: u32,
+    row_v: [f32; 3],
+    /// Wrap along u in bits 0–3, along v in bits 4–7 ([`mirrorbox_scene::texture::Wrap::code`]).
+    wrap: u32,
+    /// The texture's top-left texel in the colour atlas, and its size.
+    origin: [u32; 2],
+    size: [u32; 2],
+}
+
+/// Where each texture of a geometry lies in the colour atlas: shelves of textures, tallest
+/// first, in an atlas as wide as the widest texture or the square root of all texels (at
+/// most [`MAX_ATLAS_WIDTH`]).
+struct AtlasLayout {
+    width: u32,
+    height: u32,
+    origins: Vec<[u32; 2]>,
+}
+
+/// The colour atlas's widest row: WebGPU's default 2D texture limit.
+const MAX_ATLAS_WIDTH: u32 = 8192;
+
+fn atlas_layout(g: &mirrorbox_scene::Geometry) -> AtlasLayout {
+    let textures = &g.textures;
+    if textures.is_empty() {
+        return AtlasLayout {
+            width: 1,
+            height: 1,
+            origins: Vec::new(),
+        };
+    }
+    let widest = textures.iter().map(|t| t.width).max().unwrap_or(1);
+    let texels: u64 = textures
+        .iter()
+        .map(|t| u64::from(t.width) * u64::from(t.height))
+        .sum();
+    let width = widest.max(((texels as f64).sqrt().ceil() as u32).min(MAX_ATLAS_WIDTH));
+    let mut order: Vec<usize> = (0..textures.len()).collect();
+    order.sort_by_key(|&i| std::cmp::Reverse(textures[i].height));
+    let mut origins = vec![[0u32; 2]; textures.len()];
+    let (mut x, mut y, mut shelf) = (0u32, 0u32, 0u32);
+    for i in order {
+        let t = &textures[i];
+        if x + t.width > width {
+            y += shelf;
+            x = 0;
+            shelf = 0;
+        }
+        origins[i] = [x, y];
+        x += t.width;
+        shelf = shelf.max(t.height);
+    }
+    AtlasLayout {
+        width,
+        height: y + shelf,
+        origins,
+    }
+}
+
+/// The atlas's texels, sRGB RGBA8 packed little-endian in a u32 each.
+fn atlas_texels(g: &mirrorbox_scene::Geometry, layout: &AtlasLayout) -> Vec<u32> {
+    let mut texels = vec![0u32; layout.width as usize * layout.height as usize];
+    for (t, origin) in g.textures.iter().zip(&layout.origins) {
+        for (row, line) in t.texels.chunks_exact(t.width as usize).enumerate() {
+            let start = (origin[1] as usize + row) * layout.width as usize + origin[0] as usize;
+            for (dst, src) in texels[start..start + line.len()].iter_mut().zip(line) {
+                *dst = u32::from_le_bytes(*src);
+            }
+        }
+    }
+    texels
+}
+
+fn texture_map(
+    g: &mirrorbox_scene::Geometry,
+    layout: &AtlasLayout,
+    map: Option<mirrorbox_scene::texture::TextureMap>,
+) -> GpuTextureMap {
+    let Some(m) = map else {
+        return Zeroable::zeroed();
+    };
+    let t = &g.textures[m.texture as usize];
+    let k = m.transform;
+    GpuTextureMap {
+        row_u: [k[0], k[1], k[2]],
+        present: 1,
+        row_v: [k[3], k[4], k[5]],
+        wrap: m.wrap[0].code() | m.wrap[1].code() << 4,
+        origin: layout.origins[m.texture as usize],
+        size: [t.width, t.height],
+    }
+}
+
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 pub struct GpuSurface {
@@ -137,6 +239,8 @@ pub struct GpuSurface {
     _pad1: u32,
     /// A mirror's frame and bump.
     bump: GpuMirrorBump,
+    albedo_map: GpuTextureMap,
+    emission_map: GpuTextureMap,
 }
 
 #[repr(C)]
@@ -179,21 +283,30 @@ pub struct Vertex {
     position: [f32; 3],
     normal: [f32; 3],
     surface: u32,
+    /// Texture coordinates (location 5: 3 and 4 are the methods' own per-instance data).
+    uv: [f32; 2],
 }
 
 pub const VERTEX_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
     array_stride: std::mem::size_of::<Vertex>() as u64,
     step_mode: wgpu::VertexStepMode::Vertex,
-    attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Uint32],
+    attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Uint32, 5 => Float32x2],
 };
 
 /// Triangle `i` of `g` as three vertices sharing its face normal and surface.
 fn triangle_vertices(g: &mirrorbox_scene::Geometry, i: usize) -> [Vertex; 3] {
     let normal = g.face_normal(i).to_array();
-    g.triangles[i].map(|p| Vertex {
-        position: p.to_array(),
-        normal,
-        surface: g.surface_of[i],
+    let uv = g.uvs[i];
+    let mut k = 0;
+    g.triangles[i].map(|p| {
+        let v = Vertex {
+            position: p.to_array(),
+            normal,
+            surface: g.surface_of[i],
+            uv: uv[k].to_array(),
+        };
+        k += 1;
+        v
     })
 }
 
@@ -248,9 +361,9 @@ impl SceneBuffers {
     }
 
     /// GPU bytes of `scene`'s buffers drawing `g` ([`SceneBuffers::for_geometry`]), before
-    /// any is created: the vertex buffer (3 × 28 bytes a triangle), the frame uniform, the
-    /// surface, light and light-plane storage buffers, and the normal-map atlas (4 bytes a
-    /// texel), each at [`crate::memory`]'s granularity.
+    /// any is created: the vertex buffer (3 × 36 bytes a triangle), the frame uniform, the
+    /// surface, light and light-plane storage buffers, the normal-map atlas and the colour
+    /// atlas (4 bytes a texel each), each at [`crate::memory`]'s granularity.
     pub fn memory_bytes(scene: &Scene, g: &mirrorbox_scene::Geometry) -> u64 {
         use crate::memory::{buffer_bytes, texture_bytes};
         let size = |n: usize, each: usize| buffer_bytes((n.max(1) * each) as u64);
@@ -266,6 +379,10 @@ impl SceneBuffers {
             )
             + size(planes, 16)
             + texture_bytes(atlas_width, atlas_rows(scene), 4)
+            + {
+                let colour = atlas_layout(g);
+                texture_bytes(colour.width, colour.height, 4)
+            }
     }
 
     /// The vertex range of every mesh drawn as it is: each non-mirror part, then each mirror
@@ -312,6 +429,16 @@ impl SceneBuffers {
                 advice: "; use fewer or smaller normal maps",
             });
         }
+        let colour = atlas_layout(g);
+        if colour.height > limit || colour.width > limit {
+            return Err(crate::RasterError::ExceedsDevice {
+                what: "the colour-texture atlas (every texture packed in shelves)".into(),
+                needed: format!("{}×{} texels", colour.width, colour.height),
+                limit: format!("{limit} texels a side"),
+                adapter: gpu.report.name.clone(),
+                advice: "; use fewer or smaller textures",
+            });
+        }
         Ok(())
     }
 
@@ -334,6 +461,7 @@ impl SceneBuffers {
     ) -> Self {
         let device = &gpu.device;
         let (bumps, atlas_width, texels) = mirror_bumps(scene);
+        let colour_layout = atlas_layout(g);
         let vertex = |i: usize| triangle_vertices(g, i);
         let mut vertices: Vec<Vertex> = Vec::with_capacity(g.triangles.len() * 3);
         let mut mirror_tris = vec![Vec::new(); scene.mirrors.len()];
@@ -379,9 +507,15 @@ impl SceneBuffers {
             .surfaces
             .iter()
             .map(|s| match s {
-                Surface::Diffuse { albedo, emission } => GpuSurface {
+                Surface::Diffuse {
+                    albedo,
+                    emission,
+                    maps,
+                } => GpuSurface {
                     albedo: albedo.to_array(),
                     emission: emission.to_array(),
+                    albedo_map: texture_map(g, &colour_layout, maps.albedo),
+                    emission_map: texture_map(g, &colour_layout, maps.emission),
                     ..Zeroable::zeroed()
                 },
                 Surface::Mirror {
@@ -505,6 +639,27 @@ impl SceneBuffers {
             bytemuck::cast_slice(&texels),
         );
         let atlas_view = atlas.create_view(&Default::default());
+        let colour_atlas = wgpu::util::DeviceExt::create_texture_with_data(
+            device,
+            &gpu.queue,
+            &wgpu::TextureDescriptor {
+                label: Some("colour texture atlas"),
+                size: wgpu::Extent3d {
+                    width: colour_layout.width,
+                    height: colour_layout.height,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: wgpu::TextureFormat::R32Uint,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            },
+            wgpu::util::TextureDataOrder::LayerMajor,
+            bytemuck::cast_slice(&atlas_texels(g, &colour_layout)),
+        );
+        let colour_view = colour_atlas.create_view(&Default::default());
         let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
             binding,
             visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
@@ -546,6 +701,14 @@ impl SceneBuffers {
                         multisampled: false,
                     },
                 ),
+                entry(
+                    6,
+                    wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Uint,
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                ),
             ],
         });
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -575,6 +738,10 @@ impl SceneBuffers {
                 wgpu::BindGroupEntry {
                     binding: 5,
                     resource: wgpu::BindingResource::TextureView(&atlas_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 6,
+                    resource: wgpu::BindingResource::TextureView(&colour_view),
                 },
             ],
         });

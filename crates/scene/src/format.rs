@@ -157,6 +157,7 @@ pub enum ShapeKind {
     Sphere,
     Quad,
     Mesh,
+    Gltf,
 }
 
 impl ShapeKind {
@@ -167,6 +168,7 @@ impl ShapeKind {
             ShapeKind::Sphere => &["radius", "subdivisions"],
             ShapeKind::Quad => &["size"],
             ShapeKind::Mesh => &["path"],
+            ShapeKind::Gltf => &["path", "scene", "curved_mirrors"],
         }
     }
     pub fn name(self) -> &'static str {
@@ -175,6 +177,7 @@ impl ShapeKind {
             ShapeKind::Sphere => "sphere",
             ShapeKind::Quad => "quad",
             ShapeKind::Mesh => "mesh",
+            ShapeKind::Gltf => "gltf",
         }
     }
 }
@@ -198,12 +201,26 @@ pub struct ObjectDesc {
     pub subdivisions: Option<u32>,
     #[serde(default)]
     pub path: Option<String>,
+    /// gltf: which of the file's scenes (default: its `scene`, else the first).
+    #[serde(default)]
+    pub scene: Option<usize>,
+    /// gltf: what a mirror-like primitive that is not a planar rectangle becomes.
+    #[serde(default)]
+    pub curved_mirrors: Option<CurvedMirrorsDesc>,
     #[serde(default)]
     pub transform: Option<TransformDesc>,
     #[serde(default)]
     pub albedo: Option<Rgb>,
     #[serde(default)]
     pub emission: Option<Rgb>,
+}
+
+/// `curved_mirrors` of a glTF object (`docs/gltf.md`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CurvedMirrorsDesc {
+    Refuse,
+    Diffuse,
 }
 
 #[derive(Debug, Default, Deserialize)]

@@ -5,17 +5,23 @@
 //! (`(v1 − v0) × (v2 − v0)`, normalized), never interpolated normals, so that the rasterizer,
 //! the tracer and Mitsuba (`face_normals`) all see exactly the same surface.
 
-use glam::Vec3;
+use crate::texture::{SurfaceMaps, Texture, barycentric, interpolate_uv};
+use glam::{Vec2, Vec3};
 use std::ops::Range;
 
 /// Index into [`Geometry::surfaces`].
 pub type SurfaceId = u32;
 
 /// What a triangle is made of. See `docs/shading.md` for how each is shaded.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, PartialEq)]
 pub enum Surface {
-    /// Lambertian reflector (two-sided) with optional emission (front side only).
-    Diffuse { albedo: Vec3, emission: Vec3 },
+    /// Lambertian reflector (two-sided) with optional emission (front side only); `maps`
+    /// multiply them by textures (`docs/shading.md`, "Textures").
+    Diffuse {
+        albedo: Vec3,
+        emission: Vec3,
+        maps: SurfaceMaps,
+    },
     /// Front side of mirror `mirror` (index into `Scene::mirrors`) reflects `reflectance`;
     /// the back side is diffuse with `back_albedo`.
     Mirror {
@@ -23,6 +29,49 @@ pub enum Surface {
         reflectance: Vec3,
         back_albedo: Vec3,
     },
+}
+
+impl std::fmt::Debug for Surface {
+    /// As derived, except that an untextured diffuse surface prints without its (empty)
+    /// maps: the scene's content hash, which is the key of cached truths, stays what it was
+    /// before textures existed.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Surface::Diffuse {
+                albedo,
+                emission,
+                maps,
+            } => {
+                let mut d = f.debug_struct("Diffuse");
+                d.field("albedo", albedo).field("emission", emission);
+                if !maps.is_empty() {
+                    d.field("maps", maps);
+                }
+                d.finish()
+            }
+            Surface::Mirror {
+                mirror,
+                reflectance,
+                back_albedo,
+            } => f
+                .debug_struct("Mirror")
+                .field("mirror", mirror)
+                .field("reflectance", reflectance)
+                .field("back_albedo", back_albedo)
+                .finish(),
+        }
+    }
+}
+
+impl Surface {
+    /// A diffuse surface without textures.
+    pub fn diffuse(albedo: Vec3, emission: Vec3) -> Surface {
+        Surface::Diffuse {
+            albedo,
+            emission,
+            maps: SurfaceMaps::default(),
+        }
+    }
 }
 
 /// A named group of consecutive triangles (one scene object or one mirror).
@@ -38,6 +87,11 @@ pub struct Geometry {
     pub triangles: Vec<[Vec3; 3]>,
     /// `surface_of[i]` is the surface of `triangles[i]`.
     pub surface_of: Vec<SurfaceId>,
+    /// `uvs[i]` are the texture coordinates of `triangles[i]`'s corners (zero where the
+    /// triangle's surface has no texture). Always as long as `triangles`.
+    pub uvs: Vec<[Vec2; 3]>,
+    /// The images that surfaces' [`SurfaceMaps`] index.
+    pub textures: Vec<Texture>,
     pub surfaces: Vec<Surface>,
     pub parts: Vec<Part>,
     /// Triangles dropped at load because they had (near) zero area.
@@ -67,16 +121,31 @@ impl Geometry {
     /// Appends a part; degenerate triangles are dropped (and counted) so that every stored
     /// triangle has a well-defined face normal.
     pub fn push_part(&mut self, name: String, surface: Surface, triangles: Vec<[Vec3; 3]>) {
+        let uvs = vec![[Vec2::ZERO; 3]; triangles.len()];
+        self.push_textured_part(name, surface, triangles, uvs);
+    }
+
+    /// [`Geometry::push_part`] with each triangle's texture coordinates (`uvs[i]` for
+    /// `triangles[i]`).
+    pub fn push_textured_part(
+        &mut self,
+        name: String,
+        surface: Surface,
+        triangles: Vec<[Vec3; 3]>,
+        uvs: Vec<[Vec2; 3]>,
+    ) {
+        debug_assert_eq!(triangles.len(), uvs.len());
         let id = self.surfaces.len() as SurfaceId;
         self.surfaces.push(surface);
         let start = self.triangles.len();
-        for t in triangles {
+        for (t, uv) in triangles.into_iter().zip(uvs) {
             if is_degenerate(&t) {
                 self.degenerate_dropped += 1;
                 continue;
             }
             self.triangles.push(t);
             self.surface_of.push(id);
+            self.uvs.push(uv);
         }
         let end = self.triangles.len();
         self.parts.push(Part {
@@ -94,6 +163,45 @@ impl Geometry {
 
     pub fn surface(&self, triangle: usize) -> &Surface {
         &self.surfaces[self.surface_of[triangle] as usize]
+    }
+
+    /// The texture coordinates of point `p` (on triangle `triangle`'s plane).
+    pub fn uv_at(&self, triangle: usize, p: Vec3) -> Vec2 {
+        let b = barycentric(&self.triangles[triangle], p);
+        interpolate_uv(&self.uvs[triangle], b)
+    }
+
+    /// Whether any surface reads a texture.
+    pub fn has_textures(&self) -> bool {
+        self.surfaces
+            .iter()
+            .any(|s| matches!(s, Surface::Diffuse { maps, .. } if !maps.is_empty()))
+    }
+
+    /// The albedo and emission of the diffuse surface of `triangle` at point `p`: its
+    /// factors times its textures there (`docs/shading.md`, "Textures"). `None` for a mirror.
+    pub fn diffuse_at(&self, triangle: usize, p: Vec3) -> Option<(Vec3, Vec3)> {
+        let Surface::Diffuse {
+            albedo,
+            emission,
+            maps,
+        } = self.surface(triangle)
+        else {
+            return None;
+        };
+        if maps.is_empty() {
+            return Some((*albedo, *emission));
+        }
+        let uv = self.uv_at(triangle, p);
+        let texel = |m: &Option<crate::texture::TextureMap>| {
+            m.map_or(Vec3::ONE, |m| {
+                m.sample(&self.textures[m.texture as usize], uv)
+            })
+        };
+        Some((
+            *albedo * texel(&maps.albedo),
+            *emission * texel(&maps.emission),
+        ))
     }
 
     pub fn mirror_triangle_count(&self) -> usize {
@@ -132,6 +240,7 @@ mod tests {
         let diffuse = Surface::Diffuse {
             albedo: Vec3::splat(0.5),
             emission: Vec3::ZERO,
+            maps: Default::default(),
         };
         g.push_part("p".into(), diffuse, vec![good, collinear, repeated]);
         assert_eq!(g.triangles, vec![good]);

@@ -12,6 +12,13 @@ impl Fnv1a {
     pub fn finish(&self) -> u64 {
         self.0
     }
+    /// Feeds raw bytes (a texture's texels), as `write_str` feeds a string's.
+    pub fn write_bytes(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.0 ^= b as u64;
+            self.0 = self.0.wrapping_mul(0x0000_0100_0000_01b3);
+        }
+    }
 }
 
 impl Default for Fnv1a {
@@ -22,10 +29,7 @@ impl Default for Fnv1a {
 
 impl std::fmt::Write for Fnv1a {
     fn write_str(&mut self, s: &str) -> std::fmt::Result {
-        for b in s.bytes() {
-            self.0 ^= b as u64;
-            self.0 = self.0.wrapping_mul(0x0000_0100_0000_01b3);
-        }
+        self.write_bytes(s.as_bytes());
         Ok(())
     }
 }

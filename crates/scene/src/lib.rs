@@ -16,6 +16,7 @@ pub mod camera_path;
 pub mod error;
 pub mod format;
 pub mod geometry;
+pub mod gltf_asset;
 pub mod hash;
 pub mod light_images;
 pub mod limits;
@@ -27,6 +28,7 @@ pub mod shading;
 pub mod stereo;
 pub mod symmetry;
 pub mod tessellate;
+pub mod texture;
 
 pub use camera::{Camera, Ray, SubpixelGrid};
 pub use error::SceneError;

@@ -10,10 +10,11 @@ use crate::bump::{
 };
 use crate::error::{FieldPath, SceneError};
 use crate::format::{
-    BumpDesc, CameraDesc, LightDesc, MirrorDesc, ObjectDesc, Rgb, Scale, SceneFile, ShapeKind,
-    SymmetryPlaneDesc, TransformDesc, Vec3f,
+    BumpDesc, CameraDesc, CurvedMirrorsDesc, LightDesc, MirrorDesc, ObjectDesc, Rgb, Scale,
+    SceneFile, ShapeKind, SymmetryPlaneDesc, TransformDesc, Vec3f,
 };
 use crate::geometry::{Geometry, Surface};
+use crate::gltf_asset;
 use crate::light_images::{DEFAULT_MIN_THROUGHPUT, MAX_MIRRORED_LIGHTS};
 use crate::limits::{
     MAX_COORDINATE, MAX_IMAGE_SIDE, MAX_OBJ_FILE_BYTES, MAX_PIXELS, MAX_SCENE_FILE_BYTES,
@@ -22,6 +23,7 @@ use crate::limits::{
 use crate::shading::{Lighting, PointLight};
 use crate::symmetry::{self, MAX_SYMMETRY_PLANES, Symmetry, SymmetryPlane};
 use crate::tessellate::{self, MAX_SPHERE_SUBDIVISIONS};
+use crate::texture::MAX_TEXTURE_TEXELS;
 use crate::{Camera, Mirror, Plane, Scene};
 use glam::{EulerRot, Mat4, Quat, Vec3};
 use std::path::{Path, PathBuf};
@@ -91,6 +93,15 @@ fn strip_position(message: &str) -> String {
 
 struct Checker<'a> {
     file: &'a Path,
+}
+
+/// What glTF objects bring besides triangles: mirrors (with the object's field path),
+/// point lights and cameras.
+#[derive(Default)]
+struct AssetExtras {
+    mirrors: Vec<(FieldPath, Mirror)>,
+    lights: Vec<PointLight>,
+    cameras: Vec<gltf_asset::AssetCamera>,
 }
 
 type Result<T> = std::result::Result<T, SceneError>;
@@ -207,8 +218,9 @@ impl Checker<'_> {
         let camera = self.camera(&FieldPath::root("camera"), &file.camera)?;
         let mut geometry = Geometry::default();
         let objects = FieldPath::root("objects");
+        let mut assets = AssetExtras::default();
         for (i, object) in file.objects.iter().enumerate() {
-            self.object(&objects.index(i), i, object, &mut geometry)?;
+            self.object(&objects.index(i), i, object, &mut geometry, &mut assets)?;
         }
         let planes = self.symmetry_planes(&file.symmetry_planes)?;
         let symmetry = if planes.is_empty() {
@@ -252,13 +264,31 @@ impl Checker<'_> {
             );
             mirrors.push(mirror);
         }
+        // Mirrors of glTF assets (docs/gltf.md), after the file's own.
+        for (object_path, mirror) in assets.mirrors {
+            self.triangle_budget(&object_path, geometry.triangles.len(), 2)?;
+            let i = mirrors.len();
+            bumps.push(None);
+            let [a, b, c, d] = mirror.corners();
+            geometry.push_part(
+                mirror.name.clone(),
+                Surface::Mirror {
+                    mirror: i,
+                    reflectance: mirror.reflectance,
+                    back_albedo: mirror.back_albedo,
+                },
+                vec![[a, b, c], [a, c, d]],
+            );
+            mirrors.push(mirror);
+        }
         let lights_path = FieldPath::root("lights");
-        let lights = file
+        let mut lights = file
             .lights
             .iter()
             .enumerate()
             .map(|(i, l)| self.light(&lights_path.index(i), l))
             .collect::<Result<Vec<_>>>()?;
+        lights.extend(assets.lights);
         let lighting_desc = file.lighting.as_ref();
         let mirrored_lights = lighting_desc.and_then(|l| l.mirrored_lights).unwrap_or(0);
         let mirrored_path = FieldPath::root("lighting").field("mirrored_lights");
@@ -688,12 +718,15 @@ impl Checker<'_> {
         index: usize,
         o: &ObjectDesc,
         geometry: &mut Geometry,
+        assets: &mut AssetExtras,
     ) -> Result<()> {
         let present = [
             ("size", o.size.is_some()),
             ("radius", o.radius.is_some()),
             ("subdivisions", o.subdivisions.is_some()),
             ("path", o.path.is_some()),
+            ("scene", o.scene.is_some()),
+            ("curved_mirrors", o.curved_mirrors.is_some()),
         ];
         let allowed = o.kind.allowed_fields();
         for (field, is_present) in present {
@@ -732,6 +765,20 @@ impl Checker<'_> {
                 self.triangle_budget(path, geometry.triangles.len(), 20 << (2 * level))?;
                 tessellate::icosphere(radius, level)
             }
+            ShapeKind::Gltf => {
+                for (field, given) in [
+                    ("albedo", o.albedo.is_some()),
+                    ("emission", o.emission.is_some()),
+                ] {
+                    if given {
+                        return Err(self.invalid(
+                            &path.field(field),
+                            "is not a field of a \"gltf\" object: its materials give albedo and emission (docs/gltf.md)",
+                        ));
+                    }
+                }
+                return self.gltf(path, index, o, geometry, assets);
+            }
             ShapeKind::Mesh => {
                 let mesh_path = path.field("path");
                 let rel = o
@@ -765,15 +812,81 @@ impl Checker<'_> {
                 ),
             ));
         }
-        let surface = Surface::Diffuse {
-            albedo: self.reflectance(&path.field("albedo"), o.albedo, defaults::ALBEDO)?,
-            emission: self.radiance(&path.field("emission"), o.emission)?,
-        };
+        let surface = Surface::diffuse(
+            self.reflectance(&path.field("albedo"), o.albedo, defaults::ALBEDO)?,
+            self.radiance(&path.field("emission"), o.emission)?,
+        );
         let name = o
             .name
             .clone()
             .unwrap_or_else(|| format!("{} {index}", o.kind.name()));
         geometry.push_part(name, surface, world);
+        Ok(())
+    }
+
+    /// A glTF asset's parts into `geometry`, its mirrors and lights into `assets`.
+    fn gltf(
+        &self,
+        path: &FieldPath,
+        index: usize,
+        o: &ObjectDesc,
+        geometry: &mut Geometry,
+        assets: &mut AssetExtras,
+    ) -> Result<()> {
+        let file_path = path.field("path");
+        let rel = o.path.as_deref().ok_or_else(|| {
+            self.invalid(&file_path, "is required for a \"gltf\" object (a .gltf or .glb file, relative to the scene file)")
+        })?;
+        let transform = self.transform(&path.field("transform"), o.transform.as_ref())?;
+        let resolved: PathBuf = self.file.parent().unwrap_or(Path::new(".")).join(rel);
+        let texels: u64 = geometry
+            .textures
+            .iter()
+            .map(|t| u64::from(t.width) * u64::from(t.height))
+            .sum();
+        let options = gltf_asset::GltfOptions {
+            scene: o.scene,
+            triangle_budget: (MAX_TRIANGLES - geometry.triangles.len().min(MAX_TRIANGLES)) as u64,
+            texel_budget: MAX_TEXTURE_TEXELS.saturating_sub(texels),
+            transform,
+            curved_mirrors: match o.curved_mirrors {
+                Some(CurvedMirrorsDesc::Diffuse) => gltf_asset::CurvedMirrors::Diffuse,
+                _ => gltf_asset::CurvedMirrors::Refuse,
+            },
+        };
+        let asset = gltf_asset::load_gltf(&resolved, &options).map_err(|e| {
+            let at = if resolved.to_string_lossy() == rel {
+                String::new()
+            } else {
+                format!(" (at {})", resolved.display())
+            };
+            self.invalid(&file_path, format!("glTF \"{rel}\"{at}: {e}"))
+        })?;
+        let first_texture = geometry.textures.len() as u32;
+        geometry.textures.extend(asset.textures);
+        let object_name = o.name.clone().unwrap_or_else(|| format!("gltf {index}"));
+        for part in asset.parts {
+            let mut surface = part.surface;
+            if let Surface::Diffuse { maps, .. } = &mut surface {
+                for m in [&mut maps.albedo, &mut maps.emission].into_iter().flatten() {
+                    m.texture += first_texture;
+                }
+            }
+            geometry.push_textured_part(
+                format!("{object_name}: {}", part.name),
+                surface,
+                part.triangles,
+                part.uvs,
+            );
+        }
+        geometry
+            .obj_notes
+            .extend(asset.notes.into_iter().map(|n| format!("{file_path}: {n}")));
+        assets
+            .mirrors
+            .extend(asset.mirrors.into_iter().map(|m| (path.clone(), m)));
+        assets.lights.extend(asset.lights);
+        assets.cameras.extend(asset.cameras);
         Ok(())
     }
 

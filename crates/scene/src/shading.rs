@@ -212,14 +212,31 @@ pub enum Interaction {
 
 /// The contract's rule for each surface: a mirror reflects on its front side only and is a
 /// plain diffuse surface (no emission) on its back side.
+/// A textured surface's factors only: [`interaction_at`] evaluates its textures.
 pub fn interaction(surface: &Surface, front_facing: bool) -> Interaction {
     match *surface {
-        Surface::Diffuse { albedo, emission } => Interaction::Diffuse { albedo, emission },
+        Surface::Diffuse {
+            albedo, emission, ..
+        } => Interaction::Diffuse { albedo, emission },
         Surface::Mirror { reflectance, .. } if front_facing => Interaction::Reflect { reflectance },
         Surface::Mirror { back_albedo, .. } => Interaction::Diffuse {
             albedo: back_albedo,
             emission: Vec3::ZERO,
         },
+    }
+}
+
+/// [`interaction`] at point `p` of triangle `triangle` of `g`: a diffuse surface's albedo
+/// and emission there, textures included.
+pub fn interaction_at(
+    g: &crate::Geometry,
+    triangle: usize,
+    p: Vec3,
+    front_facing: bool,
+) -> Interaction {
+    match g.diffuse_at(triangle, p) {
+        Some((albedo, emission)) => Interaction::Diffuse { albedo, emission },
+        None => interaction(g.surface(triangle), front_facing),
     }
 }
 

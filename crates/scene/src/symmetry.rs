@@ -167,6 +167,8 @@ pub fn split_and_mirror_with_origins(
     let mut baked = Geometry {
         triangles: Vec::with_capacity(total),
         surface_of: Vec::with_capacity(total),
+        uvs: Vec::with_capacity(total),
+        textures: source.textures.clone(),
         surfaces: source.surfaces.clone(),
         parts: Vec::with_capacity(source.parts.len()),
         degenerate_dropped: source.degenerate_dropped,
@@ -175,9 +177,18 @@ pub fn split_and_mirror_with_origins(
     let mut origins = Vec::with_capacity(total);
     for (part, pieces) in source.parts.iter().zip(by_part) {
         let start = baked.triangles.len();
+        let textured = matches!(
+            &source.surfaces[part.surface as usize],
+            crate::Surface::Diffuse { maps, .. } if !maps.is_empty()
+        );
         for piece in pieces {
             baked.triangles.push(piece.vertices);
             baked.surface_of.push(part.surface);
+            baked.uvs.push(if textured {
+                piece_uvs(source, planes, &piece)
+            } else {
+                [glam::Vec2::ZERO; 3]
+            });
             origins.push(piece.origin);
         }
         baked.parts.push(Part {
@@ -187,6 +198,21 @@ pub fn split_and_mirror_with_origins(
         });
     }
     Ok((baked, origins))
+}
+
+/// The texture coordinates of a baked piece's corners: each corner taken back to its source
+/// triangle (the copy's reflections undone, the last plane's first) and interpolated there.
+fn piece_uvs(source: &Geometry, planes: &[Plane], piece: &Piece) -> [glam::Vec2; 3] {
+    let origin = piece.origin;
+    piece.vertices.map(|v| {
+        let mut x = v;
+        for (k, plane) in planes.iter().enumerate().rev() {
+            if origin.copy & (1 << k) != 0 {
+                x = plane.reflect_point(x);
+            }
+        }
+        source.uv_at(origin.source_triangle as usize, x)
+    })
 }
 
 /// A vertex of a clipped polygon; `on_plane` when the cut created it.
@@ -321,6 +347,7 @@ mod tests {
         Surface::Diffuse {
             albedo: Vec3::splat(0.5),
             emission: Vec3::ZERO,
+            maps: Default::default(),
         }
     }
 

@@ -94,7 +94,7 @@ fn gpu_structs() -> Vec<HostLayout> {
         }),
         crate::camera_rays::CameraRays::layout(),
         crate::host_layout!(TriangleRecord as "TriangleRecord" {
-            normal, surface, offset, _pad0, _pad1, _pad2
+            normal, surface, offset, _pad0, uv0, uv1, uv2
         }),
     ]
 }
@@ -229,8 +229,10 @@ struct TriangleRecord {
     surface: u32,
     offset: f32,
     _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
+    /// The corners' texture coordinates (a textured surface's lookup at a traced hit).
+    uv0: [f32; 2],
+    uv1: [f32; 2],
+    uv2: [f32; 2],
 }
 
 struct RayQueryFrame {
@@ -297,6 +299,9 @@ impl RayQueryFrame {
                 normal: n.to_array(),
                 surface: g.surface_of[i],
                 offset: n.dot(t[0]),
+                uv0: g.uvs[i][0].to_array(),
+                uv1: g.uvs[i][1].to_array(),
+                uv2: g.uvs[i][2].to_array(),
                 ..Zeroable::zeroed()
             });
         }

@@ -23,7 +23,7 @@ use crate::cpu_features::{Vectorised, widest};
 use crate::mirror_bounce::{MirrorPlanes, bounce_flat_lanes};
 use crate::sampler::SplitMix64;
 use glam::Vec3;
-use mirrorbox_scene::shading::{Interaction, interaction};
+use mirrorbox_scene::shading::{Interaction, interaction_at};
 use mirrorbox_scene::{Ray, Scene, Surface};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -403,7 +403,7 @@ impl PathTracer<'_> {
             let p = ray.at(hit.t);
             let n_f = self.normals[hit.triangle];
             let front = n_f.dot(ray.dir) < 0.0;
-            let inter = interaction(g.surface(hit.triangle), front);
+            let inter = interaction_at(g, hit.triangle, p, front);
             if let Interaction::Diffuse { emission, .. } = inter
                 && front
                 && emission != Vec3::ZERO
@@ -498,7 +498,9 @@ impl PathTracer<'_> {
                             let p_light = self.area_pdf[e.triangle] * r2 / cos_l;
                             let p_bsdf = cos_p * std::f32::consts::FRAC_1_PI;
                             let w = p_light * p_light / (p_light * p_light + p_bsdf * p_bsdf);
-                            radiance += beta * f * e.emission * (cos_p / p_light) * w;
+                            // The emission at q (its texture's), the selection by factor.
+                            let emission = g.diffuse_at(e.triangle, q).map_or(e.emission, |d| d.1);
+                            radiance += beta * f * emission * (cos_p / p_light) * w;
                         }
                     }
                     let dir = cosine_sample(n, rng.next_unit(), rng.next_unit());

@@ -17,7 +17,7 @@ use crate::cpu_features::{Vectorised, widest};
 use crate::mirror_bounce::{MirrorPlanes, bounce_flat_lanes};
 use crate::sampler::SplitMix64;
 use glam::{DVec3, Vec3};
-use mirrorbox_scene::shading::{Interaction, interaction};
+use mirrorbox_scene::shading::{Interaction, interaction_at};
 use mirrorbox_scene::{Ray, Scene};
 
 /// Fewest rays of a pixel traced as a packet; fewer go one at a time.
@@ -298,9 +298,10 @@ impl<'a> Whitted<'a> {
         let normal = self.face_normals[hit.triangle];
         let front = normal.dot(query.dir) < 0.0;
         let surface = scene.geometry.surface(hit.triangle);
-        match interaction(surface, front) {
+        let p = query.at(hit.t);
+        match interaction_at(&scene.geometry, hit.triangle, p, front) {
             Interaction::Diffuse { albedo, emission } => Next::Diffuse(DiffuseHit {
-                p: query.at(hit.t),
+                p,
                 normal,
                 to_viewer: -query.dir,
                 albedo,

@@ -155,7 +155,9 @@ fn nothing_is_brighter_than_the_contract_allows() {
     let mut bound = s.background.max(s.terminal);
     for (i, tri) in g.triangles.iter().enumerate() {
         let (albedo, emission) = match g.surface(i) {
-            mirrorbox_scene::Surface::Diffuse { albedo, emission } => (*albedo, *emission),
+            mirrorbox_scene::Surface::Diffuse {
+                albedo, emission, ..
+            } => (*albedo, *emission),
             mirrorbox_scene::Surface::Mirror { back_albedo, .. } => (*back_albedo, Vec3::ZERO),
         };
         let mut irradiance = Vec3::ZERO;
@@ -260,8 +262,9 @@ fn scene_without_mirrors_equals_the_contract_reference_exactly() {
                 sum += match closest {
                     None => s.background,
                     Some((t, i)) => {
-                        let mirrorbox_scene::Surface::Diffuse { albedo, emission } =
-                            s.geometry.surface(i)
+                        let mirrorbox_scene::Surface::Diffuse {
+                            albedo, emission, ..
+                        } = s.geometry.surface(i)
                         else {
                             unreachable!()
                         };
