@@ -56,6 +56,8 @@ enum Command {
     View(commands::view::Args),
     /// Export a scene as Mitsuba 3 XML (tools/mitsuba renders and compares it).
     ExportMitsuba(commands::export_mitsuba::Args),
+    /// Place a glTF 2.0 asset in a mirror box sized to its bounds and write the scene file (docs/gltf.md).
+    Import(commands::import::Args),
     /// Fill the generated regions of README.md, docs/methods.md and the book (docs/book/src/*.md) from the committed reports and the CLI's own help (--check: only compare).
     Readme(commands::readme::Args),
     /// Rewrite a sweep folder's report (Markdown, HTML, CSV, plots) from its results.jsonl, without rendering.
@@ -170,6 +172,7 @@ fn main() -> ExitCode {
     let cli = Cli::from_arg_matches(&command.get_matches()).unwrap_or_else(|e| e.exit());
     let result = match cli.command {
         Command::Check(args) => commands::check::run(&args),
+        Command::Import(args) => commands::import::run(&args),
         Command::Info(args) => commands::info::run(&args),
         Command::Trace(args) => commands::trace::run(&args),
         Command::Render(args) => commands::render::run(&args),

@@ -19,6 +19,12 @@
 //!   as the contract does, so the export is exact) and tiled by the bitmap's `to_uv`; a
 //!   ripple is baked into a map of 48 texels per wavelength at the texel centres
 //!   (bilinear between them: an approximation of relative size ~(π/48)²/2);
+//! - a textured diffuse part (`docs/shading.md`, "Textures") → its OBJ with texture
+//!   coordinates `(u, 1 − v)` (Mitsuba's OBJ loader turns them back into glTF's `(u, v)`,
+//!   row 0 at `v = 0`), and a `bitmap` per texture: an EXR beside the meshes holding the
+//!   factor × the sRGB-decoded texels (linear, so Mitsuba's bilinear filter blends the same
+//!   numbers as the contract's), `filter_type = bilinear`, the wrap mode, and the map's
+//!   transform as `to_uv`; both renderers' lookups are then the same arithmetic;
 //! - point light → `point` (intensity in W/sr); background → `constant` emitter.
 //!
 //! What Mitsuba cannot express — the ambient term, the terminal radiance and the exposure —
@@ -176,9 +182,14 @@ pub fn export(
                 .map(|b| (&scene.mirrors[*mirror], b)),
             Surface::Diffuse { .. } => None,
         };
-        for t in &g.triangles[part.triangles.clone()] {
-            for v in t {
+        let textured = matches!(&g.surfaces[part.surface as usize], Surface::Diffuse { maps, .. } if !maps.is_empty());
+        for (k, t) in g.triangles[part.triangles.clone()].iter().enumerate() {
+            let uv = g.uvs[part.triangles.start + k];
+            for (c, v) in t.iter().enumerate() {
                 let _ = writeln!(obj, "v {} {} {}", v.x, v.y, v.z);
+                if textured {
+                    let _ = writeln!(obj, "vt {} {}", uv[c].x, 1.0 - uv[c].y);
+                }
                 if let Some((m, _)) = bumped {
                     // OBJ's v grows upwards: (u/width + ½, v/height + ½).
                     let d = *v - m.center;
@@ -193,7 +204,7 @@ pub fn export(
         }
         for k in 0..part.triangles.len() {
             let (a, b, c) = (3 * k + 1, 3 * k + 2, 3 * k + 3);
-            if bumped.is_some() {
+            if bumped.is_some() || textured {
                 let _ = writeln!(obj, "f {a}/{a} {b}/{b} {c}/{c}");
             } else {
                 let _ = writeln!(obj, "f {a} {b} {c}");
@@ -202,11 +213,22 @@ pub fn export(
         let path = mesh_dir.join(&file);
         write_atomically(&path, obj.as_bytes())?;
         written.push(path);
+        let colour = |name: &str, what: &str, factor: Vec3, map, written: &mut Vec<PathBuf>| {
+            colour_xml(
+                g,
+                &mesh_dir,
+                (i, &part.name),
+                (name, what),
+                factor,
+                map,
+                written,
+            )
+        };
         let bsdf = match &g.surfaces[part.surface as usize] {
-            Surface::Diffuse { albedo, .. } => format!(
+            Surface::Diffuse { albedo, maps, .. } => format!(
                 "    <bsdf type=\"twosided\">\n      <bsdf type=\"diffuse\">\n        \
-                 <rgb name=\"reflectance\" value=\"{}\"/>\n      </bsdf>\n    </bsdf>",
-                rgb(*albedo)
+                 {}\n      </bsdf>\n    </bsdf>",
+                colour("reflectance", "albedo", *albedo, maps.albedo, &mut written)?
             ),
             Surface::Mirror {
                 reflectance,
@@ -252,9 +274,15 @@ pub fn export(
             }
         };
         let emitter = match &g.surfaces[part.surface as usize] {
-            Surface::Diffuse { emission, .. } if *emission != Vec3::ZERO => format!(
-                "\n    <emitter type=\"area\">\n      <rgb name=\"radiance\" value=\"{}\"/>\n    </emitter>",
-                rgb(*emission)
+            Surface::Diffuse { emission, maps, .. } if *emission != Vec3::ZERO => format!(
+                "\n    <emitter type=\"area\">\n      {}\n    </emitter>",
+                colour(
+                    "radiance",
+                    "emission",
+                    *emission,
+                    maps.emission,
+                    &mut written
+                )?
             ),
             _ => String::new(),
         };
@@ -283,6 +311,85 @@ pub fn export(
     written.push(sidecar_path);
     written.push(xml_path.to_path_buf());
     Ok(written)
+}
+
+/// A factor as `<rgb>`, or the factor × its texture as a `bitmap` reading an EXR written
+/// beside the meshes (`part`: the part's index and name; `name`: the BSDF's or emitter's
+/// parameter; `what`: the file's suffix).
+fn colour_xml(
+    g: &mirrorbox_scene::Geometry,
+    mesh_dir: &Path,
+    part: (usize, &str),
+    (name, what): (&str, &str),
+    factor: Vec3,
+    map: Option<mirrorbox_scene::texture::TextureMap>,
+    written: &mut Vec<PathBuf>,
+) -> Result<String, FileError> {
+    let Some(m) = map else {
+        return Ok(format!("<rgb name=\"{name}\" value=\"{}\"/>", rgb(factor)));
+    };
+    let file = format!("{:03}_{}_{what}.exr", part.0, slug(part.1));
+    let path = mesh_dir.join(&file);
+    bitmap_exr(&g.textures[m.texture as usize], factor, &path)?;
+    written.push(path);
+    let wrap = mitsuba_wrap(&m, part.1)?;
+    let k = m.transform;
+    Ok(format!(
+        "<texture name=\"{name}\" type=\"bitmap\">\n          \
+         <string name=\"filename\" value=\"meshes/{file}\"/>\n          \
+         <string name=\"filter_type\" value=\"bilinear\"/>\n          \
+         <string name=\"wrap_mode\" value=\"{wrap}\"/>\n          \
+         <transform name=\"to_uv\"><matrix value=\"{} {} {} {} {} {} 0 0 1\"/></transform>\n        \
+         </texture>",
+        k[0], k[1], k[2], k[3], k[4], k[5]
+    ))
+}
+
+/// A texture as Mitsuba reads it: `factor` × each texel decoded from sRGB, in linear f32.
+fn bitmap_exr(
+    texture: &mirrorbox_scene::texture::Texture,
+    factor: Vec3,
+    path: &Path,
+) -> Result<(), FileError> {
+    use mirrorbox_scene::texture::srgb_to_linear;
+    let image = mirrorbox_image::RgbImage::from_fn(texture.width, texture.height, |x, y| {
+        let t = texture.texels[(y * texture.width + x) as usize];
+        [
+            factor.x * srgb_to_linear(t[0]),
+            factor.y * srgb_to_linear(t[1]),
+            factor.z * srgb_to_linear(t[2]),
+        ]
+    });
+    mirrorbox_image::write_exr(path, &image, &[]).map_err(|e| FileError {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+        refused: false,
+    })
+}
+
+/// Mitsuba's bitmap has one wrap mode for both axes: a map whose axes differ is refused.
+fn mitsuba_wrap(
+    m: &mirrorbox_scene::texture::TextureMap,
+    part: &str,
+) -> Result<&'static str, FileError> {
+    use mirrorbox_scene::texture::Wrap;
+    let name = |w: Wrap| match w {
+        Wrap::Repeat => "repeat",
+        Wrap::ClampToEdge => "clamp",
+        Wrap::MirroredRepeat => "mirror",
+    };
+    if m.wrap[0] != m.wrap[1] {
+        return Err(FileError {
+            path: PathBuf::from(part),
+            message: format!(
+                "a texture wraps {} along u and {} along v: Mitsuba's bitmap has one wrap mode for both",
+                name(m.wrap[0]),
+                name(m.wrap[1])
+            ),
+            refused: true,
+        });
+    }
+    Ok(name(m.wrap[0]))
 }
 
 fn slug(name: &str) -> String {

@@ -155,6 +155,15 @@ impl Geometry {
         });
     }
 
+    /// A geometry without triangles that keeps this one's textures: parts copied into it
+    /// (with [`Geometry::push_textured_part`]) read the same images.
+    pub fn empty_like(&self) -> Geometry {
+        Geometry {
+            textures: self.textures.clone(),
+            ..Geometry::default()
+        }
+    }
+
     /// Unit face normal of triangle `i` (front side).
     pub fn face_normal(&self, i: usize) -> Vec3 {
         let [a, b, c] = self.triangles[i];

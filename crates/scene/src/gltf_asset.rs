@@ -33,6 +33,12 @@ pub const MAX_GLTF_TOTAL_BYTES: u64 = 512 << 20;
 /// Deepest node nesting, and most node visits (a node may be instanced many times).
 pub const MAX_NODE_DEPTH: usize = 256;
 pub const MAX_NODE_VISITS: usize = 1 << 20;
+/// The extensions read (any other may be used, but a file that requires one is refused).
+pub const READ_EXTENSIONS: [&str; 3] = [
+    "KHR_lights_punctual",
+    "KHR_materials_emissive_strength",
+    "KHR_texture_transform",
+];
 /// A metallic material this smooth or smoother is a mirror.
 pub const MIRROR_MAX_ROUGHNESS: f32 = 0.05;
 
@@ -139,6 +145,23 @@ pub fn load_gltf(path: &Path, options: &GltfOptions) -> Result<GltfAsset> {
         );
         err(if field == "." { String::new() } else { field }, message)
     })?;
+    // An extension the file requires and mirrorbox does not read refuses it, named (before
+    // the validation, which would report its consequences instead: a Draco mesh's missing
+    // buffer views).
+    if let Some((i, name)) = root
+        .extensions_required
+        .iter()
+        .enumerate()
+        .find(|(_, e)| !READ_EXTENSIONS.contains(&e.as_str()))
+    {
+        return Err(err(
+            format!("extensionsRequired[{i}]"),
+            format!(
+                "the file requires \"{name}\", which mirrorbox does not read (it reads {})",
+                READ_EXTENSIONS.join(", ")
+            ),
+        ));
+    }
     let document = gltf::Document::from_json(root).map_err(|e| match e {
         gltf::Error::Validation(list) => {
             let (field, why) = &list[0];
@@ -986,23 +1009,36 @@ fn rectangle(triangles: &[[Vec3; 3]]) -> std::result::Result<Mirror, String> {
     if triangles.iter().any(|t| area(t).dot(normal) <= 0.0) {
         return Err("its triangles do not all face one way".into());
     }
-    // The rectangle's axes: the direction of the longest edge, and normal × it.
-    let edge = triangles
+    // A rectangle's bounding box is itself along one of its edges: try each edge's direction
+    // (the first 64 triangles' edges) and keep the smallest box.
+    let bounds = |a: Vec3| {
+        let b = normal.cross(a);
+        points.iter().fold(
+            (Vec2::splat(f32::MAX), Vec2::splat(f32::MIN)),
+            |(lo, hi), p| {
+                let q = Vec2::new(p.dot(a), p.dot(b));
+                (lo.min(q), hi.max(q))
+            },
+        )
+    };
+    let (a, lo, hi) = triangles
         .iter()
+        .take(64)
         .flat_map(|t| [t[1] - t[0], t[2] - t[1], t[0] - t[2]])
-        .max_by(|a, b| a.length_squared().total_cmp(&b.length_squared()))
-        .unwrap_or(Vec3::X);
-    let a = (edge - normal * edge.dot(normal)).normalize();
+        .filter_map(|e| (e - normal * e.dot(normal)).try_normalize())
+        .map(|a| {
+            let (lo, hi) = bounds(a);
+            (a, lo, hi)
+        })
+        .min_by(|x, y| {
+            let area = |(_, lo, hi): &(Vec3, Vec2, Vec2)| (*hi - *lo).x * (*hi - *lo).y;
+            area(x).total_cmp(&area(y))
+        })
+        .ok_or("its triangles have no edges")?;
     let b = normal.cross(a);
-    let (lo, hi) = points.iter().fold(
-        (Vec2::splat(f32::MAX), Vec2::splat(f32::MIN)),
-        |(lo, hi), p| {
-            let q = Vec2::new(p.dot(a), p.dot(b));
-            (lo.min(q), hi.max(q))
-        },
-    );
     let extent = hi - lo;
-    let covered = total.length();
+    // Twice the triangles' area is the cross products' length.
+    let covered = 0.5 * total.length();
     if extent.min_element() <= 0.0
         || (covered - extent.x * extent.y).abs() > 1e-3 * extent.x * extent.y
     {

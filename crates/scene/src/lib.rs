@@ -18,6 +18,7 @@ pub mod format;
 pub mod geometry;
 pub mod gltf_asset;
 pub mod hash;
+pub mod import;
 pub mod light_images;
 pub mod limits;
 pub mod load;
@@ -120,14 +121,15 @@ impl Scene {
     /// renders identically, so comparing raster and trace on it measures the floor of the
     /// comparison — rasterization and arithmetic, no mirror effect.
     pub fn without_mirrors(&self) -> Scene {
-        let mut geometry = Geometry::default();
+        let mut geometry = self.geometry.empty_like();
         for part in &self.geometry.parts {
             let surface = &self.geometry.surfaces[part.surface as usize];
             if matches!(surface, Surface::Diffuse { .. }) {
-                geometry.push_part(
+                geometry.push_textured_part(
                     part.name.clone(),
                     surface.clone(),
                     self.geometry.triangles[part.triangles.clone()].to_vec(),
+                    self.geometry.uvs[part.triangles.clone()].to_vec(),
                 );
             }
         }

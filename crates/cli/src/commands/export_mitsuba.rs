@@ -39,8 +39,13 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             .set_reflectance(glam::Vec3::splat(r))
             .map_err(|e| super::light_budget(&scene, "--reflectance", e))?;
     }
-    let written = export(&scene, &xml, ExportSettings { spp: args.spp })
-        .map_err(|e| Failure::Other(e.to_string()))?;
+    let written = export(&scene, &xml, ExportSettings { spp: args.spp }).map_err(|e| {
+        if e.refused {
+            Failure::BadInput(e.to_string())
+        } else {
+            Failure::Other(e.to_string())
+        }
+    })?;
     println!(
         "exported {} to {} ({} files)",
         args.scene.display(),

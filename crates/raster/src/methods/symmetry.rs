@@ -187,9 +187,9 @@ impl<'a> SymmetryInput<'a> {
                 source: Cow::Borrowed(&s.source),
             },
             None => {
-                let mut objects = Geometry::default();
-                for (name, surface, triangles) in parts_of(&scene.geometry, false) {
-                    objects.push_part(name, surface, triangles);
+                let mut objects = scene.geometry.empty_like();
+                for (name, surface, triangles, uvs) in parts_of(&scene.geometry, false) {
+                    objects.push_textured_part(name, surface, triangles, uvs);
                 }
                 SymmetryInput {
                     planes: Vec::new(),
@@ -200,11 +200,12 @@ impl<'a> SymmetryInput<'a> {
     }
 }
 
-/// The diffuse parts (`mirrors` false) or the mirror parts of `g`: name, surface, triangles.
-pub(crate) fn parts_of(
-    g: &Geometry,
-    mirrors: bool,
-) -> impl Iterator<Item = (String, Surface, Vec<[Vec3; 3]>)> + '_ {
+/// A part of a geometry, copied out: name, surface, triangles and their texture coordinates.
+pub(crate) type PartCopy = (String, Surface, Vec<[Vec3; 3]>, Vec<[glam::Vec2; 3]>);
+
+/// The diffuse parts (`mirrors` false) or the mirror parts of `g`, copied out (into a
+/// geometry made by `g.empty_like()`, which keeps the textures their surfaces index).
+pub(crate) fn parts_of(g: &Geometry, mirrors: bool) -> impl Iterator<Item = PartCopy> + '_ {
     g.parts.iter().filter_map(move |part| {
         let surface = &g.surfaces[part.surface as usize];
         (matches!(surface, Surface::Mirror { .. }) == mirrors).then(|| {
@@ -212,6 +213,7 @@ pub(crate) fn parts_of(
                 part.name.clone(),
                 surface.clone(),
                 g.triangles[part.triangles.clone()].to_vec(),
+                g.uvs[part.triangles.clone()].to_vec(),
             )
         })
     })
@@ -372,7 +374,7 @@ pub(crate) fn plan_copies(
     // The object parts, culled ones first (one contiguous vertex range each class).
     let mut culled_parts = Vec::new();
     let mut unculled_parts = Vec::new();
-    for (name, surface, triangles) in parts_of(&input.source, false) {
+    for (name, surface, triangles, uvs) in parts_of(&input.source, false) {
         if triangles.is_empty() {
             continue;
         }
@@ -384,24 +386,24 @@ pub(crate) fn plan_copies(
             });
         let culled = is_closed(&triangles) && eye_outside_every_copy(planes, &masks, eye, lo, hi);
         if culled {
-            culled_parts.push((name, surface, triangles));
+            culled_parts.push((name, surface, triangles, uvs));
         } else {
-            unculled_parts.push((name, surface, triangles));
+            unculled_parts.push((name, surface, triangles, uvs));
         }
     }
     let part_count = culled_parts.len() + unculled_parts.len();
     let culled_part_count = culled_parts.len();
-    let mut geometry = Geometry::default();
-    for (name, surface, triangles) in culled_parts {
-        geometry.push_part(name, surface, triangles);
+    let mut geometry = input.source.empty_like();
+    for (name, surface, triangles, uvs) in culled_parts {
+        geometry.push_textured_part(name, surface, triangles, uvs);
     }
     let culled_vertices = 3 * geometry.triangles.len() as u32;
-    for (name, surface, triangles) in unculled_parts {
-        geometry.push_part(name, surface, triangles);
+    for (name, surface, triangles, uvs) in unculled_parts {
+        geometry.push_textured_part(name, surface, triangles, uvs);
     }
     let object_vertices = 3 * geometry.triangles.len() as u32;
-    for (name, surface, triangles) in parts_of(&scene.geometry, true) {
-        geometry.push_part(name, surface, triangles);
+    for (name, surface, triangles, uvs) in parts_of(&scene.geometry, true) {
+        geometry.push_textured_part(name, surface, triangles, uvs);
     }
     let all_vertices = 3 * geometry.triangles.len() as u32;
 
@@ -780,7 +782,7 @@ mod tests {
     fn closed_meshes_are_told_from_open_ones() {
         let scene = mirrorbox_scene::load::bundled_scene("mirror_box.json");
         let parts: Vec<(String, bool)> = parts_of(&scene.geometry, false)
-            .map(|(name, _, t)| (name, is_closed(&t)))
+            .map(|(name, _, t, _)| (name, is_closed(&t)))
             .collect();
         // The floor is a quad (open); boxes and spheres are closed.
         assert!(parts.iter().any(|(_, closed)| *closed), "{parts:?}");

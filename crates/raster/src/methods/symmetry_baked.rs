@@ -67,7 +67,7 @@ impl RasterMethod for SymmetryBakedMethod {
     ) -> Result<Box<dyn PlannedFrame>, PlanError> {
         let input = SymmetryInput::of(scene);
         let mirrors: Vec<_> = parts_of(&scene.geometry, true).collect();
-        let mirror_triangles: usize = mirrors.iter().map(|(_, _, t)| t.len()).sum();
+        let mirror_triangles: usize = mirrors.iter().map(|(_, _, t, _)| t.len()).sum();
         let budget = mirrorbox_scene::limits::MAX_TRIANGLES.saturating_sub(mirror_triangles);
         let started = Instant::now();
         let (mut geometry, origins) =
@@ -75,8 +75,8 @@ impl RasterMethod for SymmetryBakedMethod {
                 .map_err(|e| PlanError::Bake(e.to_string()))?;
         let bake_ms = started.elapsed().as_secs_f64() * 1e3;
         let objects = 3 * geometry.triangles.len() as u32;
-        for (name, surface, triangles) in mirrors {
-            geometry.push_part(name, surface, triangles);
+        for (name, surface, triangles, uvs) in mirrors {
+            geometry.push_textured_part(name, surface, triangles, uvs);
         }
         let all = 3 * geometry.triangles.len() as u32;
         let p = input.planes.len();

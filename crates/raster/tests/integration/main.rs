@@ -2,6 +2,7 @@
 //! one concern.
 
 mod device_limits;
+mod gltf_corpus;
 mod memory;
 mod methods;
 mod mirrored_lights_closed_form;
