@@ -1952,3 +1952,93 @@ fn a_sequence_sweep_compares_every_frame_with_its_truth() {
         assert!(run.stderr.contains(expected), "{args:?}: {}", run.stderr);
     }
 }
+
+/// `mirrorbox import` (docs/gltf.md): the project's textured asset in a mirror box, written,
+/// then traced and rendered from the written file — the two-command path from an asset to an
+/// image; a second import over it replaces it whole. A broken glTF exits 2 naming the scene,
+/// the asset and the glTF field; nothing is written.
+#[test]
+fn import_writes_a_scene_that_traces_and_renders_and_a_broken_gltf_exits_2() {
+    let dir = tempfile::tempdir().unwrap();
+    let asset = repo().join("scenes/assets/textured_cube.gltf");
+    let scene = dir.path().join("imported.json");
+    let scene_s = scene.to_str().unwrap();
+    let out = mirrorbox(
+        &[
+            "import",
+            asset.to_str().unwrap(),
+            "-o",
+            scene_s,
+            "--width",
+            "32",
+            "--height",
+            "18",
+        ],
+        &[],
+    );
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    assert!(
+        out.stdout.contains("2 textures, 3 mirrors, 2 lights"),
+        "{}",
+        out.stdout
+    );
+    let text = std::fs::read_to_string(&scene).unwrap();
+    // Outside the output's folder: the asset by its absolute path.
+    assert!(
+        text.contains(&format!(
+            "\"path\": {:?}",
+            asset.canonicalize().unwrap().to_str().unwrap()
+        )),
+        "{text}"
+    );
+    let truth = dir.path().join("truth.exr");
+    let out = mirrorbox(&["trace", scene_s, "-o", truth.to_str().unwrap()], &[]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let raster = dir.path().join("unrolled.png");
+    let out = mirrorbox(
+        &[
+            "render",
+            scene_s,
+            "--method",
+            "unrolled",
+            "-o",
+            raster.to_str().unwrap(),
+            "--frames",
+            "1",
+            "--warmup",
+            "0",
+        ],
+        &[],
+    );
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    assert!(raster.exists() && truth.exists());
+
+    let broken = dir.path().join("broken.gltf");
+    std::fs::write(
+        &broken,
+        r#"{"asset": {"version": "2.0"}, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+            "meshes": [{"primitives": [{"attributes": {"POSITION": 7}}]}]}"#,
+    )
+    .unwrap();
+    let refused = dir.path().join("refused.json");
+    let out = mirrorbox(
+        &[
+            "import",
+            broken.to_str().unwrap(),
+            "-o",
+            refused.to_str().unwrap(),
+        ],
+        &[],
+    );
+    assert_eq!(out.code, 2, "{}", out.stderr);
+    assert!(
+        out.stderr.contains("broken.gltf")
+            && out
+                .stderr
+                .contains("meshes[0].primitives[0].attributes[\"POSITION\"]"),
+        "{}",
+        out.stderr
+    );
+    assert!(!out.stderr.contains("panicked"), "{}", out.stderr);
+    assert!(!refused.exists(), "a refused import wrote its output");
+}

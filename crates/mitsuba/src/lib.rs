@@ -24,7 +24,8 @@
 //!   row 0 at `v = 0`), and a `bitmap` per texture: an EXR beside the meshes holding the
 //!   factor × the sRGB-decoded texels (linear, so Mitsuba's bilinear filter blends the same
 //!   numbers as the contract's), `filter_type = bilinear`, the wrap mode, and the map's
-//!   transform as `to_uv`; both renderers' lookups are then the same arithmetic;
+//!   transform as `to_uv` (a 4×4 matrix: Mitsuba reads a 2D translation from its 4th
+//!   column); both renderers' lookups are then the same arithmetic;
 //! - point light → `point` (intensity in W/sr); background → `constant` emitter.
 //!
 //! What Mitsuba cannot express — the ambient term, the terminal radiance and the exposure —
@@ -333,13 +334,17 @@ fn colour_xml(
     bitmap_exr(&g.textures[m.texture as usize], factor, &path)?;
     written.push(path);
     let wrap = mitsuba_wrap(&m, part.1)?;
+    // Mitsuba's OBJ loader turns `vt` (u, 1 − v) back into (u, v) and its bitmap reads row 0
+    // at v = 0, so the contract's transform applies as it is. `to_uv` is a 2D transform
+    // extracted from a 4×4 matrix: its translation is read from the 4th column (a 3×3 matrix
+    // in the XML loses it), hence the 16 values.
     let k = m.transform;
     Ok(format!(
         "<texture name=\"{name}\" type=\"bitmap\">\n          \
          <string name=\"filename\" value=\"meshes/{file}\"/>\n          \
          <string name=\"filter_type\" value=\"bilinear\"/>\n          \
          <string name=\"wrap_mode\" value=\"{wrap}\"/>\n          \
-         <transform name=\"to_uv\"><matrix value=\"{} {} {} {} {} {} 0 0 1\"/></transform>\n        \
+         <transform name=\"to_uv\"><matrix value=\"{} {} 0 {} {} {} 0 {} 0 0 1 0 0 0 0 1\"/></transform>\n        \
          </texture>",
         k[0], k[1], k[2], k[3], k[4], k[5]
     ))

@@ -162,6 +162,25 @@ pub fn load_gltf(path: &Path, options: &GltfOptions) -> Result<GltfAsset> {
             ),
         ));
     }
+    // The gltf crate's validator indexes the POSITION accessor before checking that it exists
+    // (gltf-json 1.4.1, mesh.rs:151): a reference past the accessors would panic there.
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            let position = gltf::json::validation::Checked::Valid(gltf::Semantic::Positions);
+            if let Some(index) = primitive.attributes.get(&position)
+                && index.value() >= root.accessors.len()
+            {
+                return Err(err(
+                    format!("meshes[{m}].primitives[{p}].attributes[\"POSITION\"]"),
+                    format!(
+                        "refers to accessor {}; the file has {}",
+                        index.value(),
+                        root.accessors.len()
+                    ),
+                ));
+            }
+        }
+    }
     let document = gltf::Document::from_json(root).map_err(|e| match e {
         gltf::Error::Validation(list) => {
             let (field, why) = &list[0];
@@ -387,8 +406,10 @@ impl Reader<'_> {
             DataType::U32 => Some(u32::from_le_bytes([b[0], b[1], b[2], b[3]])),
             _ => None,
         };
-        let mut out = Vec::with_capacity(a.count());
-        for element in self.element_bytes(a, field)? {
+        // The elements checked against the buffer first: `count` is the file's word.
+        let elements = self.element_bytes(a, field)?;
+        let mut out = Vec::with_capacity(elements.len());
+        for element in elements {
             out.push(read(element).ok_or_else(|| {
                 err(
                     format!("{here}.componentType"),
@@ -912,11 +933,20 @@ impl Reader<'_> {
             return Ok(t);
         }
         let field = format!("images[{i}]");
-        let bytes = match image.source() {
-            gltf::image::Source::View { view, .. } => self.view_bytes(&view)?.to_vec(),
-            gltf::image::Source::Uri { uri, .. } => {
-                self.uri_bytes(&format!("{field}.uri"), uri, "glTF image")?
+        // From the JSON: the crate's `Image::source` unwraps a missing `uri` or `mimeType`.
+        let json = &self.document.as_json().images[i];
+        let bytes = match (&json.buffer_view, &json.uri) {
+            (Some(v), _) => {
+                let view = self.document.views().nth(v.value()).ok_or_else(|| {
+                    err(
+                        format!("{field}.bufferView"),
+                        "refers to a buffer view the file does not have",
+                    )
+                })?;
+                self.view_bytes(&view)?.to_vec()
             }
+            (None, Some(uri)) => self.uri_bytes(&format!("{field}.uri"), uri, "glTF image")?,
+            (None, None) => return Err(err(field, "has neither a uri nor a bufferView")),
         };
         let texture = decode_png(
             &bytes,

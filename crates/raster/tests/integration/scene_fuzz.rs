@@ -17,7 +17,7 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::{Path, PathBuf};
 
 /// SplitMix64: small, fast and good enough to pick mutations.
-struct Rng(u64);
+pub(crate) struct Rng(pub(crate) u64);
 
 impl Rng {
     fn next(&mut self) -> u64 {
@@ -116,7 +116,7 @@ fn parent_and_key<'a>(root: &'a mut Value, path: &[Value]) -> (&'a mut Value, Va
 }
 
 /// One mutation of `scene`: replace a node, delete it, or repeat an array element.
-fn mutate(scene: &Value, rng: &mut Rng) -> Value {
+pub(crate) fn mutate(scene: &Value, rng: &mut Rng) -> Value {
     let mut mutant = scene.clone();
     let mut paths = Vec::new();
     node_paths(&mutant, &mut Vec::new(), &mut paths);
