@@ -109,6 +109,62 @@ pub struct SceneBvh {
     packet_bvh: OnceLock<(PacketBvh, Duration)>,
 }
 
+/// Deepest 8-wide hierarchy obvhs's traversal holds (`cwbvh::TRAVERSAL_STACK_SIZE`, private:
+/// its `validate` asserts depth < 32).
+const CWBVH_MAX_DEPTH: u32 = 31;
+
+/// obvhs's `build_cwbvh_from_tris` without pre-splits (our parameters have none), keeping the
+/// binary hierarchy: the 8-wide one collapsed from it, or the binary one where the collapsed
+/// hierarchy is deeper than [`CWBVH_MAX_DEPTH`] (its traversal would overrun its stack, and
+/// obvhs's debug validation asserts). Same steps, same result as the helper otherwise.
+fn build_cwbvh(
+    tris: &[Triangle],
+    params: BvhBuildParams,
+    build_time: &mut Duration,
+) -> Result<CwBvh, Box<obvhs::bvh2::Bvh2>> {
+    let start = std::time::Instant::now();
+    let mut bvh2 = obvhs::ploc::PlocBuilder::with_capacity(tris.len()).build(
+        params.ploc_search_distance,
+        tris,
+        (0..tris.len() as u32).collect::<Vec<_>>(),
+        params.sort_precision,
+        params.search_depth_threshold,
+    );
+    obvhs::bvh2::reinsertion::ReinsertionOptimizer::default().run(
+        &mut bvh2,
+        params.reinsertion_batch_ratio,
+        None,
+    );
+    let cwbvh = obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh(
+        &bvh2,
+        params.max_prims_per_leaf.clamp(1, 3),
+        true,
+        false,
+    );
+    *build_time += start.elapsed();
+    if cwbvh_depth(&cwbvh) > CWBVH_MAX_DEPTH {
+        Err(Box::new(bvh2))
+    } else {
+        Ok(cwbvh)
+    }
+}
+
+/// Levels below the root of the deepest inner node (obvhs's `calculate_max_depth`).
+fn cwbvh_depth(bvh: &CwBvh) -> u32 {
+    let mut deepest = 0;
+    let mut stack = vec![(0usize, 0u32)];
+    while let Some((i, d)) = stack.pop() {
+        deepest = deepest.max(d);
+        let node = &bvh.nodes[i];
+        for ch in 0..8 {
+            if !node.is_child_empty(ch) && !node.is_leaf(ch) {
+                stack.push((node.child_node_index(ch) as usize, d + 1));
+            }
+        }
+    }
+    deepest
+}
+
 impl SceneBvh {
     pub fn build(geometry: &Geometry) -> Self {
         Self::build_with(geometry, BvhKind::default())
@@ -117,7 +173,12 @@ impl SceneBvh {
     /// Builds `kind` over `geometry`. Every vertex must lie within the scene extent
     /// ([`MAX_COORDINATE`], what loading a scene checks): obvhs indexes out of bounds on
     /// non-finite or overflowing bounds, so they are never handed to it.
+    ///
+    /// A [`BvhKind::Cwbvh`] deeper than obvhs's 32-entry traversal stack (degenerate input:
+    /// assimp's `box_longline.obj`, one long thin box) is replaced by the binary hierarchy
+    /// it was built from, and `kind` says so.
     pub fn build_with(geometry: &Geometry, kind: BvhKind) -> Self {
+        let mut kind = kind;
         if let Some(p) = geometry
             .triangles
             .iter()
@@ -144,15 +205,19 @@ impl SceneBvh {
             (Hierarchy::Empty, Vec::new())
         } else {
             match kind {
-                BvhKind::Cwbvh => {
-                    let bvh = obvhs::cwbvh::builder::build_cwbvh_from_tris(
-                        &tris,
-                        params,
-                        &mut build_time,
-                    );
-                    let order = bvh.primitive_indices.clone();
-                    (Hierarchy::Cw(bvh), order)
-                }
+                BvhKind::Cwbvh => match build_cwbvh(&tris, params, &mut build_time) {
+                    Ok(bvh) => {
+                        let order = bvh.primitive_indices.clone();
+                        (Hierarchy::Cw(bvh), order)
+                    }
+                    // Too deep for obvhs's fixed traversal stack: the binary hierarchy it
+                    // was collapsed from, whose traversal stack grows as needed.
+                    Err(bvh2) => {
+                        kind = BvhKind::Bvh2;
+                        let order = bvh2.primitive_indices.clone();
+                        (Hierarchy::Binary(*bvh2), order)
+                    }
+                },
                 BvhKind::Bvh2 => {
                     let bvh =
                         obvhs::bvh2::builder::build_bvh2_from_tris(&tris, params, &mut build_time);
