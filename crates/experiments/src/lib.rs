@@ -18,6 +18,7 @@ pub mod engine_reflections;
 pub mod frontier;
 pub mod lighting;
 pub mod motion;
+pub mod real_assets;
 pub mod scripts;
 pub mod stereo;
 pub mod symmetry_scaling;
@@ -67,6 +68,7 @@ pub const EXPERIMENTS: &[&Experiment] = &[
     &motion::MOTION,
     &frontier::FRONTIER,
     &engine_reflections::ENGINE_REFLECTIONS,
+    &real_assets::REAL_ASSETS,
     &scripts::GPU_TRUTH,
     &scripts::LIGHTING_TRACE_COST,
     &scripts::MEMORY_PEAKS,

@@ -57,8 +57,12 @@ pub fn mirror_box_scene(
     let v3 = |v: Vec3| format!("[{}, {}, {}]", r(v.x), r(v.y), r(v.z));
     let intensity = r(PAPER_BOX_INTENSITY * (h / 2.0) * (h / 2.0));
     let scene_field = scene.map_or(String::new(), |i| format!(", \"scene\": {i}"));
-    let camera = v3(Vec3::new(c.x + 0.4 * h, floor + 0.6 * wall, c.z + 0.85 * h));
-    let look_at = v3(Vec3::new(c.x - 0.12 * h, floor + 0.38 * wall, c.z - h));
+    let camera = v3(Vec3::new(
+        c.x + 0.35 * h,
+        floor + 0.7 * wall,
+        c.z + 0.95 * h,
+    ));
+    let look_at = v3(Vec3::new(c.x - 0.1 * h, floor + 0.3 * wall, c.z - h));
     let front = v3(Vec3::new(c.x, mirror_y, c.z - h));
     let back = v3(Vec3::new(c.x, mirror_y, c.z + h));
     let side = r(2.0 * h);
