@@ -10,7 +10,8 @@ exercise every glTF path of the contract at once, with textures whose orientatio
   rotation 0.3 rad, an offset) and a mirrored-repeat sampler;
 - a small emissive panel: emissive factor × an emissive texture of stripes;
 - a mirror: a planar rectangle of metallic 1, roughness 0 (mirrorbox makes it a mirror);
-- a KHR_lights_punctual point light.
+- a KHR_lights_punctual point light;
+- a perspective camera (for a scene's `camera.gltf`).
 Only the Python standard library; run it again to regenerate the same bytes.
 """
 import base64
@@ -116,7 +117,7 @@ def main():
         "scene": 0,
         "scenes": [{"nodes": [0]}],
         "nodes": [
-            {"name": "root", "children": [1, 2, 3, 4, 5, 6], "translation": [0, 0, 0]},
+            {"name": "root", "children": [1, 2, 3, 4, 5, 6, 7], "translation": [0, 0, 0]},
             {"name": "cube", "mesh": 0, "translation": [-0.45, 0.35, -0.2],
              "rotation": [0, s, 0, c], "scale": [0.7, 0.7, 0.7]},
             {"name": "mirrored cube", "mesh": 0, "translation": [0.55, 0.25, 0.35],
@@ -127,7 +128,11 @@ def main():
              "rotation": [0, -0.7071068, 0, 0.7071068], "scale": [0.9, 1.1, 1]},
             {"name": "light", "translation": [0.0, 1.6, 0.4],
              "extensions": {"KHR_lights_punctual": {"light": 0}}},
+            {"name": "camera", "camera": 0, "translation": [0.2, 1.3, 1.9],
+             "rotation": [math.sin(math.radians(-12)), 0, 0, math.cos(math.radians(-12))]},
         ],
+        "cameras": [{"type": "perspective", "perspective": {
+            "yfov": 0.8, "znear": 0.05, "aspectRatio": 1.7777778}}],
         "meshes": [
             {"name": "cube", "primitives": [prim(cp, ci, 0, cu)]},
             {"name": "tile", "primitives": [prim(qp, qi, 1, qu)]},

@@ -44,11 +44,21 @@ pub struct SymmetryPlaneDesc {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CameraDesc {
-    pub position: Vec3f,
-    pub look_at: Vec3f,
+    /// Required unless `gltf` places the camera.
+    #[serde(default)]
+    pub position: Option<Vec3f>,
+    #[serde(default)]
+    pub look_at: Option<Vec3f>,
     #[serde(default)]
     pub up: Option<Vec3f>,
-    pub fov_y_deg: f32,
+    #[serde(default)]
+    pub fov_y_deg: Option<f32>,
+    /// A glTF asset's camera as the scene camera: the `path` of one of the scene's `gltf`
+    /// objects, and `index`, the number of its perspective camera in node order.
+    #[serde(default)]
+    pub gltf: Option<String>,
+    #[serde(default)]
+    pub index: Option<usize>,
     pub width: u32,
     pub height: u32,
     #[serde(default)]

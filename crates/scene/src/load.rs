@@ -101,7 +101,16 @@ struct Checker<'a> {
 struct AssetExtras {
     mirrors: Vec<(FieldPath, Mirror)>,
     lights: Vec<PointLight>,
-    cameras: Vec<gltf_asset::AssetCamera>,
+    /// Each glTF object's path (as the scene file writes it) and its cameras.
+    cameras: Vec<(String, Vec<gltf_asset::AssetCamera>)>,
+}
+
+/// Where the camera is and looks, before it is checked: the file's fields or a glTF camera.
+struct CameraFrame {
+    position: Vec3f,
+    look_at: Vec3f,
+    up: Option<Vec3f>,
+    fov_y_deg: f32,
 }
 
 type Result<T> = std::result::Result<T, SceneError>;
@@ -215,13 +224,15 @@ impl Checker<'_> {
     }
 
     fn compile(&self, file: SceneFile) -> Result<Scene> {
-        let camera = self.camera(&FieldPath::root("camera"), &file.camera)?;
         let mut geometry = Geometry::default();
         let objects = FieldPath::root("objects");
         let mut assets = AssetExtras::default();
         for (i, object) in file.objects.iter().enumerate() {
             self.object(&objects.index(i), i, object, &mut geometry, &mut assets)?;
         }
+        // After the objects: a glTF object may hold the camera.
+        let frame = self.camera_frame(&FieldPath::root("camera"), &file.camera, &assets)?;
+        let camera = self.camera(&FieldPath::root("camera"), &file.camera, &frame)?;
         let planes = self.symmetry_planes(&file.symmetry_planes)?;
         let symmetry = if planes.is_empty() {
             None
@@ -317,7 +328,11 @@ impl Checker<'_> {
             source: self.file.to_path_buf(),
             camera,
             mirrors,
-            stereo: self.stereo(&FieldPath::root("camera").field("stereo"), &file.camera)?,
+            stereo: self.stereo(
+                &FieldPath::root("camera").field("stereo"),
+                &file.camera,
+                &frame,
+            )?,
             camera_path,
             head: None,
             bumps,
@@ -368,14 +383,86 @@ impl Checker<'_> {
             .collect()
     }
 
-    fn camera(&self, path: &FieldPath, c: &CameraDesc) -> Result<Camera> {
-        let position = self.position(&path.field("position"), c.position)?;
-        let look_at = self.position(&path.field("look_at"), c.look_at)?;
+    /// The camera's position, look-at point, up (if given) and field of view: the file's, or
+    /// a glTF object's camera (`camera.gltf`, `camera.index`), never both.
+    fn camera_frame(
+        &self,
+        path: &FieldPath,
+        c: &CameraDesc,
+        assets: &AssetExtras,
+    ) -> Result<CameraFrame> {
+        let Some(gltf) = &c.gltf else {
+            if c.index.is_some() {
+                return Err(self.invalid(
+                    &path.field("index"),
+                    "needs camera.gltf (the glTF object whose camera it numbers)",
+                ));
+            }
+            let required = |field: &str| {
+                self.invalid(
+                    &path.field(field),
+                    "is required (or camera.gltf and camera.index: a glTF object's camera)",
+                )
+            };
+            return Ok(CameraFrame {
+                position: c.position.ok_or_else(|| required("position"))?,
+                look_at: c.look_at.ok_or_else(|| required("look_at"))?,
+                up: c.up,
+                fov_y_deg: c.fov_y_deg.ok_or_else(|| required("fov_y_deg"))?,
+            });
+        };
+        for (field, given) in [
+            ("position", c.position.is_some()),
+            ("look_at", c.look_at.is_some()),
+            ("up", c.up.is_some()),
+            ("fov_y_deg", c.fov_y_deg.is_some()),
+            ("path", c.path.is_some()),
+        ] {
+            if given {
+                return Err(self.invalid(
+                    &path.field(field),
+                    "is not allowed with camera.gltf: the glTF camera places the view",
+                ));
+            }
+        }
+        let Some(cameras) = assets
+            .cameras
+            .iter()
+            .find(|(p, _)| p == gltf)
+            .map(|(_, c)| c)
+        else {
+            let paths: Vec<&str> = assets.cameras.iter().map(|(p, _)| p.as_str()).collect();
+            return Err(self.invalid(
+                &path.field("gltf"),
+                format!("must be the path of one of the scene's gltf objects (they are: {paths:?}), got {gltf:?}"),
+            ));
+        };
+        let index = c.index.unwrap_or(0);
+        let Some(g) = cameras.get(index) else {
+            return Err(self.invalid(
+                &path.field("index"),
+                format!(
+                    "the asset places {} perspective cameras; camera {index} was asked for",
+                    cameras.len()
+                ),
+            ));
+        };
+        Ok(CameraFrame {
+            position: g.position.to_array(),
+            look_at: (g.position + g.forward).to_array(),
+            up: Some(g.up.to_array()),
+            fov_y_deg: g.fov_y_deg,
+        })
+    }
+
+    fn camera(&self, path: &FieldPath, c: &CameraDesc, frame: &CameraFrame) -> Result<Camera> {
+        let position = self.position(&path.field("position"), frame.position)?;
+        let look_at = self.position(&path.field("look_at"), frame.look_at)?;
         let forward = (look_at - position).try_normalize().ok_or_else(|| {
             self.invalid(&path.field("look_at"), "must differ from camera.position")
         })?;
         let up_path = path.field("up");
-        let up = self.direction(&up_path, c.up.unwrap_or(defaults::CAMERA_UP))?;
+        let up = self.direction(&up_path, frame.up.unwrap_or(defaults::CAMERA_UP))?;
         if forward.cross(up).length() < 1e-4 {
             return Err(self.invalid(
                 &up_path,
@@ -383,7 +470,7 @@ impl Checker<'_> {
             ));
         }
         let fov_path = path.field("fov_y_deg");
-        let fov = self.finite(&fov_path, c.fov_y_deg)?;
+        let fov = self.finite(&fov_path, frame.fov_y_deg)?;
         if !(fov > 0.0 && fov < 180.0) {
             return Err(self.invalid(&fov_path, format!("must be in (0, 180) degrees, got {fov}")));
         }
@@ -548,7 +635,12 @@ impl Checker<'_> {
 
     /// `camera.stereo` (`crate::stereo`): an IPD in [0, [`MAX_IPD`]] scene units, a known
     /// convergence and a positive convergence distance.
-    fn stereo(&self, path: &FieldPath, c: &CameraDesc) -> Result<Option<crate::stereo::Stereo>> {
+    fn stereo(
+        &self,
+        path: &FieldPath,
+        c: &CameraDesc,
+        frame: &CameraFrame,
+    ) -> Result<Option<crate::stereo::Stereo>> {
         use crate::stereo::{Convergence, Stereo};
         let Some(s) = &c.stereo else {
             return Ok(None);
@@ -571,7 +663,7 @@ impl Checker<'_> {
                 ));
             }
         };
-        let default = (Vec3::from_array(c.look_at) - Vec3::from_array(c.position)).length();
+        let default = (Vec3::from_array(frame.look_at) - Vec3::from_array(frame.position)).length();
         let distance = self.positive(
             &path.field("convergence_distance"),
             s.convergence_distance.unwrap_or(default),
@@ -886,7 +978,7 @@ impl Checker<'_> {
             .mirrors
             .extend(asset.mirrors.into_iter().map(|m| (path.clone(), m)));
         assets.lights.extend(asset.lights);
-        assets.cameras.extend(asset.cameras);
+        assets.cameras.push((rel.to_string(), asset.cameras));
         Ok(())
     }
 
@@ -1468,6 +1560,59 @@ mod tests {
                 && e.contains("4194304"),
             "{e}"
         );
+    }
+
+    /// `camera.gltf`: the scene camera is the asset's (the project's textured asset places one
+    /// at (0.2, 1.3, 1.9), tilted 24° down, yfov 0.8 rad), through the object's transform;
+    /// mixed with the file's own view fields, past the asset's cameras or naming no object,
+    /// it is refused with its field.
+    #[test]
+    fn a_gltf_camera_can_be_the_scene_camera() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/scene.json");
+        let scene = |camera: &str| {
+            parse_scene(
+                &format!(
+                    r#"{{ "camera": {{ {camera}, "width": 64, "height": 36 }},
+                    "objects": [ {{ "type": "gltf", "path": "assets/textured_cube.gltf",
+                    "transform": {{ "translate": [1, 0, 0] }} }} ] }}"#
+                ),
+                &dir,
+            )
+        };
+        let s = scene(r#""gltf": "assets/textured_cube.gltf", "index": 0"#).unwrap();
+        let c = &s.camera;
+        assert!(
+            (c.position - Vec3::new(1.2, 1.3, 1.9)).length() < 1e-5,
+            "{:?}",
+            c.position
+        );
+        let forward = (c.look_at - c.position).normalize();
+        assert!(
+            (forward.y - (-24f32).to_radians().sin()).abs() < 1e-5,
+            "{forward}"
+        );
+        assert!((c.fov_y_deg - 0.8f32.to_degrees()).abs() < 1e-4);
+        for (camera, words) in [
+            (
+                r#""gltf": "assets/textured_cube.gltf", "index": 1"#,
+                "camera.index: the asset places 1 perspective cameras",
+            ),
+            (
+                r#""gltf": "other.glb""#,
+                "camera.gltf: must be the path of one of the scene's gltf objects",
+            ),
+            (
+                r#""gltf": "assets/textured_cube.gltf", "position": [0, 0, 0]"#,
+                "camera.position: is not allowed with camera.gltf",
+            ),
+            (
+                r#""look_at": [0, 0, 0], "fov_y_deg": 40"#,
+                "camera.position: is required",
+            ),
+        ] {
+            let e = scene(camera).err().unwrap().to_string();
+            assert!(e.contains(words), "{camera}: {e}");
+        }
     }
 
     #[test]

@@ -17,9 +17,10 @@ pub struct Args {
     /// Which of the asset's scenes (default: its `scene`, else the first).
     #[arg(long)]
     scene: Option<usize>,
-    /// Image width and height of the scene's camera.
+    /// Image width of the scene's camera, in pixels.
     #[arg(long, default_value_t = 640)]
     width: u32,
+    /// Image height of the scene's camera, in pixels.
     #[arg(long, default_value_t = 360)]
     height: u32,
 }
