@@ -211,15 +211,17 @@ fn texture_sample(m: TextureMap, uv: vec2f) -> vec3f {
 }
 
 // A diffuse surface's albedo and emission at texture coordinates uv: factor × texture.
+// TEXTURED is set by the composer (crates/raster/src/wgsl.rs): false for a scene without
+// textures, where the lookups are dead code.
 fn surface_albedo(s: Surface, uv: vec2f) -> vec3f {
-    if (s.albedo_map.present == 0u) {
+    if (!TEXTURED || s.albedo_map.present == 0u) {
         return s.albedo;
     }
     return s.albedo * texture_sample(s.albedo_map, uv);
 }
 
 fn surface_emission(s: Surface, uv: vec2f) -> vec3f {
-    if (s.emission_map.present == 0u) {
+    if (!TEXTURED || s.emission_map.present == 0u) {
         return s.emission;
     }
     return s.emission * texture_sample(s.emission_map, uv);

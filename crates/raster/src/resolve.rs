@@ -17,7 +17,7 @@ impl Resolve {
     pub fn new(gpu: &Gpu, source: &RenderTarget, factor: u32) -> Self {
         use wgpu::util::DeviceExt;
         let device = &gpu.device;
-        let module = gpu.shader_module(&crate::wgsl::RESOLVE);
+        let module = gpu.shader_module(&crate::wgsl::RESOLVE, false);
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("resolve"),
             entries: &[

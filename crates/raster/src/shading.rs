@@ -342,6 +342,9 @@ pub struct SceneBuffers {
     pub parts: Vec<(std::ops::Range<u32>, glam::Vec3, glam::Vec3)>,
     pub layout: wgpu::BindGroupLayout,
     pub bind_group: wgpu::BindGroup,
+    /// Whether the drawn geometry has textures: the shader variant its pipelines need
+    /// (`Gpu::shader_module`).
+    pub textured: bool,
 }
 
 impl SceneBuffers {
@@ -752,6 +755,7 @@ impl SceneBuffers {
             parts,
             layout,
             bind_group,
+            textured: g.has_textures(),
         }
     }
 }

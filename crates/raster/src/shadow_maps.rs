@@ -160,7 +160,7 @@ impl ShadowMaps {
                 resource: record_binding::<GpuShadowView>(&uniforms),
             }],
         });
-        let module = gpu.shader_module(&SHADER);
+        let module = gpu.shader_module(&SHADER, false);
         let pipeline_layout = pipeline_layout(device, "shadow map", &[&layout]);
         let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("shadow map"),

@@ -202,6 +202,11 @@ pub fn load_gltf(path: &Path, options: &GltfOptions) -> Result<GltfAsset> {
         }
         other => err("", other.to_string()),
     })?;
+    // Extensions the file uses (not requires) that are not read: what they add is not drawn.
+    let unread: Vec<&str> = document
+        .extensions_used()
+        .filter(|e| !READ_EXTENSIONS.contains(e))
+        .collect();
     let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
     let mut reader = Reader {
         document: &document,
@@ -215,6 +220,11 @@ pub fn load_gltf(path: &Path, options: &GltfOptions) -> Result<GltfAsset> {
         options: *options,
         triangles: 0,
     };
+    for name in unread {
+        reader.note(format!(
+            "extensionsUsed: {name} is not read (the core glTF material and geometry are drawn)"
+        ));
+    }
     reader.read_buffers()?;
     reader.read_scene()?;
     Ok(reader.asset)

@@ -320,10 +320,13 @@ impl PortalStencil {
         let layout = pipeline_layout(device, "portal", &[&scene_buffers.layout, &path_layout]);
         let clipping = Clipping::for_features(gpu.features);
         let depth_format = depth_stencil_format(gpu.features);
-        let shader = gpu.shader_module(match clipping {
-            Clipping::ClipDistances => &CLIP_DISTANCE_SHADER,
-            Clipping::FragmentDiscard | Clipping::None => &SHADER,
-        });
+        let shader = gpu.shader_module(
+            match clipping {
+                Clipping::ClipDistances => &CLIP_DISTANCE_SHADER,
+                Clipping::FragmentDiscard | Clipping::None => &SHADER,
+            },
+            scene_buffers.textured,
+        );
         // Scene draws clip at the path's last mirror: by clip distance, or per fragment.
         let (scene_vertex, fs_object, fs_mirror, fs_mark) = match clipping {
             Clipping::ClipDistances => ("vs_clip_distances", "fs_object", "fs_mirror", "fs_none"),

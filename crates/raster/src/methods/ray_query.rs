@@ -460,7 +460,7 @@ impl RayQueryFrame {
         });
         let pipeline_layout =
             pipeline_layout(device, "ray query", &[&scene_buffers.layout, &layout]);
-        let module = gpu.shader_module(&SHADER);
+        let module = gpu.shader_module(&SHADER, scene_buffers.textured);
         let scene_pipeline = |label, vertex, fragment, write, compare, colour| {
             let buffers: &[Option<wgpu::VertexBufferLayout>] = if vertex == "vs_main" {
                 &[Some(VERTEX_LAYOUT)]

@@ -1022,13 +1022,13 @@ impl TexturePipelines {
         let clipping = Clipping::for_features(gpu.features);
         let (shader, vertex, fs_object, fs_mirror) = match clipping {
             Clipping::ClipDistances => (
-                gpu.shader_module(shaders[1]),
+                gpu.shader_module(shaders[1], scene_buffers.textured),
                 "vs_clip_distances",
                 "fs_object",
                 "fs_mirror",
             ),
             Clipping::FragmentDiscard | Clipping::None => (
-                gpu.shader_module(shaders[0]),
+                gpu.shader_module(shaders[0], scene_buffers.textured),
                 "vs_main",
                 "fs_object_discard",
                 "fs_mirror_discard",

@@ -396,7 +396,7 @@ impl SsrFrame {
             })
         };
         let pyramid_levels: Vec<wgpu::TextureView> = (0..levels).map(level_view).collect();
-        let module = gpu.shader_module(&SHADER);
+        let module = gpu.shader_module(&SHADER, scene_buffers.textured);
         let base_layout_all = pipeline_layout(
             device,
             "ssr scene pass",
@@ -428,7 +428,7 @@ impl SsrFrame {
             cache: None,
         });
         // The pyramid: level 0 written by the scene pass, each next level reduced from the last.
-        let pyramid_module = gpu.shader_module(&PYRAMID_SHADER);
+        let pyramid_module = gpu.shader_module(&PYRAMID_SHADER, false);
         let fullscreen = |label: &str, fragment: &str| {
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some(label),

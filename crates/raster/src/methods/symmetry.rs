@@ -664,11 +664,14 @@ impl CopiesFrame {
         });
         let pipeline_layout =
             pipeline_layout(device, "symmetry", &[&scene_buffers.layout, &layout]);
-        let module = gpu.shader_module(if clip_distances {
-            &CLIP_DISTANCE_SHADER
-        } else {
-            &SHADER
-        });
+        let module = gpu.shader_module(
+            if clip_distances {
+                &CLIP_DISTANCE_SHADER
+            } else {
+                &SHADER
+            },
+            scene_buffers.textured,
+        );
         let vertex = match (settings.per_copy, clip_distances) {
             (false, false) => "vs_instanced",
             (true, false) => "vs_per_copy",

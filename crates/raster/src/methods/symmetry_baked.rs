@@ -223,7 +223,7 @@ impl BakedFrame {
         });
         let pipeline_layout =
             pipeline_layout(device, "symmetry-baked", &[&scene_buffers.layout, &layout]);
-        let module = gpu.shader_module(&SHADER);
+        let module = gpu.shader_module(&SHADER, scene_buffers.textured);
         const COPY_ID_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
             array_stride: 4,
             step_mode: wgpu::VertexStepMode::Vertex,

@@ -529,8 +529,9 @@ impl Unrolled {
                 .collect::<Vec<_>>(),
         });
         let layout = pipeline_layout(device, "unrolled", &[&scene_buffers.layout, &layout]);
-        let guarded_module = gpu.shader_module(&GUARDED_SHADER);
-        let clipped_module = clip_distances.then(|| gpu.shader_module(&CLIP_DISTANCE_SHADER));
+        let guarded_module = gpu.shader_module(&GUARDED_SHADER, scene_buffers.textured);
+        let clipped_module = clip_distances
+            .then(|| gpu.shader_module(&CLIP_DISTANCE_SHADER, scene_buffers.textured));
         let background_layout = wgpu::VertexBufferLayout {
             array_stride: std::mem::size_of::<BackgroundVertex>() as u64,
             step_mode: wgpu::VertexStepMode::Vertex,
