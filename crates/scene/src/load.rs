@@ -83,6 +83,22 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene> {
     Checker { file: path }.compile(file)
 }
 
+/// Mirror `mirror` appended to the scene's `mirrors` and its two front triangles to
+/// `geometry` (its surface indexes it there).
+fn push_mirror(geometry: &mut Geometry, mirrors: &mut Vec<Mirror>, mirror: Mirror) {
+    let [a, b, c, d] = mirror.corners();
+    geometry.push_part(
+        mirror.name.clone(),
+        Surface::Mirror {
+            mirror: mirrors.len(),
+            reflectance: mirror.reflectance,
+            back_albedo: mirror.back_albedo,
+        },
+        vec![[a, b, c], [a, c, d]],
+    );
+    mirrors.push(mirror);
+}
+
 /// serde_json appends " at line L column C"; we print the position in front instead.
 fn strip_position(message: &str) -> String {
     match message.rfind(" at line ") {
@@ -263,34 +279,13 @@ impl Checker<'_> {
                 Some(b) => Some(self.bump(&mirror_path.field("bump"), b)?),
                 None => None,
             });
-            let [a, b, c, d] = mirror.corners();
-            geometry.push_part(
-                mirror.name.clone(),
-                Surface::Mirror {
-                    mirror: i,
-                    reflectance: mirror.reflectance,
-                    back_albedo: mirror.back_albedo,
-                },
-                vec![[a, b, c], [a, c, d]],
-            );
-            mirrors.push(mirror);
+            push_mirror(&mut geometry, &mut mirrors, mirror);
         }
         // Mirrors of glTF assets (docs/gltf.md), after the file's own.
         for (object_path, mirror) in assets.mirrors {
             self.triangle_budget(&object_path, geometry.triangles.len(), 2)?;
-            let i = mirrors.len();
             bumps.push(None);
-            let [a, b, c, d] = mirror.corners();
-            geometry.push_part(
-                mirror.name.clone(),
-                Surface::Mirror {
-                    mirror: i,
-                    reflectance: mirror.reflectance,
-                    back_albedo: mirror.back_albedo,
-                },
-                vec![[a, b, c], [a, c, d]],
-            );
-            mirrors.push(mirror);
+            push_mirror(&mut geometry, &mut mirrors, mirror);
         }
         let lights_path = FieldPath::root("lights");
         let mut lights = file

@@ -131,7 +131,7 @@ fn imported(rel: &str, w: u32, h: u32) -> Scene {
     parse_scene(&json, Path::new("imported.json")).unwrap_or_else(|e| panic!("{rel}: {e}"))
 }
 
-fn trace_depth(s: &Scene, depth: u32) -> RgbImage {
+pub(crate) fn trace_depth(s: &Scene, depth: u32) -> RgbImage {
     let bvh = SceneBvh::build(&s.geometry);
     let settings = TraceSettings::whitted(1).with_integrator(WhittedSettings {
         max_depth: depth,
@@ -140,7 +140,7 @@ fn trace_depth(s: &Scene, depth: u32) -> RgbImage {
     mirrorbox_trace::render(s, &bvh, &settings, &|_| {}).image
 }
 
-fn settings(method: Method) -> RenderSettings {
+pub(crate) fn settings(method: Method) -> RenderSettings {
     RenderSettings {
         ssaa: 1,
         warmup: 0,
@@ -149,7 +149,7 @@ fn settings(method: Method) -> RenderSettings {
 }
 
 /// Pixels off by more than 1e-3 (largest channel), and FLIP.
-fn off_and_flip(image: &RgbImage, truth: &RgbImage) -> (usize, f64) {
+pub(crate) fn off_and_flip(image: &RgbImage, truth: &RgbImage) -> (usize, f64) {
     let off = image
         .pixels
         .iter()
