@@ -139,7 +139,7 @@ pub fn load_gltf(path: &Path, options: &GltfOptions) -> Result<GltfAsset> {
         let inner = e.into_inner();
         let message = format!(
             "{} (line {}, column {} of the JSON)",
-            strip_position(&inner.to_string()),
+            crate::load::strip_position(&inner.to_string()),
             inner.line(),
             inner.column()
         );
@@ -228,14 +228,6 @@ pub fn load_gltf(path: &Path, options: &GltfOptions) -> Result<GltfAsset> {
     reader.read_buffers()?;
     reader.read_scene()?;
     Ok(reader.asset)
-}
-
-/// serde_json appends " at line L column C"; the position is given separately.
-fn strip_position(message: &str) -> String {
-    match message.rfind(" at line ") {
-        Some(i) => message[..i].to_string(),
-        None => message.to_string(),
-    }
 }
 
 struct Reader<'a> {

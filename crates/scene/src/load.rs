@@ -100,7 +100,7 @@ fn push_mirror(geometry: &mut Geometry, mirrors: &mut Vec<Mirror>, mirror: Mirro
 }
 
 /// serde_json appends " at line L column C"; we print the position in front instead.
-fn strip_position(message: &str) -> String {
+pub(crate) fn strip_position(message: &str) -> String {
     match message.rfind(" at line ") {
         Some(i) => message[..i].to_string(),
         None => message.to_string(),

@@ -9,11 +9,11 @@
 //!
 //! The corpus tests are skipped, saying so, where the corpus is missing.
 
+use crate::methods::{settings, trace_depth};
 use mirrorbox_image::RgbImage;
-use mirrorbox_raster::{Gpu, Method, RenderSettings, render};
+use mirrorbox_raster::{Gpu, Method, render};
 use mirrorbox_scene::Scene;
 use mirrorbox_scene::load::parse_scene;
-use mirrorbox_trace::{SceneBvh, TraceSettings, WhittedSettings};
 use std::path::Path;
 
 const CORPUS: &str = "/usr/share/assimp/models/glTF2";
@@ -131,23 +131,6 @@ fn imported(rel: &str, w: u32, h: u32) -> Scene {
     parse_scene(&json, Path::new("imported.json")).unwrap_or_else(|e| panic!("{rel}: {e}"))
 }
 
-pub(crate) fn trace_depth(s: &Scene, depth: u32) -> RgbImage {
-    let bvh = SceneBvh::build(&s.geometry);
-    let settings = TraceSettings::whitted(1).with_integrator(WhittedSettings {
-        max_depth: depth,
-        min_throughput: 1e-4,
-    });
-    mirrorbox_trace::render(s, &bvh, &settings, &|_| {}).image
-}
-
-pub(crate) fn settings(method: Method) -> RenderSettings {
-    RenderSettings {
-        ssaa: 1,
-        warmup: 0,
-        ..RenderSettings::new(method)
-    }
-}
-
 /// Pixels off by more than 1e-3 (largest channel), and FLIP.
 pub(crate) fn off_and_flip(image: &RgbImage, truth: &RgbImage) -> (usize, f64) {
     let off = image
@@ -211,7 +194,7 @@ fn every_real_gltf_traces_and_renders_with_every_method() {
         );
         for entry in mirrorbox_raster::METHODS {
             let method = Method::defaults(entry);
-            let out = render(&gpu, &s, &settings(method.clone()))
+            let out = render(&gpu, &s, &settings(method.clone(), 1))
                 .unwrap_or_else(|e| panic!("{rel} {method}: {e}"));
             let image = &out.image;
             assert!(
@@ -229,7 +212,7 @@ fn every_real_gltf_traces_and_renders_with_every_method() {
     let out = render(
         &gpu,
         &s,
-        &settings(Method::parse("unrolled depth=8").unwrap()),
+        &settings(Method::parse("unrolled depth=8").unwrap(), 1),
     )
     .unwrap();
     let truth = trace_depth(&s, out.stats.depth as u32);
@@ -264,7 +247,7 @@ fn textured_scenes_agree_at_the_floor() {
     for (name, s) in scenes {
         assert!(s.geometry.has_textures(), "{name}");
         let bare = s.without_mirrors();
-        let raster = render(&gpu, &bare, &settings(Method::parse("naive").unwrap())).unwrap();
+        let raster = render(&gpu, &bare, &settings(Method::parse("naive").unwrap(), 1)).unwrap();
         let truth = trace_depth(&bare, 1);
         let (off, flip) = off_and_flip(&raster.image, &truth);
         println!("{name} without mirrors: {off} pixels off by > 1e-3, FLIP {flip:.2e}");
@@ -274,7 +257,7 @@ fn textured_scenes_agree_at_the_floor() {
         );
         for key in ["unrolled depth=16", "ray-query depth=16"] {
             let method = Method::parse(key).unwrap();
-            let out = match render(&gpu, &s, &settings(method)) {
+            let out = match render(&gpu, &s, &settings(method, 1)) {
                 Ok(out) => out,
                 // ray-query needs the adapter's ray queries (lavapipe has them).
                 Err(e) if key.starts_with("ray-query") => {
@@ -322,10 +305,7 @@ fn no_mutated_gltf_panics_the_loader() {
             seeds.push(Path::new(CORPUS).join(rel));
         }
     }
-    let mutants: usize = std::env::var("MIRRORBOX_FUZZ_MUTANTS")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .map_or(600, |n: usize| n.max(1));
+    let mutants = crate::scene_fuzz::env_number("MIRRORBOX_FUZZ_MUTANTS", 600).max(1) as usize;
     let options = GltfOptions {
         scene: None,
         triangle_budget: 1 << 16,
@@ -333,10 +313,7 @@ fn no_mutated_gltf_panics_the_loader() {
         transform: glam::Mat4::IDENTITY,
         curved_mirrors: CurvedMirrors::Refuse,
     };
-    let seed = std::env::var("MIRRORBOX_FUZZ_SEED")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(0x6c7f_2024);
+    let seed = crate::scene_fuzz::env_number("MIRRORBOX_FUZZ_SEED", 0x6c7f_2024);
     let mut rng = Rng(seed);
     let (mut loaded, mut refused) = (0, 0);
     for (k, seed) in seeds.iter().enumerate() {

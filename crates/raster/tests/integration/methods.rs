@@ -22,7 +22,7 @@ fn m(key: &str) -> Method {
     Method::parse(key).unwrap()
 }
 
-fn settings(method: Method, ssaa: u32) -> RenderSettings {
+pub(crate) fn settings(method: Method, ssaa: u32) -> RenderSettings {
     RenderSettings {
         ssaa,
         warmup: 0,
@@ -338,7 +338,7 @@ fn exact(method: Method) -> RenderSettings {
     settings(method, 1)
 }
 
-fn trace_depth(s: &Scene, depth: u32) -> RgbImage {
+pub(crate) fn trace_depth(s: &Scene, depth: u32) -> RgbImage {
     let bvh = SceneBvh::build(&s.geometry);
     let settings = TraceSettings::whitted(1).with_integrator(WhittedSettings {
         max_depth: depth,

@@ -121,7 +121,8 @@ fn every_obj_of_the_corpus_loads_or_is_refused_with_its_reason() {
 
 #[test]
 fn every_obj_that_loads_traces_and_renders_as_the_truth() {
-    use crate::gltf_corpus::{off_and_flip, settings, trace_depth};
+    use crate::gltf_corpus::off_and_flip;
+    use crate::methods::{settings, trace_depth};
     use mirrorbox_raster::{Gpu, Method, render};
     if !Path::new(CORPUS).join("OBJ").is_dir() {
         eprintln!("skipped: no {CORPUS}");
@@ -140,7 +141,7 @@ fn every_obj_that_loads_traces_and_renders_as_the_truth() {
             "{rel}: {kind:?}"
         );
         let truth = trace_depth(&scene, 8);
-        let image = render(&gpu, &scene, &settings(method.clone()))
+        let image = render(&gpu, &scene, &settings(method.clone(), 1))
             .unwrap()
             .image;
         let (off, _) = off_and_flip(&image, &truth);

@@ -316,7 +316,7 @@ fn load(text: &str, path: &Path) -> Result<Result<Scene, String>, String> {
     .map_err(|e| panic_text(&e))
 }
 
-fn env_number(name: &str, default: u64) -> u64 {
+pub(crate) fn env_number(name: &str, default: u64) -> u64 {
     std::env::var(name)
         .ok()
         .and_then(|v| v.parse().ok())
