@@ -10,14 +10,24 @@
 //! - mirrors are delta reflections (no light sampling through them, as in Mitsuba: light that
 //!   reaches a surface only via a mirror is found by BSDF sampling alone);
 //! - the background is a constant environment emitter, found by escaping rays;
-//! - **Russian roulette** from depth `rr_depth` on, survival probability max(throughput) ≤ 0.95.
+//! - **Russian roulette** from depth `rr_depth` on, survival probability max(throughput) ≤ 0.95;
+//! - a shadow ray (to a point light, or to the sampled point on an emitter) is blocked by
+//!   any hit nearer than a relative 10⁻⁴ short of its end, other than the triangle it
+//!   leaves (an any-hit query).
+//!
+//! **Every sample its own random stream** (issue 41), split off its pixel's stream in
+//! sample order ([`SplitMix64::split`]): so the samples of neighbouring pixels walk side by
+//! side, [`LANES`] at a time, each round's closest-hit and shadow queries going to the BVH
+//! as packets, Russian roulette ending each lane on its own ([`PathTracer::radiance_lanes`]);
+//! one at a time, a sample draws the same numbers and takes the same steps
+//! ([`PathTracer::radiance_one`]).
 //!
 //! Depth follows Mitsuba's `max_depth`: it counts path segments, so 1 shows only directly
 //! visible emitters, 2 adds direct light, and N visible reflections need N + 2. The ambient
 //! term of the contract is not physical and is not used here.
 
 use super::{Integrator, PathResult, Termination, face_normals};
-use crate::bvh::packet::{LANES, LaneMask, NO_TRIANGLE, RayPacket, first_lanes, lanes};
+use crate::bvh::packet::{LANES, LaneHits, LaneMask, NO_TRIANGLE, RayPacket, first_lanes, lanes};
 use crate::bvh::{Hit, SceneBvh};
 use crate::cpu_features::{Vectorised, widest};
 use crate::mirror_bounce::{MirrorPlanes, bounce_flat_lanes};
@@ -65,6 +75,21 @@ pub struct PathTracer<'a> {
     area_pdf: Vec<f32>,
     mirror_planes: MirrorPlanes,
 }
+
+/// Diffuse vertices a path may have passed for its closest-hit queries to go to the packet
+/// kernel; later queries go one at a time to the single-ray hierarchy. Camera rays and the
+/// mirror chains after them are coherent (neighbouring samples, planar mirrors); the
+/// cosine-sampled rays after a diffuse vertex are not, and a 32-lane packet of them visits
+/// the union of their nodes. Measured (one thread, 640×360, 16 spp, depth 10, AMD EPYC
+/// AVX-512): everything in packets 1.12 s (`mirror_box`) and 2.24 s (`mirror_room`); 1:
+/// 0.73 s and 1.55 s; 2: 0.72 s and 1.64 s.
+const PACKET_VERTICES: u32 = 1;
+
+/// Likewise for the next-event shadow rays: those from a path's first diffuse vertex start
+/// at neighbouring points and go towards one light (or one emitter), and are traced as
+/// any-hit packets; later ones one at a time (measured with [`PACKET_VERTICES`] 1: none in
+/// packets 0.78 s and 1.63 s; 1: 0.73 s and 1.55 s; 2: 0.74 s and 1.68 s).
+const PACKET_SHADOW_VERTICES: u32 = 1;
 
 fn luminance(c: Vec3) -> f32 {
     0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
@@ -121,23 +146,6 @@ impl<'a> PathTracer<'a> {
             mirror_planes,
         }
     }
-
-    /// Whether the segment from `p` (on triangle `from`) to `q` is unblocked; `q` lies on
-    /// triangle `to`, or is a point light (`None`: then any hit blocks it, and the any-hit
-    /// query answers without looking for the closest).
-    fn visible(&self, p: Vec3, from: usize, q: Vec3, to: Option<usize>) -> bool {
-        let (ray, t_max) = segment(p, q);
-        if to.is_none() {
-            return !self.bvh.occluded(&ray, 0.0, t_max, None, Some(from));
-        }
-        match self
-            .bvh
-            .closest_hit_skipping(&ray, 0.0, t_max, None, Some(from))
-        {
-            None => true,
-            Some(h) => Some(h.triangle) == to,
-        }
-    }
 }
 
 /// The shadow ray from `p` towards `q` and its far limit: hits nearer than `q` by a
@@ -164,416 +172,478 @@ fn faces_light(p: Vec3, n: Vec3, light: Vec3) -> (bool, f32, f32) {
     (cos > 0.0 && r2 > 1e-8, cos, r2)
 }
 
-/// The closest hit of one query of a path, found ahead of the path (by a packet).
+/// What a path does after [`PathTracer::vertex`].
+enum Vertex {
+    End(Termination),
+    /// Its next ray is `walk.ray`.
+    Next,
+    /// Its next ray is `walk.ray` bounced off this flat mirror plane (unit normal, offset).
+    FlatBounce((glam::DVec3, f64)),
+}
+
+/// A shadow ray asked by the path in lane `.0`, of kind `.1` (point light, or the emitter
+/// sample), with its answer (blocked) where it was traced at once.
+type Asked = (usize, usize, ShadowRay, Option<bool>);
+
+/// A path between its vertices: its next ray and what it carries.
 #[derive(Clone, Copy)]
-struct Hinted {
+struct Walk {
     ray: Ray,
-    skip_mirror: Option<usize>,
-    hit: Option<Hit>,
+    beta: Vec3,
+    radiance: Vec3,
+    rays: u32,
+    bounces: u32,
+    /// Solid-angle pdf of the BSDF sample that produced `ray`; None after the camera or a
+    /// mirror.
+    bsdf_pdf: Option<f32>,
+    /// The diffuse triangle `ray` leaves (skipped by its query), if any.
+    from_triangle: Option<usize>,
+    /// The mirror `ray` leaves (skipped by its query), if any.
+    from_mirror: Option<usize>,
+    /// Segments so far.
+    depth: u32,
+    /// Diffuse vertices passed so far.
+    diffuse_vertices: u32,
 }
 
-/// What the paths of up to [`LANES`] rays know before they draw a random number
-/// ([`PathTracer::mirror_chains`]): each query of their mirror chains with its hit, and
-/// where a chain ends on a diffuse surface, whether each point light lights that point.
-#[derive(Default)]
-struct Ahead {
-    /// `rounds[k][i]`: the k-th query of ray `i`'s path and its closest hit.
-    rounds: Vec<[Option<Hinted>; LANES]>,
-    /// Per lane, the round whose hit (diffuse) ends its chain: its first diffuse vertex;
-    /// `u32::MAX` where the chain ends otherwise.
-    diffuse_round: [u32; LANES],
-    /// Per point light, the lanes whose shadow ray from their first diffuse vertex was
-    /// traced, and of those, the lanes it found unblocked.
-    traced: Vec<LaneMask>,
-    lit: Vec<LaneMask>,
-}
+impl Walk {
+    fn start(ray: Ray) -> Self {
+        Walk {
+            ray,
+            beta: Vec3::ONE,
+            radiance: Vec3::ZERO,
+            rays: 0,
+            bounces: 0,
+            bsdf_pdf: None,
+            from_triangle: None,
+            from_mirror: None,
+            depth: 0,
+            diffuse_vertices: 0,
+        }
+    }
 
-impl Ahead {
-    /// Whether the shadow ray from lane `lane`'s diffuse vertex in round `round` to light
-    /// `light` is unblocked, if it was traced ahead.
-    fn lit(&self, lane: usize, round: u32, light: usize) -> Option<bool> {
-        (self.diffuse_round[lane] == round && self.traced[light] >> lane & 1 == 1)
-            .then(|| self.lit[light] >> lane & 1 == 1)
+    fn result(&self, termination: Termination) -> PathResult {
+        PathResult {
+            radiance: self.radiance,
+            bounces: self.bounces,
+            termination,
+            rays: self.rays,
+        }
     }
 }
 
-/// Fewest rays of a pixel whose mirror chains are traced as packets.
-const MIN_PACKET: usize = 4;
-
-/// How far past `rr_depth` the mirror chains are traced ahead ([`PathTracer::mirror_chains`]).
-const CHAIN_PAST_ROULETTE: u32 = 8;
+/// A next-event shadow ray a path vertex asks for, and the radiance it adds when nothing
+/// blocks it: the ray from the shaded point (on triangle `from`, skipped) towards a point
+/// light or a point on an emitter, blocked by any hit in `[0, t_max)`.
+#[derive(Clone, Copy)]
+struct ShadowRay {
+    ray: Ray,
+    t_max: f32,
+    from: usize,
+    contribution: Vec3,
+}
 
 impl PathTracer<'_> {
-    /// The deterministic start of each of `rays`' paths (at most [`LANES`] rays) — the
-    /// camera ray and the chain of front-facing mirror reflections after it, which draw no
-    /// random numbers (Russian roulette may end the path there, but does not change the next
-    /// ray) — traced side by side: every round's closest-hit queries go to the BVH as one
-    /// packet. `ahead.rounds[k][i]` gets the k-th query of ray `i`'s path with its hit, for
-    /// [`PathTracer::radiance_hinted`]. The chain's rays are computed as the path computes
-    /// them (f32 rays, the bounce in f64). Where a chain ends on a diffuse surface, the
-    /// shadow rays from there to the point lights are deterministic too: traced as any-hit
-    /// packets, one per light, into `ahead.lit`.
+    /// One vertex of a path: `hit` is the closest hit of `walk.ray` (skipping the mirror or
+    /// triangle it leaves). Adds what is seen there (the background, or an emitter's
+    /// emission with its MIS weight), asks `shadow(k, ray)` for each next-event shadow ray
+    /// — `k` the point light's index, or the number of lights for the emitter sample —
+    /// whose contribution the caller adds, in the order asked, where it is unblocked; then
+    /// samples the next ray and plays Russian roulette. Returns how the path ended, if it
+    /// did, or, with `DEFER_FLAT`, the plane of the flat mirror whose bounce of `walk.ray`
+    /// the caller computes ([`bounce_flat_lanes`], the same bits as
+    /// [`MirrorPlanes::reflect`], side by side for a packet's lanes).
     ///
-    /// Compiled for the CPU's widest vectors ([`crate::cpu_features`], kernel inlined); the
-    /// bounces off flat mirrors are computed in one lane loop ([`bounce_flat_lanes`]).
-    fn mirror_chains(&self, rays: &[Ray], ahead: &mut Ahead) {
-        struct Work<'w, 'a> {
-            path: &'w PathTracer<'a>,
-            rays: &'w [Ray],
-            ahead: &'w mut Ahead,
-        }
-        impl Vectorised for Work<'_, '_> {
-            type Output = ();
-            #[inline(always)]
-            fn run(self) {
-                self.path.mirror_chains_inline(self.rays, self.ahead)
-            }
-        }
-        widest(Work {
-            path: self,
-            rays,
-            ahead,
-        })
-    }
-
+    /// The shadow rays' answers change no random number and no later ray, so a caller may
+    /// trace them after this returns: one path at a time ([`PathTracer::radiance_one`]) or
+    /// [`LANES`] paths' together ([`PathTracer::radiance_lanes`]), to the same bits.
     #[inline(always)]
-    fn mirror_chains_inline(&self, rays: &[Ray], ahead: &mut Ahead) {
-        let g = &self.scene.geometry;
-        let rounds = &mut ahead.rounds;
-        rounds.clear();
-        ahead.diffuse_round = [u32::MAX; LANES];
-        // The first diffuse vertices: point and normal on the side the path arrives from.
-        let mut vertex = [(Vec3::ZERO, Vec3::ZERO); LANES];
-        let mut on_triangle = [NO_TRIANGLE; LANES];
-        // The chains' rays: f32 values (as the path holds them) in f64 lanes (the bounce's
-        // input).
-        let (mut origin, mut dir) = RayPacket::f64_lanes(rays);
-        let mut normal = [[0.0f64; LANES]; 3];
-        let mut offset = [0.0f64; LANES];
-        let mut active = first_lanes(rays.len());
-        let mut packet = RayPacket::default();
-        let mut hits = [None; LANES];
-        // Chains are traced ahead to at most CHAIN_PAST_ROULETTE queries past the depth
-        // where Russian roulette starts: deeper, it has ended most paths, and the rest go one
-        // ray at a time (`mirror_room` at depth 66, one thread: 1.94 s traced to the end,
-        // 1.79 s with this limit).
-        let chain_limit = (self.settings.max_depth)
-            .min(self.settings.rr_depth.saturating_add(CHAIN_PAST_ROULETTE));
-        while active != 0 {
-            packet.set_rays_f64(&origin, &dir);
-            self.bvh.closest_hits_inline(&packet, active, &mut hits);
-            rounds.push([None; LANES]);
-            // The path follows a front-facing mirror to its next query, unless that query
-            // would be past the depth limit.
-            let deeper = (rounds.len() as u32) < chain_limit;
-            let index = rounds.len() as u32 - 1;
-            let round = rounds.last_mut().expect("just pushed");
-            let mut flat = [false; LANES];
-            for lane in lanes(active) {
-                let (ray, skip_mirror) = packet.lane(lane);
-                round[lane] = Some(Hinted {
-                    ray,
-                    skip_mirror,
-                    hit: hits[lane],
-                });
-                let Some(hit) = hits[lane] else {
-                    active &= !(1 << lane);
-                    continue;
-                };
-                let n_f = self.normals[hit.triangle];
-                let front = n_f.dot(ray.dir) < 0.0;
-                let mirror = match *g.surface(hit.triangle) {
-                    Surface::Mirror { mirror, .. } if front => Some(mirror),
-                    _ => None,
-                };
-                let Some(mirror) = mirror.filter(|_| deeper) else {
-                    // The path shades a diffuse hit unless it is at the depth limit.
-                    if mirror.is_none() && index + 1 < self.settings.max_depth {
-                        ahead.diffuse_round[lane] = index;
-                        let n = if front { n_f } else { -n_f };
-                        vertex[lane] = (ray.at(hit.t), n);
-                        on_triangle[lane] = hit.triangle as u32;
-                    }
-                    active &= !(1 << lane);
-                    continue;
-                };
-                packet.set_skip(lane, Some(mirror));
-                if let Some((n, off)) = self.mirror_planes.flat_plane(mirror) {
-                    flat[lane] = true;
-                    for k in 0..3 {
-                        normal[k][lane] = n[k];
-                    }
-                    offset[lane] = off;
-                    continue;
-                }
-                let (o, d) = (ray.origin.as_dvec3(), ray.dir.as_dvec3());
-                let Some((o, d)) = self.mirror_planes.reflect(mirror, o, d) else {
-                    active &= !(1 << lane);
-                    continue;
-                };
-                for k in 0..3 {
-                    origin[k][lane] = o[k] as f32 as f64;
-                    dir[k][lane] = d[k] as f32 as f64;
-                }
-            }
-            if flat.iter().any(|&f| f) {
-                bounce_flat_lanes::<LANES, true>(&flat, &normal, &offset, &mut origin, &mut dir);
-            }
-        }
-        // The first diffuse vertices' shadow rays, as the path asks them
-        // (`PathTracer::visible` towards a point light).
-        let diffuse = lanes(first_lanes(rays.len()))
-            .filter(|&lane| ahead.diffuse_round[lane] != u32::MAX)
-            .fold(0, |mask: LaneMask, lane| mask | 1 << lane);
-        ahead.traced.clear();
-        ahead.lit.clear();
-        let mut t_max = [0.0f32; LANES];
-        for light in &self.scene.lighting.lights {
-            let mut traced: LaneMask = 0;
-            for lane in lanes(diffuse) {
-                let (p, n) = vertex[lane];
-                if faces_light(p, n, light.position).0 {
-                    let (ray, far) = segment(p, light.position);
-                    packet.set(lane, &ray, None);
-                    t_max[lane] = far;
-                    traced |= 1 << lane;
-                }
-            }
-            let blocked = if traced == 0 {
-                0
-            } else {
-                self.bvh
-                    .occluded_lanes_inline(&packet, traced, &t_max, &on_triangle)
-            };
-            ahead.traced.push(traced);
-            ahead.lit.push(traced & !blocked);
-        }
-    }
-
-    /// Radiance along `ray`, random numbers from `rng`; the closest hit of the path's k-th
-    /// query is taken from `ahead.rounds[k][lane]` when that is the same query (ray bits
-    /// and skips), else asked of the BVH, and so are the point lights' shadow rays from
-    /// the diffuse hit that ends the chain. With nothing ahead, [`Integrator::radiance`].
-    fn radiance_hinted(
+    fn vertex<const DEFER_FLAT: bool>(
         &self,
-        ray: Ray,
+        w: &mut Walk,
+        hit: Option<Hit>,
         rng: &mut SplitMix64,
-        ahead: Option<&Ahead>,
-        lane: usize,
-    ) -> PathResult {
-        let rounds = ahead.map_or(&[][..], |a| &a.rounds[..]);
+        mut shadow: impl FnMut(usize, ShadowRay),
+    ) -> Vertex {
         let scene = self.scene;
         let g = &scene.geometry;
-        let mut ray = ray;
-        let mut beta = Vec3::ONE;
-        let mut radiance = Vec3::ZERO;
-        let mut rays = 0u32;
-        let mut bounces = 0u32;
-        // Solid-angle pdf of the BSDF sample that produced `ray`; None after the camera or a mirror.
-        let mut bsdf_pdf: Option<f32> = None;
-        let mut from_triangle: Option<usize> = None;
-        let mut from_mirror: Option<usize> = None;
-        let mut depth = 0u32;
-        let termination = loop {
-            rays += 1;
-            let hinted = rounds.get(depth as usize).and_then(|r| r[lane].as_ref());
-            let hinted = hinted.filter(|h| {
-                from_triangle.is_none()
-                    && h.skip_mirror == from_mirror
-                    && h.ray.origin.to_array().map(f32::to_bits)
-                        == ray.origin.to_array().map(f32::to_bits)
-                    && h.ray.dir.to_array().map(f32::to_bits)
-                        == ray.dir.to_array().map(f32::to_bits)
-            });
-            let was_hinted = hinted.is_some();
-            let hit = match hinted {
-                Some(h) => h.hit,
-                None => self.bvh.closest_hit_skipping(
-                    &ray,
-                    0.0,
-                    f32::INFINITY,
-                    from_mirror,
-                    from_triangle,
-                ),
+        let ray = w.ray;
+        w.rays += 1;
+        let Some(hit) = hit else {
+            w.radiance += w.beta * scene.background;
+            return Vertex::End(Termination::Escaped);
+        };
+        let mut flat = None;
+        let p = ray.at(hit.t);
+        let n_f = self.normals[hit.triangle];
+        let front = n_f.dot(ray.dir) < 0.0;
+        let inter = interaction_at(g, hit.triangle, p, front);
+        if let Interaction::Diffuse { emission, .. } = inter
+            && front
+            && emission != Vec3::ZERO
+        {
+            let weight = match w.bsdf_pdf {
+                None => 1.0,
+                Some(p_bsdf) => {
+                    let cos_l = n_f.dot(-ray.dir).max(1e-8);
+                    let p_light = self.area_pdf[hit.triangle] * hit.t * hit.t / cos_l;
+                    p_bsdf * p_bsdf / (p_bsdf * p_bsdf + p_light * p_light)
+                }
             };
-            let Some(hit) = hit else {
-                radiance += beta * scene.background;
-                break Termination::Escaped;
-            };
-            let p = ray.at(hit.t);
-            let n_f = self.normals[hit.triangle];
-            let front = n_f.dot(ray.dir) < 0.0;
-            let inter = interaction_at(g, hit.triangle, p, front);
-            if let Interaction::Diffuse { emission, .. } = inter
-                && front
-                && emission != Vec3::ZERO
-            {
-                let weight = match bsdf_pdf {
-                    None => 1.0,
-                    Some(p_bsdf) => {
-                        let cos_l = n_f.dot(-ray.dir).max(1e-8);
-                        let p_light = self.area_pdf[hit.triangle] * hit.t * hit.t / cos_l;
-                        p_bsdf * p_bsdf / (p_bsdf * p_bsdf + p_light * p_light)
-                    }
+            w.radiance += w.beta * emission * weight;
+        }
+        if w.depth + 1 >= self.settings.max_depth {
+            return Vertex::End(Termination::Depth);
+        }
+        match inter {
+            Interaction::Reflect { reflectance } => {
+                let Surface::Mirror { mirror, .. } = *g.surface(hit.triangle) else {
+                    unreachable!("only mirrors reflect")
                 };
-                radiance += beta * emission * weight;
-            }
-            if depth + 1 >= self.settings.max_depth {
-                break Termination::Depth;
-            }
-            match inter {
-                Interaction::Reflect { reflectance } => {
-                    let Surface::Mirror { mirror, .. } = *g.surface(hit.triangle) else {
-                        unreachable!("only mirrors reflect")
-                    };
-                    beta *= reflectance;
-                    // After a hinted query, the chain's next query is this very bounce
-                    // (computed from the same ray and hit, the same way): take its ray.
-                    let chained = rounds
-                        .get(depth as usize + 1)
-                        .and_then(|r| r[lane].as_ref())
-                        .filter(|h| was_hinted && h.skip_mirror == Some(mirror));
-                    if let Some(next) = chained {
-                        ray = next.ray;
-                    } else {
+                w.beta *= reflectance;
+                match self.mirror_planes.flat_plane(mirror).filter(|_| DEFER_FLAT) {
+                    // The caller bounces the ray ([`Vertex::FlatBounce`]).
+                    Some(plane) => flat = Some(plane),
+                    None => {
                         let Some((origin, dir)) = self.mirror_planes.reflect(
                             mirror,
                             ray.origin.as_dvec3(),
                             ray.dir.as_dvec3(),
                         ) else {
-                            break Termination::Absorbed;
+                            return Vertex::End(Termination::Absorbed);
                         };
-                        ray = Ray {
+                        w.ray = Ray {
                             origin: origin.as_vec3(),
                             dir: dir.as_vec3(),
                         };
                     }
-                    bsdf_pdf = None;
-                    from_mirror = Some(mirror);
-                    from_triangle = None;
-                    bounces += 1;
                 }
-                Interaction::Diffuse { albedo, .. } => {
-                    let n = if front { n_f } else { -n_f };
-                    let f = albedo * std::f32::consts::FRAC_1_PI;
-                    for (l, light) in scene.lighting.lights.iter().enumerate() {
-                        let (faces, cos, r2) = faces_light(p, n, light.position);
-                        // Traced ahead where this is the hinted diffuse hit that ends
-                        // the mirror chain (the same point, so the same shadow ray).
-                        let ahead_lit = ahead
-                            .filter(|_| was_hinted)
-                            .and_then(|a| a.lit(lane, depth, l));
-                        if faces
-                            && ahead_lit.unwrap_or_else(|| {
-                                self.visible(p, hit.triangle, light.position, None)
-                            })
-                        {
-                            rays += 1;
-                            radiance += beta * f * light.intensity * (cos / r2);
-                        }
-                    }
-                    if !self.emitters.is_empty() {
-                        let u = rng.next_unit();
-                        let k = self
-                            .cdf
-                            .partition_point(|&c| c <= u)
-                            .min(self.emitters.len() - 1);
-                        let e = &self.emitters[k];
-                        let t = g.triangles[e.triangle];
-                        let (mut a, mut b) = (rng.next_unit(), rng.next_unit());
-                        if a + b > 1.0 {
-                            (a, b) = (1.0 - a, 1.0 - b);
-                        }
-                        let q = t[0] + (t[1] - t[0]) * a + (t[2] - t[0]) * b;
-                        let to = q - p;
-                        let r2 = to.length_squared();
-                        let l = to / r2.sqrt();
-                        let cos_p = n.dot(l);
-                        let cos_l = -self.normals[e.triangle].dot(l);
-                        if cos_p > 0.0
-                            && cos_l > 0.0
-                            && self.visible(p, hit.triangle, q, Some(e.triangle))
-                        {
-                            rays += 1;
-                            let p_light = self.area_pdf[e.triangle] * r2 / cos_l;
-                            let p_bsdf = cos_p * std::f32::consts::FRAC_1_PI;
-                            let w = p_light * p_light / (p_light * p_light + p_bsdf * p_bsdf);
-                            // The emission at q (its texture's), the selection by factor.
-                            let emission = g.diffuse_at(e.triangle, q).map_or(e.emission, |d| d.1);
-                            radiance += beta * f * emission * (cos_p / p_light) * w;
-                        }
-                    }
-                    let dir = cosine_sample(n, rng.next_unit(), rng.next_unit());
-                    bsdf_pdf = Some(n.dot(dir) * std::f32::consts::FRAC_1_PI);
-                    beta *= albedo; // f·cos/pdf = ρ/π·cos/(cos/π)
-                    ray = Ray { origin: p, dir };
-                    from_triangle = Some(hit.triangle);
-                    from_mirror = None;
-                }
+                w.bsdf_pdf = None;
+                w.from_mirror = Some(mirror);
+                w.from_triangle = None;
+                w.bounces += 1;
             }
-            depth += 1;
-            if depth >= self.settings.rr_depth {
-                let q = beta.max_element().min(0.95);
-                if q <= 0.0 || rng.next_unit() >= q {
-                    break Termination::Roulette;
+            Interaction::Diffuse { albedo, .. } => {
+                let n = if front { n_f } else { -n_f };
+                let f = albedo * std::f32::consts::FRAC_1_PI;
+                let lights = &scene.lighting.lights;
+                for (l, light) in lights.iter().enumerate() {
+                    let (faces, cos, r2) = faces_light(p, n, light.position);
+                    if faces {
+                        let (ray, t_max) = segment(p, light.position);
+                        let contribution = w.beta * f * light.intensity * (cos / r2);
+                        shadow(
+                            l,
+                            ShadowRay {
+                                ray,
+                                t_max,
+                                from: hit.triangle,
+                                contribution,
+                            },
+                        );
+                    }
                 }
-                beta /= q;
+                if !self.emitters.is_empty() {
+                    let u = rng.next_unit();
+                    let k = self
+                        .cdf
+                        .partition_point(|&c| c <= u)
+                        .min(self.emitters.len() - 1);
+                    let e = &self.emitters[k];
+                    let t = g.triangles[e.triangle];
+                    let (mut a, mut b) = (rng.next_unit(), rng.next_unit());
+                    if a + b > 1.0 {
+                        (a, b) = (1.0 - a, 1.0 - b);
+                    }
+                    let q = t[0] + (t[1] - t[0]) * a + (t[2] - t[0]) * b;
+                    let to = q - p;
+                    let r2 = to.length_squared();
+                    let l = to / r2.sqrt();
+                    let cos_p = n.dot(l);
+                    let cos_l = -self.normals[e.triangle].dot(l);
+                    if cos_p > 0.0 && cos_l > 0.0 {
+                        let p_light = self.area_pdf[e.triangle] * r2 / cos_l;
+                        let p_bsdf = cos_p * std::f32::consts::FRAC_1_PI;
+                        let weight = p_light * p_light / (p_light * p_light + p_bsdf * p_bsdf);
+                        // The emission at q (its texture's), the selection by factor.
+                        let emission = g.diffuse_at(e.triangle, q).map_or(e.emission, |d| d.1);
+                        let (ray, t_max) = segment(p, q);
+                        let contribution = w.beta * f * emission * (cos_p / p_light) * weight;
+                        shadow(
+                            lights.len(),
+                            ShadowRay {
+                                ray,
+                                t_max,
+                                from: hit.triangle,
+                                contribution,
+                            },
+                        );
+                    }
+                }
+                let dir = cosine_sample(n, rng.next_unit(), rng.next_unit());
+                w.bsdf_pdf = Some(n.dot(dir) * std::f32::consts::FRAC_1_PI);
+                w.beta *= albedo; // f·cos/pdf = ρ/π·cos/(cos/π)
+                w.ray = Ray { origin: p, dir };
+                w.from_triangle = Some(hit.triangle);
+                w.from_mirror = None;
+                w.diffuse_vertices += 1;
             }
-        };
-        PathResult {
-            radiance,
-            bounces,
-            termination,
+        }
+        w.depth += 1;
+        if w.depth >= self.settings.rr_depth {
+            let q = w.beta.max_element().min(0.95);
+            if q <= 0.0 || rng.next_unit() >= q {
+                return Vertex::End(Termination::Roulette);
+            }
+            w.beta /= q;
+        }
+        match flat {
+            Some(plane) => Vertex::FlatBounce(plane),
+            None => Vertex::Next,
+        }
+    }
+
+    /// Radiance along `ray`, random numbers from `rng` (the sample's own stream), one query
+    /// at a time through the single-ray hierarchy.
+    fn radiance_one(&self, ray: Ray, rng: &mut SplitMix64) -> PathResult {
+        let mut w = Walk::start(ray);
+        let mut unblocked: Vec<Vec3> = Vec::new();
+        loop {
+            let hit = self.bvh.closest_hit_skipping(
+                &w.ray,
+                0.0,
+                f32::INFINITY,
+                w.from_mirror,
+                w.from_triangle,
+            );
+            unblocked.clear();
+            let end = self.vertex::<false>(&mut w, hit, rng, |_, s| {
+                if !self.bvh.occluded(&s.ray, 0.0, s.t_max, None, Some(s.from)) {
+                    unblocked.push(s.contribution);
+                }
+            });
+            for &c in &unblocked {
+                w.radiance += c;
+                w.rays += 1;
+            }
+            if let Vertex::End(end) = end {
+                return w.result(end);
+            }
+        }
+    }
+
+    /// The radiance of each of `rays` (one per entry of `rngs`, each sample's own stream),
+    /// in order, into `out`: [`LANES`] paths walk side by side, and each round's queries go
+    /// to the BVH as packets — the closest hits of every path's next ray (camera, mirror
+    /// and diffuse-bounce rays alike) as one packet, the shadow rays the round's vertices
+    /// ask for as one any-hit packet per point light and one for the emitter samples.
+    /// Russian roulette ends each lane on its own. Every path takes the same steps as
+    /// [`PathTracer::radiance_one`] with the same stream, so with the same answers from the
+    /// hierarchy the results are the same bits.
+    ///
+    /// Compiled for the CPU's widest vectors ([`crate::cpu_features`], kernel inlined).
+    fn radiance_lanes(
+        &self,
+        rays: &[Ray],
+        rngs: &mut [SplitMix64],
+        asked: &mut Vec<Asked>,
+        out: &mut Vec<PathResult>,
+    ) {
+        struct Work<'w, 'a> {
+            path: &'w PathTracer<'a>,
+            rays: &'w [Ray],
+            rngs: &'w mut [SplitMix64],
+            asked: &'w mut Vec<Asked>,
+            out: &'w mut Vec<PathResult>,
+        }
+        impl Vectorised for Work<'_, '_> {
+            type Output = ();
+            #[inline(always)]
+            fn run(self) {
+                self.path
+                    .radiance_lanes_inline(self.rays, self.rngs, self.asked, self.out)
+            }
+        }
+        widest(Work {
+            path: self,
             rays,
+            rngs,
+            asked,
+            out,
+        })
+    }
+
+    #[inline(always)]
+    fn radiance_lanes_inline(
+        &self,
+        rays: &[Ray],
+        rngs: &mut [SplitMix64],
+        asked: &mut Vec<Asked>,
+        out: &mut Vec<PathResult>,
+    ) {
+        let kinds = self.scene.lighting.lights.len() + 1;
+        let mut packet = RayPacket::default();
+        let mut skip = [NO_TRIANGLE; LANES];
+        let mut hits = LaneHits::default();
+        let mut t_max = [0.0f32; LANES];
+        let mut from = [NO_TRIANGLE; LANES];
+        // A round's flat-mirror bounces, per lane (set for the lanes that have one).
+        let mut normal = [[0.0f64; LANES]; 3];
+        let mut offset = [0.0f64; LANES];
+        let (mut origin, mut dir) = ([[0.0f64; LANES]; 3], [[0.0f64; LANES]; 3]);
+        // Per kind of shadow ray (light, then emitter), the round's blocked lanes.
+        let mut blocked: Vec<LaneMask> = Vec::with_capacity(kinds);
+        for (chunk, rngs) in rays.chunks(LANES).zip(rngs.chunks_mut(LANES)) {
+            let mut walks = [Walk::start(chunk[0]); LANES];
+            for (w, &ray) in walks.iter_mut().zip(chunk) {
+                w.ray = ray;
+            }
+            let mut ends = [Termination::Escaped; LANES];
+            let mut active = first_lanes(chunk.len());
+            while active != 0 {
+                // Paths before their first diffuse vertex (camera rays and mirror chains)
+                // are coherent: their queries go to the packet kernel; later ones are
+                // scattered, and go one at a time to the single-ray hierarchy.
+                let mut coherent: LaneMask = 0;
+                for lane in lanes(active) {
+                    let w = &walks[lane];
+                    if w.diffuse_vertices < PACKET_VERTICES {
+                        coherent |= 1 << lane;
+                        packet.set(lane, &w.ray, w.from_mirror);
+                        skip[lane] = w.from_triangle.map_or(NO_TRIANGLE, |t| t as u32);
+                    }
+                }
+                if coherent != 0 {
+                    self.bvh
+                        .closest_hit_lanes_skipping_inline(&packet, coherent, &skip, &mut hits);
+                }
+                asked.clear();
+                let mut flat = [false; LANES];
+                let mut any_flat = false;
+                for lane in lanes(active) {
+                    let w = &mut walks[lane];
+                    let in_packet = coherent >> lane & 1 == 1;
+                    let hit = if in_packet {
+                        hits.get(lane)
+                    } else {
+                        self.bvh.closest_hit_skipping(
+                            &w.ray,
+                            0.0,
+                            f32::INFINITY,
+                            w.from_mirror,
+                            w.from_triangle,
+                        )
+                    };
+                    let shadow_in_packet = w.diffuse_vertices < PACKET_SHADOW_VERTICES;
+                    let step = self.vertex::<true>(w, hit, &mut rngs[lane], |k, s| {
+                        let answer = (!shadow_in_packet)
+                            .then(|| self.bvh.occluded(&s.ray, 0.0, s.t_max, None, Some(s.from)));
+                        asked.push((lane, k, s, answer))
+                    });
+                    match step {
+                        Vertex::End(end) => {
+                            ends[lane] = end;
+                            active &= !(1 << lane);
+                        }
+                        Vertex::FlatBounce((n, off)) => {
+                            flat[lane] = true;
+                            any_flat = true;
+                            for k in 0..3 {
+                                normal[k][lane] = n[k];
+                                origin[k][lane] = w.ray.origin[k] as f64;
+                                dir[k][lane] = w.ray.dir[k] as f64;
+                            }
+                            offset[lane] = off;
+                        }
+                        Vertex::Next => {}
+                    }
+                }
+                // The round's bounces off flat mirrors, side by side (f64, rounded to the
+                // path's f32 rays).
+                if any_flat {
+                    bounce_flat_lanes::<LANES, true>(
+                        &flat,
+                        &normal,
+                        &offset,
+                        &mut origin,
+                        &mut dir,
+                    );
+                    for lane in (0..LANES).filter(|&lane| flat[lane]) {
+                        let at = |a: &[[f64; LANES]; 3]| {
+                            Vec3::new(a[0][lane] as f32, a[1][lane] as f32, a[2][lane] as f32)
+                        };
+                        walks[lane].ray = Ray {
+                            origin: at(&origin),
+                            dir: at(&dir),
+                        };
+                    }
+                }
+                if asked.is_empty() {
+                    continue;
+                }
+                // The round's shadow rays: one any-hit packet per light (and one for the
+                // emitter samples); a lane asks at most one of each.
+                blocked.clear();
+                for k in 0..kinds {
+                    let mut mask: LaneMask = 0;
+                    for &(lane, _, s, _) in asked.iter().filter(|a| a.1 == k && a.3.is_none()) {
+                        packet.set(lane, &s.ray, None);
+                        t_max[lane] = s.t_max;
+                        from[lane] = s.from as u32;
+                        mask |= 1 << lane;
+                    }
+                    let b = if mask == 0 {
+                        0
+                    } else {
+                        self.bvh.occluded_lanes_inline(&packet, mask, &t_max, &from)
+                    };
+                    blocked.push(b);
+                }
+                for &(lane, k, s, answer) in asked.iter() {
+                    if !answer.unwrap_or(blocked[k] >> lane & 1 == 1) {
+                        let w = &mut walks[lane];
+                        w.radiance += s.contribution;
+                        w.rays += 1;
+                    }
+                }
+            }
+            out.extend((0..chunk.len()).map(|lane| walks[lane].result(ends[lane])));
         }
     }
 }
 
 impl Integrator for PathTracer<'_> {
-    /// Radiance along `ray`, random numbers from `rng`.
+    /// Radiance along `ray`: the sample's own stream is split off the pixel's `rng`
+    /// ([`SplitMix64::split`]), as [`Integrator::radiance_all`] splits one per sample.
     fn radiance(&self, ray: Ray, rng: &mut SplitMix64) -> PathResult {
-        self.radiance_hinted(ray, rng, None, 0)
+        self.radiance_one(ray, &mut rng.split())
     }
 
-    /// Enough pixels to fill a packet's lanes with their mirror chains when packets are
-    /// traced and a pixel has enough samples to make one ([`MIN_PACKET`]), at least one;
-    /// each pixel keeps its own stream, so the images do not change.
+    /// Enough pixels to fill a packet's lanes when packets are traced (at least one): every
+    /// sample has its own stream, so any samples can walk side by side.
     fn pixels_per_call(&self, samples_per_pixel: usize) -> usize {
-        super::packet_pixels(self.bvh, samples_per_pixel, MIN_PACKET)
+        super::packet_pixels(self.bvh, samples_per_pixel, 1)
     }
 
-    /// One ray at a time in order, each pixel's rays sharing its stream, as
-    /// [`Integrator::radiance`]; when the BVH traces packets, the deterministic mirror chains
-    /// at the start of the paths are traced first, [`LANES`] rays side by side (two pixels'
-    /// at 16 samples: [`Integrator::pixels_per_call`]), and each path takes its hits from
-    /// there.
+    /// Each ray's stream split off its pixel's in order (as [`Integrator::radiance`] does),
+    /// then [`LANES`] paths side by side ([`PathTracer::radiance_lanes`]) when the BVH
+    /// traces packets, else one at a time.
     fn radiance_all(&self, rays: &[Ray], rngs: &mut [SplitMix64], out: &mut Vec<PathResult>) {
         out.clear();
         let per_pixel = super::rays_per_pixel(rays, rngs);
-        if !self.bvh.packets() || rays.len() < MIN_PACKET {
-            for (pixel, rng) in rays.chunks(per_pixel).zip(rngs) {
-                out.extend(
-                    pixel
-                        .iter()
-                        .map(|&ray| self.radiance_hinted(ray, rng, None, 0)),
-                );
-            }
+        let mut streams: Vec<SplitMix64> = Vec::with_capacity(rays.len());
+        for rng in rngs.iter_mut() {
+            streams.extend((0..per_pixel).map(|_| rng.split()));
+        }
+        if !self.bvh.packets() {
+            out.extend(
+                rays.iter()
+                    .zip(&mut streams)
+                    .map(|(&ray, rng)| self.radiance_one(ray, rng)),
+            );
             return;
         }
-        // One buffer per thread, kept from pixel to pixel: a fresh one per pixel, up to
-        // 2 KB per round and `max_depth` rounds, went to `mmap` and page faults (5 % at the
-        // default depth of 66).
-        thread_local! {
-            static AHEAD: std::cell::RefCell<Ahead> = std::cell::RefCell::new(Ahead::default());
-        }
-        AHEAD.with_borrow_mut(|ahead| {
-            for (chunk_index, chunk) in rays.chunks(LANES).enumerate() {
-                self.mirror_chains(chunk, ahead);
-                for (lane, &ray) in chunk.iter().enumerate() {
-                    let rng = &mut rngs[(chunk_index * LANES + lane) / per_pixel];
-                    out.push(self.radiance_hinted(ray, rng, Some(ahead), lane));
-                }
-            }
-        });
+        let mut asked = Vec::new();
+        self.radiance_lanes(rays, &mut streams, &mut asked, out);
     }
 }
