@@ -2,18 +2,25 @@
 """Render a mirrorbox scene exported with `mirrorbox export-mitsuba` in Mitsuba 3.
 
 Integrators:
-  whitted  our shading contract (docs/shading.md) written as a Mitsuba SamplingIntegrator:
-           perfect mirror chains (throughput x reflectance), at the first diffuse hit the
-           emission, the point lights without shadows and the ambient term (read from
-           mirrorbox.json beside the XML, as are background and terminal radiance).
-  path     Mitsuba's own `path` integrator (adds diffuse interreflection; no ambient term).
+  whitted       our shading contract (docs/shading.md) written as a Mitsuba SamplingIntegrator:
+                perfect mirror chains (throughput x reflectance), at the first diffuse hit the
+                emission, the point lights without shadows and the ambient term (read from
+                mirrorbox.json beside the XML, as are background and terminal radiance). The
+                leanest formulation found (issue 41, the benchmark's baseline): camera rays
+                intersected with Mitsuba's `coherent` hint, no sampler draws (a mirror's
+                reflection is deterministic), each point light's term computed from one
+                diffuse-reflectance lookup per hit instead of a BSDF evaluation per light, the
+                area-emitter lookup only where the scene has area emitters.
+  whitted-bsdf  the same contract in Mitsuba's general form (sampler draws for `bsdf.sample`,
+                `sample_direction` and `bsdf.eval` per light): the same image, kept to show it.
+  path          Mitsuba's own `path` integrator (adds diffuse interreflection; no ambient term).
 
 Writes a float32 RGB EXR and prints one JSON line with the timings. The first render of a
 JIT variant (llvm_*) includes kernel compilation; --runs K renders K more times and reports
 the fastest as `render_seconds`.
 
 Usage: .venv/bin/python render.py SCENE.xml -o OUT.exr [--integrator whitted|path]
-         [--variant llvm_ad_rgb|scalar_rgb] [--spp N] [--max-depth D] [--runs K]
+         [--variant llvm_ad_rgb|scalar_rgb] [--spp N] [--max-depth D] [--rr-depth R] [--runs K]
 """
 import argparse
 import json
@@ -33,12 +40,14 @@ def parse_args():
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("scene")
     p.add_argument("-o", "--output", required=True)
-    p.add_argument("--integrator", choices=["whitted", "path"], default="whitted")
+    p.add_argument("--integrator", choices=["whitted", "whitted-bsdf", "path"], default="whitted")
     p.add_argument("--variant", default="llvm_ad_rgb")
     p.add_argument("--spp", type=int, default=None, help="default: the export's")
     p.add_argument("--max-depth", type=int, default=10000,
                    help="mirror reflections (whitted) or path segments (path)")
     p.add_argument("--min-throughput", type=float, default=1e-4)
+    p.add_argument("--rr-depth", type=int, default=1 << 30,
+                   help="path: depth from which Russian roulette may end paths (default: never)")
     p.add_argument("--runs", type=int, default=1, help="timed renders after the first")
     p.add_argument("--seed", type=int, default=0, help="seed of Mitsuba's sampler")
     return p.parse_args()
@@ -100,6 +109,72 @@ def define_whitted():
     mi.register_integrator("mirrorbox_whitted", lambda props: Whitted(props))
 
 
+def define_whitted_lean():
+    """The contract as `Whitted` above, in fewer operations (the same image, checked by
+    tests/mitsuba.rs): see the module's doc."""
+
+    class WhittedLean(mi.SamplingIntegrator):
+        def __init__(self, props):
+            super().__init__(props)
+            self.max_depth = props.get("max_depth", 10000)
+            self.min_throughput = props.get("min_throughput", 1e-4)
+            self.ambient = mi.Color3f(props.get("ambient_r", 0.0), props.get("ambient_g", 0.0), props.get("ambient_b", 0.0))
+            self.background = mi.Color3f(props.get("background_r", 0.0), props.get("background_g", 0.0), props.get("background_b", 0.0))
+            self.terminal = mi.Color3f(props.get("terminal_r", 0.0), props.get("terminal_g", 0.0), props.get("terminal_b", 0.0))
+
+        @dr.syntax
+        def sample(self, scene, sampler, ray, medium=None, active=True):
+            ctx = mi.BSDFContext()
+            ray = mi.Ray3f(ray)
+            active = mi.Bool(active)
+            L = mi.Spectrum(0.0)
+            beta = mi.Spectrum(1.0)
+            depth = mi.UInt32(0)
+            emitters = scene.emitters()
+            lights = [e for e in emitters if mi.has_flag(e.flags(), mi.EmitterFlags.DeltaPosition)]
+            surface_emitters = any(mi.has_flag(e.flags(), mi.EmitterFlags.Surface) for e in emitters)
+            # A mirror's reflection needs no random numbers: its delta lobe is sampled the
+            # same for any sample values, and a diffuse hit's sampled direction is not used.
+            no_sample = mi.Point2f(0.5)
+            # The camera rays of neighbouring samples are coherent.
+            si = scene.ray_intersect(ray, mi.RayFlags.All, True, active)
+            while active:
+                escaped = active & ~si.is_valid()
+                L += dr.select(escaped, beta * self.background, 0.0)
+                active &= si.is_valid()
+                bsdf = si.bsdf(ray)
+                bs, weight = bsdf.sample(ctx, si, 0.5, no_sample, active)
+                mirror = active & mi.has_flag(bs.sampled_type, mi.BSDFFlags.DeltaReflection)
+                diffuse = active & ~mirror
+                # Diffuse: E (front only, via the area emitter) + albedo * (sum over the
+                # lights of max(0, n.l) I / (pi r^2) + ambient), on the side the ray arrives.
+                albedo = bsdf.eval_diffuse_reflectance(si, diffuse)
+                side = dr.sign(mi.Frame3f.cos_theta(si.wi))
+                irradiance = mi.Spectrum(self.ambient)
+                for light in lights:
+                    ds, intensity = light.sample_direction(si, no_sample, diffuse)
+                    cos = dr.maximum(mi.Frame3f.cos_theta(si.to_local(ds.d)) * side, 0.0)
+                    irradiance += intensity * (cos * dr.inv_pi)
+                Ld = albedo * irradiance
+                if surface_emitters:
+                    Ld += si.emitter(scene).eval(si, diffuse)
+                L += dr.select(diffuse, beta * Ld, 0.0)
+                absorbed = mirror & (dr.max(weight) == 0.0)
+                mirror &= ~absorbed
+                nxt = beta * weight
+                cut = mirror & ((depth >= self.max_depth) | (dr.max(nxt) < self.min_throughput))
+                L += dr.select(cut, beta * self.terminal, 0.0)
+                follow = mirror & ~cut
+                beta = dr.select(follow, nxt, beta)
+                ray = dr.select(follow, si.spawn_ray(si.to_world(bs.wo)), ray)
+                depth = dr.select(follow, depth + 1, depth)
+                active = follow
+                si = scene.ray_intersect(ray, active)
+            return L, mi.Bool(True), []
+
+    mi.register_integrator("mirrorbox_whitted_lean", lambda props: WhittedLean(props))
+
+
 def main():
     args = parse_args()
     mi.set_variant(args.variant)
@@ -107,14 +182,19 @@ def main():
     with open(os.path.join(scene_dir, "mirrorbox.json")) as f:
         extra = json.load(f)
     spp = args.spp or extra["spp"]
-    if args.integrator == "whitted":
-        define_whitted()
-        integrator = {"type": "mirrorbox_whitted", "max_depth": args.max_depth, "min_throughput": args.min_throughput}
+    if args.integrator in ("whitted", "whitted-bsdf"):
+        if args.integrator == "whitted":
+            define_whitted_lean()
+            kind = "mirrorbox_whitted_lean"
+        else:
+            define_whitted()
+            kind = "mirrorbox_whitted"
+        integrator = {"type": kind, "max_depth": args.max_depth, "min_throughput": args.min_throughput}
         for name in ("ambient", "background", "terminal"):
             for c, v in zip("rgb", extra[name]):
                 integrator[f"{name}_{c}"] = float(v)
     else:
-        integrator = {"type": "path", "max_depth": args.max_depth, "rr_depth": 1 << 30}
+        integrator = {"type": "path", "max_depth": args.max_depth, "rr_depth": args.rr_depth}
     t0 = time.perf_counter()
     scene = mi.load_file(args.scene, spp=spp)
     load_seconds = time.perf_counter() - t0
