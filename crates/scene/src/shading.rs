@@ -213,6 +213,7 @@ pub enum Interaction {
 /// The contract's rule for each surface: a mirror reflects on its front side only and is a
 /// plain diffuse surface (no emission) on its back side.
 /// A textured surface's factors only: [`interaction_at`] evaluates its textures.
+#[inline]
 pub fn interaction(surface: &Surface, front_facing: bool) -> Interaction {
     match *surface {
         Surface::Diffuse {
@@ -228,6 +229,7 @@ pub fn interaction(surface: &Surface, front_facing: bool) -> Interaction {
 
 /// [`interaction`] at point `p` of triangle `triangle` of `g`: a diffuse surface's albedo
 /// and emission there, textures included.
+#[inline(always)]
 pub fn interaction_at(
     g: &crate::Geometry,
     triangle: usize,

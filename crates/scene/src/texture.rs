@@ -172,6 +172,7 @@ pub struct SurfaceMaps {
 }
 
 impl SurfaceMaps {
+    #[inline]
     pub fn is_empty(&self) -> bool {
         self.albedo.is_none() && self.emission.is_none()
     }
