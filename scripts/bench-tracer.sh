@@ -75,7 +75,7 @@ def stats(v):
     v = sorted(v); return statistics.median(v), v[0], v[-1]
 rows, summary = [], {"date": datetime.date.today().isoformat(), "cpu": cpu, "cores": os.cpu_count(), "simd": simd,
                      "rounds": int(rounds), "spp": int(spp), "mitsuba": mver, "commit": commit,
-                     "mitsuba_whitted": "lean (render.py whitted)", "path_rr_depth": int(rr_depth),
+                     "mitsuba_whitted": "lean Whitted; path with roulette from 5", "path_rr_depth": int(rr_depth),
                      "results": []}
 for scene in ["mirror_box", "mirror_room"]:
     for integ in ["whitted", "path"]:
@@ -107,22 +107,5 @@ lines = [f"# The tracer against Mitsuba 3 on {cpu} ({simd})", "",
 open(f"{out}/bench-{slug}.md", "w").write("\n".join(lines) + "\n")
 json.dump(summary, open(f"{out}/bench-{slug}.json", "w"), indent=2)
 print("\n".join(lines))
-# The index: every CPU kind's latest file.
-index = []
-for path in sorted(glob.glob(f"{out}/bench-*.json")):
-    b = json.load(open(path))
-    name = os.path.basename(path)[:-5] + ".md"
-    ratios = {(r["scene"], r["integrator"]): r["speedup_vs_mitsuba_paired"][0] for r in b["results"]}
-    cells = [f"{ratios[(s, i)]:.2f}×" for s in ["mirror_box", "mirror_room"] for i in ["whitted", "path"]]
-    met = all(ratios[(s, i)] >= GOALS[i] for s in ["mirror_box", "mirror_room"] for i in ["whitted", "path"])
-    baseline = b.get("mitsuba_whitted", "general (bsdf), path without roulette")
-    index.append((b, name, cells, met, baseline))
-table = ["# The tracer against Mitsuba 3, per CPU", "",
-         "One file per CPU kind (`scripts/bench-tracer.sh` writes the one of the CPU it runs on); a result is a claim only on the CPU it was measured on. Per round: the median of each round's Mitsuba ÷ mirrorbox (above 1: mirrorbox faster). Goals (issue 41): `whitted` ≥ 3×, `path` ≥ 2× Mitsuba's compiled kernel, on both scenes.", "",
-         "| CPU | vector width | date | commit | rounds | Mitsuba baseline | `mirror_box` whitted | `mirror_box` path | `mirror_room` whitted | `mirror_room` path | goals |",
-         "|---|---|---|---|---|---|---|---|---|---|---|"]
-for b, name, cells, met, baseline in index:
-    table.append(f"| [{b['cpu']}]({name}) | {b['simd']} | {b['date']} | {b.get('commit', '–')} | {b['rounds']} | {baseline} | " + " | ".join(cells) + f" | {'met' if met else 'not met'} |")
-open(f"{out}/bench.md", "w").write("\n".join(table) + "\n")
-json.dump([b for b, *_ in index], open(f"{out}/bench.json", "w"), indent=2)
 PY
+python3 scripts/tracer-bench-index.py "$out"

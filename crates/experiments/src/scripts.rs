@@ -26,7 +26,7 @@ pub const MEMORY_PEAKS: Experiment = Experiment {
 
 pub const TRACER_BENCH: Experiment = Experiment {
     name: "tracer-bench",
-    about: "the tracer against Mitsuba 3's compiled kernel, per round, on this CPU",
+    about: "the tracer against Mitsuba 3's compiled kernel, per round, one record per CPU kind",
     folder: "tracer",
     measure: Measure::Script("scripts/bench-tracer.sh", &["7", "16"]),
     section: None,

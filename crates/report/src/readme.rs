@@ -99,6 +99,11 @@ pub const REGIONS: &[(&str, &str, &str)] = &[
         "the tracer against Mitsuba 3 side by side (scripts/bench-tracer.sh)",
     ),
     (
+        "tracer-bench-summary",
+        "tracer/bench.md",
+        "the tracer against Mitsuba 3: one row per CPU kind measured, with the goals",
+    ),
+    (
         "motion",
         "motion",
         "error over time: feedback, cubemap, auxiliary and an exact method, still and walking (mirrorbox motion)",
@@ -320,6 +325,18 @@ fn report_body_region(path: &Path) -> Result<String, ReadmeError> {
         .collect::<Vec<_>>()
         .join("\n");
     Ok(format!("{}\n", body.trim_end()))
+}
+
+/// A report's body up to its first `## ` section: the summary before the details (the
+/// tracer bench's table of CPUs, each CPU's table after it).
+fn report_summary_region(path: &Path) -> Result<String, ReadmeError> {
+    let body = report_body_region(path)?;
+    let summary = body
+        .lines()
+        .take_while(|l| !l.starts_with("## "))
+        .collect::<Vec<_>>()
+        .join("\n");
+    Ok(format!("{}\n", summary.trim_end()))
 }
 
 fn trace_cost_region(path: &Path) -> Result<String, ReadmeError> {
@@ -663,6 +680,7 @@ pub fn generate(id: &str, reports: &Path) -> Result<Region, ReadmeError> {
             crate::motion::readme_region(&info, &records)
         }
         "viewer-frame-rates" | "tracer-bench" => report_body_region(&folder(source))?,
+        "tracer-bench-summary" => report_summary_region(&folder(source))?,
         _ => unreachable!("every ID in REGIONS has a generator"),
     };
     Ok(Region {

@@ -66,7 +66,8 @@ macro_rules! with_triangle_test {
             ($kx:literal, $ky:literal, $kz:literal) => {{
                 let $test = |r: &obvhs::ray::Ray, slot: usize| {
                     let s = &slots[slot];
-                    if (s.mirror == skip && skip != NOT_A_MIRROR) || original[slot] == skip_tri {
+                    if ((s.mirror == skip) & (skip != NOT_A_MIRROR)) | (original[slot] == skip_tri)
+                    {
                         return f32::INFINITY;
                     }
                     wt.intersect_axes::<$kx, $ky, $kz>(s.v[0], s.v[1], s.v[2], r.tmin, r.tmax)

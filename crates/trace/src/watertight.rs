@@ -144,7 +144,12 @@ impl WatertightRay {
         let mut u = cx * by - cy * bx;
         let mut v = ax * cy - ay * cx;
         let mut w = bx * ay - by * ax;
-        if u == 0.0 || v == 0.0 || w == 0.0 {
+        // The decisions below combine their comparisons with `|` and `&`, not `||` and `&&`:
+        // one branch per decision instead of one per comparison, which incoherent rays
+        // mispredicted (issue 41: a sixth of `path`'s mispredicted branches were in this
+        // test; `path` ×0.97–0.98). The same decisions, so the same answers. (Dividing
+        // before the edge decision, to leave one select at the end, measured ×1.025.)
+        if (u == 0.0) | (v == 0.0) | (w == 0.0) {
             let (ax, ay, bx, by, cx, cy) = (
                 ax as f64, ay as f64, bx as f64, by as f64, cx as f64, cy as f64,
             );
@@ -152,18 +157,16 @@ impl WatertightRay {
             v = (ax * cy - ay * cx) as f32;
             w = (bx * ay - by * ax) as f32;
         }
-        if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
-            return f32::INFINITY;
-        }
+        let both_signs = ((u < 0.0) | (v < 0.0) | (w < 0.0)) & ((u > 0.0) | (v > 0.0) | (w > 0.0));
         let det = u + v + w;
-        if det == 0.0 {
+        if both_signs | (det == 0.0) {
             return f32::INFINITY;
         }
         let az = self.sz * a[kz];
         let bz = self.sz * b[kz];
         let cz = self.sz * c[kz];
         let t = (u * az + v * bz + w * cz) / det;
-        if t >= t_min && t <= t_max {
+        if (t >= t_min) & (t <= t_max) {
             t
         } else {
             f32::INFINITY

@@ -1,0 +1,39 @@
+#!/usr/bin/env python3
+"""The index of the tracer benches (issue 41): reports/tracer/bench.md and bench.json from
+every CPU kind's reports/tracer/bench-<cpu>-<width>.json (written by scripts/bench-tracer.sh
+on that CPU): a summary row per CPU with the per-round ratios and the goals, then each CPU's
+table. A result is a claim only on the CPU it was measured on.
+
+Usage: scripts/tracer-bench-index.py [FOLDER]     (default reports/tracer)"""
+import glob
+import json
+import os
+import sys
+
+GOALS = {"whitted": 3.0, "path": 2.0}
+SCENES = ["mirror_box", "mirror_room"]
+out = sys.argv[1] if len(sys.argv) > 1 else "reports/tracer"
+benches = []
+for path in sorted(glob.glob(os.path.join(out, "bench-*.json"))):
+    b = json.load(open(path))
+    name = os.path.basename(path)[:-5] + ".md"
+    ratios = {(r["scene"], r["integrator"]): r["speedup_vs_mitsuba_paired"][0] for r in b["results"]}
+    cells = [f"{ratios[(s, i)]:.2f}×" for s in SCENES for i in ["whitted", "path"]]
+    met = all(ratios[(s, i)] >= GOALS[i] for s in SCENES for i in ["whitted", "path"])
+    body = open(os.path.join(out, name)).read().split("\n")
+    body = "\n".join(l for l in body if not l.startswith("# ")).strip()
+    benches.append((b, name, cells, met, body))
+lines = ["# The tracer against Mitsuba 3, per CPU", "",
+         "One record per CPU kind: `scripts/bench-tracer.sh` writes the one of the CPU it runs on, "
+         "and a result is a claim only on that CPU. Per round: the median of each round's Mitsuba ÷ "
+         "mirrorbox (above 1: mirrorbox faster). Goals (issue 41): `whitted` ≥ 3×, `path` ≥ 2× "
+         "Mitsuba's compiled kernel, on both scenes.", "",
+         "| CPU | vector width | date | commit | rounds | Mitsuba baseline | `mirror_box` whitted | `mirror_box` path | `mirror_room` whitted | `mirror_room` path | goals |",
+         "|---|---|---|---|---|---|---|---|---|---|---|"]
+for b, name, cells, met, _ in benches:
+    lines.append(f"| [{b['cpu']}]({name}) | {b['simd']} | {b['date']} | {b.get('commit', '–')} | {b['rounds']} | "
+                 f"{b.get('mitsuba_whitted', '–')} | " + " | ".join(cells) + f" | {'met' if met else 'not met'} |")
+for b, name, _, _, body in benches:
+    lines += ["", f"## {b['cpu']} ({b['simd']})", "", body]
+open(os.path.join(out, "bench.md"), "w").write("\n".join(lines) + "\n")
+json.dump([b for b, *_ in benches], open(os.path.join(out, "bench.json"), "w"), indent=2)
