@@ -24,7 +24,9 @@ cd "$(dirname "$0")/.."
 rounds=${1:-5}
 spp=${2:-16}
 bin=target/release/mirrorbox
-[ -x "$bin" ] || cargo build --release --locked -p mirrorbox
+# Always built (a no-op when current), so that the record's commit is the build measured;
+# a tree with changes to the code is marked "+changes".
+cargo build --release --locked -p mirrorbox >&2
 tools/mitsuba/setup.sh >&2
 py=tools/mitsuba/.venv/bin/python
 out=reports/tracer
@@ -35,6 +37,7 @@ scenes="mirror_box mirror_room"
 # path: Russian roulette from this depth in both renderers (Mitsuba's default is 5 too).
 rr_depth=5
 commit=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)
+git diff --quiet HEAD -- crates shaders Cargo.toml Cargo.lock tools 2>/dev/null || commit="$commit+changes"
 # Whitted follows mirror chains to 10 000 reflections (cut by the throughput); path traces
 # to 10 segments with Russian roulette from 5, the same in both renderers.
 for s in $scenes; do
@@ -75,7 +78,7 @@ def stats(v):
     v = sorted(v); return statistics.median(v), v[0], v[-1]
 rows, summary = [], {"date": datetime.date.today().isoformat(), "cpu": cpu, "cores": os.cpu_count(), "simd": simd,
                      "rounds": int(rounds), "spp": int(spp), "mitsuba": mver, "commit": commit,
-                     "mitsuba_whitted": "lean Whitted; path with roulette from 5", "path_rr_depth": int(rr_depth),
+                     "mitsuba_whitted": f"lean Whitted; path with roulette from {rr_depth}", "path_rr_depth": int(rr_depth),
                      "results": []}
 for scene in ["mirror_box", "mirror_room"]:
     for integ in ["whitted", "path"]:

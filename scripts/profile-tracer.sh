@@ -4,7 +4,7 @@
 # source file, into reports/tracer/profile_<scene>_<integrator>.txt with the CPU and date.
 #
 # Usage: scripts/profile-tracer.sh SCENE INTEGRATOR     (e.g. mirror_room path)
-#   Needs perf (apt install linux-perf) and the release build (built if missing).
+#   Needs perf (apt install linux-perf); builds the release binary (a no-op when current).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if [ $# -ne 2 ]; then
@@ -16,7 +16,10 @@ scene=$1 integrator=$2
 case $integrator in whitted) depth=10000 ;; path) depth=10 ;; *) echo "INTEGRATOR must be whitted or path, not '$integrator'" >&2; exit 2 ;; esac
 command -v perf > /dev/null || { echo "perf is not installed (apt install linux-perf)" >&2; exit 1; }
 bin=target/release/mirrorbox
-[ -x "$bin" ] || cargo build --release --locked -p mirrorbox
+# Always built (a no-op when current), so that the profile's commit is the build profiled.
+cargo build --release --locked -p mirrorbox >&2
+commit=$(git rev-parse --short HEAD)
+git diff --quiet HEAD -- crates shaders Cargo.toml Cargo.lock || commit="$commit+changes"
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 args=(trace "scenes/$scene.json" --width 640 --height 360 --spp 16 --integrator "$integrator" --max-depth "$depth")
@@ -25,7 +28,7 @@ cpu=$(grep -m1 '^model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ *//')
 simd=SSE; grep -qw avx2 /proc/cpuinfo && simd=AVX2; grep -qw avx512f /proc/cpuinfo && simd=AVX-512
 out=reports/tracer/profile_${scene}_${integrator}.txt
 {
-  echo "# perf record (1 thread, 15 kHz); mirrorbox ${args[*]}; $(date -u +%F), $cpu ($simd), $(nproc) cores, commit $(git rev-parse --short HEAD)"
+  echo "# perf record (1 thread, 15 kHz); mirrorbox ${args[*]}; $(date -u +%F), $cpu ($simd), $(nproc) cores, commit $commit"
   echo "# Functions above 0.7 % of self time. cpu_features::x86::* is code compiled through cpu_features::widest: the packet walks with the kernel inlined (and, for path, the per-lane path code), and the image row; obvhs::cwbvh is the single-ray hierarchy."
   perf report -i "$work/perf.data" --no-children --sort comm,dso,symbol 2>/dev/null | grep -v '^#' | grep -v '^$' |
     awk '{ v = $1; sub("%", "", v); if (v + 0 >= 0.7) print }'

@@ -19,7 +19,7 @@ Writes a float32 RGB EXR and prints one JSON line with the timings. The first re
 JIT variant (llvm_*) includes kernel compilation; --runs K renders K more times and reports
 the fastest as `render_seconds`.
 
-Usage: .venv/bin/python render.py SCENE.xml -o OUT.exr [--integrator whitted|path]
+Usage: .venv/bin/python render.py SCENE.xml -o OUT.exr [--integrator whitted|whitted-bsdf|path]
          [--variant llvm_ad_rgb|scalar_rgb] [--spp N] [--max-depth D] [--rr-depth R] [--runs K]
 """
 import argparse
@@ -212,7 +212,9 @@ def main():
     mi.Bitmap(image).write(args.output)
     print(json.dumps({
         "output": args.output, "variant": args.variant, "integrator": args.integrator,
-        "spp": spp, "max_depth": args.max_depth, "width": extra["width"], "height": extra["height"],
+        "spp": spp, "max_depth": args.max_depth,
+        "rr_depth": args.rr_depth if args.integrator == "path" else None,
+        "width": extra["width"], "height": extra["height"],
         "load_seconds": load_seconds, "first_render_seconds": first,
         "render_seconds": min(times) if times else first, "runs": len(times),
         "threads": os.cpu_count(),

@@ -390,36 +390,6 @@ impl SceneBvh {
         }
     }
 
-    /// [`SceneBvh::closest_hit_lanes_inline`] where lane `i` also skips triangle
-    /// `skip_triangle[i]` ([`packet::NO_TRIANGLE`]: none): what
-    /// [`SceneBvh::closest_hit_skipping`] answers for each lane (`path`'s rays leaving a
-    /// diffuse triangle).
-    #[inline(always)]
-    pub(crate) fn closest_hit_lanes_skipping_inline(
-        &self,
-        packet: &RayPacket,
-        active: LaneMask,
-        skip_triangle: &[u32; LANES],
-        out: &mut LaneHits,
-    ) {
-        if self.packets {
-            let bvh = self.packet_bvh();
-            if bvh.usable() {
-                return bvh.closest_hit_lanes_skipping_inline(packet, active, skip_triangle, out);
-            }
-        }
-        *out = LaneHits::default();
-        for lane in packet::lanes(active) {
-            let (ray, skip) = packet.lane(lane);
-            let skip_triangle = (skip_triangle[lane] != packet::NO_TRIANGLE)
-                .then_some(skip_triangle[lane] as usize);
-            out.set(
-                lane,
-                self.closest_hit_skipping(&ray, 0.0, f32::INFINITY, skip, skip_triangle),
-            );
-        }
-    }
-
     /// The lanes of `active` in `packet` whose segment is blocked: lane `i`'s ray hits
     /// something in `[0, t_max[i])` other than its skipped mirror and triangle
     /// `skip_triangle[i]` ([`packet::NO_TRIANGLE`]: none) — what [`SceneBvh::occluded`]

@@ -335,35 +335,7 @@ impl PacketBvh {
         out: &mut LaneHits,
     ) {
         *out = LaneHits::default();
-        self.trace_lanes::<false, false>(
-            packet,
-            active,
-            &mut out.t,
-            &mut out.triangle,
-            &NO_TRIANGLES,
-        );
-    }
-
-    /// [`PacketBvh::closest_hit_lanes_inline`] where lane `i` also skips triangle
-    /// `skip_triangle[i]` (the scene's numbering; [`NO_TRIANGLE`] for none): what
-    /// [`super::SceneBvh::closest_hit_skipping`] answers, for rays leaving a diffuse
-    /// triangle (`path`). A third monomorphised kernel, so the skip costs the others nothing.
-    #[inline(always)]
-    pub(super) fn closest_hit_lanes_skipping_inline(
-        &self,
-        packet: &RayPacket,
-        active: LaneMask,
-        skip_triangle: &[u32; LANES],
-        out: &mut LaneHits,
-    ) {
-        *out = LaneHits::default();
-        self.trace_lanes::<false, true>(
-            packet,
-            active,
-            &mut out.t,
-            &mut out.triangle,
-            skip_triangle,
-        );
+        self.trace_lanes::<false>(packet, active, &mut out.t, &mut out.triangle, &NO_TRIANGLES);
     }
 
     /// The lanes of `active` whose segment is blocked: whose ray hits a triangle at
@@ -381,7 +353,7 @@ impl PacketBvh {
     ) -> LaneMask {
         let mut best_t = *t_max;
         let mut best_triangle = [NO_TRIANGLE; LANES];
-        self.trace_lanes::<true, true>(
+        self.trace_lanes::<true>(
             packet,
             active,
             &mut best_t,
@@ -399,7 +371,7 @@ impl PacketBvh {
     /// first hit). Two monomorphised kernels, so that the any-hit mode costs the closest-hit
     /// one nothing.
     #[inline(always)]
-    fn trace_lanes<const ANY_HIT: bool, const SKIP: bool>(
+    fn trace_lanes<const ANY_HIT: bool>(
         &self,
         packet: &RayPacket,
         active: LaneMask,
@@ -425,12 +397,12 @@ impl PacketBvh {
                 skip_triangle,
             );
             match axes_of(code) {
-                (1, 2, 0) => self.traverse::<1, 2, 0, ANY_HIT, SKIP>(p, q, group, t, s, k),
-                (2, 1, 0) => self.traverse::<2, 1, 0, ANY_HIT, SKIP>(p, q, group, t, s, k),
-                (2, 0, 1) => self.traverse::<2, 0, 1, ANY_HIT, SKIP>(p, q, group, t, s, k),
-                (0, 2, 1) => self.traverse::<0, 2, 1, ANY_HIT, SKIP>(p, q, group, t, s, k),
-                (0, 1, 2) => self.traverse::<0, 1, 2, ANY_HIT, SKIP>(p, q, group, t, s, k),
-                (1, 0, 2) => self.traverse::<1, 0, 2, ANY_HIT, SKIP>(p, q, group, t, s, k),
+                (1, 2, 0) => self.traverse::<1, 2, 0, ANY_HIT>(p, q, group, t, s, k),
+                (2, 1, 0) => self.traverse::<2, 1, 0, ANY_HIT>(p, q, group, t, s, k),
+                (2, 0, 1) => self.traverse::<2, 0, 1, ANY_HIT>(p, q, group, t, s, k),
+                (0, 2, 1) => self.traverse::<0, 2, 1, ANY_HIT>(p, q, group, t, s, k),
+                (0, 1, 2) => self.traverse::<0, 1, 2, ANY_HIT>(p, q, group, t, s, k),
+                (1, 0, 2) => self.traverse::<1, 0, 2, ANY_HIT>(p, q, group, t, s, k),
                 other => unreachable!("not an axis permutation: {other:?}"),
             }
         }
@@ -440,13 +412,7 @@ impl PacketBvh {
     /// a node is entered when any of them hits its box before its closest hit so far; the
     /// nearer child (along the group's first lane's direction) first.
     #[inline(always)]
-    fn traverse<
-        const KX: usize,
-        const KY: usize,
-        const KZ: usize,
-        const ANY_HIT: bool,
-        const SKIP: bool,
-    >(
+    fn traverse<const KX: usize, const KY: usize, const KZ: usize, const ANY_HIT: bool>(
         &self,
         p: &RayPacket,
         q: &Prepared,
@@ -479,7 +445,7 @@ impl PacketBvh {
                 let hit = box_hits(node, mirror, p, q, best_t, group);
                 if hit != 0 {
                     for slot in node.first..node.first + node.count {
-                        self.triangle::<KX, KY, KZ, ANY_HIT, SKIP>(
+                        self.triangle::<KX, KY, KZ, ANY_HIT>(
                             slot,
                             p,
                             q,
@@ -513,17 +479,11 @@ impl PacketBvh {
     /// and recording the scene's index of the triangle hit. Two loops branch free over the
     /// lanes (the compiler vectorises them): the edge functions, then, only if some lane is
     /// inside the edges, the distance; the rare lanes with an exact zero edge function or
-    /// an exact tie are finished one by one. `SKIP`: lanes also skip `skip_triangle`.
-    /// `ANY_HIT`: a hit stops the lane (`best` becomes [`STOPPED`]).
+    /// an exact tie are finished one by one. `ANY_HIT`: lanes also skip `skip_triangle`, and
+    /// a hit stops the lane (`best` becomes [`STOPPED`]).
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
-    fn triangle<
-        const KX: usize,
-        const KY: usize,
-        const KZ: usize,
-        const ANY_HIT: bool,
-        const SKIP: bool,
-    >(
+    fn triangle<const KX: usize, const KY: usize, const KZ: usize, const ANY_HIT: bool>(
         &self,
         slot: u32,
         p: &RayPacket,
@@ -568,7 +528,7 @@ impl PacketBvh {
             let all_negative = max(max(u, v), w) < 0.0;
             let asked = (hit >> i & 1 == 1)
                 & (s.mirror != p.skip[i])
-                & (!SKIP || triangle != skip_triangle[i]);
+                & (!ANY_HIT || triangle != skip_triangle[i]);
             zero[i] = asked & exact_zero;
             inside[i] = asked & (all_positive | all_negative);
             edges[0][i] = u;

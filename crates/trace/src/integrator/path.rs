@@ -17,8 +17,10 @@
 //!
 //! **Every sample its own random stream** (issue 41), split off its pixel's stream in
 //! sample order ([`SplitMix64::split`]): so the samples of neighbouring pixels walk side by
-//! side, [`LANES`] at a time, each round's closest-hit and shadow queries going to the BVH
-//! as packets, Russian roulette ending each lane on its own ([`PathTracer::radiance_lanes`]);
+//! side, [`LANES`] at a time — each round's closest-hit and shadow queries of the paths
+//! before their first diffuse vertex (coherent) going to the BVH as packets, the scattered
+//! ones after it one at a time — Russian roulette ending each lane on its own
+//! ([`PathTracer::radiance_lanes`]);
 //! one at a time, a sample draws the same numbers and takes the same steps
 //! ([`PathTracer::radiance_one`]).
 //!
@@ -82,7 +84,9 @@ pub struct PathTracer<'a> {
 /// cosine-sampled rays after a diffuse vertex are not, and a 32-lane packet of them visits
 /// the union of their nodes. Measured (one thread, 640×360, 16 spp, depth 10, AMD EPYC
 /// AVX-512): everything in packets 1.12 s (`mirror_box`) and 2.24 s (`mirror_room`); 1:
-/// 0.73 s and 1.55 s; 2: 0.72 s and 1.64 s.
+/// 0.73 s and 1.55 s; 2: 0.72 s and 1.64 s (with a packet kernel that skipped the diffuse
+/// triangle a ray leaves, since removed: the same on `mirror_box`, slower on `mirror_room`).
+/// Above 1 needs that kernel back.
 const PACKET_VERTICES: u32 = 1;
 
 /// Likewise for the next-event shadow rays: those from a path's first diffuse vertex start
@@ -433,10 +437,12 @@ impl PathTracer<'_> {
     }
 
     /// The radiance of each of `rays` (one per entry of `rngs`, each sample's own stream),
-    /// in order, into `out`: [`LANES`] paths walk side by side, and each round's queries go
-    /// to the BVH as packets — the closest hits of every path's next ray (camera, mirror
-    /// and diffuse-bounce rays alike) as one packet, the shadow rays the round's vertices
-    /// ask for as one any-hit packet per point light and one for the emitter samples.
+    /// in order, into `out`: [`LANES`] paths walk side by side, and each round's coherent
+    /// queries go to the BVH as packets — the closest hits of the paths before their first
+    /// diffuse vertex (camera rays, mirror chains) as one packet, the shadow rays of their
+    /// first diffuse vertex as one any-hit packet per point light and one for the emitter
+    /// samples; the scattered queries after it go one at a time ([`PACKET_VERTICES`],
+    /// [`PACKET_SHADOW_VERTICES`]).
     /// Russian roulette ends each lane on its own. Every path takes the same steps as
     /// [`PathTracer::radiance_one`] with the same stream, so with the same answers from the
     /// hierarchy the results are the same bits.
@@ -483,7 +489,6 @@ impl PathTracer<'_> {
     ) {
         let kinds = self.scene.lighting.lights.len() + 1;
         let mut packet = RayPacket::default();
-        let mut skip = [NO_TRIANGLE; LANES];
         let mut hits = LaneHits::default();
         let mut t_max = [0.0f32; LANES];
         let mut from = [NO_TRIANGLE; LANES];
@@ -503,19 +508,22 @@ impl PathTracer<'_> {
             while active != 0 {
                 // Paths before their first diffuse vertex (camera rays and mirror chains)
                 // are coherent: their queries go to the packet kernel; later ones are
-                // scattered, and go one at a time to the single-ray hierarchy.
+                // scattered, and go one at a time to the single-ray hierarchy. (Before a
+                // diffuse vertex a ray leaves no diffuse triangle, so the packet kernel's
+                // closest hits need skip only mirrors; `PACKET_VERTICES` above 1 would need
+                // a kernel that skips a triangle per lane, as the any-hit one does.)
                 let mut coherent: LaneMask = 0;
                 for lane in lanes(active) {
                     let w = &walks[lane];
                     if w.diffuse_vertices < PACKET_VERTICES {
+                        debug_assert!(w.from_triangle.is_none());
                         coherent |= 1 << lane;
                         packet.set(lane, &w.ray, w.from_mirror);
-                        skip[lane] = w.from_triangle.map_or(NO_TRIANGLE, |t| t as u32);
                     }
                 }
                 if coherent != 0 {
                     self.bvh
-                        .closest_hit_lanes_skipping_inline(&packet, coherent, &skip, &mut hits);
+                        .closest_hit_lanes_inline(&packet, coherent, &mut hits);
                 }
                 asked.clear();
                 let mut flat = [false; LANES];

@@ -5,7 +5,8 @@
 //! packet; rows of 48 pixels end in part-filled packets) and 1×1 (one ray at a time), with
 //! shadow legs, uneven
 //! mirrors, symmetry planes and stereo rigs' scenes among them. So does `path`, whose
-//! mirror chains the packets trace ahead of its samples.
+//! samples (each with its own stream since issue 41) walk side by side, their coherent
+//! queries traced as packets.
 
 use mirrorbox_scene::load::bundled_scene;
 use mirrorbox_trace::{BvhKind, PathSettings, SceneBvh, TraceSettings, WhittedSettings, render};
@@ -68,11 +69,11 @@ fn whitted_renders_every_bundled_scene_to_the_same_bits_with_packets() {
     }
 }
 
-/// `path` takes the hits of its deterministic mirror chains from packets traced ahead of its
-/// samples, several pixels' at once (2, 3 and 8 pixels per call at these grids), each pixel
-/// drawing from its own random stream; its streams and every other query are unchanged, so
-/// its images are the same bits as one ray at a time, one pixel per call, through the same
-/// hierarchy.
+/// `path` walks 32 samples side by side, each with its own stream split off its pixel's in
+/// order, several pixels' at once (2, 3 and 8 pixels per call at these grids); the queries
+/// of paths before their first diffuse vertex and that vertex's shadow rays go to the
+/// packet kernel, the rest one at a time. Its images are the same bits as one sample at a
+/// time, one pixel per call, through the same hierarchy.
 #[test]
 fn path_renders_every_bundled_scene_to_the_same_bits_with_packets() {
     for name in &bundled_names() {
