@@ -54,7 +54,7 @@ def parse_args():
 
 
 def define_whitted():
-    """Defined after mi.set_variant: the class binds to the variant's types."""
+    """Defined after mi.set_variant: the class binds to the variant's types. Returns it."""
 
     class Whitted(mi.SamplingIntegrator):
         def __init__(self, props):
@@ -107,21 +107,15 @@ def define_whitted():
             return L, mi.Bool(True), []
 
     mi.register_integrator("mirrorbox_whitted", lambda props: Whitted(props))
+    return Whitted
 
 
 def define_whitted_lean():
     """The contract as `Whitted` above, in fewer operations (the same image, checked by
     tests/mitsuba.rs): see the module's doc."""
 
-    class WhittedLean(mi.SamplingIntegrator):
-        def __init__(self, props):
-            super().__init__(props)
-            self.max_depth = props.get("max_depth", 10000)
-            self.min_throughput = props.get("min_throughput", 1e-4)
-            self.ambient = mi.Color3f(props.get("ambient_r", 0.0), props.get("ambient_g", 0.0), props.get("ambient_b", 0.0))
-            self.background = mi.Color3f(props.get("background_r", 0.0), props.get("background_g", 0.0), props.get("background_b", 0.0))
-            self.terminal = mi.Color3f(props.get("terminal_r", 0.0), props.get("terminal_g", 0.0), props.get("terminal_b", 0.0))
-
+    # The same settings as the general form (its __init__); only `sample` differs.
+    class WhittedLean(define_whitted()):
         @dr.syntax
         def sample(self, scene, sampler, ray, medium=None, active=True):
             ctx = mi.BSDFContext()
