@@ -408,10 +408,16 @@ impl PathTracer<'_> {
     }
 
     /// Radiance along `ray`, random numbers from `rng` (the sample's own stream), one query
-    /// at a time through the single-ray hierarchy.
-    fn radiance_one(&self, ray: Ray, rng: &mut SplitMix64) -> PathResult {
+    /// at a time through the single-ray hierarchy. `unblocked` holds a vertex's unblocked
+    /// shadow contributions until they are added (the caller's, kept from path to path: a
+    /// fresh one allocated for every path with a diffuse hit).
+    fn radiance_one(
+        &self,
+        ray: Ray,
+        rng: &mut SplitMix64,
+        unblocked: &mut Vec<Vec3>,
+    ) -> PathResult {
         let mut w = Walk::start(ray);
-        let mut unblocked: Vec<Vec3> = Vec::new();
         loop {
             let hit = self.bvh.closest_hit_skipping(
                 &w.ray,
@@ -426,7 +432,7 @@ impl PathTracer<'_> {
                     unblocked.push(s.contribution);
                 }
             });
-            for &c in &unblocked {
+            for &c in unblocked.iter() {
                 w.radiance += c;
                 w.rays += 1;
             }
@@ -624,7 +630,7 @@ impl Integrator for PathTracer<'_> {
     /// Radiance along `ray`: the sample's own stream is split off the pixel's `rng`
     /// ([`SplitMix64::split`]), as [`Integrator::radiance_all`] splits one per sample.
     fn radiance(&self, ray: Ray, rng: &mut SplitMix64) -> PathResult {
-        self.radiance_one(ray, &mut rng.split())
+        self.radiance_one(ray, &mut rng.split(), &mut Vec::new())
     }
 
     /// Enough pixels to fill a packet's lanes when packets are traced (at least one): every
@@ -644,10 +650,11 @@ impl Integrator for PathTracer<'_> {
             streams.extend((0..per_pixel).map(|_| rng.split()));
         }
         if !self.bvh.packets() {
+            let mut unblocked = Vec::new();
             out.extend(
                 rays.iter()
                     .zip(&mut streams)
-                    .map(|(&ray, rng)| self.radiance_one(ray, rng)),
+                    .map(|(&ray, rng)| self.radiance_one(ray, rng, &mut unblocked)),
             );
             return;
         }
