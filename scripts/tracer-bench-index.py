@@ -10,39 +10,47 @@ import json
 import os
 import sys
 
+# Per round, Mitsuba ÷ mirrorbox (issue 41); scripts/bench-tracer.sh reads them from here.
 GOALS = {"whitted": 3.0, "path": 2.0}
 SCENES = ["mirror_box", "mirror_room"]
-out = sys.argv[1] if len(sys.argv) > 1 else "reports/tracer"
-benches = []
-for path in sorted(glob.glob(os.path.join(out, "bench-*.json"))):
-    try:
-        b = json.load(open(path))
-    except (OSError, ValueError) as e:
-        sys.exit(f"{path}: not a bench record ({e})")
-    name = os.path.basename(path)[:-5] + ".md"
-    ratios = {(r.get("scene"), r.get("integrator")): r.get("speedup_vs_mitsuba_paired", [None])[0]
-              for r in b.get("results", [])}
-    # A record without a scene or integrator shows "–" there and cannot meet the goals.
-    cells = [f"{ratios[(s, i)]:.2f}×" if ratios.get((s, i)) is not None else "–"
-             for s in SCENES for i in ["whitted", "path"]]
-    met = all((ratios.get((s, i)) or 0) >= GOALS[i] for s in SCENES for i in ["whitted", "path"])
-    try:
-        body = open(os.path.join(out, name)).read().split("\n")
-        body = "\n".join(l for l in body if not l.startswith("# ")).strip()
-    except OSError:
-        body = f"(`{name}` is missing: only the record's ratios above.)"
-    benches.append((b, name, cells, met, body))
-lines = ["# The tracer against Mitsuba 3, per CPU", "",
-         "One record per CPU kind: `scripts/bench-tracer.sh` writes the one of the CPU it runs on, "
-         "and a result is a claim only on that CPU. Per round: the median of each round's Mitsuba ÷ "
-         "mirrorbox (above 1: mirrorbox faster). Goals (issue 41): `whitted` ≥ 3×, `path` ≥ 2× "
-         "Mitsuba's compiled kernel, on both scenes.", "",
-         "| CPU | vector width | date | commit | rounds | Mitsuba baseline | `mirror_box` whitted | `mirror_box` path | `mirror_room` whitted | `mirror_room` path | goals |",
-         "|---|---|---|---|---|---|---|---|---|---|---|"]
-for b, name, cells, met, _ in benches:
-    lines.append(f"| [{b.get('cpu', '?')}]({name}) | {b.get('simd', '?')} | {b.get('date', '?')} | {b.get('commit', '–')} | {b.get('rounds', '?')} | "
-                 f"{b.get('mitsuba_whitted', '–')} | " + " | ".join(cells) + f" | {'met' if met else 'not met'} |")
-for b, name, _, _, body in benches:
-    lines += ["", f"## {b.get('cpu', '?')} ({b.get('simd', '?')})", "", body]
-open(os.path.join(out, "bench.md"), "w").write("\n".join(lines) + "\n")
-json.dump([b for b, *_ in benches], open(os.path.join(out, "bench.json"), "w"), indent=2)
+
+
+def main():
+    out = sys.argv[1] if len(sys.argv) > 1 else "reports/tracer"
+    benches = []
+    for path in sorted(glob.glob(os.path.join(out, "bench-*.json"))):
+        try:
+            b = json.load(open(path))
+        except (OSError, ValueError) as e:
+            sys.exit(f"{path}: not a bench record ({e})")
+        name = os.path.basename(path)[:-5] + ".md"
+        ratios = {(r.get("scene"), r.get("integrator")): r.get("speedup_vs_mitsuba_paired", [None])[0]
+                  for r in b.get("results", [])}
+        # A record without a scene or integrator shows "–" there and cannot meet the goals.
+        cells = [f"{ratios[(s, i)]:.2f}×" if ratios.get((s, i)) is not None else "–"
+                 for s in SCENES for i in ["whitted", "path"]]
+        met = all((ratios.get((s, i)) or 0) >= GOALS[i] for s in SCENES for i in ["whitted", "path"])
+        try:
+            body = open(os.path.join(out, name)).read().split("\n")
+            body = "\n".join(l for l in body if not l.startswith("# ")).strip()
+        except OSError:
+            body = f"(`{name}` is missing: only the record's ratios above.)"
+        benches.append((b, name, cells, met, body))
+    lines = ["# The tracer against Mitsuba 3, per CPU", "",
+             "One record per CPU kind: `scripts/bench-tracer.sh` writes the one of the CPU it runs on, "
+             "and a result is a claim only on that CPU. Per round: the median of each round's Mitsuba ÷ "
+             "mirrorbox (above 1: mirrorbox faster). Goals (issue 41): `whitted` ≥ 3×, `path` ≥ 2× "
+             "Mitsuba's compiled kernel, on both scenes.", "",
+             "| CPU | vector width | date | commit | rounds | Mitsuba baseline | `mirror_box` whitted | `mirror_box` path | `mirror_room` whitted | `mirror_room` path | goals |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
+    for b, name, cells, met, _ in benches:
+        lines.append(f"| [{b.get('cpu', '?')}]({name}) | {b.get('simd', '?')} | {b.get('date', '?')} | {b.get('commit', '–')} | {b.get('rounds', '?')} | "
+                     f"{b.get('mitsuba_whitted', '–')} | " + " | ".join(cells) + f" | {'met' if met else 'not met'} |")
+    for b, name, _, _, body in benches:
+        lines += ["", f"## {b.get('cpu', '?')} ({b.get('simd', '?')})", "", body]
+    open(os.path.join(out, "bench.md"), "w").write("\n".join(lines) + "\n")
+    json.dump([b for b, *_ in benches], open(os.path.join(out, "bench.json"), "w"), indent=2)
+
+
+if __name__ == "__main__":
+    main()
