@@ -9,8 +9,7 @@
 //!
 //! The corpus tests are skipped, saying so, where the corpus is missing.
 
-use crate::methods::{settings, trace_depth};
-use mirrorbox_image::RgbImage;
+use crate::methods::{error_against, settings, trace_depth};
 use mirrorbox_raster::{Gpu, Method, render};
 use mirrorbox_scene::Scene;
 use mirrorbox_scene::load::parse_scene;
@@ -131,20 +130,6 @@ fn imported(rel: &str, w: u32, h: u32) -> Scene {
     parse_scene(&json, Path::new("imported.json")).unwrap_or_else(|e| panic!("{rel}: {e}"))
 }
 
-/// Pixels off by more than 1e-3 (largest channel), and FLIP.
-pub(crate) fn off_and_flip(image: &RgbImage, truth: &RgbImage) -> (usize, f64) {
-    let off = image
-        .pixels
-        .iter()
-        .zip(&truth.pixels)
-        .filter(|(p, q)| (0..3).any(|c| (p[c] - q[c]).abs() > 1e-3))
-        .count();
-    let flip = mirrorbox_image::metrics::compare(truth, image, 1.0)
-        .unwrap()
-        .flip_mean;
-    (off, flip)
-}
-
 #[test]
 fn every_gltf_of_the_corpus_loads_or_is_refused_naming_its_field() {
     if !corpus_present() {
@@ -216,7 +201,7 @@ fn every_real_gltf_traces_and_renders_with_every_method() {
     )
     .unwrap();
     let truth = trace_depth(&s, out.stats.depth as u32);
-    let (off, flip) = off_and_flip(&out.image, &truth);
+    let (off, flip) = error_against(&truth, &out.image);
     let n = truth.pixels.len();
     println!("2CylinderEngine unrolled depth 8 at 96×54: {off} of {n} pixels off, FLIP {flip:.2e}");
     assert!(
@@ -249,7 +234,7 @@ fn textured_scenes_agree_at_the_floor() {
         let bare = s.without_mirrors();
         let raster = render(&gpu, &bare, &settings(Method::parse("naive").unwrap(), 1)).unwrap();
         let truth = trace_depth(&bare, 1);
-        let (off, flip) = off_and_flip(&raster.image, &truth);
+        let (off, flip) = error_against(&truth, &raster.image);
         println!("{name} without mirrors: {off} pixels off by > 1e-3, FLIP {flip:.2e}");
         assert!(
             off * 1000 <= truth.pixels.len() && flip < 1e-4,
@@ -267,7 +252,7 @@ fn textured_scenes_agree_at_the_floor() {
                 Err(e) => panic!("{name} {key}: {e}"),
             };
             let truth = trace_depth(&s, 16);
-            let (off, flip) = off_and_flip(&out.image, &truth);
+            let (off, flip) = error_against(&truth, &out.image);
             println!("{name} {key}: {off} pixels off by > 1e-3, FLIP {flip:.2e}");
             assert!(
                 off * 200 <= truth.pixels.len() && flip < 1e-3,

@@ -937,8 +937,8 @@ fn copy_ids(image: &RgbImage) -> Vec<u32> {
     image.pixels.iter().map(|p| p[0].round() as u32).collect()
 }
 
-/// Pixels off the truth by more than 1e-3, and FLIP.
-fn error_against(truth: &RgbImage, image: &RgbImage) -> (usize, f64) {
+/// Pixels off the truth by more than 1e-3 (largest channel), and FLIP.
+pub(crate) fn error_against(truth: &RgbImage, image: &RgbImage) -> (usize, f64) {
     let off = differences(image, truth)
         .iter()
         .filter(|&&x| x > 1e-3)

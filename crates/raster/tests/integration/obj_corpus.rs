@@ -121,7 +121,7 @@ fn every_obj_of_the_corpus_loads_or_is_refused_with_its_reason() {
 
 #[test]
 fn every_obj_that_loads_traces_and_renders_as_the_truth() {
-    use crate::gltf_corpus::off_and_flip;
+    use crate::methods::error_against;
     use crate::methods::{settings, trace_depth};
     use mirrorbox_raster::{Gpu, Method, render};
     if !Path::new(CORPUS).join("OBJ").is_dir() {
@@ -144,7 +144,7 @@ fn every_obj_that_loads_traces_and_renders_as_the_truth() {
         let image = render(&gpu, &scene, &settings(method.clone(), 1))
             .unwrap()
             .image;
-        let (off, _) = off_and_flip(&image, &truth);
+        let (off, _) = error_against(&truth, &image);
         println!("{rel}: {off} of {} pixels off", truth.pixels.len());
         assert!(
             off * 50 <= truth.pixels.len(),
