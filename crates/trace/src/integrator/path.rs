@@ -645,20 +645,39 @@ impl Integrator for PathTracer<'_> {
     fn radiance_all(&self, rays: &[Ray], rngs: &mut [SplitMix64], out: &mut Vec<PathResult>) {
         out.clear();
         let per_pixel = super::rays_per_pixel(rays, rngs);
-        let mut streams: Vec<SplitMix64> = Vec::with_capacity(rays.len());
-        for rng in rngs.iter_mut() {
-            streams.extend((0..per_pixel).map(|_| rng.split()));
+        // Buffers kept per thread from call to call (a call is a few pixels).
+        thread_local! {
+            static SCRATCH: std::cell::RefCell<Scratch> = std::cell::RefCell::default();
         }
-        if !self.bvh.packets() {
-            let mut unblocked = Vec::new();
-            out.extend(
-                rays.iter()
-                    .zip(&mut streams)
-                    .map(|(&ray, rng)| self.radiance_one(ray, rng, &mut unblocked)),
-            );
-            return;
-        }
-        let mut asked = Vec::new();
-        self.radiance_lanes(rays, &mut streams, &mut asked, out);
+        SCRATCH.with_borrow_mut(
+            |Scratch {
+                 streams,
+                 asked,
+                 unblocked,
+             }| {
+                streams.clear();
+                for rng in rngs.iter_mut() {
+                    streams.extend((0..per_pixel).map(|_| rng.split()));
+                }
+                if self.bvh.packets() {
+                    self.radiance_lanes(rays, streams, asked, out);
+                } else {
+                    out.extend(
+                        rays.iter()
+                            .zip(streams.iter_mut())
+                            .map(|(&ray, rng)| self.radiance_one(ray, rng, unblocked)),
+                    );
+                }
+            },
+        );
     }
+}
+
+/// [`PathTracer`]'s buffers for one [`Integrator::radiance_all`] call: each sample's stream,
+/// the shadow rays a round asks for, a vertex's unblocked contributions.
+#[derive(Default)]
+struct Scratch {
+    streams: Vec<SplitMix64>,
+    asked: Vec<Asked>,
+    unblocked: Vec<Vec3>,
 }
