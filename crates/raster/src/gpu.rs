@@ -71,6 +71,8 @@ pub struct Gpu {
     errors: Arc<Mutex<Vec<String>>>,
     /// Shader modules compiled on this device, by source ([`Gpu::shader_module`]).
     modules: Mutex<std::collections::HashMap<(usize, bool), wgpu::ShaderModule>>,
+    /// Layouts and render pipelines made on this device ([`crate::state_cache`]).
+    pub states: crate::state_cache::StateCache,
 }
 
 /// wgpu's defaults, raised to what the adapter offers for image sizes and buffer sizes (the
@@ -201,6 +203,7 @@ impl Gpu {
             features,
             errors,
             modules: Mutex::default(),
+            states: Default::default(),
         })
     }
 
@@ -223,6 +226,26 @@ impl Gpu {
             .entry(key)
             .or_insert_with(|| crate::wgsl::shader_module(&self.device, shader, textured))
             .clone()
+    }
+
+    /// A bind-group layout as `desc` describes it, made once per device
+    /// ([`crate::state_cache`]).
+    pub fn bind_group_layout(
+        &self,
+        desc: &wgpu::BindGroupLayoutDescriptor,
+    ) -> wgpu::BindGroupLayout {
+        self.states.bind_group_layout(&self.device, desc)
+    }
+
+    /// A pipeline layout as `desc` describes it, made once per device.
+    pub fn pipeline_layout(&self, desc: &wgpu::PipelineLayoutDescriptor) -> wgpu::PipelineLayout {
+        self.states.pipeline_layout(&self.device, desc)
+    }
+
+    /// A render pipeline as `desc` describes it, compiled once per device: a frame built
+    /// again (a moved camera in `view`, the next point of a sweep) finds it.
+    pub fn render_pipeline(&self, desc: &wgpu::RenderPipelineDescriptor) -> wgpu::RenderPipeline {
+        self.states.render_pipeline(&self.device, desc)
     }
 
     /// Fails with the first error wgpu reported since the last check.

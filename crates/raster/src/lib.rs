@@ -40,6 +40,7 @@ pub mod resolve;
 pub mod shading;
 pub mod shadow_maps;
 pub mod shadow_plan;
+pub mod state_cache;
 pub mod stereo_mirrors;
 pub mod stereo_pair;
 pub mod symmetry_cells;

@@ -51,36 +51,35 @@ impl ScenePipeline<'_> {
         cull_mode: Option<wgpu::Face>,
         front_face: wgpu::FrontFace,
     ) -> wgpu::RenderPipeline {
-        gpu.device
-            .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(self.label),
-                layout: Some(self.layout),
-                vertex: wgpu::VertexState {
-                    module: self.module,
-                    entry_point: Some(self.vertex),
-                    compilation_options: Default::default(),
-                    buffers: self.buffers,
-                },
-                primitive: wgpu::PrimitiveState {
-                    cull_mode,
-                    front_face,
-                    ..Default::default()
-                },
-                depth_stencil: Some(self.depth_stencil.clone()),
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: self.module,
-                    entry_point: Some(self.fragment),
-                    compilation_options: Default::default(),
-                    targets: &[Some(wgpu::ColorTargetState {
-                        format: gpu.color_format.texture_format(),
-                        blend: None,
-                        write_mask: self.color_writes,
-                    })],
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
+        gpu.render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some(self.label),
+            layout: Some(self.layout),
+            vertex: wgpu::VertexState {
+                module: self.module,
+                entry_point: Some(self.vertex),
+                compilation_options: Default::default(),
+                buffers: self.buffers,
+            },
+            primitive: wgpu::PrimitiveState {
+                cull_mode,
+                front_face,
+                ..Default::default()
+            },
+            depth_stencil: Some(self.depth_stencil.clone()),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: self.module,
+                entry_point: Some(self.fragment),
+                compilation_options: Default::default(),
+                targets: &[Some(wgpu::ColorTargetState {
+                    format: gpu.color_format.texture_format(),
+                    blend: None,
+                    write_mask: self.color_writes,
+                })],
+            }),
+            multiview_mask: None,
+            cache: None,
+        })
     }
 }
 
@@ -100,14 +99,14 @@ pub fn depth_state(
     }
 }
 
-/// A labelled pipeline layout over `groups` (bind groups 0, 1, …).
+/// A labelled pipeline layout over `groups` (bind groups 0, 1, …), made once per device.
 pub fn pipeline_layout(
-    device: &wgpu::Device,
+    gpu: &Gpu,
     label: &str,
     groups: &[&wgpu::BindGroupLayout],
 ) -> wgpu::PipelineLayout {
     let groups: Vec<Option<&wgpu::BindGroupLayout>> = groups.iter().map(|g| Some(*g)).collect();
-    device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+    gpu.pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(label),
         bind_group_layouts: &groups,
         immediate_size: 0,

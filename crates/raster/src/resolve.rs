@@ -18,7 +18,7 @@ impl Resolve {
         use wgpu::util::DeviceExt;
         let device = &gpu.device;
         let module = gpu.shader_module(&crate::wgsl::RESOLVE, false);
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        let layout = gpu.bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("resolve"),
             entries: &[
                 wgpu::BindGroupLayoutEntry {
@@ -53,12 +53,12 @@ impl Resolve {
                 },
             ],
         });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        let pipeline_layout = gpu.pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("resolve"),
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        let pipeline = gpu.render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("resolve"),
             layout: Some(&pipeline_layout),
             vertex: wgpu::VertexState {

@@ -674,7 +674,7 @@ impl SceneBuffers {
             has_dynamic_offset: false,
             min_binding_size: None,
         };
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        let layout = gpu.bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("scene"),
             entries: &[
                 entry(

@@ -145,7 +145,7 @@ impl ShadowMaps {
         let mut arena = UniformArena::new(device);
         let offsets = plan.views.iter().map(|v| arena.push(v)).collect();
         let uniforms = arena.buffer(device, "shadow views");
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        let layout = gpu.bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("shadow view"),
             entries: &[dynamic_uniform_entry(
                 0,
@@ -161,8 +161,8 @@ impl ShadowMaps {
             }],
         });
         let module = gpu.shader_module(&SHADER, false);
-        let pipeline_layout = pipeline_layout(device, "shadow map", &[&layout]);
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        let pipeline_layout = pipeline_layout(gpu, "shadow map", &[&layout]);
+        let pipeline = gpu.render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("shadow map"),
             layout: Some(&pipeline_layout),
             vertex: wgpu::VertexState {

@@ -302,7 +302,7 @@ impl PortalStencil {
             offsets.push(arena.push(&u));
         }
         let uniforms = arena.buffer(device, "portal paths");
-        let path_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        let path_layout = gpu.bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("portal path"),
             entries: &[dynamic_uniform_entry(
                 0,
@@ -317,7 +317,7 @@ impl PortalStencil {
                 resource: record_binding::<PathUniform>(&uniforms),
             }],
         });
-        let layout = pipeline_layout(device, "portal", &[&scene_buffers.layout, &path_layout]);
+        let layout = pipeline_layout(gpu, "portal", &[&scene_buffers.layout, &path_layout]);
         let clipping = Clipping::for_features(gpu.features);
         let depth_format = depth_stencil_format(gpu.features);
         let shader = gpu.shader_module(

@@ -413,7 +413,7 @@ impl RayQueryFrame {
             ty,
             count: None,
         };
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        let layout = gpu.bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("ray query"),
             entries: &[
                 entry(
@@ -458,8 +458,7 @@ impl RayQueryFrame {
                 },
             ],
         });
-        let pipeline_layout =
-            pipeline_layout(device, "ray query", &[&scene_buffers.layout, &layout]);
+        let pipeline_layout = pipeline_layout(gpu, "ray query", &[&scene_buffers.layout, &layout]);
         let module = gpu.shader_module(&SHADER, scene_buffers.textured);
         let scene_pipeline = |label, vertex, fragment, write, compare, colour| {
             let buffers: &[Option<wgpu::VertexBufferLayout>] = if vertex == "vs_main" {

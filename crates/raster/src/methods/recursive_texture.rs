@@ -1009,13 +1009,12 @@ impl TexturePipelines {
         shaders: [&'static crate::wgsl::WgslSource; 2],
         mirror_entries: &[wgpu::BindGroupLayoutEntry],
     ) -> Self {
-        let device = &gpu.device;
         let stages = wgpu::ShaderStages::VERTEX_FRAGMENT;
-        let pass_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        let pass_layout = gpu.bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("pass"),
             entries: &[dynamic_uniform_entry(0, stages)],
         });
-        let mirror_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        let mirror_layout = gpu.bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("mirror"),
             entries: mirror_entries,
         });
@@ -1051,13 +1050,13 @@ impl TexturePipelines {
         };
         let objects = pipeline(
             "texture pass objects",
-            &pipeline_layout(device, "texture pass objects", &[sl, &pass_layout]),
+            &pipeline_layout(gpu, "texture pass objects", &[sl, &pass_layout]),
             fs_object,
         );
         let mirrors = pipeline(
             "texture pass mirrors",
             &pipeline_layout(
-                device,
+                gpu,
                 "texture pass mirrors",
                 &[sl, &pass_layout, &mirror_layout],
             ),

@@ -342,7 +342,7 @@ impl SsrFrame {
             },
             count: None,
         };
-        let base_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        let base_layout = gpu.bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("ssr scene pass"),
             entries: &[uniform],
         });
@@ -398,12 +398,12 @@ impl SsrFrame {
         let pyramid_levels: Vec<wgpu::TextureView> = (0..levels).map(level_view).collect();
         let module = gpu.shader_module(&SHADER, scene_buffers.textured);
         let base_layout_all = pipeline_layout(
-            device,
+            gpu,
             "ssr scene pass",
             &[&scene_buffers.layout, &base_layout],
         );
         // Two targets: the colour (mirror marks in alpha) and the pyramid's level 0.
-        let base_pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        let base_pipeline = gpu.render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("ssr scene pass"),
             layout: Some(&base_layout_all),
             vertex: wgpu::VertexState {
@@ -430,7 +430,7 @@ impl SsrFrame {
         // The pyramid: level 0 written by the scene pass, each next level reduced from the last.
         let pyramid_module = gpu.shader_module(&PYRAMID_SHADER, false);
         let fullscreen = |label: &str, fragment: &str| {
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            gpu.render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some(label),
                 layout: None,
                 vertex: wgpu::VertexState {
@@ -466,7 +466,7 @@ impl SsrFrame {
             })
             .collect();
         let whole_pyramid = pyramid.create_view(&Default::default());
-        let reflect_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        let reflect_layout = gpu.bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("ssr reflect"),
             entries: &[
                 uniform,
@@ -512,7 +512,7 @@ impl SsrFrame {
         let reflect_pipeline = ScenePipeline {
             label: "ssr reflect",
             layout: &pipeline_layout(
-                device,
+                gpu,
                 "ssr reflect",
                 &[&scene_buffers.layout, &reflect_layout],
             ),

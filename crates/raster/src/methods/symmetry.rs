@@ -543,9 +543,9 @@ pub(crate) fn copy_id_warning(gpu: &Gpu, copy_ids: bool, copies: usize) -> Optio
 
 /// The symmetry methods' bind group layout: the frame (binding 0), the masks (1) and a copy
 /// record at a dynamic offset (2).
-fn copies_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+fn copies_layout(gpu: &Gpu) -> wgpu::BindGroupLayout {
     let visibility = wgpu::ShaderStages::VERTEX_FRAGMENT;
-    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+    gpu.bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("symmetry"),
         entries: &[
             uniform_entry(0),
@@ -643,7 +643,7 @@ impl CopiesFrame {
             vec![arena.push(&CopyRecord::zeroed())]
         };
         let records = arena.buffer(device, "symmetry copy records");
-        let layout = copies_layout(device);
+        let layout = copies_layout(gpu);
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("symmetry"),
             layout: &layout,
@@ -662,8 +662,7 @@ impl CopiesFrame {
                 },
             ],
         });
-        let pipeline_layout =
-            pipeline_layout(device, "symmetry", &[&scene_buffers.layout, &layout]);
+        let pipeline_layout = pipeline_layout(gpu, "symmetry", &[&scene_buffers.layout, &layout]);
         let module = gpu.shader_module(
             if clip_distances {
                 &CLIP_DISTANCE_SHADER

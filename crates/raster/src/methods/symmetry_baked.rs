@@ -198,7 +198,7 @@ impl BakedFrame {
             contents: bytemuck::bytes_of(&planned.frame),
             usage: wgpu::BufferUsages::UNIFORM,
         });
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        let layout = gpu.bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("symmetry-baked"),
             entries: &[uniform_entry(0)],
         });
@@ -222,7 +222,7 @@ impl BakedFrame {
             })
         });
         let pipeline_layout =
-            pipeline_layout(device, "symmetry-baked", &[&scene_buffers.layout, &layout]);
+            pipeline_layout(gpu, "symmetry-baked", &[&scene_buffers.layout, &layout]);
         let module = gpu.shader_module(&SHADER, scene_buffers.textured);
         const COPY_ID_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
             array_stride: 4,

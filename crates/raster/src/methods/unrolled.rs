@@ -512,7 +512,7 @@ impl Unrolled {
                 count: None,
             })
             .collect();
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        let layout = gpu.bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("unrolled"),
             entries: &entries,
         });
@@ -528,7 +528,7 @@ impl Unrolled {
                 })
                 .collect::<Vec<_>>(),
         });
-        let layout = pipeline_layout(device, "unrolled", &[&scene_buffers.layout, &layout]);
+        let layout = pipeline_layout(gpu, "unrolled", &[&scene_buffers.layout, &layout]);
         let guarded_module = gpu.shader_module(&GUARDED_SHADER, scene_buffers.textured);
         let clipped_module = clip_distances
             .then(|| gpu.shader_module(&CLIP_DISTANCE_SHADER, scene_buffers.textured));
