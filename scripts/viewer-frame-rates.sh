@@ -54,7 +54,7 @@ for path in sorted(glob.glob(f"{work}/*.jsonl")):
     moving = [r for r in recs if r["frame"] > 35 and (r.get("build_ms") or 0) > 0]
     d = rows.setdefault(method, {"key": recs[-1]["method"], "still_gpu": [], "still_wall": [], "move_wall": [], "move_build": [], "still_draw": [], "still_paint": [], "passes": recs[-1]["passes"]})
     d["still_gpu"] += [r["gpu_ms"] for r in still]
-    d["still_draw"] += [r["phases_ms"]["draw_and_read_back"] for r in still]
+    d["still_draw"] += [r["phases_ms"]["draw"] for r in still]
     d["still_paint"] += [r["phases_ms"]["paint_present"] for r in still]
     d["still_wall"] += [r["wall_ms"] for r in still]
     d["move_wall"] += [r["wall_ms"] for r in moving]

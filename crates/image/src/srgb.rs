@@ -34,6 +34,45 @@ pub fn decode8(v: u8) -> f32 {
     decode(v as f32 / 255.0)
 }
 
+/// The table that lets a GPU write [`encode8`]'s bytes without its `pow`: entry `k`
+/// (1…255) is the smallest `f32` that `encode8` maps to `k` or above (entry 0 is unused,
+/// 0). `encode8` is monotone, so `encode8(v)` is the number of entries `k ≥ 1` with
+/// `v ≥ table[k]` ([`encode8_by_thresholds`]; NaN compares false with all: 0). Found by
+/// bisecting the bit patterns of [0, 1], which order as the values do.
+pub fn encode8_thresholds() -> [f32; 256] {
+    let mut table = [0.0f32; 256];
+    let one = 1.0f32.to_bits();
+    for (k, entry) in table.iter_mut().enumerate().skip(1) {
+        // Smallest bit pattern in [0, one] whose byte is ≥ k (encode8(1.0) = 255).
+        let (mut lo, mut hi) = (0u32, one);
+        while lo < hi {
+            let mid = lo + (hi - lo) / 2;
+            if usize::from(encode8(f32::from_bits(mid))) >= k {
+                hi = mid;
+            } else {
+                lo = mid + 1;
+            }
+        }
+        *entry = f32::from_bits(lo);
+    }
+    table
+}
+
+/// [`encode8`] by the table of [`encode8_thresholds`], searched as
+/// `shaders/display_tone_map.wgsl` does: 8 halving steps.
+pub fn encode8_by_thresholds(v: f32, table: &[f32; 256]) -> u8 {
+    let mut k = 0usize;
+    let mut step = 128;
+    while step > 0 {
+        let next = k + step;
+        if next <= 255 && v >= table[next] {
+            k = next;
+        }
+        step >>= 1;
+    }
+    k as u8
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -51,6 +90,59 @@ mod tests {
         // The two pieces meet at the breakpoint.
         let b = 0.003_130_8f32;
         assert!((12.92 * b - (1.055 * b.powf(1.0 / 2.4) - 0.055)).abs() < 1e-6);
+    }
+
+    /// The table gives encode8's byte: at every threshold and the 2¹⁶ floats on each side
+    /// of it (the only places a byte changes, far wider than `powf`'s error of an ulp or
+    /// two could wiggle), across [0, 1] on a grid, and for what lies outside.
+    #[test]
+    fn thresholds_give_encode8s_bytes() {
+        let table = encode8_thresholds();
+        for k in 1..=255usize {
+            let t = table[k];
+            assert!(usize::from(encode8(t)) >= k, "t_{k} = {t}");
+            assert!(usize::from(encode8(f32::from_bits(t.to_bits() - 1))) < k);
+            assert!(table[k - 1] <= t, "the table is sorted at {k}");
+            for d in -(1i64 << 16)..=(1 << 16) {
+                let bits = i64::from(t.to_bits()) + d;
+                let v = f32::from_bits(bits as u32);
+                assert_eq!(encode8_by_thresholds(v, &table), encode8(v), "{v:e}");
+            }
+        }
+        let specials = [
+            f32::NAN,
+            -f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            -0.0,
+            0.0,
+        ];
+        let outside = [
+            -1.0,
+            -1e-30,
+            1.0,
+            1.000_001,
+            7.5,
+            f32::MAX,
+            f32::MIN_POSITIVE,
+            1e-40,
+        ];
+        let grid = (0..=1_000_000).map(|i| i as f32 / 1_000_000.0);
+        for v in specials.into_iter().chain(outside).chain(grid) {
+            assert_eq!(encode8_by_thresholds(v, &table), encode8(v), "{v:e}");
+        }
+    }
+
+    /// Every f32 in [0, 1] (1.07·10⁹ of them, ~5 s in release): run with `--ignored` after
+    /// changing `encode`. Passed on 2026-11-26 (glibc's powf, x86-64).
+    #[test]
+    #[ignore]
+    fn thresholds_give_encode8s_bytes_for_every_f32_in_0_1() {
+        let table = encode8_thresholds();
+        for bits in 0..=1.0f32.to_bits() {
+            let v = f32::from_bits(bits);
+            assert_eq!(encode8_by_thresholds(v, &table), encode8(v), "{v:e}");
+        }
     }
 
     #[test]

@@ -23,6 +23,7 @@ pub mod adapter;
 pub mod camera_rays;
 pub mod color_format;
 pub mod culling;
+pub mod display_tone_map;
 pub mod exact_paths;
 pub mod gpu;
 pub mod lighting;
@@ -370,11 +371,14 @@ pub(crate) fn add_shadow_maps(
 
 /// A frame built on the device, ready to be drawn any number of times: what `render` times
 /// once, and what `mirrorbox view` draws every frame while the view stays the same (a
-/// method's uniforms hold the camera, so a moved camera needs a new one).
+/// method's uniforms hold the camera: a moved camera builds a frame again, with
+/// [`build_planned_reusing`], from the device's cached pipelines and the previous frame's
+/// targets).
 pub struct BuiltView {
     target: targets::RenderTarget,
     resolve: resolve::Resolve,
     encoder: Box<dyn timing::FrameEncoder>,
+    queries: Option<timing::FrameQueries>,
     pub stats: FrameStats,
     pub warnings: Vec<String>,
     pub bake_ms: Option<f64>,
@@ -396,6 +400,40 @@ impl BuiltView {
             warmup,
             frames,
         )
+    }
+
+    /// Draws one frame and waits for it, without reading the image back: `after` adds its
+    /// commands to the frame's submission (the viewer's tone map of [`BuiltView::output`]
+    /// into its pane). Returns the frame's milliseconds and how they were measured.
+    pub fn draw(
+        &self,
+        gpu: &Gpu,
+        after: &dyn Fn(&mut wgpu::CommandEncoder),
+    ) -> Result<(f64, TimingSource), RasterError> {
+        let encode =
+            |encoder: &mut wgpu::CommandEncoder,
+             first_pass: Option<wgpu::RenderPassTimestampWrites<'_>>| {
+                self.encoder.encode(encoder, &self.target, first_pass)
+            };
+        let (ms, _) =
+            timing::submit_frame(gpu, self.queries.as_ref(), &encode, &[&self.resolve], after)?;
+        let source = if self.queries.is_some() {
+            TimingSource::GpuTimestamps
+        } else {
+            TimingSource::WallClock
+        };
+        Ok((ms, source))
+    }
+
+    /// The linear image of the frame last drawn (the values `render` writes), read back.
+    pub fn read_image(&self, gpu: &Gpu) -> Result<RgbImage, RasterError> {
+        readback::read_texture(gpu, &self.resolve.output)
+    }
+
+    /// The texture the frame's image is resolved into (the image's size, the device's colour
+    /// format), readable by a shader.
+    pub fn output(&self) -> &wgpu::Texture {
+        &self.resolve.output
     }
 
     /// Commits the frame last drawn as the state of a stateful method (`feedback`): the next
@@ -427,11 +465,35 @@ pub fn build_planned(
     planned: Planned,
     settings: &RenderSettings,
 ) -> Result<BuiltView, RasterError> {
+    build_planned_reusing(gpu, scene, planned, settings, None)
+}
+
+/// [`build_planned`] in place of `previous` (the viewer's frame before the camera moved or
+/// a setting changed): its render target, resolve and timestamp queries are kept where the
+/// render size and SSAA factor are the same, so only what the plan changes is made again
+/// (the pipelines come from the device's cache, [`state_cache`]).
+pub fn build_planned_reusing(
+    gpu: &Gpu,
+    scene: &Scene,
+    planned: Planned,
+    settings: &RenderSettings,
+    previous: Option<BuiltView>,
+) -> Result<BuiltView, RasterError> {
     let scene = &*lighting::lit_scene(scene, settings.method.params());
     let (w, h) = check_planned_frame(gpu, scene, settings, &planned.key, planned.size)?;
-    let target =
-        targets::RenderTarget::new(gpu, "view", w, h, wgpu::TextureUsages::TEXTURE_BINDING);
-    let resolve = resolve::Resolve::new(gpu, &target, settings.ssaa);
+    let kept = previous.and_then(|p| {
+        (p.target.width == w && p.target.height == h && p.resolve.factor == settings.ssaa)
+            .then_some((p.target, p.resolve, p.queries))
+    });
+    let (target, resolve, queries) = match kept {
+        Some(kept) => kept,
+        None => {
+            let target =
+                targets::RenderTarget::new(gpu, "view", w, h, wgpu::TextureUsages::TEXTURE_BINDING);
+            let resolve = resolve::Resolve::new(gpu, &target, settings.ssaa);
+            (target, resolve, timing::FrameQueries::new(gpu))
+        }
+    };
     let shadows = shadow_maps::ShadowMaps::new(gpu, scene, planned.shadows)?;
     let mut built = planned.frame.build(gpu, scene, &shadows)?;
     add_shadow_maps(
@@ -453,6 +515,7 @@ pub fn build_planned(
         target,
         resolve,
         encoder: built.encoder,
+        queries,
         stats: built.stats,
         warnings: built.warnings,
         bake_ms: built.bake_ms,

@@ -10,6 +10,8 @@ pub struct Resolve {
     bind_group: wgpu::BindGroup,
     pub output: wgpu::Texture,
     output_view: wgpu::TextureView,
+    /// The SSAA factor it filters by.
+    pub factor: u32,
 }
 
 impl Resolve {
@@ -90,7 +92,10 @@ impl Resolve {
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
             format: gpu.color_format.texture_format(),
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            // Read back (`render`), or read by the display tone map (`view`).
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::COPY_SRC
+                | wgpu::TextureUsages::TEXTURE_BINDING,
             view_formats: &[],
         });
         Resolve {
@@ -98,6 +103,7 @@ impl Resolve {
             bind_group,
             output_view: output.create_view(&Default::default()),
             output,
+            factor,
         }
     }
 

@@ -137,6 +137,92 @@ pub fn run_frames(
     Ok((images.remove(0), timing))
 }
 
+/// A frame's two timestamps (the start of its first pass, the end of its last resolve) and
+/// the buffers they are read through; `None` on a device without timestamps.
+pub struct FrameQueries {
+    set: wgpu::QuerySet,
+    resolved: wgpu::Buffer,
+    read: wgpu::Buffer,
+}
+
+impl FrameQueries {
+    pub fn new(gpu: &Gpu) -> Option<FrameQueries> {
+        let device = &gpu.device;
+        gpu.timestamps.then(|| FrameQueries {
+            set: device.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some("frame"),
+                ty: wgpu::QueryType::Timestamp,
+                count: 2,
+            }),
+            resolved: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("timestamps"),
+                size: 16,
+                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            }),
+            read: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("timestamps read"),
+                size: 16,
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+        })
+    }
+
+    fn writes(&self, index: u32) -> wgpu::RenderPassTimestampWrites<'_> {
+        wgpu::RenderPassTimestampWrites {
+            query_set: &self.set,
+            beginning_of_pass_write_index: (index == 0).then_some(0),
+            end_of_pass_write_index: (index == 1).then_some(1),
+        }
+    }
+}
+
+/// Encodes one frame — `encode`'s passes, each of `resolves`, then `after` (the viewer's
+/// tone map into its pane) — submits it and waits for it. Returns its milliseconds (GPU
+/// timestamps from the first pass to the end of the last resolve, or the wall time of
+/// submit-to-done without them) and the CPU milliseconds of encoding and submitting it.
+pub fn submit_frame(
+    gpu: &Gpu,
+    queries: Option<&FrameQueries>,
+    encode: &EncodeFrame<'_>,
+    resolves: &[&Resolve],
+    after: &dyn Fn(&mut wgpu::CommandEncoder),
+) -> Result<(f64, f64), RasterError> {
+    let encoding = Instant::now();
+    let mut encoder = gpu
+        .device
+        .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("frame"),
+        });
+    encode(&mut encoder, queries.map(|q| q.writes(0)));
+    let (last, others) = resolves.split_last().expect("a frame resolves a view");
+    for resolve in others {
+        resolve.encode(&mut encoder, None);
+    }
+    last.encode(&mut encoder, queries.map(|q| q.writes(1)));
+    if let Some(q) = queries {
+        encoder.resolve_query_set(&q.set, 0..2, &q.resolved, 0);
+        encoder.copy_buffer_to_buffer(&q.resolved, 0, &q.read, 0, 16);
+    }
+    after(&mut encoder);
+    let started = Instant::now();
+    gpu.queue.submit([encoder.finish()]);
+    let encoded_ms = encoding.elapsed().as_secs_f64() * 1e3;
+    gpu.wait()?;
+    let wall_ms = started.elapsed().as_secs_f64() * 1e3;
+    gpu.check()?;
+    let ms = match queries {
+        Some(q) => {
+            let ticks: Vec<u64> = map_read(gpu, &q.read)?;
+            let period_ns = f64::from(gpu.queue.get_timestamp_period());
+            ticks[1].wrapping_sub(ticks[0]) as f64 * period_ns / 1e6
+        }
+        None => wall_ms,
+    };
+    Ok((ms, encoded_ms))
+}
+
 /// What a frame draws before its resolves: its scene passes, the first one carrying the
 /// timestamp write it is given.
 pub type EncodeFrame<'a> =
@@ -152,72 +238,11 @@ pub fn run_frames_of(
     warmup: u32,
     frames: u32,
 ) -> Result<(Vec<RgbImage>, FrameTiming), RasterError> {
-    let device = &gpu.device;
-    let queries = gpu.timestamps.then(|| {
-        let set = device.create_query_set(&wgpu::QuerySetDescriptor {
-            label: Some("frame"),
-            ty: wgpu::QueryType::Timestamp,
-            count: 2,
-        });
-        let resolved = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("timestamps"),
-            size: 16,
-            usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
-        let read = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("timestamps read"),
-            size: 16,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        (set, resolved, read)
-    });
-    let period_ns = gpu.queue.get_timestamp_period() as f64;
+    let queries = FrameQueries::new(gpu);
     let mut frames_ms = Vec::with_capacity(frames as usize);
     let mut encode_ms = Vec::with_capacity(frames as usize);
     for frame in 0..warmup + frames.max(1) {
-        let encoding = Instant::now();
-        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("frame"),
-        });
-        let begin = queries
-            .as_ref()
-            .map(|(set, _, _)| wgpu::RenderPassTimestampWrites {
-                query_set: set,
-                beginning_of_pass_write_index: Some(0),
-                end_of_pass_write_index: None,
-            });
-        encode(&mut encoder, begin);
-        let (last, others) = resolves.split_last().expect("a frame resolves a view");
-        for resolve in others {
-            resolve.encode(&mut encoder, None);
-        }
-        let end = queries
-            .as_ref()
-            .map(|(set, _, _)| wgpu::RenderPassTimestampWrites {
-                query_set: set,
-                beginning_of_pass_write_index: None,
-                end_of_pass_write_index: Some(1),
-            });
-        last.encode(&mut encoder, end);
-        if let Some((set, resolved, read)) = &queries {
-            encoder.resolve_query_set(set, 0..2, resolved, 0);
-            encoder.copy_buffer_to_buffer(resolved, 0, read, 0, 16);
-        }
-        let started = Instant::now();
-        gpu.queue.submit([encoder.finish()]);
-        let encoded_ms = encoding.elapsed().as_secs_f64() * 1e3;
-        gpu.wait()?;
-        let wall_ms = started.elapsed().as_secs_f64() * 1e3;
-        gpu.check()?;
-        let ms = match &queries {
-            Some((_, _, read)) => {
-                let ticks: Vec<u64> = map_read(gpu, read)?;
-                ticks[1].wrapping_sub(ticks[0]) as f64 * period_ns / 1e6
-            }
-            None => wall_ms,
-        };
+        let (ms, encoded_ms) = submit_frame(gpu, queries.as_ref(), encode, resolves, &|_| {})?;
         if frame >= warmup {
             frames_ms.push(ms);
             encode_ms.push(encoded_ms);

@@ -145,6 +145,7 @@ mod tests {
         let mut all = vec![
             ("resolve", &RESOLVE),
             ("shadow maps", &crate::shadow_maps::SHADER),
+            ("display tone map", &crate::display_tone_map::SHADER),
         ];
         for e in METHODS {
             assert!(!e.shaders.is_empty(), "{} lists no shader", e.name);
@@ -225,6 +226,11 @@ mod tests {
             crate::shadow_maps::gpu_structs()
                 .into_iter()
                 .map(|l| (l, vec![&crate::shadow_maps::SHADER])),
+        );
+        layouts.extend(
+            crate::display_tone_map::gpu_structs()
+                .into_iter()
+                .map(|l| (l, vec![&crate::display_tone_map::SHADER])),
         );
         for e in METHODS {
             layouts.extend(

@@ -454,9 +454,22 @@ impl App {
             self.log.remove(0);
         }
         if let Some((path, target)) = capture {
-            let result = target.read(&r.gpu).and_then(|pixels| {
-                screenshot::save(&path, &pixels, &r.session, &panes, &self.options)
-            });
+            // The method's linear image, read back at the screenshot's pace.
+            let result = r
+                .session
+                .method_image(&r.gpu)
+                .map_err(|e| e.to_string())
+                .and_then(|image| {
+                    let pixels = target.read(&r.gpu)?;
+                    screenshot::save(
+                        &path,
+                        &pixels,
+                        &r.session,
+                        image.as_deref(),
+                        &panes,
+                        &self.options,
+                    )
+                });
             if let Err(e) = result {
                 self.fail(event_loop, ViewError::Failed(e));
                 return;

@@ -155,7 +155,7 @@ pub fn frame_record(
         "panes": panes_json(panes),
         "phases_ms": {
             "build": phases.update.build,
-            "draw_and_read_back": phases.update.draw,
+            "draw": phases.update.draw,
             "panes": phases.update.panes,
             "ui": phases.ui,
             "acquire": phases.acquire,
@@ -170,16 +170,17 @@ pub fn save(
     path: &Path,
     (w, h, rgb): &(u32, u32, Vec<u8>),
     session: &Session,
+    method_image: Option<&mirrorbox_image::RgbImage>,
     panes: &[(&'static str, [u32; 4])],
     options: &ViewOptions,
 ) -> Result<(), String> {
     let err = |e: mirrorbox_image::ImageError| format!("{}: {e}", path.display());
     mirrorbox_image::write_png_bytes(path, *w, *h, rgb).map_err(err)?;
     let camera = session.view_camera();
-    if let Some(frame) = &session.frame {
+    if let Some(image) = method_image {
         mirrorbox_image::write_exr(
             &with_suffix(path, ".method.exr"),
-            &frame.image,
+            image,
             &[("mirrorbox.method", session.method.key())],
         )
         .map_err(err)?;

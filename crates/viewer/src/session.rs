@@ -6,6 +6,7 @@ use crate::error_view::{ErrorImage, ErrorMode, error_image};
 use crate::fly_camera::FlyCamera;
 use crate::live_truth::{LiveTruth, TruthDevice, TruthLevel, TruthRequest, level_count};
 use mirrorbox_image::RgbImage;
+use mirrorbox_raster::display_tone_map::{DisplayToneMap, ToneMapSource};
 use mirrorbox_raster::{BuiltView, FrameStats, Gpu, Method, RasterError, RenderSettings};
 use mirrorbox_scene::{Camera, Scene};
 use std::collections::VecDeque;
@@ -32,7 +33,7 @@ impl PaneTexture {
             label,
             size.0,
             size.1,
-            wgpu::TextureFormat::Rgba8Unorm,
+            mirrorbox_raster::display_tone_map::PANE_FORMAT,
             wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
         );
         PaneTexture {
@@ -43,16 +44,15 @@ impl PaneTexture {
         }
     }
 
-    /// Writes RGB 8-bit sRGB bytes of `size` into the texture, recreating it (and its egui
-    /// registration) when the size changed.
-    pub fn upload(
-        slot: &mut Option<PaneTexture>,
+    /// The texture of `size` in `slot`, made (and registered with egui) when there is none
+    /// of that size.
+    pub fn ensure<'a>(
+        slot: &'a mut Option<PaneTexture>,
         gpu: &Gpu,
         renderer: &mut egui_wgpu::Renderer,
         label: &str,
         size: (u32, u32),
-        rgb: &[u8],
-    ) {
+    ) -> &'a PaneTexture {
         if slot.as_ref().map(|t| t.size) != Some(size) {
             if let Some(old) = slot.take().and_then(|t| t.id) {
                 renderer.free_texture(&old);
@@ -62,7 +62,20 @@ impl PaneTexture {
             t.id = Some(renderer.register_native_texture(&gpu.device, &view, t.filter));
             *slot = Some(t);
         }
-        let t = slot.as_ref().expect("texture just made");
+        slot.as_ref().expect("texture just made")
+    }
+
+    /// Writes RGB 8-bit sRGB bytes of `size` into the texture (the truth's and the error's
+    /// panes, images of the CPU), recreating it when the size changed.
+    pub fn upload(
+        slot: &mut Option<PaneTexture>,
+        gpu: &Gpu,
+        renderer: &mut egui_wgpu::Renderer,
+        label: &str,
+        size: (u32, u32),
+        rgb: &[u8],
+    ) {
+        let t = PaneTexture::ensure(slot, gpu, renderer, label, size);
         let rgba: Vec<u8> = rgb
             .chunks_exact(3)
             .flat_map(|p| [p[0], p[1], p[2], 255])
@@ -107,7 +120,10 @@ impl PaneTexture {
 
 /// The method's last frame.
 pub struct MethodFrame {
-    pub image: Arc<RgbImage>,
+    /// Its linear image, read back from the GPU when first asked for
+    /// ([`Session::method_image`]: the error view, a screenshot); the pane shows the frame
+    /// tone-mapped on the GPU without it.
+    image: std::cell::OnceCell<Arc<RgbImage>>,
     pub stats: FrameStats,
     /// GPU milliseconds of the frame (timestamps), or the CPU wall time of submit-to-done
     /// where the adapter has no timestamps.
@@ -136,9 +152,10 @@ pub struct FrameTime {
 pub struct UpdatePhases {
     /// Planning and building the method's frame (0 while the view stays).
     pub build: f64,
-    /// Drawing the frame and reading the image back.
+    /// Drawing the frame and tone-mapping it into its pane, on the GPU, waiting for both.
     pub draw: f64,
-    /// Tone mapping and uploading the panes, the truth's and the error's included.
+    /// Tone mapping and uploading the truth's and the error's panes (images of the CPU,
+    /// when they change), the method's image read back when the error view needs it.
     pub panes: f64,
 }
 
@@ -181,6 +198,9 @@ pub struct Session {
     pub method_texture: Option<PaneTexture>,
     pub truth_texture: Option<PaneTexture>,
     pub error_texture: Option<PaneTexture>,
+    /// The GPU tone map into the method's pane (made at the first frame) and its binding
+    /// of the current frame's image.
+    tone_map: Option<(DisplayToneMap, Option<ToneMapSource>)>,
 }
 
 impl Session {
@@ -219,6 +239,7 @@ impl Session {
             method_texture: None,
             truth_texture: None,
             error_texture: None,
+            tone_map: None,
         }
     }
 
@@ -269,6 +290,8 @@ impl Session {
             // A stateful method (`feedback`) continues from the frame drawn last, as in an
             // engine: a moved camera reads the textures of where it was.
             let history = self.built.as_ref().and_then(|b| b.view.history());
+            // The frame being replaced: its targets serve the new one where sizes agree.
+            let previous = self.built.take().map(|b| b.view);
             let budget = self.memory_budget;
             match mirrorbox_raster::plan_frame(scene, &settings)
                 .and_then(|mut planned| {
@@ -279,8 +302,11 @@ impl Session {
                     Ok(planned)
                 })
                 .map_err(RasterError::from)
-                .and_then(|planned| mirrorbox_raster::build_planned(gpu, scene, planned, &settings))
-            {
+                .and_then(|planned| {
+                    mirrorbox_raster::build_planned_reusing(
+                        gpu, scene, planned, &settings, previous,
+                    )
+                }) {
                 Ok(view) => {
                     self.builds += 1;
                     self.built = Some(Built {
@@ -306,27 +332,32 @@ impl Session {
         let panes_start;
         if let Some(built) = &self.built {
             let drawing = Instant::now();
-            let (image, timing) = built.view.run(gpu, 0, 1)?;
+            let output = built.view.output();
+            let size = (output.width(), output.height());
+            let pane =
+                PaneTexture::ensure(&mut self.method_texture, gpu, renderer, "method pane", size);
+            let (tone_map, source) = self
+                .tone_map
+                .get_or_insert_with(|| (DisplayToneMap::new(gpu), None));
+            if !source.as_ref().is_some_and(|s| s.reads(output)) {
+                *source = Some(tone_map.bind(gpu, output));
+            }
+            let source = source.as_ref().expect("bound above");
+            let exposure = self.scene.camera.exposure;
+            // The frame and its tone map into the pane in one submission: no readback.
+            let (gpu_ms, timing_source) = built.view.draw(gpu, &|encoder| {
+                tone_map.encode(gpu, encoder, source, exposure, &pane.texture)
+            })?;
             let stats = built.view.drawn_stats();
             // Every drawn frame is committed: feedback's row grows by one per frame.
             built.view.advance();
             draw_ms = drawing.elapsed().as_secs_f64() * 1e3;
             panes_start = Instant::now();
-            let rgb = image.to_srgb8(self.scene.camera.exposure);
-            PaneTexture::upload(
-                &mut self.method_texture,
-                gpu,
-                renderer,
-                "method pane",
-                (image.width, image.height),
-                &rgb,
-            );
-            let gpu_ms = timing.median_ms();
             self.frame = Some(MethodFrame {
-                image: Arc::new(image),
+                image: Default::default(),
                 stats,
                 gpu_ms,
-                timing_source: timing.source.name().to_string(),
+                timing_source: timing_source.name().to_string(),
                 warnings: built.view.warnings.clone(),
                 camera: built.camera.clone(),
                 build: self.builds,
@@ -343,7 +374,7 @@ impl Session {
             panes_start = Instant::now();
         }
         self.update_truth(gpu, renderer);
-        self.update_error(gpu, renderer);
+        self.update_error(gpu, renderer)?;
         self.update_phases = UpdatePhases {
             build: build_ms,
             draw: draw_ms,
@@ -398,11 +429,28 @@ impl Session {
             .then_some(level)
     }
 
-    fn update_error(&mut self, gpu: &Gpu, renderer: &mut egui_wgpu::Renderer) {
+    /// The linear image of the method's frame shown (the values `render` writes), read back
+    /// from the GPU the first time it is asked for after each drawn frame.
+    pub fn method_image(&self, gpu: &Gpu) -> Result<Option<Arc<RgbImage>>, RasterError> {
+        let (Some(frame), Some(built)) = (&self.frame, &self.built) else {
+            return Ok(None);
+        };
+        if let Some(image) = frame.image.get() {
+            return Ok(Some(image.clone()));
+        }
+        let image = Arc::new(built.view.read_image(gpu)?);
+        Ok(Some(frame.image.get_or_init(|| image).clone()))
+    }
+
+    fn update_error(
+        &mut self,
+        gpu: &Gpu,
+        renderer: &mut egui_wgpu::Renderer,
+    ) -> Result<(), RasterError> {
         let (Some(truth), Some(frame)) = (self.complete_truth(), self.frame.as_ref()) else {
             self.error = None;
             self.error_key = None;
-            return;
+            return Ok(());
         };
         let key = (
             frame.build,
@@ -411,11 +459,15 @@ impl Session {
             self.error_gain.to_bits(),
         );
         if self.error_key == Some(key) {
-            return;
+            return Ok(());
         }
+        let truth_image = truth.image.clone();
+        let Some(image) = self.method_image(gpu)? else {
+            return Ok(());
+        };
         match error_image(
-            &truth.image,
-            &frame.image,
+            &truth_image,
+            &image,
             self.scene.camera.exposure,
             self.error_mode,
             self.error_gain,
@@ -434,6 +486,7 @@ impl Session {
             Err(_) => self.error = None,
         }
         self.error_key = Some(key);
+        Ok(())
     }
 
     /// Waits for the current view's complete truth (a script's `wait-truth`).

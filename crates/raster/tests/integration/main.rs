@@ -9,3 +9,4 @@ mod mirrored_lights_closed_form;
 mod obj_corpus;
 mod scene_fuzz;
 mod structure;
+mod view_rebuild;
