@@ -1,5 +1,7 @@
-// Entry point of crates/raster/src/display_tone_map.rs: the linear image tone-mapped to the
-// 8-bit sRGB bytes `RgbImage::to_srgb8` writes, on the GPU (what `mirrorbox view` paints).
+// Entry points of crates/raster/src/display_tone_map.rs: the linear image tone-mapped to the
+// 8-bit sRGB bytes `RgbImage::to_srgb8` writes, drawn into a rectangle of an RGBA8 or BGRA8
+// unorm target (what `mirrorbox view` paints as the method's pane, inside the window's own
+// paint).
 //
 // The CPU encodes byte = srgb::encode8(c * exposure). That function is monotone in its
 // argument, so the byte of v is the number of thresholds t_1 <= … <= t_255 with v >= t_k,
@@ -7,23 +9,23 @@
 // encode8 itself). Here: the same single f32 multiply, a guess of the byte, then the table
 // walked from the guess to the byte whose thresholds enclose the value — the same byte for
 // every input, NaN (0), negatives (0) and values above 1 (255) included, however the GPU's
-// pow rounds.
+// pow rounds. The byte k leaves as k / 255, which the target's unorm conversion stores as k
+// (k / 255 × 255 is within an ulp of k; drivers round to nearest).
 
 struct ToneMap {
+    // The rectangle's top-left corner in the target's pixels.
+    origin: vec2f,
+    // Image pixels per target pixel: 1 shows the image 1:1 (the exact bytes); above 1 the
+    // image is shrunk to fit, each target pixel the bilinear blend of the linear image at
+    // its centre, then tone-mapped.
+    step: f32,
     exposure: f32,
-    width: u32,
-    height: u32,
-    // Words (pixels) per row of the output buffer: rows are padded to 256 bytes for the
-    // copy into the pane's texture.
-    row_words: u32,
 }
 
 @group(0) @binding(0) var<uniform> tone_map: ToneMap;
 @group(0) @binding(1) var source: texture_2d<f32>;
 // thresholds[k] = t_k for k in 1…255; thresholds[0] is unused.
 @group(0) @binding(2) var<storage, read> thresholds: array<f32, 256>;
-// One RGBA8 pixel per word: red in the low byte.
-@group(0) @binding(3) var<storage, read_write> pixels: array<u32>;
 
 fn byte_of(v: f32) -> u32 {
     // Below the first threshold, or NaN (no comparison holds): 0; from the last: 255.
@@ -48,12 +50,35 @@ fn byte_of(v: f32) -> u32 {
     return k;
 }
 
-@compute @workgroup_size(8, 8)
-fn cs_main(@builtin(global_invocation_id) id: vec3u) {
-    if id.x >= tone_map.width || id.y >= tone_map.height {
-        return;
+@vertex
+fn vs_main(@builtin(vertex_index) i: u32) -> @builtin(position) vec4f {
+    // One triangle covering the viewport (the rectangle).
+    let uv = vec2f(f32((i << 1u) & 2u), f32(i & 2u));
+    return vec4f(uv * 2.0 - 1.0, 0.0, 1.0);
+}
+
+fn texel(p: vec2i) -> vec3f {
+    let last = vec2i(textureDimensions(source)) - 1;
+    return textureLoad(source, clamp(p, vec2i(0), last), 0).rgb;
+}
+
+@fragment
+fn fs_main(@builtin(position) frag: vec4f) -> @location(0) vec4f {
+    let local = frag.xy - tone_map.origin;
+    var c: vec3f;
+    if tone_map.step == 1.0 {
+        c = texel(vec2i(floor(local)));
+    } else {
+        let p = local * tone_map.step - 0.5;
+        let base = floor(p);
+        let f = p - base;
+        let i = vec2i(base);
+        c = mix(
+            mix(texel(i), texel(i + vec2i(1, 0)), f.x),
+            mix(texel(i + vec2i(0, 1)), texel(i + vec2i(1, 1)), f.x),
+            f.y,
+        );
     }
-    let c = textureLoad(source, id.xy, 0).rgb * tone_map.exposure;
-    pixels[id.y * tone_map.row_words + id.x] =
-        byte_of(c.r) | (byte_of(c.g) << 8u) | (byte_of(c.b) << 16u) | (255u << 24u);
+    let v = c * tone_map.exposure;
+    return vec4f(vec3f(f32(byte_of(v.r)), f32(byte_of(v.g)), f32(byte_of(v.b))) / 255.0, 1.0);
 }

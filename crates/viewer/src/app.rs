@@ -192,6 +192,10 @@ impl App {
             truth_device,
         );
         session.memory_budget = o.memory_budget;
+        // The method's pane is tone-mapped into the window's own format as egui paints.
+        session.display_tone_map = Some(Arc::new(
+            mirrorbox_raster::display_tone_map::DisplayToneMap::new(&gpu, format),
+        ));
         let mut ui = panel::UiState::new(o.vsync);
         ui.speed = speed;
         Ok(Running {

@@ -17,6 +17,7 @@ mod app;
 pub mod error_view;
 pub mod fly_camera;
 pub mod live_truth;
+mod method_pane;
 mod panel;
 pub mod scene_copy;
 mod screenshot;

@@ -2,8 +2,10 @@
 //! frame times), the image panes, the help overlay, and the keys.
 
 use crate::error_view::ErrorMode;
+use crate::method_pane::MethodPanePaint;
 use crate::session::Session;
 use egui::{Color32, Pos2, Rect, Vec2};
+use mirrorbox_raster::display_tone_map::ToneMapUniform;
 use mirrorbox_raster::method::OptionKind;
 use mirrorbox_raster::{Gpu, METHODS, Method, ParamValue};
 use winit::keyboard::KeyCode;
@@ -481,8 +483,12 @@ fn panes(
         state
             .panes_px
             .push((name, [px[0] as u32, px[1] as u32, pw as u32, ph as u32]));
+        let method_pane = match name {
+            "method" => session.method_pane(),
+            _ => None,
+        };
         let texture = match name {
-            "method" => session.method_texture.as_mut(),
+            "method" => None,
             "truth" => session.truth_texture.as_mut(),
             _ => session.error_texture.as_mut(),
         };
@@ -491,8 +497,24 @@ fn panes(
             "truth" => session.truth_shown.is_some(),
             _ => session.error.is_some(),
         };
-        match texture {
-            Some(t) if shown => {
+        match (method_pane, texture) {
+            (Some((tone_map, source)), _) => {
+                // Tone-mapped from the frame's linear image as the window is painted.
+                let uniform = ToneMapUniform {
+                    origin: px,
+                    step: if scale == 1.0 { 1.0 } else { w as f32 / pw },
+                    exposure: session.scene.camera.exposure,
+                };
+                painter.add(egui_wgpu::Callback::new_paint_callback(
+                    rect,
+                    MethodPanePaint {
+                        tone_map,
+                        source,
+                        uniform,
+                    },
+                ));
+            }
+            (None, Some(t)) if shown => {
                 // A coarse truth level is smaller than the pane: scaled up, blocky.
                 t.set_filter(gpu, renderer, filter);
                 if let Some(id) = t.id {

@@ -33,7 +33,7 @@ impl PaneTexture {
             label,
             size.0,
             size.1,
-            mirrorbox_raster::display_tone_map::PANE_FORMAT,
+            wgpu::TextureFormat::Rgba8Unorm,
             wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
         );
         PaneTexture {
@@ -121,7 +121,7 @@ impl PaneTexture {
 /// The method's last frame.
 pub struct MethodFrame {
     /// Its linear image, read back from the GPU when first asked for
-    /// ([`Session::method_image`]: the error view, a screenshot); the pane shows the frame
+    /// ([`Session::method_image`]: the error view, a screenshot); the pane is the frame
     /// tone-mapped on the GPU without it.
     image: std::cell::OnceCell<Arc<RgbImage>>,
     pub stats: FrameStats,
@@ -152,7 +152,8 @@ pub struct FrameTime {
 pub struct UpdatePhases {
     /// Planning and building the method's frame (0 while the view stays).
     pub build: f64,
-    /// Drawing the frame and tone-mapping it into its pane, on the GPU, waiting for both.
+    /// Drawing the frame on the GPU and waiting for it (its pane is tone-mapped from the
+    /// GPU's image as the window paints).
     pub draw: f64,
     /// Tone mapping and uploading the truth's and the error's panes (images of the CPU,
     /// when they change), the method's image read back when the error view needs it.
@@ -195,12 +196,12 @@ pub struct Session {
     pub history: VecDeque<FrameTime>,
     pub update_phases: UpdatePhases,
     last_frame: Option<Instant>,
-    pub method_texture: Option<PaneTexture>,
     pub truth_texture: Option<PaneTexture>,
     pub error_texture: Option<PaneTexture>,
-    /// The GPU tone map into the method's pane (made at the first frame) and its binding
-    /// of the current frame's image.
-    tone_map: Option<(DisplayToneMap, Option<ToneMapSource>)>,
+    /// The GPU tone map that paints the method's pane into the window (set by the window,
+    /// which knows its format), and its binding of the current frame's image.
+    pub display_tone_map: Option<Arc<DisplayToneMap>>,
+    method_source: Option<Arc<ToneMapSource>>,
 }
 
 impl Session {
@@ -236,10 +237,10 @@ impl Session {
             history: VecDeque::with_capacity(HISTORY),
             update_phases: UpdatePhases::default(),
             last_frame: None,
-            method_texture: None,
             truth_texture: None,
             error_texture: None,
-            tone_map: None,
+            display_tone_map: None,
+            method_source: None,
         }
     }
 
@@ -332,22 +333,14 @@ impl Session {
         let panes_start;
         if let Some(built) = &self.built {
             let drawing = Instant::now();
+            // The frame alone: its pane is tone-mapped from `output` as the window paints.
+            let (gpu_ms, timing_source) = built.view.draw(gpu, &|_| {})?;
             let output = built.view.output();
-            let size = (output.width(), output.height());
-            let pane =
-                PaneTexture::ensure(&mut self.method_texture, gpu, renderer, "method pane", size);
-            let (tone_map, source) = self
-                .tone_map
-                .get_or_insert_with(|| (DisplayToneMap::new(gpu), None));
-            if !source.as_ref().is_some_and(|s| s.reads(output)) {
-                *source = Some(tone_map.bind(gpu, output));
+            if let Some(tone_map) = &self.display_tone_map
+                && !self.method_source.as_ref().is_some_and(|s| s.reads(output))
+            {
+                self.method_source = Some(Arc::new(tone_map.bind(gpu, output)));
             }
-            let source = source.as_ref().expect("bound above");
-            let exposure = self.scene.camera.exposure;
-            // The frame and its tone map into the pane in one submission: no readback.
-            let (gpu_ms, timing_source) = built.view.draw(gpu, &|encoder| {
-                tone_map.encode(gpu, encoder, source, exposure, &pane.texture)
-            })?;
             let stats = built.view.drawn_stats();
             // Every drawn frame is committed: feedback's row grows by one per frame.
             built.view.advance();
@@ -427,6 +420,13 @@ impl Session {
         let frame = self.frame.as_ref()?;
         (level.generation == self.truth.generation() && frame.camera == self.view_camera())
             .then_some(level)
+    }
+
+    /// What paints the method's pane this frame (the tone map and its binding of the frame's
+    /// image), when there is a frame.
+    pub fn method_pane(&self) -> Option<(Arc<DisplayToneMap>, Arc<ToneMapSource>)> {
+        self.frame.as_ref()?;
+        Some((self.display_tone_map.clone()?, self.method_source.clone()?))
     }
 
     /// The linear image of the method's frame shown (the values `render` writes), read back
