@@ -148,6 +148,7 @@ pub fn frame_record(
         "timing": method.map(|f| f.timing_source.clone()),
         "wall_ms": history.map(|t| t.wall_ms),
         "build_ms": history.map(|t| t.build_ms),
+        "plan_ms": history.map(|t| t.plan_ms),
         "truth_level": session.truth_shown.as_ref().map(|l| l.level),
         "truth_complete": session.complete_truth().is_some(),
         "flip_mean": session.error.as_ref().map(|e| e.metrics.flip_mean),
@@ -155,6 +156,7 @@ pub fn frame_record(
         "panes": panes_json(panes),
         "phases_ms": {
             "build": phases.update.build,
+            "plan": phases.update.plan,
             "draw": phases.update.draw,
             "panes": phases.update.panes,
             "ui": phases.ui,

@@ -145,6 +145,8 @@ pub struct FrameTime {
     pub gpu_ms: f64,
     /// CPU time spent re-planning and building the method's frame (a moved camera).
     pub build_ms: f64,
+    /// Of `build_ms`, planning on the CPU (paths, visibility, culling for the new view).
+    pub plan_ms: f64,
 }
 
 /// Milliseconds of one update's parts (the log's `phases_ms`).
@@ -152,6 +154,8 @@ pub struct FrameTime {
 pub struct UpdatePhases {
     /// Planning and building the method's frame (0 while the view stays).
     pub build: f64,
+    /// Of `build`, planning on the CPU.
+    pub plan: f64,
     /// Drawing the frame on the GPU and waiting for it (its pane is tone-mapped from the
     /// GPU's image as the window paints).
     pub draw: f64,
@@ -282,7 +286,7 @@ impl Session {
             settings.ssaa,
             camera
         );
-        let mut build_ms = 0.0;
+        let (mut build_ms, mut plan_ms) = (0.0, 0.0);
         let refused_again = self.method_error.is_some() && self.refused_key.as_ref() == Some(&key);
         if self.built.as_ref().map(|b| &b.key) != Some(&key) && !refused_again {
             let started = Instant::now();
@@ -300,6 +304,7 @@ impl Session {
                         planned.continue_from(h);
                     }
                     planned.check_memory(scene, &settings, budget)?;
+                    plan_ms = started.elapsed().as_secs_f64() * 1e3;
                     Ok(planned)
                 })
                 .map_err(RasterError::from)
@@ -362,6 +367,7 @@ impl Session {
                 wall_ms,
                 gpu_ms,
                 build_ms,
+                plan_ms,
             });
         } else {
             panes_start = Instant::now();
@@ -370,6 +376,7 @@ impl Session {
         self.update_error(gpu, renderer)?;
         self.update_phases = UpdatePhases {
             build: build_ms,
+            plan: plan_ms,
             draw: draw_ms,
             panes: panes_start.elapsed().as_secs_f64() * 1e3,
         };
