@@ -15,6 +15,7 @@
 # 5th–95th percentile range, the phases of a frame, the goals met or not, and the device.
 #
 # Usage: scripts/viewer-frame-rates.sh [SCENE] [ROUNDS]   (defaults: scenes/mirror_box.json 3)
+#        METHODS="symmetry naive" … measures only those (the report then lists only them).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scene=${1:-scenes/mirror_box.json}
@@ -25,8 +26,8 @@ baseline=${BASELINE_BIN:-}
 out=reports/viewer
 mkdir -p "$out"
 work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-methods=$("$bin" render --help | sed -n '/Possible values:/,/default:/p' | grep -oE '^ +- [a-z-]+:' | sed -E 's/ +- //; s/://')
+echo "logs in $work (removed when the report is written)" >&2
+methods=${METHODS:-$("$bin" render --help | sed -n '/Possible values:/,/default:/p' | grep -oE '^ +- [a-z-]+:' | sed -E 's/ +- //; s/://')}
 {
   echo "truth off"
   echo "frames 5"
@@ -175,3 +176,4 @@ open(f"{out}/frame_rates.md", "w").write("\n".join(lines) + "\n")
 json.dump(summary, open(f"{out}/frame_rates.json", "w"), indent=2)
 print("\n".join(lines))
 PY
+rm -rf "$work"
