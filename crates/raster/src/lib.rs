@@ -17,7 +17,9 @@
 //!   (device and errors), [`color_format`] (RGBA32F, else RGBA16F;
 //!   `MIRRORBOX_COLOR_FORMAT` forces one), [`projection`] (the one projection: infinite
 //!   reversed Z), [`targets`], [`pipeline`] (scene-pipeline builder, uniform arena),
-//!   [`resolve`] (SSAA), [`timing`] (GPU timestamps), [`readback`].
+//!   [`state_cache`] (layouts and pipelines made once per device), [`resolve`] (SSAA),
+//!   [`timing`] (GPU timestamps), [`readback`], [`display_tone_map`] (the viewer's pane:
+//!   the image to sRGB bytes on the GPU).
 
 pub mod adapter;
 pub mod camera_rays;
