@@ -6,9 +6,9 @@
 # interleaved over rounds (a shuffled order per round) so that drift of a shared machine
 # spreads over all methods alike.
 #
-# Per method and round: 5 warm-up frames, 30 frames with a still camera, 30 frames walking
-# (the camera moved before every frame). With BASELINE_BIN=path/to/an/older/mirrorbox, each
-# round also runs that binary on every method, interleaved with this one, for a before/after
+# Per method and round: 5 warm-up frames, then 30 frames with a still camera and 30 walking
+# (the camera moved before each frame), alternating in blocks of 5. With
+# BASELINE_BIN=path/to/an/older/mirrorbox, each round also runs that binary on every method, interleaved with this one, for a before/after
 # table measured in the same minutes on the same machine.
 #
 # Writes reports/viewer/frame_rates.md and .json: medians over all rounds' frames with the
@@ -28,11 +28,15 @@ mkdir -p "$out"
 work=$(mktemp -d)
 echo "logs in $work (removed when the report is written)" >&2
 methods=${METHODS:-$("$bin" render --help | sed -n '/Possible values:/,/default:/p' | grep -oE '^ +- [a-z-]+:' | sed -E 's/ +- //; s/://')}
+# Standing and walking alternate in blocks of 5 frames, so that a noisy minute of a shared
+# machine falls on both alike.
 {
   echo "truth off"
   echo "frames 5"
-  echo "frames 30"
-  for _ in $(seq 30); do echo "walk 0.01 0 0"; echo "frames 1"; done
+  for _ in $(seq 6); do
+    echo "frames 5"
+    for _ in $(seq 5); do echo "walk 0.01 0 0"; echo "frames 1"; done
+  done
   echo "exit"
 } > "$work/script.txt"
 run() {
@@ -87,7 +91,7 @@ def frames_of(path):
             "frame": r["frame"], "method": r["method"], "passes": r["passes"],
             "wall": nxt["wall_ms"],  # this frame's start to the next one's
             "gpu": r["gpu_ms"], "draw": draw, "panes": ph["panes"], "ui": ph["ui"],
-            "build": ph["build"], "plan": ph.get("plan"),
+            "build": ph["build"], "plan": ph.get("plan"), "moved": (r.get("build_ms") or 0) > 0,
             "window": nxt["wall_ms"] - update - ph["ui"],
             "overhead": update - r["gpu_ms"] + ph["ui"],
         })
@@ -97,12 +101,13 @@ data = {}
 for path in sorted(glob.glob(f"{work}/*.jsonl")):
     which, method = os.path.basename(path).split(".")[:2]
     for f in frames_of(path):
-        # Frames 1-5 warm up; 6-35 still; 36-65 walking (built again for each position).
-        kind = "still" if 6 <= f["frame"] <= 35 else "walking" if f["frame"] >= 36 else None
+        # Frames 1-5 warm up; then a frame is walking where the camera moved before it (its
+        # frame built again), standing otherwise.
+        kind = None if f["frame"] <= 5 else "walking" if f["moved"] else "still"
         if kind:
             d = data.setdefault(which, {}).setdefault(f["method"], {"passes": f["passes"]})
             for k, v in f.items():
-                if isinstance(v, (int, float)) and k not in ("frame", "passes"):
+                if isinstance(v, (int, float)) and not isinstance(v, bool) and k not in ("frame", "passes"):
                     d.setdefault(f"{kind}_{k}", []).append(v)
 
 info = open(f"{work}/info.txt").read().splitlines()
@@ -123,7 +128,7 @@ summary = {"scene": scene, "rounds": int(rounds), "adapter": adapter, "cpu": cpu
 lines = ["# `mirrorbox view` frame rates", "",
          f"Measured {date} at {commit} with `scripts/viewer-frame-rates.sh {scene} {rounds}` on {cpu}, "
          f"{os.cpu_count()} cores: adapter {adapter}, the default window (1600×728: the panel and four 640×360 panes) under Xvfb, live truth off. "
-         "Per method and round 30 frames standing and 30 walking (the camera moved before each frame), methods in a shuffled order per round; "
+         "Per method and round 30 frames standing and 30 walking (the camera moved before each frame), alternating in blocks of 5, methods in a shuffled order per round; "
          "medians over all rounds' frames, [5th–95th percentile].", "",
          "## The goals (issue 42)", "",
          f"Walking within {round((WALK_RATIO - 1) * 100)} % of standing; standing within the GPU frame plus the window's paint and present plus {OVERHEAD_MS:.0f} ms "
