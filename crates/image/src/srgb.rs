@@ -34,11 +34,11 @@ pub fn decode8(v: u8) -> f32 {
     decode(v as f32 / 255.0)
 }
 
-/// The table that lets a GPU write [`encode8`]'s bytes without its `pow`: entry `k`
-/// (1…255) is the smallest `f32` that `encode8` maps to `k` or above (entry 0 is unused,
+/// The table that lets a GPU write [`encode8`]'s bytes exactly, whatever its `pow`: entry
+/// `k` (1…255) is the smallest `f32` that `encode8` maps to `k` or above (entry 0 is unused,
 /// 0). `encode8` is monotone, so `encode8(v)` is the number of entries `k ≥ 1` with
-/// `v ≥ table[k]` ([`encode8_by_thresholds`]; NaN compares false with all: 0). Found by
-/// bisecting the bit patterns of [0, 1], which order as the values do.
+/// `v ≥ table[k]` ([`encode8_by_thresholds`]). Found by bisecting the bit patterns of [0, 1],
+/// which order as the values do.
 pub fn encode8_thresholds() -> [f32; 256] {
     let mut table = [0.0f32; 256];
     let one = 1.0f32.to_bits();
@@ -58,17 +58,29 @@ pub fn encode8_thresholds() -> [f32; 256] {
     table
 }
 
-/// [`encode8`] by the table of [`encode8_thresholds`], searched as
-/// `shaders/display_tone_map.wgsl` does: 8 halving steps.
-pub fn encode8_by_thresholds(v: f32, table: &[f32; 256]) -> u8 {
-    let mut k = 0usize;
-    let mut step = 128;
-    while step > 0 {
-        let next = k + step;
-        if next <= 255 && v >= table[next] {
-            k = next;
-        }
-        step >>= 1;
+/// [`encode8`] by the table of [`encode8_thresholds`], as `shaders/display_tone_map.wgsl`
+/// computes it (its `byte_of`, step for step): the sign and NaN decided on the bit pattern,
+/// the rest compared as bit patterns (non-negative floats order as their bits), a guess of
+/// the byte from the transfer function, then a walk through the table to the byte whose
+/// thresholds enclose the value. `guess` stands for the GPU's `pow`, whose precision WGSL
+/// leaves open: the walk ends at the same byte whatever it returns.
+pub fn encode8_by_thresholds(v: f32, table: &[f32; 256], guess: impl Fn(f32) -> f32) -> u8 {
+    let b = v.to_bits();
+    let t = |k: usize| table[k].to_bits();
+    if b >= 0x8000_0000 || b > 0x7f80_0000 || b < t(1) {
+        return 0;
+    }
+    if b >= t(255) {
+        return 255;
+    }
+    let e = guess(v.clamp(0.0, 1.0));
+    // WGSL's u32(f32) saturates, as Rust's `as` does.
+    let mut k = ((e * 255.0 + 0.5) as u32).clamp(1, 254) as usize;
+    while b < t(k) {
+        k -= 1;
+    }
+    while b >= t(k + 1) {
+        k += 1;
     }
     k as u8
 }
@@ -92,21 +104,36 @@ mod tests {
         assert!((12.92 * b - (1.055 * b.powf(1.0 / 2.4) - 0.055)).abs() < 1e-6);
     }
 
+    /// The shader's transfer function, as a first guess.
+    fn pow_guess(x: f32) -> f32 {
+        encode(x)
+    }
+
     /// The table gives encode8's byte: at every threshold and the 2¹⁶ floats on each side
-    /// of it (the only places a byte changes, far wider than `powf`'s error of an ulp or
-    /// two could wiggle), across [0, 1] on a grid, and for what lies outside.
+    /// of it (the only places a byte changes), across [0, 1] on a grid, and for what lies
+    /// outside — with the transfer function's guess, and with guesses off by far more than
+    /// any GPU `pow` could be (the walk must end at the same byte).
     #[test]
     fn thresholds_give_encode8s_bytes() {
         let table = encode8_thresholds();
+        let guesses: [&dyn Fn(f32) -> f32; 4] = [
+            &pow_guess,
+            &|x| (pow_guess(x) + 3.0 / 255.0).min(1.0),
+            &|x| (pow_guess(x) - 2.0 / 255.0).max(0.0),
+            &|_| f32::NAN,
+        ];
         for k in 1..=255usize {
             let t = table[k];
             assert!(usize::from(encode8(t)) >= k, "t_{k} = {t}");
             assert!(usize::from(encode8(f32::from_bits(t.to_bits() - 1))) < k);
             assert!(table[k - 1] <= t, "the table is sorted at {k}");
             for d in -(1i64 << 16)..=(1 << 16) {
-                let bits = i64::from(t.to_bits()) + d;
-                let v = f32::from_bits(bits as u32);
-                assert_eq!(encode8_by_thresholds(v, &table), encode8(v), "{v:e}");
+                let v = f32::from_bits((i64::from(t.to_bits()) + d) as u32);
+                assert_eq!(
+                    encode8_by_thresholds(v, &table, pow_guess),
+                    encode8(v),
+                    "{v:e}"
+                );
             }
         }
         let specials = [
@@ -129,7 +156,9 @@ mod tests {
         ];
         let grid = (0..=1_000_000).map(|i| i as f32 / 1_000_000.0);
         for v in specials.into_iter().chain(outside).chain(grid) {
-            assert_eq!(encode8_by_thresholds(v, &table), encode8(v), "{v:e}");
+            for guess in guesses {
+                assert_eq!(encode8_by_thresholds(v, &table, guess), encode8(v), "{v:e}");
+            }
         }
     }
 
@@ -141,7 +170,11 @@ mod tests {
         let table = encode8_thresholds();
         for bits in 0..=1.0f32.to_bits() {
             let v = f32::from_bits(bits);
-            assert_eq!(encode8_by_thresholds(v, &table), encode8(v), "{v:e}");
+            assert_eq!(
+                encode8_by_thresholds(v, &table, pow_guess),
+                encode8(v),
+                "{v:e}"
+            );
         }
     }
 

@@ -6,9 +6,14 @@
 //! `to_srgb8` computes `srgb::encode8(c × exposure)` per channel. The shader
 //! (`shaders/display_tone_map.wgsl`) does the same IEEE multiply, then finds the byte in the
 //! table of [`encode8_thresholds`](mirrorbox_image::srgb::encode8_thresholds): `encode8` is
-//! monotone, so the byte is the number of thresholds the value reaches, for every input
-//! (tested for every f32 in [0, 1] in `mirrorbox-image`; end to end by the viewer tests,
-//! which compare the pane in a screenshot with `render`'s PNG).
+//! monotone, so the byte is the number of thresholds the value reaches, found from the
+//! value's bits (sign and NaN first, then integer comparisons: exact whatever a compiler
+//! assumes about floats). Tested three ways: the shader's search on the CPU
+//! ([`encode8_by_thresholds`](mirrorbox_image::srgb::encode8_by_thresholds)) against
+//! `encode8` around every threshold and, with `--ignored`, for every f32 in [0, 1]; this
+//! pass on the GPU for every threshold ± 2 ulps and the special values
+//! (`crates/raster/tests/integration/display_tone_map.rs`); and end to end by the viewer
+//! tests, which compare the pane in a screenshot with `render`'s PNG.
 //!
 //! Measured on lavapipe (640×360, 2 cores): a pass of its own — compute into a buffer
 //! copied into a texture egui then painted, or a full-screen pass into such a texture —
@@ -31,15 +36,17 @@ pub static SHADER: crate::wgsl::WgslSource = crate::wgsl::WgslSource {
 pub struct ToneMapUniform {
     /// The rectangle's top-left corner in the target's pixels.
     pub origin: [f32; 2],
-    /// Image pixels per target pixel: 1 for the image shown 1:1 (its exact bytes).
-    pub step: f32,
+    /// Image pixels per target pixel, per axis: (1, 1) for the image shown 1:1 (its exact
+    /// bytes).
+    pub step: [f32; 2],
     pub exposure: f32,
+    pub pad: f32,
 }
 
 /// The pass's layout for `crate::wgsl`'s test against the WGSL struct.
 pub fn gpu_structs() -> Vec<crate::wgsl::HostLayout> {
     vec![crate::host_layout!(ToneMapUniform as "ToneMap" {
-        origin, step, exposure
+        origin, step, exposure, pad
     })]
 }
 
@@ -71,8 +78,17 @@ impl ToneMapSource {
 }
 
 impl DisplayToneMap {
-    /// The pipeline drawing into targets of `format` (an 8-bit unorm RGBA or BGRA format:
-    /// the window's surface).
+    /// Whether a target of `format` holds the bytes this pass writes: 8-bit unorm RGBA or
+    /// BGRA, not sRGB (which would encode them again).
+    pub fn exact_on(format: wgpu::TextureFormat) -> bool {
+        matches!(
+            format,
+            wgpu::TextureFormat::Rgba8Unorm | wgpu::TextureFormat::Bgra8Unorm
+        )
+    }
+
+    /// The pipeline drawing into targets of `format` (the window's surface; the bytes are
+    /// `to_srgb8`'s where [`DisplayToneMap::exact_on`] holds).
     pub fn new(gpu: &Gpu, format: wgpu::TextureFormat) -> Self {
         let layout = gpu.bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("display tone map"),

@@ -380,7 +380,9 @@ pub struct BuiltView {
     target: targets::RenderTarget,
     resolve: resolve::Resolve,
     encoder: Box<dyn timing::FrameEncoder>,
-    queries: Option<timing::FrameQueries>,
+    /// [`BuiltView::draw`]'s timestamp queries, made at its first call (`render` times
+    /// with [`BuiltView::run`]'s own).
+    queries: std::sync::OnceLock<Option<timing::FrameQueries>>,
     pub stats: FrameStats,
     pub warnings: Vec<String>,
     pub bake_ms: Option<f64>,
@@ -404,22 +406,21 @@ impl BuiltView {
         )
     }
 
-    /// Draws one frame and waits for it, without reading the image back: `after` adds its
-    /// commands to the frame's submission (the viewer's tone map of [`BuiltView::output`]
-    /// into its pane). Returns the frame's milliseconds and how they were measured.
-    pub fn draw(
-        &self,
-        gpu: &Gpu,
-        after: &dyn Fn(&mut wgpu::CommandEncoder),
-    ) -> Result<(f64, TimingSource), RasterError> {
+    /// Draws one frame and waits for it, without reading the image back (the viewer
+    /// tone-maps [`BuiltView::output`] into its window as it paints). Returns the frame's
+    /// milliseconds and how they were measured.
+    pub fn draw(&self, gpu: &Gpu) -> Result<(f64, TimingSource), RasterError> {
         let encode =
             |encoder: &mut wgpu::CommandEncoder,
              first_pass: Option<wgpu::RenderPassTimestampWrites<'_>>| {
                 self.encoder.encode(encoder, &self.target, first_pass)
             };
-        let (ms, _) =
-            timing::submit_frame(gpu, self.queries.as_ref(), &encode, &[&self.resolve], after)?;
-        let source = if self.queries.is_some() {
+        let queries = self
+            .queries
+            .get_or_init(|| timing::FrameQueries::new(gpu))
+            .as_ref();
+        let (ms, _) = timing::submit_frame(gpu, queries, &encode, &[&self.resolve])?;
+        let source = if queries.is_some() {
             TimingSource::GpuTimestamps
         } else {
             TimingSource::WallClock
@@ -439,7 +440,7 @@ impl BuiltView {
     }
 
     /// Commits the frame last drawn as the state of a stateful method (`feedback`): the next
-    /// [`BuiltView::run`] draws the frame after it. What `mirrorbox view` does every frame.
+    /// [`BuiltView::run`] or [`BuiltView::draw`] draws the frame after it. What `mirrorbox view` does every frame.
     pub fn advance(&self) {
         self.encoder.advance();
     }
@@ -493,7 +494,7 @@ pub fn build_planned_reusing(
             let target =
                 targets::RenderTarget::new(gpu, "view", w, h, wgpu::TextureUsages::TEXTURE_BINDING);
             let resolve = resolve::Resolve::new(gpu, &target, settings.ssaa);
-            (target, resolve, timing::FrameQueries::new(gpu))
+            (target, resolve, Default::default())
         }
     };
     let shadows = shadow_maps::ShadowMaps::new(gpu, scene, planned.shadows)?;

@@ -178,8 +178,8 @@ impl FrameQueries {
     }
 }
 
-/// Encodes one frame — `encode`'s passes, each of `resolves`, then `after` (the viewer's
-/// tone map into its pane) — submits it and waits for it. Returns its milliseconds (GPU
+/// Encodes one frame — `encode`'s passes, then each of `resolves` — submits it and waits
+/// for it. Returns its milliseconds (GPU
 /// timestamps from the first pass to the end of the last resolve, or the wall time of
 /// submit-to-done without them) and the CPU milliseconds of encoding and submitting it.
 pub fn submit_frame(
@@ -187,7 +187,6 @@ pub fn submit_frame(
     queries: Option<&FrameQueries>,
     encode: &EncodeFrame<'_>,
     resolves: &[&Resolve],
-    after: &dyn Fn(&mut wgpu::CommandEncoder),
 ) -> Result<(f64, f64), RasterError> {
     let encoding = Instant::now();
     let mut encoder = gpu
@@ -205,7 +204,6 @@ pub fn submit_frame(
         encoder.resolve_query_set(&q.set, 0..2, &q.resolved, 0);
         encoder.copy_buffer_to_buffer(&q.resolved, 0, &q.read, 0, 16);
     }
-    after(&mut encoder);
     let started = Instant::now();
     gpu.queue.submit([encoder.finish()]);
     let encoded_ms = encoding.elapsed().as_secs_f64() * 1e3;
@@ -242,7 +240,7 @@ pub fn run_frames_of(
     let mut frames_ms = Vec::with_capacity(frames as usize);
     let mut encode_ms = Vec::with_capacity(frames as usize);
     for frame in 0..warmup + frames.max(1) {
-        let (ms, encoded_ms) = submit_frame(gpu, queries.as_ref(), encode, resolves, &|_| {})?;
+        let (ms, encoded_ms) = submit_frame(gpu, queries.as_ref(), encode, resolves)?;
         if frame >= warmup {
             frames_ms.push(ms);
             encode_ms.push(encoded_ms);

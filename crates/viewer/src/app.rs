@@ -135,6 +135,12 @@ impl App {
             })
             .or_else(|| caps.formats.first().copied())
             .ok_or_else(|| ViewError::Failed("the window's surface offers no format".into()))?;
+        if !mirrorbox_raster::display_tone_map::DisplayToneMap::exact_on(format) {
+            eprintln!(
+                "warning: the window's surface offers no 8-bit unorm RGBA or BGRA format, only \
+                 {format:?}: the panes show the images, but not the exact bytes `render` writes"
+            );
+        }
         let size = window.inner_size();
         let usage = if caps.usages.contains(wgpu::TextureUsages::COPY_SRC) {
             wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC

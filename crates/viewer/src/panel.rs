@@ -389,8 +389,8 @@ fn controls(
 const GRAPH_SECONDS: f64 = 10.0;
 
 /// The last seconds of frame times, newest on the right: the method's GPU time and the wall
-/// time between shown frames (which adds planning, readback, the truth's share of the CPU
-/// and the window's own work).
+/// time between shown frames (which adds planning for a moved camera, the truth's share of
+/// the CPU and the window's own work).
 fn frame_graph(ui: &mut egui::Ui, session: &Session) {
     let (rect, _) =
         ui.allocate_exact_size(Vec2::new(ui.available_width(), 70.0), egui::Sense::hover());
@@ -487,23 +487,29 @@ fn panes(
             "method" => session.method_pane(),
             _ => None,
         };
+        // The truth's and the error's panes are images of the CPU, uploaded when they change.
         let texture = match name {
-            "method" => None,
             "truth" => session.truth_texture.as_mut(),
-            _ => session.error_texture.as_mut(),
+            "error" => session.error_texture.as_mut(),
+            _ => None,
         };
         let shown = match name {
-            "method" => session.frame.is_some(),
             "truth" => session.truth_shown.is_some(),
-            _ => session.error.is_some(),
+            "error" => session.error.is_some(),
+            _ => false,
         };
         match (method_pane, texture) {
             (Some((tone_map, source)), _) => {
                 // Tone-mapped from the frame's linear image as the window is painted.
                 let uniform = ToneMapUniform {
                     origin: px,
-                    step: if scale == 1.0 { 1.0 } else { w as f32 / pw },
+                    step: if scale == 1.0 {
+                        [1.0, 1.0]
+                    } else {
+                        [w as f32 / pw, h as f32 / ph]
+                    },
                     exposure: session.scene.camera.exposure,
+                    pad: 0.0,
                 };
                 painter.add(egui_wgpu::Callback::new_paint_callback(
                     rect,

@@ -16,9 +16,10 @@ use std::time::{Duration, Instant};
 /// Frame times kept for the graph.
 pub const HISTORY: usize = 600;
 
-/// One pane's image on the GPU, as egui paints it: RGBA8 holding the contract's sRGB bytes
-/// (egui's textures are not sRGB-aware; its shader writes them to a non-sRGB target as they
-/// are, so a pane shown 1:1 holds the same bytes as the PNG `render` writes).
+/// The truth's or the error's pane on the GPU, as egui paints it: RGBA8 holding the
+/// contract's sRGB bytes (egui's textures are not sRGB-aware; its shader writes them to a
+/// non-sRGB target as they are, so a pane shown 1:1 holds the same bytes as the PNG `trace`
+/// writes).
 pub struct PaneTexture {
     pub texture: wgpu::Texture,
     pub id: Option<egui::TextureId>,
@@ -44,15 +45,17 @@ impl PaneTexture {
         }
     }
 
-    /// The texture of `size` in `slot`, made (and registered with egui) when there is none
-    /// of that size.
-    pub fn ensure<'a>(
-        slot: &'a mut Option<PaneTexture>,
+    /// Writes RGB 8-bit sRGB bytes of `size` into the texture (the truth's and the error's
+    /// panes, images of the CPU), recreating it (and its egui registration) when the size
+    /// changed.
+    pub fn upload(
+        slot: &mut Option<PaneTexture>,
         gpu: &Gpu,
         renderer: &mut egui_wgpu::Renderer,
         label: &str,
         size: (u32, u32),
-    ) -> &'a PaneTexture {
+        rgb: &[u8],
+    ) {
         if slot.as_ref().map(|t| t.size) != Some(size) {
             if let Some(old) = slot.take().and_then(|t| t.id) {
                 renderer.free_texture(&old);
@@ -62,20 +65,7 @@ impl PaneTexture {
             t.id = Some(renderer.register_native_texture(&gpu.device, &view, t.filter));
             *slot = Some(t);
         }
-        slot.as_ref().expect("texture just made")
-    }
-
-    /// Writes RGB 8-bit sRGB bytes of `size` into the texture (the truth's and the error's
-    /// panes, images of the CPU), recreating it when the size changed.
-    pub fn upload(
-        slot: &mut Option<PaneTexture>,
-        gpu: &Gpu,
-        renderer: &mut egui_wgpu::Renderer,
-        label: &str,
-        size: (u32, u32),
-        rgb: &[u8],
-    ) {
-        let t = PaneTexture::ensure(slot, gpu, renderer, label, size);
+        let t = slot.as_ref().expect("texture just made");
         let rgba: Vec<u8> = rgb
             .chunks_exact(3)
             .flat_map(|p| [p[0], p[1], p[2], 255])
@@ -326,6 +316,7 @@ impl Session {
                     // The pane says why instead of showing another setting's image.
                     self.built = None;
                     self.frame = None;
+                    self.method_source = None;
                     self.method_error = Some(e.to_string());
                     // Not planned again until the view or the settings change.
                     self.refused_key = Some(key);
@@ -339,7 +330,7 @@ impl Session {
         if let Some(built) = &self.built {
             let drawing = Instant::now();
             // The frame alone: its pane is tone-mapped from `output` as the window paints.
-            let (gpu_ms, timing_source) = built.view.draw(gpu, &|_| {})?;
+            let (gpu_ms, timing_source) = built.view.draw(gpu)?;
             let output = built.view.output();
             if let Some(tone_map) = &self.display_tone_map
                 && !self.method_source.as_ref().is_some_and(|s| s.reads(output))

@@ -2,6 +2,7 @@
 //! one concern.
 
 mod device_limits;
+mod display_tone_map;
 mod gltf_corpus;
 mod memory;
 mod methods;
