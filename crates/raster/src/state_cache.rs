@@ -14,7 +14,8 @@
 //! identity): a pipeline layout made of cached bind-group layouts is itself found again, and
 //! a render pipeline over a cached layout and a cached module ([`crate::Gpu::shader_module`])
 //! too. Descriptors with pipeline-overridable constants are not cached (none of the methods
-//! has one). The cache only grows, by one entry per distinct state: a few dozen per method
+//! has one). A pipeline that fails validation is kept like any other: its error surfaces
+//! when it is made (the build's `gpu.check()`), and a later frame drawing it fails on it. The cache only grows, by one entry per distinct state: a few dozen per method
 //! and option combination drawn in the process.
 
 // The one place the device makes these states (clippy.toml refuses them elsewhere).
