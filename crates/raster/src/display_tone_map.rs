@@ -116,29 +116,14 @@ impl DisplayToneMap {
                 },
             ],
         });
-        let pipeline_layout = crate::pipeline::pipeline_layout(gpu, "display tone map", &[&layout]);
         let module = gpu.shader_module(&SHADER, false);
-        let pipeline = gpu.render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("display tone map"),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: Default::default(),
-            depth_stencil: None,
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(format.into())],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let pipeline = crate::pipeline::full_screen_pipeline(
+            gpu,
+            "display tone map",
+            &[&layout],
+            &module,
+            format,
+        );
         let thresholds = gpu
             .device
             .create_buffer_init(&wgpu::util::BufferInitDescriptor {

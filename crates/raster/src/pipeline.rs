@@ -83,6 +83,40 @@ impl ScenePipeline<'_> {
     }
 }
 
+/// A pipeline drawing one full-screen (or full-viewport) triangle with `module`'s `vs_main`,
+/// shaded by its `fs_main` into a `format` target, without depth: the SSAA resolve and the
+/// viewer's display tone map.
+pub fn full_screen_pipeline(
+    gpu: &Gpu,
+    label: &str,
+    groups: &[&wgpu::BindGroupLayout],
+    module: &wgpu::ShaderModule,
+    format: wgpu::TextureFormat,
+) -> wgpu::RenderPipeline {
+    let layout = pipeline_layout(gpu, label, groups);
+    gpu.render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(label),
+        layout: Some(&layout),
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some("vs_main"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        primitive: Default::default(),
+        depth_stencil: None,
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module,
+            entry_point: Some("fs_main"),
+            compilation_options: Default::default(),
+            targets: &[Some(format.into())],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
 /// A depth (or depth-stencil) state without bias.
 pub fn depth_state(
     format: wgpu::TextureFormat,

@@ -55,32 +55,13 @@ impl Resolve {
                 },
             ],
         });
-        let pipeline_layout = gpu.pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("resolve"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let pipeline = gpu.render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("resolve"),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: Default::default(),
-            depth_stencil: None,
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(gpu.color_format.texture_format().into())],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let pipeline = crate::pipeline::full_screen_pipeline(
+            gpu,
+            "resolve",
+            &[&layout],
+            &module,
+            gpu.color_format.texture_format(),
+        );
         let output = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("output"),
             size: wgpu::Extent3d {
