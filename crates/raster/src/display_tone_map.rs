@@ -21,6 +21,7 @@
 //! costs what the quad did plus the arithmetic.
 
 use crate::gpu::Gpu;
+use crate::pipeline::fragment_buffer_entry;
 use wgpu::util::DeviceExt;
 
 /// The WGSL of the pass.
@@ -93,27 +94,9 @@ impl DisplayToneMap {
         let layout = gpu.bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("display tone map"),
             entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
+                fragment_buffer_entry(0, wgpu::BufferBindingType::Uniform),
                 crate::targets::texture_entry(1),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 2,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Storage { read_only: true },
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
+                fragment_buffer_entry(2, wgpu::BufferBindingType::Storage { read_only: true }),
             ],
         });
         let module = gpu.shader_module(&SHADER, false);

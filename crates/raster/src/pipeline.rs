@@ -147,6 +147,24 @@ pub fn pipeline_layout(
     })
 }
 
+/// A buffer binding read by the fragment stage at a fixed offset: a uniform, or a read-only
+/// storage buffer (full-screen passes: the resolve, the display tone map).
+pub fn fragment_buffer_entry(
+    binding: u32,
+    ty: wgpu::BufferBindingType,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Buffer {
+            ty,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
 /// A uniform-buffer binding of one record, read at a dynamic offset.
 pub fn dynamic_uniform_entry(
     binding: u32,

@@ -2,6 +2,7 @@
 //! image (`shaders/resolve.wgsl`).
 
 use crate::gpu::Gpu;
+use crate::pipeline::fragment_buffer_entry;
 use crate::targets::{RenderTarget, texture_entry};
 
 /// Box-filters the `factor × factor` supersampled view into the output image.
@@ -23,16 +24,7 @@ impl Resolve {
         let layout = gpu.bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("resolve"),
             entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
+                fragment_buffer_entry(0, wgpu::BufferBindingType::Uniform),
                 texture_entry(1),
             ],
         });
