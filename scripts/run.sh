@@ -13,7 +13,12 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 export NODEVICE_SELECT=1
 bin=target/release/mirrorbox
-steps_total=0 # set once the binary can list the experiments
+# The steps: install, build, check, info, one per experiment of the main job, the overview and
+# the README. The experiments are counted from their source before the build (each registry
+# row of crates/experiments says `main_job: true|false`), so the counter is right from the
+# first step; the built binary's own list is checked against that count below.
+main_job_in_source=$(cat crates/experiments/src/*.rs | grep -cE '^[[:space:]]*main_job: true,' || true)
+steps_total=$((6 + main_job_in_source))
 step=0
 steps_json=""
 started_at=$(date -u +%Y-%m-%dT%H:%M:%SZ)
@@ -41,15 +46,19 @@ run_step() {
 run_step scripts/install-system-deps.sh
 # --timings: target/cargo-timings/cargo-timing.html says which crates the build's time goes to.
 run_step cargo build --release --locked -p mirrorbox --timings
-# install, build, check, info, the experiments, the overview and the README.
-steps_total=$((6 + $("$bin" experiment --main-job | wc -l)))
+main_job_experiments=$("$bin" experiment --main-job)
+main_job_built=$(echo "$main_job_experiments" | grep -c . || true)
+if [ "$main_job_built" -ne "$main_job_in_source" ]; then
+  steps_total=$((6 + main_job_built))
+  echo "== run.sh: the binary lists $main_job_built experiments of the main job, but 'main_job: true' appears $main_job_in_source times in crates/experiments/src: counting $steps_total steps from here (scripts/run.sh's count needs fixing)." >&2
+fi
 run_step "$bin" check scenes/*.json
 run_step "$bin" info
 # Every experiment of the registry the main job runs, in its order (crates/experiments:
 # `mirrorbox experiment --list` says what each measures).
 # One truth cache for all of them: Table 1's repeat and the depth scaling trace the truths
 # Table 1 traced (the cache is keyed by the scene's content and the truth's settings).
-for experiment in $("$bin" experiment --main-job); do
+for experiment in $main_job_experiments; do
   run_step "$bin" experiment "$experiment" --fresh --truth-cache target/truth-cache
 done
 cpu=$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//; s/"/'"'"'/g')
