@@ -24,6 +24,9 @@ for line in sys.stdin:
 done
 gzip -9 .gpu/*
 if ! ls .gl/libvulkan1_*.deb >/dev/null 2>&1; then
+  # Not through scripts/lib/apt.sh: a private lists folder and `apt-get download` into .gl/
+  # take none of the system's apt or dpkg locks (checked with apt 2.6.1 while all four were
+  # held: both succeed), so there is nothing of another apt-get's to wait for.
   o='-oAPT::Architecture=amd64 -oAPT::Architectures=amd64 -oDir::State::Lists=/tmp/amd64'
   mkdir -p /tmp/amd64/partial
   # shellcheck disable=SC2086

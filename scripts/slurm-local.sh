@@ -1,26 +1,73 @@
 #!/usr/bin/env bash
 # A one-node Slurm on this machine, for the end-to-end test of sharded sweeps (issue 20):
-#   scripts/slurm-local.sh install    apt-get slurm-wlm and munge when missing (root)
+#   scripts/slurm-local.sh install    apt-get slurm-wlm and munge when missing (root); exits 1
+#                                     naming them when they cannot be installed, or when not
+#                                     root (the local Slurm needs it), unless MIRRORBOX_TEST_SKIP
+#                                     names `slurm` (then a warning, exit 0)
 #   scripts/slurm-local.sh start DIR  write DIR/slurm.conf, start munged, slurmctld and slurmd
 #                                     (state and logs in DIR); prints `export SLURM_CONF=...`
 #   scripts/slurm-local.sh stop DIR   stop the daemons started with DIR
 # Needs root (the daemons run as root, munged as the munge user). Debian 12: Slurm 22.05.
+# apt-get runs through scripts/lib/apt.sh: it waits for the package system's locks, at most
+# MIRRORBOX_APT_LOCK_TIMEOUT seconds (default 600), and names the process holding them.
 set -euo pipefail
 cmd=${1:-}
 dir=${2:-}
+here="$(cd "$(dirname "$0")" && pwd)"
+APT_LOG_PREFIX=slurm-local
+# shellcheck source=scripts/lib/skip.sh
+. "$here/lib/skip.sh"
+# shellcheck source=scripts/lib/apt.sh
+. "$here/lib/apt.sh"
 
-install() {
-  if command -v slurmctld >/dev/null && command -v slurmd >/dev/null && command -v munged >/dev/null; then
+slurm_missing() {
+  if ! command -v slurmctld >/dev/null || ! command -v slurmd >/dev/null; then echo slurm-wlm; fi
+  command -v munged >/dev/null || echo munge
+}
+
+# Installs slurm-wlm and munge when missing (progress on stderr: `start`'s stdout is eval'd).
+# False, with $why set, when they are still missing afterwards or this is not root.
+why=""
+install_slurm() {
+  local missing rc
+  missing=$(slurm_missing | paste -sd' ')
+  if [ "$(id -u)" -ne 0 ]; then
+    why="the local Slurm needs root (its daemons run as root), and this is uid $(id -u)${missing:+; missing too: $missing}: run as root"
+    return 1
+  fi
+  if [ -z "$missing" ]; then
+    echo "slurm-local: slurm-wlm and munge present; nothing to install." >&2
     return 0
   fi
-  if [ "$(id -u)" -ne 0 ]; then
-    echo "slurm-local: slurm-wlm and munge are missing; run as root to install them" >&2
-    exit 2
+  echo "slurm-local: installing $missing with apt-get..." >&2
+  rc=0
+  apt_get -qq update >/dev/null || rc=$?
+  if [ "$rc" -eq "$APT_LOCK_TIMED_OUT" ]; then
+    why=$APT_ERROR
+    return 1
+  elif [ "$rc" -ne 0 ]; then
+    echo "slurm-local: warning: $APT_ERROR; installing from the package lists already here." >&2
   fi
-  echo "slurm-local: installing slurm-wlm and munge with apt-get..."
-  export DEBIAN_FRONTEND=noninteractive
-  apt-get update -qq
-  apt-get install -y -qq --no-install-recommends slurm-wlm munge >/dev/null
+  rc=0
+  # shellcheck disable=SC2086 # $missing: one or two package names
+  apt_get install -y -qq --no-install-recommends $missing >/dev/null || rc=$?
+  missing=$(slurm_missing | paste -sd' ')
+  if [ -n "$missing" ]; then
+    why="not installed: $missing (${APT_ERROR:-apt-get reported success, but slurmctld, slurmd or munged is still not on PATH})"
+    return 1
+  fi
+  echo "slurm-local: installed slurm-wlm and munge." >&2
+}
+
+install() {
+  skip_check_list slurm-local
+  install_slurm && return 0
+  if skip_allowed slurm; then
+    echo "slurm-local: warning: $why. MIRRORBOX_TEST_SKIP names slurm, so the Slurm test will skip." >&2
+    return 0
+  fi
+  echo "slurm-local: error: $why. To go without the local Slurm test instead: MIRRORBOX_TEST_SKIP=slurm." >&2
+  exit 1
 }
 
 need_dir() {
@@ -33,7 +80,10 @@ need_dir() {
 }
 
 start() {
-  install
+  if ! install_slurm; then
+    echo "slurm-local: cannot start: $why." >&2
+    exit 1
+  fi
   need_dir
   mkdir -p "$dir/ctld" "$dir/d" /run/munge
   chown munge:munge /run/munge
