@@ -10,8 +10,23 @@
 # compiler of the workspace's own crates, which is what `cargo clippy` does, but with code
 # generation), so no crate is compiled twice. `cargo clippy --workspace --all-targets -- -D
 # warnings` reports the same lints.
+#
+# MIRRORBOX_TEST_SKIP (scripts/lib/skip.sh; CI sets none): the components the user agrees to
+# go without (corpus, xvfb, xdotool, slurm, mitsuba, chromium, raytracing). The install steps
+# fail on a component they cannot install unless it is listed; a test that skips appends
+# `<component>\t<test name>\t<reason>` to $MIRRORBOX_SKIP_LOG (target/test-skips.tsv, emptied
+# here). The end lists every skip with its reason, records them in target/test-timing.json
+# ("skipped"), and fails when a test skipped a component the list does not name: that is a
+# bug in the test.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# shellcheck source=scripts/lib/skip.sh
+. scripts/lib/skip.sh
+skip_check_list test
+mkdir -p target
+export MIRRORBOX_SKIP_LOG="$PWD/target/test-skips.tsv"
+: >"$MIRRORBOX_SKIP_LOG"
+echo "== MIRRORBOX_TEST_SKIP: $(skip_listed) (the components agreed to be skipped; a skip is logged to target/test-skips.tsv)"
 steps_json=""
 timed() {
   echo "== $*"
@@ -26,12 +41,81 @@ timed scripts/install-system-deps.sh
 # Mitsuba 3 for the agreement tests (tests/mitsuba.rs): a pinned venv, and libllvm19 via apt.
 timed tools/mitsuba/setup.sh
 export MIRRORBOX_MITSUBA_PYTHON="$PWD/tools/mitsuba/.venv/bin/python"
-# Slurm and munge for the sharded-sweep test on a local one-node Slurm (tests/slurm.rs, root).
-if [ "$(id -u)" -eq 0 ]; then
-  timed scripts/slurm-local.sh install
-fi
+# Slurm and munge for the sharded-sweep test on a local one-node Slurm (tests/slurm.rs, root;
+# not root: exits 1 unless MIRRORBOX_TEST_SKIP names slurm).
+timed scripts/slurm-local.sh install
 # The cluster files: Slurm scripts parse, the Kubernetes manifest validates.
 timed scripts/check-deploy.sh
+
+# JSON string contents: backslashes, quotes and control characters escaped.
+json_escape() {
+  local s=$1
+  s=${s//\\/\\\\}
+  s=${s//\"/\\\"}
+  s=${s//$'\t'/\\t}
+  s=${s//$'\r'/\\r}
+  printf '%s' "$s" | tr -d '\000-\010\013-\037'
+}
+# The skips the tests logged (collect_skips): skips_json for target/test-timing.json, the
+# summary's lines, and in skip_bugs the skips MIRRORBOX_TEST_SKIP did not agree to (or lines
+# that are not `<component>\t<test name>\t<reason>`). print_skips prints the summary.
+skips_json=""
+skip_lines=()
+skip_bugs=0
+skips_printed=""
+collect_skips() {
+  skips_json=""
+  skip_lines=()
+  skip_bugs=0
+  local line component test reason agreed
+  [ -f "$MIRRORBOX_SKIP_LOG" ] || return 0
+  while IFS= read -r line || [ -n "$line" ]; do
+    [ -n "$line" ] || continue
+    if [[ $line == *$'\t'*$'\t'* ]]; then
+      component=${line%%$'\t'*}
+      test=${line#*$'\t'}
+      reason=${test#*$'\t'}
+      test=${test%%$'\t'*}
+    else
+      component=$line test="" reason=""
+    fi
+    agreed=true
+    if [ -z "$test" ] || [ -z "$reason" ] || ! skip_allowed "$component"; then
+      agreed=false
+      skip_bugs=$((skip_bugs + 1))
+      skip_lines+=("NOT AGREED: ${line//$'\t'/ | }")
+    else
+      skip_lines+=("$component: $test: $reason")
+    fi
+    skips_json+="${skips_json:+,}{\"component\":\"$(json_escape "$component")\",\"test\":\"$(json_escape "$test")\",\"reason\":\"$(json_escape "$reason")\",\"agreed\":$agreed}"
+  done <"$MIRRORBOX_SKIP_LOG"
+}
+print_skips() {
+  skips_printed=yes
+  echo "== skipped tests (target/test-skips.tsv; MIRRORBOX_TEST_SKIP: $(skip_listed)):"
+  if [ ${#skip_lines[@]} -eq 0 ]; then
+    echo "==   no test skipped"
+  else
+    printf '==   %s\n' "${skip_lines[@]}"
+  fi
+  if [ "$skip_bugs" -gt 0 ]; then
+    {
+      echo "== ERROR: $skip_bugs skip(s) above marked NOT AGREED: a test skipped a component that MIRRORBOX_TEST_SKIP ($(skip_listed)) does not name, or wrote a line that is not <component> TAB <test name> TAB <reason>."
+      [ -n "$(skip_names)" ] || echo "== ERROR: MIRRORBOX_TEST_SKIP is empty, so no test may skip at all."
+      echo "== ERROR: that is a bug in the test that wrote it: a test may skip only a component the user named in MIRRORBOX_TEST_SKIP, and must fail otherwise."
+    } >&2
+  fi
+}
+# A failing step ends the script early: the skips logged so far are still listed.
+on_exit() {
+  local rc=$?
+  if [ -z "$skips_printed" ]; then
+    collect_skips || true
+    print_skips || true
+  fi
+  exit "$rc"
+}
+trap on_exit EXIT
 
 timed cargo fmt --all -- --check
 . scripts/test-build-env.sh
@@ -47,8 +131,15 @@ if cargo nextest --version >/dev/null 2>&1; then
 else
   timed cargo test --workspace --locked --no-fail-fast --lib --bins --tests
 fi
+collect_skips
 cpu=$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//; s/"/'"'"'/g')
 mkdir -p target
-printf '{"date":"%s","cpu":"%s, %s cores","seconds":%s,"steps":[%s]}\n' \
-  "$(date -u +%Y-%m-%dT%H:%M:%SZ)" "$cpu" "$(nproc)" "$SECONDS" "$steps_json" >target/test-timing.json
+printf '{"date":"%s","cpu":"%s, %s cores","seconds":%s,"steps":[%s],"test_skip":"%s","skipped":[%s]}\n' \
+  "$(date -u +%Y-%m-%dT%H:%M:%SZ)" "$cpu" "$(nproc)" "$SECONDS" "$steps_json" \
+  "$(json_escape "${MIRRORBOX_TEST_SKIP:-}")" "$skips_json" >target/test-timing.json
 echo "== tests done in $SECONDS s on $cpu, $(nproc) cores"
+print_skips
+if [ "$skip_bugs" -gt 0 ]; then
+  echo "== tests FAILED: $skip_bugs skip(s) without MIRRORBOX_TEST_SKIP's agreement (listed above)" >&2
+  exit 1
+fi
