@@ -6,11 +6,13 @@
 //!   [`IntegratorSettings`]:
 //!   - [`whitted`]: the integrator that follows the shading contract to deep bounce counts;
 //!   - [`path`]: the physically based integrator, for comparison with Mitsuba's `path`.
+//! - [`hit_point`]: a diffuse hit's point re-solved on its triangle's plane in f64.
 //! - [`sampler`]: the shared sub-pixel grid, or stratified jitter.
 //! - [`render`](mod@render): the parallel image loop and its statistics.
 
 pub mod bvh;
 pub mod cpu_features;
+pub mod hit_point;
 pub mod integrator;
 pub mod mirror_bounce;
 pub mod mirror_mask;

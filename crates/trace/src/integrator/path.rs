@@ -32,6 +32,7 @@ use super::{Integrator, PathResult, Termination, face_normals};
 use crate::bvh::packet::{LANES, LaneHits, LaneMask, NO_TRIANGLE, RayPacket, first_lanes, lanes};
 use crate::bvh::{Hit, SceneBvh};
 use crate::cpu_features::{Vectorised, widest};
+use crate::hit_point::on_triangle_plane;
 use crate::mirror_bounce::{MirrorPlanes, bounce_flat_lanes};
 use crate::sampler::SplitMix64;
 use glam::Vec3;
@@ -278,7 +279,13 @@ impl PathTracer<'_> {
             return Vertex::End(Termination::Escaped);
         };
         let mut flat = None;
-        let p = ray.at(hit.t);
+        let p = on_triangle_plane(
+            g,
+            hit.triangle,
+            ray.origin.as_dvec3(),
+            ray.dir.as_dvec3(),
+            hit.t,
+        );
         let n_f = self.normals[hit.triangle];
         let front = n_f.dot(ray.dir) < 0.0;
         let inter = interaction_at(g, hit.triangle, p, front);

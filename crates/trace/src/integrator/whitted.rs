@@ -14,6 +14,7 @@ use super::{Integrator, PathResult, Termination, face_normals};
 use crate::bvh::packet::{LANES, LaneHits, LaneMask, RayPacket, first_lanes, lanes};
 use crate::bvh::{Hit, SceneBvh};
 use crate::cpu_features::{Vectorised, widest};
+use crate::hit_point::on_triangle_plane;
 use crate::mirror_bounce::{MirrorPlanes, bounce_flat_lanes};
 use crate::sampler::SplitMix64;
 use glam::{DVec3, Vec3};
@@ -118,7 +119,7 @@ impl<'a> Whitted<'a> {
                 dir: dir.as_vec3(),
             };
             let hit = self.bvh.closest_hit(&query, 0.0, f32::INFINITY, leaving);
-            let mirror = match self.step(&mut carried, &query, hit) {
+            let mirror = match self.step(&mut carried, &query, (origin, dir), hit) {
                 Next::End(end) => return carried.result(end),
                 Next::Diffuse(d) => {
                     let end = self.shade(&mut carried, &d);
@@ -194,7 +195,12 @@ impl<'a> Whitted<'a> {
                 let mut diffuse = [false; LANES];
                 for lane in lanes(active) {
                     let (query, _) = packet.lane(lane);
-                    let mirror = match self.step(&mut carried[lane], &query, hits.get(lane)) {
+                    let exact = (
+                        DVec3::new(origin[0][lane], origin[1][lane], origin[2][lane]),
+                        DVec3::new(dir[0][lane], dir[1][lane], dir[2][lane]),
+                    );
+                    let mirror = match self.step(&mut carried[lane], &query, exact, hits.get(lane))
+                    {
                         Next::End(end) => {
                             ends[lane] = end;
                             active &= !(1 << lane);
@@ -283,12 +289,19 @@ impl<'a> Whitted<'a> {
         Termination::Diffuse
     }
 
-    /// One step of a path: `hit` is the closest hit of `query` (the path's current ray).
-    /// Ends it (escaped, or cut at a mirror), asks for the shading of a diffuse hit, or,
-    /// at a mirror, takes its reflectance and asks for the bounce; the caller computes
-    /// those two.
+    /// One step of a path: `hit` is the closest hit of `query` (the path's current ray,
+    /// rounded to f32 from `exact`, its origin and direction in f64). Ends it (escaped, or
+    /// cut at a mirror), asks for the shading of a diffuse hit (at the point re-solved on
+    /// the triangle's plane from `exact`, [`on_triangle_plane`]), or, at a mirror, takes its
+    /// reflectance and asks for the bounce; the caller computes those two.
     #[inline(always)]
-    fn step(&self, carried: &mut Carried, query: &Ray, hit: Option<Hit>) -> Next {
+    fn step(
+        &self,
+        carried: &mut Carried,
+        query: &Ray,
+        exact: (DVec3, DVec3),
+        hit: Option<Hit>,
+    ) -> Next {
         let scene = self.scene;
         carried.rays += 1;
         let Some(hit) = hit else {
@@ -298,7 +311,7 @@ impl<'a> Whitted<'a> {
         let normal = self.face_normals[hit.triangle];
         let front = normal.dot(query.dir) < 0.0;
         let surface = scene.geometry.surface(hit.triangle);
-        let p = query.at(hit.t);
+        let p = on_triangle_plane(&scene.geometry, hit.triangle, exact.0, exact.1, hit.t);
         match interaction_at(&scene.geometry, hit.triangle, p, front) {
             Interaction::Diffuse { albedo, emission } => Next::Diffuse(DiffuseHit {
                 p,

@@ -261,15 +261,21 @@ fn scene_without_mirrors_equals_the_contract_reference_exactly() {
                     .min_by(|a, b| a.0.total_cmp(&b.0));
                 sum += match closest {
                     None => s.background,
-                    Some((t, i)) => {
+                    Some((_, i)) => {
                         let mirrorbox_scene::Surface::Diffuse {
                             albedo, emission, ..
                         } = s.geometry.surface(i)
                         else {
                             unreachable!()
                         };
+                        // The hit point on the triangle's plane, solved in f64 from the ray
+                        // (the contract's hit point, `hit_point`), not `ray.at(t)`.
+                        let [a, b, c] = s.geometry.triangles[i].map(|v| v.as_dvec3());
+                        let (o, d) = (ray.origin.as_dvec3(), ray.dir.as_dvec3());
+                        let n = (b - a).cross(c - a);
+                        let p = o + d * (n.dot(a - o) / n.dot(d));
                         s.lighting.diffuse_radiance(
-                            ray.at(t),
+                            p.as_vec3(),
                             s.geometry.face_normal(i),
                             -ray.dir,
                             *albedo,
