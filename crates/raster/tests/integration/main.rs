@@ -3,6 +3,7 @@
 
 mod device_limits;
 mod display_tone_map;
+mod exact_at_every_depth;
 mod gltf_corpus;
 mod memory;
 mod methods;
