@@ -1,6 +1,9 @@
 //! The raster methods on lavapipe (or whatever `mirrorbox info` picks), against golden
 //! images and against the tracer. On failure, actual and difference images are written to
-//! `target/tmp/golden-failures/`; `MIRRORBOX_BLESS=1` rewrites the golden images.
+//! `target/tmp/golden-failures/`; `MIRRORBOX_BLESS=1` rewrites the golden images. A missing
+//! golden image fails (its render written there to look at and bless). A test whose adapter
+//! lacks what it compares against (GL, clip distances) fails too, unless `MIRRORBOX_TEST_SKIP`
+//! names it (`mirrorbox_testing`).
 
 use glam::Vec3;
 use mirrorbox_image::{RgbImage, read_image, write_png};
@@ -58,7 +61,7 @@ fn failures_dir() -> PathBuf {
 }
 
 /// Writes `actual` and a ×16 amplified difference image for a failed comparison.
-fn dump(name: &str, actual: &RgbImage, expected: &RgbImage) -> String {
+pub(crate) fn dump(name: &str, actual: &RgbImage, expected: &RgbImage) -> String {
     let dir = failures_dir();
     write_png(&dir.join(format!("{name}.actual.png")), actual, 1.0).unwrap();
     write_png(&dir.join(format!("{name}.expected.png")), expected, 1.0).unwrap();
@@ -71,7 +74,7 @@ fn dump(name: &str, actual: &RgbImage, expected: &RgbImage) -> String {
 }
 
 /// Per-pixel largest channel difference.
-fn differences(a: &RgbImage, b: &RgbImage) -> Vec<f32> {
+pub(crate) fn differences(a: &RgbImage, b: &RgbImage) -> Vec<f32> {
     assert_eq!((a.width, a.height), (b.width, b.height));
     a.pixels
         .iter()
@@ -88,13 +91,19 @@ fn assert_golden(name: &str, actual: &RgbImage) {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("tests/golden")
         .join(format!("{name}.png"));
-    if std::env::var_os("MIRRORBOX_BLESS").is_some() || !path.exists() {
+    if std::env::var_os("MIRRORBOX_BLESS").is_some() {
         write_png(&path, actual, 1.0).unwrap();
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "golden image {name} missing in CI"
-        );
         return;
+    }
+    if !path.exists() {
+        let actual_path = failures_dir().join(format!("{name}.actual.png"));
+        write_png(&actual_path, actual, 1.0).unwrap();
+        panic!(
+            "golden image {} is missing: this render is written to {}; look at it, then \
+             bless it (copy it there, or run the test with MIRRORBOX_BLESS=1)",
+            path.display(),
+            actual_path.display()
+        );
     }
     let expected = read_image(&path).unwrap();
     let a8 = actual.to_srgb8(1.0);
@@ -115,8 +124,8 @@ fn assert_golden(name: &str, actual: &RgbImage) {
 }
 
 /// The registry walked: every registered method, at its defaults, on `mirror_box` 160×90,
-/// against its golden image `golden/<name>_mirror_box.png` (a new method without one fails
-/// in CI) and against the truth traced to the depth `d` the method says it shows
+/// against its golden image `golden/<name>_mirror_box.png` (a new method without one fails:
+/// bless it with `MIRRORBOX_BLESS=1`) and against the truth traced to the depth `d` the method says it shows
 /// (`FrameStats::depth`). An exact method must match that truth up to edge samples. An
 /// inexact one (the paper's, whose hidden mirrors show what lies behind them instead of the
 /// terminal radiance) must at least be closer to the truth at `d` than at `d − 1` (at 1 when
@@ -499,8 +508,11 @@ fn exact_methods_keep_geometry_behind_a_mirror_out() {
 #[test]
 fn unrolled_clip_distances_and_fragment_discard_agree() {
     let gpu = Gpu::new().unwrap();
-    if !gpu.features.contains(wgpu::Features::CLIP_DISTANCES) {
-        eprintln!("skipped: this adapter has no clip distances");
+    if !mirrorbox_testing::require(
+        mirrorbox_testing::CLIP_DISTANCES,
+        gpu.features.contains(wgpu::Features::CLIP_DISTANCES),
+        &format!("{} has no clip distances", gpu.report.name),
+    ) {
         return;
     }
     let s = scene("mirror_room.json", 96, 54);
@@ -819,8 +831,8 @@ fn rgba16float_targets_change_only_the_rounding() {
 /// wgpu's GL backend renders every registered method (it has no RGBA32F colour buffers on
 /// core-profile GL, so the device falls back to RGBA16F), and the images are the Vulkan
 /// RGBA32F ones up to the half-precision bound, except on 0.5 % of pixels (edge samples the
-/// two backends may rasterize differently). Skipped, saying so, only where there is no GL
-/// adapter (scripts/install-system-deps.sh installs Mesa's EGL for one).
+/// two backends may rasterize differently). Without a GL adapter it fails, unless
+/// `MIRRORBOX_TEST_SKIP` names `gl` (scripts/install-system-deps.sh installs Mesa's EGL).
 #[test]
 fn every_registered_method_renders_on_the_gl_backend() {
     let Some(gl) = gl_gpu() else { return };
@@ -860,7 +872,8 @@ fn every_registered_method_renders_on_the_gl_backend() {
     }
 }
 
-/// wgpu's GL adapter (llvmpipe through EGL), or `None`, saying so, where there is none.
+/// wgpu's GL adapter (llvmpipe through EGL); where there is none, a failure, or `None` where
+/// `MIRRORBOX_TEST_SKIP` names `gl`.
 fn gl_gpu() -> Option<Gpu> {
     match Gpu::with_options(GpuOptions {
         backends: Some(wgpu::Backends::GL),
@@ -868,7 +881,11 @@ fn gl_gpu() -> Option<Gpu> {
     }) {
         Ok(gpu) => Some(gpu),
         Err(mirrorbox_raster::RasterError::Adapter(e)) => {
-            eprintln!("skipped: no GL adapter ({e})");
+            mirrorbox_testing::require(
+                mirrorbox_testing::GL,
+                false,
+                &format!("no GL adapter ({e})"),
+            );
             None
         }
         Err(e) => panic!("the GL adapter cannot render: {e}"),
@@ -1121,14 +1138,12 @@ fn symmetry_methods_without_planes_are_the_floor() {
 /// The symmetry methods with planes on wgpu's GL backend (llvmpipe through EGL): the seed's
 /// star and the perpendicular planes, each method and clipping stage, equal Vulkan's RGBA32F
 /// images up to the half-precision bound except on 0.5 % of pixels, with the same stats.
-/// Skipped, saying so, where there is no GL adapter.
+/// Without a GL adapter it fails, unless `MIRRORBOX_TEST_SKIP` names `gl`.
 #[test]
 fn symmetry_methods_render_on_the_gl_backend() {
     let Some(gl) = gl_gpu() else { return };
-    let Ok(vulkan) = gpu_with(Some(wgpu::Backends::VULKAN), ColorFormat::Rgba32Float) else {
-        eprintln!("skipped: no Vulkan reference");
-        return;
-    };
+    let vulkan = gpu_with(Some(wgpu::Backends::VULKAN), ColorFormat::Rgba32Float)
+        .expect("a Vulkan adapter (scripts/install-system-deps.sh installs Mesa's lavapipe)");
     for name in ["symmetry_star.json", "symmetry_cube.json"] {
         let s = scene(name, 160, 90);
         for key in [
