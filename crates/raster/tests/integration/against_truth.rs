@@ -48,7 +48,7 @@ pub(crate) fn pixels_off(a: &RgbImage, b: &RgbImage) -> usize {
 }
 
 /// One method's render against the truth at its depth.
-pub(crate) struct MethodError {
+struct MethodError {
     pub method: String,
     pub name: &'static str,
     pub exact: bool,
@@ -62,12 +62,7 @@ pub(crate) struct MethodError {
 
 /// Every registered method at its defaults on `scene`, each against `truth` at the depth it
 /// reports. A method that cannot render the scene fails the test, naming it.
-pub(crate) fn every_method(
-    gpu: &Gpu,
-    scene: &Scene,
-    truth: &mut Truth,
-    label: &str,
-) -> Vec<MethodError> {
+fn every_method(gpu: &Gpu, scene: &Scene, truth: &mut Truth, label: &str) -> Vec<MethodError> {
     mirrorbox_raster::METHODS
         .iter()
         .map(|entry| {
@@ -94,8 +89,65 @@ pub(crate) fn every_method(
         .collect()
 }
 
+/// The bounds every method is held to against the truth at its depth: the largest share of
+/// pixels off (by more than [`OFF_BY`]) and the largest FLIP mean.
+pub(crate) struct Bounds {
+    /// Every method whose registry row says `exact`.
+    pub exact: (f64, f64),
+    /// Each inexact method by name; one missing here fails, asking for its bound.
+    pub inexact: &'static [(&'static str, f64, f64)],
+}
+
+/// Every registered method on `scene` (see [`every_method`]) held to `bounds`: the summary
+/// line of the errors measured, and a message for each bound exceeded (its images written).
+pub(crate) fn check_every_method(
+    gpu: &Gpu,
+    scene: &Scene,
+    truth: &mut Truth,
+    label: &str,
+    bounds: &Bounds,
+) -> (String, Vec<String>) {
+    let mut line = String::new();
+    let mut failures = Vec::new();
+    for e in every_method(gpu, scene, truth, label) {
+        line += &format!(
+            "; {} (depth {}) {:.2} % off, FLIP {:.2e}",
+            e.name,
+            e.depth,
+            100.0 * e.off_share,
+            e.flip
+        );
+        let (off_bound, flip_bound) = if e.exact {
+            bounds.exact
+        } else {
+            let Some(&(_, off, flip)) = bounds.inexact.iter().find(|b| b.0 == e.name) else {
+                failures.push(format!(
+                    "{label} {}: an inexact method without a measured bound: measure it and add it",
+                    e.name
+                ));
+                continue;
+            };
+            (off, flip)
+        };
+        if e.off_share > off_bound || e.flip > flip_bound {
+            failures.push(format!(
+                "{label} {}: {} pixels ({:.2} %) off the truth at depth {}, FLIP {:.2e}; \
+                 its bound: {} %, FLIP {flip_bound:.2e}; {}",
+                e.method,
+                e.off,
+                100.0 * e.off_share,
+                e.depth,
+                e.flip,
+                100.0 * off_bound,
+                dump_failure(label, &e, truth)
+            ));
+        }
+    }
+    (line, failures)
+}
+
 /// Writes the method's image, the truth and their difference for a failed bound; where.
-pub(crate) fn dump_failure(label: &str, e: &MethodError, truth: &mut Truth) -> String {
+fn dump_failure(label: &str, e: &MethodError, truth: &mut Truth) -> String {
     let slug: String = label
         .chars()
         .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
