@@ -6,9 +6,9 @@
 //!
 //! - `MIRRORBOX_TEST_SKIP` is a comma-separated list of component names the user agrees to
 //!   skip: [`CORPUS`], [`XVFB`], [`XDOTOOL`], [`SLURM`] (also covers not being root),
-//!   [`MITSUBA`], [`CHROMIUM`], [`RAYTRACING`] (the adapter lacks ray queries), and the two
-//!   adapter features some tests compare against, [`GL`] and [`CLIP_DISTANCES`]. CI sets
-//!   none.
+//!   [`MITSUBA`], [`CHROMIUM`], [`RAYTRACING`] (the adapter lacks ray queries) — the list
+//!   `scripts/lib/skip.sh` checks the variable against. CI sets none. What else a test needs
+//!   (Mesa's lavapipe, its GL backend and clip distances) has no opt-out: its absence fails.
 //! - A test whose component is missing calls [`require`] with `present: false`:
 //!   - if the component is in `MIRRORBOX_TEST_SKIP`, it prints
 //!     `skipped: <component>: <reason>` to stderr, appends one line
@@ -43,13 +43,9 @@ pub const MITSUBA: &str = "mitsuba";
 pub const CHROMIUM: &str = "chromium";
 /// An adapter with ray queries (`wgpu::Features::EXPERIMENTAL_RAY_QUERY`).
 pub const RAYTRACING: &str = "raytracing";
-/// wgpu's GL backend (Mesa's EGL), which the GL-against-Vulkan tests render on.
-pub const GL: &str = "gl";
-/// An adapter with hardware clip distances (`wgpu::Features::CLIP_DISTANCES`).
-pub const CLIP_DISTANCES: &str = "clip-distances";
 
 /// Every component a test may need, with how to get it.
-pub const COMPONENTS: [(&str, &str); 9] = [
+pub const COMPONENTS: [(&str, &str); 7] = [
     (
         CORPUS,
         "scripts/install-system-deps.sh installs Debian's assimp-testmodels",
@@ -71,14 +67,6 @@ pub const COMPONENTS: [(&str, &str); 9] = [
     (
         RAYTRACING,
         "Mesa ≥ 25's lavapipe has ray queries: scripts/install-system-deps.sh installs it",
-    ),
-    (
-        GL,
-        "scripts/install-system-deps.sh installs Mesa's EGL and GL drivers",
-    ),
-    (
-        CLIP_DISTANCES,
-        "Mesa ≥ 25's lavapipe has them: scripts/install-system-deps.sh installs it",
     ),
 ];
 

@@ -2,8 +2,7 @@
 //! images and against the tracer. On failure, actual and difference images are written to
 //! `target/tmp/golden-failures/`; `MIRRORBOX_BLESS=1` rewrites the golden images. A missing
 //! golden image fails (its render written there to look at and bless). A test whose adapter
-//! lacks what it compares against (GL, clip distances) fails too, unless `MIRRORBOX_TEST_SKIP`
-//! names it (`mirrorbox_testing`).
+//! lacks what it compares against (a GL backend, clip distances) fails too.
 
 use glam::Vec3;
 use mirrorbox_image::{RgbImage, read_image, write_png};
@@ -508,13 +507,11 @@ fn exact_methods_keep_geometry_behind_a_mirror_out() {
 #[test]
 fn unrolled_clip_distances_and_fragment_discard_agree() {
     let gpu = Gpu::new().unwrap();
-    if !mirrorbox_testing::require(
-        mirrorbox_testing::CLIP_DISTANCES,
+    assert!(
         gpu.features.contains(wgpu::Features::CLIP_DISTANCES),
-        &format!("{} has no clip distances", gpu.report.name),
-    ) {
-        return;
-    }
+        "{} has no clip distances (Mesa ≥ 25's lavapipe has them: scripts/install-system-deps.sh)",
+        gpu.report.name
+    );
     let s = scene("mirror_room.json", 96, 54);
     let a = render(&gpu, &s, &exact(m("unrolled depth=16"))).unwrap();
     let b = render(&gpu, &s, &exact(m("unrolled depth=16 fragment-clipping"))).unwrap();
@@ -831,15 +828,14 @@ fn rgba16float_targets_change_only_the_rounding() {
 /// wgpu's GL backend renders every registered method (it has no RGBA32F colour buffers on
 /// core-profile GL, so the device falls back to RGBA16F), and the images are the Vulkan
 /// RGBA32F ones up to the half-precision bound, except on 0.5 % of pixels (edge samples the
-/// two backends may rasterize differently). Without a GL adapter it fails, unless
-/// `MIRRORBOX_TEST_SKIP` names `gl` (scripts/install-system-deps.sh installs Mesa's EGL).
+/// two backends may rasterize differently). Without a GL adapter it fails
+/// (scripts/install-system-deps.sh installs Mesa's EGL).
 #[test]
 fn every_registered_method_renders_on_the_gl_backend() {
-    let Some(gl) = gl_gpu() else { return };
+    let gl = gl_gpu();
     assert_eq!(gl.report.backend, "gl");
-    let reference = gpu_with(Some(wgpu::Backends::VULKAN), ColorFormat::Rgba32Float)
-        .map_err(|e| eprintln!("no Vulkan reference ({e}): GL images are not compared"))
-        .ok();
+    let vulkan = gpu_with(Some(wgpu::Backends::VULKAN), ColorFormat::Rgba32Float)
+        .expect("a Vulkan adapter (scripts/install-system-deps.sh installs Mesa's lavapipe)");
     let s = scene("mirror_box.json", 160, 90);
     for entry in mirrorbox_raster::METHODS {
         let method = Method::defaults(entry);
@@ -860,10 +856,9 @@ fn every_registered_method_renders_on_the_gl_backend() {
         let out = render(&gl, &s, &settings(method.clone(), 1))
             .unwrap_or_else(|e| panic!("{method} on GL: {e}"));
         assert_eq!(out.color_format, gl.color_format);
-        let Some(vulkan) = &reference else { continue };
         assert_gl_matches_vulkan(
             &out,
-            vulkan,
+            &vulkan,
             &s,
             &method,
             &method.to_string(),
@@ -872,23 +867,16 @@ fn every_registered_method_renders_on_the_gl_backend() {
     }
 }
 
-/// wgpu's GL adapter (llvmpipe through EGL); where there is none, a failure, or `None` where
-/// `MIRRORBOX_TEST_SKIP` names `gl`.
-fn gl_gpu() -> Option<Gpu> {
+/// wgpu's GL adapter (llvmpipe through EGL); where there is none, a failure.
+fn gl_gpu() -> Gpu {
     match Gpu::with_options(GpuOptions {
         backends: Some(wgpu::Backends::GL),
         color_format: None,
     }) {
-        Ok(gpu) => Some(gpu),
-        Err(mirrorbox_raster::RasterError::Adapter(e)) => {
-            mirrorbox_testing::require(
-                mirrorbox_testing::GL,
-                false,
-                &format!("no GL adapter ({e})"),
-            );
-            None
-        }
-        Err(e) => panic!("the GL adapter cannot render: {e}"),
+        Ok(gpu) => gpu,
+        Err(e) => panic!(
+            "no GL adapter that renders ({e}): scripts/install-system-deps.sh installs Mesa's EGL"
+        ),
     }
 }
 
@@ -1138,10 +1126,10 @@ fn symmetry_methods_without_planes_are_the_floor() {
 /// The symmetry methods with planes on wgpu's GL backend (llvmpipe through EGL): the seed's
 /// star and the perpendicular planes, each method and clipping stage, equal Vulkan's RGBA32F
 /// images up to the half-precision bound except on 0.5 % of pixels, with the same stats.
-/// Without a GL adapter it fails, unless `MIRRORBOX_TEST_SKIP` names `gl`.
+/// Without a GL adapter it fails.
 #[test]
 fn symmetry_methods_render_on_the_gl_backend() {
-    let Some(gl) = gl_gpu() else { return };
+    let gl = gl_gpu();
     let vulkan = gpu_with(Some(wgpu::Backends::VULKAN), ColorFormat::Rgba32Float)
         .expect("a Vulkan adapter (scripts/install-system-deps.sh installs Mesa's lavapipe)");
     for name in ["symmetry_star.json", "symmetry_cube.json"] {
