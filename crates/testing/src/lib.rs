@@ -148,13 +148,15 @@ pub fn append_line(path: &Path, line: &str) -> std::io::Result<()> {
 
 /// Whether the test may go on: `true` where `present`. Where not, `false` if `component` is
 /// in `MIRRORBOX_TEST_SKIP` (the skip printed and logged: see the crate's contract);
-/// otherwise it panics, naming the component, how to install it and the opt-out.
+/// otherwise it panics, naming the component, how to install it and the opt-out (at the
+/// caller's line).
 ///
 /// ```text
 /// if !mirrorbox_testing::require(XVFB, on_path("Xvfb"), "Xvfb is not installed") {
 ///     return;
 /// }
 /// ```
+#[track_caller]
 pub fn require(component: &str, present: bool, reason: &str) -> bool {
     let skip_list = std::env::var(SKIP_VAR).ok();
     match decide(
