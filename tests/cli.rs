@@ -604,6 +604,158 @@ fn trace_refuses_bad_arguments_before_writing_anything() {
 }
 
 // ---------------------------------------------------------------------------------------
+// trace --device gpu
+
+/// Whether the adapter `trace --device gpu` opens has ray queries; where not, a failure, or
+/// `false` where `MIRRORBOX_TEST_SKIP` names `raytracing` (`mirrorbox_testing`).
+fn ray_queries() -> bool {
+    let report = mirrorbox_raster::select_adapter()
+        .expect("a wgpu adapter (scripts/install-system-deps.sh installs Mesa's lavapipe)")
+        .report;
+    mirrorbox_testing::require(
+        mirrorbox_testing::RAYTRACING,
+        report.ray_query,
+        &format!("{} has no ray queries", report.name),
+    )
+}
+
+/// What only the CPU tracer does is refused on the GPU (exit 2, naming the flag) before any
+/// device is opened or anything written; so is a device that does not exist.
+#[test]
+fn trace_on_the_gpu_refuses_what_only_the_cpu_does_before_writing_anything() {
+    let dir = tempfile::tempdir().unwrap();
+    let exr = dir.path().join("x.exr");
+    let bounces = dir.path().join("b.exr");
+    let (exr_s, bounces_s) = (exr.to_str().unwrap(), bounces.to_str().unwrap());
+    let cases: [(Vec<&str>, &str); 5] = [
+        (
+            trace_args(exr_s, &["--device", "gpu", "--integrator", "path"]),
+            "--device gpu: --integrator path is CPU only (the GPU traces whitted)",
+        ),
+        (
+            trace_args(exr_s, &["--device", "gpu", "--jitter"]),
+            "--device gpu: --jitter is CPU only (the GPU samples the fixed grid)",
+        ),
+        (
+            trace_args(exr_s, &["--device", "gpu", "--bounces", bounces_s]),
+            "--device gpu: --bounces is CPU only",
+        ),
+        (
+            trace_args(exr_s, &["--device", "gpu", "--spp", "81"]),
+            "--device gpu: --spp must be at most 64 (a 8×8 grid), got 81",
+        ),
+        (
+            trace_args(exr_s, &["--device", "tpu"]),
+            "invalid value 'tpu' for '--device <DEVICE>'",
+        ),
+    ];
+    for (args, message) in cases {
+        let out = mirrorbox(&args, &[]);
+        assert_eq!(out.code, 2, "{args:?}: {}", out.stderr);
+        assert!(out.stderr.contains(message), "{args:?}: {}", out.stderr);
+    }
+    assert_eq!(
+        std::fs::read_dir(dir.path()).unwrap().count(),
+        0,
+        "nothing may be written on a refusal"
+    );
+}
+
+/// `trace --device gpu` writes what the CPU truth writes — the EXR (with its provenance) and
+/// its PNG — equal to the CPU truth of the same flags within float precision (flat mirrors,
+/// no shadows: the GPU follows the same paths in f32); it follows at most 4096 reflections,
+/// saying so when `--max-depth` (10 000 by default) asks for more, and honours a lower one.
+#[test]
+fn trace_on_the_gpu_writes_the_cpu_truth_and_caps_its_depth() {
+    if !ray_queries() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let path = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
+    let (gpu, gpu8, cpu, cpu8) = (
+        path("gpu.exr"),
+        path("gpu8.exr"),
+        path("cpu.exr"),
+        path("cpu8.exr"),
+    );
+
+    // The default depth, capped, in words.
+    let out = mirrorbox(&trace_args(&gpu, &["--device", "gpu"]), &[]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    assert!(
+        out.stdout
+            .contains("traced scenes/mirror_box.json on the GPU (")
+            && out
+                .stdout
+                .contains("48x27, 4 spp (the 2×2 grid), whitted to 4096 reflections")
+            && out.stdout.contains(
+                "(the GPU follows at most 4096 reflections; --max-depth 10000 was capped)"
+            ),
+        "{}",
+        out.stdout
+    );
+    for f in ["gpu.exr", "gpu.png"] {
+        assert!(dir.path().join(f).is_file(), "{f} missing");
+    }
+    let attrs = mirrorbox_image::read_exr_attributes(Path::new(&gpu)).unwrap();
+    let get = |k: &str| {
+        attrs
+            .iter()
+            .find(|(key, _)| key == k)
+            .map(|(_, v)| v.clone())
+    };
+    assert_eq!(
+        get("mirrorbox.integrator").as_deref(),
+        Some("whitted (gpu ray queries)")
+    );
+    assert_eq!(get("mirrorbox.max_depth").as_deref(), Some("4096"));
+    assert_eq!(get("mirrorbox.spp").as_deref(), Some("4"));
+    assert!(get("mirrorbox.adapter").is_some_and(|a| !a.is_empty()));
+
+    // A lower depth is honoured, and said in the JSON summary.
+    let out = mirrorbox(
+        &trace_args(&gpu8, &["--device", "gpu", "--max-depth", "8", "--json"]),
+        &[],
+    );
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let v: Value = serde_json::from_str(out.stdout.trim()).unwrap();
+    assert_eq!(v["device"], "gpu");
+    assert_eq!(v["max_depth"], 8);
+    assert_eq!(
+        (v["width"].as_u64(), v["spp"].as_u64()),
+        (Some(48), Some(4))
+    );
+    assert_eq!(v["outputs"].as_array().map(Vec::len), Some(2), "{v}");
+    assert!(v["trace_ms"].as_f64().is_some_and(|ms| ms > 0.0), "{v}");
+
+    // Both are the CPU truth of the same flags.
+    for (out_path, extra) in [(&cpu, &[][..]), (&cpu8, &["--max-depth", "8"][..])] {
+        let out = mirrorbox(&trace_args(out_path, extra), &[]);
+        assert_eq!(out.code, 0, "{}", out.stderr);
+    }
+    let image = |p: &str| mirrorbox_image::read_image(Path::new(p)).unwrap();
+    let largest = |a: &str, b: &str| {
+        let (a, b) = (image(a), image(b));
+        assert_eq!((a.width, a.height), (b.width, b.height));
+        a.pixels
+            .iter()
+            .zip(&b.pixels)
+            .flat_map(|(p, q)| (0..3).map(move |c| (p[c] - q[c]).abs()))
+            .fold(0.0f32, f32::max)
+    };
+    let (deep, shallow, depth) = (
+        largest(&gpu, &cpu),
+        largest(&gpu8, &cpu8),
+        largest(&gpu, &gpu8),
+    );
+    println!(
+        "GPU vs CPU truth: max |Δ| {deep:.2e} (default depth), {shallow:.2e} (depth 8); GPU depth 8 vs default: {depth:.2e}"
+    );
+    assert!(deep <= 1e-4 && shallow <= 1e-4, "{deep} {shallow}");
+    assert!(depth > 1e-3, "--max-depth 8 changed nothing: {depth}");
+}
+
+// ---------------------------------------------------------------------------------------
 // render
 
 #[test]

@@ -1,7 +1,7 @@
 //! Agreement with Mitsuba 3 at tiny resolution, both integrators, on `mirror_box`.
 //! Needs `tools/mitsuba/setup.sh`; `scripts/test.sh` runs it and sets
-//! `MIRRORBOX_MITSUBA_PYTHON`. Without it the test says so and passes — except under CI,
-//! where Mitsuba must be there.
+//! `MIRRORBOX_MITSUBA_PYTHON`. Without it the tests fail, unless `MIRRORBOX_TEST_SKIP` names
+//! `mitsuba` (`mirrorbox_testing`).
 
 use mirrorbox_image::{RgbImage, read_image};
 use std::path::{Path, PathBuf};
@@ -11,19 +11,19 @@ fn repo() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
 
+/// Mitsuba's Python (`MIRRORBOX_MITSUBA_PYTHON`); where it is not there, a failure, or `None`
+/// where `MIRRORBOX_TEST_SKIP` names `mitsuba`.
 fn python() -> Option<String> {
-    match std::env::var("MIRRORBOX_MITSUBA_PYTHON") {
-        Ok(p) => Some(p),
-        Err(_) if std::env::var_os("CI").is_some() => {
-            panic!("CI must run the Mitsuba check: scripts/test.sh sets MIRRORBOX_MITSUBA_PYTHON")
-        }
-        Err(_) => {
-            eprintln!(
-                "skipped: MIRRORBOX_MITSUBA_PYTHON is not set (run tools/mitsuba/setup.sh, or scripts/test.sh)"
-            );
-            None
-        }
-    }
+    let (present, reason) = match std::env::var("MIRRORBOX_MITSUBA_PYTHON") {
+        Ok(p) if Path::new(&p).is_file() => return Some(p),
+        Ok(p) => (
+            false,
+            format!("MIRRORBOX_MITSUBA_PYTHON names {p}, which is not a file"),
+        ),
+        Err(_) => (false, "MIRRORBOX_MITSUBA_PYTHON is not set".to_string()),
+    };
+    mirrorbox_testing::require(mirrorbox_testing::MITSUBA, present, &reason);
+    None
 }
 
 fn run(program: &str, args: &[&str]) {

@@ -4,8 +4,8 @@
 //! dependent job; the merged sweep must hold the unsharded sweep's points with the same
 //! images bit for bit and the same errors. The daemons are stopped however the test ends.
 //!
-//! Needs root (to install and run the daemons). Outside CI without root the test says so and
-//! passes; under CI (`CI` set) it must run.
+//! Needs root (to install and run the daemons): without root it fails, unless
+//! `MIRRORBOX_TEST_SKIP` names `slurm` (`mirrorbox_testing`).
 
 use crate::common::{SMALL_SWEEP, assert_same_points, mirrorbox, repo, sweep_records as records};
 use std::path::PathBuf;
@@ -35,12 +35,11 @@ impl Drop for LocalSlurm {
 
 #[test]
 fn a_sharded_sweep_through_slurm_merges_into_the_unsharded_one() {
-    if !is_root() {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "CI must run the Slurm test as root (scripts/test.sh)"
-        );
-        eprintln!("skipped: the local Slurm needs root (scripts/slurm-local.sh)");
+    if !mirrorbox_testing::require(
+        mirrorbox_testing::SLURM,
+        is_root(),
+        "the local Slurm needs root to install and run its daemons (scripts/slurm-local.sh)",
+    ) {
         return;
     }
     let dir = tempfile::tempdir().unwrap();

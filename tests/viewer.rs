@@ -8,8 +8,9 @@
 //! - switching methods changes the passes the viewer reports; a resize does not crash;
 //! - bad input (a script line, no display) is a clear error, not a panic.
 //!
-//! Needs Xvfb (`scripts/install-system-deps.sh` installs it). Without it the window tests say
-//! so and pass, except under CI (`CI` set), where they must run.
+//! Needs Xvfb, and xdotool for the input test (`scripts/install-system-deps.sh` installs
+//! both). Without them the window tests fail, unless `MIRRORBOX_TEST_SKIP` names `xvfb`
+//! (`xdotool`) (`mirrorbox_testing`).
 //! `MIRRORBOX_VIEWER_SCREENSHOT=PATH` keeps the last screenshot (the README's picture).
 
 use crate::common::{mirrorbox, repo};
@@ -26,8 +27,16 @@ struct VirtualDisplay {
 
 impl VirtualDisplay {
     /// Starts Xvfb on a free display number (it prints the number it took); `None` where
-    /// Xvfb is not installed.
+    /// Xvfb is not installed and `MIRRORBOX_TEST_SKIP` names `xvfb` (a failure where it does
+    /// not).
     fn start() -> Option<VirtualDisplay> {
+        if !mirrorbox_testing::require(
+            mirrorbox_testing::XVFB,
+            mirrorbox_testing::on_path("Xvfb"),
+            "Xvfb is not installed",
+        ) {
+            return None;
+        }
         let mut server = Command::new("Xvfb")
             .args([
                 "-displayfd",
@@ -41,7 +50,7 @@ impl VirtualDisplay {
             .stdout(Stdio::piped())
             .stderr(Stdio::null())
             .spawn()
-            .ok()?;
+            .unwrap_or_else(|e| panic!("Xvfb does not start: {e}"));
         let mut line = String::new();
         BufReader::new(server.stdout.take().expect("piped"))
             .read_line(&mut line)
@@ -63,15 +72,7 @@ impl Drop for VirtualDisplay {
 }
 
 fn display_or_skip() -> Option<VirtualDisplay> {
-    let display = VirtualDisplay::start();
-    if display.is_none() {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "Xvfb is missing under CI: scripts/install-system-deps.sh installs it"
-        );
-        eprintln!("skipped: Xvfb is not installed (scripts/install-system-deps.sh installs it)");
-    }
-    display
+    VirtualDisplay::start()
 }
 
 fn rgb(path: &Path) -> image::RgbImage {
@@ -397,15 +398,14 @@ fn wait_for(path: &Path, viewer: &mut Child) {
 /// walks the camera forward along the view; dragging right on the method pane turns it right.
 #[test]
 fn held_keys_and_a_mouse_drag_move_the_camera() {
-    let Some(x) = display_or_skip() else { return };
-    if Command::new("xdotool").arg("version").output().is_err() {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "xdotool is missing under CI: scripts/install-system-deps.sh installs it"
-        );
-        eprintln!("skipped: xdotool is not installed");
+    if !mirrorbox_testing::require(
+        mirrorbox_testing::XDOTOOL,
+        mirrorbox_testing::on_path("xdotool"),
+        "xdotool is not installed",
+    ) {
         return;
     }
+    let Some(x) = display_or_skip() else { return };
     let dir = tempfile::tempdir().unwrap();
     let shot = |name: &str| dir.path().join(name);
     // The viewer keeps drawing during `seconds`, while the test types and drags.

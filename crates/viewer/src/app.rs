@@ -253,10 +253,12 @@ impl App {
                 self.waiting_truth = None;
             } else if Instant::now() > deadline {
                 let file = self.options.script_name.clone();
+                let device = r.session.truth_device();
                 self.fail(
                     event_loop,
                     ViewError::Failed(format!(
-                        "{file}:{line}: wait-truth: the truth of the view was not complete in time"
+                        "{file}:{line}: wait-truth: the truth of the view was not complete in time \
+                         (traced by the {device})"
                     )),
                 );
                 return false;

@@ -16,7 +16,9 @@
 //! traces each level with `ray-query --primary rays` (`trace --device gpu`: the same paths
 //! in f32, equal to the CPU truth within float precision); a level is one frame, so a stale
 //! view is abandoned between levels. Where no adapter has ray queries it says so and traces
-//! on the CPU. The CPU truth stays the reference of every report.
+//! on the CPU; so it does where a level fails on the GPU: the failure is kept and shown
+//! ([`LiveTruth::device`], the panel, a screenshot's JSON), and that level and every later
+//! one is traced on the CPU. The CPU truth stays the reference of every report.
 
 use mirrorbox_image::RgbImage;
 use mirrorbox_scene::{Camera, Scene};
@@ -104,9 +106,13 @@ struct Shared {
     latest: Mutex<Option<TruthLevel>>,
     /// Set when the viewer closes.
     closing: std::sync::atomic::AtomicBool,
-    /// Where the worker traces (the GPU asked for, and the CPU where that failed).
+    /// Where the worker traces (the GPU asked for, and the CPU where that failed), and why
+    /// not on the GPU.
     device: Mutex<(TruthDevice, Option<String>)>,
 }
+
+/// How a level is traced on the GPU: [`trace_on_gpu`] (the tests put a failing one in).
+type GpuTracer = fn(&mirrorbox_raster::Gpu, &Scene, u32) -> Result<(RgbImage, Duration), String>;
 
 /// The background tracer. Dropping it stops the worker (after its current row).
 pub struct LiveTruth {
@@ -119,6 +125,11 @@ impl LiveTruth {
     /// Starts the worker for `scene` (the camera of each request replaces the scene's),
     /// tracing on `device`.
     pub fn start(scene: Arc<Scene>, device: TruthDevice) -> Self {
+        Self::start_with(scene, device, trace_on_gpu)
+    }
+
+    /// [`LiveTruth::start`], the GPU's levels traced by `gpu_tracer`.
+    fn start_with(scene: Arc<Scene>, device: TruthDevice, gpu_tracer: GpuTracer) -> Self {
         let shared = Arc::new(Shared {
             request: Mutex::new(None),
             wake: Condvar::new(),
@@ -130,7 +141,7 @@ impl LiveTruth {
         let for_worker = shared.clone();
         let worker = std::thread::Builder::new()
             .name("live truth".into())
-            .spawn(move || work(&scene, &for_worker))
+            .spawn(move || work(&scene, &for_worker, gpu_tracer))
             .expect("spawning the live-truth thread");
         LiveTruth {
             shared,
@@ -150,7 +161,8 @@ impl LiveTruth {
         self.shared.wake.notify_all();
     }
 
-    /// Where the truth is traced, and why not on the GPU where that was asked for and failed.
+    /// Where the truth is traced, and why not on the GPU where that was asked for and failed
+    /// (no device with ray queries, or a level that failed on it).
     pub fn device(&self) -> (TruthDevice, Option<String>) {
         self.shared.device.lock().expect("truth device").clone()
     }
@@ -215,8 +227,8 @@ fn open_gpu(shared: &Shared) -> Option<mirrorbox_raster::Gpu> {
     }
 }
 
-fn work(scene: &Scene, shared: &Shared) {
-    let gpu = open_gpu(shared);
+fn work(scene: &Scene, shared: &Shared, gpu_tracer: GpuTracer) {
+    let mut gpu = open_gpu(shared);
     let bvh = SceneBvh::build(&scene.geometry);
     // One mono copy whose camera each level replaces.
     let mut view = scene.clone();
@@ -240,9 +252,19 @@ fn work(scene: &Scene, shared: &Shared) {
         for level in 0..level_count() {
             let (camera, grid_side) = level_setup(&request, level);
             view.camera = camera;
-            let traced = match &gpu {
-                Some(gpu) => trace_on_gpu(gpu, &view, grid_side),
-                None => {
+            let traced = match gpu.as_ref().map(|g| gpu_tracer(g, &view, grid_side)) {
+                Some(Ok(traced)) => Some(traced),
+                on_cpu => {
+                    // A failed GPU level is shown, not dropped: the failure is kept for the
+                    // panel and the screenshot, and the CPU traces this level and the rest.
+                    if let Some(Err(why)) = on_cpu {
+                        let (w, h) = (view.camera.width, view.camera.height);
+                        *shared.device.lock().expect("truth device") = (
+                            TruthDevice::Cpu,
+                            Some(format!("the GPU trace of a {w}×{h} level failed: {why}")),
+                        );
+                        gpu = None;
+                    }
                     let settings = TraceSettings::whitted(grid_side);
                     mirrorbox_trace::render_while(&view, &bvh, &settings, &|_| {}, &current)
                         .map(|out| (out.image, out.wall))
@@ -268,23 +290,23 @@ fn work(scene: &Scene, shared: &Shared) {
 }
 
 /// One level on the GPU: `trace --device gpu` of `view` on the `grid_side²` grid, to the
-/// CPU truth's depth and throughput cut (the depth capped at the GPU's 4096). `None` where the
-/// device fails (the level is not shown).
+/// CPU truth's depth and throughput cut (the depth capped at the GPU's 4096), or why the
+/// device could not.
 fn trace_on_gpu(
     gpu: &mirrorbox_raster::Gpu,
     view: &Scene,
     grid_side: u32,
-) -> Option<(RgbImage, Duration)> {
+) -> Result<(RgbImage, Duration), String> {
     let truth = mirrorbox_trace::WhittedSettings::default();
     let settings = mirrorbox_raster::methods::ray_query::gpu_truth_settings(
         grid_side,
         truth.max_depth,
         truth.min_throughput,
     )
-    .ok()?;
+    .map_err(|e| e.to_string())?;
     let start = Instant::now();
-    let out = mirrorbox_raster::render(gpu, view, &settings).ok()?;
-    Some((out.image, start.elapsed()))
+    let out = mirrorbox_raster::render(gpu, view, &settings).map_err(|e| e.to_string())?;
+    Ok((out.image, start.elapsed()))
 }
 
 #[cfg(test)]
@@ -320,8 +342,23 @@ mod tests {
 
     /// `--truth gpu` (issue 39): the last level is `trace --device gpu` of the view bit for
     /// bit, and within float precision of the CPU truth; the worker says it traces on the GPU.
+    /// Whether this machine's adapter has ray queries; where not, a failure, or `false`
+    /// where `MIRRORBOX_TEST_SKIP` names `raytracing`.
+    fn ray_queries() -> bool {
+        let gpu = mirrorbox_raster::Gpu::new().expect("a wgpu adapter");
+        mirrorbox_testing::require(
+            mirrorbox_testing::RAYTRACING,
+            gpu.features
+                .contains(wgpu::Features::EXPERIMENTAL_RAY_QUERY),
+            &format!("{} has no ray queries", gpu.report.name),
+        )
+    }
+
     #[test]
     fn the_gpu_last_level_is_trace_on_the_gpu() {
+        if !ray_queries() {
+            return;
+        }
         let scene = small_scene();
         let mut truth = LiveTruth::start(Arc::new(scene.clone()), TruthDevice::Gpu);
         truth.request(TruthRequest {
@@ -331,11 +368,7 @@ mod tests {
         let level = truth
             .wait_complete(Duration::from_secs(120))
             .expect("the truth completes");
-        assert_eq!(
-            truth.device(),
-            (TruthDevice::Gpu, None),
-            "lavapipe has ray queries"
-        );
+        assert_eq!(truth.device(), (TruthDevice::Gpu, None));
         let gpu = mirrorbox_raster::Gpu::new().unwrap();
         let d = mirrorbox_trace::WhittedSettings::default();
         let settings = mirrorbox_raster::methods::ray_query::gpu_truth_settings(
@@ -357,6 +390,42 @@ mod tests {
             .flat_map(|(a, b)| (0..3).map(move |c| (a[c] - b[c]).abs()))
             .fold(0.0f32, f32::max);
         assert!(worst <= 1e-4, "GPU and CPU truth differ by {worst}");
+    }
+
+    /// A GPU level that fails is shown, not dropped (issue 50): the worker says where the
+    /// truth is traced now and why, and the CPU traces that level and the rest, so the truth
+    /// still completes — as the offline CPU trace.
+    #[test]
+    fn a_failed_gpu_level_is_shown_and_traced_on_the_cpu() {
+        if !ray_queries() {
+            return;
+        }
+        fn failing(
+            _: &mirrorbox_raster::Gpu,
+            _: &Scene,
+            _: u32,
+        ) -> Result<(RgbImage, Duration), String> {
+            Err("device lost (injected)".into())
+        }
+        let scene = small_scene();
+        let mut truth = LiveTruth::start_with(Arc::new(scene.clone()), TruthDevice::Gpu, failing);
+        truth.request(TruthRequest {
+            camera: scene.camera.clone(),
+            grid_side: 2,
+        });
+        let level = truth
+            .wait_complete(Duration::from_secs(120))
+            .expect("the truth completes on the CPU");
+        let (device, why) = truth.device();
+        assert_eq!(device, TruthDevice::Cpu);
+        assert_eq!(
+            why.as_deref(),
+            Some("the GPU trace of a 8×5 level failed: device lost (injected)")
+        );
+        let bvh = SceneBvh::build(&scene.geometry);
+        let offline =
+            mirrorbox_trace::render(&scene, &bvh, &TraceSettings::whitted(2), &|_| {}).image;
+        assert_eq!(level.image.pixels, offline.pixels);
     }
 
     #[test]

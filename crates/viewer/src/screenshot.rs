@@ -5,8 +5,9 @@
 //! - `OUT.method.exr`: the method's linear image (the values `render` writes);
 //! - `OUT.truth.exr`: the truth's linear image, when the truth of the view is complete;
 //! - `OUT.error.png`: the heat map, when there is one;
-//! - `OUT.json`: the method, camera, timings, metrics and each pane's rectangle in the
-//!   window's pixels (so a test can cut the panes out of `OUT.png`).
+//! - `OUT.json`: the method, camera, timings, metrics, where the truth is traced (and why
+//!   not on the GPU, where that failed) and each pane's rectangle in the window's pixels (so
+//!   a test can cut the panes out of `OUT.png`).
 
 use crate::ViewOptions;
 use crate::session::Session;
@@ -151,6 +152,7 @@ pub fn frame_record(
         "plan_ms": history.map(|t| t.plan_ms),
         "truth_level": session.truth_shown.as_ref().map(|l| l.level),
         "truth_complete": session.complete_truth().is_some(),
+        "truth_device": session.truth_device(),
         "flip_mean": session.error.as_ref().map(|e| e.metrics.flip_mean),
         "window": [window.0, window.1],
         "panes": panes_json(panes),
@@ -222,6 +224,7 @@ pub fn save(
         "reflections": frame.map(|f| f.stats.depth),
         "gpu_ms": frame.map(|f| f.gpu_ms),
         "truth_complete": truth.is_some(),
+        "truth_device": session.truth_device(),
         "error_map": session.error_mode.name(),
         "metrics": session.error.as_ref().map(|e| json!({
             "flip_mean": e.metrics.flip_mean,

@@ -3,12 +3,16 @@
 //! (`scenes/assets/textured_cube.gltf`, `scenes/textured_box.json`).
 //!
 //! - every real file loads, is placed in a mirror box by `mirrorbox import`'s
-//!   `mirror_box_scene`, traces and renders with every registered method at a small size;
+//!   `mirror_box_scene`, is seen in the truth, and every registered method draws it as the
+//!   truth at its depth within bounds measured here (issue 50: before, only "finite and not
+//!   one flat colour");
 //! - every broken file is refused naming its glTF field;
 //! - textured scenes: trace ↔ raster at the floor (the shading contract's "Textures").
 //!
-//! The corpus tests are skipped, saying so, where the corpus is missing.
+//! Where the corpus is missing the corpus tests fail, unless `MIRRORBOX_TEST_SKIP` names
+//! `corpus` (`mirrorbox_testing`).
 
+use crate::against_truth::Bounds;
 use crate::methods::{error_against, settings, trace_depth};
 use mirrorbox_raster::{Gpu, Method, render};
 use mirrorbox_scene::Scene;
@@ -111,23 +115,27 @@ const BROKEN: [(&str, &str); 17] = [
     ),
 ];
 
+/// Whether the corpus is there; where not, the test fails, or returns where
+/// `MIRRORBOX_TEST_SKIP` names `corpus` (`mirrorbox_testing`).
 fn corpus_present() -> bool {
-    let present = Path::new(CORPUS).is_dir();
-    if !present {
-        eprintln!(
-            "skipped: no {CORPUS} (scripts/install-system-deps.sh installs assimp-testmodels)"
-        );
-    }
-    present
+    mirrorbox_testing::require(
+        mirrorbox_testing::CORPUS,
+        Path::new(CORPUS).is_dir(),
+        &format!("no {CORPUS}"),
+    )
+}
+
+/// The scene file `mirrorbox import` writes for the asset at `rel`, `w × h` pixels.
+fn imported_json(rel: &str, w: u32, h: u32) -> String {
+    let path = Path::new(CORPUS).join(rel);
+    mirrorbox_scene::import::mirror_box_scene(&path, &path.to_string_lossy(), None, w, h)
+        .unwrap_or_else(|e| panic!("{rel}: {e}"))
 }
 
 /// The asset at `rel` in the mirror box `mirrorbox import` builds, `w × h` pixels.
 fn imported(rel: &str, w: u32, h: u32) -> Scene {
-    let path = Path::new(CORPUS).join(rel);
-    let json =
-        mirrorbox_scene::import::mirror_box_scene(&path, &path.to_string_lossy(), None, w, h)
-            .unwrap_or_else(|e| panic!("{rel}: {e}"));
-    parse_scene(&json, Path::new("imported.json")).unwrap_or_else(|e| panic!("{rel}: {e}"))
+    parse_scene(&imported_json(rel, w, h), Path::new("imported.json"))
+        .unwrap_or_else(|e| panic!("{rel}: {e}"))
 }
 
 #[test]
@@ -161,53 +169,76 @@ fn every_gltf_of_the_corpus_loads_or_is_refused_naming_its_field() {
     }
 }
 
-/// Each real asset, in its imported mirror box at 32×18: every registered method renders it
-/// (finite, not one flat colour), and `unrolled` equals the truth traced to its depth up to edge samples —
-/// on the engine (a real CAD mesh, 110 k triangles) at 96×54.
+/// The size of the renders of every real asset.
+const SIZE: (u32, u32) = (64, 36);
+
+/// Each asset is seen: the truth with it differs from the truth of its box without it on at
+/// least this share of the pixels. Measured (64×36, 2026-11-27): 16.1 % (the engine) to 53.2 %
+/// (the boxes): `mirrorbox import` builds the box around the asset.
+const SEEN_SHARE: f64 = 0.10;
+
+/// The bounds of every method against the truth at its depth, measured on the 12 assets at
+/// 64×36 (2026-11-27, lavapipe), the largest over the assets beside each. Exact methods:
+/// at most 5 pixels of 2 304 off (0.22 %, the engine's thin CAD silhouettes: edge samples)
+/// and FLIP ≤ 3.71e-3 (the engine; ≤ 4.03e-4 elsewhere), held to the exact methods'
+/// criterion of 0.5 % and to 8e-3; the inexact ones 10 % (pixels off) and 20 % (FLIP) above
+/// what they measured.
+const BOUNDS: Bounds = Bounds {
+    exact: (0.005, 8e-3),
+    inexact: &[
+        // depth 2; measured ≤ 6.77 % off, FLIP ≤ 3.04e-2.
+        ("naive", 0.0745, 0.0365),
+        ("auxiliary", 0.0745, 0.0365),
+        // depth 1, exact there; measured ≤ 0.09 %, FLIP ≤ 2.82e-3.
+        ("feedback", 0.005, 8e-3),
+        // depth 1 and parallax; measured ≤ 31.73 %, FLIP ≤ 2.18e-1.
+        ("cubemap", 0.349, 0.262),
+        // depth 1, off-screen reflections missing; measured ≤ 30.56 %, FLIP ≤ 2.06e-1.
+        ("ssr", 0.336, 0.247),
+    ],
+};
+
+/// Each real asset in the mirror box `mirrorbox import` builds around it, at 64×36: its
+/// truth is finite and shows it (at least [`SEEN_SHARE`] of the pixels differ from its box's
+/// without it), and every registered method draws it as that truth at the method's depth
+/// within [`BOUNDS`] — the engine (a real CAD mesh, 110 k triangles) included.
 #[test]
 fn every_real_gltf_traces_and_renders_with_every_method() {
+    use crate::against_truth::{Truth, check_every_method, pixels_off};
     if !corpus_present() {
         return;
     }
     let gpu = Gpu::new().unwrap();
+    let n = (SIZE.0 * SIZE.1) as f64;
+    let mut failures = Vec::new();
     for (rel, _) in REAL {
-        let s = imported(rel, 32, 18);
-        let truth = trace_depth(&s, 8);
+        let json = imported_json(rel, SIZE.0, SIZE.1);
+        let s = parse_scene(&json, Path::new("imported.json")).unwrap();
+        // The box alone: the asset's object taken out of the same scene file.
+        let mut v: serde_json::Value = serde_json::from_str(&json).unwrap();
+        v["objects"]
+            .as_array_mut()
+            .unwrap()
+            .retain(|o| o["type"] != "gltf");
+        let bare = parse_scene(&v.to_string(), Path::new("imported.json")).unwrap();
+        let mut truth = Truth::new(&s);
         assert!(
-            truth.pixels.iter().flatten().all(|c| c.is_finite()),
+            truth.at(8).pixels.iter().flatten().all(|c| c.is_finite()),
             "{rel}"
         );
-        for entry in mirrorbox_raster::METHODS {
-            let method = Method::defaults(entry);
-            let out = render(&gpu, &s, &settings(method.clone(), 1))
-                .unwrap_or_else(|e| panic!("{rel} {method}: {e}"));
-            let image = &out.image;
-            assert!(
-                image.pixels.iter().flatten().all(|c| c.is_finite()),
-                "{rel} {method}"
-            );
-            let first = image.pixels[0];
-            assert!(
-                image.pixels.iter().any(|p| *p != first),
-                "{rel} {method}: a blank image"
-            );
+        let seen = pixels_off(truth.at(8), &trace_depth(&bare, 8)) as f64 / n;
+        if seen < SEEN_SHARE {
+            failures.push(format!(
+                "{rel}: seen on {:.2} % of pixels, under {} %",
+                100.0 * seen,
+                100.0 * SEEN_SHARE
+            ));
         }
+        let (errors, failed) = check_every_method(&gpu, &s, &mut truth, rel, &BOUNDS);
+        println!("{rel}: seen on {:.1} % of pixels{errors}", 100.0 * seen);
+        failures.extend(failed);
     }
-    let s = imported(REAL[0].0, 96, 54);
-    let out = render(
-        &gpu,
-        &s,
-        &settings(Method::parse("unrolled depth=8").unwrap(), 1),
-    )
-    .unwrap();
-    let truth = trace_depth(&s, out.stats.depth as u32);
-    let (off, flip) = error_against(&truth, &out.image);
-    let n = truth.pixels.len();
-    println!("2CylinderEngine unrolled depth 8 at 96×54: {off} of {n} pixels off, FLIP {flip:.2e}");
-    assert!(
-        off * 100 <= n && flip <= 2e-3,
-        "{off} of {n} off, FLIP {flip}"
-    );
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
 /// The contract's textures in both renderers: with the mirrors removed (the floor of every
@@ -229,6 +260,14 @@ fn textured_scenes_agree_at_the_floor() {
             imported("BoxTextured-glTF/BoxTextured.gltf", 160, 90),
         ));
     }
+    // ray-query needs the adapter's ray queries (lavapipe has them): skipped only where they
+    // are missing and MIRRORBOX_TEST_SKIP names `raytracing`; any other error fails.
+    let ray_queries = mirrorbox_testing::require(
+        mirrorbox_testing::RAYTRACING,
+        gpu.features
+            .contains(wgpu::Features::EXPERIMENTAL_RAY_QUERY),
+        &format!("{} has no ray queries", gpu.report.name),
+    );
     for (name, s) in scenes {
         assert!(s.geometry.has_textures(), "{name}");
         let bare = s.without_mirrors();
@@ -241,16 +280,12 @@ fn textured_scenes_agree_at_the_floor() {
             "{name}: {off} off, FLIP {flip}"
         );
         for key in ["unrolled depth=16", "ray-query depth=16"] {
+            if key.starts_with("ray-query") && !ray_queries {
+                continue;
+            }
             let method = Method::parse(key).unwrap();
-            let out = match render(&gpu, &s, &settings(method, 1)) {
-                Ok(out) => out,
-                // ray-query needs the adapter's ray queries (lavapipe has them).
-                Err(e) if key.starts_with("ray-query") => {
-                    eprintln!("{name} {key}: skipped ({e})");
-                    continue;
-                }
-                Err(e) => panic!("{name} {key}: {e}"),
-            };
+            let out = render(&gpu, &s, &settings(method, 1))
+                .unwrap_or_else(|e| panic!("{name} {key}: {e}"));
             let truth = trace_depth(&s, 16);
             let (off, flip) = error_against(&truth, &out.image);
             println!("{name} {key}: {off} pixels off by > 1e-3, FLIP {flip:.2e}");

@@ -1,6 +1,7 @@
 //! The crate's integration tests, one binary (one link) for all of them; each module is
 //! one concern.
 
+mod against_truth;
 mod device_limits;
 mod display_tone_map;
 mod exact_at_every_depth;

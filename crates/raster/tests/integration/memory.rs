@@ -2,21 +2,70 @@
 //! for every registered method at its defaults (and with shadow maps) on a few bundled
 //! scenes, the GPU bytes the device holds while the frame is alive
 //! (`RenderOutput::gpu_memory`, read on a fresh device so nothing else is counted) are at
-//! most the estimate's GPU part, and the estimate is not loose: at most
-//! `LOOSENESS × measured + SLACK`.
+//! most the estimate's GPU part, and the estimate is not loose: at most the measurement plus
+//! what the estimate counts and the counters cannot see, part by part, plus a slack
+//! proportional to what is measured — not a fixed allowance (issue 50: the old
+//! `1.5 × measured + 1 MiB` was 28 render targets of 64×36, so an estimate counting a
+//! mirror-texture set twice passed). What the counters cannot see:
 //!
-//! Why those numbers: the estimate counts what the measurement cannot see — the readback
-//! buffer (freed before the counters are read: `W·H·16` bytes), 64 KiB of wgpu slack, and
-//! uniform records at 256 bytes where lavapipe aligns them tighter. Measured at 64×36 the
-//! ratio estimate ÷ measured was 1.01–1.23 and the excess at most ~0.45 MiB; 1.5× + 1 MiB leaves
-//! room for other drivers' layouts while still catching an estimate that forgets a
-//! mirror texture set or counts one twice.
+//! - the readback buffer, freed before the counters are read: `views × H × ⌈16·W⌉₂₅₆` bytes;
+//! - [`WGPU_UNSEEN`]: the 64 KiB of `mirrorbox_raster::memory::WGPU_DEVICE_BYTES` for
+//!   timestamp queries, staging belts and bookkeeping;
+//! - the parts in [`UNSEEN_PARTS`]: those the counters do not hold while the frame lives, or
+//!   that the estimate counts at their largest on purpose;
+//!
+//! and [`SLACK_SHARE`] of the measured bytes covers layout rounding and uniform records
+//! counted at 256 bytes where lavapipe aligns them tighter. Measured at 64×36 on every row of
+//! both tests (Mesa 25.0.7 lavapipe, 2026-11-27): beyond what the counters cannot see the
+//! estimate exceeds them by 0.1–1.1 % of the measured bytes (at most 11 696 bytes, `feedback`
+//! in the lit room with shadow maps). A mirror-texture set counted twice adds ≥ 53 504 bytes
+//! (6.6 % of `naive`'s 805 380 on `mirror_box`), a render target 46 080 (5.7 %): both fail.
 
+use mirrorbox_raster::memory::{MemoryEstimate, buffer_bytes};
 use mirrorbox_raster::{Gpu, METHODS, Method, RenderSettings, plan_frame, render_planned};
 use mirrorbox_scene::Scene;
 
-const LOOSENESS: f64 = 1.5;
-const SLACK: u64 = 1 << 20;
+/// wgpu's device allowance that its counters do not list (the rest of
+/// `WGPU_DEVICE_BYTES`, its 512 KiB zero buffer, they do).
+const WGPU_UNSEEN: u64 = 64 << 10;
+
+/// Parts of an estimate the counters cannot be held to, with why.
+const UNSEEN_PARTS: [(&str, &str); 3] = [
+    (
+        mirrorbox_raster::methods::ray_query::ACCELERATION_STRUCTURES,
+        "wgpu's counters do not include acceleration structures",
+    ),
+    (
+        "the BLAS inputs and triangle records",
+        "ray-query drops the BLAS inputs once the acceleration structures are built",
+    ),
+    (
+        "the path instances",
+        "unrolled counts them at their largest: every item of every visible piece",
+    ),
+];
+
+/// The share of the measured bytes the estimate may exceed them by, beyond what they cannot
+/// see.
+const SLACK_SHARE: f64 = 0.02;
+
+/// The largest GPU estimate wgpu's counters (`measured` bytes) allow for a frame of `views`
+/// views of `w × h` pixels (see the module's documentation), and the part of `estimate`
+/// held to it: its GPU bytes without the [`UNSEEN_PARTS`].
+fn bound(estimate: &MemoryEstimate, measured: u64, views: u64, (w, h): (u32, u32)) -> (u64, u64) {
+    let readback = views * buffer_bytes((u64::from(w) * 16).next_multiple_of(256) * u64::from(h));
+    let unseen: u64 = estimate
+        .parts
+        .iter()
+        .filter(|p| UNSEEN_PARTS.iter().any(|(what, _)| *what == p.what))
+        .map(|p| p.gpu_bytes)
+        .sum();
+    let slack = (SLACK_SHARE * measured as f64) as u64;
+    (
+        measured + readback + WGPU_UNSEEN + slack,
+        estimate.gpu_bytes - unseen,
+    )
+}
 
 fn scene(name: &str, w: u32, h: u32) -> Scene {
     let mut s = mirrorbox_scene::load::bundled_scene(name);
@@ -76,28 +125,22 @@ fn gpu_estimate_bounds_wgpus_counters_for_every_method() {
                     estimate.gpu_bytes,
                     estimate.parts
                 );
-                let bound = (LOOSENESS * measured as f64) as u64 + SLACK;
-                // wgpu's counters do not see acceleration structures (`ray-query`): the rest
-                // of the estimate is held to them.
-                let unseen: u64 = estimate
-                    .parts
-                    .iter()
-                    .filter(|p| {
-                        p.what == mirrorbox_raster::methods::ray_query::ACCELERATION_STRUCTURES
-                    })
-                    .map(|p| p.gpu_bytes)
-                    .sum();
+                let (limit, held) =
+                    bound(&estimate, measured, 1, (s.camera.width, s.camera.height));
                 assert!(
-                    estimate.gpu_bytes - unseen <= bound,
-                    "{key}: the estimate's GPU part {} is loose: above {LOOSENESS} × {measured} + {SLACK} ({:?})",
-                    estimate.gpu_bytes,
+                    held <= limit,
+                    "{key}: the estimate's GPU part {held} (without the UNSEEN_PARTS) is loose: \
+                     above {limit}, the {measured} bytes wgpu holds plus what it cannot see and \
+                     {SLACK_SHARE} of them ({:?})",
                     estimate.parts
                 );
                 rows.push(format!(
-                    "{key}: measured {measured}, estimate {} (×{:.2}, +{} bytes)",
+                    "{key}: measured {measured}, estimate {} (×{:.2}, +{} bytes); held {held} ≤ {limit} \
+                     ({:.2} % of measured beyond what it cannot see)",
                     estimate.gpu_bytes,
                     estimate.gpu_bytes as f64 / measured as f64,
-                    estimate.gpu_bytes - measured
+                    estimate.gpu_bytes - measured,
+                    100.0 * (held as f64 - (limit - (SLACK_SHARE * measured as f64) as u64) as f64) / measured as f64
                 ));
             }
         }
@@ -139,10 +182,16 @@ fn pair_estimate_bounds_wgpus_counters() {
             "{key}: {measured} > {}",
             estimate.gpu_bytes
         );
-        assert!(
-            estimate.gpu_bytes <= (LOOSENESS * measured as f64) as u64 + SLACK,
-            "{key}: {} loose against {measured}",
+        let (limit, held) = bound(&estimate, measured, 2, (s.camera.width, s.camera.height));
+        println!(
+            "{key}: measured {measured}, estimate {} (held: {held} ≤ {limit})",
             estimate.gpu_bytes
+        );
+        assert!(
+            held <= limit,
+            "{key}: the estimate's GPU part {held} is loose: above {limit} for {measured} \
+             measured ({:?})",
+            estimate.parts
         );
     }
 }

@@ -1,6 +1,8 @@
 //! The raster methods on lavapipe (or whatever `mirrorbox info` picks), against golden
 //! images and against the tracer. On failure, actual and difference images are written to
-//! `target/tmp/golden-failures/`; `MIRRORBOX_BLESS=1` rewrites the golden images.
+//! `target/tmp/golden-failures/`; `MIRRORBOX_BLESS=1` rewrites the golden images. A missing
+//! golden image fails (its render written there to look at and bless). A test whose adapter
+//! lacks what it compares against (a GL backend, clip distances) fails too.
 
 use glam::Vec3;
 use mirrorbox_image::{RgbImage, read_image, write_png};
@@ -58,7 +60,7 @@ fn failures_dir() -> PathBuf {
 }
 
 /// Writes `actual` and a ×16 amplified difference image for a failed comparison.
-fn dump(name: &str, actual: &RgbImage, expected: &RgbImage) -> String {
+pub(crate) fn dump(name: &str, actual: &RgbImage, expected: &RgbImage) -> String {
     let dir = failures_dir();
     write_png(&dir.join(format!("{name}.actual.png")), actual, 1.0).unwrap();
     write_png(&dir.join(format!("{name}.expected.png")), expected, 1.0).unwrap();
@@ -71,7 +73,7 @@ fn dump(name: &str, actual: &RgbImage, expected: &RgbImage) -> String {
 }
 
 /// Per-pixel largest channel difference.
-fn differences(a: &RgbImage, b: &RgbImage) -> Vec<f32> {
+pub(crate) fn differences(a: &RgbImage, b: &RgbImage) -> Vec<f32> {
     assert_eq!((a.width, a.height), (b.width, b.height));
     a.pixels
         .iter()
@@ -88,13 +90,19 @@ fn assert_golden(name: &str, actual: &RgbImage) {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("tests/golden")
         .join(format!("{name}.png"));
-    if std::env::var_os("MIRRORBOX_BLESS").is_some() || !path.exists() {
+    if std::env::var_os("MIRRORBOX_BLESS").is_some() {
         write_png(&path, actual, 1.0).unwrap();
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "golden image {name} missing in CI"
-        );
         return;
+    }
+    if !path.exists() {
+        let actual_path = failures_dir().join(format!("{name}.actual.png"));
+        write_png(&actual_path, actual, 1.0).unwrap();
+        panic!(
+            "golden image {} is missing: this render is written to {}; look at it, then \
+             bless it (copy it there, or run the test with MIRRORBOX_BLESS=1)",
+            path.display(),
+            actual_path.display()
+        );
     }
     let expected = read_image(&path).unwrap();
     let a8 = actual.to_srgb8(1.0);
@@ -115,8 +123,8 @@ fn assert_golden(name: &str, actual: &RgbImage) {
 }
 
 /// The registry walked: every registered method, at its defaults, on `mirror_box` 160×90,
-/// against its golden image `golden/<name>_mirror_box.png` (a new method without one fails
-/// in CI) and against the truth traced to the depth `d` the method says it shows
+/// against its golden image `golden/<name>_mirror_box.png` (a new method without one fails:
+/// bless it with `MIRRORBOX_BLESS=1`) and against the truth traced to the depth `d` the method says it shows
 /// (`FrameStats::depth`). An exact method must match that truth up to edge samples. An
 /// inexact one (the paper's, whose hidden mirrors show what lies behind them instead of the
 /// terminal radiance) must at least be closer to the truth at `d` than at `d − 1` (at 1 when
@@ -499,10 +507,11 @@ fn exact_methods_keep_geometry_behind_a_mirror_out() {
 #[test]
 fn unrolled_clip_distances_and_fragment_discard_agree() {
     let gpu = Gpu::new().unwrap();
-    if !gpu.features.contains(wgpu::Features::CLIP_DISTANCES) {
-        eprintln!("skipped: this adapter has no clip distances");
-        return;
-    }
+    assert!(
+        gpu.features.contains(wgpu::Features::CLIP_DISTANCES),
+        "{} has no clip distances (Mesa ≥ 25's lavapipe has them: scripts/install-system-deps.sh)",
+        gpu.report.name
+    );
     let s = scene("mirror_room.json", 96, 54);
     let a = render(&gpu, &s, &exact(m("unrolled depth=16"))).unwrap();
     let b = render(&gpu, &s, &exact(m("unrolled depth=16 fragment-clipping"))).unwrap();
@@ -819,15 +828,14 @@ fn rgba16float_targets_change_only_the_rounding() {
 /// wgpu's GL backend renders every registered method (it has no RGBA32F colour buffers on
 /// core-profile GL, so the device falls back to RGBA16F), and the images are the Vulkan
 /// RGBA32F ones up to the half-precision bound, except on 0.5 % of pixels (edge samples the
-/// two backends may rasterize differently). Skipped, saying so, only where there is no GL
-/// adapter (scripts/install-system-deps.sh installs Mesa's EGL for one).
+/// two backends may rasterize differently). Without a GL adapter it fails
+/// (scripts/install-system-deps.sh installs Mesa's EGL).
 #[test]
 fn every_registered_method_renders_on_the_gl_backend() {
-    let Some(gl) = gl_gpu() else { return };
+    let gl = gl_gpu();
     assert_eq!(gl.report.backend, "gl");
-    let reference = gpu_with(Some(wgpu::Backends::VULKAN), ColorFormat::Rgba32Float)
-        .map_err(|e| eprintln!("no Vulkan reference ({e}): GL images are not compared"))
-        .ok();
+    let vulkan = gpu_with(Some(wgpu::Backends::VULKAN), ColorFormat::Rgba32Float)
+        .expect("a Vulkan adapter (scripts/install-system-deps.sh installs Mesa's lavapipe)");
     let s = scene("mirror_box.json", 160, 90);
     for entry in mirrorbox_raster::METHODS {
         let method = Method::defaults(entry);
@@ -848,10 +856,9 @@ fn every_registered_method_renders_on_the_gl_backend() {
         let out = render(&gl, &s, &settings(method.clone(), 1))
             .unwrap_or_else(|e| panic!("{method} on GL: {e}"));
         assert_eq!(out.color_format, gl.color_format);
-        let Some(vulkan) = &reference else { continue };
         assert_gl_matches_vulkan(
             &out,
-            vulkan,
+            &vulkan,
             &s,
             &method,
             &method.to_string(),
@@ -860,18 +867,16 @@ fn every_registered_method_renders_on_the_gl_backend() {
     }
 }
 
-/// wgpu's GL adapter (llvmpipe through EGL), or `None`, saying so, where there is none.
-fn gl_gpu() -> Option<Gpu> {
+/// wgpu's GL adapter (llvmpipe through EGL); where there is none, a failure.
+fn gl_gpu() -> Gpu {
     match Gpu::with_options(GpuOptions {
         backends: Some(wgpu::Backends::GL),
         color_format: None,
     }) {
-        Ok(gpu) => Some(gpu),
-        Err(mirrorbox_raster::RasterError::Adapter(e)) => {
-            eprintln!("skipped: no GL adapter ({e})");
-            None
-        }
-        Err(e) => panic!("the GL adapter cannot render: {e}"),
+        Ok(gpu) => gpu,
+        Err(e) => panic!(
+            "no GL adapter that renders ({e}): scripts/install-system-deps.sh installs Mesa's EGL"
+        ),
     }
 }
 
@@ -1121,14 +1126,12 @@ fn symmetry_methods_without_planes_are_the_floor() {
 /// The symmetry methods with planes on wgpu's GL backend (llvmpipe through EGL): the seed's
 /// star and the perpendicular planes, each method and clipping stage, equal Vulkan's RGBA32F
 /// images up to the half-precision bound except on 0.5 % of pixels, with the same stats.
-/// Skipped, saying so, where there is no GL adapter.
+/// Without a GL adapter it fails.
 #[test]
 fn symmetry_methods_render_on_the_gl_backend() {
-    let Some(gl) = gl_gpu() else { return };
-    let Ok(vulkan) = gpu_with(Some(wgpu::Backends::VULKAN), ColorFormat::Rgba32Float) else {
-        eprintln!("skipped: no Vulkan reference");
-        return;
-    };
+    let gl = gl_gpu();
+    let vulkan = gpu_with(Some(wgpu::Backends::VULKAN), ColorFormat::Rgba32Float)
+        .expect("a Vulkan adapter (scripts/install-system-deps.sh installs Mesa's lavapipe)");
     for name in ["symmetry_star.json", "symmetry_cube.json"] {
         let s = scene(name, 160, 90);
         for key in [
