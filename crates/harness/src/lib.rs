@@ -31,7 +31,7 @@ use mirrorbox_image::{
     write_png_bytes,
 };
 use mirrorbox_raster::{Gpu, METHODS, Method, PlanError, RasterError, RenderSettings};
-use mirrorbox_report::{MetricValues, Record, SweepInfo, read_records, write_report};
+use mirrorbox_report::{ErrorSplit, MetricValues, Record, SweepInfo, read_records, write_report};
 use mirrorbox_scene::limits::{SettingError, unit_interval};
 use mirrorbox_scene::{Scene, SceneError, load_scene};
 use mirrorbox_trace::{SceneBvh, TraceSettings, WhittedSettings};
@@ -529,6 +529,55 @@ fn truth(
     write_mask(scene, &bvh, config, &path)?;
     summary.truths_traced += 1;
     Ok((out.image, path))
+}
+
+/// The truth of `scene` with at most `reflections` reflections (the terminal radiance
+/// beyond, as `trace --max-depth`), from the cache when present; the full truth's own file
+/// when `reflections` reaches its depth.
+fn truth_at_depth(
+    scene: &Scene,
+    config: &SweepConfig,
+    reflections: usize,
+    cache: &Path,
+    summary: &mut Summary,
+) -> Result<PathBuf, HarnessError> {
+    let depth = u32::try_from(reflections).unwrap_or(u32::MAX);
+    let mut truncated = config.clone();
+    truncated.truth.max_depth = depth.min(config.truth.max_depth);
+    Ok(truth(scene, &truncated, cache, summary)?.1)
+}
+
+/// A point's [`ErrorSplit`]: the truncated truth against the full one, the raster against
+/// the truncated one, over the whole image and over the full truth's mirror pixels.
+fn error_split(
+    full: &Path,
+    truncated: &Path,
+    raster: &Path,
+    exposure: f32,
+    reflections: usize,
+) -> Result<ErrorSplit, HarnessError> {
+    let (full_image, truncated_image) = (read_image(full)?, read_image(truncated)?);
+    let raster_image = read_image(raster)?;
+    let mask = read_mask(full)
+        .map(|(m, _)| m)
+        .filter(|m| m.len() == raster_image.pixels.len());
+    let part = |reference: &RgbImage, test: &RgbImage| -> Result<_, HarnessError> {
+        let c = compare_detailed(reference, test, exposure)?;
+        let mirror = mask
+            .as_ref()
+            .and_then(|m| c.masked(reference, test, m))
+            .map(|m| metric_values(&m));
+        Ok((metric_values(&c.metrics), mirror))
+    };
+    let (truncation, truncation_mirror) = part(&full_image, &truncated_image)?;
+    let (approximation, approximation_mirror) = part(&truncated_image, &raster_image)?;
+    Ok(ErrorSplit {
+        reflections,
+        truncation,
+        truncation_mirror,
+        approximation,
+        approximation_mirror,
+    })
 }
 
 /// Where the mirror masks of the cached truth `truth` are kept: red where a pixel shows a
@@ -1034,6 +1083,15 @@ pub fn run_sweep(
             truth: images.join(format!("truth_{truth_name}.png")),
         };
         let views = compare_views(&truths[i], &rasters, exposure, marker, &files)?;
+        let split = match (&p.method, truths[i].as_slice()) {
+            (Some(_), [full]) => {
+                let (scene, _) = point_setup(&base, p, config)?;
+                let at = report.depth;
+                let truncated = truth_at_depth(&scene, config, at, &truth_cache, &mut summary)?;
+                Some(error_split(full, &truncated, &rasters[0], exposure, at)?)
+            }
+            _ => None,
+        };
         for r in &rasters {
             let _ = std::fs::remove_file(r);
         }
@@ -1095,6 +1153,7 @@ pub fn run_sweep(
             metrics: views.metrics,
             mirror_metrics: views.mirror_metrics,
             mirror_pixel_share: views.mirror_pixel_share,
+            split,
             reflection_offscreen_share: views.reflection_offscreen_share,
             adapter: s.adapter.clone(),
             backend: s.backend.clone(),

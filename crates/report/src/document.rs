@@ -334,6 +334,7 @@ pub(crate) mod fixtures {
             },
             mirror_metrics: None,
             mirror_pixel_share: None,
+            split: None,
             reflection_offscreen_share: None,
             adapter: "test".into(),
             backend: "vulkan".into(),

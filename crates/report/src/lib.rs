@@ -19,6 +19,7 @@ pub mod plot;
 pub mod readme;
 mod runs;
 pub mod sections;
+pub mod split;
 pub mod stats;
 pub mod stereo;
 pub mod symmetry;
@@ -238,6 +239,11 @@ pub struct Record {
     /// The share of the image's pixels that are mirror pixels, in [0, 1].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mirror_pixel_share: Option<f64>,
+    /// The point's error split into what stopping at its reflection count leaves out and what
+    /// the method gets wrong of what it shows (issue 50). Absent for the floor, stereo points
+    /// and older records.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub split: Option<ErrorSplit>,
     /// The share of the mirror pixels whose first reflection is off screen (behind the camera
     /// or outside the image), in [0, 1]: what screen-space reflections cannot show (issue 39).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -253,6 +259,24 @@ pub struct Record {
     pub truth_image: String,
     pub raster_image: String,
     pub heatmap_image: String,
+}
+
+/// A point's error against the truth, split at the reflection count `reflections` it shows
+/// (the method's `FrameStats::depth`): **truncation**, the truth traced with at most that
+/// many reflections (the terminal radiance beyond, as `trace --max-depth`) against the full
+/// truth — what any method stopping there leaves out; and **approximation**, the method
+/// against that truncated truth — what it gets wrong of what it claims to show (for an exact
+/// method, edge samples within the rasterizer's sub-pixel grid; for the paper's auxiliary
+/// mirrors, what they distort). Over the whole image and over the full truth's mirror pixels.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ErrorSplit {
+    pub reflections: usize,
+    pub truncation: MetricValues,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub truncation_mirror: Option<MetricValues>,
+    pub approximation: MetricValues,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub approximation_mirror: Option<MetricValues>,
 }
 
 /// The names of the scene axes in [`Record::axes`].

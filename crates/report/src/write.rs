@@ -322,17 +322,26 @@ fn inline(s: &str) -> String {
     out
 }
 
+/// A value of `r`'s error split ([`crate::ErrorSplit`]), empty where it has none.
+fn split(r: &Record, value: impl Fn(&crate::ErrorSplit) -> Option<f64>) -> String {
+    r.split
+        .as_ref()
+        .and_then(value)
+        .map_or(String::new(), |v| v.to_string())
+}
+
 fn write_csv(path: &Path, records: &[Record]) -> Result<(), FileError> {
     let mut s = String::from(
         "kind,method,n,depth,alpha,width,height,ssaa,ms_median,ms_ci_low,ms_ci_high,ms_min,timing_order,timing_source,frames,passes,draws,texture_renders,reflections,\
-         rmse,relmse,smape,max_abs,psnr,ssim,flip_mean,flip_p95,flip_p99,adapter,backend,scene,scene_hash,color_format,peak_memory_bytes,plan_ms,encode_ms,gpu_buffer_bytes,gpu_texture_bytes,method_options,symmetry_planes,copies_drawn,copies_total,bake_ms,mirrored_lights,bump_amplitude_deg,stereo_ipd,marker_disparity_px,truth_marker_disparity_px\n",
+         rmse,relmse,smape,max_abs,psnr,ssim,flip_mean,flip_p95,flip_p99,adapter,backend,scene,scene_hash,color_format,peak_memory_bytes,plan_ms,encode_ms,gpu_buffer_bytes,gpu_texture_bytes,method_options,symmetry_planes,copies_drawn,copies_total,bake_ms,mirrored_lights,bump_amplitude_deg,stereo_ipd,marker_disparity_px,truth_marker_disparity_px,\
+         mirror_flip_mean,truncation_flip_mean,approximation_flip_mean,truncation_mirror_flip_mean,approximation_mirror_flip_mean,truncation_relmse,approximation_relmse\n",
     );
     for r in records {
         let m = &r.metrics;
         let opt = |v: Option<u32>| v.map_or(String::new(), |x| x.to_string());
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},\"{}\",{},\"{}\",{},{},{},{},{},{},{},\"{}\",{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},\"{}\",{},\"{}\",{},{},{},{},{},{},{},\"{}\",{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             r.kind,
             r.method,
             opt(r.n),
@@ -383,6 +392,15 @@ fn write_csv(path: &Path, records: &[Record]) -> Result<(), FileError> {
                 .map_or(String::new(), |st| st.ipd.to_string()),
             crate::stereo::disparity(r, false).map_or(String::new(), |d| d.to_string()),
             crate::stereo::disparity(r, true).map_or(String::new(), |d| d.to_string()),
+            r.mirror_metrics
+                .as_ref()
+                .map_or(String::new(), |m| m.flip_mean.to_string()),
+            split(r, |s| Some(s.truncation.flip_mean)),
+            split(r, |s| Some(s.approximation.flip_mean)),
+            split(r, |s| s.truncation_mirror.as_ref().map(|m| m.flip_mean)),
+            split(r, |s| s.approximation_mirror.as_ref().map(|m| m.flip_mean)),
+            split(r, |s| Some(s.truncation.relmse)),
+            split(r, |s| Some(s.approximation.relmse)),
         );
     }
     write_atomically(path, s.as_bytes())
@@ -1016,6 +1034,7 @@ fn document(info: &SweepInfo, records: &[Record], sections: &[Section]) -> Vec<B
             }),
         ));
     }
+    b.extend(crate::split::split_section(records, &info.exact_methods));
     if !points.is_empty() {
         b.push(Block::Heading(2, "All points".into()));
         b.push(Block::Table(
@@ -1404,16 +1423,16 @@ pub(crate) mod tests {
             "{md}"
         );
         let csv = std::fs::read_to_string(dir.path().join("results.csv")).unwrap();
-        assert!(csv.lines().next().unwrap().ends_with(
+        assert!(csv.lines().next().unwrap().contains(
             ",color_format,peak_memory_bytes,plan_ms,encode_ms,gpu_buffer_bytes,gpu_texture_bytes,\
              method_options,symmetry_planes,copies_drawn,copies_total,bake_ms,mirrored_lights,\
-             bump_amplitude_deg,stereo_ipd,marker_disparity_px,truth_marker_disparity_px"
+             bump_amplitude_deg,stereo_ipd,marker_disparity_px,truth_marker_disparity_px,"
         ));
         assert!(
             csv.lines()
                 .nth(2)
                 .unwrap()
-                .ends_with(",rgba16float,,,,,,\"\",,,,,,,,,")
+                .contains(",rgba16float,,,,,,\"\",,,,,,,,,")
         );
         // Every row has the header's number of columns (no value here holds a comma).
         let columns = |l: &str| l.split(',').count();
