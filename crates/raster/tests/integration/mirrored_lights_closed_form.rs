@@ -78,6 +78,22 @@ fn scene_json(
     parse_scene(&v.to_string(), Path::new("closed_form.json")).unwrap()
 }
 
+/// The light's images in two parallel mirrors, with their attenuation: the chains alternate
+/// sides, first reflection in either mirror, then the other, ….
+fn pair_images(planes: &[Plane; 2]) -> Vec<(DVec3, f64)> {
+    let mut images = Vec::new();
+    for first in 0..2 {
+        let mut p = DVec3::from(LIGHT);
+        let mut attenuation = 1.0;
+        for j in 0..MIRRORED_LIGHTS {
+            p = planes[(first + j as usize) % 2].reflect(p);
+            attenuation *= R;
+            images.push((p, attenuation));
+        }
+    }
+    images
+}
+
 /// Mirrors at x = ±1 facing each other, the floor between them; the image's columns run
 /// along x and its outer columns end within half a pixel of each mirror.
 fn parallel_pair() -> Case {
@@ -101,21 +117,10 @@ fn parallel_pair() -> Case {
         json!({ "type": "quad", "size": [2, 8], "transform": { "rotate_deg": [-90, 0, 0] },
                 "albedo": [ALBEDO, ALBEDO, ALBEDO] }),
     );
-    // The chains alternate sides: first reflection in either mirror, then the other, ...
-    let mut images = Vec::new();
-    for first in 0..2 {
-        let mut p = DVec3::from(LIGHT);
-        let mut attenuation = 1.0;
-        for j in 0..MIRRORED_LIGHTS {
-            p = planes[(first + j as usize) % 2].reflect(p);
-            attenuation *= R;
-            images.push((p, attenuation));
-        }
-    }
     Case {
         name: "parallel_pair",
+        images: pair_images(&planes),
         scene,
-        images,
         floor: [-1.0, 1.0, -4.0, 4.0],
     }
 }
@@ -195,18 +200,11 @@ fn wide_ground(mirrors: bool) -> Case {
         json!({ "type": "quad", "size": [200, 1.9], "transform": { "rotate_deg": [-90, 0, 0] },
                 "albedo": [ALBEDO, ALBEDO, ALBEDO] }),
     );
-    let mut images = Vec::new();
-    if mirrors {
-        for first in 0..2 {
-            let mut p = DVec3::from(LIGHT);
-            let mut attenuation = 1.0;
-            for j in 0..MIRRORED_LIGHTS {
-                p = planes[(first + j as usize) % 2].reflect(p);
-                attenuation *= R;
-                images.push((p, attenuation));
-            }
-        }
-    }
+    let images = if mirrors {
+        pair_images(&planes)
+    } else {
+        Vec::new()
+    };
     Case {
         name: if mirrors {
             "wide_ground"
