@@ -53,9 +53,9 @@ fn findings(points: &[(&Record, &ErrorSplit)], exact_methods: &[String]) -> Vec<
                 .all(|(r, _)| exact_methods.contains(&r.method) && r.method_options.is_empty());
             if exact {
                 format!(
-                    "`{v}` (exact): approximation {approx} (FLIP over the mirror pixels) — the \
-                     samples its rasterizer decides within its sub-pixel grid of an edge; the \
-                     rest of its error ({error}) is {truncation_words}."
+                    "`{v}` (exact): of its error {error} (FLIP over the mirror pixels), \
+                     approximation {approx} — the samples its rasterizer decides within its \
+                     sub-pixel grid of an edge — and {truncation_words}."
                 )
             } else if of.iter().all(|(r, s)| approximation(s) > total(r)) {
                 format!(
@@ -205,7 +205,10 @@ mod tests {
             "{findings:?}"
         );
         assert!(
-            findings[1].starts_with("`portal` (exact): approximation 4.000e-5"),
+            findings[1].starts_with(
+                "`portal` (exact): of its error 2.000e-3 (FLIP over the mirror pixels), \
+                 approximation 4.000e-5 "
+            ),
             "{findings:?}"
         );
         let Block::Table(_, rows) = &blocks[3] else {
