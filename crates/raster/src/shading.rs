@@ -67,10 +67,14 @@ fn atlas_width(scene: &Scene) -> u32 {
 }
 
 /// The mirrors' frames and bumps, and the normal maps' atlas: its width and its texels
-/// packed one u32 each, every map's rows below the previous map's.
+/// packed one u32 each, every map's rows below the previous map's — each map once, however
+/// many mirrors share it (the loader decodes a file once; mirrors sharing it share its
+/// texels, which identify it here).
 fn mirror_bumps(scene: &Scene) -> (Vec<GpuMirrorBump>, u32, Vec<u32>) {
     let atlas_width = atlas_width(scene);
     let mut texels: Vec<u32> = Vec::new();
+    let mut placed: std::collections::HashMap<*const mirrorbox_scene::bump::Texels, u32> =
+        Default::default();
     let mut bumps = Vec::with_capacity(scene.mirrors.len());
     for (m, bump) in scene.mirrors.iter().zip(&scene.bumps) {
         let mut g = GpuMirrorBump {
@@ -92,20 +96,23 @@ fn mirror_bumps(scene: &Scene) -> (Vec<GpuMirrorBump>, u32, Vec<u32>) {
             }
             if let Some(map) = &b.normal_map {
                 g.flags |= 2;
-                g.map_offset = (texels.len() / atlas_width as usize) as u32;
                 g.map_width = map.width;
                 g.map_height = map.height;
                 g.strength = map.strength;
                 g.tiling = map.tiling;
-                for row in map.texels.chunks_exact(map.width as usize) {
-                    let start = texels.len();
-                    texels.extend(
-                        row.iter().map(|t| {
-                            u32::from(t[0]) | u32::from(t[1]) << 8 | u32::from(t[2]) << 16
-                        }),
-                    );
-                    texels.resize(start + atlas_width as usize, 0);
-                }
+                g.map_offset = *placed
+                    .entry(std::sync::Arc::as_ptr(&map.texels))
+                    .or_insert_with(|| {
+                        let offset = (texels.len() / atlas_width as usize) as u32;
+                        for row in map.texels.chunks_exact(map.width as usize) {
+                            let start = texels.len();
+                            texels.extend(row.iter().map(|t| {
+                                u32::from(t[0]) | u32::from(t[1]) << 8 | u32::from(t[2]) << 16
+                            }));
+                            texels.resize(start + atlas_width as usize, 0);
+                        }
+                        offset
+                    });
             }
         }
         bumps.push(g);
@@ -116,13 +123,16 @@ fn mirror_bumps(scene: &Scene) -> (Vec<GpuMirrorBump>, u32, Vec<u32>) {
     (bumps, atlas_width, texels)
 }
 
-/// Rows of the normal-map atlas (every map's height, stacked).
+/// Rows of the normal-map atlas: every distinct map's height, stacked (what
+/// [`mirror_bumps`] packs: a map shared by many mirrors once).
 fn atlas_rows(scene: &Scene) -> u32 {
+    let mut seen = std::collections::HashSet::new();
     scene
         .bumps
         .iter()
         .flatten()
         .filter_map(|b| b.normal_map.as_ref())
+        .filter(|m| seen.insert(std::sync::Arc::as_ptr(&m.texels)))
         .map(|m| m.height)
         .sum::<u32>()
         .max(1)
@@ -420,7 +430,7 @@ impl SceneBuffers {
         )?;
         let planes: usize = l.images.images.iter().map(|i| i.beam.len()).sum();
         gpu.check_buffer("light plane", planes as u64 * 16, true)?;
-        // The atlas is one texture: every map's rows stacked.
+        // The atlas is one texture: every distinct map's rows stacked.
         let rows = atlas_rows(scene);
         let limit = gpu.device.limits().max_texture_dimension_2d;
         if rows > limit {
@@ -757,5 +767,42 @@ impl SceneBuffers {
             bind_group,
             textured: g.has_textures(),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    /// Mirrors sharing a normal map share one copy of it in the atlas (issue 51: 100 facets
+    /// sharing a 256² map needed 25 600 rows and were refused on lavapipe's 16 384).
+    #[test]
+    fn a_shared_normal_map_is_packed_once() {
+        let mirror = |x: f32, map: &str| {
+            format!(
+                r#"{{ "center": [{x}, 1, 0], "normal": [0, 0, 1], "up": [0, 1, 0], "width": 0.5,
+                     "height": 0.5, "bump": {{ "normal_map": {{ "path": "{map}" }} }} }}"#
+            )
+        };
+        let mut mirrors: Vec<String> = (0..100)
+            .map(|k| mirror(k as f32, "textures/hammered.png"))
+            .collect();
+        // Another read of the same image (another spelling of its path): a second copy.
+        mirrors.push(mirror(200.0, "textures/../textures/hammered.png"));
+        let text = format!(
+            r#"{{ "camera": {{ "position": [0, 1, 3], "look_at": [0, 1, 0], "fov_y_deg": 60,
+                              "width": 32, "height": 18 }},
+                 "mirrors": [{}] }}"#,
+            mirrors.join(",")
+        );
+        let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/shared.json");
+        let scene = mirrorbox_scene::load::parse_scene(&text, &file).unwrap();
+        let map_height = 256;
+        assert_eq!(atlas_rows(&scene), 2 * map_height);
+        let (bumps, width, texels) = mirror_bumps(&scene);
+        assert_eq!(texels.len(), (2 * map_height * width) as usize);
+        assert!(bumps[..100].iter().all(|b| b.map_offset == 0));
+        assert_eq!(bumps[100].map_offset, map_height);
     }
 }

@@ -16,6 +16,7 @@ use glam::{Vec3, Vec3A};
 use mirrorbox_scene::limits::{MAX_COORDINATE, within_extent};
 use mirrorbox_scene::{Geometry, Ray, Surface};
 use obvhs::BvhBuildParams;
+use obvhs::aabb::Aabb;
 use obvhs::bvh2::Bvh2;
 use obvhs::cwbvh::CwBvh;
 use obvhs::ray::RayHit;
@@ -119,15 +120,15 @@ const CWBVH_MAX_DEPTH: u32 = 31;
 /// hierarchy is deeper than [`CWBVH_MAX_DEPTH`] (its traversal would overrun its stack, and
 /// obvhs's debug validation asserts). Same steps, same result as the helper otherwise.
 fn build_cwbvh(
-    tris: &[Triangle],
+    boxes: &[Aabb],
     params: BvhBuildParams,
     build_time: &mut Duration,
 ) -> Result<CwBvh, Box<obvhs::bvh2::Bvh2>> {
     let start = std::time::Instant::now();
-    let mut bvh2 = obvhs::ploc::PlocBuilder::with_capacity(tris.len()).build(
+    let mut bvh2 = obvhs::ploc::PlocBuilder::with_capacity(boxes.len()).build(
         params.ploc_search_distance,
-        tris,
-        (0..tris.len() as u32).collect::<Vec<_>>(),
+        boxes,
+        (0..boxes.len() as u32).collect::<Vec<_>>(),
         params.sort_precision,
         params.search_depth_threshold,
     );
@@ -148,6 +149,47 @@ fn build_cwbvh(
     } else {
         Ok(cwbvh)
     }
+}
+
+/// Fewest triangles sharing one box exactly whose boxes [`primitive_boxes`] spreads.
+const TIED_BOXES: usize = 32;
+
+/// Each triangle's box, as the builder sees it. Where many triangles share one box exactly
+/// (coincident mirrors: a degenerate scene, but one the format accepts), every merge cost of
+/// obvhs's PLOC ties, and a sweep merges only the one pair whose neighbours agree: one pair
+/// per sweep, quadratic (20 000 coincident mirrors: 19.6 s, issue 51). Those boxes are
+/// spread: each grown on every side by a pseudo-random share (at most 10⁻³) of its size,
+/// which breaks the ties; it still bounds its triangle (traversal tests the triangles
+/// themselves, [`Slot`]). Boxes shared by fewer than [`TIED_BOXES`] triangles — every box of
+/// the bundled scenes — are the triangles' own, so those hierarchies are unchanged.
+fn primitive_boxes(tris: &[Triangle]) -> Vec<Aabb> {
+    use obvhs::Boundable;
+    let mut boxes: Vec<Aabb> = tris.iter().map(Boundable::aabb).collect();
+    let key = |b: &Aabb| {
+        let (lo, hi) = (b.min.to_array(), b.max.to_array());
+        [lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]].map(f32::to_bits)
+    };
+    let mut sharing: std::collections::HashMap<[u32; 6], usize> = Default::default();
+    for b in &boxes {
+        *sharing.entry(key(b)).or_default() += 1;
+    }
+    if sharing.values().all(|&n| n < TIED_BOXES) {
+        return boxes;
+    }
+    for (i, b) in boxes.iter_mut().enumerate() {
+        if sharing[&key(b)] < TIED_BOXES {
+            continue;
+        }
+        // A share in (0, 1] from the index (splitmix64's finaliser).
+        let mut z = (i as u64).wrapping_add(0x9e37_79b9_7f4a_7c15);
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        let share = ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32 + 1e-3;
+        let size = (b.max - b.min).max_element() + 1e-6 * (1.0 + b.max.abs().max_element());
+        let pad = Vec3A::splat(1e-3 * share * size);
+        *b = Aabb::new(b.min - pad, b.max + pad);
+    }
+    boxes
 }
 
 /// Levels below the root of the deepest inner node (obvhs's `calculate_max_depth`).
@@ -200,13 +242,14 @@ impl SceneBvh {
                 v2: Vec3A::from(t[2]),
             })
             .collect();
+        let boxes = primitive_boxes(&tris);
         let mut build_time = Duration::ZERO;
         let params = BvhBuildParams::medium_build();
         let (hierarchy, original) = if tris.is_empty() {
             (Hierarchy::Empty, Vec::new())
         } else {
             match kind {
-                BvhKind::Cwbvh => match build_cwbvh(&tris, params, &mut build_time) {
+                BvhKind::Cwbvh => match build_cwbvh(&boxes, params, &mut build_time) {
                     Ok(bvh) => {
                         let order = bvh.primitive_indices.clone();
                         (Hierarchy::Cw(bvh), order)
@@ -220,8 +263,10 @@ impl SceneBvh {
                     }
                 },
                 BvhKind::Bvh2 => {
-                    let bvh =
-                        obvhs::bvh2::builder::build_bvh2_from_tris(&tris, params, &mut build_time);
+                    // obvhs's `build_bvh2_from_tris` over the boxes (our parameters have no
+                    // pre-splits, the one step that needs the triangles).
+                    debug_assert!(!params.pre_split);
+                    let bvh = obvhs::bvh2::builder::build_bvh2(&boxes, params, &mut build_time);
                     let order = bvh.primitive_indices.clone();
                     (Hierarchy::Binary(bvh), order)
                 }
@@ -580,6 +625,65 @@ mod tests {
                 }
             }
             assert!(hits > cam.width as usize * cam.height as usize / 2);
+        }
+    }
+
+    /// Coincident mirrors (issue 51): the builder sees their boxes spread, and both
+    /// hierarchies still find the closest hit at every pixel — the same distance as brute
+    /// force, on one of the coincident triangles where the brute force finds one of them.
+    #[test]
+    fn coincident_mirrors_are_found_as_brute_force_finds_them() {
+        let mirror = r#"{ "center": [0, 1, -1], "normal": [0, 0, 1], "up": [0, 1, 0],
+                          "width": 2, "height": 2 }"#;
+        let text = format!(
+            r#"{{ "camera": {{ "position": [0.3, 1.2, 2], "look_at": [0, 1, -1],
+                              "fov_y_deg": 60, "width": 24, "height": 16 }},
+                 "mirrors": [{}],
+                 "objects": [ {{ "type": "quad", "size": [6, 6],
+                                 "transform": {{ "rotate_deg": [-90, 0, 0] }} }} ] }}"#,
+            vec![mirror; 2 * TIED_BOXES].join(",")
+        );
+        let scene = parse_scene(&text, Path::new("coincident.json")).unwrap();
+        let g = &scene.geometry;
+        let tris: Vec<Triangle> = g
+            .triangles
+            .iter()
+            .map(|t| Triangle {
+                v0: t[0].into(),
+                v1: t[1].into(),
+                v2: t[2].into(),
+            })
+            .collect();
+        let boxes = primitive_boxes(&tris);
+        for (t, b) in tris.iter().zip(&boxes) {
+            let own = obvhs::Boundable::aabb(t);
+            assert!(b.contains_point(own.min) && b.contains_point(own.max));
+        }
+        // The floor's two triangles keep their own boxes; the mirrors' are spread apart.
+        let is_mirror = |i: usize| matches!(g.surface(i), Surface::Mirror { .. });
+        let floor = (0..tris.len()).find(|&i| !is_mirror(i)).unwrap();
+        assert_eq!(boxes[floor], obvhs::Boundable::aabb(&tris[floor]));
+        let mirrors: Vec<usize> = (0..tris.len()).filter(|&i| is_mirror(i)).collect();
+        assert!(
+            boxes[mirrors[0]] != boxes[mirrors[1]],
+            "tied boxes are spread"
+        );
+        for kind in [BvhKind::Cwbvh, BvhKind::Bvh2] {
+            let bvh = SceneBvh::build_with(g, kind);
+            let cam = &scene.camera;
+            for y in 0..cam.height {
+                for x in 0..cam.width {
+                    let ray = cam.primary_ray(x as f32 + 0.5, y as f32 + 0.5);
+                    let got = bvh.closest_hit(&ray, 0.0, f32::INFINITY, None);
+                    let want = brute_force(g, &ray);
+                    assert_eq!(got.map(|h| h.t), want.map(|h| h.t), "{kind:?} ({x},{y})");
+                    assert_eq!(
+                        got.map(|h| g.triangles[h.triangle]),
+                        want.map(|h| g.triangles[h.triangle]),
+                        "{kind:?} ({x},{y})"
+                    );
+                }
+            }
         }
     }
 

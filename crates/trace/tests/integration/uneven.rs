@@ -57,7 +57,7 @@ fn a_constant_tilt_moves_the_reflection_by_the_closed_form() {
             resolved: "uniform.png".into(),
             width: 1,
             height: 1,
-            texels: Arc::new(vec![texel]),
+            texels: Arc::new(mirrorbox_scene::bump::Texels::new(vec![texel])),
             tiling: [1.0, 1.0],
             strength: 1.5,
         }),
