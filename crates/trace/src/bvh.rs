@@ -122,6 +122,7 @@ const CWBVH_MAX_DEPTH: u32 = 31;
 fn build_cwbvh(
     boxes: &[Aabb],
     params: BvhBuildParams,
+    max_depth: u32,
     build_time: &mut Duration,
 ) -> Result<CwBvh, Box<obvhs::bvh2::Bvh2>> {
     let start = std::time::Instant::now();
@@ -144,7 +145,7 @@ fn build_cwbvh(
         false,
     );
     *build_time += start.elapsed();
-    if cwbvh_depth(&cwbvh) > CWBVH_MAX_DEPTH {
+    if cwbvh_depth(&cwbvh) > max_depth {
         Err(Box::new(bvh2))
     } else {
         Ok(cwbvh)
@@ -221,6 +222,12 @@ impl SceneBvh {
     /// assimp's `box_longline.obj`, one long thin box) is replaced by the binary hierarchy
     /// it was built from, and `kind` says so.
     pub fn build_with(geometry: &Geometry, kind: BvhKind) -> Self {
+        Self::build_within(geometry, kind, CWBVH_MAX_DEPTH)
+    }
+
+    /// [`SceneBvh::build_with`], an 8-wide hierarchy kept only up to `max_depth` levels (the
+    /// tests lower it to reach the fallback, which real input reaches only when degenerate).
+    fn build_within(geometry: &Geometry, kind: BvhKind, max_depth: u32) -> Self {
         let mut kind = kind;
         if let Some(p) = geometry
             .triangles
@@ -249,7 +256,7 @@ impl SceneBvh {
             (Hierarchy::Empty, Vec::new())
         } else {
             match kind {
-                BvhKind::Cwbvh => match build_cwbvh(&boxes, params, &mut build_time) {
+                BvhKind::Cwbvh => match build_cwbvh(&boxes, params, max_depth, &mut build_time) {
                     Ok(bvh) => {
                         let order = bvh.primitive_indices.clone();
                         (Hierarchy::Cw(bvh), order)
@@ -683,6 +690,34 @@ mod tests {
                         "{kind:?} ({x},{y})"
                     );
                 }
+            }
+        }
+    }
+
+    /// An 8-wide hierarchy deeper than obvhs's 32-entry traversal stack holds (degenerate
+    /// input; here the limit lowered to 0 levels) is replaced by the binary one, said by
+    /// `kind`, which finds what brute force finds.
+    #[test]
+    fn a_hierarchy_too_deep_for_eight_wide_traversal_falls_back_to_the_binary_one() {
+        let scene = parse_scene(SCENE, Path::new("inline.json")).unwrap();
+        let g = &scene.geometry;
+        assert_eq!(
+            SceneBvh::build_within(g, BvhKind::Cwbvh, 31).kind,
+            BvhKind::Cwbvh
+        );
+        let bvh = SceneBvh::build_within(g, BvhKind::Cwbvh, 0);
+        assert_eq!(bvh.kind, BvhKind::Bvh2);
+        let cam = &scene.camera;
+        for y in 0..cam.height {
+            for x in 0..cam.width {
+                let ray = cam.primary_ray(x as f32 + 0.5, y as f32 + 0.5);
+                let got = bvh.closest_hit(&ray, 0.0, f32::INFINITY, None);
+                let want = brute_force(g, &ray);
+                assert_eq!(
+                    got.map(|h| h.triangle),
+                    want.map(|h| h.triangle),
+                    "({x},{y})"
+                );
             }
         }
     }
