@@ -163,7 +163,9 @@ for rep in $(seq "$reps"); do
           record kind run variant "$v" n "json:$n" command "$c" rep "json:$rep" skipped "no scene (the generator failed)"
           continue
         fi
-        if [ -f "$work/timedout.$v.$c" ]; then
+        # Skipped only at the N it timed out at and above (a later repetition still runs the
+        # smaller N).
+        if [ -f "$work/timedout.$v.$c" ] && [ "$n" -ge "$(cat "$work/timedout_n.$v.$c")" ]; then
           record kind run variant "$v" n "json:$n" command "$c" rep "json:$rep" skipped "$(cat "$work/timedout.$v.$c")"
           continue
         fi
@@ -182,7 +184,10 @@ for rep in $(seq "$reps"); do
         # before the limit is another SIGKILL (the kernel's out-of-memory killer).
         if [ "$rc" = 124 ] || { [ "$rc" = 137 ] && [ "${secs%.*}" -ge "$cap" ] 2>/dev/null; }; then
           err="timed out after $cap s"
-          echo "timed out at N=$n in rep $rep" > "$work/timedout.$v.$c"
+          if [ ! -f "$work/timedout.$v.$c" ] || [ "$n" -lt "$(cat "$work/timedout_n.$v.$c")" ]; then
+            echo "timed out at N=$n in rep $rep" > "$work/timedout.$v.$c"
+            echo "$n" > "$work/timedout_n.$v.$c"
+          fi
         elif [ "$rc" -gt 128 ]; then
           err="killed by signal $((rc - 128))"
           [ "$rc" != 137 ] || err="$err (SIGKILL: out of memory?)"
