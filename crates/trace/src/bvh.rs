@@ -676,20 +676,26 @@ mod tests {
             "tied boxes are spread"
         );
         for kind in [BvhKind::Cwbvh, BvhKind::Bvh2] {
-            let bvh = SceneBvh::build_with(g, kind);
-            let cam = &scene.camera;
-            for y in 0..cam.height {
-                for x in 0..cam.width {
-                    let ray = cam.primary_ray(x as f32 + 0.5, y as f32 + 0.5);
-                    let got = bvh.closest_hit(&ray, 0.0, f32::INFINITY, None);
-                    let want = brute_force(g, &ray);
-                    assert_eq!(got.map(|h| h.t), want.map(|h| h.t), "{kind:?} ({x},{y})");
-                    assert_eq!(
-                        got.map(|h| g.triangles[h.triangle]),
-                        want.map(|h| g.triangles[h.triangle]),
-                        "{kind:?} ({x},{y})"
-                    );
-                }
+            assert_finds_as_brute_force(&scene, &SceneBvh::build_with(g, kind));
+        }
+    }
+
+    /// At every pixel centre of `scene`'s camera, `bvh` finds the closest hit brute force
+    /// finds: the same distance, on a triangle of the same corners (one of coincident ones).
+    fn assert_finds_as_brute_force(scene: &mirrorbox_scene::Scene, bvh: &SceneBvh) {
+        let (g, cam) = (&scene.geometry, &scene.camera);
+        for y in 0..cam.height {
+            for x in 0..cam.width {
+                let ray = cam.primary_ray(x as f32 + 0.5, y as f32 + 0.5);
+                let got = bvh.closest_hit(&ray, 0.0, f32::INFINITY, None);
+                let want = brute_force(g, &ray);
+                let kind = bvh.kind;
+                assert_eq!(got.map(|h| h.t), want.map(|h| h.t), "{kind:?} ({x},{y})");
+                assert_eq!(
+                    got.map(|h| g.triangles[h.triangle]),
+                    want.map(|h| g.triangles[h.triangle]),
+                    "{kind:?} ({x},{y})"
+                );
             }
         }
     }
@@ -707,19 +713,7 @@ mod tests {
         );
         let bvh = SceneBvh::build_within(g, BvhKind::Cwbvh, 0);
         assert_eq!(bvh.kind, BvhKind::Bvh2);
-        let cam = &scene.camera;
-        for y in 0..cam.height {
-            for x in 0..cam.width {
-                let ray = cam.primary_ray(x as f32 + 0.5, y as f32 + 0.5);
-                let got = bvh.closest_hit(&ray, 0.0, f32::INFINITY, None);
-                let want = brute_force(g, &ray);
-                assert_eq!(
-                    got.map(|h| h.triangle),
-                    want.map(|h| h.triangle),
-                    "({x},{y})"
-                );
-            }
-        }
+        assert_finds_as_brute_force(&scene, &bvh);
     }
 
     #[test]
