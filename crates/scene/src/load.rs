@@ -755,7 +755,7 @@ impl Checker<'_> {
         if let Some(map) = self.normal_maps.borrow().get(&resolved) {
             return Ok((resolved, map.clone()));
         }
-        let (resolved, width, height, texels) = self.normal_map_texels(path, rel)?;
+        let (width, height, texels) = self.normal_map_texels(path, rel, &resolved)?;
         let map = (
             width,
             height,
@@ -767,16 +767,17 @@ impl Checker<'_> {
         Ok((resolved, map))
     }
 
-    /// A normal map PNG, relative to the scene's folder: 8-bit RGB or RGBA (alpha ignored),
+    /// A normal map PNG (`rel` as the scene wrote it, read from `resolved`, relative to the
+    /// scene's folder): 8-bit RGB or RGBA (alpha ignored),
     /// at most [`MAX_NORMAL_MAP_SIDE`] texels a side (checked from the header, before
     /// decoding), every texel's blue above 127 (its normal points out of the mirror).
     fn normal_map_texels(
         &self,
         path: &FieldPath,
         rel: &str,
-    ) -> Result<(PathBuf, u32, u32, Vec<[u8; 3]>)> {
+        resolved: &Path,
+    ) -> Result<(u32, u32, Vec<[u8; 3]>)> {
         use image::ImageDecoder;
-        let resolved: PathBuf = self.file.parent().unwrap_or(Path::new(".")).join(rel);
         let bad = |msg: String| {
             self.invalid(
                 path,
@@ -784,7 +785,7 @@ impl Checker<'_> {
             )
         };
         let bytes =
-            mirrorbox_files::read_bounded(&resolved, MAX_NORMAL_MAP_FILE_BYTES, "normal map")
+            mirrorbox_files::read_bounded(resolved, MAX_NORMAL_MAP_FILE_BYTES, "normal map")
                 .map_err(|e| bad(e.message))?;
         let decoder = image::codecs::png::PngDecoder::new(std::io::Cursor::new(&bytes))
             .map_err(|e| bad(format!("not a readable PNG file ({e})")))?;
@@ -820,7 +821,7 @@ impl Checker<'_> {
                 texels[k][2]
             )));
         }
-        Ok((resolved, w, h, texels))
+        Ok((w, h, texels))
     }
 
     fn light(&self, path: &FieldPath, l: &LightDesc) -> Result<PointLight> {

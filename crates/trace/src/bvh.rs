@@ -181,11 +181,8 @@ fn primitive_boxes(tris: &[Triangle]) -> Vec<Aabb> {
         if sharing[&key(b)] < TIED_BOXES {
             continue;
         }
-        // A share in (0, 1] from the index (splitmix64's finaliser).
-        let mut z = (i as u64).wrapping_add(0x9e37_79b9_7f4a_7c15);
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        let share = ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32 + 1e-3;
+        // A share in (0, 1] from the index.
+        let share = crate::sampler::SplitMix64::for_pixel(0, i as u64).next_unit() + 1e-3;
         let size = (b.max - b.min).max_element() + 1e-6 * (1.0 + b.max.abs().max_element());
         let pad = Vec3A::splat(1e-3 * share * size);
         *b = Aabb::new(b.min - pad, b.max + pad);

@@ -724,7 +724,7 @@ impl RecursiveTexture {
     ) -> Result<Self, RasterError> {
         let device = &gpu.device;
         let scene_buffers = SceneBuffers::new(gpu, scene, shadows.binding());
-        let b = schedule(
+        let mut b = schedule(
             scene,
             plan,
             texture_scale,
@@ -760,7 +760,6 @@ impl RecursiveTexture {
         // draw's dynamic offset), not one per draw: a frame of N mirrors each seen in the
         // other mirrors' textures draws ~N² mirrors, and a bind group each crashed lavapipe's
         // descriptor allocation at 400 mirrors (issue 51).
-        let mut b = b;
         let mut mirror_bind_groups = Vec::new();
         let mut group_of_slot: std::collections::HashMap<Option<usize>, usize> = Default::default();
         let group_of_binding: Vec<usize> = b

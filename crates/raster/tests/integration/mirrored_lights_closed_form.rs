@@ -221,24 +221,36 @@ fn wide_ground(mirrors: bool) -> Case {
 /// nothing else.
 fn assert_every_sample_sees_the_floor(case: &Case, s: u32) {
     let camera = &case.scene.camera;
+    let [x0, x1, z0, z1] = case.floor;
     for y in 0..camera.height {
         for x in 0..camera.width {
-            for j in 0..s {
-                for i in 0..s {
-                    let offset = |k: u32| (k as f32 + 0.5) / s as f32;
-                    let ray = camera.primary_ray(x as f32 + offset(i), y as f32 + offset(j));
-                    let (o, d) = (ray.origin.as_dvec3(), ray.dir.as_dvec3());
-                    let p = o + d * (-o.y / d.y);
-                    let [x0, x1, z0, z1] = case.floor;
-                    assert!(
-                        d.y < 0.0 && (x0..x1).contains(&p.x) && (z0..z1).contains(&p.z),
-                        "{}: pixel ({x}, {y}) does not see the floor",
-                        case.name
-                    );
-                }
+            for (p, d) in grid_floor_points(camera, x, y, s) {
+                assert!(
+                    d.y < 0.0 && (x0..x1).contains(&p.x) && (z0..z1).contains(&p.z),
+                    "{}: pixel ({x}, {y}) does not see the floor",
+                    case.name
+                );
             }
         }
     }
+}
+
+/// The points of the floor's plane (y = 0) that the rays of pixel `(x, y)`'s `s × s`
+/// sub-pixel grid meet, row by row, each with its ray's direction.
+fn grid_floor_points(
+    camera: &mirrorbox_scene::Camera,
+    x: u32,
+    y: u32,
+    s: u32,
+) -> impl Iterator<Item = (DVec3, DVec3)> + '_ {
+    let offset = move |k: u32| (k as f32 + 0.5) / s as f32;
+    (0..s).flat_map(move |j| {
+        (0..s).map(move |i| {
+            let ray = camera.primary_ray(x as f32 + offset(i), y as f32 + offset(j));
+            let (o, d) = (ray.origin.as_dvec3(), ray.dir.as_dvec3());
+            (o + d * (-o.y / d.y), d)
+        })
+    })
 }
 
 fn cases() -> [Case; 4] {
@@ -255,21 +267,14 @@ fn closed_form_pixel(case: &Case, x: u32, y: u32, s: u32) -> f64 {
     let camera = &case.scene.camera;
     let light = DVec3::from(LIGHT);
     let mut sum = 0.0;
-    for j in 0..s {
-        for i in 0..s {
-            let offset = |k: u32| (k as f32 + 0.5) / s as f32;
-            let ray = camera.primary_ray(x as f32 + offset(i), y as f32 + offset(j));
-            let (o, d) = (ray.origin.as_dvec3(), ray.dir.as_dvec3());
-            let p = o + d * (-o.y / d.y);
-            let mut irradiance = 0.0;
-            for (q, attenuation) in std::iter::once((light, 1.0)).chain(case.images.iter().copied())
-            {
-                let v = q - p;
-                let r2 = v.length_squared();
-                irradiance += attenuation * INTENSITY * (v.y / r2.sqrt()).max(0.0) / r2;
-            }
-            sum += ALBEDO / std::f64::consts::PI * irradiance;
+    for (p, _) in grid_floor_points(camera, x, y, s) {
+        let mut irradiance = 0.0;
+        for (q, attenuation) in std::iter::once((light, 1.0)).chain(case.images.iter().copied()) {
+            let v = q - p;
+            let r2 = v.length_squared();
+            irradiance += attenuation * INTENSITY * (v.y / r2.sqrt()).max(0.0) / r2;
         }
+        sum += ALBEDO / std::f64::consts::PI * irradiance;
     }
     sum / f64::from(s * s)
 }
