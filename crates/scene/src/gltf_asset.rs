@@ -105,6 +105,10 @@ pub struct GltfAsset {
     pub lights: Vec<PointLight>,
     pub cameras: Vec<AssetCamera>,
     pub notes: Vec<String>,
+    /// `texture_of_image[i]`: the texture `images[i]` became, as the parts' maps number
+    /// textures ([`load_gltf_reusing`]'s `texture_base` plus its place in `textures`, or the
+    /// known texture it reused); `None` for an image no drawn material uses.
+    pub texture_of_image: Vec<Option<u32>>,
 }
 
 /// What the caller allows.
@@ -121,8 +125,23 @@ pub struct GltfOptions {
     pub curved_mirrors: CurvedMirrors,
 }
 
-/// Loads the asset at `path` (see the module docs).
+/// Loads the asset at `path` (see the module docs); its parts' maps number its own
+/// `textures` from 0.
 pub fn load_gltf(path: &Path, options: &GltfOptions) -> Result<GltfAsset> {
+    load_gltf_reusing(path, options, 0, &[])
+}
+
+/// [`load_gltf`] for a scene that may already hold this file's images: `known[i]`, where
+/// `Some`, is the scene texture `images[i]` was decoded into by an earlier object naming the
+/// same file (it is not read, decoded or counted against the texel budget again: issue 51, a
+/// file instanced by many objects is decoded once); a new image becomes scene texture
+/// `texture_base + k`, `k` its place in the returned `textures`.
+pub fn load_gltf_reusing(
+    path: &Path,
+    options: &GltfOptions,
+    texture_base: u32,
+    known: &[Option<u32>],
+) -> Result<GltfAsset> {
     let bytes = mirrorbox_files::read_bounded(path, MAX_GLTF_FILE_BYTES, "glTF file")
         .map_err(|e| err("", e.message))?;
     let (json, blob) = if bytes.starts_with(b"glTF") {
@@ -215,7 +234,8 @@ pub fn load_gltf(path: &Path, options: &GltfOptions) -> Result<GltfAsset> {
         buffers: Vec::new(),
         total_bytes: 0,
         asset: GltfAsset::default(),
-        texture_of_image: Vec::new(),
+        texture_of_image: known.to_vec(),
+        texture_base,
         texels: 0,
         options: *options,
         triangles: 0,
@@ -227,6 +247,7 @@ pub fn load_gltf(path: &Path, options: &GltfOptions) -> Result<GltfAsset> {
     }
     reader.read_buffers()?;
     reader.read_scene()?;
+    reader.asset.texture_of_image = reader.texture_of_image;
     Ok(reader.asset)
 }
 
@@ -237,8 +258,10 @@ struct Reader<'a> {
     buffers: Vec<Vec<u8>>,
     total_bytes: u64,
     asset: GltfAsset,
-    /// `texture_of_image[i]`: the index in `asset.textures` of `images[i]`, once decoded.
+    /// `texture_of_image[i]`: the scene texture `images[i]` became, once decoded or known.
     texture_of_image: Vec<Option<u32>>,
+    /// The scene texture number of `asset.textures[0]`.
+    texture_base: u32,
     texels: u64,
     options: GltfOptions,
     triangles: u64,
@@ -961,7 +984,7 @@ impl Reader<'_> {
             Some(n) => format!("{field} ({n})"),
             None => field,
         };
-        let index = self.asset.textures.len() as u32;
+        let index = self.texture_base + self.asset.textures.len() as u32;
         self.asset.textures.push(Texture { name, ..texture });
         self.texture_of_image[i] = Some(index);
         Ok(index)

@@ -83,6 +83,7 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene> {
     Checker {
         file: path,
         normal_maps: Default::default(),
+        gltf_images: Default::default(),
     }
     .compile(file)
 }
@@ -118,6 +119,10 @@ struct Checker<'a> {
     /// took 18.6 s and 3.85 GB to `check`, the map decoded once per mirror). The mirrors
     /// share its texels (an `Arc`); the GPU atlas and the memory estimate count it once.
     normal_maps: std::cell::RefCell<std::collections::HashMap<PathBuf, DecodedMap>>,
+    /// For each glTF file loaded so far (by resolved path), the scene texture each of its
+    /// images became: a file instanced by many objects has its images read and decoded once
+    /// (issue 51), the objects sharing the textures.
+    gltf_images: std::cell::RefCell<std::collections::HashMap<PathBuf, Vec<Option<u32>>>>,
 }
 
 /// A decoded normal map: width, height and texels.
@@ -973,24 +978,29 @@ impl Checker<'_> {
                 _ => gltf_asset::CurvedMirrors::Refuse,
             },
         };
-        let asset = gltf_asset::load_gltf(&resolved, &options).map_err(|e| {
-            let at = if resolved.to_string_lossy() == rel {
-                String::new()
-            } else {
-                format!(" (at {})", resolved.display())
-            };
-            self.invalid(&file_path, format!("glTF \"{rel}\"{at}: {e}"))
-        })?;
-        let first_texture = geometry.textures.len() as u32;
+        let known = self
+            .gltf_images
+            .borrow()
+            .get(&resolved)
+            .cloned()
+            .unwrap_or_default();
+        let texture_base = geometry.textures.len() as u32;
+        let asset = gltf_asset::load_gltf_reusing(&resolved, &options, texture_base, &known)
+            .map_err(|e| {
+                let at = if resolved.to_string_lossy() == rel {
+                    String::new()
+                } else {
+                    format!(" (at {})", resolved.display())
+                };
+                self.invalid(&file_path, format!("glTF \"{rel}\"{at}: {e}"))
+            })?;
         geometry.textures.extend(asset.textures);
+        self.gltf_images
+            .borrow_mut()
+            .insert(resolved.clone(), asset.texture_of_image);
         let object_name = o.name.clone().unwrap_or_else(|| format!("gltf {index}"));
         for part in asset.parts {
-            let mut surface = part.surface;
-            if let Surface::Diffuse { maps, .. } = &mut surface {
-                for m in [&mut maps.albedo, &mut maps.emission].into_iter().flatten() {
-                    m.texture += first_texture;
-                }
-            }
+            let surface = part.surface;
             geometry.push_textured_part(
                 format!("{object_name}: {}", part.name),
                 surface,
@@ -1622,6 +1632,55 @@ mod tests {
                 && e.contains("4194304"),
             "{e}"
         );
+    }
+
+    /// A glTF file named by several objects has its images decoded once (issue 51): three
+    /// instances of the textured cube hold the textures of one, and every instance's maps
+    /// name those same textures (the scene texture numbers of the first), in range.
+    #[test]
+    fn a_gltf_file_instanced_many_times_decodes_its_images_once() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/scene.json");
+        let scene = |objects: usize| {
+            let objects: Vec<String> = (0..objects)
+                .map(|i| {
+                    format!(
+                        r#"{{ "type": "gltf", "path": "assets/textured_cube.gltf",
+                        "transform": {{ "translate": [{}, 0, 0] }} }}"#,
+                        2 * i
+                    )
+                })
+                .collect();
+            parse_scene(
+                &format!(
+                    r#"{{ "camera": {{ "position": [0, 1, 5], "look_at": [0, 0, 0], "fov_y_deg": 50, "width": 32, "height": 18 }},
+                    "objects": [ {} ] }}"#,
+                    objects.join(",")
+                ),
+                &dir,
+            )
+            .unwrap()
+        };
+        let maps = |s: &Scene| -> Vec<u32> {
+            s.geometry
+                .surfaces
+                .iter()
+                .filter_map(|surface| match surface {
+                    Surface::Diffuse { maps, .. } => Some(maps),
+                    _ => None,
+                })
+                .flat_map(|m| [m.albedo, m.emission].into_iter().flatten())
+                .map(|m| m.texture)
+                .collect()
+        };
+        let (one, three) = (scene(1), scene(3));
+        assert_eq!(one.geometry.textures.len(), 2, "the cube's two images");
+        assert_eq!(three.geometry.textures.len(), one.geometry.textures.len());
+        let (one_maps, three_maps) = (maps(&one), maps(&three));
+        assert!(!one_maps.is_empty());
+        assert_eq!(three_maps.len(), 3 * one_maps.len());
+        for instance in three_maps.chunks(one_maps.len()) {
+            assert_eq!(instance, one_maps.as_slice());
+        }
     }
 
     /// `camera.gltf`: the scene camera is the asset's (the project's textured asset places one
