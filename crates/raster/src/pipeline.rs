@@ -214,6 +214,11 @@ impl UniformArena {
         }
     }
 
+    /// Whether the records' bytes are kept (a device's arena), or only counted.
+    pub fn keeps_records(&self) -> bool {
+        self.keeps_records
+    }
+
     /// The size of the buffer [`UniformArena::buffer`] would create.
     pub fn buffer_size(&self) -> u64 {
         self.len.max(self.alignment.max(16)) as u64

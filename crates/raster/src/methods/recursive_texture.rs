@@ -488,6 +488,11 @@ struct Builder<'a> {
     passes: Vec<PassSpec>,
     /// (uniform offset, slot or None for the "no texture" binding) per mirror bind group.
     mirror_bindings: Vec<(u32, Option<usize>)>,
+    /// Mirror draws scheduled. With a counting-only arena (a memory estimate) the draws
+    /// and their bindings are counted, not kept: a frame of N mirrors seen in each other's
+    /// textures has ~N² of them, which the estimate must refuse before they are allocated
+    /// (issue 51: 4 000 facets held 774 MB of draw lists before the refusal).
+    mirror_draw_count: u64,
 }
 
 impl Builder<'_> {
@@ -610,6 +615,10 @@ impl Builder<'_> {
                 }
                 None => (self.uniforms.push(&MirrorUniform::zeroed()), None),
             };
+            self.mirror_draw_count += 1;
+            if !self.uniforms.keeps_records() {
+                continue;
+            }
             self.mirror_bindings.push(binding);
             draws.push(MirrorDraw {
                 mirror: inst.mirror,
@@ -845,6 +854,7 @@ fn schedule<'a>(
         slot_sizes: Vec::new(),
         passes: Vec::new(),
         mirror_bindings: Vec::new(),
+        mirror_draw_count: 0,
     };
     let roots: Vec<(&TextureNode, usize)> = plan.roots.iter().map(|n| (n, b.emit(n))).collect();
     let screen = Rect {
@@ -931,8 +941,19 @@ fn texture_memory(
         "--max-passes, --n or --depth",
         planned.plan.passes as u64 * PLAN_BYTES_PER_PASS,
     );
+    e.host(
+        "the mirror draw lists",
+        "--max-passes, --n or --depth",
+        b.mirror_draw_count * MIRROR_DRAW_HOST_BYTES,
+    );
     e
 }
+
+/// Host bytes one scheduled mirror draw holds while a frame is built: its [`MirrorDraw`],
+/// its binding record and the bind-group index it is mapped to.
+const MIRROR_DRAW_HOST_BYTES: u64 = (std::mem::size_of::<MirrorDraw>()
+    + std::mem::size_of::<(u32, Option<usize>)>()
+    + std::mem::size_of::<usize>()) as u64;
 
 /// Host bytes a plan keeps per texture render (its node, camera, hidden list and pass).
 const PLAN_BYTES_PER_PASS: u64 = 1024;
@@ -1161,5 +1182,95 @@ impl TexturePipelines {
                 pass.draw(scene_buffers.mirrors[mirror].clone(), 0..1);
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::plan::Queue;
+
+    /// A wall of `side`² small mirrors facing the camera, each slightly tilted (as
+    /// `scripts/make_mirror_mosaic.py` writes one), in front of a floor.
+    fn mosaic(side: usize) -> Scene {
+        let mirrors: Vec<String> = (0..side * side)
+            .map(|i| {
+                let (x, y) = ((i % side) as f32, (i / side) as f32);
+                let tilt = 0.02 * ((i * 7 % 5) as f32 - 2.0);
+                format!(
+                    r#"{{ "center": [{}, {}, -2], "normal": [{tilt}, 0, 1], "up": [0, 1, 0],
+                    "width": 0.3, "height": 0.3 }}"#,
+                    0.35 * (x - side as f32 / 2.0),
+                    0.5 + 0.35 * y
+                )
+            })
+            .collect();
+        let text = format!(
+            r#"{{ "camera": {{ "position": [0, 1.5, 3], "look_at": [0, 1.2, -2],
+                "fov_y_deg": 60, "width": 64, "height": 36 }},
+              "mirrors": [ {} ],
+              "objects": [ {{ "type": "quad", "size": [6, 6], "albedo": [0.5, 0.5, 0.5],
+                "transform": {{ "rotate_deg": [-90, 0, 0] }} }} ],
+              "lights": [ {{ "position": [0, 3, 1], "intensity": [10, 10, 10] }} ] }}"#,
+            mirrors.join(",")
+        );
+        mirrorbox_scene::load::parse_scene(&text, std::path::Path::new("mosaic.json")).unwrap()
+    }
+
+    /// A memory estimate schedules a frame's ~N² mirror draws (N mirrors, each drawn in the
+    /// others' textures) by counting them, keeping no draw list and no binding (issue 51: the
+    /// estimate of 4 000 facets held 774 MB of them before refusing the frame), and counts
+    /// their host bytes in the estimate.
+    #[test]
+    fn the_estimate_counts_mirror_draws_without_keeping_them() {
+        let side = 6;
+        let n = side * side;
+        let scene = mosaic(side);
+        let plan = crate::plan::plan(&scene, Queue::SceneMirrors, 64, 36, 5000).unwrap();
+        assert!(
+            plan.passes > n / 2,
+            "most facets get a texture: {}",
+            plan.passes
+        );
+        let bump = BumpSettings {
+            mode: 0,
+            strength: 0.0,
+            proxy_distance: 0.0,
+            march_steps: 0,
+            margin: 0,
+        };
+        let views = [MainView {
+            camera: scene.camera.clone(),
+            lookup: None,
+        }];
+        let b = schedule(
+            &scene,
+            &plan,
+            1.0,
+            bump,
+            &views,
+            UniformArena::with_alignment(256),
+        );
+        assert!(b.passes.iter().all(|p| p.draws.is_empty()));
+        assert!(b.mirror_bindings.is_empty());
+        // Every pass draws every mirror but those in its own portal's plane (a fifth of the
+        // facets share the untilted plane): more than (passes)·N/2.
+        let at_least = (plan.passes * n / 2) as u64;
+        let count = b.mirror_draw_count;
+        assert!(count >= at_least, "{count} draws, at least {at_least}");
+        drop(b);
+        let planned = PlannedTextures {
+            plan,
+            texture_scale: 1.0,
+            bump,
+            views: views.to_vec(),
+        };
+        let estimate = texture_memory(&scene, &planned, 8);
+        let lists = estimate
+            .parts
+            .iter()
+            .find(|p| p.what == "the mirror draw lists")
+            .expect("the estimate names the draw lists");
+        assert_eq!(lists.host_bytes, count * MIRROR_DRAW_HOST_BYTES);
     }
 }
