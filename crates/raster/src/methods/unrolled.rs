@@ -317,11 +317,16 @@ impl Unrolled {
             gpu.features.contains(wgpu::Features::CLIP_DISTANCES) && !fragment_clipping;
         let scene_buffers = SceneBuffers::new(gpu, scene, shadows.binding());
         let size = Vec2::new(width as f32, height as f32);
-        let planes: Vec<Vec4> = scene
+        // Each distinct mirror plane once: every item is tested against every plane, and
+        // stacked or coincident mirrors (a mosaic's coplanar facets, the degenerate scene of
+        // 20 000 coincident mirrors) would make that items × mirrors (issue 51).
+        let mut planes: Vec<Vec4> = scene
             .mirrors
             .iter()
             .map(|m| m.plane().coefficients())
             .collect();
+        planes.sort_unstable_by_key(|p| p.to_array().map(f32::to_bits));
+        planes.dedup_by_key(|p| p.to_array().map(f32::to_bits));
         let in_front_of_all = |lo: Vec3, hi: Vec3| {
             box_corners(lo, hi).iter().all(|p| {
                 planes
