@@ -120,10 +120,12 @@ cmd_line() {  # the command $1 on scene $2, as words
 }
 
 cpu=$(grep -m1 '^model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ *//' || true)
+# Before the record is emptied: emptying a committed raw.jsonl would itself make the tree dirty.
+commit=$(git describe --always --dirty 2>/dev/null || echo unknown)
 : > "$raw"
 record kind meta date "$(date -u +%Y-%m-%dT%H:%M:%SZ)" cpu "${cpu:-unknown}" \
   cores "json:$(nproc)" cpus_in_cpuinfo "json:$(grep -c '^processor' /proc/cpuinfo || true)" \
-  commit "$(git describe --always --dirty 2>/dev/null || echo unknown)" \
+  commit "$commit" \
   binary "$bin" binary_mtime "$(date -u -r "$bin" +%Y-%m-%dT%H:%M:%SZ)" \
   timeout_s "json:$cap" reps "json:$reps" \
   ns "json:[$(echo $ns | tr ' ' ',')]" \
