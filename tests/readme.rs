@@ -52,7 +52,8 @@ fn the_readme_agrees_with_the_committed_reports() {
     }
     // Every region the generator knows is used, so no report figure is quoted by hand.
     let text: String = filled_files().iter().map(|f| read(f)).collect();
-    for (id, _, _) in mirrorbox_report::readme::REGIONS {
+    for region in mirrorbox_experiments::regions() {
+        let id = region.id;
         assert!(
             text.contains(&format!("<!-- generated: {id} -->")),
             "none of README.md, docs/methods.md and docs/book/src/*.md has the generated region {id:?}"

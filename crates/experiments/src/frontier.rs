@@ -69,6 +69,8 @@ pub const FRONTIER: Experiment = Experiment {
         ]
     }),
     section: None,
+    regions: &[],
     chapter: "frontier.md",
     main_job: true,
+    overview: None,
 };

@@ -10,6 +10,8 @@
 use mirrorbox_harness::SweepConfig;
 use mirrorbox_harness::sequence::SequenceConfig;
 use mirrorbox_report::Section;
+use mirrorbox_report::overview::OtherReport;
+use mirrorbox_report::readme::RegionSource;
 use std::path::{Path, PathBuf};
 
 pub mod bumpy;
@@ -49,6 +51,12 @@ pub struct Experiment {
     /// Its own report section, offered every sweep's records (the sections of the report
     /// crate, or one in the experiment's module); `None`: the report every sweep has.
     pub section: Option<Section>,
+    /// The README/book regions made from its reports (`mirrorbox readme`), beside the region
+    /// `experiment-NAME` every row has.
+    pub regions: &'static [RegionSource],
+    /// Its entry in the reports' overview when its report is not a sweep folder (a sequence
+    /// sweep's, a script's); sweep folders are found by the overview itself.
+    pub overview: Option<OtherReport>,
     /// Its chapter of the book, under `docs/book/src/`; the chapter holds the generated region
     /// `experiment-NAME`.
     pub chapter: &'static str,
@@ -93,6 +101,21 @@ pub fn sections() -> Vec<Section> {
         }
     }
     out
+}
+
+/// Every region made from the committed reports: the generic ones
+/// ([`mirrorbox_report::readme::REGIONS`]), then each experiment's, in the table's order.
+pub fn regions() -> Vec<RegionSource> {
+    let mut out = mirrorbox_report::readme::REGIONS.to_vec();
+    for e in EXPERIMENTS {
+        out.extend_from_slice(e.regions);
+    }
+    out
+}
+
+/// The overview's entries of the reports that are not sweep folders, in the table's order.
+pub fn other_reports() -> Vec<OtherReport> {
+    EXPERIMENTS.iter().filter_map(|e| e.overview).collect()
 }
 
 /// `out` with `suffix` appended to its last component (`reports/lighting` →

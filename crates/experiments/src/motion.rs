@@ -4,6 +4,8 @@
 use crate::{Experiment, Measure};
 use mirrorbox_harness::sequence::{Scenario, SequenceConfig};
 use mirrorbox_raster::Method;
+use mirrorbox_report::overview::OtherReport;
+use mirrorbox_report::sequence;
 use std::path::{Path, PathBuf};
 
 /// Frames per scenario.
@@ -75,8 +77,28 @@ pub const MOTION: Experiment = Experiment {
     folder: "motion",
     measure: Measure::Sequences(sequences),
     section: None,
+    regions: &[mirrorbox_report::readme::RegionSource {
+        id: "motion",
+        source: "motion",
+        about: "error over time: feedback, cubemap, auxiliary and an exact method, still and walking (mirrorbox motion)",
+        generate: |reports| {
+            let (info, records) = sequence::read_motion(&reports.join("motion"))
+                .map_err(mirrorbox_report::readme::ReadmeError)?;
+            Ok(sequence::summary(
+                &info,
+                &records,
+                "mirrorbox motion",
+                "reports/motion/report.md",
+            ))
+        },
+    }],
     chapter: "motion.md",
     main_job: true,
+    overview: Some(OtherReport {
+        report: "motion/report.md",
+        data: "motion/frames.jsonl",
+        scene: "scenes/mirror_box_walk.json",
+    }),
 };
 
 #[cfg(test)]

@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 
 /// Table 1's methods on `scene` at 320×180, five timed frames after one warm-up.
 fn sweep(scene: &str, out: &Path) -> SweepConfig {
-    let mut methods = swept(mirrorbox_report::table1::PAPER_METHOD, 0..=4);
+    let mut methods = swept(crate::table1::rows::PAPER_METHOD, 0..=4);
     for m in ["portal", "unrolled"] {
         methods.extend(swept(m, [64]));
     }
@@ -38,6 +38,8 @@ pub const REAL_ASSETS: Experiment = Experiment {
         ]
     }),
     section: None,
+    regions: &[],
     chapter: "real-assets.md",
     main_job: false,
+    overview: None,
 };

@@ -12,7 +12,7 @@
 use crate::HarnessError;
 use mirrorbox_image::{RgbImage, read_image};
 use mirrorbox_raster::{Method, ParamValue};
-use mirrorbox_report::motion::{FrameRecord, MotionInfo, ScenarioInfo, write_motion_report};
+use mirrorbox_report::sequence::{FrameRecord, MotionInfo, ScenarioInfo, write_motion_report};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 

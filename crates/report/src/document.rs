@@ -74,7 +74,7 @@ pub fn sci(v: f64) -> String {
 
 /// The paired 95 % interval of `a`'s median time over `b`'s, where both were timed in the
 /// same interleaved rounds of the same run ([`crate::stats::paired_ratio_interval`]).
-pub(crate) fn paired_ratio(a: &Record, b: &Record) -> Option<crate::stats::Interval> {
+pub fn paired_ratio(a: &Record, b: &Record) -> Option<crate::stats::Interval> {
     let same_rounds = a.timing_order == "interleaved"
         && b.timing_order == "interleaved"
         && a.run.is_some()
@@ -274,11 +274,12 @@ pub fn variant(r: &Record) -> String {
     }
 }
 
-#[cfg(test)]
-pub(crate) mod fixtures {
+/// Records for tests: this crate's and the experiments' (whose sections are tested on them).
+#[doc(hidden)]
+pub mod fixtures {
     use crate::{MetricValues, Record};
 
-    pub(crate) fn record(n: u32, ms: f64, passes: usize, flip: f64) -> Record {
+    pub fn record(n: u32, ms: f64, passes: usize, flip: f64) -> Record {
         Record {
             key: format!("auxiliary n={n}"),
             kind: "point".into(),
@@ -344,4 +345,9 @@ pub(crate) mod fixtures {
             heatmap_image: "h.png".into(),
         }
     }
+}
+
+/// A point's place on its method's axis: n, the depth, or the symmetry planes p.
+pub fn setting(r: &Record) -> f64 {
+    r.n.or(r.depth).or(r.planes()).map_or(0.0, f64::from)
 }

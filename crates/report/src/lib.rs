@@ -3,44 +3,27 @@
 //!
 //! - [`Record`]: one measured point (one JSON line of `results.jsonl`).
 //! - [`write_report`]: `results.csv`, `report.md`, a self-contained `report.html` and the SVG
-//!   plots, including the reproduction of the seed paper's Table 1 ([`table1`]).
+//!   plots, with the sections the caller offers (each experiment's own, from the registry of
+//!   `mirrorbox-experiments`, which also holds every experiment's regions).
 //! - [`readme`]: the README's figures, generated from the committed reports.
 
 pub mod document;
-pub mod engine_reflections;
 mod error;
-pub mod exact;
-mod folder;
+pub mod folder;
 mod image_rows;
-pub mod lighting;
-pub mod motion;
 pub mod overview;
 pub mod plot;
 pub mod readme;
-mod runs;
-pub mod sections;
+pub mod sequence;
 pub mod split;
 pub mod stats;
-pub mod stereo;
-pub mod symmetry;
-pub mod table1;
-pub mod uneven;
 mod write;
 
 pub use document::{Block, Section};
 
-/// Every section of [`sections`], for this crate's tests (the registry offers the real ones).
-#[cfg(test)]
-pub(crate) const TEST_SECTIONS: [Section; 6] = [
-    sections::table1,
-    sections::depth_scaling,
-    sections::symmetry_scaling,
-    sections::lighting,
-    sections::uneven_mirrors,
-    sections::stereo,
-];
-pub use folder::rewrite_report;
-pub use write::{read_records, write_report};
+pub use folder::{Sweep, load_sweep, rewrite_report};
+pub use readme::read_lines;
+pub use write::{floor_paragraph, read_records, write_report};
 
 use serde::{Deserialize, Serialize};
 
@@ -93,6 +76,18 @@ pub struct StereoRecord {
     /// The raster's and the truth's red–cyan anaglyphs.
     pub anaglyph_image: String,
     pub truth_anaglyph_image: String,
+}
+
+impl StereoRecord {
+    /// The marker's disparity in the pair, pixels (`x_right − x_left`, positive behind the
+    /// convergence plane): of the raster's pictures, or with `truth` of the truth's.
+    pub fn disparity(&self, truth: bool) -> Option<f64> {
+        let at = |k: usize| -> Option<MarkerRecord> {
+            let e = self.eyes.get(k)?;
+            if truth { e.truth_marker } else { e.marker }
+        };
+        Some(at(1)?.x - at(0)?.x)
+    }
 }
 
 /// One eye of a stereo point.
@@ -561,10 +556,10 @@ mod structure {
                 panic!("import circle in crates/report/src: {}", circle.join(" → "));
             }
         }
-        // The sections import the experiments' report code; the document model imports none
-        // of them, nor the writer.
+        // The README's regions use the document model; the document model imports neither
+        // them nor the writer.
         let uses = |m: &str| graph.iter().find(|(n, _)| n == m).unwrap().1.clone();
-        assert!(uses("sections").contains(&"lighting".to_string()));
+        assert!(uses("readme").contains(&"document".to_string()));
         assert!(!uses("document").contains(&"write".to_string()));
     }
 }

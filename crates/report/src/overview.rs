@@ -68,7 +68,17 @@ fn device_slug(info: &SweepInfo) -> String {
     }
 }
 
-/// The sweep folders under `reports` (one level, and one below for `gpu/`), sorted.
+/// A report the overview lists that is not a sweep folder: its Markdown, the file of its
+/// measurements (whose commit the overview names) and its scenes, paths under `reports/`.
+#[derive(Clone, Copy, Debug)]
+pub struct OtherReport {
+    pub report: &'static str,
+    pub data: &'static str,
+    pub scene: &'static str,
+}
+
+/// The sweep folders under `reports` (one level, and one below: a device's records such as
+/// `gpu/`), sorted.
 fn sweep_folders(reports: &Path) -> Vec<PathBuf> {
     let mut out = Vec::new();
     let mut visit = |dir: &Path| {
@@ -82,7 +92,14 @@ fn sweep_folders(reports: &Path) -> Vec<PathBuf> {
         }
     };
     visit(reports);
-    visit(&reports.join("gpu"));
+    if let Ok(entries) = std::fs::read_dir(reports) {
+        for e in entries.flatten() {
+            let p = e.path();
+            if p.is_dir() && !p.join("sweep.json").is_file() {
+                visit(&p);
+            }
+        }
+    }
     out.sort();
     out
 }
@@ -97,7 +114,7 @@ fn first_heading(path: &Path) -> Option<String> {
 
 /// What a point's series in the frontier is: its method and non-default options.
 fn series_name(r: &Record) -> String {
-    crate::symmetry::variant(r)
+    crate::document::variant(r)
 }
 
 /// Points of a chart: (ms/frame, error).
@@ -279,10 +296,12 @@ fn frontier_chart(
 /// reports listed.
 /// `about(folder)`: what the experiment that writes `folder` (relative to `reports`)
 /// measures, from the experiment registry, where it knows the folder.
+/// `others`: the reports that are not sweep folders (a sequence sweep's, a script's).
 pub fn write_overview(
     reports: &Path,
     commit_of: &dyn Fn(&Path) -> String,
     about: &dyn Fn(&str) -> Option<String>,
+    others: &[OtherReport],
 ) -> Result<usize, ReadmeError> {
     let rel = |p: &Path| {
         p.strip_prefix(reports)
@@ -320,29 +339,22 @@ pub fn write_overview(
         });
         sweeps.push((folder, sweep));
     }
-    // The other reports: a sequence sweep, benches and one-off measurements.
-    // Each with the file of its measurements, whose commit the table names (the report
-    // beside it is rewritten with every change of the report's text).
-    for (file, data, scene) in [
-        (
-            "motion/report.md",
-            "motion/frames.jsonl",
-            "scenes/mirror_box_walk.json",
-        ),
-        (
-            "tracer/bench.md",
-            "tracer/bench.json",
-            "scenes/mirror_box.json, scenes/mirror_room.json",
-        ),
-        (
-            "viewer/frame_rates.md",
-            "viewer/frame_rates.json",
-            "scenes/mirror_box.json",
-        ),
-        ("memory/peaks.md", "memory/peaks.md", "every bundled scene"),
-        ("tests/test_times.md", "tests/test_times.md", "–"),
-        ("gpu/README.md", "gpu/info.json", "–"),
-    ] {
+    // The other reports: a sequence sweep, benches and one-off measurements (the caller's,
+    // from the experiments' rows), and the test job's times. Each with the file of its
+    // measurements, whose commit the table names (the report beside it is rewritten with
+    // every change of the report's text).
+    let tests = OtherReport {
+        report: "tests/test_times.md",
+        data: "tests/test_times.md",
+        scene: "–",
+    };
+    for OtherReport {
+        report: file,
+        data,
+        scene,
+    } in others.iter().chain([&tests])
+    {
+        let (file, data, scene) = (*file, *data, *scene);
         let path = reports.join(file);
         if !path.is_file() {
             continue;

@@ -2,20 +2,17 @@
 //!
 //! A region of `README.md`, `docs/methods.md` or a chapter of the book (`docs/book/src/*.md`)
 //! between `<!-- generated: ID -->` and `<!-- end generated: ID -->` is written by [`fill`]
-//! from the report folder its ID names (its `results.jsonl` and `sweep.json`), with the same
-//! sentences and tables the report itself prints — so the prose cannot drift from the
-//! numbers. Regions made elsewhere (the command-line reference, which the CLI crate renders
-//! from its argument parser) are passed in by the caller ([`fill_with`],
-//! [`stale_regions_with`]). `mirrorbox readme` rewrites the regions; `mirrorbox readme
+//! from the report its [`RegionSource`] names, with the same sentences and tables the report
+//! itself prints — so the prose cannot drift from the numbers. This crate has the machinery
+//! and the regions of no one experiment ([`REGIONS`]); each experiment's module declares its
+//! own, and regions made by the caller outright (the command-line reference, rendered from the
+//! CLI's argument parser) are passed in as text ([`fill_with`], [`stale_regions_with`]). `mirrorbox readme` rewrites the regions; `mirrorbox readme
 //! --check` (run by the tests) fails when a region differs from what the reports give.
 //! Everything outside the regions is left alone, byte for byte.
 
-use crate::document::{Block, markdown, ms_cell};
-use crate::folder::{Sweep, load_sweep};
-use crate::write::{depth_scaling, floor_paragraph, row_cell, symmetry_section, table1_section};
-use crate::{stats, table1};
-use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use crate::document::{Block, markdown};
+use crate::folder::Sweep;
+use std::path::Path;
 
 const BEGIN: &str = "<!-- generated: ";
 const END: &str = "<!-- end generated: ";
@@ -30,129 +27,45 @@ pub struct Region {
     pub text: String,
 }
 
-/// Every region ID the generator knows, with the report folder (under `reports/`) it is made
-/// from and what it holds.
-pub const REGIONS: &[(&str, &str, &str)] = &[
-    (
-        "table1",
-        "table1",
-        "the reproduction of Table 1, the exact methods beside it, the floor",
-    ),
-    (
-        "table1-summary",
-        "table1",
-        "Table 1's methods at one glance: ms/frame, passes, reflections and error of each point",
-    ),
-    (
-        "table1-repeat",
-        "table1_repeat",
-        "Table 1's rows from two consecutive runs side by side",
-    ),
-    (
-        "depth-scaling",
-        "depth_scaling",
-        "the exact methods' cost per bounce",
-    ),
-    (
-        "depth-scaling-table",
-        "depth_scaling",
-        "the exact methods' cost against depth, every point, and per bounce",
-    ),
-    (
-        "symmetry-scaling",
-        "symmetry_scaling",
-        "the symmetry methods against p: every point, the crossover, the pruning",
-    ),
-    (
-        "lighting",
-        "lighting",
-        "shadows and mirrored lights on the lit mirror box: each lighting variant's error and cost",
-    ),
-    (
-        "lighting-room",
-        "lighting_room",
-        "the same on the lit mirror room",
-    ),
-    (
-        "uneven-mirrors",
-        "uneven_mirrors",
-        "uneven mirrors on the rippled box: every trick's error against the tilt, and its cost",
-    ),
-    (
-        "uneven-mirrors-single",
-        "uneven_mirrors_single",
-        "the same on the hammered single mirror",
-    ),
-    (
-        "stereo",
-        "stereo",
-        "stereo mirrors: the pair's cost against mono, per-eye against shared, and the disparity check",
-    ),
-    (
-        "viewer-frame-rates",
-        "viewer/frame_rates.md",
-        "`mirrorbox view`'s frame rates per method, still and walking (scripts/viewer-frame-rates.sh)",
-    ),
-    (
-        "tracer-bench",
-        "tracer/bench.md",
-        "the tracer against Mitsuba 3 side by side (scripts/bench-tracer.sh)",
-    ),
-    (
-        "tracer-bench-summary",
-        "tracer/bench.md",
-        "the tracer against Mitsuba 3: one row per CPU kind measured, with the goals",
-    ),
-    (
-        "motion",
-        "motion",
-        "error over time: feedback, cubemap, auxiliary and an exact method, still and walking (mirrorbox motion)",
-    ),
-    (
-        "lighting-trace-cost",
-        "lighting/trace_cost.jsonl",
-        "the tracer's time against the mirrored-light depth k on both lit scenes",
-    ),
-    (
-        "gpu-table1",
-        "gpu/table1",
-        "Table 1 and the exact methods beside it, measured on a GPU",
-    ),
-    (
-        "gpu-column",
-        "gpu/table1",
-        "Table 1's points on lavapipe (reports/table1) and on a GPU side by side",
-    ),
-    (
-        "gpu-depth-scaling",
-        "gpu/depth_scaling",
-        "the exact methods' cost per bounce, measured on a GPU",
-    ),
-    (
-        "gpu-room",
-        "gpu/room_1080p.jsonl",
-        "the mirror room at 1920×1080 against depth on a GPU: where real time ends",
-    ),
-    (
-        "gpu-trace-threads",
-        "gpu/trace_threads.jsonl",
-        "the tracer against its thread count on the GPU machine's CPU",
-    ),
-    (
-        "main-job",
-        "main_job.json",
-        "the main job's steps: time and peak memory",
-    ),
-    (
-        "job-costs",
-        "main_job.json",
-        "what the two commands cost: the last recorded scripts/test.sh and scripts/run.sh",
-    ),
+/// A region made from the committed reports: its ID, the report (under `reports/`) it
+/// quotes, what it holds, and its generator, given the reports folder. The regions of no one
+/// experiment are [`REGIONS`]; each experiment's module declares its own
+/// (`mirrorbox-experiments`), and the caller passes them all ([`fill_with`]).
+#[derive(Clone, Copy)]
+pub struct RegionSource {
+    pub id: &'static str,
+    pub source: &'static str,
+    pub about: &'static str,
+    pub generate: fn(&Path) -> Result<String, ReadmeError>,
+}
+
+impl RegionSource {
+    /// The region's text from the reports under `reports`, relative links replaced by their
+    /// labels ([`without_relative_links`]).
+    pub fn text(&self, reports: &Path) -> Result<String, ReadmeError> {
+        (self.generate)(reports).map(|t| without_relative_links(&t))
+    }
+}
+
+/// The regions of no one experiment: what the two commands cost.
+pub const REGIONS: &[RegionSource] = &[
+    RegionSource {
+        id: "main-job",
+        source: "main_job.json",
+        about: "the main job's steps: time and peak memory",
+        generate: |reports| main_job_region(&reports.join("main_job.json")),
+    },
+    RegionSource {
+        id: "job-costs",
+        source: "main_job.json",
+        about: "what the two commands cost: the last recorded scripts/test.sh and scripts/run.sh",
+        generate: job_costs_region,
+    },
 ];
 
 /// "Measured DATE on DEVICE: adapter …, `COMMAND`." The date is the latest run that measured
 /// a record (the report's own date is when it was last written, perhaps by a resume).
-fn measured_on(s: &Sweep) -> String {
+pub fn measured_on(s: &Sweep) -> String {
     let info = &s.info;
     let date = s
         .records
@@ -171,7 +84,7 @@ fn measured_on(s: &Sweep) -> String {
 
 /// The blocks a README quotes: text and tables, not headings, charts or image rows (the
 /// README places those itself).
-fn prose(blocks: Vec<Block>) -> Vec<Block> {
+pub fn prose(blocks: Vec<Block>) -> Vec<Block> {
     blocks
         .into_iter()
         .filter(|b| {
@@ -183,140 +96,9 @@ fn prose(blocks: Vec<Block>) -> Vec<Block> {
         .collect()
 }
 
-fn table1_region(s: &Sweep) -> Result<String, ReadmeError> {
-    let mut blocks = vec![Block::Paragraph(measured_on(s))];
-    let section = prose(table1_section(&s.info, &s.records));
-    if section.is_empty() {
-        return Err(ReadmeError(format!(
-            "{}: not the paper's experiment (every n of Table 1 on {}), nothing to quote",
-            s.info.scene,
-            table1::PAPER_SCENE
-        )));
-    }
-    blocks.extend(section);
-    if let Some(fl) = s.records.iter().find(|r| r.kind == "floor") {
-        blocks.push(floor_paragraph(fl));
-    }
-    Ok(markdown(&blocks))
-}
-
-/// The short form of [`table1_region`]: the device, the table of every method's point (the
-/// paper's auxiliary n = 0…4 and the exact methods) and the floor.
-fn table1_summary_region(s: &Sweep) -> Result<String, ReadmeError> {
-    let table = prose(table1_section(&s.info, &s.records))
-        .into_iter()
-        .rfind(|b| matches!(b, Block::Table(..)))
-        .ok_or_else(|| {
-            ReadmeError(format!(
-                "{}: not the paper's experiment (every n of Table 1 on {}), nothing to quote",
-                s.info.scene,
-                table1::PAPER_SCENE
-            ))
-        })?;
-    let mut blocks = vec![Block::Paragraph(measured_on(s)), table];
-    if let Some(fl) = s.records.iter().find(|r| r.kind == "floor") {
-        blocks.push(floor_paragraph(fl));
-    }
-    Ok(markdown(&blocks))
-}
-
-/// The depth-scaling section's cost per bounce (and with `table`, every point).
-fn depth_scaling_region(s: &Sweep, table: bool) -> Result<String, ReadmeError> {
-    let floor = s.records.iter().find(|r| r.kind == "floor");
-    let section = prose(depth_scaling(&s.info, &s.records, floor));
-    let bullets: Vec<Block> = section
-        .into_iter()
-        .filter(|b| table || matches!(b, Block::Bullets(_)))
-        .collect();
-    if bullets.is_empty() {
-        return Err(ReadmeError(format!(
-            "{}: no exact method swept over depth, nothing to quote",
-            s.info.scene
-        )));
-    }
-    let mut blocks = vec![Block::Paragraph(measured_on(s))];
-    blocks.extend(bullets);
-    Ok(markdown(&blocks))
-}
-
-fn symmetry_region(s: &Sweep) -> Result<String, ReadmeError> {
-    let section = prose(symmetry_section(&s.records));
-    if section.is_empty() {
-        return Err(ReadmeError(format!(
-            "{}: no symmetry-planes sweep, nothing to quote",
-            s.info.scene
-        )));
-    }
-    let mut blocks = vec![Block::Paragraph(measured_on(s))];
-    blocks.extend(section);
-    Ok(markdown(&blocks))
-}
-
-fn lighting_region(s: &Sweep) -> Result<String, ReadmeError> {
-    let sentences = crate::lighting::sentences(&s.records);
-    if sentences.is_empty() {
-        return Err(ReadmeError(format!(
-            "{}: no mirrored-lights sweep, nothing to quote",
-            s.info.scene
-        )));
-    }
-    Ok(markdown(&[
-        Block::Paragraph(measured_on(s)),
-        Block::Bullets(sentences),
-    ]))
-}
-
-fn uneven_region(s: &Sweep) -> Result<String, ReadmeError> {
-    let sentences = crate::uneven::sentences(&s.records, &s.info.bump_methods);
-    if sentences.is_empty() {
-        return Err(ReadmeError(format!(
-            "{}: no bump-amplitude sweep, nothing to quote",
-            s.info.scene
-        )));
-    }
-    Ok(markdown(&[
-        Block::Paragraph(measured_on(s)),
-        crate::uneven::table(&s.records, &s.info.bump_methods, false),
-        Block::Bullets(sentences),
-    ]))
-}
-
-fn stereo_region(s: &Sweep) -> Result<String, ReadmeError> {
-    let sentences = crate::stereo::sentences(&s.records);
-    if sentences.is_empty() {
-        return Err(ReadmeError(format!(
-            "{}: no stereo sweep measuring per-eye and shared, nothing to quote",
-            s.info.scene
-        )));
-    }
-    Ok(markdown(&[
-        Block::Paragraph(measured_on(s)),
-        crate::stereo::cost_table(&s.records),
-        crate::stereo::error_table(&s.records),
-        crate::stereo::disparity_table(&s.records),
-        Block::Bullets(sentences),
-    ]))
-}
-
-/// One `trace --json` run of `scripts/lighting-trace-cost.sh`.
-#[derive(serde::Deserialize)]
-struct TraceRun {
-    scene: String,
-    mirrored_lights: u32,
-    render_seconds: f64,
-    rays: u64,
-    threads: usize,
-    lighting: TraceLighting,
-}
-
-#[derive(serde::Deserialize)]
-struct TraceLighting {
-    light_images: usize,
-}
-
 /// The tracer's median time per scene and k, with the light images and rays behind it.
 /// A Markdown report written whole by a script: its text after the title line.
-fn report_body_region(path: &Path) -> Result<String, ReadmeError> {
+pub fn report_body_region(path: &Path) -> Result<String, ReadmeError> {
     let text = mirrorbox_files::read_bounded_text(path, 1 << 20, "a report")
         .map_err(|e| ReadmeError(e.to_string()))?;
     let body = text
@@ -329,7 +111,7 @@ fn report_body_region(path: &Path) -> Result<String, ReadmeError> {
 
 /// A report's body up to its first `## ` section: the summary before the details (the
 /// tracer bench's table of CPUs, each CPU's table after it).
-fn report_summary_region(path: &Path) -> Result<String, ReadmeError> {
+pub fn report_summary_region(path: &Path) -> Result<String, ReadmeError> {
     let body = report_body_region(path)?;
     let summary = body
         .lines()
@@ -339,185 +121,27 @@ fn report_summary_region(path: &Path) -> Result<String, ReadmeError> {
     Ok(format!("{}\n", summary.trim_end()))
 }
 
-fn trace_cost_region(path: &Path) -> Result<String, ReadmeError> {
-    let runs: Vec<TraceRun> = crate::runs::read_lines(path)?;
-    let mut groups: Vec<(String, u32)> = Vec::new();
-    for r in &runs {
-        let g = (r.scene.clone(), r.mirrored_lights);
-        if !groups.contains(&g) {
-            groups.push(g);
-        }
-    }
-    groups.sort();
-    let rows = groups
-        .iter()
-        .map(|(scene, k)| {
-            let of: Vec<&TraceRun> = runs
-                .iter()
-                .filter(|r| &r.scene == scene && r.mirrored_lights == *k)
-                .collect();
-            let mut secs: Vec<f64> = of.iter().map(|r| r.render_seconds).collect();
-            secs.sort_by(f64::total_cmp);
-            let (lo, hi) = (secs[0], secs[secs.len() - 1]);
-            vec![
-                format!("`{scene}`"),
-                k.to_string(),
-                of[0].lighting.light_images.to_string(),
-                format!("{:.2} [{lo:.2}–{hi:.2}]", stats::median(&secs)),
-                format!("{:.1}", of[0].rays as f64 / 1e6),
-                of.len().to_string(),
-            ]
+/// JSON-lines files of one-off runs are a few hundred KB; the bound keeps a wrong path from
+/// being read whole.
+const MAX_RUNS_BYTES: u64 = 16 << 20;
+
+/// Reads every non-empty line of `path` as a `T`, naming the line that is not one.
+pub fn read_lines<T: serde::de::DeserializeOwned>(path: &Path) -> Result<Vec<T>, ReadmeError> {
+    let text = mirrorbox_files::read_bounded_text(path, MAX_RUNS_BYTES, "a JSON-lines file")
+        .map_err(|e| ReadmeError(e.to_string()))?;
+    let runs = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty())
+        .map(|(i, l)| {
+            serde_json::from_str(l)
+                .map_err(|e| ReadmeError(format!("{}:{}: {e}", path.display(), i + 1)))
         })
-        .collect();
-    let threads = runs.first().map_or(0, |r| r.threads);
-    Ok(markdown(&[
-        Block::Paragraph(format!(
-            "`scripts/lighting-trace-cost.sh`: `mirrorbox trace --mirrored-lights k --spp 1` at \
-             640×360 with shadows, {threads} threads, runs interleaved."
-        )),
-        Block::Table(
-            [
-                "scene",
-                "k",
-                "light images",
-                "trace s, median [min–max]",
-                "Mrays (shadow legs included)",
-                "runs",
-            ]
-            .map(String::from)
-            .to_vec(),
-            rows,
-        ),
-    ]))
-}
-
-/// The points two sweeps of one configuration share, measured on two devices, side by side:
-/// each one's ms/frame and FLIP, and how many times faster the second device is. Times compare
-/// only as ratios of medians here (the devices ran at different times); errors should agree up
-/// to each device's floor, which the last row shows.
-fn device_column_region(first: &Sweep, second: &Sweep) -> Result<String, ReadmeError> {
-    let device = |s: &Sweep| s.info.adapter.clone();
-    let mut rows = Vec::new();
-    for a in &first.records {
-        let Some(b) = second
-            .records
-            .iter()
-            .find(|b| b.key == a.key && b.kind == a.kind)
-        else {
-            continue;
-        };
-        let name = if a.kind == "floor" {
-            "floor (no mirrors)".to_string()
-        } else {
-            crate::document::label(a)
-        };
-        rows.push(vec![
-            name,
-            format!("{}", a.alpha),
-            ms_cell(a, 1),
-            ms_cell(b, 1),
-            format!("{:.0}×", a.ms_median / b.ms_median),
-            crate::document::sci(a.metrics.flip_mean),
-            crate::document::sci(b.metrics.flip_mean),
-        ]);
+        .collect::<Result<Vec<T>, _>>()?;
+    if runs.is_empty() {
+        return Err(ReadmeError(format!("{}: no runs to quote", path.display())));
     }
-    if rows.is_empty() {
-        return Err(ReadmeError(format!(
-            "{} and {}: no point in common",
-            first.info.command, second.info.command
-        )));
-    }
-    Ok(markdown(&[
-        Block::Paragraph(format!(
-            "First: {} Second: {}",
-            measured_on(first),
-            measured_on(second)
-        )),
-        Block::Table(
-            vec![
-                "point".into(),
-                "α".into(),
-                format!("{} ms/frame [95 % CI]", device(first)),
-                format!("{} ms/frame [95 % CI]", device(second)),
-                "ratio of medians".into(),
-                format!("FLIP {}", device(first)),
-                format!("FLIP {}", device(second)),
-            ],
-            rows,
-        ),
-    ]))
-}
-
-/// Table 1's rows of two runs side by side: whether each row's intervals overlap, and whether
-/// each run's times keep the order of the pass counts.
-fn repeat_region(first: &Sweep, second: &Sweep) -> Result<String, ReadmeError> {
-    let (alpha_a, a) = table1::rows(&first.records);
-    let (alpha_b, b) = table1::rows(&second.records);
-    if a.len() != table1::PAPER_MS.len() || b.len() != a.len() || alpha_a != alpha_b {
-        return Err(ReadmeError(
-            "reports/table1 and reports/table1_repeat do not both hold Table 1's rows at one α"
-                .into(),
-        ));
-    }
-    let interval = |r: &table1::Row| stats::median_interval(&r.frames_ms);
-    let mut rows = Vec::new();
-    let mut overlapping = 0;
-    for (ra, rb) in a.iter().zip(&b) {
-        let overlap = match (interval(ra), interval(rb)) {
-            (Some(x), Some(y)) if x.overlaps(&y) => {
-                overlapping += 1;
-                "yes"
-            }
-            (Some(_), Some(_)) => "no",
-            _ => "–",
-        };
-        rows.push(vec![
-            ra.n.to_string(),
-            ra.passes.to_string(),
-            row_cell(ra),
-            row_cell(rb),
-            overlap.to_string(),
-        ]);
-    }
-    // Rows are in n order, and the pass count grows with n.
-    let ordered = |rows: &[table1::Row]| rows.windows(2).all(|w| w[0].ms_median < w[1].ms_median);
-    let order = |ok: bool| {
-        if ok {
-            "keeps the order of the pass counts"
-        } else {
-            "does NOT keep the order of the pass counts"
-        }
-    };
-    let mut text = String::new();
-    let _ = write!(
-        text,
-        "First run: {} Second run: {} α = {}.",
-        measured_on(first),
-        measured_on(second),
-        alpha_a.unwrap_or(f32::NAN)
-    );
-    let blocks = vec![
-        Block::Paragraph(text),
-        Block::Table(
-            [
-                "n",
-                "passes",
-                "first run ms/frame [95 % CI]",
-                "second run ms/frame [95 % CI]",
-                "intervals overlap",
-            ]
-            .map(String::from)
-            .to_vec(),
-            rows,
-        ),
-        Block::Paragraph(format!(
-            "The intervals overlap on {overlapping} of {} rows; the first run {}, the second {}.",
-            a.len(),
-            order(ordered(&a)),
-            order(ordered(&b))
-        )),
-    ];
-    Ok(markdown(&blocks))
+    Ok(runs)
 }
 
 /// One step of the main job, as `scripts/run.sh` records it in `reports/main_job.json`.
@@ -622,70 +246,28 @@ fn job_costs_region(reports: &Path) -> Result<String, ReadmeError> {
     )]))
 }
 
-/// Every region ID there is: the reports' ([`REGIONS`]), then the caller's `extra`, comma
+/// Every region ID there is: `sources`' (the reports'), then the caller's `extra`, comma
 /// separated.
-pub fn known_regions(extra: &[Region]) -> String {
-    REGIONS
+pub fn known_regions(extra: &[Region], sources: &[RegionSource]) -> String {
+    sources
         .iter()
-        .map(|r| r.0)
+        .map(|r| r.id)
         .chain(extra.iter().map(|r| r.id))
         .collect::<Vec<_>>()
         .join(", ")
 }
 
-/// Generates the region `id` from the reports under `reports`.
-pub fn generate(id: &str, reports: &Path) -> Result<Region, ReadmeError> {
-    let (id, source, _) = REGIONS
-        .iter()
-        .find(|(name, _, _)| *name == id)
-        .ok_or_else(|| {
-            ReadmeError(format!(
-                "unknown generated region {id:?} (known: {})",
-                REGIONS.iter().map(|r| r.0).collect::<Vec<_>>().join(", ")
-            ))
-        })?;
-    let folder = |name: &str| -> PathBuf { reports.join(name) };
-    let text = match *id {
-        "table1" | "gpu-table1" => table1_region(&load_sweep(&folder(source))?)?,
-        "table1-summary" => table1_summary_region(&load_sweep(&folder(source))?)?,
-        "job-costs" => job_costs_region(reports)?,
-        "table1-repeat" => repeat_region(
-            &load_sweep(&folder("table1"))?,
-            &load_sweep(&folder(source))?,
-        )?,
-        "depth-scaling" | "gpu-depth-scaling" => {
-            depth_scaling_region(&load_sweep(&folder(source))?, false)?
-        }
-        "depth-scaling-table" => depth_scaling_region(&load_sweep(&folder(source))?, true)?,
-        "symmetry-scaling" => symmetry_region(&load_sweep(&folder(source))?)?,
-        "lighting" | "lighting-room" => lighting_region(&load_sweep(&folder(source))?)?,
-        "lighting-trace-cost" => trace_cost_region(&folder(source))?,
-        "uneven-mirrors" | "uneven-mirrors-single" => uneven_region(&load_sweep(&folder(source))?)?,
-        "stereo" => stereo_region(&load_sweep(&folder(source))?)?,
-        "gpu-column" => device_column_region(
-            &load_sweep(&folder("table1"))?,
-            &load_sweep(&folder(source))?,
-        )?,
-        "gpu-room" => crate::runs::room_region(&folder(source))?,
-        "gpu-trace-threads" => {
-            let cpu_file = folder("gpu/cpu.txt");
-            let cpu = mirrorbox_files::read_bounded_text(&cpu_file, 4096, "a CPU name")
-                .map_err(|e| ReadmeError(e.to_string()))?;
-            crate::runs::threads_region(&folder(source), cpu.trim())?
-        }
-        "main-job" => main_job_region(&folder(source))?,
-        "motion" => {
-            let (info, records) =
-                crate::motion::read_motion(&folder(source)).map_err(ReadmeError)?;
-            crate::motion::readme_region(&info, &records)
-        }
-        "viewer-frame-rates" | "tracer-bench" => report_body_region(&folder(source))?,
-        "tracer-bench-summary" => report_summary_region(&folder(source))?,
-        _ => unreachable!("every ID in REGIONS has a generator"),
-    };
+/// Generates the region `id` of `sources` from the reports under `reports`.
+pub fn generate(id: &str, reports: &Path, sources: &[RegionSource]) -> Result<Region, ReadmeError> {
+    let source = sources.iter().find(|r| r.id == id).ok_or_else(|| {
+        ReadmeError(format!(
+            "unknown generated region {id:?} (known: {})",
+            known_regions(&[], sources)
+        ))
+    })?;
     Ok(Region {
-        id,
-        text: without_relative_links(&text),
+        id: source.id,
+        text: source.text(reports)?,
     })
 }
 
@@ -785,32 +367,43 @@ fn find_regions(readme: &str) -> Result<Vec<Found>, ReadmeError> {
 }
 
 /// The text of region `id`: one of `extra` (regions made by the caller) if it has that ID,
-/// else generated from the reports.
-fn region_text(id: &str, reports: &Path, extra: &[Region]) -> Result<String, ReadmeError> {
+/// else generated from the reports by its source.
+fn region_text(
+    id: &str,
+    reports: &Path,
+    extra: &[Region],
+    sources: &[RegionSource],
+) -> Result<String, ReadmeError> {
     match extra.iter().find(|r| r.id == id) {
         Some(r) => Ok(r.text.clone()),
-        None if extra.is_empty() || REGIONS.iter().any(|r| r.0 == id) => {
-            generate(id, reports).map(|r| r.text)
-        }
-        None => Err(ReadmeError(format!(
-            "unknown generated region {id:?} (known: {})",
-            known_regions(extra)
-        ))),
+        None => match sources.iter().find(|r| r.id == id) {
+            Some(source) => source.text(reports),
+            None => Err(ReadmeError(format!(
+                "unknown generated region {id:?} (known: {})",
+                known_regions(extra, sources)
+            ))),
+        },
     }
 }
 
-/// The README with every region replaced by its generated text.
+/// The README with every region of [`REGIONS`] replaced by its generated text.
 pub fn fill(readme: &str, reports: &Path) -> Result<String, ReadmeError> {
-    fill_with(readme, reports, &[])
+    fill_with(readme, reports, &[], REGIONS)
 }
 
-/// [`fill`], with the regions of `extra` (made by the caller, e.g. from the CLI's argument
-/// parser) filled from `extra` instead of the reports.
-pub fn fill_with(readme: &str, reports: &Path, extra: &[Region]) -> Result<String, ReadmeError> {
+/// [`fill`] with the regions of `sources` (the generic [`REGIONS`] and the experiments'),
+/// and those of `extra` (made by the caller, e.g. from the CLI's argument parser) filled
+/// from `extra`'s text.
+pub fn fill_with(
+    readme: &str,
+    reports: &Path,
+    extra: &[Region],
+    sources: &[RegionSource],
+) -> Result<String, ReadmeError> {
     let mut out = String::with_capacity(readme.len());
     let mut at = 0;
     for f in find_regions(readme)? {
-        let text = region_text(&f.id, reports, extra)?;
+        let text = region_text(&f.id, reports, extra, sources)?;
         out.push_str(&readme[at..f.content.start]);
         out.push_str(&text);
         at = f.content.end;
@@ -825,7 +418,7 @@ pub fn stale_regions(
     readme: &str,
     reports: &Path,
 ) -> Result<Vec<(String, String, String)>, ReadmeError> {
-    stale_regions_with(readme, reports, &[])
+    stale_regions_with(readme, reports, &[], REGIONS)
 }
 
 /// [`stale_regions`], with the regions of `extra` compared against `extra`'s text.
@@ -833,10 +426,11 @@ pub fn stale_regions_with(
     readme: &str,
     reports: &Path,
     extra: &[Region],
+    sources: &[RegionSource],
 ) -> Result<Vec<(String, String, String)>, ReadmeError> {
     let mut stale = Vec::new();
     for f in find_regions(readme)? {
-        let generated = region_text(&f.id, reports, extra)?;
+        let generated = region_text(&f.id, reports, extra, sources)?;
         let current = &readme[f.content.clone()];
         if current != generated {
             let (have, want) = current
@@ -905,7 +499,7 @@ mod tests {
             err("<!-- generated: nonsense -->\n<!-- end generated: nonsense -->\n")
                 .contains("unknown generated region \"nonsense\"")
         );
-        assert!(err("<!-- generated: main-job -->\n<!-- generated: table1 -->\n<!-- end generated: main-job -->\n").contains("begins inside"));
+        assert!(err("<!-- generated: main-job -->\n<!-- generated: job-costs -->\n<!-- end generated: main-job -->\n").contains("begins inside"));
         assert!(
             err("x\n<!-- end generated: main-job -->\n").contains("line 2: an end marker without")
         );
@@ -913,8 +507,8 @@ mod tests {
         assert!(err(&twice.repeat(2)).contains("appears twice"));
         // A region whose report is missing names the file.
         assert!(
-            err("<!-- generated: table1 -->\n<!-- end generated: table1 -->\n")
-                .contains("table1/sweep.json")
+            err("<!-- generated: job-costs -->\n<!-- end generated: job-costs -->\n")
+                .contains("tests/test_timing.json")
         );
     }
 
@@ -938,17 +532,17 @@ mod tests {
         }];
         let text = "<!-- generated: cli -->\nold\n<!-- end generated: cli -->\n\
                     <!-- generated: main-job -->\n<!-- end generated: main-job -->\n";
-        let filled = fill_with(text, dir.path(), &extra).unwrap();
+        let filled = fill_with(text, dir.path(), &extra, REGIONS).unwrap();
         assert!(
             filled.starts_with("<!-- generated: cli -->\nusage\n<!-- end generated: cli -->\n")
         );
         assert!(filled.contains("took 5 s"));
         assert!(
-            stale_regions_with(&filled, dir.path(), &extra)
+            stale_regions_with(&filled, dir.path(), &extra, REGIONS)
                 .unwrap()
                 .is_empty()
         );
-        let stale = stale_regions_with(text, dir.path(), &extra).unwrap();
+        let stale = stale_regions_with(text, dir.path(), &extra, REGIONS).unwrap();
         assert_eq!(stale[0], ("cli".into(), "old".into(), "usage".into()));
         // Without the caller's region the ID is unknown; with it, the message lists it.
         assert!(
@@ -959,7 +553,7 @@ mod tests {
         );
         let other = "<!-- generated: nonsense -->\n<!-- end generated: nonsense -->\n";
         assert!(
-            fill_with(other, dir.path(), &extra)
+            fill_with(other, dir.path(), &extra, REGIONS)
                 .unwrap_err()
                 .0
                 .contains(", cli)")
@@ -978,7 +572,7 @@ mod tests {
                         {"name":"b","seconds":3},{"name":"tests","seconds":12}]}"#,
         )
         .unwrap();
-        let text = generate("job-costs", dir.path()).unwrap().text;
+        let text = generate("job-costs", dir.path(), REGIONS).unwrap().text;
         assert!(text.contains(
             "| `scripts/test.sh` | the tests | 2026-11-23, a test CPU | **60** | `build` 40 s; `tests` 12 s; 2 other steps 8 s |"
         ), "{text}");

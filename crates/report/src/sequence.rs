@@ -284,6 +284,17 @@ pub fn write_motion_report(
         &dir.join("motion.json"),
         &serde_json::to_string_pretty(info).expect("the motion info encodes"),
     )?;
+    write_motion_figures(dir, info, records)
+}
+
+/// Writes `report.md` and the `plot_<scenario>.svg`s of a sequence sweep from its records,
+/// leaving the records and the info as they are: what remaking a committed report rewrites
+/// (re-encoding the records would change their text, not their values).
+pub fn write_motion_figures(
+    dir: &Path,
+    info: &MotionInfo,
+    records: &[FrameRecord],
+) -> Result<(), FileError> {
     for s in &info.scenarios {
         write_text(
             &dir.join(format!("plot_{}.svg", s.name)),
@@ -332,11 +343,12 @@ pub fn read_motion(dir: &Path) -> Result<(MotionInfo, Vec<FrameRecord>), String>
     Ok((info, records))
 }
 
-/// The README's summary: per scenario, each method's mean and last-frame FLIP and its
-/// median time, and `feedback`'s settling frame on the still camera.
-pub fn readme_region(info: &MotionInfo, records: &[FrameRecord]) -> String {
+/// A README's summary of a sequence sweep measured by `command`, its report at `report`:
+/// per scenario, each method's mean and last-frame FLIP and its median time, and a stateful
+/// method's settling frame on the still camera.
+pub fn summary(info: &MotionInfo, records: &[FrameRecord], command: &str, report: &str) -> String {
     let mut md = format!(
-        "Measured by `mirrorbox motion` ({}, {}×{}, {}; report: [`reports/motion/report.md`](reports/motion/report.md)). FLIP mean against each frame's truth:\n\n",
+        "Measured by `{command}` ({}, {}×{}, {}; report: [`{report}`]({report})). FLIP mean against each frame's truth:\n\n",
         info.device, info.width, info.height, info.date
     );
     let mut head = String::from("| method |");

@@ -7,7 +7,9 @@
 //! (`mirrorbox-experiments`), whose chapter must hold it.
 
 use crate::Failure;
-use mirrorbox_report::readme::{Region, fill_with, known_regions, stale_regions_with};
+use mirrorbox_report::readme::{
+    Region, RegionSource, fill_with, known_regions, stale_regions_with,
+};
 use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
@@ -52,6 +54,8 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             text: e.region_text(),
         });
     }
+    // The regions made from the reports: the generic ones and each experiment's.
+    let sources = mirrorbox_experiments::regions();
     if args.files.is_empty() {
         check_chapters()?;
     }
@@ -59,7 +63,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     // over a stale region's exit 1.
     let (mut messages, mut bad_input) = (Vec::new(), false);
     for file in &files {
-        match one(file, args, &extra) {
+        match one(file, args, &extra, &sources) {
             Ok(()) => {}
             Err(Failure::BadInput(m)) => {
                 bad_input = true;
@@ -69,7 +73,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         }
     }
     if !args.check {
-        println!("regions known: {}", known_regions(&extra));
+        println!("regions known: {}", known_regions(&extra, &sources));
     }
     match (messages.is_empty(), bad_input) {
         (true, _) => Ok(()),
@@ -173,12 +177,18 @@ pub fn cli_reference() -> String {
 }
 
 /// Fills (or checks) one file; a malformed region or a missing report is bad input (exit 2).
-fn one(file: &Path, args: &Args, extra: &[Region]) -> Result<(), Failure> {
+fn one(
+    file: &Path,
+    args: &Args,
+    extra: &[Region],
+    sources: &[RegionSource],
+) -> Result<(), Failure> {
     let bad = |e: &dyn std::fmt::Display| Failure::BadInput(format!("{}: {e}", file.display()));
     let text = mirrorbox_files::read_bounded_text(file, MAX_README_BYTES, "a Markdown file")
         .map_err(|e| bad(&e))?;
     if args.check {
-        let stale = stale_regions_with(&text, &args.reports, extra).map_err(|e| bad(&e))?;
+        let stale =
+            stale_regions_with(&text, &args.reports, extra, sources).map_err(|e| bad(&e))?;
         if stale.is_empty() {
             println!(
                 "{}: every generated region agrees with {}",
@@ -200,7 +210,7 @@ fn one(file: &Path, args: &Args, extra: &[Region]) -> Result<(), Failure> {
             lines.join("\n  ")
         )));
     }
-    let filled = fill_with(&text, &args.reports, extra).map_err(|e| bad(&e))?;
+    let filled = fill_with(&text, &args.reports, extra, sources).map_err(|e| bad(&e))?;
     if filled != text {
         mirrorbox_files::write_atomically(file, filled.as_bytes())
             .map_err(|e| Failure::Other(e.to_string()))?;

@@ -20,8 +20,13 @@ pub struct Args {
 
 pub fn run(args: &Args) -> Result<(), Failure> {
     if let Some(reports) = &args.index {
-        let n = mirrorbox_report::overview::write_overview(reports, &records_commit, &about)
-            .map_err(|e| Failure::BadInput(format!("{}: {e}", reports.display())))?;
+        let n = mirrorbox_report::overview::write_overview(
+            reports,
+            &records_commit,
+            &about,
+            &mirrorbox_experiments::other_reports(),
+        )
+        .map_err(|e| Failure::BadInput(format!("{}: {e}", reports.display())))?;
         println!(
             "{}: index.html and README.md list {}",
             reports.display(),

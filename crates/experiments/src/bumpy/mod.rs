@@ -1,6 +1,8 @@
 //! Uneven mirrors (issue 16, seed 002's uneven mirrors): the engines' tricks for normal-mapped
 //! mirrors against a truth that reflects about the perturbed normal at every depth.
 
+pub mod section;
+
 use crate::{Experiment, Measure, beside};
 use mirrorbox_harness::{SweepConfig, along, axes, with_options};
 use mirrorbox_raster::Method;
@@ -79,7 +81,9 @@ pub const BUMPY: Experiment = Experiment {
     about: "uneven mirrors: the engines' tricks against the truth as the bump's tilt grows",
     folder: "uneven_mirrors",
     measure: Measure::Sweeps(|out| vec![sweep(out), single_sweep(&beside(out, "_single"))]),
-    section: Some(mirrorbox_report::sections::uneven_mirrors),
+    section: Some(section::section),
+    regions: section::REGIONS,
     chapter: "uneven-mirrors.md",
     main_job: true,
+    overview: None,
 };

@@ -5,9 +5,13 @@
 //! The report knows the options' names (`bump`, `bump-strength`, `proxy-distance`,
 //! `march-steps`, `texture-margin`), not the rasterizer.
 
-use crate::Record;
-use crate::document::{Block, distinct, join_words, lowest_with_ties, ms_cell, sci};
-use crate::plot::{Chart, Series, method_style};
+use mirrorbox_report::Record;
+use mirrorbox_report::document::{
+    Block, distinct, join_words, lowest_with_ties, markdown, ms_cell, sci,
+};
+use mirrorbox_report::plot::{Chart, Series, method_style};
+use mirrorbox_report::readme::{ReadmeError, RegionSource, measured_on};
+use mirrorbox_report::{Sweep, SweepInfo, load_sweep};
 
 /// The raster options of an uneven-mirror trick (crates/raster/src/uneven.rs).
 const TRICK_OPTIONS: [&str; 5] = [
@@ -169,7 +173,7 @@ pub fn sentences(records: &[Record], bump_methods: &[String]) -> Vec<String> {
 
 /// Every trick's time and error at every tilt, one row per trick; `relmse` adds the relMSE
 /// columns.
-pub(crate) fn table(records: &[Record], bump_methods: &[String], relmse: bool) -> Block {
+pub fn table(records: &[Record], bump_methods: &[String], relmse: bool) -> Block {
     let pts = points(records);
     let amps = amplitudes(&pts);
     let main = main_method(&pts);
@@ -207,7 +211,7 @@ pub(crate) fn table(records: &[Record], bump_methods: &[String], relmse: bool) -
 }
 
 /// The report section of a bump-amplitude sweep (empty for any other sweep).
-pub(crate) fn uneven_section(records: &[Record], bump_methods: &[String]) -> Vec<Block> {
+pub fn uneven_section(records: &[Record], bump_methods: &[String]) -> Vec<Block> {
     let pts = points(records);
     if pts.is_empty() {
         return Vec::new();
@@ -373,6 +377,42 @@ pub(crate) fn uneven_section(records: &[Record], bump_methods: &[String]) -> Vec
     out
 }
 
+/// The section, offered every sweep's records; empty where none carries the tilt.
+pub fn section(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
+    uneven_section(records, &info.bump_methods)
+}
+
+fn uneven_region(s: &Sweep) -> Result<String, ReadmeError> {
+    let sentences = sentences(&s.records, &s.info.bump_methods);
+    if sentences.is_empty() {
+        return Err(ReadmeError(format!(
+            "{}: no bump-amplitude sweep, nothing to quote",
+            s.info.scene
+        )));
+    }
+    Ok(markdown(&[
+        Block::Paragraph(measured_on(s)),
+        table(&s.records, &s.info.bump_methods, false),
+        Block::Bullets(sentences),
+    ]))
+}
+
+/// The regions of the uneven-mirrors chapter: the rippled box and the hammered mirror.
+pub const REGIONS: &[RegionSource] = &[
+    RegionSource {
+        id: "uneven-mirrors",
+        source: "uneven_mirrors",
+        about: "uneven mirrors on the rippled box: every trick's error against the tilt, and its cost",
+        generate: |reports| uneven_region(&load_sweep(&reports.join("uneven_mirrors"))?),
+    },
+    RegionSource {
+        id: "uneven-mirrors-single",
+        source: "uneven_mirrors_single",
+        about: "the same on the hammered single mirror",
+        generate: |reports| uneven_region(&load_sweep(&reports.join("uneven_mirrors_single"))?),
+    },
+];
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -382,10 +422,11 @@ mod tests {
     }
 
     fn record(options: &str, a: f32, flip: f64) -> Record {
-        let mut r = crate::document::fixtures::record(2, 10.0, 1, flip);
+        let mut r = mirrorbox_report::document::fixtures::record(2, 10.0, 1, flip);
         r.key = format!("{options} {a}");
         r.method_options = options.into();
-        r.axes.insert(crate::axis::BUMP_DEG.into(), f64::from(a));
+        r.axes
+            .insert(mirrorbox_report::axis::BUMP_DEG.into(), f64::from(a));
         r.metrics.flip_mean = flip;
         r
     }
@@ -447,7 +488,7 @@ mod tests {
         );
         assert!(uneven_section(&records, &bump()).len() >= 5);
         let mut plain = records[0].clone();
-        plain.axes.remove(crate::axis::BUMP_DEG);
+        plain.axes.remove(mirrorbox_report::axis::BUMP_DEG);
         assert!(uneven_section(&[plain], &bump()).is_empty());
     }
 }

@@ -6,12 +6,12 @@
 //! against one full-scene pass: the floor point, which renders the scene without mirrors
 //! once.
 
-use crate::{Record, linear_fit};
+use mirrorbox_report::{Record, linear_fit};
 
 /// Whether `r` is a point of one of the `exact` methods (names from the raster registry,
-/// carried by [`crate::SweepInfo::exact_methods`]) at a reflection depth — the mirror
+/// carried by [`mirrorbox_report::SweepInfo::exact_methods`]) at a reflection depth — the mirror
 /// methods; the exact symmetry methods have no depth and are reported over p
-/// ([`crate::symmetry`]).
+/// (`symmetry-scaling`).
 pub fn is_exact(exact: &[String], r: &Record) -> bool {
     r.kind == "point" && exact.contains(&r.method) && r.depth.is_some()
 }
@@ -27,7 +27,7 @@ pub struct DepthScaling {
     pub ms_per_bounce: Option<f64>,
     /// Its 95 % bootstrap interval: every point's frames resampled, medians refitted
     /// (`None` where a point has too few frames).
-    pub ms_per_bounce_interval: Option<crate::stats::Interval>,
+    pub ms_per_bounce_interval: Option<mirrorbox_report::stats::Interval>,
 }
 
 /// Groups the exact points by (method, α), each with at least two depths.
@@ -64,8 +64,8 @@ pub fn depth_scaling(exact: &[String], records: &[Record]) -> Vec<DepthScaling> 
 
 /// The 95 % bootstrap interval of the least-squares slope of median ms/frame against the
 /// reflections shown.
-fn slope_interval(points: &[Record]) -> Option<crate::stats::Interval> {
-    use crate::stats::{BOOTSTRAP_SEED, MIN_FRAMES_FOR_INTERVAL, bootstrap, median};
+fn slope_interval(points: &[Record]) -> Option<mirrorbox_report::stats::Interval> {
+    use mirrorbox_report::stats::{BOOTSTRAP_SEED, MIN_FRAMES_FOR_INTERVAL, bootstrap, median};
     if points
         .iter()
         .any(|r| r.frames_ms.len() < MIN_FRAMES_FOR_INTERVAL)
@@ -87,7 +87,7 @@ fn slope_interval(points: &[Record]) -> Option<crate::stats::Interval> {
     )
 }
 
-use crate::document::{ms, ms_digits};
+use mirrorbox_report::document::{ms, ms_digits};
 
 /// A sentence on the cost of one more bounce against one full-scene pass (`pass_ms`).
 pub fn bounce_sentence(g: &DepthScaling, pass_ms: Option<f64>) -> String {

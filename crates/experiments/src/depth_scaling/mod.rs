@@ -1,5 +1,8 @@
 //! The exact methods' cost per bounce: `portal` and `unrolled` at depth 1 … 1024.
 
+pub mod exact;
+pub mod section;
+
 use crate::{Experiment, Measure};
 use mirrorbox_harness::{SweepConfig, swept};
 use std::path::Path;
@@ -19,7 +22,9 @@ pub const DEPTH_SCALING: Experiment = Experiment {
     about: "the exact methods' cost against the depth cap, 1 to 1024 mirrors along a path",
     folder: "depth_scaling",
     measure: Measure::Sweeps(|out| vec![sweep(out)]),
-    section: Some(mirrorbox_report::sections::depth_scaling),
+    section: Some(section::section),
+    regions: section::REGIONS,
     chapter: "exact-methods.md",
     main_job: true,
+    overview: None,
 };

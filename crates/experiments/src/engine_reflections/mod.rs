@@ -5,6 +5,8 @@
 //! turns. Not in the main job (its budget is spent; `docs/budgets.md`): run it with
 //! `mirrorbox experiment engine-reflections`.
 
+pub mod section;
+
 use crate::{Experiment, Measure, beside};
 use mirrorbox_harness::axes::{AxisValues, CAMERA_YAW};
 use mirrorbox_harness::{SweepConfig, swept};
@@ -88,7 +90,9 @@ pub const ENGINE_REFLECTIONS: Experiment = Experiment {
             screen_sweep("scenes/mirror_room.json", &beside(out, "_ssr_room")),
         ]
     }),
-    section: Some(mirrorbox_report::sections::engine_reflections),
+    section: Some(section::section),
+    regions: &[],
     chapter: "engine-reflections.md",
     main_job: false,
+    overview: None,
 };

@@ -11,9 +11,9 @@
 //!
 //! The report knows the methods' names and options (`ssr-fallback`), not the rasterizer.
 
-use crate::Record;
-use crate::document::{Block, distinct, f, ms_cell, sci};
-use crate::plot::{Chart, Series, method_style};
+use mirrorbox_report::Record;
+use mirrorbox_report::document::{Block, distinct, f, ms_cell, sci};
+use mirrorbox_report::plot::{Chart, Series, method_style};
 
 /// The yaw axis' name in a record's `axes` (the harness's `CAMERA_YAW`).
 const YAW: &str = "yaw_deg";
@@ -31,7 +31,7 @@ fn fallback(r: &Record) -> String {
 
 /// `ssr`'s style per fallback, the variants the overview gives them in key order (`none`,
 /// the default `cubemap`, `planar`): square, hollow square, triangle.
-fn ssr_style(fallback: &str) -> crate::plot::Style {
+fn ssr_style(fallback: &str) -> mirrorbox_report::plot::Style {
     let base = method_style("ssr");
     match fallback {
         "cubemap" => base.variant(1),
@@ -313,6 +313,11 @@ fn table(pts: &[&Record], screen: bool) -> Block {
         })
         .collect();
     Block::Table(header, rows)
+}
+
+/// The section, offered every sweep's records; empty where no engine method was measured.
+pub fn section(info: &mirrorbox_report::SweepInfo, records: &[Record]) -> Vec<Block> {
+    engine_reflections_section(records, &info.truth)
 }
 
 #[cfg(test)]

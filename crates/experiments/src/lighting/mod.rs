@@ -1,6 +1,9 @@
 //! Shadows and mirrored lights (issue 15, seed 002's mirrored light sources): each raster
 //! lighting variant against truths lit through chains of up to k mirrors.
 
+pub mod section;
+pub mod trace_cost;
+
 use crate::{Experiment, Measure, beside};
 use mirrorbox_harness::{SweepConfig, along, axes, swept, with_options};
 use std::path::{Path, PathBuf};
@@ -25,7 +28,7 @@ const SHADOWED_METHODS: [&str; 2] = ["unrolled depth=64", "auxiliary n=2"];
 /// 320×180, 6 timed frames after one warm-up.
 pub fn sweep(out: &Path) -> SweepConfig {
     let mut methods = Vec::new();
-    let mut bases = swept(mirrorbox_report::table1::PAPER_METHOD, 0..=4);
+    let mut bases = swept(crate::table1::rows::PAPER_METHOD, 0..=4);
     bases.extend(swept("unrolled", [64]));
     bases.extend(swept("portal", [64]));
     for base in &bases {
@@ -81,7 +84,9 @@ pub const LIGHTING: Experiment = Experiment {
     about: "shadows and mirrored lights: each raster lighting variant against truths lit through up to k mirrors",
     folder: "lighting",
     measure: Measure::Sweeps(|out| vec![sweep(out), room_sweep(&beside(out, "_room"))]),
-    section: Some(mirrorbox_report::sections::lighting),
+    section: Some(section::section),
+    regions: section::REGIONS,
     chapter: "lighting.md",
     main_job: true,
+    overview: None,
 };

@@ -6,9 +6,11 @@
 //! `shadow-map-size=…`, `shadow-bias=…`): the report knows the options' names, not the
 //! rasterizer.
 
-use crate::Record;
-use crate::document::{Block, f, ms_cell, sci};
-use crate::plot::{Chart, Series, method_style};
+use mirrorbox_report::Record;
+use mirrorbox_report::document::{Block, f, markdown, ms_cell, sci};
+use mirrorbox_report::plot::{Chart, Series, method_style};
+use mirrorbox_report::readme::{ReadmeError, RegionSource, measured_on};
+use mirrorbox_report::{Sweep, load_sweep};
 
 /// The raster option that chooses direct or mirrored lights.
 pub const LIGHTS_OPTION: &str = "lights";
@@ -62,7 +64,7 @@ fn lit_points(records: &[Record]) -> Vec<&Record> {
         .collect()
 }
 
-use crate::document::distinct;
+use mirrorbox_report::document::distinct;
 
 /// The method the sentences and the error-against-k chart follow: the first exact one
 /// measured (`unrolled`, `portal`), else the first.
@@ -137,7 +139,7 @@ pub fn sentences(records: &[Record]) -> Vec<String> {
 }
 
 /// The report section of a mirrored-lights sweep (empty for any other sweep).
-pub(crate) fn lighting_section(records: &[Record]) -> Vec<Block> {
+pub fn lighting_section(records: &[Record]) -> Vec<Block> {
     let points = lit_points(records);
     if points.is_empty() {
         return Vec::new();
@@ -293,17 +295,53 @@ pub(crate) fn lighting_section(records: &[Record]) -> Vec<Block> {
     out
 }
 
+/// The section, offered every sweep's records; empty where none carries the mirrored-light
+/// depth.
+pub fn section(_: &mirrorbox_report::SweepInfo, records: &[Record]) -> Vec<Block> {
+    lighting_section(records)
+}
+
+fn lighting_region(s: &Sweep) -> Result<String, ReadmeError> {
+    let sentences = sentences(&s.records);
+    if sentences.is_empty() {
+        return Err(ReadmeError(format!(
+            "{}: no mirrored-lights sweep, nothing to quote",
+            s.info.scene
+        )));
+    }
+    Ok(markdown(&[
+        Block::Paragraph(measured_on(s)),
+        Block::Bullets(sentences),
+    ]))
+}
+
+/// The regions of the lighting chapter: the lit mirror box and the lit mirror room.
+pub const REGIONS: &[RegionSource] = &[
+    RegionSource {
+        id: "lighting",
+        source: "lighting",
+        about: "shadows and mirrored lights on the lit mirror box: each lighting variant's error and cost",
+        generate: |reports| lighting_region(&load_sweep(&reports.join("lighting"))?),
+    },
+    RegionSource {
+        id: "lighting-room",
+        source: "lighting_room",
+        about: "the same on the lit mirror room",
+        generate: |reports| lighting_region(&load_sweep(&reports.join("lighting_room"))?),
+    },
+];
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     fn record(method: &str, options: &str, k: u32, flip: f64) -> Record {
-        let mut r = crate::document::fixtures::record(0, 10.0, 1, flip);
+        let mut r = mirrorbox_report::document::fixtures::record(0, 10.0, 1, flip);
         r.method = method.into();
         r.n = None;
         r.method_options = options.into();
         r.axes
-            .insert(crate::axis::MIRRORED_LIGHTS.into(), f64::from(k));
+            .insert(mirrorbox_report::axis::MIRRORED_LIGHTS.into(), f64::from(k));
         r.metrics.flip_mean = flip;
         if method == "unrolled" {
             r.depth = Some(64);
@@ -360,7 +398,7 @@ mod tests {
         assert!(lighting_section(&records).len() >= 5);
         // Not a mirrored-lights sweep: no section.
         let mut plain = records[0].clone();
-        plain.axes.remove(crate::axis::MIRRORED_LIGHTS);
+        plain.axes.remove(mirrorbox_report::axis::MIRRORED_LIGHTS);
         assert!(lighting_section(&[plain]).is_empty());
     }
 }

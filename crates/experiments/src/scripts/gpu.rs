@@ -3,39 +3,14 @@
 //! mirror room at 1920×1080 against depth, and the tracer against its thread count
 //! (`scripts/gpu-measure.sh`, steps `room` and `trace`).
 
-use crate::document::{Block, markdown, ms};
-use crate::error::ReadmeError;
-use crate::stats;
+use mirrorbox_report::document::{Block, markdown, ms};
+use mirrorbox_report::readme::{ReadmeError, RegionSource, read_lines};
+use mirrorbox_report::stats;
 use std::collections::BTreeMap;
 use std::path::Path;
 
 /// A frame budget of 60 Hz, the usual line between real-time and not.
 pub const REAL_TIME_MS: f64 = 1000.0 / 60.0;
-
-/// JSON-lines files of one-off runs are a few hundred KB; the bound keeps a wrong path from
-/// being read whole.
-const MAX_RUNS_BYTES: u64 = 16 << 20;
-
-/// Reads every non-empty line of `path` as a `T`, naming the line that is not one.
-pub(crate) fn read_lines<T: serde::de::DeserializeOwned>(
-    path: &Path,
-) -> Result<Vec<T>, ReadmeError> {
-    let text = mirrorbox_files::read_bounded_text(path, MAX_RUNS_BYTES, "a JSON-lines file")
-        .map_err(|e| ReadmeError(e.to_string()))?;
-    let runs = text
-        .lines()
-        .enumerate()
-        .filter(|(_, l)| !l.trim().is_empty())
-        .map(|(i, l)| {
-            serde_json::from_str(l)
-                .map_err(|e| ReadmeError(format!("{}:{}: {e}", path.display(), i + 1)))
-        })
-        .collect::<Result<Vec<T>, _>>()?;
-    if runs.is_empty() {
-        return Err(ReadmeError(format!("{}: no runs to quote", path.display())));
-    }
-    Ok(runs)
-}
 
 /// One `render --json` run of the room step, or the refusal the script wrote in its place.
 #[derive(serde::Deserialize)]
@@ -262,6 +237,48 @@ pub fn threads_region(path: &Path, cpu: &str) -> Result<String, ReadmeError> {
         ),
     ]))
 }
+
+/// The regions of the GPU chapter: Table 1, the depth scaling and the mirror room measured
+/// on a GPU, and the tracer's threads on that machine's CPU.
+pub const REGIONS: &[RegionSource] = &[
+    RegionSource {
+        id: "gpu-table1",
+        source: "gpu/table1",
+        about: "Table 1 and the exact methods beside it, measured on a GPU",
+        generate: |reports| crate::table1::section::region_of(reports, "gpu/table1"),
+    },
+    RegionSource {
+        id: "gpu-column",
+        source: "gpu/table1",
+        about: "Table 1's points on lavapipe (reports/table1) and on a GPU side by side",
+        generate: |reports| crate::table1::section::device_column(reports, "gpu/table1"),
+    },
+    RegionSource {
+        id: "gpu-depth-scaling",
+        source: "gpu/depth_scaling",
+        about: "the exact methods' cost per bounce, measured on a GPU",
+        generate: |reports| {
+            crate::depth_scaling::section::region_of(reports, "gpu/depth_scaling", false)
+        },
+    },
+    RegionSource {
+        id: "gpu-room",
+        source: "gpu/room_1080p.jsonl",
+        about: "the mirror room at 1920×1080 against depth on a GPU: where real time ends",
+        generate: |reports| room_region(&reports.join("gpu/room_1080p.jsonl")),
+    },
+    RegionSource {
+        id: "gpu-trace-threads",
+        source: "gpu/trace_threads.jsonl",
+        about: "the tracer against its thread count on the GPU machine's CPU",
+        generate: |reports| {
+            let cpu_file = reports.join("gpu/cpu.txt");
+            let cpu = mirrorbox_files::read_bounded_text(&cpu_file, 4096, "a CPU name")
+                .map_err(|e| ReadmeError(e.to_string()))?;
+            threads_region(&reports.join("gpu/trace_threads.jsonl"), cpu.trim())
+        },
+    },
+];
 
 #[cfg(test)]
 mod tests {

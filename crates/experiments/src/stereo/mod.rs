@@ -1,6 +1,8 @@
 //! Stereo mirrors (issue 17, seed 002's per-eye mirror cameras): per-eye mirror textures
 //! against the head's shared ones.
 
+pub mod section;
+
 use crate::{Experiment, Measure};
 use mirrorbox_harness::{AxisValues, SweepConfig, axes};
 use mirrorbox_raster::Method;
@@ -51,7 +53,9 @@ pub const STEREO: Experiment = Experiment {
     about: "stereo mirrors: per-eye mirror textures against shared ones as the IPD grows",
     folder: "stereo",
     measure: Measure::Sweeps(|out| vec![sweep(out)]),
-    section: Some(mirrorbox_report::sections::stereo),
+    section: Some(section::section),
+    regions: section::REGIONS,
     chapter: "stereo.md",
     main_job: true,
+    overview: None,
 };

@@ -9,9 +9,11 @@
 //! the mirror, so its true disparity is larger than the mirror surface's; the shared shortcut
 //! paints it at the mirror's.
 
-use crate::document::{Block, distinct, f, ms_cell, sci};
-use crate::plot::{Chart, Series, method_style, styles_for};
-use crate::{MarkerRecord, Record};
+use mirrorbox_report::Record;
+use mirrorbox_report::document::{Block, distinct, f, markdown, ms_cell, sci};
+use mirrorbox_report::plot::{Chart, Series, method_style, styles_for};
+use mirrorbox_report::readme::{ReadmeError, RegionSource, measured_on};
+use mirrorbox_report::{Sweep, load_sweep};
 
 /// The method option that chooses shared mirror textures (crates/raster/src/stereo_mirrors.rs).
 const SHARED_OPTION: &str = "stereo-mirrors";
@@ -66,16 +68,9 @@ fn mono_of<'a>(records: &'a [Record], pair: &Record) -> Option<&'a Record> {
     })
 }
 
-/// The marker's disparity in a pair, pixels (`x_right − x_left`, positive behind the
-/// convergence plane): of the raster's pictures,
-/// or of the truth's.
+/// The marker's disparity in a pair ([`mirrorbox_report::StereoRecord::disparity`]).
 pub fn disparity(r: &Record, truth: bool) -> Option<f64> {
-    let s = r.stereo.as_ref()?;
-    let at = |k: usize| -> Option<MarkerRecord> {
-        let e = s.eyes.get(k)?;
-        if truth { e.truth_marker } else { e.marker }
-    };
-    Some(at(1)?.x - at(0)?.x)
+    r.stereo.as_ref()?.disparity(truth)
 }
 
 fn find<'a>(points: &[&'a Record], variant: &str, d: f32) -> Option<&'a Record> {
@@ -90,7 +85,7 @@ fn px(v: Option<f64>) -> String {
 }
 
 /// The pair's time against the mono frame: one row per variant, at the largest IPD.
-pub(crate) fn cost_table(records: &[Record]) -> Block {
+pub fn cost_table(records: &[Record]) -> Block {
     let pts = pairs(records);
     let widest = ipds(&pts).last().copied().unwrap_or(0.0);
     let header = vec![
@@ -118,7 +113,7 @@ pub(crate) fn cost_table(records: &[Record]) -> Block {
 }
 
 /// FLIP (the mean of both eyes', each against its own truth) per variant and IPD.
-pub(crate) fn error_table(records: &[Record]) -> Block {
+pub fn error_table(records: &[Record]) -> Block {
     let pts = pairs(records);
     let ds = ipds(&pts);
     let mut header = vec!["method, mirrors".to_string()];
@@ -138,7 +133,7 @@ pub(crate) fn error_table(records: &[Record]) -> Block {
 }
 
 /// The marker's disparity per variant and IPD, the truth's first.
-pub(crate) fn disparity_table(records: &[Record]) -> Block {
+pub fn disparity_table(records: &[Record]) -> Block {
     let pts = pairs(records);
     let ds = ipds(&pts);
     let mut header = vec!["marker's reflection disparity (px)".to_string()];
@@ -180,13 +175,14 @@ pub fn sentences(records: &[Record]) -> Vec<String> {
             continue;
         };
         let saved = own.ms_median - shared.ms_median;
-        let ratio = crate::document::paired_ratio(shared, own).map_or(String::new(), |i| {
-            format!(
-                " (shared ÷ per-eye: 95 % CI [{}, {}])",
-                f(i.low, 2),
-                f(i.high, 2)
-            )
-        });
+        let ratio =
+            mirrorbox_report::document::paired_ratio(shared, own).map_or(String::new(), |i| {
+                format!(
+                    " (shared ÷ per-eye: 95 % CI [{}, {}])",
+                    f(i.low, 2),
+                    f(i.high, 2)
+                )
+            });
         let mut s = format!(
             "`{m}` at IPD {widest}: sharing the head's mirror textures saves {} ms per stereo \
              pair ({} % of per-eye's {} ms){ratio} and raises FLIP from {} to {}",
@@ -279,7 +275,7 @@ fn chart(records: &[Record], name: &str, title: &str, y_label: &str, y_log: bool
 }
 
 /// The report section of an `--ipd` sweep (empty for any other sweep).
-pub(crate) fn stereo_section(records: &[Record]) -> Vec<Block> {
+pub fn stereo_section(records: &[Record]) -> Vec<Block> {
     let pts = pairs(records);
     if pts.is_empty() {
         return Vec::new();
@@ -368,13 +364,43 @@ pub(crate) fn stereo_section(records: &[Record]) -> Vec<Block> {
     out
 }
 
+/// The section, offered every sweep's records; empty where none is a stereo pair.
+pub fn section(_: &mirrorbox_report::SweepInfo, records: &[Record]) -> Vec<Block> {
+    stereo_section(records)
+}
+
+fn stereo_region(s: &Sweep) -> Result<String, ReadmeError> {
+    let sentences = sentences(&s.records);
+    if sentences.is_empty() {
+        return Err(ReadmeError(format!(
+            "{}: no stereo sweep measuring per-eye and shared, nothing to quote",
+            s.info.scene
+        )));
+    }
+    Ok(markdown(&[
+        Block::Paragraph(measured_on(s)),
+        cost_table(&s.records),
+        error_table(&s.records),
+        disparity_table(&s.records),
+        Block::Bullets(sentences),
+    ]))
+}
+
+/// The region of the stereo chapter.
+pub const REGIONS: &[RegionSource] = &[RegionSource {
+    id: "stereo",
+    source: "stereo",
+    about: "stereo mirrors: the pair's cost against mono, per-eye against shared, and the disparity check",
+    generate: |reports| stereo_region(&load_sweep(&reports.join("stereo"))?),
+}];
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{EyeRecord, StereoRecord};
+    use mirrorbox_report::{EyeRecord, MarkerRecord, StereoRecord};
 
     fn eye(name: &str, flip: f64, x: f64, truth_x: f64) -> EyeRecord {
-        let mut metrics = crate::document::fixtures::record(2, 1.0, 1, flip).metrics;
+        let mut metrics = mirrorbox_report::document::fixtures::record(2, 1.0, 1, flip).metrics;
         metrics.flip_mean = flip;
         let at = |x| {
             Some(MarkerRecord {
@@ -392,7 +418,7 @@ mod tests {
     }
 
     fn pair(options: &str, d: f32, ms: f64, flip: f64, x_right: f64) -> Record {
-        let mut r = crate::document::fixtures::record(2, ms, 30, flip);
+        let mut r = mirrorbox_report::document::fixtures::record(2, ms, 30, flip);
         r.key = format!("{options} {d}");
         r.method_options = options.into();
         r.frames_ms = vec![ms; 6];
@@ -410,7 +436,7 @@ mod tests {
 
     #[test]
     fn sharing_is_weighed_by_its_saving_error_and_disparity() {
-        let mut mono = crate::document::fixtures::record(2, 50.0, 15, 0.01);
+        let mut mono = mirrorbox_report::document::fixtures::record(2, 50.0, 15, 0.01);
         mono.key = "mono".into();
         let records = vec![
             pair("", 0.1, 110.0, 0.01, 97.0),

@@ -1,6 +1,9 @@
 //! Symmetry planes (seed 001): the seed's method, pruned copies and the CPU-baked mesh against
 //! the number of planes p.
 
+pub mod planes;
+pub mod section;
+
 use crate::{Experiment, Measure};
 use mirrorbox_harness::{SweepConfig, along, axes};
 use mirrorbox_raster::Method;
@@ -39,7 +42,9 @@ pub const SYMMETRY_SCALING: Experiment = Experiment {
     about: "the symmetry-plane methods' cost against the number of planes p = 0…10",
     folder: "symmetry_scaling",
     measure: Measure::Sweeps(|out| vec![sweep(out)]),
-    section: Some(mirrorbox_report::sections::symmetry_scaling),
+    section: Some(section::section),
+    regions: section::REGIONS,
     chapter: "symmetry.md",
     main_job: true,
+    overview: None,
 };

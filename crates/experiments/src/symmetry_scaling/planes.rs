@@ -2,8 +2,8 @@
 //! planes p, where the seed's method draws 2^p copies, pruning removes copies whose cell is
 //! empty or out of view, and the CPU's split-and-mirror mesh is drawn once.
 
-use crate::Record;
-use crate::document::ms;
+use mirrorbox_report::Record;
+use mirrorbox_report::document::ms;
 
 /// The method that draws the CPU-baked mesh once; the others are compared with it.
 pub const BAKED_METHOD: &str = "symmetry-baked";
@@ -23,7 +23,7 @@ pub struct PlaneScaling {
 }
 
 /// The method and its options as a report names them.
-pub use crate::document::variant;
+pub use mirrorbox_report::document::variant;
 
 /// Groups the points that carry a plane count by method variant, each in p order.
 pub fn plane_scaling(records: &[Record]) -> Vec<PlaneScaling> {
@@ -114,10 +114,11 @@ mod tests {
     use super::*;
 
     fn point(method: &str, p: u32, ms: f64, drawn: usize) -> Record {
-        let mut r = crate::document::fixtures::record(0, ms, 1, 0.0);
+        let mut r = mirrorbox_report::document::fixtures::record(0, ms, 1, 0.0);
         r.method = method.into();
         r.n = None;
-        r.axes.insert(crate::axis::PLANES.into(), f64::from(p));
+        r.axes
+            .insert(mirrorbox_report::axis::PLANES.into(), f64::from(p));
         r.copies_drawn = Some(drawn);
         r.copies_total = Some(1 << p);
         // A tight interval: ±1 %.

@@ -2,6 +2,9 @@
 //! methods at depth 64 beside it — run twice by the main job, the second run into its own
 //! folder, so that two consecutive runs stand side by side.
 
+pub mod rows;
+pub mod section;
+
 use crate::{Experiment, Measure};
 use mirrorbox_harness::{SweepConfig, swept};
 use std::path::Path;
@@ -9,7 +12,7 @@ use std::path::Path;
 /// The auxiliary method for n = 0…4 on mirror_box at α = 1 and the paper's 0.7, with
 /// `portal` and `unrolled` at depth 64 beside it; 9 timed frames.
 pub fn sweep(out: &Path) -> SweepConfig {
-    let mut methods = swept(mirrorbox_report::table1::PAPER_METHOD, 0..=4);
+    let mut methods = swept(rows::PAPER_METHOD, 0..=4);
     // A preset is a fixed experiment: its methods are named, not taken from the table.
     for m in ["portal", "unrolled"] {
         methods.extend(swept(m, [64]));
@@ -22,9 +25,11 @@ pub const TABLE1: Experiment = Experiment {
     about: "the paper's Table 1: its auxiliary mirrors at n = 0…4 against the truth, with the exact methods beside it",
     folder: "table1",
     measure: Measure::Sweeps(|out| vec![sweep(out)]),
-    section: Some(mirrorbox_report::sections::table1),
+    section: Some(section::table1_section),
+    regions: section::REGIONS,
     chapter: "table1.md",
     main_job: true,
+    overview: None,
 };
 
 pub const TABLE1_REPEAT: Experiment = Experiment {
@@ -32,7 +37,9 @@ pub const TABLE1_REPEAT: Experiment = Experiment {
     about: "Table 1 measured again right after the first run: how much two runs differ",
     folder: "table1_repeat",
     measure: Measure::Sweeps(|out| vec![sweep(out)]),
-    section: Some(mirrorbox_report::sections::table1),
+    section: Some(section::table1_section),
+    regions: section::REPEAT_REGIONS,
     chapter: "table1.md",
     main_job: true,
+    overview: None,
 };

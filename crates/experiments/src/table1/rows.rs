@@ -5,7 +5,7 @@
 /// check it is registered).
 pub const PAPER_METHOD: &str = "auxiliary";
 
-use crate::Record;
+use mirrorbox_report::Record;
 
 /// Table 1 of the seed paper: ms/frame for n = 0…4 auxiliary mirrors, "tested on Safari".
 pub const PAPER_MS: [f64; 5] = [25.0, 61.0, 142.0, 435.0, 1330.0];
@@ -67,7 +67,7 @@ pub fn slope(points: &[(f64, f64)]) -> Option<f64> {
         .filter(|(p, t)| *p > 0.0 && *t > 0.0)
         .map(|(p, t)| (p.ln(), t.ln()))
         .collect();
-    crate::linear_fit(&pts).map(|(_, b)| b)
+    mirrorbox_report::linear_fit(&pts).map(|(_, b)| b)
 }
 
 /// The paper's scene: Table 1 is reproduced only on it.
@@ -85,31 +85,31 @@ pub fn is_papers_sweep(scene: &str, rows: &[Row]) -> bool {
 /// `[low, high]` with the decimals the interval can tell apart (two significant digits of its
 /// width, at least two decimals): a narrow interval must not print as "[0.47, 0.47]".
 fn bracket(low: f64, high: f64) -> String {
-    let d = crate::document::interval_digits(low, high).max(2);
+    let d = mirrorbox_report::document::interval_digits(low, high).max(2);
     format!("[{low:.d$}, {high:.d$}]")
 }
 
 /// The 95 % bootstrap interval of our exponent: every row's frames resampled with
 /// replacement, its median taken, the power law fitted again. `None` without frames.
-pub fn exponent_interval(rows: &[Row]) -> Option<crate::stats::Interval> {
+pub fn exponent_interval(rows: &[Row]) -> Option<mirrorbox_report::stats::Interval> {
     if rows
         .iter()
-        .any(|r| r.frames_ms.len() < crate::stats::MIN_FRAMES_FOR_INTERVAL)
+        .any(|r| r.frames_ms.len() < mirrorbox_report::stats::MIN_FRAMES_FOR_INTERVAL)
     {
         return None;
     }
     let groups: Vec<&[f64]> = rows.iter().map(|r| r.frames_ms.as_slice()).collect();
-    crate::stats::bootstrap(
+    mirrorbox_report::stats::bootstrap(
         &groups,
         |resampled| {
             let pts: Vec<(f64, f64)> = rows
                 .iter()
                 .zip(resampled)
-                .map(|(r, frames)| (r.passes as f64, crate::stats::median(frames)))
+                .map(|(r, frames)| (r.passes as f64, mirrorbox_report::stats::median(frames)))
                 .collect();
             slope(&pts).unwrap_or(f64::NAN)
         },
-        crate::stats::BOOTSTRAP_SEED,
+        mirrorbox_report::stats::BOOTSTRAP_SEED,
     )
 }
 
@@ -138,7 +138,7 @@ pub fn growth_sentence(rows: &[Row]) -> String {
         let (lo, hi) = v
             .iter()
             .fold((f64::INFINITY, 0.0f64), |(a, b), &x| (a.min(x), b.max(x)));
-        let digits = crate::document::ms_digits(lo, 1);
+        let digits = mirrorbox_report::document::ms_digits(lo, 1);
         (format!("{lo:.digits$}–{hi:.digits$}"), hi / lo)
     };
     let ((ours_range, ours_ratio), (paper_range, paper_ratio)) =
@@ -146,11 +146,11 @@ pub fn growth_sentence(rows: &[Row]) -> String {
     // ms = a + b·passes: a is the frame's fixed cost, b one pass's.
     let fixed = |ms: &dyn Fn(&Row) -> f64| {
         let pts: Vec<(f64, f64)> = rows.iter().map(|r| (r.passes as f64, ms(r))).collect();
-        crate::linear_fit(&pts).map_or("–".into(), |(a, b)| {
+        mirrorbox_report::linear_fit(&pts).map_or("–".into(), |(a, b)| {
             format!(
                 "a = {} ms, b = {} ms",
-                crate::document::ms(a, 1),
-                crate::document::ms(b, 1)
+                mirrorbox_report::document::ms(a, 1),
+                mirrorbox_report::document::ms(b, 1)
             )
         })
     };

@@ -1,4 +1,5 @@
 //! The experiment registry's tests, one binary (CONTRIBUTING, "Where tests go").
 
+mod records;
 mod registry;
 mod resume_keys;

@@ -59,29 +59,59 @@ fn every_experiment_is_runnable_and_named_once() {
 }
 
 #[test]
-fn every_report_section_belongs_to_an_experiment() {
-    use mirrorbox_report::sections as s;
-    let known: [mirrorbox_report::Section; 6] = [
-        s::table1,
-        s::depth_scaling,
-        s::symmetry_scaling,
-        s::lighting,
-        s::uneven_mirrors,
-        s::stereo,
-    ];
+fn each_report_section_and_region_is_offered_once() {
     let registered = sections();
-    for k in known {
-        assert!(
-            registered.iter().any(|r| std::ptr::fn_addr_eq(*r, k)),
-            "a section of the report crate no experiment offers"
-        );
-    }
+    assert!(registered.len() >= 7, "the experiments' own sections");
     for (i, r) in registered.iter().enumerate() {
         assert!(
             !registered[..i].iter().any(|o| std::ptr::fn_addr_eq(*o, *r)),
             "each section offered once"
         );
     }
+    let regions = mirrorbox_experiments::regions();
+    for (i, r) in regions.iter().enumerate() {
+        assert!(
+            !regions[..i].iter().any(|o| o.id == r.id),
+            "region {:?} declared twice",
+            r.id
+        );
+    }
+}
+
+/// The report crate knows documents, charts, statistics and the writer, not the experiments
+/// (issue 52): no file of `crates/report/src` is named after an experiment, and none holds an
+/// experiment's name or report folder as a string literal (`"table1"`, `"lighting_room"`,
+/// `"reports/stereo…"`) — an experiment's section, regions and figures' choices live in its
+/// module here.
+#[test]
+fn the_report_crate_names_no_experiment() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("../report/src");
+    let mut found = Vec::new();
+    for entry in std::fs::read_dir(&src).unwrap().flatten() {
+        let file = entry.file_name().to_string_lossy().into_owned();
+        let text = std::fs::read_to_string(entry.path()).unwrap();
+        for e in EXPERIMENTS {
+            let stem = file.trim_end_matches(".rs");
+            if stem == e.name.replace('-', "_") || stem == e.folder {
+                found.push(format!("src/{file} is named after experiment {}", e.name));
+            }
+            for word in [e.name, e.folder] {
+                for literal in [
+                    format!("\"{word}\""),
+                    format!("\"{word}/"),
+                    format!("\"reports/{word}"),
+                ] {
+                    if text.contains(&literal) {
+                        found.push(format!(
+                            "src/{file} holds {literal}… (experiment {})",
+                            e.name
+                        ));
+                    }
+                }
+            }
+        }
+    }
+    assert!(found.is_empty(), "{}", found.join("\n"));
 }
 
 /// An experiment's module without its row (or a row's module without its `pub mod` line)
@@ -98,14 +128,21 @@ fn every_experiment_module_has_its_row() {
     let mut consts = 0;
     for entry in std::fs::read_dir(&src).unwrap().flatten() {
         let file = entry.file_name().to_string_lossy().into_owned();
-        let Some(module) = file.strip_suffix(".rs").filter(|m| *m != "lib") else {
-            continue;
+        // A module is a file `NAME.rs` or a folder `NAME/mod.rs` (an experiment with its
+        // section and regions beside its row).
+        let (module, path) = if entry.path().is_dir() {
+            (file.clone(), entry.path().join("mod.rs"))
+        } else {
+            match file.strip_suffix(".rs").filter(|m| *m != "lib") {
+                Some(m) => (m.to_string(), entry.path()),
+                None => continue,
+            }
         };
         assert!(
             lib.contains(&format!("pub mod {module};")),
             "src/{file} is not a module of the crate: add `pub mod {module};`"
         );
-        let text = std::fs::read_to_string(entry.path()).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
         for line in text
             .lines()
             .filter(|l| l.ends_with(": Experiment = Experiment {"))

@@ -55,7 +55,7 @@ fn depth_scaling_keys_are_those_of_earlier_sweeps() {
 
 #[test]
 fn the_paper_method_is_registered() {
-    let m = mirrorbox_raster::registry::find(mirrorbox_report::table1::PAPER_METHOD)
+    let m = mirrorbox_raster::registry::find(mirrorbox_experiments::table1::rows::PAPER_METHOD)
         .expect("Table 1's method is in the raster registry");
     assert!(m.swept.is_some_and(|o| o.name == "n"));
 }

@@ -1,0 +1,148 @@
+//! The depth-scaling report section (the exact methods' cost against the depth cap, per
+//! bounce) and the regions that quote it.
+
+use mirrorbox_report::document::{Block, distinct, markdown, ms_cell, sci, setting};
+use mirrorbox_report::plot::{Chart, Reference, Series};
+use mirrorbox_report::readme::{ReadmeError, RegionSource, measured_on, prose};
+use mirrorbox_report::{Record, Sweep, SweepInfo, load_sweep};
+
+/// The section: every sweep's records are offered it; empty where no exact method was swept
+/// over depth.
+pub fn section(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
+    let floor = records.iter().find(|r| r.kind == "floor");
+    depth_scaling(info, records, floor)
+}
+
+/// ms/frame against the depth cap for each exact method with several depths.
+pub fn depth_scaling(info: &SweepInfo, records: &[Record], floor: Option<&Record>) -> Vec<Block> {
+    let groups = super::exact::depth_scaling(&info.exact_methods, records);
+    if groups.is_empty() {
+        return Vec::new();
+    }
+    let mut out = vec![
+        Block::Heading(2, "Exact methods: cost against depth".into()),
+        Block::Chart("plot_ms_vs_depth.svg".into(), {
+            let styles = mirrorbox_report::plot::styles_for(
+                &groups.iter().map(|g| g.method.as_str()).collect::<Vec<_>>(),
+            );
+            let alphas = distinct(groups.iter().map(|g| g.alpha.to_bits()));
+            Box::new(Chart {
+                x_log: true,
+                y_log: true,
+                x_ticks_at_data: true,
+                series: groups
+                    .iter()
+                    .zip(styles)
+                    .map(|(g, style)| {
+                        let name = if alphas.len() > 1 {
+                            format!("{}, α={}", g.method, g.alpha)
+                        } else {
+                            g.method.clone()
+                        };
+                        let mut s = Series::new(
+                            name,
+                            style,
+                            g.points.iter().map(|r| (setting(r), r.ms_median)).collect(),
+                        );
+                        s.y_intervals = g.points.iter().map(|r| r.ms_interval).collect();
+                        s
+                    })
+                    .collect(),
+                references: floor
+                    .map(|fl| vec![Reference::Level("one full-scene pass".into(), fl.ms_median)])
+                    .unwrap_or_default(),
+                ..Chart::new(
+                    "Cost of the exact methods vs depth cap",
+                    "depth cap (most mirrors along a path)",
+                    "ms/frame (median, 95 % CI bars)",
+                )
+            })
+        }),
+        Block::Table(
+            [
+                "method",
+                "α",
+                "depth cap",
+                "reflections shown",
+                "paths kept (pruned)",
+                "passes",
+                "draws",
+                "triangles",
+                "ms/frame median [95 % CI]",
+                "FLIP mean",
+            ]
+            .map(String::from)
+            .to_vec(),
+            groups
+                .iter()
+                .flat_map(|g| &g.points)
+                .map(|r| {
+                    let opt = |v: Option<usize>| v.map_or("–".into(), |x| x.to_string());
+                    vec![
+                        r.method.clone(),
+                        r.alpha.to_string(),
+                        opt(r.depth.map(|d| d as usize)),
+                        r.reflections.to_string(),
+                        format!("{} ({})", opt(r.paths), opt(r.paths_pruned)),
+                        r.passes.to_string(),
+                        r.draws.to_string(),
+                        opt(r.triangles),
+                        ms_cell(r, 2),
+                        sci(r.metrics.flip_mean),
+                    ]
+                })
+                .collect(),
+        ),
+    ];
+    out.push(Block::Bullets(
+        groups
+            .iter()
+            .map(|g| super::exact::bounce_sentence(g, floor.map(|fl| fl.ms_median)))
+            .collect(),
+    ));
+    out
+}
+
+/// The depth-scaling section's cost per bounce (and with `table`, every point).
+fn depth_scaling_region(s: &Sweep, table: bool) -> Result<String, ReadmeError> {
+    let floor = s.records.iter().find(|r| r.kind == "floor");
+    let section = prose(depth_scaling(&s.info, &s.records, floor));
+    let bullets: Vec<Block> = section
+        .into_iter()
+        .filter(|b| table || matches!(b, Block::Bullets(_)))
+        .collect();
+    if bullets.is_empty() {
+        return Err(ReadmeError(format!(
+            "{}: no exact method swept over depth, nothing to quote",
+            s.info.scene
+        )));
+    }
+    let mut blocks = vec![Block::Paragraph(measured_on(s))];
+    blocks.extend(bullets);
+    Ok(markdown(&blocks))
+}
+
+/// The sweep in `reports/<folder>`'s cost per bounce (with `table`, every point too).
+pub fn region_of(
+    reports: &std::path::Path,
+    folder: &str,
+    table: bool,
+) -> Result<String, ReadmeError> {
+    depth_scaling_region(&load_sweep(&reports.join(folder))?, table)
+}
+
+/// The regions of the exact methods' chapter.
+pub const REGIONS: &[RegionSource] = &[
+    RegionSource {
+        id: "depth-scaling",
+        source: "depth_scaling",
+        about: "the exact methods' cost per bounce",
+        generate: |reports| region_of(reports, "depth_scaling", false),
+    },
+    RegionSource {
+        id: "depth-scaling-table",
+        source: "depth_scaling",
+        about: "the exact methods' cost against depth, every point, and per bounce",
+        generate: |reports| region_of(reports, "depth_scaling", true),
+    },
+];

@@ -1,0 +1,530 @@
+//! Table 1's report section and the README/book regions that quote it: the paper's rows beside
+//! ours, the exact methods beside the paper's method, and two runs (or two devices) side by side.
+
+use super::rows::{self as table1, Row};
+use mirrorbox_report::document::{
+    Block, f, interval_digits, label, markdown, ms, ms_cell, ms_digits, paired_ratio, sci,
+};
+use mirrorbox_report::readme::{ReadmeError, measured_on, prose};
+use mirrorbox_report::stats;
+use mirrorbox_report::{Record, Sweep, SweepInfo, floor_paragraph, load_sweep};
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// A Table 1 row's cell: "median [low–high]", or "median [min m]" for older records.
+pub fn row_cell(r: &Row) -> String {
+    let digits = match stats::median_interval(&r.frames_ms) {
+        Some(i) => interval_digits(i.low, i.high),
+        None => ms_digits(r.ms_median, 1),
+    };
+    format!("{} [{}]", f(r.ms_median, digits), row_interval(r, digits))
+}
+
+/// A Table 1 row's interval, "low–high", or "min m" for older records.
+fn row_interval(r: &Row, digits: usize) -> String {
+    match stats::median_interval(&r.frames_ms) {
+        Some(i) => {
+            let d = interval_digits(i.low, i.high);
+            format!("{}–{}", f(i.low, d), f(i.high, d))
+        }
+        None => format!("min {}", f(r.ms_min, digits)),
+    }
+}
+
+/// The exact methods beside the paper's method at the Table 1 α: time and error.
+fn exact_comparison(info: &SweepInfo, records: &[Record], rows: &[Row], alpha: f32) -> Vec<Block> {
+    let exact = crate::depth_scaling::exact::comparison_points(&info.exact_methods, records, alpha);
+    if exact.is_empty() {
+        return Vec::new();
+    }
+    let aux: Vec<&Record> = rows
+        .iter()
+        .filter_map(|row| {
+            records.iter().find(|r| {
+                r.kind == "point"
+                    && r.method == table1::PAPER_METHOD
+                    && r.n == Some(row.n)
+                    && r.alpha == alpha
+            })
+        })
+        .collect();
+    let line = |r: &Record| {
+        vec![
+            label(r),
+            ms_cell(r, 1),
+            r.passes.to_string(),
+            r.draws.to_string(),
+            r.reflections.to_string(),
+            sci(r.metrics.flip_mean),
+            sci(r.metrics.relmse),
+        ]
+    };
+    let mut out = vec![
+        Block::Heading(3, format!("The exact methods beside it (α = {alpha})")),
+        Block::Table(
+            [
+                "method",
+                "ms/frame median [95 % CI]",
+                "passes",
+                "draws",
+                "reflections shown",
+                "FLIP mean",
+                "relMSE",
+            ]
+            .map(String::from)
+            .to_vec(),
+            aux.iter().chain(&exact).map(|r| line(r)).collect(),
+        ),
+    ];
+    // A speed ratio is stated only where the 95 % intervals of the two medians are apart.
+    // Where both points were timed in the same interleaved rounds, the ratio also gets its
+    // paired interval (rounds resampled jointly), which drift of the machine cannot widen.
+    let times = |a: &Record, e: &Record| {
+        let ratio = a.ms_median / e.ms_median;
+        let paired = paired_ratio(a, e).map(|i| {
+            if ratio >= 1.0 {
+                format!("{:.2}–{:.2}×", i.low, i.high)
+            } else {
+                format!("{:.2}–{:.2}×", 1.0 / i.high, 1.0 / i.low)
+            }
+        });
+        let paired_note = |claim: bool| match (&paired, claim) {
+            (Some(p), true) => format!(" (paired by round: {p})"),
+            (Some(p), false) => format!("; paired by round the ratio is {ratio:.2}× [{p}]"),
+            (None, _) => String::new(),
+        };
+        match (a.ms_ci(), e.ms_ci()) {
+            (Some(ia), Some(ie)) if ia.overlaps(&ie) => format!(
+                "not shown apart in time at 95 % on this device (intervals overlap){}",
+                paired_note(false)
+            ),
+            (Some(_), Some(_)) if ratio >= 1.0 => {
+                format!("{ratio:.2}× faster{}", paired_note(true))
+            }
+            (Some(_), Some(_)) => format!("{:.2}× slower{}", 1.0 / ratio, paired_note(true)),
+            _ => "no time comparison (too few frames for intervals)".to_string(),
+        }
+    };
+    let lower_error = |a: &Record, e: &Record| {
+        let (fa, fe) = (a.metrics.flip_mean, e.metrics.flip_mean);
+        if fe > 0.0 && fa > fe {
+            format!("{:.0}× lower error", fa / fe)
+        } else {
+            format!("FLIP {} against {}", sci(fe), sci(fa))
+        }
+    };
+    let sentences: Vec<String> = exact
+        .iter()
+        .map(|e| {
+            let against: Vec<String> = aux
+                .iter()
+                .filter(|a| matches!(a.n, Some(2) | Some(4)))
+                .map(|a| {
+                    format!(
+                        "against {} (FLIP {}, {} ms): {}, {}",
+                        label(a),
+                        sci(a.metrics.flip_mean),
+                        ms_cell(a, 1),
+                        lower_error(a, e),
+                        times(a, e)
+                    )
+                })
+                .collect();
+            format!(
+                "{} shows {} reflections with FLIP {} in {} ms; {}.",
+                label(e),
+                e.reflections,
+                sci(e.metrics.flip_mean),
+                ms_cell(e, 1),
+                against.join("; ")
+            )
+        })
+        .collect();
+    out.push(Block::Bullets(sentences));
+    out
+}
+
+/// The reproduction of the paper's Table 1 with the exact methods beside it — only in the
+/// paper's experiment ([`table1::is_papers_sweep`]); empty otherwise.
+pub fn table1_section(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
+    let mut b = Vec::new();
+    let (alpha, rows) = table1::rows(records);
+    if table1::is_papers_sweep(&info.scene, &rows) {
+        b.push(Block::Heading(
+            2,
+            "Reproduction of the paper's Table 1".into(),
+        ));
+        b.push(Block::Paragraph(format!(
+            "Auxiliary method, α = {}; ours is the median ms/frame over the timed frames with its \
+             95 % bootstrap interval (frames timed interleaved: one per point per round, the points \
+             in an order shuffled per round). The paper's column is its Table 1 (Safari, hardware \
+             not stated).",
+            alpha.unwrap_or(f32::NAN)
+        )));
+        let step = |s: Option<f64>| s.map_or("–".into(), |v| format!("{v:.2}"));
+        b.push(Block::Table(
+            [
+                "n",
+                "paper ms/frame",
+                "ours ms/frame median [95 % CI]",
+                "passes",
+                "ours ms/pass",
+                "paper ms/pass",
+                "step ratio paper",
+                "step ratio ours",
+            ]
+            .map(String::from)
+            .to_vec(),
+            rows.iter()
+                .map(|r| {
+                    vec![
+                        r.n.to_string(),
+                        f(r.paper_ms, 0),
+                        row_cell(r),
+                        r.passes.to_string(),
+                        ms(r.ms_median / r.passes as f64, 2),
+                        ms(r.paper_ms / r.passes as f64, 2),
+                        step(r.paper_step),
+                        step(r.ours_step),
+                    ]
+                })
+                .collect(),
+        ));
+        b.push(Block::Paragraph(table1::growth_sentence(&rows)));
+        if let Some(a) = alpha {
+            b.extend(exact_comparison(info, records, &rows, a));
+        }
+    }
+    b
+}
+
+pub fn table1_region(s: &Sweep) -> Result<String, ReadmeError> {
+    let mut blocks = vec![Block::Paragraph(measured_on(s))];
+    let section = prose(table1_section(&s.info, &s.records));
+    if section.is_empty() {
+        return Err(ReadmeError(format!(
+            "{}: not the paper's experiment (every n of Table 1 on {}), nothing to quote",
+            s.info.scene,
+            table1::PAPER_SCENE
+        )));
+    }
+    blocks.extend(section);
+    if let Some(fl) = s.records.iter().find(|r| r.kind == "floor") {
+        blocks.push(floor_paragraph(fl));
+    }
+    Ok(markdown(&blocks))
+}
+
+/// The short form of [`table1_region`]: the device, the table of every method's point (the
+/// paper's auxiliary n = 0…4 and the exact methods) and the floor.
+fn table1_summary_region(s: &Sweep) -> Result<String, ReadmeError> {
+    let table = prose(table1_section(&s.info, &s.records))
+        .into_iter()
+        .rfind(|b| matches!(b, Block::Table(..)))
+        .ok_or_else(|| {
+            ReadmeError(format!(
+                "{}: not the paper's experiment (every n of Table 1 on {}), nothing to quote",
+                s.info.scene,
+                table1::PAPER_SCENE
+            ))
+        })?;
+    let mut blocks = vec![Block::Paragraph(measured_on(s)), table];
+    if let Some(fl) = s.records.iter().find(|r| r.kind == "floor") {
+        blocks.push(floor_paragraph(fl));
+    }
+    Ok(markdown(&blocks))
+}
+
+/// The points two sweeps of one configuration share, measured on two devices, side by side:
+/// each one's ms/frame and FLIP, and how many times faster the second device is. Times compare
+/// only as ratios of medians here (the devices ran at different times); errors should agree up
+/// to each device's floor, which the last row shows.
+fn device_column_region(first: &Sweep, second: &Sweep) -> Result<String, ReadmeError> {
+    let device = |s: &Sweep| s.info.adapter.clone();
+    let mut rows = Vec::new();
+    for a in &first.records {
+        let Some(b) = second
+            .records
+            .iter()
+            .find(|b| b.key == a.key && b.kind == a.kind)
+        else {
+            continue;
+        };
+        let name = if a.kind == "floor" {
+            "floor (no mirrors)".to_string()
+        } else {
+            label(a)
+        };
+        rows.push(vec![
+            name,
+            format!("{}", a.alpha),
+            ms_cell(a, 1),
+            ms_cell(b, 1),
+            format!("{:.0}×", a.ms_median / b.ms_median),
+            sci(a.metrics.flip_mean),
+            sci(b.metrics.flip_mean),
+        ]);
+    }
+    if rows.is_empty() {
+        return Err(ReadmeError(format!(
+            "{} and {}: no point in common",
+            first.info.command, second.info.command
+        )));
+    }
+    Ok(markdown(&[
+        Block::Paragraph(format!(
+            "First: {} Second: {}",
+            measured_on(first),
+            measured_on(second)
+        )),
+        Block::Table(
+            vec![
+                "point".into(),
+                "α".into(),
+                format!("{} ms/frame [95 % CI]", device(first)),
+                format!("{} ms/frame [95 % CI]", device(second)),
+                "ratio of medians".into(),
+                format!("FLIP {}", device(first)),
+                format!("FLIP {}", device(second)),
+            ],
+            rows,
+        ),
+    ]))
+}
+
+/// Table 1's rows of two runs side by side: whether each row's intervals overlap, and whether
+/// each run's times keep the order of the pass counts.
+fn repeat_region(first: &Sweep, second: &Sweep) -> Result<String, ReadmeError> {
+    let (alpha_a, a) = table1::rows(&first.records);
+    let (alpha_b, b) = table1::rows(&second.records);
+    if a.len() != table1::PAPER_MS.len() || b.len() != a.len() || alpha_a != alpha_b {
+        return Err(ReadmeError(
+            "reports/table1 and reports/table1_repeat do not both hold Table 1's rows at one α"
+                .into(),
+        ));
+    }
+    let interval = |r: &Row| stats::median_interval(&r.frames_ms);
+    let mut rows = Vec::new();
+    let mut overlapping = 0;
+    for (ra, rb) in a.iter().zip(&b) {
+        let overlap = match (interval(ra), interval(rb)) {
+            (Some(x), Some(y)) if x.overlaps(&y) => {
+                overlapping += 1;
+                "yes"
+            }
+            (Some(_), Some(_)) => "no",
+            _ => "–",
+        };
+        rows.push(vec![
+            ra.n.to_string(),
+            ra.passes.to_string(),
+            row_cell(ra),
+            row_cell(rb),
+            overlap.to_string(),
+        ]);
+    }
+    // Rows are in n order, and the pass count grows with n.
+    let ordered = |rows: &[Row]| rows.windows(2).all(|w| w[0].ms_median < w[1].ms_median);
+    let order = |ok: bool| {
+        if ok {
+            "keeps the order of the pass counts"
+        } else {
+            "does NOT keep the order of the pass counts"
+        }
+    };
+    let mut text = String::new();
+    let _ = write!(
+        text,
+        "First run: {} Second run: {} α = {}.",
+        measured_on(first),
+        measured_on(second),
+        alpha_a.unwrap_or(f32::NAN)
+    );
+    let blocks = vec![
+        Block::Paragraph(text),
+        Block::Table(
+            [
+                "n",
+                "passes",
+                "first run ms/frame [95 % CI]",
+                "second run ms/frame [95 % CI]",
+                "intervals overlap",
+            ]
+            .map(String::from)
+            .to_vec(),
+            rows,
+        ),
+        Block::Paragraph(format!(
+            "The intervals overlap on {overlapping} of {} rows; the first run {}, the second {}.",
+            a.len(),
+            order(ordered(&a)),
+            order(ordered(&b))
+        )),
+    ];
+    Ok(markdown(&blocks))
+}
+
+/// The regions of Table 1's chapter: the first run, its summary, and the two runs.
+pub const REGIONS: &[mirrorbox_report::readme::RegionSource] = &[
+    mirrorbox_report::readme::RegionSource {
+        id: "table1",
+        source: "table1",
+        about: "the reproduction of Table 1, the exact methods beside it, the floor",
+        generate: |reports| table1_region(&load_sweep(&reports.join("table1"))?),
+    },
+    mirrorbox_report::readme::RegionSource {
+        id: "table1-summary",
+        source: "table1",
+        about: "Table 1's methods at one glance: ms/frame, passes, reflections and error of each point",
+        generate: |reports| table1_summary_region(&load_sweep(&reports.join("table1"))?),
+    },
+];
+
+/// The region of the repeat's row: both runs side by side.
+pub const REPEAT_REGIONS: &[mirrorbox_report::readme::RegionSource] =
+    &[mirrorbox_report::readme::RegionSource {
+        id: "table1-repeat",
+        source: "table1_repeat",
+        about: "Table 1's rows from two consecutive runs side by side",
+        generate: |reports| {
+            repeat_region(
+                &load_sweep(&reports.join("table1"))?,
+                &load_sweep(&reports.join("table1_repeat"))?,
+            )
+        },
+    }];
+
+/// Table 1 (the first run) against the same sweep on another device, `reports/<folder>`.
+pub fn device_column(reports: &Path, folder: &str) -> Result<String, ReadmeError> {
+    device_column_region(
+        &load_sweep(&reports.join("table1"))?,
+        &load_sweep(&reports.join(folder))?,
+    )
+}
+
+/// [`table1_region`] of the sweep in `reports/<folder>` (another device's Table 1).
+pub fn region_of(reports: &Path, folder: &str) -> Result<String, ReadmeError> {
+    table1_region(&load_sweep(&reports.join(folder))?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use mirrorbox_report::document::fixtures::record;
+    use mirrorbox_report::{Section, write_report};
+
+    /// This module's section as the registry offers it.
+    const SECTION: Section = table1_section;
+
+    /// `r` timed in 9 interleaved rounds of one run, round k taking `ms · drift(k)`.
+    fn interleaved(mut r: Record, drift: &dyn Fn(usize) -> f64) -> Record {
+        r.frames_ms = (0..9).map(|k| r.ms_median * drift(k)).collect();
+        r.ms_median = stats::median(&r.frames_ms);
+        r.ms_interval = stats::median_interval(&r.frames_ms).map(|i| [i.low, i.high]);
+        r.timing_order = "interleaved".into();
+        r.run = Some("2026-11-22T10:00:00Z".into());
+        r
+    }
+
+    #[test]
+    fn report_files_hold_the_table_and_the_points() {
+        let dir = tempfile::tempdir().unwrap();
+        let records = vec![
+            record(0, 20.0, 3, 0.1),
+            record(1, 45.0, 7, 0.05),
+            record(2, 100.0, 15, 0.02),
+            record(3, 300.0, 46, 0.01),
+            record(4, 900.0, 139, 0.005),
+        ];
+        let info = |scene: &str| SweepInfo {
+            scene: scene.into(),
+            ..Default::default()
+        };
+        write_report(
+            dir.path(),
+            &info("scenes/mirror_box.json"),
+            &records,
+            &[SECTION],
+        )
+        .unwrap();
+        let md = std::fs::read_to_string(dir.path().join("report.md")).unwrap();
+        assert!(md.contains("Reproduction of the paper's Table 1"));
+        assert!(md.contains("| 2 | 142 | 100.0 [min 100.0] | 15 |"), "{md}");
+        let html = std::fs::read_to_string(dir.path().join("report.html")).unwrap();
+        assert!(html.contains("<svg") && html.contains("<table>"));
+        let csv = std::fs::read_to_string(dir.path().join("results.csv")).unwrap();
+        assert_eq!(csv.lines().count(), 6);
+        // A custom sweep of the method (another scene, or not every n) has no Table 1.
+        for (scene, points) in [
+            ("scenes/tilted_pair.json", 5),
+            ("scenes/mirror_box.json", 3),
+        ] {
+            let other = tempfile::tempdir().unwrap();
+            write_report(other.path(), &info(scene), &records[..points], &[SECTION]).unwrap();
+            let md = std::fs::read_to_string(other.path().join("report.md")).unwrap();
+            assert!(!md.contains("Table 1"), "{scene}, {points} points: {md}");
+        }
+        for f in [
+            "plot_flip_vs_ms.svg",
+            "plot_relmse_vs_ms.svg",
+            "plot_flip_vs_n.svg",
+        ] {
+            assert!(dir.path().join(f).is_file(), "{f}");
+        }
+    }
+
+    #[test]
+    fn speed_claims_need_intervals_apart_and_carry_the_paired_ratio() {
+        let info = SweepInfo {
+            scene: "scenes/mirror_box.json".into(),
+            exact_methods: vec!["unrolled".into()],
+            bump_methods: Vec::new(),
+            ..SweepInfo::default()
+        };
+        let exact_point = |ms: f64, drift: &dyn Fn(usize) -> f64| {
+            let mut e = interleaved(record(0, ms, 1, 1e-4), drift);
+            e.method = "unrolled".into();
+            e.key = "unrolled depth=64".into();
+            (e.n, e.depth) = (None, Some(64));
+            e
+        };
+        let passes = [3, 7, 15, 46, 139];
+        let sentences = |drift: &dyn Fn(usize) -> f64, unrolled_ms: f64| {
+            let mut records: Vec<Record> = (0..5)
+                .map(|n| {
+                    interleaved(
+                        record(
+                            n,
+                            10.0 * passes[n as usize] as f64,
+                            passes[n as usize],
+                            0.01,
+                        ),
+                        drift,
+                    )
+                })
+                .collect();
+            records.push(exact_point(unrolled_ms, drift));
+            let dir = tempfile::tempdir().unwrap();
+            write_report(dir.path(), &info, &records, &[SECTION]).unwrap();
+            let md = std::fs::read_to_string(dir.path().join("report.md")).unwrap();
+            md.lines()
+                .find(|l| l.starts_with("- unrolled depth=64 shows"))
+                .unwrap_or_else(|| panic!("{md}"))
+                .to_string()
+        };
+        // Steady machine (±1 %): 150 ms against 40 ms, apart; the paired ratio is exact.
+        let steady = sentences(&|k| 1.0 + 0.0025 * k as f64, 40.0);
+        assert!(
+            steady.contains("3.75× faster (paired by round: 3.75–3.75×)"),
+            "{steady}"
+        );
+        // A machine slowing down 10 % per round: the medians' intervals of 150 ms and 120 ms
+        // overlap, so no claim; paired by round the ratio is still visibly 1.25.
+        let drifting = sentences(&|k| 1.0 + 0.1 * k as f64, 120.0);
+        assert!(
+            drifting.contains("against auxiliary n=2 (FLIP")
+                && drifting.contains("not shown apart in time at 95 % on this device (intervals overlap); paired by round the ratio is 1.25× [1.25–1.25×]"),
+            "{drifting}"
+        );
+    }
+}
