@@ -1466,7 +1466,11 @@ fn sweep_measures_the_symmetry_methods_by_plane_count() {
         assert_eq!(planes, vec![0, 1, 2, 3], "{method}");
         for r in &recs {
             let p = r["axes"]["planes"].as_f64().unwrap() as u64;
-            assert_eq!(r["copies_total"].as_u64(), Some(1 << p), "{method}");
+            assert_eq!(
+                r["values"]["copies_total"].as_f64(),
+                Some((1u64 << p) as f64),
+                "{method}"
+            );
             assert!(
                 r["key"]
                     .as_str()
@@ -1480,12 +1484,16 @@ fn sweep_measures_the_symmetry_methods_by_plane_count() {
         .iter()
         .find(|r| r["method"] == "symmetry-pruned" && r["axes"]["planes"] == 3.0)
         .unwrap();
-    assert_eq!(pruned["copies_drawn"].as_u64(), Some(6), "{pruned}");
+    assert_eq!(
+        pruned["values"]["copies_drawn"].as_f64(),
+        Some(6.0),
+        "{pruned}"
+    );
     let baked = all
         .iter()
         .find(|r| r["method"] == "symmetry-baked" && r["axes"]["planes"] == 3.0)
         .unwrap();
-    assert!(baked["bake_ms"].as_f64().is_some());
+    assert!(baked["values"]["bake_ms"].as_f64().is_some());
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
     assert!(
         report.contains("## Symmetry planes: cost against p"),

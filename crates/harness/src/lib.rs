@@ -31,7 +31,9 @@ use mirrorbox_image::{
     write_png_bytes,
 };
 use mirrorbox_raster::{Gpu, METHODS, Method, PlanError, RasterError, RenderSettings};
-use mirrorbox_report::{ErrorSplit, MetricValues, Record, SweepInfo, read_records, write_report};
+use mirrorbox_report::{
+    ErrorSplit, MetricValues, Record, SweepInfo, read_records, value, write_report,
+};
 use mirrorbox_scene::limits::{SettingError, unit_interval};
 use mirrorbox_scene::{Scene, SceneError, load_scene};
 use mirrorbox_trace::{SceneBvh, TraceSettings, WhittedSettings};
@@ -1118,12 +1120,19 @@ pub fn run_sweep(
                 .iter()
                 .map(|(a, v)| (a.name.to_string(), *v))
                 .collect(),
-            symmetry_planes: None,
-            mirrored_lights: None,
-            bump_amplitude_deg: None,
-            copies_drawn: s.copies.map(|c| c.drawn),
-            copies_total: s.copies.map(|c| c.total),
-            bake_ms: s.bake_ms,
+            values: [
+                (value::COPIES_DRAWN, s.copies.map(|c| c.drawn as f64)),
+                (value::COPIES_TOTAL, s.copies.map(|c| c.total as f64)),
+                (value::BAKE_MS, s.bake_ms),
+                (
+                    value::REFLECTION_OFFSCREEN_SHARE,
+                    views.reflection_offscreen_share,
+                ),
+            ]
+            .into_iter()
+            .filter_map(|(name, v)| Some((name.to_string(), v?)))
+            .collect(),
+            legacy: Default::default(),
             n: p.method.as_ref().and_then(|m| m.count_of("n")),
             depth: p.method.as_ref().and_then(|m| m.count_of("depth")),
             alpha: p.alpha,
@@ -1154,7 +1163,6 @@ pub fn run_sweep(
             mirror_metrics: views.mirror_metrics,
             mirror_pixel_share: views.mirror_pixel_share,
             split,
-            reflection_offscreen_share: views.reflection_offscreen_share,
             adapter: s.adapter.clone(),
             backend: s.backend.clone(),
             color_format: s.color_format.clone(),

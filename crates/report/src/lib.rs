@@ -135,15 +135,19 @@ pub struct Record {
     /// kept them in fields of their own; [`read_records`] moves those here.
     #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
     pub axes: std::collections::BTreeMap<String, f64>,
-    /// Older records' symmetry planes (now `axes["planes"]`); read, never written.
-    #[serde(default, skip_serializing)]
-    pub symmetry_planes: Option<u32>,
-    /// Older records' mirrored-light depth (now `axes["mirrored_lights"]`).
-    #[serde(default, skip_serializing)]
-    pub mirrored_lights: Option<u32>,
-    /// Older records' tilt (now `axes["bump_deg"]`).
-    #[serde(default, skip_serializing)]
-    pub bump_amplitude_deg: Option<f32>,
+    /// Numbers a method or an experiment reports of a point beyond the common columns, by
+    /// name ([`value`] names them): `copies_drawn` and `copies_total` (the symmetry methods'
+    /// copies drawn, and 2^p), `bake_ms` (`symmetry-baked`'s CPU bake, outside the frame
+    /// time), `reflection_offscreen_share` (the share of the mirror pixels whose first
+    /// reflection is off screen, in [0, 1]: what screen-space reflections cannot show, issue
+    /// 39). Records older than the map kept them in fields of their own; [`read_records`]
+    /// moves those here.
+    #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    pub values: std::collections::BTreeMap<String, f64>,
+    /// The fields of older records that now live in [`Record::axes`] and [`Record::values`]:
+    /// read, moved into the maps by [`Record::migrate`], never written.
+    #[serde(flatten, skip_serializing)]
+    pub legacy: LegacyColumns,
     /// A stereo point (an `--ipd` sweep): the IPD and each eye's comparison; `metrics` is then
     /// the mean of both eyes', the images are side by side, the time is the pair's.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -152,14 +156,6 @@ pub struct Record {
     /// adapter and CPU), so that timings are read per device.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub device: Option<String>,
-    /// Symmetry methods: copies of the objects drawn, and 2^p.
-    #[serde(default)]
-    pub copies_drawn: Option<usize>,
-    #[serde(default)]
-    pub copies_total: Option<usize>,
-    /// `symmetry-baked`: CPU time of the split-and-mirror bake, ms, outside the frame time.
-    #[serde(default)]
-    pub bake_ms: Option<f64>,
     /// Auxiliary mirrors (auxiliary method).
     pub n: Option<u32>,
     /// Reflection depth (depth-limited methods).
@@ -239,10 +235,6 @@ pub struct Record {
     /// and older records.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub split: Option<ErrorSplit>,
-    /// The share of the mirror pixels whose first reflection is off screen (behind the camera
-    /// or outside the image), in [0, 1]: what screen-space reflections cannot show (issue 39).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub reflection_offscreen_share: Option<f64>,
     pub adapter: String,
     pub backend: String,
     /// The colour format of the raster targets (`rgba32float`, or `rgba16float` where the
@@ -254,6 +246,42 @@ pub struct Record {
     pub truth_image: String,
     pub raster_image: String,
     pub heatmap_image: String,
+}
+
+/// The columns of older records that moved into [`Record::axes`] and [`Record::values`].
+#[derive(Clone, Debug, Default, PartialEq, Deserialize)]
+pub struct LegacyColumns {
+    /// Now `axes["planes"]`.
+    #[serde(default)]
+    symmetry_planes: Option<u32>,
+    /// Now `axes["mirrored_lights"]`.
+    #[serde(default)]
+    mirrored_lights: Option<u32>,
+    /// Now `axes["bump_deg"]`.
+    #[serde(default)]
+    bump_amplitude_deg: Option<f32>,
+    /// Now `values["copies_drawn"]`, `values["copies_total"]`, `values["bake_ms"]`.
+    #[serde(default)]
+    copies_drawn: Option<usize>,
+    #[serde(default)]
+    copies_total: Option<usize>,
+    #[serde(default)]
+    bake_ms: Option<f64>,
+    /// Now `values["reflection_offscreen_share"]`.
+    #[serde(default)]
+    reflection_offscreen_share: Option<f64>,
+}
+
+/// The names of [`Record::values`].
+pub mod value {
+    /// Copies of the objects a symmetry method drew, of [`COPIES_TOTAL`].
+    pub const COPIES_DRAWN: &str = "copies_drawn";
+    /// 2^p: the copies the seed's method draws.
+    pub const COPIES_TOTAL: &str = "copies_total";
+    /// `symmetry-baked`'s CPU bake, ms, outside the frame time.
+    pub const BAKE_MS: &str = "bake_ms";
+    /// The share of the mirror pixels whose first reflection is off screen, in [0, 1].
+    pub const REFLECTION_OFFSCREEN_SHARE: &str = "reflection_offscreen_share";
 }
 
 /// A point's error against the truth, split at the reflection count `reflections` it shows
@@ -303,19 +331,36 @@ impl Record {
         self.axis(axis::BUMP_DEG).map(|v| v as f32)
     }
 
-    /// Moves the axes of a record older than [`Record::axes`] into the map.
-    pub fn migrate_axes(&mut self) {
-        let legacy = [
-            (axis::PLANES, self.symmetry_planes.take().map(f64::from)),
+    /// The value `name` of [`Record::values`], if the point has it.
+    pub fn value(&self, name: &str) -> Option<f64> {
+        self.values.get(name).copied()
+    }
+
+    /// Moves the columns of a record older than [`Record::axes`] and [`Record::values`] into
+    /// the maps.
+    pub fn migrate(&mut self) {
+        let old = std::mem::take(&mut self.legacy);
+        let values = [
+            (value::COPIES_DRAWN, old.copies_drawn.map(|c| c as f64)),
+            (value::COPIES_TOTAL, old.copies_total.map(|c| c as f64)),
+            (value::BAKE_MS, old.bake_ms),
             (
-                axis::MIRRORED_LIGHTS,
-                self.mirrored_lights.take().map(f64::from),
+                value::REFLECTION_OFFSCREEN_SHARE,
+                old.reflection_offscreen_share,
             ),
+        ];
+        for (name, v) in values {
+            if let Some(v) = v {
+                self.values.entry(name.to_string()).or_insert(v);
+            }
+        }
+        let legacy = [
+            (axis::PLANES, old.symmetry_planes.map(f64::from)),
+            (axis::MIRRORED_LIGHTS, old.mirrored_lights.map(f64::from)),
             // The f32 as its shortest decimal, as the key wrote it.
             (
                 axis::BUMP_DEG,
-                self.bump_amplitude_deg
-                    .take()
+                old.bump_amplitude_deg
                     .map(|a| a.to_string().parse().unwrap_or(f64::from(a))),
             ),
             (

@@ -6,7 +6,7 @@ use crate::document::{
     markdown, ms, ms_cell, remove_stale, sci, setting,
 };
 use crate::plot::{Chart, Series};
-use crate::{Record, SweepInfo};
+use crate::{Record, SweepInfo, value};
 use base64::Engine;
 use mirrorbox_files::{FileError, write_atomically};
 use std::fmt::Write as _;
@@ -27,7 +27,7 @@ pub fn read_records(path: &Path) -> std::io::Result<Vec<Record>> {
         .lines()
         .filter_map(|l| serde_json::from_str::<Record>(l).ok())
     {
-        record.migrate_axes();
+        record.migrate();
         match index.get(&record.key) {
             Some(&i) => records[i] = record,
             None => {
@@ -356,9 +356,12 @@ fn write_csv(path: &Path, records: &[Record]) -> Result<(), FileError> {
             r.gpu_texture_bytes.map_or(String::new(), |b| b.to_string()),
             r.method_options,
             opt(r.planes()),
-            r.copies_drawn.map_or(String::new(), |c| c.to_string()),
-            r.copies_total.map_or(String::new(), |c| c.to_string()),
-            r.bake_ms.map_or(String::new(), |ms| ms.to_string()),
+            r.value(value::COPIES_DRAWN)
+                .map_or(String::new(), |c| c.to_string()),
+            r.value(value::COPIES_TOTAL)
+                .map_or(String::new(), |c| c.to_string()),
+            r.value(value::BAKE_MS)
+                .map_or(String::new(), |ms| ms.to_string()),
             opt(r.lights_depth()),
             r.tilt_deg().map_or(String::new(), |a| a.to_string()),
             r.stereo
@@ -772,6 +775,49 @@ pub(crate) mod tests {
                 .unwrap()
                 .is_empty()
         );
+    }
+
+    /// A record older than the maps (issue 52) keeps its experiment's columns as fields of
+    /// their own: read, they are in `axes` and `values`; written again, only the maps are, and
+    /// they read back the same.
+    #[test]
+    fn older_columns_are_read_into_the_maps_and_written_only_there() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("results.jsonl");
+        let mut old: serde_json::Value = serde_json::to_value(record(0, 1.0, 3, 0.1)).unwrap();
+        for (k, v) in [
+            ("symmetry_planes", serde_json::json!(3)),
+            ("copies_drawn", serde_json::json!(6)),
+            ("copies_total", serde_json::json!(8)),
+            ("bake_ms", serde_json::json!(1.5)),
+            ("reflection_offscreen_share", serde_json::json!(0.25)),
+            ("mirrored_lights", serde_json::json!(2)),
+            ("bump_amplitude_deg", serde_json::json!(7.5)),
+        ] {
+            old[k] = v;
+        }
+        std::fs::write(&p, format!("{old}\n")).unwrap();
+        let read = read_records(&p).unwrap();
+        let r = &read[0];
+        assert_eq!(r.planes(), Some(3));
+        assert_eq!(r.lights_depth(), Some(2));
+        assert_eq!(r.tilt_deg(), Some(7.5));
+        assert_eq!(r.value(value::COPIES_DRAWN), Some(6.0));
+        assert_eq!(r.value(value::COPIES_TOTAL), Some(8.0));
+        assert_eq!(r.value(value::BAKE_MS), Some(1.5));
+        assert_eq!(r.value(value::REFLECTION_OFFSCREEN_SHARE), Some(0.25));
+        let written = serde_json::to_value(r).unwrap();
+        for k in [
+            "symmetry_planes",
+            "copies_drawn",
+            "bake_ms",
+            "reflection_offscreen_share",
+        ] {
+            assert!(written.get(k).is_none(), "{k} written: {written}");
+        }
+        assert_eq!(written["values"]["copies_drawn"], 6.0);
+        std::fs::write(&p, format!("{written}\n")).unwrap();
+        assert_eq!(&read_records(&p).unwrap()[0], r);
     }
 
     #[test]

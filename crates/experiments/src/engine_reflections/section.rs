@@ -11,9 +11,9 @@
 //!
 //! The report knows the methods' names and options (`ssr-fallback`), not the rasterizer.
 
-use mirrorbox_report::Record;
 use mirrorbox_report::document::{Block, distinct, f, ms_cell, sci};
 use mirrorbox_report::plot::{Chart, Series, method_style};
+use mirrorbox_report::{Record, value};
 
 /// The yaw axis' name in a record's `axes` (the harness's `CAMERA_YAW`).
 const YAW: &str = "yaw_deg";
@@ -217,7 +217,7 @@ fn screen_blocks(pts: &[&Record], truth: &str) -> Vec<Block> {
     let ssr: Vec<&Record> = pts
         .iter()
         .copied()
-        .filter(|r| r.method == "ssr" && r.reflection_offscreen_share.is_some())
+        .filter(|r| r.method == "ssr" && r.value(value::REFLECTION_OFFSCREEN_SHARE).is_some())
         .collect();
     let mut chart = Chart::new(
         "ssr: error over the mirror pixels against the reflections off screen",
@@ -232,13 +232,18 @@ fn screen_blocks(pts: &[&Record], truth: &str) -> Vec<Block> {
     {
         let mut of: Vec<&Record> = ssr.iter().copied().filter(|r| fallback(r) == *fb).collect();
         of.sort_by(|a, b| {
-            a.reflection_offscreen_share
+            a.value(value::REFLECTION_OFFSCREEN_SHARE)
                 .unwrap_or(0.0)
-                .total_cmp(&b.reflection_offscreen_share.unwrap_or(0.0))
+                .total_cmp(&b.value(value::REFLECTION_OFFSCREEN_SHARE).unwrap_or(0.0))
         });
         let xy: Vec<(f64, f64)> = of
             .iter()
-            .map(|r| (r.reflection_offscreen_share.unwrap_or(0.0), mirror_flip(r)))
+            .map(|r| {
+                (
+                    r.value(value::REFLECTION_OFFSCREEN_SHARE).unwrap_or(0.0),
+                    mirror_flip(r),
+                )
+            })
             .collect();
         let mut s = Series::new(format!("ssr, fallback {fb}"), ssr_style(fb), xy.clone());
         // Each point is a camera turn: x is not a swept variable, so no line.
@@ -295,7 +300,7 @@ fn table(pts: &[&Record], screen: bool) -> Block {
             if screen {
                 row.push(r.axis(YAW).map_or("–".into(), |y| format!("{y}°")));
                 row.push(
-                    r.reflection_offscreen_share
+                    r.value(value::REFLECTION_OFFSCREEN_SHARE)
                         .map_or("–".into(), |s| format!("{} %", f(100.0 * s, 1))),
                 );
             } else {

@@ -2,8 +2,8 @@
 //! planes p, where the seed's method draws 2^p copies, pruning removes copies whose cell is
 //! empty or out of view, and the CPU's split-and-mirror mesh is drawn once.
 
-use mirrorbox_report::Record;
 use mirrorbox_report::document::ms;
+use mirrorbox_report::{Record, value};
 
 /// The method that draws the CPU-baked mesh once; the others are compared with it.
 pub const BAKED_METHOD: &str = "symmetry-baked";
@@ -100,7 +100,11 @@ pub fn crossover_sentence(baked: &PlaneScaling, other: &PlaneScaling) -> String 
 /// How many of the 2^p copies pruning keeps, at the largest p measured.
 pub fn pruning_sentence(pruned: &PlaneScaling) -> Option<String> {
     let r = pruned.points.last()?;
-    let (p, drawn, total) = (r.planes()?, r.copies_drawn?, r.copies_total?);
+    let (p, drawn, total) = (
+        r.planes()?,
+        r.value(value::COPIES_DRAWN)? as usize,
+        r.value(value::COPIES_TOTAL)? as usize,
+    );
     Some(format!(
         "`{}` draws {drawn} of the 2^{p} = {total} copies at p = {p} ({:.1} %: the rest have an \
          empty cell or lie outside the view).",
@@ -119,8 +123,9 @@ mod tests {
         r.n = None;
         r.axes
             .insert(mirrorbox_report::axis::PLANES.into(), f64::from(p));
-        r.copies_drawn = Some(drawn);
-        r.copies_total = Some(1 << p);
+        r.values.insert(value::COPIES_DRAWN.into(), drawn as f64);
+        r.values
+            .insert(value::COPIES_TOTAL.into(), f64::from(1u32 << p));
         // A tight interval: ±1 %.
         r.ms_interval = Some([ms * 0.99, ms * 1.01]);
         r

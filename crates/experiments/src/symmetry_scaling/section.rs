@@ -5,7 +5,7 @@ use super::planes::variant;
 use mirrorbox_report::document::{Block, f, markdown, ms_cell, sci, setting};
 use mirrorbox_report::plot::{Chart, Reference, Series};
 use mirrorbox_report::readme::{ReadmeError, RegionSource, measured_on, prose};
-use mirrorbox_report::{Record, Sweep, SweepInfo, load_sweep};
+use mirrorbox_report::{Record, Sweep, SweepInfo, load_sweep, value};
 
 /// The section, offered every sweep's records; empty where none carries a plane count.
 pub fn section(_: &SweepInfo, records: &[Record]) -> Vec<Block> {
@@ -88,9 +88,13 @@ pub fn symmetry_section(records: &[Record]) -> Vec<Block> {
                     vec![
                         variant(r),
                         opt(r.planes().map(|p| p as usize)),
-                        format!("{} / {}", opt(r.copies_drawn), opt(r.copies_total)),
+                        format!(
+                            "{} / {}",
+                            opt(r.value(value::COPIES_DRAWN).map(|c| c as usize)),
+                            opt(r.value(value::COPIES_TOTAL).map(|c| c as usize))
+                        ),
                         opt(r.triangles),
-                        r.bake_ms.map_or("–".into(), |ms| f(ms, 2)),
+                        r.value(value::BAKE_MS).map_or("–".into(), |ms| f(ms, 2)),
                         ms_cell(r, 2),
                         sci(r.metrics.flip_mean),
                     ]
