@@ -48,10 +48,15 @@ done
 for round in $(seq "$rounds"); do
   for s in $scenes; do
     for integrator in whitted path; do
-      depth=10000; [ "$integrator" = path ] && depth=10
+      # Ours counts whitted's reflections (--max-depth) and path's segments (--max-segments,
+      # Mitsuba's max_depth); Mitsuba's script takes its own names for both.
+      depth=10000; ours_cut=(--max-depth "$depth")
+      if [ "$integrator" = path ]; then
+        depth=10; ours_cut=(--max-segments "$depth" --rr-from "$rr_depth")
+      fi
       echo "round $round: $s $integrator" >&2
       "$bin" trace "scenes/$s.json" -o "$work/ours.exr" --spp "$spp" --integrator "$integrator" \
-        --max-depth "$depth" --rr-depth "$rr_depth" --json > "$work/ours.json" 2>/dev/null
+        "${ours_cut[@]}" --json > "$work/ours.json" 2>/dev/null
       # Parsed after the render, not through a pipe: a Python started beside the render
       # took one of the two cores during it (0.15 s instead of 0.10 s for mirror_box).
       python3 -c "import json,sys; r=json.load(sys.stdin); print(json.dumps({'who':'mirrorbox','scene':'$s','integrator':'$integrator','round':$round,'seconds':r['render_seconds'],'rays':r['rays'],'threads':r['threads']}))" < "$work/ours.json" >> "$work/runs.jsonl"

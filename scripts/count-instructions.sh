@@ -9,7 +9,7 @@
 #   e.g. scripts/count-instructions.sh target/release/mirrorbox mirror_room
 #   BIN: a path from where you call it; SCENE: a name in scenes/. Defaults: 160×90, 16 spp,
 #   Whitted to 10 000 reflections, one thread; TRACE_ARGS come after them (so
-#   `--integrator path --max-depth 10` overrides). Needs valgrind (apt install valgrind),
+#   `--integrator path --max-segments 10` overrides). Needs valgrind (apt install valgrind),
 #   which offers no AVX-512: the AVX2 build is what gets counted. The whole process is
 #   counted: loading and the BVH build too (a few per cent at this size).
 set -euo pipefail
@@ -29,7 +29,7 @@ trap 'rm -rf "$work"' EXIT
 RAYON_NUM_THREADS=1 valgrind --tool=cachegrind --cache-sim=no --branch-sim=yes \
   --cachegrind-out-file="$work/counts" \
   "$bin" trace "scenes/$scene.json" -o "$work/out.exr" \
-  --width 160 --height 90 --spp 16 --max-depth 10000 "$@" 2> "$work/log" > /dev/null ||
+  --width 160 --height 90 --spp 16 "$@" 2> "$work/log" > /dev/null ||
   { cat "$work/log" >&2; exit 1; }
 grep -qE 'I +refs' "$work/log" || { cat "$work/log" >&2; echo "no instruction count in valgrind's output" >&2; exit 1; }
 grep -E 'I +refs|Mispredicts' "$work/log" | sed -e 's/^==[0-9]*== *//' -e "s|^|$scene: |"

@@ -13,7 +13,7 @@ if [ $# -ne 2 ]; then
 fi
 scene=$1 integrator=$2
 [ -f "scenes/$scene.json" ] || { echo "no scene scenes/$scene.json" >&2; exit 2; }
-case $integrator in whitted) depth=10000 ;; path) depth=10 ;; *) echo "INTEGRATOR must be whitted or path, not '$integrator'" >&2; exit 2 ;; esac
+case $integrator in whitted) cut=(--max-depth 10000) ;; path) cut=(--max-segments 10) ;; *) echo "INTEGRATOR must be whitted or path, not '$integrator'" >&2; exit 2 ;; esac
 command -v perf > /dev/null || { echo "perf is not installed (apt install linux-perf)" >&2; exit 1; }
 bin=target/release/mirrorbox
 # Always built (a no-op when current), so that the profile's commit is the build profiled.
@@ -22,7 +22,7 @@ commit=$(git rev-parse --short HEAD)
 git diff --quiet HEAD -- crates shaders Cargo.toml Cargo.lock || commit="$commit+changes"
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-args=(trace "scenes/$scene.json" --width 640 --height 360 --spp 16 --integrator "$integrator" --max-depth "$depth")
+args=(trace "scenes/$scene.json" --width 640 --height 360 --spp 16 --integrator "$integrator" "${cut[@]}")
 RAYON_NUM_THREADS=1 perf record -F 15000 -o "$work/perf.data" "$bin" "${args[@]}" -o "$work/out.exr" > /dev/null 2>&1
 cpu=$(grep -m1 '^model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ *//')
 simd=SSE; grep -qw avx2 /proc/cpuinfo && simd=AVX2; grep -qw avx512f /proc/cpuinfo && simd=AVX-512

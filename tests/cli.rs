@@ -492,6 +492,47 @@ fn trace_args<'a>(out: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
     args
 }
 
+/// "Depth" counts mirror reflections everywhere (docs/shading.md): `path`'s length is counted
+/// in segments under its own flag, recorded under its own name; each integrator refuses the
+/// other's cut, exit 2, naming the flag to use, and writes nothing.
+#[test]
+fn trace_depth_counts_reflections_and_path_length_counts_segments() {
+    let dir = tempfile::tempdir().unwrap();
+    let exr = dir.path().join("t.exr");
+    let exr_s = exr.to_str().unwrap();
+    for (extra, says) in [
+        (
+            &["--integrator", "path", "--max-depth", "4"][..],
+            "use --max-segments",
+        ),
+        (&["--max-segments", "4"][..], "whitted follows at most --max-depth"),
+        (&["--rr-from", "2"][..], "--integrator path"),
+    ] {
+        let out = mirrorbox(&trace_args(exr_s, extra), &[]);
+        assert_eq!(out.code, 2, "{extra:?}: {}", out.stderr);
+        assert!(out.stderr.contains(says), "{extra:?}: {}", out.stderr);
+        assert!(!exr.exists(), "{extra:?}: nothing written");
+    }
+    let out = mirrorbox(
+        &trace_args(
+            exr_s,
+            &["--integrator", "path", "--max-segments", "3", "--json"],
+        ),
+        &[],
+    );
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let v: serde_json::Value = serde_json::from_str(out.stdout.trim()).unwrap();
+    assert!(v["ended"]["max_segments"].as_u64().unwrap() > 0, "{v}");
+    assert!(v["ended"].get("max_depth").is_none(), "{v}");
+    let attrs = mirrorbox_image::read_exr_attributes(&exr).unwrap();
+    assert!(
+        attrs
+            .iter()
+            .any(|(k, v)| k == "mirrorbox.max_segments" && v == "3"),
+        "{attrs:?}"
+    );
+}
+
 #[test]
 fn trace_writes_exr_png_and_bounces_with_provenance() {
     let dir = tempfile::tempdir().unwrap();

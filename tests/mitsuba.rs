@@ -74,11 +74,14 @@ fn both_of(
         spp,
         "--integrator",
         integrator,
-        "--max-depth",
-        depth,
-        "--rr-depth",
-        "1000000",
     ];
+    // Whitted's cut counts reflections; path's counts segments (Mitsuba's max_depth), with
+    // Russian roulette kept out of the comparison.
+    if integrator == "path" {
+        trace.extend(["--max-segments", depth, "--rr-from", "1000000"]);
+    } else {
+        trace.extend(["--max-depth", depth]);
+    }
     trace.extend(size);
     run(bin, &trace);
     run(

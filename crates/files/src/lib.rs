@@ -282,6 +282,17 @@ fn kind_of(meta: &std::fs::Metadata) -> &'static str {
     }
 }
 
+/// `out/x.exr` → `out/x_left.exr`: `suffix` joined to the file's stem with `_`, the extension
+/// kept (a stereo eye's name, `sbs`, `anaglyph`).
+pub fn with_stem_suffix(path: &Path, suffix: &str) -> PathBuf {
+    let stem = path.file_stem().unwrap_or_default().to_string_lossy();
+    let name = match path.extension() {
+        Some(ext) => format!("{stem}_{suffix}.{}", ext.to_string_lossy()),
+        None => format!("{stem}_{suffix}"),
+    };
+    path.with_file_name(name)
+}
+
 /// `1.5 GB`, `36 KB`, `12 bytes` (decimal units, as disks and memory are sold).
 pub fn human_bytes(n: u64) -> String {
     const UNITS: [(&str, f64); 4] = [("TB", 1e12), ("GB", 1e9), ("MB", 1e6), ("KB", 1e3)];

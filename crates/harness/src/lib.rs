@@ -24,7 +24,7 @@ mod worker;
 pub use axes::{AxisSpec, AxisValues, PointAxes};
 pub use worker::{RenderJob, RenderReport, Rendered, peak_memory_bytes, serve};
 
-use mirrorbox_files::{FileError, FolderLock, write_atomically};
+use mirrorbox_files::{FileError, FolderLock, with_stem_suffix, write_atomically};
 use mirrorbox_image::metrics::{MetricsError, compare_detailed};
 use mirrorbox_image::{
     ImageError, RgbImage, StagedFiles, colormap, read_image, stage_exr, stage_png, write_png,
@@ -677,12 +677,6 @@ fn marker_albedo(config: &SweepConfig, scene: &Scene) -> Result<Option<[f32; 3]>
     }
 }
 
-/// `images/x.png` → `images/x_anaglyph.png`.
-fn with_suffix(path: &Path, suffix: &str) -> PathBuf {
-    let stem = path.file_stem().unwrap_or_default().to_string_lossy();
-    path.with_file_name(format!("{stem}_{suffix}.png"))
-}
-
 /// Where a point's pictures go: the raster, its FLIP map and its truth (a stereo point: side
 /// by side, with the raster's and the truth's anaglyphs beside them, `_anaglyph`).
 struct ViewFiles {
@@ -787,7 +781,7 @@ fn compare_views(
     write_png_bytes(&files.truth, 2 * w, h, &sbs(t_l, t_r))?;
     for (file, l, r) in [(&files.raster, r_l, r_r), (&files.truth, t_l, t_r)] {
         let anaglyph = mirrorbox_image::stereo::anaglyph(l, r);
-        write_png_bytes(&with_suffix(file, "anaglyph"), w, h, &anaglyph)?;
+        write_png_bytes(&with_stem_suffix(file, "anaglyph"), w, h, &anaglyph)?;
     }
     Ok(Compared {
         metrics: MetricValues::mean(&metrics),
@@ -1173,8 +1167,8 @@ pub fn run_sweep(
             stereo: views.eyes.map(|eyes| mirrorbox_report::StereoRecord {
                 ipd: ipd.unwrap_or(0.0),
                 eyes,
-                anaglyph_image: rel(&with_suffix(&files.raster, "anaglyph")),
-                truth_anaglyph_image: rel(&with_suffix(&files.truth, "anaglyph")),
+                anaglyph_image: rel(&with_stem_suffix(&files.raster, "anaglyph")),
+                truth_anaglyph_image: rel(&with_stem_suffix(&files.truth, "anaglyph")),
             }),
         };
         let line = serde_json::to_string(&record)?;

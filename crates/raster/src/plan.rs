@@ -543,7 +543,7 @@ mod tests {
             min_attenuation: 1e-4,
         };
         for depth in [1, 4, 16] {
-            let p = plan_paths(&s, limits(depth), 320, 180, 5000).unwrap();
+            let p = plan_path_textures(&s, limits(depth), 320, 180, 5000).unwrap();
             assert_eq!((p.passes, p.depth), (1 + depth as usize, depth as usize));
             let mut node = &p.roots[0];
             while let Some(child) = node.children.first() {
@@ -556,10 +556,10 @@ mod tests {
             }
         }
         // 0.9^k ≥ 1e-4 up to k = 87: a depth of 1000 stops there.
-        let p = plan_paths(&s, limits(1000), 320, 180, 5000).unwrap();
+        let p = plan_path_textures(&s, limits(1000), 320, 180, 5000).unwrap();
         assert_eq!(p.depth, 87);
         let room = scene("mirror_room.json");
-        let e = plan_paths(&room, limits(64), 320, 180, 5000).unwrap_err();
+        let e = plan_path_textures(&room, limits(64), 320, 180, 5000).unwrap_err();
         assert!(
             matches!(e, PlanError::TooManyPasses { limit: 5000, .. }),
             "{e}"
@@ -760,7 +760,7 @@ mod tests {
     }
 }
 
-/// The limits of a per-path texture plan ([`plan_paths`]).
+/// The limits of a per-path texture plan ([`plan_path_textures`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PathTextureLimits {
     /// Most mirrors along a path (`--depth`).
@@ -836,7 +836,7 @@ impl Planner<'_> {
 /// other — each texture cut to the part of the screen its parent's texture covers (a
 /// reflection is only seen through its parent's mirror). Refuses, after at most
 /// `max_passes` nodes, a plan of more scene passes.
-pub fn plan_paths(
+pub fn plan_path_textures(
     scene: &Scene,
     limits: PathTextureLimits,
     width: u32,

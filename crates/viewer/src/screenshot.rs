@@ -98,9 +98,10 @@ impl Capture {
     }
 }
 
-fn with_suffix(path: &Path, suffix: &str) -> PathBuf {
+/// `shot.png` → `shot.method.exr`: the path without its extension, then `ending`.
+fn with_ending(path: &Path, ending: &str) -> PathBuf {
     let stem = path.with_extension("");
-    PathBuf::from(format!("{}{suffix}", stem.display()))
+    PathBuf::from(format!("{}{ending}", stem.display()))
 }
 
 fn panes_json(panes: &[(&'static str, [u32; 4])]) -> serde_json::Value {
@@ -183,7 +184,7 @@ pub fn save(
     let camera = session.view_camera();
     if let Some(image) = method_image {
         mirrorbox_image::write_exr(
-            &with_suffix(path, ".method.exr"),
+            &with_ending(path, ".method.exr"),
             image,
             &[("mirrorbox.method", session.method.key())],
         )
@@ -192,7 +193,7 @@ pub fn save(
     let truth = session.complete_truth();
     if let Some(level) = truth {
         mirrorbox_image::write_exr(
-            &with_suffix(path, ".truth.exr"),
+            &with_ending(path, ".truth.exr"),
             &level.image,
             &[("mirrorbox.spp", (session.ssaa * session.ssaa).to_string())],
         )
@@ -200,7 +201,7 @@ pub fn save(
     }
     if let Some(e) = &session.error {
         mirrorbox_image::write_png_bytes(
-            &with_suffix(path, ".error.png"),
+            &with_ending(path, ".error.png"),
             e.width,
             e.height,
             &e.heat_rgb8,

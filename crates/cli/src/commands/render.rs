@@ -2,9 +2,10 @@
 //! the registry (`mirrorbox_raster::METHODS`) with wgpu, timed.
 
 use super::method_flags::{RenderOptions, method_value_parser};
-use super::stereo::{eye_path, with_suffix};
+use super::stereo::eye_path;
 use super::{check_outputs, load, output_path, unit_interval};
 use crate::Failure;
+use mirrorbox_files::with_stem_suffix;
 use mirrorbox_image::{StagedFiles, stage_exr, stage_png, stage_png_bytes};
 use mirrorbox_raster::methods::recursive_texture::TEXTURE_SCALE;
 use mirrorbox_raster::{FrameHistory, Gpu, RenderSettings, plan_frame, render_planned_after};
@@ -64,7 +65,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         args,
         |args, time, suffix| Args {
             time,
-            output: super::stereo::with_suffix(&args.output, suffix),
+            output: mirrorbox_files::with_stem_suffix(&args.output, suffix),
             ..args.clone()
         },
         |args| run_frame(args, &mut carry.borrow_mut()),
@@ -97,8 +98,8 @@ fn run_frame(args: &Args, carry: &mut Carry) -> Result<(), Failure> {
         outputs.push(("-o (its EXR)", eye_path(&exr, *eye)));
     }
     if rig.is_some() {
-        outputs.push(("-o (side by side)", with_suffix(&png, "sbs")));
-        outputs.push(("-o (anaglyph)", with_suffix(&png, "anaglyph")));
+        outputs.push(("-o (side by side)", with_stem_suffix(&png, "sbs")));
+        outputs.push(("-o (anaglyph)", with_stem_suffix(&png, "anaglyph")));
     }
     check_outputs(&outputs)?;
     args.size.apply(&mut scene)?;
@@ -196,7 +197,7 @@ fn run_frame(args: &Args, carry: &mut Carry) -> Result<(), Failure> {
         let sbs = mirrorbox_image::stereo::side_by_side(&a, &b, w, h);
         let ana = mirrorbox_image::stereo::anaglyph(&a, &b);
         for (suffix, w, bytes) in [("sbs", 2 * w, &sbs), ("anaglyph", w, &ana)] {
-            let path = with_suffix(&png, suffix);
+            let path = with_stem_suffix(&png, suffix);
             stage_png_bytes(&mut staged, &path, w, h, bytes).map_err(write_failed)?;
             written.push(path);
         }

@@ -42,16 +42,6 @@ impl StereoArgs {
     }
 }
 
-/// `out/x.exr` → `out/x_left.exr` (the eye's name, or another suffix such as `sbs`).
-pub fn with_suffix(path: &Path, suffix: &str) -> PathBuf {
-    let stem = path.file_stem().unwrap_or_default().to_string_lossy();
-    let name = match path.extension() {
-        Some(ext) => format!("{stem}_{suffix}.{}", ext.to_string_lossy()),
-        None => format!("{stem}_{suffix}"),
-    };
-    path.with_file_name(name)
-}
-
 /// Each eye's scene (or the scene itself, mono) and the suffix its outputs take.
 pub fn views(scene: &Scene, rig: Option<Stereo>) -> Vec<(Option<Eye>, Scene)> {
     match rig {
@@ -67,6 +57,6 @@ pub fn views(scene: &Scene, rig: Option<Stereo>) -> Vec<(Option<Eye>, Scene)> {
 pub fn eye_path(path: &Path, eye: Option<Eye>) -> PathBuf {
     match eye {
         None => path.to_path_buf(),
-        Some(e) => with_suffix(path, e.name()),
+        Some(e) => mirrorbox_files::with_stem_suffix(path, e.name()),
     }
 }

@@ -72,13 +72,18 @@ pub struct Args {
     /// through mirrors by its own sampling, and never from point lights.
     #[arg(long)]
     mirrored_lights: Option<u32>,
-    /// whitted: most mirror reflections a path follows; path: longest path in segments
-    /// (Mitsuba's max_depth: N visible reflections need N + 2).
-    #[arg(long, default_value_t = 10_000)]
-    max_depth: u32,
-    /// path: depth from which Russian roulette may end paths (Mitsuba's rr_depth).
-    #[arg(long, default_value_t = 5)]
-    rr_depth: u32,
+    /// whitted: most mirror reflections a path follows (depth, as everywhere in mirrorbox)
+    /// [default: 10000]. `path` counts its length in segments instead: --max-segments.
+    #[arg(long)]
+    max_depth: Option<u32>,
+    /// path: longest path in segments, diffuse bounces included (Mitsuba's max_depth: N
+    /// visible reflections need N + 2) [default: 10000].
+    #[arg(long)]
+    max_segments: Option<u32>,
+    /// path: the segment count from which Russian roulette may end paths (Mitsuba's
+    /// rr_depth) [default: 5].
+    #[arg(long)]
+    rr_from: Option<u32>,
     /// Stop a path when its throughput's largest channel would fall below this, in [0, 1).
     #[arg(long, default_value_t = 1e-4, allow_negative_numbers = true)]
     min_throughput: f32,
@@ -112,11 +117,55 @@ pub struct Args {
     stereo: super::stereo::StereoArgs,
 }
 
+/// `--max-depth` when none is given (whitted), and `--max-segments` (path).
+const DEFAULT_MAX_DEPTH: u32 = 10_000;
+const DEFAULT_MAX_SEGMENTS: u32 = 10_000;
+const DEFAULT_RR_FROM: u32 = 5;
+
+impl Args {
+    /// The integrator's cut of a path's length, as (flag, record key, value): whitted's
+    /// reflections (`--max-depth`), path's segments (`--max-segments`).
+    fn length_cut(&self) -> (&'static str, &'static str, u32) {
+        match self.integrator {
+            Integrator::Whitted => (
+                "--max-depth",
+                "max_depth",
+                self.max_depth.unwrap_or(DEFAULT_MAX_DEPTH),
+            ),
+            Integrator::Path => (
+                "--max-segments",
+                "max_segments",
+                self.max_segments.unwrap_or(DEFAULT_MAX_SEGMENTS),
+            ),
+        }
+    }
+}
+
 fn check_args(args: &Args) -> Result<(SubpixelGrid, WhittedSettings), Failure> {
     let s = grid_side(args.spp)?;
     unit_interval("--alpha", args.reflectance)?;
+    // "Depth" is mirror reflections everywhere (docs/shading.md); a physically based path's
+    // length, diffuse bounces included, is counted in segments under its own flag.
+    match args.integrator {
+        Integrator::Path if args.max_depth.is_some() => {
+            return Err(Failure::BadInput(
+                "--max-depth counts mirror reflections (whitted); `path` counts its length in \
+                 segments, diffuse bounces included: use --max-segments (N visible reflections \
+                 need N + 2)"
+                    .into(),
+            ));
+        }
+        Integrator::Whitted if args.max_segments.is_some() || args.rr_from.is_some() => {
+            return Err(Failure::BadInput(
+                "--max-segments and --rr-from are the `path` integrator's (--integrator path); \
+                 whitted follows at most --max-depth mirror reflections"
+                    .into(),
+            ));
+        }
+        _ => {}
+    }
     let whitted = WhittedSettings {
-        max_depth: args.max_depth,
+        max_depth: args.max_depth.unwrap_or(DEFAULT_MAX_DEPTH),
         min_throughput: args.min_throughput,
     };
     whitted.check().map_err(setting)?;
@@ -134,7 +183,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         args,
         |args, time, suffix| Args {
             time,
-            output: super::stereo::with_suffix(&args.output, suffix),
+            output: mirrorbox_files::with_stem_suffix(&args.output, suffix),
             ..args.clone()
         },
         run_frame,
@@ -142,7 +191,8 @@ pub fn run(args: &Args) -> Result<(), Failure> {
 }
 
 fn run_frame(args: &Args) -> Result<(), Failure> {
-    use super::stereo::{eye_path, views, with_suffix};
+    use super::stereo::{eye_path, views};
+    use mirrorbox_files::with_stem_suffix;
     let (grid, whitted) = check_args(args)?;
     let exr_path = output_path("-o", &args.output, "exr")?;
     let bounces_path = args
@@ -170,11 +220,11 @@ fn run_frame(args: &Args) -> Result<(), Failure> {
     if rig.is_some() {
         outputs.push((
             "-o (side by side)",
-            with_suffix(&exr_path, "sbs").with_extension("png"),
+            with_stem_suffix(&exr_path, "sbs").with_extension("png"),
         ));
         outputs.push((
             "-o (anaglyph)",
-            with_suffix(&exr_path, "anaglyph").with_extension("png"),
+            with_stem_suffix(&exr_path, "anaglyph").with_extension("png"),
         ));
     }
     check_outputs(&outputs)?;
@@ -219,8 +269,8 @@ fn run_frame(args: &Args) -> Result<(), Failure> {
         SceneBvh::build_with(&scene.geometry, kind).with_packets(args.kernel == Kernel::Packet);
     let integrator: mirrorbox_trace::IntegratorSettings = match args.integrator {
         Integrator::Path => mirrorbox_trace::PathSettings {
-            max_depth: args.max_depth,
-            rr_depth: args.rr_depth,
+            max_segments: args.max_segments.unwrap_or(DEFAULT_MAX_SEGMENTS),
+            rr_from: args.rr_from.unwrap_or(DEFAULT_RR_FROM),
             seed: args.seed,
         }
         .into(),
@@ -259,10 +309,10 @@ fn run_frame(args: &Args) -> Result<(), Failure> {
         let (a, b) = (left.image.to_srgb8(e), right.image.to_srgb8(e));
         let (w, h) = (l.camera.width, l.camera.height);
         let sbs = mirrorbox_image::stereo::side_by_side(&a, &b, w, h);
-        let sbs_path = with_suffix(&exr_path, "sbs").with_extension("png");
+        let sbs_path = with_stem_suffix(&exr_path, "sbs").with_extension("png");
         stage_png_bytes(&mut staged, &sbs_path, 2 * w, h, &sbs).map_err(write_failed)?;
         let ana = mirrorbox_image::stereo::anaglyph(&a, &b);
-        let ana_path = with_suffix(&exr_path, "anaglyph").with_extension("png");
+        let ana_path = with_stem_suffix(&exr_path, "anaglyph").with_extension("png");
         stage_png_bytes(&mut staged, &ana_path, w, h, &ana).map_err(write_failed)?;
     }
     let written = staged.commit().map_err(write_failed)?;
@@ -308,7 +358,13 @@ fn stage_view(
         ),
         ("mirrorbox.spp", grid.samples_per_pixel().to_string()),
         ("mirrorbox.sampling", sampling.describe()),
-        ("mirrorbox.max_depth", whitted.max_depth.to_string()),
+        (
+            match args.length_cut().1 {
+                "max_depth" => "mirrorbox.max_depth",
+                _ => "mirrorbox.max_segments",
+            },
+            args.length_cut().2.to_string(),
+        ),
         (
             "mirrorbox.min_throughput",
             whitted.min_throughput.to_string(),
@@ -380,7 +436,7 @@ fn report(
     let mrays = s.rays as f64 / secs / 1e6;
     let (w, h) = (scene.camera.width, scene.camera.height);
     if args.json {
-        let v = serde_json::json!({
+        let mut v = serde_json::json!({
             "scene": args.scene.display().to_string(),
             "eye": eye.map(|e| e.name()),
             "scene_hash": format!("{:016x}", scene.content_hash()),
@@ -392,7 +448,7 @@ fn report(
             "packet_bvh_build_seconds": bvh.packet_build_time().map(|t| t.as_secs_f64()),
             "simd": mirrorbox_trace::cpu_features::widest_name(),
             "threads": out.threads,
-            "ended": { "diffuse": s.diffuse, "escaped": s.escaped, "max_depth": s.cut_by_depth,
+            "ended": { "diffuse": s.diffuse, "escaped": s.escaped,
                        "min_throughput": s.cut_by_throughput, "roulette": s.cut_by_roulette,
                        "absorbed_by_uneven_mirrors": s.absorbed },
             "outputs": written.iter().map(|p| p.display().to_string()).collect::<Vec<_>>(),
@@ -402,6 +458,8 @@ fn report(
                           "pruned_dim": scene.lighting.images.pruned_dim,
                           "pruned_bound": scene.lighting.images.pruned_bound },
         });
+        // Cut by `max_depth` (whitted's reflections) or `max_segments` (path's length).
+        v["ended"][args.length_cut().1] = s.cut_by_depth.into();
         println!("{v}");
         return;
     }
@@ -417,18 +475,20 @@ fn report(
         out.threads,
     );
     println!(
-        "  {} paths ended: {} at diffuse surfaces, {} escaped, {} cut by --max-depth {}, {} cut by --min-throughput {}{}",
+        "  {} paths ended: {} at diffuse surfaces, {} escaped, {} cut by {} {}, {} cut by --min-throughput {}{}",
         s.paths,
         s.diffuse,
         s.escaped,
         s.cut_by_depth,
-        args.max_depth,
+        args.length_cut().0,
+        args.length_cut().2,
         s.cut_by_throughput,
         args.min_throughput,
         if args.integrator == Integrator::Path {
             format!(
-                ", {} by Russian roulette from --rr-depth {}",
-                s.cut_by_roulette, args.rr_depth
+                ", {} by Russian roulette from --rr-from {}",
+                s.cut_by_roulette,
+                args.rr_from.unwrap_or(DEFAULT_RR_FROM)
             )
         } else {
             String::new()

@@ -213,7 +213,7 @@ impl RecursiveTextureMethod {
         match self.queue {
             TextureQueue::Paper(q) => crate::plan::plan(scene, q, width, height, self.max_passes),
             TextureQueue::Paths(limits) => {
-                crate::plan::plan_paths(scene, limits, width, height, self.max_passes)
+                crate::plan::plan_path_textures(scene, limits, width, height, self.max_passes)
             }
         }
     }

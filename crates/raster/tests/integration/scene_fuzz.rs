@@ -239,8 +239,8 @@ fn exercise(scene: &Scene, gpu: &Gpu, render_too: bool, tally: &mut Tally) -> Ve
                 min_throughput: 1e-3,
             }),
             PathSettings {
-                max_depth: 8,
-                rr_depth: 3,
+                max_segments: 8,
+                rr_from: 3,
                 seed: 1,
             }
             .into(),

@@ -10,7 +10,7 @@
 //! - mirrors are delta reflections (no light sampling through them, as in Mitsuba: light that
 //!   reaches a surface only via a mirror is found by BSDF sampling alone);
 //! - the background is a constant environment emitter, found by escaping rays;
-//! - **Russian roulette** from depth `rr_depth` on, survival probability max(throughput) ≤ 0.95;
+//! - **Russian roulette** from segment `rr_from` (Mitsuba's `rr_depth`) on, survival probability max(throughput) ≤ 0.95;
 //! - a shadow ray (to a point light, or to the sampled point on an emitter) is blocked by
 //!   any hit nearer than a relative 10⁻⁴ short of its end, other than the triangle it
 //!   leaves (an any-hit query).
@@ -24,8 +24,9 @@
 //! one at a time, a sample draws the same numbers and takes the same steps
 //! ([`PathTracer::radiance_one`]).
 //!
-//! Depth follows Mitsuba's `max_depth`: it counts path segments, so 1 shows only directly
-//! visible emitters, 2 adds direct light, and N visible reflections need N + 2. The ambient
+//! A path's length is counted in segments, as Mitsuba's `max_depth` counts it (its
+//! "depth"; here "depth" means mirror reflections only, docs/shading.md): 1 shows only
+//! directly visible emitters, 2 adds direct light, and N visible reflections need N + 2. The ambient
 //! term of the contract is not physical and is not used here.
 
 use super::{Integrator, PathResult, Termination, face_normals};
@@ -42,9 +43,9 @@ use mirrorbox_scene::{Ray, Scene, Surface};
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PathSettings {
     /// Longest path in segments (Mitsuba's `max_depth`).
-    pub max_depth: u32,
-    /// Depth from which Russian roulette may end paths (Mitsuba's `rr_depth`).
-    pub rr_depth: u32,
+    pub max_segments: u32,
+    /// The segment count from which Russian roulette may end paths (Mitsuba's `rr_depth`).
+    pub rr_from: u32,
     /// Seed of the per-pixel random streams.
     pub seed: u64,
 }
@@ -52,8 +53,8 @@ pub struct PathSettings {
 impl Default for PathSettings {
     fn default() -> Self {
         PathSettings {
-            max_depth: 66,
-            rr_depth: 5,
+            max_segments: 66,
+            rr_from: 5,
             seed: 0,
         }
     }
@@ -83,7 +84,7 @@ pub struct PathTracer<'a> {
 /// kernel; later queries go one at a time to the single-ray hierarchy. Camera rays and the
 /// mirror chains after them are coherent (neighbouring samples, planar mirrors); the
 /// cosine-sampled rays after a diffuse vertex are not, and a 32-lane packet of them visits
-/// the union of their nodes. Measured (one thread, 640×360, 16 spp, depth 10, AMD EPYC
+/// the union of their nodes. Measured (one thread, 640×360, 16 spp, 10 segments, AMD EPYC
 /// AVX-512): everything in packets 1.12 s (`mirror_box`) and 2.24 s (`mirror_room`); 1:
 /// 0.73 s and 1.55 s; 2: 0.72 s and 1.64 s (with a packet kernel that skipped the diffuse
 /// triangle a ray leaves, since removed: the same on `mirror_box`, slower on `mirror_room`).
@@ -206,7 +207,7 @@ struct Walk {
     /// The mirror `ray` leaves (skipped by its query), if any.
     from_mirror: Option<usize>,
     /// Segments so far.
-    depth: u32,
+    segments: u32,
     /// Diffuse vertices passed so far.
     diffuse_vertices: u32,
 }
@@ -222,7 +223,7 @@ impl Walk {
             bsdf_pdf: None,
             from_triangle: None,
             from_mirror: None,
-            depth: 0,
+            segments: 0,
             diffuse_vertices: 0,
         }
     }
@@ -303,7 +304,7 @@ impl PathTracer<'_> {
             };
             w.radiance += w.beta * emission * weight;
         }
-        if w.depth + 1 >= self.settings.max_depth {
+        if w.segments + 1 >= self.settings.max_segments {
             return Vertex::End(Termination::Depth);
         }
         match inter {
@@ -400,8 +401,8 @@ impl PathTracer<'_> {
                 w.diffuse_vertices += 1;
             }
         }
-        w.depth += 1;
-        if w.depth >= self.settings.rr_depth {
+        w.segments += 1;
+        if w.segments >= self.settings.rr_from {
             let q = w.beta.max_element().min(0.95);
             if q <= 0.0 || rng.next_unit() >= q {
                 return Vertex::End(Termination::Roulette);

@@ -223,8 +223,8 @@ fn path_finds_the_mirrored_light_that_whitted_computes() {
             TraceSettings::path(
                 96,
                 PathSettings {
-                    max_depth: 3,
-                    rr_depth: 1000,
+                    max_segments: 3,
+                    rr_from: 1000,
                     seed: 7,
                 },
             ),

@@ -79,15 +79,15 @@ fn path_renders_every_bundled_scene_to_the_same_bits_with_packets() {
     for name in &bundled_names() {
         let mut scene = bundled_scene(name);
         scene.camera = scene.camera.with_size(32, 18);
-        for (grid, max_depth) in [(4, 10), (3, 10), (2, 66)] {
+        for (grid, max_segments) in [(4, 10), (3, 10), (2, 66)] {
             let settings = TraceSettings::path(
                 grid,
                 PathSettings {
-                    max_depth,
+                    max_segments,
                     ..Default::default()
                 },
             );
-            let what = format!("path, {name}, {grid}×{grid} grid, depth {max_depth}");
+            let what = format!("path, {name}, {grid}×{grid} grid, {max_segments} segments");
             same_with_and_without_packets(&scene, &settings, &what);
         }
     }

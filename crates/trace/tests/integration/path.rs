@@ -35,8 +35,8 @@ fn direct_light_equals_the_contract() {
         &s,
         2,
         PathSettings {
-            max_depth: 2,
-            rr_depth: 1000,
+            max_segments: 2,
+            rr_from: 1000,
             seed: 0,
         },
     );
@@ -61,8 +61,8 @@ fn roulette_ends_are_counted_separately() {
     }));
     let bvh = SceneBvh::build(&s.geometry);
     let path = PathSettings {
-        max_depth: 100,
-        rr_depth: 1,
+        max_segments: 100,
+        rr_from: 1,
         seed: 2,
     };
     let stats = render(&s, &bvh, &TraceSettings::path(2, path), &|_| {}).stats;
@@ -121,8 +121,8 @@ fn white_furnace_converges_to_e_over_one_minus_rho() {
         &s,
         8,
         PathSettings {
-            max_depth: 10_000,
-            rr_depth: 3,
+            max_segments: 10_000,
+            rr_from: 3,
             seed: 1,
         },
     );
