@@ -505,7 +505,10 @@ fn trace_depth_counts_reflections_and_path_length_counts_segments() {
             &["--integrator", "path", "--max-depth", "4"][..],
             "use --max-segments",
         ),
-        (&["--max-segments", "4"][..], "whitted follows at most --max-depth"),
+        (
+            &["--max-segments", "4"][..],
+            "whitted follows at most --max-depth",
+        ),
         (&["--rr-from", "2"][..], "--integrator path"),
     ] {
         let out = mirrorbox(&trace_args(exr_s, extra), &[]);

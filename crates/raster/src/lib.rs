@@ -1,56 +1,41 @@
 //! The wgpu rasterizer of mirrorbox.
 //!
-//! [`methods`]: the raster methods, one file each, one row each in [`METHODS`] (see
-//! `CONTRIBUTING.md`); [`plan`] is the CPU plan of the seed paper's recursion.
-//!
-//! What they share:
-//! - [`method`]: the interface — [`MethodEntry`], the [`RasterMethod`] trait, options,
-//!   parameters, frame stats; [`registry`]: the table looked up, configured [`Method`]s and
-//!   their keys.
-//! - [`exact_paths`]: the exact methods' options and reflection-path planning.
-//! - [`ping_pong`]: the frame-to-frame state of the stateful methods (`feedback`, `cubemap`).
-//! - [`culling`]: footprint rectangles and parts against a path's portal.
-//! - [`symmetry_cells`]: seed 001's symmetry cascade on the CPU — copy transforms, cells,
-//!   which copies a frame can leave out.
-//! - [`shading`]: the scene buffers the contract's WGSL reads; [`wgsl`]: all WGSL composition.
-//! - The thin wgpu layer: [`adapter`] (Vulkan, then GL; `WGPU_BACKEND` overrides), [`gpu`]
-//!   (device and errors), [`color_format`] (RGBA32F, else RGBA16F;
-//!   `MIRRORBOX_COLOR_FORMAT` forces one), [`projection`] (the one projection: infinite
-//!   reversed Z), [`targets`], [`pipeline`] (scene-pipeline builder, uniform arena),
-//!   [`state_cache`] (layouts and pipelines made once per device), [`resolve`] (SSAA),
-//!   [`timing`] (GPU timestamps), [`readback`], [`display_tone_map`] (the viewer's pane:
-//!   the image to sRGB bytes on the GPU).
+//! Three floors, each importing only the ones below it (`tests::floors`):
+//! - [`plan`]: what every method plans from, on the CPU (the seed paper's recursion, the
+//!   exact methods' reflection paths, culling, symmetry cells, shadow plans, the memory
+//!   estimate, the projection);
+//! - [`gpu`]: the wgpu layer (adapter, device, targets, pipelines, caches, resolve, timing,
+//!   readback, WGSL composition);
+//! - the methods, [`methods`] (one file each, one row each in [`METHODS`]: see
+//!   `CONTRIBUTING.md`), and what they share at this crate's root: [`method`] (the
+//!   interface — [`MethodEntry`], the [`RasterMethod`] trait, options, parameters, frame
+//!   stats), [`registry`] (the table looked up, configured [`Method`]s and their keys),
+//!   [`exact_options`] (the exact methods' options), [`ping_pong`] (the frame-to-frame state
+//!   of `feedback` and `cubemap`), [`shading`] (the scene buffers the contract's WGSL reads),
+//!   [`shadow_maps`], [`lighting`], [`uneven`], [`stereo_pair`] and [`stereo_mirrors`].
 
-pub mod adapter;
-pub mod camera_rays;
-pub mod color_format;
-pub mod culling;
-pub mod display_tone_map;
-pub mod exact_paths;
+pub mod exact_options;
 pub mod gpu;
 pub mod lighting;
-pub mod memory;
 pub mod method;
 mod method_options;
 pub mod methods;
 pub mod ping_pong;
-pub mod pipeline;
 pub mod plan;
-pub mod projection;
-pub mod readback;
 pub mod registry;
-pub mod resolve;
 pub mod shading;
 pub mod shadow_maps;
-pub mod shadow_plan;
-pub mod state_cache;
 pub mod stereo_mirrors;
 pub mod stereo_pair;
-pub mod symmetry_cells;
-pub mod targets;
-pub mod timing;
 pub mod uneven;
-pub mod wgsl;
+
+// The floors' modules at the crate's root too, where the crates above (and the methods)
+// have always named them: `mirrorbox_raster::targets` is `gpu::targets`.
+pub use gpu::{
+    adapter, camera_rays, color_format, display_tone_map, pipeline, readback, resolve, state_cache,
+    targets, timing, wgsl,
+};
+pub use plan::{culling, exact_paths, memory, projection, shadow_plan, symmetry_cells};
 
 pub use adapter::{
     AdapterError, AdapterReport, MIN_MESA, SelectedAdapter, mesa_version, select_adapter,
@@ -575,4 +560,94 @@ pub fn render(
 ) -> Result<RenderOutput, RasterError> {
     let planned = plan_frame(scene, settings)?;
     render_planned(gpu, scene, planned, settings)
+}
+
+#[cfg(test)]
+mod tests {
+    use std::collections::BTreeSet;
+    use std::path::{Path, PathBuf};
+
+    /// The `.rs` files of `dir` (one level).
+    fn files(dir: &Path) -> Vec<PathBuf> {
+        let mut out: Vec<PathBuf> = std::fs::read_dir(dir)
+            .unwrap()
+            .flatten()
+            .map(|e| e.path())
+            .filter(|p| p.extension().is_some_and(|x| x == "rs"))
+            .collect();
+        out.sort();
+        out
+    }
+
+    /// The crate paths a file's code names (`crate::NAME`, `use crate::{A, B::…}`, macros
+    /// `crate::NAME!`): the first segment after `crate::`. Comments and the `tests` module at
+    /// the file's end are not code that ships.
+    fn names(path: &Path) -> BTreeSet<String> {
+        let text = std::fs::read_to_string(path).unwrap();
+        let code = text.split("\n#[cfg(test)]\nmod tests").next().unwrap();
+        let mut out = BTreeSet::new();
+        for line in code.lines().filter(|l| !l.trim_start().starts_with("//")) {
+            for (i, _) in line.match_indices("crate::") {
+                let rest = &line[i + "crate::".len()..];
+                if let Some(list) = rest.strip_prefix('{') {
+                    // `use crate::{a, b::c};` on one line (rustfmt breaks long ones).
+                    for item in list.split([',', '}']) {
+                        let first = item.trim().split("::").next().unwrap_or("");
+                        if !first.is_empty() {
+                            out.insert(first.to_string());
+                        }
+                    }
+                } else {
+                    let name: String = rest
+                        .chars()
+                        .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+                        .collect();
+                    out.insert(name);
+                }
+            }
+        }
+        out
+    }
+
+    /// The module names of a floor: its folder's files and the floor itself.
+    fn floor(dir: &Path) -> BTreeSet<String> {
+        let mut out: BTreeSet<String> = files(dir)
+            .iter()
+            .map(|p| p.file_stem().unwrap().to_string_lossy().into_owned())
+            .filter(|n| n != "mod")
+            .collect();
+        out.insert(dir.file_name().unwrap().to_string_lossy().into_owned());
+        out
+    }
+
+    /// The rasterizer's floors (issue 52): `plan/` imports nothing of the crate above itself,
+    /// `gpu/` nothing above `plan/` and itself — the methods and what they share import both,
+    /// never the other way round. (The floors' modules are re-exported at the crate's root,
+    /// so a name is judged by the module it names, whatever path the code takes to it.)
+    #[test]
+    fn floors() {
+        let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+        let plan = floor(&src.join("plan"));
+        let mut gpu = floor(&src.join("gpu"));
+        // The macros `gpu::wgsl` exports at the crate's root.
+        gpu.extend(["host_layout", "mirror_plane_shaders"].map(String::from));
+        let mut wrong = Vec::new();
+        for (dir, allowed) in [
+            ("plan", plan.clone()),
+            ("gpu", plan.union(&gpu).cloned().collect()),
+        ] {
+            for file in files(&src.join(dir)) {
+                for name in names(&file) {
+                    if !allowed.contains(&name) {
+                        wrong.push(format!(
+                            "src/{dir}/{} names crate::{name}, above its floor",
+                            file.file_name().unwrap().to_string_lossy()
+                        ));
+                    }
+                }
+            }
+        }
+        assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+        assert!(plan.len() >= 7 && gpu.len() >= 12, "{plan:?} {gpu:?}");
+    }
 }

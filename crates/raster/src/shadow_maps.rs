@@ -28,8 +28,14 @@ use mirrorbox_scene::Scene;
 
 pub use crate::shadow_plan::{
     GpuShadowView, LightShadow, MAX_SHADOW_BYTES, ShadowPlan, ShadowSettings, TooManyShadowLayers,
-    gpu_structs,
 };
+
+/// The layout of [`GpuShadowView`] as the WGSL declares it (checked by [`crate::wgsl`]'s tests).
+pub fn gpu_structs() -> Vec<crate::wgsl::HostLayout> {
+    vec![crate::host_layout!(GpuShadowView as "ShadowView" {
+        clip_from_world, keep, origin, skip_surface
+    })]
+}
 
 /// The shadow-map pass's WGSL.
 pub static SHADER: WgslSource = WgslSource {

@@ -20,7 +20,8 @@
 //! frame's stats and warnings state (far surfaces closer than `t²·2⁻²⁴/NEAR` may swap).
 
 use crate::culling::{box_corners, box_may_touch, footprint_rect};
-use crate::exact_paths::{DEPTH, MIN_ATTENUATION, MIN_PORTAL_AREA, PlannedPaths, plan_paths};
+use crate::exact_options::{DEPTH, MIN_ATTENUATION, MIN_PORTAL_AREA};
+use crate::exact_paths::{PlannedPaths, plan_paths};
 use crate::gpu::{Gpu, RasterError};
 use crate::method::{
     BuiltFrame, Clipping, FrameStats, MethodEntry, PathCounts, PlannedFrame, RasterMethod,
@@ -52,7 +53,7 @@ pub static PORTAL: MethodEntry = MethodEntry {
     required_features: wgpu::Features::empty(),
     shaders: &[&SHADER, &CLIP_DISTANCE_SHADER],
     gpu_structs,
-    configure: |p| Box::new(Portal(crate::exact_paths::limits(p))),
+    configure: |p| Box::new(Portal(crate::exact_options::limits(p))),
 };
 
 const ENTRY_POINTS: &str = include_str!("../../../../shaders/portal_stencil.wgsl");

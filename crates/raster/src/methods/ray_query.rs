@@ -20,7 +20,7 @@
 //! (wall clock, reported as the frame's one-off build, `bake_ms`): the scenes are static, and
 //! an engine rebuilds a BLAS only when its mesh changes. Frames time the tracing.
 
-use crate::exact_paths::{DEPTH, MIN_ATTENUATION};
+use crate::exact_options::{DEPTH, MIN_ATTENUATION};
 use crate::gpu::{Gpu, RasterError};
 use crate::method::{
     BuiltFrame, Clipping, FrameStats, MethodEntry, OptionKind, OptionSpec, ParamValue,

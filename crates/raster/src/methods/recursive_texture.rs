@@ -86,12 +86,12 @@ pub static PATH_TEXTURES: MethodEntry = MethodEntry {
     exact: true,
     depth_limited: true,
     options: crate::method_options![
-        &crate::exact_paths::DEPTH,
-        &crate::exact_paths::MIN_ATTENUATION,
+        &crate::exact_options::DEPTH,
+        &crate::exact_options::MIN_ATTENUATION,
         &MAX_PASSES;
         mirror_textures
     ],
-    swept: Some(&crate::exact_paths::DEPTH),
+    swept: Some(&crate::exact_options::DEPTH),
     optional_features: wgpu::Features::CLIP_DISTANCES,
     required_features: wgpu::Features::empty(),
     shaders: SHADERS,
@@ -99,8 +99,8 @@ pub static PATH_TEXTURES: MethodEntry = MethodEntry {
     configure: |p| {
         Box::new(RecursiveTextureMethod {
             queue: TextureQueue::Paths(crate::plan::PathTextureLimits {
-                depth: p.count(&crate::exact_paths::DEPTH),
-                min_attenuation: p.real(&crate::exact_paths::MIN_ATTENUATION),
+                depth: p.count(&crate::exact_options::DEPTH),
+                min_attenuation: p.real(&crate::exact_options::MIN_ATTENUATION),
             }),
             texture_scale: 1.0,
             max_passes: p.count(&MAX_PASSES) as usize,

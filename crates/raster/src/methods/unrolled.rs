@@ -34,7 +34,8 @@
 //! shows the terminal radiance.
 
 use crate::culling::{box_corners, box_may_touch};
-use crate::exact_paths::{DEPTH, MIN_ATTENUATION, MIN_PORTAL_AREA, PlannedPaths, plan_paths};
+use crate::exact_options::{DEPTH, MIN_ATTENUATION, MIN_PORTAL_AREA};
+use crate::exact_paths::{PlannedPaths, plan_paths};
 use crate::gpu::{Gpu, RasterError};
 use crate::method::{
     BuiltFrame, Clipping, FrameStats, MethodEntry, OptionKind, OptionSpec, ParamValue, PathCounts,
@@ -74,7 +75,7 @@ pub static UNROLLED: MethodEntry = MethodEntry {
     gpu_structs,
     configure: |p| {
         Box::new(UnrolledMethod {
-            limits: crate::exact_paths::limits(p),
+            limits: crate::exact_options::limits(p),
             fragment_clipping: p.switch(&FRAGMENT_CLIPPING),
         })
     },

@@ -28,7 +28,7 @@ use wgpu::util::DeviceExt;
 pub static SHADER: crate::wgsl::WgslSource = crate::wgsl::WgslSource {
     label: "display tone map",
     enable: &[],
-    parts: &[include_str!("../../../shaders/display_tone_map.wgsl")],
+    parts: &[include_str!("../../../../shaders/display_tone_map.wgsl")],
 };
 
 /// The shader's `ToneMap` uniform.

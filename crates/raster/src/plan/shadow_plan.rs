@@ -36,12 +36,6 @@ pub struct GpuShadowView {
     pub skip_surface: u32,
 }
 
-pub fn gpu_structs() -> Vec<crate::wgsl::HostLayout> {
-    vec![crate::host_layout!(GpuShadowView as "ShadowView" {
-        clip_from_world, keep, origin, skip_surface
-    })]
-}
-
 /// Near plane of the cube faces, scene units: far below any gap between a light and a surface
 /// in a scene of a few units.
 const CUBE_NEAR: f32 = 1e-3;

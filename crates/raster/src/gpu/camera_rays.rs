@@ -7,7 +7,7 @@ use bytemuck::{Pod, Zeroable};
 use mirrorbox_scene::Camera;
 
 /// `shaders/camera_rays.wgsl`.
-pub const WGSL: &str = include_str!("../../../shaders/camera_rays.wgsl");
+pub const WGSL: &str = include_str!("../../../../shaders/camera_rays.wgsl");
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]

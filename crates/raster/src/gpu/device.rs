@@ -150,7 +150,7 @@ impl Gpu {
     /// Opens `selected` (chosen by [`crate::adapter`]'s rule) as [`Gpu::open`] does, with the
     /// colour format `forced` or the best the adapter has.
     pub fn open_adapter(
-        selected: crate::SelectedAdapter,
+        selected: crate::adapter::SelectedAdapter,
         wanted: wgpu::Features,
         forced: Option<ColorFormat>,
     ) -> Result<Gpu, RasterError> {

@@ -14,24 +14,24 @@
 /// `shaders/shading.wgsl` then `shaders/shadow_map_legs.wgsl`: the shading contract and the
 /// scene bindings (group 0), with shadows tested in the shadow maps (every raster method).
 pub const SHADING: &str = concat!(
-    include_str!("../../../shaders/shading.wgsl"),
+    include_str!("../../../../shaders/shading.wgsl"),
     "\n",
-    include_str!("../../../shaders/shadow_map_legs.wgsl")
+    include_str!("../../../../shaders/shadow_map_legs.wgsl")
 );
 
 /// `shaders/shading.wgsl` alone: the contract without a shadow test, for a shader that brings
 /// its own `unshadowed` (`ray-query`: a ray query per leg).
-pub const SHADING_CONTRACT: &str = include_str!("../../../shaders/shading.wgsl");
+pub const SHADING_CONTRACT: &str = include_str!("../../../../shaders/shading.wgsl");
 
 /// `shaders/mirror_plane_clip_distances.wgsl`: the clip-distance vertex stage of the methods
 /// that clip a mirror's world at the mirror's plane (`portal`, `naive`, `auxiliary`); it
 /// follows the method's own file, which defines `VertexOut` and `scene_vertex`.
 pub const MIRROR_PLANE_CLIP_DISTANCES: &str =
-    include_str!("../../../shaders/mirror_plane_clip_distances.wgsl");
+    include_str!("../../../../shaders/mirror_plane_clip_distances.wgsl");
 /// The fragment entry points of the methods that clip a mirror's world at its plane (plain,
 /// and `*_discard` for adapters without clip distances).
 pub const MIRROR_PLANE_FRAGMENTS: &str =
-    include_str!("../../../shaders/mirror_plane_fragments.wgsl");
+    include_str!("../../../../shaders/mirror_plane_fragments.wgsl");
 
 /// Declares `SHADER` and `CLIP_DISTANCE_SHADER`, the two variants of a method that clips a
 /// mirror's world at the mirror's plane (`portal`, the paper's methods): `SHADER` runs on
@@ -98,7 +98,7 @@ impl WgslSource {
 pub static RESOLVE: WgslSource = WgslSource {
     label: "resolve",
     enable: &[],
-    parts: &[include_str!("../../../shaders/resolve.wgsl")],
+    parts: &[include_str!("../../../../shaders/resolve.wgsl")],
 };
 
 /// Compiles a variant on `device`.
