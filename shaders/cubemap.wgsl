@@ -36,29 +36,13 @@ struct CubeDraw {
 @group(2) @binding(5) var face4: texture_2d<f32>;
 @group(2) @binding(6) var face5: texture_2d<f32>;
 
-struct VertexOut {
-    @builtin(position) @invariant clip: vec4f,
-    @location(0) world: vec3f,
-    @location(1) @interpolate(flat) normal: vec3f,
-    @location(2) @interpolate(flat) surface: u32,
-    @location(3) plane_distance: f32,
-    @location(8) uv: vec2f,
+// The pass's view: a cube face's or the camera's (mirror_plane_vertex.wgsl's hooks).
+fn view_clip_from_world() -> mat4x4f {
+    return pass_.clip_from_world;
 }
 
-fn scene_vertex(v: VertexIn) -> VertexOut {
-    var out: VertexOut;
-    out.clip = pass_.clip_from_world * vec4f(v.position, 1.0);
-    out.world = v.position;
-    out.normal = v.normal;
-    out.surface = v.surface;
-    out.uv = v.uv;
-    out.plane_distance = dot(pass_.plane, vec4f(v.position, 1.0));
-    return out;
-}
-
-@vertex
-fn vs_main(v: VertexIn) -> VertexOut {
-    return scene_vertex(v);
+fn view_plane() -> vec4f {
+    return pass_.plane;
 }
 
 fn shade_diffuse(in: VertexOut, albedo: vec3f, emission: vec3f) -> vec3f {

@@ -1,8 +1,8 @@
 // The hardware-clipped vertex stage of the methods that draw a mirror's world through the
-// mirror's plane (crates/raster/src/methods/portal_stencil.rs and recursive_texture.rs),
+// mirror's plane (crates/raster/src/methods/portal_stencil.rs, recursive_texture.rs and cubemap.rs),
 // compiled only where the adapter has `clip_distances`: the module starts with
-// `enable clip_distances;`, then shading.wgsl and the method's file, which defines
-// `VertexOut` (position, world, normal, surface, plane_distance) and `scene_vertex`.
+// `enable clip_distances;`, then shading.wgsl, mirror_plane_vertex.wgsl (`VertexOut`,
+// `scene_vertex`) and the method's file.
 // Clip distance 0 is the signed distance to the plane: the hardware clips what lies behind
 // the mirror, so the method's plain fragment entry points need no discard.
 

@@ -18,31 +18,13 @@ struct Path {
 
 @group(1) @binding(0) var<uniform> path: Path;
 
-struct VertexOut {
-    // Invariant: a mirror marked in the stencil pass must meet the depth its world pass wrote.
-    @builtin(position) @invariant clip: vec4f,
-    @location(0) world: vec3f,
-    @location(1) @interpolate(flat) normal: vec3f,
-    @location(2) @interpolate(flat) surface: u32,
-    // Signed distance to the path's last mirror plane (scene units).
-    @location(3) plane_distance: f32,
-    @location(8) uv: vec2f,
+// The path's view and its last mirror plane (mirror_plane_vertex.wgsl's hooks).
+fn view_clip_from_world() -> mat4x4f {
+    return path.clip_from_world;
 }
 
-fn scene_vertex(v: VertexIn) -> VertexOut {
-    var out: VertexOut;
-    out.clip = path.clip_from_world * vec4f(v.position, 1.0);
-    out.world = v.position;
-    out.normal = v.normal;
-    out.surface = v.surface;
-    out.uv = v.uv;
-    out.plane_distance = dot(path.plane, vec4f(v.position, 1.0));
-    return out;
-}
-
-@vertex
-fn vs_main(v: VertexIn) -> VertexOut {
-    return scene_vertex(v);
+fn view_plane() -> vec4f {
+    return path.plane;
 }
 
 fn shade(in: VertexOut, albedo: vec3f, emission: vec3f) -> vec3f {

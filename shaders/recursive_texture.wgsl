@@ -60,30 +60,13 @@ struct MirrorDraw {
 @group(2) @binding(0) var<uniform> mirror: MirrorDraw;
 @group(2) @binding(1) var mirror_texture: texture_2d<f32>;
 
-struct VertexOut {
-    @builtin(position) @invariant clip: vec4f,
-    @location(0) world: vec3f,
-    @location(1) @interpolate(flat) normal: vec3f,
-    @location(2) @interpolate(flat) surface: u32,
-    // Signed distance to the pass's mirror plane (scene units).
-    @location(3) plane_distance: f32,
-    @location(8) uv: vec2f,
+// The pass's view: a mirror camera's, or the frame's camera (mirror_plane_vertex.wgsl's hooks).
+fn view_clip_from_world() -> mat4x4f {
+    return pass_.clip_from_world;
 }
 
-fn scene_vertex(v: VertexIn) -> VertexOut {
-    var out: VertexOut;
-    out.clip = pass_.clip_from_world * vec4f(v.position, 1.0);
-    out.world = v.position;
-    out.normal = v.normal;
-    out.surface = v.surface;
-    out.uv = v.uv;
-    out.plane_distance = dot(pass_.plane, vec4f(v.position, 1.0));
-    return out;
-}
-
-@vertex
-fn vs_main(v: VertexIn) -> VertexOut {
-    return scene_vertex(v);
+fn view_plane() -> vec4f {
+    return pass_.plane;
 }
 
 fn shade_diffuse(in: VertexOut, albedo: vec3f, emission: vec3f) -> vec3f {

@@ -23,9 +23,14 @@ pub const SHADING: &str = concat!(
 /// its own `unshadowed` (`ray-query`: a ray query per leg).
 pub const SHADING_CONTRACT: &str = include_str!("../../../../shaders/shading.wgsl");
 
+/// `shaders/mirror_plane_vertex.wgsl`: the vertex stage of the methods that draw a mirror's
+/// world through its plane (`VertexOut`, `scene_vertex`, `vs_main`), from the view the
+/// method's own file gives (`view_clip_from_world`, `view_plane`).
+pub const MIRROR_PLANE_VERTEX: &str = include_str!("../../../../shaders/mirror_plane_vertex.wgsl");
+
 /// `shaders/mirror_plane_clip_distances.wgsl`: the clip-distance vertex stage of the methods
 /// that clip a mirror's world at the mirror's plane (`portal`, `naive`, `auxiliary`); it
-/// follows the method's own file, which defines `VertexOut` and `scene_vertex`.
+/// follows [`MIRROR_PLANE_VERTEX`]'s `VertexOut` and `scene_vertex`.
 pub const MIRROR_PLANE_CLIP_DISTANCES: &str =
     include_str!("../../../../shaders/mirror_plane_clip_distances.wgsl");
 /// The fragment entry points of the methods that clip a mirror's world at its plane (plain,
@@ -46,6 +51,7 @@ macro_rules! mirror_plane_shaders {
             enable: &[],
             parts: &[
                 $crate::wgsl::SHADING,
+                $crate::wgsl::MIRROR_PLANE_VERTEX,
                 $entry_points,
                 $crate::wgsl::MIRROR_PLANE_FRAGMENTS,
             ],
@@ -55,6 +61,7 @@ macro_rules! mirror_plane_shaders {
             enable: &["clip_distances"],
             parts: &[
                 $crate::wgsl::SHADING,
+                $crate::wgsl::MIRROR_PLANE_VERTEX,
                 $entry_points,
                 $crate::wgsl::MIRROR_PLANE_FRAGMENTS,
                 $crate::wgsl::MIRROR_PLANE_CLIP_DISTANCES,
