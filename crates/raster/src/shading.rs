@@ -358,6 +358,38 @@ pub struct SceneBuffers {
 }
 
 impl SceneBuffers {
+    /// Begins a frame's one pass into `target` (the exact and ray-query methods): colour
+    /// cleared to `clear`, `depth` (the method's own depth(-stencil) view) to far and its
+    /// stencil to `stencil` where given, the scene bound at group 0 and the method's
+    /// `group1` (a bind group and its dynamic offsets) at group 1.
+    #[allow(clippy::too_many_arguments)]
+    pub fn begin_frame_pass<'e>(
+        &self,
+        encoder: &'e mut wgpu::CommandEncoder,
+        target: &crate::targets::RenderTarget,
+        label: &str,
+        clear: glam::Vec3,
+        depth: &wgpu::TextureView,
+        stencil: Option<u32>,
+        group1: (&wgpu::BindGroup, &[u32]),
+        first_pass: Option<wgpu::RenderPassTimestampWrites<'_>>,
+    ) -> wgpu::RenderPass<'e> {
+        let mut pass = target.begin_pass_with(
+            encoder,
+            label,
+            clear,
+            crate::targets::DepthClear {
+                view: depth,
+                depth: crate::projection::FAR_DEPTH,
+                stencil,
+            },
+            first_pass,
+        );
+        pass.set_bind_group(0, &self.bind_group, &[]);
+        pass.set_bind_group(1, group1.0, group1.1);
+        pass
+    }
+
     /// A frame's memory estimate that starts with these buffers for `g` (the scene's
     /// geometry, or a method's own baked copy): every method uploads them.
     pub fn memory_estimate(

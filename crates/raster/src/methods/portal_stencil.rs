@@ -31,9 +31,9 @@ use crate::pipeline::{
     record_binding,
 };
 use crate::plan::PlanError;
-use crate::projection::{FAR_DEPTH, NEARER_OR_EQUAL};
+use crate::projection::NEARER_OR_EQUAL;
 use crate::shading::{SceneBuffers, VERTEX_LAYOUT};
-use crate::targets::{DEPTH_STENCIL_FORMAT, DepthClear, RenderTarget, depth_stencil_format};
+use crate::targets::{DEPTH_STENCIL_FORMAT, RenderTarget, depth_stencil_format};
 use crate::timing::FrameEncoder;
 use crate::wgsl::HostLayout;
 use bytemuck::{Pod, Zeroable};
@@ -514,20 +514,17 @@ impl FrameEncoder for PortalStencil {
         target: &RenderTarget,
         first_pass: Option<wgpu::RenderPassTimestampWrites<'_>>,
     ) {
-        let mut pass = target.begin_pass_with(
+        let mut pass = self.scene_buffers.begin_frame_pass(
             encoder,
+            target,
             "portal stencil pass",
             self.background,
-            DepthClear {
-                view: &self.depth_stencil,
-                depth: FAR_DEPTH,
-                stencil: Some(1),
-            },
+            &self.depth_stencil,
+            Some(1),
+            (&self.path_bind_group, &[self.offsets[0]]),
             first_pass,
         );
         pass.set_vertex_buffer(0, self.scene_buffers.vertices.slice(..));
-        pass.set_bind_group(0, &self.scene_buffers.bind_group, &[]);
-        pass.set_bind_group(1, &self.path_bind_group, &[self.offsets[0]]);
         let scissor = |pass: &mut wgpu::RenderPass<'_>, path: usize| {
             let [x, y, w, h] = self.scissors[path];
             pass.set_scissor_rect(x, y, w, h);

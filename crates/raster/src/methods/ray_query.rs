@@ -28,9 +28,9 @@ use crate::method::{
 };
 use crate::pipeline::{ScenePipeline, depth_state, pipeline_layout};
 use crate::plan::PlanError;
-use crate::projection::{FAR_DEPTH, NEARER};
+use crate::projection::NEARER;
 use crate::shading::{SceneBuffers, VERTEX_LAYOUT};
-use crate::targets::{DEPTH_FORMAT, DepthClear, RenderTarget};
+use crate::targets::{DEPTH_FORMAT, RenderTarget};
 use crate::timing::FrameEncoder;
 use crate::wgsl::{HostLayout, WgslSource};
 use bytemuck::{Pod, Zeroable};
@@ -569,19 +569,16 @@ impl FrameEncoder for RayQueryFrame {
         target: &RenderTarget,
         first_pass: Option<wgpu::RenderPassTimestampWrites<'_>>,
     ) {
-        let mut pass = target.begin_pass_with(
+        let mut pass = self.scene_buffers.begin_frame_pass(
             encoder,
+            target,
             "ray query pass",
             self.background,
-            DepthClear {
-                view: &self.depth,
-                depth: FAR_DEPTH,
-                stencil: None,
-            },
+            &self.depth,
+            None,
+            (&self.bind_group, &[]),
             first_pass,
         );
-        pass.set_bind_group(0, &self.scene_buffers.bind_group, &[]);
-        pass.set_bind_group(1, &self.bind_group, &[]);
         if self.settings.primary_rays {
             pass.set_pipeline(&self.primary_rays);
             pass.draw(0..3, 0..1);

@@ -43,9 +43,9 @@ use crate::method::{
 };
 use crate::pipeline::{ScenePipeline, depth_state, pipeline_layout};
 use crate::plan::PlanError;
-use crate::projection::{FAR_DEPTH, NEARER};
+use crate::projection::NEARER;
 use crate::shading::{SceneBuffers, VERTEX_LAYOUT};
-use crate::targets::{DEPTH_FORMAT, DepthClear, RenderTarget};
+use crate::targets::{DEPTH_FORMAT, RenderTarget};
 use crate::timing::FrameEncoder;
 use crate::wgsl::{HostLayout, WgslSource};
 use bytemuck::{Pod, Zeroable};
@@ -674,19 +674,16 @@ impl FrameEncoder for Unrolled {
         target: &RenderTarget,
         first_pass: Option<wgpu::RenderPassTimestampWrites<'_>>,
     ) {
-        let mut pass = target.begin_pass_with(
+        let mut pass = self.scene_buffers.begin_frame_pass(
             encoder,
+            target,
             "unrolled pass",
             self.clear,
-            DepthClear {
-                view: &self.depth,
-                depth: FAR_DEPTH,
-                stencil: None,
-            },
+            &self.depth,
+            None,
+            (&self.bind_group, &[]),
             first_pass,
         );
-        pass.set_bind_group(0, &self.scene_buffers.bind_group, &[]);
-        pass.set_bind_group(1, &self.bind_group, &[]);
         if let Some((buffer, count)) = &self.background {
             pass.set_pipeline(&self.background_pipeline);
             pass.set_vertex_buffer(0, buffer.slice(..));
