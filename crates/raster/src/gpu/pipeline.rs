@@ -182,6 +182,123 @@ pub fn dynamic_uniform_entry(
     }
 }
 
+/// A bind group and its layout from one list of bindings, each binding's type and resource
+/// written once, side by side, numbered from 0 in the order given (in the spirit of kajiya's
+/// pass builder: a method says what it binds, the builder writes the layout entries and the
+/// group entries that must agree). The layout is made through the device's cache.
+///
+/// ```ignore
+/// let (layout, group) = BindGroupBuilder::new("portal path")
+///     .record::<PathUniform>(wgpu::ShaderStages::VERTEX_FRAGMENT, &uniforms)
+///     .build(gpu);
+/// ```
+pub struct BindGroupBuilder<'a> {
+    label: &'static str,
+    entries: Vec<wgpu::BindGroupLayoutEntry>,
+    resources: Vec<wgpu::BindingResource<'a>>,
+}
+
+impl<'a> BindGroupBuilder<'a> {
+    pub fn new(label: &'static str) -> Self {
+        BindGroupBuilder {
+            label,
+            entries: Vec::new(),
+            resources: Vec::new(),
+        }
+    }
+
+    /// The next binding: `ty`, seen by `visibility`, bound to `resource`.
+    pub fn binding(
+        mut self,
+        visibility: wgpu::ShaderStages,
+        ty: wgpu::BindingType,
+        resource: wgpu::BindingResource<'a>,
+    ) -> Self {
+        self.entries.push(wgpu::BindGroupLayoutEntry {
+            binding: self.entries.len() as u32,
+            visibility,
+            ty,
+            count: None,
+        });
+        self.resources.push(resource);
+        self
+    }
+
+    /// One `T` record of a [`UniformArena`]'s buffer, read at a dynamic offset.
+    pub fn record<T>(self, visibility: wgpu::ShaderStages, arena: &'a wgpu::Buffer) -> Self {
+        let ty = dynamic_uniform_entry(0, visibility).ty;
+        self.binding(visibility, ty, record_binding::<T>(arena))
+    }
+
+    /// A whole buffer: a uniform, or a storage buffer (read-only unless `read_only` is false).
+    pub fn buffer(
+        self,
+        visibility: wgpu::ShaderStages,
+        ty: wgpu::BufferBindingType,
+        buffer: &'a wgpu::Buffer,
+    ) -> Self {
+        self.binding(
+            visibility,
+            wgpu::BindingType::Buffer {
+                ty,
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            buffer.as_entire_binding(),
+        )
+    }
+
+    /// A read-only storage buffer.
+    pub fn storage(self, visibility: wgpu::ShaderStages, buffer: &'a wgpu::Buffer) -> Self {
+        self.buffer(
+            visibility,
+            wgpu::BufferBindingType::Storage { read_only: true },
+            buffer,
+        )
+    }
+
+    /// A 2D texture of floats read with `textureLoad` or a non-filtering sampler.
+    pub fn texture(self, visibility: wgpu::ShaderStages, view: &'a wgpu::TextureView) -> Self {
+        self.binding(
+            visibility,
+            wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                view_dimension: wgpu::TextureViewDimension::D2,
+                multisampled: false,
+            },
+            wgpu::BindingResource::TextureView(view),
+        )
+    }
+
+    /// The layout alone, as [`BindGroupBuilder::build`] makes it.
+    pub fn layout(&self, gpu: &Gpu) -> wgpu::BindGroupLayout {
+        gpu.bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some(self.label),
+            entries: &self.entries,
+        })
+    }
+
+    /// The layout (from the device's cache) and the bind group.
+    pub fn build(self, gpu: &Gpu) -> (wgpu::BindGroupLayout, wgpu::BindGroup) {
+        let layout = self.layout(gpu);
+        let entries: Vec<wgpu::BindGroupEntry> = self
+            .resources
+            .into_iter()
+            .enumerate()
+            .map(|(i, resource)| wgpu::BindGroupEntry {
+                binding: i as u32,
+                resource,
+            })
+            .collect();
+        let group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some(self.label),
+            layout: &layout,
+            entries: &entries,
+        });
+        (layout, group)
+    }
+}
+
 /// Uniform records packed into one buffer at the device's offset alignment, each bound by
 /// its dynamic offset (one buffer and bind group for all passes or paths of a frame).
 pub struct UniformArena {

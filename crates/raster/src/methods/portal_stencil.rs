@@ -27,8 +27,7 @@ use crate::method::{
     BuiltFrame, Clipping, FrameStats, MethodEntry, PathCounts, PlannedFrame, RasterMethod,
 };
 use crate::pipeline::{
-    ScenePipeline, UniformArena, depth_state, dynamic_uniform_entry, pipeline_layout,
-    record_binding,
+    BindGroupBuilder, ScenePipeline, UniformArena, depth_state, pipeline_layout,
 };
 use crate::plan::PlanError;
 use crate::projection::NEARER_OR_EQUAL;
@@ -303,21 +302,9 @@ impl PortalStencil {
             offsets.push(arena.push(&u));
         }
         let uniforms = arena.buffer(device, "portal paths");
-        let path_layout = gpu.bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("portal path"),
-            entries: &[dynamic_uniform_entry(
-                0,
-                wgpu::ShaderStages::VERTEX_FRAGMENT,
-            )],
-        });
-        let path_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("portal path"),
-            layout: &path_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: record_binding::<PathUniform>(&uniforms),
-            }],
-        });
+        let (path_layout, path_bind_group) = BindGroupBuilder::new("portal path")
+            .record::<PathUniform>(wgpu::ShaderStages::VERTEX_FRAGMENT, &uniforms)
+            .build(gpu);
         let layout = pipeline_layout(gpu, "portal", &[&scene_buffers.layout, &path_layout]);
         let clipping = Clipping::for_features(gpu.features);
         let depth_format = depth_stencil_format(gpu.features);

@@ -26,7 +26,7 @@ use crate::method::{
     BuiltFrame, Clipping, FrameStats, MethodEntry, OptionKind, OptionSpec, ParamValue,
     PlannedFrame, RasterMethod,
 };
-use crate::pipeline::{ScenePipeline, depth_state, pipeline_layout};
+use crate::pipeline::{BindGroupBuilder, ScenePipeline, depth_state, pipeline_layout};
 use crate::plan::PlanError;
 use crate::projection::NEARER;
 use crate::shading::{SceneBuffers, VERTEX_LAYOUT};
@@ -407,57 +407,18 @@ impl RayQueryFrame {
             contents: bytemuck::bytes_of(&params),
             usage: wgpu::BufferUsages::UNIFORM,
         });
-        let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-            ty,
-            count: None,
-        };
-        let layout = gpu.bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("ray query"),
-            entries: &[
-                entry(
-                    0,
-                    wgpu::BindingType::AccelerationStructure {
-                        vertex_return: false,
-                    },
-                ),
-                entry(
-                    1,
-                    wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Storage { read_only: true },
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                ),
-                entry(
-                    2,
-                    wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                ),
-            ],
-        });
-        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("ray query"),
-            layout: &layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: tlas.as_binding(),
+        let stages = wgpu::ShaderStages::VERTEX_FRAGMENT;
+        let (layout, bind_group) = BindGroupBuilder::new("ray query")
+            .binding(
+                stages,
+                wgpu::BindingType::AccelerationStructure {
+                    vertex_return: false,
                 },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: record_buffer.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: params_buffer.as_entire_binding(),
-                },
-            ],
-        });
+                tlas.as_binding(),
+            )
+            .storage(stages, &record_buffer)
+            .buffer(stages, wgpu::BufferBindingType::Uniform, &params_buffer)
+            .build(gpu);
         let pipeline_layout = pipeline_layout(gpu, "ray query", &[&scene_buffers.layout, &layout]);
         let module = gpu.shader_module(&SHADER, scene_buffers.textured);
         let scene_pipeline = |label, vertex, fragment, write, compare, colour| {

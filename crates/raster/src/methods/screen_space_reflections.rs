@@ -18,11 +18,11 @@ use crate::method::{
     BuiltFrame, Clipping, FrameStats, MethodEntry, OptionKind, OptionSpec, ParamValue,
     PlannedFrame, RasterMethod,
 };
-use crate::pipeline::{ScenePipeline, depth_state, pipeline_layout};
+use crate::pipeline::{BindGroupBuilder, ScenePipeline, depth_state, pipeline_layout};
 use crate::plan::PlanError;
 use crate::projection::{FAR_DEPTH, NEARER};
 use crate::shading::{SceneBuffers, VERTEX_LAYOUT};
-use crate::targets::{DEPTH_FORMAT, RenderTarget, texture_entry};
+use crate::targets::{DEPTH_FORMAT, RenderTarget};
 use crate::timing::FrameEncoder;
 use crate::wgsl::{HostLayout, WgslSource};
 use bytemuck::{Pod, Zeroable};
@@ -332,28 +332,14 @@ impl SsrFrame {
             contents: bytemuck::bytes_of(&params),
             usage: wgpu::BufferUsages::UNIFORM,
         });
-        let uniform = wgpu::BindGroupLayoutEntry {
-            binding: 0,
-            visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Uniform,
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        };
-        let base_layout = gpu.bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("ssr scene pass"),
-            entries: &[uniform],
-        });
-        let base_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("ssr scene pass"),
-            layout: &base_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: params_buffer.as_entire_binding(),
-            }],
-        });
+        let (vf, f) = (
+            wgpu::ShaderStages::VERTEX_FRAGMENT,
+            wgpu::ShaderStages::FRAGMENT,
+        );
+        let uniform = wgpu::BufferBindingType::Uniform;
+        let (base_layout, base_group) = BindGroupBuilder::new("ssr scene pass")
+            .buffer(vf, uniform, &params_buffer)
+            .build(gpu);
         let colour_format = gpu.color_format.texture_format();
         let sampled = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
         let base_colour = crate::targets::texture_2d(
@@ -466,49 +452,23 @@ impl SsrFrame {
             })
             .collect();
         let whole_pyramid = pyramid.create_view(&Default::default());
-        let reflect_layout = gpu.bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("ssr reflect"),
-            entries: &[
-                uniform,
-                texture_entry(1),
-                texture_entry(2),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 3,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Uint,
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-            ],
-        });
         let fallback_view = fallback
             .as_ref()
             .map_or(&base_colour, |(_, target)| &target.color_view);
-        let reflect_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("ssr reflect"),
-            layout: &reflect_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: params_buffer.as_entire_binding(),
+        let (reflect_layout, reflect_group) = BindGroupBuilder::new("ssr reflect")
+            .buffer(vf, uniform, &params_buffer)
+            .texture(f, &base_colour)
+            .texture(f, fallback_view)
+            .binding(
+                f,
+                wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Uint,
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled: false,
                 },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::TextureView(&base_colour),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: wgpu::BindingResource::TextureView(fallback_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: wgpu::BindingResource::TextureView(&whole_pyramid),
-                },
-            ],
-        });
+                wgpu::BindingResource::TextureView(&whole_pyramid),
+            )
+            .build(gpu);
         let reflect_pipeline = ScenePipeline {
             label: "ssr reflect",
             layout: &pipeline_layout(

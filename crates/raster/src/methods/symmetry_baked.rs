@@ -19,9 +19,9 @@ use crate::method::{
 };
 use crate::methods::symmetry::{
     CLIP_DISTANCE_SHADER, COPY_IDS, SHADER, SymmetryFrame, SymmetryInput, copy_id_warning,
-    gpu_structs, parts_of, uniform_entry,
+    gpu_structs, parts_of,
 };
-use crate::pipeline::{ScenePipeline, depth_state, pipeline_layout};
+use crate::pipeline::{BindGroupBuilder, ScenePipeline, depth_state, pipeline_layout};
 use crate::plan::PlanError;
 use crate::projection::NEARER;
 use crate::shading::{SceneBuffers, VERTEX_LAYOUT};
@@ -198,18 +198,13 @@ impl BakedFrame {
             contents: bytemuck::bytes_of(&planned.frame),
             usage: wgpu::BufferUsages::UNIFORM,
         });
-        let layout = gpu.bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("symmetry-baked"),
-            entries: &[uniform_entry(0)],
-        });
-        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("symmetry-baked"),
-            layout: &layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: frame_buffer.as_entire_binding(),
-            }],
-        });
+        let (layout, bind_group) = BindGroupBuilder::new("symmetry-baked")
+            .buffer(
+                wgpu::ShaderStages::VERTEX_FRAGMENT,
+                wgpu::BufferBindingType::Uniform,
+                &frame_buffer,
+            )
+            .build(gpu);
         let copy_ids = planned.copy_of_vertex.as_ref().map(|ids| {
             let mut ids = ids.clone();
             if ids.is_empty() {

@@ -41,7 +41,7 @@ use crate::method::{
     BuiltFrame, Clipping, FrameStats, MethodEntry, OptionKind, OptionSpec, ParamValue, PathCounts,
     PlannedFrame, RasterMethod,
 };
-use crate::pipeline::{ScenePipeline, depth_state, pipeline_layout};
+use crate::pipeline::{BindGroupBuilder, ScenePipeline, depth_state, pipeline_layout};
 use crate::plan::PlanError;
 use crate::projection::NEARER;
 use crate::shading::{SceneBuffers, VERTEX_LAYOUT};
@@ -506,34 +506,12 @@ impl Unrolled {
                 bytemuck::cast_slice(&mirror_rects).to_vec(),
             ),
         ];
-        let entries: Vec<wgpu::BindGroupLayoutEntry> = (0..4)
-            .map(|binding| wgpu::BindGroupLayoutEntry {
-                binding,
-                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Storage { read_only: true },
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                count: None,
+        let (layout, bind_group) = buffers
+            .iter()
+            .fold(BindGroupBuilder::new("unrolled"), |b, buffer| {
+                b.storage(wgpu::ShaderStages::VERTEX_FRAGMENT, buffer)
             })
-            .collect();
-        let layout = gpu.bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("unrolled"),
-            entries: &entries,
-        });
-        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("unrolled"),
-            layout: &layout,
-            entries: &buffers
-                .iter()
-                .enumerate()
-                .map(|(i, b)| wgpu::BindGroupEntry {
-                    binding: i as u32,
-                    resource: b.as_entire_binding(),
-                })
-                .collect::<Vec<_>>(),
-        });
+            .build(gpu);
         let layout = pipeline_layout(gpu, "unrolled", &[&scene_buffers.layout, &layout]);
         let guarded_module = gpu.shader_module(&GUARDED_SHADER, scene_buffers.textured);
         let clipped_module = clip_distances
