@@ -291,11 +291,7 @@ pub struct Unrolled {
     draws: Vec<Draw>,
     background: Option<(wgpu::Buffer, u32)>,
     depth: wgpu::TextureView,
-    clipped_object: Option<wgpu::RenderPipeline>,
-    clipped_mirror: Option<wgpu::RenderPipeline>,
-    guarded_object: wgpu::RenderPipeline,
-    guarded_mirror: wgpu::RenderPipeline,
-    background_pipeline: wgpu::RenderPipeline,
+    pipelines: Pipelines,
     clear: Vec3,
     pub stats: FrameStats,
 }
@@ -312,55 +308,133 @@ impl Unrolled {
     ) -> Result<Self, RasterError> {
         use wgpu::util::DeviceExt;
         let device = &gpu.device;
-        let (paths, projection) = (&planned.paths, planned.projection);
+        let paths = &planned.paths;
         let (width, height) = (planned.width, planned.height);
         let clip_distances =
             gpu.features.contains(wgpu::Features::CLIP_DISTANCES) && !fragment_clipping;
         let scene_buffers = SceneBuffers::new(gpu, scene, shadows.binding());
-        let size = Vec2::new(width as f32, height as f32);
-        // Each distinct mirror plane once: every item is tested against every plane, and
-        // stacked or coincident mirrors (a mosaic's coplanar facets, the degenerate scene of
-        // 20 000 coincident mirrors) would make that items × mirrors (issue 51).
-        let mut planes: Vec<Vec4> = scene
-            .mirrors
-            .iter()
-            .map(|m| m.plane().coefficients())
-            .collect();
-        planes.sort_unstable_by_key(|p| p.to_array().map(f32::to_bits));
-        planes.dedup_by_key(|p| p.to_array().map(f32::to_bits));
-        let in_front_of_all = |lo: Vec3, hi: Vec3| {
-            box_corners(lo, hi).iter().all(|p| {
-                planes
-                    .iter()
-                    .all(|pl| pl.dot(p.extend(1.0)) >= -FRONT_EPSILON)
-            })
-        };
-        let mut items: Vec<Item> = scene_buffers
-            .parts
-            .iter()
-            .map(|(range, lo, hi)| Item {
-                vertices: range.clone(),
-                lo: *lo,
-                hi: *hi,
-                mirror: None,
-                in_front_of_all_mirrors: in_front_of_all(*lo, *hi),
-            })
-            .collect();
-        for (m, mirror) in scene.mirrors.iter().enumerate() {
-            let c = mirror.corners();
-            let lo = c.iter().fold(Vec3::INFINITY, |a, p| a.min(*p));
-            let hi = c.iter().fold(Vec3::NEG_INFINITY, |a, p| a.max(*p));
-            items.push(Item {
-                vertices: scene_buffers.mirrors[m].clone(),
-                lo,
-                hi,
-                mirror: Some(m),
-                in_front_of_all_mirrors: in_front_of_all(lo, hi),
-            });
+        let items = items(scene, &scene_buffers);
+        let instances = Instances::of(planned, &items, clip_distances);
+        let (ids, draws, item_triangles) = draw_lists(&items, &instances.lists);
+        let background = instances.background;
+        let triangles = background.len() / 3 + item_triangles;
+        if triangles > MAX_TRIANGLES_PER_FRAME {
+            return Err(RasterError::Plan(PlanError::TooManyTriangles {
+                triangles,
+                limit: MAX_TRIANGLES_PER_FRAME,
+            }));
         }
+        let (layout, bind_group) =
+            storage_group(gpu, scene, &instances.cell_pieces, &instances.edges, &ids);
+        let layout = pipeline_layout(gpu, "unrolled", &[&scene_buffers.layout, &layout]);
+        let pipelines = Pipelines::new(gpu, &layout, scene_buffers.textured, clip_distances);
+        let depth = crate::targets::texture_2d(
+            device,
+            "unrolled depth",
+            width,
+            height,
+            DEPTH_FORMAT,
+            wgpu::TextureUsages::RENDER_ATTACHMENT,
+        )
+        .create_view(&Default::default());
+        let background = (!background.is_empty()).then(|| {
+            (
+                device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("unrolled backgrounds"),
+                    contents: bytemuck::cast_slice(&background),
+                    usage: wgpu::BufferUsages::VERTEX,
+                }),
+                background.len() as u32,
+            )
+        });
+        let stats = FrameStats {
+            passes: 1,
+            texture_renders: 0,
+            draws: draws.len() + usize::from(background.is_some()) + 1,
+            depth: paths.deepest,
+            triangles,
+            paths: Some(PathCounts::of(paths)),
+            clipping: if clip_distances {
+                Clipping::ClipDistances
+            } else {
+                Clipping::FragmentDiscard
+            },
+            depth_format: DEPTH_FORMAT,
+            copies: None,
+        };
+        Ok(Unrolled {
+            scene_buffers,
+            bind_group,
+            draws,
+            background,
+            depth,
+            pipelines,
+            clear: scene.background,
+            stats,
+        })
+    }
+}
 
-        // Per path, per piece of its visible region: its data, its edges, and which items it
-        // draws with which stage.
+/// Every diffuse part and mirror a path may draw, with its bounds and whether it needs the
+/// guard.
+fn items(scene: &Scene, scene_buffers: &SceneBuffers) -> Vec<Item> {
+    // Each distinct mirror plane once: every item is tested against every plane, and
+    // stacked or coincident mirrors (a mosaic's coplanar facets, the degenerate scene of
+    // 20 000 coincident mirrors) would make that items × mirrors (issue 51).
+    let mut planes: Vec<Vec4> = scene
+        .mirrors
+        .iter()
+        .map(|m| m.plane().coefficients())
+        .collect();
+    planes.sort_unstable_by_key(|p| p.to_array().map(f32::to_bits));
+    planes.dedup_by_key(|p| p.to_array().map(f32::to_bits));
+    let in_front_of_all = |lo: Vec3, hi: Vec3| {
+        box_corners(lo, hi).iter().all(|p| {
+            planes
+                .iter()
+                .all(|pl| pl.dot(p.extend(1.0)) >= -FRONT_EPSILON)
+        })
+    };
+    let mut items: Vec<Item> = scene_buffers
+        .parts
+        .iter()
+        .map(|(range, lo, hi)| Item {
+            vertices: range.clone(),
+            lo: *lo,
+            hi: *hi,
+            mirror: None,
+            in_front_of_all_mirrors: in_front_of_all(*lo, *hi),
+        })
+        .collect();
+    for (m, mirror) in scene.mirrors.iter().enumerate() {
+        let c = mirror.corners();
+        let lo = c.iter().fold(Vec3::INFINITY, |a, p| a.min(*p));
+        let hi = c.iter().fold(Vec3::NEG_INFINITY, |a, p| a.max(*p));
+        items.push(Item {
+            vertices: scene_buffers.mirrors[m].clone(),
+            lo,
+            hi,
+            mirror: Some(m),
+            in_front_of_all_mirrors: in_front_of_all(lo, hi),
+        });
+    }
+    items
+}
+
+/// Per path, per piece of its visible region: its data, its edges, and which items it
+/// draws with which stage; and the portals' background triangles.
+struct Instances {
+    cell_pieces: Vec<CellPiece>,
+    edges: Vec<Vec4>,
+    /// Per item, the cell pieces that draw it, by stage (clipped, guarded).
+    lists: Vec<[Vec<u32>; 2]>,
+    background: Vec<BackgroundVertex>,
+}
+
+impl Instances {
+    fn of(planned: &PlannedPaths, items: &[Item], clip_distances: bool) -> Self {
+        let (paths, projection) = (&planned.paths, planned.projection);
+        let size = Vec2::new(planned.width as f32, planned.height as f32);
         let mut cell_pieces = Vec::with_capacity(paths.paths.len());
         let mut edges: Vec<Vec4> = Vec::new();
         let mut lists: Vec<[Vec<u32>; 2]> = vec![[Vec::new(), Vec::new()]; items.len()];
@@ -436,86 +510,115 @@ impl Unrolled {
                 }
             }
         }
-
-        let mut ids: Vec<u32> = Vec::new();
-        let mut draws = Vec::new();
-        let mut triangles = background.len() / 3;
-        for (item, list) in items.iter().zip(&lists) {
-            for (stage, list) in [Stage::Clipped, Stage::Guarded].into_iter().zip(list) {
-                if list.is_empty() {
-                    continue;
-                }
-                let first = ids.len() as u32;
-                ids.extend(list);
-                triangles += list.len() * item.vertices.len() / 3;
-                draws.push(Draw {
-                    stage,
-                    mirror: item.mirror.is_some(),
-                    vertices: item.vertices.clone(),
-                    instances: first..ids.len() as u32,
-                });
-            }
+        Instances {
+            cell_pieces,
+            edges,
+            lists,
+            background,
         }
-        if triangles > MAX_TRIANGLES_PER_FRAME {
-            return Err(RasterError::Plan(PlanError::TooManyTriangles {
-                triangles,
-                limit: MAX_TRIANGLES_PER_FRAME,
-            }));
-        }
+    }
+}
 
-        let mirror_rects: Vec<MirrorRect> = scene
-            .mirrors
-            .iter()
-            .map(|m| MirrorRect {
-                plane: m.plane().coefficients().to_array(),
-                center: m.center.to_array(),
-                half_width: 0.5 * m.width,
-                right: m.right().to_array(),
-                half_height: 0.5 * m.height,
-                up: m.up.to_array(),
-                _pad: 0.0,
-            })
-            .collect();
-        // Storage buffers may not be empty.
-        let nonempty = |mut v: Vec<u8>| {
-            if v.is_empty() {
-                v.resize(16, 0);
+/// The instanced draws, one per item and stage with any instance, their instance ids, and
+/// the triangles they submit.
+fn draw_lists(items: &[Item], lists: &[[Vec<u32>; 2]]) -> (Vec<u32>, Vec<Draw>, usize) {
+    let mut ids: Vec<u32> = Vec::new();
+    let mut draws = Vec::new();
+    let mut triangles = 0;
+    for (item, list) in items.iter().zip(lists) {
+        for (stage, list) in [Stage::Clipped, Stage::Guarded].into_iter().zip(list) {
+            if list.is_empty() {
+                continue;
             }
-            v
-        };
-        let storage = |label: &str, bytes: Vec<u8>| {
-            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents: &nonempty(bytes),
-                usage: wgpu::BufferUsages::STORAGE,
-            })
-        };
-        let buffers = [
-            storage(
-                "unrolled cell pieces",
-                bytemuck::cast_slice(&cell_pieces).to_vec(),
-            ),
-            storage(
-                "unrolled edges",
-                bytemuck::cast_slice(&edges.iter().map(|e| e.to_array()).collect::<Vec<_>>())
-                    .to_vec(),
-            ),
-            storage("unrolled ids", bytemuck::cast_slice(&ids).to_vec()),
-            storage(
-                "unrolled mirrors",
-                bytemuck::cast_slice(&mirror_rects).to_vec(),
-            ),
-        ];
-        let (layout, bind_group) = buffers
-            .iter()
-            .fold(BindGroupBuilder::new("unrolled"), |b, buffer| {
-                b.storage(wgpu::ShaderStages::VERTEX_FRAGMENT, buffer)
-            })
-            .build(gpu);
-        let layout = pipeline_layout(gpu, "unrolled", &[&scene_buffers.layout, &layout]);
-        let guarded_module = gpu.shader_module(&GUARDED_SHADER, scene_buffers.textured);
-        let clipped_module = clip_distances
-            .then(|| gpu.shader_module(&CLIP_DISTANCE_SHADER, scene_buffers.textured));
+            let first = ids.len() as u32;
+            ids.extend(list);
+            triangles += list.len() * item.vertices.len() / 3;
+            draws.push(Draw {
+                stage,
+                mirror: item.mirror.is_some(),
+                vertices: item.vertices.clone(),
+                instances: first..ids.len() as u32,
+            });
+        }
+    }
+    (ids, draws, triangles)
+}
+
+/// The storage buffers the shaders read (cell pieces, edges, instance ids, mirror rectangles)
+/// and their bind group.
+fn storage_group(
+    gpu: &Gpu,
+    scene: &Scene,
+    cell_pieces: &[CellPiece],
+    edges: &[Vec4],
+    ids: &[u32],
+) -> (wgpu::BindGroupLayout, wgpu::BindGroup) {
+    use wgpu::util::DeviceExt;
+    let device = &gpu.device;
+    let mirror_rects: Vec<MirrorRect> = scene
+        .mirrors
+        .iter()
+        .map(|m| MirrorRect {
+            plane: m.plane().coefficients().to_array(),
+            center: m.center.to_array(),
+            half_width: 0.5 * m.width,
+            right: m.right().to_array(),
+            half_height: 0.5 * m.height,
+            up: m.up.to_array(),
+            _pad: 0.0,
+        })
+        .collect();
+    // Storage buffers may not be empty.
+    let nonempty = |mut v: Vec<u8>| {
+        if v.is_empty() {
+            v.resize(16, 0);
+        }
+        v
+    };
+    let storage = |label: &str, bytes: Vec<u8>| {
+        device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(label),
+            contents: &nonempty(bytes),
+            usage: wgpu::BufferUsages::STORAGE,
+        })
+    };
+    let buffers = [
+        storage(
+            "unrolled cell pieces",
+            bytemuck::cast_slice(cell_pieces).to_vec(),
+        ),
+        storage(
+            "unrolled edges",
+            bytemuck::cast_slice(&edges.iter().map(|e| e.to_array()).collect::<Vec<_>>()).to_vec(),
+        ),
+        storage("unrolled ids", bytemuck::cast_slice(ids).to_vec()),
+        storage(
+            "unrolled mirrors",
+            bytemuck::cast_slice(&mirror_rects).to_vec(),
+        ),
+    ];
+    buffers
+        .iter()
+        .fold(BindGroupBuilder::new("unrolled"), |b, buffer| {
+            b.storage(wgpu::ShaderStages::VERTEX_FRAGMENT, buffer)
+        })
+        .build(gpu)
+}
+
+/// The pipelines: guarded (every adapter), clipped (with clip distances), backgrounds.
+struct Pipelines {
+    guarded_object: wgpu::RenderPipeline,
+    guarded_mirror: wgpu::RenderPipeline,
+    background: wgpu::RenderPipeline,
+    clipped_object: Option<wgpu::RenderPipeline>,
+    clipped_mirror: Option<wgpu::RenderPipeline>,
+}
+
+impl Pipelines {
+    fn new(gpu: &Gpu, layout: &wgpu::PipelineLayout, textured: bool, clip_distances: bool) -> Self {
+        let guarded_module = gpu.shader_module(&GUARDED_SHADER, textured);
+        let clipped_module =
+            clip_distances.then(|| gpu.shader_module(&CLIP_DISTANCE_SHADER, textured));
         let background_layout = wgpu::VertexBufferLayout {
             array_stride: std::mem::size_of::<BackgroundVertex>() as u64,
             step_mode: wgpu::VertexStepMode::Vertex,
@@ -529,7 +632,7 @@ impl Unrolled {
                         background: bool| {
             ScenePipeline {
                 label,
-                layout: &layout,
+                layout,
                 module,
                 vertex,
                 fragment,
@@ -594,54 +697,13 @@ impl Unrolled {
                 false,
             )
         });
-        let depth = crate::targets::texture_2d(
-            device,
-            "unrolled depth",
-            width,
-            height,
-            DEPTH_FORMAT,
-            wgpu::TextureUsages::RENDER_ATTACHMENT,
-        )
-        .create_view(&Default::default());
-        let background = (!background.is_empty()).then(|| {
-            (
-                device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some("unrolled backgrounds"),
-                    contents: bytemuck::cast_slice(&background),
-                    usage: wgpu::BufferUsages::VERTEX,
-                }),
-                background.len() as u32,
-            )
-        });
-        let stats = FrameStats {
-            passes: 1,
-            texture_renders: 0,
-            draws: draws.len() + usize::from(background.is_some()) + 1,
-            depth: paths.deepest,
-            triangles,
-            paths: Some(PathCounts::of(paths)),
-            clipping: if clip_distances {
-                Clipping::ClipDistances
-            } else {
-                Clipping::FragmentDiscard
-            },
-            depth_format: DEPTH_FORMAT,
-            copies: None,
-        };
-        Ok(Unrolled {
-            scene_buffers,
-            bind_group,
-            draws,
-            background,
-            depth,
-            clipped_object,
-            clipped_mirror,
+        Pipelines {
             guarded_object,
             guarded_mirror,
-            background_pipeline,
-            clear: scene.background,
-            stats,
-        })
+            background: background_pipeline,
+            clipped_object,
+            clipped_mirror,
+        }
     }
 }
 
@@ -663,17 +725,17 @@ impl FrameEncoder for Unrolled {
             first_pass,
         );
         if let Some((buffer, count)) = &self.background {
-            pass.set_pipeline(&self.background_pipeline);
+            pass.set_pipeline(&self.pipelines.background);
             pass.set_vertex_buffer(0, buffer.slice(..));
             pass.draw(0..*count, 0..1);
         }
         pass.set_vertex_buffer(0, self.scene_buffers.vertices.slice(..));
         for d in &self.draws {
             let pipeline = match (d.stage, d.mirror) {
-                (Stage::Clipped, false) => self.clipped_object.as_ref(),
-                (Stage::Clipped, true) => self.clipped_mirror.as_ref(),
-                (Stage::Guarded, false) => Some(&self.guarded_object),
-                (Stage::Guarded, true) => Some(&self.guarded_mirror),
+                (Stage::Clipped, false) => self.pipelines.clipped_object.as_ref(),
+                (Stage::Clipped, true) => self.pipelines.clipped_mirror.as_ref(),
+                (Stage::Guarded, false) => Some(&self.pipelines.guarded_object),
+                (Stage::Guarded, true) => Some(&self.pipelines.guarded_mirror),
             }
             .expect("clipped draws exist only with clip distances");
             pass.set_pipeline(pipeline);
