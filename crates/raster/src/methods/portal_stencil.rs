@@ -231,12 +231,7 @@ pub struct PortalStencil {
     /// Last mirror of each path (not drawn in its own world: it is the near plane).
     last_mirror: Vec<Option<usize>>,
     ops: Vec<Op>,
-    objects: wgpu::RenderPipeline,
-    mirrors: wgpu::RenderPipeline,
-    mark: wgpu::RenderPipeline,
-    clear_region: wgpu::RenderPipeline,
-    retire: wgpu::RenderPipeline,
-    decrement: wgpu::RenderPipeline,
+    pipelines: Pipelines,
     background: Vec3,
     mirror_count: usize,
     pub stats: FrameStats,
@@ -266,8 +261,74 @@ impl PortalStencil {
         ops: Vec<Op>,
     ) -> Result<Self, RasterError> {
         let device = &gpu.device;
-        let (paths, projection) = (&planned.paths, planned.projection);
+        let paths = &planned.paths;
         let scene_buffers = SceneBuffers::new(gpu, scene, shadows.binding());
+        let records = PathRecords::of(gpu, planned, &scene_buffers);
+        let (path_layout, path_bind_group) = BindGroupBuilder::new("portal path")
+            .record::<PathUniform>(wgpu::ShaderStages::VERTEX_FRAGMENT, &records.uniforms)
+            .build(gpu);
+        let layout = pipeline_layout(gpu, "portal", &[&scene_buffers.layout, &path_layout]);
+        let clipping = Clipping::for_features(gpu.features);
+        let depth_format = depth_stencil_format(gpu.features);
+        let pipelines =
+            Pipelines::new(gpu, &layout, scene_buffers.textured, clipping, depth_format);
+        let depth_stencil = crate::targets::texture_2d(
+            device,
+            "portal depth-stencil",
+            planned.width,
+            planned.height,
+            depth_format,
+            wgpu::TextureUsages::RENDER_ATTACHMENT,
+        )
+        .create_view(&Default::default());
+        let mirror_count = scene.mirrors.len();
+        let PathRecords {
+            offsets,
+            visible_parts,
+            scissors,
+            ..
+        } = records;
+        let stats = frame_stats(
+            paths,
+            &ops,
+            &visible_parts,
+            &scene_buffers,
+            (clipping, depth_format),
+        )?;
+        Ok(PortalStencil {
+            scene_buffers,
+            scissors,
+            visible_parts,
+            depth_stencil,
+            path_bind_group,
+            offsets,
+            last_mirror: paths
+                .paths
+                .iter()
+                .map(|p| p.mirrors.last().copied())
+                .collect(),
+            ops,
+            pipelines,
+            background: scene.background,
+            mirror_count,
+            stats,
+        })
+    }
+}
+
+/// Per path, what its operations need: its uniform record's offset (the records in one
+/// buffer), the parts visible through its portal, and its portal's scissor rectangle.
+struct PathRecords {
+    uniforms: wgpu::Buffer,
+    offsets: Vec<u32>,
+    visible_parts: Vec<Vec<usize>>,
+    scissors: Vec<[u32; 4]>,
+}
+
+impl PathRecords {
+    fn of(gpu: &Gpu, planned: &PlannedPaths, scene_buffers: &SceneBuffers) -> Self {
+        let device = &gpu.device;
+        let (paths, projection) = (&planned.paths, planned.projection);
         let size = glam::Vec2::new(planned.width as f32, planned.height as f32);
         let mut arena = UniformArena::new(device);
         let mut offsets = Vec::with_capacity(paths.paths.len());
@@ -301,19 +362,40 @@ impl PortalStencil {
             };
             offsets.push(arena.push(&u));
         }
-        let uniforms = arena.buffer(device, "portal paths");
-        let (path_layout, path_bind_group) = BindGroupBuilder::new("portal path")
-            .record::<PathUniform>(wgpu::ShaderStages::VERTEX_FRAGMENT, &uniforms)
-            .build(gpu);
-        let layout = pipeline_layout(gpu, "portal", &[&scene_buffers.layout, &path_layout]);
-        let clipping = Clipping::for_features(gpu.features);
-        let depth_format = depth_stencil_format(gpu.features);
+        PathRecords {
+            uniforms: arena.buffer(device, "portal paths"),
+            offsets,
+            visible_parts,
+            scissors,
+        }
+    }
+}
+
+/// The pass's pipelines: a path's world (objects, mirrors), the stencil marks of its
+/// children, and the full-screen region clear, retire and decrement.
+struct Pipelines {
+    objects: wgpu::RenderPipeline,
+    mirrors: wgpu::RenderPipeline,
+    mark: wgpu::RenderPipeline,
+    clear_region: wgpu::RenderPipeline,
+    retire: wgpu::RenderPipeline,
+    decrement: wgpu::RenderPipeline,
+}
+
+impl Pipelines {
+    fn new(
+        gpu: &Gpu,
+        layout: &wgpu::PipelineLayout,
+        textured: bool,
+        clipping: Clipping,
+        depth_format: wgpu::TextureFormat,
+    ) -> Self {
         let shader = gpu.shader_module(
             match clipping {
                 Clipping::ClipDistances => &CLIP_DISTANCE_SHADER,
                 Clipping::FragmentDiscard | Clipping::None => &SHADER,
             },
-            scene_buffers.textured,
+            textured,
         );
         // Scene draws clip at the path's last mirror: by clip distance, or per fragment.
         let (scene_vertex, fs_object, fs_mirror, fs_mark) = match clipping {
@@ -339,7 +421,7 @@ impl PortalStencil {
             };
             ScenePipeline {
                 label,
-                layout: &layout,
+                layout,
                 module: &shader,
                 vertex,
                 fragment,
@@ -411,87 +493,73 @@ impl PortalStencil {
             C::Always,
             stencil(C::Equal, S::DecrementClamp),
         );
-        let depth_stencil = crate::targets::texture_2d(
-            device,
-            "portal depth-stencil",
-            planned.width,
-            planned.height,
-            depth_format,
-            wgpu::TextureUsages::RENDER_ATTACHMENT,
-        )
-        .create_view(&Default::default());
-        let mirror_count = scene.mirrors.len();
-        let world_triangles = |path: usize| -> usize {
-            visible_parts[path]
-                .iter()
-                .map(|&k| scene_buffers.parts[k].0.len() / 3)
-                .sum::<usize>()
-                + 2 * mirror_count
-        };
-        let triangles: usize = ops
-            .iter()
-            .map(|op| {
-                if let Op::World { path, .. } = op {
-                    world_triangles(*path)
-                } else {
-                    1
-                }
-            })
-            .sum();
-        if triangles > MAX_TRIANGLES_IN_ONE_PASS {
-            return Err(RasterError::Plan(
-                crate::plan::PlanError::TooManyTriangles {
-                    triangles,
-                    limit: MAX_TRIANGLES_IN_ONE_PASS,
-                },
-            ));
-        }
-        let draws = ops
-            .iter()
-            .map(|op| match op {
-                Op::World { path, .. } => {
-                    visible_parts[*path].len() + mirror_count
-                        - usize::from(paths.paths[*path].plane.is_some())
-                }
-                _ => 1,
-            })
-            .sum::<usize>()
-            + 1;
-        let stats = FrameStats {
-            passes: 1,
-            texture_renders: 0,
-            draws,
-            depth: paths.deepest,
-            triangles,
-            paths: Some(PathCounts::of(paths)),
-            clipping,
-            depth_format,
-            copies: None,
-        };
-        Ok(PortalStencil {
-            scene_buffers,
-            scissors,
-            visible_parts,
-            depth_stencil,
-            path_bind_group,
-            offsets,
-            last_mirror: paths
-                .paths
-                .iter()
-                .map(|p| p.mirrors.last().copied())
-                .collect(),
-            ops,
+        Pipelines {
             objects,
             mirrors,
             mark,
             clear_region,
             retire,
             decrement,
-            background: scene.background,
-            mirror_count,
-            stats,
-        })
+        }
     }
+}
+
+/// The frame's triangles (refused past [`MAX_TRIANGLES_IN_ONE_PASS`]) and draws.
+fn frame_stats(
+    paths: &PathSet,
+    ops: &[Op],
+    visible_parts: &[Vec<usize>],
+    scene_buffers: &SceneBuffers,
+    (clipping, depth_format): (Clipping, wgpu::TextureFormat),
+) -> Result<FrameStats, RasterError> {
+    let mirror_count = scene_buffers.mirrors.len();
+    let world_triangles = |path: usize| -> usize {
+        visible_parts[path]
+            .iter()
+            .map(|&k| scene_buffers.parts[k].0.len() / 3)
+            .sum::<usize>()
+            + 2 * mirror_count
+    };
+    let triangles: usize = ops
+        .iter()
+        .map(|op| {
+            if let Op::World { path, .. } = op {
+                world_triangles(*path)
+            } else {
+                1
+            }
+        })
+        .sum();
+    if triangles > MAX_TRIANGLES_IN_ONE_PASS {
+        return Err(RasterError::Plan(
+            crate::plan::PlanError::TooManyTriangles {
+                triangles,
+                limit: MAX_TRIANGLES_IN_ONE_PASS,
+            },
+        ));
+    }
+    let draws = ops
+        .iter()
+        .map(|op| match op {
+            Op::World { path, .. } => {
+                visible_parts[*path].len() + mirror_count
+                    - usize::from(paths.paths[*path].plane.is_some())
+            }
+            _ => 1,
+        })
+        .sum::<usize>()
+        + 1;
+    Ok(FrameStats {
+        passes: 1,
+        texture_renders: 0,
+        draws,
+        depth: paths.deepest,
+        triangles,
+        paths: Some(PathCounts::of(paths)),
+        clipping,
+        depth_format,
+        copies: None,
+    })
 }
 
 impl FrameEncoder for PortalStencil {
@@ -522,11 +590,11 @@ impl FrameEncoder for PortalStencil {
                     scissor(&mut pass, path);
                     pass.set_stencil_reference(value);
                     pass.set_bind_group(1, &self.path_bind_group, &[self.offsets[path]]);
-                    pass.set_pipeline(&self.objects);
+                    pass.set_pipeline(&self.pipelines.objects);
                     for &k in &self.visible_parts[path] {
                         pass.draw(self.scene_buffers.parts[k].0.clone(), 0..1);
                     }
-                    pass.set_pipeline(&self.mirrors);
+                    pass.set_pipeline(&self.pipelines.mirrors);
                     for m in 0..self.mirror_count {
                         if self.last_mirror[path] != Some(m) {
                             pass.draw(self.scene_buffers.mirrors[m].clone(), 0..1);
@@ -542,23 +610,23 @@ impl FrameEncoder for PortalStencil {
                     scissor(&mut pass, child);
                     pass.set_stencil_reference(value);
                     pass.set_bind_group(1, &self.path_bind_group, &[self.offsets[path]]);
-                    pass.set_pipeline(&self.mark);
+                    pass.set_pipeline(&self.pipelines.mark);
                     pass.draw(self.scene_buffers.mirrors[mirror].clone(), 0..1);
                 }
                 Op::ClearRegion { path, value } => {
                     scissor(&mut pass, path);
                     pass.set_stencil_reference(value);
                     pass.set_bind_group(1, &self.path_bind_group, &[self.offsets[path]]);
-                    pass.set_pipeline(&self.clear_region);
+                    pass.set_pipeline(&self.pipelines.clear_region);
                     pass.draw(0..3, 0..1);
                 }
                 Op::Retire { path, value } | Op::Decrement { path, value } => {
                     scissor(&mut pass, path);
                     pass.set_stencil_reference(value);
                     pass.set_pipeline(if matches!(op, Op::Retire { .. }) {
-                        &self.retire
+                        &self.pipelines.retire
                     } else {
-                        &self.decrement
+                        &self.pipelines.decrement
                     });
                     pass.draw(0..3, 0..1);
                 }
