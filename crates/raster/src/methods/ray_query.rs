@@ -242,11 +242,7 @@ struct RayQueryFrame {
     _tlas: wgpu::Tlas,
     bind_group: wgpu::BindGroup,
     depth: wgpu::TextureView,
-    /// Rasterized primary visibility: the depth pre-pass and the shading pass.
-    depth_prepass: wgpu::RenderPipeline,
-    shade: wgpu::RenderPipeline,
-    /// Primary rays (the GPU truth).
-    primary_rays: wgpu::RenderPipeline,
+    pipelines: Pipelines,
     settings: RayQuerySettings,
     /// Draw ranges of every mesh (objects, then mirrors) in the scene's vertex buffer.
     draws: Vec<std::ops::Range<u32>>,
@@ -264,51 +260,10 @@ impl RayQueryFrame {
     ) -> Result<Self, RasterError> {
         let device = &gpu.device;
         let g = &scene.geometry;
-        let limits = device.limits();
         let meshes = &planned.meshes;
-        let too_many = |what: &str, needed: usize, limit: u32| RasterError::ExceedsDevice {
-            what: what.into(),
-            needed: needed.to_string(),
-            limit: limit.to_string(),
-            adapter: gpu.report.name.clone(),
-            advice: "; use a scene with fewer meshes or triangles",
-        };
-        if meshes.len() > limits.max_tlas_instance_count as usize {
-            return Err(too_many(
-                "TLAS instances (one per mesh)",
-                meshes.len(),
-                limits.max_tlas_instance_count,
-            ));
-        }
-        if let Some(big) = meshes.iter().map(|r| r.len()).max()
-            && big > limits.max_blas_primitive_count as usize
-        {
-            return Err(too_many(
-                "triangles in one BLAS",
-                big,
-                limits.max_blas_primitive_count,
-            ));
-        }
+        check_limits(gpu, meshes)?;
         let scene_buffers = SceneBuffers::new(gpu, scene, shadows.binding());
-        let mut positions: Vec<[f32; 3]> = Vec::with_capacity(3 * g.triangles.len().max(1));
-        let mut records = Vec::with_capacity(g.triangles.len().max(1));
-        for (i, t) in g.triangles.iter().enumerate() {
-            positions.extend(t.map(|p| p.to_array()));
-            let n = g.face_normal(i);
-            records.push(TriangleRecord {
-                normal: n.to_array(),
-                surface: g.surface_of[i],
-                offset: n.dot(t[0]),
-                uv0: g.uvs[i][0].to_array(),
-                uv1: g.uvs[i][1].to_array(),
-                uv2: g.uvs[i][2].to_array(),
-                ..Zeroable::zeroed()
-            });
-        }
-        if positions.is_empty() {
-            positions.push([0.0; 3]);
-            records.push(Zeroable::zeroed());
-        }
+        let (positions, records) = triangle_records(g);
         let position_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("ray query BLAS vertices"),
             contents: bytemuck::cast_slice(&positions),
@@ -319,81 +274,7 @@ impl RayQueryFrame {
             contents: bytemuck::cast_slice(&records),
             usage: wgpu::BufferUsages::STORAGE,
         });
-        let sizes: Vec<wgpu::BlasTriangleGeometrySizeDescriptor> = meshes
-            .iter()
-            .map(|range| wgpu::BlasTriangleGeometrySizeDescriptor {
-                vertex_format: wgpu::VertexFormat::Float32x3,
-                vertex_count: 3 * range.len() as u32,
-                index_format: None,
-                index_count: None,
-                // Opaque: no candidate comes to the shader (docs/ray-query.md).
-                flags: wgpu::AccelerationStructureGeometryFlags::OPAQUE,
-            })
-            .collect();
-        let blas: Vec<wgpu::Blas> = sizes
-            .iter()
-            .map(|size| {
-                device.create_blas(
-                    &wgpu::CreateBlasDescriptor {
-                        label: Some("ray query mesh"),
-                        flags: wgpu::AccelerationStructureFlags::PREFER_FAST_TRACE,
-                        update_mode: wgpu::AccelerationStructureUpdateMode::Build,
-                    },
-                    wgpu::BlasGeometrySizeDescriptors::Triangles {
-                        descriptors: vec![size.clone()],
-                    },
-                )
-            })
-            .collect();
-        let mut tlas = device.create_tlas(&wgpu::CreateTlasDescriptor {
-            label: Some("ray query scene"),
-            max_instances: meshes.len().max(1) as u32,
-            flags: wgpu::AccelerationStructureFlags::PREFER_FAST_TRACE,
-            update_mode: wgpu::AccelerationStructureUpdateMode::Build,
-        });
-        const IDENTITY: [f32; 12] = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0];
-        for (k, (range, b)) in meshes.iter().zip(&blas).enumerate() {
-            // Custom data: the mesh's first triangle, so that a hit's triangle is it plus the
-            // primitive index (24 bits: the scene limit of 4 M triangles fits).
-            tlas[k] = Some(wgpu::TlasInstance::new(
-                b,
-                IDENTITY,
-                range.start as u32,
-                0xff,
-            ));
-        }
-        // Build once, timed apart from the frames.
-        let entries: Vec<wgpu::BlasBuildEntry> = meshes
-            .iter()
-            .zip(&blas)
-            .zip(&sizes)
-            .map(|((range, b), size)| wgpu::BlasBuildEntry {
-                blas: b,
-                geometry: wgpu::BlasGeometries::TriangleGeometries(vec![
-                    wgpu::BlasTriangleGeometry {
-                        size,
-                        vertex_buffer: &position_buffer,
-                        first_vertex: 3 * range.start as u32,
-                        vertex_stride: 12,
-                        index_buffer: None,
-                        first_index: None,
-                        transform_buffer: None,
-                        transform_buffer_offset: None,
-                    },
-                ]),
-            })
-            .collect();
-        gpu.wait()?;
-        let start = std::time::Instant::now();
-        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("ray query acceleration structures"),
-        });
-        encoder.build_acceleration_structures(entries.iter(), std::iter::once(&tlas));
-        gpu.queue.submit([encoder.finish()]);
-        gpu.wait()?;
-        let build_ms = start.elapsed().as_secs_f64() * 1e3;
-        drop(entries);
-
+        let (blas, tlas, build_ms) = acceleration_structures(gpu, meshes, &position_buffer)?;
         let (w, h) = (planned.width, planned.height);
         let params = Params {
             camera: crate::camera_rays::CameraRays::new(&scene.camera, w, h),
@@ -420,7 +301,203 @@ impl RayQueryFrame {
             .buffer(stages, wgpu::BufferBindingType::Uniform, &params_buffer)
             .build(gpu);
         let pipeline_layout = pipeline_layout(gpu, "ray query", &[&scene_buffers.layout, &layout]);
-        let module = gpu.shader_module(&SHADER, scene_buffers.textured);
+        let pipelines = Pipelines::new(gpu, &pipeline_layout, scene_buffers.textured);
+        let depth = crate::targets::texture_2d(
+            device,
+            "ray query depth",
+            w,
+            h,
+            DEPTH_FORMAT,
+            wgpu::TextureUsages::RENDER_ATTACHMENT,
+        )
+        .create_view(&Default::default());
+        let draws = scene_buffers.draw_ranges();
+        let triangles = g.triangles.len();
+        let stats = FrameStats {
+            passes: 1,
+            texture_renders: 0,
+            draws: if planned.settings.primary_rays {
+                2
+            } else {
+                2 * draws.len() + 1
+            },
+            depth: planned.settings.max_depth as usize,
+            triangles: if planned.settings.primary_rays {
+                1
+            } else {
+                2 * triangles
+            },
+            paths: None,
+            clipping: Clipping::None,
+            depth_format: DEPTH_FORMAT,
+            copies: None,
+        };
+        gpu.check()?;
+        Ok(RayQueryFrame {
+            scene_buffers,
+            _blas: blas,
+            _tlas: tlas,
+            bind_group,
+            depth,
+            pipelines,
+            settings: planned.settings,
+            draws,
+            background: scene.background,
+            build_ms,
+            stats,
+        })
+    }
+}
+
+/// Refuses a scene past the device's acceleration-structure limits, naming them.
+fn check_limits(gpu: &Gpu, meshes: &[std::ops::Range<usize>]) -> Result<(), RasterError> {
+    let limits = gpu.device.limits();
+    let too_many = |what: &str, needed: usize, limit: u32| RasterError::ExceedsDevice {
+        what: what.into(),
+        needed: needed.to_string(),
+        limit: limit.to_string(),
+        adapter: gpu.report.name.clone(),
+        advice: "; use a scene with fewer meshes or triangles",
+    };
+    if meshes.len() > limits.max_tlas_instance_count as usize {
+        return Err(too_many(
+            "TLAS instances (one per mesh)",
+            meshes.len(),
+            limits.max_tlas_instance_count,
+        ));
+    }
+    if let Some(big) = meshes.iter().map(|r| r.len()).max()
+        && big > limits.max_blas_primitive_count as usize
+    {
+        return Err(too_many(
+            "triangles in one BLAS",
+            big,
+            limits.max_blas_primitive_count,
+        ));
+    }
+    Ok(())
+}
+
+/// Every triangle's corners (the BLAS input) and its record (what a hit shades), at least one
+/// (a buffer may not be empty).
+fn triangle_records(g: &mirrorbox_scene::Geometry) -> (Vec<[f32; 3]>, Vec<TriangleRecord>) {
+    let mut positions: Vec<[f32; 3]> = Vec::with_capacity(3 * g.triangles.len().max(1));
+    let mut records = Vec::with_capacity(g.triangles.len().max(1));
+    for (i, t) in g.triangles.iter().enumerate() {
+        positions.extend(t.map(|p| p.to_array()));
+        let n = g.face_normal(i);
+        records.push(TriangleRecord {
+            normal: n.to_array(),
+            surface: g.surface_of[i],
+            offset: n.dot(t[0]),
+            uv0: g.uvs[i][0].to_array(),
+            uv1: g.uvs[i][1].to_array(),
+            uv2: g.uvs[i][2].to_array(),
+            ..Zeroable::zeroed()
+        });
+    }
+    if positions.is_empty() {
+        positions.push([0.0; 3]);
+        records.push(Zeroable::zeroed());
+    }
+    (positions, records)
+}
+
+/// One BLAS per mesh and the TLAS over them, built once (timed apart from the frames: the
+/// build's milliseconds are returned).
+fn acceleration_structures(
+    gpu: &Gpu,
+    meshes: &[std::ops::Range<usize>],
+    position_buffer: &wgpu::Buffer,
+) -> Result<(Vec<wgpu::Blas>, wgpu::Tlas, f64), RasterError> {
+    let device = &gpu.device;
+    let sizes: Vec<wgpu::BlasTriangleGeometrySizeDescriptor> = meshes
+        .iter()
+        .map(|range| wgpu::BlasTriangleGeometrySizeDescriptor {
+            vertex_format: wgpu::VertexFormat::Float32x3,
+            vertex_count: 3 * range.len() as u32,
+            index_format: None,
+            index_count: None,
+            // Opaque: no candidate comes to the shader (docs/ray-query.md).
+            flags: wgpu::AccelerationStructureGeometryFlags::OPAQUE,
+        })
+        .collect();
+    let blas: Vec<wgpu::Blas> = sizes
+        .iter()
+        .map(|size| {
+            device.create_blas(
+                &wgpu::CreateBlasDescriptor {
+                    label: Some("ray query mesh"),
+                    flags: wgpu::AccelerationStructureFlags::PREFER_FAST_TRACE,
+                    update_mode: wgpu::AccelerationStructureUpdateMode::Build,
+                },
+                wgpu::BlasGeometrySizeDescriptors::Triangles {
+                    descriptors: vec![size.clone()],
+                },
+            )
+        })
+        .collect();
+    let mut tlas = device.create_tlas(&wgpu::CreateTlasDescriptor {
+        label: Some("ray query scene"),
+        max_instances: meshes.len().max(1) as u32,
+        flags: wgpu::AccelerationStructureFlags::PREFER_FAST_TRACE,
+        update_mode: wgpu::AccelerationStructureUpdateMode::Build,
+    });
+    const IDENTITY: [f32; 12] = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+    for (k, (range, b)) in meshes.iter().zip(&blas).enumerate() {
+        // Custom data: the mesh's first triangle, so that a hit's triangle is it plus the
+        // primitive index (24 bits: the scene limit of 4 M triangles fits).
+        tlas[k] = Some(wgpu::TlasInstance::new(
+            b,
+            IDENTITY,
+            range.start as u32,
+            0xff,
+        ));
+    }
+    // Build once, timed apart from the frames.
+    let entries: Vec<wgpu::BlasBuildEntry> = meshes
+        .iter()
+        .zip(&blas)
+        .zip(&sizes)
+        .map(|((range, b), size)| wgpu::BlasBuildEntry {
+            blas: b,
+            geometry: wgpu::BlasGeometries::TriangleGeometries(vec![wgpu::BlasTriangleGeometry {
+                size,
+                vertex_buffer: position_buffer,
+                first_vertex: 3 * range.start as u32,
+                vertex_stride: 12,
+                index_buffer: None,
+                first_index: None,
+                transform_buffer: None,
+                transform_buffer_offset: None,
+            }]),
+        })
+        .collect();
+    gpu.wait()?;
+    let start = std::time::Instant::now();
+    let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+        label: Some("ray query acceleration structures"),
+    });
+    encoder.build_acceleration_structures(entries.iter(), std::iter::once(&tlas));
+    gpu.queue.submit([encoder.finish()]);
+    gpu.wait()?;
+    let build_ms = start.elapsed().as_secs_f64() * 1e3;
+    drop(entries);
+
+    Ok((blas, tlas, build_ms))
+}
+
+/// The pipelines: the depth pre-pass and the shading pass of rasterized primary visibility,
+/// and the full-screen pass of primary rays.
+struct Pipelines {
+    depth_prepass: wgpu::RenderPipeline,
+    shade: wgpu::RenderPipeline,
+    primary_rays: wgpu::RenderPipeline,
+}
+
+impl Pipelines {
+    fn new(gpu: &Gpu, pipeline_layout: &wgpu::PipelineLayout, textured: bool) -> Self {
+        let module = gpu.shader_module(&SHADER, textured);
         let scene_pipeline = |label, vertex, fragment, write, compare, colour| {
             let buffers: &[Option<wgpu::VertexBufferLayout>] = if vertex == "vs_main" {
                 &[Some(VERTEX_LAYOUT)]
@@ -429,7 +506,7 @@ impl RayQueryFrame {
             };
             ScenePipeline {
                 label,
-                layout: &pipeline_layout,
+                layout: pipeline_layout,
                 module: &module,
                 vertex,
                 fragment,
@@ -474,52 +551,11 @@ impl RayQueryFrame {
             C::Always,
             true,
         );
-        let depth = crate::targets::texture_2d(
-            device,
-            "ray query depth",
-            w,
-            h,
-            DEPTH_FORMAT,
-            wgpu::TextureUsages::RENDER_ATTACHMENT,
-        )
-        .create_view(&Default::default());
-        let draws = scene_buffers.draw_ranges();
-        let triangles = g.triangles.len();
-        let stats = FrameStats {
-            passes: 1,
-            texture_renders: 0,
-            draws: if planned.settings.primary_rays {
-                2
-            } else {
-                2 * draws.len() + 1
-            },
-            depth: planned.settings.max_depth as usize,
-            triangles: if planned.settings.primary_rays {
-                1
-            } else {
-                2 * triangles
-            },
-            paths: None,
-            clipping: Clipping::None,
-            depth_format: DEPTH_FORMAT,
-            copies: None,
-        };
-        gpu.check()?;
-        Ok(RayQueryFrame {
-            scene_buffers,
-            _blas: blas,
-            _tlas: tlas,
-            bind_group,
-            depth,
+        Pipelines {
             depth_prepass,
             shade,
             primary_rays,
-            settings: planned.settings,
-            draws,
-            background: scene.background,
-            build_ms,
-            stats,
-        })
+        }
     }
 }
 
@@ -541,12 +577,12 @@ impl FrameEncoder for RayQueryFrame {
             first_pass,
         );
         if self.settings.primary_rays {
-            pass.set_pipeline(&self.primary_rays);
+            pass.set_pipeline(&self.pipelines.primary_rays);
             pass.draw(0..3, 0..1);
             return;
         }
         pass.set_vertex_buffer(0, self.scene_buffers.vertices.slice(..));
-        for pipeline in [&self.depth_prepass, &self.shade] {
+        for pipeline in [&self.pipelines.depth_prepass, &self.pipelines.shade] {
             pass.set_pipeline(pipeline);
             for r in &self.draws {
                 pass.draw(r.clone(), 0..1);
