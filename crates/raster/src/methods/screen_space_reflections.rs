@@ -307,17 +307,7 @@ impl SsrFrame {
         fallback: Option<(Box<dyn FrameEncoder>, RenderTarget)>,
     ) -> Result<Self, RasterError> {
         let device = &gpu.device;
-        let surfaces = scene.geometry.surfaces.len();
-        // Mirror pixels carry their surface + 1 in the scene pass's alpha: exact in f16 up to 2048.
-        if gpu.color_format.texel_bytes() < 16 && surfaces >= 2048 {
-            return Err(RasterError::ExceedsDevice {
-                what: "surfaces for ssr's mirror marks in an RGBA16F alpha".into(),
-                needed: surfaces.to_string(),
-                limit: "2047".into(),
-                adapter: gpu.report.name.clone(),
-                advice: "; use RGBA32F targets (MIRRORBOX_COLOR_FORMAT=rgba32float)",
-            });
-        }
+        check_mark_precision(gpu, scene)?;
         let scene_buffers = SceneBuffers::new(gpu, scene, shadows.binding());
         let levels = pyramid_levels(width, height);
         let params = Params {
@@ -360,6 +350,159 @@ impl SsrFrame {
             wgpu::TextureUsages::RENDER_ATTACHMENT,
         )
         .create_view(&Default::default());
+        let module = gpu.shader_module(&SHADER, scene_buffers.textured);
+        let base_layout_all = pipeline_layout(
+            gpu,
+            "ssr scene pass",
+            &[&scene_buffers.layout, &base_layout],
+        );
+        let base_pipeline = base_pipeline(gpu, &module, &base_layout_all, colour_format);
+        let DepthPyramid {
+            levels: pyramid_levels,
+            groups: pyramid_groups,
+            reduce,
+            whole: whole_pyramid,
+        } = DepthPyramid::new(gpu, width, height, levels);
+        let fallback_view = fallback
+            .as_ref()
+            .map_or(&base_colour, |(_, target)| &target.color_view);
+        let (reflect_layout, reflect_group) = BindGroupBuilder::new("ssr reflect")
+            .buffer(vf, uniform, &params_buffer)
+            .texture(f, &base_colour)
+            .texture(f, fallback_view)
+            .binding(
+                f,
+                wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Uint,
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled: false,
+                },
+                wgpu::BindingResource::TextureView(&whole_pyramid),
+            )
+            .build(gpu);
+        let reflect_pipeline =
+            reflect_pipeline(gpu, &module, &[&scene_buffers.layout, &reflect_layout]);
+        let draws = scene_buffers.draw_ranges();
+        // The scene pass, the pyramid's coarser levels, the reflect pass.
+        let stats = FrameStats {
+            passes: 1 + levels as usize,
+            texture_renders: 0,
+            draws: draws.len() + levels as usize,
+            depth: 1,
+            triangles: scene.geometry.triangles.len() + levels as usize,
+            paths: None,
+            clipping: Clipping::None,
+            depth_format: DEPTH_FORMAT,
+            copies: None,
+        };
+        gpu.check()?;
+        Ok(SsrFrame {
+            scene_buffers,
+            fallback,
+            base_pipeline,
+            base_group,
+            base_colour,
+            depth,
+            pyramid_levels,
+            pyramid_groups,
+            reduce,
+            reflect_pipeline,
+            reflect_group,
+            draws,
+            background: scene.background,
+            stats,
+        })
+    }
+}
+
+/// Mirror pixels carry their surface + 1 in the scene pass's alpha: exact in f16 up to
+/// 2048 surfaces; a scene with more is refused on RGBA16F targets.
+fn check_mark_precision(gpu: &Gpu, scene: &Scene) -> Result<(), RasterError> {
+    let surfaces = scene.geometry.surfaces.len();
+    if gpu.color_format.texel_bytes() < 16 && surfaces >= 2048 {
+        return Err(RasterError::ExceedsDevice {
+            what: "surfaces for ssr's mirror marks in an RGBA16F alpha".into(),
+            needed: surfaces.to_string(),
+            limit: "2047".into(),
+            adapter: gpu.report.name.clone(),
+            advice: "; use RGBA32F targets (MIRRORBOX_COLOR_FORMAT=rgba32float)",
+        });
+    }
+    Ok(())
+}
+
+/// The scene pass's pipeline: two targets, the colour (mirror marks in alpha) and the depth
+/// pyramid's level 0.
+fn base_pipeline(
+    gpu: &Gpu,
+    module: &wgpu::ShaderModule,
+    layout: &wgpu::PipelineLayout,
+    colour_format: wgpu::TextureFormat,
+) -> wgpu::RenderPipeline {
+    gpu.render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("ssr scene pass"),
+        layout: Some(layout),
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some("vs_scene"),
+            compilation_options: Default::default(),
+            buffers: &[Some(VERTEX_LAYOUT)],
+        },
+        primitive: Default::default(),
+        depth_stencil: Some(depth_state(DEPTH_FORMAT, true, NEARER, Default::default())),
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module,
+            entry_point: Some("fs_base"),
+            compilation_options: Default::default(),
+            targets: &[
+                Some(colour_format.into()),
+                Some(wgpu::TextureFormat::R32Uint.into()),
+            ],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+/// The full-screen reflect pass's pipeline, bound to the scene's and the pass's `groups`.
+fn reflect_pipeline(
+    gpu: &Gpu,
+    module: &wgpu::ShaderModule,
+    groups: &[&wgpu::BindGroupLayout],
+) -> wgpu::RenderPipeline {
+    ScenePipeline {
+        label: "ssr reflect",
+        layout: &pipeline_layout(gpu, "ssr reflect", groups),
+        module,
+        vertex: "vs_fullscreen",
+        fragment: "fs_reflect",
+        buffers: &[],
+        depth_stencil: depth_state(
+            DEPTH_FORMAT,
+            false,
+            wgpu::CompareFunction::Always,
+            Default::default(),
+        ),
+        color_writes: wgpu::ColorWrites::ALL,
+    }
+    .build(gpu)
+}
+
+/// The nearest-depth pyramid: its mip levels' views, the reduction pipeline and a bind group
+/// per coarser level (reading the level below), and the whole pyramid's view (the reflect
+/// pass's march reads it).
+struct DepthPyramid {
+    levels: Vec<wgpu::TextureView>,
+    groups: Vec<wgpu::BindGroup>,
+    reduce: wgpu::RenderPipeline,
+    whole: wgpu::TextureView,
+}
+
+impl DepthPyramid {
+    fn new(gpu: &Gpu, width: u32, height: u32, levels: u32) -> Self {
+        let device = &gpu.device;
+        let sampled = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
         let pyramid = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("ssr depth pyramid"),
             size: wgpu::Extent3d {
@@ -382,37 +525,6 @@ impl SsrFrame {
             })
         };
         let pyramid_levels: Vec<wgpu::TextureView> = (0..levels).map(level_view).collect();
-        let module = gpu.shader_module(&SHADER, scene_buffers.textured);
-        let base_layout_all = pipeline_layout(
-            gpu,
-            "ssr scene pass",
-            &[&scene_buffers.layout, &base_layout],
-        );
-        // Two targets: the colour (mirror marks in alpha) and the pyramid's level 0.
-        let base_pipeline = gpu.render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("ssr scene pass"),
-            layout: Some(&base_layout_all),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_scene"),
-                compilation_options: Default::default(),
-                buffers: &[Some(VERTEX_LAYOUT)],
-            },
-            primitive: Default::default(),
-            depth_stencil: Some(depth_state(DEPTH_FORMAT, true, NEARER, Default::default())),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_base"),
-                compilation_options: Default::default(),
-                targets: &[
-                    Some(colour_format.into()),
-                    Some(wgpu::TextureFormat::R32Uint.into()),
-                ],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
         // The pyramid: level 0 written by the scene pass, each next level reduced from the last.
         let pyramid_module = gpu.shader_module(&PYRAMID_SHADER, false);
         let fullscreen = |label: &str, fragment: &str| {
@@ -451,74 +563,12 @@ impl SsrFrame {
                 })
             })
             .collect();
-        let whole_pyramid = pyramid.create_view(&Default::default());
-        let fallback_view = fallback
-            .as_ref()
-            .map_or(&base_colour, |(_, target)| &target.color_view);
-        let (reflect_layout, reflect_group) = BindGroupBuilder::new("ssr reflect")
-            .buffer(vf, uniform, &params_buffer)
-            .texture(f, &base_colour)
-            .texture(f, fallback_view)
-            .binding(
-                f,
-                wgpu::BindingType::Texture {
-                    sample_type: wgpu::TextureSampleType::Uint,
-                    view_dimension: wgpu::TextureViewDimension::D2,
-                    multisampled: false,
-                },
-                wgpu::BindingResource::TextureView(&whole_pyramid),
-            )
-            .build(gpu);
-        let reflect_pipeline = ScenePipeline {
-            label: "ssr reflect",
-            layout: &pipeline_layout(
-                gpu,
-                "ssr reflect",
-                &[&scene_buffers.layout, &reflect_layout],
-            ),
-            module: &module,
-            vertex: "vs_fullscreen",
-            fragment: "fs_reflect",
-            buffers: &[],
-            depth_stencil: depth_state(
-                DEPTH_FORMAT,
-                false,
-                wgpu::CompareFunction::Always,
-                Default::default(),
-            ),
-            color_writes: wgpu::ColorWrites::ALL,
-        }
-        .build(gpu);
-        let draws = scene_buffers.draw_ranges();
-        // The scene pass, the pyramid's coarser levels, the reflect pass.
-        let stats = FrameStats {
-            passes: 1 + levels as usize,
-            texture_renders: 0,
-            draws: draws.len() + levels as usize,
-            depth: 1,
-            triangles: scene.geometry.triangles.len() + levels as usize,
-            paths: None,
-            clipping: Clipping::None,
-            depth_format: DEPTH_FORMAT,
-            copies: None,
-        };
-        gpu.check()?;
-        Ok(SsrFrame {
-            scene_buffers,
-            fallback,
-            base_pipeline,
-            base_group,
-            base_colour,
-            depth,
-            pyramid_levels,
-            pyramid_groups,
+        DepthPyramid {
+            levels: pyramid_levels,
+            groups: pyramid_groups,
             reduce,
-            reflect_pipeline,
-            reflect_group,
-            draws,
-            background: scene.background,
-            stats,
-        })
+            whole: pyramid.create_view(&Default::default()),
+        }
     }
 }
 
