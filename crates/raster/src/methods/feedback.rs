@@ -236,22 +236,7 @@ impl FeedbackFrame {
             .flat_map(|c| [(c.region.w, c.region.h); 2])
             .collect();
         check_mirror_textures(gpu, &sizes)?;
-        let own = [0, 1].map(|_| {
-            Arc::new(
-                cameras
-                    .iter()
-                    .map(|c| {
-                        RenderTarget::new(
-                            gpu,
-                            "feedback texture",
-                            c.region.w,
-                            c.region.h,
-                            wgpu::TextureUsages::TEXTURE_BINDING,
-                        )
-                    })
-                    .collect::<Vec<_>>(),
-            )
-        });
+        let own = texture_sets(gpu, &cameras);
 
         let mut uniforms = UniformArena::new(device);
         let camera_offsets: Vec<u32> = mirror_cameras
@@ -295,87 +280,15 @@ impl FeedbackFrame {
             views.extend(c.textures.iter().map(|t| &t.color_view));
         }
 
-        // A pass's draw of every scene mirror but those in its own plane: textured from the
-        // set `source` holds for the mirror, if any, looked up through the texture's camera.
-        let no_texture = uniforms.push(&MirrorUniform::zeroed());
-        let mut draws_reading = |source: Source, plane: Option<&mirrorbox_scene::Plane>| {
-            let set: Option<(&[TextureCamera], usize)> = match source {
-                Source::Nothing => None,
-                Source::Carried => state.carried().map(|c| (&c.cameras[..], carried_base)),
-                Source::Own(i) => Some((&cameras[..], own_base[i])),
-            };
-            let mut draws = Vec::new();
-            for (j, mirror) in scene.mirrors.iter().enumerate() {
-                if let Some(p) = plane
-                    && mirror
-                        .corners()
-                        .iter()
-                        .all(|c| p.signed_distance(*c).abs() < 1e-5)
-                {
-                    continue;
-                }
-                let texture = set.and_then(|(cams, base)| {
-                    let t = cams.iter().position(|c| c.mirror == j)?;
-                    Some((cams[t], base + t))
-                });
-                draws.push(match texture {
-                    Some((tc, bind_group)) => Draw {
-                        mirror: j,
-                        bind_group,
-                        offset: uniforms.push(&MirrorUniform {
-                            exact: 0,
-                            projected: 1,
-                            lookup_from_world: tc.screen_from_world.to_cols_array_2d(),
-                            ..MirrorUniform::textured(tc.region)
-                        }),
-                    },
-                    None => Draw {
-                        mirror: j,
-                        bind_group: 0,
-                        offset: no_texture,
-                    },
-                });
-            }
-            draws
-        };
-        let sources = [
-            Source::Nothing,
-            Source::Carried,
-            Source::Own(0),
-            Source::Own(1),
-        ];
-        let camera_draws = sources.map(|s| {
-            mirror_cameras
-                .iter()
-                .map(|c| draws_reading(s, Some(&c.plane)))
-                .collect::<Vec<_>>()
-        });
-        // The main pass applies this frame's textures of the mirrors it sees (their cameras
-        // are its own mirror cameras: texel (x, y) is screen pixel region origin + (x, y)).
-        let main_draws = [0, 1].map(|i| {
-            scene
-                .mirrors
-                .iter()
-                .enumerate()
-                .map(|(j, _)| {
-                    let seen = mirror_cameras
-                        .iter()
-                        .position(|c| c.mirror == j && c.view.depth == 1);
-                    match seen {
-                        Some(t) => Draw {
-                            mirror: j,
-                            bind_group: own_base[i] + t,
-                            offset: uniforms.push(&MirrorUniform::textured(cameras[t].region)),
-                        },
-                        None => Draw {
-                            mirror: j,
-                            bind_group: 0,
-                            offset: no_texture,
-                        },
-                    }
-                })
-                .collect::<Vec<_>>()
-        });
+        let carried_cameras = state.carried().map(|c| &c.cameras[..]);
+        let (camera_draws, main_draws) = draw_lists(
+            scene,
+            &mirror_cameras,
+            &cameras,
+            carried_cameras,
+            (own_base, carried_base),
+            &mut uniforms,
+        );
 
         let buffer = uniforms.buffer(device, "feedback uniforms");
         let pipelines = TexturePipelines::new(gpu, &scene_buffers);
@@ -386,28 +299,15 @@ impl FeedbackFrame {
             .map(|v| pipelines.mirror_bind_group(gpu, &buffer, v))
             .collect();
 
-        let read = if state.carried().is_some() {
-            Source::Carried
-        } else {
-            Source::Nothing
-        };
-        let passes = cameras.len() + 1;
-        let mirror_draws = camera_draws[source_index(read)]
-            .iter()
-            .map(Vec::len)
-            .sum::<usize>()
-            + main_draws[0].len();
-        let object_triangles = scene_buffers.objects.len() / 3;
         let stats = FrameStats {
-            passes,
-            texture_renders: cameras.len(),
-            draws: passes + mirror_draws + 1,
             depth: state.first_depth(),
-            triangles: passes * object_triangles + 2 * mirror_draws,
-            paths: None,
             clipping: pipelines.clipping,
-            depth_format: DEPTH_FORMAT,
-            copies: None,
+            ..frame_stats(
+                &camera_draws,
+                &main_draws,
+                state.carried().is_some(),
+                scene_buffers.objects.len() / 3,
+            )
         };
         Ok(FeedbackFrame {
             scene_buffers,
@@ -492,6 +392,155 @@ impl FrameEncoder for FeedbackFrame {
             })
         })
     }
+}
+
+/// The frame's passes (one per mirror camera, and the main pass), draws and triangles,
+/// reading the carried textures where there are some; depth and clipping left to the caller.
+fn frame_stats(
+    camera_draws: &[Vec<Vec<Draw>>; 4],
+    main_draws: &[Vec<Draw>; 2],
+    carried: bool,
+    object_triangles: usize,
+) -> FrameStats {
+    let read = if carried {
+        Source::Carried
+    } else {
+        Source::Nothing
+    };
+    let cameras = camera_draws[0].len();
+    let passes = cameras + 1;
+    let mirror_draws = camera_draws[source_index(read)]
+        .iter()
+        .map(Vec::len)
+        .sum::<usize>()
+        + main_draws[0].len();
+    FrameStats {
+        passes,
+        texture_renders: cameras,
+        draws: passes + mirror_draws + 1,
+        depth: 0,
+        triangles: passes * object_triangles + 2 * mirror_draws,
+        paths: None,
+        clipping: crate::method::Clipping::None,
+        depth_format: DEPTH_FORMAT,
+        copies: None,
+    }
+}
+
+/// The two sets of this frame's textures, written in turn (one per mirror camera each).
+fn texture_sets(gpu: &Gpu, cameras: &[TextureCamera]) -> [Arc<Vec<RenderTarget>>; 2] {
+    [0, 1].map(|_| {
+        Arc::new(
+            cameras
+                .iter()
+                .map(|c| {
+                    RenderTarget::new(
+                        gpu,
+                        "feedback texture",
+                        c.region.w,
+                        c.region.h,
+                        wgpu::TextureUsages::TEXTURE_BINDING,
+                    )
+                })
+                .collect::<Vec<_>>(),
+        )
+    })
+}
+
+/// Every pass's mirror draws: per source a mirror camera's pass reads (nothing, the carried
+/// textures, either own set), each camera's draws; and the main pass's, reading either own
+/// set. Their uniform records go into `uniforms`.
+#[allow(clippy::type_complexity)]
+fn draw_lists(
+    scene: &Scene,
+    mirror_cameras: &[MirrorCamera],
+    cameras: &[TextureCamera],
+    carried: Option<&[TextureCamera]>,
+    (own_base, carried_base): ([usize; 2], usize),
+    uniforms: &mut UniformArena,
+) -> ([Vec<Vec<Draw>>; 4], [Vec<Draw>; 2]) {
+    // A pass's draw of every scene mirror but those in its own plane: textured from the
+    // set `source` holds for the mirror, if any, looked up through the texture's camera.
+    let no_texture = uniforms.push(&MirrorUniform::zeroed());
+    let mut draws_reading = |source: Source, plane: Option<&mirrorbox_scene::Plane>| {
+        let set: Option<(&[TextureCamera], usize)> = match source {
+            Source::Nothing => None,
+            Source::Carried => carried.map(|c| (c, carried_base)),
+            Source::Own(i) => Some((cameras, own_base[i])),
+        };
+        let mut draws = Vec::new();
+        for (j, mirror) in scene.mirrors.iter().enumerate() {
+            if let Some(p) = plane
+                && mirror
+                    .corners()
+                    .iter()
+                    .all(|c| p.signed_distance(*c).abs() < 1e-5)
+            {
+                continue;
+            }
+            let texture = set.and_then(|(cams, base)| {
+                let t = cams.iter().position(|c| c.mirror == j)?;
+                Some((cams[t], base + t))
+            });
+            draws.push(match texture {
+                Some((tc, bind_group)) => Draw {
+                    mirror: j,
+                    bind_group,
+                    offset: uniforms.push(&MirrorUniform {
+                        exact: 0,
+                        projected: 1,
+                        lookup_from_world: tc.screen_from_world.to_cols_array_2d(),
+                        ..MirrorUniform::textured(tc.region)
+                    }),
+                },
+                None => Draw {
+                    mirror: j,
+                    bind_group: 0,
+                    offset: no_texture,
+                },
+            });
+        }
+        draws
+    };
+    let sources = [
+        Source::Nothing,
+        Source::Carried,
+        Source::Own(0),
+        Source::Own(1),
+    ];
+    let camera_draws = sources.map(|s| {
+        mirror_cameras
+            .iter()
+            .map(|c| draws_reading(s, Some(&c.plane)))
+            .collect::<Vec<_>>()
+    });
+    // The main pass applies this frame's textures of the mirrors it sees (their cameras
+    // are its own mirror cameras: texel (x, y) is screen pixel region origin + (x, y)).
+    let main_draws = [0, 1].map(|i| {
+        scene
+            .mirrors
+            .iter()
+            .enumerate()
+            .map(|(j, _)| {
+                let seen = mirror_cameras
+                    .iter()
+                    .position(|c| c.mirror == j && c.view.depth == 1);
+                match seen {
+                    Some(t) => Draw {
+                        mirror: j,
+                        bind_group: own_base[i] + t,
+                        offset: uniforms.push(&MirrorUniform::textured(cameras[t].region)),
+                    },
+                    None => Draw {
+                        mirror: j,
+                        bind_group: 0,
+                        offset: no_texture,
+                    },
+                }
+            })
+            .collect::<Vec<_>>()
+    });
+    (camera_draws, main_draws)
 }
 
 /// The index of a read source in [`FeedbackFrame::camera_draws`].
