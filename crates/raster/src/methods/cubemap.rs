@@ -323,77 +323,11 @@ impl CubeFrame {
         let faces = 2 * 6 * cubes.len();
         check_mirror_textures(gpu, &vec![(size, size); faces])?;
         let scene_buffers = SceneBuffers::new(gpu, scene, shadows.binding());
-        let own = [0, 1].map(|_| {
-            Arc::new(
-                cubes
-                    .iter()
-                    .map(|_| {
-                        [0, 1, 2, 3, 4, 5].map(|_| {
-                            RenderTarget::new(
-                                gpu,
-                                "cube face",
-                                size,
-                                size,
-                                wgpu::TextureUsages::TEXTURE_BINDING,
-                            )
-                        })
-                    })
-                    .collect::<CubeSet>(),
-            )
-        });
+        let own = cube_sets(gpu, cubes.len(), size);
 
-        let mut uniforms = UniformArena::new(device);
-        let pass = |clip: Mat4, eye: Vec3, plane: Vec4| PassUniform {
-            clip_from_world: clip.to_cols_array_2d(),
-            eye: eye.to_array(),
-            _pad0: 0.0,
-            plane: plane.to_array(),
-        };
-        let face_offsets: Vec<[u32; 6]> = cubes
-            .iter()
-            .map(|c| {
-                let plane = c.plane.map_or(Vec4::W, |p| p.coefficients());
-                c.faces.map(|f| uniforms.push(&pass(f, c.centre, plane)))
-            })
-            .collect();
-        let camera = scene.camera.with_size(w, h);
-        let main_offset = uniforms.push(&pass(
-            camera_projection(&camera, w, h) * camera.view(),
-            camera.position,
-            Vec4::W,
-        ));
-        // One uniform per cube (the same for every set: the cubes do not move), and "none".
-        let cube_uniforms: Vec<u32> = cubes
-            .iter()
-            .map(|c| {
-                uniforms.push(&CubeUniform {
-                    faces: c.faces.map(|f| f.to_cols_array_2d()),
-                    centre: c.centre.to_array(),
-                    has_cube: 1,
-                    face_size: size as f32,
-                    ..Zeroable::zeroed()
-                })
-            })
-            .collect();
-        let no_cube_uniform = uniforms.push(&CubeUniform {
-            face_size: 1.0,
-            ..Zeroable::zeroed()
-        });
-        let cube_mirrors: Vec<Vec<usize>> = cubes
-            .iter()
-            .map(|c| {
-                (0..scene.mirrors.len())
-                    .filter(|&j| {
-                        c.plane.is_none_or(|p| {
-                            !scene.mirrors[j]
-                                .corners()
-                                .iter()
-                                .all(|x| p.signed_distance(*x).abs() < 1e-5)
-                        })
-                    })
-                    .collect()
-            })
-            .collect();
+        let (uniforms, face_offsets, main_offset, (cube_uniforms, no_cube_uniform)) =
+            cube_records(gpu, scene, &cubes, size, (w, h));
+        let cube_mirrors = cube_mirrors(scene, &cubes);
         let reads: Vec<usize> = (0..scene.mirrors.len())
             .map(|j| if per_mirror { j } else { 0 })
             .collect();
@@ -431,20 +365,14 @@ impl CubeFrame {
 
         let clipping = pipelines.clipping;
 
-        let passes = 6 * cubes.len() + 1;
-        let mirror_draws: usize =
-            6 * cube_mirrors.iter().map(Vec::len).sum::<usize>() + scene.mirrors.len();
-        let object_triangles = scene_buffers.objects.len() / 3;
         let stats = FrameStats {
-            passes,
-            texture_renders: 6 * cubes.len(),
-            draws: passes + mirror_draws + 1,
             depth: state.first_depth(),
-            triangles: passes * object_triangles + 2 * mirror_draws,
-            paths: None,
-            clipping,
-            depth_format: DEPTH_FORMAT,
-            copies: None,
+            ..frame_stats(
+                &cube_mirrors,
+                scene.mirrors.len(),
+                scene_buffers.objects.len() / 3,
+                clipping,
+            )
         };
         Ok(CubeFrame {
             scene_buffers,
@@ -497,6 +425,127 @@ impl CubeFrame {
             offset,
             mirrors,
         );
+    }
+}
+
+/// The uniform records of a frame: each cube face's pass, the main pass, one per cube (the
+/// same for every set: the cubes do not move) and "no cube"; with their offsets.
+#[allow(clippy::type_complexity)]
+fn cube_records(
+    gpu: &Gpu,
+    scene: &Scene,
+    cubes: &[Cube],
+    size: u32,
+    (w, h): (u32, u32),
+) -> (UniformArena, Vec<[u32; 6]>, u32, (Vec<u32>, u32)) {
+    let device = &gpu.device;
+    let mut uniforms = UniformArena::new(device);
+    let pass = |clip: Mat4, eye: Vec3, plane: Vec4| PassUniform {
+        clip_from_world: clip.to_cols_array_2d(),
+        eye: eye.to_array(),
+        _pad0: 0.0,
+        plane: plane.to_array(),
+    };
+    let face_offsets: Vec<[u32; 6]> = cubes
+        .iter()
+        .map(|c| {
+            let plane = c.plane.map_or(Vec4::W, |p| p.coefficients());
+            c.faces.map(|f| uniforms.push(&pass(f, c.centre, plane)))
+        })
+        .collect();
+    let camera = scene.camera.with_size(w, h);
+    let main_offset = uniforms.push(&pass(
+        camera_projection(&camera, w, h) * camera.view(),
+        camera.position,
+        Vec4::W,
+    ));
+    // One uniform per cube (the same for every set: the cubes do not move), and "none".
+    let cube_uniforms: Vec<u32> = cubes
+        .iter()
+        .map(|c| {
+            uniforms.push(&CubeUniform {
+                faces: c.faces.map(|f| f.to_cols_array_2d()),
+                centre: c.centre.to_array(),
+                has_cube: 1,
+                face_size: size as f32,
+                ..Zeroable::zeroed()
+            })
+        })
+        .collect();
+    let no_cube_uniform = uniforms.push(&CubeUniform {
+        face_size: 1.0,
+        ..Zeroable::zeroed()
+    });
+    (
+        uniforms,
+        face_offsets,
+        main_offset,
+        (cube_uniforms, no_cube_uniform),
+    )
+}
+
+/// The two sets of this frame's cube maps, written in turn (`count` cubes of six `size`²
+/// faces each).
+fn cube_sets(gpu: &Gpu, count: usize, size: u32) -> [Arc<CubeSet>; 2] {
+    [0, 1].map(|_| {
+        Arc::new(
+            (0..count)
+                .map(|_| {
+                    [0, 1, 2, 3, 4, 5].map(|_| {
+                        RenderTarget::new(
+                            gpu,
+                            "cube face",
+                            size,
+                            size,
+                            wgpu::TextureUsages::TEXTURE_BINDING,
+                        )
+                    })
+                })
+                .collect::<CubeSet>(),
+        )
+    })
+}
+
+/// Per cube, the scene mirrors its faces draw: all but those in its own mirror's plane.
+fn cube_mirrors(scene: &Scene, cubes: &[Cube]) -> Vec<Vec<usize>> {
+    cubes
+        .iter()
+        .map(|c| {
+            (0..scene.mirrors.len())
+                .filter(|&j| {
+                    c.plane.is_none_or(|p| {
+                        !scene.mirrors[j]
+                            .corners()
+                            .iter()
+                            .all(|x| p.signed_distance(*x).abs() < 1e-5)
+                    })
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// The frame's passes (six faces per cube, and the main pass), draws and triangles; its
+/// depth left to the caller.
+fn frame_stats(
+    cube_mirrors: &[Vec<usize>],
+    mirrors: usize,
+    object_triangles: usize,
+    clipping: crate::method::Clipping,
+) -> FrameStats {
+    let cubes = cube_mirrors.len();
+    let passes = 6 * cubes + 1;
+    let mirror_draws: usize = 6 * cube_mirrors.iter().map(Vec::len).sum::<usize>() + mirrors;
+    FrameStats {
+        passes,
+        texture_renders: 6 * cubes,
+        draws: passes + mirror_draws + 1,
+        depth: 0,
+        triangles: passes * object_triangles + 2 * mirror_draws,
+        paths: None,
+        clipping,
+        depth_format: DEPTH_FORMAT,
+        copies: None,
     }
 }
 
