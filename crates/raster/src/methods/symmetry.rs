@@ -423,37 +423,7 @@ pub(crate) fn plan_copies(
         (0..culled_vertices, true),
         (culled_vertices..object_vertices, false),
     ];
-    let mut draws = Vec::new();
-    let mut add = |odd: bool, instances: Range<u32>, record: Option<usize>| {
-        for (vertices, culled) in &classes {
-            if vertices.is_empty() {
-                continue;
-            }
-            draws.push(ObjectDraw {
-                pipeline: if *culled {
-                    ObjectPipeline::Culled { odd }
-                } else {
-                    ObjectPipeline::Unculled
-                },
-                vertices: vertices.clone(),
-                instances: instances.clone(),
-                record,
-            });
-        }
-    };
-    if settings.per_copy {
-        for (k, &mask) in masks.iter().enumerate() {
-            add(reverses_winding(mask), 0..1, Some(k));
-        }
-    } else {
-        let n_even = even.len() as u32;
-        if !even.is_empty() {
-            add(false, 0..n_even, None);
-        }
-        if !odd.is_empty() {
-            add(true, n_even..masks.len() as u32, None);
-        }
-    }
+    let draws = object_draws(&classes, &masks, even.len(), settings.per_copy);
     let stats = CopyCounts {
         planes: planes.len(),
         total: copy_count(planes.len()),
@@ -474,6 +444,49 @@ pub(crate) fn plan_copies(
         stats,
         triangles,
     }))
+}
+
+/// The object draws of a frame: per vertex class (closed parts culled per copy's winding,
+/// the rest unculled), the copies `masks` (the even ones first, `even` of them) instanced
+/// by winding, or with `per_copy` one draw per copy with its own record.
+fn object_draws(
+    classes: &[(Range<u32>, bool); 2],
+    masks: &[u32],
+    even: usize,
+    per_copy: bool,
+) -> Vec<ObjectDraw> {
+    let mut draws = Vec::new();
+    let mut add = |odd: bool, instances: Range<u32>, record: Option<usize>| {
+        for (vertices, culled) in classes {
+            if vertices.is_empty() {
+                continue;
+            }
+            draws.push(ObjectDraw {
+                pipeline: if *culled {
+                    ObjectPipeline::Culled { odd }
+                } else {
+                    ObjectPipeline::Unculled
+                },
+                vertices: vertices.clone(),
+                instances: instances.clone(),
+                record,
+            });
+        }
+    };
+    if per_copy {
+        for (k, &mask) in masks.iter().enumerate() {
+            add(reverses_winding(mask), 0..1, Some(k));
+        }
+    } else {
+        let n_even = even as u32;
+        if even > 0 {
+            add(false, 0..n_even, None);
+        }
+        if even < masks.len() {
+            add(true, n_even..masks.len() as u32, None);
+        }
+    }
+    draws
 }
 
 /// Host bytes of a geometry copy a plan keeps: each triangle's corners and surface id.
@@ -586,10 +599,7 @@ struct CopiesFrame {
     record_offsets: Vec<u32>,
     draws: Vec<ObjectDraw>,
     mirrors: Range<u32>,
-    culled_even: wgpu::RenderPipeline,
-    culled_odd: wgpu::RenderPipeline,
-    unculled: wgpu::RenderPipeline,
-    mirror_pipeline: wgpu::RenderPipeline,
+    pipelines: CopyPipelines,
     clear: Vec3,
     stats: FrameStats,
 }
@@ -663,49 +673,13 @@ impl CopiesFrame {
             ],
         });
         let pipeline_layout = pipeline_layout(gpu, "symmetry", &[&scene_buffers.layout, &layout]);
-        let module = gpu.shader_module(
-            if clip_distances {
-                &CLIP_DISTANCE_SHADER
-            } else {
-                &SHADER
-            },
+        let pipelines = CopyPipelines::new(
+            gpu,
+            &pipeline_layout,
             scene_buffers.textured,
+            clip_distances,
+            settings,
         );
-        let vertex = match (settings.per_copy, clip_distances) {
-            (false, false) => "vs_instanced",
-            (true, false) => "vs_per_copy",
-            (false, true) => "vs_instanced_clipped",
-            (true, true) => "vs_per_copy_clipped",
-        };
-        let fragment = match (settings.copy_ids, clip_distances) {
-            (false, false) => "fs_object_discard",
-            (true, false) => "fs_copy_id_discard",
-            (false, true) => "fs_object_clipped",
-            (true, true) => "fs_copy_id_clipped",
-        };
-        let pipeline =
-            |label: &'static str, vertex: &'static str, fragment: &'static str| ScenePipeline {
-                label,
-                layout: &pipeline_layout,
-                module: &module,
-                vertex,
-                fragment,
-                buffers: &[Some(VERTEX_LAYOUT)],
-                depth_stencil: depth_state(DEPTH_FORMAT, true, NEARER, Default::default()),
-                color_writes: wgpu::ColorWrites::ALL,
-            };
-        let culled_even = pipeline("symmetry even copies (culled)", vertex, fragment)
-            .build_culling_back_faces(gpu, wgpu::FrontFace::Ccw);
-        let culled_odd = pipeline("symmetry odd copies (culled)", vertex, fragment)
-            .build_culling_back_faces(gpu, wgpu::FrontFace::Cw);
-        let unculled = pipeline("symmetry copies (not culled)", vertex, fragment).build(gpu);
-        let mirror_fragment = if settings.copy_ids {
-            "fs_mirror_copy_id"
-        } else {
-            "fs_mirror"
-        };
-        let mirror_pipeline =
-            pipeline("symmetry mirrors", "vs_unmoved", mirror_fragment).build(gpu);
 
         let draws = planned.draws;
         let stats = FrameStats {
@@ -729,10 +703,7 @@ impl CopiesFrame {
             record_offsets,
             draws,
             mirrors: planned.mirrors,
-            culled_even,
-            culled_odd,
-            unculled,
-            mirror_pipeline,
+            pipelines,
             clear: if settings.copy_ids {
                 Vec3::ZERO
             } else {
@@ -740,6 +711,77 @@ impl CopiesFrame {
             },
             stats,
         })
+    }
+}
+
+/// The copies' pipelines: closed parts culled by each copy's winding (even, odd), the rest
+/// unculled, and the mirrors (drawn once, unmoved); by clip distances where the adapter has
+/// them for this many planes, else by a discard per fragment.
+struct CopyPipelines {
+    culled_even: wgpu::RenderPipeline,
+    culled_odd: wgpu::RenderPipeline,
+    unculled: wgpu::RenderPipeline,
+    mirror: wgpu::RenderPipeline,
+}
+
+impl CopyPipelines {
+    fn new(
+        gpu: &Gpu,
+        pipeline_layout: &wgpu::PipelineLayout,
+        textured: bool,
+        clip_distances: bool,
+        settings: CopySettings,
+    ) -> Self {
+        let module = gpu.shader_module(
+            if clip_distances {
+                &CLIP_DISTANCE_SHADER
+            } else {
+                &SHADER
+            },
+            textured,
+        );
+        let vertex = match (settings.per_copy, clip_distances) {
+            (false, false) => "vs_instanced",
+            (true, false) => "vs_per_copy",
+            (false, true) => "vs_instanced_clipped",
+            (true, true) => "vs_per_copy_clipped",
+        };
+        let fragment = match (settings.copy_ids, clip_distances) {
+            (false, false) => "fs_object_discard",
+            (true, false) => "fs_copy_id_discard",
+            (false, true) => "fs_object_clipped",
+            (true, true) => "fs_copy_id_clipped",
+        };
+        let pipeline =
+            |label: &'static str, vertex: &'static str, fragment: &'static str| ScenePipeline {
+                label,
+                layout: pipeline_layout,
+                module: &module,
+                vertex,
+                fragment,
+                buffers: &[Some(VERTEX_LAYOUT)],
+                depth_stencil: depth_state(DEPTH_FORMAT, true, NEARER, Default::default()),
+                color_writes: wgpu::ColorWrites::ALL,
+            };
+        let culled_even = pipeline("symmetry even copies (culled)", vertex, fragment)
+            .build_culling_back_faces(gpu, wgpu::FrontFace::Ccw);
+        let culled_odd = pipeline("symmetry odd copies (culled)", vertex, fragment)
+            .build_culling_back_faces(gpu, wgpu::FrontFace::Cw);
+        let unculled = pipeline("symmetry copies (not culled)", vertex, fragment).build(gpu);
+        let mirror_fragment = if settings.copy_ids {
+            "fs_mirror_copy_id"
+        } else {
+            "fs_mirror"
+        };
+        let mirror_pipeline =
+            pipeline("symmetry mirrors", "vs_unmoved", mirror_fragment).build(gpu);
+
+        CopyPipelines {
+            culled_even,
+            culled_odd,
+            unculled,
+            mirror: mirror_pipeline,
+        }
     }
 }
 
@@ -758,9 +800,9 @@ impl FrameEncoder for CopiesFrame {
         for d in &self.draws {
             if bound != Some(d.pipeline) {
                 pass.set_pipeline(match d.pipeline {
-                    ObjectPipeline::Culled { odd: false } => &self.culled_even,
-                    ObjectPipeline::Culled { odd: true } => &self.culled_odd,
-                    ObjectPipeline::Unculled => &self.unculled,
+                    ObjectPipeline::Culled { odd: false } => &self.pipelines.culled_even,
+                    ObjectPipeline::Culled { odd: true } => &self.pipelines.culled_odd,
+                    ObjectPipeline::Unculled => &self.pipelines.unculled,
                 });
                 bound = Some(d.pipeline);
             }
@@ -770,7 +812,7 @@ impl FrameEncoder for CopiesFrame {
             pass.draw(d.vertices.clone(), d.instances.clone());
         }
         if !self.mirrors.is_empty() {
-            pass.set_pipeline(&self.mirror_pipeline);
+            pass.set_pipeline(&self.pipelines.mirror);
             pass.draw(self.mirrors.clone(), 0..1);
         }
     }

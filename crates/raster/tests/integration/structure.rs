@@ -8,7 +8,12 @@ use std::path::Path;
 fn module_graph() -> BTreeMap<String, BTreeSet<String>> {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
     let mut files = Vec::new();
-    for dir in [src.clone(), src.join("methods")] {
+    for dir in [
+        src.clone(),
+        src.join("methods"),
+        src.join("gpu"),
+        src.join("plan"),
+    ] {
         for e in std::fs::read_dir(&dir).unwrap() {
             let p = e.unwrap().path();
             if p.extension().is_some_and(|x| x == "rs") {
@@ -19,10 +24,18 @@ fn module_graph() -> BTreeMap<String, BTreeSet<String>> {
     let mut graph = BTreeMap::new();
     for f in files {
         let rel = f.strip_prefix(&src).unwrap().with_extension("");
-        let name = rel.to_string_lossy().replace("/mod", "").replace('/', "::");
-        if name == "lib" {
-            continue;
-        }
+        let rel = rel.to_string_lossy();
+        // The floors' modules by the names the crate re-exports them under (`targets`,
+        // `culling`); their hubs (`gpu`, `plan`) are the items of `device` and `recursion`.
+        let name = match rel.as_ref() {
+            "lib" | "gpu/mod" | "plan/mod" => continue,
+            "gpu/device" => "gpu".to_string(),
+            "plan/recursion" => "plan".to_string(),
+            r if r.starts_with("gpu/") || r.starts_with("plan/") => {
+                r.split('/').nth(1).unwrap().to_string()
+            }
+            r => r.replace("/mod", "").replace('/', "::"),
+        };
         let text = std::fs::read_to_string(&f).unwrap();
         let code = text.split("#[cfg(test)]").next().unwrap();
         let mut deps = BTreeSet::new();
@@ -35,6 +48,17 @@ fn module_graph() -> BTreeMap<String, BTreeSet<String>> {
                     .take_while(|c| c.is_alphanumeric() || *c == '_')
                     .collect();
                 let mut dep = word.clone();
+                if word == "gpu" || word == "plan" {
+                    // `crate::gpu::targets::…` names the submodule, `crate::gpu::Gpu` the hub.
+                    let sub: String = rest[word.len()..]
+                        .trim_start_matches("::")
+                        .chars()
+                        .take_while(|c| c.is_alphanumeric() || *c == '_')
+                        .collect();
+                    if src.join(&word).join(format!("{sub}.rs")).is_file() {
+                        dep = sub;
+                    }
+                }
                 if word == "methods" {
                     let sub: String = rest[word.len()..]
                         .trim_start_matches("::")
@@ -45,8 +69,12 @@ fn module_graph() -> BTreeMap<String, BTreeSet<String>> {
                         dep = format!("methods::{sub}");
                     }
                 }
-                // `crate::host_layout!` is a macro, not a module.
-                if dep != name && dep != "host_layout" {
+                // `crate::host_layout!` and `crate::mirror_plane_shaders!` are macros; an item
+                // re-exported at the root (`crate::Clipping`) is no module of its own.
+                let module = dep.starts_with(char::is_lowercase)
+                    && dep != "host_layout"
+                    && dep != "mirror_plane_shaders";
+                if dep != name && module {
                     deps.insert(dep);
                 }
             }
@@ -150,4 +178,51 @@ fn every_method_and_shader_is_documented() {
             );
         }
     }
+}
+
+/// No function of a method is longer than [`MAX_METHOD_FN_LINES`] (issue 52): a method's
+/// constructor reads as its phases (its records, its bind groups through
+/// `pipeline::BindGroupBuilder`, its pipelines, its stats), each a named function, as kajiya's
+/// passes read through their builder. Counted on the rustfmt'd source, from a `fn` line to
+/// the closing brace at its indentation.
+#[test]
+fn no_method_function_is_longer_than_its_phases() {
+    const MAX_METHOD_FN_LINES: usize = 120;
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("src/methods");
+    let mut long = Vec::new();
+    for e in std::fs::read_dir(&dir).unwrap() {
+        let path = e.unwrap().path();
+        let text = std::fs::read_to_string(&path).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        let mut i = 0;
+        while i < lines.len() {
+            let line = lines[i];
+            let indent = line.len() - line.trim_start().len();
+            let head = line.trim_start();
+            let is_fn = ["fn ", "pub fn ", "pub(crate) fn "]
+                .iter()
+                .any(|p| head.starts_with(p))
+                && !line.trim_end().ends_with(';');
+            if is_fn {
+                let close = format!("{}}}", " ".repeat(indent));
+                let end = (i..lines.len()).find(|&j| lines[j] == close).unwrap_or(i);
+                let n = end - i + 1;
+                if n > MAX_METHOD_FN_LINES {
+                    long.push(format!(
+                        "{}:{} `{}` is {n} lines",
+                        path.file_name().unwrap().to_string_lossy(),
+                        i + 1,
+                        head.split('(').next().unwrap()
+                    ));
+                }
+                i = end;
+            }
+            i += 1;
+        }
+    }
+    assert!(
+        long.is_empty(),
+        "longer than {MAX_METHOD_FN_LINES} lines: split into named phases\n{}",
+        long.join("\n")
+    );
 }
