@@ -158,17 +158,17 @@ say "steps: $*"
 for s in "$@"; do
   case $s in
   info) step info 10 info ;;
-  table1) step table1 120 "$bin" table1 --out reports/gpu/table1 ;;
-  depth) step depth-scaling 120 "$bin" depth-scaling --out reports/gpu/depth_scaling ;;
+  table1) step table1 120 "$bin" experiment table1 --out reports/gpu/table1 ;;
+  depth) step depth-scaling 120 "$bin" experiment depth-scaling --out reports/gpu/depth_scaling ;;
   room) step room 120 room ;;
   trace) step trace-threads 60 trace_threads ;;
   tests) step tests 60 tests ;;
   retest) step retest 30 retest ;;
-  table1-repeat) step table1-repeat 60 "$bin" table1 --out reports/gpu/table1_repeat ;;
+  table1-repeat) step table1-repeat 60 "$bin" experiment table1 --out reports/gpu/table1_repeat ;;
   table1-1080p) step table1-1080p 60 table1_1080p ;;
   depth-1080p) step depth-1080p 60 depth_1080p ;;
-  symmetry) step symmetry-scaling 120 "$bin" symmetry-scaling --out reports/gpu/symmetry_scaling ;;
-  lighting) step lighting 120 "$bin" lighting --out reports/gpu/lighting ;;
+  symmetry) step symmetry-scaling 120 "$bin" experiment symmetry-scaling --out reports/gpu/symmetry_scaling ;;
+  lighting) step lighting 120 "$bin" experiment lighting --out reports/gpu/lighting ;;
   *) say "unknown step $s" ;;
   esac
 done

@@ -17,7 +17,7 @@ times=""
 for r in $(seq 1 "$rounds"); do
   rm -rf "$work/unsharded" "$work/runs"
   t0=$(date +%s.%N)
-  "$bin" table1 --out "$work/unsharded" >/dev/null 2>&1
+  "$bin" experiment table1 --out "$work/unsharded" >/dev/null 2>&1
   t1=$(date +%s.%N)
   MIRRORBOX=$bin SWEEP_COMMAND=table1 deploy/slurm/submit.sh 4 2 "$work/runs" >/dev/null
   while [ -n "$(squeue -h -o %i)" ]; do sleep 1; done

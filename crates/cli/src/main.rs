@@ -37,20 +37,6 @@ enum Command {
     Sweep(commands::sweep::Args),
     /// Run an experiment of the registry (crates/experiments): its sweeps, sequences or script, into its report folder (`--list` lists them).
     Experiment(commands::sweep::ExperimentArgs),
-    /// The preset sweep reproducing the paper's Table 1, exact methods beside it (writes reports/table1/).
-    Table1(commands::sweep::PresetArgs),
-    /// The preset sweep of the exact methods' cost against depth 1…1024 (writes reports/depth_scaling/).
-    DepthScaling(commands::sweep::PresetArgs),
-    /// The preset sweep of the symmetry methods against the number of planes p = 0…10 (writes reports/symmetry_scaling/).
-    SymmetryScaling(commands::sweep::PresetArgs),
-    /// The preset sweep of lighting variants (direct, mirrored lights, shadow maps) against mirrored-light depth k on the lit mirror box and room (writes reports/lighting/ and reports/lighting_room/).
-    Lighting(commands::sweep::PresetArgs),
-    /// The preset sweep of the uneven-mirror tricks (distort, proxy, march, flat) against the bump's tilt 0…10° on the rippled box and the hammered single mirror (writes reports/uneven_mirrors/ and reports/uneven_mirrors_single/).
-    Bumpy(commands::sweep::PresetArgs),
-    /// The preset sweep of stereo mirrors: per-eye mirror textures against the head's shared ones, both eyes as one frame, against each eye's truth at IPD 0…0.1 and mono (writes reports/stereo/).
-    Stereo(commands::sweep::PresetArgs),
-    /// Error over time: feedback's convergence for a still camera and its lag walking at real time and three times it on the paper's box, beside auxiliary n = 0…4 and an exact method, frame by frame against the truth (writes reports/motion/).
-    Motion(commands::sweep::MotionArgs),
     /// A window: the method live (free camera, every option switchable), the traced truth
     /// refining beside it, and their error (docs/viewer.md).
     View(commands::view::Args),
@@ -179,15 +165,6 @@ fn main() -> ExitCode {
         Command::Compare(args) => commands::compare::run(&args),
         Command::Sweep(args) => commands::sweep::run(&args),
         Command::Experiment(args) => commands::sweep::run_experiment_command(&args),
-        Command::Table1(args) => commands::sweep::run_experiment("table1", &args),
-        Command::DepthScaling(args) => commands::sweep::run_experiment("depth-scaling", &args),
-        Command::SymmetryScaling(args) => {
-            commands::sweep::run_experiment("symmetry-scaling", &args)
-        }
-        Command::Lighting(args) => commands::sweep::run_experiment("lighting", &args),
-        Command::Bumpy(args) => commands::sweep::run_experiment("bumpy", &args),
-        Command::Stereo(args) => commands::sweep::run_experiment("stereo", &args),
-        Command::Motion(args) => commands::sweep::run_motion(&args),
         Command::View(args) => commands::view::run(&args),
         Command::ExportMitsuba(args) => commands::export_mitsuba::run(&args),
         Command::Readme(args) => commands::readme::run(&args),

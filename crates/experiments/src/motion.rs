@@ -80,14 +80,14 @@ pub const MOTION: Experiment = Experiment {
     regions: &[mirrorbox_report::readme::RegionSource {
         id: "motion",
         source: "motion",
-        about: "error over time: feedback, cubemap, auxiliary and an exact method, still and walking (mirrorbox motion)",
+        about: "error over time: feedback, cubemap, auxiliary and an exact method, still and walking (mirrorbox experiment motion)",
         generate: |reports| {
             let (info, records) = sequence::read_motion(&reports.join("motion"))
                 .map_err(mirrorbox_report::readme::ReadmeError)?;
             Ok(sequence::summary(
                 &info,
                 &records,
-                "mirrorbox motion",
+                "mirrorbox experiment motion",
                 "reports/motion/report.md",
             ))
         },

@@ -1,6 +1,6 @@
 //! Sequence sweeps (issue 22): every method and the truth rendered frame by frame along a
 //! camera path, each frame compared with the truth of that frame
-//! (`mirrorbox sweep --path`, and the `mirrorbox motion` preset).
+//! (`mirrorbox sweep --path`, and `mirrorbox experiment motion`).
 //!
 //! Each sequence runs in a child process of this executable — `trace --sequence` for the
 //! truth, `render --sequence` per method — so a stateful method (`feedback`) carries its

@@ -51,7 +51,7 @@ pub fn rewrite_report(
     records_commit: &str,
     sections: &[crate::Section],
 ) -> Result<usize, ReadmeError> {
-    // A sequence sweep's folder (`mirrorbox motion`, `sweep --path`) has its own files.
+    // A sequence sweep's folder (`mirrorbox experiment motion`, `sweep --path`) has its own files.
     if dir.join("motion.json").is_file() && !dir.join("sweep.json").exists() {
         let (mut info, records) = crate::sequence::read_motion(dir).map_err(ReadmeError)?;
         info.records_commit = records_commit.to_string();

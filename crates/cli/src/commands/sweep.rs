@@ -1,4 +1,4 @@
-//! `mirrorbox sweep SCENE --out DIR` and its preset `mirrorbox table1`: raster methods timed
+//! `mirrorbox sweep SCENE --out DIR` and `mirrorbox experiment NAME`: raster methods timed
 //! and compared with cached ground truths, resumable, with reports.
 
 use super::method_flags::SweepOptions;
@@ -393,9 +393,9 @@ pub fn run_experiment_command(args: &ExperimentArgs) -> Result<(), Failure> {
     run_experiment(name, &args.preset)
 }
 
-/// Runs the registry's experiment `name` with the preset options (the older preset commands,
-/// `mirrorbox table1` and the like, are this with their experiment's name).
-pub fn run_experiment(name: &str, args: &PresetArgs) -> Result<(), Failure> {
+/// Runs the registry's experiment `name` with the preset options (`mirrorbox experiment
+/// NAME`; the older preset subcommands, `mirrorbox table1` and the like, are gone: one way in).
+fn run_experiment(name: &str, args: &PresetArgs) -> Result<(), Failure> {
     use mirrorbox_experiments::Measure;
     let e = mirrorbox_experiments::find(name)
         .ok_or_else(|| bad(format!("no experiment named {name:?} in the registry")))?;
@@ -439,30 +439,6 @@ pub fn run_experiment(name: &str, args: &PresetArgs) -> Result<(), Failure> {
             }
         }
     }
-}
-
-/// `mirrorbox motion`'s options.
-#[derive(clap::Args, Clone, Debug)]
-pub struct MotionArgs {
-    /// Output folder of the committed report (default reports/motion).
-    #[arg(long)]
-    out: Option<PathBuf>,
-    /// Frames per scenario (default 12), 1..1000.
-    #[arg(long)]
-    frames: Option<u32>,
-}
-
-/// Error over time (the registry's `motion`): a still camera and two walking speeds on the
-/// paper's box, into `reports/motion/` by default.
-pub fn run_motion(args: &MotionArgs) -> Result<(), Failure> {
-    run_experiment(
-        "motion",
-        &PresetArgs {
-            out: args.out.clone(),
-            frames: args.frames,
-            ..PresetArgs::default()
-        },
-    )
 }
 
 fn run_sequences(config: &SequenceConfig) -> Result<(), Failure> {
