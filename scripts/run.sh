@@ -20,6 +20,13 @@ bin=target/release/mirrorbox
 main_job_in_source=$(cat crates/experiments/src/*.rs | grep -cE '^[[:space:]]*main_job: true,' || true)
 steps_total=$((6 + main_job_in_source))
 step=0
+# Whether cargo had to download the crates: a fresh machine's cost is with an empty cache
+# (issue 51); recorded beside the times.
+if [ -n "$(ls -A "${CARGO_HOME:-$HOME/.cargo}/registry/cache" 2>/dev/null)" ]; then
+  cargo_cache=warm
+else
+  cargo_cache=empty
+fi
 steps_json=""
 started_at=$(date -u +%Y-%m-%dT%H:%M:%SZ)
 peak_file=$(mktemp)
@@ -64,8 +71,8 @@ done
 cpu=$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//; s/"/'"'"'/g')
 cores=$(nproc)
 tmp=$(mktemp reports/.main_job.XXXXXX)
-printf '{"date":"%s","cpu":"%s, %s cores","seconds":%s,"steps":[%s]}\n' \
-  "$started_at" "$cpu" "$cores" "$SECONDS" "$steps_json" >"$tmp"
+printf '{"date":"%s","cpu":"%s, %s cores","cargo_cache":"%s","seconds":%s,"steps":[%s]}\n' \
+  "$started_at" "$cpu" "$cores" "$cargo_cache" "$SECONDS" "$steps_json" >"$tmp"
 mv "$tmp" reports/main_job.json
 run_step "$bin" report --index reports
 run_step "$bin" readme

@@ -27,6 +27,13 @@ mkdir -p target
 export MIRRORBOX_SKIP_LOG="$PWD/target/test-skips.tsv"
 : >"$MIRRORBOX_SKIP_LOG"
 echo "== MIRRORBOX_TEST_SKIP: $(skip_listed) (the components agreed to be skipped; a skip is logged to target/test-skips.tsv)"
+# Whether cargo had to download the crates: a fresh machine's cost is with an empty cache
+# (issue 51); recorded beside the times.
+if [ -n "$(ls -A "${CARGO_HOME:-$HOME/.cargo}/registry/cache" 2>/dev/null)" ]; then
+  cargo_cache=warm
+else
+  cargo_cache=empty
+fi
 steps_json=""
 timed() {
   echo "== $*"
@@ -134,8 +141,8 @@ fi
 collect_skips
 cpu=$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//; s/"/'"'"'/g')
 mkdir -p target
-printf '{"date":"%s","cpu":"%s, %s cores","seconds":%s,"steps":[%s],"test_skip":"%s","skipped":[%s]}\n' \
-  "$(date -u +%Y-%m-%dT%H:%M:%SZ)" "$cpu" "$(nproc)" "$SECONDS" "$steps_json" \
+printf '{"date":"%s","cpu":"%s, %s cores","cargo_cache":"%s","seconds":%s,"steps":[%s],"test_skip":"%s","skipped":[%s]}\n' \
+  "$(date -u +%Y-%m-%dT%H:%M:%SZ)" "$cpu" "$(nproc)" "$cargo_cache" "$SECONDS" "$steps_json" \
   "$(json_escape "${MIRRORBOX_TEST_SKIP:-}")" "$skips_json" >target/test-timing.json
 echo "== tests done in $SECONDS s on $cpu, $(nproc) cores"
 print_skips

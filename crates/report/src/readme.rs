@@ -156,6 +156,10 @@ struct Step {
 struct MainJob {
     date: String,
     cpu: String,
+    /// `empty` when cargo had to download every crate (a fresh machine), `warm` when not;
+    /// absent in older records.
+    #[serde(default)]
+    cargo_cache: Option<String>,
     seconds: u64,
     steps: Vec<Step>,
 }
@@ -221,9 +225,14 @@ fn job_costs_region(reports: &Path) -> Result<String, ReadmeError> {
             format!("`{command}`"),
             what.to_string(),
             format!(
-                "{}, {}",
+                "{}, {}{}",
                 job.date.split('T').next().unwrap_or(&job.date),
-                job.cpu
+                job.cpu,
+                match job.cargo_cache.as_deref() {
+                    Some("empty") => ", empty cargo cache",
+                    Some("warm") => ", crates already downloaded",
+                    _ => "",
+                }
             ),
             format!("**{}**", job.seconds),
             parts.join("; "),
@@ -567,14 +576,14 @@ mod tests {
         std::fs::create_dir(dir.path().join("tests")).unwrap();
         std::fs::write(
             dir.path().join(TEST_JOB),
-            r#"{"date":"2026-11-23T10:00:00Z","cpu":"a test CPU","seconds":60,
+            r#"{"date":"2026-11-23T10:00:00Z","cpu":"a test CPU","cargo_cache":"empty","seconds":60,
                "steps":[{"name":"a","seconds":5},{"name":"build","seconds":40},
                         {"name":"b","seconds":3},{"name":"tests","seconds":12}]}"#,
         )
         .unwrap();
         let text = generate("job-costs", dir.path(), REGIONS).unwrap().text;
         assert!(text.contains(
-            "| `scripts/test.sh` | the tests | 2026-11-23, a test CPU | **60** | `build` 40 s; `tests` 12 s; 2 other steps 8 s |"
+            "| `scripts/test.sh` | the tests | 2026-11-23, a test CPU, empty cargo cache | **60** | `build` 40 s; `tests` 12 s; 2 other steps 8 s |"
         ), "{text}");
         assert!(text.contains("| `scripts/run.sh` | the main job | 2026-11-22, a test CPU | **300** | `cargo build` 300 s |"), "{text}");
     }
