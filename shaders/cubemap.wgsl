@@ -36,18 +36,7 @@ struct CubeDraw {
 @group(2) @binding(5) var face4: texture_2d<f32>;
 @group(2) @binding(6) var face5: texture_2d<f32>;
 
-// The pass's view: a cube face's or the camera's (mirror_plane_vertex.wgsl's hooks).
-fn view_clip_from_world() -> mat4x4f {
-    return pass_.clip_from_world;
-}
-
-fn view_plane() -> vec4f {
-    return pass_.plane;
-}
-
-fn shade_diffuse(in: VertexOut, albedo: vec3f, emission: vec3f) -> vec3f {
-    return diffuse_radiance(in.world, in.normal, normalize(pass_.eye - in.world), albedo, emission);
-}
+// The pass's view and diffuse shading: pass_view.wgsl.
 
 fn object_colour(in: VertexOut) -> vec4f {
     let s = surfaces[in.surface];

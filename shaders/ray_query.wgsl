@@ -228,24 +228,12 @@ fn follow(origin: vec3f, direction: vec3f, first: Hit) -> vec3f {
 
 // --- Rasterized primary visibility (`ray-query`)
 
-struct VertexOut {
-    // Invariant: the shading pass must meet the depth the pre-pass wrote.
-    @builtin(position) @invariant clip: vec4f,
-    @location(0) world: vec3f,
-    @location(1) @interpolate(flat) normal: vec3f,
-    @location(2) @interpolate(flat) surface: u32,
-    @location(8) uv: vec2f,
-}
+// Invariant (scene_vertex.wgsl): the shading pass meets the depth the pre-pass wrote.
+alias VertexOut = SceneVertexOut;
 
 @vertex
 fn vs_main(v: VertexIn) -> VertexOut {
-    var out: VertexOut;
-    out.clip = params.camera.clip_from_world * vec4f(v.position, 1.0);
-    out.world = v.position;
-    out.normal = v.normal;
-    out.surface = v.surface;
-    out.uv = v.uv;
-    return out;
+    return scene_vertex_through(v, params.camera.clip_from_world);
 }
 
 @fragment

@@ -60,18 +60,7 @@ struct MirrorDraw {
 @group(2) @binding(0) var<uniform> mirror: MirrorDraw;
 @group(2) @binding(1) var mirror_texture: texture_2d<f32>;
 
-// The pass's view: a mirror camera's, or the frame's camera (mirror_plane_vertex.wgsl's hooks).
-fn view_clip_from_world() -> mat4x4f {
-    return pass_.clip_from_world;
-}
-
-fn view_plane() -> vec4f {
-    return pass_.plane;
-}
-
-fn shade_diffuse(in: VertexOut, albedo: vec3f, emission: vec3f) -> vec3f {
-    return diffuse_radiance(in.world, in.normal, normalize(pass_.eye - in.world), albedo, emission);
-}
+// The pass's view and diffuse shading: pass_view.wgsl.
 
 // Alpha: the distance from the pass's eye (a texture's distances, which --bump march reads).
 fn eye_distance(in: VertexOut) -> f32 {

@@ -25,23 +25,11 @@ struct SsrParams {
 
 @group(1) @binding(0) var<uniform> ssr: SsrParams;
 
-struct SceneOut {
-    @builtin(position) clip: vec4f,
-    @location(0) world: vec3f,
-    @location(1) @interpolate(flat) normal: vec3f,
-    @location(2) @interpolate(flat) surface: u32,
-    @location(8) uv: vec2f,
-}
+alias SceneOut = SceneVertexOut;
 
 @vertex
 fn vs_scene(v: VertexIn) -> SceneOut {
-    var out: SceneOut;
-    out.clip = ssr.camera.clip_from_world * vec4f(v.position, 1.0);
-    out.world = v.position;
-    out.normal = v.normal;
-    out.surface = v.surface;
-    out.uv = v.uv;
-    return out;
+    return scene_vertex_through(v, ssr.camera.clip_from_world);
 }
 
 // The scene pass's two targets: the contract's radiance with the mirror mark in alpha, and the

@@ -142,23 +142,11 @@ fn fs_copy_id_discard(in: CopyOut) -> @location(0) vec4f {
 }
 
 // Scene mirrors and the baked mesh: drawn as they are, once.
-struct UnmovedOut {
-    @builtin(position) @invariant clip: vec4f,
-    @location(0) world: vec3f,
-    @location(1) @interpolate(flat) normal: vec3f,
-    @location(2) @interpolate(flat) surface: u32,
-    @location(8) uv: vec2f,
-}
+alias UnmovedOut = SceneVertexOut;
 
 @vertex
 fn vs_unmoved(v: VertexIn) -> UnmovedOut {
-    var out: UnmovedOut;
-    out.clip = symmetry.clip_from_world * vec4f(v.position, 1.0);
-    out.world = v.position;
-    out.normal = v.normal;
-    out.surface = v.surface;
-    out.uv = v.uv;
-    return out;
+    return scene_vertex_through(v, symmetry.clip_from_world);
 }
 
 // The symmetry methods follow no mirror (reflection depth 0): a mirror's front shows the

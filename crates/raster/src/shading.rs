@@ -358,38 +358,6 @@ pub struct SceneBuffers {
 }
 
 impl SceneBuffers {
-    /// Begins a frame's one pass into `target` (the exact and ray-query methods): colour
-    /// cleared to `clear`, `depth` (the method's own depth(-stencil) view) to far and its
-    /// stencil to `stencil` where given, the scene bound at group 0 and the method's
-    /// `group1` (a bind group and its dynamic offsets) at group 1.
-    #[allow(clippy::too_many_arguments)]
-    pub fn begin_frame_pass<'e>(
-        &self,
-        encoder: &'e mut wgpu::CommandEncoder,
-        target: &crate::targets::RenderTarget,
-        label: &str,
-        clear: glam::Vec3,
-        depth: &wgpu::TextureView,
-        stencil: Option<u32>,
-        group1: (&wgpu::BindGroup, &[u32]),
-        first_pass: Option<wgpu::RenderPassTimestampWrites<'_>>,
-    ) -> wgpu::RenderPass<'e> {
-        let mut pass = target.begin_pass_with(
-            encoder,
-            label,
-            clear,
-            crate::targets::DepthClear {
-                view: depth,
-                depth: crate::projection::FAR_DEPTH,
-                stencil,
-            },
-            first_pass,
-        );
-        pass.set_bind_group(0, &self.bind_group, &[]);
-        pass.set_bind_group(1, group1.0, group1.1);
-        pass
-    }
-
     /// A frame's memory estimate that starts with these buffers for `g` (the scene's
     /// geometry, or a method's own baked copy): every method uploads them.
     pub fn memory_estimate(
@@ -799,6 +767,54 @@ impl SceneBuffers {
             bind_group,
             textured: g.has_textures(),
         }
+    }
+}
+
+/// A frame drawn in one pass over the scene with its depth cleared to far (the exact methods
+/// `portal` and `unrolled`, and `ray-query`): what its pass is, then what it draws in it.
+/// Its [`FrameEncoder`](crate::timing::FrameEncoder) is the one below, so no method writes a
+/// pass's preamble of its own.
+pub trait OnePassFrame {
+    /// The pass this frame draws in.
+    fn pass(&self) -> OnePass<'_>;
+    /// Everything drawn in the pass (the scene bound at group 0 and the frame's group 1).
+    fn draw(&self, pass: &mut wgpu::RenderPass<'_>);
+}
+
+/// A frame's one pass: colour cleared to `clear`, `depth` (the frame's own depth(-stencil)
+/// view) to far and its stencil to `stencil` where given, `scene` bound at group 0 and
+/// `group1` (a bind group and its dynamic offsets) at group 1.
+pub struct OnePass<'a> {
+    pub scene: &'a SceneBuffers,
+    pub label: &'static str,
+    pub clear: glam::Vec3,
+    pub depth: &'a wgpu::TextureView,
+    pub stencil: Option<u32>,
+    pub group1: (&'a wgpu::BindGroup, &'a [u32]),
+}
+
+impl<T: OnePassFrame> crate::timing::FrameEncoder for T {
+    fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &crate::targets::RenderTarget,
+        first_pass: Option<wgpu::RenderPassTimestampWrites<'_>>,
+    ) {
+        let p = self.pass();
+        let mut pass = target.begin_pass_with(
+            encoder,
+            p.label,
+            p.clear,
+            crate::targets::DepthClear {
+                view: p.depth,
+                depth: crate::projection::FAR_DEPTH,
+                stencil: p.stencil,
+            },
+            first_pass,
+        );
+        pass.set_bind_group(0, &p.scene.bind_group, &[]);
+        pass.set_bind_group(1, p.group1.0, p.group1.1);
+        self.draw(&mut pass);
     }
 }
 

@@ -28,6 +28,14 @@ pub const SHADING_CONTRACT: &str = include_str!("../../../../shaders/shading.wgs
 /// method's own file gives (`view_clip_from_world`, `view_plane`).
 pub const MIRROR_PLANE_VERTEX: &str = include_str!("../../../../shaders/mirror_plane_vertex.wgsl");
 
+/// `shaders/scene_vertex.wgsl`: the plain vertex stage of a scene seen through one camera
+/// (`SceneVertexOut`, `scene_vertex_through`), for the methods that clip at no mirror plane.
+pub const SCENE_VERTEX: &str = include_str!("../../../../shaders/scene_vertex.wgsl");
+
+/// `shaders/pass_view.wgsl`: the view hooks and diffuse shading of a method whose passes read
+/// one `Pass` uniform `pass_` (the paper's methods, `cubemap`); it follows the method's file.
+pub const PASS_VIEW: &str = include_str!("../../../../shaders/pass_view.wgsl");
+
 /// `shaders/mirror_plane_clip_distances.wgsl`: the clip-distance vertex stage of the methods
 /// that clip a mirror's world at the mirror's plane (`portal`, `naive`, `auxiliary`); it
 /// follows [`MIRROR_PLANE_VERTEX`]'s `VertexOut` and `scene_vertex`.
@@ -39,20 +47,21 @@ pub const MIRROR_PLANE_FRAGMENTS: &str =
     include_str!("../../../../shaders/mirror_plane_fragments.wgsl");
 
 /// Declares `SHADER` and `CLIP_DISTANCE_SHADER`, the two variants of a method that clips a
-/// mirror's world at the mirror's plane (`portal`, the paper's methods): `SHADER` runs on
+/// mirror's world at the mirror's plane (`portal`, the paper's methods, `cubemap`), from its
+/// own parts (its entry points, and [`PASS_VIEW`] where it reads a `Pass`): `SHADER` runs on
 /// every adapter and tests the plane per fragment (the `*_discard` entry points of
 /// [`MIRROR_PLANE_FRAGMENTS`]); `CLIP_DISTANCE_SHADER` adds the hardware clip-distance
 /// vertex stage ([`MIRROR_PLANE_CLIP_DISTANCES`]) for adapters with `CLIP_DISTANCES`.
 #[macro_export]
 macro_rules! mirror_plane_shaders {
-    ($label:literal, $entry_points:expr) => {
+    ($label:literal, $($part:expr),+ $(,)?) => {
         static SHADER: $crate::wgsl::WgslSource = $crate::wgsl::WgslSource {
             label: $label,
             enable: &[],
             parts: &[
                 $crate::wgsl::SHADING,
                 $crate::wgsl::MIRROR_PLANE_VERTEX,
-                $entry_points,
+                $($part,)+
                 $crate::wgsl::MIRROR_PLANE_FRAGMENTS,
             ],
         };
@@ -62,7 +71,7 @@ macro_rules! mirror_plane_shaders {
             parts: &[
                 $crate::wgsl::SHADING,
                 $crate::wgsl::MIRROR_PLANE_VERTEX,
-                $entry_points,
+                $($part,)+
                 $crate::wgsl::MIRROR_PLANE_FRAGMENTS,
                 $crate::wgsl::MIRROR_PLANE_CLIP_DISTANCES,
             ],

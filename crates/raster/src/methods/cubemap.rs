@@ -55,7 +55,7 @@ pub static CUBEMAP: MethodEntry = MethodEntry {
 
 const ENTRY_POINTS: &str = include_str!("../../../../shaders/cubemap.wgsl");
 
-crate::mirror_plane_shaders!("cubemap", ENTRY_POINTS);
+crate::mirror_plane_shaders!("cubemap", ENTRY_POINTS, crate::wgsl::PASS_VIEW);
 
 fn gpu_structs() -> Vec<HostLayout> {
     vec![

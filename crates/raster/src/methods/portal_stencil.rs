@@ -31,9 +31,8 @@ use crate::pipeline::{
 };
 use crate::plan::PlanError;
 use crate::projection::NEARER_OR_EQUAL;
-use crate::shading::{SceneBuffers, VERTEX_LAYOUT};
-use crate::targets::{DEPTH_STENCIL_FORMAT, RenderTarget, depth_stencil_format};
-use crate::timing::FrameEncoder;
+use crate::shading::{OnePass, OnePassFrame, SceneBuffers, VERTEX_LAYOUT};
+use crate::targets::{DEPTH_STENCIL_FORMAT, depth_stencil_format};
 use crate::wgsl::HostLayout;
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec3, Vec4};
@@ -562,23 +561,19 @@ fn frame_stats(
     })
 }
 
-impl FrameEncoder for PortalStencil {
-    fn encode(
-        &self,
-        encoder: &mut wgpu::CommandEncoder,
-        target: &RenderTarget,
-        first_pass: Option<wgpu::RenderPassTimestampWrites<'_>>,
-    ) {
-        let mut pass = self.scene_buffers.begin_frame_pass(
-            encoder,
-            target,
-            "portal stencil pass",
-            self.background,
-            &self.depth_stencil,
-            Some(1),
-            (&self.path_bind_group, &[self.offsets[0]]),
-            first_pass,
-        );
+impl OnePassFrame for PortalStencil {
+    fn pass(&self) -> OnePass<'_> {
+        OnePass {
+            scene: &self.scene_buffers,
+            label: "portal stencil pass",
+            clear: self.background,
+            depth: &self.depth_stencil,
+            stencil: Some(1),
+            group1: (&self.path_bind_group, &self.offsets[..1]),
+        }
+    }
+
+    fn draw(&self, pass: &mut wgpu::RenderPass<'_>) {
         pass.set_vertex_buffer(0, self.scene_buffers.vertices.slice(..));
         let scissor = |pass: &mut wgpu::RenderPass<'_>, path: usize| {
             let [x, y, w, h] = self.scissors[path];
@@ -587,7 +582,7 @@ impl FrameEncoder for PortalStencil {
         for op in &self.ops {
             match *op {
                 Op::World { path, value } => {
-                    scissor(&mut pass, path);
+                    scissor(pass, path);
                     pass.set_stencil_reference(value);
                     pass.set_bind_group(1, &self.path_bind_group, &[self.offsets[path]]);
                     pass.set_pipeline(&self.pipelines.objects);
@@ -607,21 +602,21 @@ impl FrameEncoder for PortalStencil {
                     mirror,
                     value,
                 } => {
-                    scissor(&mut pass, child);
+                    scissor(pass, child);
                     pass.set_stencil_reference(value);
                     pass.set_bind_group(1, &self.path_bind_group, &[self.offsets[path]]);
                     pass.set_pipeline(&self.pipelines.mark);
                     pass.draw(self.scene_buffers.mirrors[mirror].clone(), 0..1);
                 }
                 Op::ClearRegion { path, value } => {
-                    scissor(&mut pass, path);
+                    scissor(pass, path);
                     pass.set_stencil_reference(value);
                     pass.set_bind_group(1, &self.path_bind_group, &[self.offsets[path]]);
                     pass.set_pipeline(&self.pipelines.clear_region);
                     pass.draw(0..3, 0..1);
                 }
                 Op::Retire { path, value } | Op::Decrement { path, value } => {
-                    scissor(&mut pass, path);
+                    scissor(pass, path);
                     pass.set_stencil_reference(value);
                     pass.set_pipeline(if matches!(op, Op::Retire { .. }) {
                         &self.pipelines.retire

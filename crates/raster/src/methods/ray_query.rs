@@ -29,9 +29,8 @@ use crate::method::{
 use crate::pipeline::{BindGroupBuilder, ScenePipeline, depth_state, pipeline_layout};
 use crate::plan::PlanError;
 use crate::projection::NEARER;
-use crate::shading::{SceneBuffers, VERTEX_LAYOUT};
-use crate::targets::{DEPTH_FORMAT, RenderTarget};
-use crate::timing::FrameEncoder;
+use crate::shading::{OnePass, OnePassFrame, SceneBuffers, VERTEX_LAYOUT};
+use crate::targets::DEPTH_FORMAT;
 use crate::wgsl::{HostLayout, WgslSource};
 use bytemuck::{Pod, Zeroable};
 use mirrorbox_scene::Scene;
@@ -82,6 +81,7 @@ static SHADER: WgslSource = WgslSource {
     enable: &["wgpu_ray_query"],
     parts: &[
         crate::wgsl::SHADING_CONTRACT,
+        crate::wgsl::SCENE_VERTEX,
         crate::camera_rays::WGSL,
         include_str!("../../../../shaders/ray_query.wgsl"),
     ],
@@ -559,23 +559,19 @@ impl Pipelines {
     }
 }
 
-impl FrameEncoder for RayQueryFrame {
-    fn encode(
-        &self,
-        encoder: &mut wgpu::CommandEncoder,
-        target: &RenderTarget,
-        first_pass: Option<wgpu::RenderPassTimestampWrites<'_>>,
-    ) {
-        let mut pass = self.scene_buffers.begin_frame_pass(
-            encoder,
-            target,
-            "ray query pass",
-            self.background,
-            &self.depth,
-            None,
-            (&self.bind_group, &[]),
-            first_pass,
-        );
+impl OnePassFrame for RayQueryFrame {
+    fn pass(&self) -> OnePass<'_> {
+        OnePass {
+            scene: &self.scene_buffers,
+            label: "ray query pass",
+            clear: self.background,
+            depth: &self.depth,
+            stencil: None,
+            group1: (&self.bind_group, &[]),
+        }
+    }
+
+    fn draw(&self, pass: &mut wgpu::RenderPass<'_>) {
         if self.settings.primary_rays {
             pass.set_pipeline(&self.pipelines.primary_rays);
             pass.draw(0..3, 0..1);

@@ -112,7 +112,7 @@ pub static PATH_TEXTURES: MethodEntry = MethodEntry {
 
 const ENTRY_POINTS: &str = include_str!("../../../../shaders/recursive_texture.wgsl");
 
-crate::mirror_plane_shaders!("recursive texture", ENTRY_POINTS);
+crate::mirror_plane_shaders!("recursive texture", ENTRY_POINTS, crate::wgsl::PASS_VIEW);
 
 /// The shader variants of every texture method (this file's and `feedback`'s).
 pub(crate) static SHADERS: &[&crate::wgsl::WgslSource] = &[&SHADER, &CLIP_DISTANCE_SHADER];

@@ -101,6 +101,7 @@ static SHADER: WgslSource = WgslSource {
     enable: &[],
     parts: &[
         crate::wgsl::SHADING,
+        crate::wgsl::SCENE_VERTEX,
         crate::camera_rays::WGSL,
         include_str!("../../../../shaders/screen_space_reflections.wgsl"),
     ],

@@ -105,7 +105,11 @@ const ENTRY_POINTS: &str = include_str!("../../../../shaders/symmetry.wgsl");
 pub(crate) static SHADER: WgslSource = WgslSource {
     label: "symmetry",
     enable: &[],
-    parts: &[crate::wgsl::SHADING, ENTRY_POINTS],
+    parts: &[
+        crate::wgsl::SHADING,
+        crate::wgsl::SCENE_VERTEX,
+        ENTRY_POINTS,
+    ],
 };
 
 /// Adds the hardware clip-distance stage, for adapters with `CLIP_DISTANCES` (p ≤ 8).
@@ -114,6 +118,7 @@ pub(crate) static CLIP_DISTANCE_SHADER: WgslSource = WgslSource {
     enable: &["clip_distances"],
     parts: &[
         crate::wgsl::SHADING,
+        crate::wgsl::SCENE_VERTEX,
         ENTRY_POINTS,
         include_str!("../../../../shaders/symmetry_clip_distances.wgsl"),
     ],

@@ -44,9 +44,8 @@ use crate::method::{
 use crate::pipeline::{BindGroupBuilder, ScenePipeline, depth_state, pipeline_layout};
 use crate::plan::PlanError;
 use crate::projection::NEARER;
-use crate::shading::{SceneBuffers, VERTEX_LAYOUT};
-use crate::targets::{DEPTH_FORMAT, RenderTarget};
-use crate::timing::FrameEncoder;
+use crate::shading::{OnePass, OnePassFrame, SceneBuffers, VERTEX_LAYOUT};
+use crate::targets::DEPTH_FORMAT;
 use crate::wgsl::{HostLayout, WgslSource};
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3, Vec4};
@@ -707,23 +706,19 @@ impl Pipelines {
     }
 }
 
-impl FrameEncoder for Unrolled {
-    fn encode(
-        &self,
-        encoder: &mut wgpu::CommandEncoder,
-        target: &RenderTarget,
-        first_pass: Option<wgpu::RenderPassTimestampWrites<'_>>,
-    ) {
-        let mut pass = self.scene_buffers.begin_frame_pass(
-            encoder,
-            target,
-            "unrolled pass",
-            self.clear,
-            &self.depth,
-            None,
-            (&self.bind_group, &[]),
-            first_pass,
-        );
+impl OnePassFrame for Unrolled {
+    fn pass(&self) -> OnePass<'_> {
+        OnePass {
+            scene: &self.scene_buffers,
+            label: "unrolled pass",
+            clear: self.clear,
+            depth: &self.depth,
+            stencil: None,
+            group1: (&self.bind_group, &[]),
+        }
+    }
+
+    fn draw(&self, pass: &mut wgpu::RenderPass<'_>) {
         if let Some((buffer, count)) = &self.background {
             pass.set_pipeline(&self.pipelines.background);
             pass.set_vertex_buffer(0, buffer.slice(..));
