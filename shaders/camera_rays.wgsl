@@ -1,5 +1,5 @@
 // The camera on the GPU for the methods that follow rays from it (ray_query.wgsl,
-// screen_space_reflections.wgsl), driven by crates/raster/src/camera_rays.rs: its raster
+// screen_space_reflections.wgsl), driven by crates/raster/src/gpu/camera_rays.rs: its raster
 // transform, and its primary ray through any position of the render target — the CPU's
 // crates/scene/src/camera.rs, `RayGenerator::dir`, in f32:
 // d = normalize(forward + (ndc_x − shift_x)·right + ndc_y·up), right and up scaled by the

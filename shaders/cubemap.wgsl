@@ -1,9 +1,10 @@
 // Entry points of crates/raster/src/methods/cubemap.rs: one scene pass — a cube face seen
 // from a cube map's centre, or the camera's view — in which a mirror shows a cube map looked
 // up by the reflected view direction, as if everything it reflects were infinitely far away
-// (the method's parallax error). Prepended with shading.wgsl; followed by
-// mirror_plane_fragments.wgsl (and mirror_plane_clip_distances.wgsl where the adapter has
-// clip distances): a per-mirror cube keeps what lies in front of its mirror.
+// (the method's parallax error). Prepended with shading.wgsl and mirror_plane_vertex.wgsl;
+// followed by pass_view.wgsl and mirror_plane_fragments.wgsl (and
+// mirror_plane_clip_distances.wgsl where the adapter has clip distances): a per-mirror cube
+// keeps what lies in front of its mirror.
 
 struct Pass {
     clip_from_world: mat4x4f,

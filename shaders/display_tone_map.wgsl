@@ -1,4 +1,4 @@
-// Entry points of crates/raster/src/display_tone_map.rs: the linear image tone-mapped to the
+// Entry points of crates/raster/src/gpu/display_tone_map.rs: the linear image tone-mapped to the
 // 8-bit sRGB bytes `RgbImage::to_srgb8` writes, drawn into a rectangle of an RGBA8 or BGRA8
 // unorm target (what `mirrorbox view` paints as the method's pane, inside the window's own
 // paint).

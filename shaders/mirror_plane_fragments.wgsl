@@ -1,7 +1,7 @@
 // The fragment entry points of the methods that draw a mirror's world through the mirror's
-// plane (crates/raster/src/methods/portal_stencil.rs and recursive_texture.rs), composed
-// after the method's file, which defines `VertexOut` (with `plane_distance`),
-// `object_colour` and `mirror_colour`.
+// plane (crates/raster/src/methods/portal_stencil.rs, recursive_texture.rs and cubemap.rs),
+// composed after mirror_plane_vertex.wgsl (`VertexOut`, with `plane_distance`) and the
+// method's file, which defines `object_colour` and `mirror_colour`.
 
 @fragment
 fn fs_object(in: VertexOut) -> @location(0) vec4f {

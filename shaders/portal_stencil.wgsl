@@ -1,7 +1,8 @@
-// Entry points of crates/raster/src/portal_stencil.rs: exact mirrors by stencil recursion.
+// Entry points of crates/raster/src/methods/portal_stencil.rs: exact mirrors by stencil recursion.
 // Each reflection path draws its world where the stencil holds its value, in front of its last
 // mirror, attenuated by the product of the reflectances along it. Prepended with
-// shading.wgsl; followed by mirror_plane_clip_distances.wgsl where the adapter has clip
+// shading.wgsl and mirror_plane_vertex.wgsl; followed by mirror_plane_fragments.wgsl, and by
+// mirror_plane_clip_distances.wgsl where the adapter has clip
 // distances (vs_clip_distances with fs_object / fs_mirror / fs_none), else the plane is
 // tested per fragment (vs_main with the *_discard entry points).
 

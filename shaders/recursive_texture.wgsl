@@ -1,6 +1,7 @@
-// Entry points of crates/raster/src/recursive_texture.rs: one scene pass of the seed paper's
+// Entry points of crates/raster/src/methods/recursive_texture.rs: one scene pass of the seed paper's
 // Algorithm 1, drawn from a (possibly reflected) camera into a screen-space texture, keeping
-// what lies in front of the pass's mirror. Prepended with shading.wgsl; followed by
+// what lies in front of the pass's mirror. Prepended with shading.wgsl and
+// mirror_plane_vertex.wgsl; followed by pass_view.wgsl, mirror_plane_fragments.wgsl and
 // mirror_plane_clip_distances.wgsl where the adapter has clip distances (vs_clip_distances with
 // fs_object / fs_mirror), else the plane is tested per fragment (vs_main with
 // fs_object_discard / fs_mirror_discard).

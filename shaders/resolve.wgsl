@@ -1,4 +1,4 @@
-// Entry points of crates/raster/src/resolve.rs: box-filters the s×s supersampled image down
+// Entry points of crates/raster/src/gpu/resolve.rs: box-filters the s×s supersampled image down
 // to the output, summing the samples row by row like the tracer (docs/shading.md).
 
 struct Resolve {

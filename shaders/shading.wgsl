@@ -211,7 +211,7 @@ fn texture_sample(m: TextureMap, uv: vec2f) -> vec3f {
 }
 
 // A diffuse surface's albedo and emission at texture coordinates uv: factor × texture.
-// TEXTURED is set by the composer (crates/raster/src/wgsl.rs): false for a scene without
+// TEXTURED is set by the composer (crates/raster/src/gpu/wgsl.rs): false for a scene without
 // textures, where the lookups are dead code.
 fn surface_albedo(s: Surface, uv: vec2f) -> vec3f {
     if (!TEXTURED || s.albedo_map.present == 0u) {

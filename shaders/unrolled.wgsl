@@ -1,4 +1,4 @@
-// Entry points of crates/raster/src/unrolled.rs: every kept reflection path drawn as
+// Entry points of crates/raster/src/methods/unrolled.rs: every kept reflection path drawn as
 // instances of the scene, one per convex piece of its visible region. Prepended with
 // shading.wgsl; unrolled_clip_distances.wgsl adds the hardware-clipped vertex stage where the
 // adapter has clip distances.

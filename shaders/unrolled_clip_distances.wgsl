@@ -1,4 +1,4 @@
-// The clip-distance vertex stage of crates/raster/src/unrolled.rs, compiled only where the
+// The clip-distance vertex stage of crates/raster/src/methods/unrolled.rs, compiled only where the
 // adapter has `clip_distances` (the module starts with `enable clip_distances;`, then
 // shading.wgsl and unrolled.wgsl). Distance 0 is the last mirror's plane, 1..=7 the piece's
 // edges; the hardware clips, so the fragment stage needs no discard and keeps early depth.
