@@ -176,6 +176,10 @@ pub enum Reference {
     Curve(String, Vec<(f64, f64)>),
 }
 
+/// What an axis label adds when its points carry their 95 % intervals as bars
+/// (`"ms/frame (median, 95 % CI bars)"`); [`Chart::axis_label`] drops it where none is drawn.
+pub const CI_BARS: &str = ", 95 % CI bars";
+
 pub struct Chart {
     pub title: String,
     pub x_label: String,
@@ -195,6 +199,21 @@ pub struct Chart {
 }
 
 impl Chart {
+    /// An axis label as drawn: a label that promises interval bars ([`CI_BARS`]) keeps the
+    /// promise only where some series draws an interval on that axis (issue 54: every
+    /// frontier chart said "95 % CI bars" and drew none).
+    fn axis_label(&self, label: &str, intervals: fn(&Series) -> &Vec<Option<[f64; 2]>>) -> String {
+        let drawn = self
+            .series
+            .iter()
+            .any(|s| intervals(s).iter().any(Option::is_some));
+        if drawn {
+            label.to_string()
+        } else {
+            label.replace(CI_BARS, "")
+        }
+    }
+
     /// A chart with no series yet, log axes as given, no footer.
     pub fn new(
         title: impl Into<String>,
@@ -664,14 +683,14 @@ impl Chart {
             r#"<text x="{:.1}" y="{:.1}" text-anchor="middle">{}</text>"#,
             LEFT + PLOT_W / 2.0,
             TOP + PLOT_H + 36.0,
-            esc(&self.x_label)
+            esc(&self.axis_label(&self.x_label, |s| &s.x_intervals))
         );
         let _ = writeln!(
             s,
             r#"<text x="18" y="{:.1}" text-anchor="middle" transform="rotate(-90 18 {:.1})">{}</text>"#,
             TOP + PLOT_H / 2.0,
             TOP + PLOT_H / 2.0,
-            esc(&self.y_label)
+            esc(&self.axis_label(&self.y_label, |s| &s.y_intervals))
         );
         let mut below = TOP + PLOT_H + 54.0;
         if let Some(note) = floor_note {
@@ -909,6 +928,24 @@ impl Chart {
 
 #[cfg(test)]
 mod tests {
+    /// An axis label claims interval bars only where some series draws one on that axis.
+    #[test]
+    fn an_axis_promises_ci_bars_only_where_they_are_drawn() {
+        let label = "ms/frame (median, 95 % CI bars)";
+        let mut chart = Chart {
+            series: vec![Series::new(
+                "a",
+                method_style("naive"),
+                vec![(1.0, 2.0), (3.0, 4.0)],
+            )],
+            ..Chart::new("t", label, "FLIP")
+        };
+        let svg = chart.to_svg();
+        assert!(svg.contains(">ms/frame (median)<"), "{svg}");
+        chart.series[0].x_intervals = vec![Some([0.9, 1.1]), None];
+        assert!(chart.to_svg().contains(">ms/frame (median, 95 % CI bars)<"));
+    }
+
     use super::*;
 
     fn chart(series: Vec<Series>) -> Chart {
