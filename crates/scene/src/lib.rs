@@ -83,6 +83,14 @@ impl Mirror {
     pub fn plane(&self) -> Plane {
         Plane::from_point_normal(self.center, self.normal)
     }
+
+    /// Whether the mirror lies in `plane` (every corner within 1e-5 scene units of it): a
+    /// pass through that plane's mirror does not draw it, it is the portal itself.
+    pub fn lies_in(&self, plane: &Plane) -> bool {
+        self.corners()
+            .iter()
+            .all(|c| plane.signed_distance(*c).abs() < 1e-5)
+    }
 }
 
 /// A validated scene: what a scene file describes, with every number checked.

@@ -365,15 +365,12 @@ impl CubeFrame {
 
         let clipping = pipelines.clipping;
 
-        let stats = FrameStats {
-            depth: state.first_depth(),
-            ..frame_stats(
-                &cube_mirrors,
-                scene.mirrors.len(),
-                scene_buffers.objects.len() / 3,
-                clipping,
-            )
-        };
+        let stats = frame_stats(
+            &cube_mirrors,
+            scene.mirrors.len(),
+            scene_buffers.objects.len() / 3,
+            (state.first_depth(), clipping),
+        );
         Ok(CubeFrame {
             scene_buffers,
             pipelines,
@@ -512,26 +509,18 @@ fn cube_mirrors(scene: &Scene, cubes: &[Cube]) -> Vec<Vec<usize>> {
         .iter()
         .map(|c| {
             (0..scene.mirrors.len())
-                .filter(|&j| {
-                    c.plane.is_none_or(|p| {
-                        !scene.mirrors[j]
-                            .corners()
-                            .iter()
-                            .all(|x| p.signed_distance(*x).abs() < 1e-5)
-                    })
-                })
+                .filter(|&j| c.plane.is_none_or(|p| !scene.mirrors[j].lies_in(&p)))
                 .collect()
         })
         .collect()
 }
 
-/// The frame's passes (six faces per cube, and the main pass), draws and triangles; its
-/// depth left to the caller.
+/// The frame's passes (six faces per cube, and the main pass), draws and triangles.
 fn frame_stats(
     cube_mirrors: &[Vec<usize>],
     mirrors: usize,
     object_triangles: usize,
-    clipping: crate::method::Clipping,
+    (depth, clipping): (usize, crate::method::Clipping),
 ) -> FrameStats {
     let cubes = cube_mirrors.len();
     let passes = 6 * cubes + 1;
@@ -540,7 +529,7 @@ fn frame_stats(
         passes,
         texture_renders: 6 * cubes,
         draws: passes + mirror_draws + 1,
-        depth: 0,
+        depth,
         triangles: passes * object_triangles + 2 * mirror_draws,
         paths: None,
         clipping,

@@ -299,16 +299,13 @@ impl FeedbackFrame {
             .map(|v| pipelines.mirror_bind_group(gpu, &buffer, v))
             .collect();
 
-        let stats = FrameStats {
-            depth: state.first_depth(),
-            clipping: pipelines.clipping,
-            ..frame_stats(
-                &camera_draws,
-                &main_draws,
-                state.carried().is_some(),
-                scene_buffers.objects.len() / 3,
-            )
-        };
+        let stats = frame_stats(
+            &camera_draws,
+            &main_draws,
+            state.carried().is_some(),
+            scene_buffers.objects.len() / 3,
+            (state.first_depth(), pipelines.clipping),
+        );
         Ok(FeedbackFrame {
             scene_buffers,
             pipelines,
@@ -395,12 +392,13 @@ impl FrameEncoder for FeedbackFrame {
 }
 
 /// The frame's passes (one per mirror camera, and the main pass), draws and triangles,
-/// reading the carried textures where there are some; depth and clipping left to the caller.
+/// reading the carried textures where there are some.
 fn frame_stats(
     camera_draws: &[Vec<Vec<Draw>>; 4],
     main_draws: &[Vec<Draw>; 2],
     carried: bool,
     object_triangles: usize,
+    (depth, clipping): (usize, crate::method::Clipping),
 ) -> FrameStats {
     let read = if carried {
         Source::Carried
@@ -418,10 +416,10 @@ fn frame_stats(
         passes,
         texture_renders: cameras,
         draws: passes + mirror_draws + 1,
-        depth: 0,
+        depth,
         triangles: passes * object_triangles + 2 * mirror_draws,
         paths: None,
-        clipping: crate::method::Clipping::None,
+        clipping,
         depth_format: DEPTH_FORMAT,
         copies: None,
     }
@@ -470,12 +468,7 @@ fn draw_lists(
         };
         let mut draws = Vec::new();
         for (j, mirror) in scene.mirrors.iter().enumerate() {
-            if let Some(p) = plane
-                && mirror
-                    .corners()
-                    .iter()
-                    .all(|c| p.signed_distance(*c).abs() < 1e-5)
-            {
+            if plane.is_some_and(|p| mirror.lies_in(p)) {
                 continue;
             }
             let texture = set.and_then(|(cams, base)| {

@@ -592,12 +592,7 @@ impl Builder<'_> {
                 continue;
             }
             let mirror = &self.scene.mirrors[inst.mirror];
-            if let Some(p) = plane
-                && mirror
-                    .corners()
-                    .iter()
-                    .all(|c| p.signed_distance(*c).abs() < 1e-5)
-            {
+            if plane.is_some_and(|p| mirror.lies_in(p)) {
                 continue;
             }
             let binding = match children.iter().find(|(c, _)| c.instance == i) {
