@@ -18,13 +18,15 @@ use crate::method::{
     RasterMethod, SweepAxis,
 };
 use crate::methods::feedback::HISTORY;
-use crate::methods::recursive_texture::{TexturePipelines, check_mirror_textures};
+use crate::methods::recursive_texture::{
+    TexturePipelines, check_mirror_textures, texture_frame_stats,
+};
 use crate::ping_pong::{Carried, PingPong, Source};
 use crate::pipeline::{UniformArena, dynamic_uniform_entry, record_binding};
 use crate::plan::PlanError;
 use crate::projection::camera_projection;
 use crate::shading::SceneBuffers;
-use crate::targets::{DEPTH_FORMAT, RenderTarget, texture_entry};
+use crate::targets::{RenderTarget, texture_entry};
 use crate::timing::{FrameEncoder, FrameHistory};
 use crate::wgsl::HostLayout;
 use bytemuck::{Pod, Zeroable};
@@ -365,9 +367,10 @@ impl CubeFrame {
 
         let clipping = pipelines.clipping;
 
-        let stats = frame_stats(
-            &cube_mirrors,
-            scene.mirrors.len(),
+        // Six faces a cube, each drawing its cube's mirrors, then the main pass all of them.
+        let stats = texture_frame_stats(
+            (6 * cubes.len(), 1),
+            6 * cube_mirrors.iter().map(Vec::len).sum::<usize>() + scene.mirrors.len(),
             scene_buffers.objects.len() / 3,
             (state.first_depth(), clipping),
         );
@@ -513,29 +516,6 @@ fn cube_mirrors(scene: &Scene, cubes: &[Cube]) -> Vec<Vec<usize>> {
                 .collect()
         })
         .collect()
-}
-
-/// The frame's passes (six faces per cube, and the main pass), draws and triangles.
-fn frame_stats(
-    cube_mirrors: &[Vec<usize>],
-    mirrors: usize,
-    object_triangles: usize,
-    (depth, clipping): (usize, crate::method::Clipping),
-) -> FrameStats {
-    let cubes = cube_mirrors.len();
-    let passes = 6 * cubes + 1;
-    let mirror_draws: usize = 6 * cube_mirrors.iter().map(Vec::len).sum::<usize>() + mirrors;
-    FrameStats {
-        passes,
-        texture_renders: 6 * cubes,
-        draws: passes + mirror_draws + 1,
-        depth,
-        triangles: passes * object_triangles + 2 * mirror_draws,
-        paths: None,
-        clipping,
-        depth_format: DEPTH_FORMAT,
-        copies: None,
-    }
 }
 
 impl FrameEncoder for CubeFrame {

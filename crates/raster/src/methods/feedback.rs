@@ -25,12 +25,13 @@ use crate::method::{
 };
 use crate::methods::recursive_texture::{
     MirrorUniform, SHADERS, ScreenSpace, TexturePipelines, check_mirror_textures, gpu_structs,
+    texture_frame_stats,
 };
 use crate::ping_pong::{Carried, PingPong, Source};
 use crate::pipeline::UniformArena;
 use crate::plan::{MirrorCamera, PlanError, Rect};
 use crate::shading::SceneBuffers;
-use crate::targets::{DEPTH_FORMAT, RenderTarget};
+use crate::targets::RenderTarget;
 use crate::timing::{FrameEncoder, FrameHistory};
 use bytemuck::Zeroable;
 use glam::{Mat4, Vec3, Vec4};
@@ -299,10 +300,9 @@ impl FeedbackFrame {
             .map(|v| pipelines.mirror_bind_group(gpu, &buffer, v))
             .collect();
 
-        let stats = frame_stats(
-            &camera_draws,
-            &main_draws,
-            state.carried().is_some(),
+        let stats = texture_frame_stats(
+            (cameras.len(), 1),
+            mirror_draws(&camera_draws, &main_draws, state.carried().is_some()),
             scene_buffers.objects.len() / 3,
             (state.first_depth(), pipelines.clipping),
         );
@@ -391,38 +391,23 @@ impl FrameEncoder for FeedbackFrame {
     }
 }
 
-/// The frame's passes (one per mirror camera, and the main pass), draws and triangles,
-/// reading the carried textures where there are some.
-fn frame_stats(
+/// The mirrors a frame draws: each mirror camera's pass, reading the carried textures where
+/// there are some, then the main pass.
+fn mirror_draws(
     camera_draws: &[Vec<Vec<Draw>>; 4],
     main_draws: &[Vec<Draw>; 2],
     carried: bool,
-    object_triangles: usize,
-    (depth, clipping): (usize, crate::method::Clipping),
-) -> FrameStats {
+) -> usize {
     let read = if carried {
         Source::Carried
     } else {
         Source::Nothing
     };
-    let cameras = camera_draws[0].len();
-    let passes = cameras + 1;
-    let mirror_draws = camera_draws[source_index(read)]
+    camera_draws[source_index(read)]
         .iter()
         .map(Vec::len)
         .sum::<usize>()
-        + main_draws[0].len();
-    FrameStats {
-        passes,
-        texture_renders: cameras,
-        draws: passes + mirror_draws + 1,
-        depth,
-        triangles: passes * object_triangles + 2 * mirror_draws,
-        paths: None,
-        clipping,
-        depth_format: DEPTH_FORMAT,
-        copies: None,
-    }
+        + main_draws[0].len()
 }
 
 /// The two sets of this frame's textures, written in turn (one per mirror camera each).

@@ -780,24 +780,12 @@ impl RecursiveTexture {
         for d in b.passes.iter_mut().flat_map(|p| p.draws.iter_mut()) {
             d.bind_group = group_of_binding[d.bind_group];
         }
-        let clipping = pipelines.clipping;
-        let draws: usize = b.passes.iter().map(|p| 1 + p.draws.len()).sum::<usize>() + 1;
-        let object_triangles = scene_buffers.objects.len() / 3;
-        let stats = FrameStats {
-            passes: plan.passes - 1 + views.len(),
-            texture_renders: plan.passes - 1,
-            draws,
-            depth: plan.depth,
-            triangles: b
-                .passes
-                .iter()
-                .map(|p| object_triangles + 2 * p.draws.len())
-                .sum(),
-            paths: None,
-            clipping,
-            depth_format: DEPTH_FORMAT,
-            copies: None,
-        };
+        let stats = texture_frame_stats(
+            (plan.passes - 1, views.len()),
+            b.passes.iter().map(|p| p.draws.len()).sum(),
+            scene_buffers.objects.len() / 3,
+            (plan.depth, pipelines.clipping),
+        );
         Ok(RecursiveTexture {
             scene_buffers,
             pipelines,
@@ -813,6 +801,29 @@ impl RecursiveTexture {
             },
             stats,
         })
+    }
+}
+
+/// The stats of a frame of `texture_renders` texture passes and `main_passes` main passes
+/// (the paper's methods, `feedback`, `cubemap`), each drawing the scene's objects, with
+/// `mirror_draws` mirrors drawn in all: a draw per pass and per mirror, and the resolve.
+pub(crate) fn texture_frame_stats(
+    (texture_renders, main_passes): (usize, usize),
+    mirror_draws: usize,
+    object_triangles: usize,
+    (depth, clipping): (usize, crate::method::Clipping),
+) -> FrameStats {
+    let passes = texture_renders + main_passes;
+    FrameStats {
+        passes,
+        texture_renders,
+        draws: passes + mirror_draws + 1,
+        depth,
+        triangles: passes * object_triangles + 2 * mirror_draws,
+        paths: None,
+        clipping,
+        depth_format: DEPTH_FORMAT,
+        copies: None,
     }
 }
 
