@@ -6,11 +6,14 @@
 #   .gpu/<test>.gz             the raster crate's test binaries (goldens, truth agreement)
 #   .gl/*.deb                  the Vulkan/EGL loaders (libvulkan1, libglvnd, …)
 # Usage there (repository root, `.gl` and `.gpu` carried):
-#   scripts/gpu-measure.sh STEP...      steps: info table1 table1-repeat table1-1080p depth
-#                                       depth-1080p room trace tests retest symmetry lighting
-# Results go to reports/gpu/ and, packed, to $OUT/gpu.tar.gz (what comes back). Each step is
-# skipped once less than its own budget is left of MIRRORBOX_GPU_DEADLINE seconds (default 540),
-# so the command ends inside the tool's 10-minute limit; sweeps resume where a cut one stopped.
+#   scripts/gpu-measure.sh STEP...      steps: info frontier engine real-assets table1-pair
+#                                       table1 table1-repeat table1-1080p depth depth-1080p
+#                                       room trace tests retest symmetry lighting
+# Results go to reports/gpu/ and, packed one archive per step, to $OUT/gpu-STEP.tar.gz (what
+# comes back: at most 8 files of 16 MiB each, so a step's images travel in its own archive).
+# Each step is skipped once less than its own budget is left of MIRRORBOX_GPU_DEADLINE seconds
+# (default 540), so the command ends inside the tool's 10-minute limit; sweeps resume where a
+# cut one stopped.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 out=${OUT:-/tmp/gpu-out}
@@ -33,13 +36,29 @@ mkdir -p /tmp/gpu-bin
 for f in .gpu/*.gz; do gunzip -c "$f" >"/tmp/gpu-bin/$(basename "$f" .gz)"; done
 chmod +x /tmp/gpu-bin/*
 bin=/tmp/gpu-bin/mirrorbox
+# The commit the binary was built from (scripts/gpu-prepare.sh), for the records.
+if [ -f .gpu/commit.txt ]; then
+  MIRRORBOX_SOURCE_COMMIT=$(cat .gpu/commit.txt)
+  export MIRRORBOX_SOURCE_COMMIT
+fi
 
+# The 2CylinderEngine glTF of `real-assets` (Debian's assimp-testmodels here), carried in
+# .gpu/assets/ by scripts/gpu-prepare.sh and put where scenes/imported/engine_box.json names it.
+engine_glb=/usr/share/assimp/models/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb
+if [ ! -f "$engine_glb" ] && [ -f .gpu/assets/2CylinderEngine.glb ]; then
+  mkdir -p "$(dirname "$engine_glb")" && cp .gpu/assets/2CylinderEngine.glb "$engine_glb"
+fi
+
+# pack NAME: what the step wrote (reports/gpu/ files newer than its start marker) into
+# $OUT/gpu-NAME.tar.gz. Truth caches, locks and 1920×1080 images (several MiB each: too large
+# to bring back or to keep in git) stay behind; those reports keep their numbers and plots.
 pack() {
-  # 1920×1080 images (several MiB each) stay behind: too large to bring back (16 MiB a file)
-  # or to keep in git; those reports keep their numbers and plots.
-  tar -czf "$out/gpu.tar.gz.part" --exclude='*/cache' --exclude='.mirrorbox.lock' \
-    --exclude='reports/gpu/*_1080p/images' reports/gpu &&
-    mv "$out/gpu.tar.gz.part" "$out/gpu.tar.gz"
+  local name=$1
+  (find reports/gpu -type f -newer "$out/.started-$name" -not -path '*/cache/*' \
+    -not -name '.mirrorbox.lock' -not -path 'reports/gpu/*_1080p/images/*' -print0 |
+    tar -czf "$out/gpu-$name.tar.gz.part" --null -T -) &&
+    mv "$out/gpu-$name.tar.gz.part" "$out/gpu-$name.tar.gz"
+  rm -f "$out/.started-$name"
 }
 
 # step NAME BUDGET_SECONDS COMMAND...: runs COMMAND (a program with a timeout of what is left,
@@ -53,13 +72,15 @@ step() {
     return
   fi
   say "== $name: start"
+  touch "$out/.started-$name"
+  sleep 1 # the marker's time is in whole seconds on some file systems
   if declare -F "$1" >/dev/null; then
     "$@" >>"$log" 2>&1 # a function of this script: its commands carry their own timeouts
   else
     timeout "$left" "$@" >>"$log" 2>&1
   fi
   say "== $name: exit $?"
-  pack
+  pack "$name"
 }
 
 info() {
@@ -154,10 +175,24 @@ depth_1080p() {
     --out reports/gpu/depth_scaling_1080p
 }
 
+# Table 1 twice on this device, back to back (issue 57: a repeat is only a repeat on the same
+# device and in the same lease), into folders named after the GPU (the H100's table1/ stays).
+table1_pair() {
+  local gpu
+  gpu=$(nvidia-smi --query-gpu=name --format=csv,noheader 2>/dev/null | head -n1 | grep -oE 'H[0-9]+' | tr 'H' 'h')
+  gpu=${gpu:-gpu}
+  timeout 200 "$bin" experiment table1 --fresh --out "reports/gpu/table1_$gpu" &&
+    timeout 200 "$bin" experiment table1-repeat --fresh --out "reports/gpu/table1_repeat_$gpu"
+}
+
 say "steps: $*"
 for s in "$@"; do
   case $s in
   info) step info 10 info ;;
+  frontier) step frontier 120 "$bin" experiment frontier --out reports/gpu/frontier_box ;;
+  engine) step engine-reflections 150 "$bin" experiment engine-reflections --out reports/gpu/engine_reflections ;;
+  real-assets) step real-assets 90 "$bin" experiment real-assets --out reports/gpu/real_assets ;;
+  table1-pair) step table1-pair 100 table1_pair ;;
   table1) step table1 120 "$bin" experiment table1 --out reports/gpu/table1 ;;
   depth) step depth-scaling 120 "$bin" experiment depth-scaling --out reports/gpu/depth_scaling ;;
   room) step room 120 room ;;
@@ -172,5 +207,4 @@ for s in "$@"; do
   *) say "unknown step $s" ;;
   esac
 done
-pack
 say "done"

@@ -11,18 +11,35 @@ rm -rf .gpu && mkdir -p .gpu .gl
 "${CARGO:-cargo}" build --release --locked -p mirrorbox
 strip -o .gpu/mirrorbox target/release/mirrorbox
 # The raster crate's test binaries (dev profile, optimized): their paths from cargo's messages.
-"${CARGO:-cargo}" test --locked -p mirrorbox-raster --no-run --message-format=json 2>/dev/null |
-  python3 -c '
+# MIRRORBOX_GPU_TESTS=0 leaves them out (the `tests` and `retest` steps need them; the
+# measurements do not, and the binaries are most of what travels).
+if [ "${MIRRORBOX_GPU_TESTS:-1}" != 0 ]; then
+  "${CARGO:-cargo}" test --locked -p mirrorbox-raster --no-run --message-format=json 2>/dev/null |
+    python3 -c '
 import json, sys
 for line in sys.stdin:
     m = json.loads(line)
     if m.get("reason") == "compiler-artifact" and m.get("executable") and m["profile"]["test"]:
         print(m["target"]["name"], m["executable"])
 ' | while read -r name exe; do
-  [ "$name" = structure ] && continue # reads sources only; nothing GPU-dependent
-  strip -o ".gpu/test_$name" "$exe"
-done
+    [ "$name" = structure ] && continue # reads sources only; nothing GPU-dependent
+    strip -o ".gpu/test_$name" "$exe"
+  done
+fi
 gzip -9 .gpu/*
+# The commit the binary was built from, as the sweeps record it (harness `source_commit`, read
+# there from MIRRORBOX_SOURCE_COMMIT): the GPU machine has no history to ask.
+commit=$(git describe --always --abbrev=10)
+if [ -n "$(git status --porcelain -- crates shaders scenes scripts tools Cargo.toml Cargo.lock)" ]; then
+  commit="$commit-dirty"
+fi
+echo "$commit" >.gpu/commit.txt
+# The real-assets experiment's engine (Debian's assimp-testmodels here; the GPU machine has
+# no package registry).
+engine_glb=/usr/share/assimp/models/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb
+if [ -f "$engine_glb" ]; then
+  mkdir -p .gpu/assets && cp "$engine_glb" .gpu/assets/
+fi
 if ! ls .gl/libvulkan1_*.deb >/dev/null 2>&1; then
   # Not through scripts/lib/apt.sh: a private lists folder and `apt-get download` into .gl/
   # take none of the system's apt or dpkg locks (checked with apt 2.6.1 while all four were

@@ -2295,3 +2295,52 @@ fn import_writes_a_scene_that_traces_and_renders_and_a_broken_gltf_exits_2() {
     assert!(!out.stderr.contains("panicked"), "{}", out.stderr);
     assert!(!refused.exists(), "a refused import wrote its output");
 }
+
+/// Issue 57: a sweep on an adapter without a feature one of its methods needs (ray queries on
+/// llvmpipe's GL here; on the H100/H200's Vulkan) measures the others and says what it left
+/// out, in its output and its report, instead of failing every point.
+#[test]
+fn a_sweep_leaves_out_the_methods_its_adapter_cannot_run_and_says_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let out_dir = dir.path().join("sweep");
+    let out = mirrorbox(
+        &[
+            "sweep",
+            "scenes/mirror_box.json",
+            "--methods",
+            "ray-query,portal",
+            "--depth",
+            "1",
+            "--alpha",
+            "1",
+            "--width",
+            "32",
+            "--height",
+            "18",
+            "--frames",
+            "1",
+            "--out",
+            out_dir.to_str().unwrap(),
+        ],
+        &[("WGPU_BACKEND", "gl")],
+    );
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    assert!(
+        out.stderr.contains("ray-query depth=1")
+            && out.stderr.contains("left out: --method ray-query needs"),
+        "{}",
+        out.stderr
+    );
+    assert!(out.stdout.contains("1 left out"), "{}", out.stdout);
+    let results = std::fs::read_to_string(out_dir.join("results.jsonl")).unwrap();
+    let methods: Vec<String> = results
+        .lines()
+        .map(|l| serde_json::from_str::<Value>(l).unwrap()["method"].to_string())
+        .collect();
+    assert_eq!(methods, ["\"floor\"", "\"portal\""], "{results}");
+    let report = std::fs::read_to_string(out_dir.join("report.md")).unwrap();
+    assert!(
+        report.contains("Not measured on this adapter") && report.contains("ray-query"),
+        "{report}"
+    );
+}

@@ -350,6 +350,11 @@ pub enum Event<'a> {
     Finished {
         record: &'a Record,
     },
+    /// A point is left out: this adapter lacks a feature its method needs (`reason`).
+    Unsupported {
+        label: &'a str,
+        reason: &'a str,
+    },
 }
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -358,6 +363,8 @@ pub struct Summary {
     pub reused: usize,
     pub truths_traced: usize,
     pub truths_cached: usize,
+    /// Points left out because the adapter lacks a feature their method needs.
+    pub unsupported: usize,
 }
 
 struct Point {
@@ -953,15 +960,38 @@ pub fn run_sweep(
     let existing = read_records(&results).map_err(io(&results))?;
     salvage(&results, &existing)?;
     let todo = still_to_do(&existing);
+    let reused = all.len() - todo.len();
+    let gpu = Gpu::new()?;
+    // A method this adapter cannot run (ray queries on a GPU without them) is left out and
+    // said, not fatal to the other methods: its points stay to do, for a run on an adapter
+    // that has the feature.
+    let mut unsupported: Vec<String> = Vec::new();
+    let todo: Vec<&Point> = todo
+        .into_iter()
+        .filter(|p| {
+            let Some(Err(why)) = p.method.as_ref().map(|m| m.entry().check_features(&gpu)) else {
+                return true;
+            };
+            let why = why.to_string();
+            progress(Event::Unsupported {
+                label: &p.label,
+                reason: &why,
+            });
+            if !unsupported.contains(&why) {
+                unsupported.push(why);
+            }
+            false
+        })
+        .collect();
     let mut summary = Summary {
-        reused: all.len() - todo.len(),
+        reused,
+        unsupported: all.len() - reused - todo.len(),
         ..Default::default()
     };
     progress(Event::Planned {
         todo: todo.len(),
         reused: summary.reused,
     });
-    let gpu = Gpu::new()?;
     // Truths first (traced or from the cache), so that timing rounds run back to back; and
     // each point's render job, the same in every round. Only paths are kept: a sweep may
     // have thousands of points.
@@ -1232,6 +1262,7 @@ pub fn run_sweep(
         shard: config.shard.map(|s| s.to_string()),
         point_keys,
         shards: Vec::new(),
+        unsupported,
     };
     write_atomically(
         &out.join("sweep.json"),
@@ -1244,8 +1275,16 @@ pub fn run_sweep(
 /// The commit of the checkout the running binary was built in (`git describe --always`, run
 /// beside the executable), with `-dirty` when its code differs from that commit — the sources,
 /// shaders, scenes, scripts and tools, not `reports/`, which a main job rewrites as it goes:
-/// what a report's figures name as the code that measured them. Empty outside a git checkout.
+/// what a report's figures name as the code that measured them. Empty outside a git checkout,
+/// unless `MIRRORBOX_SOURCE_COMMIT` says it: a binary carried to a machine without the
+/// repository's history (the lent GPU, `scripts/gpu-prepare.sh`) names its commit so.
 pub fn source_commit() -> String {
+    if let Some(commit) = std::env::var("MIRRORBOX_SOURCE_COMMIT")
+        .ok()
+        .filter(|c| !c.trim().is_empty())
+    {
+        return commit.trim().to_string();
+    }
     let Some(dir) = std::env::current_exe()
         .ok()
         .and_then(|e| e.parent().map(Path::to_path_buf))

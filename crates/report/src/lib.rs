@@ -466,6 +466,11 @@ pub struct SweepInfo {
     /// A merged sweep: where each shard ran and how many points it measured.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub shards: Vec<ShardInfo>,
+    /// The methods this run's adapter cannot run, each with why (a feature it lacks, e.g.
+    /// ray queries on a GPU without them): their points were left out, not measured, and stay
+    /// to do for a run on an adapter that has it (issue 57).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub unsupported: Vec<String>,
 }
 
 /// One shard of a merged sweep (`mirrorbox merge`).

@@ -431,6 +431,12 @@ fn document(info: &SweepInfo, records: &[Record], sections: &[Section]) -> Vec<B
             format!("Command: `{}`", info.command),
         ]),
     ];
+    if !info.unsupported.is_empty() {
+        b.push(Block::Paragraph(format!(
+            "Not measured on this adapter (left out of the sweep, not counted as errors): {}.",
+            info.unsupported.join("; ")
+        )));
+    }
     let points: Vec<&Record> = records.iter().filter(|r| r.kind == "point").collect();
     let floor = records.iter().find(|r| r.kind == "floor");
     let latest_run = records.iter().filter_map(|r| r.run.as_deref()).max();

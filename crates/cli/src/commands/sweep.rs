@@ -497,6 +497,9 @@ fn execute(config: &SweepConfig, fresh: bool) -> Result<(), Failure> {
                 b.inc(1);
             }
         }
+        Event::Unsupported { label, reason } => {
+            eprintln!("  {label:<28} left out: {reason}");
+        }
         Event::Finished { record } => {
             let line = format!(
                 "  {:<28} {:>9.2} ms/frame  {:>5} passes  FLIP {:.5}  relMSE {:.3e}",
@@ -517,11 +520,15 @@ fn execute(config: &SweepConfig, fresh: bool) -> Result<(), Failure> {
     }
     let summary = result?;
     println!(
-        "sweep done in {:.1} s (peak memory {}): {} points computed, {} reused; truths: {} traced, {} from cache; wrote {}",
+        "sweep done in {:.1} s (peak memory {}): {} points computed, {} reused{}; truths: {} traced, {} from cache; wrote {}",
         started.elapsed().as_secs_f64(),
         super::peak_memory().unwrap_or_else(|| "unknown".into()),
         summary.computed,
         summary.reused,
+        match summary.unsupported {
+            0 => String::new(),
+            n => format!(", {n} left out (the adapter lacks a feature their method needs)"),
+        },
         summary.truths_traced,
         summary.truths_cached,
         config.out.join("report.md").display()
