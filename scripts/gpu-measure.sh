@@ -7,6 +7,7 @@
 #   .gl/*.deb                  the Vulkan/EGL loaders (libvulkan1, libglvnd, …)
 # Usage there (repository root, `.gl` and `.gpu` carried):
 #   scripts/gpu-measure.sh STEP...      steps: info frontier engine real-assets table1-pair
+#                                       table1-pair-reversed
 #                                       table1 table1-repeat table1-1080p depth depth-1080p
 #                                       room trace tests retest symmetry lighting
 # Results go to reports/gpu/ and, packed one archive per step, to $OUT/gpu-STEP.tar.gz (what
@@ -184,6 +185,15 @@ table1_pair() {
   timeout 200 "$bin" experiment table1 --fresh --out "reports/gpu/table1_$gpu" &&
     timeout 200 "$bin" experiment table1-repeat --fresh --out "reports/gpu/table1_repeat_$gpu"
 }
+# The same pair again, the repeat first (issue 54: on lavapipe whichever runs second is slower
+# for the exact methods): into table1_repeat_<gpu>_run2, then table1_<gpu>_run2.
+table1_pair_reversed() {
+  local gpu
+  gpu=$(nvidia-smi --query-gpu=name --format=csv,noheader 2>/dev/null | head -n1 | grep -oE 'H[0-9]+' | tr 'H' 'h')
+  gpu=${gpu:-gpu}
+  timeout 200 "$bin" experiment table1-repeat --fresh --out "reports/gpu/table1_repeat_${gpu}_run2" &&
+    timeout 200 "$bin" experiment table1 --fresh --out "reports/gpu/table1_${gpu}_run2"
+}
 
 say "steps: $*"
 for s in "$@"; do
@@ -193,6 +203,7 @@ for s in "$@"; do
   engine) step engine-reflections 150 "$bin" experiment engine-reflections --out reports/gpu/engine_reflections ;;
   real-assets) step real-assets 90 "$bin" experiment real-assets --out reports/gpu/real_assets ;;
   table1-pair) step table1-pair 100 table1_pair ;;
+  table1-pair-reversed) step table1-pair-reversed 100 table1_pair_reversed ;;
   table1) step table1 120 "$bin" experiment table1 --out reports/gpu/table1 ;;
   depth) step depth-scaling 120 "$bin" experiment depth-scaling --out reports/gpu/depth_scaling ;;
   room) step room 120 room ;;

@@ -51,21 +51,25 @@ fn scene_stem(scene: &str) -> &str {
         .unwrap_or(scene)
 }
 
-/// A device's short name for file names: `lavapipe`, `h100`, or the adapter's first word.
+/// A device's short name for file names: `lavapipe`, else the adapter's first word with a digit
+/// in it (its model: `h100` of "NVIDIA H100 80GB HBM3", `h200` of "NVIDIA H200"), else its
+/// first word.
 fn device_slug(info: &SweepInfo) -> String {
     let a = info.adapter.to_lowercase();
     if a.contains("llvmpipe") {
-        "lavapipe".into()
-    } else if let Some(i) = a.find("h100") {
-        a[i..i + 4].to_string()
-    } else {
-        a.split_whitespace()
-            .next()
-            .unwrap_or("device")
-            .chars()
-            .filter(char::is_ascii_alphanumeric)
-            .collect()
+        return "lavapipe".into();
     }
+    let words: Vec<String> = a
+        .split_whitespace()
+        .map(|w| w.chars().filter(char::is_ascii_alphanumeric).collect())
+        .filter(|w: &String| !w.is_empty())
+        .collect();
+    words
+        .iter()
+        .find(|w| w.chars().any(|c| c.is_ascii_digit()))
+        .or(words.first())
+        .cloned()
+        .unwrap_or_else(|| "device".into())
 }
 
 /// A report the overview lists that is not a sweep folder: its Markdown, the file of its
@@ -188,11 +192,32 @@ pub(crate) fn frontiers(sweeps: &[(String, Sweep)]) -> Vec<Frontier> {
             g.1 = kept;
         }
         groups.retain(|g| distinct(g.1.iter().map(|r| r.method.clone())).len() >= 2);
+        // Panels of one setting side by side, lavapipe first, then each GPU: the same
+        // question on each device (issue 57).
+        let pixels = |size: &str| -> u64 {
+            size.split('x')
+                .map(|d| d.parse::<u64>().unwrap_or(0))
+                .product()
+        };
+        groups.sort_by(|a, b| {
+            let key = |g: &(GroupKey, Vec<&Record>, &SweepInfo)| {
+                (pixels(&g.0.2), f32::from_bits(g.0.3), g.0.0 != "lavapipe")
+            };
+            let (ka, kb) = (key(a), key(b));
+            ka.0.cmp(&kb.0)
+                .then(kb.1.total_cmp(&ka.1))
+                .then(ka.2.cmp(&kb.2))
+                .then(a.0.0.cmp(&b.0.0))
+        });
+        // The headline (`frontier_<scene>.svg`, the README's figure): a real GPU's panel where
+        // one was measured, else lavapipe's; the one with most methods, then most points.
         let headline = groups
             .iter()
             .enumerate()
-            .filter(|(_, g)| g.0.0 == "lavapipe")
-            .max_by_key(|(_, g)| g.1.len())
+            .max_by_key(|(_, g)| {
+                let methods = distinct(g.1.iter().map(|r| r.method.clone())).len();
+                (g.0.0 != "lavapipe", methods, g.1.len())
+            })
             .map(|(i, _)| i);
         for (i, ((slug, device, size, alpha), records, info)) in groups.iter().enumerate() {
             let alpha = f32::from_bits(*alpha);
@@ -470,5 +495,21 @@ mod tests {
             steps,
             vec![(1.0, 10.0), (2.0, 10.0), (2.0, 5.0), (4.0, 5.0), (4.0, 1.0)]
         );
+    }
+
+    #[test]
+    fn a_device_is_named_by_its_model_in_file_names() {
+        let slug = |adapter: &str| {
+            device_slug(&SweepInfo {
+                adapter: adapter.into(),
+                ..Default::default()
+            })
+        };
+        assert_eq!(slug("llvmpipe (LLVM 15.0.6, 256 bits)"), "lavapipe");
+        assert_eq!(slug("NVIDIA H100 80GB HBM3"), "h100");
+        // Two GPUs of one vendor are two devices, not one "nvidia".
+        assert_eq!(slug("NVIDIA H200"), "h200");
+        assert_eq!(slug("Apple M3"), "m3");
+        assert_eq!(slug("Some GPU"), "some");
     }
 }

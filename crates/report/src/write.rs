@@ -143,8 +143,26 @@ pub fn write_report(
     write_csv(&dir.join("results.csv"), records)?;
     let blocks = document(info, records, sections);
     // Each truth | raster | FLIP row is followed by its 4× inset where its images are there.
+    // A row none of whose images was kept (a lent GPU's 1920×1080 images stay behind: too
+    // large to bring back) says so instead of linking files that are not there.
     let mut with_insets = Vec::with_capacity(blocks.len());
     for b in blocks {
+        let b = match b {
+            Block::Images(images)
+                if !images.is_empty()
+                    && images.iter().all(|(_, file)| !dir.join(file).is_file()) =>
+            {
+                Block::Paragraph(format!(
+                    "(Images not kept with these records: {}.)",
+                    images
+                        .iter()
+                        .map(|(_, file)| format!("`{file}`"))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ))
+            }
+            b => b,
+        };
         let inset = match &b {
             Block::Images(images) if crate::document::is_flip_row(images) => {
                 crate::image_rows::inset(dir, &images[0].1, &images[1].1)
@@ -904,6 +922,27 @@ pub(crate) mod tests {
         write_report(dir.path(), &SweepInfo::default(), &[new], &[]).unwrap();
         let md = std::fs::read_to_string(dir.path().join("report.md")).unwrap();
         assert!(!md.contains('†'), "{md}");
+    }
+
+    /// A lent GPU's 1920×1080 images stay behind (issue 57): the report says they were not
+    /// kept instead of linking files that are not there; kept images are linked.
+    #[test]
+    fn rows_whose_images_were_not_kept_say_so_instead_of_linking_them() {
+        let dir = tempfile::tempdir().unwrap();
+        let records = [record(0, 20.0, 3, 0.1)];
+        write_report(dir.path(), &SweepInfo::default(), &records, &[]).unwrap();
+        let md = std::fs::read_to_string(dir.path().join("report.md")).unwrap();
+        assert!(
+            md.contains("(Images not kept with these records: `t.png`, `r.png`,"),
+            "{md}"
+        );
+        assert!(!md.contains("](t.png)"), "{md}");
+        for f in ["t.png", "r.png"] {
+            std::fs::write(dir.path().join(f), b"").unwrap();
+        }
+        write_report(dir.path(), &SweepInfo::default(), &records, &[]).unwrap();
+        let md = std::fs::read_to_string(dir.path().join("report.md")).unwrap();
+        assert!(md.contains("](t.png)") && !md.contains("not kept"), "{md}");
     }
 
     #[test]

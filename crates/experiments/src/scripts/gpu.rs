@@ -238,6 +238,15 @@ pub fn threads_region(path: &Path, cpu: &str) -> Result<String, ReadmeError> {
     ]))
 }
 
+/// Table 1 on the NVIDIA H200 of 2026-11-27, in the order the four runs started
+/// (`scripts/gpu-measure.sh` steps `table1-pair`, then `table1-pair-reversed`).
+const H200_TABLE1_RUNS: &[&str] = &[
+    "gpu/table1_h200",
+    "gpu/table1_repeat_h200",
+    "gpu/table1_repeat_h200_run2",
+    "gpu/table1_h200_run2",
+];
+
 /// The regions of the GPU chapter: Table 1, the depth scaling and the mirror room measured
 /// on a GPU, and the tracer's threads on that machine's CPU.
 pub const REGIONS: &[RegionSource] = &[
@@ -252,6 +261,18 @@ pub const REGIONS: &[RegionSource] = &[
         source: "gpu/table1",
         about: "Table 1's points on lavapipe (reports/table1) and on a GPU side by side",
         generate: |reports| crate::table1::section::device_column(reports, "gpu/table1"),
+    },
+    RegionSource {
+        id: "gpu-table1-h200",
+        source: "gpu/table1_h200",
+        about: "Table 1 and the exact methods beside it, measured on an NVIDIA H200",
+        generate: |reports| crate::table1::section::region_of(reports, "gpu/table1_h200"),
+    },
+    RegionSource {
+        id: "gpu-table1-runs",
+        source: "gpu/table1_h200",
+        about: "four runs of Table 1 on one GPU, the repeat run first in the second pair: the exact methods' paired speed ratios",
+        generate: |reports| crate::table1::section::runs_region(reports, H200_TABLE1_RUNS),
     },
     RegionSource {
         id: "gpu-depth-scaling",

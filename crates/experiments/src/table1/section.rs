@@ -364,6 +364,130 @@ fn repeat_region(first: &Sweep, second: &Sweep) -> Result<String, ReadmeError> {
     Ok(markdown(&blocks))
 }
 
+/// Several runs of Table 1 (`reports/<folder>` each, in the order they ran) in one table: per
+/// run, the paper's method at n = 2 and each exact method at depth 64 (α of [`table1::rows`]),
+/// with the exact method's paired speed ratio against n = 2 — whether a speed verdict survives
+/// a repeat, and a repeat in the other order (issue 54), on one device.
+pub fn runs_region(reports: &Path, folders: &[&str]) -> Result<String, ReadmeError> {
+    let mut exact: Vec<String> = Vec::new();
+    let mut runs = Vec::new();
+    for folder in folders {
+        let s = load_sweep(&reports.join(folder))?;
+        let (Some(alpha), _) = table1::rows(&s.records) else {
+            return Err(ReadmeError(format!(
+                "reports/{folder} holds no row of the paper's method"
+            )));
+        };
+        let at = |method: &str, n: Option<u32>, depth: Option<u32>| {
+            s.records.iter().find(|r| {
+                r.kind == "point"
+                    && r.method == method
+                    && r.n == n
+                    && r.depth == depth
+                    && (r.alpha - alpha).abs() < 1e-6
+            })
+        };
+        let Some(base) = at(table1::PAPER_METHOD, Some(2), None).cloned() else {
+            return Err(ReadmeError(format!(
+                "reports/{folder} holds no point of {} n=2",
+                table1::PAPER_METHOD
+            )));
+        };
+        for m in &s.info.exact_methods {
+            if at(m, None, Some(64)).is_some() && !exact.contains(m) {
+                exact.push(m.clone());
+            }
+        }
+        let points: Vec<Option<Record>> = exact
+            .iter()
+            .map(|m| at(m, None, Some(64)).cloned())
+            .collect();
+        runs.push((folder.to_string(), s.info.clone(), alpha, base, points));
+    }
+    let mut header = vec![
+        "run".to_string(),
+        "started".to_string(),
+        format!("{} n=2 ms [95 % CI]", table1::PAPER_METHOD),
+    ];
+    for m in &exact {
+        header.push(format!("{m} depth=64 ms [95 % CI]"));
+        header.push(format!("{m}: times faster than n=2, paired [95 % CI]"));
+    }
+    let mut rows = Vec::new();
+    for (folder, info, alpha, base, points) in &runs {
+        let started = base.run.as_deref().unwrap_or(&info.date);
+        let mut row = vec![
+            format!("`{folder}` (α = {alpha})"),
+            started.get(..19).unwrap_or(started).replace('T', " "),
+            ms_cell(base, 3),
+        ];
+        for p in exact
+            .iter()
+            .enumerate()
+            .map(|(i, _)| points.get(i).cloned().flatten())
+        {
+            match p {
+                Some(p) => {
+                    row.push(ms_cell(&p, 3));
+                    row.push(match paired_ratio(base, &p) {
+                        Some(i) => format!(
+                            "{:.2}× [{:.2}–{:.2}×]",
+                            base.ms_median / p.ms_median,
+                            i.low,
+                            i.high
+                        ),
+                        None => "–".into(),
+                    });
+                }
+                None => row.extend(["–".to_string(), "–".to_string()]),
+            }
+        }
+        rows.push(row);
+    }
+    // Per exact method: do the runs' paired intervals share a value (one verdict), or not?
+    let mut verdicts = Vec::new();
+    for (i, m) in exact.iter().enumerate() {
+        let intervals: Vec<stats::Interval> = runs
+            .iter()
+            .filter_map(|(_, _, _, base, points)| {
+                let p = points.get(i)?.as_ref()?;
+                paired_ratio(base, p)
+            })
+            .collect();
+        if intervals.len() < 2 {
+            continue;
+        }
+        let low = intervals.iter().map(|i| i.low).fold(f64::MIN, f64::max);
+        let high = intervals.iter().map(|i| i.high).fold(f64::MAX, f64::min);
+        verdicts.push(if low <= high {
+            format!(
+                "{m}: the {} runs' paired intervals share {low:.2}–{high:.2}×, one verdict",
+                intervals.len()
+            )
+        } else {
+            format!(
+                "{m}: the {} runs' paired intervals do NOT overlap (from {:.2}× to {:.2}×): the runs disagree",
+                intervals.len(),
+                intervals.iter().map(|i| i.low).fold(f64::MAX, f64::min),
+                intervals.iter().map(|i| i.high).fold(f64::MIN, f64::max)
+            )
+        });
+    }
+    let devices: Vec<String> = mirrorbox_report::document::distinct(
+        runs.iter()
+            .map(|(_, info, ..)| format!("{} on {}", info.adapter_description(), info.cpu)),
+    );
+    let blocks = vec![
+        Block::Paragraph(format!(
+            "Measured on {}; the runs in the order they started.",
+            devices.join("; ")
+        )),
+        Block::Table(header, rows),
+        Block::Bullets(verdicts),
+    ];
+    Ok(markdown(&blocks))
+}
+
 /// The regions of Table 1's chapter: the first run, its summary, and the two runs.
 pub const REGIONS: &[mirrorbox_report::readme::RegionSource] = &[
     mirrorbox_report::readme::RegionSource {
@@ -424,6 +548,57 @@ mod tests {
         r.timing_order = "interleaved".into();
         r.run = Some("2026-11-22T10:00:00Z".into());
         r
+    }
+
+    /// A Table 1 run in `reports/<folder>`: n = 2 at 10 ms, unrolled depth 64 at `unrolled_ms`,
+    /// each timed in 9 interleaved rounds with round k slower by `drift(k)`.
+    fn write_run(reports: &Path, folder: &str, unrolled_ms: f64, drift: &dyn Fn(usize) -> f64) {
+        let dir = reports.join(folder);
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut exact = interleaved(record(0, unrolled_ms, 1, 1e-4), drift);
+        exact.method = "unrolled".into();
+        exact.key = "unrolled depth=64".into();
+        (exact.n, exact.depth) = (None, Some(64));
+        let records = [interleaved(record(2, 10.0, 15, 0.01), drift), exact];
+        let info = SweepInfo {
+            scene: "scenes/mirror_box.json".into(),
+            exact_methods: vec!["unrolled".into()],
+            ..SweepInfo::default()
+        };
+        write_report(&dir, &info, &records, &[]).unwrap();
+        let lines: Vec<String> = records
+            .iter()
+            .map(|r| serde_json::to_string(r).unwrap())
+            .collect();
+        std::fs::write(dir.join("results.jsonl"), lines.join("\n") + "\n").unwrap();
+        std::fs::write(
+            dir.join("sweep.json"),
+            serde_json::to_string(&info).unwrap(),
+        )
+        .unwrap();
+    }
+
+    #[test]
+    fn runs_agree_only_where_their_paired_ratios_share_a_value() {
+        let reports = tempfile::tempdir().unwrap();
+        let wobble = |k: usize| 1.0 + 0.01 * (k % 3) as f64;
+        write_run(reports.path(), "a", 5.0, &wobble);
+        write_run(reports.path(), "b", 5.0, &|k| 1.3 * wobble(k));
+        let text = runs_region(reports.path(), &["a", "b"]).unwrap();
+        // A slower machine in the second run (both points alike) leaves the paired ratio.
+        assert!(
+            text.contains("unrolled: the 2 runs' paired intervals share 2.00–2.00×, one verdict"),
+            "{text}"
+        );
+        assert!(text.contains("| `a` (α = 0.7) |"), "{text}");
+        // The exact method slower in the second run only: two verdicts, said.
+        write_run(reports.path(), "c", 8.0, &wobble);
+        let text = runs_region(reports.path(), &["a", "c"]).unwrap();
+        assert!(
+            text.contains("do NOT overlap (from 1.25× to 2.00×): the runs disagree"),
+            "{text}"
+        );
+        assert!(runs_region(reports.path(), &["a", "missing"]).is_err());
     }
 
     #[test]
