@@ -17,6 +17,7 @@ pub mod error;
 pub mod format;
 pub mod geometry;
 pub mod gltf_asset;
+pub mod gltf_export;
 pub mod hash;
 pub mod import;
 pub mod light_images;
