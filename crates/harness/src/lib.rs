@@ -17,6 +17,7 @@
 //!   when there is no mirror effect to truncate.
 
 pub mod axes;
+pub mod exchange;
 pub mod merge;
 pub mod sequence;
 mod worker;
@@ -293,6 +294,9 @@ pub enum HarnessError {
     /// `--symmetry-planes` asks for more planes than the scene has, or the bake is refused.
     #[error("--symmetry-planes: {0}")]
     SymmetryPlanes(#[from] mirrorbox_scene::symmetry::SymmetryError),
+    /// A file of the exchange (`export-views`, `score`) refused: the file or field, and why.
+    #[error("{0}")]
+    Exchange(String),
     /// At a swept reflectance (or the truth's threshold) the scene's light images exceed
     /// their budget.
     #[error("{}: {source}", .scene.display())]
@@ -312,6 +316,7 @@ impl HarnessError {
             | HarnessError::SymmetryPlanes(_)
             | HarnessError::LightImages { .. }
             | HarnessError::OutputFolder { .. }
+            | HarnessError::Exchange(_)
             | HarnessError::Sequence(_) => true,
             HarnessError::Raster(e) => e.is_refusal(),
             HarnessError::File(e) => e.refused,

@@ -474,7 +474,9 @@ mod tests {
                         maps,
                     } => format!(
                         "diffuse {albedo} {emission} {:?} {:?} uv {:?}",
-                        maps.albedo.as_ref().map(|m| (m.wrap, m.transform.map(|x| (x * 1e4).round()))),
+                        maps.albedo
+                            .as_ref()
+                            .map(|m| (m.wrap, m.transform.map(|x| (x * 1e4).round()))),
                         maps.emission.as_ref().map(|m| m.wrap),
                         g.uvs[i]
                     ),
@@ -490,7 +492,11 @@ mod tests {
 
     #[test]
     fn an_exported_scene_loads_back_with_the_same_triangles_surfaces_and_lights() {
-        for name in ["mirror_box_lit.json", "textured_box.json", "mirror_room.json"] {
+        for name in [
+            "mirror_box_lit.json",
+            "textured_box.json",
+            "mirror_room.json",
+        ] {
             let scene = crate::load::load_scene(&root().join("scenes").join(name)).unwrap();
             let dir = tempfile::tempdir().unwrap();
             let back = round_trip(&scene, dir.path());

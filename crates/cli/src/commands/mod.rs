@@ -1,6 +1,7 @@
 pub mod check;
 pub mod compare;
 pub mod export_mitsuba;
+pub mod export_views;
 pub mod import;
 pub mod info;
 pub mod merge;

@@ -1,0 +1,465 @@
+//! The open exchange (issue 53): any renderer scored against the truth.
+//!
+//! Out (`mirrorbox export-views`, [`export_views`]): a folder with the scene as glTF
+//! (`mirrorbox_scene::gltf_export`), the scene file that reads it back (`scene.json`), per
+//! view the camera in every convention a client may need and the traced truth with and
+//! without mirrors (`views.json`, `truth/`). In (`mirrorbox score`, [`crate::score`]): a
+//! client's images and timings, scored as a sweep scores our methods. The exchange's fields:
+//! `docs/exchange.md`.
+
+use crate::{HarnessError, Summary, SweepConfig, io, truth};
+use glam::{Mat4, Vec3};
+use mirrorbox_scene::Scene;
+use mirrorbox_scene::gltf_export::{self, BIN_NAME, camera_frame, clip_planes};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// The version of `views.json` (and of `timing.json`, read by `score`).
+pub const FORMAT_VERSION: u32 = 1;
+/// Most views one export may hold (each is traced twice).
+pub const MAX_VIEWS: usize = 64;
+
+/// What a client must do to draw what the truth shows (`docs/shading.md`, in short). Written
+/// into `views.json`; every rule is one a client can check in its own code.
+pub const CLIENT_RULES: &[&str] = &[
+    "Write linear radiance: no tone mapping, no exposure, no sRGB encoding, no dithering (EXR float, or an 8-bit PNG sRGB-encoded from the linear value, its quantisation stated).",
+    "Diffuse surfaces are Lambertian and two-sided, shaded with their face normal (the glTF NORMAL attribute): L = E·[front] + ρ/π · Σ I·max(0, n·l)/r² + ρ·A, with ρ the base colour (× its texture, decoded from sRGB), E the emissive factor × strength (× its texture), I a point light's colour × intensity read as W/sr (glTF candela), A the scene's extras.mirrorbox.ambient.",
+    "No shadows and no light reflected by mirrors onto surfaces, unless views.json's lighting says otherwise; no indirect light; no specular term on diffuse surfaces.",
+    "A mirror (metallic 1, roughness 0, extras.mirrorbox_mirror) reflects reflectance × the radiance of the reflected ray, at every angle (no Fresnel); its back is diffuse with back_albedo.",
+    "A ray that leaves the scene sees extras.mirrorbox.background; a mirror a method can no longer follow shows extras.mirrorbox.terminal × the reflectances so far.",
+    "Textures: bilinear between the four texels around the sample, no mip-maps, wrap modes and KHR_texture_transform as glTF says; alpha ignored (opaque).",
+    "Pixel (x, y), y down, is the mean of the radiance at the s × s sub-pixel positions (x + (i + ½)/s, y + (j + ½)/s) of the view's ssaa s: render at s× the size and box-filter, or sample those positions.",
+];
+
+/// One camera of a view list (`--views FILE`): where it is and where it looks; the scene's
+/// up and field of view unless given.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ViewSpec {
+    pub name: String,
+    pub position: [f32; 3],
+    pub look_at: [f32; 3],
+    #[serde(default)]
+    pub up: Option<[f32; 3]>,
+    #[serde(default)]
+    pub fov_y_deg: Option<f32>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ViewList {
+    views: Vec<ViewSpec>,
+}
+
+/// What to export.
+#[derive(Clone, Debug, Default)]
+pub struct ExportSettings {
+    pub width: Option<u32>,
+    pub height: Option<u32>,
+    pub ssaa: u32,
+    /// Every mirror's reflectance set to α (a sweep's α), else the scene's.
+    pub alpha: Option<f32>,
+    /// The views; empty: the scene's camera, named `camera`.
+    pub views: Vec<ViewSpec>,
+}
+
+/// `views.json`: one exported view.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ExportedView {
+    pub name: String,
+    pub width: u32,
+    pub height: u32,
+    /// Sub-pixel grid side: each pixel is the mean of ssaa × ssaa samples.
+    pub ssaa: u32,
+    pub camera: ViewCamera,
+    /// World to camera (right-handed, the camera looking down −z), column-major.
+    pub view_matrix: [f32; 16],
+    /// Perspective with OpenGL's depth range (−1…1), column-major.
+    pub projection_gl: [f32; 16],
+    /// Perspective with Vulkan's, WebGPU's and Direct3D's depth range (0…1), column-major.
+    pub projection_zero_to_one: [f32; 16],
+    /// The truth (linear radiance, EXR) and beside it its sRGB PNG and its mirror mask
+    /// (`<name>.mirrors.png`: red where a primary ray first meets a mirror's front).
+    pub truth: String,
+    /// The truth of the scene without its mirrors: a client's error there is its floor.
+    pub floor: String,
+    /// The scene's content hash at this view (the truth's key).
+    pub scene_hash: String,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ViewCamera {
+    pub position: [f32; 3],
+    pub look_at: [f32; 3],
+    pub up: [f32; 3],
+    pub right: [f32; 3],
+    pub forward: [f32; 3],
+    pub fov_y_deg: f32,
+    pub aspect: f32,
+    pub near: f32,
+    pub far: f32,
+    /// The output transform's multiplier (metrics and pictures apply it; a client does not).
+    pub exposure: f32,
+}
+
+/// `views.json`.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ViewsFile {
+    pub format: String,
+    pub version: u32,
+    /// The glTF file, relative to this one.
+    pub gltf: String,
+    /// The mirrorbox scene file that reads the glTF back (`mirrorbox trace scene.json`).
+    pub scene: String,
+    /// The scene file exported, as given.
+    pub source: String,
+    pub alpha: Option<f32>,
+    pub contract: Contract,
+    pub views: Vec<ExportedView>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Contract {
+    pub document: String,
+    pub version: u32,
+    pub ambient: [f32; 3],
+    pub background: [f32; 3],
+    pub terminal: [f32; 3],
+    /// "direct, no shadows" for the default contract.
+    pub lighting: String,
+    /// The truth: its integrator and limits.
+    pub truth: String,
+    pub rules: Vec<String>,
+}
+
+/// The contract's version (`docs/shading.md`): raised when a rule a client follows changes.
+pub const CONTRACT_VERSION: u32 = 1;
+
+/// Reads a `--views FILE`: `{"views": [{"name", "position", "look_at", "up"?, "fov_y_deg"?}]}`,
+/// 1 to [`MAX_VIEWS`] views with distinct names of letters, digits, `-` and `_`.
+pub fn read_view_list(path: &Path) -> Result<Vec<ViewSpec>, HarnessError> {
+    let bad = |message: String| HarnessError::Exchange(format!("{}: {message}", path.display()));
+    let text = mirrorbox_files::read_bounded_text(path, 1 << 20, "a view list")
+        .map_err(|e| bad(e.to_string()))?;
+    let list: ViewList = serde_json::from_str(&text).map_err(|e| bad(e.to_string()))?;
+    if list.views.is_empty() || list.views.len() > MAX_VIEWS {
+        return Err(bad(format!(
+            "views: {} views; 1 to {MAX_VIEWS} are allowed",
+            list.views.len()
+        )));
+    }
+    for (i, v) in list.views.iter().enumerate() {
+        if !valid_name(&v.name) {
+            return Err(bad(format!(
+                "views[{i}].name {:?}: 1 to 64 letters, digits, '-' or '_'",
+                v.name
+            )));
+        }
+        if list.views[..i].iter().any(|w| w.name == v.name) {
+            return Err(bad(format!("views[{i}].name {:?} appears twice", v.name)));
+        }
+    }
+    Ok(list.views)
+}
+
+/// A file-name-safe view, client or variant name.
+pub fn valid_name(name: &str) -> bool {
+    !name.is_empty()
+        && name.len() <= 64
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
+}
+
+/// What an export wrote.
+pub struct Exported {
+    pub views: usize,
+    pub files: usize,
+    pub truths_traced: usize,
+}
+
+/// Writes the exchange for `scene_path` into `dir` (see the module docs). `dir`'s parent must
+/// exist; `dir` itself is made, or replaced when it holds an earlier export (its `views.json`)
+/// or nothing. Everything is written into `dir.partial` first and moved into place at the end,
+/// so a failed export leaves no half-written folder.
+pub fn export_views(
+    scene_path: &Path,
+    dir: &Path,
+    settings: &ExportSettings,
+) -> Result<Exported, HarnessError> {
+    crate::check_output_parent(dir)?;
+    if dir.exists() && !dir.join("views.json").is_file() && !is_empty_dir(dir) {
+        return Err(HarnessError::Exchange(format!(
+            "{}: exists and holds no earlier export (views.json); give a new or empty folder",
+            dir.display()
+        )));
+    }
+    let mut config = SweepConfig::new(
+        scene_path.to_path_buf(),
+        dir.to_path_buf(),
+        Vec::new(),
+        settings.alpha.into_iter().collect(),
+    );
+    config.width = settings.width;
+    config.height = settings.height;
+    config.ssaa = settings.ssaa.max(1);
+    let (mut base, _, _) = crate::base_scene(&config)?;
+    if let Some(a) = settings.alpha {
+        base.set_reflectance(Vec3::splat(a))
+            .map_err(|source| HarnessError::LightImages {
+                scene: base.source.clone(),
+                source,
+            })?;
+    }
+    let threshold = base.lighting.images.min_throughput;
+    base.enumerate_light_images(threshold)
+        .map_err(|source| HarnessError::LightImages {
+            scene: base.source.clone(),
+            source,
+        })?;
+    let files = gltf_export::export(&base)
+        .map_err(|e| HarnessError::Exchange(format!("{}: {e}", scene_path.display())))?;
+    let partial = PathBuf::from(format!("{}.partial", dir.display()));
+    if partial.exists() {
+        std::fs::remove_dir_all(&partial).map_err(io(&partial))?;
+    }
+    let truth_dir = partial.join("truth");
+    std::fs::create_dir_all(&truth_dir).map_err(io(&truth_dir))?;
+    let result = write_export(&base, &files, &partial, &config, settings, scene_path);
+    let exported = match result {
+        Ok(e) => e,
+        Err(e) => {
+            let _ = std::fs::remove_dir_all(&partial);
+            return Err(e);
+        }
+    };
+    if dir.exists() {
+        std::fs::remove_dir_all(dir).map_err(io(dir))?;
+    }
+    std::fs::rename(&partial, dir).map_err(io(dir))?;
+    Ok(exported)
+}
+
+fn is_empty_dir(dir: &Path) -> bool {
+    std::fs::read_dir(dir).is_ok_and(|mut d| d.next().is_none())
+}
+
+fn write_export(
+    base: &Scene,
+    files: &gltf_export::GltfFiles,
+    out: &Path,
+    config: &SweepConfig,
+    settings: &ExportSettings,
+    scene_path: &Path,
+) -> Result<Exported, HarnessError> {
+    let write = |name: &str, bytes: &[u8]| -> Result<(), HarnessError> {
+        let p = out.join(name);
+        if let Some(parent) = p.parent() {
+            std::fs::create_dir_all(parent).map_err(io(parent))?;
+        }
+        std::fs::write(&p, bytes).map_err(io(&p))
+    };
+    write("scene.gltf", files.json.as_bytes())?;
+    write(BIN_NAME, &files.bin)?;
+    for (name, bytes) in &files.images {
+        write(name, bytes)?;
+    }
+    write(
+        "scene.json",
+        gltf_export::scene_file(base, "scene.gltf").as_bytes(),
+    )?;
+    let specs = if settings.views.is_empty() {
+        let c = &base.camera;
+        vec![ViewSpec {
+            name: "camera".into(),
+            position: c.position.to_array(),
+            look_at: c.look_at.to_array(),
+            up: Some(c.up.to_array()),
+            fov_y_deg: Some(c.fov_y_deg),
+        }]
+    } else {
+        settings.views.clone()
+    };
+    let mut summary = Summary::default();
+    let mut views = Vec::with_capacity(specs.len());
+    let truth_dir = out.join("truth");
+    for spec in &specs {
+        let scene = view_scene(base, spec)?;
+        let floor_scene = scene.without_mirrors();
+        for (s, name) in [
+            (&scene, spec.name.clone()),
+            (&floor_scene, format!("{}_floor", spec.name)),
+        ] {
+            let (_, path) = truth(s, config, &truth_dir, &mut summary)?;
+            for (from, to) in [
+                (path.clone(), truth_dir.join(format!("{name}.exr"))),
+                (
+                    path.with_extension("png"),
+                    truth_dir.join(format!("{name}.png")),
+                ),
+                (
+                    crate::mask_path(&path),
+                    truth_dir.join(format!("{name}.mirrors.png")),
+                ),
+            ] {
+                std::fs::rename(&from, &to).map_err(io(&to))?;
+            }
+        }
+        views.push(exported_view(&scene, spec, config.ssaa));
+    }
+    let l = &base.lighting;
+    let doc = ViewsFile {
+        format: "mirrorbox-views".into(),
+        version: FORMAT_VERSION,
+        gltf: "scene.gltf".into(),
+        scene: "scene.json".into(),
+        source: scene_path.display().to_string(),
+        alpha: settings.alpha,
+        contract: Contract {
+            document: "docs/shading.md".into(),
+            version: CONTRACT_VERSION,
+            ambient: l.ambient.to_array(),
+            background: base.background.to_array(),
+            terminal: base.terminal.to_array(),
+            lighting: l.describe(),
+            truth: format!(
+                "whitted, max depth {}, min throughput {}",
+                config.truth.max_depth, config.truth.min_throughput
+            ),
+            rules: CLIENT_RULES.iter().map(|r| r.to_string()).collect(),
+        },
+        views,
+    };
+    write("views.json", serde_json::to_string_pretty(&doc)?.as_bytes())?;
+    Ok(Exported {
+        views: specs.len(),
+        files: 4 + files.images.len() + 6 * specs.len(),
+        truths_traced: summary.truths_traced,
+    })
+}
+
+/// `base` seen from `spec`'s camera.
+fn view_scene(base: &Scene, spec: &ViewSpec) -> Result<Scene, HarnessError> {
+    let mut scene = base.clone();
+    let c = &mut scene.camera;
+    c.position = Vec3::from_array(spec.position);
+    c.look_at = Vec3::from_array(spec.look_at);
+    if let Some(up) = spec.up {
+        c.up = Vec3::from_array(up);
+    }
+    if let Some(fov) = spec.fov_y_deg {
+        c.fov_y_deg = fov;
+    }
+    let forward = c.look_at - c.position;
+    let bad = |what: &str| HarnessError::Exchange(format!("view {:?}: {what}", spec.name));
+    if !forward.is_finite() || forward.length() < 1e-6 {
+        return Err(bad("position and look_at must be finite and apart"));
+    }
+    if !c.up.is_finite() || forward.normalize().cross(c.up).length() < 1e-6 {
+        return Err(bad("up must be finite and not along the view direction"));
+    }
+    if !(c.fov_y_deg > 0.0 && c.fov_y_deg < 180.0) {
+        return Err(bad("fov_y_deg must be in (0, 180)"));
+    }
+    c.up = c.up.normalize();
+    Ok(scene)
+}
+
+fn exported_view(scene: &Scene, spec: &ViewSpec, ssaa: u32) -> ExportedView {
+    let c = &scene.camera;
+    let (right, up, forward) = camera_frame(scene);
+    let (near, far) = clip_planes(scene);
+    let aspect = c.width as f32 / c.height as f32;
+    let fov = c.fov_y_deg.to_radians();
+    ExportedView {
+        name: spec.name.clone(),
+        width: c.width,
+        height: c.height,
+        ssaa,
+        camera: ViewCamera {
+            position: c.position.to_array(),
+            look_at: c.look_at.to_array(),
+            up: up.to_array(),
+            right: right.to_array(),
+            forward: forward.to_array(),
+            fov_y_deg: c.fov_y_deg,
+            aspect,
+            near,
+            far,
+            exposure: c.exposure,
+        },
+        view_matrix: view_matrix(c.position, right, up, forward).to_cols_array(),
+        projection_gl: perspective(fov, aspect, near, far, DepthRange::MinusOneToOne)
+            .to_cols_array(),
+        projection_zero_to_one: perspective(fov, aspect, near, far, DepthRange::ZeroToOne)
+            .to_cols_array(),
+        truth: format!("truth/{}.exr", spec.name),
+        floor: format!("truth/{}_floor.exr", spec.name),
+        scene_hash: format!("{:016x}", scene.content_hash()),
+    }
+}
+
+/// World to camera: rows right, up, −forward, the camera at the origin looking down −z.
+fn view_matrix(position: Vec3, right: Vec3, up: Vec3, forward: Vec3) -> Mat4 {
+    Mat4::from_cols(
+        glam::Vec4::new(right.x, up.x, -forward.x, 0.0),
+        glam::Vec4::new(right.y, up.y, -forward.y, 0.0),
+        glam::Vec4::new(right.z, up.z, -forward.z, 0.0),
+        glam::Vec4::new(
+            -right.dot(position),
+            -up.dot(position),
+            forward.dot(position),
+            1.0,
+        ),
+    )
+}
+
+/// A clip space's depth range: OpenGL's and WebGL's, or Vulkan's, WebGPU's and Direct3D's.
+#[derive(Clone, Copy)]
+enum DepthRange {
+    MinusOneToOne,
+    ZeroToOne,
+}
+
+/// The right-handed perspective of vertical field `fov` (radians): `t = 1/tan(fov/2)`,
+/// x·t/aspect, y·t, and z from `near` to `far` onto the depth range, w = −z.
+fn perspective(fov: f32, aspect: f32, near: f32, far: f32, range: DepthRange) -> Mat4 {
+    let t = 1.0 / (0.5 * fov).tan();
+    let (a, b) = match range {
+        DepthRange::MinusOneToOne => ((far + near) / (near - far), 2.0 * far * near / (near - far)),
+        DepthRange::ZeroToOne => (far / (near - far), far * near / (near - far)),
+    };
+    Mat4::from_cols(
+        glam::Vec4::new(t / aspect, 0.0, 0.0, 0.0),
+        glam::Vec4::new(0.0, t, 0.0, 0.0),
+        glam::Vec4::new(0.0, 0.0, a, -1.0),
+        glam::Vec4::new(0.0, 0.0, b, 0.0),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A point on the view axis at `near` lands on the near end of each depth range and one
+    /// at `far` on the far end; the camera's position maps to the origin.
+    #[test]
+    fn the_matrices_put_near_and_far_at_the_ends_of_each_depth_range() {
+        let (pos, fwd) = (Vec3::new(1.0, 2.0, 3.0), Vec3::new(0.0, 0.0, -1.0));
+        let (right, up) = (Vec3::X, Vec3::Y);
+        let view = view_matrix(pos, right, up, fwd);
+        assert!(view.transform_point3(pos).length() < 1e-6);
+        for (range, lo) in [
+            (DepthRange::MinusOneToOne, -1.0),
+            (DepthRange::ZeroToOne, 0.0),
+        ] {
+            let p = perspective(1.0, 1.5, 0.1, 100.0, range) * view;
+            let ndc = |d: f32| {
+                let c = p * (pos + fwd * d).extend(1.0);
+                c.z / c.w
+            };
+            assert!((ndc(0.1) - lo).abs() < 1e-4, "{}", ndc(0.1));
+            assert!((ndc(100.0) - 1.0).abs() < 1e-4, "{}", ndc(100.0));
+        }
+    }
+}
