@@ -44,6 +44,8 @@ enum Command {
     ExportMitsuba(commands::export_mitsuba::Args),
     /// Export a scene for any renderer: glTF, its views in every camera convention, and their truths with and without mirrors (docs/exchange.md).
     ExportViews(commands::export_views::Args),
+    /// Score any renderer's images and timings against an export's truths, into a sweep folder (docs/exchange.md).
+    Score(commands::score::Args),
     /// Place a glTF 2.0 asset in a mirror box sized to its bounds and write the scene file (docs/gltf.md).
     Import(commands::import::Args),
     /// Fill the generated regions of README.md, docs/methods.md and the book (docs/book/src/*.md) from the committed reports and the CLI's own help (--check: only compare).
@@ -170,6 +172,7 @@ fn main() -> ExitCode {
         Command::View(args) => commands::view::run(&args),
         Command::ExportMitsuba(args) => commands::export_mitsuba::run(&args),
         Command::ExportViews(args) => commands::export_views::run(&args),
+        Command::Score(args) => commands::score::run(&args),
         Command::Readme(args) => commands::readme::run(&args),
         Command::Report(args) => commands::report::run(&args),
         Command::Merge(args) => commands::merge::run(&args),

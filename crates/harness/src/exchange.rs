@@ -198,7 +198,8 @@ pub fn export_views(
         scene_path.to_path_buf(),
         dir.to_path_buf(),
         Vec::new(),
-        settings.alpha.into_iter().collect(),
+        // A sweep's validation wants an α; the scene's own reflectances stay without one.
+        vec![settings.alpha.unwrap_or(1.0)],
     );
     config.width = settings.width;
     config.height = settings.height;

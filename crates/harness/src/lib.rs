@@ -19,6 +19,7 @@
 pub mod axes;
 pub mod exchange;
 pub mod merge;
+pub mod score;
 pub mod sequence;
 mod worker;
 

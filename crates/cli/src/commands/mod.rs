@@ -9,6 +9,7 @@ pub mod method_flags;
 pub mod readme;
 pub mod render;
 pub mod report;
+pub mod score;
 pub mod stereo;
 pub mod sweep;
 pub mod trace;

@@ -1,0 +1,397 @@
+//! The exchange's way in (`mirrorbox score EXPORT RUN -o OUT`, issue 53, `docs/exchange.md`):
+//! a client's images (`RUN/<client>/<variant>/<view>.exr` or `.png`) and timings
+//! (`timing.json`) compared with the export's truths exactly as a sweep compares our methods,
+//! written as the same records and report. A variant named `floor` drew the scene without its
+//! mirrors and is compared with the floor truth.
+
+use crate::exchange::{FORMAT_VERSION, ViewsFile, valid_name};
+use crate::{HarnessError, ViewFiles, compare_views, io};
+use mirrorbox_report::{Record, SweepInfo, write_report};
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// Most frames one view's timing may list.
+pub const MAX_FRAMES: usize = 10_000;
+/// Most clients × variants one run may hold.
+pub const MAX_VARIANTS: usize = 256;
+
+/// `timing.json` of one variant.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Timing {
+    pub format: String,
+    pub version: u32,
+    pub engine: String,
+    pub engine_version: String,
+    pub device: String,
+    #[serde(default)]
+    pub driver: String,
+    pub timing: String,
+    #[serde(default)]
+    pub parameters: BTreeMap<String, serde_json::Value>,
+    #[serde(default)]
+    pub equivalent: Option<String>,
+    pub views: BTreeMap<String, Vec<f64>>,
+}
+
+/// What a score wrote.
+pub struct Scored {
+    pub records: usize,
+    pub variants: usize,
+}
+
+fn refused(path: &Path, message: impl std::fmt::Display) -> HarnessError {
+    HarnessError::Exchange(format!("{}: {message}", path.display()))
+}
+
+/// Reads `EXPORT/views.json`.
+pub fn read_views(export: &Path) -> Result<ViewsFile, HarnessError> {
+    let path = export.join("views.json");
+    let text = mirrorbox_files::read_bounded_text(&path, 16 << 20, "views.json")
+        .map_err(|e| refused(&path, e))?;
+    let views: ViewsFile = serde_json::from_str(&text).map_err(|e| refused(&path, e))?;
+    if views.format != "mirrorbox-views" || views.version != FORMAT_VERSION {
+        return Err(refused(
+            &path,
+            format!(
+                "format {:?} version {}: mirrorbox-views version {FORMAT_VERSION} is read",
+                views.format, views.version
+            ),
+        ));
+    }
+    Ok(views)
+}
+
+fn read_timing(path: &Path, views: &ViewsFile) -> Result<Timing, HarnessError> {
+    let text = mirrorbox_files::read_bounded_text(path, 16 << 20, "a timing file")
+        .map_err(|e| refused(path, e))?;
+    let t: Timing = serde_json::from_str(&text).map_err(|e| refused(path, e))?;
+    if t.format != "mirrorbox-timing" || t.version != FORMAT_VERSION {
+        return Err(refused(
+            path,
+            format!(
+                "format {:?} version {}: mirrorbox-timing version {FORMAT_VERSION} is read",
+                t.format, t.version
+            ),
+        ));
+    }
+    for v in &views.views {
+        let Some(frames) = t.views.get(&v.name) else {
+            return Err(refused(
+                path,
+                format!("views: no frames for view {:?}", v.name),
+            ));
+        };
+        if frames.is_empty() || frames.len() > MAX_FRAMES {
+            return Err(refused(
+                path,
+                format!(
+                    "views.{}: {} frames; 1 to {MAX_FRAMES} are read",
+                    v.name,
+                    frames.len()
+                ),
+            ));
+        }
+        if let Some(bad) = frames.iter().find(|ms| !ms.is_finite() || **ms < 0.0) {
+            return Err(refused(
+                path,
+                format!("views.{}: {bad} ms is not a time (finite, ≥ 0)", v.name),
+            ));
+        }
+    }
+    if let Some(extra) = t
+        .views
+        .keys()
+        .find(|k| !views.views.iter().any(|v| &v.name == *k))
+    {
+        return Err(refused(
+            path,
+            format!("views.{extra}: no such view in views.json"),
+        ));
+    }
+    Ok(t)
+}
+
+/// Every `RUN/<client>/<variant>/` folder, sorted.
+fn variants(run: &Path) -> Result<Vec<(String, String, PathBuf)>, HarnessError> {
+    let list = |dir: &Path| -> Result<Vec<(String, PathBuf)>, HarnessError> {
+        let mut out = Vec::new();
+        for e in std::fs::read_dir(dir).map_err(io(dir))? {
+            let e = e.map_err(io(dir))?;
+            if e.path().is_dir() {
+                let name = e.file_name().to_string_lossy().into_owned();
+                if !valid_name(&name) {
+                    return Err(refused(
+                        &e.path(),
+                        "a client or variant name is 1 to 64 letters, digits, '-' or '_'",
+                    ));
+                }
+                out.push((name, e.path()));
+            }
+        }
+        out.sort();
+        Ok(out)
+    };
+    let mut out = Vec::new();
+    for (client, dir) in list(run)? {
+        for (variant, vdir) in list(&dir)? {
+            out.push((client.clone(), variant, vdir));
+            if out.len() > MAX_VARIANTS {
+                return Err(refused(run, format!("more than {MAX_VARIANTS} variants")));
+            }
+        }
+    }
+    if out.is_empty() {
+        return Err(refused(run, "holds no <client>/<variant>/ folder"));
+    }
+    Ok(out)
+}
+
+/// A view's image in a variant folder: `<view>.exr`, else `<view>.png`; checked for its size
+/// and for pixels that are not radiance (NaN, infinite, negative).
+fn view_image(dir: &Path, view: &crate::exchange::ExportedView) -> Result<PathBuf, HarnessError> {
+    let exr = dir.join(format!("{}.exr", view.name));
+    let path = if exr.is_file() {
+        exr
+    } else {
+        dir.join(format!("{}.png", view.name))
+    };
+    if !path.is_file() {
+        return Err(refused(
+            dir,
+            format!("no image of view {:?} ({0}.exr or {0}.png)", view.name),
+        ));
+    }
+    let img = mirrorbox_image::read_image(&path).map_err(|e| refused(&path, e))?;
+    if (img.width, img.height) != (view.width, view.height) {
+        return Err(refused(
+            &path,
+            format!(
+                "is {}×{}; view {:?} is {}×{}",
+                img.width, img.height, view.name, view.width, view.height
+            ),
+        ));
+    }
+    if let Some((i, p)) = img
+        .pixels
+        .iter()
+        .enumerate()
+        .find(|(_, p)| p.iter().any(|c| !c.is_finite() || *c < 0.0))
+    {
+        let w = img.width as usize;
+        return Err(refused(
+            &path,
+            format!(
+                "pixel ({}, {}) is {p:?}: radiance is finite and ≥ 0",
+                i % w,
+                i / w
+            ),
+        ));
+    }
+    Ok(path)
+}
+
+/// Scores `run` against `export` into `out` (see the module docs). Every input is read and
+/// checked before anything is written; the report goes to `out.partial` and is moved into
+/// place at the end (an earlier score in `out` is replaced).
+pub fn score(export: &Path, run: &Path, out: &Path, command: &str) -> Result<Scored, HarnessError> {
+    let views = read_views(export)?;
+    let found = variants(run)?;
+    crate::check_output_parent(out)?;
+    if out.exists()
+        && !out.join("sweep.json").is_file()
+        && std::fs::read_dir(out).is_ok_and(|mut d| d.next().is_some())
+    {
+        return Err(refused(
+            out,
+            "exists and holds no earlier score (sweep.json); give a new or empty folder",
+        ));
+    }
+    // Everything read and checked first.
+    let mut inputs = Vec::new();
+    for (client, variant, dir) in &found {
+        let timing = read_timing(&dir.join("timing.json"), &views)?;
+        let mut images = Vec::new();
+        for v in &views.views {
+            images.push(view_image(dir, v)?);
+        }
+        inputs.push((client, variant, timing, images));
+    }
+    let partial = PathBuf::from(format!("{}.partial", out.display()));
+    if partial.exists() {
+        std::fs::remove_dir_all(&partial).map_err(io(&partial))?;
+    }
+    let images_dir = partial.join("images");
+    std::fs::create_dir_all(&images_dir).map_err(io(&images_dir))?;
+    let result = (|| -> Result<Scored, HarnessError> {
+        let mut records = Vec::new();
+        let run_started = crate::now_rfc3339();
+        for (client, variant, timing, images) in &inputs {
+            for (vi, (v, image)) in views.views.iter().zip(images).enumerate() {
+                let floor = variant.as_str() == "floor";
+                let truth = export.join(if floor { &v.floor } else { &v.truth });
+                let slug = format!("{client}_{variant}_{}", v.name);
+                let files = ViewFiles {
+                    raster: images_dir.join(format!("{slug}.png")),
+                    heat: images_dir.join(format!("{slug}_flip.png")),
+                    truth: images_dir.join(format!(
+                        "truth_{}{}.png",
+                        v.name,
+                        if floor { "_floor" } else { "" }
+                    )),
+                };
+                let compared = compare_views(
+                    std::slice::from_ref(&truth),
+                    std::slice::from_ref(image),
+                    v.camera.exposure,
+                    None,
+                    &files,
+                )?;
+                let frames_ms = timing.views[&v.name].clone();
+                let interval = mirrorbox_report::stats::median_interval(&frames_ms);
+                let rel = |p: &Path| {
+                    p.strip_prefix(&partial)
+                        .unwrap_or(p)
+                        .to_string_lossy()
+                        .into_owned()
+                };
+                let png = image
+                    .extension()
+                    .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+                records.push(Record {
+                    key: format!(
+                        "{client}/{variant}|{}|a{:?}|{}x{}|ssaa{}",
+                        v.name, views.alpha, v.width, v.height, v.ssaa
+                    ),
+                    kind: if floor { "floor" } else { "point" }.into(),
+                    scene: views.source.clone(),
+                    scene_hash: v.scene_hash.clone(),
+                    method: if floor {
+                        client.to_string()
+                    } else {
+                        format!("{client}-{variant}")
+                    },
+                    method_options: timing
+                        .parameters
+                        .iter()
+                        .map(|(k, v)| format!("{k}={}", v.to_string().trim_matches('"')))
+                        .collect::<Vec<_>>()
+                        .join(" "),
+                    axes: if views.views.len() > 1 {
+                        [("view".to_string(), vi as f64)].into_iter().collect()
+                    } else {
+                        BTreeMap::new()
+                    },
+                    values: BTreeMap::new(),
+                    legacy: Default::default(),
+                    stereo: None,
+                    device: None,
+                    n: None,
+                    depth: None,
+                    alpha: views.alpha.unwrap_or(1.0),
+                    width: v.width,
+                    height: v.height,
+                    ssaa: v.ssaa,
+                    ms_median: mirrorbox_report::stats::median(&frames_ms),
+                    ms_min: frames_ms.iter().copied().fold(f64::INFINITY, f64::min),
+                    ms_interval: interval.map(|i| [i.low, i.high]),
+                    frames: frames_ms.len() as u32,
+                    frames_ms,
+                    timing_order: "external".into(),
+                    run: Some(run_started.clone()),
+                    peak_memory_bytes: None,
+                    plan_ms: None,
+                    encode_ms: None,
+                    gpu_buffer_bytes: None,
+                    gpu_texture_bytes: None,
+                    timing_source: timing.timing.clone(),
+                    passes: 0,
+                    draws: 0,
+                    texture_renders: 0,
+                    reflections: 0,
+                    triangles: None,
+                    paths: None,
+                    paths_pruned: None,
+                    metrics: compared.metrics,
+                    mirror_metrics: compared.mirror_metrics,
+                    mirror_pixel_share: compared.mirror_pixel_share,
+                    split: None,
+                    adapter: timing.device.clone(),
+                    backend: format!("{} {}", timing.engine, timing.engine_version),
+                    color_format: if png {
+                        "png8 (sRGB)".into()
+                    } else {
+                        "exr (float)".into()
+                    },
+                    truth_image: rel(&files.truth),
+                    raster_image: rel(&files.raster),
+                    heatmap_image: rel(&files.heat),
+                });
+            }
+        }
+        let lines: String = records
+            .iter()
+            .map(|r| serde_json::to_string(r).map(|l| l + "\n"))
+            .collect::<Result<_, _>>()?;
+        let results = partial.join("results.jsonl");
+        std::fs::write(&results, lines).map_err(io(&results))?;
+        let devices = mirrorbox_report::document::distinct(
+            inputs
+                .iter()
+                .map(|(_, _, t, _)| format!("{} ({} {})", t.device, t.engine, t.engine_version)),
+        );
+        let drivers = mirrorbox_report::document::distinct(
+            inputs
+                .iter()
+                .map(|(_, _, t, _)| t.driver.clone())
+                .filter(|d| !d.is_empty()),
+        );
+        let first = &views.views[0];
+        let info = SweepInfo {
+            command: command.to_string(),
+            date: crate::now_rfc3339(),
+            cpu: crate::cpu_description(),
+            adapter: devices.join("; "),
+            backend: "external (mirrorbox score)".into(),
+            device_type: "external".into(),
+            driver: drivers.join("; "),
+            versions: format!(
+                "mirrorbox {}, exchange version {FORMAT_VERSION}",
+                env!("CARGO_PKG_VERSION")
+            ),
+            scene: views.source.clone(),
+            resolution: format!(
+                "{}x{}, ssaa {} (truth: the same {}x{} sub-pixel grid)",
+                first.width, first.height, first.ssaa, first.ssaa, first.ssaa
+            ),
+            truth: views.contract.truth.clone(),
+            commit: crate::source_commit(),
+            exact_methods: mirrorbox_raster::METHODS
+                .iter()
+                .filter(|e| e.exact)
+                .map(|e| e.name.to_string())
+                .collect(),
+            ..SweepInfo::default()
+        };
+        let sweep = partial.join("sweep.json");
+        std::fs::write(&sweep, serde_json::to_string_pretty(&info)?).map_err(io(&sweep))?;
+        write_report(&partial, &info, &records, &[])?;
+        Ok(Scored {
+            records: records.len(),
+            variants: inputs.len(),
+        })
+    })();
+    let scored = match result {
+        Ok(s) => s,
+        Err(e) => {
+            let _ = std::fs::remove_dir_all(&partial);
+            return Err(e);
+        }
+    };
+    if out.exists() {
+        std::fs::remove_dir_all(out).map_err(io(out))?;
+    }
+    std::fs::rename(&partial, out).map_err(io(out))?;
+    Ok(scored)
+}

@@ -1,0 +1,292 @@
+//! The exchange (issue 53, docs/exchange.md) end to end: `export-views` writes a glTF that
+//! traces back to its truth bit for bit, and `score` of our own `render` output, passed
+//! through the exchange as if an external client drew it, gives `sweep`'s numbers exactly;
+//! bad runs are refused naming the file, with nothing written.
+
+use crate::common::{mirrorbox, repo};
+use serde_json::Value;
+use std::path::Path;
+
+const SIZE: [&str; 4] = ["--width", "64", "--height", "36"];
+
+fn export(dir: &Path) {
+    let mut args = vec![
+        "export-views",
+        "scenes/mirror_box.json",
+        "-o",
+        dir.to_str().unwrap(),
+        "--alpha",
+        "0.9",
+    ];
+    args.extend(SIZE);
+    let out = mirrorbox(&args, &[]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+}
+
+fn timing(views: &str) -> String {
+    format!(
+        r#"{{"format":"mirrorbox-timing","version":1,"engine":"mirrorbox","engine_version":"test",
+        "device":"the test's adapter","timing":"GPU timestamps","parameters":{{"method":"naive"}},
+        "equivalent":"naive","views":{{{views}}}}}"#
+    )
+}
+
+/// `RUN/mirrorbox/naive/`: `render --method naive` of the export's view, with a timing file.
+fn our_run(run: &Path) -> std::path::PathBuf {
+    let variant = run.join("mirrorbox/naive");
+    std::fs::create_dir_all(&variant).unwrap();
+    let png = variant.join("camera.png");
+    let mut args = vec![
+        "render",
+        "scenes/mirror_box.json",
+        "--method",
+        "naive",
+        "--alpha",
+        "0.9",
+        "-o",
+        png.to_str().unwrap(),
+    ];
+    args.extend(SIZE);
+    let out = mirrorbox(&args, &[]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    std::fs::remove_file(&png).unwrap(); // the EXR beside it is read first anyway
+    std::fs::write(
+        variant.join("timing.json"),
+        timing(r#""camera":[1,1.1,0.9,1,1.2,1]"#),
+    )
+    .unwrap();
+    variant
+}
+
+fn records(folder: &Path) -> Vec<Value> {
+    std::fs::read_to_string(folder.join("results.jsonl"))
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect()
+}
+
+#[test]
+fn an_export_traces_back_to_its_truth_and_our_render_scores_as_the_sweep_does() {
+    let tmp = tempfile::tempdir().unwrap();
+    let ex = tmp.path().join("export");
+    export(&ex);
+    let views: Value =
+        serde_json::from_str(&std::fs::read_to_string(ex.join("views.json")).unwrap()).unwrap();
+    assert_eq!(views["views"][0]["width"], 64);
+    assert_eq!(views["contract"]["version"], 1);
+    // The glTF read back through scene.json traces to the exported truth, bit for bit.
+    let traced = tmp.path().join("traced.exr");
+    let out = mirrorbox(
+        &[
+            "trace",
+            ex.join("scene.json").to_str().unwrap(),
+            "-o",
+            traced.to_str().unwrap(),
+        ],
+        &[],
+    );
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let out = mirrorbox(
+        &[
+            "compare",
+            ex.join("truth/camera.exr").to_str().unwrap(),
+            traced.to_str().unwrap(),
+            "--json",
+        ],
+        &[],
+    );
+    let c: Value = serde_json::from_str(out.stdout.trim()).unwrap();
+    assert_eq!(c["max_abs"], 0.0, "{c}");
+    // Our own render, scored through the exchange, against the sweep of the same point.
+    let run = tmp.path().join("run");
+    our_run(&run);
+    let scored = tmp.path().join("scored");
+    let out = mirrorbox(
+        &[
+            "score",
+            ex.to_str().unwrap(),
+            run.to_str().unwrap(),
+            "-o",
+            scored.to_str().unwrap(),
+        ],
+        &[],
+    );
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let sweep = tmp.path().join("sweep");
+    let mut args = vec![
+        "sweep",
+        "scenes/mirror_box.json",
+        "--methods",
+        "naive",
+        "--alpha",
+        "0.9",
+        "--frames",
+        "1",
+        "--out",
+        sweep.to_str().unwrap(),
+    ];
+    args.extend(SIZE);
+    let out = mirrorbox(&args, &[]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let ours = &records(&scored)[0];
+    let swept = records(&sweep)
+        .into_iter()
+        .find(|r| r["method"] == "naive")
+        .unwrap();
+    assert_eq!(ours["method"], "mirrorbox-naive");
+    assert_eq!(ours["metrics"], swept["metrics"]);
+    assert_eq!(ours["mirror_metrics"], swept["mirror_metrics"]);
+    assert_eq!(ours["ms_median"], 1.0);
+    assert!(
+        std::fs::read_to_string(scored.join("report.md"))
+            .unwrap()
+            .contains("mirrorbox-naive")
+    );
+}
+
+#[test]
+fn a_bad_run_is_refused_naming_the_file_and_nothing_is_written() {
+    let tmp = tempfile::tempdir().unwrap();
+    let ex = tmp.path().join("export");
+    export(&ex);
+    let run = tmp.path().join("run");
+    let variant = our_run(&run);
+    let scored = tmp.path().join("scored");
+    let score = || {
+        mirrorbox(
+            &[
+                "score",
+                ex.to_str().unwrap(),
+                run.to_str().unwrap(),
+                "-o",
+                scored.to_str().unwrap(),
+            ],
+            &[],
+        )
+    };
+    let refused = |what: &str, needle: &str| {
+        let out = score();
+        assert_eq!(out.code, 2, "{what}: {}", out.stderr);
+        assert!(out.stderr.contains(needle), "{what}: {}", out.stderr);
+        assert!(
+            !scored.exists() && !tmp.path().join("scored.partial").exists(),
+            "{what}"
+        );
+    };
+    let exr = variant.join("camera.exr");
+    let good = std::fs::read(&exr).unwrap();
+    // A missing view.
+    std::fs::rename(&exr, tmp.path().join("aside.exr")).unwrap();
+    refused("missing view", "no image of view \"camera\"");
+    // A wrong size.
+    let small = mirrorbox_image::RgbImage {
+        width: 32,
+        height: 18,
+        pixels: vec![[0.1; 3]; 32 * 18],
+    };
+    mirrorbox_image::write_exr(&exr, &small, &[]).unwrap();
+    refused("wrong size", "is 32×18; view \"camera\" is 64×36");
+    // A NaN and a negative pixel.
+    for bad in [f32::NAN, -1.0] {
+        let mut img = mirrorbox_image::RgbImage {
+            width: 64,
+            height: 36,
+            pixels: vec![[0.1; 3]; 64 * 36],
+        };
+        img.pixels[64 * 2 + 5] = [0.1, bad, 0.1];
+        mirrorbox_image::write_exr(&exr, &img, &[]).unwrap();
+        refused("bad pixel", "pixel (5, 2)");
+    }
+    std::fs::write(&exr, &good).unwrap();
+    // An unreadable timing file, one without the view, and a negative time.
+    let timing_file = variant.join("timing.json");
+    for (text, needle) in [
+        ("{not json".to_string(), "timing.json"),
+        (timing(r#""other":[1]"#), "no frames for view \"camera\""),
+        (timing(r#""camera":[1,-2]"#), "-2 ms is not a time"),
+    ] {
+        std::fs::write(&timing_file, text).unwrap();
+        refused("timing", needle);
+    }
+    std::fs::write(&timing_file, timing(r#""camera":[1]"#)).unwrap();
+    // A run without variants, and an export without views.json.
+    let empty = tmp.path().join("empty");
+    std::fs::create_dir(&empty).unwrap();
+    let out = mirrorbox(
+        &[
+            "score",
+            ex.to_str().unwrap(),
+            empty.to_str().unwrap(),
+            "-o",
+            scored.to_str().unwrap(),
+        ],
+        &[],
+    );
+    assert_eq!(out.code, 2, "{}", out.stderr);
+    assert!(
+        out.stderr.contains("holds no <client>/<variant>/ folder"),
+        "{}",
+        out.stderr
+    );
+    let out = mirrorbox(
+        &[
+            "score",
+            run.to_str().unwrap(),
+            run.to_str().unwrap(),
+            "-o",
+            scored.to_str().unwrap(),
+        ],
+        &[],
+    );
+    assert_eq!(out.code, 2, "{}", out.stderr);
+    assert!(out.stderr.contains("views.json"), "{}", out.stderr);
+    // Now it scores.
+    assert_eq!(score().code, 0);
+    let _ = repo();
+}
+
+#[test]
+fn a_bad_view_list_is_refused_naming_the_field() {
+    let tmp = tempfile::tempdir().unwrap();
+    let list = tmp.path().join("views.json");
+    let ex = tmp.path().join("export");
+    for (text, needle) in [
+        (r#"{"views": []}"#, "0 views; 1 to 64"),
+        (
+            r#"{"views": [{"name": "a b", "position": [0,1,2], "look_at": [0,0,0]}]}"#,
+            "views[0].name",
+        ),
+        (
+            r#"{"views": [{"name": "a", "position": [0,1,2], "look_at": [0,0,0]}, {"name": "a", "position": [0,1,2], "look_at": [0,0,0]}]}"#,
+            "views[1].name \"a\" appears twice",
+        ),
+        (
+            r#"{"views": [{"name": "a", "position": [0,1,2], "look_at": [0,1,2]}]}"#,
+            "view \"a\": position and look_at",
+        ),
+    ] {
+        std::fs::write(&list, text).unwrap();
+        let out = mirrorbox(
+            &[
+                "export-views",
+                "scenes/mirror_box.json",
+                "-o",
+                ex.to_str().unwrap(),
+                "--views",
+                list.to_str().unwrap(),
+                "--width",
+                "32",
+                "--height",
+                "18",
+            ],
+            &[],
+        );
+        assert_eq!(out.code, 2, "{text}: {}", out.stderr);
+        assert!(out.stderr.contains(needle), "{text}: {}", out.stderr);
+        assert!(
+            !ex.exists() && !tmp.path().join("export.partial").exists(),
+            "{text}"
+        );
+    }
+}
