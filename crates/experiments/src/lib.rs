@@ -25,6 +25,7 @@ pub mod scripts;
 pub mod stereo;
 pub mod symmetry_scaling;
 pub mod table1;
+pub mod web_engines;
 
 /// How an experiment is measured.
 pub enum Measure {
@@ -77,6 +78,7 @@ pub const EXPERIMENTS: &[&Experiment] = &[
     &frontier::FRONTIER,
     &engine_reflections::ENGINE_REFLECTIONS,
     &real_assets::REAL_ASSETS,
+    &web_engines::WEB_ENGINES,
     &scripts::GPU_TRUTH,
     &scripts::LIGHTING_TRACE_COST,
     &scripts::MEMORY_PEAKS,

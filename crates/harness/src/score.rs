@@ -35,6 +35,15 @@ pub struct Timing {
     pub views: BTreeMap<String, Vec<f64>>,
 }
 
+/// How to score: the command line (for the report), our sweeps to set beside the run
+/// (`--with`), and the report sections (the experiments' registry).
+#[derive(Default)]
+pub struct ScoreSettings {
+    pub command: String,
+    pub with: Vec<PathBuf>,
+    pub sections: Vec<mirrorbox_report::Section>,
+}
+
 /// What a score wrote.
 pub struct Scored {
     pub records: usize,
@@ -195,8 +204,35 @@ fn view_image(dir: &Path, view: &crate::exchange::ExportedView) -> Result<PathBu
 /// Scores `run` against `export` into `out` (see the module docs). Every input is read and
 /// checked before anything is written; the report goes to `out.partial` and is moved into
 /// place at the end (an earlier score in `out` is replaced).
-pub fn score(export: &Path, run: &Path, out: &Path, command: &str) -> Result<Scored, HarnessError> {
+pub fn score(
+    export: &Path,
+    run: &Path,
+    out: &Path,
+    settings: &ScoreSettings,
+) -> Result<Scored, HarnessError> {
+    let command = settings.command.as_str();
     let views = read_views(export)?;
+    // Our own sweeps of the same views, set beside the run's variants in one report: their
+    // records as they are (their own truth, device and timing), checked to be of this scene.
+    let mut ours: Vec<Record> = Vec::new();
+    for dir in &settings.with {
+        let sweep = mirrorbox_report::load_sweep(dir).map_err(|e| refused(dir, e))?;
+        if let Some(r) = sweep.records.iter().find(|r| {
+            !views
+                .views
+                .iter()
+                .any(|v| v.width == r.width && v.height == r.height)
+        }) {
+            return Err(refused(
+                dir,
+                format!(
+                    "{}: {}×{} is not the size of any view of the export",
+                    r.key, r.width, r.height
+                ),
+            ));
+        }
+        ours.extend(sweep.records);
+    }
     let found = variants(run)?;
     crate::check_output_parent(out)?;
     if out.exists()
@@ -272,10 +308,13 @@ pub fn score(export: &Path, run: &Path, out: &Path, command: &str) -> Result<Sco
                     } else {
                         format!("{client}-{variant}")
                     },
+                    // The variant's parameters, then the method it is meant to match.
                     method_options: timing
                         .parameters
                         .iter()
                         .map(|(k, v)| format!("{k}={}", v.to_string().trim_matches('"')))
+                        .chain(timing.equivalent.iter().map(|e| format!("equivalent={e}")))
+                        .map(|w| w.replace(char::is_whitespace, "_"))
                         .collect::<Vec<_>>()
                         .join(" "),
                     axes: if views.views.len() > 1 {
@@ -330,6 +369,7 @@ pub fn score(export: &Path, run: &Path, out: &Path, command: &str) -> Result<Sco
                 });
             }
         }
+        records.extend(ours.iter().cloned());
         let lines: String = records
             .iter()
             .map(|r| serde_json::to_string(r).map(|l| l + "\n"))
@@ -376,7 +416,7 @@ pub fn score(export: &Path, run: &Path, out: &Path, command: &str) -> Result<Sco
         };
         let sweep = partial.join("sweep.json");
         std::fs::write(&sweep, serde_json::to_string_pretty(&info)?).map_err(io(&sweep))?;
-        write_report(&partial, &info, &records, &[])?;
+        write_report(&partial, &info, &records, &settings.sections)?;
         Ok(Scored {
             records: records.len(),
             variants: inputs.len(),

@@ -16,11 +16,19 @@ pub struct Args {
     /// earlier score there is replaced.
     #[arg(short, long)]
     output: PathBuf,
+    /// A sweep folder of our own methods on the same views, set beside the run's variants in
+    /// the report (repeatable): e.g. the equivalents measured on the same device.
+    #[arg(long)]
+    with: Vec<PathBuf>,
 }
 
 pub fn run(args: &Args) -> Result<(), Failure> {
-    let command = std::env::args().collect::<Vec<_>>().join(" ");
-    let done = mirrorbox_harness::score::score(&args.export, &args.run, &args.output, &command)
+    let settings = mirrorbox_harness::score::ScoreSettings {
+        command: std::env::args().collect::<Vec<_>>().join(" "),
+        with: args.with.clone(),
+        sections: mirrorbox_experiments::sections(),
+    };
+    let done = mirrorbox_harness::score::score(&args.export, &args.run, &args.output, &settings)
         .map_err(Failure::from)?;
     println!(
         "scored {} variant(s) of {} against {}: {} records; wrote {}",

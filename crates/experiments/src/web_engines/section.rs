@@ -1,0 +1,147 @@
+//! A scored run's section (`mirrorbox score`, issue 53): each external variant beside its
+//! client's floor, our equivalent on the same view and the best exact method at its cost —
+//! one table and one finding per variant, computed from the records. Empty for any report
+//! without external records (`timing_order` "external").
+
+use mirrorbox_report::document::{Block, f, ms_cell, sci};
+use mirrorbox_report::{Record, SweepInfo};
+
+/// FLIP over the mirror pixels where the mask was kept, else over the image.
+fn mirror_flip(r: &Record) -> f64 {
+    r.mirror_metrics
+        .as_ref()
+        .map_or(r.metrics.flip_mean, |m| m.flip_mean)
+}
+
+fn external(r: &Record) -> bool {
+    r.timing_order == "external"
+}
+
+/// The client of an external record: its method up to the first `-` (`three-reflector`), or
+/// the whole method for its floor.
+fn client(r: &Record) -> &str {
+    r.method.split('-').next().unwrap_or(&r.method)
+}
+
+pub fn section(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
+    let variants: Vec<&Record> = records
+        .iter()
+        .filter(|r| external(r) && r.kind == "point")
+        .collect();
+    if variants.is_empty() {
+        return Vec::new();
+    }
+    let ours: Vec<&Record> = records
+        .iter()
+        .filter(|r| !external(r) && r.kind == "point")
+        .collect();
+    let our_floor = records.iter().find(|r| !external(r) && r.kind == "floor");
+    let mut rows = Vec::new();
+    let mut findings = Vec::new();
+    for r in &variants {
+        let floor = records
+            .iter()
+            .find(|f| external(f) && f.kind == "floor" && f.method == client(r));
+        let equivalent = r.option("equivalent");
+        let eq = equivalent.and_then(|m| ours.iter().find(|o| o.method == m));
+        // The best of our exact methods that costs no more on its own device.
+        let exact = ours
+            .iter()
+            .filter(|o| info.exact_methods.contains(&o.method) && o.ms_median <= r.ms_median)
+            .min_by(|a, b| mirror_flip(a).total_cmp(&mirror_flip(b)));
+        rows.push(vec![
+            r.method.clone(),
+            r.adapter.clone(),
+            floor.map_or("–".into(), |fl| sci(fl.metrics.flip_mean)),
+            sci(mirror_flip(r)),
+            sci(r.metrics.flip_mean),
+            ms_cell(r, 3),
+            eq.map_or("–".into(), |e| {
+                format!("{} {}", e.method, sci(mirror_flip(e)))
+            }),
+            eq.map_or("–".into(), |e| ms_cell(e, 3)),
+            exact.map_or("–".into(), |e| {
+                format!(
+                    "{} {}",
+                    mirrorbox_report::document::label(e),
+                    sci(mirror_flip(e))
+                )
+            }),
+        ]);
+        let mut s = format!(
+            "**{}** ({}): FLIP over the mirror pixels {}",
+            r.method,
+            r.backend,
+            sci(mirror_flip(r))
+        );
+        if let Some(e) = eq {
+            s.push_str(&format!(
+                ", {}× that of our `{}` ({}) on the same view",
+                f(mirror_flip(r) / mirror_flip(e), 2),
+                e.method,
+                sci(mirror_flip(e))
+            ));
+        }
+        if let Some(fl) = floor {
+            s.push_str(&format!(
+                "; its floor (no mirrors) {}",
+                sci(fl.metrics.flip_mean)
+            ));
+            if let Some(of) = our_floor {
+                s.push_str(&format!(", ours {}", sci(of.metrics.flip_mean)));
+            }
+        }
+        s.push_str(&format!(
+            "; {} ms/frame on {} ({})",
+            f(r.ms_median, 3),
+            r.adapter,
+            r.timing_source
+        ));
+        if let Some(e) = eq {
+            s.push_str(&format!(
+                " against our `{}`'s {} ms on {} ({})",
+                e.method,
+                f(e.ms_median, 3),
+                e.adapter,
+                e.timing_source
+            ));
+        }
+        match exact {
+            Some(e) => s.push_str(&format!(
+                "; at no more cost our `{}` reaches {}.",
+                mirrorbox_report::document::label(e),
+                sci(mirror_flip(e))
+            )),
+            None => s.push_str("; none of our exact methods is as cheap."),
+        }
+        findings.push(s);
+    }
+    vec![
+        Block::Heading(2, "External renderers against the truth".into()),
+        Block::Paragraph(
+            "Each variant a client drew (`mirrorbox score`, docs/exchange.md), its client's \
+             floor (the scene without mirrors: shading and rasterization alone), our \
+             equivalent on the same view, and the best of our exact methods that costs no \
+             more. Times come from different clocks where the devices or timing sources \
+             differ (named in each finding)."
+                .into(),
+        ),
+        Block::Table(
+            [
+                "variant",
+                "device",
+                "client's floor FLIP",
+                "FLIP over mirror pixels",
+                "FLIP over image",
+                "ms/frame [95 % CI]",
+                "our equivalent: mirror FLIP",
+                "our equivalent: ms/frame",
+                "our best exact at no more cost",
+            ]
+            .map(String::from)
+            .to_vec(),
+            rows,
+        ),
+        Block::Bullets(findings),
+    ]
+}

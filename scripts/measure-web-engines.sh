@@ -1,0 +1,47 @@
+#!/usr/bin/env bash
+# Experiment web-engines (issue 53): the planar reflections two web engines ship, scored
+# against the truth through the exchange (docs/exchange.md), beside our own equivalents
+# measured on the same device.
+#
+# Per scene (mirror_box, mirror_room, textured_box at 320×180, α = 0.9):
+#   1. `mirrorbox export-views` into target/web-engines/<scene>/export (truths not committed);
+#   2. the web clients (clients/web, headless Chromium: WebGL 2 on ANGLE on SwiftShader)
+#      draw every variant (floor, reflector, cubecamera) into target/web-engines/<scene>/run;
+#   3. our equivalents (naive; cubemap at 256², history 0: one reflection, as a CubeCamera
+#      updated each frame with the mirror hidden) and the exact methods swept on SwiftShader's Vulkan —
+#      the same software rasterizer the browser runs on, loaded by wgpu from Chromium's own
+#      ICD file — so that milliseconds compare like with like;
+#   4. `mirrorbox score … --with <our sweep>` writes reports/web_engines[_room|_textured].
+# Usage: scripts/measure-web-engines.sh [FRAMES]   (timed frames per point, default 9)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bin=${MIRRORBOX:-target/release/mirrorbox}
+frames=${1:-9}
+work=target/web-engines
+icd=/usr/lib/chromium/vk_swiftshader_icd.json
+if [ ! -f "$icd" ]; then
+  echo "measure-web-engines: $icd not found (Chromium's SwiftShader Vulkan driver, from Debian's chromium-headless-shell)" >&2
+  exit 1
+fi
+scripts/install-web-clients.sh
+mkdir -p "$work"
+for entry in mirror_box: mirror_room:_room textured_box:_textured; do
+  scene=${entry%%:*}
+  suffix=${entry##*:}
+  dir=$work/$scene
+  rm -rf "$dir/run" "$dir/ours"
+  mkdir -p "$dir"
+  echo "== $scene: export"
+  "$bin" export-views "scenes/$scene.json" -o "$dir/export" --width 320 --height 180 --alpha 0.9
+  echo "== $scene: web clients"
+  node clients/web/run.mjs "$dir/export" "$dir/run" --variants floor,reflector,cubecamera \
+    --frames "$frames" --warmup 2
+  echo "== $scene: our methods on SwiftShader"
+  depths=1,4,16,64
+  [ "$scene" = mirror_room ] && depths=1,2,4,8
+  VK_DRIVER_FILES=$icd "$bin" sweep "scenes/$scene.json" --alpha 0.9 --width 320 --height 180 \
+    --frames "$frames" --warmup 2 --out "$dir/ours" \
+    --methods naive,cubemap,portal,unrolled --depth "$depths" --history 0 --cube-size 256
+  echo "== $scene: score"
+  "$bin" score "$dir/export" "$dir/run" --with "$dir/ours" -o "reports/web_engines$suffix"
+done
