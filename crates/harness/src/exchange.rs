@@ -438,6 +438,45 @@ fn perspective(fov: f32, aspect: f32, near: f32, far: f32, range: DepthRange) ->
     )
 }
 
+/// A `views.json` as an export writes it, for tests of what reads it.
+#[cfg(test)]
+pub(crate) mod tests_support {
+    use super::*;
+
+    pub fn sample_view() -> ViewsFile {
+        let scene = mirrorbox_scene::load::load_scene(
+            &Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/mirror_box.json"),
+        )
+        .unwrap();
+        let spec = ViewSpec {
+            name: "camera".into(),
+            position: scene.camera.position.to_array(),
+            look_at: scene.camera.look_at.to_array(),
+            up: None,
+            fov_y_deg: None,
+        };
+        ViewsFile {
+            format: "mirrorbox-views".into(),
+            version: FORMAT_VERSION,
+            gltf: "scene.gltf".into(),
+            scene: "scene.json".into(),
+            source: "scenes/mirror_box.json".into(),
+            alpha: Some(0.9),
+            contract: Contract {
+                document: "docs/shading.md".into(),
+                version: CONTRACT_VERSION,
+                ambient: [0.0; 3],
+                background: [0.0; 3],
+                terminal: [0.0; 3],
+                lighting: scene.lighting.describe(),
+                truth: "whitted".into(),
+                rules: CLIENT_RULES.iter().map(|r| r.to_string()).collect(),
+            },
+            views: vec![exported_view(&scene, &spec, 1)],
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

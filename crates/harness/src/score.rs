@@ -435,3 +435,67 @@ pub fn score(
     std::fs::rename(&partial, out).map_err(io(out))?;
     Ok(scored)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn schema(name: &str) -> serde_json::Value {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../docs/exchange")
+            .join(name);
+        serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+    }
+
+    /// The published schema of timing.json says what `score` reads: its example is read, a
+    /// file without any one required field is refused, and so is one with a field the schema
+    /// does not name (additionalProperties: false).
+    #[test]
+    fn the_timing_schema_is_what_score_reads() {
+        let s = schema("timing.schema.json");
+        let example = s["examples"][0].clone();
+        assert!(serde_json::from_value::<Timing>(example.clone()).is_ok());
+        let properties: Vec<&String> = s["properties"].as_object().unwrap().keys().collect();
+        for required in s["required"].as_array().unwrap() {
+            let mut doc = example.clone();
+            doc.as_object_mut()
+                .unwrap()
+                .remove(required.as_str().unwrap());
+            assert!(serde_json::from_value::<Timing>(doc).is_err(), "{required}");
+        }
+        let required = s["required"].as_array().unwrap();
+        for p in &properties {
+            assert!(example.get(p.as_str()).is_some(), "the example shows {p}");
+            if !required.iter().any(|r| r == p.as_str()) {
+                let mut doc = example.clone();
+                doc.as_object_mut().unwrap().remove(p.as_str());
+                assert!(serde_json::from_value::<Timing>(doc).is_ok(), "{p} is optional");
+            }
+        }
+        let mut doc = example;
+        doc["unknown"] = serde_json::json!(1);
+        assert!(serde_json::from_value::<Timing>(doc).is_err());
+    }
+
+    /// An export's views.json holds every field the schema requires, at every level.
+    #[test]
+    fn views_json_as_written_has_what_its_schema_requires() {
+        let s = schema("views.schema.json");
+        let view = crate::exchange::tests_support::sample_view();
+        let doc = serde_json::to_value(&view).unwrap();
+        let check = |schema: &serde_json::Value, doc: &serde_json::Value, at: &str| {
+            for r in schema["required"].as_array().unwrap() {
+                assert!(doc.get(r.as_str().unwrap()).is_some(), "{at}.{r}");
+            }
+        };
+        check(&s, &doc, "views.json");
+        check(&s["properties"]["contract"], &doc["contract"], "contract");
+        let item = &s["properties"]["views"]["items"];
+        check(item, &doc["views"][0], "views[0]");
+        check(
+            &item["properties"]["camera"],
+            &doc["views"][0]["camera"],
+            "views[0].camera",
+        );
+    }
+}
