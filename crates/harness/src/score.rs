@@ -297,8 +297,12 @@ pub fn score(
                     .is_some_and(|e| e.eq_ignore_ascii_case("png"));
                 records.push(Record {
                     key: format!(
-                        "{client}/{variant}|{}|a{:?}|{}x{}|ssaa{}",
-                        v.name, views.alpha, v.width, v.height, v.ssaa
+                        "{client}/{variant}|{}|a{}|{}x{}|ssaa{}",
+                        v.name,
+                        views.alpha.map_or("-".to_string(), |a| a.to_string()),
+                        v.width,
+                        v.height,
+                        v.ssaa
                     ),
                     kind: if floor { "floor" } else { "point" }.into(),
                     scene: views.source.clone(),
@@ -469,7 +473,10 @@ mod tests {
             if !required.iter().any(|r| r == p.as_str()) {
                 let mut doc = example.clone();
                 doc.as_object_mut().unwrap().remove(p.as_str());
-                assert!(serde_json::from_value::<Timing>(doc).is_ok(), "{p} is optional");
+                assert!(
+                    serde_json::from_value::<Timing>(doc).is_ok(),
+                    "{p} is optional"
+                );
             }
         }
         let mut doc = example;

@@ -1,0 +1,55 @@
+#!/usr/bin/env python3
+"""A minimal client of mirrorbox's exchange (docs/exchange.md), to copy and adapt.
+
+Draws every view of an export with a renderer and writes RUN/<client>/<variant>/ — one
+image per view and timing.json — for `mirrorbox score EXPORT RUN -o OUT`. Replace draw()
+with your renderer; as shipped it runs mirrorbox's own `naive` method, so its score equals
+what `mirrorbox sweep` measures for `naive` (tests/exchange.rs checks it).
+
+usage: client.py EXPORT RUN [--mirrorbox PATH] [--frames N]
+"""
+import argparse, json, os, pathlib, subprocess, time
+
+CLIENT, VARIANT, EQUIVALENT = "minimal", "naive", "naive"
+
+
+def draw(export, view, out, mirrorbox):
+    """Your renderer: view (from views.json) into out, linear radiance (EXR) or 8-bit sRGB (PNG)."""
+    scene = json.loads((export / "scene.json").read_text())
+    cam = view["camera"]
+    scene["camera"].update(position=cam["position"], look_at=cam["look_at"], up=cam["up"],
+                           fov_y_deg=cam["fov_y_deg"], width=view["width"], height=view["height"])
+    view_scene = export / f".view_{view['name']}.json"  # beside scene.gltf, which it names
+    view_scene.write_text(json.dumps(scene))
+    subprocess.run([mirrorbox, "render", str(view_scene), "--method", "naive", "--ssaa", str(view["ssaa"]),
+                    "-o", str(out.with_suffix(".png"))], check=True, capture_output=True)
+    view_scene.unlink()
+    out.with_suffix(".png").unlink()  # `render` writes the linear EXR beside its PNG
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("export", type=pathlib.Path)
+    p.add_argument("run", type=pathlib.Path)
+    p.add_argument("--mirrorbox", default=os.environ.get("MIRRORBOX", "mirrorbox"))
+    p.add_argument("--frames", type=int, default=6, help="timed frames per view (6+ give an interval)")
+    a = p.parse_args()
+    views = json.loads((a.export / "views.json").read_text())["views"]
+    folder = a.run / CLIENT / VARIANT
+    folder.mkdir(parents=True, exist_ok=True)
+    times = {}
+    for view in views:
+        times[view["name"]] = []
+        for _ in range(a.frames):  # every frame draws the view again; the last one is kept
+            start = time.perf_counter()
+            draw(a.export, view, folder / f"{view['name']}.exr", a.mirrorbox)
+            times[view["name"]].append(1000 * (time.perf_counter() - start))
+    (folder / "timing.json").write_text(json.dumps({
+        "format": "mirrorbox-timing", "version": 1, "engine": "mirrorbox render (minimal client)",
+        "engine_version": "1", "device": "this machine's default adapter", "equivalent": EQUIVALENT,
+        "timing": "wall clock around one `mirrorbox render` process per frame", "views": times}, indent=1))
+    print(f"wrote {folder}: {len(views)} view(s); next: mirrorbox score {a.export} {a.run} -o OUT")
+
+
+if __name__ == "__main__":
+    main()
