@@ -37,7 +37,7 @@ MESA_MIN=25.0.7
 MESA_PACKAGES=(mesa-vulkan-drivers libvulkan1 libegl1 libegl-mesa0 libgl1-mesa-dri)
 # The other packages, in the order they are named.
 PACKAGES=(libx11-6 libx11-xcb1 libxcursor1 libxrandr2 libxi6 libxkbcommon-x11-0 xvfb xauth
-  xdotool time chromium-headless-shell assimp-testmodels)
+  xdotool time chromium-headless-shell assimp-testmodels nodejs npm)
 
 ldconfig_bin=$(command -v ldconfig || echo /sbin/ldconfig)
 # (grep reads all of ldconfig's output: `grep -q` would end the pipe early, and pipefail
@@ -64,6 +64,8 @@ present() {
     time) [ -x /usr/bin/time ] ;;
     chromium-headless-shell) command -v chromium-headless-shell >/dev/null 2>&1 ;;
     assimp-testmodels) [ -d /usr/share/assimp/models/OBJ ] ;;
+    nodejs) command -v node >/dev/null 2>&1 ;;
+    npm) command -v npm >/dev/null 2>&1 ;;
     *) return 1 ;;
   esac
 }
@@ -74,6 +76,7 @@ component_of() {
     xdotool) echo xdotool ;;
     chromium-headless-shell) echo chromium ;;
     assimp-testmodels) echo corpus ;;
+    nodejs | npm) echo web ;;
     *) echo "" ;;
   esac
 }

@@ -12,7 +12,7 @@
 # warnings` reports the same lints.
 #
 # MIRRORBOX_TEST_SKIP (scripts/lib/skip.sh; CI sets none): the components the user agrees to
-# go without (corpus, xvfb, xdotool, slurm, mitsuba, chromium, raytracing). The install steps
+# go without (corpus, xvfb, xdotool, slurm, mitsuba, chromium, raytracing, web). The install steps
 # fail on a component they cannot install unless it is listed; a test that skips appends
 # `<component>\t<test name>\t<reason>` to $MIRRORBOX_SKIP_LOG (target/test-skips.tsv, emptied
 # here). The end lists every skip with its reason, records them in target/test-timing.json
@@ -48,6 +48,10 @@ timed scripts/install-system-deps.sh
 # Mitsuba 3 for the agreement tests (tests/mitsuba.rs): a pinned venv, and libllvm19 via apt.
 timed tools/mitsuba/setup.sh
 export MIRRORBOX_MITSUBA_PYTHON="$PWD/tools/mitsuba/.venv/bin/python"
+# The web clients of the exchange (clients/web: three.js in headless Chromium) for
+# tests/exchange.rs: pinned npm packages, installed by `npm ci` (exits 1 unless
+# MIRRORBOX_TEST_SKIP names web).
+timed scripts/install-web-clients.sh
 # Slurm and munge for the sharded-sweep test on a local one-node Slurm (tests/slurm.rs, root;
 # not root: exits 1 unless MIRRORBOX_TEST_SKIP names slurm).
 timed scripts/slurm-local.sh install

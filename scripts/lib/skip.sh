@@ -8,6 +8,7 @@
 #   mitsuba     tools/mitsuba/.venv and libllvm19: the Mitsuba 3 agreement tests
 #   chromium    chromium-headless-shell: the reports opened in a browser
 #   raytracing  the adapter's ray queries (Mesa >= 25's lavapipe has them)
+#   web         nodejs, npm and clients/web's npm packages: the web engines' exchange test
 # A component not in the list is required: an install script that cannot install it exits
 # non-zero naming the packages, and a test that finds it missing fails. A listed one is not:
 # the install scripts warn instead of failing, and a test that skips for it appends
@@ -18,7 +19,7 @@
 # skip_allowed COMPONENT   true when the list names COMPONENT
 # skip_listed              the list, normalised: names separated by ", ", or "none"
 
-MIRRORBOX_COMPONENTS=(corpus xvfb xdotool slurm mitsuba chromium raytracing)
+MIRRORBOX_COMPONENTS=(corpus xvfb xdotool slurm mitsuba chromium raytracing web)
 
 # The list's names, one a line, blanks removed and empty entries dropped.
 skip_names() {

@@ -6,7 +6,7 @@
 //!
 //! - `MIRRORBOX_TEST_SKIP` is a comma-separated list of component names the user agrees to
 //!   skip: [`CORPUS`], [`XVFB`], [`XDOTOOL`], [`SLURM`] (also covers not being root),
-//!   [`MITSUBA`], [`CHROMIUM`], [`RAYTRACING`] (the adapter lacks ray queries) — the list
+//!   [`MITSUBA`], [`CHROMIUM`], [`RAYTRACING`] (the adapter lacks ray queries), [`WEB`] — the list
 //!   `scripts/lib/skip.sh` checks the variable against. CI sets none. What else a test needs
 //!   (Mesa's lavapipe, its GL backend and clip distances) has no opt-out: its absence fails.
 //! - A test whose component is missing calls [`require`] with `present: false`:
@@ -43,9 +43,11 @@ pub const MITSUBA: &str = "mitsuba";
 pub const CHROMIUM: &str = "chromium";
 /// An adapter with ray queries (`wgpu::Features::EXPERIMENTAL_RAY_QUERY`).
 pub const RAYTRACING: &str = "raytracing";
+/// Node.js and the web clients' npm packages (`clients/web`, issue 53's exchange).
+pub const WEB: &str = "web";
 
 /// Every component a test may need, with how to get it.
-pub const COMPONENTS: [(&str, &str); 7] = [
+pub const COMPONENTS: [(&str, &str); 8] = [
     (
         CORPUS,
         "scripts/install-system-deps.sh installs Debian's assimp-testmodels",
@@ -67,6 +69,10 @@ pub const COMPONENTS: [(&str, &str); 7] = [
     (
         RAYTRACING,
         "Mesa ≥ 25's lavapipe has ray queries: scripts/install-system-deps.sh installs it",
+    ),
+    (
+        WEB,
+        "scripts/install-system-deps.sh installs nodejs and npm, scripts/install-web-clients.sh the pinned packages of clients/web",
     ),
 ];
 
