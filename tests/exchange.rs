@@ -58,6 +58,15 @@ fn our_run(run: &Path) -> std::path::PathBuf {
     variant
 }
 
+/// `mirrorbox score EXPORT RUN -o OUT`, which must succeed; the records it wrote.
+fn score(export: &Path, run: &Path, out: &Path) -> Vec<Value> {
+    let path = |p: &Path| p.to_str().unwrap().to_string();
+    let (export, run, out_s) = (path(export), path(run), path(out));
+    let done = mirrorbox(&["score", &export, &run, "-o", &out_s], &[]);
+    assert_eq!(done.code, 0, "{}", done.stderr);
+    records(out)
+}
+
 fn records(folder: &Path) -> Vec<Value> {
     std::fs::read_to_string(folder.join("results.jsonl"))
         .unwrap()
@@ -102,17 +111,7 @@ fn an_export_traces_back_to_its_truth_and_our_render_scores_as_the_sweep_does() 
     let run = tmp.path().join("run");
     our_run(&run);
     let scored = tmp.path().join("scored");
-    let out = mirrorbox(
-        &[
-            "score",
-            ex.to_str().unwrap(),
-            run.to_str().unwrap(),
-            "-o",
-            scored.to_str().unwrap(),
-        ],
-        &[],
-    );
-    assert_eq!(out.code, 0, "{}", out.stderr);
+    let ours = &score(&ex, &run, &scored)[0];
     let sweep = tmp.path().join("sweep");
     let mut args = vec![
         "sweep",
@@ -129,7 +128,6 @@ fn an_export_traces_back_to_its_truth_and_our_render_scores_as_the_sweep_does() 
     args.extend(SIZE);
     let out = mirrorbox(&args, &[]);
     assert_eq!(out.code, 0, "{}", out.stderr);
-    let ours = &records(&scored)[0];
     let swept = records(&sweep)
         .into_iter()
         .find(|r| r["method"] == "naive")
@@ -157,19 +155,7 @@ fn an_export_traces_back_to_its_truth_and_our_render_scores_as_the_sweep_does() 
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let minimal_scored = tmp.path().join("minimal-scored");
-    let out = mirrorbox(
-        &[
-            "score",
-            ex.to_str().unwrap(),
-            minimal_run.to_str().unwrap(),
-            "-o",
-            minimal_scored.to_str().unwrap(),
-        ],
-        &[],
-    );
-    assert_eq!(out.code, 0, "{}", out.stderr);
-    let minimal = &records(&minimal_scored)[0];
+    let minimal = &score(&ex, &minimal_run, &tmp.path().join("minimal-scored"))[0];
     assert_eq!(minimal["key"], "minimal/naive|camera|a0.9|64x36|ssaa1");
     // Drawn from the scene read back from the glTF (mirrors rebuilt from their rectangles),
     // the raster differs from the sweep's in the last bits only (every metric within 1e-6 of it).

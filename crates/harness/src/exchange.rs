@@ -220,15 +220,27 @@ pub fn export_views(
         })?;
     let files = gltf_export::export(&base)
         .map_err(|e| HarnessError::Exchange(format!("{}: {e}", scene_path.display())))?;
+    in_staged_folder(dir, |partial| {
+        let truth_dir = partial.join("truth");
+        std::fs::create_dir_all(&truth_dir).map_err(io(&truth_dir))?;
+        write_export(&base, &files, partial, &config, settings, scene_path)
+    })
+}
+
+/// Runs `write` on `dir.partial` (made empty first), then puts that folder in `dir`'s place,
+/// replacing what was there; where `write` fails, removes it: a folder of the exchange is
+/// written whole or not at all.
+pub(crate) fn in_staged_folder<T>(
+    dir: &Path,
+    write: impl FnOnce(&Path) -> Result<T, HarnessError>,
+) -> Result<T, HarnessError> {
     let partial = PathBuf::from(format!("{}.partial", dir.display()));
     if partial.exists() {
         std::fs::remove_dir_all(&partial).map_err(io(&partial))?;
     }
-    let truth_dir = partial.join("truth");
-    std::fs::create_dir_all(&truth_dir).map_err(io(&truth_dir))?;
-    let result = write_export(&base, &files, &partial, &config, settings, scene_path);
-    let exported = match result {
-        Ok(e) => e,
+    std::fs::create_dir_all(&partial).map_err(io(&partial))?;
+    let done = match write(&partial) {
+        Ok(done) => done,
         Err(e) => {
             let _ = std::fs::remove_dir_all(&partial);
             return Err(e);
@@ -238,7 +250,7 @@ pub fn export_views(
         std::fs::remove_dir_all(dir).map_err(io(dir))?;
     }
     std::fs::rename(&partial, dir).map_err(io(dir))?;
-    Ok(exported)
+    Ok(done)
 }
 
 fn is_empty_dir(dir: &Path) -> bool {

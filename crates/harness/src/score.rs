@@ -254,13 +254,9 @@ pub fn score(
         }
         inputs.push((client, variant, timing, images));
     }
-    let partial = PathBuf::from(format!("{}.partial", out.display()));
-    if partial.exists() {
-        std::fs::remove_dir_all(&partial).map_err(io(&partial))?;
-    }
-    let images_dir = partial.join("images");
-    std::fs::create_dir_all(&images_dir).map_err(io(&images_dir))?;
-    let result = (|| -> Result<Scored, HarnessError> {
+    crate::exchange::in_staged_folder(out, |partial| {
+        let images_dir = partial.join("images");
+        std::fs::create_dir_all(&images_dir).map_err(io(&images_dir))?;
         let mut records = Vec::new();
         let run_started = crate::now_rfc3339();
         for (client, variant, timing, images) in &inputs {
@@ -287,7 +283,7 @@ pub fn score(
                 let frames_ms = timing.views[&v.name].clone();
                 let interval = mirrorbox_report::stats::median_interval(&frames_ms);
                 let rel = |p: &Path| {
-                    p.strip_prefix(&partial)
+                    p.strip_prefix(partial)
                         .unwrap_or(p)
                         .to_string_lossy()
                         .into_owned()
@@ -420,24 +416,12 @@ pub fn score(
         };
         let sweep = partial.join("sweep.json");
         std::fs::write(&sweep, serde_json::to_string_pretty(&info)?).map_err(io(&sweep))?;
-        write_report(&partial, &info, &records, &settings.sections)?;
+        write_report(partial, &info, &records, &settings.sections)?;
         Ok(Scored {
             records: records.len(),
             variants: inputs.len(),
         })
-    })();
-    let scored = match result {
-        Ok(s) => s,
-        Err(e) => {
-            let _ = std::fs::remove_dir_all(&partial);
-            return Err(e);
-        }
-    };
-    if out.exists() {
-        std::fs::remove_dir_all(out).map_err(io(out))?;
-    }
-    std::fs::rename(&partial, out).map_err(io(out))?;
-    Ok(scored)
+    })
 }
 
 #[cfg(test)]
