@@ -321,3 +321,92 @@ fn a_bad_view_list_is_refused_naming_the_field() {
         );
     }
 }
+
+/// The web client (clients/web: three.js 0.187 in headless Chromium on SwiftShader) draws
+/// mirror_box through the exchange: its floor (no mirrors) stays within 10⁻² FLIP of the
+/// floor truth (measured 5.2·10⁻³ at 64×36: SwiftShader snaps vertices to 1/16 pixel), and
+/// its `Reflector` — two levels of reflection, as `naive` — within 2.5× `naive`'s error over
+/// the mirror pixels (measured 1.7×: its half-float, 4× MSAA target), and above its floor.
+#[test]
+fn three_reflector_scores_within_its_stated_bounds() {
+    let web = repo().join("clients/web");
+    let present = mirrorbox_testing::on_path("node")
+        && mirrorbox_testing::on_path("chromium-headless-shell")
+        && web.join("node_modules/three/package.json").is_file()
+        && web
+            .join("node_modules/puppeteer-core/package.json")
+            .is_file();
+    if !mirrorbox_testing::require(
+        mirrorbox_testing::WEB,
+        present,
+        "node, chromium-headless-shell or clients/web's packages (scripts/install-web-clients.sh) missing",
+    ) {
+        return;
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    let ex = tmp.path().join("export");
+    export(&ex);
+    let run = tmp.path().join("run");
+    let out = std::process::Command::new("node")
+        .arg(web.join("run.mjs"))
+        .args([ex.as_os_str(), run.as_os_str()])
+        .args([
+            "--variants",
+            "floor,reflector",
+            "--frames",
+            "1",
+            "--warmup",
+            "1",
+        ])
+        .output()
+        .expect("node runs");
+    assert!(
+        out.status.success(),
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let scored = score(&ex, &run, &tmp.path().join("scored"));
+    let floor = scored.iter().find(|r| r["kind"] == "floor").unwrap();
+    let reflector = scored
+        .iter()
+        .find(|r| r["method"] == "three-reflector")
+        .unwrap();
+    assert!(
+        reflector["method_options"]
+            .as_str()
+            .unwrap()
+            .contains("equivalent=naive")
+    );
+    let floor_flip = floor["metrics"]["flip_mean"].as_f64().unwrap();
+    assert!(floor_flip <= 1e-2, "three's floor FLIP {floor_flip}");
+    let sweep = tmp.path().join("naive");
+    let mut args = vec![
+        "sweep",
+        "scenes/mirror_box.json",
+        "--methods",
+        "naive",
+        "--alpha",
+        "0.9",
+        "--frames",
+        "1",
+        "--out",
+        sweep.to_str().unwrap(),
+    ];
+    args.extend(SIZE);
+    assert_eq!(mirrorbox(&args, &[]).code, 0);
+    let naive = records(&sweep)
+        .into_iter()
+        .find(|r| r["method"] == "naive")
+        .unwrap();
+    let mirror_flip = |r: &Value| r["mirror_metrics"]["flip_mean"].as_f64().unwrap();
+    let (theirs, ours) = (mirror_flip(reflector), mirror_flip(&naive));
+    assert!(
+        theirs <= 2.5 * ours,
+        "Reflector {theirs} against naive {ours}"
+    );
+    assert!(
+        theirs > floor_flip,
+        "Reflector {theirs} against its floor {floor_flip}"
+    );
+}
