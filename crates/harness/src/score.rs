@@ -32,6 +32,10 @@ pub struct Timing {
     pub parameters: BTreeMap<String, serde_json::Value>,
     #[serde(default)]
     pub equivalent: Option<String>,
+    /// How the variant follows the contract, in prose (materials, units, targets): for the
+    /// report, not for the variant's name.
+    #[serde(default)]
+    pub notes: Option<String>,
     pub views: BTreeMap<String, Vec<f64>>,
 }
 
@@ -417,6 +421,34 @@ pub fn score(
         let sweep = partial.join("sweep.json");
         std::fs::write(&sweep, serde_json::to_string_pretty(&info)?).map_err(io(&sweep))?;
         write_report(partial, &info, &records, &settings.sections)?;
+        // Each variant's engine, knobs and notes (how it follows the contract), in prose.
+        let mut variants_md = String::from("# The variants scored\n\n");
+        for (client, variant, t, _) in &inputs {
+            variants_md.push_str(&format!(
+                "## {client}/{variant}\n\n- Engine: {} {}\n- Device: {}{}\n- Timing: {}\n",
+                t.engine,
+                t.engine_version,
+                t.device,
+                if t.driver.is_empty() {
+                    String::new()
+                } else {
+                    format!(" ({})", t.driver)
+                },
+                t.timing
+            ));
+            if let Some(e) = &t.equivalent {
+                variants_md.push_str(&format!("- Meant to match: `{e}`\n"));
+            }
+            for (k, v) in &t.parameters {
+                variants_md.push_str(&format!("- `{k}`: {}\n", v.to_string().trim_matches('"')));
+            }
+            if let Some(n) = &t.notes {
+                variants_md.push_str(&format!("\n{n}\n"));
+            }
+            variants_md.push('\n');
+        }
+        let variants_file = partial.join("variants.md");
+        std::fs::write(&variants_file, variants_md).map_err(io(&variants_file))?;
         Ok(Scored {
             records: records.len(),
             variants: inputs.len(),
