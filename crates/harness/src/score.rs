@@ -54,6 +54,17 @@ pub struct Scored {
     pub variants: usize,
 }
 
+/// A parameter short enough to name a variant by: at most [`MAX_KNOB_CHARS`] characters, no
+/// spaces, in the key and the value (a description belongs in `notes`).
+fn is_knob(key: &str, value: &str) -> bool {
+    [key, value]
+        .iter()
+        .all(|t| t.chars().count() <= MAX_KNOB_CHARS && !t.contains(char::is_whitespace))
+}
+
+/// The longest parameter key or value shown in a variant's name.
+pub const MAX_KNOB_CHARS: usize = 20;
+
 fn refused(path: &Path, message: impl std::fmt::Display) -> HarnessError {
     HarnessError::Exchange(format!("{}: {message}", path.display()))
 }
@@ -312,13 +323,15 @@ pub fn score(
                     } else {
                         format!("{client}-{variant}")
                     },
-                    // The variant's parameters, then the method it is meant to match.
+                    // The variant's short knobs (its name in legends and tables), then the
+                    // method it is meant to match; every parameter is in variants.md.
                     method_options: timing
                         .parameters
                         .iter()
-                        .map(|(k, v)| format!("{k}={}", v.to_string().trim_matches('"')))
+                        .map(|(k, v)| (k, v.to_string().trim_matches('"').to_string()))
+                        .filter(|(k, v)| is_knob(k, v))
+                        .map(|(k, v)| format!("{k}={v}"))
                         .chain(timing.equivalent.iter().map(|e| format!("equivalent={e}")))
-                        .map(|w| w.replace(char::is_whitespace, "_"))
                         .collect::<Vec<_>>()
                         .join(" "),
                     axes: if views.views.len() > 1 {

@@ -13,6 +13,27 @@ fn mirror_flip(r: &Record) -> f64 {
         .map_or(r.metrics.flip_mean, |m| m.flip_mean)
 }
 
+/// `text` cut to `n` characters, with an ellipsis where cut (a device string can run to
+/// hundreds: the full one is in the record and in `variants.md`).
+fn short(text: &str, n: usize) -> String {
+    if text.chars().count() <= n {
+        text.to_string()
+    } else {
+        format!("{}…", text.chars().take(n).collect::<String>().trim_end())
+    }
+}
+
+/// A timing source in a few words: up to its first parenthesis or comma.
+fn clock(r: &Record) -> String {
+    let t = r
+        .timing_source
+        .split(['(', ','])
+        .next()
+        .unwrap_or_default()
+        .trim();
+    short(t, 40)
+}
+
 fn external(r: &Record) -> bool {
     r.timing_order == "external"
 }
@@ -50,8 +71,8 @@ pub fn section(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
             .filter(|o| info.exact_methods.contains(&o.method) && o.ms_median <= r.ms_median)
             .min_by(|a, b| mirror_flip(a).total_cmp(&mirror_flip(b)));
         rows.push(vec![
-            r.method.clone(),
-            r.adapter.clone(),
+            mirrorbox_report::document::label(r),
+            short(&r.adapter, 60),
             floor.map_or("–".into(), |fl| sci(fl.metrics.flip_mean)),
             sci(mirror_flip(r)),
             sci(r.metrics.flip_mean),
@@ -91,19 +112,14 @@ pub fn section(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
                 s.push_str(&format!(", ours {}", sci(of.metrics.flip_mean)));
             }
         }
-        s.push_str(&format!(
-            "; {} ms/frame on {} ({})",
-            f(r.ms_median, 3),
-            r.adapter,
-            r.timing_source
-        ));
+        s.push_str(&format!("; {} ms/frame ({})", f(r.ms_median, 3), clock(r)));
         if let Some(e) = eq {
             s.push_str(&format!(
-                " against our `{}`'s {} ms on {} ({})",
+                " against our `{}`'s {} ms ({}) on {}",
                 e.method,
                 f(e.ms_median, 3),
-                e.adapter,
-                e.timing_source
+                clock(e),
+                short(&e.adapter, 40)
             ));
         }
         match exact {
