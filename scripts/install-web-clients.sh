@@ -53,7 +53,8 @@ for (( try = 1; try <= tries; try++ )); do
   # --ignore-scripts: no dependency needs an install script (puppeteer-core downloads nothing).
   if (cd "$client" && npm ci --ignore-scripts --no-audit --no-fund); then
     printf '%s\n' "$hash" > "$stamp"
-    say "installed clients/web from package-lock.json: three.js $(cd "$client" && node -p 'require("./node_modules/three/package.json").version' 2>/dev/null || echo '?')"
+    version() { (cd "$client" && node -p "require('./node_modules/$1/package.json').version" 2>/dev/null) || echo '?'; }
+    say "installed clients/web from package-lock.json: three.js $(version three), Babylon.js $(version @babylonjs/core)"
     exit 0
   fi
   if (( try < tries )); then

@@ -5,10 +5,12 @@
 #
 # Per scene (mirror_box, mirror_room, textured_box at 320×180, α = 0.9):
 #   1. `mirrorbox export-views` into target/web-engines/<scene>/export (truths not committed);
-#   2. the web clients (clients/web, headless Chromium: WebGL 2 on ANGLE on SwiftShader)
-#      draw every variant (floor, reflector, cubecamera) into target/web-engines/<scene>/run;
-#   3. our equivalents (naive; cubemap at 256², history 0: one reflection, as a CubeCamera
-#      updated each frame with the mirror hidden) and the exact methods swept on SwiftShader's Vulkan —
+#   2. the web clients (clients/web, headless Chromium: WebGL 2 on ANGLE on SwiftShader) draw
+#      every variant — three.js: floor, reflector, cubecamera; Babylon.js: floor,
+#      mirrortexture, probe — into target/web-engines/<scene>/run;
+#   3. our equivalents (naive for the Reflector; feedback at history 0 for the MirrorTexture,
+#      one texture per mirror per frame; cubemap at 256², history 0, for the probes) and the
+#      exact methods swept on SwiftShader's Vulkan —
 #      the same software rasterizer the browser runs on, loaded by wgpu from Chromium's own
 #      ICD file — so that milliseconds compare like with like;
 #   4. `mirrorbox score … --with <our sweep>` writes reports/web_engines[_room|_textured].
@@ -34,14 +36,15 @@ for entry in mirror_box: mirror_room:_room textured_box:_textured; do
   echo "== $scene: export"
   "$bin" export-views "scenes/$scene.json" -o "$dir/export" --width 320 --height 180 --alpha 0.9
   echo "== $scene: web clients"
-  node clients/web/run.mjs "$dir/export" "$dir/run" --variants floor,reflector,cubecamera \
+  node clients/web/run.mjs "$dir/export" "$dir/run" --clients three,babylon \
+    --variants floor,reflector,cubecamera,mirrortexture,probe \
     --frames "$frames" --warmup 2
   echo "== $scene: our methods on SwiftShader"
   depths=1,4,16,64
   [ "$scene" = mirror_room ] && depths=1,2,4,8
   VK_DRIVER_FILES=$icd "$bin" sweep "scenes/$scene.json" --alpha 0.9 --width 320 --height 180 \
     --frames "$frames" --warmup 2 --out "$dir/ours" \
-    --methods naive,cubemap,portal,unrolled --depth "$depths" --history 0 --cube-size 256
+    --methods naive,feedback,cubemap,portal,unrolled --depth "$depths" --history 0 --cube-size 256
   echo "== $scene: score"
   "$bin" score "$dir/export" "$dir/run" --with "$dir/ours" -o "reports/web_engines$suffix"
 done

@@ -351,6 +351,8 @@ fn three_reflector_scores_within_its_stated_bounds() {
         .arg(web.join("run.mjs"))
         .args([ex.as_os_str(), run.as_os_str()])
         .args([
+            "--clients",
+            "three",
             "--variants",
             "floor,reflector",
             "--frames",

@@ -1,6 +1,6 @@
 #!/usr/bin/env node
-// Draws a mirrorbox export (docs/exchange.md) with three.js in headless Chromium and writes
-// RUN_DIR/three/<variant>/<view>.exr and timing.json. See README.md.
+// Draws a mirrorbox export (docs/exchange.md) with web engines in headless Chromium — three.js
+// and Babylon.js — and writes RUN_DIR/<client>/<variant>/<view>.exr and timing.json. See README.md.
 import fs from 'node:fs';
 import http from 'node:http';
 import path from 'node:path';
@@ -8,12 +8,114 @@ import { fileURLToPath } from 'node:url';
 import { encodeExr } from './exr.mjs';
 
 const HERE = path.dirname(fileURLToPath(import.meta.url));
-const CLIENT = 'three';
-const ALL_VARIANTS = ['floor', 'reflector', 'cubecamera'];
-const EQUIVALENT = { floor: null, reflector: 'naive', cubecamera: 'cubemap' };
-const USAGE = `usage: node clients/web/run.mjs EXPORT_DIR RUN_DIR [--variants floor,reflector,cubecamera]
+
+// Every client: its page, its variants (and the mirrorbox method each is meant to match), the
+// package whose version it reports, and what its timing.json says about the variants.
+const CLIENTS = {
+  three: {
+    engine: 'three.js',
+    package: 'three',
+    page: 'three/page.html',
+    variants: ['floor', 'reflector', 'cubecamera'],
+    equivalent: { floor: null, reflector: 'naive', cubecamera: 'cubemap' },
+    checkVersion: (version, info) => version.startsWith(`0.${info.revision}.`) || `three ${version} installed but the page runs r${info.revision}`,
+    timing: (syncMs) => 'wall clock (performance.now, cross-origin isolated) around the frame (cube faces, renderer.render '
+      + 'with its Reflector passes) + gl.finish() + a 1x1 readRenderTargetPixels (Chromium\'s finish() is only a flush; '
+      + `the readback waits for the GPU and adds ~${syncMs.toFixed(2)} ms, measured alone and not subtracted); `
+      + 'warm frames only, interleaved: each round draws every variant once in a shuffled order',
+    // Short knobs (they name the variant in reports: no spaces, ≤ 20 characters); the prose is in notes.
+    parameters(name, opts) {
+      const parameters = { material: 'lambert' };
+      let notes = 'Shading: MeshLambertMaterial, DoubleSide, the file\'s face normals, emission from the front only '
+        + '(patched); AmbientLight of intensity π·A; PointLight decay 2, distance 0 (candela = W/sr). Output: '
+        + 'WebGLRenderTarget FloatType RGBA, readRenderTargetPixels, box filter in JS.';
+      if (name === 'floor') {
+        parameters.mirrors = 'removed';
+        notes += ' The mirrors\' meshes are removed.';
+      }
+      if (name === 'reflector') {
+        Object.assign(parameters, { msaa: opts.reflectorSamples, target: 'half', clip_bias: 0 });
+        notes += ' Each mirror is a Reflector with its render target at the canvas size (width×ssaa by '
+          + 'height×ssaa), HalfFloatType, as shipped; its shader multiplies the reflected colour by the '
+          + 'reflectance instead of its blendOverlay with a colour; the mirror\'s back is its child, hidden '
+          + 'while it renders. A facing Reflector met in its view renders its own view nested: two levels.';
+      }
+      if (name === 'cubecamera') {
+        Object.assign(parameters, { cube_size: opts.cubeSize, cube_type: 'half' });
+        notes += ' Each mirror has a CubeCamera at its centre, updated every frame with the mirror hidden; '
+          + 'the mirror is a MeshBasicMaterial with the cube as envMap (MultiplyOperation, colour = '
+          + 'reflectance), its reflection vector per fragment (patched: as shipped it is per vertex); the '
+          + 'cubes show the other mirrors as the previous frame left them (one reflection deeper per frame).';
+      }
+      return { parameters, notes };
+    },
+  },
+  babylon: {
+    engine: 'Babylon.js',
+    package: '@babylonjs/core',
+    page: 'babylon/page.html',
+    variants: ['floor', 'mirrortexture', 'probe'],
+    equivalent: { floor: null, mirrortexture: 'feedback', probe: 'cubemap' },
+    checkVersion: (version, info) => version === info.version || `@babylonjs/core ${version} installed but the page runs ${info.version}`,
+    timing: (syncMs) => 'wall clock (performance.now, cross-origin isolated) around the frame (Scene.render: its '
+      + 'MirrorTexture / ReflectionProbe passes, then the camera\'s pass into its float output target) + gl.finish() + a 1x1 '
+      + `gl.readPixels of that target (Chromium's finish() is only a flush; the readback waits for the GPU and adds ~${syncMs.toFixed(2)} ms, `
+      + 'measured alone and not subtracted); warm frames only, interleaved: each round draws every variant once in a shuffled order',
+    // Short knobs (they name the variant in reports: no spaces, ≤ 20 characters); the prose is in notes.
+    parameters(name, opts) {
+      const parameters = { material: 'pbr-lambert', light_falloff: 'physical' };
+      let notes = "Scene: right-handed (glTF's axes, no handedness flip), loaded with Babylon's glTF loader "
+        + '(SceneLoader ImportMeshAsync, @babylonjs/loaders); camera from views.json (TargetCamera, vertical fov, near/far); '
+        + 'clear colour the background. Diffuse: the loader\'s PBRMaterial with Lambert\'s 1/π diffuse (brdf.baseDiffuseModel '
+        + 'LAMBERT), metallicF0Factor 0 and no legacy specular energy conservation (no specular lobe, no (1 − F) on the diffuse), '
+        + 'ambientColor white × scene.ambientColor A (ρ·A), two-sided lighting without culling on the file\'s face normals, '
+        + 'front-only emission (a material plugin zeroing the emission on back faces), textures as the loader makes them '
+        + '(sRGB buffers, bilinear, no mip-maps) with anisotropic filtering off. Point lights: FALLOFF_PHYSICAL (1/r²), '
+        + 'luminous intensity (candela = W/sr), specular black. Output: PBR\'s image processing "applied by a post process" '
+        + '(none is added; skipFinalColorClamp), so it is linear and unclamped; the scene\'s image processing is disabled. '
+        + 'The camera renders into its outputRenderTarget, a float RGBA RenderTargetTexture without MSAA, read back with '
+        + 'gl.readPixels (rows flipped) and box-filtered in JS.';
+      if (name === 'floor') {
+        parameters.mirrors = 'removed';
+        notes += ' The mirrors\' meshes are disposed.';
+      }
+      const back = ' The mirror\'s back is a copy of its triangles, winding reversed and normals negated, diffuse with '
+        + 'back_albedo, culled on the mirror\'s front.';
+      if (name === 'mirrortexture') {
+        Object.assign(parameters, {
+          texture_type: opts.mirrorType, texture_size: 'canvas', blur_kernel: 0, clip_plane: 'shipped', levels: 1,
+        });
+        notes += ' Each mirror is a MirrorTexture at the canvas size (width×ssaa by height×ssaa), '
+          + `${{ byte: 'UNSIGNED_BYTE (Babylon\'s default)', half: 'HALF_FLOAT', float: 'FLOAT' }[opts.mirrorType]}, `
+          + 'bilinear, no mip-maps, blurKernel 0, adaptiveBlurKernel 0, mirrorPlane = the mirror\'s plane with its normal into '
+          + 'the mirror (Babylon keeps plane·x ≤ 0), its clip plane as shipped (scene.clipPlane = mirrorPlane during its pass), '
+          + 'renderList every other mesh (the other mirrors and their backs included), refreshed every frame. The mirror is a '
+          + 'StandardMaterial with only that reflectionTexture (level 1; diffuse, specular, emissive and ambient black, lighting '
+          + 'off) times a Fresnel term whose left and right colours are both the reflectance (R·(1 − f) + f·R = R). One level of '
+          + 'reflection: a mirror seen in a mirror shows its own MirrorTexture, rendered for the main camera\'s reflection in it, '
+          + 'looked up with the reflected camera\'s projection (measured: no pixel needing two reflections is right except where '
+          + 'the second reflection sees the background). Equivalent: feedback at --history 0 (one texture per mirror per frame, '
+          + 'the mirrors inside it textured with what their textures hold), which shows terminal there instead.' + back;
+      }
+      if (name === 'probe') {
+        Object.assign(parameters, { cube_size: opts.cubeSize, cube_type: 'half', refresh: 'every_frame', invert_z: false });
+        notes += ` Each mirror has a ReflectionProbe at its centre (${opts.cubeSize}² faces, half float, no mip-maps, `
+          + 'near/far the camera\'s, no clip plane), renderList every other mesh (the other mirrors and their backs included), '
+          + 'refreshed every frame, its cube cleared to terminal before the first. The mirror is a StandardMaterial with the '
+          + 'probe\'s cube as reflectionTexture, looked up per fragment along the view direction reflected about the mesh normal '
+          + '(the face normal), times the reflectance (a Fresnel term with both colours the reflectance). The cube\'s invertZ is '
+          + 'set false: as shipped, a right-handed scene\'s probe is looked up with z reversed (every mirror showed what lies '
+          + 'behind it). The cubes show the other mirrors as the previous frame left them (one reflection deeper per frame).' + back;
+      }
+      return { parameters, notes };
+    },
+  },
+};
+const ALL_VARIANTS = [...new Set(Object.values(CLIENTS).flatMap((c) => c.variants))];
+const USAGE = `usage: node clients/web/run.mjs EXPORT_DIR RUN_DIR [--clients three,babylon]
+       [--variants ${ALL_VARIANTS.join(',')}]
        [--frames 9] [--warmup 2] [--chromium /usr/bin/chromium-headless-shell]
-       [--cube-size 256] [--reflector-samples 4] [--seed 1] [--timeout 600]`;
+       [--cube-size 256] [--reflector-samples 4] [--mirror-type half] [--seed 1] [--timeout 600]`;
 
 function fail(message, code = 1) {
   console.error(`run.mjs: ${message}`);
@@ -22,8 +124,8 @@ function fail(message, code = 1) {
 
 function parseArgs(argv) {
   const opts = {
-    variants: ALL_VARIANTS, frames: 9, warmup: 2, chromium: '/usr/bin/chromium-headless-shell',
-    cubeSize: 256, reflectorSamples: 4, seed: 1, timeout: 600,
+    clients: Object.keys(CLIENTS), variants: null, frames: 9, warmup: 2, chromium: '/usr/bin/chromium-headless-shell',
+    cubeSize: 256, reflectorSamples: 4, mirrorType: 'half', seed: 1, timeout: 600,
   };
   const positional = [];
   const integer = (flag, v, min) => {
@@ -38,8 +140,13 @@ function parseArgs(argv) {
     const v = argv[++i];
     if (v === undefined) fail(`${a} needs a value\n${USAGE}`);
     switch (a) {
+      case '--clients':
+        opts.clients = [...new Set(v.split(',').filter(Boolean))];
+        for (const n of opts.clients) if (!CLIENTS[n]) fail(`unknown client "${n}" (${Object.keys(CLIENTS).join(', ')})`);
+        if (opts.clients.length === 0) fail('--clients is empty');
+        break;
       case '--variants':
-        opts.variants = v.split(',').filter(Boolean);
+        opts.variants = [...new Set(v.split(',').filter(Boolean))];
         for (const n of opts.variants) if (!ALL_VARIANTS.includes(n)) fail(`unknown variant "${n}" (${ALL_VARIANTS.join(', ')})`);
         if (opts.variants.length === 0) fail('--variants is empty');
         break;
@@ -48,6 +155,10 @@ function parseArgs(argv) {
       case '--chromium': opts.chromium = v; break;
       case '--cube-size': opts.cubeSize = integer(a, v, 1); break;
       case '--reflector-samples': opts.reflectorSamples = integer(a, v, 0); break;
+      case '--mirror-type':
+        if (!['byte', 'half', 'float'].includes(v)) fail(`--mirror-type is byte, half or float, not "${v}"`);
+        opts.mirrorType = v;
+        break;
       case '--seed': opts.seed = integer(a, v, 0); break;
       case '--timeout': opts.timeout = integer(a, v, 1); break;
       default: fail(`unknown option ${a}\n${USAGE}`);
@@ -55,6 +166,12 @@ function parseArgs(argv) {
   }
   if (positional.length !== 2) fail(USAGE);
   [opts.exportDir, opts.runDir] = positional.map((p) => path.resolve(p));
+  // Each client draws the listed variants it has (all of its own without --variants); a client
+  // with none of them is skipped.
+  opts.plan = opts.clients
+    .map((name) => ({ name, variants: CLIENTS[name].variants.filter((n) => !opts.variants || opts.variants.includes(n)) }))
+    .filter((c) => c.variants.length > 0);
+  if (opts.plan.length === 0) fail(`no client of ${opts.clients.join(', ')} has the variants ${opts.variants.join(', ')}`);
   return opts;
 }
 
@@ -84,7 +201,7 @@ const TYPES = {
   '.gltf': 'model/gltf+json', '.bin': 'application/octet-stream', '.png': 'image/png', '.jpg': 'image/jpeg',
 };
 
-// /client/… is this folder (the pages and node_modules/three), /export/… the export.
+// /client/… is this folder (the pages and node_modules), /export/… the export.
 function serve(exportDir, failures) {
   const roots = { client: HERE, export: exportDir };
   const server = http.createServer((req, res) => {
@@ -128,12 +245,15 @@ async function main() {
   const opts = parseArgs(process.argv.slice(2));
   const views = readExport(opts.exportDir);
   if (views.contract.lighting !== 'direct, no shadows') {
-    console.error(`warning: views.json's lighting is "${views.contract.lighting}": this client draws direct light `
-      + 'without shadows or light through mirrors, so its floor includes that difference');
+    console.error(`warning: views.json's lighting is "${views.contract.lighting}": these clients draw direct light `
+      + 'without shadows or light through mirrors, so their floor includes that difference');
   }
-  const threePackage = path.join(HERE, 'node_modules', 'three', 'package.json');
-  if (!fs.existsSync(threePackage)) fail(`three is not installed in ${HERE}: run scripts/install-web-clients.sh`);
-  const threeVersion = JSON.parse(fs.readFileSync(threePackage, 'utf8')).version;
+  const versions = {};
+  for (const { name } of opts.plan) {
+    const pkg = path.join(HERE, 'node_modules', CLIENTS[name].package, 'package.json');
+    if (!fs.existsSync(pkg)) fail(`${CLIENTS[name].package} is not installed in ${HERE}: run scripts/install-web-clients.sh`);
+    versions[name] = JSON.parse(fs.readFileSync(pkg, 'utf8')).version;
+  }
   if (!fs.existsSync(opts.chromium)) fail(`no Chromium at ${opts.chromium} (give --chromium PATH)`);
   const { default: puppeteer } = await import('puppeteer-core');
 
@@ -154,128 +274,120 @@ async function main() {
       headless: 'shell',
       args: ['--enable-unsafe-swiftshader', '--use-angle=swiftshader', '--no-sandbox', '--ignore-gpu-blocklist'],
     });
-    const page = await browser.newPage();
-    page.setDefaultTimeout(opts.timeout * 1000);
-    page.on('console', (msg) => {
-      const type = msg.type();
-      if (type === 'error') { consoleErrors.push(msg.text()); console.error(`page error: ${msg.text()}`); }
-      else if (/WebGL: INVALID|GL_INVALID|CONTEXT_LOST/.test(msg.text())) {
-        consoleErrors.push(msg.text()); // WebGL reports its errors as warnings
-        console.error(`page WebGL error: ${msg.text()}`);
-      } else if ((type === 'warn' || type === 'warning') && !/GPU stall due to ReadPixels/.test(msg.text())) {
-        console.error(`page warning: ${msg.text()}`);
-      }
-    });
-    page.on('pageerror', (err) => failures.push(`page exception: ${err.message}`));
-    // GLTFLoader's FileLoader re-wraps fetch's body stream; Chromium then reports the finished
-    // request as net::ERR_ABORTED. A file that really fails to load fails the loader (and a
-    // missing one the server), so only other network errors count here.
-    page.on('requestfailed', (req) => {
-      const why = req.failure()?.errorText;
-      if (why !== 'net::ERR_ABORTED') failures.push(`request failed: ${req.url()} (${why})`);
-    });
     const check = () => {
       if (failures.length || consoleErrors.length) {
         throw new Error([...failures, ...consoleErrors.map((e) => `console error: ${e}`)].join('\n'));
       }
     };
-    await page.goto(`${base}/client/three/page.html`, { waitUntil: 'load' });
-    await page.waitForFunction('window.mirrorboxReady === true || window.mirrorboxFailed', { timeout: 60000 })
-      .catch(() => { check(); throw new Error('the page did not start (client.mjs never loaded)'); });
-    const failed = await page.evaluate(() => window.mirrorboxFailed);
-    if (failed) failures.push(`the page did not start: ${failed}`);
-    check();
-    const info = await page.evaluate((o) => window.mirrorbox.init(o), {
-      gltfUrl: `${base}/export/${views.gltf || 'scene.gltf'}`,
-      views: views.views,
-      contract: views.contract,
-      variants: opts.variants,
-      cubeSize: opts.cubeSize,
-      reflectorSamples: opts.reflectorSamples,
-      clipBias: 0,
-      seed: opts.seed,
-    });
-    check();
-    if (!threeVersion.startsWith(`0.${info.revision}.`)) fail(`three ${threeVersion} installed but the page runs r${info.revision}`);
-    if (!info.isolated) console.error('warning: the page is not cross-origin isolated: performance.now() is coarser (100 µs)');
-    const extras = info.gltfExtras || {};
-    for (const key of ['ambient', 'background', 'terminal']) {
-      const a = extras[key];
-      const b = views.contract[key];
-      if (!a || a.some((x, i) => Math.abs(x - b[i]) > 1e-6)) {
-        console.error(`warning: scene.gltf's extras.mirrorbox.${key} ${JSON.stringify(a)} differs from views.json's ${JSON.stringify(b)}; using views.json's`);
-      }
-    }
-    console.log(`three ${threeVersion} on ${info.device} (${info.driver.split(';')[0]}); mirrors: ${info.mirrors[opts.variants[0]]}; subpixel bits: ${info.subpixelBits}`);
-
-    const results = {}; // view -> { times, images }
-    for (const view of views.views) {
+    const drawn = {}; // client -> { info, results }
+    // One client after the other, each in its own page (its own WebGL context); a client's
+    // variants are interleaved frame by frame, the clients are not.
+    for (const { name: client, variants } of opts.plan) {
+      const spec = CLIENTS[client];
+      const page = await browser.newPage();
+      page.setDefaultTimeout(opts.timeout * 1000);
+      page.on('console', (msg) => {
+        const type = msg.type();
+        if (type === 'error') { consoleErrors.push(msg.text()); console.error(`${client} page error: ${msg.text()}`); }
+        else if (/WebGL: INVALID|GL_INVALID|CONTEXT_LOST/.test(msg.text())) {
+          consoleErrors.push(msg.text()); // WebGL reports its errors as warnings
+          console.error(`${client} page WebGL error: ${msg.text()}`);
+        } else if ((type === 'warn' || type === 'warning') && !/GPU stall due to ReadPixels/.test(msg.text())) {
+          console.error(`${client} page warning: ${msg.text()}`);
+        }
+      });
+      page.on('pageerror', (err) => failures.push(`${client} page exception: ${err.message}`));
+      // GLTFLoader's FileLoader re-wraps fetch's body stream; Chromium then reports the finished
+      // request as net::ERR_ABORTED. A file that really fails to load fails the loader (and a
+      // missing one the server), so only other network errors count here.
+      page.on('requestfailed', (req) => {
+        const why = req.failure()?.errorText;
+        if (why !== 'net::ERR_ABORTED') failures.push(`request failed: ${req.url()} (${why})`);
+      });
       const t0 = Date.now();
-      const r = await page.evaluate((v, f, w) => window.mirrorbox.runView(v, f, w), view, opts.frames, opts.warmup);
+      await page.goto(`${base}/client/${spec.page}`, { waitUntil: 'load' });
+      await page.waitForFunction('window.mirrorboxReady === true || window.mirrorboxFailed', { timeout: 60000 })
+        .catch(() => { check(); throw new Error(`the ${client} page did not start (client.mjs never loaded)`); });
+      const failed = await page.evaluate(() => window.mirrorboxFailed);
+      if (failed) failures.push(`the ${client} page did not start: ${failed}`);
       check();
-      if (r.cameraDiff > 1e-5) console.error(`warning: view ${view.name}: three's camera differs from views.json's matrices by ${r.cameraDiff}`);
-      results[view.name] = r;
-      const med = (a) => a.slice().sort((x, y) => x - y)[a.length >> 1];
-      const summary = opts.variants.map((n) => `${n} ${med(r.times[n]).toFixed(2)} ms`).join(', ');
-      console.log(`view ${view.name} ${view.width}x${view.height} ssaa ${view.ssaa}: ${summary} (median; sync alone ${r.syncMs.toFixed(2)} ms; ${((Date.now() - t0) / 1000).toFixed(1)} s)`);
+      const info = await page.evaluate((o) => window.mirrorbox.init(o), {
+        gltfUrl: `${base}/export/${views.gltf || 'scene.gltf'}`,
+        views: views.views,
+        contract: views.contract,
+        variants,
+        cubeSize: opts.cubeSize,
+        reflectorSamples: opts.reflectorSamples,
+        mirrorType: opts.mirrorType,
+        clipBias: 0,
+        seed: opts.seed,
+      });
+      check();
+      const versionOk = spec.checkVersion(versions[client], info);
+      if (versionOk !== true) fail(versionOk);
+      if (!info.isolated) console.error(`warning: the ${client} page is not cross-origin isolated: performance.now() is coarser (100 µs)`);
+      const extras = info.gltfExtras || {};
+      for (const key of ['ambient', 'background', 'terminal']) {
+        const a = extras[key];
+        const b = views.contract[key];
+        if (!a || a.some((x, i) => Math.abs(x - b[i]) > 1e-6)) {
+          console.error(`warning: scene.gltf's extras.mirrorbox.${key} ${JSON.stringify(a)} differs from views.json's ${JSON.stringify(b)}; using views.json's`);
+        }
+      }
+      console.log(`${spec.engine} ${versions[client]} on ${info.device} (${info.driver.split(';')[0]}); mirrors: ${info.mirrors[variants[0]]}; subpixel bits: ${info.subpixelBits}; loaded in ${((Date.now() - t0) / 1000).toFixed(1)} s`);
+
+      const results = {}; // view -> { times, images }
+      for (const view of views.views) {
+        const t1 = Date.now();
+        const r = await page.evaluate((v, f, w) => window.mirrorbox.runView(v, f, w), view, opts.frames, opts.warmup);
+        check();
+        if (r.cameraDiff > 1e-5) console.error(`warning: view ${view.name}: ${spec.engine}'s camera differs from views.json's matrices by ${r.cameraDiff}`);
+        results[view.name] = r;
+        const med = (a) => a.slice().sort((x, y) => x - y)[a.length >> 1];
+        const summary = variants.map((n) => `${n} ${med(r.times[n]).toFixed(2)} ms`).join(', ');
+        console.log(`${client} view ${view.name} ${view.width}x${view.height} ssaa ${view.ssaa}: ${summary} (median; sync alone ${r.syncMs.toFixed(2)} ms; ${((Date.now() - t1) / 1000).toFixed(1)} s)`);
+      }
+      await page.close();
+      check();
+      drawn[client] = { info, results, variants };
     }
     await browser.close();
     browser = null;
 
-    // All views drew: write each file under a temporary name, then rename it.
-    const syncMs = Math.max(...Object.values(results).map((r) => r.syncMs));
-    const timingText = 'wall clock (performance.now, cross-origin isolated) around the frame (cube faces, renderer.render '
-      + 'with its Reflector passes) + gl.finish() + a 1x1 readRenderTargetPixels (Chromium\'s finish() is only a flush; '
-      + `the readback waits for the GPU and adds ~${syncMs.toFixed(2)} ms, measured alone and not subtracted); `
-      + 'warm frames only, interleaved: each round draws every variant once in a shuffled order';
-    for (const name of opts.variants) {
-      const dir = path.join(opts.runDir, CLIENT, name);
-      fs.mkdirSync(dir, { recursive: true });
-      for (const view of views.views) {
-        const floats = new Float32Array(new Uint8Array(Buffer.from(results[view.name].images[name], 'base64')).buffer);
-        writeAtomic(path.join(dir, `${view.name}.exr`), encodeExr(view.width, view.height, floats));
+    // Every client drew every view: write each file under a temporary name, then rename it.
+    for (const { name: client } of opts.plan) {
+      const spec = CLIENTS[client];
+      const { info, results, variants } = drawn[client];
+      const syncMs = Math.max(...Object.values(results).map((r) => r.syncMs));
+      for (const name of variants) {
+        const dir = path.join(opts.runDir, client, name);
+        fs.mkdirSync(dir, { recursive: true });
+        for (const view of views.views) {
+          const floats = new Float32Array(new Uint8Array(Buffer.from(results[view.name].images[name], 'base64')).buffer);
+          writeAtomic(path.join(dir, `${view.name}.exr`), encodeExr(view.width, view.height, floats));
+        }
+        const own = spec.parameters(name, opts);
+        const parameters = own.parameters;
+        const notes = `${own.notes ?? ''} Timing: ${opts.frames} timed frames after ${opts.warmup} warm-up `
+          + `frames per view; the wait for the GPU (finish + 1×1 readback) costs ${syncMs.toFixed(3)} ms alone.`;
+        const timing = {
+          format: 'mirrorbox-timing',
+          version: 1,
+          engine: spec.engine,
+          engine_version: versions[client],
+          device: info.device,
+          driver: info.driver,
+          timing: spec.timing(syncMs),
+          parameters,
+          ...(spec.equivalent[name] ? { equivalent: spec.equivalent[name] } : {}),
+          notes: notes.trim(),
+          views: Object.fromEntries(views.views.map((v) => [v.name, results[v.name].times[name].map((ms) => Number(ms.toFixed(4)))])),
+        };
+        writeAtomic(path.join(dir, 'timing.json'), `${JSON.stringify(timing, null, 2)}\n`);
       }
-      const parameters = {
-        ssaa: views.views[0].ssaa,
-        frames: opts.frames,
-        warmup: opts.warmup,
-        sync_overhead_ms: Number(syncMs.toFixed(4)),
-        shading: 'MeshLambertMaterial, DoubleSide, file normals, front-only emission; AmbientLight π·A; PointLight decay 2, distance 0',
-        target: 'WebGLRenderTarget FloatType RGBA, readRenderTargetPixels, box filter in JS',
-      };
-      if (name === 'floor') parameters.mirrors = 'removed';
-      if (name === 'reflector') {
-        Object.assign(parameters, {
-          texture: 'canvas size (width×ssaa × height×ssaa), HalfFloatType',
-          multisample: opts.reflectorSamples,
-          clip_bias: 0,
-          shader: 'ReflectorShader with reflectance × reflected colour instead of blendOverlay',
-        });
-      }
-      if (name === 'cubecamera') {
-        Object.assign(parameters, {
-          cube_size: opts.cubeSize,
-          cube_type: 'HalfFloatType',
-          placement: "mirror's centre, updated every frame with the mirror hidden",
-          material: 'MeshBasicMaterial envMap (MultiplyOperation), colour = reflectance, reflection vector per fragment (patched)',
-          history: 'the cubes show the other mirrors as the previous frame left them (one reflection deeper per frame)',
-        });
-      }
-      const timing = {
-        format: 'mirrorbox-timing',
-        version: 1,
-        engine: 'three.js',
-        engine_version: threeVersion,
-        device: info.device,
-        driver: info.driver,
-        timing: timingText,
-        parameters,
-        ...(EQUIVALENT[name] ? { equivalent: EQUIVALENT[name] } : {}),
-        views: Object.fromEntries(views.views.map((v) => [v.name, results[v.name].times[name].map((ms) => Number(ms.toFixed(4)))])),
-      };
-      writeAtomic(path.join(dir, 'timing.json'), `${JSON.stringify(timing, null, 2)}\n`);
+      console.log(`wrote ${path.join(opts.runDir, client)}/{${variants.join(',')}}`);
     }
-    console.log(`wrote ${path.join(opts.runDir, CLIENT)}/{${opts.variants.join(',')}} in ${((Date.now() - started) / 1000).toFixed(1)} s`);
+    console.log(`done in ${((Date.now() - started) / 1000).toFixed(1)} s`);
   } catch (err) {
     console.error(`run.mjs: ${err.message.split('\n').join('\nrun.mjs: ')}`);
     console.error('run.mjs: failed; nothing written');
