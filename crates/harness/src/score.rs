@@ -229,7 +229,7 @@ pub fn score(
     let views = read_views(export)?;
     // Our own sweeps of the same views, set beside the run's variants in one report: their
     // records as they are (their own truth, device and timing), checked to be of this scene.
-    let mut ours: Vec<Record> = Vec::new();
+    let mut ours: Vec<(PathBuf, Record)> = Vec::new();
     for dir in &settings.with {
         let sweep = mirrorbox_report::load_sweep(dir).map_err(|e| refused(dir, e))?;
         if let Some(r) = sweep.records.iter().find(|r| {
@@ -246,7 +246,7 @@ pub fn score(
                 ),
             ));
         }
-        ours.extend(sweep.records);
+        ours.extend(sweep.records.into_iter().map(|r| (dir.clone(), r)));
     }
     let found = variants(run)?;
     crate::check_output_parent(out)?;
@@ -354,7 +354,7 @@ pub fn score(
                     ms_interval: interval.map(|i| [i.low, i.high]),
                     frames: frames_ms.len() as u32,
                     frames_ms,
-                    timing_order: "external".into(),
+                    timing_order: mirrorbox_report::EXTERNAL_TIMING.into(),
                     run: Some(run_started.clone()),
                     peak_memory_bytes: None,
                     plan_ms: None,
@@ -386,7 +386,28 @@ pub fn score(
                 });
             }
         }
-        records.extend(ours.iter().cloned());
+        // Our records' pictures come along (`images/with<k>_…`), so that their rows show.
+        for (k, dir) in settings.with.iter().enumerate() {
+            for (_, r) in ours.iter().filter(|(d, _)| d == dir) {
+                let mut r = r.clone();
+                for image in [
+                    &mut r.truth_image,
+                    &mut r.raster_image,
+                    &mut r.heatmap_image,
+                ] {
+                    let from = dir.join(&*image);
+                    let name = Path::new(image.as_str())
+                        .file_name()
+                        .map(|n| format!("images/with{k}_{}", n.to_string_lossy()));
+                    if let (true, Some(name)) = (from.is_file(), name) {
+                        let to = partial.join(&name);
+                        std::fs::copy(&from, &to).map_err(io(&to))?;
+                        *image = name;
+                    }
+                }
+                records.push(r);
+            }
+        }
         let lines: String = records
             .iter()
             .map(|r| serde_json::to_string(r).map(|l| l + "\n"))

@@ -267,7 +267,9 @@ pub fn markdown(blocks: &[Block]) -> String {
 }
 
 pub fn variant(r: &Record) -> String {
-    if r.method_options.is_empty() {
+    // An outside renderer's variant (`mirrorbox score`) is named by its method alone: its
+    // knobs are in its report's table and variants.md, not in every legend.
+    if r.method_options.is_empty() || r.is_external() {
         r.method.clone()
     } else {
         format!("{} {}", r.method, r.method_options)

@@ -383,6 +383,11 @@ impl Record {
             .map(|[low, high]| stats::Interval { low, high })
     }
 
+    /// A variant an outside renderer drew, scored through the exchange (`mirrorbox score`).
+    pub fn is_external(&self) -> bool {
+        self.timing_order == EXTERNAL_TIMING
+    }
+
     /// The value of raster option `name` among the record's non-default options.
     pub fn option(&self, name: &str) -> Option<&str> {
         self.method_options.split_whitespace().find_map(|w| {
@@ -419,6 +424,10 @@ impl Record {
 fn rgba32float() -> String {
     "rgba32float".into()
 }
+
+/// The `timing_order` of a variant an outside renderer drew (its own clock and rounds,
+/// `mirrorbox score`).
+pub const EXTERNAL_TIMING: &str = "external";
 
 /// Facts about the whole sweep, printed at the top of every report and kept in the sweep
 /// folder's `sweep.json` (which the README's generated regions read).

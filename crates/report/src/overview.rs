@@ -54,8 +54,8 @@ fn scene_stem(scene: &str) -> &str {
 /// A device's short name for file names: `lavapipe`, else the adapter's first word with a digit
 /// in it (its model: `h100` of "NVIDIA H100 80GB HBM3", `h200` of "NVIDIA H200"), else its
 /// first word.
-fn device_slug(info: &SweepInfo) -> String {
-    let a = info.adapter.to_lowercase();
+fn device_slug(adapter: &str) -> String {
+    let a = adapter.to_lowercase();
     if a.contains("llvmpipe") {
         return "lavapipe".into();
     }
@@ -163,12 +163,24 @@ pub(crate) fn frontiers(sweeps: &[(String, Sweep)]) -> Vec<Frontier> {
             }
             // The scene as its file has it: a point with a scene axis (mirrored lights, a
             // tilt, a camera turn, …) or a stereo pair is another scene.
+            // Our methods only (an outside renderer's variants have their own clock: their
+            // report sets them beside ours), each on the device its record names (a scored
+            // folder holds our sweep of another device beside them).
             for r in sweep.records.iter().filter(|r| {
-                r.kind == "point" && r.axes.is_empty() && r.stereo.is_none() && r.device.is_none()
+                r.kind == "point"
+                    && r.axes.is_empty()
+                    && r.stereo.is_none()
+                    && r.device.is_none()
+                    && !r.is_external()
             }) {
+                let (adapter, backend) = if r.adapter.is_empty() {
+                    (sweep.info.adapter.clone(), sweep.info.backend.clone())
+                } else {
+                    (r.adapter.clone(), r.backend.clone())
+                };
                 let key = (
-                    device_slug(&sweep.info),
-                    format!("{} ({})", sweep.info.adapter, sweep.info.backend),
+                    device_slug(&adapter),
+                    format!("{adapter} ({backend})"),
                     format!("{}x{}", r.width, r.height),
                     r.alpha.to_bits(),
                 );
@@ -210,13 +222,14 @@ pub(crate) fn frontiers(sweeps: &[(String, Sweep)]) -> Vec<Frontier> {
                 .then(a.0.0.cmp(&b.0.0))
         });
         // The headline (`frontier_<scene>.svg`, the README's figure): a real GPU's panel where
-        // one was measured, else lavapipe's; the one with most methods, then most points.
+        // one was measured, else the CPU's; the one with most methods, then most points.
+        let gpu = |info: &SweepInfo| info.device_type.contains("Gpu");
         let headline = groups
             .iter()
             .enumerate()
             .max_by_key(|(_, g)| {
                 let methods = distinct(g.1.iter().map(|r| r.method.clone())).len();
-                (g.0.0 != "lavapipe", methods, g.1.len())
+                (gpu(g.2), g.0.0 == "lavapipe", methods, g.1.len())
             })
             .map(|(i, _)| i);
         for (i, ((slug, device, size, alpha), records, info)) in groups.iter().enumerate() {
@@ -499,17 +512,13 @@ mod tests {
 
     #[test]
     fn a_device_is_named_by_its_model_in_file_names() {
-        let slug = |adapter: &str| {
-            device_slug(&SweepInfo {
-                adapter: adapter.into(),
-                ..Default::default()
-            })
-        };
+        let slug = |adapter: &str| device_slug(adapter);
         assert_eq!(slug("llvmpipe (LLVM 15.0.6, 256 bits)"), "lavapipe");
         assert_eq!(slug("NVIDIA H100 80GB HBM3"), "h100");
         // Two GPUs of one vendor are two devices, not one "nvidia".
         assert_eq!(slug("NVIDIA H200"), "h200");
         assert_eq!(slug("Apple M3"), "m3");
+        assert_eq!(slug("SwiftShader Device (Subzero)"), "swiftshader");
         assert_eq!(slug("Some GPU"), "some");
     }
 }

@@ -515,12 +515,38 @@ fn document(info: &SweepInfo, records: &[Record], sections: &[Section]) -> Vec<B
         .iter()
         .any(|r| r.lights_depth().is_some() || r.tilt_deg().is_some() || r.stereo.is_some());
     let alphas = distinct(points.iter().map(|r| r.alpha.to_bits()));
-    let styles = crate::plot::styles_for(
-        &groups
-            .iter()
-            .map(|(m, _)| m.split_whitespace().next().unwrap_or_default())
-            .collect::<Vec<_>>(),
-    );
+    // Each method its fixed style; an outside renderer's variant its equivalent's colour in a
+    // style of its own (dashed or hollow), so that it reads beside what it is meant to match.
+    let bases: Vec<(String, usize)> = groups
+        .iter()
+        .map(|(m, a)| {
+            let r = points
+                .iter()
+                .find(|r| &crate::document::variant(r) == m && r.alpha == *a);
+            match r {
+                Some(r) if r.is_external() => {
+                    (r.option("equivalent").unwrap_or(&r.method).to_string(), 1)
+                }
+                _ => (
+                    m.split_whitespace().next().unwrap_or_default().to_string(),
+                    0,
+                ),
+            }
+        })
+        .collect();
+    let styles: Vec<crate::plot::Style> = bases
+        .iter()
+        .enumerate()
+        .map(|(i, (base, external))| {
+            // Ours count among ours (the first keeps the method's own style); an outside
+            // variant takes the odd variants, hollow markers.
+            let k = bases[..i]
+                .iter()
+                .filter(|(b, e)| b == base && e == external)
+                .count();
+            crate::plot::method_style(base).variant(k * (1 + external) + external)
+        })
+        .collect();
     // `keep`: which of a group's points the chart shows; `ms_on_x`: x is the median time,
     // drawn with its 95 % interval as an error bar.
     let series = |keep: &dyn Fn(&Record) -> bool,

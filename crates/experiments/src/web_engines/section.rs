@@ -35,7 +35,7 @@ fn clock(r: &Record) -> String {
 }
 
 fn external(r: &Record) -> bool {
-    r.timing_order == "external"
+    r.is_external()
 }
 
 /// The client of an external record: its method up to the first `-` (`three-reflector`), or
