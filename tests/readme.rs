@@ -290,3 +290,34 @@ fn links_and_anchors_are_read_as_markdown_writes_them() {
     );
     assert_eq!(anchor(" The `cli` region"), "the-cli-region");
 }
+
+/// Issue 54: mdBook builds only `docs/book/src/`, so every image a chapter shows must be a
+/// file inside it — a repository figure linked as `figures/<path>` and its copy up to date
+/// (`mirrorbox readme` makes it), none left over.
+#[test]
+fn every_image_of_the_book_resolves_inside_its_source() {
+    let root = repo();
+    let s = mirrorbox_report::book_figures::sync(&root, &root.join("docs/book/src"), true).unwrap();
+    assert!(
+        s.broken.is_empty(),
+        "links out of the book or to nothing: {:?}",
+        s.broken
+    );
+    assert!(
+        s.written.is_empty(),
+        "copies missing or stale (run mirrorbox readme): {:?}",
+        s.written
+    );
+    assert!(
+        s.removed.is_empty(),
+        "copies no chapter links: {:?}",
+        s.removed
+    );
+    // And the book shows figures at all (the links were once all outside it).
+    let table1 = std::fs::read_to_string(root.join("docs/book/src/table1.md")).unwrap();
+    assert!(
+        mirrorbox_report::book_figures::image_links(&table1)
+            .iter()
+            .any(|l| l.starts_with("figures/"))
+    );
+}

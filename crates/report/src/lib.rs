@@ -7,6 +7,7 @@
 //!   `mirrorbox-experiments`, which also holds every experiment's regions).
 //! - [`readme`]: the README's figures, generated from the committed reports.
 
+pub mod book_figures;
 pub mod document;
 mod error;
 pub mod folder;

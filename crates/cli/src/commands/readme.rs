@@ -72,6 +72,9 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             Err(Failure::Other(m)) => messages.push(m),
         }
     }
+    if args.files.is_empty() {
+        book_figures(args.check, &mut messages, &mut bad_input)?;
+    }
     if !args.check {
         println!("regions known: {}", known_regions(&extra, &sources));
     }
@@ -80,6 +83,43 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         (false, true) => Err(Failure::BadInput(messages.join("\n"))),
         (false, false) => Err(Failure::Other(messages.join("\n"))),
     }
+}
+
+/// The book's figures copied inside it (`mirrorbox_report::book_figures`): written, or with
+/// `check` compared; a stale copy is a message (exit 1), a broken link bad input (exit 2).
+fn book_figures(
+    check: bool,
+    messages: &mut Vec<String>,
+    bad_input: &mut bool,
+) -> Result<(), Failure> {
+    use mirrorbox_report::book_figures::sync;
+    let s = sync(Path::new("."), Path::new(BOOK_SOURCE), check)
+        .map_err(|e| Failure::Other(format!("{BOOK_SOURCE}/figures: {e}")))?;
+    for b in &s.broken {
+        *bad_input = true;
+        messages.push(format!("{BOOK_SOURCE}/{b}"));
+    }
+    if check {
+        for p in &s.written {
+            messages.push(format!(
+                "{}: missing or stale (mirrorbox readme copies it)",
+                p.display()
+            ));
+        }
+        for p in &s.removed {
+            messages.push(format!(
+                "{}: no chapter links it (mirrorbox readme removes it)",
+                p.display()
+            ));
+        }
+    } else if !s.written.is_empty() || !s.removed.is_empty() {
+        println!(
+            "{BOOK_SOURCE}/figures: {} figure(s) copied, {} removed",
+            s.written.len(),
+            s.removed.len()
+        );
+    }
+    Ok(())
 }
 
 /// Every experiment of the registry has its chapter in the book, listed in its `SUMMARY.md`,
