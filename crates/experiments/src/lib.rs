@@ -17,6 +17,7 @@ use std::path::{Path, PathBuf};
 pub mod bumpy;
 pub mod depth_scaling;
 pub mod engine_reflections;
+pub mod findings;
 pub mod frontier;
 pub mod lighting;
 pub mod motion;
@@ -109,11 +110,41 @@ pub fn sections() -> Vec<Section> {
 /// ([`mirrorbox_report::readme::REGIONS`]), then each experiment's, in the table's order.
 pub fn regions() -> Vec<RegionSource> {
     let mut out = mirrorbox_report::readme::REGIONS.to_vec();
+    out.extend_from_slice(FINDINGS_REGIONS);
     for e in EXPERIMENTS {
         out.extend_from_slice(e.regions);
     }
     out
 }
+
+/// What was found ([`findings`]), for the README (links from the root) and for the book
+/// (links from `docs/book/src`).
+const FINDINGS_REGIONS: &[RegionSource] = &[
+    RegionSource {
+        id: "findings",
+        source: "table1",
+        about: "what was found, ranked, computed from the committed records",
+        generate: |reports| {
+            Ok(findings::rebased(
+                &findings::findings(reports)?,
+                "reports/",
+                "",
+            ))
+        },
+    },
+    RegionSource {
+        id: "findings-book",
+        source: "table1",
+        about: "what was found, for the book's introduction",
+        generate: |reports| {
+            Ok(findings::rebased(
+                &findings::findings(reports)?,
+                "../../../reports/",
+                "../../../",
+            ))
+        },
+    },
+];
 
 /// The overview's entries of the reports that are not sweep folders, in the table's order.
 pub fn other_reports() -> Vec<OtherReport> {

@@ -20,11 +20,16 @@ pub struct Args {
 
 pub fn run(args: &Args) -> Result<(), Failure> {
     if let Some(reports) = &args.index {
+        // What was found leads the overview, its links relative to `reports/` as written.
+        let findings = mirrorbox_experiments::findings::findings(reports)
+            .map_err(|e| Failure::BadInput(format!("{}: the findings: {e}", reports.display())))?;
+        let lead = mirrorbox_experiments::findings::rebased(&findings, "", "../");
         let n = mirrorbox_report::overview::write_overview(
             reports,
             &records_commit,
             &about,
             &mirrorbox_experiments::other_reports(),
+            mirrorbox_report::overview::Lead(&lead),
         )
         .map_err(|e| Failure::BadInput(format!("{}: {e}", reports.display())))?;
         println!(
