@@ -48,6 +48,12 @@ fn point<'a>(s: &'a Sweep, method: &str, n: Option<u32>, depth: Option<u32>) -> 
     })
 }
 
+/// Three significant digits (0.00482, 0.164, 2.85).
+fn sig(v: f64) -> String {
+    let digits = (2 - v.abs().max(1e-12).log10().floor() as i32).max(0) as usize;
+    format!("{v:.digits$}")
+}
+
 fn load(reports: &Path, folder: &str) -> Result<Sweep, ReadmeError> {
     load_sweep(&reports.join(folder))
 }
@@ -215,13 +221,86 @@ fn room_front(reports: &Path) -> Result<String, ReadmeError> {
     ))
 }
 
+/// What one more bounce of `portal` costs, as a share of a full-scene pass, on each device
+/// whose depth sweep is committed.
+fn bounce_cost(reports: &Path) -> Result<String, ReadmeError> {
+    let mut parts = Vec::new();
+    for (folder, device) in [
+        ("depth_scaling", "lavapipe"),
+        ("gpu/depth_scaling", "an NVIDIA H100"),
+    ] {
+        let s = load(reports, folder)?;
+        let groups = crate::depth_scaling::exact::depth_scaling(&s.info.exact_methods, &s.records);
+        let floor = s.records.iter().find(|r| r.kind == "floor");
+        let Some(g) = groups.iter().find(|g| g.method == "portal") else {
+            return Err(ReadmeError(format!(
+                "reports/{folder} holds no portal depth sweep"
+            )));
+        };
+        let (Some(ms), Some(i), Some(pass)) = (
+            g.ms_per_bounce,
+            g.ms_per_bounce_interval,
+            floor.map(|f| f.ms_median),
+        ) else {
+            return Err(ReadmeError(format!(
+                "reports/{folder}: no per-bounce fit or floor"
+            )));
+        };
+        parts.push(format!(
+            "{} ms [{}–{}] on {device} ({:.1} % of its {} ms full-scene pass)",
+            sig(ms),
+            sig(i.low),
+            sig(i.high),
+            100.0 * ms / pass,
+            sig(pass)
+        ));
+    }
+    Ok(format!(
+        "**An exact mirror's next bounce is cheap**: one more reflection of `portal` along a \
+         path costs {} (mirror_box, 640×360, depth 1…1024, least squares with a 95 % interval; \
+         [figure](depth_scaling/plot_ms_vs_depth.svg)).",
+        parts.join(", ")
+    ))
+}
+
+/// Screen-space reflections against the share of their reflections off screen (the camera
+/// turns of the room), fallback `none`.
+fn ssr_offscreen(reports: &Path) -> Result<String, ReadmeError> {
+    let s = load(reports, "engine_reflections_ssr_room")?;
+    let share = mirrorbox_report::value::REFLECTION_OFFSCREEN_SHARE;
+    let none: Vec<(f64, f64)> = s
+        .records
+        .iter()
+        .filter(|r| r.method == "ssr" && r.option("ssr-fallback") == Some("none"))
+        .filter_map(|r| Some((r.value(share)?, mirror_flip(r))))
+        .collect();
+    let rho = crate::engine_reflections::section::spearman(&none).ok_or_else(|| {
+        ReadmeError("reports/engine_reflections_ssr_room: too few ssr turns".into())
+    })?;
+    let lo = none.iter().map(|p| p.1).fold(f64::INFINITY, f64::min);
+    let hi = none.iter().map(|p| p.1).fold(0.0, f64::max);
+    Ok(format!(
+        "**Screen-space reflections fail where the screen lacks the reflection**: without a \
+         fallback, `ssr`'s FLIP over the mirror pixels of the mirror room ranges {} to {} over \
+         {} camera turns, rank-correlated with the share of reflections off screen (Spearman's \
+         ρ {:.2}; {}, one-bounce truth; [figure](engine_reflections_ssr_room/ssr_offscreen.svg)).",
+        sci(lo),
+        sci(hi),
+        none.len(),
+        rho,
+        s.info.adapter
+    ))
+}
+
 /// The findings, ranked, as blocks (a heading, then one numbered sentence each).
 pub fn findings(reports: &Path) -> Result<Vec<Block>, ReadmeError> {
     let sentences = [
         exact_error(reports)?,
         exact_speed(reports)?,
         room_front(reports)?,
+        bounce_cost(reports)?,
         web_engines(reports)?,
+        ssr_offscreen(reports)?,
     ];
     let mut blocks = vec![Block::Heading(2, "What was found".into())];
     blocks.push(Block::Paragraph(

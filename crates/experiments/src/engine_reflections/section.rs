@@ -58,7 +58,7 @@ fn mirror_flip(r: &Record) -> f64 {
 }
 
 /// Spearman's rank correlation of `(x, y)` (ties at their mean rank).
-fn spearman(points: &[(f64, f64)]) -> Option<f64> {
+pub(crate) fn spearman(points: &[(f64, f64)]) -> Option<f64> {
     let ranks = |v: Vec<f64>| -> Vec<f64> {
         let mut idx: Vec<usize> = (0..v.len()).collect();
         idx.sort_by(|&a, &b| v[a].total_cmp(&v[b]));
