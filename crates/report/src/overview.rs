@@ -414,6 +414,25 @@ fn frontier_chart(
 /// `about(folder)`: what the experiment that writes `folder` (relative to `reports`)
 /// measures, from the experiment registry, where it knows the folder.
 /// `others`: the reports that are not sweep folders (a sequence sweep's, a script's).
+/// The figure check of the overview's frontier charts ([`crate::plot::Chart::lint`]), drawn
+/// from the sweep folders under `reports` as [`write_overview`] draws them, without writing.
+pub fn lint_frontiers(reports: &Path) -> Result<Vec<String>, ReadmeError> {
+    let mut sweeps = Vec::new();
+    for dir in sweep_folders(reports) {
+        sweeps.push((dir.display().to_string(), load_sweep(&dir)?));
+    }
+    Ok(frontiers(&sweeps)
+        .iter()
+        .filter(|c| c.chart.is_drawable())
+        .flat_map(|c| {
+            c.chart
+                .lint()
+                .into_iter()
+                .map(move |m| format!("{}: {m}", c.file))
+        })
+        .collect())
+}
+
 /// `write_overview`'s lead: Markdown (links relative to `reports/`) set first on both pages —
 /// what was found, before the charts.
 pub struct Lead<'a>(pub &'a str);

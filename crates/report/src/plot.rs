@@ -503,8 +503,85 @@ fn wrap(text: &str, max: usize) -> Vec<String> {
     lines
 }
 
+thread_local! {
+    /// Where [`Chart::to_svg`] reports each chart's [`Chart::lint`] while
+    /// [`collect_lint`] runs; `None` otherwise.
+    static LINT: std::cell::RefCell<Option<Vec<String>>> = const { std::cell::RefCell::new(None) };
+}
+
+/// Runs `f` and returns, beside its result, every lint message of every chart drawn meanwhile
+/// on this thread, each prefixed by the chart's title: the figure check of the tests (issue
+/// 54), run over every report they regenerate.
+pub fn collect_lint<T>(f: impl FnOnce() -> T) -> (T, Vec<String>) {
+    LINT.with(|l| *l.borrow_mut() = Some(Vec::new()));
+    let out = f();
+    let messages = LINT.with(|l| l.borrow_mut().take().unwrap_or_default());
+    (out, messages)
+}
+
 impl Chart {
+    /// What a reviewer would send back about this chart (issue 54): two series drawn alike
+    /// (one colour, marker and fill; the dash too where joined), a legend entry for a series
+    /// with nothing drawn, points the axis cannot show (≤ 0 on a log axis, not finite), a line
+    /// joining points whose x goes back or repeats (a sweep axis other than the chart's x).
+    pub fn lint(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        let ok = |v: f64, log: bool| drawable(v, log);
+        let shown = |s: &Series| {
+            s.points
+                .iter()
+                .filter(|(x, y)| ok(*x, self.x_log) && ok(*y, self.y_log))
+                .count()
+        };
+        for (i, a) in self.series.iter().enumerate() {
+            let n = shown(a);
+            if n == 0 {
+                out.push(format!(
+                    "\"{}\" has a legend entry and no point drawn",
+                    a.name
+                ));
+                continue;
+            }
+            if n < a.points.len() {
+                out.push(format!(
+                    "{} of the points of \"{}\" cannot be drawn on this axis (≤ 0 on a log axis, or not finite)",
+                    a.points.len() - n,
+                    a.name
+                ));
+            }
+            for b in self.series[..i].iter().filter(|b| shown(b) > 0) {
+                let (sa, sb) = (&a.style, &b.style);
+                let alike = sa.color == sb.color
+                    && sa.marker == sb.marker
+                    && sa.hollow == sb.hollow
+                    && (sa.dash == sb.dash || !(a.joined && b.joined));
+                if alike {
+                    out.push(format!(
+                        "\"{}\" and \"{}\" are drawn alike (colour, marker, fill)",
+                        b.name, a.name
+                    ));
+                }
+            }
+            if a.joined && a.points.windows(2).any(|w| w[1].0 <= w[0].0) {
+                out.push(format!(
+                    "\"{}\" joins points whose x goes back or repeats (a line across another axis)",
+                    a.name
+                ));
+            }
+        }
+        out
+    }
+
     pub fn to_svg(&self) -> String {
+        LINT.with(|l| {
+            if let Some(v) = l.borrow_mut().as_mut() {
+                v.extend(
+                    self.lint()
+                        .into_iter()
+                        .map(|m| format!("{}: {m}", self.title)),
+                );
+            }
+        });
         // The axes span the points, their error bars and the reference curves' points that
         // lie within the data's x (a reference never widens x).
         let bounds = |i: &[Option<[f64; 2]>]| -> Vec<f64> {
@@ -928,6 +1005,48 @@ impl Chart {
 
 #[cfg(test)]
 mod tests {
+    /// The figure check flags what a reviewer would send back, and nothing in a clean chart.
+    #[test]
+    fn lint_flags_look_alike_series_empty_legends_undrawable_points_and_zigzags() {
+        let style = method_style("portal");
+        let mut c = Chart::new("t", "x", "y");
+        c.x_log = true;
+        c.y_log = true;
+        c.series
+            .push(Series::new("a", style, vec![(1.0, 1.0), (2.0, 2.0)]));
+        assert!(c.lint().is_empty(), "{:?}", c.lint());
+        c.series.push(Series::new("b", style, vec![(3.0, 1.0)]));
+        c.series
+            .push(Series::new("c", method_style("naive"), vec![]));
+        c.series.push(Series::new(
+            "d",
+            method_style("unrolled"),
+            vec![(1.0, 0.0), (2.0, 1.0)],
+        ));
+        c.series.push(Series::new(
+            "e",
+            method_style("feedback"),
+            vec![(2.0, 1.0), (1.0, 2.0)],
+        ));
+        let lint = c.lint().join("\n");
+        assert!(lint.contains("\"a\" and \"b\" are drawn alike"), "{lint}");
+        assert!(
+            lint.contains("\"c\" has a legend entry and no point drawn"),
+            "{lint}"
+        );
+        assert!(
+            lint.contains("1 of the points of \"d\" cannot be drawn"),
+            "{lint}"
+        );
+        assert!(
+            lint.contains("\"e\" joins points whose x goes back"),
+            "{lint}"
+        );
+        // A variant of the method is told apart.
+        c.series[1].style = style.variant(1);
+        assert!(!c.lint().join("\n").contains("drawn alike"));
+    }
+
     /// An axis label claims interval bars only where some series draws one on that axis.
     #[test]
     fn an_axis_promises_ci_bars_only_where_they_are_drawn() {

@@ -572,6 +572,20 @@ fn document(info: &SweepInfo, records: &[Record], sections: &[Section]) -> Vec<B
                 } else {
                     m.clone()
                 };
+                // A value the log axes cannot show (an error of exactly 0) is named in the
+                // legend, not drawn.
+                let (shown, zero): (Vec<&&Record>, Vec<&&Record>) = pts.iter().partition(|r| {
+                    let (px, py) = (x(r), y(r).unwrap_or(f64::NAN));
+                    px.is_finite() && px > 0.0 && py.is_finite() && py > 0.0
+                });
+                let pts = shown;
+                if pts.is_empty() {
+                    return None;
+                }
+                let name = match zero.len() {
+                    0 => name,
+                    n => format!("{name} ({n} at 0, not drawn)"),
+                };
                 let mut s = Series::new(
                     name,
                     *style,
@@ -579,6 +593,11 @@ fn document(info: &SweepInfo, records: &[Record], sections: &[Section]) -> Vec<B
                         .map(|r| (x(r), y(r).unwrap_or(f64::NAN)))
                         .collect(),
                 );
+                // Joined along its swept setting only where x grows with it and no scene axis
+                // (a camera turn, a tilt) separates the points: else the line would zigzag
+                // across another variable.
+                s.joined = s.points.windows(2).all(|w| w[1].0 > w[0].0)
+                    && pts.iter().all(|r| r.axes.is_empty());
                 s.labels = pts
                     .iter()
                     .map(|r| crate::document::swept_label(r))

@@ -18,7 +18,7 @@ use mirrorbox_report::{Record, value};
 /// The yaw axis' name in a record's `axes` (the harness's `CAMERA_YAW`).
 const YAW: &str = "yaw_deg";
 /// The exact methods whose depth is swept here.
-const DEPTH_SWEPT: [&str; 3] = ["ray-query", "unrolled", "portal"];
+const DEPTH_SWEPT: [&str; 4] = ["ray-query", "unrolled", "portal", "path-textures"];
 
 fn points(records: &[Record]) -> Vec<&Record> {
     records.iter().filter(|r| r.kind == "point").collect()
@@ -175,19 +175,33 @@ fn depth_blocks(pts: &[&Record]) -> Vec<Block> {
     }
     // The one-setting methods, each a point at the depth it shows (not joined: no variable
     // is swept).
+    // Each its own style: a method's second setting (auxiliary n = 1, a second cube size)
+    // its next variant.
+    let mut seen: Vec<&str> = Vec::new();
     for r in pts
         .iter()
         .copied()
         .filter(|r| !DEPTH_SWEPT.contains(&r.method.as_str()))
     {
         let depth = r.reflections.max(1) as f64;
+        let k = seen.iter().filter(|m| **m == r.method).count();
+        seen.push(&r.method);
         let style = if r.method == "ssr" {
             ssr_style(&fallback(r))
         } else {
-            method_style(&r.method)
+            method_style(&r.method).variant(k)
+        };
+        // Its count where it has one (auxiliary n=1), else the method as its key names it,
+        // every option included (two cube sizes).
+        let label = if r.method == "ssr" {
+            name(r)
+        } else if r.n.is_some() {
+            mirrorbox_report::document::label(r)
+        } else {
+            r.key.split('|').next().unwrap_or(&r.method).to_string()
         };
         for (chart, y) in [(&mut error, mirror_flip(r)), (&mut cost, r.ms_median)] {
-            let mut s = Series::new(name(r), style, vec![(depth, y)]);
+            let mut s = Series::new(label.clone(), style, vec![(depth, y)]);
             s.joined = false;
             chart.series.push(s);
         }

@@ -68,6 +68,8 @@ fn every_committed_report_is_rewritten_byte_for_byte() {
     folders.extend(files.iter().map(|f| f.parent().unwrap().to_path_buf()));
     folders.push(root().join("reports/motion"));
     let sections = mirrorbox_experiments::sections();
+    // The figure check (issue 54): every chart of every committed report, as it is drawn.
+    let mut problems: Vec<String> = Vec::new();
     for folder in &folders {
         let dir = tempfile::tempdir().unwrap();
         let mut copied = 0;
@@ -88,7 +90,13 @@ fn every_committed_report_is_rewritten_byte_for_byte() {
                 }
             }
         }
-        assert!(mirrorbox_report::rewrite_report(dir.path(), "", &sections).unwrap() > 0);
+        let (written, lint) = mirrorbox_report::plot::collect_lint(|| {
+            mirrorbox_report::rewrite_report(dir.path(), "", &sections).unwrap()
+        });
+        assert!(written > 0);
+        for m in lint {
+            problems.push(format!("{}: {m}", folder.display()));
+        }
         let want = std::fs::read_to_string(folder.join("report.md")).unwrap();
         let have = std::fs::read_to_string(dir.path().join("report.md")).unwrap();
         assert!(
@@ -97,4 +105,12 @@ fn every_committed_report_is_rewritten_byte_for_byte() {
             folder.display()
         );
     }
+    // And the overview's frontier charts.
+    problems.extend(mirrorbox_report::overview::lint_frontiers(&root().join("reports")).unwrap());
+    assert!(
+        problems.is_empty(),
+        "{} figure problems:\n{}",
+        problems.len(),
+        problems.join("\n")
+    );
 }
