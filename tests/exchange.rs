@@ -58,6 +58,26 @@ fn our_run(run: &Path) -> std::path::PathBuf {
     variant
 }
 
+/// `sweep` of `naive` at the export's size and α into `out`: its point's record.
+fn sweep_naive(out: &Path) -> Value {
+    let mut args = vec![
+        "sweep",
+        "scenes/mirror_box.json",
+        "--methods",
+        "naive",
+        "--alpha",
+        "0.9",
+    ];
+    args.extend(["--frames", "1", "--out", out.to_str().unwrap()]);
+    args.extend(SIZE);
+    let done = mirrorbox(&args, &[]);
+    assert_eq!(done.code, 0, "{}", done.stderr);
+    records(out)
+        .into_iter()
+        .find(|r| r["method"] == "naive")
+        .unwrap()
+}
+
 /// `mirrorbox score EXPORT RUN -o OUT`, which must succeed; the records it wrote.
 fn score(export: &Path, run: &Path, out: &Path) -> Vec<Value> {
     let path = |p: &Path| p.to_str().unwrap().to_string();
@@ -112,26 +132,7 @@ fn an_export_traces_back_to_its_truth_and_our_render_scores_as_the_sweep_does() 
     our_run(&run);
     let scored = tmp.path().join("scored");
     let ours = &score(&ex, &run, &scored)[0];
-    let sweep = tmp.path().join("sweep");
-    let mut args = vec![
-        "sweep",
-        "scenes/mirror_box.json",
-        "--methods",
-        "naive",
-        "--alpha",
-        "0.9",
-        "--frames",
-        "1",
-        "--out",
-        sweep.to_str().unwrap(),
-    ];
-    args.extend(SIZE);
-    let out = mirrorbox(&args, &[]);
-    assert_eq!(out.code, 0, "{}", out.stderr);
-    let swept = records(&sweep)
-        .into_iter()
-        .find(|r| r["method"] == "naive")
-        .unwrap();
+    let swept = sweep_naive(&tmp.path().join("sweep"));
     assert_eq!(ours["method"], "mirrorbox-naive");
     assert_eq!(ours["metrics"], swept["metrics"]);
     assert_eq!(ours["mirror_metrics"], swept["mirror_metrics"]);
@@ -382,25 +383,7 @@ fn three_reflector_scores_within_its_stated_bounds() {
     );
     let floor_flip = floor["metrics"]["flip_mean"].as_f64().unwrap();
     assert!(floor_flip <= 1e-2, "three's floor FLIP {floor_flip}");
-    let sweep = tmp.path().join("naive");
-    let mut args = vec![
-        "sweep",
-        "scenes/mirror_box.json",
-        "--methods",
-        "naive",
-        "--alpha",
-        "0.9",
-        "--frames",
-        "1",
-        "--out",
-        sweep.to_str().unwrap(),
-    ];
-    args.extend(SIZE);
-    assert_eq!(mirrorbox(&args, &[]).code, 0);
-    let naive = records(&sweep)
-        .into_iter()
-        .find(|r| r["method"] == "naive")
-        .unwrap();
+    let naive = sweep_naive(&tmp.path().join("naive"));
     let mirror_flip = |r: &Value| r["mirror_metrics"]["flip_mean"].as_f64().unwrap();
     let (theirs, ours) = (mirror_flip(reflector), mirror_flip(&naive));
     assert!(

@@ -26,6 +26,7 @@ import '@babylonjs/core/Engines/Extensions/engine.renderTarget.js';
 import '@babylonjs/core/Engines/Extensions/engine.renderTargetCube.js';
 import { ImportMeshAsync } from '@babylonjs/core/Loading/sceneLoader.js';
 import '@babylonjs/loaders/glTF/2.0/index.js';
+import { boxFilter, base64 } from '../pixels.mjs';
 
 const linear = (rgb) => new Color3(rgb[0], rgb[1], rgb[2]);
 
@@ -345,33 +346,10 @@ function readTarget(v, x, y, w, h, out) {
 
 // Mean of each pixel's s × s block, rows flipped (GL reads bottom-up; EXR line 0 is the top).
 function readBack(v, view) {
-  const s = view.ssaa;
   const { width: W, height: H } = size;
   const rgba = new Float32Array(W * H * 4);
   readTarget(v, 0, 0, W, H, rgba);
-  const out = new Float32Array(view.width * view.height * 3);
-  for (let y = 0; y < view.height; y++) {
-    for (let x = 0; x < view.width; x++) {
-      let r = 0, g = 0, b = 0;
-      for (let j = 0; j < s; j++) {
-        const row = H - 1 - (y * s + j);
-        for (let i = 0; i < s; i++) {
-          const k = (row * W + x * s + i) * 4;
-          r += rgba[k]; g += rgba[k + 1]; b += rgba[k + 2];
-        }
-      }
-      const o = (y * view.width + x) * 3;
-      out[o] = r / (s * s); out[o + 1] = g / (s * s); out[o + 2] = b / (s * s);
-    }
-  }
-  return out;
-}
-
-function base64(floats) {
-  const bytes = new Uint8Array(floats.buffer, floats.byteOffset, floats.byteLength);
-  let s = '';
-  for (let i = 0; i < bytes.length; i += 0x8000) s += String.fromCharCode.apply(null, bytes.subarray(i, i + 0x8000));
-  return btoa(s);
+  return boxFilter(rgba, W, H, view);
 }
 
 // Wait for the GPU. Chromium's gl.finish() is only a flush; a 1×1 readback of the target blocks

@@ -5,6 +5,7 @@
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { Reflector } from 'three/addons/objects/Reflector.js';
+import { boxFilter, base64 } from '../pixels.mjs';
 
 // Reflector's shader with one line changed: the shipped one blends the reflected colour with
 // `color` by an overlay, which is not a reflectance; this one multiplies it by the mirror's
@@ -241,33 +242,10 @@ function draw(v, camera) {
 
 // Mean of each pixel's s × s block, rows flipped (GL reads bottom-up; EXR line 0 is the top).
 function readBack(view) {
-  const s = view.ssaa;
   const { width: W, height: H } = size;
   const rgba = new Float32Array(W * H * 4);
   renderer.readRenderTargetPixels(target, 0, 0, W, H, rgba);
-  const out = new Float32Array(view.width * view.height * 3);
-  for (let y = 0; y < view.height; y++) {
-    for (let x = 0; x < view.width; x++) {
-      let r = 0, g = 0, b = 0;
-      for (let j = 0; j < s; j++) {
-        const row = H - 1 - (y * s + j);
-        for (let i = 0; i < s; i++) {
-          const k = (row * W + x * s + i) * 4;
-          r += rgba[k]; g += rgba[k + 1]; b += rgba[k + 2];
-        }
-      }
-      const o = (y * view.width + x) * 3;
-      out[o] = r / (s * s); out[o + 1] = g / (s * s); out[o + 2] = b / (s * s);
-    }
-  }
-  return out;
-}
-
-function base64(floats) {
-  const bytes = new Uint8Array(floats.buffer, floats.byteOffset, floats.byteLength);
-  let s = '';
-  for (let i = 0; i < bytes.length; i += 0x8000) s += String.fromCharCode.apply(null, bytes.subarray(i, i + 0x8000));
-  return btoa(s);
+  return boxFilter(rgba, W, H, view);
 }
 
 // Wait for the GPU. Chromium's gl.finish() is only a flush (it returns before the GPU is
