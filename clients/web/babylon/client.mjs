@@ -26,7 +26,7 @@ import '@babylonjs/core/Engines/Extensions/engine.renderTarget.js';
 import '@babylonjs/core/Engines/Extensions/engine.renderTargetCube.js';
 import { ImportMeshAsync } from '@babylonjs/core/Loading/sceneLoader.js';
 import '@babylonjs/loaders/glTF/2.0/index.js';
-import { boxFilter, base64 } from '../pixels.mjs';
+import { boxFilter, base64, seededShuffle } from '../pixels.mjs';
 
 const linear = (rgb) => new Color3(rgb[0], rgb[1], rgb[2]);
 
@@ -360,29 +360,10 @@ function finish(v) {
   readTarget(v, 0, 0, 1, 1, pixel);
 }
 
-// A seeded shuffle (mulberry32), so a run's order is reproducible.
-function random(seed) {
-  let a = seed >>> 0;
-  return () => {
-    a = (a + 0x6d2b79f5) >>> 0;
-    let t = a;
-    t = Math.imul(t ^ (t >>> 15), t | 1);
-    t ^= t + Math.imul(t ^ (t >>> 7), t | 61);
-    return ((t ^ (t >>> 14)) >>> 0) / 4294967296;
-  };
-}
-let rand;
-function shuffled(list) {
-  const a = list.slice();
-  for (let i = a.length - 1; i > 0; i--) {
-    const j = Math.floor(rand() * (i + 1));
-    [a[i], a[j]] = [a[j], a[i]];
-  }
-  return a;
-}
+let shuffled;
 
 async function init(options) {
-  rand = random(options.seed);
+  shuffled = seededShuffle(options.seed);
   if (!(options.mirrorType in TEXTURE_TYPES)) throw new Error(`unknown mirror texture type ${options.mirrorType}`);
   const canvas = document.getElementById('canvas');
   engine = new Engine(canvas, false, {

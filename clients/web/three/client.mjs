@@ -5,7 +5,7 @@
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { Reflector } from 'three/addons/objects/Reflector.js';
-import { boxFilter, base64 } from '../pixels.mjs';
+import { boxFilter, base64, seededShuffle } from '../pixels.mjs';
 
 // Reflector's shader with one line changed: the shipped one blends the reflected colour with
 // `color` by an overlay, which is not a reflectance; this one multiplies it by the mirror's
@@ -256,30 +256,11 @@ function finish() {
   renderer.readRenderTargetPixels(target, 0, 0, 1, 1, pixel);
 }
 
-// A seeded shuffle (mulberry32), so a run's order is reproducible.
-function random(seed) {
-  let a = seed >>> 0;
-  return () => {
-    a = (a + 0x6d2b79f5) >>> 0;
-    let t = a;
-    t = Math.imul(t ^ (t >>> 15), t | 1);
-    t ^= t + Math.imul(t ^ (t >>> 7), t | 61);
-    return ((t ^ (t >>> 14)) >>> 0) / 4294967296;
-  };
-}
-let rand;
-function shuffled(list) {
-  const a = list.slice();
-  for (let i = a.length - 1; i > 0; i--) {
-    const j = Math.floor(rand() * (i + 1));
-    [a[i], a[j]] = [a[j], a[i]];
-  }
-  return a;
-}
+let shuffled;
 
 async function init(options) {
   settings = options;
-  rand = random(options.seed);
+  shuffled = seededShuffle(options.seed);
   renderer = new THREE.WebGLRenderer({ canvas: document.getElementById('canvas'), antialias: false, alpha: false });
   renderer.setPixelRatio(1);
   renderer.toneMapping = THREE.NoToneMapping;
