@@ -16,7 +16,10 @@ use std::path::Path;
 
 /// The Table 1 runs of one device, in the order they ran, and what to call the device.
 const TABLE1_RUNS: &[(&str, &[&str])] = &[
-    ("lavapipe (2 CPU cores)", &["table1", "table1_repeat"]),
+    (
+        "lavapipe (2 CPU cores)",
+        crate::table1::section::LAVAPIPE_RUNS,
+    ),
     ("an NVIDIA H100", &["gpu/table1"]),
     (
         "an NVIDIA H200",

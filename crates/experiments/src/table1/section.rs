@@ -504,9 +504,28 @@ pub const REGIONS: &[mirrorbox_report::readme::RegionSource] = &[
     },
 ];
 
-/// The region of the repeat's row: both runs side by side.
-pub const REPEAT_REGIONS: &[mirrorbox_report::readme::RegionSource] =
-    &[mirrorbox_report::readme::RegionSource {
+/// Every committed run of Table 1 on lavapipe, in the order they ran: the main job's two
+/// (`table1`, `table1_repeat`), then four run back to back in both orders
+/// (`reports/table1_runs/`, issue 54).
+pub const LAVAPIPE_RUNS: &[&str] = &[
+    "table1",
+    "table1_repeat",
+    "table1_runs/a_table1",
+    "table1_runs/b_repeat",
+    "table1_runs/c_repeat",
+    "table1_runs/d_table1",
+];
+
+/// The regions of the repeat's row: both runs side by side, and every lavapipe run's paired
+/// speed ratios with their verdicts.
+pub const REPEAT_REGIONS: &[mirrorbox_report::readme::RegionSource] = &[
+    mirrorbox_report::readme::RegionSource {
+        id: "table1-runs",
+        source: "table1_runs",
+        about: "every committed lavapipe run of Table 1: the exact methods' paired speed ratios and whether the runs agree",
+        generate: |reports| runs_region(reports, LAVAPIPE_RUNS),
+    },
+    mirrorbox_report::readme::RegionSource {
         id: "table1-repeat",
         source: "table1_repeat",
         about: "Table 1's rows from two consecutive runs side by side",
@@ -516,7 +535,8 @@ pub const REPEAT_REGIONS: &[mirrorbox_report::readme::RegionSource] =
                 &load_sweep(&reports.join("table1_repeat"))?,
             )
         },
-    }];
+    },
+];
 
 /// Table 1 (the first run) against the same sweep on another device, `reports/<folder>`.
 pub fn device_column(reports: &Path, folder: &str) -> Result<String, ReadmeError> {
