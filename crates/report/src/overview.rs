@@ -383,7 +383,12 @@ fn frontier_chart(
         references: vec![Reference::Curve("Pareto front".into(), steps)],
         ..Chart::new(
             format!(
-                "What each millisecond buys: {scene}, {}, {size}, α = {alpha}",
+                "What each millisecond buys ({}): {scene}, {}, {size}, α = {alpha}",
+                if mirror {
+                    "FLIP over the mirror pixels"
+                } else {
+                    "FLIP over the image"
+                },
                 device.split(" (").next().unwrap_or(device)
             ),
             "ms/frame (median, 95 % CI bars)",

@@ -258,6 +258,8 @@ impl Chart {
 /// Width of the plot area; the legend's column is added to its right, as wide as its longest
 /// entry needs.
 const PLOT_W: f64 = 450.0;
+/// The title's width per character (15 px sans-serif, generous).
+const TITLE_CHAR_W: f64 = 8.5;
 const PLOT_H: f64 = 330.0;
 const LEFT: f64 = 80.0;
 /// Approximate advance of one character of the 12 px sans-serif legend text.
@@ -526,6 +528,24 @@ impl Chart {
     /// joining points whose x goes back or repeats (a sweep axis other than the chart's x).
     pub fn lint(&self) -> Vec<String> {
         let mut out = Vec::new();
+        // The title says what is measured: an error metric with its domain (the image or the
+        // mirror pixels), or a cost.
+        let error_metric = ["FLIP", "relMSE", "SSIM", "PSNR", "RMSE"]
+            .iter()
+            .any(|m| self.title.contains(m));
+        let domain = ["image", "mirror pixels"]
+            .iter()
+            .any(|d| self.title.contains(d));
+        let cost = ["cost", "Cost", "ms/frame", "disparity"]
+            .iter()
+            .any(|c| self.title.contains(c));
+        if error_metric && !domain {
+            out.push("the title names an error metric without its domain (the image or the mirror pixels)".into());
+        } else if !error_metric && !cost {
+            out.push(
+                "the title names no metric (FLIP, relMSE, … with its domain) and no cost".into(),
+            );
+        }
         let ok = |v: f64, log: bool| drawable(v, log);
         let shown = |s: &Series| {
             s.points
@@ -666,7 +686,10 @@ impl Chart {
             .map(|(n, _)| n.chars().count())
             .max()
             .unwrap_or(0);
+        // Wide enough for the legend and for the title (which never runs off the canvas).
+        let title_w = TITLE_CHAR_W * self.title.chars().count() as f64;
         let w = (LEFT + PLOT_W + LEGEND_PAD + LEGEND_CHAR_W * legend_chars as f64)
+            .max(title_w + 16.0)
             .ceil()
             .max(LEFT + PLOT_W + 40.0);
         let footer_lines = wrap(&self.footer, ((w - 20.0) / SMALL_CHAR_W) as usize);
@@ -682,7 +705,6 @@ impl Chart {
         );
         let _ = writeln!(s, r#"<rect width="{w}" height="{h}" fill="white"/>"#);
         // Centred over the plot, moved right as far as a long title needs to stay inside.
-        let title_w = 8.5 * self.title.chars().count() as f64;
         let _ = writeln!(
             s,
             r#"<text x="{:.1}" y="22" text-anchor="middle" font-size="15">{}</text>"#,
@@ -1009,7 +1031,7 @@ mod tests {
     #[test]
     fn lint_flags_look_alike_series_empty_legends_undrawable_points_and_zigzags() {
         let style = method_style("portal");
-        let mut c = Chart::new("t", "x", "y");
+        let mut c = Chart::new("FLIP over the image vs cost", "x", "y");
         c.x_log = true;
         c.y_log = true;
         c.series
@@ -1045,6 +1067,11 @@ mod tests {
         // A variant of the method is told apart.
         c.series[1].style = style.variant(1);
         assert!(!c.lint().join("\n").contains("drawn alike"));
+        // A title without the metric's domain, or without any metric.
+        c.title = "FLIP vs cost".into();
+        assert!(c.lint().join("\n").contains("without its domain"));
+        c.title = "Error vs depth".into();
+        assert!(c.lint().join("\n").contains("names no metric"));
     }
 
     /// An axis label claims interval bars only where some series draws one on that axis.

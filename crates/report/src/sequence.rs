@@ -251,7 +251,7 @@ pub fn chart(records: &[FrameRecord], scenario: &str) -> Chart {
             })
             .collect(),
         ..Chart::new(
-            format!("Error per frame: {scenario}"),
+            format!("FLIP over the image per frame: {scenario}"),
             "frame",
             "FLIP mean over the image (log)",
         )

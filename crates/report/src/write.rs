@@ -644,7 +644,7 @@ fn document(info: &SweepInfo, records: &[Record], sections: &[Section]) -> Vec<B
                 series: series(&any, &|r| r.ms_median, &flip, true),
                 floor: floor.map(|fl| fl.metrics.flip_mean),
                 ..Chart::new(
-                    format!("Whole-image error vs cost{alpha_note}"),
+                    format!("FLIP over the image vs cost{alpha_note}"),
                     "ms/frame (median, 95 % CI bars)",
                     "FLIP mean over the image (lower is better)",
                 )
@@ -657,7 +657,7 @@ fn document(info: &SweepInfo, records: &[Record], sections: &[Section]) -> Vec<B
                 y_log: true,
                 series: series(&any, &|r| r.ms_median, &mirror_flip, true),
                 ..Chart::new(
-                    format!("Error over the mirror pixels vs cost{alpha_note}"),
+                    format!("FLIP over the mirror pixels vs cost{alpha_note}"),
                     "ms/frame (median, 95 % CI bars)",
                     "FLIP mean over the mirror pixels",
                 )
@@ -671,7 +671,7 @@ fn document(info: &SweepInfo, records: &[Record], sections: &[Section]) -> Vec<B
                 series: series(&any, &|r| r.ms_median, &|r| Some(r.metrics.relmse), true),
                 floor: floor.map(|fl| fl.metrics.relmse),
                 ..Chart::new(
-                    format!("relMSE (linear radiance) vs cost{alpha_note}"),
+                    format!("relMSE over the image (linear radiance) vs cost{alpha_note}"),
                     "ms/frame (median, 95 % CI bars)",
                     "relMSE over the image",
                 )
@@ -690,7 +690,7 @@ fn document(info: &SweepInfo, records: &[Record], sections: &[Section]) -> Vec<B
                 floor: floor.map(|fl| fl.metrics.flip_mean),
                 x_ticks_at_data: true,
                 ..Chart::new(
-                    format!("Error vs auxiliary mirrors n{alpha_note}"),
+                    format!("FLIP over the image vs auxiliary mirrors n{alpha_note}"),
                     "n (auxiliary mirrors)",
                     "FLIP mean over the image",
                 )
@@ -710,7 +710,7 @@ fn document(info: &SweepInfo, records: &[Record], sections: &[Section]) -> Vec<B
                 floor: floor.map(|fl| fl.metrics.flip_mean),
                 x_ticks_at_data: true,
                 ..Chart::new(
-                    format!("Error vs depth cap{alpha_note}"),
+                    format!("FLIP over the image vs depth cap{alpha_note}"),
                     "depth cap (most mirrors along a path)",
                     "FLIP mean over the image",
                 )

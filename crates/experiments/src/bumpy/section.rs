@@ -319,7 +319,7 @@ pub fn uneven_section(records: &[Record], bump_methods: &[String]) -> Vec<Block>
                 series,
                 x_ticks_at_data: true,
                 ..Chart::new(
-                    format!("Error vs tilt: {m}'s tricks, each at its best setting"),
+                    format!("FLIP over the image vs tilt: {m}'s tricks, each at its best setting"),
                     "the bump's steepest tilt (degrees)",
                     "FLIP mean over the image",
                 )

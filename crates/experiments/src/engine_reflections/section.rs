@@ -118,7 +118,7 @@ pub fn engine_reflections_section(records: &[Record], truth: &str) -> Vec<Block>
 fn depth_blocks(pts: &[&Record]) -> Vec<Block> {
     let mut out = Vec::new();
     let mut error = Chart::new(
-        "Error over the mirror pixels against the depth cap",
+        "FLIP over the mirror pixels against the depth cap",
         "depth cap (reflections followed)",
         "FLIP mean over the mirror pixels",
     );
@@ -234,7 +234,7 @@ fn screen_blocks(pts: &[&Record], truth: &str) -> Vec<Block> {
         .filter(|r| r.method == "ssr" && r.value(value::REFLECTION_OFFSCREEN_SHARE).is_some())
         .collect();
     let mut chart = Chart::new(
-        "ssr: error over the mirror pixels against the reflections off screen",
+        "ssr: FLIP over the mirror pixels against the reflections off screen",
         "share of mirror pixels whose first reflection is off screen",
         "FLIP mean over the mirror pixels",
     );

@@ -211,7 +211,7 @@ pub fn lighting_section(records: &[Record]) -> Vec<Block> {
                 y_log: true,
                 series: error_vs_ms,
                 ..Chart::new(
-                    format!("Error vs cost of each lighting variant, k = {k_max}"),
+                    format!("FLIP over the image vs cost of each lighting variant, k = {k_max}"),
                     "ms/frame (median, 95 % CI bars)",
                     "FLIP mean over the image",
                 )
@@ -251,7 +251,7 @@ pub fn lighting_section(records: &[Record]) -> Vec<Block> {
                 series,
                 x_ticks_at_data: true,
                 ..Chart::new(
-                    format!("Error vs mirrored-light depth k, {method}"),
+                    format!("FLIP over the image vs mirrored-light depth k, {method}"),
                     "k (most mirrors between a light and a surface)",
                     "FLIP mean over the image",
                 )

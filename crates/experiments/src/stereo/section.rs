@@ -300,7 +300,7 @@ pub fn stereo_section(records: &[Record]) -> Vec<Block> {
         chart(
             records,
             "plot_stereo_error_vs_ipd.svg",
-            "FLIP mean (both eyes) vs interpupillary distance",
+            "FLIP over the image (both eyes) vs interpupillary distance",
             "FLIP mean",
             true,
         ),
