@@ -273,7 +273,14 @@ pub fn score(
         let images_dir = partial.join("images");
         std::fs::create_dir_all(&images_dir).map_err(io(&images_dir))?;
         let mut records = Vec::new();
-        let run_started = crate::now_rfc3339();
+        // A scored folder is one run: the outside variants share the run of our sweep beside
+        // them (`--with`, measured with them), else the scoring's time. (No paired ratio is
+        // taken with an outside variant: its timing order is its own.)
+        let run_started = ours
+            .iter()
+            .filter_map(|(_, r)| r.run.clone())
+            .max()
+            .unwrap_or_else(crate::now_rfc3339);
         for (client, variant, timing, images) in &inputs {
             for (vi, (v, image)) in views.views.iter().zip(images).enumerate() {
                 let floor = variant.as_str() == "floor";
