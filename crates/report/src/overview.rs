@@ -545,7 +545,8 @@ pub fn write_overview(
         "\n\n## What each millisecond buys\n\n\
          Every method at its sweep points on the bundled mirror scenes, error against ms/frame \
          (log–log, lower left is better); the grey step line is the Pareto front, labelled with \
-         the settings on it. One chart per device, size and α.\n\n",
+         the settings on it. First each scene's headline panel (a GPU's where one was measured), \
+         then one per device, size and α.\n\n",
     );
     let mut html = String::from(
         "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>mirrorbox reports</title>\
@@ -563,10 +564,24 @@ pub fn write_overview(
     html.push_str(
         "<h2>What each millisecond buys</h2>\n<p>Every method at its sweep \
          points on the bundled mirror scenes, error against ms/frame (log–log, lower left is \
-         better); the grey step line is the Pareto front, labelled with the settings on it. One \
-         chart per device, size and α.</p>\n",
+         better); the grey step line is the Pareto front, labelled with the settings on it. First \
+         each scene's headline panel (a GPU's where one was measured), then one per device, size \
+         and α.</p>\n",
     );
-    for c in charts.iter().filter(|c| c.chart.is_drawable()) {
+    // The headline panel of each scene first (`frontier_<scene>.svg`: a GPU's where one was
+    // measured), then every other device, size and α.
+    let drawable: Vec<&Frontier> = charts.iter().filter(|c| c.chart.is_drawable()).collect();
+    let (headlines, others): (Vec<&Frontier>, Vec<&Frontier>) =
+        drawable.into_iter().partition(|c| {
+            FRONTIER_SCENES
+                .iter()
+                .any(|s| c.file == format!("frontier_{s}.svg"))
+        });
+    for (i, c) in headlines.iter().chain(&others).enumerate() {
+        if i == headlines.len() && !others.is_empty() {
+            md.push_str("### Every other device, size and α\n\n");
+            html.push_str("<h3>Every other device, size and α</h3>\n");
+        }
         let svg = c.chart.to_svg();
         write_atomically(&reports.join(&c.file), svg.as_bytes())
             .map_err(|e| ReadmeError(e.to_string()))?;
