@@ -144,7 +144,8 @@ fn exact_speed(reports: &Path) -> Result<String, ReadmeError> {
     }
     Ok(format!(
         "**Speed, paired by round: `portal` at depth 64 against `auxiliary` n = 2** — {} \
-         (mirror_box, 640×360, α = 0.7; [the runs side by side](../docs/book/src/gpu.md)).",
+         (mirror_box, 640×360, α = 0.7; the runs side by side: [lavapipe](../docs/book/src/table1.md), \
+         [GPUs](../docs/book/src/gpu.md)).",
         parts.join("; ")
     ))
 }
