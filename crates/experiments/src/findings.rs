@@ -321,12 +321,62 @@ pub fn findings(reports: &Path) -> Result<Vec<Block>, ReadmeError> {
 
 /// [`findings`] as Markdown with its links (written relative to `reports/`) made relative to
 /// another file: `to_reports` is the way from that file's folder to `reports/`, `to_root` to
-/// the repository root (the README: `reports/` and ``; the book: `../../../reports/` and
-/// `../../../`).
+/// the repository root (the overview: `` and `../`).
 pub fn rebased(blocks: &[Block], to_reports: &str, to_root: &str) -> String {
     const UP: &str = "\u{1}";
     markdown(blocks)
         .replace("](../", &format!("]({UP}"))
         .replace("](", &format!("]({to_reports}"))
         .replace(&format!("{to_reports}{UP}"), to_root)
+}
+
+/// [`findings`] for a region (the README, the book), where relative links cannot stay (a
+/// region's text is the same in files at different depths): each `[label](target)` becomes
+/// `label` and the target's path from the repository root in code, so it can still be found.
+pub fn with_paths(blocks: &[Block]) -> String {
+    let text = rebased(blocks, "reports/", "");
+    let mut out = String::new();
+    let mut rest = text.as_str();
+    while let Some(open) = rest.find('[') {
+        let after = &rest[open + 1..];
+        let link = after
+            .find(']')
+            .filter(|c| after[*c..].starts_with("]("))
+            .and_then(|c| {
+                let target = &after[c + 2..];
+                target
+                    .find(')')
+                    .map(|e| (&after[..c], &target[..e], c + 2 + e + 1))
+            });
+        match link {
+            Some((label, target, len)) => {
+                out.push_str(&rest[..open]);
+                out.push_str(&format!("{label}: `{target}`"));
+                rest = &after[len..];
+            }
+            None => {
+                out.push_str(&rest[..open + 1]);
+                rest = after;
+            }
+        }
+    }
+    out.push_str(rest);
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_regions_links_become_paths_from_the_root_and_intervals_stay() {
+        let b = [Block::Paragraph(
+            "see [figure](table1/p.svg) and [book](../docs/x.md); 1.2× [1.1–1.3×] stays".into(),
+        )];
+        assert_eq!(
+            with_paths(&b).trim(),
+            "see figure: `reports/table1/p.svg` and book: `docs/x.md`; 1.2× [1.1–1.3×] stays"
+        );
+        assert!(rebased(&b, "", "../").contains("[book](../docs/x.md)"));
+    }
 }

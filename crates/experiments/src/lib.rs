@@ -117,34 +117,13 @@ pub fn regions() -> Vec<RegionSource> {
     out
 }
 
-/// What was found ([`findings`]), for the README (links from the root) and for the book
-/// (links from `docs/book/src`).
-const FINDINGS_REGIONS: &[RegionSource] = &[
-    RegionSource {
-        id: "findings",
-        source: "table1",
-        about: "what was found, ranked, computed from the committed records",
-        generate: |reports| {
-            Ok(findings::rebased(
-                &findings::findings(reports)?,
-                "reports/",
-                "",
-            ))
-        },
-    },
-    RegionSource {
-        id: "findings-book",
-        source: "table1",
-        about: "what was found, for the book's introduction",
-        generate: |reports| {
-            Ok(findings::rebased(
-                &findings::findings(reports)?,
-                "../../../reports/",
-                "../../../",
-            ))
-        },
-    },
-];
+/// What was found ([`findings`]), quoted in the README and the book's introduction.
+const FINDINGS_REGIONS: &[RegionSource] = &[RegionSource {
+    id: "findings",
+    source: "table1",
+    about: "what was found, ranked, computed from the committed records",
+    generate: |reports| Ok(findings::with_paths(&findings::findings(reports)?)),
+}];
 
 /// The overview's entries of the reports that are not sweep folders, in the table's order.
 pub fn other_reports() -> Vec<OtherReport> {
