@@ -382,8 +382,7 @@ fn exported_view(scene: &Scene, spec: &ViewSpec, ssaa: u32) -> ExportedView {
     let c = &scene.camera;
     let (right, up, forward) = camera_frame(scene);
     let (near, far) = clip_planes(scene);
-    let aspect = c.width as f32 / c.height as f32;
-    let fov = c.fov_y_deg.to_radians();
+    let aspect = c.aspect();
     ExportedView {
         name: spec.name.clone(),
         width: c.width,
@@ -401,53 +400,20 @@ fn exported_view(scene: &Scene, spec: &ViewSpec, ssaa: u32) -> ExportedView {
             far,
             exposure: c.exposure,
         },
-        view_matrix: view_matrix(c.position, right, up, forward).to_cols_array(),
-        projection_gl: perspective(fov, aspect, near, far, DepthRange::MinusOneToOne)
-            .to_cols_array(),
-        projection_zero_to_one: perspective(fov, aspect, near, far, DepthRange::ZeroToOne)
-            .to_cols_array(),
+        view_matrix: c.view().to_cols_array(),
+        projection_gl: gl_projection(c, near, far).to_cols_array(),
+        projection_zero_to_one: c.projection(near, far).to_cols_array(),
         truth: format!("truth/{}.exr", spec.name),
         floor: format!("truth/{}_floor.exr", spec.name),
         scene_hash: format!("{:016x}", scene.content_hash()),
     }
 }
 
-/// World to camera: rows right, up, −forward, the camera at the origin looking down −z.
-fn view_matrix(position: Vec3, right: Vec3, up: Vec3, forward: Vec3) -> Mat4 {
-    Mat4::from_cols(
-        glam::Vec4::new(right.x, up.x, -forward.x, 0.0),
-        glam::Vec4::new(right.y, up.y, -forward.y, 0.0),
-        glam::Vec4::new(right.z, up.z, -forward.z, 0.0),
-        glam::Vec4::new(
-            -right.dot(position),
-            -up.dot(position),
-            forward.dot(position),
-            1.0,
-        ),
-    )
-}
-
-/// A clip space's depth range: OpenGL's and WebGL's, or Vulkan's, WebGPU's and Direct3D's.
-#[derive(Clone, Copy)]
-enum DepthRange {
-    MinusOneToOne,
-    ZeroToOne,
-}
-
-/// The right-handed perspective of vertical field `fov` (radians): `t = 1/tan(fov/2)`,
-/// x·t/aspect, y·t, and z from `near` to `far` onto the depth range, w = −z.
-fn perspective(fov: f32, aspect: f32, near: f32, far: f32, range: DepthRange) -> Mat4 {
-    let t = 1.0 / (0.5 * fov).tan();
-    let (a, b) = match range {
-        DepthRange::MinusOneToOne => ((far + near) / (near - far), 2.0 * far * near / (near - far)),
-        DepthRange::ZeroToOne => (far / (near - far), far * near / (near - far)),
-    };
-    Mat4::from_cols(
-        glam::Vec4::new(t / aspect, 0.0, 0.0, 0.0),
-        glam::Vec4::new(0.0, t, 0.0, 0.0),
-        glam::Vec4::new(0.0, 0.0, a, -1.0),
-        glam::Vec4::new(0.0, 0.0, b, 0.0),
-    )
+/// The camera's projection with OpenGL's and WebGL's depth range (−1…1), beside
+/// [`mirrorbox_scene::camera::Camera::projection`]'s 0…1 (Vulkan, WebGPU, Direct3D). An
+/// exported camera has no lens shift (stereo is refused).
+fn gl_projection(c: &mirrorbox_scene::camera::Camera, near: f32, far: f32) -> Mat4 {
+    glam::camera::rh::proj::opengl::perspective(c.fov_y_deg.to_radians(), c.aspect(), near, far)
 }
 
 /// A `views.json` as an export writes it, for tests of what reads it.
@@ -498,14 +464,23 @@ mod tests {
     #[test]
     fn the_matrices_put_near_and_far_at_the_ends_of_each_depth_range() {
         let (pos, fwd) = (Vec3::new(1.0, 2.0, 3.0), Vec3::new(0.0, 0.0, -1.0));
-        let (right, up) = (Vec3::X, Vec3::Y);
-        let view = view_matrix(pos, right, up, fwd);
+        let c = mirrorbox_scene::camera::Camera {
+            position: pos,
+            look_at: pos + fwd,
+            up: Vec3::Y,
+            fov_y_deg: 1f32.to_degrees(),
+            width: 150,
+            height: 100,
+            exposure: 1.0,
+            shift_x: 0.0,
+        };
+        let view = c.view();
         assert!(view.transform_point3(pos).length() < 1e-6);
-        for (range, lo) in [
-            (DepthRange::MinusOneToOne, -1.0),
-            (DepthRange::ZeroToOne, 0.0),
+        for (projection, lo) in [
+            (gl_projection(&c, 0.1, 100.0), -1.0),
+            (c.projection(0.1, 100.0), 0.0),
         ] {
-            let p = perspective(1.0, 1.5, 0.1, 100.0, range) * view;
+            let p = projection * view;
             let ndc = |d: f32| {
                 let c = p * (pos + fwd * d).extend(1.0);
                 c.z / c.w
