@@ -32,13 +32,6 @@ const TABLE1_RUNS: &[(&str, &[&str])] = &[
     ),
 ];
 
-/// FLIP over the mirror pixels where the mask was kept, else over the image.
-fn mirror_flip(r: &Record) -> f64 {
-    r.mirror_metrics
-        .as_ref()
-        .map_or(r.metrics.flip_mean, |m| m.flip_mean)
-}
-
 /// A sweep's point of `method` at count `n` or depth `depth` and Table 1's α.
 fn point<'a>(s: &'a Sweep, method: &str, n: Option<u32>, depth: Option<u32>) -> Option<&'a Record> {
     let (alpha, _) = table1::rows(&s.records);
@@ -76,10 +69,10 @@ fn exact_error(reports: &Path) -> Result<String, ReadmeError> {
         "**Exact mirrors beat the paper's method on error by {:.0}×**: `portal` at depth 64 shows \
          {} reflections with FLIP {} over the mirror pixels, the paper's `auxiliary` n = 2 {} \
          ({}, {}×{}, α = {}; [figure](table1/plot_mirror_flip_vs_ms.svg)).",
-        mirror_flip(aux) / mirror_flip(portal),
+        aux.mirror_flip() / portal.mirror_flip(),
         portal.reflections,
-        sci(mirror_flip(portal)),
-        sci(mirror_flip(aux)),
+        sci(portal.mirror_flip()),
+        sci(aux.mirror_flip()),
         s.info.scene,
         portal.width,
         portal.height,
@@ -165,7 +158,7 @@ fn web_engines(reports: &Path) -> Result<String, ReadmeError> {
                 "reports/{folder} lacks three-reflector or naive"
             )));
         };
-        ratios.push(mirror_flip(theirs) / mirror_flip(ours));
+        ratios.push(theirs.mirror_flip() / ours.mirror_flip());
         if let (Some(a), Some(b)) = (
             find(&|r| r.is_external() && r.kind == "floor" && r.method == "three"),
             find(&|r| !r.is_external() && r.kind == "floor"),
@@ -198,11 +191,11 @@ fn room_front(reports: &Path) -> Result<String, ReadmeError> {
         .iter()
         .filter(|r| r.kind == "point" && r.alpha == 1.0)
         .collect();
-    let coords: Vec<(f64, f64)> = pts.iter().map(|r| (r.ms_median, mirror_flip(r))).collect();
+    let coords: Vec<(f64, f64)> = pts.iter().map(|r| (r.ms_median, r.mirror_flip())).collect();
     let (front, _) = mirrorbox_report::overview::pareto_steps(&coords);
     let mut names: Vec<(f64, String)> = pts
         .iter()
-        .filter(|r| front.contains(&(r.ms_median, mirror_flip(r))))
+        .filter(|r| front.contains(&(r.ms_median, r.mirror_flip())))
         .map(|r| {
             (
                 r.ms_median,
@@ -210,7 +203,7 @@ fn room_front(reports: &Path) -> Result<String, ReadmeError> {
                     "{} ({} ms, FLIP {})",
                     mirrorbox_report::document::label(r),
                     mirrorbox_report::document::f(r.ms_median, 3),
-                    sci(mirror_flip(r))
+                    sci(r.mirror_flip())
                 ),
             )
         })
@@ -276,7 +269,7 @@ fn ssr_offscreen(reports: &Path) -> Result<String, ReadmeError> {
         .records
         .iter()
         .filter(|r| r.method == "ssr" && r.option("ssr-fallback") == Some("none"))
-        .filter_map(|r| Some((r.value(share)?, mirror_flip(r))))
+        .filter_map(|r| Some((r.value(share)?, r.mirror_flip())))
         .collect();
     let rho = crate::engine_reflections::section::spearman(&none).ok_or_else(|| {
         ReadmeError("reports/engine_reflections_ssr_room: too few ssr turns".into())

@@ -384,6 +384,14 @@ impl Record {
             .map(|[low, high]| stats::Interval { low, high })
     }
 
+    /// The error a point is judged by: its FLIP mean over the mirror pixels where the mask
+    /// was kept, else over the image.
+    pub fn mirror_flip(&self) -> f64 {
+        self.mirror_metrics
+            .as_ref()
+            .map_or(self.metrics.flip_mean, |m| m.flip_mean)
+    }
+
     /// A variant an outside renderer drew, scored through the exchange (`mirrorbox score`).
     pub fn is_external(&self) -> bool {
         self.timing_order == EXTERNAL_TIMING

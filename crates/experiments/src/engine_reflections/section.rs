@@ -49,14 +49,6 @@ fn name(r: &Record) -> String {
     }
 }
 
-/// The error a point is judged by: FLIP over the mirror pixels where the mask was kept, else
-/// over the image.
-fn mirror_flip(r: &Record) -> f64 {
-    r.mirror_metrics
-        .as_ref()
-        .map_or(r.metrics.flip_mean, |m| m.flip_mean)
-}
-
 /// Spearman's rank correlation of `(x, y)` (ties at their mean rank).
 pub(crate) fn spearman(points: &[(f64, f64)]) -> Option<f64> {
     let ranks = |v: Vec<f64>| -> Vec<f64> {
@@ -149,7 +141,7 @@ fn depth_blocks(pts: &[&Record]) -> Vec<Block> {
         error.series.push(Series::new(
             m,
             style,
-            of.iter().map(|r| (d(r), mirror_flip(r))).collect(),
+            of.iter().map(|r| (d(r), r.mirror_flip())).collect(),
         ));
         let mut s = Series::new(m, style, of.iter().map(|r| (d(r), r.ms_median)).collect());
         s.y_intervals = of.iter().map(|r| r.ms_interval).collect();
@@ -200,7 +192,7 @@ fn depth_blocks(pts: &[&Record]) -> Vec<Block> {
         } else {
             r.key.split('|').next().unwrap_or(&r.method).to_string()
         };
-        for (chart, y) in [(&mut error, mirror_flip(r)), (&mut cost, r.ms_median)] {
+        for (chart, y) in [(&mut error, r.mirror_flip()), (&mut cost, r.ms_median)] {
             let mut s = Series::new(label.clone(), style, vec![(depth, y)]);
             s.joined = false;
             chart.series.push(s);
@@ -255,7 +247,7 @@ fn screen_blocks(pts: &[&Record], truth: &str) -> Vec<Block> {
             .map(|r| {
                 (
                     r.value(value::REFLECTION_OFFSCREEN_SHARE).unwrap_or(0.0),
-                    mirror_flip(r),
+                    r.mirror_flip(),
                 )
             })
             .collect();

@@ -6,13 +6,6 @@
 use mirrorbox_report::document::{Block, f, ms_cell, sci};
 use mirrorbox_report::{Record, SweepInfo};
 
-/// FLIP over the mirror pixels where the mask was kept, else over the image.
-fn mirror_flip(r: &Record) -> f64 {
-    r.mirror_metrics
-        .as_ref()
-        .map_or(r.metrics.flip_mean, |m| m.flip_mean)
-}
-
 /// `text` cut to `n` characters, with an ellipsis where cut (a device string can run to
 /// hundreds: the full one is in the record and in `variants.md`).
 fn short(text: &str, n: usize) -> String {
@@ -69,23 +62,23 @@ pub fn section(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
         let exact = ours
             .iter()
             .filter(|o| info.exact_methods.contains(&o.method) && o.ms_median <= r.ms_median)
-            .min_by(|a, b| mirror_flip(a).total_cmp(&mirror_flip(b)));
+            .min_by(|a, b| a.mirror_flip().total_cmp(&b.mirror_flip()));
         rows.push(vec![
             mirrorbox_report::document::label(r),
             short(&r.adapter, 60),
             floor.map_or("–".into(), |fl| sci(fl.metrics.flip_mean)),
-            sci(mirror_flip(r)),
+            sci(r.mirror_flip()),
             sci(r.metrics.flip_mean),
             ms_cell(r, 3),
             eq.map_or("–".into(), |e| {
-                format!("{} {}", e.method, sci(mirror_flip(e)))
+                format!("{} {}", e.method, sci(e.mirror_flip()))
             }),
             eq.map_or("–".into(), |e| ms_cell(e, 3)),
             exact.map_or("–".into(), |e| {
                 format!(
                     "{} {}",
                     mirrorbox_report::document::label(e),
-                    sci(mirror_flip(e))
+                    sci(e.mirror_flip())
                 )
             }),
         ]);
@@ -93,14 +86,14 @@ pub fn section(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
             "**{}** ({}): FLIP over the mirror pixels {}",
             r.method,
             r.backend,
-            sci(mirror_flip(r))
+            sci(r.mirror_flip())
         );
         if let Some(e) = eq {
             s.push_str(&format!(
                 ", {}× that of our `{}` ({}) on the same view",
-                f(mirror_flip(r) / mirror_flip(e), 2),
+                f(r.mirror_flip() / e.mirror_flip(), 2),
                 e.method,
-                sci(mirror_flip(e))
+                sci(e.mirror_flip())
             ));
         }
         if let Some(fl) = floor {
@@ -126,7 +119,7 @@ pub fn section(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
             Some(e) => s.push_str(&format!(
                 "; at no more cost our `{}` reaches {}.",
                 mirrorbox_report::document::label(e),
-                sci(mirror_flip(e))
+                sci(e.mirror_flip())
             )),
             None => s.push_str("; none of our exact methods is as cheap."),
         }
