@@ -187,13 +187,7 @@ pub fn export_views(
     dir: &Path,
     settings: &ExportSettings,
 ) -> Result<Exported, HarnessError> {
-    crate::check_output_parent(dir)?;
-    if dir.exists() && !dir.join("views.json").is_file() && !is_empty_dir(dir) {
-        return Err(HarnessError::Exchange(format!(
-            "{}: exists and holds no earlier export (views.json); give a new or empty folder",
-            dir.display()
-        )));
-    }
+    replaceable(dir, "views.json", "export")?;
     let mut config = SweepConfig::new(
         scene_path.to_path_buf(),
         dir.to_path_buf(),
@@ -253,8 +247,19 @@ pub(crate) fn in_staged_folder<T>(
     Ok(done)
 }
 
-fn is_empty_dir(dir: &Path) -> bool {
-    std::fs::read_dir(dir).is_ok_and(|mut d| d.next().is_none())
+/// Whether [`in_staged_folder`] may write `dir`: its parent exists, and it is absent, empty,
+/// or holds an earlier output of the same command (its `marker` file, e.g. `views.json`).
+/// Checked before any work, so that a mistyped folder costs nothing.
+pub(crate) fn replaceable(dir: &Path, marker: &str, what: &str) -> Result<(), HarnessError> {
+    crate::check_output_parent(dir)?;
+    let empty = std::fs::read_dir(dir).is_ok_and(|mut d| d.next().is_none());
+    if dir.exists() && !dir.join(marker).is_file() && !empty {
+        return Err(HarnessError::Exchange(format!(
+            "{}: exists and holds no earlier {what} ({marker}); give a new or empty folder",
+            dir.display()
+        )));
+    }
+    Ok(())
 }
 
 fn write_export(

@@ -249,16 +249,7 @@ pub fn score(
         ours.extend(sweep.records.into_iter().map(|r| (dir.clone(), r)));
     }
     let found = variants(run)?;
-    crate::check_output_parent(out)?;
-    if out.exists()
-        && !out.join("sweep.json").is_file()
-        && std::fs::read_dir(out).is_ok_and(|mut d| d.next().is_some())
-    {
-        return Err(refused(
-            out,
-            "exists and holds no earlier score (sweep.json); give a new or empty folder",
-        ));
-    }
+    crate::exchange::replaceable(out, "sweep.json", "score")?;
     // Everything read and checked first.
     let mut inputs = Vec::new();
     for (client, variant, dir) in &found {
