@@ -9,7 +9,7 @@
 //! the runs disagree and by how much.
 
 use crate::table1::rows::{self as table1};
-use mirrorbox_report::document::{Block, markdown, paired_ratio, sci};
+use mirrorbox_report::document::{Block, markdown, ms, paired_ratio, sci};
 use mirrorbox_report::readme::ReadmeError;
 use mirrorbox_report::{Record, Sweep, load_sweep};
 use std::path::Path;
@@ -32,24 +32,6 @@ const TABLE1_RUNS: &[(&str, &[&str])] = &[
     ),
 ];
 
-/// A sweep's point of `method` at count `n` or depth `depth` and Table 1's α.
-fn point<'a>(s: &'a Sweep, method: &str, n: Option<u32>, depth: Option<u32>) -> Option<&'a Record> {
-    let (alpha, _) = table1::rows(&s.records);
-    s.records.iter().find(|r| {
-        r.kind == "point"
-            && r.method == method
-            && r.n == n
-            && r.depth == depth
-            && alpha.is_some_and(|a| (r.alpha - a).abs() < 1e-6)
-    })
-}
-
-/// Three significant digits (0.00482, 0.164, 2.85).
-fn sig(v: f64) -> String {
-    let digits = (2 - v.abs().max(1e-12).log10().floor() as i32).max(0) as usize;
-    format!("{v:.digits$}")
-}
-
 fn load(reports: &Path, folder: &str) -> Result<Sweep, ReadmeError> {
     load_sweep(&reports.join(folder))
 }
@@ -58,8 +40,8 @@ fn load(reports: &Path, folder: &str) -> Result<Sweep, ReadmeError> {
 fn exact_error(reports: &Path) -> Result<String, ReadmeError> {
     let s = load(reports, "table1")?;
     let (Some(aux), Some(portal)) = (
-        point(&s, table1::PAPER_METHOD, Some(2), None),
-        point(&s, "portal", None, Some(64)),
+        table1::point_at(&s.records, table1::PAPER_METHOD, Some(2), None),
+        table1::point_at(&s.records, "portal", None, Some(64)),
     ) else {
         return Err(ReadmeError(
             "reports/table1 lacks auxiliary n=2 or portal depth=64".into(),
@@ -89,8 +71,8 @@ fn exact_speed(reports: &Path) -> Result<String, ReadmeError> {
         for folder in *folders {
             let s = load(reports, folder)?;
             let (Some(aux), Some(portal)) = (
-                point(&s, table1::PAPER_METHOD, Some(2), None),
-                point(&s, "portal", None, Some(64)),
+                table1::point_at(&s.records, table1::PAPER_METHOD, Some(2), None),
+                table1::point_at(&s.records, "portal", None, Some(64)),
             ) else {
                 return Err(ReadmeError(format!(
                     "reports/{folder} lacks auxiliary n=2 or portal depth=64"
@@ -103,21 +85,14 @@ fn exact_speed(reports: &Path) -> Result<String, ReadmeError> {
         if intervals.is_empty() {
             continue;
         }
-        let low = intervals
-            .iter()
-            .map(|(_, i)| i.low)
-            .fold(f64::MIN, f64::max);
-        let high = intervals
-            .iter()
-            .map(|(_, i)| i.high)
-            .fold(f64::MAX, f64::min);
+        let shared = table1::shared_interval(intervals.iter().map(|(_, i)| *i));
         parts.push(if intervals.len() == 1 {
             let (r, i) = &intervals[0];
             format!(
                 "on {device}, {r:.2}× faster [{:.2}–{:.2}×] (one run)",
                 i.low, i.high
             )
-        } else if low <= high {
+        } else if let Some((low, high)) = shared {
             format!(
                 "on {device}, {:.2}× faster (all {} runs agree: their paired 95 % intervals share {low:.2}–{high:.2}×)",
                 intervals[0].0,
@@ -234,7 +209,7 @@ fn bounce_cost(reports: &Path) -> Result<String, ReadmeError> {
                 "reports/{folder} holds no portal depth sweep"
             )));
         };
-        let (Some(ms), Some(i), Some(pass)) = (
+        let (Some(per_bounce), Some(i), Some(pass)) = (
             g.ms_per_bounce,
             g.ms_per_bounce_interval,
             floor.map(|f| f.ms_median),
@@ -245,11 +220,11 @@ fn bounce_cost(reports: &Path) -> Result<String, ReadmeError> {
         };
         parts.push(format!(
             "{} ms [{}–{}] on {device} ({:.1} % of its {} ms full-scene pass)",
-            sig(ms),
-            sig(i.low),
-            sig(i.high),
-            100.0 * ms / pass,
-            sig(pass)
+            ms(per_bounce, 2),
+            ms(i.low, 2),
+            ms(i.high, 2),
+            100.0 * per_bounce / pass,
+            ms(pass, 2)
         ));
     }
     Ok(format!(

@@ -189,6 +189,37 @@ pub fn growth_sentence(rows: &[Row]) -> String {
     )
 }
 
+/// The point of `method` at count `n` or depth `depth` and Table 1's α ([`rows`]): how the
+/// exact methods are set beside the paper's in a Table 1 sweep.
+pub fn point_at<'a>(
+    records: &'a [Record],
+    method: &str,
+    n: Option<u32>,
+    depth: Option<u32>,
+) -> Option<&'a Record> {
+    let (alpha, _) = rows(records);
+    records.iter().find(|r| {
+        r.kind == "point"
+            && r.method == method
+            && r.n == n
+            && r.depth == depth
+            && alpha.is_some_and(|a| (r.alpha - a).abs() < 1e-6)
+    })
+}
+
+/// What several runs' 95 % intervals of one ratio share, `(low, high)`, or `None` where two
+/// of them do not overlap: one verdict, or runs that disagree.
+pub fn shared_interval(
+    intervals: impl IntoIterator<Item = mirrorbox_report::stats::Interval>,
+) -> Option<(f64, f64)> {
+    let (low, high) = intervals
+        .into_iter()
+        .fold((f64::MIN, f64::MAX), |(lo, hi), i| {
+            (lo.max(i.low), hi.min(i.high))
+        });
+    (low <= high).then_some((low, high))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -379,13 +379,7 @@ pub fn runs_region(reports: &Path, folders: &[&str]) -> Result<String, ReadmeErr
             )));
         };
         let at = |method: &str, n: Option<u32>, depth: Option<u32>| {
-            s.records.iter().find(|r| {
-                r.kind == "point"
-                    && r.method == method
-                    && r.n == n
-                    && r.depth == depth
-                    && (r.alpha - alpha).abs() < 1e-6
-            })
+            table1::point_at(&s.records, method, n, depth)
         };
         let Some(base) = at(table1::PAPER_METHOD, Some(2), None).cloned() else {
             return Err(ReadmeError(format!(
@@ -457,9 +451,7 @@ pub fn runs_region(reports: &Path, folders: &[&str]) -> Result<String, ReadmeErr
         if intervals.len() < 2 {
             continue;
         }
-        let low = intervals.iter().map(|i| i.low).fold(f64::MIN, f64::max);
-        let high = intervals.iter().map(|i| i.high).fold(f64::MAX, f64::min);
-        verdicts.push(if low <= high {
+        verdicts.push(if let Some((low, high)) = table1::shared_interval(intervals.clone()) {
             format!(
                 "{m}: the {} runs' paired intervals share {low:.2}–{high:.2}×, one verdict",
                 intervals.len()
