@@ -176,12 +176,18 @@ depth_1080p() {
     --out reports/gpu/depth_scaling_1080p
 }
 
+# The GPU's model for folder names (`h200`), or `gpu` where nvidia-smi names none.
+gpu_slug() {
+  local g
+  g=$(nvidia-smi --query-gpu=name --format=csv,noheader 2>/dev/null | head -n1 | grep -oE 'H[0-9]+' | tr 'H' 'h')
+  echo "${g:-gpu}"
+}
+
 # Table 1 twice on this device, back to back (issue 57: a repeat is only a repeat on the same
 # device and in the same lease), into folders named after the GPU (the H100's table1/ stays).
 table1_pair() {
   local gpu
-  gpu=$(nvidia-smi --query-gpu=name --format=csv,noheader 2>/dev/null | head -n1 | grep -oE 'H[0-9]+' | tr 'H' 'h')
-  gpu=${gpu:-gpu}
+  gpu=$(gpu_slug)
   timeout 200 "$bin" experiment table1 --fresh --out "reports/gpu/table1_$gpu" &&
     timeout 200 "$bin" experiment table1-repeat --fresh --out "reports/gpu/table1_repeat_$gpu"
 }
@@ -189,8 +195,7 @@ table1_pair() {
 # for the exact methods): into table1_repeat_<gpu>_run2, then table1_<gpu>_run2.
 table1_pair_reversed() {
   local gpu
-  gpu=$(nvidia-smi --query-gpu=name --format=csv,noheader 2>/dev/null | head -n1 | grep -oE 'H[0-9]+' | tr 'H' 'h')
-  gpu=${gpu:-gpu}
+  gpu=$(gpu_slug)
   timeout 200 "$bin" experiment table1-repeat --fresh --out "reports/gpu/table1_repeat_${gpu}_run2" &&
     timeout 200 "$bin" experiment table1 --fresh --out "reports/gpu/table1_${gpu}_run2"
 }
