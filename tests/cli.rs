@@ -372,6 +372,44 @@ fn info_reports_the_adapter_and_its_timing_support() {
     );
 }
 
+/// The commands that time frames compile their shaders afresh (Mesa's disk cache off: lavapipe
+/// runs cached shaders slower, issue 54) unless the user says otherwise, and `info` says which.
+#[test]
+fn timing_commands_turn_mesas_shader_cache_off_unless_told_otherwise() {
+    // `info --json` with MESA_SHADER_CACHE_DISABLE as given (None: unset, whatever the
+    // test's own environment says): (Mesa's version, the shader cache reported).
+    let info = |value: Option<&str>| {
+        let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_mirrorbox"));
+        cmd.args(["info", "--json"]).current_dir(repo());
+        match value {
+            Some(v) => cmd.env("MESA_SHADER_CACHE_DISABLE", v),
+            None => cmd.env_remove("MESA_SHADER_CACHE_DISABLE"),
+        };
+        let out = cmd.output().unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+        (
+            v["mesa"].is_string(),
+            v["shader_cache"].as_str().map(str::to_string),
+        )
+    };
+    let (mesa, unset) = info(None);
+    if !mesa {
+        // Another driver: nothing of Mesa's to report.
+        assert_eq!(unset, None);
+        return;
+    }
+    assert_eq!(unset.as_deref(), Some("Mesa's disk shader cache off"));
+    assert_eq!(
+        info(Some("false")).1.as_deref(),
+        Some("Mesa's disk shader cache on")
+    );
+}
+
 /// `MIRRORBOX_COLOR_FORMAT` forces the colour format: `info` and `render` say so; a value
 /// that names no format is refused (exit 2) before anything is written.
 #[test]

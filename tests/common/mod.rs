@@ -19,6 +19,9 @@ pub struct Output {
 pub fn mirrorbox(args: &[&str], envs: &[(&str, &str)]) -> Output {
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_mirrorbox"));
     cmd.args(args).current_dir(repo());
+    // Images, not times: keep Mesa's shader cache, which timing commands turn off (issue 54;
+    // `scripts/test.sh` says so for every process of the suite).
+    cmd.env("MESA_SHADER_CACHE_DISABLE", "false");
     for (k, v) in envs {
         cmd.env(k, v);
     }

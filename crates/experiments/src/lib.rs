@@ -70,6 +70,7 @@ pub struct Experiment {
 pub const EXPERIMENTS: &[&Experiment] = &[
     &table1::TABLE1,
     &table1::TABLE1_REPEAT,
+    &table1::TABLE1_RUNS,
     &depth_scaling::DEPTH_SCALING,
     &symmetry_scaling::SYMMETRY_SCALING,
     &lighting::LIGHTING,
@@ -118,12 +119,61 @@ pub fn regions() -> Vec<RegionSource> {
 }
 
 /// What was found ([`findings`]), quoted in the README and the book's introduction.
-const FINDINGS_REGIONS: &[RegionSource] = &[RegionSource {
-    id: "findings",
-    source: "table1",
-    about: "what was found, ranked, computed from the committed records",
-    generate: |reports| Ok(findings::with_paths(&findings::findings(reports)?)),
-}];
+/// Then each chapter's own findings, at its top (region `found-<chapter>`).
+const FINDINGS_REGIONS: &[RegionSource] = &[
+    RegionSource {
+        id: "findings",
+        source: "table1",
+        about: "what was found, ranked, computed from the committed records",
+        generate: |reports| Ok(findings::with_paths(&findings::findings(reports)?)),
+    },
+    found("found-table1", "table1", |r| {
+        findings::chapter_findings(r, "table1.md")
+    }),
+    found("found-gpu", "gpu", |r| {
+        findings::chapter_findings(r, "gpu.md")
+    }),
+    found("found-frontier", "frontier_room", |r| {
+        findings::chapter_findings(r, "frontier.md")
+    }),
+    found("found-exact-methods", "depth_scaling", |r| {
+        findings::chapter_findings(r, "exact-methods.md")
+    }),
+    found("found-exchange", "web_engines", |r| {
+        findings::chapter_findings(r, "exchange.md")
+    }),
+    found(
+        "found-engine-reflections",
+        "engine_reflections_ssr_room",
+        |r| findings::chapter_findings(r, "engine-reflections.md"),
+    ),
+    found("found-stereo", "stereo", |r| {
+        findings::chapter_findings(r, "stereo.md")
+    }),
+    found("found-lighting", "lighting", |r| {
+        findings::chapter_findings(r, "lighting.md")
+    }),
+    found("found-symmetry", "symmetry_scaling", |r| {
+        findings::chapter_findings(r, "symmetry.md")
+    }),
+    found("found-uneven-mirrors", "uneven_mirrors", |r| {
+        findings::chapter_findings(r, "uneven-mirrors.md")
+    }),
+];
+
+/// A chapter's findings region.
+const fn found(
+    id: &'static str,
+    source: &'static str,
+    generate: fn(&std::path::Path) -> Result<String, mirrorbox_report::readme::ReadmeError>,
+) -> RegionSource {
+    RegionSource {
+        id,
+        source,
+        about: "the findings this chapter opens with, from the ranked findings",
+        generate,
+    }
+}
 
 /// The overview's entries of the reports that are not sweep folders, in the table's order.
 pub fn other_reports() -> Vec<OtherReport> {

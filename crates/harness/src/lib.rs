@@ -9,7 +9,8 @@
 //! - **Interleaved timing**: the points still to do are timed round-robin — `frames` rounds,
 //!   each rendering every point's warm-up frames and one timed frame, in an order shuffled
 //!   per round with a fixed seed — so drift of a shared machine hits every point alike. Each
-//!   record holds every frame, the median, its 95 % bootstrap interval and the minimum.
+//!   record holds every frame, the median, its 95 % bootstrap interval and the minimum. A
+//!   [settling round](SETTLING_ROUNDS) renders every point once, untimed, before them.
 //! - **Resume**: points whose key is already in `results.jsonl` are skipped. Points are
 //!   written once all rounds are done: an interrupted sweep keeps every point written
 //!   before, and measures the interrupted batch again.
@@ -333,6 +334,14 @@ fn io(path: &Path) -> impl FnOnce(std::io::Error) -> HarnessError + '_ {
     }
 }
 
+/// Untimed rounds before the timed ones: every point renders its warm-up and timed frames
+/// once, and none of it is kept. The first round after a sweep's shaders are compiled ran
+/// slower for some methods than for others — on lavapipe the paper's `auxiliary` n = 2 took
+/// 21–26 ms in the first round and about 15 ms after it while `portal` did not change (the
+/// `table1-runs` records of issue 54, frames kept in round order) — which biased the paired
+/// ratios.
+pub const SETTLING_ROUNDS: u32 = 1;
+
 /// The seed of the per-round shuffles of interleaved timing.
 pub const INTERLEAVE_SEED: u64 = 2026;
 
@@ -345,6 +354,10 @@ pub enum Event<'a> {
     },
     /// A point's truth is being traced or read from the cache.
     Started {
+        label: &'a str,
+    },
+    /// A point renders in the untimed settling round ([`SETTLING_ROUNDS`]).
+    Settling {
         label: &'a str,
     },
     /// A point renders its frame of timing round `round` (1-based) of `rounds`.
@@ -895,14 +908,14 @@ pub fn point_keys(config: &SweepConfig) -> Result<Vec<String>, HarnessError> {
         .collect())
 }
 
-/// Runs (or resumes) the sweep and writes its reports; `fresh` discards the points already
-/// in `results.jsonl` first (cached truths stay). The output folder is locked for the whole
-/// run: a second sweep into it is refused at once, naming the process that holds it.
 /// The current UTC time, RFC 3339 to the second.
 pub(crate) fn now_rfc3339() -> String {
     humantime::format_rfc3339_seconds(std::time::SystemTime::now()).to_string()
 }
 
+/// Runs (or resumes) the sweep and writes its reports; `fresh` discards the points already
+/// in `results.jsonl` first (cached truths stay). The output folder is locked for the whole
+/// run: a second sweep into it is refused at once, naming the process that holds it.
 pub fn run_sweep(
     config: &SweepConfig,
     fresh: bool,
@@ -1053,14 +1066,20 @@ pub fn run_sweep(
     let mut encodes: Vec<Vec<f64>> = vec![Vec::new(); todo.len()];
     let mut order: Vec<usize> = (0..todo.len()).collect();
     let mut rng = mirrorbox_report::stats::Rng::new(INTERLEAVE_SEED);
-    for round in 0..config.frames {
+    for round in 0..SETTLING_ROUNDS + config.frames {
+        let settling = round < SETTLING_ROUNDS;
+        let round = round.saturating_sub(SETTLING_ROUNDS);
         rng.shuffle(&mut order);
         for &i in &order {
             let p = todo[i];
-            progress(Event::Timing {
-                label: &p.label,
-                round: round + 1,
-                rounds: config.frames,
+            progress(if settling {
+                Event::Settling { label: &p.label }
+            } else {
+                Event::Timing {
+                    label: &p.label,
+                    round: round + 1,
+                    rounds: config.frames,
+                }
             });
             let job = &jobs[i];
             let report = match &config.worker {
@@ -1068,17 +1087,20 @@ pub fn run_sweep(
                 None => {
                     let rendered = worker::render_scene(job, &scenes[i], &gpu)?;
                     // Only the last round's image is compared; the others are not written.
-                    if round + 1 == config.frames {
+                    if !settling && round + 1 == config.frames {
                         worker::write_images(job, rendered)?
                     } else {
                         rendered.report
                     }
                 }
             };
+            peaks[i] = peaks[i].max(report.peak_memory_bytes);
+            if settling {
+                continue;
+            }
             timed[i].extend(&report.frames_ms);
             plans[i].push(report.plan_ms);
             encodes[i].extend(&report.encode_ms);
-            peaks[i] = peaks[i].max(report.peak_memory_bytes);
             last[i] = Some(report);
         }
     }
@@ -1236,6 +1258,7 @@ pub fn run_sweep(
         driver: format!("{} {}", gpu.report.driver, gpu.report.driver_info)
             .trim()
             .to_string(),
+        shader_cache: gpu.report.shader_cache().unwrap_or_default().to_string(),
         commit: source_commit(),
         records_commit: String::new(),
         versions: format!(
@@ -1329,4 +1352,51 @@ pub fn git_output(dir: &Path, args: &[&str]) -> Option<String> {
         .ok()
         .filter(|o| o.status.success())
         .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every point renders once in the settling round before its timed rounds, and only the
+    /// timed rounds' frames are kept.
+    #[test]
+    fn a_settling_round_renders_every_point_before_the_timed_rounds_and_is_not_kept() {
+        let out = tempfile::tempdir().unwrap();
+        let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/mirror_box.json");
+        let mut config = SweepConfig::new(
+            scene,
+            out.path().join("sweep"),
+            vec![Method::parse("naive").unwrap()],
+            vec![0.5],
+        );
+        (config.width, config.height, config.frames, config.warmup) = (Some(32), Some(18), 2, 0);
+        let mut events = Vec::new();
+        run_sweep(&config, true, &mut |e| match e {
+            Event::Settling { label } => events.push(format!("settle {label}")),
+            Event::Timing { label, round, .. } => events.push(format!("time {round} {label}")),
+            _ => {}
+        })
+        .unwrap();
+        // The floor and one point: both settle before either is timed.
+        assert_eq!(
+            events.len(),
+            2 * (SETTLING_ROUNDS as usize + 2),
+            "{events:?}"
+        );
+        assert!(
+            events[..2].iter().all(|e| e.starts_with("settle")),
+            "{events:?}"
+        );
+        assert!(
+            events[2..].iter().all(|e| e.starts_with("time")),
+            "{events:?}"
+        );
+        let records = read_records(&out.path().join("sweep/results.jsonl")).unwrap();
+        assert_eq!(records.len(), 2);
+        assert!(
+            records.iter().all(|r| r.frames_ms.len() == 2),
+            "{records:?}"
+        );
+    }
 }

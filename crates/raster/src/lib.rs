@@ -38,7 +38,8 @@ pub use gpu::{
 pub use plan::{culling, exact_paths, memory, projection, shadow_plan, symmetry_cells};
 
 pub use adapter::{
-    AdapterError, AdapterReport, MIN_MESA, SelectedAdapter, mesa_version, select_adapter,
+    AdapterError, AdapterReport, MIN_MESA, SelectedAdapter, mesa_shader_cache_disabled,
+    mesa_version, select_adapter,
 };
 pub use color_format::ColorFormat;
 pub use gpu::{Gpu, GpuOptions, RasterError};

@@ -453,6 +453,11 @@ pub struct SweepInfo {
     /// The adapter's driver and its version (`wgpu::AdapterInfo::driver` and `driver_info`);
     /// empty in sweeps written before it was recorded.
     pub driver: String,
+    /// For a Mesa driver, whether its on-disk shader cache was on (lavapipe runs shaders it
+    /// loads from there slower than those it compiles: issue 54); empty for other drivers and
+    /// in sweeps written before it was recorded.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub shader_cache: String,
     pub versions: String,
     pub scene: String,
     pub resolution: String,
@@ -530,6 +535,11 @@ impl SweepInfo {
             String::new()
         } else {
             format!(", driver {}", self.driver.trim())
+        };
+        let driver = if self.shader_cache.is_empty() {
+            driver
+        } else {
+            format!("{driver}, {}", self.shader_cache)
         };
         format!(
             "adapter {} ({}, {}{driver})",

@@ -33,6 +33,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             "clip_distances": r.clip_distances,
             "ray_query": r.ray_query,
             "mesa": mirrorbox_raster::mesa_version(&r.driver_info).map(|(a, b, c)| format!("{a}.{b}.{c}")),
+            "shader_cache": r.shader_cache(),
             "warning": r.platform_warning(),
             "color_format": color_format.as_ref().ok().map(|f| f.name()),
             "color_format_error": color_format.as_ref().err(),

@@ -38,7 +38,8 @@ pub struct Args {
     /// Supersampling s of the raster (the truth uses the same s×s sub-pixel grid).
     #[arg(long, default_value_t = 1)]
     ssaa: u32,
-    /// Timed frames per point (after --warmup untimed ones).
+    /// Timed frames per point, one per interleaved round (after --warmup untimed ones each,
+    /// and an untimed settling round of every point first).
     #[arg(long, default_value_t = 5)]
     frames: u32,
     /// Untimed frames rendered first (driver caches, pipeline compilation), 0..1000.
@@ -193,9 +194,9 @@ pub struct PresetArgs {
     /// Output folder of the committed report (default: the preset's folder in reports/).
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Timed frames per point, one per interleaved round (default: the experiment's, 9 for
-    /// Table 1; 6 or more give each median a 95 % interval); a sequence experiment (motion):
-    /// frames per scenario.
+    /// Timed frames per point, one per interleaved round after an untimed settling round
+    /// (default: the experiment's: 9, 15 for Table 1; 6 or more give each median a 95 %
+    /// interval); a sequence experiment (motion): frames per scenario.
     #[arg(long)]
     frames: Option<u32>,
     /// Discard earlier results and measure every point again (cached truths stay).
@@ -476,15 +477,21 @@ fn execute(config: &SweepConfig, fresh: bool) -> Result<(), Failure> {
                 "sweep: {todo} points to compute, {reused} already in {}",
                 config.out.join("results.jsonl").display()
             );
-            // One step per timed render (points × rounds).
+            // One step per render (points × rounds, the settling round included).
             bar = Some(progress_bar(
-                todo as u64 * u64::from(config.frames),
+                todo as u64 * u64::from(config.frames + mirrorbox_harness::SETTLING_ROUNDS),
                 "sweep",
             ));
         }
         Event::Started { label } => {
             if let Some(b) = &bar {
                 b.set_message(format!("truth: {label}"));
+            }
+        }
+        Event::Settling { label } => {
+            if let Some(b) = &bar {
+                b.set_message(format!("settling round: {label}"));
+                b.inc(1);
             }
         }
         Event::Timing {

@@ -220,9 +220,119 @@ pub fn shared_interval(
     (low <= high).then_some((low, high))
 }
 
+/// The verdict of one paired speed ratio `comparator ms / method ms` with its 95 % interval:
+/// `"faster"` where the interval lies above 1, `"slower"` below, else `"not shown apart"`.
+pub fn speed_verdict(i: mirrorbox_report::stats::Interval) -> &'static str {
+    if i.low > 1.0 {
+        "faster"
+    } else if i.high < 1.0 {
+        "slower"
+    } else {
+        "not shown apart"
+    }
+}
+
+/// What several runs of one paired speed ratio say together (issue 54: a verdict stands only
+/// where every run gives it).
+#[derive(Clone, Debug, PartialEq)]
+pub enum RunsVerdict {
+    /// Every run gives `verdict`; `shared` is what their intervals share, `None` where two of
+    /// them do not overlap (one verdict, sizes that differ).
+    Agree {
+        verdict: &'static str,
+        shared: Option<(f64, f64)>,
+    },
+    /// The runs give different verdicts: how many give each, in the order first seen, and
+    /// the lowest and highest interval ends.
+    Disagree {
+        counts: Vec<(&'static str, usize)>,
+        low: f64,
+        high: f64,
+    },
+}
+
+impl RunsVerdict {
+    pub fn of(intervals: &[mirrorbox_report::stats::Interval]) -> Self {
+        let mut counts: Vec<(&'static str, usize)> = Vec::new();
+        for i in intervals {
+            let v = speed_verdict(*i);
+            match counts.iter_mut().find(|(w, _)| *w == v) {
+                Some((_, n)) => *n += 1,
+                None => counts.push((v, 1)),
+            }
+        }
+        match counts.as_slice() {
+            [(verdict, _)] => RunsVerdict::Agree {
+                verdict,
+                shared: shared_interval(intervals.iter().copied()),
+            },
+            _ => RunsVerdict::Disagree {
+                counts,
+                low: intervals.iter().map(|i| i.low).fold(f64::MAX, f64::min),
+                high: intervals.iter().map(|i| i.high).fold(f64::MIN, f64::max),
+            },
+        }
+    }
+
+    /// "faster in all 4 runs, their paired intervals sharing 1.38–1.40×", "slower in all 2
+    /// runs, their paired intervals apart (0.71–0.95×)", or "the runs disagree: faster in 1,
+    /// slower in 5 (paired intervals from 0.71× to 1.89×)".
+    pub fn sentence(&self, runs: usize) -> String {
+        match self {
+            RunsVerdict::Agree {
+                verdict,
+                shared: Some((low, high)),
+            } => format!(
+                "{verdict} in all {runs} runs, their paired intervals sharing {low:.2}–{high:.2}×"
+            ),
+            RunsVerdict::Agree {
+                verdict,
+                shared: None,
+            } => format!(
+                "{verdict} in all {runs} runs, though their paired intervals do not all overlap"
+            ),
+            RunsVerdict::Disagree { counts, low, high } => {
+                let each: Vec<String> = counts.iter().map(|(v, n)| format!("{v} in {n}")).collect();
+                format!(
+                    "the runs disagree: {} (paired intervals from {low:.2}× to {high:.2}×)",
+                    each.join(", ")
+                )
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn runs_agree_only_on_one_verdict_each() {
+        let i = |low, high| mirrorbox_report::stats::Interval { low, high };
+        assert_eq!(speed_verdict(i(1.1, 1.3)), "faster");
+        assert_eq!(speed_verdict(i(0.7, 0.9)), "slower");
+        assert_eq!(speed_verdict(i(0.9, 1.1)), "not shown apart");
+        let agree = RunsVerdict::of(&[i(1.2, 1.5), i(1.4, 1.9)]);
+        assert_eq!(
+            agree.sentence(2),
+            "faster in all 2 runs, their paired intervals sharing 1.40–1.50×"
+        );
+        // One verdict, sizes apart.
+        let apart = RunsVerdict::of(&[i(1.1, 1.2), i(1.4, 1.9)]);
+        assert_eq!(
+            apart,
+            RunsVerdict::Agree {
+                verdict: "faster",
+                shared: None
+            }
+        );
+        // Intervals that overlap can still give two verdicts: no verdict then.
+        let two = RunsVerdict::of(&[i(1.05, 1.3), i(0.95, 1.2), i(1.1, 1.4)]);
+        assert_eq!(
+            two.sentence(3),
+            "the runs disagree: faster in 2, not shown apart in 1 (paired intervals from 0.95× to 1.40×)"
+        );
+    }
 
     #[test]
     fn slope_of_a_power_law() {

@@ -235,6 +235,18 @@ fn table1_summary_region(s: &Sweep) -> Result<String, ReadmeError> {
     Ok(markdown(&blocks))
 }
 
+/// Whether two resume keys name the same point measured with any number of timed rounds (Table
+/// 1 moved from 9 to 15: issue 54; another device's run may have either).
+fn same_point(a: &str, b: &str) -> bool {
+    let without_frames = |k: &str| -> Vec<String> {
+        k.split('|')
+            .filter(|p| !p.starts_with("frames="))
+            .map(String::from)
+            .collect()
+    };
+    without_frames(a) == without_frames(b)
+}
+
 /// The points two sweeps of one configuration share, measured on two devices, side by side:
 /// each one's ms/frame and FLIP, and how many times faster the second device is. Times compare
 /// only as ratios of medians here (the devices ran at different times); errors should agree up
@@ -246,7 +258,7 @@ fn device_column_region(first: &Sweep, second: &Sweep) -> Result<String, ReadmeE
         let Some(b) = second
             .records
             .iter()
-            .find(|b| b.key == a.key && b.kind == a.kind)
+            .find(|b| same_point(&b.key, &a.key) && b.kind == a.kind)
         else {
             continue;
         };
@@ -340,7 +352,7 @@ fn repeat_region(first: &Sweep, second: &Sweep) -> Result<String, ReadmeError> {
         measured_on(second),
         alpha_a.unwrap_or(f32::NAN)
     );
-    let blocks = vec![
+    let mut blocks = vec![
         Block::Paragraph(text),
         Block::Table(
             [
@@ -361,7 +373,53 @@ fn repeat_region(first: &Sweep, second: &Sweep) -> Result<String, ReadmeError> {
             order(ordered(&b))
         )),
     ];
+    blocks.extend(verdicts_held(first, second));
     Ok(markdown(&blocks))
+}
+
+/// Whether every speed verdict of the first run holds in the second (issue 54): each exact
+/// method at depth 64 against the paper's n = 2, paired by round, faster / slower / not shown
+/// apart in each run ([`table1::speed_verdict`]).
+fn verdicts_held(first: &Sweep, second: &Sweep) -> Vec<Block> {
+    let pair = |s: &Sweep, m: &str| {
+        let base = table1::point_at(&s.records, table1::PAPER_METHOD, Some(2), None)?;
+        let p = table1::point_at(&s.records, m, None, Some(64))?;
+        Some((base.ms_median / p.ms_median, paired_ratio(base, p)?))
+    };
+    let mut bullets = Vec::new();
+    let mut broken = 0;
+    for m in &first.info.exact_methods {
+        let (Some((ra, ia)), Some((rb, ib))) = (pair(first, m), pair(second, m)) else {
+            continue;
+        };
+        let (va, vb) = (table1::speed_verdict(ia), table1::speed_verdict(ib));
+        broken += usize::from(va != vb);
+        bullets.push(format!(
+            "{m} depth=64 against n=2: {va} in the first run ({ra:.2}× [{:.2}–{:.2}×]), {vb} in \
+             the second ({rb:.2}× [{:.2}–{:.2}×]): {}",
+            ia.low,
+            ia.high,
+            ib.low,
+            ib.high,
+            if va == vb { "holds" } else { "does NOT hold" }
+        ));
+    }
+    if bullets.is_empty() {
+        return Vec::new();
+    }
+    let summary = if broken == 0 {
+        format!(
+            "Every speed verdict of the first run holds in the second ({} of {}), paired by round:",
+            bullets.len(),
+            bullets.len()
+        )
+    } else {
+        format!(
+            "{broken} of {} speed verdicts of the first run do NOT hold in the second, paired by round:",
+            bullets.len()
+        )
+    };
+    vec![Block::Paragraph(summary), Block::Bullets(bullets)]
 }
 
 /// Several runs of Table 1 (`reports/<folder>` each, in the order they ran) in one table: per
@@ -398,11 +456,15 @@ pub fn runs_region(reports: &Path, folders: &[&str]) -> Result<String, ReadmeErr
             .collect();
         runs.push((folder.to_string(), s.info.clone(), alpha, base, points));
     }
-    let mut header = vec![
-        "run".to_string(),
-        "started".to_string(),
-        format!("{} n=2 ms [95 % CI]", table1::PAPER_METHOD),
-    ];
+    // Mesa's shader cache decided lavapipe's verdicts (issue 54): said per run where recorded.
+    let caches = runs
+        .iter()
+        .any(|(_, info, ..)| !info.shader_cache.is_empty());
+    let mut header = vec!["run".to_string(), "started".to_string()];
+    if caches {
+        header.push("shader cache".to_string());
+    }
+    header.push(format!("{} n=2 ms [95 % CI]", table1::PAPER_METHOD));
     for m in &exact {
         header.push(format!("{m} depth=64 ms [95 % CI]"));
         header.push(format!("{m}: times faster than n=2, paired [95 % CI]"));
@@ -413,8 +475,14 @@ pub fn runs_region(reports: &Path, folders: &[&str]) -> Result<String, ReadmeErr
         let mut row = vec![
             format!("`{folder}` (α = {alpha})"),
             started.get(..19).unwrap_or(started).replace('T', " "),
-            ms_cell(base, 3),
         ];
+        if caches {
+            row.push(match info.shader_cache.as_str() {
+                "" => "not recorded".to_string(),
+                c => c.to_string(),
+            });
+        }
+        row.push(ms_cell(base, 3));
         for p in exact
             .iter()
             .enumerate()
@@ -438,7 +506,7 @@ pub fn runs_region(reports: &Path, folders: &[&str]) -> Result<String, ReadmeErr
         }
         rows.push(row);
     }
-    // Per exact method: do the runs' paired intervals share a value (one verdict), or not?
+    // Per exact method: does every run give the same verdict, and do their intervals meet?
     let mut verdicts = Vec::new();
     for (i, m) in exact.iter().enumerate() {
         let intervals: Vec<stats::Interval> = runs
@@ -451,19 +519,10 @@ pub fn runs_region(reports: &Path, folders: &[&str]) -> Result<String, ReadmeErr
         if intervals.len() < 2 {
             continue;
         }
-        verdicts.push(if let Some((low, high)) = table1::shared_interval(intervals.clone()) {
-            format!(
-                "{m}: the {} runs' paired intervals share {low:.2}–{high:.2}×, one verdict",
-                intervals.len()
-            )
-        } else {
-            format!(
-                "{m}: the {} runs' paired intervals do NOT overlap (from {:.2}× to {:.2}×): the runs disagree",
-                intervals.len(),
-                intervals.iter().map(|i| i.low).fold(f64::MAX, f64::min),
-                intervals.iter().map(|i| i.high).fold(f64::MIN, f64::max)
-            )
-        });
+        verdicts.push(format!(
+            "{m} against n=2: {}",
+            table1::RunsVerdict::of(&intervals).sentence(intervals.len())
+        ));
     }
     let devices: Vec<String> = mirrorbox_report::document::distinct(
         runs.iter()
@@ -496,9 +555,9 @@ pub const REGIONS: &[mirrorbox_report::readme::RegionSource] = &[
     },
 ];
 
-/// Every committed run of Table 1 on lavapipe, in the order they ran: the main job's two
-/// (`table1`, `table1_repeat`), then four run back to back in both orders
-/// (`reports/table1_runs/`, issue 54).
+/// Every committed run of Table 1 on lavapipe with the timing commands' default (every
+/// shader compiled afresh), in the order they ran: the main job's two (`table1`,
+/// `table1_repeat`), then four run back to back in both orders (experiment `table1-runs`).
 pub const LAVAPIPE_RUNS: &[&str] = &[
     "table1",
     "table1_repeat",
@@ -508,9 +567,35 @@ pub const LAVAPIPE_RUNS: &[&str] = &[
     "table1_runs/d_table1",
 ];
 
-/// The regions of the repeat's row: both runs side by side, and every lavapipe run's paired
-/// speed ratios with their verdicts.
+/// Table 1 with Mesa's disk shader cache cold, warm and off, twice over (experiment
+/// `table1-runs`): what decided lavapipe's verdicts before issue 54.
+pub const SHADER_CACHE_RUNS: &[&str] = &[
+    "table1_runs/cache_1_cold",
+    "table1_runs/cache_2_warm",
+    "table1_runs/cache_3_off",
+    "table1_runs/cache_4_cold",
+    "table1_runs/cache_5_warm",
+    "table1_runs/cache_6_off",
+];
+
+/// The repeat's region: both runs side by side, and whether the first run's verdicts hold.
 pub const REPEAT_REGIONS: &[mirrorbox_report::readme::RegionSource] = &[
+    mirrorbox_report::readme::RegionSource {
+        id: "table1-repeat",
+        source: "table1_repeat",
+        about: "Table 1's rows from two consecutive runs side by side, and whether the first run's speed verdicts hold in the second",
+        generate: |reports| {
+            repeat_region(
+                &load_sweep(&reports.join("table1"))?,
+                &load_sweep(&reports.join("table1_repeat"))?,
+            )
+        },
+    },
+];
+
+/// The regions of `table1-runs`: every lavapipe run's paired speed ratios with their
+/// verdicts, and the runs with the shader cache cold, warm and off.
+pub const RUNS_REGIONS: &[mirrorbox_report::readme::RegionSource] = &[
     mirrorbox_report::readme::RegionSource {
         id: "table1-runs",
         source: "table1_runs",
@@ -518,15 +603,10 @@ pub const REPEAT_REGIONS: &[mirrorbox_report::readme::RegionSource] = &[
         generate: |reports| runs_region(reports, LAVAPIPE_RUNS),
     },
     mirrorbox_report::readme::RegionSource {
-        id: "table1-repeat",
-        source: "table1_repeat",
-        about: "Table 1's rows from two consecutive runs side by side",
-        generate: |reports| {
-            repeat_region(
-                &load_sweep(&reports.join("table1"))?,
-                &load_sweep(&reports.join("table1_repeat"))?,
-            )
-        },
+        id: "table1-shader-cache",
+        source: "table1_runs",
+        about: "Table 1 with Mesa's disk shader cache cold, warm and off: the exact methods' paired speed ratios",
+        generate: |reports| runs_region(reports, SHADER_CACHE_RUNS),
     },
 ];
 
@@ -591,7 +671,7 @@ mod tests {
     }
 
     #[test]
-    fn runs_agree_only_where_their_paired_ratios_share_a_value() {
+    fn runs_agree_only_where_every_run_gives_the_same_verdict() {
         let reports = tempfile::tempdir().unwrap();
         let wobble = |k: usize| 1.0 + 0.01 * (k % 3) as f64;
         write_run(reports.path(), "a", 5.0, &wobble);
@@ -599,18 +679,64 @@ mod tests {
         let text = runs_region(reports.path(), &["a", "b"]).unwrap();
         // A slower machine in the second run (both points alike) leaves the paired ratio.
         assert!(
-            text.contains("unrolled: the 2 runs' paired intervals share 2.00–2.00×, one verdict"),
+            text.contains(
+                "unrolled against n=2: faster in all 2 runs, their paired intervals sharing 2.00–2.00×"
+            ),
             "{text}"
         );
         assert!(text.contains("| `a` (α = 0.7) |"), "{text}");
-        // The exact method slower in the second run only: two verdicts, said.
+        // No shader cache recorded in any run: no column for it.
+        assert!(!text.contains("shader cache"), "{text}");
+        // The exact method slower in the second run only: one verdict, sizes apart, said.
         write_run(reports.path(), "c", 8.0, &wobble);
         let text = runs_region(reports.path(), &["a", "c"]).unwrap();
         assert!(
-            text.contains("do NOT overlap (from 1.25× to 2.00×): the runs disagree"),
+            text.contains("faster in all 2 runs, though their paired intervals do not all overlap"),
+            "{text}"
+        );
+        // Slower than n = 2 in a third run: the runs disagree.
+        write_run(reports.path(), "d", 12.5, &wobble);
+        let text = runs_region(reports.path(), &["a", "c", "d"]).unwrap();
+        assert!(
+            text.contains(
+                "the runs disagree: faster in 2, slower in 1 (paired intervals from 0.80× to 2.00×)"
+            ),
             "{text}"
         );
         assert!(runs_region(reports.path(), &["a", "missing"]).is_err());
+    }
+
+    #[test]
+    fn points_are_the_same_whatever_their_number_of_timed_rounds() {
+        let k =
+            |frames| format!("portal depth=64|alpha=0.7|640x360|ssaa=1|frames={frames}|scene=ee52");
+        assert!(same_point(&k(9), &k(15)));
+        assert!(!same_point(&k(9), &k(9).replace("depth=64", "depth=32")));
+    }
+
+    #[test]
+    fn the_repeat_says_whether_each_verdict_of_the_first_run_holds() {
+        let reports = tempfile::tempdir().unwrap();
+        let wobble = |k: usize| 1.0 + 0.01 * (k % 3) as f64;
+        write_run(reports.path(), "a", 5.0, &wobble);
+        write_run(reports.path(), "b", 6.0, &|k| 1.3 * wobble(k));
+        write_run(reports.path(), "c", 12.5, &wobble);
+        let sweep = |f: &str| load_sweep(&reports.path().join(f)).unwrap();
+        let text = markdown(&verdicts_held(&sweep("a"), &sweep("b")));
+        assert!(
+            text.contains("Every speed verdict of the first run holds in the second (1 of 1)"),
+            "{text}"
+        );
+        assert!(
+            text.contains("unrolled depth=64 against n=2: faster in the first run (2.00× [2.00–2.00×]), faster in the second (1.67× [1.67–1.67×]): holds"),
+            "{text}"
+        );
+        let text = markdown(&verdicts_held(&sweep("a"), &sweep("c")));
+        assert!(
+            text.contains("1 of 1 speed verdicts of the first run do NOT hold in the second")
+                && text.contains("slower in the second (0.80× [0.80–0.80×]): does NOT hold"),
+            "{text}"
+        );
     }
 
     #[test]

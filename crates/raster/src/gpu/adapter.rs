@@ -57,7 +57,36 @@ pub fn mesa_version(driver_info: &str) -> Option<(u32, u32, u32)> {
     Some((major, minor, patch))
 }
 
+/// Whether Mesa's on-disk shader cache is off in this process (`MESA_SHADER_CACHE_DISABLE`).
+pub fn mesa_shader_cache_disabled() -> bool {
+    shader_cache_disabled_by(std::env::var("MESA_SHADER_CACHE_DISABLE").ok().as_deref())
+}
+
+/// Whether a value of `MESA_SHADER_CACHE_DISABLE` turns Mesa's disk cache off, read as Mesa
+/// reads a boolean option: `1`, `true`, `yes`, `y`, `t` in any case; anything else or unset
+/// leaves it on.
+pub fn shader_cache_disabled_by(value: Option<&str>) -> bool {
+    value.is_some_and(|v| {
+        matches!(
+            v.trim().to_ascii_lowercase().as_str(),
+            "1" | "true" | "yes" | "y" | "t"
+        )
+    })
+}
+
 impl AdapterReport {
+    /// For a Mesa driver, whether its on-disk shader cache is on: shaders lavapipe loads from
+    /// there run slower than those it compiles (Mesa 25.0.7: `portal` depth 64 1.7×, issue
+    /// 54, docs/budgets.md), so a timing must say which it had. `None` for other drivers.
+    pub fn shader_cache(&self) -> Option<&'static str> {
+        mesa_version(&format!("{} {}", self.driver, self.driver_info))?;
+        Some(if mesa_shader_cache_disabled() {
+            "Mesa's disk shader cache off"
+        } else {
+            "Mesa's disk shader cache on"
+        })
+    }
+
     /// Whether this is Mesa's CPU rasterizer (lavapipe on Vulkan, llvmpipe on GL).
     pub fn is_llvmpipe(&self) -> bool {
         self.name.contains("llvmpipe")
@@ -113,6 +142,9 @@ impl fmt::Display for AdapterReport {
         writeln!(f, "backend:          {}", self.backend)?;
         writeln!(f, "device type:      {}", self.device_type)?;
         writeln!(f, "driver:           {} {}", self.driver, self.driver_info)?;
+        if let Some(cache) = self.shader_cache() {
+            writeln!(f, "shader cache:     {cache}")?;
+        }
         writeln!(f, "timestamp query:  {}", yes_no(self.timestamp_query))?;
         writeln!(
             f,
@@ -281,6 +313,31 @@ mod tests {
         );
         assert_eq!(mesa_version("NVIDIA 550.54"), None);
         assert_eq!(mesa_version("Mesa x"), None);
+    }
+
+    #[test]
+    fn the_shader_cache_is_off_for_the_values_mesa_reads_as_true() {
+        for off in ["1", "true", "TRUE", "yes", "y", "t", " true "] {
+            assert!(shader_cache_disabled_by(Some(off)), "{off:?}");
+        }
+        for on in [
+            None,
+            Some(""),
+            Some("0"),
+            Some("false"),
+            Some("no"),
+            Some("off"),
+        ] {
+            assert!(!shader_cache_disabled_by(on), "{on:?}");
+        }
+        // Only a Mesa driver has Mesa's cache to report.
+        let nvidia = AdapterReport {
+            driver: "NVIDIA".into(),
+            driver_info: "580.159.04".into(),
+            ..lavapipe("")
+        };
+        assert_eq!(nvidia.shader_cache(), None);
+        assert!(lavapipe("Mesa 25.0.7").shader_cache().is_some());
     }
 
     #[test]
