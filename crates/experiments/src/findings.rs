@@ -5,8 +5,9 @@
 //! so that the tests fail when a record changes and a sentence does not.
 //!
 //! A speed finding is a paired ratio and is stated as one verdict only where every committed
-//! run of it agrees (their paired intervals share a value); otherwise the sentence says that
-//! the runs disagree and by how much.
+//! run of it gives the same verdict (faster, slower, not shown apart); otherwise the sentence
+//! says that the runs disagree and by how much. Each finding names the book chapters that
+//! open with it (regions `found-<chapter>`).
 
 use crate::table1::rows::{self as table1};
 use mirrorbox_report::document::{Block, markdown, ms, paired_ratio, sci};
@@ -63,7 +64,7 @@ fn exact_error(reports: &Path) -> Result<String, ReadmeError> {
 }
 
 /// `portal` depth 64 against `auxiliary` n = 2, paired by round, in every committed run of
-/// each device: one verdict where the runs' intervals share a value, else the spread.
+/// each device: one verdict where every run gives it, else the runs' spread.
 fn exact_speed(reports: &Path) -> Result<String, ReadmeError> {
     let mut parts = Vec::new();
     for (device, folders) in TABLE1_RUNS {
@@ -85,29 +86,29 @@ fn exact_speed(reports: &Path) -> Result<String, ReadmeError> {
         if intervals.is_empty() {
             continue;
         }
-        let shared = table1::shared_interval(intervals.iter().map(|(_, i)| *i));
-        parts.push(if intervals.len() == 1 {
-            let (r, i) = &intervals[0];
-            format!(
-                "on {device}, {r:.2}× faster [{:.2}–{:.2}×] (one run)",
-                i.low, i.high
-            )
-        } else if let Some((low, high)) = shared {
-            format!(
-                "on {device}, {:.2}× faster (all {} runs agree: their paired 95 % intervals share {low:.2}–{high:.2}×)",
-                intervals[0].0,
-                intervals.len()
-            )
-        } else {
-            let each: Vec<String> = intervals
-                .iter()
-                .map(|(r, i)| format!("{r:.2}× [{:.2}–{:.2}×]", i.low, i.high))
-                .collect();
-            format!(
-                "on {device}, the {} runs **disagree** ({}): no verdict",
-                intervals.len(),
+        let ratios: Vec<f64> = intervals.iter().map(|(r, _)| *r).collect();
+        let each: Vec<String> = intervals
+            .iter()
+            .map(|(r, i)| format!("{r:.2}× [{:.2}–{:.2}×]", i.low, i.high))
+            .collect();
+        let verdict =
+            table1::RunsVerdict::of(&intervals.iter().map(|(_, i)| *i).collect::<Vec<_>>());
+        parts.push(match (&verdict, intervals.len()) {
+            (_, 1) => format!(
+                "on {device}, {} as fast: {} (one run)",
+                each[0],
+                table1::speed_verdict(intervals[0].1)
+            ),
+            (table1::RunsVerdict::Agree { .. }, runs) => format!(
+                "on {device}, {:.2}× as fast ({})",
+                mirrorbox_report::stats::median(&ratios),
+                verdict.sentence(runs)
+            ),
+            (table1::RunsVerdict::Disagree { .. }, runs) => format!(
+                "on {device}, **no verdict**: {} ({})",
+                verdict.sentence(runs),
                 each.join(", ")
-            )
+            ),
         });
     }
     Ok(format!(
@@ -264,16 +265,127 @@ fn ssr_offscreen(reports: &Path) -> Result<String, ReadmeError> {
     ))
 }
 
+/// Baking the symmetry copies on the CPU against the seed's instanced copies, paired by
+/// round at the most planes measured, and how many copies pruning keeps.
+fn symmetry(reports: &Path) -> Result<String, ReadmeError> {
+    use crate::symmetry_scaling::planes::{
+        BAKED_METHOD, PRUNED_METHOD, SEED_METHOD, plane_scaling, pruning_sentence,
+    };
+    let s = load(reports, "symmetry_scaling")?;
+    let groups = plane_scaling(&s.records);
+    let group = |m: &str| groups.iter().find(|g| g.name == m);
+    let (Some(baked), Some(seed)) = (group(BAKED_METHOD), group(SEED_METHOD)) else {
+        return Err(ReadmeError(
+            "reports/symmetry_scaling lacks symmetry-baked or symmetry".into(),
+        ));
+    };
+    let b = baked
+        .points
+        .last()
+        .ok_or_else(|| ReadmeError("reports/symmetry_scaling: no baked point".into()))?;
+    let o = seed
+        .points
+        .iter()
+        .find(|o| o.planes() == b.planes())
+        .ok_or_else(|| ReadmeError("reports/symmetry_scaling: no common p".into()))?;
+    let i = paired_ratio(o, b).ok_or_else(|| {
+        ReadmeError("reports/symmetry_scaling: no paired interval at the largest p".into())
+    })?;
+    let pruning = group(PRUNED_METHOD)
+        .and_then(pruning_sentence)
+        .map_or(String::new(), |p| format!("; {}", p.trim_end_matches('.')));
+    Ok(format!(
+        "**Symmetry planes: the CPU's split-and-mirror mesh against the seed's 2^p copies** — at \
+         p = {}, drawing the baked mesh once (`{BAKED_METHOD}`, {} ms) is {:.0}× [{:.0}–{:.0}×] \
+         as fast as the seed's instanced copies (`{SEED_METHOD}`, {} ms), paired by round: {} \
+         (one run){pruning} ({}, {}; [figure](symmetry_scaling/plot_ms_vs_planes.svg)).",
+        b.planes().unwrap_or(0),
+        ms(b.ms_median, 2),
+        o.ms_median / b.ms_median,
+        i.low,
+        i.high,
+        ms(o.ms_median, 2),
+        table1::speed_verdict(i),
+        s.info.scene,
+        s.info.adapter
+    ))
+}
+
+/// Per-eye mirror textures against the head's shared ones, at the widest IPD.
+fn stereo(reports: &Path) -> Result<String, ReadmeError> {
+    let s = load(reports, "stereo")?;
+    let sentence = crate::stereo::section::flattening(&s.records).ok_or_else(|| {
+        ReadmeError("reports/stereo holds no per-eye and shared pair with a marker".into())
+    })?;
+    Ok(format!(
+        "**Stereo: sharing one set of mirror textures between the eyes flattens the mirror** — {sentence} ({}, {}; [figure](stereo/plot_stereo_disparity_vs_ipd.svg)).",
+        s.info.scene, s.info.adapter
+    ))
+}
+
+/// Ignoring mirrored light, as today's raster does, against truths lit through k mirrors.
+fn lighting(reports: &Path) -> Result<String, ReadmeError> {
+    let s = load(reports, "lighting")?;
+    let sentences = crate::lighting::section::sentences(&s.records);
+    let grows = sentences
+        .iter()
+        .find(|t| t.starts_with("The error of ignoring mirrored light grows"))
+        .ok_or_else(|| ReadmeError("reports/lighting holds no k sweep of lights=direct".into()))?;
+    Ok(format!(
+        "**Light through mirrors matters** (FLIP over the image): {} ({}, {}; [figure](lighting/plot_lighting_error_vs_k.svg)).",
+        lowercase_first(grows.trim_end_matches('.')),
+        s.info.scene,
+        s.info.adapter
+    ))
+}
+
+/// The engines' tricks for uneven mirrors at the steepest bump measured.
+fn uneven(reports: &Path) -> Result<String, ReadmeError> {
+    let s = load(reports, "uneven_mirrors")?;
+    let steepest = crate::bumpy::section::sentences(&s.records, &s.info.bump_methods)
+        .pop()
+        .ok_or_else(|| ReadmeError("reports/uneven_mirrors holds no tilt".into()))?;
+    Ok(format!(
+        "**Uneven mirrors: how far the engines' tricks stay from the truth** (FLIP over the image) — {} ({}, {}; [figure](uneven_mirrors/plot_uneven_error_vs_tilt.svg)).",
+        lowercase_first(steepest.trim_end_matches('.')),
+        s.info.scene,
+        s.info.adapter
+    ))
+}
+
+/// A report's sentence continued after a dash or colon: its first letter in lower case.
+fn lowercase_first(s: &str) -> String {
+    let mut c = s.chars();
+    c.next()
+        .map_or(String::new(), |f| f.to_lowercase().chain(c).collect())
+}
+
+/// One finding: its sentence and the book chapters that open with it.
+pub struct Finding {
+    pub text: String,
+    /// Chapters under `docs/book/src/`.
+    pub chapters: &'static [&'static str],
+}
+
+/// Every finding, ranked: what a reader should take away first comes first.
+pub fn ranked(reports: &Path) -> Result<Vec<Finding>, ReadmeError> {
+    let finding = |text: String, chapters| Finding { text, chapters };
+    Ok(vec![
+        finding(exact_error(reports)?, &["table1.md"]),
+        finding(exact_speed(reports)?, &["table1.md", "gpu.md"]),
+        finding(room_front(reports)?, &["frontier.md"]),
+        finding(bounce_cost(reports)?, &["exact-methods.md"]),
+        finding(web_engines(reports)?, &["exchange.md"]),
+        finding(ssr_offscreen(reports)?, &["engine-reflections.md"]),
+        finding(stereo(reports)?, &["stereo.md"]),
+        finding(lighting(reports)?, &["lighting.md"]),
+        finding(symmetry(reports)?, &["symmetry.md"]),
+        finding(uneven(reports)?, &["uneven-mirrors.md"]),
+    ])
+}
+
 /// The findings, ranked, as blocks (a heading, then one numbered sentence each).
 pub fn findings(reports: &Path) -> Result<Vec<Block>, ReadmeError> {
-    let sentences = [
-        exact_error(reports)?,
-        exact_speed(reports)?,
-        room_front(reports)?,
-        bounce_cost(reports)?,
-        web_engines(reports)?,
-        ssr_offscreen(reports)?,
-    ];
     let mut blocks = vec![Block::Heading(2, "What was found".into())];
     blocks.push(Block::Paragraph(
         "Computed from the committed records by `mirrorbox readme` and `mirrorbox report \
@@ -281,10 +393,31 @@ pub fn findings(reports: &Path) -> Result<Vec<Block>, ReadmeError> {
          sentence does not."
             .into(),
     ));
-    for (i, s) in sentences.iter().enumerate() {
-        blocks.push(Block::Paragraph(format!("{}. {s}", i + 1)));
+    for (i, f) in ranked(reports)?.iter().enumerate() {
+        blocks.push(Block::Paragraph(format!("{}. {}", i + 1, f.text)));
     }
     Ok(blocks)
+}
+
+/// The findings a chapter opens with (region `found-<chapter>`), numbered as in the ranked
+/// list, their links as paths.
+pub fn chapter_findings(reports: &Path, chapter: &str) -> Result<String, ReadmeError> {
+    let blocks: Vec<Block> = ranked(reports)?
+        .into_iter()
+        .enumerate()
+        .filter(|(_, f)| f.chapters.contains(&chapter))
+        .map(|(i, f)| {
+            Block::Paragraph(format!(
+                "**Found** (finding {} of the book's introduction, computed from the records): {}",
+                i + 1,
+                f.text
+            ))
+        })
+        .collect();
+    if blocks.is_empty() {
+        return Err(ReadmeError(format!("no finding opens {chapter}")));
+    }
+    Ok(with_paths(&blocks))
 }
 
 /// [`findings`] as Markdown with its links (written relative to `reports/`) made relative to

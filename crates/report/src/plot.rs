@@ -347,8 +347,16 @@ impl Axis {
                 .map(|e| 10f64.powi(e))
                 .filter(|&v| self.contains(v))
                 .collect();
-            if decades.len() >= 2 {
-                return decades;
+            if let [first, .., last] = decades[..] {
+                // Beyond the outer decades, the 2× and 5× steps too: no point lies more than
+                // a factor 2.5 past the outermost tick (issue 54: points below the lowest).
+                let mut out: Vec<f64> = (a..=b)
+                    .flat_map(|e| [2.0, 5.0].map(|m| m * 10f64.powi(e)))
+                    .filter(|&v| (v < first || v > last) && self.contains(v))
+                    .chain(decades)
+                    .collect();
+                out.sort_by(f64::total_cmp);
+                return out;
             }
             let mut out: Vec<f64> = (a..=b)
                 .flat_map(|e| [1.0, 2.0, 5.0].map(|m| m * 10f64.powi(e)))
@@ -589,21 +597,49 @@ impl Chart {
                 ));
             }
         }
+        // Every point within reach of a tick: at most a factor 2.5 past the outermost tick of
+        // a log axis, one step past that of a linear one.
+        let (ax, ay) = self.axes();
+        let mut axes = vec![("y", &ay, false)];
+        if !self.x_ticks_at_data {
+            axes.push(("x", &ax, true));
+        }
+        for (name, axis, is_x) in axes {
+            let ticks = axis.ticks();
+            let (Some(&first), Some(&last)) = (ticks.first(), ticks.last()) else {
+                out.push(format!("the {name} axis has no tick"));
+                continue;
+            };
+            let beyond = |v: f64| {
+                if axis.log {
+                    (first / v).max(v / last) > 2.5 * (1.0 + 1e-9)
+                } else {
+                    let step = ticks.get(1).map_or(f64::INFINITY, |t| t - first);
+                    v < first - step * (1.0 + 1e-9) || v > last + step * (1.0 + 1e-9)
+                }
+            };
+            let far = self
+                .series
+                .iter()
+                .flat_map(|s| s.points.iter())
+                .map(|&(x, y)| if is_x { x } else { y })
+                .filter(|v| drawable(*v, axis.log) && beyond(*v))
+                .count();
+            if far > 0 {
+                out.push(format!(
+                    "{far} point(s) lie beyond the outermost tick of the {name} axis ({} to {})",
+                    fmt_tick(first),
+                    fmt_tick(last)
+                ));
+            }
+        }
         out
     }
 
-    pub fn to_svg(&self) -> String {
-        LINT.with(|l| {
-            if let Some(v) = l.borrow_mut().as_mut() {
-                v.extend(
-                    self.lint()
-                        .into_iter()
-                        .map(|m| format!("{}: {m}", self.title)),
-                );
-            }
-        });
-        // The axes span the points, their error bars and the reference curves' points that
-        // lie within the data's x (a reference never widens x).
+    /// The chart's axes: they span the points, their error bars, the floor where it is near
+    /// the data, and the reference curves' points that lie within the data's x (a reference
+    /// never widens x).
+    fn axes(&self) -> (Axis, Axis) {
         let bounds = |i: &[Option<[f64; 2]>]| -> Vec<f64> {
             i.iter().flatten().flatten().copied().collect()
         };
@@ -618,11 +654,7 @@ impl Chart {
             .iter()
             .flat_map(|s| s.points.iter().map(|p| p.1).chain(bounds(&s.y_intervals)))
             .collect();
-        let data_lo = ys
-            .iter()
-            .copied()
-            .filter(|v| drawable(*v, self.y_log))
-            .fold(f64::INFINITY, f64::min);
+        let data_lo = self.data_lo_y(self.y_log);
         // The floor joins the y range only when it is near the data (within a factor 10 on a
         // log axis); otherwise it is a note under the plot.
         let floor_near = self.floor.filter(|&f| {
@@ -644,7 +676,34 @@ impl Chart {
             ),
             self.y_log,
         );
+        (ax, ay)
+    }
 
+    /// The lowest drawable y of the data (points and error bars), `inf` with none.
+    fn data_lo_y(&self, log: bool) -> f64 {
+        self.series
+            .iter()
+            .flat_map(|s| {
+                s.points
+                    .iter()
+                    .map(|p| p.1)
+                    .chain(s.y_intervals.iter().flatten().flatten().copied())
+            })
+            .filter(|v| drawable(*v, log))
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    pub fn to_svg(&self) -> String {
+        LINT.with(|l| {
+            if let Some(v) = l.borrow_mut().as_mut() {
+                v.extend(
+                    self.lint()
+                        .into_iter()
+                        .map(|m| format!("{}: {m}", self.title)),
+                );
+            }
+        });
+        let (ax, ay) = self.axes();
         // Legend entries: series (with a note where one coincides with an earlier one), then
         // references.
         let px_of = |x: f64| LEFT + ax.t(x) * PLOT_W;
@@ -1027,6 +1086,25 @@ impl Chart {
 
 #[cfg(test)]
 mod tests {
+    /// Points past the outer decades of a log axis (2e-4 under a lowest decade of 1e-3, 3
+    /// left of 10) get 2× and 5× ticks there, so none lies far below the lowest tick.
+    #[test]
+    fn log_axes_tick_the_stretches_beyond_their_outer_decades() {
+        let mut c = Chart::new("FLIP over the mirror pixels vs cost", "ms", "FLIP");
+        (c.x_log, c.y_log) = (true, true);
+        c.series.push(Series::new(
+            "portal",
+            method_style("portal"),
+            vec![(3.0, 0.1), (10.0, 0.01), (30.0, 1e-3), (100.0, 2e-4)],
+        ));
+        assert!(c.lint().is_empty(), "{:?}", c.lint());
+        let (ax, ay) = c.axes();
+        assert!(ax.ticks().contains(&5.0), "{:?}", ax.ticks());
+        assert!(ay.ticks().contains(&5e-4), "{:?}", ay.ticks());
+        // The decades stay the only ticks between them.
+        assert!(!ay.ticks().contains(&0.02), "{:?}", ay.ticks());
+    }
+
     /// The figure check flags what a reviewer would send back, and nothing in a clean chart.
     #[test]
     fn lint_flags_look_alike_series_empty_legends_undrawable_points_and_zigzags() {
