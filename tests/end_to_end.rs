@@ -3,6 +3,7 @@
 
 mod common;
 
+mod advise;
 mod cli;
 mod exchange;
 mod hardening;

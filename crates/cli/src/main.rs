@@ -37,6 +37,8 @@ enum Command {
     Sweep(commands::sweep::Args),
     /// Run an experiment of the registry (crates/experiments): its sweeps, sequences or script, into its report folder (`--list` lists them).
     Experiment(commands::sweep::ExperimentArgs),
+    /// The method and setting to ship for a scene and a frame budget on this device: a search that times few candidates, with the pick, its ties, the next better choice and the front (issue 55).
+    Advise(commands::advise::Args),
     /// A window: the method live (free camera, every option switchable), the traced truth
     /// refining beside it, and their error (docs/viewer.md).
     View(commands::view::Args),
@@ -75,7 +77,7 @@ fn quiet_mesa_device_select() {
 /// 64 took 1.7× and `unrolled` 1.4× as long while the paper's method and the floor did not
 /// change (`reports/shader_cache`, issue 54). Whether a run found the cache warm (a second run
 /// on a machine, not a fresh one) then decided a speed verdict, so the commands that time
-/// frames compile every shader afresh, unless the user set `MESA_SHADER_CACHE_DISABLE`
+/// frames (`advise` among them) compile every shader afresh, unless the user set `MESA_SHADER_CACHE_DISABLE`
 /// themselves; each sweep records which (`sweep.json`, `shader_cache`), and `info` says what
 /// they will have.
 fn compile_shaders_afresh_when_timing(command: &Command) {
@@ -85,6 +87,7 @@ fn compile_shaders_afresh_when_timing(command: &Command) {
             | Command::Render(_)
             | Command::Sweep(_)
             | Command::Experiment(_)
+            | Command::Advise(_)
             | Command::View(_)
             | Command::RenderWorker
     );
@@ -195,6 +198,7 @@ fn main() -> ExitCode {
         Command::Compare(args) => commands::compare::run(&args),
         Command::Sweep(args) => commands::sweep::run(&args),
         Command::Experiment(args) => commands::sweep::run_experiment_command(&args),
+        Command::Advise(args) => commands::advise::run(&args),
         Command::View(args) => commands::view::run(&args),
         Command::ExportMitsuba(args) => commands::export_mitsuba::run(&args),
         Command::ExportViews(args) => commands::export_views::run(&args),

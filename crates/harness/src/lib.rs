@@ -17,6 +17,7 @@
 //! - **Floor**: raster vs trace on the scene without its mirrors, the error that is left
 //!   when there is no mirror effect to truncate.
 
+pub mod advise;
 pub mod axes;
 pub mod exchange;
 pub mod merge;
@@ -906,6 +907,26 @@ pub fn point_keys(config: &SweepConfig) -> Result<Vec<String>, HarnessError> {
         .into_iter()
         .map(|p| p.key)
         .collect())
+}
+
+/// The points of `config` whose frame the plan's memory estimate refuses (before any GPU
+/// work), each with why: what `mirrorbox advise` leaves out instead of failing its search
+/// (issue 55). The floor is never refused.
+pub fn refused_points(config: &SweepConfig) -> Result<Vec<(Method, String)>, HarnessError> {
+    let (base, w, h) = base_scene(config)?;
+    let mut out = Vec::new();
+    for p in points(config, base.content_hash(), w, h) {
+        let Some(method) = p.method.clone() else {
+            continue;
+        };
+        let (scene, settings) = point_setup(&base, &p, config)?;
+        if let Err(why) = worker::plan_point(&scene, &settings)
+            .and_then(|planned| planned.check_memory(&scene, &settings, config.memory_budget))
+        {
+            out.push((method, why.to_string()));
+        }
+    }
+    Ok(out)
 }
 
 /// The current UTC time, RFC 3339 to the second.

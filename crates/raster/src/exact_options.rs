@@ -6,6 +6,10 @@ use crate::method::{OptionKind, OptionSpec, ParamValue, Params, SweepAxis};
 use mirrorbox_scene::reflection_paths::PathLimits;
 
 /// `--depth`: most mirrors along a reflection path.
+/// The depths `mirrorbox advise` times first for an exact method (issue 55): powers of two,
+/// then bisection between the last within budget and the first over it.
+pub const DEPTHS_COARSE: &[u32] = &[1, 2, 4, 8, 16, 32, 64, 128, 256, 512, 1024];
+
 pub static DEPTH: OptionSpec = OptionSpec {
     name: "depth",
     help: "Most mirrors along a reflection path.",

@@ -45,8 +45,8 @@ pub use color_format::ColorFormat;
 pub use gpu::{Gpu, GpuOptions, RasterError};
 pub use memory::{DEFAULT_MEMORY_BUDGET, MemoryEstimate, OverMemoryBudget, parse_memory_size};
 pub use method::{
-    Clipping, CopyCounts, FrameStats, MethodEntry, OptionSpec, ParamError, ParamValue, PathCounts,
-    RasterMethod,
+    Advise, Clipping, CopyCounts, FrameStats, MethodEntry, OptionSpec, ParamError, ParamValue,
+    PathCounts, RasterMethod,
 };
 pub use plan::PlanError;
 pub use registry::{METHODS, Method};

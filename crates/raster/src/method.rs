@@ -50,6 +50,28 @@ pub struct MethodEntry {
     pub gpu_structs: fn() -> Vec<crate::wgsl::HostLayout>,
     /// The method's typed settings from validated parameters.
     pub configure: fn(&Params) -> Box<dyn RasterMethod>,
+    /// How `mirrorbox advise` searches it (issue 55).
+    pub advise: Advise,
+}
+
+/// How `mirrorbox advise` searches a method for a scene and a frame budget (issue 55): the
+/// candidates it is offered, declared in the method's row rather than in the advisor.
+#[derive(Clone, Copy, Debug)]
+pub enum Advise {
+    /// Not a candidate for mirrors (the symmetry-plane methods draw a scene's symmetry
+    /// copies, not its mirrors).
+    Skip,
+    /// One candidate per variant (options as `render` words, `""` for the defaults).
+    Fixed(&'static [&'static str]),
+    /// Per variant, `option` over its values: the cost rises with the value and the error
+    /// does not (more reflections, finer textures). The advisor times `coarse` first (in
+    /// ascending order, stopping where a value is over budget), then bisects between the
+    /// last value within budget and the first over it.
+    Knob {
+        option: &'static OptionSpec,
+        coarse: &'static [u32],
+        variants: &'static [&'static str],
+    },
 }
 
 impl MethodEntry {

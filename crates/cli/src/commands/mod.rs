@@ -1,3 +1,4 @@
+pub mod advise;
 pub mod check;
 pub mod compare;
 pub mod export_mitsuba;

@@ -14,7 +14,7 @@
 
 use crate::gpu::{Gpu, RasterError};
 use crate::method::{
-    BuiltFrame, FrameStats, MethodEntry, OptionKind, OptionSpec, ParamValue, PlannedFrame,
+    Advise, BuiltFrame, FrameStats, MethodEntry, OptionKind, OptionSpec, ParamValue, PlannedFrame,
     RasterMethod, SweepAxis,
 };
 use crate::methods::feedback::HISTORY;
@@ -52,6 +52,11 @@ pub static CUBEMAP: MethodEntry = MethodEntry {
             per_mirror: p.choice(&CUBE_CENTRE) == "mirror",
             history: p.count(&HISTORY),
         })
+    },
+    advise: Advise::Knob {
+        option: &CUBE_SIZE,
+        coarse: &[32, 64, 128, 256, 512, 1024],
+        variants: &["history=16"],
     },
 };
 

@@ -20,7 +20,7 @@
 
 use crate::gpu::{Gpu, RasterError};
 use crate::method::{
-    BuiltFrame, FrameStats, MethodEntry, OptionKind, OptionSpec, ParamValue, PlannedFrame,
+    Advise, BuiltFrame, FrameStats, MethodEntry, OptionKind, OptionSpec, ParamValue, PlannedFrame,
     RasterMethod, SweepAxis,
 };
 use crate::methods::recursive_texture::{
@@ -55,6 +55,7 @@ pub static FEEDBACK: MethodEntry = MethodEntry {
             history: p.count(&HISTORY),
         })
     },
+    advise: Advise::Fixed(&["history=16"]),
 };
 
 /// `--history K`: frames drawn from the same view before the one shown.

@@ -24,7 +24,7 @@ use crate::exact_options::{DEPTH, MIN_ATTENUATION, MIN_PORTAL_AREA};
 use crate::exact_paths::{PlannedPaths, plan_paths};
 use crate::gpu::{Gpu, RasterError};
 use crate::method::{
-    BuiltFrame, Clipping, FrameStats, MethodEntry, PathCounts, PlannedFrame, RasterMethod,
+    Advise, BuiltFrame, Clipping, FrameStats, MethodEntry, PathCounts, PlannedFrame, RasterMethod,
 };
 use crate::pipeline::{
     BindGroupBuilder, ScenePipeline, UniformArena, depth_state, pipeline_layout,
@@ -52,6 +52,11 @@ pub static PORTAL: MethodEntry = MethodEntry {
     shaders: &[&SHADER, &CLIP_DISTANCE_SHADER],
     gpu_structs,
     configure: |p| Box::new(Portal(crate::exact_options::limits(p))),
+    advise: Advise::Knob {
+        option: &DEPTH,
+        coarse: crate::exact_options::DEPTHS_COARSE,
+        variants: &[""],
+    },
 };
 
 const ENTRY_POINTS: &str = include_str!("../../../../shaders/portal_stencil.wgsl");

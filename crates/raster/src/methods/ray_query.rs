@@ -23,7 +23,7 @@
 use crate::exact_options::{DEPTH, MIN_ATTENUATION};
 use crate::gpu::{Gpu, RasterError};
 use crate::method::{
-    BuiltFrame, Clipping, FrameStats, MethodEntry, OptionKind, OptionSpec, ParamValue,
+    Advise, BuiltFrame, Clipping, FrameStats, MethodEntry, OptionKind, OptionSpec, ParamValue,
     PlannedFrame, RasterMethod,
 };
 use crate::pipeline::{BindGroupBuilder, ScenePipeline, depth_state, pipeline_layout};
@@ -59,6 +59,11 @@ pub static RAY_QUERY: MethodEntry = MethodEntry {
             },
             shadow_maps: crate::lighting::wants_shadow_maps(p),
         })
+    },
+    advise: Advise::Knob {
+        option: &DEPTH,
+        coarse: crate::exact_options::DEPTHS_COARSE,
+        variants: &[""],
     },
 };
 

@@ -15,8 +15,8 @@
 
 use crate::gpu::{Gpu, RasterError};
 use crate::method::{
-    BuiltFrame, Clipping, FrameStats, MethodEntry, OptionKind, OptionSpec, ParamValue, Params,
-    PlannedFrame, RasterMethod, SweepAxis,
+    Advise, BuiltFrame, Clipping, FrameStats, MethodEntry, OptionKind, OptionSpec, ParamValue,
+    Params, PlannedFrame, RasterMethod, SweepAxis,
 };
 use crate::pipeline::{
     ScenePipeline, UniformArena, depth_state, dynamic_uniform_entry, pipeline_layout,
@@ -48,6 +48,7 @@ pub static NAIVE: MethodEntry = MethodEntry {
     shaders: SHADERS,
     gpu_structs,
     configure: |p| Box::new(RecursiveTextureMethod::new(Queue::SceneMirrors, p)),
+    advise: Advise::Fixed(&[""]),
 };
 
 /// The paper's §3.1–3.2: n auxiliary mirrors coincide with the two real ones (n + 2 in the
@@ -73,6 +74,11 @@ pub static AUXILIARY: MethodEntry = MethodEntry {
             },
             p,
         ))
+    },
+    advise: Advise::Knob {
+        option: &AUXILIARY_MIRRORS,
+        coarse: &[0, 1, 2, 3, 4],
+        variants: &[""],
     },
 };
 
@@ -107,6 +113,11 @@ pub static PATH_TEXTURES: MethodEntry = MethodEntry {
             bump: BumpSettings::from_params(p),
             shared_mirrors: shared_mirrors(p),
         })
+    },
+    advise: Advise::Knob {
+        option: &crate::exact_options::DEPTH,
+        coarse: &[1, 2, 4, 8, 16, 32, 64],
+        variants: &[""],
     },
 };
 

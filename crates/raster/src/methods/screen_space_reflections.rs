@@ -15,7 +15,7 @@
 
 use crate::gpu::{Gpu, RasterError};
 use crate::method::{
-    BuiltFrame, Clipping, FrameStats, MethodEntry, OptionKind, OptionSpec, ParamValue,
+    Advise, BuiltFrame, Clipping, FrameStats, MethodEntry, OptionKind, OptionSpec, ParamValue,
     PlannedFrame, RasterMethod,
 };
 use crate::pipeline::{BindGroupBuilder, ScenePipeline, depth_state, pipeline_layout};
@@ -55,6 +55,11 @@ pub static SSR: MethodEntry = MethodEntry {
             thickness: p.real(&THICKNESS),
         })
     },
+    advise: Advise::Fixed(&[
+        "ssr-fallback=none",
+        "ssr-fallback=cubemap",
+        "ssr-fallback=planar",
+    ]),
 };
 
 /// `--ssr-fallback none|cubemap|planar`.

@@ -34,8 +34,8 @@
 
 use crate::gpu::{Gpu, RasterError};
 use crate::method::{
-    BuiltFrame, Clipping, CopyCounts, FrameStats, MethodEntry, OptionKind, OptionSpec, ParamValue,
-    Params, PlannedFrame, RasterMethod,
+    Advise, BuiltFrame, Clipping, CopyCounts, FrameStats, MethodEntry, OptionKind, OptionSpec,
+    ParamValue, Params, PlannedFrame, RasterMethod,
 };
 use crate::methods::unrolled::FRAGMENT_CLIPPING;
 use crate::pipeline::{
@@ -73,6 +73,7 @@ pub static SYMMETRY: MethodEntry = MethodEntry {
             settings: CopySettings::of(p),
         })
     },
+    advise: Advise::Skip,
 };
 
 /// `--symmetry-draws`: the copies as instances, or one draw each (the seed's cost model).

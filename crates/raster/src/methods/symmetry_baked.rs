@@ -15,7 +15,7 @@
 
 use crate::gpu::{Gpu, RasterError};
 use crate::method::{
-    BuiltFrame, Clipping, CopyCounts, FrameStats, MethodEntry, PlannedFrame, RasterMethod,
+    Advise, BuiltFrame, Clipping, CopyCounts, FrameStats, MethodEntry, PlannedFrame, RasterMethod,
 };
 use crate::methods::symmetry::{
     CLIP_DISTANCE_SHADER, COPY_IDS, SHADER, SymmetryFrame, SymmetryInput, copy_id_warning,
@@ -51,6 +51,7 @@ pub static SYMMETRY_BAKED: MethodEntry = MethodEntry {
             copy_ids: p.switch(&COPY_IDS),
         })
     },
+    advise: Advise::Skip,
 };
 
 /// The typed settings of `symmetry-baked`.

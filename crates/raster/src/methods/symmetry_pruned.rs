@@ -10,7 +10,7 @@
 //! why the others were not. The pruning runs on the CPU every frame: one convex polytope clip
 //! per plane and bitmask prefix, an empty prefix pruning its whole subtree.
 
-use crate::method::{MethodEntry, PlannedFrame, RasterMethod};
+use crate::method::{Advise, MethodEntry, PlannedFrame, RasterMethod};
 use crate::methods::symmetry::{
     CLIP_DISTANCE_SHADER, COPY_IDS, CopySettings, SHADER, SYMMETRY_DRAWS, SymmetryFrame,
     SymmetryInput, gpu_structs, plan_copies,
@@ -37,6 +37,7 @@ pub static SYMMETRY_PRUNED: MethodEntry = MethodEntry {
             settings: CopySettings::of(p),
         })
     },
+    advise: Advise::Skip,
 };
 
 /// The typed settings of `symmetry-pruned`.

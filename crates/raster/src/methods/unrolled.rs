@@ -38,8 +38,8 @@ use crate::exact_options::{DEPTH, MIN_ATTENUATION, MIN_PORTAL_AREA};
 use crate::exact_paths::{PlannedPaths, plan_paths};
 use crate::gpu::{Gpu, RasterError};
 use crate::method::{
-    BuiltFrame, Clipping, FrameStats, MethodEntry, OptionKind, OptionSpec, ParamValue, PathCounts,
-    PlannedFrame, RasterMethod,
+    Advise, BuiltFrame, Clipping, FrameStats, MethodEntry, OptionKind, OptionSpec, ParamValue,
+    PathCounts, PlannedFrame, RasterMethod,
 };
 use crate::pipeline::{BindGroupBuilder, ScenePipeline, depth_state, pipeline_layout};
 use crate::plan::PlanError;
@@ -77,6 +77,11 @@ pub static UNROLLED: MethodEntry = MethodEntry {
             limits: crate::exact_options::limits(p),
             fragment_clipping: p.switch(&FRAGMENT_CLIPPING),
         })
+    },
+    advise: Advise::Knob {
+        option: &DEPTH,
+        coarse: crate::exact_options::DEPTHS_COARSE,
+        variants: &[""],
     },
 };
 

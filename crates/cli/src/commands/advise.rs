@@ -1,0 +1,144 @@
+//! `mirrorbox advise SCENE --budget-ms B`: the method and setting to ship for a scene and a
+//! frame budget on this device, found by a search that measures few candidates (issue 55,
+//! `mirrorbox_harness::advise`).
+
+use super::{grid_side, unit_interval};
+use crate::Failure;
+use mirrorbox_harness::advise::{AdviseConfig, Metric, advise_into, sentences, to_json};
+use mirrorbox_harness::{Event, SweepConfig};
+use mirrorbox_raster::{Advise, METHODS};
+use std::path::PathBuf;
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Scene file (JSON); `mirrorbox check` must accept it.
+    scene: PathBuf,
+    /// The frame budget in ms: a candidate fits only if the upper end of its ms/frame 95 %
+    /// interval is at most this. Above 0.
+    #[arg(long = "budget-ms", allow_negative_numbers = true)]
+    budget_ms: f64,
+    #[command(flatten)]
+    size: super::SizeArgs,
+    /// Supersampling s of the raster (the truth uses the same s×s sub-pixel grid).
+    #[arg(long, default_value_t = 1)]
+    ssaa: u32,
+    /// α: every mirror's reflectance, in [0, 1], as in a sweep.
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
+    alpha: f32,
+    /// The error to minimise: flip (FLIP mean over the mirror pixels) or relmse (over the
+    /// image).
+    #[arg(long, default_value = "flip")]
+    metric: String,
+    /// Only these methods (comma-separated registry names); default: every method the
+    /// registry offers for mirrors.
+    #[arg(long, value_delimiter = ',')]
+    methods: Vec<String>,
+    /// Timed rounds per candidate (6 or more give each median a 95 % interval), 6..100.
+    #[arg(long, default_value_t = 9)]
+    frames: u32,
+    /// Output folder (its parent must exist): advice.md, advice.json, front.svg, the pick's
+    /// images, and the search's rounds. An earlier advice there is replaced.
+    #[arg(short, long, default_value = "advice")]
+    output: PathBuf,
+    /// Also print the answer as JSON on stdout.
+    #[arg(long)]
+    json: bool,
+    #[command(flatten)]
+    memory: super::MemoryBudgetArgs,
+}
+
+/// The methods `advise` can offer, for messages.
+fn offered() -> Vec<&'static str> {
+    METHODS
+        .iter()
+        .filter(|e| !matches!(e.advise, Advise::Skip))
+        .map(|e| e.name)
+        .collect()
+}
+
+pub fn run(args: &Args) -> Result<(), Failure> {
+    if !(args.budget_ms.is_finite() && args.budget_ms > 0.0) {
+        return Err(Failure::BadInput(format!(
+            "--budget-ms: a frame time in ms above 0, got {}",
+            args.budget_ms
+        )));
+    }
+    let metric = Metric::parse(&args.metric).ok_or_else(|| {
+        Failure::BadInput(format!(
+            "--metric: one of flip, relmse, got {:?}",
+            args.metric
+        ))
+    })?;
+    if let Some(m) = args
+        .methods
+        .iter()
+        .find(|m| !offered().contains(&m.as_str()))
+    {
+        return Err(Failure::BadInput(format!(
+            "--methods: {m:?} is not a method advise offers (one of {})",
+            offered().join(", ")
+        )));
+    }
+    if !(6..=100).contains(&args.frames) {
+        return Err(Failure::BadInput(format!(
+            "--frames: 6..100 timed rounds (a 95 % interval needs 6), got {}",
+            args.frames
+        )));
+    }
+    grid_side(args.ssaa * args.ssaa)?;
+    unit_interval("--alpha", Some(args.alpha))?;
+    // The scene as `check` reads it: a clear error (exit 2) before any search.
+    super::load(&args.scene)?;
+    let sweep = SweepConfig {
+        width: args.size.width,
+        height: args.size.height,
+        ssaa: args.ssaa,
+        frames: args.frames,
+        memory_budget: args.memory.memory_budget,
+        command: std::env::args().collect::<Vec<_>>().join(" "),
+        sections: Vec::new(),
+        ..SweepConfig::new(
+            args.scene.clone(),
+            PathBuf::new(),
+            Vec::new(),
+            vec![args.alpha],
+        )
+    };
+    let config = AdviseConfig {
+        sweep,
+        budget_ms: args.budget_ms,
+        metric,
+        methods: args.methods.clone(),
+    };
+    let started = std::time::Instant::now();
+    let advice = advise_into(&config, &args.output, &mut |e| {
+        if let Event::Finished { record } = e
+            && record.kind != "floor"
+        {
+            eprintln!(
+                "  {:<34} {:>9.3} ms/frame  {}",
+                record.key.split('|').next().unwrap_or_default(),
+                record.ms_median,
+                if mirrorbox_harness::advise::within(record, args.budget_ms) {
+                    "within budget"
+                } else {
+                    "over budget"
+                }
+            );
+        }
+    })
+    .map_err(Failure::from)?;
+    if args.json {
+        println!("{}", to_json(&advice, metric, &args.scene));
+    } else {
+        for s in sentences(&advice, metric, &args.scene) {
+            println!("{s}");
+        }
+        println!(
+            "{}: advice.md, advice.json, front.svg ({:.1} s)",
+            args.output.display(),
+            started.elapsed().as_secs_f64()
+        );
+    }
+    Ok(())
+}

@@ -1,0 +1,706 @@
+//! `mirrorbox advise` (issue 55): for a scene and a frame budget, the method and setting to
+//! ship, found by measuring as few candidates as the answer needs.
+//!
+//! The candidates come from the raster registry: each method's [`Advise`] row says whether it
+//! is one candidate per variant (`Fixed`) or an option that trades cost for error (`Knob`:
+//! depth, n, cube size). The search times candidates with the sweep's own interleaved timing
+//! (each round a [`run_sweep`] into `OUT/search/round-K`, one cached truth for all):
+//!
+//! 1. **Coarse**: every fixed candidate and each knob's first coarse value; then, round by
+//!    round, each knob's next coarse value while the last one was within budget.
+//! 2. **Bisection**: between each knob's last value within budget and its first over it, the
+//!    middle value, until the two are neighbours.
+//!
+//! A candidate is **within budget** only if the upper end of its ms/frame 95 % interval is.
+//! Of the candidates within budget, those within 2 % of the lowest error are **tied**; the
+//! cheapest of them is the pick, the others are named beside it. Before a round renders, the plan's memory
+//! estimate refuses what would not fit (said, never rendered).
+
+use crate::{Event, HarnessError, SweepConfig, refused_points, run_sweep};
+use mirrorbox_raster::{Advise, METHODS, Method, ParamValue};
+use mirrorbox_report::{Record, read_records};
+use std::path::{Path, PathBuf};
+
+/// Errors within this share of the lowest are a tie (as the uneven-mirror report's winners).
+pub const TIE: f64 = 0.02;
+
+/// The error a pick minimises.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Metric {
+    /// FLIP mean over the mirror pixels (over the image where a record has no mirror mask).
+    Flip,
+    /// relMSE over the image.
+    Relmse,
+}
+
+impl Metric {
+    pub fn parse(s: &str) -> Option<Metric> {
+        match s {
+            "flip" => Some(Metric::Flip),
+            "relmse" => Some(Metric::Relmse),
+            _ => None,
+        }
+    }
+
+    pub fn of(self, r: &Record) -> f64 {
+        match self {
+            Metric::Flip => r.mirror_flip(),
+            Metric::Relmse => r.metrics.relmse,
+        }
+    }
+
+    /// What the value is, for sentences and axes.
+    pub fn name(self) -> &'static str {
+        match self {
+            Metric::Flip => "FLIP mean over the mirror pixels",
+            Metric::Relmse => "relMSE over the image",
+        }
+    }
+}
+
+/// What to advise on: the sweep settings every round shares (scene, size, SSAA, α, frames,
+/// memory budget, truth cache), the budget and the metric.
+pub struct AdviseConfig {
+    /// The rounds' settings; its `methods` and `out` are set per round.
+    pub sweep: SweepConfig,
+    pub budget_ms: f64,
+    pub metric: Metric,
+    /// Only these methods (registry names); empty: every method the registry offers.
+    pub methods: Vec<String>,
+}
+
+/// One knob being searched: a method variant, the option, its coarse values and where the
+/// search stands.
+struct Knob {
+    base: Method,
+    option: &'static mirrorbox_raster::OptionSpec,
+    coarse: &'static [u32],
+    /// The next coarse index to time while ascending.
+    next: usize,
+    ascending: bool,
+    last_within: Option<u32>,
+    first_over: Option<u32>,
+}
+
+impl Knob {
+    fn at(&self, v: u32) -> Method {
+        self.base
+            .clone()
+            .with(self.option, ParamValue::Count(v))
+            .expect("coarse values lie within the option's bounds (registry test)")
+    }
+
+    fn value(&self, m: &Method) -> Option<u32> {
+        m.count_of(self.option.name)
+    }
+}
+
+/// The answer.
+#[derive(Clone, Debug, Default)]
+pub struct Advice {
+    pub budget_ms: f64,
+    /// Every candidate measured, in the order measured.
+    pub measured: Vec<Record>,
+    /// The pick: the cheapest of the candidates within budget tied for the lowest error.
+    pub pick: Option<Record>,
+    /// The other candidates within budget tied for the lowest error (within [`TIE`]).
+    pub ties: Vec<Record>,
+    /// The cheapest candidate with a lower error than the pick's (over budget).
+    pub next_better: Option<Record>,
+    /// With nothing within budget: the candidate whose ms/frame comes closest.
+    pub closest: Option<Record>,
+    /// Candidates the memory estimate refused, with why.
+    pub refused: Vec<(String, String)>,
+    /// Methods the adapter cannot run (from the rounds' sweeps).
+    pub unsupported: Vec<String>,
+    /// Timing rounds run, and the frames rendered in them (settling and warm-up included).
+    pub rounds: usize,
+    pub renders: u64,
+    /// Where each measured record's images are: the round's folder.
+    pub folders: Vec<PathBuf>,
+}
+
+/// Whether `r` is within `budget` ms: the upper end of its 95 % interval (its median where
+/// it has none) at most the budget.
+pub fn within(r: &Record, budget: f64) -> bool {
+    r.ms_interval.map_or(r.ms_median, |[_, hi]| hi) <= budget
+}
+
+/// The registry's candidates for a scene: fixed ones, and knobs to search.
+fn candidates(only: &[String]) -> (Vec<Method>, Vec<Knob>) {
+    let mut fixed = Vec::new();
+    let mut knobs = Vec::new();
+    for e in METHODS {
+        if !only.is_empty() && !only.iter().any(|m| m == e.name) {
+            continue;
+        }
+        let variant = |words: &str| {
+            Method::parse(&format!("{} {words}", e.name))
+                .unwrap_or_else(|err| panic!("{}'s advise variant {words:?}: {err}", e.name))
+        };
+        match e.advise {
+            Advise::Skip => {}
+            Advise::Fixed(variants) => fixed.extend(variants.iter().map(|v| variant(v))),
+            Advise::Knob {
+                option,
+                coarse,
+                variants,
+            } => knobs.extend(variants.iter().map(|v| Knob {
+                base: variant(v),
+                option,
+                coarse,
+                next: 0,
+                ascending: true,
+                last_within: None,
+                first_over: None,
+            })),
+        }
+    }
+    (fixed, knobs)
+}
+
+impl Knob {
+    /// Whether `m` is this knob's method variant at some value of its option.
+    fn owns(&self, m: &Method) -> bool {
+        self.base.name() == m.name() && self.base.variant_options() == m.variant_options()
+    }
+
+    /// A value measured (or refused): within budget or over it.
+    fn saw(&mut self, v: u32, fits: bool) {
+        if fits {
+            self.last_within = Some(self.last_within.map_or(v, |w| w.max(v)));
+        } else {
+            self.ascending = false;
+            self.first_over = Some(self.first_over.map_or(v, |o| o.min(v)));
+        }
+    }
+}
+
+/// Runs the search into `out` (`out/search/round-K` per round), reporting the rounds'
+/// progress.
+pub fn advise(
+    config: &AdviseConfig,
+    out: &Path,
+    progress: &mut dyn FnMut(Event),
+) -> Result<Advice, HarnessError> {
+    let (mut todo, mut knobs) = candidates(&config.methods);
+    let mut advice = Advice {
+        budget_ms: config.budget_ms,
+        ..Default::default()
+    };
+    let mut unsupported: Vec<String> = Vec::new();
+    let search = out.join("search");
+    std::fs::create_dir_all(&search).map_err(crate::io(&search))?;
+    for k in &mut knobs {
+        todo.push(k.at(k.coarse[0]));
+        k.next = 1;
+    }
+    while !todo.is_empty() {
+        let folder = search.join(format!("round-{}", advice.rounds + 1));
+        let mut sweep = SweepConfig {
+            methods: todo,
+            out: folder.clone(),
+            ..config.sweep.clone()
+        };
+        // Refused by the memory estimate: said, and over budget for the search.
+        let refused = refused_points(&sweep)?;
+        for (m, why) in &refused {
+            advice.refused.push((m.key(), why.clone()));
+            for k in knobs.iter_mut().filter(|k| k.owns(m)) {
+                if let Some(v) = k.value(m) {
+                    k.saw(v, false);
+                }
+            }
+        }
+        sweep
+            .methods
+            .retain(|m| !refused.iter().any(|(r, _)| r == m));
+        if !sweep.methods.is_empty() {
+            run_sweep(&sweep, true, &mut |e| {
+                if let Event::Unsupported { reason, .. } = &e
+                    && !unsupported.iter().any(|u| u == reason)
+                {
+                    unsupported.push(reason.to_string());
+                }
+                progress(e)
+            })?;
+            advice.rounds += 1;
+            advice.renders += renders(&sweep);
+            let results = folder.join("results.jsonl");
+            let records = read_records(&results).map_err(crate::io(&results))?;
+            for r in records.into_iter().filter(|r| r.kind != "floor") {
+                let key = r.key.split('|').next().unwrap_or_default();
+                if let Ok(m) = Method::parse(key) {
+                    for k in knobs.iter_mut().filter(|k| k.owns(&m)) {
+                        if let Some(v) = k.value(&m) {
+                            k.saw(v, within(&r, config.budget_ms));
+                        }
+                    }
+                }
+                advice.measured.push(r);
+                advice.folders.push(folder.clone());
+            }
+        }
+        // The next round: ascend where the last value was within budget, else bisect.
+        todo = Vec::new();
+        for k in knobs.iter_mut() {
+            if k.ascending {
+                if let Some(&v) = k.coarse.get(k.next) {
+                    k.next += 1;
+                    todo.push(k.at(v));
+                    continue;
+                }
+                k.ascending = false;
+            }
+            if let (Some(lo), Some(hi)) = (k.last_within, k.first_over)
+                && hi > lo + 1
+            {
+                todo.push(k.at(lo + (hi - lo) / 2));
+            }
+        }
+    }
+    advice.unsupported = unsupported;
+    choose(&mut advice, config.metric);
+    Ok(advice)
+}
+
+/// The frames a round renders: every point (the floor included) in the settling round and in
+/// each timed round, warm-up frames and the timed one.
+fn renders(sweep: &SweepConfig) -> u64 {
+    let points = sweep.methods.len() as u64 * sweep.alphas.len() as u64 + 1;
+    points * u64::from(crate::SETTLING_ROUNDS + sweep.frames) * u64::from(sweep.warmup + 1)
+}
+
+/// The pick, its ties, the next better choice, or the closest when nothing fits.
+pub fn choose(advice: &mut Advice, metric: Metric) {
+    let budget = advice.budget_ms;
+    let fits: Vec<&Record> = advice
+        .measured
+        .iter()
+        .filter(|r| within(r, budget))
+        .collect();
+    let lowest = fits
+        .iter()
+        .map(|r| metric.of(r))
+        .fold(f64::INFINITY, f64::min);
+    // Within TIE of the lowest error: a tie, and the cheapest of the tied is the pick.
+    let tied: Vec<&Record> = fits
+        .iter()
+        .copied()
+        .filter(|r| metric.of(r) <= lowest * (1.0 + TIE))
+        .collect();
+    let best = tied
+        .iter()
+        .copied()
+        .min_by(|a, b| a.ms_median.total_cmp(&b.ms_median));
+    advice.pick = best.cloned();
+    advice.ties = match best {
+        Some(p) => tied
+            .iter()
+            .filter(|r| r.key != p.key)
+            .map(|r| (*r).clone())
+            .collect(),
+        None => Vec::new(),
+    };
+    advice.next_better = match best {
+        Some(p) => advice
+            .measured
+            .iter()
+            .filter(|r| !within(r, budget) && metric.of(r) < metric.of(p) / (1.0 + TIE))
+            .min_by(|a, b| a.ms_median.total_cmp(&b.ms_median))
+            .cloned(),
+        None => None,
+    };
+    advice.closest = if best.is_none() {
+        advice
+            .measured
+            .iter()
+            .min_by(|a, b| a.ms_median.total_cmp(&b.ms_median))
+            .cloned()
+    } else {
+        None
+    };
+}
+
+/// The command that renders `r` as measured: method, options, size, SSAA, α.
+pub fn render_command(scene: &Path, r: &Record) -> String {
+    let key = r.key.split('|').next().unwrap_or_default();
+    let mut words: Vec<String> = key.split_whitespace().map(String::from).collect();
+    let method = words.remove(0);
+    let options: String = words
+        .iter()
+        .map(|w| match w.split_once('=') {
+            Some((k, v)) => format!(" --{k} {v}"),
+            None => format!(" --{w}"),
+        })
+        .collect();
+    format!(
+        "mirrorbox render {} --method {method}{options} --width {} --height {} --ssaa {} --alpha {} -o pick.png",
+        scene.display(),
+        r.width,
+        r.height,
+        r.ssaa,
+        r.alpha
+    )
+}
+
+/// `method (ms [lo–hi], error)` for sentences.
+fn described(r: &Record, metric: Metric) -> String {
+    let ms = match r.ms_interval {
+        Some([lo, hi]) => format!(
+            "{} ms [{}–{}]",
+            mirrorbox_report::document::ms(r.ms_median, 3),
+            mirrorbox_report::document::ms(lo, 3),
+            mirrorbox_report::document::ms(hi, 3)
+        ),
+        None => format!("{} ms", mirrorbox_report::document::ms(r.ms_median, 3)),
+    };
+    format!(
+        "`{}` ({ms}, {} {})",
+        r.key.split('|').next().unwrap_or_default(),
+        metric.name(),
+        mirrorbox_report::document::sci(metric.of(r))
+    )
+}
+
+/// The answer in sentences: the pick and its ties, the next better choice, or the closest.
+pub fn sentences(advice: &Advice, metric: Metric, scene: &Path) -> Vec<String> {
+    let budget = mirrorbox_report::document::ms(advice.budget_ms, 3);
+    let mut out = Vec::new();
+    match (&advice.pick, &advice.closest) {
+        (Some(p), _) => {
+            out.push(format!(
+                "Ship {}: the lowest error of the {} candidates measured whose 95 % interval \
+                 of ms/frame lies within {budget} ms.",
+                described(p, metric),
+                advice.measured.len()
+            ));
+            if !advice.ties.is_empty() {
+                let ties: Vec<String> = advice.ties.iter().map(|t| described(t, metric)).collect();
+                out.push(format!(
+                    "Tied with it (error within {:.0} %): {}.",
+                    100.0 * TIE,
+                    ties.join(", ")
+                ));
+            }
+            match &advice.next_better {
+                Some(n) => out.push(format!(
+                    "The next better choice: {}, {:.2}× the budget.",
+                    described(n, metric),
+                    n.ms_median / advice.budget_ms
+                )),
+                None => out.push("No candidate measured has a lower error.".into()),
+            }
+            out.push(format!("Render it: `{}`", render_command(scene, p)));
+        }
+        (None, Some(c)) => out.push(format!(
+            "No candidate fits {budget} ms: the cheapest is {}, {:.2}× the budget.",
+            described(c, metric),
+            c.ms_median / advice.budget_ms
+        )),
+        (None, None) => out.push("No candidate was measured.".into()),
+    }
+    if !advice.refused.is_empty() {
+        let r: Vec<String> = advice
+            .refused
+            .iter()
+            .map(|(k, why)| format!("`{k}` ({why})"))
+            .collect();
+        out.push(format!(
+            "Refused by the memory estimate before rendering: {}.",
+            r.join("; ")
+        ));
+    }
+    if !advice.unsupported.is_empty() {
+        out.push(format!(
+            "Not measured on this adapter: {}.",
+            advice.unsupported.join("; ")
+        ));
+    }
+    out.push(format!(
+        "Search cost: {} candidates in {} timing rounds, {} frames rendered.",
+        advice.measured.len(),
+        advice.rounds,
+        advice.renders
+    ));
+    out
+}
+
+/// The measured candidates as a chart: error against ms/frame, one series per method in its
+/// fixed style (its settings as labels, not joined: a search's order is not an axis), the
+/// Pareto front of what was measured, and the budget.
+pub fn chart(
+    advice: &Advice,
+    metric: Metric,
+    title_scene: &str,
+    footer: String,
+) -> mirrorbox_report::plot::Chart {
+    use mirrorbox_report::plot::{Chart, Reference, Series, method_style};
+    let mut methods: Vec<&str> = Vec::new();
+    for r in &advice.measured {
+        if !methods.contains(&r.method.as_str()) {
+            methods.push(&r.method);
+        }
+    }
+    let mut series = Vec::new();
+    for m in methods {
+        let mut pts: Vec<&Record> = advice.measured.iter().filter(|r| r.method == m).collect();
+        pts.sort_by(|a, b| a.ms_median.total_cmp(&b.ms_median));
+        // Variants of one method (ssr's fallbacks, cubemap's history) share its style: one
+        // series per method, labelled per point.
+        let mut s = Series::new(
+            m,
+            method_style(m),
+            pts.iter().map(|r| (r.ms_median, metric.of(r))).collect(),
+        );
+        s.joined = false;
+        s.x_intervals = pts.iter().map(|r| r.ms_interval).collect();
+        s.labels = pts
+            .iter()
+            .map(|r| mirrorbox_report::document::label(r).replace(&format!("{m} "), ""))
+            .collect();
+        series.push(s);
+    }
+    let coords: Vec<(f64, f64)> = advice
+        .measured
+        .iter()
+        .map(|r| (r.ms_median, metric.of(r)))
+        .collect();
+    let (_, steps) = mirrorbox_report::overview::pareto_steps(&coords);
+    let errors: Vec<f64> = coords.iter().map(|c| c.1).filter(|e| *e > 0.0).collect();
+    let (lo, hi) = (
+        errors.iter().copied().fold(f64::INFINITY, f64::min),
+        errors.iter().copied().fold(0.0, f64::max),
+    );
+    let mut references = vec![Reference::Curve(
+        "Pareto front of the candidates".into(),
+        steps,
+    )];
+    if lo.is_finite() {
+        references.push(Reference::Curve(
+            format!(
+                "budget {} ms",
+                mirrorbox_report::document::ms(advice.budget_ms, 3)
+            ),
+            vec![(advice.budget_ms, lo), (advice.budget_ms, hi)],
+        ));
+    }
+    Chart {
+        title: format!(
+            "{} vs cost: advise on {title_scene}, budget {} ms",
+            match metric {
+                Metric::Flip => "FLIP over the mirror pixels",
+                Metric::Relmse => "relMSE over the image",
+            },
+            mirrorbox_report::document::ms(advice.budget_ms, 3)
+        ),
+        x_label: format!("ms/frame (median{})", mirrorbox_report::plot::CI_BARS),
+        y_label: metric.name().into(),
+        x_log: true,
+        y_log: true,
+        series,
+        references,
+        floor: None,
+        x_ticks_at_data: false,
+        footer,
+    }
+}
+
+/// [`advise`] into `out` whole or not at all: the search and the answer are written into
+/// `OUT.partial` and moved into place at the end (an earlier advice there is replaced; any
+/// other non-empty folder is refused). Writes `advice.md`, `advice.json`, `front.svg`, and the
+/// pick's image, its truth and its FLIP map (`pick.png`, `truth.png`, `pick_flip.png`).
+pub fn advise_into(
+    config: &AdviseConfig,
+    out: &Path,
+    progress: &mut dyn FnMut(Event),
+) -> Result<Advice, HarnessError> {
+    crate::exchange::replaceable(out, "advice.json", "advice")?;
+    let partial = PathBuf::from(format!("{}.partial", out.display()));
+    if partial.exists() {
+        std::fs::remove_dir_all(&partial).map_err(crate::io(&partial))?;
+    }
+    std::fs::create_dir_all(&partial).map_err(crate::io(&partial))?;
+    let mut sweep = config.sweep.clone();
+    // One truth for every round: the cache outlives the rounds' folders.
+    sweep.truth_cache = Some(
+        config
+            .sweep
+            .truth_cache
+            .clone()
+            .unwrap_or_else(|| partial.join("cache")),
+    );
+    let config = AdviseConfig {
+        sweep,
+        budget_ms: config.budget_ms,
+        metric: config.metric,
+        methods: config.methods.clone(),
+    };
+    let advice = advise(&config, &partial, progress)?;
+    write_advice(&advice, &config, &partial)?;
+    // The rounds' folders name `OUT.partial`; the files keep working after the move.
+    if out.exists() {
+        std::fs::remove_dir_all(out).map_err(crate::io(out))?;
+    }
+    std::fs::rename(&partial, out).map_err(crate::io(out))?;
+    Ok(advice)
+}
+
+fn write_advice(advice: &Advice, config: &AdviseConfig, out: &Path) -> Result<(), HarnessError> {
+    let scene = &config.sweep.scene;
+    let metric = config.metric;
+    let write = |name: &str, bytes: &[u8]| -> Result<(), HarnessError> {
+        let p = out.join(name);
+        Ok(mirrorbox_files::write_atomically(&p, bytes)?)
+    };
+    if let Some(p) = &advice.pick
+        && let Some(i) = advice.measured.iter().position(|r| r.key == p.key)
+    {
+        let folder = &advice.folders[i];
+        for (from, to) in [
+            (&p.raster_image, "pick.png"),
+            (&p.truth_image, "truth.png"),
+            (&p.heatmap_image, "pick_flip.png"),
+        ] {
+            let src = folder.join(from);
+            std::fs::copy(&src, out.join(to)).map_err(crate::io(&src))?;
+        }
+    }
+    let info = advice
+        .measured
+        .first()
+        .map(|r| (r.adapter.clone(), r.width, r.height, r.alpha));
+    let footer = match &info {
+        Some((adapter, w, h, a)) => format!(
+            "{} · {w}x{h} · α = {a} · {adapter} · {}",
+            scene.display(),
+            crate::now_rfc3339()
+        ),
+        None => scene.display().to_string(),
+    };
+    let stem = scene
+        .file_stem()
+        .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+    let svg = chart(advice, metric, &stem, footer).to_svg();
+    write("front.svg", svg.as_bytes())?;
+    let text = sentences(advice, metric, scene);
+    let mut md = format!(
+        "# Advice: {} within {} ms/frame\n\n",
+        scene.display(),
+        mirrorbox_report::document::ms(advice.budget_ms, 3)
+    );
+    for s in &text {
+        md.push_str(&format!("- {s}\n"));
+    }
+    if advice.pick.is_some() {
+        md.push_str("\nThe pick | the truth | FLIP of the pick against the truth:\n\n![pick](pick.png) ![truth](truth.png) ![FLIP](pick_flip.png)\n");
+    }
+    md.push_str("\n![the candidates measured](front.svg)\n\n| candidate | ms/frame [95 % CI] | error | within budget |\n|---|---|---|---|\n");
+    for r in &advice.measured {
+        md.push_str(&format!(
+            "| `{}` | {} | {} | {} |\n",
+            r.key.split('|').next().unwrap_or_default(),
+            mirrorbox_report::document::ms_cell(r, 3),
+            mirrorbox_report::document::sci(metric.of(r)),
+            if within(r, advice.budget_ms) {
+                "yes"
+            } else {
+                "no"
+            }
+        ));
+    }
+    write("advice.md", md.as_bytes())?;
+    write(
+        "advice.json",
+        serde_json::to_string_pretty(&to_json(advice, metric, scene))?.as_bytes(),
+    )?;
+    Ok(())
+}
+
+/// The answer as JSON (`advice.json`, `advise --json`).
+pub fn to_json(advice: &Advice, metric: Metric, scene: &Path) -> serde_json::Value {
+    let point = |r: &Record| {
+        serde_json::json!({
+            "method": r.key.split('|').next().unwrap_or_default(),
+            "ms_median": r.ms_median,
+            "ms_interval": r.ms_interval,
+            "error": metric.of(r),
+            "within_budget": within(r, advice.budget_ms),
+        })
+    };
+    serde_json::json!({
+        "scene": scene.display().to_string(),
+        "budget_ms": advice.budget_ms,
+        "metric": metric.name(),
+        "pick": advice.pick.as_ref().map(point),
+        "ties": advice.ties.iter().map(point).collect::<Vec<_>>(),
+        "next_better": advice.next_better.as_ref().map(point),
+        "closest": advice.closest.as_ref().map(point),
+        "render": advice.pick.as_ref().map(|p| render_command(scene, p)),
+        "refused": advice.refused.iter().map(|(k, why)| serde_json::json!({"method": k, "why": why})).collect::<Vec<_>>(),
+        "unsupported": advice.unsupported,
+        "measured": advice.measured.iter().map(point).collect::<Vec<_>>(),
+        "rounds": advice.rounds,
+        "renders": advice.renders,
+        "sentences": sentences(advice, metric, scene),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use mirrorbox_report::document::fixtures::record;
+
+    /// A candidate `key` at `ms` [lo–hi] with FLIP `flip` (no mirror mask: over the image).
+    fn candidate(key: &str, ms: f64, hi: f64, flip: f64) -> Record {
+        let mut r = record(0, ms, 1, flip);
+        r.key = format!("{key}|alpha=1|32x18");
+        r.method = key.split(' ').next().unwrap().into();
+        r.ms_interval = Some([ms * 0.9, hi]);
+        r
+    }
+
+    #[test]
+    fn the_pick_is_the_cheapest_tied_for_the_lowest_error_within_budget() {
+        let mut a = Advice {
+            budget_ms: 10.0,
+            measured: vec![
+                candidate("portal depth=8", 8.0, 9.5, 0.100),
+                candidate("unrolled depth=8", 6.0, 7.0, 0.101),
+                candidate("naive", 2.0, 3.0, 0.5),
+                // Median within budget, interval not: over budget.
+                candidate("portal depth=16", 9.8, 10.5, 0.05),
+                candidate("unrolled depth=16", 11.0, 12.0, 0.049),
+            ],
+            ..Default::default()
+        };
+        choose(&mut a, Metric::Flip);
+        let key = |r: &Option<Record>| {
+            r.as_ref()
+                .map(|r| r.key.split('|').next().unwrap().to_string())
+        };
+        assert_eq!(key(&a.pick).as_deref(), Some("unrolled depth=8"));
+        assert_eq!(a.ties.len(), 1);
+        assert!(a.ties[0].key.starts_with("portal depth=8"));
+        // The cheapest with a lower error, though its median is within budget.
+        assert_eq!(key(&a.next_better).as_deref(), Some("portal depth=16"));
+        assert!(a.closest.is_none());
+        let text = sentences(&a, Metric::Flip, Path::new("scenes/s.json")).join("\n");
+        assert!(text.contains("Ship `unrolled depth=8`"), "{text}");
+        assert!(
+            text.contains("mirrorbox render scenes/s.json --method unrolled --depth 8"),
+            "{text}"
+        );
+        // Nothing fits: the cheapest is named, with how far it is over.
+        a.budget_ms = 1.0;
+        choose(&mut a, Metric::Flip);
+        assert!(a.pick.is_none());
+        assert_eq!(key(&a.closest).as_deref(), Some("naive"));
+        let text = sentences(&a, Metric::Flip, Path::new("s.json")).join("\n");
+        assert!(
+            text.contains("No candidate fits 1.000 ms: the cheapest is `naive`"),
+            "{text}"
+        );
+        assert!(text.contains("2.00× the budget"), "{text}");
+    }
+}
