@@ -17,7 +17,7 @@ bin=target/release/mirrorbox
 # the README. The experiments are counted from their source before the build (each registry
 # row of crates/experiments says `main_job: true|false`), so the counter is right from the
 # first step; the built binary's own list is checked against that count below.
-main_job_in_source=$(cat crates/experiments/src/*.rs | grep -cE '^[[:space:]]*main_job: true,' || true)
+main_job_in_source=$(cat crates/experiments/src/*.rs crates/experiments/src/*/*.rs | grep -cE '^[[:space:]]*main_job: true,' || true)
 steps_total=$((6 + main_job_in_source))
 step=0
 # Whether cargo had to download the crates: a fresh machine's cost is with an empty cache

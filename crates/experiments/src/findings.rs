@@ -399,6 +399,30 @@ pub fn findings(reports: &Path) -> Result<Vec<Block>, ReadmeError> {
     Ok(blocks)
 }
 
+/// [`findings`] with each finding's figure shown under it (the overview: one chart per
+/// question, in the order of the findings).
+pub fn findings_with_figures(reports: &Path) -> Result<Vec<Block>, ReadmeError> {
+    let mut out = Vec::new();
+    for (i, b) in findings(reports)?.into_iter().enumerate() {
+        let figure = match &b {
+            Block::Paragraph(text) => text
+                .split("[figure](")
+                .nth(1)
+                .and_then(|rest| rest.split(')').next())
+                .map(str::to_string),
+            _ => None,
+        };
+        out.push(b);
+        if let Some(f) = figure {
+            out.push(Block::Paragraph(format!(
+                "![the figure of finding {}]({f})",
+                i - 1
+            )));
+        }
+    }
+    Ok(out)
+}
+
 /// The findings a chapter opens with (region `found-<chapter>`), numbered as in the ranked
 /// list, their links as paths.
 pub fn chapter_findings(reports: &Path, chapter: &str) -> Result<String, ReadmeError> {

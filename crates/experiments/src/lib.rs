@@ -14,6 +14,7 @@ use mirrorbox_report::overview::OtherReport;
 use mirrorbox_report::readme::RegionSource;
 use std::path::{Path, PathBuf};
 
+pub mod advise;
 pub mod bumpy;
 pub mod depth_scaling;
 pub mod engine_reflections;
@@ -81,6 +82,7 @@ pub const EXPERIMENTS: &[&Experiment] = &[
     &engine_reflections::ENGINE_REFLECTIONS,
     &real_assets::REAL_ASSETS,
     &web_engines::WEB_ENGINES,
+    &advise::ADVISE,
     &scripts::GPU_TRUTH,
     &scripts::LIGHTING_TRACE_COST,
     &scripts::MEMORY_PEAKS,

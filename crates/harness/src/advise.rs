@@ -116,14 +116,25 @@ pub struct Advice {
     /// Timing rounds run, and the frames rendered in them (settling and warm-up included).
     pub rounds: usize,
     pub renders: u64,
+    /// The search's wall time (rounds, truth and memory checks).
+    pub seconds: f64,
     /// Where each measured record's images are: the round's folder.
     pub folders: Vec<PathBuf>,
 }
 
 /// Whether `r` is within `budget` ms: the upper end of its 95 % interval (its median where
 /// it has none) at most the budget.
+///
+/// A candidate whose interval holds the budget is at the budget: within it in one run, over
+/// it in another ([`straddles`]).
 pub fn within(r: &Record, budget: f64) -> bool {
     r.ms_interval.map_or(r.ms_median, |[_, hi]| hi) <= budget
+}
+
+/// Whether `r`'s 95 % interval holds `budget`: two runs may judge it either way.
+pub fn straddles(r: &Record, budget: f64) -> bool {
+    r.ms_interval
+        .is_some_and(|[lo, hi]| lo <= budget && budget <= hi)
 }
 
 /// The registry's candidates for a scene: fixed ones, and knobs to search.
@@ -165,15 +176,26 @@ impl Knob {
         self.base.name() == m.name() && self.base.variant_options() == m.variant_options()
     }
 
-    /// A value measured (or refused): within budget or over it.
-    fn saw(&mut self, v: u32, fits: bool) {
+    /// A value measured (or refused): within budget (its interval), or not; and whether its
+    /// median is. While ascending, a value whose median fits but whose interval does not
+    /// neither ends the ascent nor closes the bracket.
+    fn saw(&mut self, v: u32, fits: bool, median_fits: bool) {
         if fits {
             self.last_within = Some(self.last_within.map_or(v, |w| w.max(v)));
-        } else {
+        } else if !(self.ascending && median_fits) {
             self.ascending = false;
             self.first_over = Some(self.first_over.map_or(v, |o| o.min(v)));
         }
     }
+}
+
+/// What one round of the search returns: the candidates measured (in order), those the
+/// memory estimate refused with why, where the round's records are, and the frames rendered.
+pub struct Round {
+    pub measured: Vec<Record>,
+    pub refused: Vec<(Method, String)>,
+    pub folder: PathBuf,
+    pub renders: u64,
 }
 
 /// Runs the search into `out` (`out/search/round-K` per round), reporting the rounds'
@@ -183,38 +205,29 @@ pub fn advise(
     out: &Path,
     progress: &mut dyn FnMut(Event),
 ) -> Result<Advice, HarnessError> {
-    let (mut todo, mut knobs) = candidates(&config.methods);
-    let mut advice = Advice {
-        budget_ms: config.budget_ms,
-        ..Default::default()
-    };
+    let started = std::time::Instant::now();
+    let search_dir = out.join("search");
+    std::fs::create_dir_all(&search_dir).map_err(crate::io(&search_dir))?;
     let mut unsupported: Vec<String> = Vec::new();
-    let search = out.join("search");
-    std::fs::create_dir_all(&search).map_err(crate::io(&search))?;
-    for k in &mut knobs {
-        todo.push(k.at(k.coarse[0]));
-        k.next = 1;
-    }
-    while !todo.is_empty() {
-        let folder = search.join(format!("round-{}", advice.rounds + 1));
+    let mut rounds = 0;
+    let mut advice = search(config, &mut |methods| {
+        rounds += 1;
+        let folder = search_dir.join(format!("round-{rounds}"));
         let mut sweep = SweepConfig {
-            methods: todo,
+            methods,
             out: folder.clone(),
             ..config.sweep.clone()
         };
-        // Refused by the memory estimate: said, and over budget for the search.
         let refused = refused_points(&sweep)?;
-        for (m, why) in &refused {
-            advice.refused.push((m.key(), why.clone()));
-            for k in knobs.iter_mut().filter(|k| k.owns(m)) {
-                if let Some(v) = k.value(m) {
-                    k.saw(v, false);
-                }
-            }
-        }
         sweep
             .methods
             .retain(|m| !refused.iter().any(|(r, _)| r == m));
+        let mut round = Round {
+            measured: Vec::new(),
+            refused,
+            folder: folder.clone(),
+            renders: 0,
+        };
         if !sweep.methods.is_empty() {
             run_sweep(&sweep, true, &mut |e| {
                 if let Event::Unsupported { reason, .. } = &e
@@ -224,24 +237,70 @@ pub fn advise(
                 }
                 progress(e)
             })?;
-            advice.rounds += 1;
-            advice.renders += renders(&sweep);
+            round.renders = renders(&sweep);
             let results = folder.join("results.jsonl");
-            let records = read_records(&results).map_err(crate::io(&results))?;
-            for r in records.into_iter().filter(|r| r.kind != "floor") {
-                let key = r.key.split('|').next().unwrap_or_default();
-                if let Ok(m) = Method::parse(key) {
-                    for k in knobs.iter_mut().filter(|k| k.owns(&m)) {
-                        if let Some(v) = k.value(&m) {
-                            k.saw(v, within(&r, config.budget_ms));
-                        }
-                    }
+            round.measured = read_records(&results)
+                .map_err(crate::io(&results))?
+                .into_iter()
+                .filter(|r| r.kind != "floor")
+                .collect();
+        }
+        Ok(round)
+    })?;
+    advice.unsupported = unsupported;
+    advice.seconds = started.elapsed().as_secs_f64();
+    Ok(advice)
+}
+
+/// The search itself, each round's candidates measured by `round` (a sweep in [`advise`],
+/// a model of costs and errors in the tests): coarse values ascending, then bisection.
+///
+/// A knob keeps ascending while a value's median is within the budget, even where its
+/// interval's upper end is not (one noisy round must not end the ascent); the bracket of the
+/// bisection is the last value within budget and the first over it.
+pub fn search(
+    config: &AdviseConfig,
+    round: &mut dyn FnMut(Vec<Method>) -> Result<Round, HarnessError>,
+) -> Result<Advice, HarnessError> {
+    let (mut todo, mut knobs) = candidates(&config.methods);
+    let mut advice = Advice {
+        budget_ms: config.budget_ms,
+        ..Default::default()
+    };
+    for k in &mut knobs {
+        todo.push(k.at(k.coarse[0]));
+        k.next = 1;
+    }
+    let budget = config.budget_ms;
+    while !todo.is_empty() {
+        let r = round(todo)?;
+        // Refused by the memory estimate: said, and over budget for the search.
+        for (m, why) in &r.refused {
+            advice.refused.push((m.key(), why.clone()));
+            for k in knobs.iter_mut().filter(|k| k.owns(m)) {
+                if let Some(v) = k.value(m) {
+                    k.saw(v, false, false);
                 }
-                advice.measured.push(r);
-                advice.folders.push(folder.clone());
             }
         }
-        // The next round: ascend where the last value was within budget, else bisect.
+        if !r.measured.is_empty() {
+            advice.rounds += 1;
+            advice.renders += r.renders;
+        }
+        for rec in r.measured {
+            let key = rec.key.split('|').next().unwrap_or_default();
+            if let Ok(m) = Method::parse(key) {
+                for k in knobs.iter_mut().filter(|k| k.owns(&m)) {
+                    if let Some(v) = k.value(&m) {
+                        k.saw(v, within(&rec, budget), rec.ms_median <= budget);
+                    }
+                }
+            }
+            advice.measured.push(rec);
+            advice.folders.push(r.folder.clone());
+        }
+        // The next round: ascend where the last value's median was within budget, else
+        // bisect.
         todo = Vec::new();
         for k in knobs.iter_mut() {
             if k.ascending {
@@ -259,7 +318,6 @@ pub fn advise(
             }
         }
     }
-    advice.unsupported = unsupported;
     choose(&mut advice, config.metric);
     Ok(advice)
 }
@@ -384,8 +442,14 @@ pub fn sentences(advice: &Advice, metric: Metric, scene: &Path) -> Vec<String> {
                 ));
             }
             match &advice.next_better {
+                Some(n) if n.ms_median <= advice.budget_ms => out.push(format!(
+                    "The next better choice: {}, its median within the budget but its \
+                     interval's upper end over it: at the budget, another run may pick it \
+                     (a tie with the budget).",
+                    described(n, metric)
+                )),
                 Some(n) => out.push(format!(
-                    "The next better choice: {}, {:.2}× the budget.",
+                    "The next better choice: {}, its median {:.2}× the budget.",
                     described(n, metric),
                     n.ms_median / advice.budget_ms
                 )),
@@ -418,10 +482,11 @@ pub fn sentences(advice: &Advice, metric: Metric, scene: &Path) -> Vec<String> {
         ));
     }
     out.push(format!(
-        "Search cost: {} candidates in {} timing rounds, {} frames rendered.",
+        "Search cost: {} candidates in {} timing rounds, {} frames rendered, {:.0} s.",
         advice.measured.len(),
         advice.rounds,
-        advice.renders
+        advice.renders,
+        advice.seconds
     ));
     out
 }
@@ -642,6 +707,11 @@ pub fn to_json(advice: &Advice, metric: Metric, scene: &Path) -> serde_json::Val
         "measured": advice.measured.iter().map(point).collect::<Vec<_>>(),
         "rounds": advice.rounds,
         "renders": advice.renders,
+        "seconds": advice.seconds,
+        "device": advice.measured.first().map(|r| r.adapter.clone()),
+        "width": advice.measured.first().map(|r| r.width),
+        "height": advice.measured.first().map(|r| r.height),
+        "alpha": advice.measured.first().map(|r| r.alpha),
         "sentences": sentences(advice, metric, scene),
     })
 }
@@ -658,6 +728,64 @@ mod tests {
         r.method = key.split(' ').next().unwrap().into();
         r.ms_interval = Some([ms * 0.9, hi]);
         r
+    }
+
+    /// The search against a model of `portal`: depth d costs 1 + 0.1·d ms, its error is 1/d;
+    /// depth 8's interval (a noisy round) reaches over the budget though its median does not.
+    #[test]
+    fn the_search_ascends_past_a_noisy_value_then_bisects_to_the_last_depth_within_budget() {
+        let config = AdviseConfig {
+            sweep: SweepConfig::new(PathBuf::new(), PathBuf::new(), Vec::new(), vec![1.0]),
+            budget_ms: 3.05,
+            metric: Metric::Flip,
+            methods: vec!["portal".into()],
+        };
+        let mut asked: Vec<Vec<String>> = Vec::new();
+        let advice = search(&config, &mut |methods| {
+            asked.push(methods.iter().map(Method::key).collect());
+            let measured = methods
+                .iter()
+                .map(|m| {
+                    let d = f64::from(m.count_of("depth").unwrap());
+                    let ms = 1.0 + 0.1 * d;
+                    let hi = if d == 8.0 { 3.5 } else { ms * 1.01 };
+                    candidate(&m.key(), ms, hi, 1.0 / d)
+                })
+                .collect();
+            Ok(Round {
+                measured,
+                refused: Vec::new(),
+                folder: PathBuf::new(),
+                renders: 1,
+            })
+        })
+        .unwrap();
+        let depths: Vec<&str> = asked.iter().map(|r| r[0].as_str()).collect();
+        assert_eq!(
+            depths,
+            [
+                "portal depth=1",
+                "portal depth=2",
+                "portal depth=4",
+                "portal depth=8",
+                "portal depth=16",
+                "portal depth=32",
+                "portal depth=24",
+                "portal depth=20",
+                "portal depth=22",
+                "portal depth=21",
+            ]
+        );
+        let pick = advice.pick.unwrap();
+        assert!(pick.key.starts_with("portal depth=20|"), "{}", pick.key);
+        assert!(
+            advice
+                .next_better
+                .unwrap()
+                .key
+                .starts_with("portal depth=21|")
+        );
+        assert_eq!(advice.rounds, 10);
     }
 
     #[test]

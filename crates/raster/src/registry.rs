@@ -212,6 +212,49 @@ fn or_list(items: &[&str]) -> String {
 mod tests {
     use super::*;
 
+    /// `mirrorbox advise` takes its candidates from the rows: every variant parses, every
+    /// coarse value lies within the knob's bounds, ascending, and the knob is an option of
+    /// the method (issue 55).
+    #[test]
+    fn every_advise_row_names_candidates_the_method_accepts() {
+        use crate::method::Advise;
+        let mut offered = 0;
+        for e in METHODS {
+            let parse = |words: &str| {
+                Method::parse(&format!("{} {words}", e.name))
+                    .unwrap_or_else(|err| panic!("{}: variant {words:?}: {err}", e.name))
+            };
+            match e.advise {
+                Advise::Skip => {}
+                Advise::Fixed(variants) => {
+                    assert!(!variants.is_empty(), "{}", e.name);
+                    variants.iter().for_each(|v| drop(parse(v)));
+                    offered += 1;
+                }
+                Advise::Knob {
+                    option,
+                    coarse,
+                    variants,
+                } => {
+                    assert!(e.accepts(option), "{}: {}", e.name, option.name);
+                    assert!(coarse.windows(2).all(|w| w[0] < w[1]), "{}", e.name);
+                    for v in variants {
+                        for &c in coarse {
+                            parse(v)
+                                .with(option, ParamValue::Count(c))
+                                .unwrap_or_else(|err| {
+                                    panic!("{} {v} {}={c}: {err}", e.name, option.name)
+                                });
+                        }
+                    }
+                    offered += 1;
+                }
+            }
+        }
+        // Every mirror method: all but the three symmetry-plane ones.
+        assert_eq!(offered, METHODS.len() - 3);
+    }
+
     #[test]
     fn every_method_takes_the_shared_options() {
         // `method_options!` appends them; an entry that lists its options by hand must too.

@@ -72,12 +72,24 @@ fn device_slug(adapter: &str) -> String {
         .unwrap_or_else(|| "device".into())
 }
 
-/// The lead's Markdown as HTML: `## ` headings, `- ` items, other lines paragraphs; inline
-/// `**bold**`, `` `code` `` and `[text](link)`.
+/// The lead's Markdown as HTML: `## ` headings, `- ` items, a line `![alt](src)` an image,
+/// other lines paragraphs; inline `**bold**`, `` `code` `` and `[text](link)`.
 fn lead_html(md: &str) -> String {
     let mut out = String::new();
     let mut in_list = false;
     for line in md.lines() {
+        if let Some((alt, src, len)) = line.strip_prefix('!').and_then(parse_link)
+            && len == line.len() - 1
+        {
+            let esc = crate::document::escape_html;
+            let _ = writeln!(
+                out,
+                "<p><img src=\"{}\" alt=\"{}\"></p>",
+                esc(src),
+                esc(alt)
+            );
+            continue;
+        }
         let (tag, text) = if let Some(t) = line.strip_prefix("## ") {
             ("h2", t)
         } else if let Some(t) = line.strip_prefix("- ") {
@@ -643,10 +655,16 @@ mod tests {
 
     #[test]
     fn the_lead_renders_links_bold_and_code_and_leaves_intervals_as_text() {
-        let html = lead_html("## Found\n\n1. **A** `x` is 1.2× [1.1–1.3×] ([figure](a.svg)).\n");
+        let html = lead_html(
+            "## Found\n\n1. **A** `x` is 1.2× [1.1–1.3×] ([figure](a.svg)).\n\n![finding 1](a.svg)\n",
+        );
+        assert!(
+            html.contains("<p><img src=\"a.svg\" alt=\"finding 1\"></p>"),
+            "{html}"
+        );
         assert_eq!(
             html,
-            "<h2>Found</h2>\n<p>1. <strong>A</strong> <code>x</code> is 1.2× [1.1–1.3×] (<a href=\"a.svg\">figure</a>).</p>\n"
+            "<h2>Found</h2>\n<p>1. <strong>A</strong> <code>x</code> is 1.2× [1.1–1.3×] (<a href=\"a.svg\">figure</a>).</p>\n<p><img src=\"a.svg\" alt=\"finding 1\"></p>\n"
         );
     }
 

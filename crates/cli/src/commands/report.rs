@@ -20,8 +20,9 @@ pub struct Args {
 
 pub fn run(args: &Args) -> Result<(), Failure> {
     if let Some(reports) = &args.index {
-        // What was found leads the overview, its links relative to `reports/` as written.
-        let findings = mirrorbox_experiments::findings::findings(reports)
+        // What was found leads the overview, each finding with its figure, its links relative
+        // to `reports/` as written.
+        let findings = mirrorbox_experiments::findings::findings_with_figures(reports)
             .map_err(|e| Failure::BadInput(format!("{}: the findings: {e}", reports.display())))?;
         let lead = mirrorbox_experiments::findings::rebased(&findings, "", "../");
         let n = mirrorbox_report::overview::write_overview(

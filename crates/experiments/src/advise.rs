@@ -1,0 +1,278 @@
+//! The advisor on four scenes at three budgets each (issue 55): what `mirrorbox advise`
+//! picked, what its search cost, whether a repeat picks the same, and — on the two scenes the
+//! frontier sweeps every method on — whether the pick is as good as the best the exhaustive
+//! sweep found within the same budget.
+
+use crate::{Experiment, Measure};
+use mirrorbox_harness::advise::{TIE, within};
+use mirrorbox_report::Record;
+use mirrorbox_report::document::{Block, markdown, ms, sci};
+use mirrorbox_report::load_sweep;
+use mirrorbox_report::readme::{ReadmeError, RegionSource};
+use serde_json::Value;
+use std::path::Path;
+
+/// The frontier sweep of a scene (320×180, α = 1, every method at a few settings), if any.
+fn frontier_of(scene: &str) -> Option<&'static str> {
+    match scene {
+        "scenes/mirror_box.json" => Some("frontier_box"),
+        "scenes/mirror_room.json" => Some("frontier_room"),
+        _ => None,
+    }
+}
+
+/// Every advice under `reports/advise/`, by folder name.
+fn advices(reports: &Path) -> Result<Vec<(String, Value)>, ReadmeError> {
+    let dir = reports.join("advise");
+    let mut out = Vec::new();
+    let entries =
+        std::fs::read_dir(&dir).map_err(|e| ReadmeError(format!("{}: {e}", dir.display())))?;
+    for e in entries.flatten() {
+        let path = e.path().join("advice.json");
+        if !path.is_file() {
+            continue;
+        }
+        let text = std::fs::read_to_string(&path)
+            .map_err(|e| ReadmeError(format!("{}: {e}", path.display())))?;
+        let v: Value = serde_json::from_str(&text)
+            .map_err(|e| ReadmeError(format!("{}: {e}", path.display())))?;
+        out.push((e.file_name().to_string_lossy().into_owned(), v));
+    }
+    // Scene, then budget, then the repeat after its first run.
+    out.sort_by(|a, b| {
+        let key = |v: &Value, f: &str| {
+            (
+                v["scene"].as_str().unwrap_or_default().to_string(),
+                v["budget_ms"].as_f64().unwrap_or(0.0),
+                f.ends_with("_repeat"),
+            )
+        };
+        key(&a.1, &a.0)
+            .partial_cmp(&key(&b.1, &b.0))
+            .unwrap_or(std::cmp::Ordering::Equal)
+    });
+    if out.is_empty() {
+        return Err(ReadmeError(format!("{}: no advice.json", dir.display())));
+    }
+    Ok(out)
+}
+
+/// The method of a JSON point, or "–".
+fn method(v: &Value) -> String {
+    v["method"]
+        .as_str()
+        .map_or("–".into(), |m| format!("`{m}`"))
+}
+
+/// Why the advisor's pick is worse than the exhaustive sweep's best within budget, `x`:
+/// either the advisor measured `x` and found it over budget (the two runs' timings disagree:
+/// a tie at the budget where its interval holds the budget), or it never measured it.
+fn timing_verdict(advice: &Value, x: &Record, budget: f64) -> String {
+    let key = x.key.split('|').next().unwrap_or_default();
+    let theirs = advice["measured"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .find(|m| m["method"].as_str() == Some(key));
+    let sweep_ms = ms(x.ms_median, 3);
+    match theirs {
+        Some(m) => {
+            let median = m["ms_median"].as_f64().unwrap_or(f64::NAN);
+            let (lo, hi) = match m["ms_interval"].as_array().map(|i| {
+                (
+                    i[0].as_f64().unwrap_or(median),
+                    i[1].as_f64().unwrap_or(median),
+                )
+            }) {
+                Some(i) => i,
+                None => (median, median),
+            };
+            let at = if lo <= budget && budget <= hi {
+                "a tie at the budget"
+            } else {
+                "the runs' timings disagree"
+            };
+            format!(
+                "{at}: `{key}` ({}) fits the sweep's run ({sweep_ms} ms) but not the advisor's \
+                 ({} [{}–{}] ms)",
+                sci(x.mirror_flip()),
+                ms(median, 3),
+                ms(lo, 3),
+                ms(hi, 3)
+            )
+        }
+        None => format!(
+            "NO: the advisor never measured `{key}` ({}, {sweep_ms} ms in the sweep)",
+            sci(x.mirror_flip())
+        ),
+    }
+}
+
+/// The region: one row per advice, then the repeat's verdict.
+fn advise_region(reports: &Path) -> Result<String, ReadmeError> {
+    let all = advices(reports)?;
+    let mut rows = Vec::new();
+    let mut notes = Vec::new();
+    for (folder, v) in &all {
+        let scene = v["scene"].as_str().unwrap_or_default();
+        let budget = v["budget_ms"].as_f64().unwrap_or(0.0);
+        let pick = &v["pick"];
+        let error = |p: &Value| p["error"].as_f64();
+        let (pick_text, pick_ms, pick_error) = if pick.is_null() {
+            (
+                format!("none fits; cheapest {}", method(&v["closest"])),
+                v["closest"]["ms_median"]
+                    .as_f64()
+                    .map_or("–".into(), |m| ms(m, 3)),
+                v["closest"]["error"].as_f64().map_or("–".into(), sci),
+            )
+        } else {
+            let ties = v["ties"].as_array().map_or(0, Vec::len);
+            (
+                if ties > 0 {
+                    format!("{} (+{ties} tied)", method(pick))
+                } else {
+                    method(pick)
+                },
+                match pick["ms_interval"].as_array() {
+                    Some(i) if i.len() == 2 => format!(
+                        "{} [{}–{}]",
+                        ms(pick["ms_median"].as_f64().unwrap_or(0.0), 3),
+                        ms(i[0].as_f64().unwrap_or(0.0), 3),
+                        ms(i[1].as_f64().unwrap_or(0.0), 3)
+                    ),
+                    _ => ms(pick["ms_median"].as_f64().unwrap_or(0.0), 3),
+                },
+                error(pick).map_or("–".into(), sci),
+            )
+        };
+        // Against the exhaustive frontier sweep of the same scene, size and α.
+        let (exhaustive, verdict) = match frontier_of(scene) {
+            Some(f) => {
+                let s = load_sweep(&reports.join(f))?;
+                let points: Vec<_> = s.records.iter().filter(|r| r.kind != "floor").collect();
+                let best = points
+                    .iter()
+                    .filter(|r| within(r, budget))
+                    .map(|r| r.mirror_flip())
+                    .fold(f64::INFINITY, f64::min);
+                let best_point = points
+                    .iter()
+                    .copied()
+                    .filter(|r| within(r, budget))
+                    .min_by(|a, b| a.mirror_flip().total_cmp(&b.mirror_flip()));
+                let verdict = match (error(pick), best_point) {
+                    (_, None) => "the sweep has nothing within budget".into(),
+                    (Some(e), Some(_)) if e <= best * (1.0 + TIE) => format!(
+                        "yes: {} against the sweep's best within budget {}",
+                        sci(e),
+                        sci(best)
+                    ),
+                    (_, Some(x)) => timing_verdict(v, x, budget),
+                };
+                (format!("{} (`{f}`)", points.len()), verdict)
+            }
+            None => ("–".into(), "no exhaustive sweep of this scene".into()),
+        };
+        rows.push(vec![
+            format!("`{folder}`"),
+            ms(budget, 3),
+            pick_text,
+            pick_ms,
+            pick_error,
+            format!(
+                "{} in {} rounds, {} frames, {:.0} s",
+                v["measured"].as_array().map_or(0, Vec::len),
+                v["rounds"],
+                v["renders"],
+                v["seconds"].as_f64().unwrap_or(0.0)
+            ),
+            exhaustive,
+            verdict,
+        ]);
+        if let Some(first) = folder.strip_suffix("_repeat")
+            && let Some((_, a)) = all.iter().find(|(f, _)| f == first)
+        {
+            let name = |p: &Value| p["method"].as_str().unwrap_or("none").to_string();
+            let set = |v: &Value| -> Vec<String> {
+                std::iter::once(name(&v["pick"]))
+                    .chain(v["ties"].as_array().into_iter().flatten().map(name))
+                    .collect()
+            };
+            let (p1, p2) = (name(&a["pick"]), name(&v["pick"]));
+            // A pick of one run that the other run measured with an interval holding the
+            // budget: the runs differ by the noise at the budget, a tie.
+            let at_budget = |run: &Value, key: &str| {
+                run["measured"].as_array().into_iter().flatten().any(|m| {
+                    m["method"].as_str() == Some(key)
+                        && m["ms_interval"].as_array().is_some_and(|i| {
+                            i[0].as_f64().is_some_and(|lo| lo <= budget)
+                                && i[1].as_f64().is_some_and(|hi| budget <= hi)
+                        })
+                })
+            };
+            notes.push(if p1 == p2 {
+                format!("`{folder}` picks what `{first}` picked: `{p1}`.")
+            } else if set(a).contains(&p2) || set(v).contains(&p1) {
+                format!(
+                    "`{folder}` picks `{p2}`, tied with `{first}`'s `{p1}` (errors within {:.0} %).",
+                    100.0 * TIE
+                )
+            } else if at_budget(v, &p1) || at_budget(a, &p2) {
+                format!(
+                    "`{folder}` picks `{p2}` where `{first}` picked `{p1}`: a tie at the budget \
+                     (one run's 95 % interval for the other's pick holds the budget)."
+                )
+            } else {
+                format!("`{folder}` picks `{p2}` where `{first}` picked `{p1}`: they DIFFER.")
+            });
+        }
+    }
+    let device = all
+        .first()
+        .and_then(|(_, v)| v["device"].as_str())
+        .unwrap_or("an unrecorded device")
+        .to_string();
+    let mut blocks = vec![
+        Block::Paragraph(format!(
+            "Measured on {device}, 320×180, α = 1, error = FLIP mean over the mirror pixels; \
+             a pick fits only if its ms/frame interval's upper end is within the budget."
+        )),
+        Block::Table(
+            [
+                "advice",
+                "budget ms",
+                "pick",
+                "ms/frame [95 % CI]",
+                "error",
+                "search: candidates, rounds, frames, time",
+                "exhaustive sweep: candidates",
+                "as good as the exhaustive sweep's best within budget",
+            ]
+            .map(String::from)
+            .to_vec(),
+            rows,
+        ),
+    ];
+    if !notes.is_empty() {
+        blocks.push(Block::Bullets(notes));
+    }
+    Ok(markdown(&blocks))
+}
+
+pub const ADVISE: Experiment = Experiment {
+    name: "advise",
+    about: "mirrorbox advise on four scenes at three budgets each: its picks, their search cost, a repeat, and the exhaustive frontier's best beside them",
+    folder: "advise",
+    measure: Measure::Script("scripts/measure-advise.sh", &[]),
+    section: None,
+    regions: &[RegionSource {
+        id: "advise",
+        source: "advise",
+        about: "what the advisor picked per scene and budget, its search cost, and the exhaustive frontier's best beside it",
+        generate: advise_region,
+    }],
+    chapter: "advise.md",
+    main_job: false,
+    overview: None,
+};

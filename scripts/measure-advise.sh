@@ -1,0 +1,34 @@
+#!/usr/bin/env bash
+# Experiment advise (issue 55): `mirrorbox advise` on the paper's box, the mirror room, the
+# imported CAD engine (110 k triangles) and a scene the search was never tuned on
+# (tilted_pair), at three budgets each, 320×180, α = 1 — the frontier's size and α, so that
+# the picks on mirror_box and mirror_room can be set against the frontier sweeps' fronts —
+# and the mirror room's middle budget a second time (does a repeat pick the same or a tie?).
+# Each advice goes to reports/advise/<scene>_<budget>ms[_repeat]/ (its search rounds' images
+# are not kept: the pick's are).
+# Usage: scripts/measure-advise.sh
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bin=${MIRRORBOX:-target/release/mirrorbox}
+out=reports/advise
+rm -rf "$out"
+mkdir -p "$out"
+advise() { # SCENE BUDGET_MS [SUFFIX] [FLAGS...]
+  local scene=$1 budget=$2 suffix=${3:-}
+  shift 3 || shift $#
+  local dir="$out/${scene##*/}_${budget}ms$suffix"
+  echo "== advise: $scene within $budget ms$suffix"
+  "$bin" advise "scenes/$scene.json" --budget-ms "$budget" --width 320 --height 180 \
+    --alpha 1 -o "$dir" "$@"
+  # Of the rounds, the records only (results.jsonl, sweep.json): their images, caches and
+  # reports are not kept (advice.md shows the pick's images; ~5 MB per advice otherwise).
+  find "$dir/search" -mindepth 2 -maxdepth 2 ! -name results.jsonl ! -name sweep.json \
+    -exec rm -rf {} +
+  rm -rf "$dir/cache"
+}
+for budget in 2 4 8; do advise mirror_box "$budget" ""; done
+for budget in 3 6 12; do advise mirror_room "$budget" ""; done
+advise mirror_room 6 _repeat
+for budget in 2 4 8; do advise tilted_pair "$budget" ""; done
+# The engine: every frame 40 ms and more here; 6 timed rounds per candidate.
+for budget in 60 120 400; do advise imported/engine_box "$budget" "" --frames 6; done
