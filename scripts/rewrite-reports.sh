@@ -13,8 +13,10 @@ if [ $# -ge 2 ] && [ "$1" = --bin ]; then bin=$2; shift 2; fi
 [ $# -eq 0 ] || { sed -n '/^# Usage:/p' "$0" >&2; exit 2; }
 [ -x "$bin" ] || { echo "error: $bin is not built (cargo build --release --locked -p mirrorbox)" >&2; exit 2; }
 dirs=()
+# An advice's rounds (reports/advise/*/search/round-K) keep their records only: the advice
+# is rewritten as a whole (its advice.json), not its rounds.
 while IFS= read -r f; do dirs+=("$(dirname "$f")"); done < <(
-  find reports -name sweep.json -o -name motion.json | sort)
+  find reports \( -path '*/search/round-*' -prune \) -o \( -name sweep.json -o -name motion.json -o -name advice.json \) -print | sort)
 echo "rewriting ${#dirs[@]} report folders"
 "$bin" report "${dirs[@]}" >/dev/null
 "$bin" report --index reports

@@ -80,6 +80,9 @@ struct Knob {
     ascending: bool,
     last_within: Option<u32>,
     first_over: Option<u32>,
+    /// Values measured while ascending whose median fit but whose interval did not: not
+    /// measured again by the bisection, which counts them over budget.
+    straddled: Vec<u32>,
 }
 
 impl Knob {
@@ -164,6 +167,7 @@ fn candidates(only: &[String]) -> (Vec<Method>, Vec<Knob>) {
                 ascending: true,
                 last_within: None,
                 first_over: None,
+                straddled: Vec::new(),
             })),
         }
     }
@@ -182,7 +186,9 @@ impl Knob {
     fn saw(&mut self, v: u32, fits: bool, median_fits: bool) {
         if fits {
             self.last_within = Some(self.last_within.map_or(v, |w| w.max(v)));
-        } else if !(self.ascending && median_fits) {
+        } else if self.ascending && median_fits {
+            self.straddled.push(v);
+        } else {
             self.ascending = false;
             self.first_over = Some(self.first_over.map_or(v, |o| o.min(v)));
         }
@@ -311,10 +317,17 @@ pub fn search(
                 }
                 k.ascending = false;
             }
-            if let (Some(lo), Some(hi)) = (k.last_within, k.first_over)
+            while let (Some(lo), Some(hi)) = (k.last_within, k.first_over)
                 && hi > lo + 1
             {
-                todo.push(k.at(lo + (hi - lo) / 2));
+                let mid = lo + (hi - lo) / 2;
+                if k.straddled.contains(&mid) {
+                    // Measured while ascending, its interval over: over, not timed again.
+                    k.first_over = Some(mid);
+                    continue;
+                }
+                todo.push(k.at(mid));
+                break;
             }
         }
     }
@@ -457,6 +470,11 @@ pub fn sentences(advice: &Advice, metric: Metric, scene: &Path) -> Vec<String> {
             }
             out.push(format!("Render it: `{}`", render_command(scene, p)));
         }
+        (None, Some(c)) if c.ms_median <= advice.budget_ms => out.push(format!(
+            "No candidate fits {budget} ms with its whole interval: the cheapest, {}, has \
+             its median within the budget and its interval over it (a tie with the budget).",
+            described(c, metric)
+        )),
         (None, Some(c)) => out.push(format!(
             "No candidate fits {budget} ms: the cheapest is {}, {:.2}× the budget.",
             described(c, metric),
@@ -491,6 +509,21 @@ pub fn sentences(advice: &Advice, metric: Metric, scene: &Path) -> Vec<String> {
     out
 }
 
+/// A candidate's label on the chart: its knob's setting (`depth=8`, `cube-size=64`), else
+/// its variant (`ssr-fallback=none`), else nothing.
+fn setting_label(r: &Record) -> String {
+    let key = r.key.split('|').next().unwrap_or_default();
+    let Ok(m) = Method::parse(key) else {
+        return String::new();
+    };
+    match m.entry().advise {
+        Advise::Knob { option, .. } => m
+            .count_of(option.name)
+            .map_or(String::new(), |v| format!("{}={v}", option.name)),
+        _ => m.variant_options(),
+    }
+}
+
 /// The measured candidates as a chart: error against ms/frame, one series per method in its
 /// fixed style (its settings as labels, not joined: a search's order is not an axis), the
 /// Pareto front of what was measured, and the budget.
@@ -520,10 +553,7 @@ pub fn chart(
         );
         s.joined = false;
         s.x_intervals = pts.iter().map(|r| r.ms_interval).collect();
-        s.labels = pts
-            .iter()
-            .map(|r| mirrorbox_report::document::label(r).replace(&format!("{m} "), ""))
-            .collect();
+        s.labels = pts.iter().map(|r| setting_label(r)).collect();
         series.push(s);
     }
     let coords: Vec<(f64, f64)> = advice
@@ -611,6 +641,64 @@ pub fn advise_into(
     Ok(advice)
 }
 
+/// An advice folder's answer and files remade from its records (`advice.json` for the
+/// budget, metric, scene and search cost; `search/round-K/results.jsonl` for the candidates),
+/// without measuring: what `mirrorbox report DIR` does for an advice after a change to how
+/// the answer is chosen or drawn.
+pub fn rewrite(out: &Path) -> Result<Advice, HarnessError> {
+    let path = out.join("advice.json");
+    let text = std::fs::read_to_string(&path).map_err(crate::io(&path))?;
+    let v: serde_json::Value = serde_json::from_str(&text)?;
+    let bad = |what: &str| HarnessError::Exchange(format!("{}: {what}", path.display()));
+    let metric = match v["metric"].as_str() {
+        Some(m) if m == Metric::Flip.name() => Metric::Flip,
+        Some(m) if m == Metric::Relmse.name() => Metric::Relmse,
+        _ => return Err(bad("no metric this version knows")),
+    };
+    let scene = PathBuf::from(v["scene"].as_str().ok_or_else(|| bad("no scene"))?);
+    let mut advice = Advice {
+        budget_ms: v["budget_ms"].as_f64().ok_or_else(|| bad("no budget_ms"))?,
+        renders: v["renders"].as_u64().unwrap_or(0),
+        seconds: v["seconds"].as_f64().unwrap_or(0.0),
+        ..Default::default()
+    };
+    for r in v["refused"].as_array().into_iter().flatten() {
+        advice.refused.push((
+            r["method"].as_str().unwrap_or_default().into(),
+            r["why"].as_str().unwrap_or_default().into(),
+        ));
+    }
+    advice.unsupported = v["unsupported"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .filter_map(|u| u.as_str().map(String::from))
+        .collect();
+    for k in 1.. {
+        let folder = out.join("search").join(format!("round-{k}"));
+        let results = folder.join("results.jsonl");
+        if !results.is_file() {
+            break;
+        }
+        advice.rounds += 1;
+        for r in read_records(&results).map_err(crate::io(&results))? {
+            if r.kind != "floor" {
+                advice.measured.push(r);
+                advice.folders.push(folder.clone());
+            }
+        }
+    }
+    choose(&mut advice, metric);
+    let config = AdviseConfig {
+        sweep: SweepConfig::new(scene, out.to_path_buf(), Vec::new(), vec![1.0]),
+        budget_ms: advice.budget_ms,
+        metric,
+        methods: Vec::new(),
+    };
+    write_advice(&advice, &config, out)?;
+    Ok(advice)
+}
+
 fn write_advice(advice: &Advice, config: &AdviseConfig, out: &Path) -> Result<(), HarnessError> {
     let scene = &config.sweep.scene;
     let metric = config.metric;
@@ -627,19 +715,23 @@ fn write_advice(advice: &Advice, config: &AdviseConfig, out: &Path) -> Result<()
             (&p.truth_image, "truth.png"),
             (&p.heatmap_image, "pick_flip.png"),
         ] {
+            // A rewrite from the records finds the rounds' images gone and the copies made.
             let src = folder.join(from);
-            std::fs::copy(&src, out.join(to)).map_err(crate::io(&src))?;
+            if src.is_file() {
+                std::fs::copy(&src, out.join(to)).map_err(crate::io(&src))?;
+            }
         }
     }
     let info = advice
         .measured
         .first()
-        .map(|r| (r.adapter.clone(), r.width, r.height, r.alpha));
+        .map(|r| (r.adapter.clone(), r.width, r.height, r.alpha, r.run.clone()));
+    // Dated when measured (the first round's start), not when drawn.
     let footer = match &info {
-        Some((adapter, w, h, a)) => format!(
-            "{} · {w}x{h} · α = {a} · {adapter} · {}",
+        Some((adapter, w, h, a, run)) => format!(
+            "{} · {w}x{h} · α = {a} · {adapter} · measured {}",
             scene.display(),
-            crate::now_rfc3339()
+            run.as_deref().unwrap_or("at an unrecorded time")
         ),
         None => scene.display().to_string(),
     };
@@ -786,6 +878,44 @@ mod tests {
                 .starts_with("portal depth=21|")
         );
         assert_eq!(advice.rounds, 10);
+    }
+
+    /// A value that straddled the budget while ascending is not timed again by the bisection:
+    /// depth 2's interval holds the budget, depth 4 is over; the bracket (1, 4) ends at 2
+    /// without a fourth round.
+    #[test]
+    fn the_bisection_does_not_time_a_straddling_value_again() {
+        let config = AdviseConfig {
+            sweep: SweepConfig::new(PathBuf::new(), PathBuf::new(), Vec::new(), vec![1.0]),
+            budget_ms: 1.3,
+            metric: Metric::Flip,
+            methods: vec!["portal".into()],
+        };
+        let mut asked = Vec::new();
+        let advice = search(&config, &mut |methods| {
+            asked.extend(methods.iter().map(Method::key));
+            let measured = methods
+                .iter()
+                .map(|m| {
+                    let d = f64::from(m.count_of("depth").unwrap());
+                    let ms = 1.0 + 0.1 * d;
+                    let hi = if d == 2.0 { 1.5 } else { ms * 1.01 };
+                    candidate(&m.key(), ms, hi, 1.0 / d)
+                })
+                .collect();
+            Ok(Round {
+                measured,
+                refused: Vec::new(),
+                folder: PathBuf::new(),
+                renders: 1,
+            })
+        })
+        .unwrap();
+        assert_eq!(
+            asked,
+            ["portal depth=1", "portal depth=2", "portal depth=4"]
+        );
+        assert!(advice.pick.unwrap().key.starts_with("portal depth=1|"));
     }
 
     #[test]

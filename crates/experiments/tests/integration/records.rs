@@ -65,11 +65,43 @@ fn every_committed_report_is_rewritten_byte_for_byte() {
     let mut folders = Vec::new();
     let mut files = Vec::new();
     results_files(&root().join("reports"), &mut files);
-    folders.extend(files.iter().map(|f| f.parent().unwrap().to_path_buf()));
+    // An advice's rounds keep their records only; the advice is remade as a whole below.
+    let (rounds, sweeps): (Vec<PathBuf>, Vec<PathBuf>) = files
+        .iter()
+        .map(|f| f.parent().unwrap().to_path_buf())
+        .partition(|d| d.parent().is_some_and(|p| p.ends_with("search")));
+    folders.extend(sweeps);
     folders.push(root().join("reports/motion"));
     let sections = mirrorbox_experiments::sections();
     // The figure check (issue 54): every chart of every committed report, as it is drawn.
     let mut problems: Vec<String> = Vec::new();
+    // Every advice (issue 55): its advice.md and front.svg from its rounds' records.
+    let mut advices: Vec<PathBuf> = rounds
+        .iter()
+        .filter_map(|r| r.parent()?.parent().map(Path::to_path_buf))
+        .collect();
+    advices.dedup();
+    for advice in &advices {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::copy(advice.join("advice.json"), dir.path().join("advice.json")).unwrap();
+        for round in rounds.iter().filter(|r| r.starts_with(advice)) {
+            let to = dir.path().join("search").join(round.file_name().unwrap());
+            std::fs::create_dir_all(&to).unwrap();
+            for f in ["results.jsonl", "sweep.json"] {
+                std::fs::copy(round.join(f), to.join(f)).unwrap();
+            }
+        }
+        let (_, lint) = mirrorbox_report::plot::collect_lint(|| {
+            mirrorbox_harness::advise::rewrite(dir.path()).unwrap()
+        });
+        problems.extend(lint.into_iter().map(|m| format!("{}: {m}", advice.display())));
+        for f in ["advice.md", "front.svg"] {
+            let want = std::fs::read_to_string(advice.join(f)).unwrap();
+            let have = std::fs::read_to_string(dir.path().join(f)).unwrap();
+            assert!(have == want, "{}: the remade {f} differs", advice.display());
+        }
+    }
+    assert!(!advices.is_empty());
     for folder in &folders {
         let dir = tempfile::tempdir().unwrap();
         let mut copied = 0;
