@@ -12,6 +12,10 @@ height=${2:-18}
 bin=${MIRRORBOX:-target/release/mirrorbox}
 [ -x "$bin" ] || cargo build --release -p mirrorbox
 export NODEVICE_SELECT=1
+# Memory, not time: keep Mesa's shader cache, which `render` turns off for its timings (issue
+# 54). With it off, every one of its `render` processes compiled its shaders: 227 s in the main
+# job of 2026-11-27 (fresh clone of 27cba85), 32 s with the cache (the step alone, warm build).
+export MESA_SHADER_CACHE_DISABLE=false
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 methods=$("$bin" render --help | sed -n '/Possible values:/,/^$/p' | sed -n 's/^ *- \([a-z-]*\):.*/\1/p')

@@ -557,7 +557,9 @@ pub const REGIONS: &[mirrorbox_report::readme::RegionSource] = &[
 
 /// Every committed run of Table 1 on lavapipe with the timing commands' default (every
 /// shader compiled afresh), in the order they ran: the main job's two (`table1`,
-/// `table1_repeat`), then four run back to back in both orders (experiment `table1-runs`).
+/// `table1_repeat`), then four run back to back in both orders (experiment `table1-runs`),
+/// then the other order in the fresh clone of the main job (`fresh_e_repeat`, then
+/// `fresh_f_table1`, by hand: `experiment table1-repeat`, then `table1`, each `--out`).
 pub const LAVAPIPE_RUNS: &[&str] = &[
     "table1",
     "table1_repeat",
@@ -565,6 +567,8 @@ pub const LAVAPIPE_RUNS: &[&str] = &[
     "table1_runs/b_repeat",
     "table1_runs/c_repeat",
     "table1_runs/d_table1",
+    "table1_runs/fresh_e_repeat",
+    "table1_runs/fresh_f_table1",
 ];
 
 /// Table 1 with Mesa's disk shader cache cold, warm and off, twice over (experiment

@@ -94,7 +94,10 @@ fn every_committed_report_is_rewritten_byte_for_byte() {
         let (_, lint) = mirrorbox_report::plot::collect_lint(|| {
             mirrorbox_harness::advise::rewrite(dir.path()).unwrap()
         });
-        problems.extend(lint.into_iter().map(|m| format!("{}: {m}", advice.display())));
+        problems.extend(
+            lint.into_iter()
+                .map(|m| format!("{}: {m}", advice.display())),
+        );
         for f in ["advice.md", "front.svg"] {
             let want = std::fs::read_to_string(advice.join(f)).unwrap();
             let have = std::fs::read_to_string(dir.path().join(f)).unwrap();
