@@ -822,25 +822,25 @@ mod tests {
         r
     }
 
-    /// The search against a model of `portal`: depth d costs 1 + 0.1·d ms, its error is 1/d;
-    /// depth 8's interval (a noisy round) reaches over the budget though its median does not.
-    #[test]
-    fn the_search_ascends_past_a_noisy_value_then_bisects_to_the_last_depth_within_budget() {
+    /// The search on `portal` alone against a model: depth d costs 1 + 0.1·d ms, its error
+    /// is 1/d, and at depth `noisy` the interval reaches `noisy_hi` (a noisy round). Returns
+    /// the advice and every candidate asked for, in order.
+    fn search_model(budget_ms: f64, noisy: f64, noisy_hi: f64) -> (Advice, Vec<String>) {
         let config = AdviseConfig {
             sweep: SweepConfig::new(PathBuf::new(), PathBuf::new(), Vec::new(), vec![1.0]),
-            budget_ms: 3.05,
+            budget_ms,
             metric: Metric::Flip,
             methods: vec!["portal".into()],
         };
-        let mut asked: Vec<Vec<String>> = Vec::new();
+        let mut asked = Vec::new();
         let advice = search(&config, &mut |methods| {
-            asked.push(methods.iter().map(Method::key).collect());
+            asked.extend(methods.iter().map(Method::key));
             let measured = methods
                 .iter()
                 .map(|m| {
                     let d = f64::from(m.count_of("depth").unwrap());
                     let ms = 1.0 + 0.1 * d;
-                    let hi = if d == 8.0 { 3.5 } else { ms * 1.01 };
+                    let hi = if d == noisy { noisy_hi } else { ms * 1.01 };
                     candidate(&m.key(), ms, hi, 1.0 / d)
                 })
                 .collect();
@@ -852,7 +852,15 @@ mod tests {
             })
         })
         .unwrap();
-        let depths: Vec<&str> = asked.iter().map(|r| r[0].as_str()).collect();
+        (advice, asked)
+    }
+
+    /// Depth 8's interval (a noisy round) reaches over the budget though its median does not:
+    /// the ascent goes on, then the bisection ends at the last depth within budget.
+    #[test]
+    fn the_search_ascends_past_a_noisy_value_then_bisects_to_the_last_depth_within_budget() {
+        let (advice, asked) = search_model(3.05, 8.0, 3.5);
+        let depths: Vec<&str> = asked.iter().map(String::as_str).collect();
         assert_eq!(
             depths,
             [
@@ -885,32 +893,7 @@ mod tests {
     /// without a fourth round.
     #[test]
     fn the_bisection_does_not_time_a_straddling_value_again() {
-        let config = AdviseConfig {
-            sweep: SweepConfig::new(PathBuf::new(), PathBuf::new(), Vec::new(), vec![1.0]),
-            budget_ms: 1.3,
-            metric: Metric::Flip,
-            methods: vec!["portal".into()],
-        };
-        let mut asked = Vec::new();
-        let advice = search(&config, &mut |methods| {
-            asked.extend(methods.iter().map(Method::key));
-            let measured = methods
-                .iter()
-                .map(|m| {
-                    let d = f64::from(m.count_of("depth").unwrap());
-                    let ms = 1.0 + 0.1 * d;
-                    let hi = if d == 2.0 { 1.5 } else { ms * 1.01 };
-                    candidate(&m.key(), ms, hi, 1.0 / d)
-                })
-                .collect();
-            Ok(Round {
-                measured,
-                refused: Vec::new(),
-                folder: PathBuf::new(),
-                renders: 1,
-            })
-        })
-        .unwrap();
+        let (advice, asked) = search_model(1.3, 2.0, 1.5);
         assert_eq!(
             asked,
             ["portal depth=1", "portal depth=2", "portal depth=4"]
