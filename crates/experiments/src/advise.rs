@@ -80,6 +80,14 @@ fn advices(reports: &Path) -> Result<Vec<(String, Value)>, ReadmeError> {
     Ok(out)
 }
 
+/// A JSON point's ms/frame median and, where it has one, its 95 % interval.
+fn timing(p: &Value) -> (f64, Option<(f64, f64)>) {
+    let interval = p["ms_interval"]
+        .as_array()
+        .and_then(|i| Some((i.first()?.as_f64()?, i.get(1)?.as_f64()?)));
+    (p["ms_median"].as_f64().unwrap_or(f64::NAN), interval)
+}
+
 /// The method of a JSON point, or "–".
 fn method(v: &Value) -> String {
     v["method"]
@@ -91,7 +99,7 @@ fn method(v: &Value) -> String {
 /// either the advisor measured `x` and found it over budget (the two runs' timings disagree:
 /// a tie at the budget where its interval holds the budget), or it never measured it.
 fn timing_verdict(advice: &Value, x: &Record, budget: f64) -> String {
-    let key = x.key.split('|').next().unwrap_or_default();
+    let key = x.method_key();
     let theirs = advice["measured"]
         .as_array()
         .into_iter()
@@ -100,16 +108,8 @@ fn timing_verdict(advice: &Value, x: &Record, budget: f64) -> String {
     let sweep_ms = ms(x.ms_median, 3);
     match theirs {
         Some(m) => {
-            let median = m["ms_median"].as_f64().unwrap_or(f64::NAN);
-            let (lo, hi) = match m["ms_interval"].as_array().map(|i| {
-                (
-                    i[0].as_f64().unwrap_or(median),
-                    i[1].as_f64().unwrap_or(median),
-                )
-            }) {
-                Some(i) => i,
-                None => (median, median),
-            };
+            let (median, interval) = timing(m);
+            let (lo, hi) = interval.unwrap_or((median, median));
             let at = if lo <= budget && budget <= hi {
                 "a tie at the budget"
             } else {
@@ -157,14 +157,11 @@ fn advise_region(reports: &Path) -> Result<String, ReadmeError> {
                 } else {
                     method(pick)
                 },
-                match pick["ms_interval"].as_array() {
-                    Some(i) if i.len() == 2 => format!(
-                        "{} [{}–{}]",
-                        ms(pick["ms_median"].as_f64().unwrap_or(0.0), 3),
-                        ms(i[0].as_f64().unwrap_or(0.0), 3),
-                        ms(i[1].as_f64().unwrap_or(0.0), 3)
-                    ),
-                    _ => ms(pick["ms_median"].as_f64().unwrap_or(0.0), 3),
+                match timing(pick) {
+                    (median, Some((lo, hi))) => {
+                        format!("{} [{}–{}]", ms(median, 3), ms(lo, 3), ms(hi, 3))
+                    }
+                    (median, None) => ms(median, 3),
                 },
                 error(pick).map_or("–".into(), sci),
             )
@@ -228,10 +225,9 @@ fn advise_region(reports: &Path) -> Result<String, ReadmeError> {
             let at_budget = |run: &Value, key: &str| {
                 run["measured"].as_array().into_iter().flatten().any(|m| {
                     m["method"].as_str() == Some(key)
-                        && m["ms_interval"].as_array().is_some_and(|i| {
-                            i[0].as_f64().is_some_and(|lo| lo <= budget)
-                                && i[1].as_f64().is_some_and(|hi| budget <= hi)
-                        })
+                        && timing(m)
+                            .1
+                            .is_some_and(|(lo, hi)| lo <= budget && budget <= hi)
                 })
             };
             notes.push(if p1 == p2 {

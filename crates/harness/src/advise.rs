@@ -21,8 +21,8 @@ use mirrorbox_raster::{Advise, METHODS, Method, ParamValue};
 use mirrorbox_report::{Record, read_records};
 use std::path::{Path, PathBuf};
 
-/// Errors within this share of the lowest are a tie (as the uneven-mirror report's winners).
-pub const TIE: f64 = 0.02;
+/// Errors within this share of the lowest are a tie (the reports' tolerance).
+pub use mirrorbox_report::document::TIE_TOLERANCE as TIE;
 
 /// The error a pick minimises.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -60,6 +60,7 @@ impl Metric {
 
 /// What to advise on: the sweep settings every round shares (scene, size, SSAA, α, frames,
 /// memory budget, truth cache), the budget and the metric.
+#[derive(Clone)]
 pub struct AdviseConfig {
     /// The rounds' settings; its `methods` and `out` are set per round.
     pub sweep: SweepConfig,
@@ -126,18 +127,10 @@ pub struct Advice {
 }
 
 /// Whether `r` is within `budget` ms: the upper end of its 95 % interval (its median where
-/// it has none) at most the budget.
-///
-/// A candidate whose interval holds the budget is at the budget: within it in one run, over
-/// it in another ([`straddles`]).
+/// it has none) at most the budget. A candidate whose interval holds the budget is at the
+/// budget: within it in one run, over it in another.
 pub fn within(r: &Record, budget: f64) -> bool {
     r.ms_interval.map_or(r.ms_median, |[_, hi]| hi) <= budget
-}
-
-/// Whether `r`'s 95 % interval holds `budget`: two runs may judge it either way.
-pub fn straddles(r: &Record, budget: f64) -> bool {
-    r.ms_interval
-        .is_some_and(|[lo, hi]| lo <= budget && budget <= hi)
 }
 
 /// The registry's candidates for a scene: fixed ones, and knobs to search.
@@ -294,7 +287,7 @@ pub fn search(
             advice.renders += r.renders;
         }
         for rec in r.measured {
-            let key = rec.key.split('|').next().unwrap_or_default();
+            let key = rec.method_key();
             if let Ok(m) = Method::parse(key) {
                 for k in knobs.iter_mut().filter(|k| k.owns(&m)) {
                     if let Some(v) = k.value(&m) {
@@ -395,7 +388,7 @@ pub fn choose(advice: &mut Advice, metric: Metric) {
 
 /// The command that renders `r` as measured: method, options, size, SSAA, α.
 pub fn render_command(scene: &Path, r: &Record) -> String {
-    let key = r.key.split('|').next().unwrap_or_default();
+    let key = r.method_key();
     let mut words: Vec<String> = key.split_whitespace().map(String::from).collect();
     let method = words.remove(0);
     let options: String = words
@@ -428,7 +421,7 @@ fn described(r: &Record, metric: Metric) -> String {
     };
     format!(
         "`{}` ({ms}, {} {})",
-        r.key.split('|').next().unwrap_or_default(),
+        r.method_key(),
         metric.name(),
         mirrorbox_report::document::sci(metric.of(r))
     )
@@ -512,7 +505,7 @@ pub fn sentences(advice: &Advice, metric: Metric, scene: &Path) -> Vec<String> {
 /// A candidate's label on the chart: its knob's setting (`depth=8`, `cube-size=64`), else
 /// its variant (`ssr-fallback=none`), else nothing.
 fn setting_label(r: &Record) -> String {
-    let key = r.key.split('|').next().unwrap_or_default();
+    let key = r.method_key();
     let Ok(m) = Method::parse(key) else {
         return String::new();
     };
@@ -611,34 +604,18 @@ pub fn advise_into(
     progress: &mut dyn FnMut(Event),
 ) -> Result<Advice, HarnessError> {
     crate::exchange::replaceable(out, "advice.json", "advice")?;
-    let partial = PathBuf::from(format!("{}.partial", out.display()));
-    if partial.exists() {
-        std::fs::remove_dir_all(&partial).map_err(crate::io(&partial))?;
-    }
-    std::fs::create_dir_all(&partial).map_err(crate::io(&partial))?;
-    let mut sweep = config.sweep.clone();
-    // One truth for every round: the cache outlives the rounds' folders.
-    sweep.truth_cache = Some(
+    // The rounds' folders name `OUT.partial`; the files keep working after the move.
+    crate::exchange::in_staged_folder(out, |partial| {
+        let mut config = config.clone();
+        // One truth for every round: the cache outlives the rounds' folders.
         config
             .sweep
             .truth_cache
-            .clone()
-            .unwrap_or_else(|| partial.join("cache")),
-    );
-    let config = AdviseConfig {
-        sweep,
-        budget_ms: config.budget_ms,
-        metric: config.metric,
-        methods: config.methods.clone(),
-    };
-    let advice = advise(&config, &partial, progress)?;
-    write_advice(&advice, &config, &partial)?;
-    // The rounds' folders name `OUT.partial`; the files keep working after the move.
-    if out.exists() {
-        std::fs::remove_dir_all(out).map_err(crate::io(out))?;
-    }
-    std::fs::rename(&partial, out).map_err(crate::io(out))?;
-    Ok(advice)
+            .get_or_insert_with(|| partial.join("cache"));
+        let advice = advise(&config, partial, progress)?;
+        write_advice(&advice, &config, partial)?;
+        Ok(advice)
+    })
 }
 
 /// An advice folder's answer and files remade from its records (`advice.json` for the
@@ -756,7 +733,7 @@ fn write_advice(advice: &Advice, config: &AdviseConfig, out: &Path) -> Result<()
     for r in &advice.measured {
         md.push_str(&format!(
             "| `{}` | {} | {} | {} |\n",
-            r.key.split('|').next().unwrap_or_default(),
+            r.method_key(),
             mirrorbox_report::document::ms_cell(r, 3),
             mirrorbox_report::document::sci(metric.of(r)),
             if within(r, advice.budget_ms) {
@@ -778,7 +755,7 @@ fn write_advice(advice: &Advice, config: &AdviseConfig, out: &Path) -> Result<()
 pub fn to_json(advice: &Advice, metric: Metric, scene: &Path) -> serde_json::Value {
     let point = |r: &Record| {
         serde_json::json!({
-            "method": r.key.split('|').next().unwrap_or_default(),
+            "method": r.method_key(),
             "ms_median": r.ms_median,
             "ms_interval": r.ms_interval,
             "error": metric.of(r),
@@ -916,10 +893,7 @@ mod tests {
             ..Default::default()
         };
         choose(&mut a, Metric::Flip);
-        let key = |r: &Option<Record>| {
-            r.as_ref()
-                .map(|r| r.key.split('|').next().unwrap().to_string())
-        };
+        let key = |r: &Option<Record>| r.as_ref().map(|r| r.method_key().to_string());
         assert_eq!(key(&a.pick).as_deref(), Some("unrolled depth=8"));
         assert_eq!(a.ties.len(), 1);
         assert!(a.ties[0].key.starts_with("portal depth=8"));

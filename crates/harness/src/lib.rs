@@ -919,14 +919,23 @@ pub fn refused_points(config: &SweepConfig) -> Result<Vec<(Method, String)>, Har
         let Some(method) = p.method.clone() else {
             continue;
         };
-        let (scene, settings) = point_setup(&base, &p, config)?;
-        if let Err(why) = worker::plan_point(&scene, &settings)
-            .and_then(|planned| planned.check_memory(&scene, &settings, config.memory_budget))
-        {
+        if let Err(why) = fits_memory(&base, &p, config)? {
             out.push((method, why.to_string()));
         }
     }
     Ok(out)
+}
+
+/// Whether point `p`'s frame fits the sweep's memory budget by the plan's estimate (planned
+/// on the CPU, the plan dropped): the one check of [`run_sweep`] and [`refused_points`].
+fn fits_memory(
+    base: &Scene,
+    p: &Point,
+    config: &SweepConfig,
+) -> Result<Result<(), PlanError>, HarnessError> {
+    let (scene, settings) = point_setup(base, p, config)?;
+    Ok(worker::plan_point(&scene, &settings)
+        .and_then(|planned| planned.check_memory(&scene, &settings, config.memory_budget)))
 }
 
 /// The current UTC time, RFC 3339 to the second.
@@ -976,13 +985,10 @@ pub fn run_sweep(
         read_records(&results).map_err(io(&results))?
     };
     for p in still_to_do(&done_before) {
-        let (scene, settings) = point_setup(&base, p, config)?;
-        worker::plan_point(&scene, &settings)
-            .and_then(|planned| planned.check_memory(&scene, &settings, config.memory_budget))
-            .map_err(|source| HarnessError::Refused {
-                point: p.label.clone(),
-                source,
-            })?;
+        fits_memory(&base, p, config)?.map_err(|source| HarnessError::Refused {
+            point: p.label.clone(),
+            source,
+        })?;
     }
     let (images, cache) = (out.join("images"), out.join("cache"));
     let truth_cache = config.truth_cache.clone().unwrap_or_else(|| cache.clone());

@@ -177,7 +177,7 @@ pub fn swept_label(r: &Record) -> String {
     if let Some(d) = r.depth {
         return format!("d={d}");
     }
-    let method = r.key.split('|').next().unwrap_or_default();
+    let method = r.method_key();
     let options: Vec<&str> = r.method_options.split_whitespace().collect();
     method
         .split_whitespace()

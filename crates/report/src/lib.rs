@@ -384,6 +384,12 @@ impl Record {
             .map(|[low, high]| stats::Interval { low, high })
     }
 
+    /// The method part of the point's resume key (`portal depth=8`, `ssr ssr-fallback=none`):
+    /// what `Method::parse` reads back.
+    pub fn method_key(&self) -> &str {
+        self.key.split('|').next().unwrap_or_default()
+    }
+
     /// The error a point is judged by: its FLIP mean over the mirror pixels where the mask
     /// was kept, else over the image.
     pub fn mirror_flip(&self) -> f64 {

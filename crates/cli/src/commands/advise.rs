@@ -117,7 +117,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         {
             eprintln!(
                 "  {:<34} {:>9.3} ms/frame  {}",
-                record.key.split('|').next().unwrap_or_default(),
+                record.method_key(),
                 record.ms_median,
                 if mirrorbox_harness::advise::within(record, args.budget_ms) {
                     "within budget"

@@ -190,7 +190,7 @@ fn depth_blocks(pts: &[&Record]) -> Vec<Block> {
         } else if r.n.is_some() {
             mirrorbox_report::document::label(r)
         } else {
-            r.key.split('|').next().unwrap_or(&r.method).to_string()
+            r.method_key().to_string()
         };
         for (chart, y) in [(&mut error, r.mirror_flip()), (&mut cost, r.ms_median)] {
             let mut s = Series::new(label.clone(), style, vec![(depth, y)]);
