@@ -176,3 +176,116 @@ fn advise_names_the_closest_when_nothing_fits_and_the_best_when_everything_does(
     assert!(!dir.path().join("huge.partial").exists());
     let _ = repo();
 }
+
+/// A camera path of two views: every candidate is timed and scored from each (one sweep per
+/// view per round, `round-K/<view>`), and the advice takes each candidate's worst view — its
+/// largest median and error — and shows that view's images; `mirrorbox report` remakes the
+/// same answer from the records. A view the scene cannot be seen from is refused first.
+#[test]
+fn advise_over_a_camera_path_takes_each_candidates_worst_view() {
+    let dir = tempfile::tempdir().unwrap();
+    let views = dir.path().join("views.json");
+    std::fs::write(
+        &views,
+        r#"{"views": [
+            {"name": "scene", "position": [0.8, 1.8, 1.7], "look_at": [-0.25, 1.15, -2.0]},
+            {"name": "side", "position": [-0.6, 1.2, 1.5], "look_at": [0.4, 1.0, -2.0]}
+        ]}"#,
+    )
+    .unwrap();
+    let out = dir.path().join("path");
+    let run = |views: &std::path::Path, over: &str| {
+        mirrorbox(
+            &[
+                "advise",
+                "scenes/mirror_box.json",
+                "--budget-ms",
+                "3600000",
+                "--methods",
+                "naive,auxiliary",
+                "--width",
+                "32",
+                "--height",
+                "18",
+                "--frames",
+                "6",
+                "--views",
+                views.to_str().unwrap(),
+                "--over-views",
+                over,
+                "--json",
+                "-o",
+                out.to_str().unwrap(),
+            ],
+            &[],
+        )
+    };
+    let r = run(&views, "worst");
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let v: Value = serde_json::from_str(r.stdout.trim()).unwrap();
+    assert_eq!(v["views"], serde_json::json!(["scene", "side"]), "{v}");
+    assert_eq!(v["over_views"], "worst");
+    let per_view = |view: &str| -> Vec<Value> {
+        let text =
+            std::fs::read_to_string(out.join(format!("search/round-1/{view}/results.jsonl")))
+                .unwrap();
+        text.lines()
+            .map(|l| serde_json::from_str::<Value>(l).unwrap())
+            .filter(|r| r["kind"] != "floor")
+            .collect()
+    };
+    let (a, b) = (per_view("scene"), per_view("side"));
+    let flip = |r: &Value| {
+        r["mirror_metrics"]["flip_mean"]
+            .as_f64()
+            .unwrap_or_else(|| r["metrics"]["flip_mean"].as_f64().unwrap())
+    };
+    let first = &v["measured"][0];
+    let key = first["method"].as_str().unwrap();
+    let find = |rs: &[Value]| {
+        rs.iter()
+            .find(|r| r["key"].as_str().unwrap().starts_with(&format!("{key}|")))
+            .cloned()
+            .unwrap()
+    };
+    let (ra, rb) = (find(&a), find(&b));
+    let median = |r: &Value| r["ms_median"].as_f64().unwrap();
+    assert_eq!(
+        first["ms_median"].as_f64().unwrap(),
+        median(&ra).max(median(&rb))
+    );
+    assert_eq!(first["error"].as_f64().unwrap(), flip(&ra).max(flip(&rb)));
+    assert!(out.join("pick.png").is_file());
+    // The answer remade from the records is the same answer.
+    let before = std::fs::read_to_string(out.join("advice.json")).unwrap();
+    let r = mirrorbox(&["report", out.to_str().unwrap()], &[]);
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    assert_eq!(
+        std::fs::read_to_string(out.join("advice.json")).unwrap(),
+        before
+    );
+    // A view looking at its own position, and an unknown combination: exit 2, nothing
+    // written.
+    std::fs::remove_dir_all(&out).unwrap();
+    let bad = dir.path().join("bad_views.json");
+    std::fs::write(
+        &bad,
+        r#"{"views": [{"name": "blind", "position": [0, 1, 0], "look_at": [0, 1, 0]}]}"#,
+    )
+    .unwrap();
+    let r = run(&bad, "worst");
+    assert_eq!(r.code, 2, "{}", r.stderr);
+    assert!(
+        r.stderr.contains("bad_views.json") && r.stderr.contains("\"blind\""),
+        "{}",
+        r.stderr
+    );
+    let r = run(&views, "median");
+    assert_eq!(r.code, 2, "{}", r.stderr);
+    assert!(
+        r.stderr.contains("--over-views: one of worst, mean"),
+        "{}",
+        r.stderr
+    );
+    assert!(!out.exists());
+}

@@ -11,11 +11,16 @@
 //! 2. **Bisection**: between each knob's last value within budget and its first over it, the
 //!    middle value, until the two are neighbours.
 //!
+//! With a camera path (`--views`), every round renders each candidate from every view (one
+//! sweep per view, `round-K/<view>`, one cached truth per view), and a candidate's time and
+//! error are its worst view's, or the views' means ([`OverViews`], [`over_views`]).
+//!
 //! A candidate is **within budget** only if the upper end of its ms/frame 95 % interval is.
 //! Of the candidates within budget, those within 2 % of the lowest error are **tied**; the
 //! cheapest of them is the pick, the others are named beside it. Before a round renders, the plan's memory
 //! estimate refuses what would not fit (said, never rendered).
 
+use crate::exchange::ViewSpec;
 use crate::{Event, HarnessError, SweepConfig, refused_points, run_sweep};
 use mirrorbox_raster::{Advise, METHODS, Method, ParamValue};
 use mirrorbox_report::{Record, read_records};
@@ -58,8 +63,36 @@ impl Metric {
     }
 }
 
+/// How a camera path's views make one candidate's time and error (`--over-views`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum OverViews {
+    /// The worst view: the largest median, interval ends and error of the views. A candidate
+    /// fits only if it fits in every view.
+    Worst,
+    /// The views' means: of the medians, of each interval end (wider than the mean's own
+    /// interval: the views are timed in separate sweeps, not paired), and of the error.
+    Mean,
+}
+
+impl OverViews {
+    pub fn parse(s: &str) -> Option<OverViews> {
+        match s {
+            "worst" => Some(OverViews::Worst),
+            "mean" => Some(OverViews::Mean),
+            _ => None,
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            OverViews::Worst => "worst",
+            OverViews::Mean => "mean",
+        }
+    }
+}
+
 /// What to advise on: the sweep settings every round shares (scene, size, SSAA, α, frames,
-/// memory budget, truth cache), the budget and the metric.
+/// memory budget, truth cache), the budget, the metric and the views.
 #[derive(Clone)]
 pub struct AdviseConfig {
     /// The rounds' settings; its `methods` and `out` are set per round.
@@ -68,6 +101,9 @@ pub struct AdviseConfig {
     pub metric: Metric,
     /// Only these methods (registry names); empty: every method the registry offers.
     pub methods: Vec<String>,
+    /// A camera path (`--views FILE`); empty: the scene's camera.
+    pub views: Vec<ViewSpec>,
+    pub over_views: OverViews,
 }
 
 /// One knob being searched: a method variant, the option, its coarse values and where the
@@ -122,8 +158,12 @@ pub struct Advice {
     pub renders: u64,
     /// The search's wall time (rounds, truth and memory checks).
     pub seconds: f64,
-    /// Where each measured record's images are: the round's folder.
+    /// Where each measured record's images are: the round's folder (with views, the folder
+    /// of the view where its error is largest).
     pub folders: Vec<PathBuf>,
+    /// The views' names (empty: the scene's camera) and how they were combined.
+    pub views: Vec<String>,
+    pub over_views: Option<OverViews>,
 }
 
 /// Whether `r` is within `budget` ms: the upper end of its 95 % interval (its median where
@@ -188,13 +228,80 @@ impl Knob {
     }
 }
 
-/// What one round of the search returns: the candidates measured (in order), those the
-/// memory estimate refused with why, where the round's records are, and the frames rendered.
+/// What one round of the search returns: the candidates measured (in order) and where each
+/// one's images are, those the memory estimate refused with why, and the frames rendered.
 pub struct Round {
     pub measured: Vec<Record>,
+    pub folders: Vec<PathBuf>,
     pub refused: Vec<(Method, String)>,
-    pub folder: PathBuf,
     pub renders: u64,
+}
+
+/// One record per candidate measured in every view of `per_view` (each view's records, in
+/// the first view's order; a candidate is its method and α, as the keys also name the view's
+/// scene hash), and the index of the view whose images show it: the one where
+/// its error (`metric`) is largest. `Worst`: that view's record with the largest median and
+/// interval ends of the views; `Mean`: the means of the medians, interval ends and errors
+/// (FLIP over the image and the mirror pixels, relMSE). One view: its records unchanged.
+pub fn over_views(
+    per_view: &[Vec<Record>],
+    how: OverViews,
+    metric: Metric,
+) -> Vec<(Record, usize)> {
+    let Some(first) = per_view.first() else {
+        return Vec::new();
+    };
+    let mut out = Vec::new();
+    for r in first {
+        let Some(views): Option<Vec<&Record>> = per_view
+            .iter()
+            .map(|v| {
+                v.iter()
+                    .find(|x| x.method_key() == r.method_key() && x.alpha == r.alpha)
+            })
+            .collect()
+        else {
+            continue;
+        };
+        let worst = (0..views.len())
+            .max_by(|&a, &b| metric.of(views[a]).total_cmp(&metric.of(views[b])))
+            .expect("at least one view");
+        let mut a = views[worst].clone();
+        let ends = |v: &&Record| v.ms_interval.unwrap_or([v.ms_median, v.ms_median]);
+        let n = views.len() as f64;
+        let all_intervals = views.iter().all(|v| v.ms_interval.is_some());
+        match how {
+            OverViews::Worst => {
+                a.ms_median = views.iter().map(|v| v.ms_median).fold(f64::MIN, f64::max);
+                a.ms_interval = all_intervals.then(|| {
+                    views.iter().map(ends).fold([f64::MIN, f64::MIN], |m, e| {
+                        [m[0].max(e[0]), m[1].max(e[1])]
+                    })
+                });
+            }
+            OverViews::Mean => {
+                let mean = |f: &dyn Fn(&Record) -> f64| views.iter().map(|v| f(v)).sum::<f64>() / n;
+                a.ms_median = mean(&|v| v.ms_median);
+                a.ms_interval = all_intervals.then(|| {
+                    let s = views
+                        .iter()
+                        .map(ends)
+                        .fold([0.0, 0.0], |m, e| [m[0] + e[0], m[1] + e[1]]);
+                    [s[0] / n, s[1] / n]
+                });
+                a.metrics.flip_mean = mean(&|v| v.metrics.flip_mean);
+                a.metrics.relmse = mean(&|v| v.metrics.relmse);
+                if views.iter().all(|v| v.mirror_metrics.is_some()) {
+                    let m = mean(&|v| v.mirror_metrics.as_ref().map_or(0.0, |m| m.flip_mean));
+                    if let Some(mm) = a.mirror_metrics.as_mut() {
+                        mm.flip_mean = m;
+                    }
+                }
+            }
+        }
+        out.push((a, worst));
+    }
+    out
 }
 
 /// Runs the search into `out` (`out/search/round-K` per round), reporting the rounds'
@@ -209,25 +316,50 @@ pub fn advise(
     std::fs::create_dir_all(&search_dir).map_err(crate::io(&search_dir))?;
     let mut unsupported: Vec<String> = Vec::new();
     let mut rounds = 0;
+    // One sweep per view each round (the scene's camera alone without views).
+    let views: Vec<Option<&ViewSpec>> = if config.views.is_empty() {
+        vec![None]
+    } else {
+        config.views.iter().map(Some).collect()
+    };
     let mut advice = search(config, &mut |methods| {
         rounds += 1;
         let folder = search_dir.join(format!("round-{rounds}"));
-        let mut sweep = SweepConfig {
-            methods,
-            out: folder.clone(),
-            ..config.sweep.clone()
-        };
-        let refused = refused_points(&sweep)?;
-        sweep
-            .methods
-            .retain(|m| !refused.iter().any(|(r, _)| r == m));
+        if !config.views.is_empty() {
+            std::fs::create_dir_all(&folder).map_err(crate::io(&folder))?;
+        }
+        let sweeps: Vec<SweepConfig> = views
+            .iter()
+            .map(|v| SweepConfig {
+                methods: methods.clone(),
+                out: v.map_or(folder.clone(), |v| folder.join(&v.name)),
+                camera: v.cloned(),
+                ..config.sweep.clone()
+            })
+            .collect();
+        // Refused in any view: refused.
+        let mut refused: Vec<(Method, String)> = Vec::new();
+        for s in &sweeps {
+            for r in refused_points(s)? {
+                if !refused.iter().any(|(m, _)| *m == r.0) {
+                    refused.push(r);
+                }
+            }
+        }
         let mut round = Round {
             measured: Vec::new(),
+            folders: Vec::new(),
             refused,
-            folder: folder.clone(),
             renders: 0,
         };
-        if !sweep.methods.is_empty() {
+        let mut per_view = Vec::new();
+        for mut sweep in sweeps {
+            sweep
+                .methods
+                .retain(|m| !round.refused.iter().any(|(r, _)| r == m));
+            if sweep.methods.is_empty() {
+                break;
+            }
             run_sweep(&sweep, true, &mut |e| {
                 if let Event::Unsupported { reason, .. } = &e
                     && !unsupported.iter().any(|u| u == reason)
@@ -236,19 +368,33 @@ pub fn advise(
                 }
                 progress(e)
             })?;
-            round.renders = renders(&sweep);
-            let results = folder.join("results.jsonl");
-            round.measured = read_records(&results)
-                .map_err(crate::io(&results))?
-                .into_iter()
-                .filter(|r| r.kind != "floor")
-                .collect();
+            round.renders += renders(&sweep);
+            per_view.push(measured_in(&sweep.out)?);
+        }
+        for (r, view) in over_views(&per_view, config.over_views, config.metric) {
+            round.measured.push(r);
+            round.folders.push(match views[view] {
+                Some(v) => folder.join(&v.name),
+                None => folder.clone(),
+            });
         }
         Ok(round)
     })?;
     advice.unsupported = unsupported;
+    advice.views = config.views.iter().map(|v| v.name.clone()).collect();
+    advice.over_views = (!config.views.is_empty()).then_some(config.over_views);
     advice.seconds = started.elapsed().as_secs_f64();
     Ok(advice)
+}
+
+/// A round's records (the floor left out), from `folder/results.jsonl`.
+fn measured_in(folder: &Path) -> Result<Vec<Record>, HarnessError> {
+    let results = folder.join("results.jsonl");
+    Ok(read_records(&results)
+        .map_err(crate::io(&results))?
+        .into_iter()
+        .filter(|r| r.kind != "floor")
+        .collect())
 }
 
 /// The search itself, each round's candidates measured by `round` (a sweep in [`advise`],
@@ -286,7 +432,7 @@ pub fn search(
             advice.rounds += 1;
             advice.renders += r.renders;
         }
-        for rec in r.measured {
+        for (rec, folder) in r.measured.into_iter().zip(r.folders) {
             let key = rec.method_key();
             if let Ok(m) = Method::parse(key) {
                 for k in knobs.iter_mut().filter(|k| k.owns(&m)) {
@@ -296,7 +442,7 @@ pub fn search(
                 }
             }
             advice.measured.push(rec);
-            advice.folders.push(r.folder.clone());
+            advice.folders.push(folder);
         }
         // The next round: ascend where the last value's median was within budget, else
         // bisect.
@@ -492,6 +638,19 @@ pub fn sentences(advice: &Advice, metric: Metric, scene: &Path) -> Vec<String> {
             advice.unsupported.join("; ")
         ));
     }
+    if let Some(how) = advice.over_views {
+        out.push(format!(
+            "Over the {} views of the camera path ({}): each candidate's ms/frame and error are {}; \
+             the images are of the view where its error is largest. The render command uses the \
+             scene's own camera.",
+            advice.views.len(),
+            advice.views.join(", "),
+            match how {
+                OverViews::Worst => "those of its worst view (it fits only if it fits in every view)",
+                OverViews::Mean => "the views' means (interval ends averaged: views are timed apart, not paired)",
+            }
+        ));
+    }
     out.push(format!(
         "Search cost: {} candidates in {} timing rounds, {} frames rendered, {:.0} s.",
         advice.measured.len(),
@@ -651,18 +810,43 @@ pub fn rewrite(out: &Path) -> Result<Advice, HarnessError> {
         .flatten()
         .filter_map(|u| u.as_str().map(String::from))
         .collect();
+    advice.views = v["views"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .filter_map(|u| u.as_str().map(String::from))
+        .collect();
+    let over = match v["over_views"].as_str() {
+        None => OverViews::Worst,
+        Some(o) => OverViews::parse(o).ok_or_else(|| bad("over_views: worst or mean"))?,
+    };
+    if !advice.views.is_empty() {
+        advice.over_views = Some(over);
+    }
+    // Every round's folder (a round the memory estimate refused whole has no records).
     for k in 1.. {
         let folder = out.join("search").join(format!("round-{k}"));
-        let results = folder.join("results.jsonl");
-        if !results.is_file() {
+        if !folder.is_dir() {
             break;
         }
-        advice.rounds += 1;
-        for r in read_records(&results).map_err(crate::io(&results))? {
-            if r.kind != "floor" {
-                advice.measured.push(r);
-                advice.folders.push(folder.clone());
+        let view_folders: Vec<PathBuf> = if advice.views.is_empty() {
+            vec![folder.clone()]
+        } else {
+            advice.views.iter().map(|n| folder.join(n)).collect()
+        };
+        let mut per_view = Vec::new();
+        for f in &view_folders {
+            if f.join("results.jsonl").is_file() {
+                per_view.push(measured_in(f)?);
             }
+        }
+        if per_view.len() < view_folders.len() {
+            continue;
+        }
+        advice.rounds += 1;
+        for (r, view) in over_views(&per_view, over, metric) {
+            advice.measured.push(r);
+            advice.folders.push(view_folders[view].clone());
         }
     }
     choose(&mut advice, metric);
@@ -671,6 +855,8 @@ pub fn rewrite(out: &Path) -> Result<Advice, HarnessError> {
         budget_ms: advice.budget_ms,
         metric,
         methods: Vec::new(),
+        views: Vec::new(),
+        over_views: over,
     };
     write_advice(&advice, &config, out)?;
     Ok(advice)
@@ -704,13 +890,17 @@ fn write_advice(advice: &Advice, config: &AdviseConfig, out: &Path) -> Result<()
         .first()
         .map(|r| (r.adapter.clone(), r.width, r.height, r.alpha, r.run.clone()));
     // Dated when measured (the first round's start), not when drawn.
+    let views = match advice.over_views {
+        Some(how) => format!(" · {} views, {}", advice.views.len(), how.name()),
+        None => String::new(),
+    };
     let footer = match &info {
         Some((adapter, w, h, a, run)) => format!(
-            "{} · {w}x{h} · α = {a} · {adapter} · measured {}",
+            "{}{views} · {w}x{h} · α = {a} · {adapter} · measured {}",
             scene.display(),
             run.as_deref().unwrap_or("at an unrecorded time")
         ),
-        None => scene.display().to_string(),
+        None => format!("{}{views}", scene.display()),
     };
     let stem = scene
         .file_stem()
@@ -774,6 +964,8 @@ pub fn to_json(advice: &Advice, metric: Metric, scene: &Path) -> serde_json::Val
         "refused": advice.refused.iter().map(|(k, why)| serde_json::json!({"method": k, "why": why})).collect::<Vec<_>>(),
         "unsupported": advice.unsupported,
         "measured": advice.measured.iter().map(point).collect::<Vec<_>>(),
+        "views": advice.views,
+        "over_views": advice.over_views.map(OverViews::name),
         "rounds": advice.rounds,
         "renders": advice.renders,
         "seconds": advice.seconds,
@@ -808,11 +1000,13 @@ mod tests {
             budget_ms,
             metric: Metric::Flip,
             methods: vec!["portal".into()],
+            views: Vec::new(),
+            over_views: OverViews::Worst,
         };
         let mut asked = Vec::new();
         let advice = search(&config, &mut |methods| {
             asked.extend(methods.iter().map(Method::key));
-            let measured = methods
+            let measured: Vec<Record> = methods
                 .iter()
                 .map(|m| {
                     let d = f64::from(m.count_of("depth").unwrap());
@@ -822,9 +1016,9 @@ mod tests {
                 })
                 .collect();
             Ok(Round {
+                folders: vec![PathBuf::new(); measured.len()],
                 measured,
                 refused: Vec::new(),
-                folder: PathBuf::new(),
                 renders: 1,
             })
         })
@@ -876,6 +1070,46 @@ mod tests {
             ["portal depth=1", "portal depth=2", "portal depth=4"]
         );
         assert!(advice.pick.unwrap().key.starts_with("portal depth=1|"));
+    }
+
+    /// Two views: the worst takes each candidate's largest median, interval ends and error,
+    /// and shows the view where its error is largest; the mean averages them; a candidate
+    /// missing from a view is left out.
+    #[test]
+    fn a_camera_path_combines_each_candidate_over_its_views() {
+        let a = vec![
+            candidate("portal depth=8", 4.0, 5.0, 0.30),
+            candidate("naive", 1.0, 1.2, 0.9),
+        ];
+        let b = vec![
+            candidate("portal depth=8", 6.0, 6.5, 0.10),
+            candidate("unrolled depth=2", 2.0, 2.2, 0.5),
+        ];
+        let worst = over_views(&[a.clone(), b.clone()], OverViews::Worst, Metric::Flip);
+        assert_eq!(
+            worst.len(),
+            1,
+            "naive and unrolled were not measured in both"
+        );
+        let (r, view) = &worst[0];
+        assert_eq!(*view, 0, "the error is largest in the first view");
+        assert_eq!(r.ms_median, 6.0);
+        assert_eq!(r.ms_interval, Some([5.4, 6.5]));
+        assert_eq!(r.mirror_flip(), 0.30);
+        let mean = over_views(&[a.clone(), b], OverViews::Mean, Metric::Flip);
+        let (r, _) = &mean[0];
+        assert_eq!(r.ms_median, 5.0);
+        let [lo, hi] = r.ms_interval.unwrap();
+        assert!(
+            (lo - 4.5).abs() < 1e-12 && (hi - 5.75).abs() < 1e-12,
+            "{lo} {hi}"
+        );
+        assert!((r.mirror_flip() - 0.20).abs() < 1e-12);
+        // One view: its records as they are.
+        let one = over_views(std::slice::from_ref(&a), OverViews::Mean, Metric::Flip);
+        assert_eq!(one.len(), 2);
+        assert_eq!(one[0].0.ms_median, 4.0);
+        assert_eq!(one[1].0.mirror_flip(), 0.9);
     }
 
     #[test]

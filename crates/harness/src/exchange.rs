@@ -33,7 +33,7 @@ pub const CLIENT_RULES: &[&str] = &[
 
 /// One camera of a view list (`--views FILE`): where it is and where it looks; the scene's
 /// up and field of view unless given.
-#[derive(Clone, Debug, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct ViewSpec {
     pub name: String,
@@ -357,7 +357,9 @@ fn write_export(
 }
 
 /// `base` seen from `spec`'s camera.
-fn view_scene(base: &Scene, spec: &ViewSpec) -> Result<Scene, HarnessError> {
+/// `base` seen from `spec`: its camera moved, checked (position and look-at apart, up not
+/// along the view, field of view in (0, 180)).
+pub fn view_scene(base: &Scene, spec: &ViewSpec) -> Result<Scene, HarnessError> {
     let mut scene = base.clone();
     let c = &mut scene.camera;
     c.position = Vec3::from_array(spec.position);

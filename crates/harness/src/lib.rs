@@ -94,6 +94,9 @@ pub struct SweepConfig {
     /// Where traced truths are cached (`--truth-cache DIR`; default `OUT/cache`): several
     /// shards may share one, as every truth is written atomically under a content hash.
     pub truth_cache: Option<PathBuf>,
+    /// The scene's camera replaced by this view (`advise --views`, [`exchange::ViewSpec`]):
+    /// every point, its truth and its worker see the scene from here. `None`: the scene's own.
+    pub camera: Option<exchange::ViewSpec>,
 }
 
 /// One of `count` disjoint shares of a sweep's points (`--shard index/count`, index from 0).
@@ -168,6 +171,7 @@ impl SweepConfig {
             marker: None,
             shard: None,
             truth_cache: None,
+            camera: None,
         }
     }
 
@@ -865,6 +869,9 @@ fn point_setup(
 fn base_scene(config: &SweepConfig) -> Result<(Scene, u32, u32), HarnessError> {
     config.validate()?;
     let mut base = load_scene(&config.scene)?;
+    if let Some(view) = &config.camera {
+        base = exchange::view_scene(&base, view)?;
+    }
     base.resize(config.width, config.height)?;
     let min = mirrorbox_image::metrics::MIN_SIDE;
     for (flag, side) in [
@@ -1072,6 +1079,7 @@ pub fn run_sweep(
             warmup: config.warmup,
             scene_hash: scene.content_hash(),
             image: rendered_image(&cache, i),
+            camera: config.camera.clone(),
             axes: p
                 .axes
                 .iter()

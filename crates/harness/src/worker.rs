@@ -43,6 +43,9 @@ pub struct RenderJob {
     /// The point's scene axes (`crate::axes`), by name: `[["planes", 3]]`.
     #[serde(default)]
     pub axes: Vec<(String, f64)>,
+    /// The sweep's view in place of the scene's camera ([`crate::SweepConfig::camera`]).
+    #[serde(default)]
+    pub camera: Option<crate::exchange::ViewSpec>,
 }
 
 /// Where a stereo job's right eye goes, beside `image`.
@@ -114,6 +117,9 @@ pub fn method_text(method: &Method) -> String {
 /// The scene a job describes.
 fn job_scene(job: &RenderJob) -> Result<Scene, HarnessError> {
     let mut scene = load_scene(&job.scene)?;
+    if let Some(view) = &job.camera {
+        scene = crate::exchange::view_scene(&scene, view)?;
+    }
     scene.resize(Some(job.width), Some(job.height))?;
     let axes = job
         .axes

@@ -29,6 +29,9 @@ const COLORS: [&str; 7] = [
 ];
 /// Reference curves and floors.
 const REFERENCE_GREY: &str = "#888888";
+/// The dash of the i-th reference (cycled), in the plot and its legend alike: two references
+/// of one chart (a Pareto front and a budget) are told apart by their dash.
+const REFERENCE_DASHES: [&str; 3] = ["5 4", "1.5 3", "9 3 2 3"];
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Marker {
@@ -873,7 +876,8 @@ impl Chart {
             s,
             r#"<clipPath id="plot"><rect x="{LEFT}" y="{TOP}" width="{PLOT_W}" height="{PLOT_H}"/></clipPath><g clip-path="url(#plot)">"#
         );
-        for r in &self.references {
+        for (i, r) in self.references.iter().enumerate() {
+            let dash = REFERENCE_DASHES[i % REFERENCE_DASHES.len()];
             let pts: Vec<(f64, f64)> = match r {
                 Reference::Level(_, y) if drawable(*y, ay.log) => {
                     vec![(ax.lo, *y), (ax.hi, *y)]
@@ -892,7 +896,7 @@ impl Chart {
                     .collect();
                 let _ = writeln!(
                     s,
-                    r#"<polyline points="{}" fill="none" stroke="{REFERENCE_GREY}" stroke-width="1.5" stroke-dasharray="5 4"/>"#,
+                    r#"<polyline points="{}" fill="none" stroke="{REFERENCE_GREY}" stroke-width="1.5" stroke-dasharray="{dash}"/>"#,
                     p.join(" ")
                 );
             }
@@ -1043,6 +1047,7 @@ impl Chart {
         // The legend.
         let lx = LEFT + PLOT_W + 14.0;
         let mut ly = TOP + 10.0;
+        let mut references_drawn = 0;
         for (name, series) in &legend {
             match series {
                 Some(series) => {
@@ -1063,9 +1068,11 @@ impl Chart {
                     marker_svg(&mut s, st, lx + 12.0, ly, MARKER_R, st.hollow);
                 }
                 None => {
+                    let dash = REFERENCE_DASHES[references_drawn % REFERENCE_DASHES.len()];
+                    references_drawn += 1;
                     let _ = writeln!(
                         s,
-                        r#"<line x1="{lx}" y1="{ly}" x2="{}" y2="{ly}" stroke="{REFERENCE_GREY}" stroke-width="1.5" stroke-dasharray="5 4"/>"#,
+                        r#"<line x1="{lx}" y1="{ly}" x2="{}" y2="{ly}" stroke="{REFERENCE_GREY}" stroke-width="1.5" stroke-dasharray="{dash}"/>"#,
                         lx + 24.0
                     );
                 }
@@ -1192,6 +1199,26 @@ mod tests {
             .unwrap()
             .parse()
             .unwrap()
+    }
+
+    /// Two references (the advisor's Pareto front and its budget) are told apart: each has
+    /// its own dash, the same in the plot and in its legend row.
+    #[test]
+    fn each_reference_has_its_own_dash_in_plot_and_legend() {
+        let mut c = chart(vec![Series::new(
+            "a",
+            method_style("auxiliary"),
+            vec![(1.0, 0.5), (10.0, 0.1)],
+        )]);
+        c.references.push(Reference::Curve(
+            "budget".into(),
+            vec![(5.0, 0.1), (5.0, 0.5)],
+        ));
+        let svg = c.to_svg();
+        for dash in &REFERENCE_DASHES[..2] {
+            let n = svg.matches(&format!("stroke-dasharray=\"{dash}\"")).count();
+            assert_eq!(n, 2, "dash {dash}: {n} strokes (plot and legend)");
+        }
     }
 
     #[test]

@@ -4,7 +4,7 @@
 
 use super::{grid_side, unit_interval};
 use crate::Failure;
-use mirrorbox_harness::advise::{AdviseConfig, Metric, advise_into, sentences, to_json};
+use mirrorbox_harness::advise::{AdviseConfig, Metric, OverViews, advise_into, sentences, to_json};
 use mirrorbox_harness::{Event, SweepConfig};
 use mirrorbox_raster::{Advise, METHODS};
 use std::path::PathBuf;
@@ -36,6 +36,15 @@ pub struct Args {
     /// Timed rounds per candidate (6 or more give each median a 95 % interval), 6..100.
     #[arg(long, default_value_t = 9)]
     frames: u32,
+    /// A camera path: a view list as `export-views` reads it (`{"views": [{"name",
+    /// "position", "look_at", "up"?, "fov_y_deg"?}]}`, 1 to 64 views). Every candidate is
+    /// timed and scored from each view; default: the scene's camera.
+    #[arg(long)]
+    views: Option<PathBuf>,
+    /// How the views make one candidate's time and error: worst (every view must fit) or
+    /// mean.
+    #[arg(long = "over-views", default_value = "worst", requires = "views")]
+    over_views: String,
     /// Output folder (its parent must exist): advice.md, advice.json, front.svg, the pick's
     /// images, and the search's rounds. An earlier advice there is replaced.
     #[arg(short, long, default_value = "advice")]
@@ -87,8 +96,27 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     }
     grid_side(args.ssaa * args.ssaa)?;
     unit_interval("--alpha", Some(args.alpha))?;
-    // The scene as `check` reads it: a clear error (exit 2) before any search.
-    super::load(&args.scene)?;
+    let over_views = OverViews::parse(&args.over_views).ok_or_else(|| {
+        Failure::BadInput(format!(
+            "--over-views: one of worst, mean, got {:?}",
+            args.over_views
+        ))
+    })?;
+    // The scene as `check` reads it, and every view of it: a clear error (exit 2) before any
+    // search.
+    let scene = super::load(&args.scene)?;
+    let views = match &args.views {
+        Some(path) => {
+            let views = mirrorbox_harness::exchange::read_view_list(path)
+                .map_err(|e| Failure::BadInput(e.to_string()))?;
+            for v in &views {
+                mirrorbox_harness::exchange::view_scene(&scene, v)
+                    .map_err(|e| Failure::BadInput(format!("{}: {e}", path.display())))?;
+            }
+            views
+        }
+        None => Vec::new(),
+    };
     let sweep = SweepConfig {
         width: args.size.width,
         height: args.size.height,
@@ -109,6 +137,8 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         budget_ms: args.budget_ms,
         metric,
         methods: args.methods.clone(),
+        views,
+        over_views,
     };
     let started = std::time::Instant::now();
     let advice = advise_into(&config, &args.output, &mut |e| {

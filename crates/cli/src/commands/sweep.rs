@@ -326,6 +326,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         marker: args.marker.clone(),
         shard: None,
         truth_cache: None,
+        camera: None,
     };
     args.shard.apply(&mut config)?;
     execute(&config, args.fresh)
