@@ -22,6 +22,7 @@
 
 use crate::exchange::ViewSpec;
 use crate::{Event, HarnessError, SweepConfig, refused_points, run_sweep};
+use mirrorbox_raster::lighting::ADVISE_SHADOW_MAP_SIZES;
 use mirrorbox_raster::{Advise, METHODS, Method, ParamValue};
 use mirrorbox_report::{Record, read_records};
 use std::path::{Path, PathBuf};
@@ -104,6 +105,8 @@ pub struct AdviseConfig {
     /// A camera path (`--views FILE`); empty: the scene's camera.
     pub views: Vec<ViewSpec>,
     pub over_views: OverViews,
+    /// The scene's lighting asks for shadows: every candidate with shadow maps.
+    pub shadows: bool,
 }
 
 /// One knob being searched: a method variant, the option, its coarse values and where the
@@ -173,8 +176,28 @@ pub fn within(r: &Record, budget: f64) -> bool {
     r.ms_interval.map_or(r.ms_median, |[_, hi]| hi) <= budget
 }
 
-/// The registry's candidates for a scene: fixed ones, and knobs to search.
-fn candidates(only: &[String]) -> (Vec<Method>, Vec<Knob>) {
+/// A row's variants as candidates' option words: as declared, and with `shadows` each one
+/// also with shadow maps at every [`ADVISE_SHADOW_MAP_SIZES`] size (without them a candidate
+/// is cheaper and wrong wherever a shadow falls: the error decides).
+fn lit_variants(variants: &[&str], shadows: bool) -> Vec<String> {
+    if !shadows {
+        return variants.iter().map(|v| v.to_string()).collect();
+    }
+    variants
+        .iter()
+        .flat_map(|v| {
+            std::iter::once(v.to_string()).chain(
+                ADVISE_SHADOW_MAP_SIZES
+                    .iter()
+                    .map(move |s| format!("{v} shadows=map shadow-map-size={s}")),
+            )
+        })
+        .collect()
+}
+
+/// The registry's candidates for a scene: fixed ones, and knobs to search; with `shadows`
+/// (the scene's lighting asks for them) every one also with shadow maps ([`lit_variants`]).
+fn candidates(only: &[String], shadows: bool) -> (Vec<Method>, Vec<Knob>) {
     let mut fixed = Vec::new();
     let mut knobs = Vec::new();
     for e in METHODS {
@@ -187,12 +210,14 @@ fn candidates(only: &[String]) -> (Vec<Method>, Vec<Knob>) {
         };
         match e.advise {
             Advise::Skip => {}
-            Advise::Fixed(variants) => fixed.extend(variants.iter().map(|v| variant(v))),
+            Advise::Fixed(variants) => {
+                fixed.extend(lit_variants(variants, shadows).iter().map(|v| variant(v)))
+            }
             Advise::Knob {
                 option,
                 coarse,
                 variants,
-            } => knobs.extend(variants.iter().map(|v| Knob {
+            } => knobs.extend(lit_variants(variants, shadows).iter().map(|v| Knob {
                 base: variant(v),
                 option,
                 coarse,
@@ -407,7 +432,7 @@ pub fn search(
     config: &AdviseConfig,
     round: &mut dyn FnMut(Vec<Method>) -> Result<Round, HarnessError>,
 ) -> Result<Advice, HarnessError> {
-    let (mut todo, mut knobs) = candidates(&config.methods);
+    let (mut todo, mut knobs) = candidates(&config.methods, config.shadows);
     let mut advice = Advice {
         budget_ms: config.budget_ms,
         ..Default::default()
@@ -661,18 +686,39 @@ pub fn sentences(advice: &Advice, metric: Metric, scene: &Path) -> Vec<String> {
     out
 }
 
-/// A candidate's label on the chart: its knob's setting (`depth=8`, `cube-size=64`), else
-/// its variant (`ssr-fallback=none`), else nothing.
+/// A candidate's label on the chart: its knob's setting (`depth=8`, `cube-size=64`) and the
+/// options its variant sets that not every variant of its row sets (`n=2 texture-scale=0.5`,
+/// `ssr-fallback=none`; not cubemap's `history=16`).
 fn setting_label(r: &Record) -> String {
     let key = r.method_key();
     let Ok(m) = Method::parse(key) else {
         return String::new();
     };
+    // The variant's words, less those every declared variant has (cubemap's history=16).
+    let common = |variants: &[&str], w: &str| variants.iter().all(|v| v.split(' ').any(|x| x == w));
+    let variant = |variants: &[&str]| {
+        m.variant_options()
+            .split_whitespace()
+            .filter(|w| !common(variants, w))
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
     match m.entry().advise {
-        Advise::Knob { option, .. } => m
-            .count_of(option.name)
-            .map_or(String::new(), |v| format!("{}={v}", option.name)),
-        _ => m.variant_options(),
+        Advise::Knob {
+            option, variants, ..
+        } => {
+            let variant = variant(variants);
+            let knob = m
+                .count_of(option.name)
+                .map_or(String::new(), |v| format!("{}={v}", option.name));
+            if variant.is_empty() {
+                knob
+            } else {
+                format!("{knob} {variant}")
+            }
+        }
+        Advise::Fixed(variants) => variant(variants),
+        Advise::Skip => m.variant_options(),
     }
 }
 
@@ -857,6 +903,7 @@ pub fn rewrite(out: &Path) -> Result<Advice, HarnessError> {
         methods: Vec::new(),
         views: Vec::new(),
         over_views: over,
+        shadows: false,
     };
     write_advice(&advice, &config, out)?;
     Ok(advice)
@@ -1002,6 +1049,7 @@ mod tests {
             methods: vec!["portal".into()],
             views: Vec::new(),
             over_views: OverViews::Worst,
+            shadows: false,
         };
         let mut asked = Vec::new();
         let advice = search(&config, &mut |methods| {
@@ -1110,6 +1158,58 @@ mod tests {
         assert_eq!(one.len(), 2);
         assert_eq!(one[0].0.ms_median, 4.0);
         assert_eq!(one[1].0.mirror_flip(), 0.9);
+    }
+
+    /// On a shadowed scene every candidate is offered without shadows and with shadow maps at
+    /// each offered size; on another, the rows' variants as declared (the paper's method at
+    /// two texture scales).
+    #[test]
+    fn a_shadowed_scene_gets_every_candidate_with_shadow_maps() {
+        let key = |m: &Method| m.key();
+        let (fixed, knobs) = candidates(&["naive".into(), "portal".into()], false);
+        assert_eq!(
+            fixed.iter().map(key).collect::<Vec<_>>(),
+            ["naive", "naive texture-scale=0.5"]
+        );
+        assert_eq!(knobs.len(), 1);
+        let (fixed, knobs) = candidates(&["naive".into(), "portal".into()], true);
+        // 1024 texels is the option's default: a key names only what differs from it.
+        assert_eq!(
+            fixed.iter().map(key).collect::<Vec<_>>(),
+            [
+                "naive",
+                "naive shadows=map shadow-map-size=256",
+                "naive shadows=map",
+                "naive texture-scale=0.5",
+                "naive texture-scale=0.5 shadows=map shadow-map-size=256",
+                "naive texture-scale=0.5 shadows=map",
+            ]
+        );
+        assert_eq!(knobs.len(), 1 + ADVISE_SHADOW_MAP_SIZES.len());
+        assert_eq!(
+            knobs
+                .iter()
+                .filter(|k| k.at(4).key().contains("shadows=map"))
+                .count(),
+            ADVISE_SHADOW_MAP_SIZES.len()
+        );
+    }
+
+    #[test]
+    fn a_label_names_the_knob_and_what_sets_its_variant_apart() {
+        let label = |key: &str| setting_label(&candidate(key, 1.0, 1.1, 0.1));
+        assert_eq!(label("cubemap cube-size=64 history=16"), "cube-size=64");
+        assert_eq!(label("auxiliary n=2"), "n=2");
+        assert_eq!(
+            label("auxiliary n=2 texture-scale=0.5"),
+            "n=2 texture-scale=0.5"
+        );
+        assert_eq!(label("naive"), "");
+        assert_eq!(label("ssr ssr-fallback=planar"), "ssr-fallback=planar");
+        assert_eq!(
+            label("portal depth=4 shadows=map shadow-map-size=256"),
+            "depth=4 shadows=map shadow-map-size=256"
+        );
     }
 
     #[test]

@@ -51,6 +51,12 @@ pub static SHADOWS: OptionSpec = OptionSpec {
     in_key: true,
 };
 
+/// What `mirrorbox advise` offers beside every candidate on a scene whose lighting asks for
+/// shadows (`lighting.shadows`): the same with shadow maps, at each of these sizes (texels per
+/// side) — the truth traces every shadow ray, so a candidate without them is wrong wherever a
+/// shadow falls, and cheaper.
+pub const ADVISE_SHADOW_MAP_SIZES: &[u32] = &[256, 1024];
+
 /// `--shadow-map-size N`: texels per side of every shadow map layer.
 pub static SHADOW_MAP_SIZE: OptionSpec = OptionSpec {
     name: "shadow-map-size",

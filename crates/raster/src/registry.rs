@@ -220,7 +220,12 @@ mod tests {
         use crate::method::Advise;
         let mut offered = 0;
         for e in METHODS {
+            // Each variant as declared and with the shadow maps a shadowed scene adds.
             let parse = |words: &str| {
+                for s in crate::lighting::ADVISE_SHADOW_MAP_SIZES {
+                    let lit = format!("{} {words} shadows=map shadow-map-size={s}", e.name);
+                    Method::parse(&lit).unwrap_or_else(|err| panic!("{lit:?}: {err}"));
+                }
                 Method::parse(&format!("{} {words}", e.name))
                     .unwrap_or_else(|err| panic!("{}: variant {words:?}: {err}", e.name))
             };

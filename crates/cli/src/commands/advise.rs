@@ -139,6 +139,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         methods: args.methods.clone(),
         views,
         over_views,
+        shadows: scene.lighting.shadows,
     };
     let started = std::time::Instant::now();
     let advice = advise_into(&config, &args.output, &mut |e| {

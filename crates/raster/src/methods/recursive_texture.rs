@@ -48,7 +48,8 @@ pub static NAIVE: MethodEntry = MethodEntry {
     shaders: SHADERS,
     gpu_structs,
     configure: |p| Box::new(RecursiveTextureMethod::new(Queue::SceneMirrors, p)),
-    advise: Advise::Fixed(&[""]),
+    // Mirror textures at full and at half the mirror's footprint: cost against blur.
+    advise: Advise::Fixed(&["", "texture-scale=0.5"]),
 };
 
 /// The paper's §3.1–3.2: n auxiliary mirrors coincide with the two real ones (n + 2 in the
@@ -78,7 +79,7 @@ pub static AUXILIARY: MethodEntry = MethodEntry {
     advise: Advise::Knob {
         option: &AUXILIARY_MIRRORS,
         coarse: &[0, 1, 2, 3, 4],
-        variants: &[""],
+        variants: &["", "texture-scale=0.5"],
     },
 };
 
