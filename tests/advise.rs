@@ -129,6 +129,35 @@ fn advise_names_the_closest_when_nothing_fits_and_the_best_when_everything_does(
         "{v}"
     );
     assert_eq!(v["rounds"], 1, "{v}");
+    // --exhaustive times every coarse candidate (n = 0…4 at both texture scales) in that one
+    // round, whatever the budget.
+    let out = dir.path().join("exhaustive");
+    let r = mirrorbox(
+        &[
+            "advise",
+            "scenes/mirror_box.json",
+            "--budget-ms",
+            "0.000001",
+            "--methods",
+            "auxiliary",
+            "--width",
+            "32",
+            "--height",
+            "18",
+            "--frames",
+            "6",
+            "--exhaustive",
+            "--json",
+            "-o",
+            out.to_str().unwrap(),
+        ],
+        &[],
+    );
+    assert_eq!(r.code, 0, "{}", r.stderr);
+    let v: Value = serde_json::from_str(r.stdout.trim()).unwrap();
+    assert_eq!(v["rounds"], 1, "{v}");
+    assert_eq!(v["exhaustive"], true, "{v}");
+    assert_eq!(v["measured"].as_array().unwrap().len(), 10, "{v}");
     // Everything renders within an hour: the ascent times n = 0…4 at both texture scales,
     // one n per round, and the pick is the cheapest of those within 2 % of the lowest error.
     let out = dir.path().join("huge");

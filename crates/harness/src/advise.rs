@@ -107,6 +107,9 @@ pub struct AdviseConfig {
     pub over_views: OverViews,
     /// The scene's lighting asks for shadows: every candidate with shadow maps.
     pub shadows: bool,
+    /// Time every coarse candidate in one round, no ascent and no bisection (`--exhaustive`):
+    /// the search's whole first stage, to judge the search against.
+    pub exhaustive: bool,
 }
 
 /// One knob being searched: a method variant, the option, its coarse values and where the
@@ -167,6 +170,8 @@ pub struct Advice {
     /// The views' names (empty: the scene's camera) and how they were combined.
     pub views: Vec<String>,
     pub over_views: Option<OverViews>,
+    /// Every coarse candidate timed in one round ([`AdviseConfig::exhaustive`]).
+    pub exhaustive: bool,
 }
 
 /// Whether `r` is within `budget` ms: the upper end of its 95 % interval (its median where
@@ -435,11 +440,19 @@ pub fn search(
     let (mut todo, mut knobs) = candidates(&config.methods, config.shadows);
     let mut advice = Advice {
         budget_ms: config.budget_ms,
+        exhaustive: config.exhaustive,
         ..Default::default()
     };
     for k in &mut knobs {
-        todo.push(k.at(k.coarse[0]));
-        k.next = 1;
+        if config.exhaustive {
+            todo.extend(k.coarse.iter().map(|&v| k.at(v)));
+            // Nothing to ascend to, nothing to bisect: one round.
+            k.next = k.coarse.len();
+            k.ascending = false;
+        } else {
+            todo.push(k.at(k.coarse[0]));
+            k.next = 1;
+        }
     }
     let budget = config.budget_ms;
     while !todo.is_empty() {
@@ -472,6 +485,9 @@ pub fn search(
         // The next round: ascend where the last value's median was within budget, else
         // bisect.
         todo = Vec::new();
+        if config.exhaustive {
+            break;
+        }
         for k in knobs.iter_mut() {
             if k.ascending {
                 if let Some(&v) = k.coarse.get(k.next) {
@@ -676,6 +692,13 @@ pub fn sentences(advice: &Advice, metric: Metric, scene: &Path) -> Vec<String> {
             }
         ));
     }
+    if advice.exhaustive {
+        out.push(
+            "Exhaustive: every coarse candidate of the registry's rows timed in one round, \
+             without ascent or bisection."
+                .into(),
+        );
+    }
     out.push(format!(
         "Search cost: {} candidates in {} timing rounds, {} frames rendered, {:.0} s.",
         advice.measured.len(),
@@ -842,6 +865,7 @@ pub fn rewrite(out: &Path) -> Result<Advice, HarnessError> {
         budget_ms: v["budget_ms"].as_f64().ok_or_else(|| bad("no budget_ms"))?,
         renders: v["renders"].as_u64().unwrap_or(0),
         seconds: v["seconds"].as_f64().unwrap_or(0.0),
+        exhaustive: v["exhaustive"].as_bool().unwrap_or(false),
         ..Default::default()
     };
     for r in v["refused"].as_array().into_iter().flatten() {
@@ -904,6 +928,7 @@ pub fn rewrite(out: &Path) -> Result<Advice, HarnessError> {
         views: Vec::new(),
         over_views: over,
         shadows: false,
+        exhaustive: advice.exhaustive,
     };
     write_advice(&advice, &config, out)?;
     Ok(advice)
@@ -1013,6 +1038,7 @@ pub fn to_json(advice: &Advice, metric: Metric, scene: &Path) -> serde_json::Val
         "measured": advice.measured.iter().map(point).collect::<Vec<_>>(),
         "views": advice.views,
         "over_views": advice.over_views.map(OverViews::name),
+        "exhaustive": advice.exhaustive,
         "rounds": advice.rounds,
         "renders": advice.renders,
         "seconds": advice.seconds,
@@ -1042,6 +1068,15 @@ mod tests {
     /// is 1/d, and at depth `noisy` the interval reaches `noisy_hi` (a noisy round). Returns
     /// the advice and every candidate asked for, in order.
     fn search_model(budget_ms: f64, noisy: f64, noisy_hi: f64) -> (Advice, Vec<String>) {
+        search_model_with(budget_ms, noisy, noisy_hi, false)
+    }
+
+    fn search_model_with(
+        budget_ms: f64,
+        noisy: f64,
+        noisy_hi: f64,
+        exhaustive: bool,
+    ) -> (Advice, Vec<String>) {
         let config = AdviseConfig {
             sweep: SweepConfig::new(PathBuf::new(), PathBuf::new(), Vec::new(), vec![1.0]),
             budget_ms,
@@ -1050,6 +1085,7 @@ mod tests {
             views: Vec::new(),
             over_views: OverViews::Worst,
             shadows: false,
+            exhaustive,
         };
         let mut asked = Vec::new();
         let advice = search(&config, &mut |methods| {
@@ -1105,6 +1141,20 @@ mod tests {
                 .starts_with("portal depth=21|")
         );
         assert_eq!(advice.rounds, 10);
+    }
+
+    /// Exhaustive: every coarse depth in one round, and no bisection though the budget lies
+    /// between two of them.
+    #[test]
+    fn an_exhaustive_search_times_every_coarse_value_once() {
+        let (advice, asked) = search_model_with(3.05, 0.0, 0.0, true);
+        let coarse: Vec<String> = mirrorbox_raster::exact_options::DEPTHS_COARSE
+            .iter()
+            .map(|d| format!("portal depth={d}"))
+            .collect();
+        assert_eq!(asked, coarse);
+        assert_eq!(advice.rounds, 1);
+        assert!(advice.pick.unwrap().key.starts_with("portal depth=16|"));
     }
 
     /// A value that straddled the budget while ascending is not timed again by the bisection:

@@ -49,6 +49,11 @@ pub struct Args {
     /// images, and the search's rounds. An earlier advice there is replaced.
     #[arg(short, long, default_value = "advice")]
     output: PathBuf,
+    /// Time every coarse candidate of the registry's rows in one round, without ascent or
+    /// bisection: the search's whole first stage, to judge the search against (its cost is
+    /// stated beside the search's).
+    #[arg(long)]
+    exhaustive: bool,
     /// Also print the answer as JSON on stdout.
     #[arg(long)]
     json: bool,
@@ -140,6 +145,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         views,
         over_views,
         shadows: scene.lighting.shadows,
+        exhaustive: args.exhaustive,
     };
     let started = std::time::Instant::now();
     let advice = advise_into(&config, &args.output, &mut |e| {
