@@ -16,6 +16,7 @@
 //! error are its worst view's, or the views' means ([`OverViews`], [`over_views`]).
 //!
 //! A candidate is **within budget** only if the upper end of its ms/frame 95 % interval is.
+//! A candidate its method refuses to render (a limit of its plan) is left out, said.
 //! Of the candidates within budget, those within 2 % of the lowest error are **tied**; the
 //! cheapest of them is the pick, the others are named beside it. Before a round renders, the plan's memory
 //! estimate refuses what would not fit (said, never rendered).
@@ -364,6 +365,8 @@ pub fn advise(
                 methods: methods.clone(),
                 out: v.map_or(folder.clone(), |v| folder.join(&v.name)),
                 camera: v.cloned(),
+                // A candidate its method refuses to render is left out of the answer, said.
+                drop_refused: true,
                 ..config.sweep.clone()
             })
             .collect();
@@ -390,14 +393,26 @@ pub fn advise(
             if sweep.methods.is_empty() {
                 break;
             }
+            let mut refused_here = Vec::new();
             run_sweep(&sweep, true, &mut |e| {
-                if let Event::Unsupported { reason, .. } = &e
-                    && !unsupported.iter().any(|u| u == reason)
-                {
-                    unsupported.push(reason.to_string());
+                match &e {
+                    Event::Unsupported { reason, .. }
+                        if !unsupported.iter().any(|u| u == reason) =>
+                    {
+                        unsupported.push(reason.to_string());
+                    }
+                    Event::Refused { method, reason, .. } => {
+                        refused_here.push(((*method).clone(), reason.to_string()));
+                    }
+                    _ => {}
                 }
                 progress(e)
             })?;
+            for (m, why) in refused_here {
+                if !round.refused.iter().any(|(r, _)| *r == m) {
+                    round.refused.push((m, why));
+                }
+            }
             round.renders += renders(&sweep);
             per_view.push(measured_in(&sweep.out)?);
         }

@@ -97,6 +97,11 @@ pub struct SweepConfig {
     /// The scene's camera replaced by this view (`advise --views`, [`exchange::ViewSpec`]):
     /// every point, its truth and its worker see the scene from here. `None`: the scene's own.
     pub camera: Option<exchange::ViewSpec>,
+    /// A point whose render the method refuses (a limit found only when the frame's GPU
+    /// resources are built, past the plan: `unrolled`'s triangles per frame) is left out and
+    /// said ([`Event::Refused`]) instead of ending the sweep: what `mirrorbox advise` wants of
+    /// its rounds. Off: the refusal ends the sweep (exit 2), as a sweep's settings are wrong.
+    pub drop_refused: bool,
 }
 
 /// One of `count` disjoint shares of a sweep's points (`--shard index/count`, index from 0).
@@ -172,6 +177,7 @@ impl SweepConfig {
             shard: None,
             truth_cache: None,
             camera: None,
+            drop_refused: false,
         }
     }
 
@@ -379,6 +385,13 @@ pub enum Event<'a> {
         label: &'a str,
         reason: &'a str,
     },
+    /// A point is left out: its method refused to render it (`reason`), with
+    /// [`SweepConfig::drop_refused`].
+    Refused {
+        label: &'a str,
+        method: &'a Method,
+        reason: &'a str,
+    },
 }
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -389,6 +402,9 @@ pub struct Summary {
     pub truths_cached: usize,
     /// Points left out because the adapter lacks a feature their method needs.
     pub unsupported: usize,
+    /// Points left out because their method refused to render them
+    /// ([`SweepConfig::drop_refused`]).
+    pub refused: usize,
 }
 
 struct Point {
@@ -916,6 +932,16 @@ pub fn point_keys(config: &SweepConfig) -> Result<Vec<String>, HarnessError> {
         .collect())
 }
 
+/// Whether `e` is a method's refusal to render a point (its plan's limits), not a failure of
+/// the device, the files or the settings.
+fn refused_by_method(e: &HarnessError) -> bool {
+    match e {
+        HarnessError::Raster(r) => r.is_refusal(),
+        HarnessError::WorkerRefused(_) => true,
+        _ => false,
+    }
+}
+
 /// The points of `config` whose frame the plan's memory estimate refuses (before any GPU
 /// work), each with why: what `mirrorbox advise` leaves out instead of failing its search
 /// (issue 55). The floor is never refused.
@@ -1099,6 +1125,8 @@ pub fn run_sweep(
     let mut peaks: Vec<Option<u64>> = vec![None; todo.len()];
     let mut plans: Vec<Vec<f64>> = vec![Vec::new(); todo.len()];
     let mut encodes: Vec<Vec<f64>> = vec![Vec::new(); todo.len()];
+    // Points their method refused to render ([`SweepConfig::drop_refused`]).
+    let mut dropped = vec![false; todo.len()];
     let mut order: Vec<usize> = (0..todo.len()).collect();
     let mut rng = mirrorbox_report::stats::Rng::new(INTERLEAVE_SEED);
     for round in 0..SETTLING_ROUNDS + config.frames {
@@ -1107,6 +1135,9 @@ pub fn run_sweep(
         rng.shuffle(&mut order);
         for &i in &order {
             let p = todo[i];
+            if dropped[i] {
+                continue;
+            }
             progress(if settling {
                 Event::Settling { label: &p.label }
             } else {
@@ -1117,17 +1148,30 @@ pub fn run_sweep(
                 }
             });
             let job = &jobs[i];
-            let report = match &config.worker {
-                Some(exe) => worker::render_in_worker(exe, job, &p.label)?,
-                None => {
-                    let rendered = worker::render_scene(job, &scenes[i], &gpu)?;
+            let rendered = match &config.worker {
+                Some(exe) => worker::render_in_worker(exe, job, &p.label),
+                None => worker::render_scene(job, &scenes[i], &gpu).and_then(|rendered| {
                     // Only the last round's image is compared; the others are not written.
                     if !settling && round + 1 == config.frames {
-                        worker::write_images(job, rendered)?
+                        worker::write_images(job, rendered)
                     } else {
-                        rendered.report
+                        Ok(rendered.report)
                     }
+                }),
+            };
+            let report = match (rendered, &p.method) {
+                (Ok(report), _) => report,
+                (Err(e), Some(method)) if config.drop_refused && refused_by_method(&e) => {
+                    progress(Event::Refused {
+                        label: &p.label,
+                        method,
+                        reason: &e.to_string(),
+                    });
+                    dropped[i] = true;
+                    summary.refused += 1;
+                    continue;
                 }
+                (Err(e), _) => return Err(e),
             };
             peaks[i] = peaks[i].max(report.peak_memory_bytes);
             if settling {
@@ -1143,6 +1187,9 @@ pub fn run_sweep(
     let exposure = base.camera.exposure;
     let marker = marker_albedo(config, &base)?;
     for (i, p) in todo.iter().enumerate() {
+        if dropped[i] {
+            continue;
+        }
         let report = last[i].take().expect("every point renders in every round");
         let frames_ms = std::mem::take(&mut timed[i]);
         let mut rasters = vec![jobs[i].image.clone()];
@@ -1392,6 +1439,42 @@ pub fn git_output(dir: &Path, args: &[&str]) -> Option<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A point its method refuses to render (`unrolled` at depth 256 in the four-mirror room
+    /// at α = 1: 83 M triangles per frame, above the limit that `Unrolled::new` checks once the
+    /// frame's instances are built; its plan passes) ends the sweep, as wrong settings do; with
+    /// `drop_refused` (advise's rounds) it is left out and said, and the other points are
+    /// measured.
+    #[test]
+    fn a_point_its_method_refuses_is_left_out_when_asked() {
+        let out = tempfile::tempdir().unwrap();
+        let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/mirror_room.json");
+        let refused = Method::parse("unrolled depth=256").unwrap();
+        let mut config = SweepConfig::new(
+            scene,
+            out.path().join("sweep"),
+            vec![Method::parse("naive").unwrap(), refused.clone()],
+            vec![1.0],
+        );
+        (config.width, config.height, config.frames, config.warmup) = (Some(320), Some(180), 1, 0);
+        let err = run_sweep(&config, true, &mut |_| {}).unwrap_err();
+        assert!(refused_by_method(&err), "{err}");
+        config.drop_refused = true;
+        let mut said = Vec::new();
+        let summary = run_sweep(&config, true, &mut |e| {
+            if let Event::Refused { method, reason, .. } = e {
+                said.push((method.clone(), reason.to_string()));
+            }
+        })
+        .unwrap();
+        assert_eq!(summary.refused, 1);
+        assert_eq!(said.len(), 1);
+        assert_eq!(said[0].0, refused);
+        assert!(said[0].1.contains("triangles"), "{}", said[0].1);
+        let records = read_records(&out.path().join("sweep/results.jsonl")).unwrap();
+        let keys: Vec<&str> = records.iter().map(|r| r.method_key()).collect();
+        assert_eq!(keys, ["floor", "naive"]);
+    }
 
     /// Every point renders once in the settling round before its timed rounds, and only the
     /// timed rounds' frames are kept.

@@ -327,6 +327,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         shard: None,
         truth_cache: None,
         camera: None,
+        drop_refused: false,
     };
     args.shard.apply(&mut config)?;
     execute(&config, args.fresh)
@@ -505,7 +506,7 @@ fn execute(config: &SweepConfig, fresh: bool) -> Result<(), Failure> {
                 b.inc(1);
             }
         }
-        Event::Unsupported { label, reason } => {
+        Event::Unsupported { label, reason } | Event::Refused { label, reason, .. } => {
             eprintln!("  {label:<28} left out: {reason}");
         }
         Event::Finished { record } => {
