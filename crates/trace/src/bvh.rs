@@ -9,6 +9,7 @@
 //! Triangles are tested with [`crate::watertight`], not obvhs' own test (see there why).
 
 pub mod packet;
+mod wide;
 
 use crate::cpu_features::{Vectorised, widest};
 use crate::watertight::WatertightRay;
@@ -40,17 +41,50 @@ pub struct Hit {
 /// traversal misses some hits a few 10⁻⁵ from a mirror corner, which the BVH2 finds
 /// (docs/tracer-performance.md). The packet kernel always traverses a BVH2 (this one when
 /// `Bvh2` is chosen, else its own).
+///
+/// `Wide` is our own 8-wide hierarchy ([`wide`], issue 56): obvhs's binary one collapsed, its
+/// boxes uncompressed, traversed eight boxes at a time; the BVH2's answers, bit for bit.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum BvhKind {
     #[default]
     Cwbvh,
     Bvh2,
+    Wide,
 }
 
 enum Hierarchy {
     Empty,
     Cw(CwBvh),
     Binary(Bvh2),
+    Wide(wide::WideBvh),
+}
+
+/// A query of the 8-wide hierarchy, compiled for the CPU's widest vectors
+/// ([`crate::cpu_features::widest`]), the watertight test specialised for the ray's axis
+/// permutation.
+struct WideQuery<'a, const ANY_HIT: bool> {
+    bvh: &'a wide::WideBvh,
+    ray: &'a wide::WideRay,
+    slots: &'a [Slot],
+    original: &'a [u32],
+}
+
+impl<const ANY_HIT: bool> Vectorised for WideQuery<'_, ANY_HIT> {
+    type Output = Option<(f32, u32)>;
+
+    #[inline(always)]
+    fn run(self) -> Self::Output {
+        let (b, r, s, o) = (self.bvh, self.ray, self.slots, self.original);
+        match r.wt.axes() {
+            (1, 2, 0) => b.trace::<1, 2, 0, ANY_HIT>(r, s, o),
+            (2, 1, 0) => b.trace::<2, 1, 0, ANY_HIT>(r, s, o),
+            (2, 0, 1) => b.trace::<2, 0, 1, ANY_HIT>(r, s, o),
+            (0, 2, 1) => b.trace::<0, 2, 1, ANY_HIT>(r, s, o),
+            (0, 1, 2) => b.trace::<0, 1, 2, ANY_HIT>(r, s, o),
+            (1, 0, 2) => b.trace::<1, 0, 2, ANY_HIT>(r, s, o),
+            other => unreachable!("not an axis permutation: {other:?}"),
+        }
+    }
 }
 
 /// Runs `$body` with `$test`, the closure obvhs calls per primitive slot: the skips, then
@@ -266,9 +300,10 @@ impl SceneBvh {
                         (Hierarchy::Binary(*bvh2), order)
                     }
                 },
-                BvhKind::Bvh2 => {
+                BvhKind::Bvh2 | BvhKind::Wide => {
                     // obvhs's `build_bvh2_from_tris` over the boxes (our parameters have no
-                    // pre-splits, the one step that needs the triangles).
+                    // pre-splits, the one step that needs the triangles); collapsed to 8
+                    // wide below, once the slots are known.
                     debug_assert!(!params.pre_split);
                     let bvh = obvhs::bvh2::builder::build_bvh2(&boxes, params, &mut build_time);
                     let order = bvh.primitive_indices.clone();
@@ -276,7 +311,7 @@ impl SceneBvh {
                 }
             }
         };
-        let slots = original
+        let slots: Vec<Slot> = original
             .iter()
             .map(|&i| {
                 let i = i as usize;
@@ -290,6 +325,22 @@ impl SceneBvh {
                 }
             })
             .collect();
+        let hierarchy = match hierarchy {
+            Hierarchy::Binary(bvh) if kind == BvhKind::Wide => {
+                let start = std::time::Instant::now();
+                let wide = wide::WideBvh::from_bvh2(&bvh, &slots);
+                build_time += start.elapsed();
+                match wide {
+                    Some(w) => Hierarchy::Wide(w),
+                    // Too deep for the 8-wide traversal's stack: the binary hierarchy.
+                    None => {
+                        kind = BvhKind::Bvh2;
+                        Hierarchy::Binary(bvh)
+                    }
+                }
+            }
+            other => other,
+        };
         SceneBvh {
             hierarchy,
             slots,
@@ -337,6 +388,26 @@ impl SceneBvh {
         skip_mirror: Option<usize>,
         skip_triangle: Option<usize>,
     ) -> Option<Hit> {
+        if let Hierarchy::Wide(w) = &self.hierarchy {
+            let r = wide::WideRay::new(
+                ray.origin,
+                ray.dir,
+                t_min,
+                t_max,
+                skip_mirror,
+                skip_triangle,
+            );
+            return widest(WideQuery::<false> {
+                bvh: w,
+                ray: &r,
+                slots: &self.slots,
+                original: &self.original,
+            })
+            .map(|(t, slot)| Hit {
+                t,
+                triangle: self.original[slot as usize] as usize,
+            });
+        }
         let wt = WatertightRay::new(ray.origin, ray.dir);
         let r = obvhs::ray::Ray::new(Vec3A::from(ray.origin), Vec3A::from(ray.dir), t_min, t_max);
         let mut hit = RayHit::none();
@@ -359,6 +430,7 @@ impl SceneBvh {
                 Hierarchy::Empty => false,
                 Hierarchy::Cw(bvh) => bvh.ray_traverse(r, &mut hit, keep_lowest),
                 Hierarchy::Binary(bvh) => bvh.ray_traverse(r, &mut hit, keep_lowest),
+                Hierarchy::Wide(_) => unreachable!("answered above"),
             }
         });
         found.then(|| Hit {
@@ -564,6 +636,23 @@ impl SceneBvh {
         skip_mirror: Option<usize>,
         skip_triangle: Option<usize>,
     ) -> bool {
+        if let Hierarchy::Wide(w) = &self.hierarchy {
+            let r = wide::WideRay::new(
+                ray.origin,
+                ray.dir,
+                t_min,
+                t_max,
+                skip_mirror,
+                skip_triangle,
+            );
+            return widest(WideQuery::<true> {
+                bvh: w,
+                ray: &r,
+                slots: &self.slots,
+                original: &self.original,
+            })
+            .is_some();
+        }
         let wt = WatertightRay::new(ray.origin, ray.dir);
         let r = obvhs::ray::Ray::new(Vec3A::from(ray.origin), Vec3A::from(ray.dir), t_min, t_max);
         with_triangle_test!(self, wt, skip_mirror, skip_triangle, |test| {
@@ -571,6 +660,7 @@ impl SceneBvh {
                 Hierarchy::Empty => false,
                 Hierarchy::Cw(bvh) => !bvh.ray_traverse_miss(r, test),
                 Hierarchy::Binary(bvh) => !bvh.ray_traverse_miss(r, test),
+                Hierarchy::Wide(_) => unreachable!("answered above"),
             }
         })
     }
@@ -611,7 +701,7 @@ mod tests {
     #[test]
     fn both_hierarchies_match_brute_force_in_the_scene_numbering() {
         let scene = parse_scene(SCENE, Path::new("inline.json")).unwrap();
-        for kind in [BvhKind::Cwbvh, BvhKind::Bvh2] {
+        for kind in [BvhKind::Cwbvh, BvhKind::Bvh2, BvhKind::Wide] {
             let bvh = SceneBvh::build_with(&scene.geometry, kind);
             let cam = &scene.camera;
             let mut hits = 0;
@@ -672,7 +762,7 @@ mod tests {
             boxes[mirrors[0]] != boxes[mirrors[1]],
             "tied boxes are spread"
         );
-        for kind in [BvhKind::Cwbvh, BvhKind::Bvh2] {
+        for kind in [BvhKind::Cwbvh, BvhKind::Bvh2, BvhKind::Wide] {
             assert_finds_as_brute_force(&scene, &SceneBvh::build_with(g, kind));
         }
     }
@@ -711,6 +801,97 @@ mod tests {
         let bvh = SceneBvh::build_within(g, BvhKind::Cwbvh, 0);
         assert_eq!(bvh.kind, BvhKind::Bvh2);
         assert_finds_as_brute_force(&scene, &bvh);
+    }
+
+    /// The 8-wide hierarchy gives the binary one's answers bit for bit (distance bits and
+    /// triangle; occluded or not) on the inline scene and the bundled mirror scenes: camera
+    /// rays, rays leaving a mirror from a point on it (skipping it), segments starting on a
+    /// triangle (skipping it, as shadow legs do), and scattered rays from anywhere, with
+    /// bounded and unbounded far limits. Its nodes hold up to eight children: far fewer nodes
+    /// than the binary hierarchy's.
+    #[test]
+    fn the_wide_hierarchy_answers_as_the_binary_one() {
+        let root = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes"));
+        let scenes = [
+            parse_scene(SCENE, Path::new("inline.json")).unwrap(),
+            mirrorbox_scene::load_scene(&root.join("mirror_box.json")).unwrap(),
+            mirrorbox_scene::load_scene(&root.join("mirror_room.json")).unwrap(),
+        ];
+        for scene in &scenes {
+            let g = &scene.geometry;
+            let binary = SceneBvh::build_with(g, BvhKind::Bvh2);
+            let wide = SceneBvh::build_with(g, BvhKind::Wide);
+            assert_eq!(wide.kind, BvhKind::Wide);
+            let Hierarchy::Wide(w) = &wide.hierarchy else {
+                panic!("not wide")
+            };
+            let Hierarchy::Binary(b) = &binary.hierarchy else {
+                panic!("not binary")
+            };
+            assert!(
+                w.len() * 3 < b.nodes.len(),
+                "{} wide nodes, {} binary",
+                w.len(),
+                b.nodes.len()
+            );
+            let mirror_of = |i: usize| match g.surface(i) {
+                Surface::Mirror { mirror, .. } => Some(*mirror),
+                Surface::Diffuse { .. } => None,
+            };
+            let mut rng = crate::sampler::SplitMix64::for_pixel(56, 0);
+            let mut r = || rng.next_unit();
+            let cam = &scene.camera;
+            let (mut hits, mut blocked) = (0, 0);
+            for i in 0..4000usize {
+                let (ray, skip_mirror, skip_triangle) = match i % 4 {
+                    0 => (
+                        cam.primary_ray(r() * cam.width as f32, r() * cam.height as f32),
+                        None,
+                        None,
+                    ),
+                    1 | 2 => {
+                        // From a point on triangle t (barycentric), into a random direction.
+                        let t = (r() * g.triangles.len() as f32) as usize % g.triangles.len();
+                        let [v0, v1, v2] = g.triangles[t];
+                        let (a, b) = (r(), r());
+                        let (a, b) = if a + b > 1.0 {
+                            (1.0 - a, 1.0 - b)
+                        } else {
+                            (a, b)
+                        };
+                        let origin = v0 + a * (v1 - v0) + b * (v2 - v0);
+                        let dir = Vec3::new(r() - 0.5, r() - 0.5, r() - 0.5).normalize_or(Vec3::Y);
+                        let m = mirror_of(t);
+                        (Ray { origin, dir }, m, m.is_none().then_some(t))
+                    }
+                    _ => {
+                        let (lo, hi) = g.bounds().unwrap();
+                        let size = hi - lo;
+                        let origin = lo + Vec3::new(r(), r(), r()) * size;
+                        let dir = Vec3::new(r() - 0.5, r() - 0.5, r() - 0.5).normalize_or(Vec3::Y);
+                        (Ray { origin, dir }, None, None)
+                    }
+                };
+                let t_max = [f32::INFINITY, 0.7, 3.0][i % 3];
+                let want =
+                    binary.closest_hit_skipping(&ray, 0.0, t_max, skip_mirror, skip_triangle);
+                let got = wide.closest_hit_skipping(&ray, 0.0, t_max, skip_mirror, skip_triangle);
+                assert_eq!(
+                    got.map(|h| (h.t.to_bits(), h.triangle)),
+                    want.map(|h| (h.t.to_bits(), h.triangle)),
+                    "ray {i}: {ray:?} to {t_max}"
+                );
+                hits += got.is_some() as usize;
+                let want = binary.occluded(&ray, 0.0, t_max, skip_mirror, skip_triangle);
+                let got = wide.occluded(&ray, 0.0, t_max, skip_mirror, skip_triangle);
+                assert_eq!(got, want, "ray {i}: {ray:?} to {t_max}");
+                blocked += got as usize;
+            }
+            assert!(
+                hits > 1000 && blocked > 1000,
+                "{hits} hits, {blocked} blocked"
+            );
+        }
     }
 
     #[test]

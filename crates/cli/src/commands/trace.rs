@@ -14,6 +14,7 @@ use std::time::Instant;
 pub enum Bvh {
     Cwbvh,
     Bvh2,
+    Wide,
 }
 
 /// How `whitted` asks the BVH for closest hits (the same answers either way).
@@ -99,7 +100,7 @@ pub struct Args {
     /// How paths are followed: the contract's Whitted chains, or physically based paths.
     #[arg(long, value_enum, default_value_t = Integrator::Whitted)]
     integrator: Integrator,
-    /// obvhs hierarchy of the single-ray queries (shadow legs, `path` after a diffuse bounce, --kernel single): cwbvh is faster, bvh2 does not miss some hits at mirror corners that cwbvh does.
+    /// Hierarchy of the single-ray queries (shadow legs, `path` after a diffuse bounce, --kernel single): obvhs's cwbvh is faster than its bvh2, bvh2 does not miss some hits at mirror corners that cwbvh does; wide is our own 8-wide one (bvh2's answers, docs/tracer-performance.md).
     #[arg(long, value_enum, default_value_t = Bvh::Cwbvh)]
     bvh: Bvh,
     /// Closest-hit kernel: packets (`whitted`'s paths, and the mirror chains that start `path`'s, traced as 32-ray packets through a BVH2) or single (one ray at a time).
@@ -263,6 +264,7 @@ fn run_frame(args: &Args) -> Result<(), Failure> {
     let kind = match args.bvh {
         Bvh::Cwbvh => BvhKind::Cwbvh,
         Bvh::Bvh2 => BvhKind::Bvh2,
+        Bvh::Wide => BvhKind::Wide,
     };
     let started = Instant::now();
     let bvh =
