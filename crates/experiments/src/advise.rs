@@ -1,28 +1,18 @@
 //! The advisor on four scenes at three budgets each (issue 55): what `mirrorbox advise`
-//! picked, what its search cost, whether a repeat picks the same, and — on the two scenes the
-//! frontier sweeps every method on — whether the pick is as good as the best the exhaustive
-//! sweep found within the same budget.
+//! picked, what its search cost, whether a repeat picks the same, and — on the two scenes
+//! whose every coarse candidate was also timed in one round (`advise --exhaustive`) — whether
+//! the pick is as good as the best of those within the same budget, at what share of their
+//! frames.
 
 use crate::{Experiment, Measure};
-use mirrorbox_harness::advise::{TIE, within};
-use mirrorbox_report::Record;
+use mirrorbox_harness::advise::TIE;
 use mirrorbox_report::document::{Block, markdown, ms, sci};
-use mirrorbox_report::load_sweep;
 use mirrorbox_report::readme::{ReadmeError, RegionSource};
 use serde_json::Value;
 use std::path::Path;
 
-/// The frontier sweep of a scene (320×180, α = 1, every method at a few settings), if any.
-fn frontier_of(scene: &str) -> Option<&'static str> {
-    match scene {
-        "scenes/mirror_box.json" => Some("frontier_box"),
-        "scenes/mirror_room.json" => Some("frontier_room"),
-        _ => None,
-    }
-}
-
-/// How many candidates the registry's advise rows offer at their coarse values: what an
-/// exhaustive sweep of the advisor's first stage would time.
+/// How many candidates the registry's advise rows offer at their coarse values on a scene
+/// without shadows: what `advise --exhaustive` times.
 pub fn coarse_space() -> usize {
     use mirrorbox_raster::{Advise, METHODS};
     METHODS
@@ -35,13 +25,6 @@ pub fn coarse_space() -> usize {
             } => coarse.len() * variants.len(),
         })
         .sum()
-}
-
-/// The points (the floor left out) of a committed frontier sweep, or 0.
-fn frontier_size(reports: &Path, folder: &str) -> usize {
-    load_sweep(&reports.join(folder)).map_or(0, |s| {
-        s.records.iter().filter(|r| r.kind != "floor").count()
-    })
 }
 
 /// Every advice under `reports/advise/`, by folder name.
@@ -95,17 +78,25 @@ fn method(v: &Value) -> String {
         .map_or("–".into(), |m| format!("`{m}`"))
 }
 
-/// Why the advisor's pick is worse than the exhaustive sweep's best within budget, `x`:
+/// Whether a JSON point fits `budget`: the upper end of its interval (its median without
+/// one) at most the budget (`advise::within`).
+fn fits(p: &Value, budget: f64) -> bool {
+    let (median, interval) = timing(p);
+    interval.map_or(median, |(_, hi)| hi) <= budget
+}
+
+/// Why the advisor's pick is worse than the exhaustive run's best within budget, `x`:
 /// either the advisor measured `x` and found it over budget (the two runs' timings disagree:
 /// a tie at the budget where its interval holds the budget), or it never measured it.
-fn timing_verdict(advice: &Value, x: &Record, budget: f64) -> String {
-    let key = x.method_key();
+fn timing_verdict(advice: &Value, x: &Value, budget: f64) -> String {
+    let key = x["method"].as_str().unwrap_or_default();
     let theirs = advice["measured"]
         .as_array()
         .into_iter()
         .flatten()
         .find(|m| m["method"].as_str() == Some(key));
-    let sweep_ms = ms(x.ms_median, 3);
+    let exhaustive_ms = ms(timing(x).0, 3);
+    let error = x["error"].as_f64().map_or("–".into(), sci);
     match theirs {
         Some(m) => {
             let (median, interval) = timing(m);
@@ -116,17 +107,16 @@ fn timing_verdict(advice: &Value, x: &Record, budget: f64) -> String {
                 "the runs' timings disagree"
             };
             format!(
-                "{at}: `{key}` ({}) fits the sweep's run ({sweep_ms} ms) but not the advisor's \
-                 ({} [{}–{}] ms)",
-                sci(x.mirror_flip()),
+                "{at}: `{key}` ({error}) fits the exhaustive run ({exhaustive_ms} ms) but not \
+                 the advisor's ({} [{}–{}] ms)",
                 ms(median, 3),
                 ms(lo, 3),
                 ms(hi, 3)
             )
         }
         None => format!(
-            "NO: the advisor never measured `{key}` ({}, {sweep_ms} ms in the sweep)",
-            sci(x.mirror_flip())
+            "NO: the advisor never measured `{key}` ({error}, {exhaustive_ms} ms in the \
+             exhaustive run)"
         ),
     }
 }
@@ -136,7 +126,17 @@ fn advise_region(reports: &Path) -> Result<String, ReadmeError> {
     let all = advices(reports)?;
     let mut rows = Vec::new();
     let mut notes = Vec::new();
+    let mut exhaustive_runs = Vec::new();
     for (folder, v) in &all {
+        if v["exhaustive"].as_bool() == Some(true) {
+            exhaustive_runs.push(format!(
+                "`{folder}` ({} candidates, {} frames, {:.0} s)",
+                v["measured"].as_array().map_or(0, Vec::len),
+                v["renders"],
+                v["seconds"].as_f64().unwrap_or(0.0)
+            ));
+            continue;
+        }
         let scene = v["scene"].as_str().unwrap_or_default();
         let budget = v["budget_ms"].as_f64().unwrap_or(0.0);
         let pick = &v["pick"];
@@ -166,33 +166,44 @@ fn advise_region(reports: &Path) -> Result<String, ReadmeError> {
                 error(pick).map_or("–".into(), sci),
             )
         };
-        // Against the exhaustive frontier sweep of the same scene, size and α.
-        let (exhaustive, verdict) = match frontier_of(scene) {
-            Some(f) => {
-                let s = load_sweep(&reports.join(f))?;
-                let points: Vec<_> = s.records.iter().filter(|r| r.kind != "floor").collect();
-                let best = points
-                    .iter()
-                    .filter(|r| within(r, budget))
-                    .map(|r| r.mirror_flip())
-                    .fold(f64::INFINITY, f64::min);
-                let best_point = points
-                    .iter()
-                    .copied()
-                    .filter(|r| within(r, budget))
-                    .min_by(|a, b| a.mirror_flip().total_cmp(&b.mirror_flip()));
-                let verdict = match (error(pick), best_point) {
-                    (_, None) => "the sweep has nothing within budget".into(),
-                    (Some(e), Some(_)) if e <= best * (1.0 + TIE) => format!(
-                        "yes: {} against the sweep's best within budget {}",
-                        sci(e),
-                        sci(best)
-                    ),
-                    (_, Some(x)) => timing_verdict(v, x, budget),
+        // Against the exhaustive run of the same scene, size and α.
+        let exhaustive = all.iter().find(|(_, x)| {
+            x["exhaustive"].as_bool() == Some(true) && x["scene"].as_str() == Some(scene)
+        });
+        let renders = v["renders"].as_u64().unwrap_or(0);
+        let (share, verdict) = match exhaustive {
+            Some((f, x)) => {
+                let best = x["measured"]
+                    .as_array()
+                    .into_iter()
+                    .flatten()
+                    .filter(|p| fits(p, budget) && p["error"].as_f64().is_some())
+                    .min_by(|a, b| {
+                        let e = |p: &&Value| p["error"].as_f64().unwrap_or(f64::INFINITY);
+                        e(a).total_cmp(&e(b))
+                    });
+                let verdict = match (error(pick), best) {
+                    (_, None) => "the exhaustive run has nothing within budget".into(),
+                    (Some(e), Some(b)) if e <= error(b).unwrap_or(0.0) * (1.0 + TIE) => {
+                        format!(
+                            "yes: {} against the exhaustive best within budget {} ({})",
+                            sci(e),
+                            error(b).map_or("–".into(), sci),
+                            method(b)
+                        )
+                    }
+                    (_, Some(b)) => timing_verdict(v, b, budget),
                 };
-                (format!("{} (`{f}`)", points.len()), verdict)
+                let theirs = x["renders"].as_u64().unwrap_or(0);
+                (
+                    format!(
+                        "{:.0} % of `{f}`'s {theirs}",
+                        100.0 * renders as f64 / theirs.max(1) as f64
+                    ),
+                    verdict,
+                )
             }
-            None => ("–".into(), "no exhaustive sweep of this scene".into()),
+            None => ("–".into(), "no exhaustive run of this scene".into()),
         };
         rows.push(vec![
             format!("`{folder}`"),
@@ -207,7 +218,7 @@ fn advise_region(reports: &Path) -> Result<String, ReadmeError> {
                 v["renders"],
                 v["seconds"].as_f64().unwrap_or(0.0)
             ),
-            exhaustive,
+            share,
             verdict,
         ]);
         if let Some(first) = folder.strip_suffix("_repeat")
@@ -255,13 +266,16 @@ fn advise_region(reports: &Path) -> Result<String, ReadmeError> {
     let mut blocks = vec![
         Block::Paragraph(format!(
             "Measured on {device}, 320×180, α = 1, error = FLIP mean over the mirror pixels; \
-             a pick fits only if its ms/frame interval's upper end is within the budget. Timing \
-             every coarse value of every method the registry offers would take {} candidates \
-             per scene (before bisection); the frontier sweeps time a hand-picked {} and {} \
-             (`frontier_box`, `frontier_room`).",
+             a pick fits only if its ms/frame interval's upper end is within the budget. The \
+             registry's rows offer {} coarse candidates per scene (before bisection); the \
+             exhaustive runs time every one of them in one round — {} — and each pick is \
+             judged against the best of those within its budget.",
             coarse_space(),
-            frontier_size(reports, "frontier_box"),
-            frontier_size(reports, "frontier_room")
+            if exhaustive_runs.is_empty() {
+                "none committed".to_string()
+            } else {
+                exhaustive_runs.join(", ")
+            }
         )),
         Block::Table(
             [
@@ -271,8 +285,8 @@ fn advise_region(reports: &Path) -> Result<String, ReadmeError> {
                 "ms/frame [95 % CI]",
                 "error",
                 "search: candidates, rounds, frames, time",
-                "frontier sweep: candidates",
-                "as good as the frontier sweep's best within budget",
+                "frames against the exhaustive run's",
+                "as good as the exhaustive run's best within budget",
             ]
             .map(String::from)
             .to_vec(),
@@ -287,14 +301,14 @@ fn advise_region(reports: &Path) -> Result<String, ReadmeError> {
 
 pub const ADVISE: Experiment = Experiment {
     name: "advise",
-    about: "mirrorbox advise on four scenes at three budgets each: its picks, their search cost, a repeat, and the exhaustive frontier's best beside them",
+    about: "mirrorbox advise on four scenes at three budgets each: its picks, their search cost, a repeat, and every coarse candidate's best beside them",
     folder: "advise",
     measure: Measure::Script("scripts/measure-advise.sh", &[]),
     section: None,
     regions: &[RegionSource {
         id: "advise",
         source: "advise",
-        about: "what the advisor picked per scene and budget, its search cost, and the exhaustive frontier's best beside it",
+        about: "what the advisor picked per scene and budget, its search cost, and the exhaustive run's best beside it",
         generate: advise_region,
     }],
     chapter: "advise.md",

@@ -684,7 +684,7 @@ pub fn sentences(advice: &Advice, metric: Metric, scene: &Path) -> Vec<String> {
             .map(|(k, why)| format!("`{k}` ({why})"))
             .collect();
         out.push(format!(
-            "Refused by the memory estimate before rendering: {}.",
+            "Refused, by the plan's limits and memory estimate before rendering or by the method as it built the frame: {}.",
             r.join("; ")
         ));
     }
