@@ -91,7 +91,9 @@ impl WatertightRay {
         (self.kx, self.ky, self.kz)
     }
 
-    /// The shear constants `(sx, sy, sz)`.
+    /// The shear constants `(sx, sy, sz)` (the lane tests repeat the scalar test's
+    /// arithmetic with them).
+    #[inline(always)]
     pub fn shear(&self) -> [f32; 3] {
         [self.sx, self.sy, self.sz]
     }
