@@ -18,8 +18,8 @@
 //! A candidate is **within budget** only if the upper end of its ms/frame 95 % interval is.
 //! A candidate its method refuses to render (a limit of its plan) is left out, said.
 //! Of the candidates within budget, those within 2 % of the lowest error are **tied**; the
-//! cheapest of them is the pick, the others are named beside it. Before a round renders, the plan's memory
-//! estimate refuses what would not fit (said, never rendered).
+//! cheapest of them is the pick, the others are named beside it. Before a round renders, the
+//! plan's limits and memory estimate refuse what would not fit (said, never rendered).
 
 use crate::exchange::ViewSpec;
 use crate::{Event, HarnessError, SweepConfig, refused_points, run_sweep};
@@ -106,7 +106,7 @@ pub struct AdviseConfig {
     /// A camera path (`--views FILE`); empty: the scene's camera.
     pub views: Vec<ViewSpec>,
     pub over_views: OverViews,
-    /// The scene's lighting asks for shadows: every candidate with shadow maps.
+    /// The scene's lighting asks for shadows: every candidate also with shadow maps.
     pub shadows: bool,
     /// Time every coarse candidate in one round, no ascent and no bisection (`--exhaustive`):
     /// the search's whole first stage, to judge the search against.
@@ -156,7 +156,8 @@ pub struct Advice {
     pub next_better: Option<Record>,
     /// With nothing within budget: the candidate whose ms/frame comes closest.
     pub closest: Option<Record>,
-    /// Candidates the memory estimate refused, with why.
+    /// Candidates refused, with why: by the plan's limits or memory estimate before a round,
+    /// or by the method as it built the frame.
     pub refused: Vec<(String, String)>,
     /// Methods the adapter cannot run (from the rounds' sweeps).
     pub unsupported: Vec<String>,
@@ -260,7 +261,8 @@ impl Knob {
 }
 
 /// What one round of the search returns: the candidates measured (in order) and where each
-/// one's images are, those the memory estimate refused with why, and the frames rendered.
+/// one's images are, those refused with why (plan, memory estimate, or the method as it built
+/// the frame), and the frames rendered.
 pub struct Round {
     pub measured: Vec<Record>,
     pub folders: Vec<PathBuf>,
@@ -472,7 +474,7 @@ pub fn search(
     let budget = config.budget_ms;
     while !todo.is_empty() {
         let r = round(todo)?;
-        // Refused by the memory estimate: said, and over budget for the search.
+        // Refused: said, and over budget for the search.
         for (m, why) in &r.refused {
             advice.refused.push((m.key(), why.clone()));
             for k in knobs.iter_mut().filter(|k| k.owns(m)) {
@@ -908,7 +910,7 @@ pub fn rewrite(out: &Path) -> Result<Advice, HarnessError> {
     if !advice.views.is_empty() {
         advice.over_views = Some(over);
     }
-    // Every round's folder (a round the memory estimate refused whole has no records).
+    // Every round's folder (a round refused whole has no records).
     for k in 1.. {
         let folder = out.join("search").join(format!("round-{k}"));
         if !folder.is_dir() {
