@@ -7,26 +7,30 @@ use serde_json::Value;
 
 /// A small search: the paper's method only (n = 0…4 on mirror_box at 32×18, 6 rounds).
 fn advise(out: &std::path::Path, budget: &str) -> crate::common::Output {
-    mirrorbox(
-        &[
-            "advise",
-            "scenes/mirror_box.json",
-            "--budget-ms",
-            budget,
-            "--methods",
-            "auxiliary",
-            "--width",
-            "32",
-            "--height",
-            "18",
-            "--frames",
-            "6",
-            "--json",
-            "-o",
-            out.to_str().unwrap(),
-        ],
-        &[],
-    )
+    advise_with(out, budget, &[])
+}
+
+/// [`advise`] with more flags.
+fn advise_with(out: &std::path::Path, budget: &str, flags: &[&str]) -> crate::common::Output {
+    let mut args = vec![
+        "advise",
+        "scenes/mirror_box.json",
+        "--budget-ms",
+        budget,
+        "--methods",
+        "auxiliary",
+        "--width",
+        "32",
+        "--height",
+        "18",
+        "--frames",
+        "6",
+        "--json",
+        "-o",
+        out.to_str().unwrap(),
+    ];
+    args.extend_from_slice(flags);
+    mirrorbox(&args, &[])
 }
 
 #[test]
@@ -132,27 +136,7 @@ fn advise_names_the_closest_when_nothing_fits_and_the_best_when_everything_does(
     // --exhaustive times every coarse candidate (n = 0…4 at both texture scales) in that one
     // round, whatever the budget.
     let out = dir.path().join("exhaustive");
-    let r = mirrorbox(
-        &[
-            "advise",
-            "scenes/mirror_box.json",
-            "--budget-ms",
-            "0.000001",
-            "--methods",
-            "auxiliary",
-            "--width",
-            "32",
-            "--height",
-            "18",
-            "--frames",
-            "6",
-            "--exhaustive",
-            "--json",
-            "-o",
-            out.to_str().unwrap(),
-        ],
-        &[],
-    );
+    let r = advise_with(&out, "0.000001", &["--exhaustive"]);
     assert_eq!(r.code, 0, "{}", r.stderr);
     let v: Value = serde_json::from_str(r.stdout.trim()).unwrap();
     assert_eq!(v["rounds"], 1, "{v}");
