@@ -16,7 +16,7 @@ fn bench(c: &mut Criterion) {
         let mut scene = base.clone();
         scene.camera = scene.camera.with_size(640, 360);
         scene.set_reflectance(Vec3::splat(reflectance)).unwrap();
-        for kind in [BvhKind::Cwbvh, BvhKind::Bvh2] {
+        for kind in [BvhKind::Cwbvh, BvhKind::Bvh2, BvhKind::Wide] {
             let bvh = SceneBvh::build_with(&scene.geometry, kind);
             let rays = render(&scene, &bvh, &settings, &|_| {}).stats.rays;
             group.throughput(Throughput::Elements(rays));

@@ -35,20 +35,19 @@ pub struct Hit {
     pub triangle: usize,
 }
 
-/// Which obvhs hierarchy the single-ray queries traverse (shadow legs, `path`, `whitted` with
-/// `--kernel single`). CWBVH (8-wide, compressed) is the default: it is much faster for
-/// incoherent rays (`path` in `mirror_room`: 1.11 s against 1.45 s with the BVH2), but its
-/// traversal misses some hits a few 10⁻⁵ from a mirror corner, which the BVH2 finds
-/// (docs/tracer-performance.md). The packet kernel always traverses a BVH2 (this one when
-/// `Bvh2` is chosen, else its own).
-///
-/// `Wide` is our own 8-wide hierarchy ([`wide`], issue 56): obvhs's binary one collapsed, its
-/// boxes uncompressed, traversed eight boxes at a time; the BVH2's answers, bit for bit.
+/// Which hierarchy the single-ray queries traverse (shadow legs, `path`, `whitted` below 4
+/// samples per pixel or with `--kernel single`). `Wide`, the default, is our own 8-wide one
+/// ([`wide`], issue 56): obvhs's binary hierarchy collapsed, its boxes uncompressed, eight
+/// boxes and a leaf's triangles tested at once; the BVH2's answers bit for bit, a tenth faster
+/// than obvhs's CWBVH on `path`. obvhs's CWBVH (8-wide, compressed) misses some hits a few
+/// 10⁻⁵ from a mirror corner, which the BVH2 finds; its BVH2 is slower on incoherent rays
+/// (`path` in `mirror_room`: 1.45 s against the CWBVH's 1.11 s; docs/tracer-performance.md).
+/// The packet kernel always traverses a BVH2 (this one when `Bvh2` is chosen, else its own).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum BvhKind {
-    #[default]
     Cwbvh,
     Bvh2,
+    #[default]
     Wide,
 }
 

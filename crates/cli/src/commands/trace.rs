@@ -101,7 +101,7 @@ pub struct Args {
     #[arg(long, value_enum, default_value_t = Integrator::Whitted)]
     integrator: Integrator,
     /// Hierarchy of the single-ray queries (shadow legs, `path` after a diffuse bounce, --kernel single): obvhs's cwbvh is faster than its bvh2, bvh2 does not miss some hits at mirror corners that cwbvh does; wide is our own 8-wide one (bvh2's answers, docs/tracer-performance.md).
-    #[arg(long, value_enum, default_value_t = Bvh::Cwbvh)]
+    #[arg(long, value_enum, default_value_t = Bvh::Wide)]
     bvh: Bvh,
     /// Closest-hit kernel: packets (`whitted`'s paths, and the mirror chains that start `path`'s, traced as 32-ray packets through a BVH2) or single (one ray at a time).
     #[arg(long, value_enum, default_value_t = Kernel::Packet)]

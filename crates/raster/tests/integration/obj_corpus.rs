@@ -251,10 +251,10 @@ fn every_obj_that_loads_is_seen_and_every_method_draws_it_as_the_truth() {
     let mut failures = Vec::new();
     for (rel, _) in LOADS {
         let scene = placed(rel);
-        // Every file's 8-wide hierarchy fits obvhs's traversal stack (the degenerate box's
-        // too, its tied boxes spread).
+        // Every file's 8-wide hierarchy fits its traversal stack (the degenerate box's too,
+        // its tied boxes spread).
         let kind = mirrorbox_trace::SceneBvh::build(&scene.geometry).kind;
-        assert_eq!(kind, mirrorbox_trace::BvhKind::Cwbvh, "{rel}");
+        assert_eq!(kind, mirrorbox_trace::BvhKind::Wide, "{rel}");
         if let Some(dir) = &png_dir {
             let mut big = scene.clone();
             big.camera = big.camera.with_size(384, 216);
