@@ -66,6 +66,24 @@ struct WideQuery<'a, const ANY_HIT: bool> {
     ray: &'a wide::WideRay,
 }
 
+/// `ray` through the wide hierarchy with `(t_min, t_max, skip_mirror, skip_triangle)`: the
+/// closest hit, or with `ANY_HIT` the first, as `(t, triangle)`.
+fn wide_query<const ANY_HIT: bool>(
+    bvh: &wide::WideBvh,
+    ray: &Ray,
+    (t_min, t_max, skip_mirror, skip_triangle): (f32, f32, Option<usize>, Option<usize>),
+) -> Option<(f32, u32)> {
+    let r = wide::WideRay::new(
+        ray.origin,
+        ray.dir,
+        t_min,
+        t_max,
+        skip_mirror,
+        skip_triangle,
+    );
+    widest(WideQuery::<ANY_HIT> { bvh, ray: &r })
+}
+
 impl<const ANY_HIT: bool> Vectorised for WideQuery<'_, ANY_HIT> {
     type Output = Option<(f32, u32)>;
 
@@ -391,15 +409,8 @@ impl SceneBvh {
         skip_triangle: Option<usize>,
     ) -> Option<Hit> {
         if let Hierarchy::Wide(w) = &self.hierarchy {
-            let r = wide::WideRay::new(
-                ray.origin,
-                ray.dir,
-                t_min,
-                t_max,
-                skip_mirror,
-                skip_triangle,
-            );
-            return widest(WideQuery::<false> { bvh: w, ray: &r }).map(|(t, triangle)| Hit {
+            let q = (t_min, t_max, skip_mirror, skip_triangle);
+            return wide_query::<false>(w, ray, q).map(|(t, triangle)| Hit {
                 t,
                 triangle: triangle as usize,
             });
@@ -633,15 +644,8 @@ impl SceneBvh {
         skip_triangle: Option<usize>,
     ) -> bool {
         if let Hierarchy::Wide(w) = &self.hierarchy {
-            let r = wide::WideRay::new(
-                ray.origin,
-                ray.dir,
-                t_min,
-                t_max,
-                skip_mirror,
-                skip_triangle,
-            );
-            return widest(WideQuery::<true> { bvh: w, ray: &r }).is_some();
+            let q = (t_min, t_max, skip_mirror, skip_triangle);
+            return wide_query::<true>(w, ray, q).is_some();
         }
         let wt = WatertightRay::new(ray.origin, ray.dir);
         let r = obvhs::ray::Ray::new(Vec3A::from(ray.origin), Vec3A::from(ray.dir), t_min, t_max);
