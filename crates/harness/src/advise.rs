@@ -22,7 +22,7 @@
 //! plan's limits and memory estimate refuse what would not fit (said, never rendered).
 
 use crate::exchange::ViewSpec;
-use crate::{Event, HarnessError, SweepConfig, refused_points, run_sweep};
+use crate::{Event, HarnessError, Summary, SweepConfig, run_sweep};
 use mirrorbox_raster::lighting::ADVISE_SHADOW_MAP_SIZES;
 use mirrorbox_raster::{Advise, METHODS, Method, ParamValue};
 use mirrorbox_report::{Record, read_records};
@@ -367,36 +367,23 @@ pub fn advise(
                 methods: methods.clone(),
                 out: v.map_or(folder.clone(), |v| folder.join(&v.name)),
                 camera: v.cloned(),
-                // A candidate its method refuses to render is left out of the answer, said.
+                // A candidate its plan or method refuses is left out of the answer, said.
                 drop_refused: true,
                 ..config.sweep.clone()
             })
             .collect();
-        // Refused in any view: refused.
-        let mut refused: Vec<(Method, String)> = Vec::new();
-        for s in &sweeps {
-            for r in refused_points(s)? {
-                if !refused.iter().any(|(m, _)| *m == r.0) {
-                    refused.push(r);
-                }
-            }
-        }
         let mut round = Round {
             measured: Vec::new(),
             folders: Vec::new(),
-            refused,
+            refused: Vec::new(),
             renders: 0,
         };
         let mut per_view = Vec::new();
-        for mut sweep in sweeps {
-            sweep
-                .methods
-                .retain(|m| !round.refused.iter().any(|(r, _)| r == m));
-            if sweep.methods.is_empty() {
-                break;
-            }
+        for sweep in sweeps {
+            // Refused in any view: refused (and `over_views` keeps only candidates measured
+            // in every view).
             let mut refused_here = Vec::new();
-            run_sweep(&sweep, true, &mut |e| {
+            let summary = run_sweep(&sweep, true, &mut |e| {
                 match &e {
                     Event::Unsupported { reason, .. }
                         if !unsupported.iter().any(|u| u == reason) =>
@@ -415,7 +402,7 @@ pub fn advise(
                     round.refused.push((m, why));
                 }
             }
-            round.renders += renders(&sweep);
+            round.renders += renders(&sweep, &summary);
             per_view.push(measured_in(&sweep.out)?);
         }
         for (r, view) in over_views(&per_view, config.over_views, config.metric) {
@@ -532,11 +519,13 @@ pub fn search(
     Ok(advice)
 }
 
-/// The frames a round renders: every point (the floor included) in the settling round and in
-/// each timed round, warm-up frames and the timed one.
-fn renders(sweep: &SweepConfig) -> u64 {
-    let points = sweep.methods.len() as u64 * sweep.alphas.len() as u64 + 1;
-    points * u64::from(crate::SETTLING_ROUNDS + sweep.frames) * u64::from(sweep.warmup + 1)
+/// The frames a round's sweep rendered: every point it measured (the floor included; not
+/// those refused) in the settling round and in each timed round, warm-up frames and the
+/// timed one.
+fn renders(sweep: &SweepConfig, summary: &Summary) -> u64 {
+    summary.computed as u64
+        * u64::from(crate::SETTLING_ROUNDS + sweep.frames)
+        * u64::from(sweep.warmup + 1)
 }
 
 /// The pick, its ties, the next better choice, or the closest when nothing fits.
@@ -910,7 +899,8 @@ pub fn rewrite(out: &Path) -> Result<Advice, HarnessError> {
     if !advice.views.is_empty() {
         advice.over_views = Some(over);
     }
-    // Every round's folder (a round refused whole has no records).
+    // Every round's folder; a round counts, as in `search`, where it measured a candidate (a
+    // round refused whole has no records, or the floor's alone).
     for k in 1.. {
         let folder = out.join("search").join(format!("round-{k}"));
         if !folder.is_dir() {
@@ -930,8 +920,9 @@ pub fn rewrite(out: &Path) -> Result<Advice, HarnessError> {
         if per_view.len() < view_folders.len() {
             continue;
         }
-        advice.rounds += 1;
-        for (r, view) in over_views(&per_view, over, metric) {
+        let measured = over_views(&per_view, over, metric);
+        advice.rounds += usize::from(!measured.is_empty());
+        for (r, view) in measured {
             advice.measured.push(r);
             advice.folders.push(view_folders[view].clone());
         }

@@ -356,7 +356,6 @@ fn write_export(
     })
 }
 
-/// `base` seen from `spec`'s camera.
 /// `base` seen from `spec`: its camera moved, checked (position and look-at apart, up not
 /// along the view, field of view in (0, 180)).
 pub fn view_scene(base: &Scene, spec: &ViewSpec) -> Result<Scene, HarnessError> {

@@ -97,10 +97,10 @@ pub struct SweepConfig {
     /// The scene's camera replaced by this view (`advise --views`, [`exchange::ViewSpec`]):
     /// every point, its truth and its worker see the scene from here. `None`: the scene's own.
     pub camera: Option<exchange::ViewSpec>,
-    /// A point whose render the method refuses (a limit found only when the frame's GPU
-    /// resources are built, past the plan: `unrolled`'s triangles per frame) is left out and
-    /// said ([`Event::Refused`]) instead of ending the sweep: what `mirrorbox advise` wants of
-    /// its rounds. Off: the refusal ends the sweep (exit 2), as a sweep's settings are wrong.
+    /// A point refused — by its plan's limits or memory estimate before any work, or by its
+    /// method as it builds the frame (`unrolled`'s triangles per frame) — is left out and said
+    /// ([`Event::Refused`]) instead of ending the sweep: what `mirrorbox advise` wants of its
+    /// rounds. Off: the refusal ends the sweep (exit 2), as a sweep's settings are wrong.
     pub drop_refused: bool,
 }
 
@@ -385,7 +385,7 @@ pub enum Event<'a> {
         label: &'a str,
         reason: &'a str,
     },
-    /// A point is left out: its method refused to render it (`reason`), with
+    /// A point is left out: its plan or its method refused it (`reason`), with
     /// [`SweepConfig::drop_refused`].
     Refused {
         label: &'a str,
@@ -402,7 +402,7 @@ pub struct Summary {
     pub truths_cached: usize,
     /// Points left out because the adapter lacks a feature their method needs.
     pub unsupported: usize,
-    /// Points left out because their method refused to render them
+    /// Points left out because their plan or method refused them
     /// ([`SweepConfig::drop_refused`]).
     pub refused: usize,
 }
@@ -942,25 +942,8 @@ fn refused_by_method(e: &HarnessError) -> bool {
     }
 }
 
-/// The points of `config` whose frame the plan's memory estimate refuses (before any GPU
-/// work), each with why: what `mirrorbox advise` leaves out instead of failing its search
-/// (issue 55). The floor is never refused.
-pub fn refused_points(config: &SweepConfig) -> Result<Vec<(Method, String)>, HarnessError> {
-    let (base, w, h) = base_scene(config)?;
-    let mut out = Vec::new();
-    for p in points(config, base.content_hash(), w, h) {
-        let Some(method) = p.method.clone() else {
-            continue;
-        };
-        if let Err(why) = fits_memory(&base, &p, config)? {
-            out.push((method, why.to_string()));
-        }
-    }
-    Ok(out)
-}
-
 /// Whether point `p`'s frame fits the sweep's memory budget by the plan's estimate (planned
-/// on the CPU, the plan dropped): the one check of [`run_sweep`] and [`refused_points`].
+/// on the CPU, the plan dropped): [`run_sweep`]'s check before any work.
 fn fits_memory(
     base: &Scene,
     p: &Point,
@@ -1017,11 +1000,27 @@ pub fn run_sweep(
     } else {
         read_records(&results).map_err(io(&results))?
     };
+    // With `drop_refused`, a refused point is left out and said instead.
+    let mut refused: Vec<&str> = Vec::new();
     for p in still_to_do(&done_before) {
-        fits_memory(&base, p, config)?.map_err(|source| HarnessError::Refused {
-            point: p.label.clone(),
-            source,
-        })?;
+        if let Err(source) = fits_memory(&base, p, config)? {
+            match &p.method {
+                Some(method) if config.drop_refused => {
+                    progress(Event::Refused {
+                        label: &p.label,
+                        method,
+                        reason: &source.to_string(),
+                    });
+                    refused.push(&p.key);
+                }
+                _ => {
+                    return Err(HarnessError::Refused {
+                        point: p.label.clone(),
+                        source,
+                    });
+                }
+            }
+        }
     }
     let (images, cache) = (out.join("images"), out.join("cache"));
     let truth_cache = config.truth_cache.clone().unwrap_or_else(|| cache.clone());
@@ -1040,6 +1039,10 @@ pub fn run_sweep(
     salvage(&results, &existing)?;
     let todo = still_to_do(&existing);
     let reused = all.len() - todo.len();
+    let todo: Vec<&Point> = todo
+        .into_iter()
+        .filter(|p| !refused.contains(&p.key.as_str()))
+        .collect();
     let gpu = Gpu::new()?;
     // A method this adapter cannot run (ray queries on a GPU without them) is left out and
     // said, not fatal to the other methods: its points stay to do, for a run on an adapter
@@ -1064,7 +1067,8 @@ pub fn run_sweep(
         .collect();
     let mut summary = Summary {
         reused,
-        unsupported: all.len() - reused - todo.len(),
+        unsupported: all.len() - reused - refused.len() - todo.len(),
+        refused: refused.len(),
         ..Default::default()
     };
     progress(Event::Planned {
