@@ -9,6 +9,7 @@
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use mirrorbox_scene::{Ray, Scene, Surface};
 use mirrorbox_trace::SceneBvh;
+use mirrorbox_trace::bvh::BvhKind;
 use mirrorbox_trace::bvh::packet::{LANES, RayPacket, first_lanes};
 use mirrorbox_trace::mirror_bounce::MirrorPlanes;
 
@@ -49,6 +50,99 @@ fn ray_sets(scene: &Scene, bvh: &SceneBvh, bounces: usize) -> Vec<Vec<Leaving>> 
         sets.push(next);
     }
     sets
+}
+
+/// Scattered rays, as `path`'s after a diffuse vertex: from the diffuse points the camera
+/// rays hit, in directions uniform over the hemisphere about the normal on the camera's side,
+/// skipping the triangle they leave (a fixed pseudo-random sequence).
+fn scattered(scene: &Scene, bvh: &SceneBvh, camera_rays: &[Leaving]) -> Vec<(Ray, usize)> {
+    let mut state = 0x9e37_79b9_7f4a_7c15u64;
+    let mut unit = move || {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (state >> 40) as f32 / (1u64 << 24) as f32
+    };
+    camera_rays
+        .iter()
+        .filter_map(|(ray, _)| {
+            let hit = bvh.closest_hit(ray, 0.0, f32::INFINITY, None)?;
+            let Surface::Diffuse { .. } = *scene.geometry.surface(hit.triangle) else {
+                return None;
+            };
+            let [a, b, c] = scene.geometry.triangles[hit.triangle];
+            let mut n = (b - a).cross(c - a).normalize();
+            if n.dot(ray.dir) > 0.0 {
+                n = -n;
+            }
+            let mut d = glam::Vec3::new(2.0 * unit() - 1.0, 2.0 * unit() - 1.0, 2.0 * unit() - 1.0);
+            while d.length_squared() > 1.0 || d.length_squared() < 1e-6 {
+                d = glam::Vec3::new(2.0 * unit() - 1.0, 2.0 * unit() - 1.0, 2.0 * unit() - 1.0);
+            }
+            let d = d.normalize();
+            let dir = if d.dot(n) < 0.0 { -d } else { d };
+            let origin = ray.origin + ray.dir * hit.t;
+            Some((Ray { origin, dir }, hit.triangle))
+        })
+        .collect()
+}
+
+/// Single rays only, every hierarchy kind: camera rays and scattered rays of `mirror_box` and
+/// `mirror_room` (the rays `path` sends one at a time).
+fn single(c: &mut Criterion) {
+    for name in ["mirror_box", "mirror_room"] {
+        let mut scene = mirrorbox_scene::load::bundled_scene(&format!("{name}.json"));
+        scene.camera = scene.camera.with_size(320, 180);
+        let reference = SceneBvh::build(&scene.geometry);
+        let camera_rays = &ray_sets(&scene, &reference, 0)[0];
+        let scattered = scattered(&scene, &reference, camera_rays);
+        let mut group = c.benchmark_group(format!("single_{name}_320x180"));
+        group.sample_size(10);
+        for kind in [BvhKind::Wide, BvhKind::Cwbvh] {
+            let bvh = SceneBvh::build_with(&scene.geometry, kind);
+            group.throughput(Throughput::Elements(camera_rays.len() as u64));
+            group.bench_function(
+                format!("camera {kind:?} ({} rays)", camera_rays.len()),
+                |b| {
+                    b.iter(|| {
+                        camera_rays
+                            .iter()
+                            .filter(|(ray, _)| {
+                                bvh.closest_hit(ray, 0.0, f32::INFINITY, None).is_some()
+                            })
+                            .count()
+                    })
+                },
+            );
+            group.throughput(Throughput::Elements(scattered.len() as u64));
+            group.bench_function(
+                format!("scattered {kind:?} ({} rays)", scattered.len()),
+                |b| {
+                    b.iter(|| {
+                        scattered
+                            .iter()
+                            .filter(|(ray, tri)| {
+                                bvh.closest_hit_skipping(ray, 0.0, f32::INFINITY, None, Some(*tri))
+                                    .is_some()
+                            })
+                            .count()
+                    })
+                },
+            );
+            group.bench_function(
+                format!("scattered any-hit {kind:?} ({} rays)", scattered.len()),
+                |b| {
+                    b.iter(|| {
+                        scattered
+                            .iter()
+                            .filter(|(ray, tri)| bvh.occluded(ray, 0.0, 1.0, None, Some(*tri)))
+                            .count()
+                    })
+                },
+            );
+        }
+        group.finish();
+    }
 }
 
 fn bench(c: &mut Criterion) {
@@ -101,5 +195,5 @@ fn bench(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench);
+criterion_group!(benches, single, bench);
 criterion_main!(benches);

@@ -63,7 +63,8 @@ enum Hierarchy {
 /// permutation.
 struct WideQuery<'a, const ANY_HIT: bool> {
     bvh: &'a wide::WideBvh,
-    ray: &'a wide::WideRay,
+    ray: &'a Ray,
+    query: (f32, f32, Option<usize>, Option<usize>),
 }
 
 /// `ray` through the wide hierarchy with `(t_min, t_max, skip_mirror, skip_triangle)`: the
@@ -71,17 +72,9 @@ struct WideQuery<'a, const ANY_HIT: bool> {
 fn wide_query<const ANY_HIT: bool>(
     bvh: &wide::WideBvh,
     ray: &Ray,
-    (t_min, t_max, skip_mirror, skip_triangle): (f32, f32, Option<usize>, Option<usize>),
+    query: (f32, f32, Option<usize>, Option<usize>),
 ) -> Option<(f32, u32)> {
-    let r = wide::WideRay::new(
-        ray.origin,
-        ray.dir,
-        t_min,
-        t_max,
-        skip_mirror,
-        skip_triangle,
-    );
-    widest(WideQuery::<ANY_HIT> { bvh, ray: &r })
+    widest(WideQuery::<ANY_HIT> { bvh, ray, query })
 }
 
 impl<const ANY_HIT: bool> Vectorised for WideQuery<'_, ANY_HIT> {
@@ -89,7 +82,16 @@ impl<const ANY_HIT: bool> Vectorised for WideQuery<'_, ANY_HIT> {
 
     #[inline(always)]
     fn run(self) -> Self::Output {
-        let (b, r) = (self.bvh, self.ray);
+        let (t_min, t_max, skip_mirror, skip_triangle) = self.query;
+        let r = &wide::WideRay::new(
+            self.ray.origin,
+            self.ray.dir,
+            t_min,
+            t_max,
+            skip_mirror,
+            skip_triangle,
+        );
+        let b = self.bvh;
         match r.wt.axes() {
             (1, 2, 0) => b.trace::<1, 2, 0, ANY_HIT>(r),
             (2, 1, 0) => b.trace::<2, 1, 0, ANY_HIT>(r),

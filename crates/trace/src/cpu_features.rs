@@ -32,7 +32,11 @@ enum Build {
 static BUILD: std::sync::LazyLock<Build> = std::sync::LazyLock::new(|| {
     #[cfg(target_arch = "x86_64")]
     {
-        if std::arch::is_x86_feature_detected!("avx512f") {
+        if std::arch::is_x86_feature_detected!("avx512f")
+            && std::arch::is_x86_feature_detected!("avx512vl")
+            && std::arch::is_x86_feature_detected!("avx512bw")
+            && std::arch::is_x86_feature_detected!("avx512dq")
+        {
             return Build::Avx512;
         }
         if std::arch::is_x86_feature_detected!("avx2") {
@@ -69,7 +73,7 @@ pub fn widest_name() -> &'static str {
 mod x86 {
     use super::Vectorised;
 
-    #[target_feature(enable = "avx512f")]
+    #[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq")]
     pub fn avx512<W: Vectorised>(work: W) -> W::Output {
         work.run()
     }

@@ -30,6 +30,15 @@ pub struct WatertightRay {
 /// for all its lanes at once with exactly these operations.
 #[inline(always)]
 pub(crate) fn shear_of(d: [f32; 3]) -> (u32, [f32; 3]) {
+    let (code, [px, py], dz) = shear_operands(d);
+    (code, [px / dz, py / dz, 1.0 / dz])
+}
+
+/// [`shear_of`] before its divisions: the permutation code, the direction's components
+/// along `kx` and `ky`, and along `kz` (the divisor), so that a caller can divide them
+/// together with other quotients in one vector division (the same bits).
+#[inline(always)]
+pub(crate) fn shear_operands(d: [f32; 3]) -> (u32, [f32; 2], f32) {
     let a = [d[0].abs(), d[1].abs(), d[2].abs()];
     let kz = if a[0] >= a[1] && a[0] >= a[2] {
         0
@@ -53,13 +62,11 @@ pub(crate) fn shear_of(d: [f32; 3]) -> (u32, [f32; 3]) {
     if swap {
         (kx, ky) = (ky, kx);
     }
-    (
-        kz * 2 + swap as u32,
-        [pick(kx) / dz, pick(ky) / dz, 1.0 / dz],
-    )
+    (kz * 2 + swap as u32, [pick(kx), pick(ky)], dz)
 }
 
 /// The `(kx, ky, kz)` of a [`shear_of`] permutation code.
+#[inline(always)]
 pub(crate) fn axes_of(code: u32) -> (usize, usize, usize) {
     let kz = (code / 2) as usize;
     let (kx, ky) = ((kz + 1) % 3, (kz + 2) % 3);
@@ -73,6 +80,22 @@ pub(crate) fn axes_of(code: u32) -> (usize, usize, usize) {
 impl WatertightRay {
     pub fn new(origin: Vec3, dir: Vec3) -> Self {
         let (code, [sx, sy, sz]) = shear_of(dir.to_array());
+        let (kx, ky, kz) = axes_of(code);
+        WatertightRay {
+            origin,
+            kx,
+            ky,
+            kz,
+            sx,
+            sy,
+            sz,
+        }
+    }
+
+    /// The ray from its [`shear_of`] permutation code and shear constants (computed by the
+    /// caller with [`shear_operands`]' operands: the same bits as [`WatertightRay::new`]).
+    #[inline(always)]
+    pub(crate) fn from_shear(origin: Vec3, code: u32, [sx, sy, sz]: [f32; 3]) -> Self {
         let (kx, ky, kz) = axes_of(code);
         WatertightRay {
             origin,

@@ -5,7 +5,8 @@
 //! it is collapsed here into nodes of up to [`WIDTH`] children — repeatedly opening the inner
 //! child with the largest surface area, as Wald et al.'s and obvhs's own collapses do — with
 //! the children's boxes stored as structure of arrays (`lo[axis][child]`), uncompressed f32.
-//! A leaf child is a range of slots (the binary leaf's); per child, the one mirror every
+//! A leaf child names the first of its blocks (the binary leaf's triangles, up to [`WIDTH`]
+//! per block as structure of arrays, tested at once); per child, the one mirror every
 //! triangle below it is on, if any (a ray leaving that mirror skips the child, as the packet
 //! kernel skips such subtrees).
 //!
@@ -15,7 +16,7 @@
 //! farther than the closest hit so far is dropped. Box tests are the packet kernel's
 //! (`safe_inverse` reciprocals, the far distance widened by 1 + 2γ₃), so no box that a ray
 //! meets is skipped; triangles are the watertight test; of equally distant hits the lowest
-//! triangle index wins. Same answers as the binary hierarchy's traversal, bit for bit
+//! triangle index wins (within a block, the least integer key of (distance, triangle)). Same answers as the binary hierarchy's traversal, bit for bit
 //! (tested), and no corner misses (obvhs's CWBVH misses some, docs/tracer-performance.md).
 //!
 //! **Stack**: each level pushes at most `WIDTH − 1` entries beyond the one it pops, so a
@@ -24,8 +25,7 @@
 //! `box_longline.obj`).
 
 use super::{NOT_A_MIRROR, Slot};
-use crate::watertight::WatertightRay;
-use obvhs::ray::safe_inverse;
+use crate::watertight::{WatertightRay, shear_operands};
 
 /// Children per node.
 pub const WIDTH: usize = 8;
@@ -59,16 +59,18 @@ const LEAF_TRIANGLES: u32 = 4;
 /// obvhs's node-to-triangle cost ratio for collapsing leaves.
 const LEAF_COLLAPSE_COST: f32 = 1.0;
 
+/// A child that is a leaf: [`WideNode::child`]'s high bit, below it the leaf's first block.
+const LEAF: u32 = 1 << 31;
+
 /// One node: its children's boxes as structure of arrays, and per child what it is.
 #[derive(Clone, Debug)]
 #[repr(C, align(64))]
 struct WideNode {
     lo: [[f32; WIDTH]; 3],
     hi: [[f32; WIDTH]; 3],
-    /// An inner child's node, or a leaf child's first slot.
-    index: [u32; WIDTH],
-    /// A leaf child's slots (at least 1); 0 for an inner child.
-    count: [u32; WIDTH],
+    /// An inner child's node, or [`LEAF`] and a leaf child's first block (its blocks follow
+    /// one another, the last with [`TriBlock::more`] false).
+    child: [u32; WIDTH],
     /// The mirror every triangle below the child is on, or [`NOT_A_MIRROR`].
     mirror: [u32; WIDTH],
     /// Bit `i`: child `i` exists.
@@ -80,8 +82,7 @@ impl WideNode {
         WideNode {
             lo: [[f32::INFINITY; WIDTH]; 3],
             hi: [[f32::NEG_INFINITY; WIDTH]; 3],
-            index: [0; WIDTH],
-            count: [0; WIDTH],
+            child: [0; WIDTH],
             mirror: [NOT_A_MIRROR; WIDTH],
             occupied: 0,
         }
@@ -99,10 +100,12 @@ struct TriBlock {
     original: [u32; WIDTH],
     /// Lanes in use (from the first).
     count: u32,
+    /// Whether the next block belongs to the same leaf.
+    more: bool,
 }
 
 /// The 8-wide hierarchy: its nodes, and its leaves' triangles in blocks (a leaf child names
-/// its first block and its triangle count; its blocks follow one another).
+/// its first block; its blocks follow one another).
 pub(super) struct WideBvh {
     nodes: Vec<WideNode>,
     blocks: Vec<TriBlock>,
@@ -122,6 +125,11 @@ pub(super) struct WideRay {
 }
 
 impl WideRay {
+    /// The traversal's constants of a ray: the watertight shear and the box test's
+    /// reciprocals (obvhs's `safe_inverse`), their six divisions done as one lane loop
+    /// (compiled inside [`crate::cpu_features::widest`]: one vector division; the same
+    /// quotients, so the same bits as [`WatertightRay::new`] and `safe_inverse`).
+    #[inline(always)]
     pub fn new(
         origin: glam::Vec3,
         dir: glam::Vec3,
@@ -130,10 +138,38 @@ impl WideRay {
         skip_mirror: Option<usize>,
         skip_triangle: Option<usize>,
     ) -> Self {
+        let d = dir.to_array();
+        let (code, [px, py], dz) = shear_operands(d);
+        // safe_inverse(x): sign(x) / ε where |x| ≤ ε, else 1 / x.
+        let small = d.map(|x| x.abs() <= f32::EPSILON);
+        let num = [
+            px,
+            py,
+            1.0,
+            if small[0] { d[0].signum() } else { 1.0 },
+            if small[1] { d[1].signum() } else { 1.0 },
+            if small[2] { d[2].signum() } else { 1.0 },
+            1.0,
+            1.0,
+        ];
+        let den = [
+            dz,
+            dz,
+            dz,
+            if small[0] { f32::EPSILON } else { d[0] },
+            if small[1] { f32::EPSILON } else { d[1] },
+            if small[2] { f32::EPSILON } else { d[2] },
+            1.0,
+            1.0,
+        ];
+        let mut q = [0.0f32; 8];
+        for i in 0..8 {
+            q[i] = num[i] / den[i];
+        }
         WideRay {
-            wt: WatertightRay::new(origin, dir),
+            wt: WatertightRay::from_shear(origin, code, [q[0], q[1], q[2]]),
             origin: origin.to_array(),
-            inv: dir.to_array().map(safe_inverse),
+            inv: [q[3], q[4], q[5]],
             t_min,
             t_max,
             skip_mirror: skip_mirror.map_or(SKIP_NOTHING, |m| m as u32),
@@ -199,14 +235,17 @@ impl WideBvh {
                 if b[c].is_leaf() {
                     let first = b[c].first_index as usize;
                     let count = b[c].prim_count as usize;
-                    node.index[i] = blocks.len() as u32;
-                    node.count[i] = count as u32;
-                    for chunk in (first..first + count).collect::<Vec<_>>().chunks(WIDTH) {
+                    node.child[i] = LEAF | blocks.len() as u32;
+                    let slots_of_leaf = (first..first + count).collect::<Vec<_>>();
+                    let chunks = slots_of_leaf.chunks(WIDTH);
+                    let last = chunks.len() - 1;
+                    for (k, chunk) in chunks.enumerate() {
                         let mut block = TriBlock {
                             v: [[[0.0; WIDTH]; 3]; 3],
                             mirror: [NOT_A_MIRROR; WIDTH],
                             original: [u32::MAX; WIDTH],
                             count: chunk.len() as u32,
+                            more: k < last,
                         };
                         for (lane, &slot) in chunk.iter().enumerate() {
                             for (corner, v) in slots[slot].v.iter().enumerate() {
@@ -221,13 +260,14 @@ impl WideBvh {
                     }
                 } else {
                     let child = nodes.len();
-                    nodes[wi].index[i] = child as u32;
+                    nodes[wi].child[i] = child as u32;
                     nodes.push(WideNode::empty());
                     todo.push((c, child, depth + 1));
                 }
             }
         }
-        ((WIDTH - 1) * deepest < STACK).then_some(WideBvh { nodes, blocks })
+        let fits = (WIDTH - 1) * deepest < STACK && blocks.len() < LEAF as usize;
+        fits.then_some(WideBvh { nodes, blocks })
     }
 
     /// Children per node, on average (tests).
@@ -266,6 +306,11 @@ impl WideBvh {
     /// The closest hit with `t` in `[t_min, t_max]`, skipping the ray's mirror and triangle:
     /// `(t, triangle)` in the scene's numbering, of equally distant hits the lowest triangle.
     /// `ANY_HIT`: the first hit found with `t < t_max` instead (its `t` is not the closest).
+    ///
+    /// The entry being visited is held apart from the stack (`current`): a child is pushed
+    /// only to be popped. (Measured on `mirror_room`'s scattered rays against pushing the hit
+    /// children in index order: no different; against placing them by rank without the
+    /// insertion loop: slower. See docs/tracer-performance.md.)
     #[inline(always)]
     pub(super) fn trace<const KX: usize, const KY: usize, const KZ: usize, const ANY_HIT: bool>(
         &self,
@@ -277,69 +322,87 @@ impl WideBvh {
         let mut best = ray.t_max;
         // The scene's index of the closest triangle so far (u32::MAX: none).
         let mut best_triangle = u32::MAX;
-        // Not initialised: entries below `sp` are written before they are read (zeroing 3 KB
-        // per query measured as a tenth of the traversal).
+        // Not initialised: entries below `sp` are written before they are read (zeroing the
+        // stack per query measured as a tenth of the traversal).
         let mut stack = [const { std::mem::MaybeUninit::<Entry>::uninit() }; STACK];
-        stack[0].write(Entry {
-            index: 0,
-            count: 0,
+        let mut sp = 0usize;
+        let mut current = Entry {
+            child: 0,
             near: ray.t_min,
-        });
-        let mut sp = 1;
-        while sp > 0 {
-            sp -= 1;
-            // SAFETY: every entry below `sp` was written (pushes write at `sp` and then raise
-            // it; pops lower it).
-            let Entry { index, count, near } = unsafe { stack[sp].assume_init() };
-            if near > best {
-                continue;
-            }
-            if count > 0 {
-                let blocks = index as usize..index as usize + (count as usize).div_ceil(WIDTH);
-                for block in &self.blocks[blocks] {
-                    let hit = self.block::<KX, KY, KZ>(block, ray, best);
-                    if let Some((t, triangle)) = hit {
+        };
+        loop {
+            if current.child & LEAF != 0 {
+                let mut b = (current.child & !LEAF) as usize;
+                loop {
+                    let block = &self.blocks[b];
+                    if let Some((t, triangle)) = self.block::<KX, KY, KZ>(block, ray, best) {
                         if ANY_HIT {
                             // `occluded`'s answer: a hit at t_min ≤ t < t_max.
                             if t < ray.t_max {
                                 return Some((t, triangle));
                             }
-                            continue;
-                        }
-                        let tie =
-                            (t == best) & (best_triangle != u32::MAX) && triangle < best_triangle;
-                        if (t < best) | tie {
-                            best = t;
-                            best_triangle = triangle;
+                        } else {
+                            // As the binary hierarchy's traversal: a hit at exactly t_max
+                            // counts only as a tie with an earlier one.
+                            let tie = (t == best)
+                                & (best_triangle != u32::MAX)
+                                & (triangle < best_triangle);
+                            if (t < best) | tie {
+                                best = t;
+                                best_triangle = triangle;
+                            }
                         }
                     }
+                    if !block.more {
+                        break;
+                    }
+                    b += 1;
                 }
-                continue;
+            } else {
+                let node = &self.nodes[current.child as usize];
+                let (bits, near) = self.meets(node, ray, best);
+                // Push the hit children farthest first, so the nearest is popped next: an
+                // insertion into the stack's top, which holds at most WIDTH entries of this
+                // node.
+                let mut bits = bits;
+                let base = sp;
+                while bits != 0 {
+                    let i = bits.trailing_zeros() as usize;
+                    bits &= bits - 1;
+                    let entry = Entry {
+                        child: node.child[i],
+                        near: near[i],
+                    };
+                    let mut j = sp;
+                    // SAFETY: entries base..sp were written by this loop; sp < STACK, as a
+                    // level pushes at most WIDTH − 1 entries beyond the one popped and the
+                    // hierarchy is shallow enough for that ([`WideBvh::from_bvh2`]).
+                    unsafe {
+                        while j > base && stack.get_unchecked(j - 1).assume_init().near < entry.near
+                        {
+                            *stack.get_unchecked_mut(j) = *stack.get_unchecked(j - 1);
+                            j -= 1;
+                        }
+                        stack.get_unchecked_mut(j).write(entry);
+                    }
+                    sp += 1;
+                }
             }
-            let node = &self.nodes[index as usize];
-            let (mut bits, near) = self.meets(node, ray, best);
-            // Push the hit children farthest first, so the nearest is popped next: an
-            // insertion into the stack's top, which holds at most WIDTH entries of this node.
-            let base = sp;
-            while bits != 0 {
-                let i = bits.trailing_zeros() as usize;
-                bits &= bits - 1;
-                let entry = Entry {
-                    index: node.index[i],
-                    count: node.count[i],
-                    near: near[i],
-                };
-                let mut j = sp;
-                // SAFETY: entries base..sp were written by this loop.
-                while j > base && unsafe { stack[j - 1].assume_init() }.near < entry.near {
-                    stack[j] = stack[j - 1];
-                    j -= 1;
+            // The next entry no farther than the closest hit so far.
+            loop {
+                if sp == 0 {
+                    return (best_triangle != u32::MAX).then_some((best, best_triangle));
                 }
-                stack[j].write(entry);
-                sp += 1;
+                sp -= 1;
+                // SAFETY: every entry below `sp` was written (a push writes at or below `sp`
+                // and then raises it; a pop lowers it).
+                let entry = unsafe { stack.get_unchecked(sp).assume_init() };
+                if entry.near <= best {
+                    current = entry;
+                    break;
+                }
             }
         }
-        (best_triangle != u32::MAX).then_some((best, best_triangle))
     }
 }
 
@@ -362,6 +425,7 @@ impl WideBvh {
         let o = ray.origin;
         let [sx, sy, sz] = ray.wt.shear();
         let mut t = [f32::INFINITY; WIDTH];
+        let mut key = [u64::MAX; WIDTH];
         let mut zero = 0u32;
         for i in 0..WIDTH {
             let d = |corner: usize, k: usize| b.v[corner][k][i] - o[k];
@@ -393,19 +457,28 @@ impl WideBvh {
             let ti = (u * az + v * bz + w * cz) / det;
             let valid = asked & !exact_zero & inside & (ti >= ray.t_min) & (ti <= best);
             t[i] = if valid { ti } else { f32::INFINITY };
-        }
-        let mut hit: Option<(f32, u32)> = None;
-        let mut keep = |ti: f32, tri: u32| {
-            let better = match hit {
-                None => ti.is_finite(),
-                Some((bt, btri)) => (ti < bt) | ((ti == bt) & (tri < btri)),
+            // The lane as one integer, ordered as (t, triangle): an integer minimum is a
+            // reduction the compiler vectorises (a float one it leaves a serial chain).
+            key[i] = if valid & (ti < f32::INFINITY) {
+                (u64::from(ordered_bits(ti)) << 32) | u64::from(b.original[i])
+            } else {
+                u64::MAX
             };
-            if better {
-                hit = Some((ti, tri));
+        }
+        // The closest lane, of equally distant ones the lowest triangle.
+        let mut nearest = u64::MAX;
+        for i in 0..WIDTH {
+            nearest = nearest.min(key[i]);
+        }
+        let mut hit = (nearest != u64::MAX)
+            .then(|| (from_ordered_bits((nearest >> 32) as u32), nearest as u32));
+        // The keys order −0 before +0, which the float comparisons tie: a hit at distance
+        // zero is decided lane by lane, as the scalar test's answers are compared.
+        if hit.is_some_and(|(t, _)| t == 0.0) {
+            hit = None;
+            for i in 0..b.count as usize {
+                keep(&mut hit, t[i], b.original[i]);
             }
-        };
-        for i in 0..b.count as usize {
-            keep(t[i], b.original[i]);
         }
         while zero != 0 {
             let i = zero.trailing_zeros() as usize;
@@ -418,19 +491,53 @@ impl WideBvh {
                 ray.t_min,
                 best,
             );
-            keep(ti, b.original[i]);
+            keep(&mut hit, ti, b.original[i]);
         }
         hit
     }
 }
 
-/// A stack entry: an inner node (its index, `count` 0) or a leaf (its first slot and
-/// `count` slots), with the distance at which the ray enters its box.
+/// A stack entry: a child as [`WideNode::child`] names it, with the distance at which the
+/// ray enters its box.
 #[derive(Clone, Copy)]
 struct Entry {
-    index: u32,
-    count: u32,
+    child: u32,
     near: f32,
+}
+
+/// `(ti, triangle)` into `hit` if it is a hit nearer than `hit`'s, or as near and of a lower
+/// triangle.
+#[inline(always)]
+fn keep(hit: &mut Option<(f32, u32)>, ti: f32, triangle: u32) {
+    let better = match *hit {
+        None => ti.is_finite(),
+        Some((bt, btri)) => (ti < bt) | ((ti == bt) & (triangle < btri)),
+    };
+    if better {
+        *hit = Some((ti, triangle));
+    }
+}
+
+/// `x`'s bits mapped so that unsigned integer order is the order of the floats (−0 just
+/// before +0; NaN aside).
+#[inline(always)]
+fn ordered_bits(x: f32) -> u32 {
+    let bits = x.to_bits();
+    if bits >> 31 == 1 {
+        !bits
+    } else {
+        bits | 1 << 31
+    }
+}
+
+/// The float of [`ordered_bits`].
+#[inline(always)]
+fn from_ordered_bits(bits: u32) -> f32 {
+    f32::from_bits(if bits >> 31 == 1 {
+        bits & !(1 << 31)
+    } else {
+        !bits
+    })
 }
 
 #[inline(always)]
@@ -476,4 +583,49 @@ fn binary_mirrors(bvh: &obvhs::bvh2::Bvh2, slots: &[Slot]) -> Vec<u32> {
         };
     }
     mirror
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+
+    /// A hit at distance zero in one leaf, decided as the scalar answers are compared: a ray
+    /// from the origin down −z meets, at t = 0, a triangle through the origin (lane 0,
+    /// triangle 0) whose watertight distance is +0 (its terms cancel exactly) and one in the
+    /// plane z = 0 (lane 1, triangle 1) whose distance is −0. The floats tie, so the lower
+    /// triangle wins, with +0; the leaf's integer keys put −0 first and must not decide.
+    #[test]
+    fn a_hit_at_distance_zero_in_a_leaf_is_decided_as_floats_tie() {
+        let v = |x: f32, y: f32, z: f32| Vec3::new(x, y, z);
+        let tilted = [v(-1.0, -1.0, 1.0), v(1.0, -1.0, -1.0), v(0.0, 1.0, 0.0)];
+        let flat = [v(-1.0, -1.0, 0.0), v(1.0, -1.0, 0.0), v(0.0, 1.0, 0.0)];
+        let ray = WideRay::new(Vec3::ZERO, Vec3::NEG_Z, 0.0, f32::INFINITY, None, None);
+        assert_eq!(ray.wt.axes(), (1, 0, 2));
+        // The configuration really gives zeros of both signs.
+        let t_of = |t: [Vec3; 3]| ray.wt.intersect(t[0], t[1], t[2], 0.0, f32::INFINITY);
+        assert_eq!(t_of(tilted).to_bits(), 0.0f32.to_bits());
+        assert_eq!(t_of(flat).to_bits(), (-0.0f32).to_bits());
+        let mut block = TriBlock {
+            v: [[[0.0; WIDTH]; 3]; 3],
+            mirror: [NOT_A_MIRROR; WIDTH],
+            original: [u32::MAX; WIDTH],
+            count: 2,
+            more: false,
+        };
+        for (lane, tri) in [tilted, flat].iter().enumerate() {
+            for (corner, p) in tri.iter().enumerate() {
+                for axis in 0..3 {
+                    block.v[corner][axis][lane] = p[axis];
+                }
+            }
+            block.original[lane] = lane as u32;
+        }
+        let bvh = WideBvh {
+            nodes: Vec::new(),
+            blocks: Vec::new(),
+        };
+        let (t, triangle) = bvh.block::<1, 0, 2>(&block, &ray, f32::INFINITY).unwrap();
+        assert_eq!((t.to_bits(), triangle), (0.0f32.to_bits(), 0));
+    }
 }

@@ -539,6 +539,20 @@ impl PathTracer<'_> {
                     self.bvh
                         .closest_hit_lanes_inline(&packet, coherent, &mut hits);
                 }
+                // The scattered lanes' queries one after another, before any lane's vertex:
+                // a run of traversals with nothing between them, which the processor
+                // overlaps better than traversals interleaved with the vertices' code.
+                let mut single: [Option<Hit>; LANES] = [None; LANES];
+                for lane in lanes(active & !coherent) {
+                    let w = &walks[lane];
+                    single[lane] = self.bvh.closest_hit_skipping(
+                        &w.ray,
+                        0.0,
+                        f32::INFINITY,
+                        w.from_mirror,
+                        w.from_triangle,
+                    );
+                }
                 asked.clear();
                 let mut flat = [false; LANES];
                 let mut any_flat = false;
@@ -548,19 +562,13 @@ impl PathTracer<'_> {
                     let hit = if in_packet {
                         hits.get(lane)
                     } else {
-                        self.bvh.closest_hit_skipping(
-                            &w.ray,
-                            0.0,
-                            f32::INFINITY,
-                            w.from_mirror,
-                            w.from_triangle,
-                        )
+                        single[lane]
                     };
+                    // A shadow ray not traced in a packet is answered one at a time after
+                    // the round's vertices (`Some` marks it; its answer goes in then).
                     let shadow_in_packet = w.diffuse_vertices < PACKET_SHADOW_VERTICES;
                     let step = self.vertex::<true>(w, hit, &mut rngs[lane], |k, s| {
-                        let answer = (!shadow_in_packet)
-                            .then(|| self.bvh.occluded(&s.ray, 0.0, s.t_max, None, Some(s.from)));
-                        asked.push((lane, k, s, answer))
+                        asked.push((lane, k, s, (!shadow_in_packet).then_some(false)))
                     });
                     match step {
                         Vertex::End(end) => {
@@ -602,6 +610,11 @@ impl PathTracer<'_> {
                 }
                 if asked.is_empty() {
                     continue;
+                }
+                for (_, _, s, answer) in asked.iter_mut() {
+                    if let Some(blocked) = answer {
+                        *blocked = self.bvh.occluded(&s.ray, 0.0, s.t_max, None, Some(s.from));
+                    }
                 }
                 // The round's shadow rays: one any-hit packet per light (and one for the
                 // emitter samples); a lane asks at most one of each.
