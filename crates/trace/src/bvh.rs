@@ -35,6 +35,17 @@ pub struct Hit {
     pub triangle: usize,
 }
 
+/// A query of [`SceneBvh::queries_inline`]: a ray with the limits and skips of
+/// [`SceneBvh::closest_hit_skipping`] and [`SceneBvh::occluded`].
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Query {
+    pub ray: Ray,
+    pub t_min: f32,
+    pub t_max: f32,
+    pub skip_mirror: Option<usize>,
+    pub skip_triangle: Option<usize>,
+}
+
 /// Which hierarchy the single-ray queries traverse (shadow legs, `path`, `whitted` below 4
 /// samples per pixel or with `--kernel single`). `Wide`, the default, is our own 8-wide one
 /// ([`wide`], issue 56): obvhs's binary hierarchy collapsed, its boxes uncompressed, eight
@@ -93,12 +104,12 @@ impl<const ANY_HIT: bool> Vectorised for WideQuery<'_, ANY_HIT> {
         );
         let b = self.bvh;
         match r.wt.axes() {
-            (1, 2, 0) => b.trace::<1, 2, 0, ANY_HIT>(r),
-            (2, 1, 0) => b.trace::<2, 1, 0, ANY_HIT>(r),
-            (2, 0, 1) => b.trace::<2, 0, 1, ANY_HIT>(r),
-            (0, 2, 1) => b.trace::<0, 2, 1, ANY_HIT>(r),
-            (0, 1, 2) => b.trace::<0, 1, 2, ANY_HIT>(r),
-            (1, 0, 2) => b.trace::<1, 0, 2, ANY_HIT>(r),
+            (1, 2, 0) => b.trace::<wide::ConstAxes<1, 2, 0>, ANY_HIT>(r),
+            (2, 1, 0) => b.trace::<wide::ConstAxes<2, 1, 0>, ANY_HIT>(r),
+            (2, 0, 1) => b.trace::<wide::ConstAxes<2, 0, 1>, ANY_HIT>(r),
+            (0, 2, 1) => b.trace::<wide::ConstAxes<0, 2, 1>, ANY_HIT>(r),
+            (0, 1, 2) => b.trace::<wide::ConstAxes<0, 1, 2>, ANY_HIT>(r),
+            (1, 0, 2) => b.trace::<wide::ConstAxes<1, 0, 2>, ANY_HIT>(r),
             other => unreachable!("not an axis permutation: {other:?}"),
         }
     }
@@ -586,6 +597,73 @@ impl SceneBvh {
             .fold(0, |blocked, lane| blocked | 1 << lane)
     }
 
+    /// The answers to `queries` in order, into `out` (as long): with `ANY_HIT` false each
+    /// query's [`SceneBvh::closest_hit_skipping`], with it true its
+    /// [`SceneBvh::occluded`] (`Some` for blocked). For callers already compiled for this CPU
+    /// ([`crate::cpu_features::widest`]). The 8-wide hierarchy traces them two at a time
+    /// ([`wide::WideBvh::trace_pair`]: the same answers, the two traversals' waits
+    /// overlapped); the others one at a time.
+    #[inline(always)]
+    pub(crate) fn queries_inline<const ANY_HIT: bool>(
+        &self,
+        queries: &[Query],
+        out: &mut [Option<Hit>],
+    ) {
+        debug_assert_eq!(queries.len(), out.len());
+        let Hierarchy::Wide(w) = &self.hierarchy else {
+            for (q, o) in queries.iter().zip(out.iter_mut()) {
+                *o = if ANY_HIT {
+                    self.occluded(&q.ray, q.t_min, q.t_max, q.skip_mirror, q.skip_triangle)
+                        .then_some(Hit {
+                            t: 0.0,
+                            triangle: usize::MAX,
+                        })
+                } else {
+                    self.closest_hit_skipping(
+                        &q.ray,
+                        q.t_min,
+                        q.t_max,
+                        q.skip_mirror,
+                        q.skip_triangle,
+                    )
+                };
+            }
+            return;
+        };
+        let wide_ray = |q: &Query| {
+            wide::WideRay::new(
+                q.ray.origin,
+                q.ray.dir,
+                q.t_min,
+                q.t_max,
+                q.skip_mirror,
+                q.skip_triangle,
+            )
+        };
+        let hit = |found: Option<(f32, u32)>| {
+            found.map(|(t, triangle)| Hit {
+                t,
+                triangle: triangle as usize,
+            })
+        };
+        let mut pairs = queries.chunks_exact(2);
+        let mut outs = out.chunks_exact_mut(2);
+        for (q, o) in (&mut pairs).zip(&mut outs) {
+            let (a, b) = (wide_ray(&q[0]), wide_ray(&q[1]));
+            let [ha, hb] = w.trace_pair::<ANY_HIT>([&a, &b]);
+            o[0] = hit(ha);
+            o[1] = hit(hb);
+        }
+        if let ([q], [o]) = (pairs.remainder(), outs.into_remainder()) {
+            *o = hit(WideQuery::<ANY_HIT> {
+                bvh: w,
+                ray: &q.ray,
+                query: (q.t_min, q.t_max, q.skip_mirror, q.skip_triangle),
+            }
+            .run());
+        }
+    }
+
     /// Builds the packet kernel's hierarchy now if packets are on (an integrator that
     /// traces packets calls it when it is created, so that the build is not part of the
     /// image loop's time, as the single-ray hierarchy's is not).
@@ -803,8 +881,9 @@ mod tests {
     /// triangle; occluded or not) on the inline scene and the bundled mirror scenes: camera
     /// rays, rays leaving a mirror from a point on it (skipping it), segments starting on a
     /// triangle (skipping it, as shadow legs do), and scattered rays from anywhere, with
-    /// bounded and unbounded far limits. Its nodes hold more than three children on average
-    /// (a binary node two).
+    /// bounded and unbounded far limits; one at a time and as a batch
+    /// ([`SceneBvh::queries_inline`], two rays traversed at once). Its nodes hold more than
+    /// three children on average (a binary node two).
     #[test]
     fn the_wide_hierarchy_answers_as_the_binary_one() {
         let root = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes"));
@@ -834,6 +913,7 @@ mod tests {
             let mut r = || rng.next_unit();
             let cam = &scene.camera;
             let (mut hits, mut blocked) = (0, 0);
+            let mut queries = Vec::new();
             for i in 0..4000usize {
                 let (ray, skip_mirror, skip_triangle) = match i % 4 {
                     0 => (
@@ -878,11 +958,58 @@ mod tests {
                 let got = wide.occluded(&ray, 0.0, t_max, skip_mirror, skip_triangle);
                 assert_eq!(got, want, "ray {i}: {ray:?} to {t_max}");
                 blocked += got as usize;
+                queries.push(Query {
+                    ray,
+                    t_min: 0.0,
+                    t_max,
+                    skip_mirror,
+                    skip_triangle,
+                });
             }
             assert!(
                 hits > 1000 && blocked > 1000,
                 "{hits} hits, {blocked} blocked"
             );
+            // The same rays as a batch, two at a time (an odd count: one alone at the end).
+            let queries = &queries[..queries.len() - 1];
+            let mut closest = vec![None; queries.len()];
+            let mut any = vec![None; queries.len()];
+            widest(Batch {
+                bvh: &wide,
+                queries,
+                closest: &mut closest,
+                any: &mut any,
+            });
+            for (i, q) in queries.iter().enumerate() {
+                let (ray, t_max) = (q.ray, q.t_max);
+                let want =
+                    binary.closest_hit_skipping(&ray, 0.0, t_max, q.skip_mirror, q.skip_triangle);
+                assert_eq!(
+                    closest[i].map(|h: Hit| (h.t.to_bits(), h.triangle)),
+                    want.map(|h| (h.t.to_bits(), h.triangle)),
+                    "batch ray {i}: {ray:?} to {t_max}"
+                );
+                let want = binary.occluded(&ray, 0.0, t_max, q.skip_mirror, q.skip_triangle);
+                assert_eq!(any[i].is_some(), want, "batch ray {i}: {ray:?} to {t_max}");
+            }
+        }
+    }
+
+    /// [`SceneBvh::queries_inline`] of a batch, closest hits and any hits, as a test runs it.
+    struct Batch<'a> {
+        bvh: &'a SceneBvh,
+        queries: &'a [Query],
+        closest: &'a mut [Option<Hit>],
+        any: &'a mut [Option<Hit>],
+    }
+
+    impl Vectorised for Batch<'_> {
+        type Output = ();
+
+        #[inline(always)]
+        fn run(self) {
+            self.bvh.queries_inline::<false>(self.queries, self.closest);
+            self.bvh.queries_inline::<true>(self.queries, self.any);
         }
     }
 

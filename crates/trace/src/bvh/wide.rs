@@ -306,101 +306,202 @@ impl WideBvh {
     /// The closest hit with `t` in `[t_min, t_max]`, skipping the ray's mirror and triangle:
     /// `(t, triangle)` in the scene's numbering, of equally distant hits the lowest triangle.
     /// `ANY_HIT`: the first hit found with `t < t_max` instead (its `t` is not the closest).
-    ///
-    /// The entry being visited is held apart from the stack (`current`): a child is pushed
-    /// only to be popped. (Measured on `mirror_room`'s scattered rays against pushing the hit
-    /// children in index order: no different; against placing them by rank without the
-    /// insertion loop: slower. See docs/tracer-performance.md.)
+    /// The ray's axis permutation is `A` (the watertight test's, [`WatertightRay::axes`]).
     #[inline(always)]
-    pub(super) fn trace<const KX: usize, const KY: usize, const KZ: usize, const ANY_HIT: bool>(
+    pub(super) fn trace<A: Axes, const ANY_HIT: bool>(&self, ray: &WideRay) -> Option<(f32, u32)> {
+        let mut walk = Walk::<A, ANY_HIT>::new(ray);
+        while !self.nodes.is_empty() && walk.step(self) {}
+        walk.answer()
+    }
+
+    /// [`WideBvh::trace`] of two rays at once, a node or leaf of each in turn: the two
+    /// traversals have no data in common, so the processor overlaps one's waits (loads,
+    /// divisions, the box tests' chains) with the other's work. Their axis permutations
+    /// are read at run time ([`RunTimeAxes`]); the same answers.
+    #[inline(always)]
+    pub(super) fn trace_pair<const ANY_HIT: bool>(
         &self,
-        ray: &WideRay,
-    ) -> Option<(f32, u32)> {
-        if self.nodes.is_empty() {
-            return None;
-        }
-        let mut best = ray.t_max;
-        // The scene's index of the closest triangle so far (u32::MAX: none).
-        let mut best_triangle = u32::MAX;
-        // Not initialised: entries below `sp` are written before they are read (zeroing the
-        // stack per query measured as a tenth of the traversal).
-        let mut stack = [const { std::mem::MaybeUninit::<Entry>::uninit() }; STACK];
-        let mut sp = 0usize;
-        let mut current = Entry {
-            child: 0,
-            near: ray.t_min,
-        };
-        loop {
-            if current.child & LEAF != 0 {
-                let mut b = (current.child & !LEAF) as usize;
-                loop {
-                    let block = &self.blocks[b];
-                    if let Some((t, triangle)) = self.block::<KX, KY, KZ>(block, ray, best) {
-                        if ANY_HIT {
-                            // `occluded`'s answer: a hit at t_min ≤ t < t_max.
-                            if t < ray.t_max {
-                                return Some((t, triangle));
-                            }
-                        } else {
-                            // As the binary hierarchy's traversal: a hit at exactly t_max
-                            // counts only as a tie with an earlier one.
-                            let tie = (t == best)
-                                & (best_triangle != u32::MAX)
-                                & (triangle < best_triangle);
-                            if (t < best) | tie {
-                                best = t;
-                                best_triangle = triangle;
-                            }
-                        }
-                    }
-                    if !block.more {
-                        break;
-                    }
-                    b += 1;
-                }
-            } else {
-                let node = &self.nodes[current.child as usize];
-                let (bits, near) = self.meets(node, ray, best);
-                // Push the hit children farthest first, so the nearest is popped next: an
-                // insertion into the stack's top, which holds at most WIDTH entries of this
-                // node.
-                let mut bits = bits;
-                let base = sp;
-                while bits != 0 {
-                    let i = bits.trailing_zeros() as usize;
-                    bits &= bits - 1;
-                    let entry = Entry {
-                        child: node.child[i],
-                        near: near[i],
-                    };
-                    let mut j = sp;
-                    // SAFETY: entries base..sp were written by this loop; sp < STACK, as a
-                    // level pushes at most WIDTH − 1 entries beyond the one popped and the
-                    // hierarchy is shallow enough for that ([`WideBvh::from_bvh2`]).
-                    unsafe {
-                        while j > base && stack.get_unchecked(j - 1).assume_init().near < entry.near
-                        {
-                            *stack.get_unchecked_mut(j) = *stack.get_unchecked(j - 1);
-                            j -= 1;
-                        }
-                        stack.get_unchecked_mut(j).write(entry);
-                    }
-                    sp += 1;
-                }
+        rays: [&WideRay; 2],
+    ) -> [Option<(f32, u32)>; 2] {
+        let mut a = Walk::<RunTimeAxes, ANY_HIT>::new(rays[0]);
+        let mut b = Walk::<RunTimeAxes, ANY_HIT>::new(rays[1]);
+        if !self.nodes.is_empty() {
+            let (mut more_a, mut more_b) = (true, true);
+            while more_a & more_b {
+                more_a = a.step(self);
+                more_b = b.step(self);
             }
-            // The next entry no farther than the closest hit so far.
+            while more_a {
+                more_a = a.step(self);
+            }
+            while more_b {
+                more_b = b.step(self);
+            }
+        }
+        [a.answer(), b.answer()]
+    }
+}
+
+/// A ray's axis permutation `(kx, ky, kz)` for the watertight test: known when compiling
+/// ([`ConstAxes`], one traversal per permutation) or read from the ray ([`RunTimeAxes`]).
+pub(super) trait Axes {
+    fn of(ray: &WideRay) -> (usize, usize, usize);
+    /// The scalar watertight test with these axes ([`WatertightRay::intersect_axes`] or
+    /// [`WatertightRay::intersect`]: the same arithmetic).
+    fn intersect(ray: &WideRay, v: [glam::Vec3; 3], t_min: f32, t_max: f32) -> f32;
+}
+
+/// Axes fixed at compile time.
+pub(super) struct ConstAxes<const KX: usize, const KY: usize, const KZ: usize>;
+
+impl<const KX: usize, const KY: usize, const KZ: usize> Axes for ConstAxes<KX, KY, KZ> {
+    #[inline(always)]
+    fn of(_: &WideRay) -> (usize, usize, usize) {
+        (KX, KY, KZ)
+    }
+
+    #[inline(always)]
+    fn intersect(ray: &WideRay, [a, b, c]: [glam::Vec3; 3], t_min: f32, t_max: f32) -> f32 {
+        ray.wt.intersect_axes::<KX, KY, KZ>(a, b, c, t_min, t_max)
+    }
+}
+
+/// The ray's own axes, read at run time.
+pub(super) struct RunTimeAxes;
+
+impl Axes for RunTimeAxes {
+    #[inline(always)]
+    fn of(ray: &WideRay) -> (usize, usize, usize) {
+        ray.wt.axes()
+    }
+
+    #[inline(always)]
+    fn intersect(ray: &WideRay, [a, b, c]: [glam::Vec3; 3], t_min: f32, t_max: f32) -> f32 {
+        ray.wt.intersect(a, b, c, t_min, t_max)
+    }
+}
+
+/// One ray's traversal, a node or a leaf per [`Walk::step`]: the entry being visited is held
+/// apart from the stack (`current`: a child is pushed only to be popped).
+struct Walk<'r, A, const ANY_HIT: bool> {
+    ray: &'r WideRay,
+    best: f32,
+    /// The scene's index of the closest triangle so far (u32::MAX: none).
+    best_triangle: u32,
+    /// `ANY_HIT`: a hit was found (the answer).
+    found: Option<(f32, u32)>,
+    /// Not initialised: entries below `sp` are written before they are read (zeroing the
+    /// stack per query measured as a tenth of the traversal).
+    stack: [std::mem::MaybeUninit<Entry>; STACK],
+    sp: usize,
+    current: Entry,
+    axes: std::marker::PhantomData<A>,
+}
+
+impl<'r, A: Axes, const ANY_HIT: bool> Walk<'r, A, ANY_HIT> {
+    #[inline(always)]
+    fn new(ray: &'r WideRay) -> Self {
+        Walk {
+            ray,
+            best: ray.t_max,
+            best_triangle: u32::MAX,
+            found: None,
+            stack: [const { std::mem::MaybeUninit::<Entry>::uninit() }; STACK],
+            sp: 0,
+            current: Entry {
+                child: 0,
+                near: ray.t_min,
+            },
+            axes: std::marker::PhantomData,
+        }
+    }
+
+    /// The answer once [`Walk::step`] has returned false.
+    #[inline(always)]
+    fn answer(&self) -> Option<(f32, u32)> {
+        if ANY_HIT {
+            self.found
+        } else {
+            (self.best_triangle != u32::MAX).then_some((self.best, self.best_triangle))
+        }
+    }
+
+    /// Visits the current entry (a node: its hit children pushed, farthest first; a leaf:
+    /// its blocks tested), then takes the next entry no farther than the closest hit so far.
+    /// False when the traversal is over.
+    #[inline(always)]
+    fn step(&mut self, bvh: &WideBvh) -> bool {
+        let ray = self.ray;
+        let current = self.current;
+        if current.child & LEAF != 0 {
+            let mut b = (current.child & !LEAF) as usize;
             loop {
-                if sp == 0 {
-                    return (best_triangle != u32::MAX).then_some((best, best_triangle));
+                let block = &bvh.blocks[b];
+                if let Some((t, triangle)) = bvh.block::<A>(block, ray, self.best) {
+                    if ANY_HIT {
+                        // `occluded`'s answer: a hit at t_min ≤ t < t_max.
+                        if t < ray.t_max {
+                            self.found = Some((t, triangle));
+                            return false;
+                        }
+                    } else {
+                        // As the binary hierarchy's traversal: a hit at exactly t_max counts
+                        // only as a tie with an earlier one.
+                        let tie = (t == self.best)
+                            & (self.best_triangle != u32::MAX)
+                            & (triangle < self.best_triangle);
+                        if (t < self.best) | tie {
+                            self.best = t;
+                            self.best_triangle = triangle;
+                        }
+                    }
                 }
-                sp -= 1;
-                // SAFETY: every entry below `sp` was written (a push writes at or below `sp`
-                // and then raises it; a pop lowers it).
-                let entry = unsafe { stack.get_unchecked(sp).assume_init() };
-                if entry.near <= best {
-                    current = entry;
+                if !block.more {
                     break;
                 }
+                b += 1;
+            }
+        } else {
+            let node = &bvh.nodes[current.child as usize];
+            let (mut bits, near) = bvh.meets(node, ray, self.best);
+            // Push the hit children farthest first, so the nearest is popped next: an
+            // insertion into the stack's top, which holds at most WIDTH entries of this node.
+            // (Measured on `mirror_room`'s scattered rays against pushing them in index
+            // order: no different; against placing them by rank without this loop: slower.)
+            let base = self.sp;
+            let stack = &mut self.stack;
+            while bits != 0 {
+                let i = bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                let entry = Entry {
+                    child: node.child[i],
+                    near: near[i],
+                };
+                let mut j = self.sp;
+                // SAFETY: entries base..sp were written by this loop; sp < STACK, as a level
+                // pushes at most WIDTH − 1 entries beyond the one popped and the hierarchy is
+                // shallow enough for that ([`WideBvh::from_bvh2`]).
+                unsafe {
+                    while j > base && stack.get_unchecked(j - 1).assume_init().near < entry.near {
+                        *stack.get_unchecked_mut(j) = *stack.get_unchecked(j - 1);
+                        j -= 1;
+                    }
+                    stack.get_unchecked_mut(j).write(entry);
+                }
+                self.sp += 1;
+            }
+        }
+        loop {
+            if self.sp == 0 {
+                return false;
+            }
+            self.sp -= 1;
+            // SAFETY: every entry below `sp` was written (a push writes at or below `sp` and
+            // then raises it; a pop lowers it).
+            let entry = unsafe { self.stack.get_unchecked(self.sp).assume_init() };
+            if entry.near <= self.best {
+                self.current = entry;
+                return true;
             }
         }
     }
@@ -416,22 +517,18 @@ impl WideBvh {
     /// triangle it skips take no part.
     #[inline(always)]
     #[allow(clippy::needless_range_loop)]
-    fn block<const KX: usize, const KY: usize, const KZ: usize>(
-        &self,
-        b: &TriBlock,
-        ray: &WideRay,
-        best: f32,
-    ) -> Option<(f32, u32)> {
+    fn block<A: Axes>(&self, b: &TriBlock, ray: &WideRay, best: f32) -> Option<(f32, u32)> {
         let o = ray.origin;
         let [sx, sy, sz] = ray.wt.shear();
+        let (kx, ky, kz) = A::of(ray);
         let mut t = [f32::INFINITY; WIDTH];
         let mut key = [u64::MAX; WIDTH];
         let mut zero = 0u32;
         for i in 0..WIDTH {
             let d = |corner: usize, k: usize| b.v[corner][k][i] - o[k];
-            let (a_x, a_y, a_z) = (d(0, KX), d(0, KY), d(0, KZ));
-            let (b_x, b_y, b_z) = (d(1, KX), d(1, KY), d(1, KZ));
-            let (c_x, c_y, c_z) = (d(2, KX), d(2, KY), d(2, KZ));
+            let (a_x, a_y, a_z) = (d(0, kx), d(0, ky), d(0, kz));
+            let (b_x, b_y, b_z) = (d(1, kx), d(1, ky), d(1, kz));
+            let (c_x, c_y, c_z) = (d(2, kx), d(2, ky), d(2, kz));
             let ax = a_x - sx * a_z;
             let ay = a_y - sy * a_z;
             let bx = b_x - sx * b_z;
@@ -484,13 +581,7 @@ impl WideBvh {
             let i = zero.trailing_zeros() as usize;
             zero &= zero - 1;
             let corner = |c: usize| glam::Vec3::new(b.v[c][0][i], b.v[c][1][i], b.v[c][2][i]);
-            let ti = ray.wt.intersect_axes::<KX, KY, KZ>(
-                corner(0),
-                corner(1),
-                corner(2),
-                ray.t_min,
-                best,
-            );
+            let ti = A::intersect(ray, [corner(0), corner(1), corner(2)], ray.t_min, best);
             keep(&mut hit, ti, b.original[i]);
         }
         hit
@@ -625,7 +716,9 @@ mod tests {
             nodes: Vec::new(),
             blocks: Vec::new(),
         };
-        let (t, triangle) = bvh.block::<1, 0, 2>(&block, &ray, f32::INFINITY).unwrap();
+        let (t, triangle) = bvh
+            .block::<ConstAxes<1, 0, 2>>(&block, &ray, f32::INFINITY)
+            .unwrap();
         assert_eq!((t.to_bits(), triangle), (0.0f32.to_bits(), 0));
     }
 }

@@ -31,7 +31,7 @@
 
 use super::{Integrator, PathResult, Termination, face_normals};
 use crate::bvh::packet::{LANES, LaneHits, LaneMask, NO_TRIANGLE, RayPacket, first_lanes, lanes};
-use crate::bvh::{Hit, SceneBvh};
+use crate::bvh::{Hit, Query, SceneBvh};
 use crate::cpu_features::{Vectorised, widest};
 use crate::hit_point::on_triangle_plane;
 use crate::mirror_bounce::{MirrorPlanes, bounce_flat_lanes};
@@ -190,6 +190,18 @@ enum Vertex {
 /// A shadow ray asked by the path in lane `.0`, of kind `.1` (point light, or the emitter
 /// sample), with its answer (blocked) where it was traced at once.
 type Asked = (usize, usize, ShadowRay, Option<bool>);
+
+/// A placeholder entry of a round's query arrays (never traced).
+const NO_QUERY: Query = Query {
+    ray: Ray {
+        origin: Vec3::ZERO,
+        dir: Vec3::Z,
+    },
+    t_min: 0.0,
+    t_max: 0.0,
+    skip_mirror: None,
+    skip_triangle: None,
+};
 
 /// A path between its vertices: its next ray and what it carries.
 #[derive(Clone, Copy)]
@@ -542,16 +554,28 @@ impl PathTracer<'_> {
                 // The scattered lanes' queries one after another, before any lane's vertex:
                 // a run of traversals with nothing between them, which the processor
                 // overlaps better than traversals interleaved with the vertices' code.
+                // (Two at a time through the 8-wide hierarchy: `SceneBvh::queries_inline`.)
                 let mut single: [Option<Hit>; LANES] = [None; LANES];
+                let mut queries = [NO_QUERY; LANES];
+                let mut lane_of = [0usize; LANES];
+                let mut n = 0;
                 for lane in lanes(active & !coherent) {
                     let w = &walks[lane];
-                    single[lane] = self.bvh.closest_hit_skipping(
-                        &w.ray,
-                        0.0,
-                        f32::INFINITY,
-                        w.from_mirror,
-                        w.from_triangle,
-                    );
+                    queries[n] = Query {
+                        ray: w.ray,
+                        t_min: 0.0,
+                        t_max: f32::INFINITY,
+                        skip_mirror: w.from_mirror,
+                        skip_triangle: w.from_triangle,
+                    };
+                    lane_of[n] = lane;
+                    n += 1;
+                }
+                let mut answers = [None; LANES];
+                self.bvh
+                    .queries_inline::<false>(&queries[..n], &mut answers[..n]);
+                for (&lane, &answer) in lane_of[..n].iter().zip(&answers[..n]) {
+                    single[lane] = answer;
                 }
                 asked.clear();
                 let mut flat = [false; LANES];
@@ -611,9 +635,31 @@ impl PathTracer<'_> {
                 if asked.is_empty() {
                     continue;
                 }
-                for (_, _, s, answer) in asked.iter_mut() {
-                    if let Some(blocked) = answer {
-                        *blocked = self.bvh.occluded(&s.ray, 0.0, s.t_max, None, Some(s.from));
+                // The shadow rays traced one at a time (two at a time through the 8-wide
+                // hierarchy), LANES per call.
+                let mut singles = asked.iter_mut().filter(|a| a.3.is_some()).peekable();
+                while singles.peek().is_some() {
+                    let mut queries = [NO_QUERY; LANES];
+                    let mut of: [Option<&mut Option<bool>>; LANES] = Default::default();
+                    let mut n = 0;
+                    for (_, _, s, answer) in singles.by_ref().take(LANES) {
+                        queries[n] = Query {
+                            ray: s.ray,
+                            t_min: 0.0,
+                            t_max: s.t_max,
+                            skip_mirror: None,
+                            skip_triangle: Some(s.from),
+                        };
+                        of[n] = Some(answer);
+                        n += 1;
+                    }
+                    let mut answers = [None; LANES];
+                    self.bvh
+                        .queries_inline::<true>(&queries[..n], &mut answers[..n]);
+                    for (answer, blocked) in of[..n].iter_mut().zip(&answers[..n]) {
+                        if let Some(answer) = answer {
+                            **answer = Some(blocked.is_some());
+                        }
                     }
                 }
                 // The round's shadow rays: one any-hit packet per light (and one for the
