@@ -242,6 +242,26 @@ pub fn interaction_at(
     }
 }
 
+/// [`interaction_at`] with the point asked for only where it matters: not at a mirror's
+/// front, which reflects whatever the point (most hits in a mirror scene), so that the
+/// tracers compute it (an f64 solve with a division, `hit_point`) only for the surfaces
+/// shaded there; `point` is called at most once, and its point returned with the
+/// interaction.
+#[inline(always)]
+pub fn interaction_with_point(
+    g: &crate::Geometry,
+    triangle: usize,
+    front_facing: bool,
+    point: impl FnOnce() -> Vec3,
+) -> (Interaction, Option<Vec3>) {
+    let reflects = interaction(g.surface(triangle), front_facing);
+    if let Interaction::Reflect { .. } = reflects {
+        return (reflects, None);
+    }
+    let p = point();
+    (interaction_at(g, triangle, p, front_facing), Some(p))
+}
+
 /// Perfect specular reflection of direction `d` about unit normal `n`: `d − 2(d·n)n`.
 pub fn reflect(d: Vec3, n: Vec3) -> Vec3 {
     d - 2.0 * d.dot(n) * n
@@ -323,6 +343,41 @@ mod tests {
                     "lane {i}"
                 );
             }
+        }
+    }
+
+    /// The point is asked for only off a mirror's front: once on a diffuse triangle and on
+    /// a mirror's back (given back with the interaction), never on a mirror's front.
+    #[test]
+    fn the_point_is_asked_for_only_where_a_surface_is_shaded() {
+        let mut g = crate::Geometry::default();
+        let tri = [Vec3::ZERO, Vec3::X, Vec3::Y];
+        g.push_part(
+            "floor".into(),
+            Surface::diffuse(Vec3::ONE, Vec3::ZERO),
+            vec![tri],
+        );
+        let mirror = Surface::Mirror {
+            mirror: 0,
+            reflectance: Vec3::splat(0.9),
+            back_albedo: Vec3::splat(0.5),
+        };
+        g.push_part("mirror".into(), mirror, vec![tri]);
+        let p = Vec3::new(0.25, 0.25, 0.0);
+        for (triangle, front, asked) in [
+            (0, true, true),
+            (0, false, true),
+            (1, false, true),
+            (1, true, false),
+        ] {
+            let mut calls = 0;
+            let (interaction, point) = interaction_with_point(&g, triangle, front, || {
+                calls += 1;
+                p
+            });
+            assert_eq!(calls, asked as usize, "triangle {triangle}, front {front}");
+            assert_eq!(point, asked.then_some(p));
+            assert_eq!(interaction, interaction_at(&g, triangle, p, front));
         }
     }
 

@@ -37,7 +37,7 @@ use crate::hit_point::on_triangle_plane;
 use crate::mirror_bounce::{MirrorPlanes, bounce_flat_lanes};
 use crate::sampler::SplitMix64;
 use glam::Vec3;
-use mirrorbox_scene::shading::{Interaction, interaction_at};
+use mirrorbox_scene::shading::{Interaction, interaction_with_point};
 use mirrorbox_scene::{Ray, Scene, Surface};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -292,16 +292,17 @@ impl PathTracer<'_> {
             return Vertex::End(Termination::Escaped);
         };
         let mut flat = None;
-        let p = on_triangle_plane(
-            g,
-            hit.triangle,
-            ray.origin.as_dvec3(),
-            ray.dir.as_dvec3(),
-            hit.t,
-        );
         let n_f = self.normals[hit.triangle];
         let front = n_f.dot(ray.dir) < 0.0;
-        let inter = interaction_at(g, hit.triangle, p, front);
+        let (inter, p) = interaction_with_point(g, hit.triangle, front, || {
+            on_triangle_plane(
+                g,
+                hit.triangle,
+                ray.origin.as_dvec3(),
+                ray.dir.as_dvec3(),
+                hit.t,
+            )
+        });
         if let Interaction::Diffuse { emission, .. } = inter
             && front
             && emission != Vec3::ZERO
@@ -348,6 +349,7 @@ impl PathTracer<'_> {
                 w.bounces += 1;
             }
             Interaction::Diffuse { albedo, .. } => {
+                let p = p.expect("a diffuse interaction comes with its point");
                 let n = if front { n_f } else { -n_f };
                 let f = albedo * std::f32::consts::FRAC_1_PI;
                 let lights = &scene.lighting.lights;

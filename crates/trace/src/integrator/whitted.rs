@@ -18,7 +18,7 @@ use crate::hit_point::on_triangle_plane;
 use crate::mirror_bounce::{MirrorPlanes, bounce_flat_lanes};
 use crate::sampler::SplitMix64;
 use glam::{DVec3, Vec3};
-use mirrorbox_scene::shading::{Interaction, interaction_at};
+use mirrorbox_scene::shading::{Interaction, interaction_with_point};
 use mirrorbox_scene::{Ray, Scene};
 
 /// Fewest rays of a pixel traced as a packet; fewer go one at a time.
@@ -311,10 +311,12 @@ impl<'a> Whitted<'a> {
         let normal = self.face_normals[hit.triangle];
         let front = normal.dot(query.dir) < 0.0;
         let surface = scene.geometry.surface(hit.triangle);
-        let p = on_triangle_plane(&scene.geometry, hit.triangle, exact.0, exact.1, hit.t);
-        match interaction_at(&scene.geometry, hit.triangle, p, front) {
+        let (interaction, p) = interaction_with_point(&scene.geometry, hit.triangle, front, || {
+            on_triangle_plane(&scene.geometry, hit.triangle, exact.0, exact.1, hit.t)
+        });
+        match interaction {
             Interaction::Diffuse { albedo, emission } => Next::Diffuse(DiffuseHit {
-                p,
+                p: p.expect("a diffuse interaction comes with its point"),
                 normal,
                 to_viewer: -query.dir,
                 albedo,
