@@ -7,6 +7,8 @@
 #
 # Usage: scripts/ab-trace.sh ROUNDS SCENE BIN_A BIN_B [-- TRACE_ARGS...]
 #   e.g. scripts/ab-trace.sh 16 mirror_room /tmp/before target/release/mirrorbox -- --spp 16
+#   Build both outside scripts/test-build-env.sh: its clippy wrapper compiles with MIR
+#   optimisations off (5-8 % slower; docs/tracer-performance.md).
 #   Name --spp in TRACE_ARGS: `trace` defaults to 1 sample per pixel since issue 37 (16 before),
 #   so two builds from either side of that change would otherwise trace different images.
 set -euo pipefail

@@ -24,6 +24,10 @@ cd "$(dirname "$0")/.."
 rounds=${1:-5}
 spp=${2:-16}
 bin=target/release/mirrorbox
+# A measured build is a plain one: scripts/test-build-env.sh's clippy wrapper compiles the
+# workspace with MIR optimisations off (clippy-driver sets mir-opt-level 0), measured 5-8 %
+# slower on the tracer (issue 56, docs/tracer-performance.md).
+unset RUSTC_WORKSPACE_WRAPPER CLIPPY_ARGS
 # Always built (a no-op when current), so that the record's commit is the build measured;
 # a tree with changes to the code is marked "+changes".
 cargo build --release --locked -p mirrorbox >&2

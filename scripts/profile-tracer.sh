@@ -16,6 +16,10 @@ scene=$1 integrator=$2
 case $integrator in whitted) cut=(--max-depth 10000) ;; path) cut=(--max-segments 10) ;; *) echo "INTEGRATOR must be whitted or path, not '$integrator'" >&2; exit 2 ;; esac
 command -v perf > /dev/null || { echo "perf is not installed (apt install linux-perf)" >&2; exit 1; }
 bin=target/release/mirrorbox
+# A measured build is a plain one: scripts/test-build-env.sh's clippy wrapper compiles the
+# workspace with MIR optimisations off (clippy-driver sets mir-opt-level 0), measured 5-8 %
+# slower on the tracer (issue 56, docs/tracer-performance.md).
+unset RUSTC_WORKSPACE_WRAPPER CLIPPY_ARGS
 # Always built (a no-op when current), so that the profile's commit is the build profiled.
 cargo build --release --locked -p mirrorbox >&2
 commit=$(git rev-parse --short HEAD)

@@ -51,6 +51,10 @@ run_step() {
   steps_json+="${steps_json:+,}{\"name\":\"$name\",\"seconds\":$took,\"peak_kb\":$peak}"
 }
 run_step scripts/install-system-deps.sh
+# A measured build is a plain one: scripts/test-build-env.sh's clippy wrapper compiles the
+# workspace with MIR optimisations off (clippy-driver sets mir-opt-level 0), measured 5-8 %
+# slower on the tracer (issue 56, docs/tracer-performance.md).
+unset RUSTC_WORKSPACE_WRAPPER CLIPPY_ARGS
 # --timings: target/cargo-timings/cargo-timing.html says which crates the build's time goes to.
 run_step cargo build --release --locked -p mirrorbox --timings
 main_job_experiments=$("$bin" experiment --main-job)
