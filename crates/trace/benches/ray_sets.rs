@@ -2,8 +2,9 @@
 //! camera rays of `mirror_box` at 640×360 (one per pixel centre), for the rays leaving the
 //! first mirror those hit, and for the rays leaving their tenth mirror — the coherence a
 //! packet kernel would exploit falls from set to set (planar mirrors keep neighbours
-//! neighbours; edges and the sphere scatter them): the single-ray kernel (obvhs' CWBVH) and
-//! the packet kernel (`bvh::packet`) on the same sets.
+//! neighbours; edges and the sphere scatter them): the default single-ray hierarchy and
+//! the packet kernel (`bvh::packet`) on the same sets. The `single_` groups: camera and
+//! scattered rays one at a time, per hierarchy (`-- single_` runs only them).
 //! Run: `cargo bench -p mirrorbox-trace --bench ray_sets`.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
@@ -87,8 +88,9 @@ fn scattered(scene: &Scene, bvh: &SceneBvh, camera_rays: &[Leaving]) -> Vec<(Ray
         .collect()
 }
 
-/// Single rays only, every hierarchy kind: camera rays and scattered rays of `mirror_box` and
-/// `mirror_room` (the rays `path` sends one at a time).
+/// Single rays only, through the 8-wide hierarchy and obvhs's CWBVH: camera rays and
+/// scattered rays of `mirror_box` and `mirror_room` (the rays `path` sends one at a time),
+/// closest hit and any hit (issue 56).
 fn single(c: &mut Criterion) {
     for name in ["mirror_box", "mirror_room"] {
         let mut scene = mirrorbox_scene::load::bundled_scene(&format!("{name}.json"));

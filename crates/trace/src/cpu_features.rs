@@ -1,7 +1,7 @@
 //! One binary, the CPU's widest vectors: code run through [`widest`] is compiled three
 //! times — for AVX-512 (F with VL, BW and DQ, which every AVX-512 CPU since Skylake-SP has:
-//! VL gives 8-lane compares into mask registers; issue 56 measured `whitted` ×0.89–0.91
-//! against F alone), for AVX2 and for the x86-64 baseline (SSE2) — and the CPU's best is
+//! VL gives 8-lane compares into mask registers, which the traversals' 8-lane loops use;
+//! not shown apart from F alone in `whitted`'s time, issue 56), for AVX2 and for the x86-64 baseline (SSE2) — and the CPU's best is
 //! chosen at run time (`is_x86_feature_detected`, once). No `target-cpu=native`.
 //!
 //! Why it is safe for the answers: Rust never contracts `a * b + c` into a fused

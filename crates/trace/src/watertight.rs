@@ -79,17 +79,8 @@ pub(crate) fn axes_of(code: u32) -> (usize, usize, usize) {
 
 impl WatertightRay {
     pub fn new(origin: Vec3, dir: Vec3) -> Self {
-        let (code, [sx, sy, sz]) = shear_of(dir.to_array());
-        let (kx, ky, kz) = axes_of(code);
-        WatertightRay {
-            origin,
-            kx,
-            ky,
-            kz,
-            sx,
-            sy,
-            sz,
-        }
+        let (code, shear) = shear_of(dir.to_array());
+        WatertightRay::from_shear(origin, code, shear)
     }
 
     /// The ray from its [`shear_of`] permutation code and shear constants (computed by the

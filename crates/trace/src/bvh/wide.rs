@@ -31,7 +31,7 @@ use crate::watertight::{WatertightRay, shear_operands};
 pub const WIDTH: usize = 8;
 
 /// Triangles per leaf block: [`LEAF_TRIANGLES`], so that a leaf is one block. (Blocks of
-/// [`WIDTH`] lanes held leaves of at most 4 in twice the memory: `path` ×0.966 / ×0.967 on
+/// [`WIDTH`] lanes held leaves of at most 4 in twice the memory: `path` ×0.963 / ×0.963 on
 /// `mirror_room` / `mirror_box` with blocks of 4, 4 % fewer instructions.)
 const BLOCK: usize = LEAF_TRIANGLES as usize;
 
