@@ -2,7 +2,8 @@
 //! renders every bundled scene to the same bits with packets as one ray at a time through
 //! the BVH2 (the packets' hierarchy; the CWBVH misses some corner hits: see `bvh.rs`), at the
 //! command line's 4×4 grid (two pixels per packet), at 3×3 and 2×2 (3 and 8 pixels per
-//! packet; rows of 48 pixels end in part-filled packets) and 1×1 (one ray at a time), with
+//! packet; rows of 48 pixels end in part-filled packets) and 1×1 (32 pixels per packet: the
+//! sweeps' truths at one sample per pixel), with
 //! shadow legs, uneven
 //! mirrors, symmetry planes and stereo rigs' scenes among them. So does `path`, whose
 //! samples (each with its own stream since issue 41) walk side by side, their coherent
