@@ -47,10 +47,9 @@ pub trait Integrator: Sync {
 }
 
 /// Pixels per [`Integrator::radiance_all`] call for an integrator that traces packets:
-/// as many as fill a packet's lanes (at least one) when `bvh` traces packets and a pixel has
-/// at least `min_packet` samples; else one.
-fn packet_pixels(bvh: &SceneBvh, samples_per_pixel: usize, min_packet: usize) -> usize {
-    if bvh.packets() && samples_per_pixel >= min_packet {
+/// as many as fill a packet's lanes (at least one) when `bvh` traces packets; else one.
+fn packet_pixels(bvh: &SceneBvh, samples_per_pixel: usize) -> usize {
+    if bvh.packets() && samples_per_pixel >= 1 {
         (crate::bvh::packet::LANES / samples_per_pixel).max(1)
     } else {
         1

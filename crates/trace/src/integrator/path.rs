@@ -705,7 +705,7 @@ impl Integrator for PathTracer<'_> {
     /// Enough pixels to fill a packet's lanes when packets are traced (at least one): every
     /// sample has its own stream, so any samples can walk side by side.
     fn pixels_per_call(&self, samples_per_pixel: usize) -> usize {
-        super::packet_pixels(self.bvh, samples_per_pixel, 1)
+        super::packet_pixels(self.bvh, samples_per_pixel)
     }
 
     /// Each ray's stream split off its pixel's in order (as [`Integrator::radiance`] does),

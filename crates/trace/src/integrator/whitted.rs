@@ -21,13 +21,6 @@ use glam::{DVec3, Vec3};
 use mirrorbox_scene::shading::{Interaction, interaction_with_point};
 use mirrorbox_scene::{Ray, Scene};
 
-/// Fewest rays of a pixel traced as a packet; fewer go one at a time. 1: at one sample per
-/// pixel (the sweeps' truths) a packet is 32 neighbouring pixels of a row. (It was 4 while the
-/// default single-ray hierarchy was obvhs's CWBVH, whose answers differ from the packets' at
-/// mirror corners, to keep the 1-spp truths' bits; the 8-wide hierarchy answers as the
-/// packets do, so the bits are the same either way: issue 56, `mirror_room` at 1 spp ×0.30.)
-const MIN_PACKET: usize = 1;
-
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct WhittedSettings {
     /// Most mirror reflections a path follows (the `--max-depth`).
@@ -403,16 +396,19 @@ impl Integrator for Whitted<'_> {
         Whitted::radiance(self, ray)
     }
 
-    /// Enough pixels to fill a packet when packets are traced and a pixel has enough samples
-    /// to make one ([`MIN_PACKET`]); at least one.
+    /// Enough pixels to fill a packet when packets are traced, at any sample count: at one
+    /// sample per pixel (the sweeps' truths) a packet is 32 neighbouring pixels of a row. (Below
+    /// 4 samples rays went one at a time while the single-ray default was obvhs's CWBVH, whose
+    /// answers differ from the packets' at mirror corners, to keep the 1-spp truths' bits; the
+    /// 8-wide hierarchy answers as the packets do: issue 56, `mirror_room` at 1 spp ×0.30.)
     fn pixels_per_call(&self, samples_per_pixel: usize) -> usize {
-        super::packet_pixels(self.bvh, samples_per_pixel, MIN_PACKET)
+        super::packet_pixels(self.bvh, samples_per_pixel)
     }
 
-    /// As packets when the BVH traces them and there are enough rays to fill some lanes.
+    /// As packets when the BVH traces them.
     fn radiance_all(&self, rays: &[Ray], _rngs: &mut [SplitMix64], out: &mut Vec<PathResult>) {
         out.clear();
-        if self.bvh.packets() && rays.len() >= MIN_PACKET {
+        if self.bvh.packets() {
             self.radiance_packet(rays, out);
         } else {
             out.extend(rays.iter().map(|&ray| Whitted::radiance(self, ray)));
