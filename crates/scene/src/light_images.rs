@@ -72,6 +72,18 @@ impl LightImage {
         let x = x.extend(1.0);
         self.beam[0].dot(x) > 0.0 && self.beam[1..].iter().all(|p| p.dot(x) >= 0.0)
     }
+
+    /// Where the line from `from` to this image's position crosses its last mirror's plane:
+    /// the mirror point of the leg from `from` ([`for_each_leg`]).
+    #[inline]
+    pub fn mirror_point(&self, from: Vec3) -> Vec3 {
+        let plane = self.beam[0];
+        let (da, db) = (
+            plane.dot(from.extend(1.0)),
+            plane.dot(self.position.extend(1.0)),
+        );
+        from + (self.position - from) * (da / (da - db))
+    }
 }
 
 /// Every light image of a scene, with what enumeration pruned.
@@ -290,12 +302,7 @@ pub fn for_each_leg(
     let mut current = Some(index);
     while let Some(i) = current {
         let image = &images[i];
-        let plane = image.beam[0];
-        let (da, db) = (
-            plane.dot(from.extend(1.0)),
-            plane.dot(image.position.extend(1.0)),
-        );
-        let hit = from + (image.position - from) * (da / (da - db));
+        let hit = image.mirror_point(from);
         if !leg(from, from_mirror, hit, Some(image.mirror)) {
             return false;
         }

@@ -125,6 +125,149 @@ impl Lighting {
         emitted + albedo * (irradiance * std::f32::consts::FRAC_1_PI + self.ambient)
     }
 
+    /// [`Lighting::diffuse_radiance_with`] at the points of the lanes of `shaded` at once,
+    /// each light's (and each light image's) legs asked together: `unoccluded(legs, clear)`
+    /// sets `clear[j]` for each of `legs` — at most one per lane, each the leg the one-point
+    /// form asks of that lane at that moment — so that a caller can trace them as one
+    /// packet. Per lane the same operations in the same order as the one-point form (the
+    /// same bits), the same legs asked (a chain stops at its first blocked leg), each counted
+    /// in `asked[lane]`. Arguments are `[component][lane]`, as
+    /// [`Lighting::direct_radiance_lanes`]'s.
+    #[allow(clippy::too_many_arguments)]
+    pub fn diffuse_radiance_lanes_with<const L: usize>(
+        &self,
+        shaded: &[bool; L],
+        p: &[[f32; L]; 3],
+        face_normal: &[[f32; L]; 3],
+        to_viewer: &[[f32; L]; 3],
+        albedo: &[[f32; L]; 3],
+        emission: &[[f32; L]; 3],
+        asked: &mut [u32; L],
+        mut unoccluded: impl FnMut(&[Leg], &mut [bool]),
+    ) -> [[f32; L]; 3] {
+        let lane = |a: &[[f32; L]; 3], i: usize| Vec3::new(a[0][i], a[1][i], a[2][i]);
+        let shaded_lanes = || (0..L).filter(|&i| shaded[i]);
+        let mut n = [Vec3::ZERO; L];
+        let mut front = [false; L];
+        for i in shaded_lanes() {
+            let face = lane(face_normal, i);
+            front[i] = face.dot(lane(to_viewer, i)) >= 0.0;
+            n[i] = if front[i] { face } else { -face };
+        }
+        let mut irradiance = [Vec3::ZERO; L];
+        let mut e = [Vec3::ZERO; L];
+        let mut legs = [Leg::NONE; L];
+        let mut clear = [false; L];
+        // Asks `legs` (at most one per lane), then keeps alive only the lanes whose leg is clear.
+        let mut ask = |legs: &[Leg], alive: &mut [bool; L]| {
+            for leg in legs {
+                asked[leg.lane] += 1;
+            }
+            unoccluded(legs, &mut clear[..legs.len()]);
+            for (leg, &clear) in legs.iter().zip(&clear) {
+                alive[leg.lane] &= clear;
+            }
+        };
+        for light in &self.lights {
+            let mut alive = [false; L];
+            let mut count = 0;
+            for i in shaded_lanes() {
+                e[i] = point_irradiance(lane(p, i), n[i], light.position, light.intensity);
+                if e[i] == Vec3::ZERO {
+                    continue;
+                }
+                if !self.shadows {
+                    irradiance[i] += e[i];
+                    continue;
+                }
+                alive[i] = true;
+                legs[count] = Leg::new(i, lane(p, i), None, light.position, None);
+                count += 1;
+            }
+            if count > 0 {
+                ask(&legs[..count], &mut alive);
+                for i in (0..L).filter(|&i| alive[i]) {
+                    irradiance[i] += e[i];
+                }
+            }
+        }
+        let images = &self.images.images;
+        // Each lane's point on its chain (written before it is read, for the lanes alive).
+        let mut from = [Vec3::ZERO; L];
+        for (index, image) in images.iter().enumerate() {
+            let mut alive = [false; L];
+            let mut any = false;
+            for i in shaded_lanes() {
+                let x = lane(p, i);
+                if !image.lights(x) {
+                    continue;
+                }
+                e[i] = point_irradiance(x, n[i], image.position, image.intensity);
+                if e[i] == Vec3::ZERO {
+                    continue;
+                }
+                if !self.shadows {
+                    irradiance[i] += e[i];
+                    continue;
+                }
+                alive[i] = true;
+                from[i] = x;
+                any = true;
+            }
+            if !any {
+                continue;
+            }
+            // The chain's legs (`for_each_leg`'s), one per lane at a time: the mirrors and
+            // images are the same for every lane, the points the lane's own.
+            let mut from_mirror = None;
+            let mut current = Some(index);
+            while let Some(c) = current {
+                let image = &images[c];
+                let mut count = 0;
+                for i in (0..L).filter(|&i| alive[i]) {
+                    let hit = image.mirror_point(from[i]);
+                    legs[count] = Leg::new(i, from[i], from_mirror, hit, Some(image.mirror));
+                    count += 1;
+                    from[i] = hit;
+                }
+                if count == 0 {
+                    break;
+                }
+                ask(&legs[..count], &mut alive);
+                from_mirror = Some(image.mirror);
+                current = image.parent;
+                if current.is_none() {
+                    let light = self.lights[image.light].position;
+                    let mut count = 0;
+                    for i in (0..L).filter(|&i| alive[i]) {
+                        legs[count] = Leg::new(i, from[i], from_mirror, light, None);
+                        count += 1;
+                    }
+                    if count > 0 {
+                        ask(&legs[..count], &mut alive);
+                    }
+                }
+            }
+            for i in (0..L).filter(|&i| alive[i]) {
+                irradiance[i] += e[i];
+            }
+        }
+        let mut out = [[0.0; L]; 3];
+        for i in shaded_lanes() {
+            let emitted = if front[i] {
+                lane(emission, i)
+            } else {
+                Vec3::ZERO
+            };
+            let l = emitted
+                + lane(albedo, i) * (irradiance[i] * std::f32::consts::FRAC_1_PI + self.ambient);
+            for k in 0..3 {
+                out[k][i] = l[k];
+            }
+        }
+        out
+    }
+
     /// Whether [`Lighting::direct_radiance_lanes`] computes this lighting: no shadows and no
     /// light images (the default contract).
     pub fn lanes_apply(&self) -> bool {
@@ -183,6 +326,37 @@ impl Lighting {
             }
         }
         out
+    }
+}
+
+/// A straight leg of a light's path that [`Lighting::diffuse_radiance_lanes_with`] asks
+/// about: lane `lane`'s, from `a` (on mirror `a_mirror`, if any) to `b` (on `b_mirror`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Leg {
+    pub lane: usize,
+    pub a: Vec3,
+    pub a_mirror: Option<usize>,
+    pub b: Vec3,
+    pub b_mirror: Option<usize>,
+}
+
+impl Leg {
+    const NONE: Leg = Leg::new(0, Vec3::ZERO, None, Vec3::ZERO, None);
+
+    const fn new(
+        lane: usize,
+        a: Vec3,
+        a_mirror: Option<usize>,
+        b: Vec3,
+        b_mirror: Option<usize>,
+    ) -> Self {
+        Leg {
+            lane,
+            a,
+            a_mirror,
+            b,
+            b_mirror,
+        }
     }
 }
 
@@ -280,6 +454,109 @@ mod tests {
             }],
             ..Default::default()
         }
+    }
+
+    /// The lane form with legs is the one-point form bit for bit, and asks each lane the same
+    /// legs in the same order (a chain stops at its first blocked leg): `mirror_room_lit`'s
+    /// light and its images through up to 8 mirrors, with and without shadows, points in the
+    /// room facing every way, some lanes not shaded; a leg is blocked by a fixed function of
+    /// its ends, so both forms see the same occluders.
+    #[test]
+    fn diffuse_radiance_lanes_with_legs_is_the_one_point_form() {
+        const L: usize = 16;
+        let scene = crate::load::bundled_scene("mirror_room_lit.json");
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let blocked = |a: Vec3, b: Vec3| {
+            let h = [a, b]
+                .iter()
+                .flat_map(|v| v.to_array())
+                .fold(0xcbf2_9ce4_8422_2325u64, |h, x| {
+                    (h ^ u64::from(x.to_bits())).wrapping_mul(0x100_0000_01b3)
+                });
+            h % 3 == 0
+        };
+        let mut legs_total = 0;
+        for shadows in [true, false] {
+            let mut lighting = scene.lighting.clone();
+            lighting.shadows = shadows;
+            assert!(lighting.images.images.len() > 20 && !lighting.lanes_apply());
+            for _ in 0..20 {
+                let mut args = [[[0.0f32; L]; 3]; 5];
+                let mut shaded = [false; L];
+                for i in 0..L {
+                    shaded[i] = next() < 0.85;
+                    let room = [4.0 * next() - 2.0, 3.0 * next(), 4.0 * next() - 2.0];
+                    let normal = Vec3::new(next() - 0.5, next() - 0.5, next() - 0.5).normalize();
+                    let view = Vec3::new(next() - 0.5, next() - 0.5, next() - 0.5).normalize();
+                    let values = [
+                        Vec3::from(room),
+                        normal,
+                        view,
+                        Vec3::splat(next()),
+                        Vec3::ZERO,
+                    ];
+                    for (a, v) in args.iter_mut().zip(values) {
+                        for k in 0..3 {
+                            a[k][i] = v[k];
+                        }
+                    }
+                }
+                let [p, n, v, albedo, emission] = &args;
+                let mut asked = [0u32; L];
+                let mut lane_legs: Vec<Vec<Leg>> = vec![Vec::new(); L];
+                let out = lighting.diffuse_radiance_lanes_with(
+                    &shaded,
+                    p,
+                    n,
+                    v,
+                    albedo,
+                    emission,
+                    &mut asked,
+                    |legs, clear| {
+                        let mut seen = [false; L];
+                        for (leg, clear) in legs.iter().zip(clear.iter_mut()) {
+                            assert!(!seen[leg.lane], "two legs of one lane in a batch");
+                            seen[leg.lane] = true;
+                            lane_legs[leg.lane].push(*leg);
+                            *clear = !blocked(leg.a, leg.b);
+                        }
+                    },
+                );
+                let at = |a: &[[f32; L]; 3], i: usize| Vec3::new(a[0][i], a[1][i], a[2][i]);
+                for i in (0..L).filter(|&i| shaded[i]) {
+                    let mut one_legs = Vec::new();
+                    let one = lighting.diffuse_radiance_with(
+                        at(p, i),
+                        at(n, i),
+                        at(v, i),
+                        at(albedo, i),
+                        at(emission, i),
+                        |a, a_mirror, b, b_mirror| {
+                            one_legs.push(Leg::new(i, a, a_mirror, b, b_mirror));
+                            !blocked(a, b)
+                        },
+                    );
+                    assert_eq!(
+                        at(&out, i).to_array().map(f32::to_bits),
+                        one.to_array().map(f32::to_bits),
+                        "lane {i}, shadows {shadows}"
+                    );
+                    assert_eq!(lane_legs[i], one_legs, "lane {i}");
+                    assert_eq!(asked[i] as usize, one_legs.len(), "lane {i}");
+                    legs_total += one_legs.len();
+                }
+                for i in (0..L).filter(|&i| !shaded[i]) {
+                    assert!(lane_legs[i].is_empty() && asked[i] == 0);
+                }
+            }
+        }
+        assert!(legs_total > 1000, "{legs_total} legs asked");
     }
 
     /// The lane form is the scalar contract bit for bit: lights in front, behind, at the

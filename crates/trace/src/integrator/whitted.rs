@@ -11,14 +11,14 @@
 //! they leave ([`crate::mirror_bounce`]).
 
 use super::{Integrator, PathResult, Termination, face_normals};
-use crate::bvh::packet::{LANES, LaneHits, LaneMask, RayPacket, first_lanes, lanes};
+use crate::bvh::packet::{LANES, LaneHits, LaneMask, NO_TRIANGLE, RayPacket, first_lanes, lanes};
 use crate::bvh::{Hit, SceneBvh};
 use crate::cpu_features::{Vectorised, widest};
 use crate::hit_point::on_triangle_plane;
 use crate::mirror_bounce::{MirrorPlanes, bounce_flat_lanes};
 use crate::sampler::SplitMix64;
 use glam::{DVec3, Vec3};
-use mirrorbox_scene::shading::{Interaction, interaction_with_point};
+use mirrorbox_scene::shading::{Interaction, Leg, interaction_with_point};
 use mirrorbox_scene::{Ray, Scene};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -84,19 +84,49 @@ impl<'a> Whitted<'a> {
     /// skipped, being planar. The leg ends at a light or on a mirror: hits within 10⁻⁴ of
     /// its length from `b` are not counted, as the `path` integrator's shadow rays do.
     fn leg_unoccluded(&self, a: Vec3, a_mirror: Option<usize>, from: usize, b: Vec3) -> bool {
-        let d = b - a;
-        let length = d.length();
-        if length == 0.0 {
+        let Some((ray, t_max, skip_triangle)) = leg_query(a, a_mirror, from, b) else {
             return true;
-        }
-        let ray = Ray {
-            origin: a,
-            dir: d / length,
         };
-        let skip_triangle = if a_mirror.is_none() { Some(from) } else { None };
-        !self
-            .bvh
-            .occluded(&ray, 0.0, length * (1.0 - 1e-4), a_mirror, skip_triangle)
+        !self.bvh.occluded(&ray, 0.0, t_max, a_mirror, skip_triangle)
+    }
+
+    /// [`Whitted::leg_unoccluded`] for a batch of legs at most one per lane (the round's
+    /// diffuse lanes', [`mirrorbox_scene::Lighting::diffuse_radiance_lanes_with`]): traced
+    /// as one any-hit packet, the same answers. `from` is each lane's shaded triangle.
+    #[inline(always)]
+    fn legs_clear_inline(&self, legs: &[Leg], clear: &mut [bool], from: &[usize; LANES]) {
+        let queries = legs.iter().map(|leg| {
+            let query = leg_query(leg.a, leg.a_mirror, from[leg.lane], leg.b);
+            (leg, query)
+        });
+        let traced = queries.clone().filter(|(_, query)| query.is_some()).count();
+        // A packet costs about as much for a few lanes as for all: few legs go one at a time.
+        if traced < MIN_PACKET_LEGS {
+            for ((leg, query), clear) in queries.zip(clear.iter_mut()) {
+                *clear = query.is_none_or(|(ray, t_max, skip_triangle)| {
+                    !self
+                        .bvh
+                        .occluded(&ray, 0.0, t_max, leg.a_mirror, skip_triangle)
+                });
+            }
+            return;
+        }
+        let mut packet = RayPacket::default();
+        let mut t_max = [0.0f32; LANES];
+        let mut skip = [NO_TRIANGLE; LANES];
+        let mut mask: LaneMask = 0;
+        for (leg, query) in queries {
+            if let Some((ray, t, skip_triangle)) = query {
+                packet.set(leg.lane, &ray, leg.a_mirror);
+                t_max[leg.lane] = t;
+                skip[leg.lane] = skip_triangle.map_or(NO_TRIANGLE, |t| t as u32);
+                mask |= 1 << leg.lane;
+            }
+        }
+        let blocked = self.bvh.occluded_lanes_inline(&packet, mask, &t_max, &skip);
+        for (leg, clear) in legs.iter().zip(clear.iter_mut()) {
+            *clear = blocked >> leg.lane & 1 == 0;
+        }
     }
 
     /// Radiance along `ray` (what [`Integrator::radiance`] returns; no random numbers).
@@ -167,7 +197,8 @@ impl<'a> Whitted<'a> {
     #[inline(always)]
     fn radiance_packet_inline(&self, rays: &[Ray], out: &mut Vec<PathResult>) {
         let lighting = &self.scene.lighting;
-        // Without shadow legs, a round's diffuse hits are shaded side by side.
+        // A round's diffuse hits are shaded side by side: without shadow legs or light
+        // images in lane loops, else with each light's legs traced as one packet.
         let lanes_shade = lighting.lanes_apply();
         // A round's flat-mirror planes and diffuse hits, per lane; set for the lanes that
         // have one, read (past values in the others, never used) by whole-packet loops.
@@ -175,6 +206,7 @@ impl<'a> Whitted<'a> {
         let mut normal = [[0.0f64; LANES]; 3];
         let mut offset = [0.0f64; LANES];
         let mut shading = [[[0.0f32; LANES]; 3]; 5];
+        let mut shaded_triangle = [0usize; LANES];
         for chunk in rays.chunks(LANES) {
             let (mut origin, mut dir) = RayPacket::f64_lanes(chunk);
             let mut carried = [Carried::START; LANES];
@@ -206,11 +238,8 @@ impl<'a> Whitted<'a> {
                         Next::Diffuse(d) => {
                             ends[lane] = Termination::Diffuse;
                             active &= !(1 << lane);
-                            if !lanes_shade {
-                                self.shade(&mut carried[lane], &d);
-                                continue;
-                            }
                             diffuse[lane] = true;
+                            shaded_triangle[lane] = d.triangle;
                             let values = [d.p, d.normal, d.to_viewer, d.albedo, d.emission];
                             for (a, value) in shading.iter_mut().zip(values) {
                                 for k in 0..3 {
@@ -244,9 +273,25 @@ impl<'a> Whitted<'a> {
                 }
                 if diffuse.iter().any(|&f| f) {
                     let [p, n, to_viewer, albedo, emission] = &shading;
-                    let shaded = lighting.direct_radiance_lanes(p, n, to_viewer, albedo, emission);
+                    let mut legs = [0u32; LANES];
+                    let shaded = if lanes_shade {
+                        lighting.direct_radiance_lanes(p, n, to_viewer, albedo, emission)
+                    } else {
+                        // Shadow legs or light images: each light's legs as one packet.
+                        lighting.diffuse_radiance_lanes_with(
+                            &diffuse,
+                            p,
+                            n,
+                            to_viewer,
+                            albedo,
+                            emission,
+                            &mut legs,
+                            |asked, clear| self.legs_clear_inline(asked, clear, &shaded_triangle),
+                        )
+                    };
                     for lane in (0..LANES).filter(|&lane| diffuse[lane]) {
                         let c = &mut carried[lane];
+                        c.rays += legs[lane];
                         let l = Vec3::new(shaded[0][lane], shaded[1][lane], shaded[2][lane]);
                         c.radiance += c.throughput * l;
                     }
@@ -346,6 +391,32 @@ impl<'a> Whitted<'a> {
 
 /// What a path carries from step to step (its ray is kept by the caller: in f64, for
 /// plane-exact bounces).
+/// Fewest legs traced as a packet ([`Whitted::legs_clear_inline`]); fewer go one at a time.
+const MIN_PACKET_LEGS: usize = 8;
+
+/// The shadow query of the leg from `a` (on mirror `a_mirror`, or else on triangle `from`,
+/// either skipped) to `b`: its ray, far limit (hits within 10⁻⁴ of its length from `b` not
+/// counted) and skipped triangle; `None` for a leg of length zero, which nothing blocks.
+#[inline(always)]
+fn leg_query(
+    a: Vec3,
+    a_mirror: Option<usize>,
+    from: usize,
+    b: Vec3,
+) -> Option<(Ray, f32, Option<usize>)> {
+    let d = b - a;
+    let length = d.length();
+    if length == 0.0 {
+        return None;
+    }
+    let ray = Ray {
+        origin: a,
+        dir: d / length,
+    };
+    let skip_triangle = if a_mirror.is_none() { Some(from) } else { None };
+    Some((ray, length * (1.0 - 1e-4), skip_triangle))
+}
+
 #[derive(Clone, Copy)]
 struct Carried {
     throughput: Vec3,
