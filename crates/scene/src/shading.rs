@@ -197,11 +197,9 @@ impl Lighting {
         for (index, image) in images.iter().enumerate() {
             let mut alive = [false; L];
             let mut any = false;
-            for i in shaded_lanes() {
+            let lit = image.lights_lanes(shaded, p);
+            for i in (0..L).filter(|&i| lit[i]) {
                 let x = lane(p, i);
-                if !image.lights(x) {
-                    continue;
-                }
                 e[i] = point_irradiance(x, n[i], image.position, image.intensity);
                 if e[i] == Vec3::ZERO {
                     continue;
