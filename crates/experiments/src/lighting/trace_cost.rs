@@ -15,6 +15,16 @@ struct TraceRun {
     rays: u64,
     threads: usize,
     lighting: TraceLighting,
+    /// Where and when it ran (runs recorded since 2026-11-27 carry them).
+    #[serde(default)]
+    measured: Option<Measured>,
+}
+
+#[derive(serde::Deserialize)]
+struct Measured {
+    date: String,
+    commit: String,
+    cpu: String,
 }
 
 #[derive(serde::Deserialize)]
@@ -53,10 +63,16 @@ fn trace_cost_region(path: &Path) -> Result<String, ReadmeError> {
         })
         .collect();
     let threads = runs.first().map_or(0, |r| r.threads);
+    let when = runs
+        .first()
+        .and_then(|r| r.measured.as_ref())
+        .map_or(String::new(), |m| {
+            format!(" Measured {} at commit {} on {}.", m.date, m.commit, m.cpu)
+        });
     Ok(markdown(&[
         Block::Paragraph(format!(
             "`scripts/lighting-trace-cost.sh`: `mirrorbox trace --mirrored-lights k --spp 1` at \
-             640×360 with shadows, {threads} threads, runs interleaved."
+             640×360 with shadows, {threads} threads, runs interleaved.{when}"
         )),
         Block::Table(
             [
