@@ -372,6 +372,20 @@ impl Scene {
     }
 }
 
+/// Helpers of the crate's unit tests.
+#[cfg(test)]
+pub(crate) mod test_support {
+    /// A fixed sequence of floats in `[0, 1)` (xorshift64 from `seed`, its top 24 bits).
+    pub fn unit_floats(mut state: u64) -> impl FnMut() -> f32 {
+        move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

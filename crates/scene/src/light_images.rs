@@ -357,13 +357,7 @@ mod tests {
         let scene = crate::load::bundled_scene("mirror_room_lit.json");
         let images = &scene.lighting.images.images;
         assert!(images.len() > 100);
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut next = crate::test_support::unit_floats(0x2545_f491_4f6c_dd1d);
         let (mut lit, mut unlit) = (0, 0);
         for _ in 0..20 {
             let mut p = [[0.0f32; L]; 3];
