@@ -530,6 +530,64 @@ fn trace_args<'a>(out: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
     args
 }
 
+/// Every vector build traces the same bits (`trace --simd`): the baseline (SSE2) build, and
+/// AVX2 where the CPU's widest is wider, against the widest, for `whitted` (packets, the lit
+/// scene's leg packets) and `path`; the JSON names the build that ran.
+#[test]
+fn trace_gives_the_same_bits_with_every_vector_build() {
+    let dir = tempfile::tempdir().unwrap();
+    for (scene, extra) in [
+        ("scenes/mirror_room.json", &["--spp", "16"][..]),
+        (
+            "scenes/mirror_room_lit.json",
+            &["--spp", "16", "--mirrored-lights", "2"][..],
+        ),
+        (
+            "scenes/mirror_box.json",
+            &["--spp", "4", "--integrator", "path", "--max-segments", "6"][..],
+        ),
+    ] {
+        let trace = |simd: &str| {
+            let exr = dir.path().join(format!("{simd}.exr"));
+            let mut args = vec![
+                "trace",
+                scene,
+                "-o",
+                exr.to_str().unwrap(),
+                "--width",
+                "40",
+                "--height",
+                "24",
+                "--simd",
+                simd,
+                "--json",
+            ];
+            args.extend_from_slice(extra);
+            let out = mirrorbox(&args, &[]);
+            assert_eq!(out.code, 0, "{scene} --simd {simd}: {}", out.stderr);
+            let record: Value = serde_json::from_str(&out.stdout).unwrap();
+            let image = mirrorbox_image::read_image(&exr).unwrap();
+            (record["simd"].as_str().unwrap().to_string(), image)
+        };
+        let (widest, reference) = trace("widest");
+        let mut narrower = vec!["baseline"];
+        if widest == "avx512" {
+            narrower.push("avx2");
+        }
+        for simd in narrower {
+            let (ran, image) = trace(simd);
+            assert_eq!(ran, simd, "{scene}: the JSON names the build");
+            let differing = reference
+                .pixels
+                .iter()
+                .zip(&image.pixels)
+                .filter(|(a, b)| a.map(f32::to_bits) != b.map(f32::to_bits))
+                .count();
+            assert_eq!(differing, 0, "{scene}: --simd {simd} against {widest}");
+        }
+    }
+}
+
 /// "Depth" counts mirror reflections everywhere (docs/shading.md): `path`'s length is counted
 /// in segments under its own flag, recorded under its own name; each integrator refuses the
 /// other's cut, exit 2, naming the flag to use, and writes nothing.

@@ -22,16 +22,56 @@ pub trait Vectorised {
     fn run(self) -> Self::Output;
 }
 
-/// The builds [`widest`] chooses from.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Build {
-    Avx512,
-    Avx2,
+/// The builds [`widest`] chooses from, narrowest first (so `min` is the narrower).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Build {
     Baseline,
+    Avx2,
+    Avx512,
 }
 
-/// This CPU's widest build, detected once.
-static BUILD: std::sync::LazyLock<Build> = std::sync::LazyLock::new(|| {
+impl Build {
+    /// Its name in reports and `--json` (`avx512`, `avx2`, `baseline`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Build::Avx512 => "avx512",
+            Build::Avx2 => "avx2",
+            Build::Baseline => "baseline",
+        }
+    }
+}
+
+/// A narrower build asked for before the first [`widest`] call ([`narrow_to`]).
+static NARROWED: std::sync::OnceLock<Build> = std::sync::OnceLock::new();
+
+/// Runs [`widest`]'s work on `build` instead of the CPU's widest: the narrower builds'
+/// code timed on a wider CPU (`trace --simd`; a CPU's own record needs that CPU, and the
+/// bench does not use it). Errors where the CPU lacks `build`, or where the build was
+/// already chosen otherwise (by a first [`widest`] call, or an earlier request).
+pub fn narrow_to(build: Build) -> Result<(), String> {
+    let widest = detected();
+    if build > widest {
+        return Err(format!(
+            "this CPU has no {} build (its widest is {})",
+            build.name(),
+            widest.name()
+        ));
+    }
+    if *NARROWED.get_or_init(|| build) != build || *BUILD != build {
+        return Err(format!(
+            "the vector build was already chosen ({})",
+            BUILD.name()
+        ));
+    }
+    Ok(())
+}
+
+/// The build [`widest`] runs: the CPU's widest, or the narrower one asked for.
+static BUILD: std::sync::LazyLock<Build> =
+    std::sync::LazyLock::new(|| NARROWED.get().map_or(detected(), |&b| b.min(detected())));
+
+/// This CPU's widest build.
+fn detected() -> Build {
     #[cfg(target_arch = "x86_64")]
     {
         if std::arch::is_x86_feature_detected!("avx512f")
@@ -46,9 +86,10 @@ static BUILD: std::sync::LazyLock<Build> = std::sync::LazyLock::new(|| {
         }
     }
     Build::Baseline
-});
+}
 
-/// Runs `work` compiled for the widest vector instructions this CPU has.
+/// Runs `work` compiled for the widest vector instructions this CPU has (or the narrower
+/// build asked for, [`narrow_to`]).
 #[inline(always)]
 pub fn widest<W: Vectorised>(work: W) -> W::Output {
     match *BUILD {
@@ -62,13 +103,9 @@ pub fn widest<W: Vectorised>(work: W) -> W::Output {
     }
 }
 
-/// The name of the build [`widest`] runs on this CPU (reports, `--json`).
+/// The name of the build [`widest`] runs (reports, `--json`).
 pub fn widest_name() -> &'static str {
-    match *BUILD {
-        Build::Avx512 => "avx512",
-        Build::Avx2 => "avx2",
-        Build::Baseline => "baseline",
-    }
+    BUILD.name()
 }
 
 #[cfg(target_arch = "x86_64")]

@@ -26,6 +26,19 @@ pub enum Kernel {
     Single,
 }
 
+/// Which vector build runs the tracer's lane loops (`mirrorbox_trace::cpu_features`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Simd {
+    /// The CPU's widest: AVX-512 (F, VL, BW, DQ), else AVX2, else the baseline.
+    Widest,
+    /// AVX-512 (an error on a CPU without it).
+    Avx512,
+    /// AVX2 (an error on a CPU without it).
+    Avx2,
+    /// The x86-64 baseline, SSE2.
+    Baseline,
+}
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Device {
     /// The CPU tracer (obvhs BVH, rayon threads).
@@ -106,6 +119,11 @@ pub struct Args {
     /// Closest-hit kernel: packets (`whitted`'s paths, and the mirror chains that start `path`'s, traced as 32-ray packets through a BVH2) or single (one ray at a time).
     #[arg(long, value_enum, default_value_t = Kernel::Packet)]
     kernel: Kernel,
+    /// Vector build of the tracer's lane loops: the CPU's widest (detected), or a narrower
+    /// one, to time the AVX2 or baseline (SSE2) code on a wider CPU; every build gives the
+    /// same bits (docs/tracer-performance.md). A build the CPU lacks is an error.
+    #[arg(long, value_enum, default_value_t = Simd::Widest)]
+    simd: Simd,
     /// Print the summary as one JSON object (one per eye with --stereo).
     #[arg(long)]
     json: bool,
@@ -143,6 +161,16 @@ impl Args {
 }
 
 fn check_args(args: &Args) -> Result<(SubpixelGrid, WhittedSettings), Failure> {
+    use mirrorbox_trace::cpu_features::{Build, narrow_to};
+    let build = match args.simd {
+        Simd::Widest => None,
+        Simd::Avx512 => Some(Build::Avx512),
+        Simd::Avx2 => Some(Build::Avx2),
+        Simd::Baseline => Some(Build::Baseline),
+    };
+    if let Some(build) = build {
+        narrow_to(build).map_err(|e| Failure::BadInput(format!("--simd: {e}")))?;
+    }
     let s = grid_side(args.spp)?;
     unit_interval("--alpha", args.reflectance)?;
     // "Depth" is mirror reflections everywhere (docs/shading.md); a physically based path's
