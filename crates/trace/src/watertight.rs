@@ -65,6 +65,22 @@ pub(crate) fn shear_operands(d: [f32; 3]) -> (u32, [f32; 2], f32) {
     (kz * 2 + swap as u32, [pick(kx), pick(ky)], dz)
 }
 
+/// [`shear_operands`] without branches, for one ray at a time (an incoherent ray's largest
+/// axis is a coin toss for the branch predictor); the same answers, NaN included. The lane
+/// loops keep [`shear_operands`]: indexing by a lane's axis stops them vectorising.
+#[inline(always)]
+pub(crate) fn shear_operands_branch_free(d: [f32; 3]) -> (u32, [f32; 2], f32) {
+    let a = [d[0].abs(), d[1].abs(), d[2].abs()];
+    let first = (a[0] >= a[1]) & (a[0] >= a[2]);
+    let second = a[1] >= a[2];
+    let kz = (1 - first as u32) * (2 - second as u32);
+    let dz = d[kz as usize % 3];
+    let swap = dz < 0.0;
+    let (x, y) = ((kz as usize + 1) % 3, (kz as usize + 2) % 3);
+    let (kx, ky) = if swap { (y, x) } else { (x, y) };
+    (kz * 2 + swap as u32, [d[kx], d[ky]], dz)
+}
+
 /// The `(kx, ky, kz)` of a [`shear_of`] permutation code.
 #[inline(always)]
 pub(crate) fn axes_of(code: u32) -> (usize, usize, usize) {
@@ -193,6 +209,53 @@ impl WatertightRay {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The branch-free permutation is [`shear_operands`]' for every kind of direction: ties
+    /// of magnitude between any two or all three axes, zeros of both signs, NaN, infinities,
+    /// and random directions (the codes and the operands' bits).
+    #[test]
+    fn branch_free_shear_operands_are_the_branching_ones() {
+        let specials = [
+            0.0f32,
+            -0.0,
+            0.5,
+            -0.5,
+            1.0,
+            -1.0,
+            f32::NAN,
+            f32::INFINITY,
+            -3.0,
+        ];
+        let mut dirs = Vec::new();
+        for &x in &specials {
+            for &y in &specials {
+                for &z in &specials {
+                    dirs.push([x, y, z]);
+                }
+            }
+        }
+        let mut state = 0x853c_49e6_748f_ea9bu64;
+        for _ in 0..10_000 {
+            let mut c = [0.0f32; 3];
+            for v in &mut c {
+                state = state
+                    .wrapping_mul(6_364_136_223_846_793_005)
+                    .wrapping_add(1);
+                *v = (state >> 40) as f32 / (1u64 << 23) as f32 - 1.0;
+            }
+            dirs.push(c);
+        }
+        for d in dirs {
+            let (code, [px, py], dz) = shear_operands(d);
+            let (code_b, [px_b, py_b], dz_b) = shear_operands_branch_free(d);
+            assert_eq!(code, code_b, "{d:?}");
+            assert_eq!(
+                [px, py, dz].map(f32::to_bits),
+                [px_b, py_b, dz_b].map(f32::to_bits),
+                "{d:?}"
+            );
+        }
+    }
 
     #[test]
     fn hits_inside_misses_outside_both_sides() {

@@ -25,7 +25,7 @@
 //! `box_longline.obj`).
 
 use super::{NOT_A_MIRROR, Slot};
-use crate::watertight::{WatertightRay, shear_operands};
+use crate::watertight::{WatertightRay, shear_operands_branch_free};
 
 /// Children per node.
 pub const WIDTH: usize = 8;
@@ -144,7 +144,7 @@ impl WideRay {
         skip_triangle: Option<usize>,
     ) -> Self {
         let d = dir.to_array();
-        let (code, [px, py], dz) = shear_operands(d);
+        let (code, [px, py], dz) = shear_operands_branch_free(d);
         // safe_inverse(x): sign(x) / ε where |x| ≤ ε, else 1 / x.
         let small = d.map(|x| x.abs() <= f32::EPSILON);
         let num = [
