@@ -11,6 +11,8 @@
 #   optimisations off (5-8 % slower; docs/tracer-performance.md).
 #   Name --spp in TRACE_ARGS: `trace` defaults to 1 sample per pixel since issue 37 (16 before),
 #   so two builds from either side of that change would otherwise trace different images.
+#   On an AVX-512 CPU, `-- … --simd avx2` (or `baseline`) times the narrower builds' code too
+#   (`trace --simd`; not a claim about an AVX2 CPU).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if [ $# -lt 4 ]; then
