@@ -389,9 +389,10 @@ impl<'a> Whitted<'a> {
     }
 }
 
-/// What a path carries from step to step (its ray is kept by the caller: in f64, for
-/// plane-exact bounces).
 /// Fewest legs traced as a packet ([`Whitted::legs_clear_inline`]); fewer go one at a time.
+/// Measured on `mirror_room_lit` / `mirror_box_lit` at k = 8, 1 spp, one thread: against
+/// the legs one at a time, every batch a packet ×1.10 / ×0.72, batches of 8 and more ×0.87 /
+/// ×0.68; against 8, 4 ×1.07 / ×1.03 and 16 ×0.98 / ×1.01.
 const MIN_PACKET_LEGS: usize = 8;
 
 /// The shadow query of the leg from `a` (on mirror `a_mirror`, or else on triangle `from`,
@@ -417,6 +418,8 @@ fn leg_query(
     Some((ray, length * (1.0 - 1e-4), skip_triangle))
 }
 
+/// What a path carries from step to step (its ray is kept by the caller: in f64, for
+/// plane-exact bounces).
 #[derive(Clone, Copy)]
 struct Carried {
     throughput: Vec3,
