@@ -157,6 +157,7 @@ pub struct MirrorBump {
 impl MirrorBump {
     /// The perturbed normal in the mirror's tangent frame (right, up, normal) at mirror-local
     /// `(u, v)` of a `width × height` mirror: the module's formulas. Unit length.
+    #[inline(always)]
     pub fn tangent_normal(&self, u: f64, v: f64, width: f64, height: f64) -> DVec3 {
         let ripple = self.ripple.map(|r| {
             let (sb, cb) = f64::from(r.direction).sin_cos();
@@ -211,6 +212,7 @@ pub fn frame_f64(mirror: &crate::Mirror) -> [DVec3; 3] {
 }
 
 /// The perturbed world normal of `mirror` at point `p` on it.
+#[inline(always)]
 pub fn world_normal(mirror: &crate::Mirror, bump: &MirrorBump, p: DVec3) -> DVec3 {
     let [right, up, n] = frame_f64(mirror);
     let d = p - mirror.center.as_dvec3();
@@ -232,6 +234,7 @@ pub fn world_normal(mirror: &crate::Mirror, bump: &MirrorBump, p: DVec3) -> DVec
 /// incoming ray sees the back of the perturbed facet (`d·n_s ≥ 0`) or the reflected ray
 /// points behind the mirror's plane (`r·n_g ≤ 0`). Mitsuba's `normalmap` BSDF has the same
 /// rule.
+#[inline(always)]
 pub fn reflect(d: DVec3, n_geometric: DVec3, n_shading: DVec3) -> Option<DVec3> {
     if d.dot(n_shading) >= 0.0 {
         return None;

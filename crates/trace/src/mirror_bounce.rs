@@ -53,6 +53,10 @@ impl MirrorPlanes {
 
     /// The ray `origin + t·dir` reflected at mirror `mirror`: (hit point, reflected
     /// direction), or `None` where an uneven mirror absorbs it (radiance 0 from there).
+    /// Inline, with the bump's normal ([`bump::world_normal`]): compiled into the walks for
+    /// their CPU features (out of line it was a quarter of `bumpy_pair`'s time, compiled for
+    /// the baseline; inlined, the uneven scenes ×0.72, the same bits).
+    #[inline(always)]
     pub fn reflect(&self, mirror: usize, origin: DVec3, dir: DVec3) -> Option<(DVec3, DVec3)> {
         let (n, offset) = self.planes[mirror];
         match &self.bumps[mirror] {
