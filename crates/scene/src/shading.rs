@@ -145,7 +145,7 @@ impl Lighting {
         albedo: &[[f32; L]; 3],
         emission: &[[f32; L]; 3],
         asked: &mut [u32; L],
-        mut unoccluded: impl FnMut(&[Leg], &mut [bool]),
+        mut unoccluded: impl LegsClear,
     ) -> [[f32; L]; 3] {
         let lane = |a: &[[f32; L]; 3], i: usize| Vec3::new(a[0][i], a[1][i], a[2][i]);
         let shaded_lanes = || (0..L).filter(|&i| shaded[i]);
@@ -160,16 +160,25 @@ impl Lighting {
         let mut e = [Vec3::ZERO; L];
         let mut legs = [Leg::NONE; L];
         let mut clear = [false; L];
-        // Asks `legs` (at most one per lane), then keeps alive only the lanes whose leg is clear.
-        let mut ask = |legs: &[Leg], alive: &mut [bool; L]| {
+        // Asks `legs` (at most one per lane), then keeps alive only the lanes whose leg is
+        // clear. (A function, not a closure: a closure is compiled on its own, without the
+        // caller's CPU features, and the legs' tracing inside it with them.)
+        #[inline(always)]
+        fn ask<const L: usize>(
+            unoccluded: &mut impl LegsClear,
+            legs: &[Leg],
+            alive: &mut [bool; L],
+            asked: &mut [u32; L],
+            clear: &mut [bool; L],
+        ) {
             for leg in legs {
                 asked[leg.lane] += 1;
             }
-            unoccluded(legs, &mut clear[..legs.len()]);
-            for (leg, &clear) in legs.iter().zip(&clear) {
+            unoccluded.clear(legs, &mut clear[..legs.len()]);
+            for (leg, &clear) in legs.iter().zip(clear.iter()) {
                 alive[leg.lane] &= clear;
             }
-        };
+        }
         for light in &self.lights {
             let mut alive = [false; L];
             let mut count = 0;
@@ -182,7 +191,13 @@ impl Lighting {
                 }
             }
             if count > 0 {
-                ask(&legs[..count], &mut alive);
+                ask(
+                    &mut unoccluded,
+                    &legs[..count],
+                    &mut alive,
+                    asked,
+                    &mut clear,
+                );
                 for i in (0..L).filter(|&i| alive[i]) {
                     irradiance[i] += e[i];
                 }
@@ -222,7 +237,13 @@ impl Lighting {
                 if count == 0 {
                     break;
                 }
-                ask(&legs[..count], &mut alive);
+                ask(
+                    &mut unoccluded,
+                    &legs[..count],
+                    &mut alive,
+                    asked,
+                    &mut clear,
+                );
                 from_mirror = Some(image.mirror);
                 current = image.parent;
                 if current.is_none() {
@@ -233,7 +254,13 @@ impl Lighting {
                         count += 1;
                     }
                     if count > 0 {
-                        ask(&legs[..count], &mut alive);
+                        ask(
+                            &mut unoccluded,
+                            &legs[..count],
+                            &mut alive,
+                            asked,
+                            &mut clear,
+                        );
                     }
                 }
             }
@@ -339,6 +366,22 @@ impl Lighting {
             }
         }
         out
+    }
+}
+
+/// What answers [`Lighting::diffuse_radiance_lanes_with`]'s legs: `clear[j]` for each of
+/// `legs`, whether nothing blocks it. A trait, so that a tracer's `#[inline(always)]`
+/// implementation is compiled into its caller for the caller's CPU features (a closure is a
+/// function of its own, compiled for the baseline: the lit scenes' leg packets ran there,
+/// three quarters of `mirror_room_lit`'s time in one closure). Closures implement it too.
+pub trait LegsClear {
+    fn clear(&mut self, legs: &[Leg], clear: &mut [bool]);
+}
+
+impl<F: FnMut(&[Leg], &mut [bool])> LegsClear for F {
+    #[inline(always)]
+    fn clear(&mut self, legs: &[Leg], clear: &mut [bool]) {
+        self(legs, clear)
     }
 }
 
@@ -525,7 +568,7 @@ mod tests {
                     albedo,
                     emission,
                     &mut asked,
-                    |legs, clear| {
+                    |legs: &[Leg], clear: &mut [bool]| {
                         let mut seen = [false; L];
                         for (leg, clear) in legs.iter().zip(clear.iter_mut()) {
                             assert!(!seen[leg.lane], "two legs of one lane in a batch");

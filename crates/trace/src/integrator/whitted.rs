@@ -18,7 +18,7 @@ use crate::hit_point::on_triangle_plane;
 use crate::mirror_bounce::{MirrorPlanes, bounce_flat_lanes};
 use crate::sampler::SplitMix64;
 use glam::{DVec3, Vec3};
-use mirrorbox_scene::shading::{Interaction, Leg, interaction_with_point};
+use mirrorbox_scene::shading::{Interaction, Leg, LegsClear, interaction_with_point};
 use mirrorbox_scene::{Ray, Scene};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -286,7 +286,10 @@ impl<'a> Whitted<'a> {
                             albedo,
                             emission,
                             &mut legs,
-                            |asked, clear| self.legs_clear_inline(asked, clear, &shaded_triangle),
+                            RoundLegs {
+                                whitted: self,
+                                from: &shaded_triangle,
+                            },
                         )
                     };
                     for lane in (0..LANES).filter(|&lane| diffuse[lane]) {
@@ -386,6 +389,20 @@ impl<'a> Whitted<'a> {
                 Next::Reflect(mirror)
             }
         }
+    }
+}
+
+/// A round's legs traced by [`Whitted::legs_clear_inline`] (`from`: each lane's shaded
+/// triangle), inline in the walk compiled for the CPU's features.
+struct RoundLegs<'w, 'a> {
+    whitted: &'w Whitted<'a>,
+    from: &'w [usize; LANES],
+}
+
+impl LegsClear for RoundLegs<'_, '_> {
+    #[inline(always)]
+    fn clear(&mut self, legs: &[Leg], clear: &mut [bool]) {
+        self.whitted.legs_clear_inline(legs, clear, self.from)
     }
 }
 
