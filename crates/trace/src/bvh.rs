@@ -46,6 +46,18 @@ pub(crate) struct Query {
     pub skip_triangle: Option<usize>,
 }
 
+/// A placeholder entry of a fixed array of queries (never traced).
+pub(crate) const NO_QUERY: Query = Query {
+    ray: Ray {
+        origin: glam::Vec3::ZERO,
+        dir: glam::Vec3::Z,
+    },
+    t_min: 0.0,
+    t_max: 0.0,
+    skip_mirror: None,
+    skip_triangle: None,
+};
+
 /// Which hierarchy the single-ray queries traverse (shadow legs, `path`, `whitted` below 4
 /// samples per pixel or with `--kernel single`). `Wide`, the default, is our own 8-wide one
 /// ([`wide`], issue 56): obvhs's binary hierarchy collapsed, its boxes uncompressed, eight

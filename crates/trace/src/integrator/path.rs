@@ -31,7 +31,7 @@
 
 use super::{Integrator, PathResult, Termination, face_normals};
 use crate::bvh::packet::{LANES, LaneHits, LaneMask, NO_TRIANGLE, RayPacket, first_lanes, lanes};
-use crate::bvh::{Hit, Query, SceneBvh};
+use crate::bvh::{Hit, NO_QUERY, Query, SceneBvh};
 use crate::cpu_features::{Vectorised, widest};
 use crate::hit_point::on_triangle_plane;
 use crate::mirror_bounce::{MirrorPlanes, bounce_flat_lanes};
@@ -190,18 +190,6 @@ enum Vertex {
 /// A shadow ray asked by the path in lane `.0`, of kind `.1` (point light, or the emitter
 /// sample), with its answer (blocked) where it was traced at once.
 type Asked = (usize, usize, ShadowRay, Option<bool>);
-
-/// A placeholder entry of a round's query arrays (never traced).
-const NO_QUERY: Query = Query {
-    ray: Ray {
-        origin: Vec3::ZERO,
-        dir: Vec3::Z,
-    },
-    t_min: 0.0,
-    t_max: 0.0,
-    skip_mirror: None,
-    skip_triangle: None,
-};
 
 /// A path between its vertices: its next ray and what it carries.
 #[derive(Clone, Copy)]
