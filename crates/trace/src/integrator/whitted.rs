@@ -99,6 +99,9 @@ impl<'a> Whitted<'a> {
             let query = leg_query(leg.a, leg.a_mirror, from[leg.lane], leg.b);
             (leg, query)
         });
+        // The queries are made twice, to count them and to use them: keeping them in an array
+        // instead measured ×1.10 slower on the lit scenes (the array's writes cost more than
+        // the arithmetic).
         let traced = queries.clone().filter(|(_, query)| query.is_some()).count();
         // A packet costs about as much for a few lanes as for all: few legs go one at a time.
         if traced < MIN_PACKET_LEGS {
