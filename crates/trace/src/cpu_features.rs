@@ -70,6 +70,59 @@ pub fn narrow_to(build: Build) -> Result<(), String> {
 static BUILD: std::sync::LazyLock<Build> =
     std::sync::LazyLock::new(|| NARROWED.get().map_or(detected(), |&b| b.min(detected())));
 
+/// The lanes `0..N` for which `flag(i)` holds, as bits (bit `i`): a lane loop's answer.
+///
+/// Why not the plain fold `bits |= (flag(i) as u32) << i`: the compiler vectorises it, and
+/// in the AVX2 build turns it into one `vmovmskps` per 8 lanes; in the AVX-512 build, where
+/// the comparisons land in mask registers, it selects powers of two under the mask and ORs
+/// them across the vector — nine instructions and their latency after every box test
+/// instead of one `kmov` (seen in the disassembly, issue 56). Here each lane becomes 0 or
+/// −1 and SSE's `movmskps` (in every x86-64 build) reads their sign bits four lanes at a
+/// time: the compiler folds that into `kmov` from the comparison's mask register in the
+/// AVX-512 build, and keeps `movmskps` in the others. The same bits (tested).
+///
+/// Used by the 8-wide traversal's box test: `path` ×0.966 / ×0.978 on `mirror_room` /
+/// `mirror_box` (docs/tracer-performance.md). Not by the packet kernel's
+/// 16 and 32 lanes: there the compiler split the comparisons into 4-lane pieces (`whitted`
+/// ×1.03–1.04 slower), and AVX-512's `vpmovd2m` behind a run-time check of the build, which
+/// gave one `kmovw`, was ×1.02 slower too.
+#[inline(always)]
+#[allow(clippy::needless_range_loop)]
+pub fn lane_bits<const N: usize>(flag: impl Fn(usize) -> bool) -> u32 {
+    const { assert!(N <= 32 && N.is_multiple_of(4)) };
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_mm_loadu_ps, _mm_movemask_ps};
+        let mut m = [0i32; N];
+        for i in 0..N {
+            m[i] = -(flag(i) as i32);
+        }
+        let mut bits = 0u32;
+        let mut c = 0;
+        while c < N {
+            // SAFETY: lanes c..c + 4 are in `m` (N is a multiple of 4); SSE is part of every
+            // x86-64 build.
+            let v = unsafe { _mm_loadu_ps(m.as_ptr().add(c).cast()) };
+            bits |= (unsafe { _mm_movemask_ps(v) } as u32) << c;
+            c += 4;
+        }
+        bits
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    lane_bits_fold::<N>(flag)
+}
+
+/// [`lane_bits`] as the plain fold (other architectures; tests).
+#[inline(always)]
+#[cfg_attr(target_arch = "x86_64", allow(dead_code))]
+fn lane_bits_fold<const N: usize>(flag: impl Fn(usize) -> bool) -> u32 {
+    let mut bits = 0u32;
+    for i in 0..N {
+        bits |= (flag(i) as u32) << i;
+    }
+    bits
+}
+
 /// This CPU's widest build.
 fn detected() -> Build {
     #[cfg(target_arch = "x86_64")]
@@ -120,5 +173,45 @@ mod x86 {
     #[target_feature(enable = "avx2")]
     pub fn avx2<W: Vectorised>(work: W) -> W::Output {
         work.run()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Bit `i` of `lane_bits(flag)` is `flag(i)`, for the lane counts the traversals use
+    /// and others, in the baseline build and in the widest this CPU has: a lane moved or
+    /// dropped fails it.
+    #[test]
+    fn lane_bits_are_the_flags() {
+        fn check<const N: usize>(seed: u64) {
+            struct Bits<'f, const N: usize>(&'f [bool; N]);
+            impl<const N: usize> Vectorised for Bits<'_, N> {
+                type Output = u32;
+                #[inline(always)]
+                fn run(self) -> u32 {
+                    lane_bits::<N>(|i| self.0[i])
+                }
+            }
+            let mut rng = crate::sampler::SplitMix64::for_pixel(seed, N as u64);
+            for _ in 0..200 {
+                let flags: [bool; N] = std::array::from_fn(|_| rng.next_unit() < 0.5);
+                let expected = (0..N).fold(0u32, |m, i| m | u32::from(flags[i]) << i);
+                assert_eq!(
+                    lane_bits::<N>(|i| flags[i]),
+                    expected,
+                    "{N} lanes: {flags:?}"
+                );
+                assert_eq!(widest(Bits(&flags)), expected, "{N} lanes: {flags:?}");
+                assert_eq!(lane_bits_fold::<N>(|i| flags[i]), expected);
+            }
+        }
+        println!("vector build: {}", widest_name());
+        check::<4>(1);
+        check::<8>(3);
+        check::<12>(4);
+        check::<16>(5);
+        check::<32>(7);
     }
 }

@@ -25,6 +25,7 @@
 //! `box_longline.obj`).
 
 use super::{NOT_A_MIRROR, Slot};
+use crate::cpu_features::lane_bits;
 use crate::watertight::{WatertightRay, shear_operands_branch_free};
 
 /// Children per node.
@@ -289,7 +290,7 @@ impl WideBvh {
     #[allow(clippy::needless_range_loop)]
     fn meets(&self, node: &WideNode, ray: &WideRay, best: f32) -> (u32, [f32; WIDTH]) {
         let mut near = [0.0f32; WIDTH];
-        let mut bits = 0u32;
+        let mut far = [0.0f32; WIDTH];
         for i in 0..WIDTH {
             let slab = |k: usize| {
                 let t0 = (node.lo[k][i] - ray.origin[k]) * ray.inv[k];
@@ -302,10 +303,11 @@ impl WideBvh {
             let n = max(max(ray.t_min, n0), max(n1, n2));
             let f = min(min(f0, f1), f2) * FAR_WIDENING;
             near[i] = n;
-            let meets = (n <= min(f, best)) & (node.mirror[i] != ray.skip_mirror);
-            bits |= (meets as u32) << i;
+            far[i] = min(f, best);
         }
-        (bits & node.occupied, near)
+        let meets =
+            lane_bits::<WIDTH>(|i| (near[i] <= far[i]) & (node.mirror[i] != ray.skip_mirror));
+        (meets & node.occupied, near)
     }
 
     /// The closest hit with `t` in `[t_min, t_max]`, skipping the ray's mirror and triangle:
