@@ -82,10 +82,10 @@ static BUILD: std::sync::LazyLock<Build> =
 /// AVX-512 build, and keeps `movmskps` in the others. The same bits (tested).
 ///
 /// Used by the 8-wide traversal's box test: `path` ×0.966 / ×0.978 on `mirror_room` /
-/// `mirror_box` (docs/tracer-performance.md). Not by the packet kernel's
-/// 16 and 32 lanes: there the compiler split the comparisons into 4-lane pieces (`whitted`
-/// ×1.03–1.04 slower), and AVX-512's `vpmovd2m` behind a run-time check of the build, which
-/// gave one `kmovw`, was ×1.02 slower too.
+/// `mirror_box` (docs/tracer-performance.md). Not by the packet kernel's 16 and 32 lanes:
+/// there the compiler split the comparisons into 4-lane pieces (`whitted` ×1.03–1.04
+/// slower), and AVX-512's `vpmovd2m` behind a run-time check of the build, which gave one
+/// `kmovw`, was ×1.02 slower too.
 #[inline(always)]
 #[allow(clippy::needless_range_loop)]
 pub fn lane_bits<const N: usize>(flag: impl Fn(usize) -> bool) -> u32 {
