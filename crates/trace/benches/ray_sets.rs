@@ -10,8 +10,8 @@
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use mirrorbox_scene::{Ray, Scene, Surface};
 use mirrorbox_trace::SceneBvh;
-use mirrorbox_trace::bvh::BvhKind;
 use mirrorbox_trace::bvh::packet::{LANES, RayPacket, first_lanes};
+use mirrorbox_trace::bvh::{BvhKind, Query};
 use mirrorbox_trace::mirror_bounce::MirrorPlanes;
 
 /// A ray with the mirror it leaves (skipped by the query, as the integrators do).
@@ -88,6 +88,31 @@ fn scattered(scene: &Scene, bvh: &SceneBvh, camera_rays: &[Leaving]) -> Vec<(Ray
         .collect()
 }
 
+/// `n` rays from 10 units around (0, 1000, 0), each pointing away from that point (uniform
+/// directions): far outside the bundled scenes, so a query is its setup and the root's box
+/// test (`tools/mitsuba/ray_costs.py` times the same for Mitsuba's Embree).
+fn missing(n: usize) -> Vec<Ray> {
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut unit = move || {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (state >> 40) as f32 / (1u64 << 24) as f32
+    };
+    (0..n)
+        .map(|_| {
+            let z = 2.0 * unit() - 1.0;
+            let phi = std::f32::consts::TAU * unit();
+            let r = (1.0 - z * z).max(0.0).sqrt();
+            let dir = glam::Vec3::new(r * phi.cos(), r * phi.sin(), z);
+            Ray {
+                origin: glam::Vec3::new(0.0, 1000.0, 0.0) + dir * 10.0,
+                dir,
+            }
+        })
+        .collect()
+}
+
 /// Single rays only, through the 8-wide hierarchy and obvhs's CWBVH: camera rays and
 /// scattered rays of `mirror_box` and `mirror_room` (the rays `path` sends one at a time),
 /// closest hit and any hit (issue 56).
@@ -98,6 +123,7 @@ fn single(c: &mut Criterion) {
         let reference = SceneBvh::build(&scene.geometry);
         let camera_rays = &ray_sets(&scene, &reference, 0)[0];
         let scattered = scattered(&scene, &reference, camera_rays);
+        let missing = missing(10_000);
         let mut group = c.benchmark_group(format!("single_{name}_320x180"));
         group.sample_size(10);
         for kind in [BvhKind::Wide, BvhKind::Cwbvh] {
@@ -131,6 +157,78 @@ fn single(c: &mut Criterion) {
                     })
                 },
             );
+            // As `path` traces them: a round's queries in one batch, two at a time through the
+            // 8-wide hierarchy (`SceneBvh::queries`).
+            let as_queries = |t_max: f32| -> Vec<Query> {
+                scattered
+                    .iter()
+                    .map(|&(ray, tri)| Query {
+                        ray,
+                        t_min: 0.0,
+                        t_max,
+                        skip_mirror: None,
+                        skip_triangle: Some(tri),
+                    })
+                    .collect()
+            };
+            for (label, any_hit, queries) in [
+                ("scattered batches", false, as_queries(f32::INFINITY)),
+                ("scattered any-hit batches", true, as_queries(1.0)),
+            ] {
+                group.bench_function(format!("{label} {kind:?} ({} rays)", queries.len()), |b| {
+                    let mut out = [None; LANES];
+                    b.iter(|| {
+                        let mut found = 0;
+                        for batch in queries.chunks(LANES) {
+                            let out = &mut out[..batch.len()];
+                            if any_hit {
+                                bvh.queries::<true>(batch, out);
+                            } else {
+                                bvh.queries::<false>(batch, out);
+                            }
+                            found += out.iter().flatten().count();
+                        }
+                        found
+                    })
+                });
+            }
+            // Rays from far outside the scene, pointing away: the fixed cost of a query
+            // (its setup and the root's box test), one at a time.
+            group.throughput(Throughput::Elements(missing.len() as u64));
+            group.bench_function(format!("miss {kind:?} ({} rays)", missing.len()), |b| {
+                b.iter(|| {
+                    missing
+                        .iter()
+                        .filter(|ray| bvh.closest_hit(ray, 0.0, f32::INFINITY, None).is_some())
+                        .count()
+                })
+            });
+            let missing_queries: Vec<Query> = missing
+                .iter()
+                .map(|&ray| Query {
+                    ray,
+                    t_min: 0.0,
+                    t_max: f32::INFINITY,
+                    skip_mirror: None,
+                    skip_triangle: None,
+                })
+                .collect();
+            group.bench_function(
+                format!("miss batches {kind:?} ({} rays)", missing.len()),
+                |b| {
+                    let mut out = [None; LANES];
+                    b.iter(|| {
+                        let mut found = 0;
+                        for batch in missing_queries.chunks(LANES) {
+                            let out = &mut out[..batch.len()];
+                            bvh.queries::<false>(batch, out);
+                            found += out.iter().flatten().count();
+                        }
+                        found
+                    })
+                },
+            );
+            group.throughput(Throughput::Elements(scattered.len() as u64));
             group.bench_function(
                 format!("scattered any-hit {kind:?} ({} rays)", scattered.len()),
                 |b| {

@@ -35,10 +35,10 @@ pub struct Hit {
     pub triangle: usize,
 }
 
-/// A query of [`SceneBvh::queries_inline`]: a ray with the limits and skips of
+/// A query of [`SceneBvh::queries`]: a ray with the limits and skips of
 /// [`SceneBvh::closest_hit_skipping`] and [`SceneBvh::occluded`].
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct Query {
+pub struct Query {
     pub ray: Ray,
     pub t_min: f32,
     pub t_max: f32,
@@ -674,6 +674,28 @@ impl SceneBvh {
             }
             .run());
         }
+    }
+
+    /// [`SceneBvh::queries_inline`] for callers not compiled for this CPU (benchmarks): the
+    /// batch as `path` traces its scattered rays, compiled for the widest vectors.
+    pub fn queries<const ANY_HIT: bool>(&self, queries: &[Query], out: &mut [Option<Hit>]) {
+        struct Batch<'b, const ANY_HIT: bool> {
+            bvh: &'b SceneBvh,
+            queries: &'b [Query],
+            out: &'b mut [Option<Hit>],
+        }
+        impl<const ANY_HIT: bool> Vectorised for Batch<'_, ANY_HIT> {
+            type Output = ();
+            #[inline(always)]
+            fn run(self) {
+                self.bvh.queries_inline::<ANY_HIT>(self.queries, self.out)
+            }
+        }
+        widest(Batch::<ANY_HIT> {
+            bvh: self,
+            queries,
+            out,
+        })
     }
 
     /// Builds the packet kernel's hierarchy now if packets are on (an integrator that
