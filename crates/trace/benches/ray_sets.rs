@@ -53,17 +53,22 @@ fn ray_sets(scene: &Scene, bvh: &SceneBvh, bounces: usize) -> Vec<Vec<Leaving>> 
     sets
 }
 
-/// Scattered rays, as `path`'s after a diffuse vertex: from the diffuse points the camera
-/// rays hit, in directions uniform over the hemisphere about the normal on the camera's side,
-/// skipping the triangle they leave (a fixed pseudo-random sequence).
-fn scattered(scene: &Scene, bvh: &SceneBvh, camera_rays: &[Leaving]) -> Vec<(Ray, usize)> {
-    let mut state = 0x9e37_79b9_7f4a_7c15u64;
-    let mut unit = move || {
+/// A fixed pseudo-random sequence in [0, 1) from `seed` (a 64-bit LCG's top 24 bits).
+fn units(seed: u64) -> impl FnMut() -> f32 {
+    let mut state = seed;
+    move || {
         state = state
             .wrapping_mul(6_364_136_223_846_793_005)
             .wrapping_add(1_442_695_040_888_963_407);
         (state >> 40) as f32 / (1u64 << 24) as f32
-    };
+    }
+}
+
+/// Scattered rays, as `path`'s after a diffuse vertex: from the diffuse points the camera
+/// rays hit, in directions uniform over the hemisphere about the normal on the camera's side,
+/// skipping the triangle they leave (a fixed pseudo-random sequence).
+fn scattered(scene: &Scene, bvh: &SceneBvh, camera_rays: &[Leaving]) -> Vec<(Ray, usize)> {
+    let mut unit = units(0x9e37_79b9_7f4a_7c15);
     camera_rays
         .iter()
         .filter_map(|(ray, _)| {
@@ -92,13 +97,7 @@ fn scattered(scene: &Scene, bvh: &SceneBvh, camera_rays: &[Leaving]) -> Vec<(Ray
 /// directions): far outside the bundled scenes, so a query is its setup and the root's box
 /// test (`tools/mitsuba/ray_costs.py` times the same for Mitsuba's Embree).
 fn missing(n: usize) -> Vec<Ray> {
-    let mut state = 0x2545_f491_4f6c_dd1du64;
-    let mut unit = move || {
-        state = state
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
-        (state >> 40) as f32 / (1u64 << 24) as f32
-    };
+    let mut unit = units(0x2545_f491_4f6c_dd1d);
     (0..n)
         .map(|_| {
             let z = 2.0 * unit() - 1.0;

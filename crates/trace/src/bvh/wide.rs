@@ -719,6 +719,36 @@ mod tests {
     use super::*;
     use glam::Vec3;
 
+    /// One leaf block of `triangles` (lane `i` numbered `first + i`), on no mirror.
+    fn block_of(triangles: &[[Vec3; 3]], first: u32) -> TriBlock {
+        let mut block = TriBlock {
+            v: [[[0.0; BLOCK]; 3]; 3],
+            mirror: [NOT_A_MIRROR; BLOCK],
+            original: [u32::MAX; BLOCK],
+            count: triangles.len() as u32,
+            more: false,
+        };
+        for (lane, tri) in triangles.iter().enumerate() {
+            for (corner, p) in tri.iter().enumerate() {
+                for axis in 0..3 {
+                    block.v[corner][axis][lane] = p[axis];
+                }
+            }
+            block.original[lane] = first + lane as u32;
+        }
+        block
+    }
+
+    impl WideBvh {
+        /// A hierarchy without nodes or blocks, to call [`WideBvh::block`] on.
+        fn no_nodes() -> Self {
+            WideBvh {
+                nodes: Vec::new(),
+                blocks: Vec::new(),
+            }
+        }
+    }
+
     /// A ray through the shared diagonal of a quad's two triangles meets both on an edge
     /// (an exact-zero edge function: the lanes the scalar test finishes). The any-hit leaf
     /// counts it as blocking within the ray's end and not beyond, as the closest-hit leaf
@@ -730,25 +760,8 @@ mod tests {
             [v(-1.0, -1.0), v(1.0, -1.0), v(1.0, 1.0)],
             [v(-1.0, -1.0), v(1.0, 1.0), v(-1.0, 1.0)],
         ];
-        let mut block = TriBlock {
-            v: [[[0.0; BLOCK]; 3]; 3],
-            mirror: [NOT_A_MIRROR; BLOCK],
-            original: [u32::MAX; BLOCK],
-            count: 2,
-            more: false,
-        };
-        for (lane, tri) in quad.iter().enumerate() {
-            for (corner, p) in tri.iter().enumerate() {
-                for axis in 0..3 {
-                    block.v[corner][axis][lane] = p[axis];
-                }
-            }
-            block.original[lane] = lane as u32 + 5;
-        }
-        let bvh = WideBvh {
-            nodes: Vec::new(),
-            blocks: Vec::new(),
-        };
+        let block = block_of(&quad, 5);
+        let bvh = WideBvh::no_nodes();
         for (t_max, blocked) in [(f32::INFINITY, true), (2.0, true), (0.5, false)] {
             let ray = WideRay::new(Vec3::Z, Vec3::NEG_Z, 0.0, t_max, None, None);
             assert_eq!(ray.wt.axes(), (1, 0, 2));
@@ -779,25 +792,8 @@ mod tests {
         let t_of = |t: [Vec3; 3]| ray.wt.intersect(t[0], t[1], t[2], 0.0, f32::INFINITY);
         assert_eq!(t_of(tilted).to_bits(), 0.0f32.to_bits());
         assert_eq!(t_of(flat).to_bits(), (-0.0f32).to_bits());
-        let mut block = TriBlock {
-            v: [[[0.0; BLOCK]; 3]; 3],
-            mirror: [NOT_A_MIRROR; BLOCK],
-            original: [u32::MAX; BLOCK],
-            count: 2,
-            more: false,
-        };
-        for (lane, tri) in [tilted, flat].iter().enumerate() {
-            for (corner, p) in tri.iter().enumerate() {
-                for axis in 0..3 {
-                    block.v[corner][axis][lane] = p[axis];
-                }
-            }
-            block.original[lane] = lane as u32;
-        }
-        let bvh = WideBvh {
-            nodes: Vec::new(),
-            blocks: Vec::new(),
-        };
+        let block = block_of(&[tilted, flat], 0);
+        let bvh = WideBvh::no_nodes();
         let (t, triangle) = bvh
             .block::<ConstAxes<1, 0, 2>, false>(&block, &ray, f32::INFINITY)
             .unwrap();
