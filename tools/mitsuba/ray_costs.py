@@ -2,14 +2,17 @@
 """What one ray query costs Mitsuba 3 (its Embree), per kind of ray, for comparison with
 mirrorbox's traversals on the same kinds of rays (issue 56; docs/tracer-performance.md).
 
-The ray sets are those of `cargo bench -p mirrorbox-trace --bench ray_sets -- single_`,
-built the same way on Mitsuba's side of an export (`mirrorbox export-mitsuba`):
-  camera     16 rays per pixel (4x4 grid) at 320x180, traced with the `coherent` hint
-             (as Mitsuba's `path` traces its camera rays) and without it;
+The scattered and missing sets are built as `cargo bench -p mirrorbox-trace --bench
+ray_sets -- single_` builds them, on Mitsuba's side of an export (`mirrorbox
+export-mitsuba`); the camera set is the render's, not the benchmark's:
+  camera     16 rays per pixel (the 4x4 grid) at 320x180, traced with the `coherent` hint
+             (as Mitsuba's `path` traces its camera rays) and without it (as it traces
+             every later ray);
   scattered  from the diffuse point each pixel-centre camera ray hits first (320x180), a
              uniform direction over the hemisphere on the camera's side: closest hit
              (`ray_intersect_preliminary`, no surface interaction), and any hit within 1;
-  miss       rays from 10 units around (0, 1000, 0) pointing away: a query's fixed cost.
+  miss       rays from 10 units around (0, 1000, 0), pointing away from it and upwards,
+             far above the scene: a query's fixed cost.
 The same number of scattered rays on both sides (printed as `scattered_rays`) checks that
 the camera and the diffuse surfaces agree. Each set is repeated to about a million rays;
 the best of 6 timed evaluations (after a first that compiles the kernel), on `--threads`
@@ -85,12 +88,15 @@ def main():
     scattered = si.spawn_ray(d)
     keep = dr.compress(diffuse)
     count = dr.width(keep)
+    if count == 0:
+        raise SystemExit(f"{args.scene}: no camera ray meets a diffuse surface")
     s_o, s_d = repeated([dr.gather(mi.Point3f, scattered.o, keep),
                          dr.gather(mi.Vector3f, scattered.d, keep)], count, TARGET)
 
     # Rays far outside the scene, pointing away.
     rng = mi.PCG32(size=TARGET)
     m_d = mi.warp.square_to_uniform_sphere(mi.Point2f(rng.next_float32(), rng.next_float32()))
+    m_d = mi.Vector3f(m_d.x, dr.abs(m_d.y), m_d.z)
     m_o = mi.Point3f(0, 1000, 0) + m_d * 10
 
     def closest(coherent):

@@ -676,8 +676,11 @@ impl SceneBvh {
         }
     }
 
-    /// [`SceneBvh::queries_inline`] for callers not compiled for this CPU (benchmarks): the
-    /// batch as `path` traces its scattered rays, compiled for the widest vectors.
+    /// [`SceneBvh::queries_inline`] compiled for the widest vectors, as a call of its own:
+    /// for callers not compiled for this CPU (benchmarks) and for `whitted`'s few shadow
+    /// legs, kept out of its walk (measured: docs/tracer-performance.md, 2026-11-28). With
+    /// `ANY_HIT` only whether an answer is `Some` means anything (blocked); its hit is any.
+    #[inline(never)]
     pub fn queries<const ANY_HIT: bool>(&self, queries: &[Query], out: &mut [Option<Hit>]) {
         struct Batch<'b, const ANY_HIT: bool> {
             bvh: &'b SceneBvh,

@@ -17,8 +17,10 @@
 //! stops at a leaf's first hit). Box tests are the packet kernel's
 //! (`safe_inverse` reciprocals, the far distance widened by 1 + 2γ₃), so no box that a ray
 //! meets is skipped; triangles are the watertight test; of equally distant hits the lowest
-//! triangle index wins (within a block, the least integer key of (distance, triangle)). Same answers as the binary hierarchy's traversal, bit for bit
-//! (tested), and no corner misses (obvhs's CWBVH misses some, docs/tracer-performance.md).
+//! triangle index wins (within a block, the least integer key of (distance, triangle)). Same
+//! answers as the binary hierarchy's traversal, bit for bit (tested: the closest hit's
+//! distance and triangle; for an any-hit query whether the ray is blocked), and no corner
+//! misses (obvhs's CWBVH misses some, docs/tracer-performance.md).
 //!
 //! **Stack**: each level pushes at most `WIDTH − 1` entries beyond the one it pops, so a
 //! hierarchy `d` levels deep needs `(WIDTH − 1)·d + 1`; one deeper than [`STACK`] holds is not
@@ -447,11 +449,11 @@ impl<'r, A: Axes, const ANY_HIT: bool> Walk<'r, A, ANY_HIT> {
                 let block = &bvh.blocks[b];
                 if let Some((t, triangle)) = bvh.block::<A, ANY_HIT>(block, ray, self.best) {
                     if ANY_HIT {
-                        // `occluded`'s answer: a hit at t_min ≤ t < t_max.
-                        if t < ray.t_max {
-                            self.found = Some((t, triangle));
-                            return false;
-                        }
+                        // `occluded`'s answer: a hit at t_min ≤ t < t_max (the block
+                        // answers only such hits in this mode).
+                        debug_assert!(t < ray.t_max);
+                        self.found = Some((t, triangle));
+                        return false;
                     } else {
                         // As the binary hierarchy's traversal: a hit at exactly t_max counts
                         // only as a tie with an earlier one.
@@ -528,7 +530,8 @@ impl WideBvh {
     /// ([`WatertightRay::intersect_axes`]) operation for operation, so the same bits; a lane
     /// with an exact zero edge function is finished by the scalar test (its f64
     /// re-evaluation). Lanes beyond the block's count, on the mirror the ray leaves or on the
-    /// triangle it skips take no part.
+    /// triangle it skips take no part. With `ANY_HIT`: some hit with `t < ray.t_max` (the
+    /// first such lane, else the first exact-zero lane the scalar test confirms), or none.
     #[inline(always)]
     #[allow(clippy::needless_range_loop)]
     fn block<A: Axes, const ANY_HIT: bool>(
@@ -719,8 +722,8 @@ mod tests {
     use super::*;
     use glam::Vec3;
 
-    /// One leaf block of `triangles` (lane `i` numbered `first + i`), on no mirror.
-    fn block_of(triangles: &[[Vec3; 3]], first: u32) -> TriBlock {
+    /// One leaf block of `triangles`, lane `i` numbered `original[i]`, on no mirror.
+    fn block_of(triangles: &[[Vec3; 3]], original: &[u32]) -> TriBlock {
         let mut block = TriBlock {
             v: [[[0.0; BLOCK]; 3]; 3],
             mirror: [NOT_A_MIRROR; BLOCK],
@@ -734,7 +737,7 @@ mod tests {
                     block.v[corner][axis][lane] = p[axis];
                 }
             }
-            block.original[lane] = first + lane as u32;
+            block.original[lane] = original[lane];
         }
         block
     }
@@ -750,9 +753,10 @@ mod tests {
     }
 
     /// A ray through the shared diagonal of a quad's two triangles meets both on an edge
-    /// (an exact-zero edge function: the lanes the scalar test finishes). The any-hit leaf
-    /// counts it as blocking within the ray's end and not beyond, as the closest-hit leaf
-    /// finds it (the lower triangle).
+    /// (an exact-zero edge function: the lanes the scalar test finishes), at t = 1. The
+    /// any-hit leaf counts it as blocking before the ray's end and not at or beyond it; the
+    /// closest-hit leaf finds it up to and at `best`, on the lower triangle (lane 1 here, so
+    /// that keeping the first lane would fail).
     #[test]
     fn a_hit_on_a_shared_edge_blocks_an_any_hit_ray() {
         let v = |x: f32, y: f32| Vec3::new(x, y, 0.0);
@@ -760,19 +764,20 @@ mod tests {
             [v(-1.0, -1.0), v(1.0, -1.0), v(1.0, 1.0)],
             [v(-1.0, -1.0), v(1.0, 1.0), v(-1.0, 1.0)],
         ];
-        let block = block_of(&quad, 5);
+        let block = block_of(&quad, &[6, 5]);
         let bvh = WideBvh::no_nodes();
-        for (t_max, blocked) in [(f32::INFINITY, true), (2.0, true), (0.5, false)] {
+        for (t_max, blocked, found) in [
+            (f32::INFINITY, true, true),
+            (2.0, true, true),
+            (1.0, false, true),
+            (0.5, false, false),
+        ] {
             let ray = WideRay::new(Vec3::Z, Vec3::NEG_Z, 0.0, t_max, None, None);
             assert_eq!(ray.wt.axes(), (1, 0, 2));
             let any = bvh.block::<ConstAxes<1, 0, 2>, true>(&block, &ray, t_max);
             assert_eq!(any.is_some(), blocked, "any hit to {t_max}");
             let closest = bvh.block::<ConstAxes<1, 0, 2>, false>(&block, &ray, t_max);
-            assert_eq!(
-                closest,
-                blocked.then_some((1.0, 5)),
-                "closest hit to {t_max}"
-            );
+            assert_eq!(closest, found.then_some((1.0, 5)), "closest hit to {t_max}");
         }
     }
 
@@ -792,7 +797,7 @@ mod tests {
         let t_of = |t: [Vec3; 3]| ray.wt.intersect(t[0], t[1], t[2], 0.0, f32::INFINITY);
         assert_eq!(t_of(tilted).to_bits(), 0.0f32.to_bits());
         assert_eq!(t_of(flat).to_bits(), (-0.0f32).to_bits());
-        let block = block_of(&[tilted, flat], 0);
+        let block = block_of(&[tilted, flat], &[0, 1]);
         let bvh = WideBvh::no_nodes();
         let (t, triangle) = bvh
             .block::<ConstAxes<1, 0, 2>, false>(&block, &ray, f32::INFINITY)

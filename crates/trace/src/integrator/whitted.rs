@@ -190,17 +190,17 @@ impl<'a> Whitted<'a> {
     /// the results are the same. Compiled for the CPU's widest vectors
     /// ([`crate::cpu_features`]), kernel included.
     pub fn radiance_packet(&self, rays: &[Ray], out: &mut Vec<PathResult>) {
-        struct Work<'w, 'a, const LANES_SHADE: bool> {
+        struct Work<'w, 'a, const SHADED_IN_LANES: bool> {
             whitted: &'w Whitted<'a>,
             rays: &'w [Ray],
             out: &'w mut Vec<PathResult>,
         }
-        impl<const LANES_SHADE: bool> Vectorised for Work<'_, '_, LANES_SHADE> {
+        impl<const SHADED_IN_LANES: bool> Vectorised for Work<'_, '_, SHADED_IN_LANES> {
             type Output = ();
             #[inline(always)]
             fn run(self) {
                 self.whitted
-                    .radiance_packet_inline::<LANES_SHADE>(self.rays, self.out)
+                    .radiance_packet_inline::<SHADED_IN_LANES>(self.rays, self.out)
             }
         }
         // Compiled apart for lighting shaded in lane loops and for lighting with shadow legs
@@ -228,16 +228,16 @@ impl<'a> Whitted<'a> {
     /// ([`mirrorbox_scene::Lighting::direct_radiance_lanes`]); the rest (the step's
     /// decisions, bumps, shadow legs) stays one lane at a time.
     #[inline(always)]
-    fn radiance_packet_inline<const LANES_SHADE: bool>(
+    fn radiance_packet_inline<const SHADED_IN_LANES: bool>(
         &self,
         rays: &[Ray],
         out: &mut Vec<PathResult>,
     ) {
         let lighting = &self.scene.lighting;
         // A round's diffuse hits are shaded side by side: without shadow legs or light
-        // images in lane loops (`LANES_SHADE`, the lighting's `lanes_apply`), else with each
+        // images in lane loops (`SHADED_IN_LANES`, the lighting's `lanes_apply`), else with each
         // light's legs traced as one packet.
-        debug_assert_eq!(LANES_SHADE, lighting.lanes_apply());
+        debug_assert_eq!(SHADED_IN_LANES, lighting.lanes_apply());
         // A round's flat-mirror planes and diffuse hits, per lane; set for the lanes that
         // have one, read (past values in the others, never used) by whole-packet loops.
         // Kept across rounds and chunks: zeroing them every round cost 2 % (memset).
@@ -312,7 +312,7 @@ impl<'a> Whitted<'a> {
                 if diffuse.iter().any(|&f| f) {
                     let [p, n, to_viewer, albedo, emission] = &shading;
                     let mut legs = [0u32; LANES];
-                    let shaded = if LANES_SHADE {
+                    let shaded = if SHADED_IN_LANES {
                         lighting.direct_radiance_lanes(p, n, to_viewer, albedo, emission)
                     } else {
                         // Shadow legs or light images: each light's legs as one packet.
