@@ -34,7 +34,7 @@ use crate::bvh::packet::{LANES, LaneHits, LaneMask, NO_TRIANGLE, RayPacket, firs
 use crate::bvh::{Hit, NO_QUERY, Query, SceneBvh};
 use crate::cpu_features::{Vectorised, widest};
 use crate::hit_point::on_triangle_plane;
-use crate::mirror_bounce::{MirrorPlanes, bounce_flat_lanes};
+use crate::mirror_bounce::{MirrorPlanes, bounce_flat_lanes, reflect_on_plane};
 use crate::sampler::SplitMix64;
 use glam::Vec3;
 use mirrorbox_scene::shading::{Interaction, interaction_with_point};
@@ -96,6 +96,10 @@ const PACKET_VERTICES: u32 = 1;
 /// any-hit packets; later ones one at a time (measured with [`PACKET_VERTICES`] 1: none in
 /// packets 0.78 s and 1.63 s; 1: 0.73 s and 1.55 s; 2: 0.74 s and 1.68 s).
 const PACKET_SHADOW_VERTICES: u32 = 1;
+
+/// A round's bounces off flat mirrors are computed lane by lane where at most this many
+/// lanes bounce, else side by side over all [`LANES`] ([`bounce_flat_lanes`]).
+const FEW_FLAT_LANES: u32 = 4;
 
 fn luminance(c: Vec3) -> f32 {
     0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
@@ -569,7 +573,7 @@ impl PathTracer<'_> {
                 }
                 asked.clear();
                 let mut flat = [false; LANES];
-                let mut any_flat = false;
+                let mut flat_lanes: LaneMask = 0;
                 for lane in lanes(active) {
                     let w = &mut walks[lane];
                     let in_packet = coherent >> lane & 1 == 1;
@@ -591,7 +595,7 @@ impl PathTracer<'_> {
                         }
                         Vertex::FlatBounce((n, off)) => {
                             flat[lane] = true;
-                            any_flat = true;
+                            flat_lanes |= 1 << lane;
                             for k in 0..3 {
                                 normal[k][lane] = n[k];
                                 origin[k][lane] = w.ray.origin[k] as f64;
@@ -602,9 +606,10 @@ impl PathTracer<'_> {
                         Vertex::Next => {}
                     }
                 }
-                // The round's bounces off flat mirrors, side by side (f64, rounded to the
-                // path's f32 rays).
-                if any_flat {
+                // The round's bounces off flat mirrors (f64, rounded to the path's f32 rays):
+                // side by side where many lanes bounce, else lane by lane (the same
+                // arithmetic: `reflect_on_plane`).
+                if flat_lanes.count_ones() > FEW_FLAT_LANES {
                     bounce_flat_lanes::<LANES, true>(
                         &flat,
                         &normal,
@@ -619,6 +624,16 @@ impl PathTracer<'_> {
                         walks[lane].ray = Ray {
                             origin: at(&origin),
                             dir: at(&dir),
+                        };
+                    }
+                } else {
+                    for lane in lanes(flat_lanes) {
+                        let at = |a: &[[f64; LANES]; 3]| [a[0][lane], a[1][lane], a[2][lane]];
+                        let (o, d) =
+                            reflect_on_plane(at(&normal), offset[lane], at(&origin), at(&dir));
+                        walks[lane].ray = Ray {
+                            origin: Vec3::new(o[0] as f32, o[1] as f32, o[2] as f32),
+                            dir: Vec3::new(d[0] as f32, d[1] as f32, d[2] as f32),
                         };
                     }
                 }
