@@ -1011,12 +1011,8 @@ mod tests {
             let queries = &queries[..queries.len() - 1];
             let mut closest = vec![None; queries.len()];
             let mut any = vec![None; queries.len()];
-            widest(Batch {
-                bvh: &wide,
-                queries,
-                closest: &mut closest,
-                any: &mut any,
-            });
+            wide.queries::<false>(queries, &mut closest);
+            wide.queries::<true>(queries, &mut any);
             for (i, q) in queries.iter().enumerate() {
                 let (ray, t_max) = (q.ray, q.t_max);
                 let want =
@@ -1029,24 +1025,6 @@ mod tests {
                 let want = binary.occluded(&ray, 0.0, t_max, q.skip_mirror, q.skip_triangle);
                 assert_eq!(any[i].is_some(), want, "batch ray {i}: {ray:?} to {t_max}");
             }
-        }
-    }
-
-    /// [`SceneBvh::queries_inline`] of a batch, closest hits and any hits, as a test runs it.
-    struct Batch<'a> {
-        bvh: &'a SceneBvh,
-        queries: &'a [Query],
-        closest: &'a mut [Option<Hit>],
-        any: &'a mut [Option<Hit>],
-    }
-
-    impl Vectorised for Batch<'_> {
-        type Output = ();
-
-        #[inline(always)]
-        fn run(self) {
-            self.bvh.queries_inline::<false>(self.queries, self.closest);
-            self.bvh.queries_inline::<true>(self.queries, self.any);
         }
     }
 

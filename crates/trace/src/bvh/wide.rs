@@ -584,6 +584,11 @@ impl WideBvh {
                 u64::MAX
             };
         }
+        // An exact-zero lane's distance by the scalar test.
+        let scalar = |i: usize| {
+            let corner = |c: usize| glam::Vec3::new(b.v[c][0][i], b.v[c][1][i], b.v[c][2][i]);
+            A::intersect(ray, [corner(0), corner(1), corner(2)], ray.t_min, best)
+        };
         if ANY_HIT {
             // Any lane nearer than the ray's end answers (which one does not matter).
             let blocking = lane_bits::<BLOCK>(|i| t[i] < ray.t_max);
@@ -591,9 +596,7 @@ impl WideBvh {
                 while zero != 0 {
                     let i = zero.trailing_zeros() as usize;
                     zero &= zero - 1;
-                    let corner =
-                        |c: usize| glam::Vec3::new(b.v[c][0][i], b.v[c][1][i], b.v[c][2][i]);
-                    let ti = A::intersect(ray, [corner(0), corner(1), corner(2)], ray.t_min, best);
+                    let ti = scalar(i);
                     if ti < ray.t_max {
                         return Some((ti, b.original[i]));
                     }
@@ -621,9 +624,7 @@ impl WideBvh {
         while zero != 0 {
             let i = zero.trailing_zeros() as usize;
             zero &= zero - 1;
-            let corner = |c: usize| glam::Vec3::new(b.v[c][0][i], b.v[c][1][i], b.v[c][2][i]);
-            let ti = A::intersect(ray, [corner(0), corner(1), corner(2)], ray.t_min, best);
-            keep(&mut hit, ti, b.original[i]);
+            keep(&mut hit, scalar(i), b.original[i]);
         }
         hit
     }
