@@ -115,6 +115,31 @@ fn rays_missing_the_scene(n: usize) -> Vec<Ray> {
         .collect()
 }
 
+/// Queries of `rays` from t = 0 to `t_max`, each skipping the triangle it leaves, if any.
+fn queries(rays: impl Iterator<Item = (Ray, Option<usize>)>, t_max: f32) -> Vec<Query> {
+    rays.map(|(ray, skip_triangle)| Query {
+        ray,
+        t_min: 0.0,
+        t_max,
+        skip_mirror: None,
+        skip_triangle,
+    })
+    .collect()
+}
+
+/// `queries` as `path` traces them, [`LANES`] per call to [`SceneBvh::queries`]: how many
+/// are answered.
+fn in_batches<const ANY_HIT: bool>(bvh: &SceneBvh, queries: &[Query]) -> usize {
+    let mut out = [None; LANES];
+    let mut found = 0;
+    for batch in queries.chunks(LANES) {
+        let out = &mut out[..batch.len()];
+        bvh.queries::<ANY_HIT>(batch, out);
+        found += out.iter().flatten().count();
+    }
+    found
+}
+
 /// Single rays only, through the 8-wide hierarchy and obvhs's CWBVH: camera rays and
 /// scattered rays of `mirror_box` and `mirror_room` (the rays `path` sends one at a time),
 /// closest hit and any hit, one query per call and in batches, and rays that miss (issue 56).
@@ -126,6 +151,10 @@ fn single(c: &mut Criterion) {
         let camera_rays = &ray_sets(&scene, &reference, 0)[0];
         let scattered = scattered(&scene, &reference, camera_rays);
         let missing = rays_missing_the_scene(10_000);
+        let scattered_queries =
+            queries(scattered.iter().map(|&(r, t)| (r, Some(t))), f32::INFINITY);
+        let scattered_within_1 = queries(scattered.iter().map(|&(r, t)| (r, Some(t))), 1.0);
+        let missing_queries = queries(missing.iter().map(|&r| (r, None)), f32::INFINITY);
         let mut group = c.benchmark_group(format!("single_{name}_320x180"));
         group.sample_size(10);
         for kind in [BvhKind::Wide, BvhKind::Cwbvh] {
@@ -161,41 +190,16 @@ fn single(c: &mut Criterion) {
             );
             // As `path` traces them: a round's queries in one batch, two at a time through the
             // 8-wide hierarchy (`SceneBvh::queries`).
-            let as_queries = |t_max: f32| -> Vec<Query> {
-                scattered
-                    .iter()
-                    .map(|&(ray, tri)| Query {
-                        ray,
-                        t_min: 0.0,
-                        t_max,
-                        skip_mirror: None,
-                        skip_triangle: Some(tri),
-                    })
-                    .collect()
-            };
-            for (label, any_hit, queries) in [
-                ("scattered batches", false, as_queries(f32::INFINITY)),
-                ("scattered any-hit batches", true, as_queries(1.0)),
-            ] {
-                group.bench_function(format!("{label} {kind:?} ({} rays)", queries.len()), |b| {
-                    let mut out = [None; LANES];
-                    b.iter(|| {
-                        let mut found = 0;
-                        for batch in queries.chunks(LANES) {
-                            let out = &mut out[..batch.len()];
-                            if any_hit {
-                                bvh.queries::<true>(batch, out);
-                            } else {
-                                bvh.queries::<false>(batch, out);
-                            }
-                            found += out.iter().flatten().count();
-                        }
-                        found
-                    })
-                });
-            }
+            let n = scattered.len();
+            group.bench_function(format!("scattered batches {kind:?} ({n} rays)"), |b| {
+                b.iter(|| in_batches::<false>(&bvh, &scattered_queries))
+            });
+            group.bench_function(
+                format!("scattered any-hit batches {kind:?} ({n} rays)"),
+                |b| b.iter(|| in_batches::<true>(&bvh, &scattered_within_1)),
+            );
             // Rays from far outside the scene, pointing away: the fixed cost of a query
-            // (its setup and the root's box test), one at a time.
+            // (its setup and the root's box test), one per call and in batches.
             group.throughput(Throughput::Elements(missing.len() as u64));
             group.bench_function(format!("miss {kind:?} ({} rays)", missing.len()), |b| {
                 b.iter(|| {
@@ -205,30 +209,9 @@ fn single(c: &mut Criterion) {
                         .count()
                 })
             });
-            let missing_queries: Vec<Query> = missing
-                .iter()
-                .map(|&ray| Query {
-                    ray,
-                    t_min: 0.0,
-                    t_max: f32::INFINITY,
-                    skip_mirror: None,
-                    skip_triangle: None,
-                })
-                .collect();
             group.bench_function(
                 format!("miss batches {kind:?} ({} rays)", missing.len()),
-                |b| {
-                    let mut out = [None; LANES];
-                    b.iter(|| {
-                        let mut found = 0;
-                        for batch in missing_queries.chunks(LANES) {
-                            let out = &mut out[..batch.len()];
-                            bvh.queries::<false>(batch, out);
-                            found += out.iter().flatten().count();
-                        }
-                        found
-                    })
-                },
+                |b| b.iter(|| in_batches::<false>(&bvh, &missing_queries)),
             );
             group.throughput(Throughput::Elements(scattered.len() as u64));
             group.bench_function(
