@@ -62,6 +62,10 @@ def main():
     p.add_argument("scene")
     p.add_argument("--threads", type=int, default=1)
     args = p.parse_args()
+    if not os.path.isfile(args.scene):
+        p.error(f"{args.scene}: no such file (a scene written by `mirrorbox export-mitsuba`)")
+    if args.threads < 1:
+        p.error(f"--threads {args.threads}: must be at least 1")
     mi.set_variant("llvm_ad_rgb")
     dr.set_thread_count(args.threads)
     scene = mi.load_file(args.scene)
@@ -89,7 +93,7 @@ def main():
     keep = dr.compress(diffuse)
     count = dr.width(keep)
     if count == 0:
-        raise SystemExit(f"{args.scene}: no camera ray meets a diffuse surface")
+        p.error(f"{args.scene}: no camera ray meets a diffuse surface (no scattered rays)")
     s_o, s_d = repeated([dr.gather(mi.Point3f, scattered.o, keep),
                          dr.gather(mi.Vector3f, scattered.d, keep)], count, TARGET)
 
