@@ -38,6 +38,35 @@ pub fn on_triangle_plane(
     }
 }
 
+/// [`on_triangle_plane`] for every lane of `o`, `d` (f64 lanes) on one triangle, into `p`:
+/// the same arithmetic in a loop over the lanes, the plane's normal computed once.
+#[inline(always)]
+pub fn on_triangle_plane_lanes<const L: usize>(
+    geometry: &Geometry,
+    triangle: usize,
+    o: &[[f64; L]; 3],
+    d: &[[f64; L]; 3],
+    t_traversal: &[f32; L],
+    p: &mut [[f32; L]; 3],
+) {
+    let [a, b, c] = geometry.triangles[triangle].map(Vec3::as_dvec3);
+    let n = (b - a).cross(c - a);
+    for lane in 0..L {
+        let o = DVec3::new(o[0][lane], o[1][lane], o[2][lane]);
+        let d = DVec3::new(d[0][lane], d[1][lane], d[2][lane]);
+        let t = n.dot(a - o) / n.dot(d);
+        let t = if t.is_finite() {
+            t
+        } else {
+            f64::from(t_traversal[lane])
+        };
+        let q = (o + d * t).as_vec3();
+        for k in 0..3 {
+            p[k][lane] = q[k];
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -86,6 +115,53 @@ mod tests {
             worst_traversal > 1e-5,
             "the traversal's t is {worst_traversal} off"
         );
+    }
+
+    /// The lane form is the one-ray form bit for bit, lane by lane: rays from many origins
+    /// meeting a large quad's plane at many angles, and a triangle without area (its lanes keep
+    /// the traversal's distance).
+    #[test]
+    fn the_lane_form_is_the_one_ray_form() {
+        const L: usize = 16;
+        let mut scene = ground(200.0);
+        let mut rng = crate::sampler::SplitMix64::for_pixel(0x5eed, 0);
+        let mut next = || f64::from(rng.next_unit());
+        let (mut o, mut d) = ([[0.0f64; L]; 3], [[0.0f64; L]; 3]);
+        let mut t = [0.0f32; L];
+        for round in 0..50 {
+            if round == 40 {
+                let [a, _, _] = scene.geometry.triangles[1];
+                scene.geometry.triangles[1] = [a, a, a];
+            }
+            for lane in 0..L {
+                let origin = DVec3::new(
+                    next() * 20.0 - 10.0,
+                    next() * 5.0 + 0.1,
+                    next() * 20.0 - 10.0,
+                );
+                let dir = DVec3::new(next() - 0.5, -next(), next() - 0.5).normalize();
+                for k in 0..3 {
+                    o[k][lane] = origin[k];
+                    d[k][lane] = dir[k];
+                }
+                t[lane] = next() as f32 * 10.0;
+            }
+            for triangle in 0..2 {
+                let mut p = [[0.0f32; L]; 3];
+                on_triangle_plane_lanes(&scene.geometry, triangle, &o, &d, &t, &mut p);
+                for lane in 0..L {
+                    let origin = DVec3::new(o[0][lane], o[1][lane], o[2][lane]);
+                    let dir = DVec3::new(d[0][lane], d[1][lane], d[2][lane]);
+                    let one = on_triangle_plane(&scene.geometry, triangle, origin, dir, t[lane]);
+                    let lanes = Vec3::new(p[0][lane], p[1][lane], p[2][lane]);
+                    assert_eq!(
+                        lanes.to_array().map(f32::to_bits),
+                        one.to_array().map(f32::to_bits),
+                        "round {round}, triangle {triangle}, lane {lane}"
+                    );
+                }
+            }
+        }
     }
 
     #[test]
