@@ -226,8 +226,8 @@ impl<'a> Whitted<'a> {
     /// bounces off flat mirrors are computed in another ([`bounce_flat_lanes`], f64), and
     /// its diffuse hits are shaded in a third where there are no shadow legs or light images
     /// ([`mirrorbox_scene::Lighting::direct_radiance_lanes`]). The step's decisions are
-    /// taken once for the packet where every lane met the same triangle
-    /// ([`Whitted::step_on_one_triangle`]), else lane by lane ([`Whitted::step_lane`]).
+    /// taken once for the lanes that met one triangle ([`Whitted::step_on_first_triangle`]),
+    /// the rest lane by lane ([`Whitted::step_lane`]).
     #[inline(always)]
     fn radiance_packet_inline<const SHADED_IN_LANES: bool>(
         &self,
@@ -251,14 +251,16 @@ impl<'a> Whitted<'a> {
                     .closest_hit_lanes_inline(&packet, walks.active, &mut hits);
                 round.flat = [false; LANES];
                 round.diffuse = [false; LANES];
-                // Rounds on one triangle in lane loops where the shading is (with shadow legs
-                // or light images, at one sample per pixel, they measured ×1.02–1.04 slower).
-                let on_one = SHADED_IN_LANES
-                    && self.step_on_one_triangle(&mut walks, &mut packet, &hits, &mut round);
-                if !on_one {
-                    for lane in lanes(walks.active) {
-                        self.step_lane(lane, &mut walks, &mut packet, &hits, &mut round);
-                    }
+                // The lanes on one triangle together where the shading is in lane loops too
+                // (with shadow legs or light images, at one sample per pixel, that measured
+                // ×1.02–1.04 slower).
+                let one_by_one = if SHADED_IN_LANES {
+                    self.step_on_first_triangle(&mut walks, &mut packet, &hits, &mut round)
+                } else {
+                    walks.active
+                };
+                for lane in lanes(one_by_one) {
+                    self.step_lane(lane, &mut walks, &mut packet, &hits, &mut round);
                 }
                 let Round {
                     flat,
@@ -377,20 +379,22 @@ impl<'a> Whitted<'a> {
         }
     }
 
-    /// A round's step for every active lane of `walks` where they all met one triangle or
-    /// all met nothing (most rounds: 95 % on `mirror_box`, 78 % on `mirror_room` at 16 spp):
-    /// the decisions [`Whitted::step`] takes per lane (which surface, which side, escaped,
-    /// reflected or shaded) taken once, the arithmetic in lane loops, the same bits. `false`,
-    /// having changed nothing, where the lanes differ (another triangle, or the two sides of
-    /// a mirror) or the surface is textured or an uneven mirror: those go lane by lane.
+    /// A round's step for the active lanes of `walks` that met what the first of them met
+    /// (one triangle, or nothing: all of them in most rounds, 95 % on `mirror_box` and 78 % on
+    /// `mirror_room` at 16 spp): the decisions [`Whitted::step`] takes per lane (which
+    /// surface, which side, escaped, reflected or shaded) taken once for them, the arithmetic
+    /// in lane loops, the same bits. Returns the active lanes it left to be stepped one by one
+    /// ([`Whitted::step_lane`]): the others, or all of them, unchanged, where that surface is
+    /// textured or an uneven mirror or the lanes met a mirror from both sides. Lane loops
+    /// write their values in every lane, so the lanes it leaves are stepped after it.
     #[inline(always)]
-    fn step_on_one_triangle(
+    fn step_on_first_triangle(
         &self,
         walks: &mut Walks,
         packet: &mut RayPacket,
         hits: &LaneHits,
         round: &mut Round,
-    ) -> bool {
+    ) -> LaneMask {
         let Walks {
             origin,
             dir,
@@ -399,20 +403,17 @@ impl<'a> Whitted<'a> {
             active,
         } = walks;
         let first = hits.triangle[active.trailing_zeros() as usize];
-        let mut same = true;
-        for lane in 0..LANES {
-            same &= (*active >> lane & 1 == 0) | (hits.triangle[lane] == first);
-        }
-        if !same {
-            return false;
-        }
+        let group = (0..LANES).fold(0, |m: LaneMask, lane| {
+            m | LaneMask::from(hits.triangle[lane] == first) << lane
+        }) & *active;
+        let others = *active & !group;
         if first == NO_TRIANGLE {
-            for lane in lanes(*active) {
+            for lane in lanes(group) {
                 carried[lane].rays += 1;
                 ends[lane] = self.escape(&mut carried[lane]);
             }
-            *active = 0;
-            return true;
+            *active &= !group;
+            return others;
         }
         let triangle = first as usize;
         let geometry = &self.scene.geometry;
@@ -422,7 +423,7 @@ impl<'a> Whitted<'a> {
             // Two-sided: the side does not matter.
             mirrorbox_scene::Surface::Diffuse { maps, .. } => {
                 if !maps.is_empty() {
-                    return false;
+                    return *active;
                 }
                 true
             }
@@ -430,13 +431,13 @@ impl<'a> Whitted<'a> {
                 let [x, y, z] = packet.dirs();
                 let (mut all_front, mut all_back) = (true, true);
                 for (lane, ((&x, &y), &z)) in x.iter().zip(y).zip(z).enumerate() {
-                    let inactive = *active >> lane & 1 == 0;
+                    let inactive = group >> lane & 1 == 0;
                     let front = face.dot(Vec3::new(x, y, z)) < 0.0;
                     all_front &= inactive | front;
                     all_back &= inactive | !front;
                 }
                 if !(all_front || all_back) {
-                    return false;
+                    return *active;
                 }
                 all_front
             }
@@ -447,9 +448,9 @@ impl<'a> Whitted<'a> {
                     unreachable!("only mirrors reflect")
                 };
                 let Some((n, off)) = self.mirror_planes.flat_plane(mirror) else {
-                    return false;
+                    return *active;
                 };
-                for lane in lanes(*active) {
+                for lane in lanes(group) {
                     let c = &mut carried[lane];
                     c.rays += 1;
                     if let Some(cut) = self.reflect(c, reflectance) {
@@ -479,16 +480,16 @@ impl<'a> Whitted<'a> {
                         emissions[k][lane] = emission[k];
                     }
                 }
-                for lane in lanes(*active) {
+                for lane in lanes(group) {
                     carried[lane].rays += 1;
                     ends[lane] = Termination::Diffuse;
                     round.diffuse[lane] = true;
                     round.shaded_triangle[lane] = triangle;
                 }
-                *active = 0;
+                *active &= !group;
             }
         }
-        true
+        others
     }
 
     /// The radiance a diffuse hit sends back along the path, shadow legs traced (the
