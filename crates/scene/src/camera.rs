@@ -161,31 +161,46 @@ impl RayGenerator {
         }
     }
 
-    /// The rays through `(x + o.x, y + o.y)` for each offset `o`, in order, appended to
-    /// `out`: [`RayGenerator::ray`]'s, bit for bit, computed sixteen at a time in lane
-    /// loops that the compiler vectorises (inline: compiled for the caller's CPU features).
+    /// The rays through the image positions `positions`, in order, appended to `out`:
+    /// [`RayGenerator::ray`]'s, bit for bit, computed sixteen at a time in lane loops
+    /// ([`RayGenerator::dirs_at`]).
     #[inline(always)]
-    pub fn rays_at_offsets(&self, x: f32, y: f32, offsets: &[Vec2], out: &mut Vec<Ray>) {
+    pub fn rays_at_positions(&self, positions: &[Vec2], out: &mut Vec<Ray>) {
         const LANES: usize = 16;
-        for chunk in offsets.chunks(LANES) {
-            // Lanes past the chunk's end keep the pixel's corner (never emitted). A lane
+        for chunk in positions.chunks(LANES) {
+            // Lanes past the chunk's end repeat its last position (never emitted). A lane
             // loop with a clamped index stayed scalar.
-            let (mut px, mut py) = ([x; LANES], [y; LANES]);
-            for (i, o) in chunk.iter().enumerate() {
-                (px[i], py[i]) = (x + o.x, y + o.y);
+            let last = chunk[chunk.len() - 1];
+            let (mut px, mut py) = ([last.x; LANES], [last.y; LANES]);
+            for (i, p) in chunk.iter().enumerate() {
+                (px[i], py[i]) = (p.x, p.y);
             }
-            let mut dir = [[0.0f32; LANES]; 3];
-            for i in 0..LANES {
-                let d = self.dir(px[i], py[i]);
-                for k in 0..3 {
-                    dir[k][i] = d[k];
-                }
-            }
+            let dir = self.dirs_at(&px, &py);
             out.extend((0..chunk.len()).map(|i| Ray {
                 origin: self.origin,
                 dir: Vec3::new(dir[0][i], dir[1][i], dir[2][i]),
             }));
         }
+    }
+
+    /// The directions of [`RayGenerator::ray`] through `(px[i], py[i])` for every lane `i`,
+    /// bit for bit, in a lane loop that the compiler vectorises (inline: compiled for the
+    /// caller's CPU features).
+    #[inline(always)]
+    pub fn dirs_at<const N: usize>(&self, px: &[f32; N], py: &[f32; N]) -> [[f32; N]; 3] {
+        let mut dir = [[0.0f32; N]; 3];
+        for i in 0..N {
+            let d = self.dir(px[i], py[i]);
+            for k in 0..3 {
+                dir[k][i] = d[k];
+            }
+        }
+        dir
+    }
+
+    /// Where every ray starts: the camera's position.
+    pub fn origin(&self) -> Vec3 {
+        self.origin
     }
 
     /// The unit direction through pixel position `(px, py)`: glam's arithmetic
@@ -270,10 +285,10 @@ mod tests {
         }
     }
 
-    /// The lane loops give [`RayGenerator::ray`]'s bits, for a full packet of offsets and a
-    /// short tail, with a shifted (stereo) frustum too.
+    /// The lane loops give [`RayGenerator::ray`]'s bits, for a full packet of positions and
+    /// a short tail, with a shifted (stereo) frustum too.
     #[test]
-    fn rays_at_offsets_are_ray_bit_for_bit() {
+    fn rays_at_positions_are_ray_bit_for_bit() {
         let mut camera = test_camera();
         for shift_x in [0.0, 0.031] {
             camera.shift_x = shift_x;
@@ -282,8 +297,12 @@ mod tests {
                 .map(|i| Vec2::new((i as f32 * 0.618_034).fract(), (i as f32 * 0.414_2).fract()))
                 .collect();
             for (x, y) in [(0.0, 0.0), (17.0, 5.0), (63.0, 35.0)] {
+                let positions: Vec<Vec2> = offsets
+                    .iter()
+                    .map(|o| Vec2::new(x + o.x, y + o.y))
+                    .collect();
                 let mut rays = Vec::new();
-                generator.rays_at_offsets(x, y, &offsets, &mut rays);
+                generator.rays_at_positions(&positions, &mut rays);
                 assert_eq!(rays.len(), offsets.len());
                 for (ray, o) in rays.iter().zip(&offsets) {
                     let one = generator.ray(x + o.x, y + o.y);

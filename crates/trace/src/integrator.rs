@@ -11,8 +11,10 @@ pub mod path;
 pub mod whitted;
 
 use crate::bvh::SceneBvh;
+use crate::cpu_features::{Vectorised, widest};
 use crate::sampler::SplitMix64;
-use glam::Vec3;
+use glam::{Vec2, Vec3};
+use mirrorbox_scene::camera::RayGenerator;
 use mirrorbox_scene::{Geometry, Ray, Scene};
 use path::{PathSettings, PathTracer};
 use whitted::{Whitted, WhittedSettings};
@@ -37,6 +39,23 @@ pub trait Integrator: Sync {
         }
     }
 
+    /// [`Integrator::radiance_all`] of the camera rays `camera` makes through the image
+    /// positions `positions` (pixel after pixel, as there), made into `rays` first (a buffer
+    /// kept by the caller). An integrator may make them itself, in the form it walks them
+    /// (`whitted`'s packets: in lanes, no buffer of rays), with the same bits.
+    fn radiance_at(
+        &self,
+        camera: &RayGenerator,
+        positions: &[Vec2],
+        rays: &mut Vec<Ray>,
+        rngs: &mut [SplitMix64],
+        out: &mut Vec<PathResult>,
+    ) {
+        rays.clear();
+        camera_rays(camera, positions, rays);
+        self.radiance_all(rays, rngs, out);
+    }
+
     /// How many neighbouring pixels of a row the image loop may hand to one
     /// [`Integrator::radiance_all`] call, their rays pixel after pixel, given
     /// `samples_per_pixel` (each with its own random stream). Default 1; 0 is taken as 1.
@@ -44,6 +63,28 @@ pub trait Integrator: Sync {
         let _ = samples_per_pixel;
         1
     }
+}
+
+/// The camera rays `camera` makes through the image positions `positions`, appended to
+/// `rays`: [`RayGenerator::rays_at_positions`] compiled for the CPU's widest vectors.
+pub fn camera_rays(camera: &RayGenerator, positions: &[Vec2], rays: &mut Vec<Ray>) {
+    struct MakeRays<'w> {
+        camera: &'w RayGenerator,
+        positions: &'w [Vec2],
+        rays: &'w mut Vec<Ray>,
+    }
+    impl Vectorised for MakeRays<'_> {
+        type Output = ();
+        #[inline(always)]
+        fn run(self) {
+            self.camera.rays_at_positions(self.positions, self.rays);
+        }
+    }
+    widest(MakeRays {
+        camera,
+        positions,
+        rays,
+    });
 }
 
 /// Pixels per [`Integrator::radiance_all`] call for an integrator that traces packets:

@@ -147,6 +147,7 @@ impl Vectorised for RowWork<'_> {
         let spp = samples as f32;
         let batch = integrator.pixels_per_call(samples).max(1) as u32;
         let mut offsets = Vec::new();
+        let mut positions = Vec::new();
         let mut camera_rays = Vec::new();
         let mut results = Vec::new();
         let mut rngs = Vec::new();
@@ -160,16 +161,21 @@ impl Vectorised for RowWork<'_> {
         for first in (0..w).step_by(batch as usize) {
             // The camera rays of pixels first.. (as many as the integrator takes per call),
             // pixel after pixel, and each pixel's random stream.
-            camera_rays.clear();
+            positions.clear();
             rngs.clear();
             for x in first..(first + batch).min(w) {
                 if per_pixel {
                     sampling.offsets(pixel_index(x), &mut offsets);
                 }
-                rays.rays_at_offsets(x as f32, y as f32, &offsets, &mut camera_rays);
+                let (x_f, y_f) = (x as f32, y as f32);
+                positions.extend(
+                    offsets
+                        .iter()
+                        .map(|o| glam::Vec2::new(x_f + o.x, y_f + o.y)),
+                );
                 rngs.push(SplitMix64::for_pixel(seed, pixel_index(x)));
             }
-            integrator.radiance_all(&camera_rays, &mut rngs, &mut results);
+            integrator.radiance_at(rays, &positions, &mut camera_rays, &mut rngs, &mut results);
             for pixel in results.chunks(samples) {
                 let mut sum = glam::Vec3::ZERO;
                 let mut bounces = 0u64;

@@ -10,14 +10,15 @@
 //! **Deep paths without drift**: mirror bounces are plane-exact in f64 and skip the mirror
 //! they leave ([`crate::mirror_bounce`]).
 
-use super::{Integrator, PathResult, Termination, face_normals};
+use super::{Integrator, PathResult, Termination, camera_rays, face_normals};
 use crate::bvh::packet::{LANES, LaneHits, LaneMask, NO_TRIANGLE, RayPacket, first_lanes, lanes};
 use crate::bvh::{Hit, NO_QUERY, Query, SceneBvh};
 use crate::cpu_features::{Vectorised, widest};
 use crate::hit_point::{on_triangle_plane, on_triangle_plane_lanes};
 use crate::mirror_bounce::{MirrorPlanes, bounce_flat_lanes};
 use crate::sampler::SplitMix64;
-use glam::{DVec3, Vec3};
+use glam::{DVec3, Vec2, Vec3};
+use mirrorbox_scene::camera::RayGenerator;
 use mirrorbox_scene::shading::{Interaction, Leg, LegsClear, interaction_with_point};
 use mirrorbox_scene::{Ray, Scene};
 
@@ -184,38 +185,38 @@ impl<'a> Whitted<'a> {
         }
     }
 
-    /// [`Whitted::radiance`] of each of `rays`, in order, into `out`: the rays walk their
-    /// paths side by side, and each round's closest-hit queries go to the BVH together as
-    /// one packet ([`SceneBvh::closest_hits`]). Every path takes the same steps as alone, so
-    /// the results are the same. Compiled for the CPU's widest vectors
+    /// [`Whitted::radiance`] of each of the rays `starts` gives, in order, into `out`: the
+    /// rays walk their paths side by side, and each round's closest-hit queries go to the BVH
+    /// together as one packet ([`SceneBvh::closest_hits`]). Every path takes the same steps as
+    /// alone, so the results are the same. Compiled for the CPU's widest vectors
     /// ([`crate::cpu_features`]), kernel included.
-    pub fn radiance_packet(&self, rays: &[Ray], out: &mut Vec<PathResult>) {
-        struct Work<'w, 'a, const SHADED_IN_LANES: bool> {
+    pub fn radiance_packet(&self, starts: impl PacketStarts, out: &mut Vec<PathResult>) {
+        struct Work<'w, 'a, S, const SHADED_IN_LANES: bool> {
             whitted: &'w Whitted<'a>,
-            rays: &'w [Ray],
+            starts: S,
             out: &'w mut Vec<PathResult>,
         }
-        impl<const SHADED_IN_LANES: bool> Vectorised for Work<'_, '_, SHADED_IN_LANES> {
+        impl<S: PacketStarts, const SHADED_IN_LANES: bool> Vectorised for Work<'_, '_, S, SHADED_IN_LANES> {
             type Output = ();
             #[inline(always)]
             fn run(self) {
                 self.whitted
-                    .radiance_packet_inline::<SHADED_IN_LANES>(self.rays, self.out)
+                    .radiance_packet_inline::<SHADED_IN_LANES>(self.starts, self.out)
             }
         }
         // Compiled apart for lighting shaded in lane loops and for lighting with shadow legs
         // or light images: the first walk holds no shadow-leg traversal, so changes to the
         // any-hit code do not move it (they moved it by 3 %, the compiler's layout).
         if self.scene.lighting.lanes_apply() {
-            widest(Work::<true> {
+            widest(Work::<_, true> {
                 whitted: self,
-                rays,
+                starts,
                 out,
             })
         } else {
-            widest(Work::<false> {
+            widest(Work::<_, false> {
                 whitted: self,
-                rays,
+                starts,
                 out,
             })
         }
@@ -231,7 +232,7 @@ impl<'a> Whitted<'a> {
     #[inline(always)]
     fn radiance_packet_inline<const SHADED_IN_LANES: bool>(
         &self,
-        rays: &[Ray],
+        starts: impl PacketStarts,
         out: &mut Vec<PathResult>,
     ) {
         let lighting = &self.scene.lighting;
@@ -241,8 +242,9 @@ impl<'a> Whitted<'a> {
         debug_assert_eq!(SHADED_IN_LANES, lighting.lanes_apply());
         let mut round = Round::default();
         let mut walks = Walks::default();
-        for chunk in rays.chunks(LANES) {
-            walks.start(chunk);
+        for first in (0..starts.count()).step_by(LANES) {
+            let n = (starts.count() - first).min(LANES);
+            walks.start(&starts, first, n);
             let mut packet = RayPacket::default();
             let mut hits = LaneHits::default();
             while walks.active != 0 {
@@ -308,7 +310,7 @@ impl<'a> Whitted<'a> {
                     );
                 }
             }
-            out.extend((0..chunk.len()).map(|lane| walks.carried[lane].result(walks.ends[lane])));
+            out.extend((0..n).map(|lane| walks.carried[lane].result(walks.ends[lane])));
         }
     }
 
@@ -613,14 +615,87 @@ impl Default for Walks {
 }
 
 impl Walks {
-    /// The walks of `rays` (at most [`LANES`]) from their start, in place (kept across
-    /// packets: no copies of the lanes).
+    /// The walks of `starts`' rays `first..first + n` (`n` at most [`LANES`]) from their
+    /// start, in place (kept across packets: no copies of the lanes).
     #[inline(always)]
-    fn start(&mut self, rays: &[Ray]) {
-        RayPacket::write_f64_lanes(rays, &mut self.origin, &mut self.dir);
+    fn start(&mut self, starts: &impl PacketStarts, first: usize, n: usize) {
+        starts.write(first, n, &mut self.origin, &mut self.dir);
         self.carried = [Carried::START; LANES];
         self.ends = [Termination::Escaped; LANES];
-        self.active = first_lanes(rays.len());
+        self.active = first_lanes(n);
+    }
+}
+
+/// Where a packet walk's rays come from: given ([`Integrator::radiance_all`]), or made from
+/// the camera in the walks' lanes ([`CameraStarts`]). A type each, so that every walk holds
+/// the code of its own (an enum in one walk made the walk with shadow legs ×1.02 slower).
+pub trait PacketStarts {
+    /// How many rays.
+    fn count(&self) -> usize;
+    /// Rays `first..first + n` (`n` at most [`LANES`]) written as f64 lanes into `origin`
+    /// and `dir`; lanes past `n` repeat ray `first + n − 1` (they are never active).
+    fn write(
+        &self,
+        first: usize,
+        n: usize,
+        origin: &mut [[f64; LANES]; 3],
+        dir: &mut [[f64; LANES]; 3],
+    );
+}
+
+impl PacketStarts for &[Ray] {
+    fn count(&self) -> usize {
+        self.len()
+    }
+
+    #[inline(always)]
+    fn write(
+        &self,
+        first: usize,
+        n: usize,
+        origin: &mut [[f64; LANES]; 3],
+        dir: &mut [[f64; LANES]; 3],
+    ) {
+        RayPacket::write_f64_lanes(&self[first..first + n], origin, dir);
+    }
+}
+
+/// The camera rays through image positions ([`Integrator::radiance_at`]), made in lane loops
+/// straight into the walks' f64 lanes: no buffer of rays to fill and read back.
+#[derive(Clone, Copy)]
+pub struct CameraStarts<'s> {
+    pub camera: &'s RayGenerator,
+    pub positions: &'s [Vec2],
+}
+
+impl PacketStarts for CameraStarts<'_> {
+    fn count(&self) -> usize {
+        self.positions.len()
+    }
+
+    #[inline(always)]
+    fn write(
+        &self,
+        first: usize,
+        n: usize,
+        origin: &mut [[f64; LANES]; 3],
+        dir: &mut [[f64; LANES]; 3],
+    ) {
+        let chunk = &self.positions[first..first + n];
+        let last = chunk[n - 1];
+        let (mut px, mut py) = ([last.x; LANES], [last.y; LANES]);
+        for (i, p) in chunk.iter().enumerate() {
+            (px[i], py[i]) = (p.x, p.y);
+        }
+        let made = self.camera.dirs_at(&px, &py);
+        for (lanes, o) in origin.iter_mut().zip(self.camera.origin().to_array()) {
+            *lanes = [f64::from(o); LANES];
+        }
+        for (lanes, made) in dir.iter_mut().zip(&made) {
+            for (d, &m) in lanes.iter_mut().zip(made) {
+                *d = f64::from(m);
+            }
+        }
     }
 }
 
@@ -766,6 +841,25 @@ impl Integrator for Whitted<'_> {
             out.extend(rays.iter().map(|&ray| Whitted::radiance(self, ray)));
         }
     }
+
+    /// As packets when the BVH traces them, their camera rays made in the walks' lanes
+    /// ([`CameraStarts`]).
+    fn radiance_at(
+        &self,
+        camera: &RayGenerator,
+        positions: &[Vec2],
+        rays: &mut Vec<Ray>,
+        rngs: &mut [SplitMix64],
+        out: &mut Vec<PathResult>,
+    ) {
+        if !self.bvh.packets() {
+            rays.clear();
+            camera_rays(camera, positions, rays);
+            return self.radiance_all(rays, rngs, out);
+        }
+        out.clear();
+        self.radiance_packet(CameraStarts { camera, positions }, out);
+    }
 }
 
 #[cfg(test)]
@@ -819,7 +913,7 @@ mod tests {
             .collect();
         assert!(first.iter().all(|&t| t == first[0]), "{first:?}");
         let mut packet = Vec::new();
-        whitted.radiance_packet(&rays, &mut packet);
+        whitted.radiance_packet(&rays[..], &mut packet);
         let mut ends = [0; 2];
         for (lane, (ray, got)) in rays.iter().zip(&packet).enumerate() {
             let alone = whitted.radiance(*ray);
