@@ -293,12 +293,14 @@ impl<'a> Whitted<'a> {
                             },
                         )
                     };
-                    for lane in (0..LANES).filter(|&lane| diffuse[lane]) {
-                        let c = &mut walks.carried[lane];
-                        c.rays += legs[lane];
-                        let l = Vec3::new(shaded[0][lane], shaded[1][lane], shaded[2][lane]);
-                        c.radiance += c.throughput * l;
+                    let shaded_lanes = (0..LANES).fold(0, |m: LaneMask, lane| {
+                        m | LaneMask::from(diffuse[lane]) << lane
+                    });
+                    let carried = &mut walks.carried;
+                    for (rays, legs) in carried.rays.iter_mut().zip(legs) {
+                        *rays += legs;
                     }
+                    carried.add(shaded_lanes, &shaded);
                 }
                 if flat.iter().any(|&f| f) {
                     bounce_flat_lanes::<LANES, false>(
@@ -310,7 +312,7 @@ impl<'a> Whitted<'a> {
                     );
                 }
             }
-            out.extend((0..n).map(|lane| walks.carried[lane].result(walks.ends[lane])));
+            out.extend((0..n).map(|lane| walks.carried.get(lane).result(walks.ends[lane])));
         }
     }
 
@@ -338,7 +340,10 @@ impl<'a> Whitted<'a> {
             DVec3::new(origin[0][lane], origin[1][lane], origin[2][lane]),
             DVec3::new(dir[0][lane], dir[1][lane], dir[2][lane]),
         );
-        let mirror = match self.step(&mut carried[lane], &query, exact, hits.get(lane)) {
+        let mut c = carried.get(lane);
+        let next = self.step(&mut c, &query, exact, hits.get(lane));
+        carried.set(lane, c);
+        let mirror = match next {
             Next::End(end) => {
                 ends[lane] = end;
                 *active &= !(1 << lane);
@@ -410,9 +415,11 @@ impl<'a> Whitted<'a> {
         }) & *active;
         let others = *active & !group;
         if first == NO_TRIANGLE {
+            carried.count_ray(group);
+            let background = self.scene.background.to_array().map(|b| [b; LANES]);
+            carried.add(group, &background);
             for lane in lanes(group) {
-                carried[lane].rays += 1;
-                ends[lane] = self.escape(&mut carried[lane]);
+                ends[lane] = Termination::Escaped;
             }
             *active &= !group;
             return others;
@@ -452,14 +459,18 @@ impl<'a> Whitted<'a> {
                 let Some((n, off)) = self.mirror_planes.flat_plane(mirror) else {
                     return *active;
                 };
-                for lane in lanes(group) {
-                    let c = &mut carried[lane];
-                    c.rays += 1;
-                    if let Some(cut) = self.reflect(c, reflectance) {
-                        ends[lane] = cut;
-                        *active &= !(1 << lane);
-                        continue;
-                    }
+                carried.count_ray(group);
+                let cut = carried.reflect(group, reflectance, &self.settings, self.scene.terminal);
+                for lane in lanes(cut) {
+                    ends[lane] = if carried.bounces[lane] >= self.settings.max_depth {
+                        Termination::Depth
+                    } else {
+                        Termination::Throughput
+                    };
+                }
+                *active &= !cut;
+                let go_on = group & !cut;
+                for lane in lanes(go_on) {
                     packet.set_skip(lane, Some(mirror));
                     round.flat[lane] = true;
                 }
@@ -482,8 +493,8 @@ impl<'a> Whitted<'a> {
                         emissions[k][lane] = emission[k];
                     }
                 }
+                carried.count_ray(group);
                 for lane in lanes(group) {
-                    carried[lane].rays += 1;
                     ends[lane] = Termination::Diffuse;
                     round.diffuse[lane] = true;
                     round.shaded_triangle[lane] = triangle;
@@ -597,7 +608,7 @@ impl<'a> Whitted<'a> {
 struct Walks {
     origin: [[f64; LANES]; 3],
     dir: [[f64; LANES]; 3],
-    carried: [Carried; LANES],
+    carried: CarriedLanes,
     ends: [Termination; LANES],
     active: LaneMask,
 }
@@ -607,7 +618,7 @@ impl Default for Walks {
         Walks {
             origin: [[0.0; LANES]; 3],
             dir: [[0.0; LANES]; 3],
-            carried: [Carried::START; LANES],
+            carried: CarriedLanes::START,
             ends: [Termination::Escaped; LANES],
             active: 0,
         }
@@ -620,7 +631,7 @@ impl Walks {
     #[inline(always)]
     fn start(&mut self, starts: &impl PacketStarts, first: usize, n: usize) {
         starts.write(first, n, &mut self.origin, &mut self.dir);
-        self.carried = [Carried::START; LANES];
+        self.carried = CarriedLanes::START;
         self.ends = [Termination::Escaped; LANES];
         self.active = first_lanes(n);
     }
@@ -796,6 +807,113 @@ impl Carried {
             termination,
             rays: self.rays,
         }
+    }
+}
+
+/// [`Carried`] for a packet's lanes, as structure of arrays: the steps taken for a group of
+/// lanes at once ([`Whitted::step_on_first_triangle`]) and the shading's sums are lane loops
+/// over it, with [`Carried`]'s arithmetic per lane (the same bits).
+struct CarriedLanes {
+    throughput: [[f32; LANES]; 3],
+    radiance: [[f32; LANES]; 3],
+    bounces: [u32; LANES],
+    rays: [u32; LANES],
+}
+
+impl CarriedLanes {
+    const START: CarriedLanes = CarriedLanes {
+        throughput: [[1.0; LANES]; 3],
+        radiance: [[0.0; LANES]; 3],
+        bounces: [0; LANES],
+        rays: [0; LANES],
+    };
+
+    #[inline(always)]
+    fn get(&self, lane: usize) -> Carried {
+        Carried {
+            throughput: Vec3::new(
+                self.throughput[0][lane],
+                self.throughput[1][lane],
+                self.throughput[2][lane],
+            ),
+            radiance: Vec3::new(
+                self.radiance[0][lane],
+                self.radiance[1][lane],
+                self.radiance[2][lane],
+            ),
+            bounces: self.bounces[lane],
+            rays: self.rays[lane],
+        }
+    }
+
+    #[inline(always)]
+    fn set(&mut self, lane: usize, c: Carried) {
+        for k in 0..3 {
+            self.throughput[k][lane] = c.throughput[k];
+            self.radiance[k][lane] = c.radiance[k];
+        }
+        self.bounces[lane] = c.bounces;
+        self.rays[lane] = c.rays;
+    }
+
+    /// Each lane of `group` casts one more ray.
+    #[inline(always)]
+    fn count_ray(&mut self, group: LaneMask) {
+        for (lane, rays) in self.rays.iter_mut().enumerate() {
+            *rays += group >> lane & 1;
+        }
+    }
+
+    /// Each lane of `group` gains `radiance` times its throughput ([`Whitted::escape`]'s and
+    /// the shading's sum).
+    #[inline(always)]
+    fn add(&mut self, group: LaneMask, radiance: &[[f32; LANES]; 3]) {
+        let sums = self.radiance.iter_mut().zip(&self.throughput).zip(radiance);
+        for ((sum, throughput), radiance) in sums {
+            for (lane, ((s, &t), &r)) in sum.iter_mut().zip(throughput).zip(radiance).enumerate() {
+                *s = if group >> lane & 1 == 1 {
+                    *s + t * r
+                } else {
+                    *s
+                };
+            }
+        }
+    }
+
+    /// [`Whitted::reflect`] for every lane of `group` at a mirror of `reflectance`: returns
+    /// the lanes cut (the scene's `terminal` radiance added); the others took the reflectance
+    /// and counted the bounce.
+    #[inline(always)]
+    fn reflect(
+        &mut self,
+        group: LaneMask,
+        reflectance: Vec3,
+        settings: &WhittedSettings,
+        terminal: Vec3,
+    ) -> LaneMask {
+        let mut cut: LaneMask = 0;
+        for lane in 0..LANES {
+            let next = [0, 1, 2].map(|k| self.throughput[k][lane] * reflectance[k]);
+            let dim = next[0].max(next[1].max(next[2])) < settings.min_throughput;
+            let deep = self.bounces[lane] >= settings.max_depth;
+            cut |= LaneMask::from(deep | dim) << lane;
+        }
+        cut &= group;
+        let go_on = group & !cut;
+        for k in 0..3 {
+            for lane in 0..LANES {
+                let t = self.throughput[k][lane];
+                let cut_here = cut >> lane & 1 == 1;
+                let on = go_on >> lane & 1 == 1;
+                let r = self.radiance[k][lane];
+                self.radiance[k][lane] = if cut_here { r + t * terminal[k] } else { r };
+                self.throughput[k][lane] = if on { t * reflectance[k] } else { t };
+            }
+        }
+        for (lane, bounces) in self.bounces.iter_mut().enumerate() {
+            *bounces += go_on >> lane & 1;
+        }
+        cut
     }
 }
 
