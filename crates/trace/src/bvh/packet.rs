@@ -18,6 +18,7 @@
 //! `1 + 2γ₃` (Ize, "Robust BVH Ray Traversal", JCGT 2013), so rounding never skips a box.
 
 use super::{Hit, NOT_A_MIRROR, Slot};
+use crate::cpu_features::lane_bits;
 use crate::watertight::{WatertightRay, axes_of, shear_of};
 use glam::Vec3;
 use mirrorbox_scene::Ray;
@@ -392,9 +393,7 @@ impl PacketBvh {
         while left != 0 {
             let code = prepared.axes[left.trailing_zeros() as usize];
             // Over all lanes, then masked: a loop without branches (vectorised).
-            let same = (0..LANES).fold(0, |m: LaneMask, i| {
-                m | ((prepared.axes[i] == code) as LaneMask) << i
-            });
+            let same = lane_bits::<LANES>(|i| prepared.axes[i] == code);
             let group = same & left;
             left &= !group;
             let (p, q, t, s, k) = (

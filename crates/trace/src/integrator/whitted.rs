@@ -13,7 +13,7 @@
 use super::{Integrator, PathResult, Termination, camera_rays, face_normals};
 use crate::bvh::packet::{LANES, LaneHits, LaneMask, NO_TRIANGLE, RayPacket, first_lanes, lanes};
 use crate::bvh::{Hit, NO_QUERY, Query, SceneBvh};
-use crate::cpu_features::{Vectorised, widest};
+use crate::cpu_features::{Vectorised, lane_bits, widest};
 use crate::hit_point::{on_triangle_plane, on_triangle_plane_lanes};
 use crate::mirror_bounce::{MirrorPlanes, bounce_flat_lanes};
 use crate::sampler::SplitMix64;
@@ -410,9 +410,7 @@ impl<'a> Whitted<'a> {
             active,
         } = walks;
         let first = hits.triangle[active.trailing_zeros() as usize];
-        let group = (0..LANES).fold(0, |m: LaneMask, lane| {
-            m | LaneMask::from(hits.triangle[lane] == first) << lane
-        }) & *active;
+        let group = lane_bits::<LANES>(|lane| hits.triangle[lane] == first) & *active;
         let others = *active & !group;
         if first == NO_TRIANGLE {
             carried.count_ray(group);
