@@ -168,14 +168,7 @@ impl RayGenerator {
     pub fn rays_at_positions(&self, positions: &[Vec2], out: &mut Vec<Ray>) {
         const LANES: usize = 16;
         for chunk in positions.chunks(LANES) {
-            // Lanes past the chunk's end repeat its last position (never emitted). A lane
-            // loop with a clamped index stayed scalar.
-            let last = chunk[chunk.len() - 1];
-            let (mut px, mut py) = ([last.x; LANES], [last.y; LANES]);
-            for (i, p) in chunk.iter().enumerate() {
-                (px[i], py[i]) = (p.x, p.y);
-            }
-            let dir = self.dirs_at(&px, &py);
+            let dir = self.dirs_through::<LANES>(chunk);
             out.extend((0..chunk.len()).map(|i| Ray {
                 origin: self.origin,
                 dir: Vec3::new(dir[0][i], dir[1][i], dir[2][i]),
@@ -183,11 +176,24 @@ impl RayGenerator {
         }
     }
 
+    /// The directions of [`RayGenerator::ray`] through `positions` (1 to `N` of them), one
+    /// per lane, bit for bit (`RayGenerator::dirs_at`); lanes past the end repeat the last
+    /// position (a lane loop with a clamped index stayed scalar).
+    #[inline(always)]
+    pub fn dirs_through<const N: usize>(&self, positions: &[Vec2]) -> [[f32; N]; 3] {
+        let last = positions[positions.len() - 1];
+        let (mut px, mut py) = ([last.x; N], [last.y; N]);
+        for (i, p) in positions.iter().enumerate() {
+            (px[i], py[i]) = (p.x, p.y);
+        }
+        self.dirs_at(&px, &py)
+    }
+
     /// The directions of [`RayGenerator::ray`] through `(px[i], py[i])` for every lane `i`,
     /// bit for bit, in a lane loop that the compiler vectorises (inline: compiled for the
     /// caller's CPU features).
     #[inline(always)]
-    pub fn dirs_at<const N: usize>(&self, px: &[f32; N], py: &[f32; N]) -> [[f32; N]; 3] {
+    fn dirs_at<const N: usize>(&self, px: &[f32; N], py: &[f32; N]) -> [[f32; N]; 3] {
         let mut dir = [[0.0f32; N]; 3];
         for i in 0..N {
             let d = self.dir(px[i], py[i]);

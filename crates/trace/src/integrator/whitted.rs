@@ -688,13 +688,9 @@ impl CameraStarts<'_> {
         origin: &mut [[f64; LANES]; 3],
         dir: &mut [[f64; LANES]; 3],
     ) {
-        let chunk = &self.positions[first..first + n];
-        let last = chunk[n - 1];
-        let (mut px, mut py) = ([last.x; LANES], [last.y; LANES]);
-        for (i, p) in chunk.iter().enumerate() {
-            (px[i], py[i]) = (p.x, p.y);
-        }
-        let made = self.camera.dirs_at(&px, &py);
+        let made = self
+            .camera
+            .dirs_through::<LANES>(&self.positions[first..first + n]);
         for (lanes, o) in origin.iter_mut().zip(self.camera.origin().to_array()) {
             *lanes = [f64::from(o); LANES];
         }
