@@ -19,20 +19,32 @@
 # the goals (per round: whitted >= 3x, path >= 2x Mitsuba's compiled kernel).
 #
 # Usage: scripts/bench-tracer.sh [ROUNDS] [SPP]      (defaults: 5 rounds, 16 spp, 640×360)
+#
+# On a machine with no toolchain or registry (a lent device machine, scripts/bench-tracer-device.sh)
+# the renderers come prepared: MIRRORBOX_BENCH_BIN names a built binary (nothing is built),
+# MIRRORBOX_MITSUBA_PYTHON a Python that imports Mitsuba (tools/mitsuba/setup.sh is not run),
+# MIRRORBOX_SOURCE_COMMIT the commit the binary was built from (no git history there) and
+# MIRRORBOX_BENCH_NOTE a sentence the record adds about where it ran.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 rounds=${1:-5}
 spp=${2:-16}
-bin=target/release/mirrorbox
+bin=${MIRRORBOX_BENCH_BIN:-target/release/mirrorbox}
 # A measured build is a plain one: scripts/test-build-env.sh's clippy wrapper compiles the
 # workspace with MIR optimisations off (clippy-driver sets mir-opt-level 0), measured 5-8 %
 # slower on the tracer (issue 56, docs/tracer-performance.md).
 unset RUSTC_WORKSPACE_WRAPPER CLIPPY_ARGS
-# Always built (a no-op when current), so that the record's commit is the build measured;
-# a tree with changes to the code is marked "+changes".
-cargo build --release --locked -p mirrorbox >&2
-tools/mitsuba/setup.sh >&2
-py=tools/mitsuba/.venv/bin/python
+# Built here (a no-op when current) unless MIRRORBOX_BENCH_BIN names a binary, so that the
+# record's commit is the build measured; a tree with changes to the code is marked "+changes".
+if [ -z "${MIRRORBOX_BENCH_BIN:-}" ]; then
+  cargo build --release --locked -p mirrorbox >&2
+fi
+if [ -n "${MIRRORBOX_MITSUBA_PYTHON:-}" ]; then
+  py=$MIRRORBOX_MITSUBA_PYTHON
+else
+  tools/mitsuba/setup.sh >&2
+  py=tools/mitsuba/.venv/bin/python
+fi
 out=reports/tracer
 mkdir -p "$out"
 work=$(mktemp -d)
@@ -40,8 +52,12 @@ trap 'rm -rf "$work"' EXIT
 scenes="mirror_box mirror_room"
 # path: Russian roulette from this depth in both renderers (Mitsuba's default is 5 too).
 rr_depth=5
-commit=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)
-git diff --quiet HEAD -- crates shaders Cargo.toml Cargo.lock tools 2>/dev/null || commit="$commit+changes"
+if [ -n "${MIRRORBOX_SOURCE_COMMIT:-}" ]; then
+  commit=$MIRRORBOX_SOURCE_COMMIT
+else
+  commit=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)
+  git diff --quiet HEAD -- crates shaders Cargo.toml Cargo.lock tools 2>/dev/null || commit="$commit+changes"
+fi
 # Whitted follows mirror chains to 10 000 reflections (cut by the throughput); path traces
 # to 10 segments with Russian roulette from 5, the same in both renderers.
 for s in $scenes; do
@@ -74,6 +90,8 @@ for round in $(seq "$rounds"); do
     done
   done
 done
+# MIRRORBOX_BENCH_RUNS: where to keep every round's raw times (one JSON object per render).
+[ -z "${MIRRORBOX_BENCH_RUNS:-}" ] || cp "$work/runs.jsonl" "$MIRRORBOX_BENCH_RUNS"
 mitsuba_version=$("$py" -c 'import mitsuba; print(mitsuba.__version__)')
 python3 - "$work/runs.jsonl" "$out" "$rounds" "$spp" "$mitsuba_version" "$commit" "$rr_depth" <<'PY'
 import json, sys, statistics, datetime, os, re, glob
@@ -108,10 +126,12 @@ for scene in ["mirror_box", "mirror_room"]:
         goal = GOALS[integ]
         met = "met" if paired[0] >= goal else f"not met ({paired[0] / goal:.0%} of it)"
         rows.append(f"| `{scene}` | {integ} | {o[0]:.3f} [{o[1]:.3f}–{o[2]:.3f}] | {rays/o[0]/1e6:.1f} | {m[0]:.3f} [{m[1]:.3f}–{m[2]:.3f}] | {f[0]:.3f} [{f[1]:.3f}–{f[2]:.3f}] | {ratio:.2f}× | {paired[0]:.2f}× [{paired[1]:.2f}–{paired[2]:.2f}] | {f[0]/o[0]:.2f}× | ≥ {goal:.0f}×: {met} |")
+note = os.environ.get("MIRRORBOX_BENCH_NOTE", "").strip()
+note = f" ({note})" if note else ""
 slug = re.sub(r"[^a-z0-9]+", "-", cpu.lower()).strip("-") + "-" + simd.lower().replace("-", "")
 summary["file"] = f"bench-{slug}.md"
 lines = [f"# The tracer against Mitsuba 3 on {cpu} ({simd})", "",
-         f"Measured {summary['date']} (commit {commit}) with `scripts/bench-tracer.sh {rounds} {spp}` on {cpu} ({simd}), {os.cpu_count()} cores: 640×360, {spp} spp; Mitsuba {mver} `llvm_ad_rgb`; the two renderers alternated, one process each per round; medians over {rounds} rounds [min–max]. A claim about this CPU only: other CPUs have their own files ([bench.md](bench.md)).",
+         f"Measured {summary['date']} (commit {commit}) with `scripts/bench-tracer.sh {rounds} {spp}` on {cpu} ({simd}), {os.cpu_count()} cores{note}: 640×360, {spp} spp; Mitsuba {mver} `llvm_ad_rgb`; the two renderers alternated, one process each per round; medians over {rounds} rounds [min–max]. A claim about this CPU only: other CPUs have their own files ([bench.md](bench.md)).",
          "",
          "| scene | integrator | mirrorbox s | mirrorbox Mrays/s | Mitsuba s (compiled kernel) | Mitsuba s (first render, JIT included) | Mitsuba ÷ mirrorbox | per round: Mitsuba ÷ mirrorbox | Mitsuba first ÷ mirrorbox | goal (per round) |",
          "|---|---|---|---|---|---|---|---|---|---|"] + rows + ["",
