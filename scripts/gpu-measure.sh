@@ -9,7 +9,7 @@
 #   scripts/gpu-measure.sh STEP...      steps: info frontier engine real-assets table1-pair
 #                                       table1-pair-reversed
 #                                       table1 table1-repeat table1-1080p depth depth-1080p
-#                                       room trace tests retest symmetry lighting
+#                                       room trace tests retest symmetry lighting advise
 # Results go to reports/gpu/ and, packed one archive per step, to $OUT/gpu-STEP.tar.gz (what
 # comes back: at most 8 files of 16 MiB each, so a step's images travel in its own archive).
 # Each step is skipped once less than its own budget is left of MIRRORBOX_GPU_DEADLINE seconds
@@ -200,6 +200,27 @@ table1_pair_reversed() {
     timeout 200 "$bin" experiment table1 --fresh --out "reports/gpu/table1_${gpu}_run2"
 }
 
+# `mirrorbox advise` on this GPU (issue 55's question, answered on lavapipe in reports/advise/,
+# where a user ships): the box and the room at 960×540 (a quarter of 1080p: the pick's images
+# stay small enough for git), α = 1, at budgets inside the spread of the methods' times on an
+# H200 (0.06–6 ms at 320×180, reports/gpu/frontier_*). Of the search rounds the records only,
+# as scripts/measure-advise.sh keeps them. ADVISE_RUNS: SCENE:BUDGET_MS pairs, most wanted first.
+advise_gpu() {
+  local gpu run scene budget dir left
+  gpu=$(gpu_slug)
+  for run in ${ADVISE_RUNS:-mirror_room:1 mirror_box:1 mirror_room:0.5 mirror_room:2 mirror_box:0.5}; do
+    scene=${run%%:*} budget=${run##*:}
+    dir=reports/gpu/advise_$gpu/${scene}_${budget}ms_960x540
+    left=$((deadline - (SECONDS - started)))
+    [ "$left" -gt 20 ] || break
+    mkdir -p "$(dirname "$dir")"
+    timeout "$left" "$bin" advise "scenes/$scene.json" --budget-ms "$budget" --width 960 --height 540 \
+      --alpha 1 -o "$dir" || echo "advise $scene $budget ms: exit $?"
+    find "$dir/search" -mindepth 2 -maxdepth 2 ! -name results.jsonl ! -name sweep.json -exec rm -rf {} + 2>/dev/null
+    rm -rf "$dir/cache"
+  done
+}
+
 say "steps: $*"
 for s in "$@"; do
   case $s in
@@ -220,6 +241,7 @@ for s in "$@"; do
   depth-1080p) step depth-1080p 60 depth_1080p ;;
   symmetry) step symmetry-scaling 120 "$bin" experiment symmetry-scaling --out reports/gpu/symmetry_scaling ;;
   lighting) step lighting 120 "$bin" experiment lighting --out reports/gpu/lighting ;;
+  advise) step advise 60 advise_gpu ;;
   *) say "unknown step $s" ;;
   esac
 done
