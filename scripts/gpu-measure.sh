@@ -84,13 +84,19 @@ step() {
   pack "$name"
 }
 
+# The adapter and the GPU, into files named after the GPU (info_h200.txt, …; the first
+# machine's, an H100's, are the unsuffixed info.txt and nvidia-smi.txt, which a later lease
+# must not overwrite).
 info() {
+  local gpu
+  gpu=$(gpu_slug)
   nvidia-smi --query-gpu=name,driver_version,memory.total,clocks.max.sm --format=csv
   grep -m1 'model name' /proc/cpuinfo
   nproc
-  "$bin" info | tee reports/gpu/info.txt
-  "$bin" info --json >reports/gpu/info.json
-  nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader >reports/gpu/nvidia-smi.txt
+  "$bin" info | tee "reports/gpu/info_$gpu.txt"
+  "$bin" info --json >"reports/gpu/info_$gpu.json"
+  nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader >"reports/gpu/nvidia-smi_$gpu.txt"
+  # The CPU beside trace_threads.jsonl (the `trace` step), which the gpu-trace-threads region names.
   grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//' >reports/gpu/cpu.txt
 }
 
@@ -205,9 +211,17 @@ table1_pair_reversed() {
 # stay small enough for git), α = 1, at budgets inside the spread of the methods' times on an
 # H200 (0.06–6 ms at 320×180, reports/gpu/frontier_*). Of the search rounds the records only,
 # as scripts/measure-advise.sh keeps them. ADVISE_RUNS: SCENE:BUDGET_MS pairs, most wanted first.
+# The first advice of the lease of 2026-11-28 (the machine's first GPU work after `info`) timed
+# every candidate 1.4× slower, with wide intervals whose low ends were the later runs' medians
+# (docs/gpu.md): so the GPU first renders untimed for WARM_SECONDS (default 60).
 advise_gpu() {
   local gpu run scene budget dir left
   gpu=$(gpu_slug)
+  local until=$((SECONDS + ${WARM_SECONDS:-60}))
+  while [ "$SECONDS" -lt "$until" ]; do
+    timeout 60 "$bin" render scenes/mirror_room.json --method portal --depth 8 --width 960 --height 540 \
+      --warmup 200 --frames 1 -o /tmp/warm.png >/dev/null || break
+  done
   for run in ${ADVISE_RUNS:-mirror_room:1 mirror_box:1 mirror_room:0.5 mirror_room:2 mirror_box:0.5}; do
     scene=${run%%:*} budget=${run##*:}
     dir=reports/gpu/advise_$gpu/${scene}_${budget}ms_960x540
