@@ -588,6 +588,89 @@ fn trace_gives_the_same_bits_with_every_vector_build() {
     }
 }
 
+/// `trace --warm-up N` renders each view N times untimed before the timed render (the bench
+/// times a warmed render, as Mitsuba's compiled-kernel time is its second render; issue 56):
+/// the same image bit for bit and the same rays, N warm-up times in the JSON; a count out of
+/// 0..=10 is refused, exit 2, naming the flag and the range, and nothing is written.
+#[test]
+fn trace_warm_up_renders_the_same_image_and_reports_each_time() {
+    let dir = tempfile::tempdir().unwrap();
+    for integrator in ["whitted", "path"] {
+        let trace = |warm_up: &str| {
+            let exr = dir.path().join(format!("{integrator}-{warm_up}.exr"));
+            let out = mirrorbox(
+                &[
+                    "trace",
+                    "scenes/mirror_room.json",
+                    "-o",
+                    exr.to_str().unwrap(),
+                    "--width",
+                    "40",
+                    "--height",
+                    "24",
+                    "--spp",
+                    "4",
+                    "--integrator",
+                    integrator,
+                    "--warm-up",
+                    warm_up,
+                    "--json",
+                ],
+                &[],
+            );
+            assert_eq!(
+                out.code, 0,
+                "{integrator} --warm-up {warm_up}: {}",
+                out.stderr
+            );
+            let record: Value = serde_json::from_str(&out.stdout).unwrap();
+            (record, mirrorbox_image::read_image(&exr).unwrap())
+        };
+        let (cold, reference) = trace("0");
+        let (warm, image) = trace("2");
+        assert_eq!(
+            cold["warm_up_seconds"],
+            serde_json::json!([]),
+            "{integrator}"
+        );
+        let times = warm["warm_up_seconds"].as_array().unwrap();
+        assert_eq!(times.len(), 2, "{integrator}: {warm}");
+        assert!(
+            times.iter().all(|t| t.as_f64().unwrap() > 0.0),
+            "{integrator}: {warm}"
+        );
+        for field in ["rays", "paths", "deepest_path", "ended"] {
+            assert_eq!(cold[field], warm[field], "{integrator}: {field}");
+        }
+        let differing = reference
+            .pixels
+            .iter()
+            .zip(&image.pixels)
+            .filter(|(a, b)| a.map(f32::to_bits) != b.map(f32::to_bits))
+            .count();
+        assert_eq!(differing, 0, "{integrator}: --warm-up 2 against none");
+    }
+    let exr = dir.path().join("refused.exr");
+    let out = mirrorbox(
+        &[
+            "trace",
+            "scenes/mirror_box.json",
+            "-o",
+            exr.to_str().unwrap(),
+            "--warm-up",
+            "11",
+        ],
+        &[],
+    );
+    assert_eq!(out.code, 2, "{}", out.stderr);
+    assert!(
+        out.stderr.contains("--warm-up") && out.stderr.contains("0..=10"),
+        "{}",
+        out.stderr
+    );
+    assert!(!exr.exists());
+}
+
 /// "Depth" counts mirror reflections everywhere (docs/shading.md): `path`'s length is counted
 /// in segments under its own flag, recorded under its own name; each integrator refuses the
 /// other's cut, exit 2, naming the flag to use, and writes nothing.

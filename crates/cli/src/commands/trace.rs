@@ -124,6 +124,12 @@ pub struct Args {
     /// same bits (docs/tracer-performance.md). A build the CPU lacks is an error.
     #[arg(long, value_enum, default_value_t = Simd::Widest)]
     simd: Simd,
+    /// Untimed renders of each view before the timed one, 0..=10: the timed render then runs
+    /// in a process that has rendered (its threads awake, its memory and caches warm), as
+    /// Mitsuba's compiled-kernel time is its second render (scripts/bench-tracer.sh). The
+    /// same image; --json gives each warm-up render's seconds (warm_up_seconds). CPU only.
+    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=10))]
+    warm_up: u32,
     /// Print the summary as one JSON object (one per eye with --stereo).
     #[arg(long)]
     json: bool,
@@ -313,6 +319,10 @@ fn run_frame(args: &Args) -> Result<(), Failure> {
     let mut staged = StagedFiles::new();
     let mut traced = Vec::new();
     for (eye, view) in views(&scene, rig) {
+        // Rendered in full and dropped: only their times are kept (--warm-up).
+        let warm_up: Vec<f64> = (0..args.warm_up)
+            .map(|_| render(&view, &bvh, &settings, &|_| {}).wall.as_secs_f64())
+            .collect();
         let bar = progress_bar(view.camera.height as u64, "tracing rows");
         let out = render(&view, &bvh, &settings, &|rows| {
             bar.set_position(rows as u64)
@@ -332,9 +342,9 @@ fn run_frame(args: &Args) -> Result<(), Failure> {
             bounces.as_deref(),
             &mut staged,
         )?;
-        traced.push((eye, view, out));
+        traced.push((eye, view, out, warm_up));
     }
-    if let [(_, l, left), (_, _, right)] = &traced[..] {
+    if let [(_, l, left, _), (_, _, right, _)] = &traced[..] {
         let e = l.camera.exposure;
         let (a, b) = (left.image.to_srgb8(e), right.image.to_srgb8(e));
         let (w, h) = (l.camera.width, l.camera.height);
@@ -347,13 +357,17 @@ fn run_frame(args: &Args) -> Result<(), Failure> {
     }
     let written = staged.commit().map_err(write_failed)?;
     let total = started.elapsed();
-    for (eye, view, out) in &traced {
+    for (eye, view, out, warm_up) in &traced {
         if let Some(e) = eye
             && !args.json
         {
             println!("{} eye:", e.name());
         }
-        report(args, view, &bvh, out, grid, total, &written, *eye);
+        let timing = Timing {
+            total,
+            warm_up_seconds: warm_up,
+        };
+        report(args, view, &bvh, out, grid, &timing, &written, *eye);
     }
     Ok(())
 }
@@ -450,6 +464,13 @@ fn stage_bounces(
     stage_png_bytes(staged, &png, image.width, image.height, &bytes).map_err(write_failed)
 }
 
+/// A traced view's times besides its timed render: the whole command's, and the untimed
+/// --warm-up renders' before it.
+struct Timing<'a> {
+    total: std::time::Duration,
+    warm_up_seconds: &'a [f64],
+}
+
 #[allow(clippy::too_many_arguments)]
 fn report(
     args: &Args,
@@ -457,10 +478,11 @@ fn report(
     bvh: &SceneBvh,
     out: &TraceOutput,
     grid: SubpixelGrid,
-    total: std::time::Duration,
+    timing: &Timing,
     written: &[PathBuf],
     eye: Option<mirrorbox_scene::stereo::Eye>,
 ) {
+    let total = timing.total;
     let s = &out.stats;
     let secs = out.wall.as_secs_f64();
     let mrays = s.rays as f64 / secs / 1e6;
@@ -473,6 +495,7 @@ fn report(
             "width": w, "height": h, "spp": grid.samples_per_pixel(),
             "paths": s.paths, "rays": s.rays, "mrays_per_s": mrays,
             "deepest_path": s.deepest, "render_seconds": secs, "total_seconds": total.as_secs_f64(),
+            "warm_up_seconds": timing.warm_up_seconds,
             "bvh": format!("{:?}", bvh.kind).to_lowercase(), "bvh_build_seconds": bvh.build_time.as_secs_f64(),
             "kernel": format!("{:?}", args.kernel).to_lowercase(),
             "packet_bvh_build_seconds": bvh.packet_build_time().map(|t| t.as_secs_f64()),
@@ -578,6 +601,12 @@ fn trace_on_gpu(
     }
     if args.bounces.is_some() {
         return Err(refuse("--bounces", "is CPU only"));
+    }
+    if args.warm_up > 0 {
+        return Err(refuse(
+            "--warm-up",
+            "is CPU only (the GPU trace times one frame of its own)",
+        ));
     }
     let per_axis = (grid.samples_per_pixel() as f64).sqrt().round() as u32;
     if per_axis > mirrorbox_raster::MAX_SSAA {
