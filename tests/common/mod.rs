@@ -75,6 +75,20 @@ pub const SMALL_SWEEP: [&str; 15] = [
     "0",
 ];
 
+/// How many pixels of two images of one size differ in any bit of any channel (0: the same
+/// image bit for bit).
+pub fn pixels_differing_in_bits(
+    a: &mirrorbox_image::RgbImage,
+    b: &mirrorbox_image::RgbImage,
+) -> usize {
+    assert_eq!((a.width, a.height), (b.width, b.height), "image sizes");
+    a.pixels
+        .iter()
+        .zip(&b.pixels)
+        .filter(|(p, q)| p.map(f32::to_bits) != q.map(f32::to_bits))
+        .count()
+}
+
 /// A merged sweep (`merged`, its folder `merged_dir`) holds exactly the points of `full`
 /// (folder `full_dir`), with the same errors (metrics may differ in the last bit: parallel
 /// sums) and the same raster and truth pictures, byte for byte.
