@@ -530,6 +530,33 @@ fn trace_args<'a>(out: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
     args
 }
 
+/// `trace SCENE` at 40×24 with `extra` flags and --json, into `dir/NAME.exr`, which must
+/// succeed: its JSON record and its image.
+fn trace_small(
+    dir: &Path,
+    name: &str,
+    scene: &str,
+    extra: &[&str],
+) -> (Value, mirrorbox_image::RgbImage) {
+    let exr = dir.join(format!("{name}.exr"));
+    let mut args = vec![
+        "trace",
+        scene,
+        "-o",
+        exr.to_str().unwrap(),
+        "--width",
+        "40",
+        "--height",
+        "24",
+        "--json",
+    ];
+    args.extend_from_slice(extra);
+    let out = mirrorbox(&args, &[]);
+    assert_eq!(out.code, 0, "{args:?}: {}", out.stderr);
+    let record: Value = serde_json::from_str(&out.stdout).unwrap();
+    (record, mirrorbox_image::read_image(&exr).unwrap())
+}
+
 /// Every vector build traces the same bits (`trace --simd`): the baseline (SSE2) build, and
 /// AVX2 where the CPU's widest is wider, against the widest, for `whitted` (packets, the lit
 /// scene's leg packets) and `path`; the JSON names the build that ran.
@@ -548,25 +575,9 @@ fn trace_gives_the_same_bits_with_every_vector_build() {
         ),
     ] {
         let trace = |simd: &str| {
-            let exr = dir.path().join(format!("{simd}.exr"));
-            let mut args = vec![
-                "trace",
-                scene,
-                "-o",
-                exr.to_str().unwrap(),
-                "--width",
-                "40",
-                "--height",
-                "24",
-                "--simd",
-                simd,
-                "--json",
-            ];
-            args.extend_from_slice(extra);
-            let out = mirrorbox(&args, &[]);
-            assert_eq!(out.code, 0, "{scene} --simd {simd}: {}", out.stderr);
-            let record: Value = serde_json::from_str(&out.stdout).unwrap();
-            let image = mirrorbox_image::read_image(&exr).unwrap();
+            let mut flags = vec!["--simd", simd];
+            flags.extend_from_slice(extra);
+            let (record, image) = trace_small(dir.path(), simd, scene, &flags);
             (record["simd"].as_str().unwrap().to_string(), image)
         };
         let (widest, reference) = trace("widest");
@@ -592,34 +603,16 @@ fn trace_warm_up_renders_the_same_image_and_reports_each_time() {
     let dir = tempfile::tempdir().unwrap();
     for integrator in ["whitted", "path"] {
         let trace = |warm_up: &str| {
-            let exr = dir.path().join(format!("{integrator}-{warm_up}.exr"));
-            let out = mirrorbox(
-                &[
-                    "trace",
-                    "scenes/mirror_room.json",
-                    "-o",
-                    exr.to_str().unwrap(),
-                    "--width",
-                    "40",
-                    "--height",
-                    "24",
-                    "--spp",
-                    "4",
-                    "--integrator",
-                    integrator,
-                    "--warm-up",
-                    warm_up,
-                    "--json",
-                ],
-                &[],
-            );
-            assert_eq!(
-                out.code, 0,
-                "{integrator} --warm-up {warm_up}: {}",
-                out.stderr
-            );
-            let record: Value = serde_json::from_str(&out.stdout).unwrap();
-            (record, mirrorbox_image::read_image(&exr).unwrap())
+            let flags = [
+                "--spp",
+                "4",
+                "--integrator",
+                integrator,
+                "--warm-up",
+                warm_up,
+            ];
+            let name = format!("{integrator}-{warm_up}");
+            trace_small(dir.path(), &name, "scenes/mirror_room.json", &flags)
         };
         let (cold, reference) = trace("0");
         let (warm, image) = trace("2");
