@@ -27,9 +27,9 @@ pub fn coarse_space() -> usize {
         .sum()
 }
 
-/// Every advice under `reports/advise/`, by folder name.
-fn advices(reports: &Path) -> Result<Vec<(String, Value)>, ReadmeError> {
-    let dir = reports.join("advise");
+/// Every advice under `reports/<folder>/`, by folder name.
+fn advices(reports: &Path, folder: &str) -> Result<Vec<(String, Value)>, ReadmeError> {
+    let dir = reports.join(folder);
     let mut out = Vec::new();
     let entries =
         std::fs::read_dir(&dir).map_err(|e| ReadmeError(format!("{}: {e}", dir.display())))?;
@@ -121,9 +121,13 @@ fn timing_verdict(advice: &Value, x: &Value, budget: f64) -> String {
     }
 }
 
-/// The region: one row per advice, then the repeat's verdict.
-fn advise_region(reports: &Path) -> Result<String, ReadmeError> {
-    let all = advices(reports)?;
+/// The suffix of an advice folder whose timings are known not to be an answer: the first
+/// work of a freshly started GPU, timed before its clocks settled (docs/gpu.md).
+const COLD: &str = "_cold";
+
+/// The region: one row per advice under `reports/<folder>/`, then the repeat's verdict.
+fn advise_region_of(reports: &Path, folder: &str) -> Result<String, ReadmeError> {
+    let all = advices(reports, folder)?;
     let mut rows = Vec::new();
     let mut notes = Vec::new();
     let mut exhaustive_runs = Vec::new();
@@ -221,6 +225,13 @@ fn advise_region(reports: &Path) -> Result<String, ReadmeError> {
             share,
             verdict,
         ]);
+        if folder.ends_with(COLD) {
+            notes.push(format!(
+                "`{folder}` timed a GPU that had just started (every candidate slower, with \
+                 wide intervals, than the same candidates in the later advices): not an \
+                 answer (docs/gpu.md)."
+            ));
+        }
         if let Some(first) = folder.strip_suffix("_repeat")
             && let Some((_, a)) = all.iter().find(|(f, _)| f == first)
         {
@@ -258,41 +269,61 @@ fn advise_region(reports: &Path) -> Result<String, ReadmeError> {
             });
         }
     }
-    let device = all
-        .first()
-        .and_then(|(_, v)| v["device"].as_str())
-        .unwrap_or("an unrecorded device")
-        .to_string();
-    let mut blocks = vec![
-        Block::Paragraph(format!(
-            "Measured on {device}, 320×180, α = 1, error = FLIP mean over the mirror pixels; \
-             a pick fits only if its ms/frame interval's upper end is within the budget. The \
-             registry's rows offer {} coarse candidates per scene (before bisection); the \
-             exhaustive runs time every one of them in one round — {} — and each pick is \
-             judged against the best of those within its budget.",
-            coarse_space(),
-            if exhaustive_runs.is_empty() {
-                "none committed".to_string()
-            } else {
-                exhaustive_runs.join(", ")
+    // What every advice of the folder shares: the device, the size, α (one value each, or
+    // each value found, in order).
+    let distinct = |f: &dyn Fn(&Value) -> String| {
+        let mut seen: Vec<String> = Vec::new();
+        for (_, v) in &all {
+            let x = f(v);
+            if !seen.contains(&x) {
+                seen.push(x);
             }
-        )),
-        Block::Table(
-            [
-                "advice",
-                "budget ms",
-                "pick",
-                "ms/frame [95 % CI]",
-                "error",
-                "search: candidates, rounds, frames, time",
-                "frames against the exhaustive run's",
-                "as good as the exhaustive run's best within budget",
-            ]
-            .map(String::from)
-            .to_vec(),
-            rows,
-        ),
-    ];
+        }
+        seen.join(", ")
+    };
+    let device = distinct(&|v| {
+        v["device"]
+            .as_str()
+            .unwrap_or("an unrecorded device")
+            .to_string()
+    });
+    let size = distinct(&|v| format!("{}×{}", v["width"], v["height"]));
+    let alpha = distinct(&|v| v["alpha"].as_f64().map_or("?".into(), |a| format!("{a}")));
+    let exhaustive = if exhaustive_runs.is_empty() {
+        "No exhaustive run of these scenes on this device: the picks are not judged against one."
+            .to_string()
+    } else {
+        format!(
+            "The exhaustive runs time every one of them in one round — {} — and each pick is \
+             judged against the best of those within its budget.",
+            exhaustive_runs.join(", ")
+        )
+    };
+    let mut blocks = vec![Block::Paragraph(format!(
+        "Measured on {device}, {size}, α = {alpha}, error = FLIP mean over the mirror \
+             pixels; a pick fits only if its ms/frame interval's upper end is within the \
+             budget. The registry's rows offer {} coarse candidates per scene (before \
+             bisection; fewer where the adapter lacks a method's feature). {exhaustive}",
+        coarse_space(),
+    ))];
+    let mut header = [
+        "advice",
+        "budget ms",
+        "pick",
+        "ms/frame [95 % CI]",
+        "error",
+        "search: candidates, rounds, frames, time",
+        "frames against the exhaustive run's",
+        "as good as the exhaustive run's best within budget",
+    ]
+    .map(String::from)
+    .to_vec();
+    if exhaustive_runs.is_empty() {
+        // Nothing to judge against: the last two columns would say so on every row.
+        header.truncate(6);
+        rows.iter_mut().for_each(|r| r.truncate(6));
+    }
+    blocks.push(Block::Table(header, rows));
     if !notes.is_empty() {
         blocks.push(Block::Bullets(notes));
     }
@@ -305,13 +336,76 @@ pub const ADVISE: Experiment = Experiment {
     folder: "advise",
     measure: Measure::Script("scripts/measure-advise.sh", &[]),
     section: None,
-    regions: &[RegionSource {
-        id: "advise",
-        source: "advise",
-        about: "what the advisor picked per scene and budget, its search cost, and the exhaustive run's best beside it",
-        generate: advise_region,
-    }],
+    regions: &[
+        RegionSource {
+            id: "advise",
+            source: "advise",
+            about: "what the advisor picked per scene and budget, its search cost, and the exhaustive run's best beside it",
+            generate: |reports| advise_region_of(reports, "advise"),
+        },
+        RegionSource {
+            id: "advise-gpu",
+            source: "gpu/advise_h200",
+            about: "what the advisor picked on an NVIDIA H200 (scripts/gpu-measure.sh advise)",
+            generate: |reports| advise_region_of(reports, "gpu/advise_h200"),
+        },
+    ],
     chapter: "advise.md",
     main_job: false,
     overview: None,
 };
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    fn write_advice(reports: &Path, folder: &str, advice: &Value) {
+        let dir = reports.join(folder);
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join("advice.json"), advice.to_string()).unwrap();
+    }
+
+    fn advice(budget: f64, exhaustive: bool) -> Value {
+        let pick = json!({"method": "unrolled depth=4", "ms_median": 0.9,
+                          "ms_interval": [0.89, 0.91], "error": 0.01});
+        json!({"scene": "scenes/mirror_box.json", "budget_ms": budget, "device": "NVIDIA H200",
+               "width": 960, "height": 540, "alpha": 1.0, "exhaustive": exhaustive,
+               "pick": pick, "ties": [], "measured": [pick], "rounds": 2, "renders": 40,
+               "seconds": 3.0})
+    }
+
+    /// A folder of advices without an exhaustive run gets a table without the two columns
+    /// that judge against one; a `_cold` advice is said not to be an answer; the paragraph
+    /// names the device, size and α the advices record.
+    #[test]
+    fn the_region_names_what_it_cannot_judge_and_what_is_not_an_answer() {
+        let reports = tempfile::tempdir().unwrap();
+        write_advice(reports.path(), "gpu/a/box_1ms", &advice(1.0, false));
+        write_advice(reports.path(), "gpu/a/box_2ms_cold", &advice(2.0, false));
+        let region = advise_region_of(reports.path(), "gpu/a").unwrap();
+        assert!(
+            region.contains("Measured on NVIDIA H200, 960×540, α = 1,"),
+            "{region}"
+        );
+        assert!(region.contains("No exhaustive run"), "{region}");
+        assert!(!region.contains("exhaustive run's best"), "{region}");
+        assert!(
+            region.contains("`box_2ms_cold` timed a GPU that had just started"),
+            "{region}"
+        );
+        assert!(!region.contains("`box_1ms` timed"), "{region}");
+        // With an exhaustive run of the scene, every row is judged against it.
+        write_advice(
+            reports.path(),
+            "gpu/a/box_8ms_exhaustive",
+            &advice(8.0, true),
+        );
+        let region = advise_region_of(reports.path(), "gpu/a").unwrap();
+        assert!(
+            region.contains("as good as the exhaustive run's best"),
+            "{region}"
+        );
+        assert!(region.contains("| yes: 1.000e-2 against"), "{region}");
+    }
+}
