@@ -202,6 +202,10 @@ fn advise_names_the_closest_when_nothing_fits_and_the_best_when_everything_does(
     ] {
         assert!(out.join(f).is_file(), "{f}");
     }
+    // The figure rings the pick and names it in its legend.
+    let svg = std::fs::read_to_string(out.join("front.svg")).unwrap();
+    let pick = v["pick"]["method"].as_str().unwrap();
+    assert!(svg.contains(&format!(">the pick: {pick}</text>")), "{svg}");
     assert!(!dir.path().join("huge.partial").exists());
     let _ = repo();
 }

@@ -753,7 +753,7 @@ fn setting_label(r: &Record) -> String {
 
 /// The measured candidates as a chart: error against ms/frame, one series per method in its
 /// fixed style (its settings as labels, not joined: a search's order is not an axis), the
-/// Pareto front of what was measured, and the budget.
+/// Pareto front of what was measured, the budget, and the pick ringed.
 pub fn chart(
     advice: &Advice,
     metric: Metric,
@@ -805,6 +805,14 @@ pub fn chart(
                 mirrorbox_report::document::ms(advice.budget_ms, 3)
             ),
             vec![(advice.budget_ms, lo), (advice.budget_ms, hi)],
+        ));
+    }
+    // The figure's answer: the pick, ringed (an error of exactly 0 has no place on the log
+    // axis; the legend names such a point instead).
+    if let Some(pick) = advice.pick.as_ref().filter(|p| metric.of(p) > 0.0) {
+        references.push(Reference::Mark(
+            format!("the pick: {}", pick.method_key()),
+            (pick.ms_median, metric.of(pick)),
         ));
     }
     Chart {

@@ -171,13 +171,19 @@ impl Series {
 }
 
 /// A reference the data are read against — not a measurement: drawn dashed grey, named
-/// "reference: …" in the legend.
+/// "reference: …" in the legend; or a mark on one of the data's points (the answer a figure
+/// gives, e.g. the advisor's pick): a black ring around it, named as given.
 pub enum Reference {
     /// A horizontal line across the plot.
     Level(String, f64),
     /// A curve through points (e.g. 2^p × a base time).
     Curve(String, Vec<(f64, f64)>),
+    /// A ring around the point (x, y), named in the legend as it is, without "reference:".
+    Mark(String, (f64, f64)),
 }
+
+/// The radius of a [`Reference::Mark`]'s ring: around a marker and its coincidence rings.
+const MARK_R: f64 = 12.5;
 
 /// What an axis label adds when its points carry their 95 % intervals as bars
 /// (`"ms/frame (median, 95 % CI bars)"`); [`Chart::axis_label`] drops it where none is drawn.
@@ -558,6 +564,15 @@ impl Chart {
             );
         }
         let ok = |v: f64, log: bool| drawable(v, log);
+        for r in &self.references {
+            if let Reference::Mark(name, (x, y)) = r
+                && !(ok(*x, self.x_log) && ok(*y, self.y_log))
+            {
+                out.push(format!(
+                    "the mark \"{name}\" has a legend entry and cannot be drawn on this axis"
+                ));
+            }
+        }
         let shown = |s: &Series| {
             s.points
                 .iter()
@@ -668,7 +683,7 @@ impl Chart {
                 self.references
                     .iter()
                     .flat_map(|r| match r {
-                        Reference::Level(_, y) => vec![*y],
+                        Reference::Level(_, y) | Reference::Mark(_, (_, y)) => vec![*y],
                         Reference::Curve(_, pts) => pts
                             .iter()
                             .filter(|p| ax.contains(p.0))
@@ -724,7 +739,8 @@ impl Chart {
                 .filter(|(x, y)| drawable(*x, ax.log) && drawable(*y, ay.log))
                 .collect()
         };
-        let mut legend: Vec<(String, Option<&Series>)> = Vec::new();
+        // Each entry: its name, and the series or the reference it shows.
+        let mut legend: Vec<(String, Option<&Series>, Option<&Reference>)> = Vec::new();
         for (i, series) in self.series.iter().enumerate() {
             let mine: Vec<_> = visible(series).into_iter().map(key).collect();
             let same = self.series[..i].iter().find(|o| {
@@ -735,17 +751,18 @@ impl Chart {
                 Some(o) => format!("{} (on {})", series.name, o.name),
                 None => series.name.clone(),
             };
-            legend.push((name, Some(series)));
+            legend.push((name, Some(series), None));
         }
         for r in &self.references {
             let name = match r {
                 Reference::Level(n, _) | Reference::Curve(n, _) => format!("reference: {n}"),
+                Reference::Mark(n, _) => n.clone(),
             };
-            legend.push((name, None));
+            legend.push((name, None, Some(r)));
         }
         let legend_chars = legend
             .iter()
-            .map(|(n, _)| n.chars().count())
+            .map(|(n, ..)| n.chars().count())
             .max()
             .unwrap_or(0);
         // Wide enough for the legend and for the title (which never runs off the canvas).
@@ -876,7 +893,11 @@ impl Chart {
             s,
             r#"<clipPath id="plot"><rect x="{LEFT}" y="{TOP}" width="{PLOT_W}" height="{PLOT_H}"/></clipPath><g clip-path="url(#plot)">"#
         );
-        for (i, r) in self.references.iter().enumerate() {
+        let lines = self
+            .references
+            .iter()
+            .filter(|r| !matches!(r, Reference::Mark(..)));
+        for (i, r) in lines.enumerate() {
             let dash = REFERENCE_DASHES[i % REFERENCE_DASHES.len()];
             let pts: Vec<(f64, f64)> = match r {
                 Reference::Level(_, y) if drawable(*y, ay.log) => {
@@ -888,6 +909,7 @@ impl Chart {
                     .copied()
                     .filter(|(x, y)| drawable(*x, ax.log) && drawable(*y, ay.log))
                     .collect(),
+                Reference::Mark(..) => Vec::new(),
             };
             if pts.len() >= 2 {
                 let p: Vec<String> = pts
@@ -1002,6 +1024,25 @@ impl Chart {
                 }
             }
         }
+        // The marks' rings, over the markers; no label may cover them.
+        for r in &self.references {
+            if let Reference::Mark(_, (x, y)) = r
+                && drawable(*x, ax.log)
+                && drawable(*y, ay.log)
+            {
+                let (xx, yy) = (px_of(*x), py_of(*y));
+                let _ = writeln!(
+                    s,
+                    r#"<circle cx="{xx:.1}" cy="{yy:.1}" r="{MARK_R}" fill="none" stroke="black" stroke-width="2"/>"#
+                );
+                taken.push(Rect {
+                    x0: xx - MARK_R,
+                    y0: yy - MARK_R,
+                    x1: xx + MARK_R,
+                    y1: yy + MARK_R,
+                });
+            }
+        }
         for (xx, yy, r, label, color) in label_queue {
             let lw = SMALL_CHAR_W * label.chars().count() as f64;
             let candidates = [
@@ -1048,7 +1089,7 @@ impl Chart {
         let lx = LEFT + PLOT_W + 14.0;
         let mut ly = TOP + 10.0;
         let mut references_drawn = 0;
-        for (name, series) in &legend {
+        for (name, series, reference) in &legend {
             match series {
                 Some(series) => {
                     let st = &series.style;
@@ -1066,6 +1107,13 @@ impl Chart {
                         );
                     }
                     marker_svg(&mut s, st, lx + 12.0, ly, MARKER_R, st.hollow);
+                }
+                None if matches!(reference, Some(Reference::Mark(..))) => {
+                    let _ = writeln!(
+                        s,
+                        r#"<circle cx="{}" cy="{ly}" r="7" fill="none" stroke="black" stroke-width="2"/>"#,
+                        lx + 12.0
+                    );
                 }
                 None => {
                     let dash = REFERENCE_DASHES[references_drawn % REFERENCE_DASHES.len()];
@@ -1219,6 +1267,47 @@ mod tests {
             let n = svg.matches(&format!("stroke-dasharray=\"{dash}\"")).count();
             assert_eq!(n, 2, "dash {dash}: {n} strokes (plot and legend)");
         }
+    }
+
+    /// A mark rings its point in the plot and in the legend (named as given, not as a
+    /// reference), takes no dash from the lines after it, and one the axis cannot show is
+    /// flagged by the figure check.
+    #[test]
+    fn a_mark_rings_its_point_and_takes_no_dash() {
+        let mut c = chart(vec![Series::new(
+            "a",
+            method_style("auxiliary"),
+            vec![(1.0, 0.5), (10.0, 0.1)],
+        )]);
+        c.y_log = true;
+        c.references = vec![Reference::Mark("the pick: a".into(), (10.0, 0.1))];
+        c.references.push(Reference::Curve(
+            "budget".into(),
+            vec![(5.0, 0.1), (5.0, 0.5)],
+        ));
+        let svg = c.to_svg();
+        let rings = svg
+            .matches(r#"fill="none" stroke="black" stroke-width="2"/>"#)
+            .count();
+        assert_eq!(rings, 2, "one ring in the plot, one in the legend:\n{svg}");
+        assert!(svg.contains(">the pick: a</text>"), "{svg}");
+        assert!(!svg.contains("reference: the pick"), "{svg}");
+        // The budget after the mark is the first line: the first dash, in plot and legend.
+        let dash = |i: usize| format!("stroke-dasharray=\"{}\"", REFERENCE_DASHES[i]);
+        assert_eq!(svg.matches(&dash(0)).count(), 2, "{svg}");
+        assert_eq!(svg.matches(&dash(1)).count(), 0, "{svg}");
+        assert!(
+            !c.lint().iter().any(|m| m.contains("mark")),
+            "{:?}",
+            c.lint()
+        );
+        c.references
+            .push(Reference::Mark("zero".into(), (10.0, 0.0)));
+        assert!(
+            c.lint().iter().any(|m| m.contains("the mark \"zero\"")),
+            "{:?}",
+            c.lint()
+        );
     }
 
     #[test]
