@@ -148,6 +148,9 @@ else
 fi
 collect_skips
 cpu=$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//; s/"/'"'"'/g')
+# The vector width names the machine kind where the model name does not (two "AMD EPYC"
+# machines here built the same tree in 394 s and 627 s: docs/budgets.md).
+if grep -qw avx512f /proc/cpuinfo; then cpu="$cpu (AVX-512)"; elif grep -qw avx2 /proc/cpuinfo; then cpu="$cpu (AVX2)"; fi
 mkdir -p target
 printf '{"date":"%s","cpu":"%s, %s cores","cargo_cache":"%s","seconds":%s,"steps":[%s],"test_skip":"%s","skipped":[%s]}\n' \
   "$(date -u +%Y-%m-%dT%H:%M:%SZ)" "$cpu" "$(nproc)" "$cargo_cache" "$SECONDS" "$steps_json" \
