@@ -43,9 +43,11 @@ prepare)
   tar -C "$work/site" -cJf "$d/mitsuba.tar.xz" .
   l=/usr/lib/x86_64-linux-gnu
   llvm=$(ls "$l"/libLLVM.so.* | sort -V | tail -n 1)
-  libs=$(ldd "$llvm" | awk '/=>/ {print $3}' | grep -E 'libLLVM|libz3|libedit|libxml2|libbsd|libmd|libicu')
+  libs=$(ldd "$llvm" | awk '/=>/ {print $3}' | grep -E 'libz3|libedit|libxml2|libbsd|libmd|libicu' || true)
+  # The files themselves (-h: ldd names symbolic links such as libedit.so.2), by their
+  # soname, flat.
   # shellcheck disable=SC2086
-  tar -cJf "$d/llvm.tar.xz" --transform 's,.*/,,' $llvm $libs 2>/dev/null
+  tar -chJf "$d/llvm.tar.xz" --transform 's,.*/,,' "$llvm" $libs
   basename "$llvm" >"$d/llvm.txt"
   du -sh "$d"
   ;;

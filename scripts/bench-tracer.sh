@@ -4,10 +4,12 @@
 # size, spp and depth, alternating the two renderers round by round so that drift of a
 # shared machine falls on both alike.
 #
-# Per scene × integrator and round: one `mirrorbox trace --json` process (its image loop's
-# time, BVH build apart) and one Mitsuba process rendering twice: the first render includes
-# compiling its JIT kernels (each Mitsuba process gets an empty Dr.Jit kernel cache), the
-# second is the compiled kernel's time. Medians over rounds with the range, and the ratios.
+# Per scene × integrator and round: one `mirrorbox trace --json --warm-up 1` process and one
+# Mitsuba process, each rendering twice and timed on its second render: Mitsuba's first
+# includes compiling its JIT kernels (each Mitsuba process gets an empty Dr.Jit kernel cache),
+# mirrorbox's starts its threads and warms its memory; both first renders are kept too.
+# mirrorbox's time is its image loop (BVH build apart). Medians over rounds with the range,
+# and the ratios.
 #
 # Mitsuba's side is the fastest formulation of the same picture (issue 41): `whitted` is
 # tools/mitsuba/render.py's lean form of the contract (tested to give the general form's
@@ -54,6 +56,8 @@ scenes="mirror_box mirror_room"
 rr_depth=5
 if [ -n "${MIRRORBOX_SOURCE_COMMIT:-}" ]; then
   commit=$MIRRORBOX_SOURCE_COMMIT
+elif [ -n "${MIRRORBOX_BENCH_BIN:-}" ]; then
+  commit="unknown (a prebuilt binary)" # not HEAD's: nothing says the binary was built from it
 else
   commit=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)
   git diff --quiet HEAD -- crates shaders Cargo.toml Cargo.lock tools 2>/dev/null || commit="$commit+changes"

@@ -96,8 +96,6 @@ info() {
   "$bin" info | tee "reports/gpu/info_$gpu.txt"
   "$bin" info --json >"reports/gpu/info_$gpu.json"
   nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader >"reports/gpu/nvidia-smi_$gpu.txt"
-  # The CPU beside trace_threads.jsonl (the `trace` step), which the gpu-trace-threads region names.
-  grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//' >reports/gpu/cpu.txt
 }
 
 # The mirror room at 1920×1080: unrolled and portal, depth 1…1024, 3 rounds in an order shuffled
@@ -134,6 +132,8 @@ trace_threads() {
     done
   done
   mv "$tmp" "$file"
+  # The CPU of these threads, which the gpu-trace-threads region names beside them.
+  grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//' >reports/gpu/cpu.txt
 }
 
 # The raster crate's tests (goldens, agreement with the truth) on the GPU. The binaries look for
@@ -255,7 +255,7 @@ for s in "$@"; do
   depth-1080p) step depth-1080p 60 depth_1080p ;;
   symmetry) step symmetry-scaling 120 "$bin" experiment symmetry-scaling --out reports/gpu/symmetry_scaling ;;
   lighting) step lighting 120 "$bin" experiment lighting --out reports/gpu/lighting ;;
-  advise) step advise 60 advise_gpu ;;
+  advise) step advise $((${WARM_SECONDS:-60} + 80)) advise_gpu ;; # the warm-up and one advice
   *) say "unknown step $s" ;;
   esac
 done

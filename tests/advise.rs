@@ -202,10 +202,13 @@ fn advise_names_the_closest_when_nothing_fits_and_the_best_when_everything_does(
     ] {
         assert!(out.join(f).is_file(), "{f}");
     }
-    // The figure rings the pick and names it in its legend.
+    // The figure rings the pick and names it in its legend: one ring in the plot, one in
+    // the legend (the ring's place on its point: the plot crate's own test).
     let svg = std::fs::read_to_string(out.join("front.svg")).unwrap();
     let pick = v["pick"]["method"].as_str().unwrap();
     assert!(svg.contains(&format!(">the pick: {pick}</text>")), "{svg}");
+    let rings = svg.matches(r#"fill="none" stroke="black" stroke-width="2"/>"#);
+    assert_eq!(rings.count(), 2, "{svg}");
     assert!(!dir.path().join("huge.partial").exists());
     let _ = repo();
 }

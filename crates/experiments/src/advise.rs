@@ -44,13 +44,16 @@ fn advices(reports: &Path, folder: &str) -> Result<Vec<(String, Value)>, ReadmeE
             .map_err(|e| ReadmeError(format!("{}: {e}", path.display())))?;
         out.push((e.file_name().to_string_lossy().into_owned(), v));
     }
-    // Scene, then budget, then the repeat after its first run.
+    // Scene, then budget, then the repeat after its first run, then the folder's name (two
+    // advices of one scene and budget, e.g. a `_cold` one and its rerun, in an order that
+    // does not depend on the file system's).
     out.sort_by(|a, b| {
         let key = |v: &Value, f: &str| {
             (
                 v["scene"].as_str().unwrap_or_default().to_string(),
                 v["budget_ms"].as_f64().unwrap_or(0.0),
                 f.ends_with("_repeat"),
+                f.to_string(),
             )
         };
         key(&a.1, &a.0)
@@ -383,7 +386,14 @@ mod tests {
         let reports = tempfile::tempdir().unwrap();
         write_advice(reports.path(), "gpu/a/box_1ms", &advice(1.0, false));
         write_advice(reports.path(), "gpu/a/box_2ms_cold", &advice(2.0, false));
+        write_advice(reports.path(), "gpu/a/box_2ms", &advice(2.0, false));
         let region = advise_region_of(reports.path(), "gpu/a").unwrap();
+        // One scene and budget twice: by folder name, whatever order the folder lists them in.
+        let at = |f: &str| region.find(&format!("| `{f}` |")).unwrap();
+        assert!(
+            at("box_1ms") < at("box_2ms") && at("box_2ms") < at("box_2ms_cold"),
+            "{region}"
+        );
         assert!(
             region.contains("Measured on NVIDIA H200, 960×540, α = 1,"),
             "{region}"

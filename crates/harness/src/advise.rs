@@ -808,7 +808,7 @@ pub fn chart(
         ));
     }
     // The figure's answer: the pick, ringed (an error of exactly 0 has no place on the log
-    // axis; the legend names such a point instead).
+    // axis: such a pick gets no ring, and the chart names its series' zero in the legend).
     if let Some(pick) = advice.pick.as_ref().filter(|p| metric.of(p) > 0.0) {
         references.push(Reference::Mark(
             format!("the pick: {}", pick.method_key()),

@@ -1290,6 +1290,29 @@ mod tests {
             .matches(r#"fill="none" stroke="black" stroke-width="2"/>"#)
             .count();
         assert_eq!(rings, 2, "one ring in the plot, one in the legend:\n{svg}");
+        // The plot's ring is centred on the point's own marker (10, 0.1).
+        let centre = |tag: &str| {
+            let at = |k: &str| {
+                let v = tag.split(&format!("{k}=\"")).nth(1).unwrap();
+                v[..v.find('"').unwrap()].to_string()
+            };
+            (at("cx"), at("cy"))
+        };
+        let ring = svg
+            .lines()
+            .find(|l| l.contains(&format!(r#"r="{MARK_R}""#)))
+            .unwrap();
+        let markers: Vec<_> = svg
+            .lines()
+            .filter(|l| l.starts_with("<circle") && l.contains(r#"r="4.0""#))
+            .map(centre)
+            .collect();
+        assert_eq!(
+            markers.len(),
+            3,
+            "two points and the legend's swatch:\n{svg}"
+        );
+        assert_eq!(centre(ring), markers[1], "{svg}");
         assert!(svg.contains(">the pick: a</text>"), "{svg}");
         assert!(!svg.contains("reference: the pick"), "{svg}");
         // The budget after the mark is the first line: the first dash, in plot and legend.

@@ -127,7 +127,8 @@ pub struct Args {
     /// Untimed renders of each view before the timed one, 0..=10: the timed render then runs
     /// in a process that has rendered (its threads awake, its memory and caches warm), as
     /// Mitsuba's compiled-kernel time is its second render (scripts/bench-tracer.sh). The
-    /// same image; --json gives each warm-up render's seconds (warm_up_seconds). CPU only.
+    /// same image; --json gives each warm-up render's seconds (warm_up_seconds; total_seconds
+    /// includes them). CPU only.
     #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=10))]
     warm_up: u32,
     /// Print the summary as one JSON object (one per eye with --stereo).
