@@ -99,58 +99,6 @@ done
 # MIRRORBOX_BENCH_RUNS: where to keep every round's raw times (one JSON object per render).
 [ -z "${MIRRORBOX_BENCH_RUNS:-}" ] || cp "$work/runs.jsonl" "$MIRRORBOX_BENCH_RUNS"
 mitsuba_version=$("$py" -c 'import mitsuba; print(mitsuba.__version__)')
-python3 - "$work/runs.jsonl" "$out" "$rounds" "$spp" "$mitsuba_version" "$commit" "$rr_depth" <<'PY'
-import json, sys, statistics, datetime, os, re, glob
-runs_path, out, rounds, spp, mver, commit, rr_depth = sys.argv[1:]
-runs = [json.loads(l) for l in open(runs_path)]
-cpu = next((l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.startswith("model name")), "?")
-flags = next((l.split(":", 1)[1].split() for l in open("/proc/cpuinfo") if l.startswith("flags")), [])
-simd = "AVX-512" if "avx512f" in flags else "AVX2" if "avx2" in flags else "SSE"
-GOALS = __import__("runpy").run_path("scripts/tracer-bench-index.py")["GOALS"]
-def stats(v):
-    v = sorted(v); return statistics.median(v), v[0], v[-1]
-rows, summary = [], {"date": datetime.date.today().isoformat(), "cpu": cpu, "cores": os.cpu_count(), "simd": simd,
-                     "rounds": int(rounds), "spp": int(spp), "mitsuba": mver, "commit": commit,
-                     "mitsuba_whitted": f"lean Whitted; path with roulette from {rr_depth}", "path_rr_depth": int(rr_depth),
-                     "mirrorbox_timed": "second render", 
-                     "results": []}
-for scene in ["mirror_box", "mirror_room"]:
-    for integ in ["whitted", "path"]:
-        ours = [r["seconds"] for r in runs if r["who"] == "mirrorbox" and r["scene"] == scene and r["integrator"] == integ]
-        mits = [r["seconds"] for r in runs if r["who"] == "mitsuba" and r["scene"] == scene and r["integrator"] == integ]
-        first = [r["first_seconds"] for r in runs if r["who"] == "mitsuba" and r["scene"] == scene and r["integrator"] == integ]
-        ours_first = [r["first_seconds"] for r in runs if r["who"] == "mirrorbox" and r["scene"] == scene and r["integrator"] == integ]
-        rays = next(r["rays"] for r in runs if r["who"] == "mirrorbox" and r["scene"] == scene and r["integrator"] == integ)
-        o, m, f, of = stats(ours), stats(mits), stats(first), stats(ours_first)
-        ratio = m[0] / o[0]
-        # Paired: within each round, Mitsuba's compiled-kernel time over ours (the two ran
-        # back to back, so a slow spell of the shared machine falls on both).
-        by_round = lambda who: {r["round"]: r["seconds"] for r in runs if r["who"] == who and r["scene"] == scene and r["integrator"] == integ}
-        ours_r, mits_r = by_round("mirrorbox"), by_round("mitsuba")
-        paired = stats([mits_r[k] / ours_r[k] for k in ours_r if k in mits_r])
-        # The same against mirrorbox's first render (how every record before 2026-11-28's
-        # fourth session of issue 56 timed mirrorbox).
-        ours_first_r = {r["round"]: r["first_seconds"] for r in runs if r["who"] == "mirrorbox" and r["scene"] == scene and r["integrator"] == integ}
-        paired_first = stats([mits_r[k] / ours_first_r[k] for k in ours_first_r if k in mits_r])
-        summary["results"].append({"scene": scene, "integrator": integ, "ours_s": o, "ours_first_s": of, "mitsuba_s": m, "mitsuba_first_s": f,
-                                   "rays": rays, "speedup_vs_mitsuba": ratio, "speedup_vs_mitsuba_paired": paired,
-                                   "speedup_vs_mitsuba_paired_first_render": paired_first,
-                                   "speedup_vs_mitsuba_first": f[0] / of[0]})
-        goal = GOALS[integ]
-        met = "met" if paired[0] >= goal else f"not met ({paired[0] / goal:.0%} of it)"
-        rows.append(f"| `{scene}` | {integ} | {o[0]:.3f} [{o[1]:.3f}–{o[2]:.3f}] | {of[0]:.3f} [{of[1]:.3f}–{of[2]:.3f}] | {rays/o[0]/1e6:.1f} | {m[0]:.3f} [{m[1]:.3f}–{m[2]:.3f}] | {f[0]:.3f} [{f[1]:.3f}–{f[2]:.3f}] | {ratio:.2f}× | {paired[0]:.2f}× [{paired[1]:.2f}–{paired[2]:.2f}] | {paired_first[0]:.2f}× [{paired_first[1]:.2f}–{paired_first[2]:.2f}] | {f[0]/of[0]:.2f}× | ≥ {goal:.0f}×: {met} |")
-note = os.environ.get("MIRRORBOX_BENCH_NOTE", "").strip()
-note = f" ({note})" if note else ""
-slug = re.sub(r"[^a-z0-9]+", "-", cpu.lower()).strip("-") + "-" + simd.lower().replace("-", "")
-summary["file"] = f"bench-{slug}.md"
-lines = [f"# The tracer against Mitsuba 3 on {cpu} ({simd})", "",
-         f"Measured {summary['date']} (commit {commit}) with `scripts/bench-tracer.sh {rounds} {spp}` on {cpu} ({simd}), {os.cpu_count()} cores{note}: 640×360, {spp} spp; Mitsuba {mver} `llvm_ad_rgb`; the two renderers alternated, one process each per round; medians over {rounds} rounds [min–max]. A claim about this CPU only: other CPUs have their own files ([bench.md](bench.md)).",
-         "",
-         "| scene | integrator | mirrorbox s (second render) | mirrorbox s (first render) | mirrorbox Mrays/s | Mitsuba s (compiled kernel: second render) | Mitsuba s (first render, JIT included) | Mitsuba ÷ mirrorbox | per round: Mitsuba ÷ mirrorbox | per round: Mitsuba ÷ mirrorbox's first render | first ÷ first | goal (per round) |",
-         "|---|---|---|---|---|---|---|---|---|---|---|---|"] + rows + ["",
-         f"A ratio above 1 means mirrorbox is faster. 'Mitsuba ÷ mirrorbox' divides the medians; 'per round' is the median [min–max] of each round's ratio of the two renders run back to back, which a slow spell of the shared machine affects less. Whitted: mirror chains to 10 000 reflections, cut at a throughput of 1e-4; Mitsuba runs `tools/mitsuba/render.py`'s lean formulation of the contract (coherent camera rays, no sampler draws, one reflectance lookup per hit; the same image as its general form, `tests/mitsuba.rs`). Path: 10 segments, Russian roulette from {rr_depth} in both renderers; Mitsuba's own `path`. mirrorbox's time is its image loop (BVH build apart); Mitsuba's is `mi.render` to an evaluated image (scene loading apart). Both are timed on their process's second render, the goal's measure: Mitsuba's first render compiles its kernels (each of its processes starts with an empty Dr.Jit kernel cache), mirrorbox's (`trace --warm-up 1`) starts its threads and warms its memory; each renderer's first render is in the table too ('first ÷ first': Mitsuba's first over mirrorbox's), and 'Mitsuba ÷ mirrorbox's first render' is the measure of the records made before 2026-11-28's fourth session of issue 56."]
-open(f"{out}/bench-{slug}.md", "w").write("\n".join(lines) + "\n")
-json.dump(summary, open(f"{out}/bench-{slug}.json", "w"), indent=2)
-print("\n".join(lines))
-PY
+# The record (and a copy of the rounds beside it, to make it again from): tracer-bench-record.py.
+python3 scripts/tracer-bench-record.py "$work/runs.jsonl" "$out" "$rounds" "$spp" "$mitsuba_version" "$commit" "$rr_depth"
 python3 scripts/tracer-bench-index.py "$out"

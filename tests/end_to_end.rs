@@ -12,4 +12,5 @@ mod mitsuba;
 mod readme;
 mod reports_html;
 mod slurm;
+mod tracer_bench;
 mod viewer;

@@ -1,0 +1,92 @@
+#!/usr/bin/env python3
+"""One CPU's tracer bench record (issue 41, 56): reports/tracer/bench-<cpu>-<width>.md and
+.json from the rounds scripts/bench-tracer.sh measured (one JSON object per render: who,
+scene, integrator, round, seconds, first_seconds, ...), which it keeps beside them as
+bench-<cpu>-<width>-rounds.jsonl, so that a record can be made again from its rounds.
+
+Per scene and integrator: medians over rounds [min–max], the ratio of the medians, and per
+round the ratio of the two renders run back to back, with the 95 % interval of that median
+(order statistics: the ranks whose binomial tails hold at most 2.5 % each, 96.5 % for 15
+rounds). A goal is met when the interval lies above it, not met when below it, and
+undecided when the interval holds it.
+
+The CPU is this machine's (/proc/cpuinfo): run it where the rounds were measured.
+MIRRORBOX_BENCH_DATE overrides the record's date (default today), MIRRORBOX_BENCH_NOTE adds
+a sentence about where it ran.
+
+Usage: scripts/tracer-bench-record.py ROUNDS.jsonl OUT_DIR ROUNDS SPP MITSUBA_VERSION COMMIT RR_DEPTH"""
+import json, sys, statistics, datetime, os, re, shutil
+from math import comb
+if len(sys.argv) != 8:
+    sys.exit(__doc__.split("Usage: ")[1])
+runs_path, out, rounds, spp, mver, commit, rr_depth = sys.argv[1:]
+runs = [json.loads(l) for l in open(runs_path)]
+cpu = next((l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.startswith("model name")), "?")
+flags = next((l.split(":", 1)[1].split() for l in open("/proc/cpuinfo") if l.startswith("flags")), [])
+simd = "AVX-512" if "avx512f" in flags else "AVX2" if "avx2" in flags else "SSE"
+GOALS = __import__("runpy").run_path("scripts/tracer-bench-index.py")["GOALS"]
+def stats(v):
+    v = sorted(v); return statistics.median(v), v[0], v[-1]
+def median_interval(v):
+    """The 95 % interval of the median of v by order statistics, or None below 6 values."""
+    v, n = sorted(v), len(v)
+    tail, j = 0.0, 0
+    while True:
+        tail += comb(n, j) / 2 ** n  # P(fewer than j + 1 values below the median)
+        if 2 * tail > 0.05:
+            break
+        j += 1
+    return (v[j - 1], v[n - j]) if j > 0 else None
+rows, summary = [], {"date": os.environ.get("MIRRORBOX_BENCH_DATE") or datetime.date.today().isoformat(), "cpu": cpu, "cores": os.cpu_count(), "simd": simd,
+                     "rounds": int(rounds), "spp": int(spp), "mitsuba": mver, "commit": commit,
+                     "mitsuba_whitted": f"lean Whitted; path with roulette from {rr_depth}", "path_rr_depth": int(rr_depth),
+                     "mirrorbox_timed": "second render", 
+                     "results": []}
+for scene in ["mirror_box", "mirror_room"]:
+    for integ in ["whitted", "path"]:
+        ours = [r["seconds"] for r in runs if r["who"] == "mirrorbox" and r["scene"] == scene and r["integrator"] == integ]
+        mits = [r["seconds"] for r in runs if r["who"] == "mitsuba" and r["scene"] == scene and r["integrator"] == integ]
+        first = [r["first_seconds"] for r in runs if r["who"] == "mitsuba" and r["scene"] == scene and r["integrator"] == integ]
+        ours_first = [r["first_seconds"] for r in runs if r["who"] == "mirrorbox" and r["scene"] == scene and r["integrator"] == integ]
+        rays = next(r["rays"] for r in runs if r["who"] == "mirrorbox" and r["scene"] == scene and r["integrator"] == integ)
+        o, m, f, of = stats(ours), stats(mits), stats(first), stats(ours_first)
+        ratio = m[0] / o[0]
+        # Paired: within each round, Mitsuba's compiled-kernel time over ours (the two ran
+        # back to back, so a slow spell of the shared machine falls on both).
+        by_round = lambda who: {r["round"]: r["seconds"] for r in runs if r["who"] == who and r["scene"] == scene and r["integrator"] == integ}
+        ours_r, mits_r = by_round("mirrorbox"), by_round("mitsuba")
+        per_round = [mits_r[k] / ours_r[k] for k in ours_r if k in mits_r]
+        paired, interval = stats(per_round), median_interval(per_round)
+        # The same against mirrorbox's first render (how every record before 2026-11-28's
+        # fourth session of issue 56 timed mirrorbox).
+        ours_first_r = {r["round"]: r["first_seconds"] for r in runs if r["who"] == "mirrorbox" and r["scene"] == scene and r["integrator"] == integ}
+        paired_first = stats([mits_r[k] / ours_first_r[k] for k in ours_first_r if k in mits_r])
+        summary["results"].append({"scene": scene, "integrator": integ, "ours_s": o, "ours_first_s": of, "mitsuba_s": m, "mitsuba_first_s": f,
+                                   "rays": rays, "speedup_vs_mitsuba": ratio, "speedup_vs_mitsuba_paired": paired,
+                                   "speedup_vs_mitsuba_paired_interval": interval,
+                                   "speedup_vs_mitsuba_paired_first_render": paired_first,
+                                   "speedup_vs_mitsuba_first": f[0] / of[0]})
+        goal = GOALS[integ]
+        if interval is None:
+            met = ("met" if paired[0] >= goal else f"not met ({paired[0] / goal:.0%} of it)") + " (too few rounds for an interval)"
+        else:
+            ci = f"the median's 95 % interval {interval[0]:.2f}–{interval[1]:.2f}×"
+            met = ("met" if interval[0] >= goal else f"not met ({paired[0] / goal:.0%} of it)" if interval[1] < goal
+                   else f"undecided ({paired[0] / goal:.0%} of it)") + f": {ci}"
+        rows.append(f"| `{scene}` | {integ} | {o[0]:.3f} [{o[1]:.3f}–{o[2]:.3f}] | {of[0]:.3f} [{of[1]:.3f}–{of[2]:.3f}] | {rays/o[0]/1e6:.1f} | {m[0]:.3f} [{m[1]:.3f}–{m[2]:.3f}] | {f[0]:.3f} [{f[1]:.3f}–{f[2]:.3f}] | {ratio:.2f}× | {paired[0]:.2f}× [{paired[1]:.2f}–{paired[2]:.2f}] | {paired_first[0]:.2f}× [{paired_first[1]:.2f}–{paired_first[2]:.2f}] | {f[0]/of[0]:.2f}× | ≥ {goal:.0f}×: {met} |")
+note = os.environ.get("MIRRORBOX_BENCH_NOTE", "").strip()
+note = f" ({note})" if note else ""
+slug = re.sub(r"[^a-z0-9]+", "-", cpu.lower()).strip("-") + "-" + simd.lower().replace("-", "")
+summary["file"] = f"bench-{slug}.md"
+lines = [f"# The tracer against Mitsuba 3 on {cpu} ({simd})", "",
+         f"Measured {summary['date']} (commit {commit}) with `scripts/bench-tracer.sh {rounds} {spp}` on {cpu} ({simd}), {os.cpu_count()} cores{note}: 640×360, {spp} spp; Mitsuba {mver} `llvm_ad_rgb`; the two renderers alternated, one process each per round; medians over {rounds} rounds [min–max]. A claim about this CPU only: other CPUs have their own files ([bench.md](bench.md)).",
+         "",
+         "| scene | integrator | mirrorbox s (second render) | mirrorbox s (first render) | mirrorbox Mrays/s | Mitsuba s (compiled kernel: second render) | Mitsuba s (first render, JIT included) | Mitsuba ÷ mirrorbox | per round: Mitsuba ÷ mirrorbox | per round: Mitsuba ÷ mirrorbox's first render | first ÷ first | goal (per round) |",
+         "|---|---|---|---|---|---|---|---|---|---|---|---|"] + rows + ["",
+         f"A ratio above 1 means mirrorbox is faster. 'Mitsuba ÷ mirrorbox' divides the medians; 'per round' is the median [min–max] of each round's ratio of the two renders run back to back, which a slow spell of the shared machine affects less; a goal is met when the 95 % interval of that median lies above it, undecided when the interval holds it. Whitted: mirror chains to 10 000 reflections, cut at a throughput of 1e-4; Mitsuba runs `tools/mitsuba/render.py`'s lean formulation of the contract (coherent camera rays, no sampler draws, one reflectance lookup per hit; the same image as its general form, `tests/mitsuba.rs`). Path: 10 segments, Russian roulette from {rr_depth} in both renderers; Mitsuba's own `path`. mirrorbox's time is its image loop (BVH build apart); Mitsuba's is `mi.render` to an evaluated image (scene loading apart). Both are timed on their process's second render, the goal's measure: Mitsuba's first render compiles its kernels (each of its processes starts with an empty Dr.Jit kernel cache), mirrorbox's (`trace --warm-up 1`) starts its threads and warms its memory; each renderer's first render is in the table too ('first ÷ first': Mitsuba's first over mirrorbox's), and 'Mitsuba ÷ mirrorbox's first render' is the measure of the records made before 2026-11-28's fourth session of issue 56."]
+open(f"{out}/bench-{slug}.md", "w").write("\n".join(lines) + "\n")
+rounds_file = f"{out}/bench-{slug}-rounds.jsonl"
+if os.path.abspath(runs_path) != os.path.abspath(rounds_file):
+    shutil.copyfile(runs_path, rounds_file)
+json.dump(summary, open(f"{out}/bench-{slug}.json", "w"), indent=2)
+print("\n".join(lines))

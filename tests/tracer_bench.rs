@@ -1,0 +1,123 @@
+//! The tracer bench's records (scripts/tracer-bench-record.py, scripts/tracer-bench-index.py):
+//! made from their rounds alone, and a goal judged by the 95 % interval of the per-round
+//! median, not by the median alone (issue 56: two runs of one build differ by ±10 %).
+
+use crate::common::repo;
+use serde_json::{Value, json};
+use std::path::Path;
+
+/// Fifteen rounds of one CPU: every scene and integrator with Mitsuba `mitsuba_s` and
+/// mirrorbox `ours(k)` seconds in round k.
+fn rounds(dir: &Path, per_round: &dyn Fn(&str, &str, u32) -> f64) -> std::path::PathBuf {
+    let mut lines = Vec::new();
+    for round in 1..=15u32 {
+        for scene in ["mirror_box", "mirror_room"] {
+            for integrator in ["whitted", "path"] {
+                let ratio = per_round(scene, integrator, round);
+                lines.push(json!({"who": "mirrorbox", "scene": scene, "integrator": integrator,
+                    "round": round, "seconds": 0.1, "first_seconds": 0.11, "rays": 1000, "threads": 2}));
+                lines.push(json!({"who": "mitsuba", "scene": scene, "integrator": integrator,
+                    "round": round, "seconds": 0.1 * ratio, "first_seconds": 0.5, "variant": "llvm_ad_rgb"}));
+            }
+        }
+    }
+    let path = dir.join("runs.jsonl");
+    let text: Vec<String> = lines.iter().map(Value::to_string).collect();
+    std::fs::write(&path, text.join("\n") + "\n").unwrap();
+    path
+}
+
+/// Runs the record and index scripts into `out`; the index's one summary row.
+fn record(runs: &Path, out: &Path) -> (Value, String) {
+    let script = |name: &str, args: &[&str]| {
+        let run = std::process::Command::new("python3")
+            .arg(repo().join("scripts").join(name))
+            .args(args)
+            .current_dir(repo())
+            .env("MIRRORBOX_BENCH_DATE", "2026-11-28")
+            .output()
+            .expect("python3 runs");
+        assert!(
+            run.status.success(),
+            "{name}: {}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+    };
+    let out_s = out.to_str().unwrap();
+    script(
+        "tracer-bench-record.py",
+        &[
+            runs.to_str().unwrap(),
+            out_s,
+            "15",
+            "16",
+            "3.9.1",
+            "abc1234",
+            "5",
+        ],
+    );
+    script("tracer-bench-index.py", &[out_s]);
+    let index: Vec<Value> =
+        serde_json::from_str(&std::fs::read_to_string(out.join("bench.json")).unwrap()).unwrap();
+    assert_eq!(index.len(), 1, "{index:?}");
+    let md = std::fs::read_to_string(out.join("bench.md")).unwrap();
+    let row = md
+        .lines()
+        .find(|l| l.contains("abc1234"))
+        .unwrap()
+        .to_string();
+    (index[0].clone(), row)
+}
+
+#[test]
+fn a_goal_is_met_only_when_the_interval_of_the_median_clears_it() {
+    let dir = tempfile::tempdir().unwrap();
+    // Every row clearly above its goal: met, and the rounds kept beside the record.
+    let above = |_: &str, integrator: &str, round: u32| {
+        (if integrator == "whitted" { 3.5 } else { 2.5 }) + 0.01 * round as f64
+    };
+    let out = dir.path().join("above");
+    std::fs::create_dir(&out).unwrap();
+    let (b, row) = record(&rounds(dir.path(), &above), &out);
+    assert!(row.ends_with("| met |"), "{row}");
+    let box_whitted = &b["results"][0];
+    let median = box_whitted["speedup_vs_mitsuba_paired"][0]
+        .as_f64()
+        .unwrap();
+    assert!((median - 3.58).abs() < 1e-9, "{median}");
+    let name = b["file"].as_str().unwrap().replace(".md", "-rounds.jsonl");
+    assert!(
+        out.join(name).is_file(),
+        "the rounds are kept beside the record"
+    );
+    // `mirror_box` whitted's median above 3 but its rounds spread across it: undecided.
+    let spread = |scene: &str, integrator: &str, round: u32| {
+        if scene == "mirror_box" && integrator == "whitted" {
+            [2.0, 4.0][round as usize % 2] + 0.01 * round as f64
+        } else {
+            above(scene, integrator, round)
+        }
+    };
+    let out = dir.path().join("spread");
+    std::fs::create_dir(&out).unwrap();
+    let (b, row) = record(&rounds(dir.path(), &spread), &out);
+    let median = b["results"][0]["speedup_vs_mitsuba_paired"][0]
+        .as_f64()
+        .unwrap();
+    assert!(median >= 3.0, "{median}");
+    assert!(row.ends_with("| undecided |"), "{row}");
+    let md = std::fs::read_to_string(out.join(b["file"].as_str().unwrap())).unwrap();
+    assert!(md.contains("≥ 3×: undecided"), "{md}");
+    // One row clearly below: not met.
+    let below = |scene: &str, integrator: &str, round: u32| {
+        if scene == "mirror_room" && integrator == "path" {
+            1.5 + 0.01 * round as f64
+        } else {
+            spread(scene, integrator, round)
+        }
+    };
+    let out = dir.path().join("below");
+    std::fs::create_dir(&out).unwrap();
+    let (_, row) = record(&rounds(dir.path(), &below), &out);
+    assert!(row.ends_with("| not met |"), "{row}");
+}
