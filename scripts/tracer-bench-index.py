@@ -15,20 +15,22 @@ GOALS = {"whitted": 3.0, "path": 2.0}
 SCENES = ["mirror_box", "mirror_room"]
 
 
+def row_state(goal, median, ci):
+    """A row against its goal: "above", "below", or "holds" (its median's 95 % interval holds
+    the goal); by the median alone where the record has no interval (records before
+    2026-11-28) and "below" where it has no median."""
+    if median is None:
+        return "below"
+    if ci:
+        return "above" if ci[0] >= goal else "below" if ci[1] < goal else "holds"
+    return "above" if median >= goal else "below"
+
+
 def verdict(ratios, intervals):
-    """"met" when every row's per-round median is above its goal, by its 95 % interval where
-    the record has one (records before 2026-11-28: by the median alone); "not met" when some
-    row is below it; else "undecided" (an interval holds a goal)."""
-    states = []
-    for s in SCENES:
-        for i in ["whitted", "path"]:
-            goal, median, ci = GOALS[i], ratios.get((s, i)), intervals.get((s, i))
-            if median is None:
-                states.append("below")
-            elif ci:
-                states.append("above" if ci[0] >= goal else "below" if ci[1] < goal else "holds")
-            else:
-                states.append("above" if median >= goal else "below")
+    """"met" when every row is above its goal, "not met" when some row is below it, else
+    "undecided" (an interval holds a goal)."""
+    states = [row_state(GOALS[i], ratios.get((s, i)), intervals.get((s, i)))
+              for s in SCENES for i in ["whitted", "path"]]
     if "below" in states:
         return "not met"
     return "undecided" if "holds" in states else "met"

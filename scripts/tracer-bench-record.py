@@ -24,11 +24,14 @@ runs = [json.loads(l) for l in open(runs_path)]
 cpu = next((l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.startswith("model name")), "?")
 flags = next((l.split(":", 1)[1].split() for l in open("/proc/cpuinfo") if l.startswith("flags")), [])
 simd = "AVX-512" if "avx512f" in flags else "AVX2" if "avx2" in flags else "SSE"
-GOALS = __import__("runpy").run_path("scripts/tracer-bench-index.py")["GOALS"]
+# The goals and the rule that judges a row against its goal: the index's, one place for both.
+index = __import__("runpy").run_path("scripts/tracer-bench-index.py")
+GOALS, row_state = index["GOALS"], index["row_state"]
 def stats(v):
     v = sorted(v); return statistics.median(v), v[0], v[-1]
 def median_interval(v):
-    """The 95 % interval of the median of v by order statistics, or None below 6 values."""
+    """The 95 % interval of the median of v by exact order statistics, or None below 6 values
+    (the Rust reports' `stats::median_interval` bootstraps the same order statistics)."""
     v, n = sorted(v), len(v)
     tail, j = 0.0, 0
     while True:
@@ -44,35 +47,34 @@ rows, summary = [], {"date": os.environ.get("MIRRORBOX_BENCH_DATE") or datetime.
                      "results": []}
 for scene in ["mirror_box", "mirror_room"]:
     for integ in ["whitted", "path"]:
-        ours = [r["seconds"] for r in runs if r["who"] == "mirrorbox" and r["scene"] == scene and r["integrator"] == integ]
-        mits = [r["seconds"] for r in runs if r["who"] == "mitsuba" and r["scene"] == scene and r["integrator"] == integ]
-        first = [r["first_seconds"] for r in runs if r["who"] == "mitsuba" and r["scene"] == scene and r["integrator"] == integ]
-        ours_first = [r["first_seconds"] for r in runs if r["who"] == "mirrorbox" and r["scene"] == scene and r["integrator"] == integ]
-        rays = next(r["rays"] for r in runs if r["who"] == "mirrorbox" and r["scene"] == scene and r["integrator"] == integ)
-        o, m, f, of = stats(ours), stats(mits), stats(first), stats(ours_first)
+        # Each renderer's times by round, for this scene and integrator.
+        def by_round(who, field):
+            return {r["round"]: r[field] for r in runs
+                    if r["who"] == who and r["scene"] == scene and r["integrator"] == integ}
+        ours_r, ours_first_r = by_round("mirrorbox", "seconds"), by_round("mirrorbox", "first_seconds")
+        mits_r, mits_first_r = by_round("mitsuba", "seconds"), by_round("mitsuba", "first_seconds")
+        rays = next(iter(by_round("mirrorbox", "rays").values()))
+        o, m, f, of = (stats(list(t.values())) for t in (ours_r, mits_r, mits_first_r, ours_first_r))
         ratio = m[0] / o[0]
         # Paired: within each round, Mitsuba's compiled-kernel time over ours (the two ran
-        # back to back, so a slow spell of the shared machine falls on both).
-        by_round = lambda who: {r["round"]: r["seconds"] for r in runs if r["who"] == who and r["scene"] == scene and r["integrator"] == integ}
-        ours_r, mits_r = by_round("mirrorbox"), by_round("mitsuba")
-        per_round = [mits_r[k] / ours_r[k] for k in ours_r if k in mits_r]
+        # back to back, so a slow spell of the shared machine falls on both); and the same
+        # against mirrorbox's first render (how every record before 2026-11-28's fourth
+        # session of issue 56 timed mirrorbox).
+        paired_with = lambda ours: [mits_r[k] / ours[k] for k in ours if k in mits_r]
+        per_round = paired_with(ours_r)
         paired, interval = stats(per_round), median_interval(per_round)
-        # The same against mirrorbox's first render (how every record before 2026-11-28's
-        # fourth session of issue 56 timed mirrorbox).
-        ours_first_r = {r["round"]: r["first_seconds"] for r in runs if r["who"] == "mirrorbox" and r["scene"] == scene and r["integrator"] == integ}
-        paired_first = stats([mits_r[k] / ours_first_r[k] for k in ours_first_r if k in mits_r])
+        paired_first = stats(paired_with(ours_first_r))
         summary["results"].append({"scene": scene, "integrator": integ, "ours_s": o, "ours_first_s": of, "mitsuba_s": m, "mitsuba_first_s": f,
                                    "rays": rays, "speedup_vs_mitsuba": ratio, "speedup_vs_mitsuba_paired": paired,
                                    "speedup_vs_mitsuba_paired_interval": interval,
                                    "speedup_vs_mitsuba_paired_first_render": paired_first,
                                    "speedup_vs_mitsuba_first": f[0] / of[0]})
         goal = GOALS[integ]
-        if interval is None:
-            met = ("met" if paired[0] >= goal else f"not met ({paired[0] / goal:.0%} of it)") + " (too few rounds for an interval)"
-        else:
-            ci = f"the median's 95 % interval {interval[0]:.2f}–{interval[1]:.2f}×"
-            met = ("met" if interval[0] >= goal else f"not met ({paired[0] / goal:.0%} of it)" if interval[1] < goal
-                   else f"undecided ({paired[0] / goal:.0%} of it)") + f": {ci}"
+        share = f"{paired[0] / goal:.0%} of it"
+        state = row_state(goal, paired[0], interval)
+        met = {"above": "met", "below": f"not met ({share})", "holds": f"undecided ({share})"}[state]
+        met += (": the median's 95 % interval " f"{interval[0]:.2f}–{interval[1]:.2f}×" if interval
+                else " (too few rounds for an interval)")
         rows.append(f"| `{scene}` | {integ} | {o[0]:.3f} [{o[1]:.3f}–{o[2]:.3f}] | {of[0]:.3f} [{of[1]:.3f}–{of[2]:.3f}] | {rays/o[0]/1e6:.1f} | {m[0]:.3f} [{m[1]:.3f}–{m[2]:.3f}] | {f[0]:.3f} [{f[1]:.3f}–{f[2]:.3f}] | {ratio:.2f}× | {paired[0]:.2f}× [{paired[1]:.2f}–{paired[2]:.2f}] | {paired_first[0]:.2f}× [{paired_first[1]:.2f}–{paired_first[2]:.2f}] | {f[0]/of[0]:.2f}× | ≥ {goal:.0f}×: {met} |")
 note = os.environ.get("MIRRORBOX_BENCH_NOTE", "").strip()
 note = f" ({note})" if note else ""
