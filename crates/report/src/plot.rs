@@ -740,7 +740,11 @@ impl Chart {
                 .collect()
         };
         // Each entry: its name, and the series or the reference it shows.
-        let mut legend: Vec<(String, Option<&Series>, Option<&Reference>)> = Vec::new();
+        enum Shows<'a> {
+            Series(&'a Series),
+            Reference(&'a Reference),
+        }
+        let mut legend: Vec<(String, Shows)> = Vec::new();
         for (i, series) in self.series.iter().enumerate() {
             let mine: Vec<_> = visible(series).into_iter().map(key).collect();
             let same = self.series[..i].iter().find(|o| {
@@ -751,18 +755,18 @@ impl Chart {
                 Some(o) => format!("{} (on {})", series.name, o.name),
                 None => series.name.clone(),
             };
-            legend.push((name, Some(series), None));
+            legend.push((name, Shows::Series(series)));
         }
         for r in &self.references {
             let name = match r {
                 Reference::Level(n, _) | Reference::Curve(n, _) => format!("reference: {n}"),
                 Reference::Mark(n, _) => n.clone(),
             };
-            legend.push((name, None, Some(r)));
+            legend.push((name, Shows::Reference(r)));
         }
         let legend_chars = legend
             .iter()
-            .map(|(n, ..)| n.chars().count())
+            .map(|(n, _)| n.chars().count())
             .max()
             .unwrap_or(0);
         // Wide enough for the legend and for the title (which never runs off the canvas).
@@ -1089,9 +1093,9 @@ impl Chart {
         let lx = LEFT + PLOT_W + 14.0;
         let mut ly = TOP + 10.0;
         let mut references_drawn = 0;
-        for (name, series, reference) in &legend {
-            match series {
-                Some(series) => {
+        for (name, shows) in &legend {
+            match shows {
+                Shows::Series(series) => {
                     let st = &series.style;
                     if series.joined {
                         let dash = if st.dash.is_empty() {
@@ -1108,14 +1112,14 @@ impl Chart {
                     }
                     marker_svg(&mut s, st, lx + 12.0, ly, MARKER_R, st.hollow);
                 }
-                None if matches!(reference, Some(Reference::Mark(..))) => {
+                Shows::Reference(Reference::Mark(..)) => {
                     let _ = writeln!(
                         s,
                         r#"<circle cx="{}" cy="{ly}" r="7" fill="none" stroke="black" stroke-width="2"/>"#,
                         lx + 12.0
                     );
                 }
-                None => {
+                Shows::Reference(_) => {
                     let dash = REFERENCE_DASHES[references_drawn % REFERENCE_DASHES.len()];
                     references_drawn += 1;
                     let _ = writeln!(
