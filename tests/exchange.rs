@@ -140,21 +140,17 @@ fn an_export_traces_back_to_its_truth_and_our_render_scores_as_the_sweep_does() 
     // The copyable minimal client (clients/minimal/client.py) draws the same through the
     // exchange.
     let minimal_run = tmp.path().join("minimal-run");
-    let out = std::process::Command::new("python3")
-        .arg(repo().join("clients/minimal/client.py"))
-        .args([ex.as_os_str(), minimal_run.as_os_str()])
-        .args([
-            "--frames",
-            "1",
-            "--mirrorbox",
-            env!("CARGO_BIN_EXE_mirrorbox"),
-        ])
-        .output()
-        .expect("python3 runs");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    crate::common::succeed(
+        std::process::Command::new("python3")
+            .arg(repo().join("clients/minimal/client.py"))
+            .args([ex.as_os_str(), minimal_run.as_os_str()])
+            .args([
+                "--frames",
+                "1",
+                "--mirrorbox",
+                env!("CARGO_BIN_EXE_mirrorbox"),
+            ]),
+        "clients/minimal/client.py",
     );
     let minimal = &score(&ex, &minimal_run, &tmp.path().join("minimal-scored"))[0];
     assert_eq!(minimal["key"], "minimal/naive|camera|a0.9|64x36|ssaa1");

@@ -27,16 +27,8 @@ fn python() -> Option<String> {
 }
 
 fn run(program: &str, args: &[&str]) {
-    let out = Command::new(program)
-        .args(args)
-        .current_dir(repo())
-        .output()
-        .expect("run");
-    assert!(
-        out.status.success(),
-        "{program} {args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let what = format!("{program} {args:?}");
+    crate::common::succeed(Command::new(program).args(args).current_dir(repo()), &what);
 }
 
 /// Renders `mirror_box` with both renderers and returns (ours, Mitsuba).

@@ -2,7 +2,7 @@
 //! made from their rounds alone, and a goal judged by the 95 % interval of the per-round
 //! median, not by the median alone (issue 56: two runs of one build differ by ±10 %).
 
-use crate::common::repo;
+use crate::common::{repo, succeed};
 use serde_json::{Value, json};
 use std::path::Path;
 
@@ -30,18 +30,14 @@ fn rounds(dir: &Path, per_round: &dyn Fn(&str, &str, u32) -> f64) -> std::path::
 /// Runs the record and index scripts into `out`; the index's one summary row.
 fn record(runs: &Path, out: &Path) -> (Value, String) {
     let script = |name: &str, args: &[&str]| {
-        let run = std::process::Command::new("python3")
-            .arg(repo().join("scripts").join(name))
-            .args(args)
-            .current_dir(repo())
-            .env("MIRRORBOX_BENCH_DATE", "2026-11-28")
-            .output()
-            .expect("python3 runs");
-        assert!(
-            run.status.success(),
-            "{name}: {}",
-            String::from_utf8_lossy(&run.stderr)
-        );
+        succeed(
+            std::process::Command::new("python3")
+                .arg(repo().join("scripts").join(name))
+                .args(args)
+                .current_dir(repo())
+                .env("MIRRORBOX_BENCH_DATE", "2026-11-28"),
+            name,
+        )
     };
     let out_s = out.to_str().unwrap();
     script(

@@ -346,15 +346,9 @@ fn without_a_display_the_viewer_says_what_it_needs() {
 }
 
 fn xdotool(display: &str, args: &[&str]) -> String {
-    let out = Command::new("xdotool")
-        .args(args)
-        .env("DISPLAY", display)
-        .output()
-        .expect("xdotool runs");
-    assert!(
-        out.status.success(),
-        "xdotool {args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
+    let out = crate::common::succeed(
+        Command::new("xdotool").args(args).env("DISPLAY", display),
+        &format!("xdotool {args:?}"),
     );
     String::from_utf8_lossy(&out.stdout).trim().to_string()
 }

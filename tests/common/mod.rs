@@ -75,6 +75,18 @@ pub const SMALL_SWEEP: [&str; 15] = [
     "0",
 ];
 
+/// Runs `cmd` to its end and asserts that it succeeded (the message: `what`, then its stderr);
+/// its output.
+pub fn succeed(cmd: &mut Command, what: &str) -> std::process::Output {
+    let out = cmd.output().unwrap_or_else(|e| panic!("{what}: {e}"));
+    assert!(
+        out.status.success(),
+        "{what}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
 /// How many pixels of two images of one size differ in any bit of any channel (0: the same
 /// image bit for bit).
 pub fn pixels_differing_in_bits(
