@@ -17,6 +17,7 @@
 # cut one stopped.
 set -uo pipefail
 cd "$(dirname "$0")/.."
+. scripts/lib/advice.sh
 out=${OUT:-/tmp/gpu-out}
 mkdir -p "$out" reports/gpu
 log=$out/log.txt
@@ -209,8 +210,8 @@ table1_pair_reversed() {
 # `mirrorbox advise` on this GPU (issue 55's question, answered on lavapipe in reports/advise/,
 # where a user ships): the box and the room at 960×540 (a quarter of 1080p: the pick's images
 # stay small enough for git), α = 1, at budgets inside the spread of the methods' times on an
-# H200 (0.06–6 ms at 320×180, reports/gpu/frontier_*). Of the search rounds the records only,
-# as scripts/measure-advise.sh keeps them. ADVISE_RUNS: SCENE:BUDGET_MS pairs, most wanted first;
+# H200 (0.06–6 ms at 320×180, reports/gpu/frontier_*). Of the search rounds the records only
+# (keep_advice_records). ADVISE_RUNS: SCENE:BUDGET_MS pairs, most wanted first;
 # the default asks for what the lease of 2026-11-28 left (it ran the room at 1 ms on a cold GPU,
 # the box at 1 ms, the room at 0.5 and 2 ms; reports/gpu/advise_h200/).
 # The first advice of the lease of 2026-11-28 (the machine's first GPU work after `info`) timed
@@ -232,8 +233,7 @@ advise_gpu() {
     mkdir -p "$(dirname "$dir")"
     timeout "$left" "$bin" advise "scenes/$scene.json" --budget-ms "$budget" --width 960 --height 540 \
       --alpha 1 -o "$dir" || echo "advise $scene $budget ms: exit $?"
-    find "$dir/search" -mindepth 2 -maxdepth 2 ! -name results.jsonl ! -name sweep.json -exec rm -rf {} + 2>/dev/null
-    rm -rf "$dir/cache"
+    keep_advice_records "$dir"
   done
 }
 

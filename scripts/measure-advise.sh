@@ -10,6 +10,7 @@
 # Usage: scripts/measure-advise.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
+. scripts/lib/advice.sh
 bin=${MIRRORBOX:-target/release/mirrorbox}
 out=reports/advise
 rm -rf "$out"
@@ -21,11 +22,7 @@ advise() { # SCENE BUDGET_MS [SUFFIX] [FLAGS...]
   echo "== advise: $scene within $budget ms$suffix"
   "$bin" advise "scenes/$scene.json" --budget-ms "$budget" --width 320 --height 180 \
     --alpha 1 -o "$dir" "$@"
-  # Of the rounds, the records only (results.jsonl, sweep.json): their images, caches and
-  # reports are not kept (advice.md shows the pick's images; ~5 MB per advice otherwise).
-  find "$dir/search" -mindepth 2 -maxdepth 2 ! -name results.jsonl ! -name sweep.json \
-    -exec rm -rf {} +
-  rm -rf "$dir/cache"
+  keep_advice_records "$dir"
 }
 for budget in 2 4 8; do advise mirror_box "$budget" ""; done
 for budget in 3 6 12; do advise mirror_room "$budget" ""; done
