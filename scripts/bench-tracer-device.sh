@@ -10,7 +10,7 @@
 #       it needs that a bare image may lack
 #   scripts/bench-tracer-device.sh run ROUNDS SPP   there: unpacks them under /tmp, checks that
 #       both renderers draw a small image, then runs scripts/bench-tracer.sh; the record lands
-#       in reports/tracer/ (carry reports/tracer) and, with the raw rounds, under $OUT
+#       in reports/tracer/ (carry reports/tracer) and, with its rounds, under $OUT
 set -euo pipefail
 cd "$(dirname "$0")/.."
 d=.bench
@@ -70,9 +70,11 @@ run)
   python3 tools/mitsuba/render.py "$t/scene.xml" -o "$t/mitsuba.exr" --integrator whitted --max-depth 10 --runs 1
   out=${OUT:-/tmp/bench-out}
   mkdir -p "$out"
-  MIRRORBOX_BENCH_RUNS=$out/runs.jsonl scripts/bench-tracer.sh "$rounds" "$spp"
-  cp reports/tracer/bench.md reports/tracer/bench.json "$out/"
-  cp "$(ls -t reports/tracer/bench-*.md | head -n 1)" "$(ls -t reports/tracer/bench-*.json | grep -v '/bench.json' | head -n 1)" "$out/"
+  scripts/bench-tracer.sh "$rounds" "$spp"
+  # This CPU's record (the newest rounds file names it) and the index.
+  rounds_file=$(ls -t reports/tracer/bench-*-rounds.jsonl | head -n 1)
+  stem=${rounds_file%-rounds.jsonl}
+  cp reports/tracer/bench.md reports/tracer/bench.json "$stem.md" "$stem.json" "$rounds_file" "$out/"
   ;;
 *)
   echo "usage: scripts/bench-tracer-device.sh prepare | run ROUNDS SPP" >&2

@@ -96,8 +96,6 @@ for round in $(seq "$rounds"); do
     done
   done
 done
-# MIRRORBOX_BENCH_RUNS: where to keep every round's raw times (one JSON object per render).
-[ -z "${MIRRORBOX_BENCH_RUNS:-}" ] || cp "$work/runs.jsonl" "$MIRRORBOX_BENCH_RUNS"
 mitsuba_version=$("$py" -c 'import mitsuba; print(mitsuba.__version__)')
 # The record (and a copy of the rounds beside it, to make it again from): tracer-bench-record.py.
 python3 scripts/tracer-bench-record.py "$work/runs.jsonl" "$out" "$rounds" "$spp" "$mitsuba_version" "$commit" "$rr_depth"
