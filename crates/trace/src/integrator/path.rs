@@ -518,6 +518,13 @@ impl PathTracer<'_> {
         let (mut origin, mut dir) = ([[0.0f64; LANES]; 3], [[0.0f64; LANES]; 3]);
         // Per kind of shadow ray (light, then emitter), the round's blocked lanes.
         let mut blocked: Vec<LaneMask> = Vec::with_capacity(kinds);
+        // A round's single queries and their answers (closest hits, then shadow rays): set
+        // up once per call, not per round (only the first `n` entries of a batch are read,
+        // each written first; a round's `single` is read only in the lanes it queried).
+        let mut single: [Option<Hit>; LANES] = [None; LANES];
+        let mut queries = [NO_QUERY; LANES];
+        let mut lane_of = [0usize; LANES];
+        let mut answers = [None; LANES];
         for (chunk, rngs) in rays.chunks(LANES).zip(rngs.chunks_mut(LANES)) {
             let mut walks = [Walk::start(chunk[0]); LANES];
             for (w, &ray) in walks.iter_mut().zip(chunk) {
@@ -549,9 +556,6 @@ impl PathTracer<'_> {
                 // a run of traversals with nothing between them, which the processor
                 // overlaps better than traversals interleaved with the vertices' code.
                 // (Two at a time through the 8-wide hierarchy: `SceneBvh::queries_inline`.)
-                let mut single: [Option<Hit>; LANES] = [None; LANES];
-                let mut queries = [NO_QUERY; LANES];
-                let mut lane_of = [0usize; LANES];
                 let mut n = 0;
                 for lane in lanes(active & !coherent) {
                     let w = &walks[lane];
@@ -565,7 +569,6 @@ impl PathTracer<'_> {
                     lane_of[n] = lane;
                     n += 1;
                 }
-                let mut answers = [None; LANES];
                 self.bvh
                     .queries_inline::<false>(&queries[..n], &mut answers[..n]);
                 for (&lane, &answer) in lane_of[..n].iter().zip(&answers[..n]) {
@@ -644,7 +647,6 @@ impl PathTracer<'_> {
                 // hierarchy), LANES per call.
                 let mut singles = asked.iter_mut().filter(|a| a.3.is_some()).peekable();
                 while singles.peek().is_some() {
-                    let mut queries = [NO_QUERY; LANES];
                     let mut of: [Option<&mut Option<bool>>; LANES] = Default::default();
                     let mut n = 0;
                     for (_, _, s, answer) in singles.by_ref().take(LANES) {
@@ -658,7 +660,6 @@ impl PathTracer<'_> {
                         of[n] = Some(answer);
                         n += 1;
                     }
-                    let mut answers = [None; LANES];
                     self.bvh
                         .queries_inline::<true>(&queries[..n], &mut answers[..n]);
                     for (answer, blocked) in of[..n].iter_mut().zip(&answers[..n]) {
