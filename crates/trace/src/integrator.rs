@@ -90,16 +90,17 @@ pub fn camera_rays(camera: &RayGenerator, positions: &[Vec2], rays: &mut Vec<Ray
 /// Packets per [`Integrator::radiance_all`] call: a call's fixed work (its walks' buffers
 /// set up, the vector build chosen, the row's per-call bookkeeping) shared by this many
 /// packets. Against one (issue 56, plain builds, one thread, this project's AVX2 AMD EPYC,
-/// paired): `whitted` `mirror_box` ×0.923 [0.866–0.973] (40 rounds), the instructions of
-/// `mirror_room` (160×90, cachegrind) −5.6 % (most of it a 3 KB `memset` per call, which
-/// valgrind counts by the byte); docs/tracer-performance.md.
+/// paired): `whitted` `mirror_box` ×0.910 [0.831–0.956] (40 rounds) and ×0.877 (30),
+/// `mirror_room` ×0.955, `path` ×0.958 / ×0.955; the instructions of `whitted` (160×90,
+/// cachegrind) −15.7 % / −5.6 % (most of it a 3 KB `memset` per call, which valgrind counts
+/// by the byte); docs/tracer-performance.md.
 const PACKETS_PER_CALL: usize = 8;
 
 /// Pixels per [`Integrator::radiance_all`] call for an integrator that traces packets:
 /// as many as fill [`PACKETS_PER_CALL`] packets' lanes, at least one, when `bvh` traces
 /// packets; else one. (A pixel that fills that many by itself goes alone: more pixels would
 /// only make the call's buffers larger — `path` at 9 216 samples a pixel measured ×1.2
-/// slower with eight.) Lanes are grouped into packets within a call, so this changes which
+/// slower with eight pixels a call.) Lanes are grouped into packets within a call, so this changes which
 /// rays share a packet, never an answer: the packets give the single-ray answers, bit for
 /// bit.
 fn packet_pixels(bvh: &SceneBvh, samples_per_pixel: usize) -> usize {

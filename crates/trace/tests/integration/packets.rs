@@ -1,8 +1,9 @@
 //! The packet kernel (issue 19) changes the speed of the truth, not the truth: `whitted`
 //! renders every bundled scene to the same bits with packets as one ray at a time through
 //! the BVH2 (the packets' hierarchy; the CWBVH misses some corner hits: see `bvh.rs`), at the
-//! command line's 4×4 grid (two pixels per packet), at 3×3 and 2×2 (3 and 8 pixels per
-//! packet; rows of 48 pixels end in part-filled packets) and 1×1 (32 pixels per packet: the
+//! command line's 4×4 grid (two pixels per packet), at 3×3 and 2×2 (a call's rays, eight
+//! packets' worth, cut into packets of 32 across pixels; at 3×3 rows of 48 pixels end in a
+//! part-filled packet) and 1×1 (32 pixels per packet, the row's last one part-filled: the
 //! sweeps' truths at one sample per pixel), with
 //! shadow legs, uneven
 //! mirrors, symmetry planes and stereo rigs' scenes among them. So does `path`, whose
@@ -71,7 +72,8 @@ fn whitted_renders_every_bundled_scene_to_the_same_bits_with_packets() {
 }
 
 /// `path` walks 32 samples side by side, each with its own stream split off its pixel's in
-/// order, several pixels' at once (2, 3 and 8 pixels per call at these grids); the queries
+/// order, several pixels' at once (16, 28 and 64 pixels per call at these grids, eight
+/// packets' worth, so at 3×3 a row of 32 ends in a part-filled call); the queries
 /// of paths before their first diffuse vertex and that vertex's shadow rays go to the
 /// packet kernel, the rest one at a time. Its images are the same bits as one sample at a
 /// time, one pixel per call, through the same hierarchy.
