@@ -706,8 +706,8 @@ impl Integrator for PathTracer<'_> {
         self.radiance_one(ray, &mut rng.split(), &mut Vec::new())
     }
 
-    /// Enough pixels to fill a packet's lanes when packets are traced (at least one): every
-    /// sample has its own stream, so any samples can walk side by side.
+    /// Enough pixels to fill a call's packets when packets are traced (at least one;
+    /// `packet_pixels`): every sample has its own stream, so any samples can walk side by side.
     fn pixels_per_call(&self, samples_per_pixel: usize) -> usize {
         super::packet_pixels(self.bvh, samples_per_pixel)
     }

@@ -933,8 +933,9 @@ impl Integrator for Whitted<'_> {
         Whitted::radiance(self, ray)
     }
 
-    /// Enough pixels to fill a packet when packets are traced, at any sample count: at one
-    /// sample per pixel (the sweeps' truths) a packet is 32 neighbouring pixels of a row. (Below
+    /// Enough pixels to fill a call's packets when packets are traced, at any sample count
+    /// (`packet_pixels`): at one sample per pixel (the sweeps' truths) a packet is 32
+    /// neighbouring pixels of a row. (Below
     /// 4 samples rays went one at a time while the single-ray default was obvhs's CWBVH, whose
     /// answers differ from the packets' at mirror corners, to keep the 1-spp truths' bits; the
     /// 8-wide hierarchy answers as the packets do: issue 56, `mirror_room` at 1 spp ×0.30.)
