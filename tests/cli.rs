@@ -635,6 +635,44 @@ fn trace_warm_up_renders_the_same_image_and_reports_each_time() {
     }
 }
 
+/// `trace --ab-switch FORM` (hidden; scripts/ab-inprocess.sh) alternates the tracer's A/B
+/// switch over the --warm-up renders from the form named and lists each render's form in the
+/// JSON; without it the list is null, and without --warm-up the flag is refused (exit 2,
+/// nothing written).
+#[test]
+fn trace_ab_switch_alternates_the_warm_up_renders() {
+    let dir = tempfile::tempdir().unwrap();
+    for (flags, forms) in [
+        (
+            &["--warm-up", "3", "--ab-switch", "b"][..],
+            serde_json::json!(["b", "a", "b"]),
+        ),
+        (
+            &["--warm-up", "2", "--ab-switch", "a"][..],
+            serde_json::json!(["a", "b"]),
+        ),
+        (&["--warm-up", "1"][..], serde_json::Value::Null),
+    ] {
+        let name = flags.join("");
+        let (json, _) = trace_small(dir.path(), &name, "scenes/mirror_box.json", flags);
+        assert_eq!(json["warm_up_forms"], forms, "{flags:?}");
+    }
+    let exr = dir.path().join("refused.exr");
+    let exr_s = exr.to_str().unwrap();
+    let args = [
+        "trace",
+        "scenes/mirror_box.json",
+        "-o",
+        exr_s,
+        "--ab-switch",
+        "a",
+    ];
+    let out = mirrorbox(&args, &[]);
+    assert_eq!(out.code, 2, "{}", out.stderr);
+    assert!(out.stderr.contains("--warm-up"), "{}", out.stderr);
+    assert!(!exr.exists());
+}
+
 /// "Depth" counts mirror reflections everywhere (docs/shading.md): `path`'s length is counted
 /// in segments under its own flag, recorded under its own name; each integrator refuses the
 /// other's cut, exit 2, naming the flag to use, and writes nothing.

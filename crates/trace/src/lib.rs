@@ -9,7 +9,9 @@
 //! - [`hit_point`]: a diffuse hit's point re-solved on its triangle's plane in f64.
 //! - [`sampler`]: the shared sub-pixel grid, or stratified jitter.
 //! - [`render`](mod@render): the parallel image loop and its statistics.
+//! - [`ab_switch`]: a switch for timing two forms of a change inside one process.
 
+pub mod ab_switch;
 pub mod bvh;
 pub mod cpu_features;
 pub mod hit_point;

@@ -39,6 +39,24 @@ pub enum Simd {
     Baseline,
 }
 
+/// A form of the change behind the tracer's A/B switch (`mirrorbox_trace::ab_switch`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum AbForm {
+    /// The switch off.
+    A,
+    /// The switch on.
+    B,
+}
+
+impl AbForm {
+    fn name(self) -> &'static str {
+        match self {
+            AbForm::A => "a",
+            AbForm::B => "b",
+        }
+    }
+}
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Device {
     /// The CPU tracer (obvhs BVH, rayon threads).
@@ -131,6 +149,12 @@ pub struct Args {
     /// includes them). CPU only.
     #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=10))]
     warm_up: u32,
+    /// For timing a change to the tracer (hidden: developers' use, scripts/ab-inprocess.sh):
+    /// the --warm-up renders alternate the tracer's A/B switch (`mirrorbox_trace::ab_switch`),
+    /// the first in the form named; --json lists each one's form (warm_up_forms). The timed
+    /// render runs in form A.
+    #[arg(long, value_enum, hide = true, requires = "warm_up")]
+    ab_switch: Option<AbForm>,
     /// Print the summary as one JSON object (one per eye with --stereo).
     #[arg(long)]
     json: bool,
@@ -318,12 +342,18 @@ fn run_frame(args: &Args) -> Result<(), Failure> {
         .with_integrator(integrator);
     // Every output appears together, or none does (a failing --bounces leaves no image).
     let mut staged = StagedFiles::new();
+    let forms = warm_up_forms(args);
     let mut traced = Vec::new();
     for (eye, view) in views(&scene, rig) {
         // Rendered in full and dropped: only their times are kept (--warm-up).
-        let warm_up: Vec<f64> = (0..args.warm_up)
-            .map(|_| render(&view, &bvh, &settings, &|_| {}).wall.as_secs_f64())
+        let warm_up: Vec<f64> = forms
+            .iter()
+            .map(|form| {
+                mirrorbox_trace::ab_switch::set(*form == Some(AbForm::B));
+                render(&view, &bvh, &settings, &|_| {}).wall.as_secs_f64()
+            })
             .collect();
+        mirrorbox_trace::ab_switch::set(false);
         let bar = progress_bar(view.camera.height as u64, "tracing rows");
         let out = render(&view, &bvh, &settings, &|rows| {
             bar.set_position(rows as u64)
@@ -367,6 +397,7 @@ fn run_frame(args: &Args) -> Result<(), Failure> {
         let timing = Timing {
             total,
             warm_up_seconds: warm_up,
+            warm_up_forms: &forms,
         };
         report(args, view, &bvh, out, grid, &timing, &written, *eye);
     }
@@ -470,6 +501,22 @@ fn stage_bounces(
 struct Timing<'a> {
     total: std::time::Duration,
     warm_up_seconds: &'a [f64],
+    /// Each warm-up render's form of the A/B switch, with --ab-switch.
+    warm_up_forms: &'a [Option<AbForm>],
+}
+
+/// The form of the A/B switch each --warm-up render runs in: alternating from --ab-switch's,
+/// or none without it.
+fn warm_up_forms(args: &Args) -> Vec<Option<AbForm>> {
+    (0..args.warm_up)
+        .map(|i| {
+            args.ab_switch.map(|first| match (first, i % 2) {
+                (form, 0) => form,
+                (AbForm::A, _) => AbForm::B,
+                (AbForm::B, _) => AbForm::A,
+            })
+        })
+        .collect()
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -497,6 +544,9 @@ fn report(
             "paths": s.paths, "rays": s.rays, "mrays_per_s": mrays,
             "deepest_path": s.deepest, "render_seconds": secs, "total_seconds": total.as_secs_f64(),
             "warm_up_seconds": timing.warm_up_seconds,
+            "warm_up_forms": args.ab_switch.map(|_| {
+                timing.warm_up_forms.iter().flatten().map(|f| f.name()).collect::<Vec<_>>()
+            }),
             "bvh": format!("{:?}", bvh.kind).to_lowercase(), "bvh_build_seconds": bvh.build_time.as_secs_f64(),
             "kernel": format!("{:?}", args.kernel).to_lowercase(),
             "packet_bvh_build_seconds": bvh.packet_build_time().map(|t| t.as_secs_f64()),
