@@ -276,7 +276,7 @@ impl PacketBvh {
     /// A binary hierarchy built over `tris` (the scene's triangles in its numbering), with
     /// `slot_of(i)` the slot of triangle `i`.
     ///
-    /// obvhs' `medium_build`, with the leaves collapsed for this kernel's costs
+    /// [`super::build_params`], with the leaves collapsed for this kernel's costs
     /// ([`LEAF_COLLAPSE_COST`]).
     pub(super) fn build(tris: &[obvhs::triangle::Triangle], slot_of: impl Fn(u32) -> Slot) -> Self {
         if tris.is_empty() {
@@ -285,7 +285,7 @@ impl PacketBvh {
         let mut build_time = std::time::Duration::ZERO;
         let params = obvhs::BvhBuildParams {
             collapse_traversal_cost: LEAF_COLLAPSE_COST,
-            ..obvhs::BvhBuildParams::medium_build()
+            ..super::build_params(tris.len())
         };
         let bvh = obvhs::bvh2::builder::build_bvh2_from_tris(tris, params, &mut build_time);
         let original = bvh.primitive_indices.clone();
