@@ -8,8 +8,9 @@
 # start alternately with A and with B, and the pairs are (A, B) or (B, A) in render order.
 # Prints each form's median render time and the median of the per-pair ratios B / A with a
 # bootstrap 90 % interval, as scripts/ab-trace.sh does: the change is real when the interval
-# excludes 1. Then confirm on two builds with scripts/ab-trace.sh: a binary holding both forms
-# lays out its code differently from either alone.
+# excludes 1. A binary holding both forms lays out its code differently from either alone, so
+# the step's two builds are compared too: scripts/count-instructions.sh, and
+# scripts/ab-trace.sh where the effect is large enough for it to resolve.
 #
 # Usage: scripts/ab-inprocess.sh PROCESSES SCENE BIN [-- TRACE_ARGS...]
 #   e.g. scripts/ab-inprocess.sh 16 mirror_room target/release/mirrorbox -- --spp 16 --width 320 --height 180
@@ -32,8 +33,12 @@ trap 'rm -rf "$work"' EXIT
 for p in $(seq "$processes"); do
   first=a
   [ $((p % 2)) = 0 ] && first=b
-  RAYON_NUM_THREADS=1 "$bin" trace "scenes/$scene.json" -o "$work/out.exr" --json \
-    --warm-up 10 --ab-switch "$first" "$@" > "$work/run-$p.json" 2>/dev/null
+  if ! RAYON_NUM_THREADS=1 "$bin" trace "scenes/$scene.json" -o "$work/out.exr" --json \
+    --warm-up 10 --ab-switch "$first" "$@" > "$work/run-$p.json" 2> "$work/stderr"; then
+    echo "$bin trace failed:" >&2
+    cat "$work/stderr" >&2
+    exit 1
+  fi
 done
 python3 - "$work" "$processes" <<'PY'
 import json, random, statistics, sys

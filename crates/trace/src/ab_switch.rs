@@ -10,8 +10,10 @@
 //!
 //! Nothing in the tracer reads the switch: a developer puts the change being timed behind
 //! `if ab_switch::on()` — read once per call, outside lane loops, so that both forms still
-//! vectorise — and takes the switch out again before committing the change, which is then
-//! kept or dropped by measurement as every other (scripts/ab-trace.sh on the two builds).
+//! vectorise — and takes the switch out again before committing the change. A binary holding
+//! both forms lays out its code differently from either alone, so the change's two builds are
+//! compared too (`scripts/count-instructions.sh`, and `scripts/ab-trace.sh` where the effect
+//! is large enough for it to resolve).
 
 use std::sync::atomic::{AtomicBool, Ordering};
 

@@ -249,6 +249,69 @@ pub(crate) fn build_params(triangles: usize) -> BvhBuildParams {
     }
 }
 
+/// A binary hierarchy over `primitives` by obvhs's `build_bvh2` steps (PLOC, reinsertion,
+/// leaf collapse, reinsertion) with [`build_params`] as `tune` adjusts them. Full reinsertion
+/// can deepen a pathological tree (the assimp corpus's long line of boxes: 232 levels) beyond
+/// the depth obvhs sized its traversal stacks for (`max_depth`, set by the PLOC step; deeper,
+/// its fixed stacks would overwrite their top entry): such a tree is built again with
+/// `medium_build`, as before. `build_time` gains the build's time.
+pub(crate) fn build_binary<T: obvhs::Boundable>(
+    primitives: &[T],
+    tune: impl Fn(BvhBuildParams) -> BvhBuildParams,
+    build_time: &mut Duration,
+) -> obvhs::bvh2::Bvh2 {
+    let medium = tune(BvhBuildParams::medium_build());
+    if primitives.len() > HIGH_QUALITY_BUILD_TRIANGLES {
+        return obvhs::bvh2::builder::build_bvh2(primitives, medium, build_time);
+    }
+    let params = tune(build_params(primitives.len()));
+    let start = std::time::Instant::now();
+    let mut bvh = obvhs::ploc::PlocBuilder::with_capacity(primitives.len()).build(
+        params.ploc_search_distance,
+        primitives,
+        (0..primitives.len() as u32).collect::<Vec<_>>(),
+        params.sort_precision,
+        params.search_depth_threshold,
+    );
+    let mut reinsertion = obvhs::bvh2::reinsertion::ReinsertionOptimizer::default();
+    reinsertion.run(&mut bvh, params.reinsertion_batch_ratio, None);
+    obvhs::bvh2::leaf_collapser::collapse(
+        &mut bvh,
+        params.max_prims_per_leaf.clamp(1, 255),
+        params.collapse_traversal_cost,
+    );
+    reinsertion.run(
+        &mut bvh,
+        params.reinsertion_batch_ratio * params.post_collapse_reinsertion_batch_ratio_multiplier,
+        None,
+    );
+    *build_time += start.elapsed();
+    if binary_depth(&bvh) < bvh.max_depth {
+        #[cfg(debug_assertions)]
+        bvh.validate(primitives, false, false);
+        bvh
+    } else {
+        obvhs::bvh2::builder::build_bvh2(primitives, medium, build_time)
+    }
+}
+
+/// Levels of a binary hierarchy (a lone leaf: 1), without recursion.
+fn binary_depth(bvh: &obvhs::bvh2::Bvh2) -> usize {
+    let mut deepest = 0;
+    let mut todo = vec![(0usize, 1usize)];
+    while let Some((i, depth)) = todo.pop() {
+        let Some(node) = bvh.nodes.get(i) else {
+            continue;
+        };
+        deepest = deepest.max(depth);
+        if !node.is_leaf() {
+            let first = node.first_index as usize;
+            todo.extend([(first, depth + 1), (first + 1, depth + 1)]);
+        }
+    }
+    deepest
+}
+
 /// Most triangles for [`build_params`]' slower, better build: 110 342 triangles (an imported
 /// glTF engine) took 0.56 s and 0.59 s for the 8-wide and packet hierarchies against 0.17 s
 /// and 0.15 s on the Zen 3 development machine, where its 640×360, 16-spp `whitted` render
@@ -371,16 +434,13 @@ impl SceneBvh {
                     }
                 },
                 BvhKind::Bvh2 | BvhKind::Wide => {
-                    // obvhs's `build_bvh2_from_tris` over the boxes (our parameters have no
-                    // pre-splits, the one step that needs the triangles); collapsed to 8
-                    // wide below, once the slots are known.
-                    debug_assert!(!params.pre_split);
-                    let params = if kind == BvhKind::Wide {
-                        wide::leaf_params(build_params(tris.len()))
+                    // [`build_binary`] over the boxes (no pre-splits, the one step that needs
+                    // the triangles); collapsed to 8 wide below, once the slots are known.
+                    let bvh = if kind == BvhKind::Wide {
+                        build_binary(&boxes, wide::leaf_params, &mut build_time)
                     } else {
-                        build_params(tris.len())
+                        build_binary(&boxes, |params| params, &mut build_time)
                     };
-                    let bvh = obvhs::bvh2::builder::build_bvh2(&boxes, params, &mut build_time);
                     let order = bvh.primitive_indices.clone();
                     (Hierarchy::Binary(bvh), order)
                 }

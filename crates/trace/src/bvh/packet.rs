@@ -276,18 +276,18 @@ impl PacketBvh {
     /// A binary hierarchy built over `tris` (the scene's triangles in its numbering), with
     /// `slot_of(i)` the slot of triangle `i`.
     ///
-    /// [`super::build_params`], with the leaves collapsed for this kernel's costs
+    /// [`super::build_binary`], with the leaves collapsed for this kernel's costs
     /// ([`LEAF_COLLAPSE_COST`]).
     pub(super) fn build(tris: &[obvhs::triangle::Triangle], slot_of: impl Fn(u32) -> Slot) -> Self {
         if tris.is_empty() {
             return PacketBvh::from_parts(Vec::new(), Vec::new(), Vec::new());
         }
         let mut build_time = std::time::Duration::ZERO;
-        let params = obvhs::BvhBuildParams {
+        let tune = |params| obvhs::BvhBuildParams {
             collapse_traversal_cost: LEAF_COLLAPSE_COST,
-            ..super::build_params(tris.len())
+            ..params
         };
-        let bvh = obvhs::bvh2::builder::build_bvh2_from_tris(tris, params, &mut build_time);
+        let bvh = super::build_binary(tris, tune, &mut build_time);
         let original = bvh.primitive_indices.clone();
         let slots = original.iter().map(|&i| slot_of(i)).collect();
         PacketBvh::from_bvh2(&bvh, slots, original)
