@@ -200,13 +200,7 @@ fn build_cwbvh(
     build_time: &mut Duration,
 ) -> Result<CwBvh, Box<obvhs::bvh2::Bvh2>> {
     let start = std::time::Instant::now();
-    let mut bvh2 = obvhs::ploc::PlocBuilder::with_capacity(boxes.len()).build(
-        params.ploc_search_distance,
-        boxes,
-        (0..boxes.len() as u32).collect::<Vec<_>>(),
-        params.sort_precision,
-        params.search_depth_threshold,
-    );
+    let mut bvh2 = ploc(boxes, &params);
     obvhs::bvh2::reinsertion::ReinsertionOptimizer::default().run(
         &mut bvh2,
         params.reinsertion_batch_ratio,
@@ -266,13 +260,7 @@ pub(crate) fn build_binary<T: obvhs::Boundable>(
     }
     let params = tune(build_params(primitives.len()));
     let start = std::time::Instant::now();
-    let mut bvh = obvhs::ploc::PlocBuilder::with_capacity(primitives.len()).build(
-        params.ploc_search_distance,
-        primitives,
-        (0..primitives.len() as u32).collect::<Vec<_>>(),
-        params.sort_precision,
-        params.search_depth_threshold,
-    );
+    let mut bvh = ploc(primitives, &params);
     let mut reinsertion = obvhs::bvh2::reinsertion::ReinsertionOptimizer::default();
     reinsertion.run(&mut bvh, params.reinsertion_batch_ratio, None);
     obvhs::bvh2::leaf_collapser::collapse(
@@ -293,6 +281,18 @@ pub(crate) fn build_binary<T: obvhs::Boundable>(
     } else {
         obvhs::bvh2::builder::build_bvh2(primitives, medium, build_time)
     }
+}
+
+/// obvhs's PLOC build of a binary hierarchy over `primitives` with `params`' search, sort
+/// and depth threshold: the first step of every build here.
+fn ploc<T: obvhs::Boundable>(primitives: &[T], params: &BvhBuildParams) -> obvhs::bvh2::Bvh2 {
+    obvhs::ploc::PlocBuilder::with_capacity(primitives.len()).build(
+        params.ploc_search_distance,
+        primitives,
+        (0..primitives.len() as u32).collect::<Vec<_>>(),
+        params.sort_precision,
+        params.search_depth_threshold,
+    )
 }
 
 /// Levels of a binary hierarchy (a lone leaf: 1), without recursion.
