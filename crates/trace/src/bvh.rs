@@ -221,30 +221,25 @@ fn build_cwbvh(
 }
 
 /// The build of the hierarchies mirrorbox traverses itself (the 8-wide one, and the binary
-/// ones of `--bvh bvh2` and the packet kernel) over `triangles` triangles: up to
-/// [`HIGH_QUALITY_BUILD_TRIANGLES`], obvhs's `medium_build` with the PLOC search, reinsertion
-/// and sort precision of its slowest presets (no pre-splits: the binary build works on
-/// boxes); above, `medium_build`. Against `medium_build`, timed inside one process
+/// ones of `--bvh bvh2` and the packet kernel) up to [`HIGH_QUALITY_BUILD_TRIANGLES`]
+/// ([`build_binary`]): obvhs's `medium_build` with the PLOC search, reinsertion and sort
+/// precision of its slowest presets (no pre-splits). Against `medium_build`, timed inside one process
 /// (`scripts/ab-inprocess.sh`, 64 pairs, 320×180, 16 spp; issue 56, sixth session): `path`
 /// ×0.977 [0.967–0.996] / ×0.993 [0.971–1.008], `whitted` ×0.995 [0.990–0.998] / ×0.978
 /// [0.971–0.991] (`mirror_room` / `mirror_box`), the same bits; each build 3–4× slower
 /// (docs/tracer-performance.md). obvhs's own CWBVH keeps `medium_build`.
-pub(crate) fn build_params(triangles: usize) -> BvhBuildParams {
-    if triangles > HIGH_QUALITY_BUILD_TRIANGLES {
-        return BvhBuildParams::medium_build();
-    }
-    BvhBuildParams {
-        ploc_search_distance: obvhs::ploc::PlocSearchDistance::High,
-        search_depth_threshold: 1,
-        reinsertion_batch_ratio: 1.0,
-        post_collapse_reinsertion_batch_ratio_multiplier: 1.0,
-        sort_precision: obvhs::ploc::SortPrecision::U128,
-        ..BvhBuildParams::medium_build()
-    }
-}
+const HIGH_QUALITY_BUILD: BvhBuildParams = BvhBuildParams {
+    ploc_search_distance: obvhs::ploc::PlocSearchDistance::High,
+    search_depth_threshold: 1,
+    reinsertion_batch_ratio: 1.0,
+    post_collapse_reinsertion_batch_ratio_multiplier: 1.0,
+    sort_precision: obvhs::ploc::SortPrecision::U128,
+    ..BvhBuildParams::medium_build()
+};
 
 /// A binary hierarchy over `primitives` by obvhs's `build_bvh2` steps (PLOC, reinsertion,
-/// leaf collapse, reinsertion) with [`build_params`] as `tune` adjusts them. Full reinsertion
+/// leaf collapse, reinsertion) with [`HIGH_QUALITY_BUILD`] as `tune` adjusts it, or with
+/// `medium_build` above [`HIGH_QUALITY_BUILD_TRIANGLES`]. Full reinsertion
 /// can deepen a pathological tree (the assimp corpus's long line of boxes: 232 levels) beyond
 /// the depth obvhs sized its traversal stacks for (`max_depth`, set by the PLOC step; deeper,
 /// its fixed stacks would overwrite their top entry): such a tree is built again with
@@ -258,7 +253,7 @@ pub(crate) fn build_binary<T: obvhs::Boundable>(
     if primitives.len() > HIGH_QUALITY_BUILD_TRIANGLES {
         return obvhs::bvh2::builder::build_bvh2(primitives, medium, build_time);
     }
-    let params = tune(build_params(primitives.len()));
+    let params = tune(HIGH_QUALITY_BUILD);
     let start = std::time::Instant::now();
     let mut bvh = ploc(primitives, &params);
     let mut reinsertion = obvhs::bvh2::reinsertion::ReinsertionOptimizer::default();
@@ -312,7 +307,7 @@ fn binary_depth(bvh: &obvhs::bvh2::Bvh2) -> usize {
     deepest
 }
 
-/// Most triangles for [`build_params`]' slower, better build: 110 342 triangles (an imported
+/// Most triangles for [`HIGH_QUALITY_BUILD`], the slower, better build: 110 342 triangles (an imported
 /// glTF engine) took 0.56 s and 0.59 s for the 8-wide and packet hierarchies against 0.17 s
 /// and 0.15 s on the Zen 3 development machine, where its 640×360, 16-spp `whitted` render
 /// takes 0.14 s on two threads: a few per cent of that is not worth 0.8 s. The bench scenes

@@ -100,9 +100,9 @@ const PACKETS_PER_CALL: usize = 8;
 /// as many as fill [`PACKETS_PER_CALL`] packets' lanes, at least one, when `bvh` traces
 /// packets; else one. (A pixel that fills that many by itself goes alone: more pixels would
 /// only make the call's buffers larger — `path` at 9 216 samples a pixel measured ×1.2
-/// slower with eight pixels a call.) Lanes are grouped into packets within a call, so this changes which
-/// rays share a packet, never an answer: the packets give the single-ray answers, bit for
-/// bit.
+/// slower with eight pixels a call.) Lanes are grouped into packets within a call, so this
+/// changes which rays share a packet, never an answer: the packets give the single-ray
+/// answers, bit for bit.
 fn packet_pixels(bvh: &SceneBvh, samples_per_pixel: usize) -> usize {
     if bvh.packets() && samples_per_pixel >= 1 {
         (crate::bvh::packet::LANES * PACKETS_PER_CALL / samples_per_pixel).max(1)

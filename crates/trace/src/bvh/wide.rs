@@ -1,7 +1,8 @@
 //! An 8-wide hierarchy of our own for single rays (issue 56): the rays packets cannot serve
 //! (`path`'s scattered continuations and shadow legs, Whitted's remaining single rays).
 //!
-//! **Build**: obvhs builds the binary hierarchy ([`super::build_params`], as for [`super::BvhKind::Bvh2`]);
+//! **Build**: obvhs builds the binary hierarchy ([`super::build_binary`], as for
+//! [`super::BvhKind::Bvh2`]);
 //! it is collapsed here into nodes of up to [`WIDTH`] children — repeatedly opening the inner
 //! child with the largest surface area, as Wald et al.'s and obvhs's own collapses do — with
 //! the children's boxes stored as structure of arrays (`lo[axis][child]`), uncompressed f32.

@@ -935,10 +935,10 @@ impl Integrator for Whitted<'_> {
 
     /// Enough pixels to fill a call's packets when packets are traced, at any sample count
     /// (`packet_pixels`): at one sample per pixel (the sweeps' truths) a packet is 32
-    /// neighbouring pixels of a row. (Below
-    /// 4 samples rays went one at a time while the single-ray default was obvhs's CWBVH, whose
-    /// answers differ from the packets' at mirror corners, to keep the 1-spp truths' bits; the
-    /// 8-wide hierarchy answers as the packets do: issue 56, `mirror_room` at 1 spp ×0.30.)
+    /// neighbouring pixels of a row. (Below 4 samples rays went one at a time while the
+    /// single-ray default was obvhs's CWBVH, whose answers differ from the packets' at mirror
+    /// corners, to keep the 1-spp truths' bits; the 8-wide hierarchy answers as the packets
+    /// do: issue 56, `mirror_room` at 1 spp ×0.30.)
     fn pixels_per_call(&self, samples_per_pixel: usize) -> usize {
         super::packet_pixels(self.bvh, samples_per_pixel)
     }
