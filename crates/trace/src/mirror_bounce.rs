@@ -1,10 +1,14 @@
 //! Plane-exact mirror bounces, shared by every integrator.
 //!
-//! A mirror hit is re-solved in f64 against the mirror's exact plane
-//! (`t = (offset − n·o)/(n·d)`) and reflected there (`d − 2(d·n)n`); the BVH only decides
-//! *which* mirror is hit. The next ray skips the mirror it leaves (a planar mirror cannot be
-//! hit again by its own reflection), so no offset epsilon is needed and error after k bounces
-//! stays at f64 rounding (tested against the closed form at k = 10 000).
+//! A mirror hit is re-solved against the mirror's exact plane (`t = (offset − n·o)/(n·d)`)
+//! and reflected there (`d − 2(d·n)n`); the BVH only decides *which* mirror is hit. The next
+//! ray skips the mirror it leaves (a planar mirror cannot be hit again by its own
+//! reflection), so no offset epsilon is needed. `whitted` bounces in f64, so that error after
+//! k bounces stays at f64 rounding (tested against the closed form at k = 10 000); `path`,
+//! whose rays are f32 and whose paths are at most a few dozen segments (as Mitsuba's, which
+//! bounces in f32), bounces in f32 — the same formula ([`reflect_on_plane`] on [`PlaneReal`]),
+//! the plane rounded to f32 ([`MirrorPlanes::flat_plane_f32`]): measured ×0.975 / ×0.971 on
+//! `path` `mirror_box` / `mirror_room` (issue 56, docs/tracer-performance.md).
 //!
 //! An uneven mirror (`mirrorbox_scene::bump`) reflects about its perturbed normal at the hit
 //! point instead, or absorbs the ray by the contract's rule (`docs/shading.md`); a flat bump
@@ -24,6 +28,8 @@ pub struct MirrorPlanes {
     /// a copy of `planes` and `bumps` together, kept apart from the large bump records so
     /// that a bounce reads one small entry).
     flat: Vec<Option<(DVec3, f64)>>,
+    /// `flat` rounded to f32 ([`MirrorPlanes::flat_plane_f32`]).
+    flat_f32: Vec<Option<([f32; 3], f32)>>,
 }
 
 impl MirrorPlanes {
@@ -43,11 +49,16 @@ impl MirrorPlanes {
             .iter()
             .zip(&bumps)
             .map(|(&plane, bump)| bump.is_none().then_some(plane))
+            .collect::<Vec<_>>();
+        let flat_f32 = flat
+            .iter()
+            .map(|p| p.map(|(n, offset)| (n.as_vec3().to_array(), offset as f32)))
             .collect();
         MirrorPlanes {
             planes,
             bumps,
             flat,
+            flat_f32,
         }
     }
 
@@ -80,25 +91,65 @@ impl MirrorPlanes {
     pub fn flat_plane(&self, mirror: usize) -> Option<(DVec3, f64)> {
         self.flat[mirror]
     }
+
+    /// [`MirrorPlanes::flat_plane`] rounded to f32: the `path` integrator's bounces
+    /// ([`reflect_on_plane`] on f32).
+    #[inline(always)]
+    pub fn flat_plane_f32(&self, mirror: usize) -> Option<([f32; 3], f32)> {
+        self.flat_f32[mirror]
+    }
+}
+
+/// The arithmetic [`reflect_on_plane`] needs, for f64 (`whitted`: plane-exact chains of
+/// thousands of bounces) and f32 (`path`, whose rays and hit points are f32, as Mitsuba's).
+pub trait PlaneReal:
+    Copy
+    + std::ops::Add<Output = Self>
+    + std::ops::Sub<Output = Self>
+    + std::ops::Mul<Output = Self>
+    + std::ops::Div<Output = Self>
+{
+    const ONE: Self;
+    const TWO: Self;
+    fn sqrt(self) -> Self;
+}
+
+impl PlaneReal for f64 {
+    const ONE: f64 = 1.0;
+    const TWO: f64 = 2.0;
+    #[inline(always)]
+    fn sqrt(self) -> f64 {
+        f64::sqrt(self)
+    }
+}
+
+impl PlaneReal for f32 {
+    const ONE: f32 = 1.0;
+    const TWO: f32 = 2.0;
+    #[inline(always)]
+    fn sqrt(self) -> f32 {
+        f32::sqrt(self)
+    }
 }
 
 /// The plane-exact bounce of `o + t·d` off the plane `n·x = offset`: the hit
 /// `o + t·d` with `t = (offset − n·o)/(n·d)`, and `normalize(d − 2(d·n)n)`. Written on
 /// arrays with glam's order of operations (its `dot`, `normalize` = `v · (1/√(v·v))`), so
 /// that a loop over the lanes of a packet vectorises and gives the same bits as one ray.
+/// In f64 for `whitted`, in f32 for `path`.
 #[inline(always)]
-pub fn reflect_on_plane(
-    n: [f64; 3],
-    offset: f64,
-    o: [f64; 3],
-    d: [f64; 3],
-) -> ([f64; 3], [f64; 3]) {
-    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+pub fn reflect_on_plane<T: PlaneReal>(
+    n: [T; 3],
+    offset: T,
+    o: [T; 3],
+    d: [T; 3],
+) -> ([T; 3], [T; 3]) {
+    let dot = |a: [T; 3], b: [T; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
     let t = (offset - dot(n, o)) / dot(n, d);
     let hit = [o[0] + d[0] * t, o[1] + d[1] * t, o[2] + d[2] * t];
-    let s = 2.0 * dot(d, n);
+    let s = T::TWO * dot(d, n);
     let r = [d[0] - s * n[0], d[1] - s * n[1], d[2] - s * n[2]];
-    let inv_length = 1.0 / dot(r, r).sqrt();
+    let inv_length = T::ONE / dot(r, r).sqrt();
     (
         hit,
         [r[0] * inv_length, r[1] * inv_length, r[2] * inv_length],
@@ -106,17 +157,16 @@ pub fn reflect_on_plane(
 }
 
 /// A packet's bounces off flat mirrors, side by side: every lane with `flat[i]` has its ray
-/// `(origin, dir)` (f64 lanes) replaced by the bounce off the plane `(normal, offset)`
-/// ([`reflect_on_plane`]), rounded to f32 when `ROUND_TO_F32` (the `path` integrator holds
-/// its rays in f32); other lanes keep their ray. Branch free over all lanes: it vectorises
-/// (inline: compiled for the caller's CPU features).
+/// `(origin, dir)` replaced by the bounce off the plane `(normal, offset)`
+/// ([`reflect_on_plane`], f64 or f32 lanes); other lanes keep their ray. Branch free over
+/// all lanes: it vectorises (inline: compiled for the caller's CPU features).
 #[inline(always)]
-pub fn bounce_flat_lanes<const L: usize, const ROUND_TO_F32: bool>(
+pub fn bounce_flat_lanes<T: PlaneReal, const L: usize>(
     flat: &[bool; L],
-    normal: &[[f64; L]; 3],
-    offset: &[f64; L],
-    origin: &mut [[f64; L]; 3],
-    dir: &mut [[f64; L]; 3],
+    normal: &[[T; L]; 3],
+    offset: &[T; L],
+    origin: &mut [[T; L]; 3],
+    dir: &mut [[T; L]; 3],
 ) {
     for i in 0..L {
         let n = [normal[0][i], normal[1][i], normal[2][i]];
@@ -124,13 +174,8 @@ pub fn bounce_flat_lanes<const L: usize, const ROUND_TO_F32: bool>(
         let d = [dir[0][i], dir[1][i], dir[2][i]];
         let (hit, r) = reflect_on_plane(n, offset[i], o, d);
         for k in 0..3 {
-            let (h, r) = if ROUND_TO_F32 {
-                (hit[k] as f32 as f64, r[k] as f32 as f64)
-            } else {
-                (hit[k], r[k])
-            };
-            origin[k][i] = if flat[i] { h } else { origin[k][i] };
-            dir[k][i] = if flat[i] { r } else { dir[k][i] };
+            origin[k][i] = if flat[i] { hit[k] } else { origin[k][i] };
+            dir[k][i] = if flat[i] { r[k] } else { dir[k][i] };
         }
     }
 }
@@ -162,6 +207,53 @@ mod tests {
             let (h, s) = reflect_on_plane(n.to_array(), offset, o.to_array(), d.to_array());
             assert_eq!(h.map(f64::to_bits), hit.to_array().map(f64::to_bits));
             assert_eq!(s.map(f64::to_bits), r.to_array().map(f64::to_bits));
+        }
+    }
+
+    /// The f32 form (`path`'s) is glam's f32 arithmetic too, and its lane form gives the
+    /// same bits as one ray: the lanes with `flat` bounce, the others keep their ray.
+    #[test]
+    fn plane_bounce_in_f32_is_glams_arithmetic_and_its_lanes_agree() {
+        use glam::Vec3;
+        let mut rng = crate::sampler::SplitMix64::for_pixel(12, 0);
+        let mut unit = || Vec3::new(rng.next_unit(), rng.next_unit(), rng.next_unit()) - 0.5;
+        const L: usize = 8;
+        for round in 0..1_000 {
+            let (mut normal, mut offset) = ([[0.0f32; L]; 3], [0.0f32; L]);
+            let (mut origin, mut dir) = ([[0.0f32; L]; 3], [[0.0f32; L]; 3]);
+            let mut flat = [false; L];
+            let mut expected = Vec::new();
+            for i in 0..L {
+                let (n, d) = (unit().normalize(), unit().normalize());
+                let o = unit() * 6.0;
+                let off = n.dot(unit() * 2.0);
+                let t = (off - n.dot(o)) / n.dot(d);
+                let hit = o + d * t;
+                let r = (d - 2.0 * d.dot(n) * n).normalize();
+                let (h, s) = reflect_on_plane(n.to_array(), off, o.to_array(), d.to_array());
+                assert_eq!(h.map(f32::to_bits), hit.to_array().map(f32::to_bits));
+                assert_eq!(s.map(f32::to_bits), r.to_array().map(f32::to_bits));
+                flat[i] = (round + i) % 3 != 0;
+                for k in 0..3 {
+                    normal[k][i] = n[k];
+                    origin[k][i] = o[k];
+                    dir[k][i] = d[k];
+                }
+                offset[i] = off;
+                expected.push(if flat[i] { (hit, r) } else { (o, d) });
+            }
+            bounce_flat_lanes(&flat, &normal, &offset, &mut origin, &mut dir);
+            for (i, (o, d)) in expected.into_iter().enumerate() {
+                let at = |a: &[[f32; L]; 3]| Vec3::new(a[0][i], a[1][i], a[2][i]);
+                assert_eq!(
+                    at(&origin).to_array().map(f32::to_bits),
+                    o.to_array().map(f32::to_bits)
+                );
+                assert_eq!(
+                    at(&dir).to_array().map(f32::to_bits),
+                    d.to_array().map(f32::to_bits)
+                );
+            }
         }
     }
 }

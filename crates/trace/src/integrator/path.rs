@@ -188,7 +188,7 @@ enum Vertex {
     /// Its next ray is `walk.ray`.
     Next,
     /// Its next ray is `walk.ray` bounced off this flat mirror plane (unit normal, offset).
-    FlatBounce((glam::DVec3, f64)),
+    FlatBounce(([f32; 3], f32)),
 }
 
 /// A shadow ray asked by the path in lane `.0`, of kind `.1` (point light, or the emitter
@@ -318,9 +318,17 @@ impl PathTracer<'_> {
                     unreachable!("only mirrors reflect")
                 };
                 w.beta *= reflectance;
-                match self.mirror_planes.flat_plane(mirror).filter(|_| DEFER_FLAT) {
+                match self.mirror_planes.flat_plane_f32(mirror) {
                     // The caller bounces the ray ([`Vertex::FlatBounce`]).
-                    Some(plane) => flat = Some(plane),
+                    Some(plane) if DEFER_FLAT => flat = Some(plane),
+                    Some((n, offset)) => {
+                        let (origin, dir) =
+                            reflect_on_plane(n, offset, ray.origin.to_array(), ray.dir.to_array());
+                        w.ray = Ray {
+                            origin: Vec3::from(origin),
+                            dir: Vec3::from(dir),
+                        };
+                    }
                     None => {
                         let Some((origin, dir)) = self.mirror_planes.reflect(
                             mirror,
@@ -513,9 +521,9 @@ impl PathTracer<'_> {
         let mut t_max = [0.0f32; LANES];
         let mut from = [NO_TRIANGLE; LANES];
         // A round's flat-mirror bounces, per lane (set for the lanes that have one).
-        let mut normal = [[0.0f64; LANES]; 3];
-        let mut offset = [0.0f64; LANES];
-        let (mut origin, mut dir) = ([[0.0f64; LANES]; 3], [[0.0f64; LANES]; 3]);
+        let mut normal = [[0.0f32; LANES]; 3];
+        let mut offset = [0.0f32; LANES];
+        let (mut origin, mut dir) = ([[0.0f32; LANES]; 3], [[0.0f32; LANES]; 3]);
         // Per kind of shadow ray (light, then emitter), the round's blocked lanes.
         let mut blocked: Vec<LaneMask> = Vec::with_capacity(kinds);
         // A round's single queries and their answers (closest hits, then shadow rays): set
@@ -601,29 +609,21 @@ impl PathTracer<'_> {
                             flat_lanes |= 1 << lane;
                             for k in 0..3 {
                                 normal[k][lane] = n[k];
-                                origin[k][lane] = w.ray.origin[k] as f64;
-                                dir[k][lane] = w.ray.dir[k] as f64;
+                                origin[k][lane] = w.ray.origin[k];
+                                dir[k][lane] = w.ray.dir[k];
                             }
                             offset[lane] = off;
                         }
                         Vertex::Next => {}
                     }
                 }
-                // The round's bounces off flat mirrors (f64, rounded to the path's f32 rays):
-                // side by side where many lanes bounce, else lane by lane (the same
-                // arithmetic: `reflect_on_plane`).
+                // The round's bounces off flat mirrors (f32): side by side where many lanes
+                // bounce, else lane by lane (the same arithmetic: `reflect_on_plane`).
                 if flat_lanes.count_ones() > FEW_FLAT_LANES {
-                    bounce_flat_lanes::<LANES, true>(
-                        &flat,
-                        &normal,
-                        &offset,
-                        &mut origin,
-                        &mut dir,
-                    );
-                    for lane in (0..LANES).filter(|&lane| flat[lane]) {
-                        let at = |a: &[[f64; LANES]; 3]| {
-                            Vec3::new(a[0][lane] as f32, a[1][lane] as f32, a[2][lane] as f32)
-                        };
+                    bounce_flat_lanes(&flat, &normal, &offset, &mut origin, &mut dir);
+                    for lane in lanes(flat_lanes) {
+                        let at =
+                            |a: &[[f32; LANES]; 3]| Vec3::new(a[0][lane], a[1][lane], a[2][lane]);
                         walks[lane].ray = Ray {
                             origin: at(&origin),
                             dir: at(&dir),
@@ -631,12 +631,12 @@ impl PathTracer<'_> {
                     }
                 } else {
                     for lane in lanes(flat_lanes) {
-                        let at = |a: &[[f64; LANES]; 3]| [a[0][lane], a[1][lane], a[2][lane]];
+                        let at = |a: &[[f32; LANES]; 3]| [a[0][lane], a[1][lane], a[2][lane]];
                         let (o, d) =
                             reflect_on_plane(at(&normal), offset[lane], at(&origin), at(&dir));
                         walks[lane].ray = Ray {
-                            origin: Vec3::new(o[0] as f32, o[1] as f32, o[2] as f32),
-                            dir: Vec3::new(d[0] as f32, d[1] as f32, d[2] as f32),
+                            origin: Vec3::from(o),
+                            dir: Vec3::from(d),
                         };
                     }
                 }

@@ -303,7 +303,7 @@ impl<'a> Whitted<'a> {
                     carried.add(shaded_lanes, &shaded);
                 }
                 if flat.iter().any(|&f| f) {
-                    bounce_flat_lanes::<LANES, false>(
+                    bounce_flat_lanes::<f64, LANES>(
                         flat,
                         plane_normal,
                         plane_offset,
