@@ -114,23 +114,20 @@ pub trait PlaneReal:
     fn sqrt(self) -> Self;
 }
 
-impl PlaneReal for f64 {
-    const ONE: f64 = 1.0;
-    const TWO: f64 = 2.0;
-    #[inline(always)]
-    fn sqrt(self) -> f64 {
-        f64::sqrt(self)
-    }
+macro_rules! plane_real {
+    ($($t:ty),*) => {$(
+        impl PlaneReal for $t {
+            const ONE: $t = 1.0;
+            const TWO: $t = 2.0;
+            #[inline(always)]
+            fn sqrt(self) -> $t {
+                <$t>::sqrt(self)
+            }
+        }
+    )*};
 }
 
-impl PlaneReal for f32 {
-    const ONE: f32 = 1.0;
-    const TWO: f32 = 2.0;
-    #[inline(always)]
-    fn sqrt(self) -> f32 {
-        f32::sqrt(self)
-    }
-}
+plane_real!(f64, f32);
 
 /// The plane-exact bounce of `o + t·d` off the plane `n·x = offset`: the hit
 /// `o + t·d` with `t = (offset − n·o)/(n·d)`, and `normalize(d − 2(d·n)n)`. Written on
