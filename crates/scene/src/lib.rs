@@ -20,6 +20,7 @@ pub mod gltf_asset;
 pub mod gltf_export;
 pub mod hash;
 pub mod import;
+pub mod lanes;
 pub mod light_images;
 pub mod limits;
 pub mod load;

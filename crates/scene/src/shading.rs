@@ -342,13 +342,17 @@ impl Lighting {
         }
         let mut irradiance = [[0.0; L]; 3];
         for light in &self.lights {
+            let mut sums = irradiance;
             for i in 0..L {
                 let e = point_irradiance(lane(p, i), lane(&n, i), light.position, light.intensity);
                 let adds = e != Vec3::ZERO;
                 for k in 0..3 {
                     let sum = irradiance[k][i] + e[k];
-                    irradiance[k][i] = if adds { sum } else { irradiance[k][i] };
+                    sums[k][i] = if adds { sum } else { irradiance[k][i] };
                 }
+            }
+            for (a, sums) in irradiance.iter_mut().zip(sums) {
+                crate::lanes::store_lanes(a, sums);
             }
         }
         let mut out = [[0.0; L]; 3];

@@ -18,6 +18,7 @@
 use glam::DVec3;
 use mirrorbox_scene::Scene;
 use mirrorbox_scene::bump::{self, MirrorBump};
+use mirrorbox_scene::lanes::store_lanes;
 
 pub struct MirrorPlanes {
     /// Per mirror: unit normal and offset, in f64.
@@ -165,15 +166,20 @@ pub fn bounce_flat_lanes<T: PlaneReal, const L: usize>(
     origin: &mut [[T; L]; 3],
     dir: &mut [[T; L]; 3],
 ) {
+    let (mut new_origin, mut new_dir) = (*origin, *dir);
     for i in 0..L {
         let n = [normal[0][i], normal[1][i], normal[2][i]];
         let o = [origin[0][i], origin[1][i], origin[2][i]];
         let d = [dir[0][i], dir[1][i], dir[2][i]];
         let (hit, r) = reflect_on_plane(n, offset[i], o, d);
         for k in 0..3 {
-            origin[k][i] = if flat[i] { hit[k] } else { origin[k][i] };
-            dir[k][i] = if flat[i] { r[k] } else { dir[k][i] };
+            new_origin[k][i] = if flat[i] { hit[k] } else { o[k] };
+            new_dir[k][i] = if flat[i] { r[k] } else { d[k] };
         }
+    }
+    for k in 0..3 {
+        store_lanes(&mut origin[k], new_origin[k]);
+        store_lanes(&mut dir[k], new_dir[k]);
     }
 }
 

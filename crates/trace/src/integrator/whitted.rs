@@ -19,6 +19,7 @@ use crate::mirror_bounce::{MirrorPlanes, bounce_flat_lanes};
 use crate::sampler::SplitMix64;
 use glam::{DVec3, Vec2, Vec3};
 use mirrorbox_scene::camera::RayGenerator;
+use mirrorbox_scene::lanes::store_lanes;
 use mirrorbox_scene::shading::{Interaction, Leg, LegsClear, interaction_with_point};
 use mirrorbox_scene::{Ray, Scene};
 
@@ -862,13 +863,12 @@ impl CarriedLanes {
     fn add(&mut self, group: LaneMask, radiance: &[[f32; LANES]; 3]) {
         let sums = self.radiance.iter_mut().zip(&self.throughput).zip(radiance);
         for ((sum, throughput), radiance) in sums {
-            for (lane, ((s, &t), &r)) in sum.iter_mut().zip(throughput).zip(radiance).enumerate() {
-                *s = if group >> lane & 1 == 1 {
-                    *s + t * r
-                } else {
-                    *s
-                };
+            let mut new = [0.0; LANES];
+            for (lane, ((n, &t), &r)) in new.iter_mut().zip(throughput).zip(radiance).enumerate() {
+                let s = sum[lane];
+                *n = if group >> lane & 1 == 1 { s + t * r } else { s };
             }
+            store_lanes(sum, new);
         }
     }
 
@@ -893,14 +893,26 @@ impl CarriedLanes {
         cut &= group;
         let go_on = group & !cut;
         for k in 0..3 {
-            for lane in 0..LANES {
-                let t = self.throughput[k][lane];
-                let cut_here = cut >> lane & 1 == 1;
-                let on = go_on >> lane & 1 == 1;
-                let r = self.radiance[k][lane];
-                self.radiance[k][lane] = if cut_here { r + t * terminal[k] } else { r };
-                self.throughput[k][lane] = if on { t * reflectance[k] } else { t };
+            let (mut radiance, mut throughput) = ([0.0; LANES], [0.0; LANES]);
+            let (old_r, old_t) = (&self.radiance[k], &self.throughput[k]);
+            for (lane, (new, (&r, &t))) in
+                radiance.iter_mut().zip(old_r.iter().zip(old_t)).enumerate()
+            {
+                *new = if cut >> lane & 1 == 1 {
+                    r + t * terminal[k]
+                } else {
+                    r
+                };
             }
+            for (lane, (new, &t)) in throughput.iter_mut().zip(old_t).enumerate() {
+                *new = if go_on >> lane & 1 == 1 {
+                    t * reflectance[k]
+                } else {
+                    t
+                };
+            }
+            store_lanes(&mut self.radiance[k], radiance);
+            store_lanes(&mut self.throughput[k], throughput);
         }
         for (lane, bounces) in self.bounces.iter_mut().enumerate() {
             *bounces += go_on >> lane & 1;
