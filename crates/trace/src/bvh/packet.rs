@@ -207,6 +207,20 @@ impl RayPacket {
         &self.dir
     }
 
+    /// The lanes of `lanes` skip mirror `mirror` from now on (a lane loop).
+    #[inline(always)]
+    pub fn set_skip_lanes(&mut self, lanes: LaneMask, mirror: usize) {
+        let mut skip = self.skip;
+        for (lane, s) in skip.iter_mut().enumerate() {
+            *s = if lanes >> lane & 1 == 1 {
+                mirror as u32
+            } else {
+                *s
+            };
+        }
+        store_lanes(&mut self.skip, skip);
+    }
+
     /// Lane `lane` skips mirror `skip_mirror` from now on.
     pub fn set_skip(&mut self, lane: usize, skip_mirror: Option<usize>) {
         self.skip[lane] = skip_mirror.map_or(SKIP_NOTHING, |m| m as u32);

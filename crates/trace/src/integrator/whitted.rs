@@ -469,10 +469,11 @@ impl<'a> Whitted<'a> {
                 }
                 *active &= !cut;
                 let go_on = group & !cut;
-                for lane in lanes(go_on) {
-                    packet.set_skip(lane, Some(mirror));
-                    round.flat[lane] = true;
-                }
+                // Lane loops: the round's lane loops and the next traversal read these
+                // arrays whole, and a vector load of lanes just written one at a time waits
+                // for those stores (store-to-load forwarding fails).
+                packet.set_skip_lanes(go_on, mirror);
+                round.flat = lane_flags(go_on);
                 for lane in 0..LANES {
                     for k in 0..3 {
                         round.plane_normal[k][lane] = n[k];
@@ -495,9 +496,14 @@ impl<'a> Whitted<'a> {
                 carried.count_ray(group);
                 for lane in lanes(group) {
                     ends[lane] = Termination::Diffuse;
-                    round.diffuse[lane] = true;
-                    round.shaded_triangle[lane] = triangle;
                 }
+                // Lane loops, as the flat lanes above.
+                round.diffuse = lane_flags(group);
+                let mut shaded = round.shaded_triangle;
+                for (lane, s) in shaded.iter_mut().enumerate() {
+                    *s = if group >> lane & 1 == 1 { triangle } else { *s };
+                }
+                store_lanes(&mut round.shaded_triangle, shaded);
                 *active &= !group;
             }
         }
@@ -701,6 +707,16 @@ impl CameraStarts<'_> {
             }
         }
     }
+}
+
+/// The lanes of `mask` as flags, in a lane loop.
+#[inline(always)]
+fn lane_flags(mask: LaneMask) -> [bool; LANES] {
+    let mut flags = [false; LANES];
+    for (lane, f) in flags.iter_mut().enumerate() {
+        *f = mask >> lane & 1 == 1;
+    }
+    flags
 }
 
 /// What a round's steps leave to its lane loops: the lanes bouncing off a flat mirror, with
