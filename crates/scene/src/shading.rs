@@ -342,12 +342,21 @@ impl Lighting {
         }
         let mut irradiance = [[0.0; L]; 3];
         for light in &self.lights {
-            let mut sums = irradiance;
+            let mut e = [[0.0; L]; 3];
             for i in 0..L {
-                let e = point_irradiance(lane(p, i), lane(&n, i), light.position, light.intensity);
-                let adds = e != Vec3::ZERO;
+                let e_i =
+                    point_irradiance(lane(p, i), lane(&n, i), light.position, light.intensity);
                 for k in 0..3 {
-                    let sum = irradiance[k][i] + e[k];
+                    e[k][i] = e_i[k];
+                }
+            }
+            // Stored whole (`store_lanes`): a select written back in place becomes a masked
+            // store, slow on AMD's AVX2 CPUs.
+            let mut sums = [[0.0; L]; 3];
+            for i in 0..L {
+                let adds = lane(&e, i) != Vec3::ZERO;
+                for k in 0..3 {
+                    let sum = irradiance[k][i] + e[k][i];
                     sums[k][i] = if adds { sum } else { irradiance[k][i] };
                 }
             }
