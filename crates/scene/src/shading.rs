@@ -350,7 +350,7 @@ impl Lighting {
                     e[k][i] = e_i[k];
                 }
             }
-            // Stored whole (`store_lanes`): a select written back in place becomes a masked
+            // Stored whole (`store_unmasked`): a select written back in place becomes a masked
             // store, slow on AMD's AVX2 CPUs.
             let mut sums = [[0.0; L]; 3];
             for i in 0..L {
@@ -360,8 +360,8 @@ impl Lighting {
                     sums[k][i] = if adds { sum } else { irradiance[k][i] };
                 }
             }
-            for (a, sums) in irradiance.iter_mut().zip(sums) {
-                crate::lanes::store_lanes(a, sums);
+            for (a, s) in irradiance.iter_mut().zip(sums) {
+                crate::lanes::store_unmasked(a, s);
             }
         }
         let mut out = [[0.0; L]; 3];

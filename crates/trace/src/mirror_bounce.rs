@@ -18,7 +18,7 @@
 use glam::DVec3;
 use mirrorbox_scene::Scene;
 use mirrorbox_scene::bump::{self, MirrorBump};
-use mirrorbox_scene::lanes::store_lanes;
+use mirrorbox_scene::lanes::store_unmasked;
 
 pub struct MirrorPlanes {
     /// Per mirror: unit normal and offset, in f64.
@@ -178,8 +178,8 @@ pub fn bounce_flat_lanes<T: PlaneReal, const L: usize>(
         }
     }
     for k in 0..3 {
-        store_lanes(&mut origin[k], new_origin[k]);
-        store_lanes(&mut dir[k], new_dir[k]);
+        store_unmasked(&mut origin[k], new_origin[k]);
+        store_unmasked(&mut dir[k], new_dir[k]);
     }
 }
 

@@ -22,7 +22,7 @@ use crate::cpu_features::lane_bits;
 use crate::watertight::{WatertightRay, axes_of, shear_of};
 use glam::Vec3;
 use mirrorbox_scene::Ray;
-use mirrorbox_scene::lanes::store_lanes;
+use mirrorbox_scene::lanes::store_unmasked;
 use obvhs::ray::safe_inverse;
 
 /// Rays per packet: two pixels' 4×4 sub-pixel grids. 32 lanes measured 6 % faster than
@@ -207,18 +207,18 @@ impl RayPacket {
         &self.dir
     }
 
-    /// The lanes of `lanes` skip mirror `mirror` from now on (a lane loop).
+    /// The lanes of `mask` skip mirror `mirror` from now on (a lane loop).
     #[inline(always)]
-    pub fn set_skip_lanes(&mut self, lanes: LaneMask, mirror: usize) {
-        let mut skip = self.skip;
-        for (lane, s) in skip.iter_mut().enumerate() {
-            *s = if lanes >> lane & 1 == 1 {
+    pub fn set_skip_lanes(&mut self, mask: LaneMask, mirror: usize) {
+        let mut skip = [0; LANES];
+        for (lane, (new, &old)) in skip.iter_mut().zip(&self.skip).enumerate() {
+            *new = if mask >> lane & 1 == 1 {
                 mirror as u32
             } else {
-                *s
+                old
             };
         }
-        store_lanes(&mut self.skip, skip);
+        store_unmasked(&mut self.skip, skip);
     }
 
     /// Lane `lane` skips mirror `skip_mirror` from now on.
@@ -559,7 +559,7 @@ impl PacketBvh {
         }
         if any(&inside) {
             // The kept distances and triangles into new arrays, stored whole by
-            // `store_lanes` (not as masked stores, slow on AMD's AVX2 CPUs).
+            // `store_unmasked` (not as masked stores, slow on AMD's AVX2 CPUs).
             let (mut new_t, mut new_triangle) = ([0.0; LANES], [0; LANES]);
             for i in 0..LANES {
                 let o_z = p.origin[KZ][i];
@@ -577,8 +577,8 @@ impl PacketBvh {
                 new_t[i] = if take { kept } else { best_t[i] };
                 new_triangle[i] = if take { triangle } else { best_triangle[i] };
             }
-            store_lanes(best_t, new_t);
-            store_lanes(best_triangle, new_triangle);
+            store_unmasked(best_t, new_t);
+            store_unmasked(best_triangle, new_triangle);
         }
         if any(&zero) {
             // The scalar test's f64 re-evaluation of exact zeros.

@@ -19,7 +19,7 @@ use crate::mirror_bounce::{MirrorPlanes, bounce_flat_lanes};
 use crate::sampler::SplitMix64;
 use glam::{DVec3, Vec2, Vec3};
 use mirrorbox_scene::camera::RayGenerator;
-use mirrorbox_scene::lanes::store_lanes;
+use mirrorbox_scene::lanes::store_unmasked;
 use mirrorbox_scene::shading::{Interaction, Leg, LegsClear, interaction_with_point};
 use mirrorbox_scene::{Ray, Scene};
 
@@ -473,6 +473,8 @@ impl<'a> Whitted<'a> {
                 // arrays whole, and a vector load of lanes just written one at a time waits
                 // for those stores (store-to-load forwarding fails).
                 packet.set_skip_lanes(go_on, mirror);
+                // The round's first writer of its flags (cleared before, stepped lanes after).
+                debug_assert!(!round.flat.iter().any(|&f| f));
                 round.flat = lane_flags(go_on);
                 for lane in 0..LANES {
                     for k in 0..3 {
@@ -498,12 +500,18 @@ impl<'a> Whitted<'a> {
                     ends[lane] = Termination::Diffuse;
                 }
                 // Lane loops, as the flat lanes above.
+                debug_assert!(!round.diffuse.iter().any(|&f| f));
                 round.diffuse = lane_flags(group);
-                let mut shaded = round.shaded_triangle;
-                for (lane, s) in shaded.iter_mut().enumerate() {
-                    *s = if group >> lane & 1 == 1 { triangle } else { *s };
+                let mut shaded = [0; LANES];
+                for (lane, (new, &old)) in shaded.iter_mut().zip(&round.shaded_triangle).enumerate()
+                {
+                    *new = if group >> lane & 1 == 1 {
+                        triangle
+                    } else {
+                        old
+                    };
                 }
-                store_lanes(&mut round.shaded_triangle, shaded);
+                store_unmasked(&mut round.shaded_triangle, shaded);
                 *active &= !group;
             }
         }
@@ -884,7 +892,7 @@ impl CarriedLanes {
                 let s = sum[lane];
                 *n = if group >> lane & 1 == 1 { s + t * r } else { s };
             }
-            store_lanes(sum, new);
+            store_unmasked(sum, new);
         }
     }
 
@@ -927,8 +935,8 @@ impl CarriedLanes {
                     t
                 };
             }
-            store_lanes(&mut self.radiance[k], radiance);
-            store_lanes(&mut self.throughput[k], throughput);
+            store_unmasked(&mut self.radiance[k], radiance);
+            store_unmasked(&mut self.throughput[k], throughput);
         }
         for (lane, bounces) in self.bounces.iter_mut().enumerate() {
             *bounces += go_on >> lane & 1;
