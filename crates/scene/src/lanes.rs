@@ -45,6 +45,17 @@ pub fn store_unmasked<T: Copy, const N: usize>(dst: &mut [T; N], value: [T; N]) 
     }
 }
 
+/// `value` in the lanes of `dst` whose bit is set in `mask` (bit `i`: lane `i`), the others
+/// as they are: a lane loop, stored by [`store_unmasked`].
+#[inline(always)]
+pub fn set_lanes<T: Copy, const N: usize>(dst: &mut [T; N], mask: u32, value: T) {
+    let mut new = [value; N];
+    for (lane, (n, &old)) in new.iter_mut().zip(dst.iter()).enumerate() {
+        *n = if mask >> lane & 1 == 1 { value } else { old };
+    }
+    store_unmasked(dst, new);
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -63,5 +74,13 @@ mod tests {
         let mut bits = [u64::MAX; 4];
         store_unmasked(&mut bits, [0, 1, 2, 3]);
         assert_eq!(bits, [0, 1, 2, 3]);
+    }
+
+    /// The lanes of the mask take the value, the others keep theirs.
+    #[test]
+    fn set_lanes_sets_the_masked_lanes_only() {
+        let mut a = [7u32; 8];
+        set_lanes(&mut a, 0b1010_0001, 3);
+        assert_eq!(a, [3, 7, 7, 7, 7, 3, 7, 3]);
     }
 }

@@ -22,7 +22,7 @@ use crate::cpu_features::lane_bits;
 use crate::watertight::{WatertightRay, axes_of, shear_of};
 use glam::Vec3;
 use mirrorbox_scene::Ray;
-use mirrorbox_scene::lanes::store_unmasked;
+use mirrorbox_scene::lanes::{set_lanes, store_unmasked};
 use obvhs::ray::safe_inverse;
 
 /// Rays per packet: two pixels' 4×4 sub-pixel grids. 32 lanes measured 6 % faster than
@@ -210,15 +210,7 @@ impl RayPacket {
     /// The lanes of `mask` skip mirror `mirror` from now on (a lane loop).
     #[inline(always)]
     pub fn set_skip_lanes(&mut self, mask: LaneMask, mirror: usize) {
-        let mut skip = [0; LANES];
-        for (lane, (new, &old)) in skip.iter_mut().zip(&self.skip).enumerate() {
-            *new = if mask >> lane & 1 == 1 {
-                mirror as u32
-            } else {
-                old
-            };
-        }
-        store_unmasked(&mut self.skip, skip);
+        set_lanes(&mut self.skip, mask, mirror as u32);
     }
 
     /// Lane `lane` skips mirror `skip_mirror` from now on.

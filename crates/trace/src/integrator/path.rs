@@ -161,16 +161,12 @@ impl<'a> PathTracer<'a> {
     }
 }
 
-/// The shadow ray from `p` along `to` (towards a point `dist` = |`to`| away) and its far
-/// limit: hits nearer than that point by a relative 10⁻⁴ block it (it lies on a surface, or
-/// is a light). One reciprocal for the direction: the caller has the distance already.
+/// The shadow ray from `p` along unit `dir` towards a point `dist` away, and its far limit:
+/// hits nearer than that point by a relative 10⁻⁴ block it (it lies on a surface, or is a
+/// light). The caller has the direction and distance already.
 #[inline(always)]
-fn segment(p: Vec3, to: Vec3, dist: f32) -> (Ray, f32) {
-    let ray = Ray {
-        origin: p,
-        dir: to * (1.0 / dist),
-    };
-    (ray, dist * (1.0 - 1e-4))
+fn segment(p: Vec3, dir: Vec3, dist: f32) -> (Ray, f32) {
+    (Ray { origin: p, dir }, dist * (1.0 - 1e-4))
 }
 
 /// Whether a point light at `light` lights a diffuse point `p` with normal `n` from its
@@ -359,7 +355,7 @@ impl PathTracer<'_> {
                 for (l, light) in lights.iter().enumerate() {
                     let (faces, cos, r2, to, dist) = faces_light(p, n, light.position);
                     if faces {
-                        let (ray, t_max) = segment(p, to, dist);
+                        let (ray, t_max) = segment(p, to * (1.0 / dist), dist);
                         let contribution = w.beta * f * light.intensity * (cos / r2);
                         shadow(
                             l,
@@ -397,7 +393,7 @@ impl PathTracer<'_> {
                         let weight = p_light * p_light / (p_light * p_light + p_bsdf * p_bsdf);
                         // The emission at q (its texture's), the selection by factor.
                         let emission = g.diffuse_at(e.triangle, q).map_or(e.emission, |d| d.1);
-                        let (ray, t_max) = segment(p, to, dist);
+                        let (ray, t_max) = segment(p, l, dist);
                         let contribution = w.beta * f * emission * (cos_p / p_light) * weight;
                         shadow(
                             lights.len(),

@@ -19,7 +19,7 @@ use crate::mirror_bounce::{MirrorPlanes, bounce_flat_lanes};
 use crate::sampler::SplitMix64;
 use glam::{DVec3, Vec2, Vec3};
 use mirrorbox_scene::camera::RayGenerator;
-use mirrorbox_scene::lanes::store_unmasked;
+use mirrorbox_scene::lanes::{set_lanes, store_unmasked};
 use mirrorbox_scene::shading::{Interaction, Leg, LegsClear, interaction_with_point};
 use mirrorbox_scene::{Ray, Scene};
 
@@ -502,16 +502,7 @@ impl<'a> Whitted<'a> {
                 // Lane loops, as the flat lanes above.
                 debug_assert!(!round.diffuse.iter().any(|&f| f));
                 round.diffuse = lane_flags(group);
-                let mut shaded = [0; LANES];
-                for (lane, (new, &old)) in shaded.iter_mut().zip(&round.shaded_triangle).enumerate()
-                {
-                    *new = if group >> lane & 1 == 1 {
-                        triangle
-                    } else {
-                        old
-                    };
-                }
-                store_unmasked(&mut round.shaded_triangle, shaded);
+                set_lanes(&mut round.shaded_triangle, group, triangle);
                 *active &= !group;
             }
         }
