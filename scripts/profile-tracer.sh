@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Where the tracer's time goes (docs/tracer-performance.md): `perf record` of one `mirrorbox
-# trace` at one thread (640×360, 16 spp; the bench's depths), reported by function and by
-# source file, into reports/tracer/profile_<scene>_<integrator>.txt with the CPU and date.
+# trace` at one thread (640×360, 16 spp; the bench's depths), reported by function and, with
+# every inlined frame resolved (scripts/profile-lines.py), by mirrorbox's own source files and
+# lines and by the integrator's call sites, into reports/tracer/profile_<scene>_<integrator>.txt
+# with the CPU and date.
 #
 # Usage: scripts/profile-tracer.sh SCENE INTEGRATOR     (e.g. mirror_room path)
 #   Needs perf (apt install linux-perf); builds the release binary (a no-op when current).
@@ -33,12 +35,11 @@ simd=SSE; grep -qw avx2 /proc/cpuinfo && simd=AVX2; grep -qw avx512f /proc/cpuin
 out=reports/tracer/profile_${scene}_${integrator}.txt
 {
   echo "# perf record (1 thread, 15 kHz); mirrorbox ${args[*]}; $(date -u +%F), $cpu ($simd), $(nproc) cores, commit $commit"
-  echo "# Functions above 0.7 % of self time. cpu_features::x86::* is code compiled through cpu_features::widest: the packet walks with the kernel inlined (and, for path, the per-lane path code), and the image row; obvhs::cwbvh is the single-ray hierarchy."
+  echo "# Functions above 0.7 % of self time. cpu_features::x86::* is code compiled through cpu_features::widest: the walks with the packet kernel and the 8-wide single-ray traversal inlined, and the image row; obvhs:: is the hierarchies' build."
   perf report -i "$work/perf.data" --no-children --sort comm,dso,symbol 2>/dev/null | grep -v '^#' | grep -v '^$' |
     awk '{ v = $1; sub("%", "", v); if (v + 0 >= 0.7) print }'
   echo
-  echo "# The same samples by source file (perf report --sort srcline, summed per file; files above 0.5 %): packet.rs + watertight.rs = the packet kernel and the single-ray triangle test, whitted.rs / path.rs = the walks, mirror_bounce.rs = the f64 bounces, shading.rs / geometry.rs = surfaces, camera.rs / render.rs = the row; index.rs, arith.rs, mod.rs, simd.rs = indexing, vector arithmetic and obvhs' SIMD node test inlined from std, glam and obvhs."
-  perf report -i "$work/perf.data" --no-children --sort srcline 2>/dev/null | grep -v '^#' | grep '%' |
-    awk '{ v = $1; sub("%", "", v); split($2, f, ":"); s[f[1]] += v } END { for (k in s) if (s[k] >= 0.5) printf "  %6.2f%%  %s\n", s[k], k }' | sort -rn
+  echo "# The same samples by mirrorbox's own source (scripts/profile-lines.py: each sampled instruction's inlined frames by addr2line -i, charged to the innermost frame in crates/; call sites: the frame inside the integrator's outermost one, which call of the walk a sample is under — the query, the bounces, the step, the shading)."
+  python3 scripts/profile-lines.py "$work/perf.data" "$(realpath "$bin")" --top 25
 } > "$out"
 echo "wrote $out" >&2
