@@ -17,6 +17,7 @@ Usage: scripts/profile-lines.py PERF_DATA BIN [--top N] [--site-file NAME ...]
 
 import argparse
 import collections
+import functools
 import os
 import re
 import subprocess
@@ -111,8 +112,7 @@ def main():
     ours_total = sum(counts.values())
     # Our crates' files: paths under this checkout's crates/ (addr2line gives full paths; the
     # standard library's are under /rustc/…, dependencies' under the cargo registry).
-    root = subprocess.run(["git", "rev-parse", "--show-toplevel"], capture_output=True, text=True, check=True).stdout.strip()
-    crates = root + "/crates/"
+    crates = os.path.join(os.path.dirname(os.path.dirname(os.path.realpath(__file__))), "crates") + "/"
 
     def short(frame):
         path, _, line = frame.rpartition(":")
@@ -122,7 +122,8 @@ def main():
         return frame.startswith(crates)
 
     def in_site(frame):
-        return frame.startswith(crates) and frame.rpartition(":")[0].rsplit("/", 1)[-1] in site_files
+        return is_ours(frame) and frame.rpartition(":")[0].rsplit("/", 1)[-1] in site_files
+
     by_line, by_file, by_site = collections.Counter(), collections.Counter(), collections.Counter()
     addresses = sorted(counts)
     resolved = {}
@@ -137,20 +138,28 @@ def main():
         site = sites[-2] if len(sites) > 1 else (sites[0] if sites else "(outside " + "/".join(site_files) + ")")
         by_site[site] += n
     print(f"# {total} samples; {ours_total} in {binary} ({100 * ours_total / total:.1f} %); shares below are of all samples")
+
+    @functools.cache
+    def source_lines(path):
+        try:
+            with open(crates + path, encoding="utf-8") as source:
+                return source.read().splitlines()
+        except OSError:
+            return []
+
     def text(key):
         """The source line itself, where `key` is `crates/`-relative `path:line`."""
         path, _, line = key.rpartition(":")
-        try:
-            with open(crates + path, encoding="utf-8") as source:
-                return " ".join(source.read().splitlines()[int(line) - 1].split())[:70]
-        except (OSError, ValueError, IndexError):
-            return ""
+        lines = source_lines(path)
+        return " ".join(lines[int(line) - 1].split())[:70] if line.isdigit() and 0 < int(line) <= len(lines) else ""
 
-    for title, table, top in (("files", by_file, 15), ("lines (innermost in crates/)", by_line, args.top),
-                              ("call sites (the frame inside the outermost one in " + "/".join(site_files) + ")", by_site, args.top)):
+    site_title = "call sites (the frame inside the outermost one in " + "/".join(site_files) + ")"
+    for title, table, top, with_text in (("files", by_file, 15, False),
+                                         ("lines (innermost in crates/)", by_line, args.top, True),
+                                         (site_title, by_site, args.top, True)):
         print(f"\n## {title}")
         for key, n in table.most_common(top):
-            shown = f"{key:45s} {text(key)}" if table is not by_file else key
+            shown = f"{key:45s} {text(key)}" if with_text else key
             print(f"{100 * n / total:6.2f} %  {shown}".rstrip())
 
 
