@@ -495,10 +495,10 @@ impl PacketBvh {
     /// The watertight test of slot `slot` for the lanes of `hit`, keeping `0 ≤ t < best`
     /// and recording the scene's index of the triangle hit. Two loops branch free over the
     /// lanes (the compiler vectorises them): the edge functions ([`TRIANGLE_CHUNK`] lanes at
-    /// a time, chunks with no lane of `hit` skipped; their lanes' flags stay unset), then,
-    /// only if some lane is inside the edges, the distance; the rare lanes with an exact zero edge function or
-    /// an exact tie are finished one by one. `ANY_HIT`: lanes also skip `skip_triangle`, and
-    /// a hit stops the lane (`best` becomes [`STOPPED`]).
+    /// a time, chunks with no lane of `hit` skipped: their lanes' flags stay unset), then,
+    /// only if some lane is inside the edges, the distance; the rare lanes with an exact
+    /// zero edge function or an exact tie are finished one by one. `ANY_HIT`: lanes also
+    /// skip `skip_triangle`, and a hit stops the lane (`best` becomes [`STOPPED`]).
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     fn triangle<const KX: usize, const KY: usize, const KZ: usize, const ANY_HIT: bool>(
