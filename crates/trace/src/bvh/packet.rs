@@ -427,7 +427,7 @@ impl PacketBvh {
     /// Depth-first traversal for the lanes of `group` (not empty): a node is entered when any of them
     /// hits its box before its closest hit so far; the nearer child (along the group's first
     /// lane's direction) first. A leaf's triangles are tested for each of `groups` (the lanes
-    /// by axis permutation, [`PacketBvh::leaf`]) with lanes that met its box: one walk of the
+    /// by axis permutation, [`PacketBvh::triangle`]) with lanes that met its box: one walk of the
     /// hierarchy where the lanes have several permutations (one traversal per permutation
     /// before: `whitted` `mirror_room`, 13 % of whose queries have more than one, ×0.971 in
     /// one process, `mirror_box` ×0.971 as two builds; issue 56's tenth session).
@@ -474,16 +474,30 @@ impl PacketBvh {
                         if h == 0 {
                             continue;
                         }
-                        let (t, s, k) = (&mut *best_t, &mut *best_triangle, skip_triangle);
-                        let slots = node.first..node.first + node.count;
-                        match axes_of(code) {
-                            (1, 2, 0) => self.leaf::<1, 2, 0, ANY_HIT>(slots, p, q, h, t, s, k),
-                            (2, 1, 0) => self.leaf::<2, 1, 0, ANY_HIT>(slots, p, q, h, t, s, k),
-                            (2, 0, 1) => self.leaf::<2, 0, 1, ANY_HIT>(slots, p, q, h, t, s, k),
-                            (0, 2, 1) => self.leaf::<0, 2, 1, ANY_HIT>(slots, p, q, h, t, s, k),
-                            (0, 1, 2) => self.leaf::<0, 1, 2, ANY_HIT>(slots, p, q, h, t, s, k),
-                            (1, 0, 2) => self.leaf::<1, 0, 2, ANY_HIT>(slots, p, q, h, t, s, k),
-                            other => unreachable!("not an axis permutation: {other:?}"),
+                        for slot in node.first..node.first + node.count {
+                            let (t, s, k) = (&mut *best_t, &mut *best_triangle, skip_triangle);
+                            // (The same arm for every slot of the leaf: one branch, predicted.)
+                            match axes_of(code) {
+                                (1, 2, 0) => {
+                                    self.triangle::<1, 2, 0, ANY_HIT>(slot, p, q, h, t, s, k)
+                                }
+                                (2, 1, 0) => {
+                                    self.triangle::<2, 1, 0, ANY_HIT>(slot, p, q, h, t, s, k)
+                                }
+                                (2, 0, 1) => {
+                                    self.triangle::<2, 0, 1, ANY_HIT>(slot, p, q, h, t, s, k)
+                                }
+                                (0, 2, 1) => {
+                                    self.triangle::<0, 2, 1, ANY_HIT>(slot, p, q, h, t, s, k)
+                                }
+                                (0, 1, 2) => {
+                                    self.triangle::<0, 1, 2, ANY_HIT>(slot, p, q, h, t, s, k)
+                                }
+                                (1, 0, 2) => {
+                                    self.triangle::<1, 0, 2, ANY_HIT>(slot, p, q, h, t, s, k)
+                                }
+                                other => unreachable!("not an axis permutation: {other:?}"),
+                            }
                         }
                     }
                     // Any hit: done once every lane has stopped (a stopped lane's box tests
@@ -503,33 +517,6 @@ impl PacketBvh {
             }
             sp -= 1;
             index = stack[sp] as usize;
-        }
-    }
-
-    /// The watertight tests of a leaf's `slots` for the lanes of `hit`, all with the axis
-    /// permutation `KX, KY, KZ` ([`PacketBvh::triangle`], compiled for it).
-    #[inline(always)]
-    #[allow(clippy::too_many_arguments)]
-    fn leaf<const KX: usize, const KY: usize, const KZ: usize, const ANY_HIT: bool>(
-        &self,
-        slots: std::ops::Range<u32>,
-        p: &RayPacket,
-        q: &Prepared,
-        hit: LaneMask,
-        best_t: &mut Lanes,
-        best_triangle: &mut [u32; LANES],
-        skip_triangle: &[u32; LANES],
-    ) {
-        for slot in slots {
-            self.triangle::<KX, KY, KZ, ANY_HIT>(
-                slot,
-                p,
-                q,
-                hit,
-                best_t,
-                best_triangle,
-                skip_triangle,
-            );
         }
     }
 
