@@ -1071,6 +1071,28 @@ mod tests {
     use super::*;
     use mirrorbox_report::document::fixtures::record;
 
+    /// What [`rewrite`] relies on: a number read back from the JSON it was written to is the
+    /// same f64 (serde_json's `float_roundtrip`; its fast parse read this one an ulp low, and
+    /// a remade `advice.json` differed from the original in its `seconds`).
+    #[test]
+    fn numbers_read_back_are_the_numbers_written() {
+        for x in [
+            11.831758175000001,
+            0.1 + 0.2,
+            2.0f64.powi(-1074),
+            f64::MAX,
+            1e-7 / 3.0,
+        ] {
+            let text = serde_json::to_string(&serde_json::json!({ "x": x })).unwrap();
+            let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+            assert_eq!(
+                v["x"].as_f64().map(f64::to_bits),
+                Some(x.to_bits()),
+                "{text}"
+            );
+        }
+    }
+
     /// A candidate `key` at `ms` [lo–hi] with FLIP `flip` (no mirror mask: over the image).
     fn candidate(key: &str, ms: f64, hi: f64, flip: f64) -> Record {
         let mut r = record(0, ms, 1, flip);

@@ -72,7 +72,7 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene> {
         line: e.line(),
         column: e.column(),
         path: field.filter(|f| f != "."),
-        message: strip_position(&e.to_string()),
+        message: finite_number_message(strip_position(&e.to_string())),
     };
     let mut de = serde_json::Deserializer::from_str(text);
     let file: SceneFile = serde_path_to_error::deserialize(&mut de).map_err(|e| {
@@ -86,6 +86,17 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene> {
         gltf_images: Default::default(),
     }
     .compile(file)
+}
+
+/// serde_json's "number out of range" (a literal such as `1e999`, or `1e39` for an f32 field:
+/// its exact parse, `float_roundtrip`, refuses what its fast parse had made infinite) in the
+/// words of the finite-number check that saw the infinity before.
+fn finite_number_message(message: String) -> String {
+    if message == "number out of range" {
+        "must be a finite number, got one out of range".into()
+    } else {
+        message
+    }
 }
 
 /// Mirror `mirror` appended to the scene's `mirrors` and its two front triangles to
