@@ -88,12 +88,15 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene> {
     .compile(file)
 }
 
+/// What a number field that is not finite is told ([`Checker`]'s check of every number).
+const NOT_FINITE: &str = "must be a finite number";
+
 /// serde_json's "number out of range" (a literal such as `1e999`, or `1e39` for an f32 field:
 /// its exact parse, `float_roundtrip`, refuses what its fast parse had made infinite) in the
 /// words of the finite-number check that saw the infinity before.
 fn finite_number_message(message: String) -> String {
     if message == "number out of range" {
-        "must be a finite number, got one out of range".into()
+        format!("{NOT_FINITE}, got one out of range")
     } else {
         message
     }
@@ -172,7 +175,7 @@ impl Checker<'_> {
         if x.is_finite() {
             Ok(x)
         } else {
-            Err(self.invalid(path, format!("must be a finite number, got {x}")))
+            Err(self.invalid(path, format!("{NOT_FINITE}, got {x}")))
         }
     }
 

@@ -383,10 +383,10 @@ impl PacketBvh {
     }
 
     /// The traversal of every lane in `active`, its leaves' triangle tests grouped by the
-    /// watertight test's axis permutation: closest hits (`ANY_HIT` false) or blocked segments (`ANY_HIT` true, see
-    /// [`PacketBvh::occluded_lanes_inline`]; a lane's `best_t` becomes [`STOPPED`] at its
-    /// first hit). Two monomorphised kernels, so that the any-hit mode costs the closest-hit
-    /// one nothing.
+    /// watertight test's axis permutation: closest hits (`ANY_HIT` false) or blocked
+    /// segments (`ANY_HIT` true, see [`PacketBvh::occluded_lanes_inline`]; a lane's `best_t`
+    /// becomes [`STOPPED`] at its first hit). Two monomorphised kernels, so that the any-hit
+    /// mode costs the closest-hit one nothing.
     #[inline(always)]
     fn trace_lanes<const ANY_HIT: bool>(
         &self,
@@ -424,13 +424,14 @@ impl PacketBvh {
         );
     }
 
-    /// Depth-first traversal for the lanes of `group` (not empty): a node is entered when any of them
-    /// hits its box before its closest hit so far; the nearer child (along the group's first
-    /// lane's direction) first. A leaf's triangles are tested for each of `groups` (the lanes
-    /// by axis permutation, [`PacketBvh::triangle`]) with lanes that met its box: one walk of the
-    /// hierarchy where the lanes have several permutations (one traversal per permutation
-    /// before: `whitted` `mirror_room`, 13 % of whose queries have more than one, ×0.971 in
-    /// one process, `mirror_box` ×0.971 as two builds; issue 56's tenth session).
+    /// Depth-first traversal for the lanes of `group` (not empty): a node is entered when any
+    /// of them hits its box before its closest hit so far; the nearer child (along the
+    /// group's first lane's direction) first. A leaf's triangles are tested for each of
+    /// `groups` (the lanes by axis permutation, [`PacketBvh::triangle`]) with lanes that met
+    /// its box: one walk of the hierarchy where the lanes have several permutations (one
+    /// traversal per permutation before: `whitted` `mirror_room`, 13 % of whose queries have
+    /// more than one, ×0.971 in one process, `mirror_box` ×0.971 as two builds; issue 56's
+    /// tenth session).
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     fn traverse<const ANY_HIT: bool>(
