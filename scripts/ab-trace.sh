@@ -1,13 +1,16 @@
 #!/usr/bin/env bash
-# Two builds of `mirrorbox` against each other on one scene, for a change to the tracer
-# (docs/tracer-performance.md): paired one-thread renders, the order alternating round by
-# round, so that drift of a shared machine falls on both alike. Prints each build's median
-# and minimum image-loop time and the median of the per-round ratios B / A with a bootstrap
-# 90 % interval: the change is real when the interval excludes 1.
+# Builds of `mirrorbox` against each other on one scene, for a change to the tracer
+# (docs/tracer-performance.md): one-thread renders of every build per round, the order rotated
+# round by round, so that drift of a shared machine falls on all alike. Prints each build's
+# median and minimum image-loop time and, for every build after the first, the median of the
+# per-round ratios to the first (B / A, C / A, ...) with a bootstrap 90 % interval: a change
+# is real when the interval excludes 1. Two builds of the same logic can differ by their
+# code's layout alone (issue 56's eleventh session: ±2 %), so more than two builds of a
+# change's forms, with a copy of the baseline as a control, show how far that goes.
 #
-# Usage: scripts/ab-trace.sh ROUNDS SCENE BIN_A BIN_B [-- TRACE_ARGS...]
+# Usage: scripts/ab-trace.sh ROUNDS SCENE BIN_A BIN_B [BIN_C ...] [-- TRACE_ARGS...]
 #   e.g. scripts/ab-trace.sh 16 mirror_room /tmp/before target/release/mirrorbox -- --spp 16
-#   Build both outside scripts/test-build-env.sh: its clippy wrapper compiles with MIR
+#   Build them outside scripts/test-build-env.sh: its clippy wrapper compiles with MIR
 #   optimisations off (5-8 % slower; docs/tracer-performance.md).
 #   Name --spp in TRACE_ARGS: `trace` defaults to 1 sample per pixel since issue 37 (16 before),
 #   so two builds from either side of that change would otherwise trace different images.
@@ -16,15 +19,22 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if [ $# -lt 4 ]; then
-  echo "usage: $0 ROUNDS SCENE BIN_A BIN_B [-- TRACE_ARGS...]" >&2
+  echo "usage: $0 ROUNDS SCENE BIN_A BIN_B [BIN_C ...] [-- TRACE_ARGS...]" >&2
   exit 2
 fi
-rounds=$1 scene=$2 a=$3 b=$4
-shift 4
+rounds=$1 scene=$2
+shift 2
+bins=()
+while [ $# -gt 0 ] && [ "$1" != "--" ]; do
+  bins+=("$1")
+  shift
+done
 [ "${1:-}" = "--" ] && shift
 case $rounds in '' | *[!0-9]* | 0*) echo "ROUNDS must be a positive whole number, not '$rounds'" >&2; exit 2 ;; esac
 [ -f "scenes/$scene.json" ] || { echo "no scene scenes/$scene.json" >&2; exit 2; }
-for bin in "$a" "$b"; do
+[ ${#bins[@]} -ge 2 ] || { echo "name at least two builds before --" >&2; exit 2; }
+[ ${#bins[@]} -le 26 ] || { echo "at most 26 builds (A to Z), not ${#bins[@]}" >&2; exit 2; }
+for bin in "${bins[@]}"; do
   [ -x "$bin" ] || { echo "not an executable: $bin" >&2; exit 2; }
 done
 work=$(mktemp -d)
@@ -38,23 +48,29 @@ seconds() {
     > "$work/run.json" 2>/dev/null
   python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['render_seconds'])" "$work/run.json"
 }
+# Round r runs the builds from index r mod N on (two builds: A then B in even rounds, B then
+# A in odd ones); each line holds one round's times in the builds' order.
+n=${#bins[@]}
 for round in $(seq "$rounds"); do
-  if [ $((round % 2)) = 0 ]; then
-    ta=$(seconds "$a" "$@"); tb=$(seconds "$b" "$@")
-  else
-    tb=$(seconds "$b" "$@"); ta=$(seconds "$a" "$@")
-  fi
-  echo "$ta $tb"
-done > "$work/pairs"
-python3 - "$work/pairs" "$a" "$b" <<'PY'
+  times=()
+  for k in $(seq 0 $((n - 1))); do
+    i=$(((round + k) % n))
+    times[i]=$(seconds "${bins[i]}" "$@")
+  done
+  echo "${times[*]}"
+done > "$work/rounds"
+python3 - "$work/rounds" "${bins[@]}" <<'PY'
 import random, statistics, sys
-pairs = [tuple(map(float, line.split())) for line in open(sys.argv[1])]
-a, b = [p[0] for p in pairs], [p[1] for p in pairs]
-ratios = [y / x for x, y in pairs]
-random.seed(1)
-boots = sorted(statistics.median(random.choices(ratios, k=len(ratios))) for _ in range(2000))
-lo, hi = boots[len(boots) * 5 // 100], boots[len(boots) * 95 // 100]
-print(f"A {sys.argv[2]}: median {statistics.median(a):.4f} s, min {min(a):.4f} s")
-print(f"B {sys.argv[3]}: median {statistics.median(b):.4f} s, min {min(b):.4f} s")
-print(f"B / A: median {statistics.median(ratios):.3f} [{lo:.3f}–{hi:.3f}] over {len(ratios)} rounds")
+rounds = [tuple(map(float, line.split())) for line in open(sys.argv[1])]
+bins = sys.argv[2:]
+letter = lambda i: chr(ord("A") + i)
+for i, b in enumerate(bins):
+    t = [r[i] for r in rounds]
+    print(f"{letter(i)} {b}: median {statistics.median(t):.4f} s, min {min(t):.4f} s")
+for i in range(1, len(bins)):
+    ratios = [r[i] / r[0] for r in rounds]
+    random.seed(1)
+    boots = sorted(statistics.median(random.choices(ratios, k=len(ratios))) for _ in range(2000))
+    lo, hi = boots[len(boots) * 5 // 100], boots[len(boots) * 95 // 100]
+    print(f"{letter(i)} / A: median {statistics.median(ratios):.3f} [{lo:.3f}–{hi:.3f}] over {len(ratios)} rounds")
 PY
