@@ -424,9 +424,9 @@ impl PacketBvh {
         );
     }
 
-    /// Depth-first traversal for the lanes of `group` (not empty): a node is entered when any
-    /// of them hits its box before its closest hit so far; the nearer child (along the
-    /// group's first lane's direction) first. A leaf's triangles are tested for each of
+    /// Depth-first traversal for the lanes of `active` (not empty): a node is entered when
+    /// any of them hits its box before its closest hit so far; the nearer child (along the
+    /// first active lane's direction) first. A leaf's triangles are tested for each of
     /// `groups` (the lanes by axis permutation, [`PacketBvh::triangle`]) with lanes that met
     /// its box: one walk of the hierarchy where the lanes have several permutations (one
     /// traversal per permutation before: `whitted` `mirror_room`, 13 % of whose queries have
@@ -438,13 +438,13 @@ impl PacketBvh {
         &self,
         p: &RayPacket,
         q: &Prepared,
-        group: LaneMask,
+        active: LaneMask,
         groups: &[(u32, LaneMask)],
         best_t: &mut Lanes,
         best_triangle: &mut [u32; LANES],
         skip_triangle: &[u32; LANES],
     ) {
-        let lead = group.trailing_zeros() as usize;
+        let lead = active.trailing_zeros() as usize;
         let lead_dir = [p.dir[0][lead], p.dir[1][lead], p.dir[2][lead]];
         let mut stack = [0u32; STACK];
         let mut sp = 0;
@@ -457,7 +457,7 @@ impl PacketBvh {
             let node = &self.nodes[index];
             let mirror = self.node_mirror[index];
             if node.count == 0 {
-                if box_any(node, mirror, p, q, best_t, group, &mut warm) {
+                if box_any(node, mirror, p, q, best_t, active, &mut warm) {
                     let (a, b) = (node.first as usize, node.first as usize + 1);
                     let gap = &self.child_gap[index];
                     let along = (0..3).map(|k| gap[k] * lead_dir[k]).sum::<f32>();
@@ -468,10 +468,10 @@ impl PacketBvh {
                     continue;
                 }
             } else {
-                let hit = box_hits(node, mirror, p, q, best_t, group);
+                let hit = box_hits(node, mirror, p, q, best_t, active);
                 if hit != 0 {
-                    for &(code, lanes) in groups {
-                        let h = hit & lanes;
+                    for &(code, members) in groups {
+                        let h = hit & members;
                         if h == 0 {
                             continue;
                         }
@@ -506,7 +506,7 @@ impl PacketBvh {
                     if ANY_HIT
                         && (0..LANES).fold(0, |m: LaneMask, i| {
                             m | ((best_t[i] >= 0.0) as LaneMask) << i
-                        }) & group
+                        }) & active
                             == 0
                     {
                         break;
