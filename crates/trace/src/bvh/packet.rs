@@ -132,6 +132,13 @@ impl LaneHits {
         })
     }
 
+    /// The lanes with no hit (where [`LaneHits::get`] answers `None`), over all lanes: the
+    /// caller masks the lanes it traced.
+    #[inline(always)]
+    pub fn misses(&self) -> LaneMask {
+        lane_bits::<LANES>(|i| self.triangle[i] == NO_TRIANGLE)
+    }
+
     /// Lane `lane` hit `hit`.
     pub fn set(&mut self, lane: usize, hit: Option<Hit>) {
         (self.t[lane], self.triangle[lane]) = match hit {

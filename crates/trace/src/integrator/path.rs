@@ -32,7 +32,7 @@
 use super::{Integrator, PathResult, Termination, face_normals};
 use crate::bvh::packet::{LANES, LaneHits, LaneMask, NO_TRIANGLE, RayPacket, first_lanes, lanes};
 use crate::bvh::{Hit, NO_QUERY, Query, SceneBvh};
-use crate::cpu_features::{Vectorised, lane_bits, widest};
+use crate::cpu_features::{Vectorised, widest};
 use crate::hit_point::on_triangle_plane;
 use crate::mirror_bounce::{MirrorPlanes, bounce_flat_lanes, reflect_on_plane};
 use crate::sampler::SplitMix64;
@@ -600,8 +600,7 @@ impl PathTracer<'_> {
                 // hits, without a branch per lane on whether there is one (`path` ×0.986–×0.996
                 // / ×0.986–×0.994 on `mirror_room` / `mirror_box` in one process, issue 56's
                 // twelfth session).
-                let mut escaped =
-                    lane_bits::<LANES>(|i| hits.triangle[i] == NO_TRIANGLE) & coherent;
+                let mut escaped = hits.misses() & coherent;
                 for lane in lanes(active & !coherent) {
                     escaped |= LaneMask::from(single[lane].is_none()) << lane;
                 }
