@@ -141,11 +141,61 @@ fn detected() -> Build {
     Build::Baseline
 }
 
+/// Whether 512-bit instructions lower this CPU's clock for the code around them: Intel's
+/// AVX-512 frequency licences (a core that runs them steps its clock down for a while after).
+/// AMD's AVX-512 CPUs (Zen 4 and 5) keep their clock, so only Intel CPUs count.
+static WIDE_VECTORS_SLOW_THE_CLOCK: std::sync::LazyLock<bool> = std::sync::LazyLock::new(|| {
+    #[cfg(target_arch = "x86_64")]
+    {
+        // Leaf 0: the vendor string in EBX, EDX, ECX.
+        let id = std::arch::x86_64::__cpuid(0);
+        [id.ebx, id.edx, id.ecx] == [0x756e_6547, 0x4965_6e69, 0x6c65_746e] // "GenuineIntel"
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    false
+});
+
+/// The build [`widest`] runs, but AVX2 in place of AVX-512 for work that does not
+/// `gain_from_512_bits` on a CPU whose clock 512-bit vectors slow
+/// ([`WIDE_VECTORS_SLOW_THE_CLOCK`]), unless AVX-512 was asked for by name ([`narrow_to`]):
+/// the build for [`run_on`], the same for all of a render's work (the image row, the camera
+/// rays, the integrator's walk), since a 512-bit loop anywhere in it slows all of it.
+pub fn build_for(gains_from_512_bits: bool) -> Build {
+    choose(
+        *BUILD,
+        gains_from_512_bits,
+        NARROWED.get().is_some(),
+        *WIDE_VECTORS_SLOW_THE_CLOCK,
+    )
+}
+
+/// [`build_for`]'s rule: `build` (the widest, or the one asked for by name when `asked`),
+/// but AVX2 for AVX-512 where the work does not gain from 512 bits and they slow the clock.
+fn choose(build: Build, gains_from_512_bits: bool, asked: bool, slows_clock: bool) -> Build {
+    if build == Build::Avx512 && !gains_from_512_bits && !asked && slows_clock {
+        Build::Avx2
+    } else {
+        build
+    }
+}
+
+/// Whether this CPU can run `build` (`trace --simd`; tests).
+pub fn cpu_has(build: Build) -> bool {
+    build <= detected()
+}
+
 /// Runs `work` compiled for the widest vector instructions this CPU has (or the narrower
 /// build asked for, [`narrow_to`]).
 #[inline(always)]
 pub fn widest<W: Vectorised>(work: W) -> W::Output {
-    match *BUILD {
+    run_on(*BUILD, work)
+}
+
+/// Runs `work` compiled for `build` ([`widest`]'s or [`build_for`]'s: one this CPU has).
+#[inline(always)]
+pub fn run_on<W: Vectorised>(build: Build, work: W) -> W::Output {
+    debug_assert!(build <= *BUILD, "{build:?} is wider than {:?}", *BUILD);
+    match build {
         // SAFETY: the CPU has AVX-512F (detected at run time).
         #[cfg(target_arch = "x86_64")]
         Build::Avx512 => unsafe { x86::avx512(work) },
@@ -179,6 +229,27 @@ mod x86 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// AVX2 in place of AVX-512 only for work that does not gain from 512 bits, on a CPU whose
+    /// clock they slow, when no build was asked for by name; every other case keeps its build.
+    #[test]
+    fn only_unasked_work_without_gain_narrows_where_the_clock_slows() {
+        use Build::*;
+        for build in [Baseline, Avx2, Avx512] {
+            for gains in [false, true] {
+                for asked in [false, true] {
+                    for slows in [false, true] {
+                        let narrowed = build == Avx512 && !gains && !asked && slows;
+                        assert_eq!(
+                            choose(build, gains, asked, slows),
+                            if narrowed { Avx2 } else { build },
+                            "{build:?} gains {gains} asked {asked} slows {slows}"
+                        );
+                    }
+                }
+            }
+        }
+    }
 
     /// Bit `i` of `lane_bits(flag)` is `flag(i)`, for the lane counts the traversals use
     /// and others, in the baseline build and in the widest this CPU has: a lane moved or

@@ -11,7 +11,7 @@ pub mod path;
 pub mod whitted;
 
 use crate::bvh::SceneBvh;
-use crate::cpu_features::{Vectorised, widest};
+use crate::cpu_features::{Vectorised, build_for, run_on};
 use crate::sampler::SplitMix64;
 use glam::{Vec2, Vec3};
 use mirrorbox_scene::camera::RayGenerator;
@@ -52,8 +52,15 @@ pub trait Integrator: Sync {
         out: &mut Vec<PathResult>,
     ) {
         rays.clear();
-        camera_rays(camera, positions, rays);
+        camera_rays(camera, positions, rays, self.gains_from_512_bits());
         self.radiance_all(rays, rngs, out);
+    }
+
+    /// Whether the AVX-512 build of a render's work (the image row, the camera rays, the
+    /// walks) pays where 512-bit vectors slow the CPU's clock
+    /// ([`crate::cpu_features::build_for`]): default yes; `path` says no.
+    fn gains_from_512_bits(&self) -> bool {
+        true
     }
 
     /// How many neighbouring pixels of a row the image loop may hand to one
@@ -66,8 +73,14 @@ pub trait Integrator: Sync {
 }
 
 /// The camera rays `camera` makes through the image positions `positions`, appended to
-/// `rays`: [`RayGenerator::rays_at_positions`] compiled for the CPU's widest vectors.
-pub fn camera_rays(camera: &RayGenerator, positions: &[Vec2], rays: &mut Vec<Ray>) {
+/// `rays`: [`RayGenerator::rays_at_positions`] compiled for the CPU's widest vectors, or the
+/// integrator's build where 512-bit ones do not pay for it ([`build_for`]).
+pub fn camera_rays(
+    camera: &RayGenerator,
+    positions: &[Vec2],
+    rays: &mut Vec<Ray>,
+    gains_from_512_bits: bool,
+) {
     struct MakeRays<'w> {
         camera: &'w RayGenerator,
         positions: &'w [Vec2],
@@ -80,11 +93,14 @@ pub fn camera_rays(camera: &RayGenerator, positions: &[Vec2], rays: &mut Vec<Ray
             self.camera.rays_at_positions(self.positions, self.rays);
         }
     }
-    widest(MakeRays {
-        camera,
-        positions,
-        rays,
-    });
+    run_on(
+        build_for(gains_from_512_bits),
+        MakeRays {
+            camera,
+            positions,
+            rays,
+        },
+    );
 }
 
 /// Packets per [`Integrator::radiance_all`] call: a call's fixed work (its walks' buffers

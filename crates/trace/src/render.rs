@@ -4,7 +4,7 @@
 //! summed in a fixed order, so the image is bit-identical whatever the thread count.
 
 use crate::bvh::SceneBvh;
-use crate::cpu_features::{Vectorised, widest};
+use crate::cpu_features::{self, Vectorised};
 use crate::integrator::{Integrator, IntegratorSettings, Termination};
 use crate::path::PathSettings;
 use crate::sampler::{Sampling, SplitMix64};
@@ -113,6 +113,8 @@ pub struct TraceOutput {
     /// Wall time of the image loop (BVH build excluded; see [`SceneBvh::build_time`]).
     pub wall: Duration,
     pub threads: usize,
+    /// The vector build the image loop ran ([`cpu_features::build_for`]).
+    pub vectors: cpu_features::Build,
 }
 
 /// One finished image row: radiance, mean bounces, statistics.
@@ -219,6 +221,7 @@ pub fn render_while(
     let rays = cam.ray_generator();
     let integrator = settings.integrator.build(scene, bvh);
     let seed = settings.integrator.seed();
+    let vectors = cpu_features::build_for(integrator.gains_from_512_bits());
     let done = AtomicU32::new(0);
     let start = Instant::now();
     let rows: Option<Vec<Row>> = (0..h)
@@ -227,14 +230,17 @@ pub fn render_while(
             if !go_on() {
                 return None;
             }
-            let row = widest(RowWork {
-                y,
-                width: w,
-                rays: &rays,
-                sampling: &settings.sampling,
-                integrator: integrator.as_ref(),
-                seed,
-            });
+            let row = cpu_features::run_on(
+                vectors,
+                RowWork {
+                    y,
+                    width: w,
+                    rays: &rays,
+                    sampling: &settings.sampling,
+                    integrator: integrator.as_ref(),
+                    seed,
+                },
+            );
             progress(done.fetch_add(1, Ordering::Relaxed) + 1);
             Some(row)
         })
@@ -257,5 +263,6 @@ pub fn render_while(
         stats,
         wall,
         threads: rayon::current_num_threads(),
+        vectors,
     })
 }

@@ -29,9 +29,10 @@ pub enum Kernel {
 /// Which vector build runs the tracer's lane loops (`mirrorbox_trace::cpu_features`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Simd {
-    /// The CPU's widest: AVX-512 (F, VL, BW, DQ), else AVX2, else the baseline.
+    /// The CPU's widest: AVX-512 (F, VL, BW, DQ), else AVX2, else the baseline; `path` takes
+    /// AVX2 on Intel's AVX-512 CPUs, whose clock 512-bit vectors slow.
     Widest,
-    /// AVX-512 (an error on a CPU without it).
+    /// AVX-512 (an error on a CPU without it), for every integrator.
     Avx512,
     /// AVX2 (an error on a CPU without it).
     Avx2,
@@ -550,7 +551,7 @@ fn report(
             "bvh": format!("{:?}", bvh.kind).to_lowercase(), "bvh_build_seconds": bvh.build_time.as_secs_f64(),
             "kernel": format!("{:?}", args.kernel).to_lowercase(),
             "packet_bvh_build_seconds": bvh.packet_build_time().map(|t| t.as_secs_f64()),
-            "simd": mirrorbox_trace::cpu_features::widest_name(),
+            "simd": out.vectors.name(),
             "threads": out.threads,
             "ended": { "diffuse": s.diffuse, "escaped": s.escaped,
                        "min_throughput": s.cut_by_throughput, "roulette": s.cut_by_roulette,
@@ -617,7 +618,7 @@ fn report(
         bvh.kind,
         scene.geometry.triangles.len(),
         bvh.build_time.as_secs_f64() * 1e3,
-        mirrorbox_trace::cpu_features::widest_name(),
+        out.vectors.name(),
         written
             .iter()
             .map(|p| p.display().to_string())

@@ -32,7 +32,7 @@
 use super::{Integrator, PathResult, Termination, face_normals};
 use crate::bvh::packet::{LANES, LaneHits, LaneMask, NO_TRIANGLE, RayPacket, first_lanes, lanes};
 use crate::bvh::{Hit, NO_QUERY, Query, SceneBvh};
-use crate::cpu_features::{Vectorised, widest};
+use crate::cpu_features::{Vectorised, build_for, run_on};
 use crate::hit_point::on_triangle_plane;
 use crate::mirror_bounce::{MirrorPlanes, bounce_flat_lanes, reflect_on_plane};
 use crate::sampler::SplitMix64;
@@ -504,13 +504,16 @@ impl PathTracer<'_> {
                     .radiance_lanes_inline(self.rays, self.rngs, self.asked, self.out)
             }
         }
-        widest(Work {
-            path: self,
-            rays,
-            rngs,
-            asked,
-            out,
-        })
+        run_on(
+            build_for(self.gains_from_512_bits()),
+            Work {
+                path: self,
+                rays,
+                rngs,
+                asked,
+                out,
+            },
+        )
     }
 
     #[inline(always)]
@@ -728,6 +731,19 @@ impl Integrator for PathTracer<'_> {
     /// ([`SplitMix64::split`]), as [`Integrator::radiance_all`] splits one per sample.
     fn radiance(&self, ray: Ray, rng: &mut SplitMix64) -> PathResult {
         self.radiance_one(ray, &mut rng.split(), &mut Vec::new())
+    }
+
+    /// No: a path's walk is mostly scalar and 8-lane code (the vertices, the single-ray
+    /// traversal), which 512-bit vectors do not speed up, and on an Intel CPU the few 32-lane
+    /// loops that use them presumably slow the clock for all of it (Intel's AVX-512 licences;
+    /// the clock is not measurable in this project's VMs, but the timings fit: any 512-bit
+    /// code in a render costs the whole render). A render in AVX2 there, against
+    /// AVX-512 (Intel Xeon, 2 cores, one thread, 640×360, 16 spp, paired over 8 rounds; issue
+    /// 56's thirteenth session): `mirror_box` ×0.942 [0.927–0.972], `mirror_room` ×0.967
+    /// [0.928–0.980]; with only the walk in AVX2 (the image row and the camera rays in
+    /// AVX-512) ×1.020 / ×1.026, slower. `whitted` is ×1.05–1.07 faster in AVX-512 and keeps it.
+    fn gains_from_512_bits(&self) -> bool {
+        false
     }
 
     /// Enough pixels to fill a call's packets when packets are traced (at least one;

@@ -992,7 +992,7 @@ impl Integrator for Whitted<'_> {
     ) {
         if !self.bvh.packets() {
             rays.clear();
-            camera_rays(camera, positions, rays);
+            camera_rays(camera, positions, rays, self.gains_from_512_bits());
             return self.radiance_all(rays, rngs, out);
         }
         out.clear();
