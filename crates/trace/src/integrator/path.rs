@@ -286,9 +286,9 @@ impl PathTracer<'_> {
         let g = &scene.geometry;
         // The ray's two vectors apart, not the 24-byte `Ray` copied: that copy was stored as
         // 16 + 8 bytes, and the direction read back as 8 bytes across the two stores, which
-        // no store forwarding serves (a stall of the store's retirement, 7 % of `path`
-        // `mirror_box` on one instruction by `perf`; ×0.884 / ×0.895 on `mirror_box` /
-        // `mirror_room`, issue 56's thirteenth session).
+        // no store forwarding serves (a wait for the stores to retire: 7 % of `path`
+        // `mirror_box` on one instruction by `perf` on an Intel Xeon; ×0.884 / ×0.895 on
+        // `mirror_box` / `mirror_room` there, issue 56's thirteenth session).
         let (origin, dir) = (w.ray.origin, w.ray.dir);
         let Some(hit) = hit else {
             w.escape(scene.background);
