@@ -578,8 +578,12 @@ impl SceneBvh {
             type Output = ();
             #[inline(always)]
             fn run(self) {
+                self.run_wide::<8>()
+            }
+            #[inline(always)]
+            fn run_wide<const F32_LANES: usize>(self) {
                 self.bvh
-                    .closest_hits_inline(self.packet, self.active, self.out)
+                    .closest_hits_inline::<F32_LANES>(self.packet, self.active, self.out)
             }
         }
         widest(Kernel {
@@ -593,14 +597,14 @@ impl SceneBvh {
     /// [`SceneBvh::closest_hits`] for callers already compiled for this CPU
     /// ([`crate::cpu_features::widest`]): the kernel is inlined into them.
     #[inline(always)]
-    pub(crate) fn closest_hits_inline(
+    pub(crate) fn closest_hits_inline<const F32_LANES: usize>(
         &self,
         packet: &RayPacket,
         active: LaneMask,
         out: &mut [Option<Hit>; LANES],
     ) {
         let mut hits = LaneHits::default();
-        self.closest_hit_lanes_inline(packet, active, &mut hits);
+        self.closest_hit_lanes_inline::<F32_LANES>(packet, active, &mut hits);
         for lane in packet::lanes(active) {
             out[lane] = hits.get(lane);
         }
@@ -609,7 +613,7 @@ impl SceneBvh {
     /// [`SceneBvh::closest_hits_inline`] as structure of arrays ([`LaneHits`], what the
     /// kernel keeps): every lane is written, those outside `active` with no hit.
     #[inline(always)]
-    pub(crate) fn closest_hit_lanes_inline(
+    pub(crate) fn closest_hit_lanes_inline<const F32_LANES: usize>(
         &self,
         packet: &RayPacket,
         active: LaneMask,
@@ -618,7 +622,7 @@ impl SceneBvh {
         if self.packets {
             let bvh = self.packet_bvh();
             if bvh.usable() {
-                return bvh.closest_hit_lanes_inline(packet, active, out);
+                return bvh.closest_hit_lanes_inline::<F32_LANES>(packet, active, out);
             }
         }
         *out = LaneHits::default();
@@ -651,7 +655,11 @@ impl SceneBvh {
             type Output = LaneMask;
             #[inline(always)]
             fn run(self) -> LaneMask {
-                self.bvh.occluded_lanes_inline(
+                self.run_wide::<8>()
+            }
+            #[inline(always)]
+            fn run_wide<const F32_LANES: usize>(self) -> LaneMask {
+                self.bvh.occluded_lanes_inline::<F32_LANES>(
                     self.packet,
                     self.active,
                     self.t_max,
@@ -671,7 +679,7 @@ impl SceneBvh {
     /// [`SceneBvh::occluded_lanes`] for callers already compiled for this CPU
     /// ([`crate::cpu_features::widest`]): the kernel is inlined into them.
     #[inline(always)]
-    pub(crate) fn occluded_lanes_inline(
+    pub(crate) fn occluded_lanes_inline<const F32_LANES: usize>(
         &self,
         packet: &RayPacket,
         active: LaneMask,
@@ -681,7 +689,12 @@ impl SceneBvh {
         if self.packets {
             let bvh = self.packet_bvh();
             if bvh.usable() {
-                return bvh.occluded_lanes_inline(packet, active, t_max, skip_triangle);
+                return bvh.occluded_lanes_inline::<F32_LANES>(
+                    packet,
+                    active,
+                    t_max,
+                    skip_triangle,
+                );
             }
         }
         packet::lanes(active)

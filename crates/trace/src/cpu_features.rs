@@ -20,6 +20,17 @@
 pub trait Vectorised {
     type Output;
     fn run(self) -> Self::Output;
+
+    /// [`Vectorised::run`] in the build whose vectors hold `F32_LANES` f32 lanes (16 for
+    /// AVX-512, 8 for AVX2, 4 for the baseline's SSE2): for work whose loops are shaped by
+    /// the vector width (the packet kernel's triangle chunks). By default `run`.
+    #[inline(always)]
+    fn run_wide<const F32_LANES: usize>(self) -> Self::Output
+    where
+        Self: Sized,
+    {
+        self.run()
+    }
 }
 
 /// The builds [`widest`] chooses from, narrowest first (so `min` is the narrower).
@@ -202,7 +213,7 @@ pub fn run_on<W: Vectorised>(build: Build, work: W) -> W::Output {
         // SAFETY: the CPU has AVX2 (detected at run time).
         #[cfg(target_arch = "x86_64")]
         Build::Avx2 => unsafe { x86::avx2(work) },
-        _ => work.run(),
+        _ => work.run_wide::<4>(),
     }
 }
 
@@ -217,12 +228,12 @@ mod x86 {
 
     #[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq")]
     pub fn avx512<W: Vectorised>(work: W) -> W::Output {
-        work.run()
+        work.run_wide::<16>()
     }
 
     #[target_feature(enable = "avx2")]
     pub fn avx2<W: Vectorised>(work: W) -> W::Output {
-        work.run()
+        work.run_wide::<8>()
     }
 }
 

@@ -352,14 +352,20 @@ impl PacketBvh {
     /// features ([`crate::cpu_features::widest`]; the same arithmetic, hence the same bits,
     /// in every build).
     #[inline(always)]
-    pub(super) fn closest_hit_lanes_inline(
+    pub(super) fn closest_hit_lanes_inline<const F32_LANES: usize>(
         &self,
         packet: &RayPacket,
         active: LaneMask,
         out: &mut LaneHits,
     ) {
         *out = LaneHits::default();
-        self.trace_lanes::<false>(packet, active, &mut out.t, &mut out.triangle, &NO_TRIANGLES);
+        self.trace_lanes::<false, F32_LANES>(
+            packet,
+            active,
+            &mut out.t,
+            &mut out.triangle,
+            &NO_TRIANGLES,
+        );
     }
 
     /// The lanes of `active` whose segment is blocked: whose ray hits a triangle at
@@ -368,7 +374,7 @@ impl PacketBvh {
     /// [`super::SceneBvh::occluded`] answers. A lane stops at its first such hit (any hit
     /// will do), and so does the traversal once every lane has stopped.
     #[inline(always)]
-    pub(super) fn occluded_lanes_inline(
+    pub(super) fn occluded_lanes_inline<const F32_LANES: usize>(
         &self,
         packet: &RayPacket,
         active: LaneMask,
@@ -377,7 +383,7 @@ impl PacketBvh {
     ) -> LaneMask {
         let mut best_t = *t_max;
         let mut best_triangle = [NO_TRIANGLE; LANES];
-        self.trace_lanes::<true>(
+        self.trace_lanes::<true, F32_LANES>(
             packet,
             active,
             &mut best_t,
@@ -395,7 +401,7 @@ impl PacketBvh {
     /// becomes [`STOPPED`] at its first hit). Two monomorphised kernels, so that the any-hit
     /// mode costs the closest-hit one nothing.
     #[inline(always)]
-    fn trace_lanes<const ANY_HIT: bool>(
+    fn trace_lanes<const ANY_HIT: bool, const F32_LANES: usize>(
         &self,
         packet: &RayPacket,
         active: LaneMask,
@@ -420,7 +426,7 @@ impl PacketBvh {
             left &= !same;
             n += 1;
         }
-        self.traverse::<ANY_HIT>(
+        self.traverse::<ANY_HIT, F32_LANES>(
             packet,
             &prepared,
             active,
@@ -441,7 +447,7 @@ impl PacketBvh {
     /// tenth session).
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
-    fn traverse<const ANY_HIT: bool>(
+    fn traverse<const ANY_HIT: bool, const F32_LANES: usize>(
         &self,
         p: &RayPacket,
         q: &Prepared,
@@ -486,24 +492,24 @@ impl PacketBvh {
                             let (t, s, k) = (&mut *best_t, &mut *best_triangle, skip_triangle);
                             // (The same arm for every slot of the leaf: one branch, predicted.)
                             match axes_of(code) {
-                                (1, 2, 0) => {
-                                    self.triangle::<1, 2, 0, ANY_HIT>(slot, p, q, h, t, s, k)
-                                }
-                                (2, 1, 0) => {
-                                    self.triangle::<2, 1, 0, ANY_HIT>(slot, p, q, h, t, s, k)
-                                }
-                                (2, 0, 1) => {
-                                    self.triangle::<2, 0, 1, ANY_HIT>(slot, p, q, h, t, s, k)
-                                }
-                                (0, 2, 1) => {
-                                    self.triangle::<0, 2, 1, ANY_HIT>(slot, p, q, h, t, s, k)
-                                }
-                                (0, 1, 2) => {
-                                    self.triangle::<0, 1, 2, ANY_HIT>(slot, p, q, h, t, s, k)
-                                }
-                                (1, 0, 2) => {
-                                    self.triangle::<1, 0, 2, ANY_HIT>(slot, p, q, h, t, s, k)
-                                }
+                                (1, 2, 0) => self.triangle::<1, 2, 0, ANY_HIT, F32_LANES>(
+                                    slot, p, q, h, t, s, k,
+                                ),
+                                (2, 1, 0) => self.triangle::<2, 1, 0, ANY_HIT, F32_LANES>(
+                                    slot, p, q, h, t, s, k,
+                                ),
+                                (2, 0, 1) => self.triangle::<2, 0, 1, ANY_HIT, F32_LANES>(
+                                    slot, p, q, h, t, s, k,
+                                ),
+                                (0, 2, 1) => self.triangle::<0, 2, 1, ANY_HIT, F32_LANES>(
+                                    slot, p, q, h, t, s, k,
+                                ),
+                                (0, 1, 2) => self.triangle::<0, 1, 2, ANY_HIT, F32_LANES>(
+                                    slot, p, q, h, t, s, k,
+                                ),
+                                (1, 0, 2) => self.triangle::<1, 0, 2, ANY_HIT, F32_LANES>(
+                                    slot, p, q, h, t, s, k,
+                                ),
                                 other => unreachable!("not an axis permutation: {other:?}"),
                             }
                         }
@@ -530,14 +536,20 @@ impl PacketBvh {
 
     /// The watertight test of slot `slot` for the lanes of `hit`, keeping `0 ≤ t < best`
     /// and recording the scene's index of the triangle hit. Two loops branch free over the
-    /// lanes (the compiler vectorises them): the edge functions ([`TRIANGLE_CHUNK`] lanes at
+    /// lanes (the compiler vectorises them): the edge functions ([`triangle_chunk`] lanes at
     /// a time, chunks with no lane of `hit` skipped: their lanes' flags stay unset), then,
     /// only if some lane is inside the edges, the distance; the rare lanes with an exact
     /// zero edge function or an exact tie are finished one by one. `ANY_HIT`: lanes also
     /// skip `skip_triangle`, and a hit stops the lane (`best` becomes [`STOPPED`]).
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
-    fn triangle<const KX: usize, const KY: usize, const KZ: usize, const ANY_HIT: bool>(
+    fn triangle<
+        const KX: usize,
+        const KY: usize,
+        const KZ: usize,
+        const ANY_HIT: bool,
+        const F32_LANES: usize,
+    >(
         &self,
         slot: u32,
         p: &RayPacket,
@@ -592,10 +604,12 @@ impl PacketBvh {
         // Chunk by chunk, skipping the chunks where no lane asks: in `mirror_room` a fifth of
         // the chunk tests of leaves met by some lane (a leaf met by a few lanes of a packet
         // whose rays have spread).
-        for c in 0..LANES / TRIANGLE_CHUNK {
-            if (hit >> (c * TRIANGLE_CHUNK)) & CHUNK_LANES != 0 {
-                for j in 0..TRIANGLE_CHUNK {
-                    edge_lane(c * TRIANGLE_CHUNK + j);
+        let chunk = triangle_chunk(F32_LANES);
+        let chunk_lanes: LaneMask = (1 << chunk) - 1;
+        for c in 0..LANES / chunk {
+            if (hit >> (c * chunk)) & chunk_lanes != 0 {
+                for j in 0..chunk {
+                    edge_lane(c * chunk + j);
                 }
             }
         }
@@ -651,17 +665,19 @@ impl PacketBvh {
     }
 }
 
-/// Lanes per step of the triangle test's edge functions, skipped where none asks (one AVX2
-/// vector of f32). Against the whole packet at once, in-process (issue 56, tenth session):
+/// Lanes per step of the triangle test's edge functions, skipped where none asks: one vector
+/// of f32 in the AVX2 and AVX-512 builds (`f32_lanes` 8 and 16), 8 in the baseline's. Against
+/// the whole packet at once, in-process (issue 56, tenth session, AMD EPYC with AVX2): 8 lanes
 /// `whitted` `mirror_room` ×0.986 [0.984–0.987], `mirror_box` ×1.002, `path` ×1.000; 16 lanes
-/// ×1.031 slower than 8 on AVX2, and the distance loop chunked too ×1.18.
-const TRIANGLE_CHUNK: usize = 8;
+/// ×1.031 slower than 8 in AVX2 (×1.023 / ×1.025 on an Intel Xeon, thirteenth session), and
+/// the distance loop chunked too ×1.18. In AVX-512 on the Intel Xeon, 16 against 8: `whitted`
+/// ×0.904 [0.901–0.918] / ×0.914 [0.897–0.927] (`mirror_room` / `mirror_box`).
+const fn triangle_chunk(f32_lanes: usize) -> usize {
+    if f32_lanes >= 16 { 16 } else { 8 }
+}
 
-/// The bits of one chunk of [`TRIANGLE_CHUNK`] lanes.
-const CHUNK_LANES: LaneMask = (1 << TRIANGLE_CHUNK) - 1;
-
-// Every lane is in some chunk.
-const _: () = assert!(LANES.is_multiple_of(TRIANGLE_CHUNK));
+// Every lane is in some chunk, whatever the build.
+const _: () = assert!(LANES.is_multiple_of(16) && LANES.is_multiple_of(8));
 
 /// One flag per lane.
 type Mask = [bool; LANES];

@@ -500,8 +500,12 @@ impl PathTracer<'_> {
             type Output = ();
             #[inline(always)]
             fn run(self) {
+                self.run_wide::<8>()
+            }
+            #[inline(always)]
+            fn run_wide<const F32_LANES: usize>(self) {
                 self.path
-                    .radiance_lanes_inline(self.rays, self.rngs, self.asked, self.out)
+                    .radiance_lanes_inline::<F32_LANES>(self.rays, self.rngs, self.asked, self.out)
             }
         }
         run_on(
@@ -517,7 +521,7 @@ impl PathTracer<'_> {
     }
 
     #[inline(always)]
-    fn radiance_lanes_inline(
+    fn radiance_lanes_inline<const F32_LANES: usize>(
         &self,
         rays: &[Ray],
         rngs: &mut [SplitMix64],
@@ -570,7 +574,7 @@ impl PathTracer<'_> {
                 }
                 if coherent != 0 {
                     self.bvh
-                        .closest_hit_lanes_inline(&packet, coherent, &mut hits);
+                        .closest_hit_lanes_inline::<F32_LANES>(&packet, coherent, &mut hits);
                 }
                 // The scattered lanes' queries one after another, before any lane's vertex:
                 // a run of traversals with nothing between them, which the processor
@@ -709,7 +713,8 @@ impl PathTracer<'_> {
                     let b = if mask == 0 {
                         0
                     } else {
-                        self.bvh.occluded_lanes_inline(&packet, mask, &t_max, &from)
+                        self.bvh
+                            .occluded_lanes_inline::<F32_LANES>(&packet, mask, &t_max, &from)
                     };
                     blocked.push(b);
                 }

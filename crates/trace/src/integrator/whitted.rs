@@ -146,7 +146,11 @@ impl<'a> Whitted<'a> {
                 mask |= 1 << leg.lane;
             }
         }
-        let blocked = self.bvh.occluded_lanes_inline(&packet, mask, &t_max, &skip);
+        // (Compiled inside the lighting's lane loops, which do not know their vector build:
+        // the kernel's triangle chunks of the AVX2 build, whatever the build.)
+        let blocked = self
+            .bvh
+            .occluded_lanes_inline::<8>(&packet, mask, &t_max, &skip);
         for (leg, clear) in legs.iter().zip(clear.iter_mut()) {
             *clear = blocked >> leg.lane & 1 == 0;
         }
@@ -201,8 +205,12 @@ impl<'a> Whitted<'a> {
             type Output = ();
             #[inline(always)]
             fn run(self) {
+                self.run_wide::<8>()
+            }
+            #[inline(always)]
+            fn run_wide<const F32_LANES: usize>(self) {
                 self.whitted
-                    .radiance_packet_inline::<SHADED_IN_LANES>(self.starts, self.out)
+                    .radiance_packet_inline::<SHADED_IN_LANES, F32_LANES>(self.starts, self.out)
             }
         }
         // Compiled apart for lighting shaded in lane loops and for lighting with shadow legs
@@ -231,7 +239,7 @@ impl<'a> Whitted<'a> {
     /// taken once for the lanes that met one triangle ([`Whitted::step_on_first_triangle`]),
     /// the rest lane by lane ([`Whitted::step_lane`]).
     #[inline(always)]
-    fn radiance_packet_inline<const SHADED_IN_LANES: bool>(
+    fn radiance_packet_inline<const SHADED_IN_LANES: bool, const F32_LANES: usize>(
         &self,
         starts: Starts<'_>,
         out: &mut Vec<PathResult>,
@@ -251,7 +259,7 @@ impl<'a> Whitted<'a> {
             while walks.active != 0 {
                 packet.set_rays_f64(&walks.origin, &walks.dir);
                 self.bvh
-                    .closest_hit_lanes_inline(&packet, walks.active, &mut hits);
+                    .closest_hit_lanes_inline::<F32_LANES>(&packet, walks.active, &mut hits);
                 round.flat = [false; LANES];
                 round.diffuse = [false; LANES];
                 // The lanes on one triangle together where the shading is in lane loops too
