@@ -491,27 +491,25 @@ impl PacketBvh {
                         for slot in node.first..node.first + node.count {
                             let (t, s, k) = (&mut *best_t, &mut *best_triangle, skip_triangle);
                             // (The same arm for every slot of the leaf: one branch, predicted.)
-                            match axes_of(code) {
-                                (1, 2, 0) => self.triangle::<1, 2, 0, ANY_HIT, F32_LANES>(
-                                    slot, p, q, h, t, s, k,
-                                ),
-                                (2, 1, 0) => self.triangle::<2, 1, 0, ANY_HIT, F32_LANES>(
-                                    slot, p, q, h, t, s, k,
-                                ),
-                                (2, 0, 1) => self.triangle::<2, 0, 1, ANY_HIT, F32_LANES>(
-                                    slot, p, q, h, t, s, k,
-                                ),
-                                (0, 2, 1) => self.triangle::<0, 2, 1, ANY_HIT, F32_LANES>(
-                                    slot, p, q, h, t, s, k,
-                                ),
-                                (0, 1, 2) => self.triangle::<0, 1, 2, ANY_HIT, F32_LANES>(
-                                    slot, p, q, h, t, s, k,
-                                ),
-                                (1, 0, 2) => self.triangle::<1, 0, 2, ANY_HIT, F32_LANES>(
-                                    slot, p, q, h, t, s, k,
-                                ),
-                                other => unreachable!("not an axis permutation: {other:?}"),
+                            macro_rules! test_with_axes {
+                                ($(($x:literal, $y:literal, $z:literal)),*) => {
+                                    match axes_of(code) {
+                                        $(($x, $y, $z) => self
+                                            .triangle::<$x, $y, $z, ANY_HIT, F32_LANES>(
+                                                slot, p, q, h, t, s, k,
+                                            ),)*
+                                        other => unreachable!("not an axis permutation: {other:?}"),
+                                    }
+                                };
                             }
+                            test_with_axes!(
+                                (1, 2, 0),
+                                (2, 1, 0),
+                                (2, 0, 1),
+                                (0, 2, 1),
+                                (0, 1, 2),
+                                (1, 0, 2)
+                            );
                         }
                     }
                     // Any hit: done once every lane has stopped (a stopped lane's box tests
