@@ -16,7 +16,9 @@
 //! what the wider vectors speed up.
 
 /// Work to compile for each CPU: implement `run` with `#[inline(always)]`, and mark
-/// `#[inline(always)]` what it calls that should be compiled with it.
+/// `#[inline(always)]` what it calls that should be compiled with it. The builds call
+/// [`Vectorised::run_wide`], which work shaped by the vector width implements instead (its
+/// `run` is then what a caller outside the builds gets).
 pub trait Vectorised {
     type Output;
     fn run(self) -> Self::Output;
