@@ -219,11 +219,6 @@ pub fn run_on<W: Vectorised>(build: Build, work: W) -> W::Output {
     }
 }
 
-/// The name of the build [`widest`] runs (reports, `--json`).
-pub fn widest_name() -> &'static str {
-    BUILD.name()
-}
-
 #[cfg(target_arch = "x86_64")]
 mod x86 {
     use super::Vectorised;
@@ -291,7 +286,7 @@ mod tests {
                 assert_eq!(lane_bits_fold::<N>(|i| flags[i]), expected);
             }
         }
-        println!("vector build: {}", widest_name());
+        println!("vector build: {}", BUILD.name());
         check::<4>(1);
         check::<8>(3);
         check::<12>(4);
