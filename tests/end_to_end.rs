@@ -4,6 +4,7 @@
 mod common;
 
 mod advise;
+mod build_profile;
 mod cli;
 mod exchange;
 mod hardening;
