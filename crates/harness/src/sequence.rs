@@ -121,17 +121,16 @@ fn frame_path(base: &Path, k: u32) -> PathBuf {
     base.with_file_name(format!("{stem}_{k:04}.exr"))
 }
 
-/// The sequence flags every child shares.
-/// The flags of frames `first .. first + count` of `s`.
-fn sequence_flags(config: &SequenceConfig, s: &Scenario, first: u32, count: u32) -> Vec<String> {
+/// The flags every child of `s` shares: its scene, frames, path time and size.
+fn sequence_flags(config: &SequenceConfig, s: &Scenario) -> Vec<String> {
     let mut flags = vec![
         s.scene.display().to_string(),
         "--sequence".into(),
-        count.to_string(),
+        s.frames.to_string(),
         "--fps".into(),
         s.fps.to_string(),
         "--time".into(),
-        (s.start + f64::from(first) / s.fps).to_string(),
+        s.start.to_string(),
     ];
     for (flag, v) in [("--width", config.width), ("--height", config.height)] {
         if let Some(v) = v {
@@ -164,70 +163,48 @@ fn camera_step(s: &Scenario) -> Result<f64, HarnessError> {
     })
 }
 
-/// Scene passes one child process may execute (frames × draws × passes per frame): Mesa
-/// 22.3's lavapipe keeps about 4 MB per executed pass until the process exits (measured:
-/// `auxiliary n=4`, 139 passes, 560 MB per frame), so a stateless method's sequence is split
-/// into processes of at most this many passes, about 2.4 GB each. A stateful method's
-/// sequence stays in one process (its state lives there); it draws few passes per frame.
-pub const MAX_PASSES_PER_PROCESS: u64 = 600;
-
-/// Renders `method`'s frames of `s` in child processes: one per sequence for a stateful
-/// method, chunks within [`MAX_PASSES_PER_PROCESS`] for the others (sized by the first
-/// frame's pass count). Returns each frame's summary and its EXR.
+/// Renders `method`'s frames of `s` in one child process (a stateful method carries its state
+/// from frame to frame there). Returns each frame's summary and its EXR.
+///
+/// Until Mesa 25 a stateless method's sequence was split into children of at most 600 scene
+/// passes, the first of a single frame: Mesa 22.3's lavapipe kept about 4 MB per executed pass
+/// until the process exited. Mesa 25 does not (docs/budgets.md), and every child compiled its
+/// shaders again — about 2 s each on lavapipe, 60 children where one per sequence makes 24:
+/// `auxiliary n=4` (139 passes) rendered 12 frames of `motion` in seven children.
 fn render_sequence(
     config: &SequenceConfig,
     s: &Scenario,
     method: &Method,
     dir: &Path,
 ) -> Result<(Vec<serde_json::Value>, Vec<PathBuf>), HarnessError> {
-    let stateful = method
-        .entry()
-        .accepts(&mirrorbox_raster::methods::feedback::HISTORY);
-    let draws = u64::from(config.warmup + config.timed);
-    let mut summaries: Vec<serde_json::Value> = Vec::new();
-    let mut images = Vec::new();
-    let mut first = 0;
-    while first < s.frames {
-        let count = match summaries.first() {
-            _ if stateful => s.frames,
-            None => 1,
-            Some(one) => {
-                let passes = one["passes"].as_u64().unwrap_or(1).max(1);
-                (MAX_PASSES_PER_PROCESS / (passes * draws.max(1))).clamp(1, u64::from(s.frames))
-                    as u32
-            }
-        }
-        .min(s.frames - first);
-        let base = dir.join(format!("{}_{first:04}.png", method.slug()));
-        let mut args = vec!["render".to_string()];
-        args.extend(sequence_flags(config, s, first, count));
-        args.extend(method_flags(method));
-        args.extend([
-            "--ssaa".into(),
-            config.ssaa.to_string(),
-            "--warmup".into(),
-            config.warmup.to_string(),
-            "--frames".into(),
-            config.timed.to_string(),
-            "--json".into(),
-            "-o".into(),
-            base.display().to_string(),
-        ]);
-        let stdout = run(&config.exe, &args)?;
-        let printed: Vec<serde_json::Value> = stdout
-            .lines()
-            .filter_map(|l| serde_json::from_str(l).ok())
-            .collect();
-        if printed.len() != count as usize {
-            return Err(HarnessError::Worker(format!(
-                "render --sequence {count} printed {} frame summaries",
-                printed.len()
-            )));
-        }
-        summaries.extend(printed);
-        images.extend((0..count).map(|j| frame_path(&base, j)));
-        first += count;
+    let base = dir.join(format!("{}_0000.png", method.slug()));
+    let mut args = vec!["render".to_string()];
+    args.extend(sequence_flags(config, s));
+    args.extend(method_flags(method));
+    args.extend([
+        "--ssaa".into(),
+        config.ssaa.to_string(),
+        "--warmup".into(),
+        config.warmup.to_string(),
+        "--frames".into(),
+        config.timed.to_string(),
+        "--json".into(),
+        "-o".into(),
+        base.display().to_string(),
+    ]);
+    let stdout = run(&config.exe, &args)?;
+    let summaries: Vec<serde_json::Value> = stdout
+        .lines()
+        .filter_map(|l| serde_json::from_str(l).ok())
+        .collect();
+    if summaries.len() != s.frames as usize {
+        return Err(HarnessError::Worker(format!(
+            "render --sequence {} printed {} frame summaries",
+            s.frames,
+            summaries.len()
+        )));
     }
+    let images = (0..s.frames).map(|k| frame_path(&base, k)).collect();
     Ok((summaries, images))
 }
 
@@ -253,7 +230,7 @@ pub fn run_sequences(
         std::fs::create_dir_all(&dir).map_err(io(&dir))?;
         let truth_base = dir.join("truth.exr");
         let mut args = vec!["trace".to_string()];
-        args.extend(sequence_flags(config, s, 0, s.frames));
+        args.extend(sequence_flags(config, s));
         args.extend([
             "--spp".into(),
             (config.ssaa * config.ssaa).to_string(),
