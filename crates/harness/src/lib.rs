@@ -41,6 +41,7 @@ use mirrorbox_report::{
 use mirrorbox_scene::limits::{SettingError, unit_interval};
 use mirrorbox_scene::{Scene, SceneError, load_scene};
 use mirrorbox_trace::{SceneBvh, TraceSettings, WhittedSettings};
+use rayon::prelude::*;
 use std::fmt::Write as _;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
@@ -861,6 +862,73 @@ pub(crate) fn check_output_parent(out: &Path) -> Result<(), HarnessError> {
 /// The method every floor point renders the mirror-free scene with: one scene pass.
 pub const FLOOR_METHOD: &str = "naive";
 
+/// A point's comparison with its truth, done after the timing rounds: what its record needs.
+struct PointImages {
+    views: Compared,
+    split: Option<ErrorSplit>,
+    files: ViewFiles,
+    /// A stereo point's IPD.
+    ipd: Option<f32>,
+}
+
+/// Compares point `p`'s last raster (`raster`, and its right eye's beside it for a stereo
+/// point) with its truths, writes its pictures into `images`, splits a mono point's error
+/// at `depth` against `truncated` (its truth cut there), and removes the rasters.
+#[allow(clippy::too_many_arguments)]
+fn compare_point(
+    p: &Point,
+    raster: &Path,
+    truths: &[PathBuf],
+    truncated: Option<&Path>,
+    depth: usize,
+    exposure: f32,
+    marker: Option<[f32; 3]>,
+    images: &Path,
+) -> Result<PointImages, HarnessError> {
+    let mut rasters = vec![raster.to_path_buf()];
+    let ipd = p
+        .axes
+        .iter()
+        .find(|(a, _)| a.name == axes::STEREO_IPD.name)
+        .map(|(_, d)| *d as f32);
+    if ipd.is_some() {
+        rasters.push(worker::right_eye_image(raster));
+    }
+    let truth_name = match &p.method {
+        None => "floor".into(),
+        Some(_) => {
+            let axes: String = p
+                .axes
+                .iter()
+                .map(|(a, v)| format!("{}{}_", a.slug, a.text(*v)))
+                .collect();
+            format!("{axes}a{}", p.alpha)
+        }
+    };
+    let files = ViewFiles {
+        raster: images.join(format!("{}.png", p.slug)),
+        heat: images.join(format!("{}_flip.png", p.slug)),
+        // One truth per α (and per plane count, light depth, tilt, IPD).
+        truth: images.join(format!("truth_{truth_name}.png")),
+    };
+    let views = compare_views(truths, &rasters, exposure, marker, &files)?;
+    let split = match (truncated, truths) {
+        (Some(truncated), [full]) => {
+            Some(error_split(full, truncated, &rasters[0], exposure, depth)?)
+        }
+        _ => None,
+    };
+    for r in &rasters {
+        let _ = std::fs::remove_file(r);
+    }
+    Ok(PointImages {
+        views,
+        split,
+        files,
+        ipd,
+    })
+}
+
 /// A point's scene (mirrors removed for the floor, reflectance α) and render settings.
 fn point_setup(
     base: &Scene,
@@ -1190,51 +1258,55 @@ pub fn run_sweep(
     // Every point shares the base scene's camera, hence its exposure.
     let exposure = base.camera.exposure;
     let marker = marker_albedo(config, &base)?;
+    // Each mono point's truth cut at the depth its method reached (the error split), traced
+    // one after another (each trace runs on every core) or read from the cache.
+    let mut truncated: Vec<Option<PathBuf>> = Vec::with_capacity(todo.len());
     for (i, p) in todo.iter().enumerate() {
-        if dropped[i] {
-            continue;
-        }
-        let report = last[i].take().expect("every point renders in every round");
-        let frames_ms = std::mem::take(&mut timed[i]);
-        let mut rasters = vec![jobs[i].image.clone()];
-        let ipd = p
-            .axes
-            .iter()
-            .find(|(a, _)| a.name == axes::STEREO_IPD.name)
-            .map(|(_, d)| *d as f32);
-        if ipd.is_some() {
-            rasters.push(worker::right_eye_image(&jobs[i].image));
-        }
-        let truth_name = match &p.method {
-            None => "floor".into(),
-            Some(_) => {
-                let axes: String = p
-                    .axes
-                    .iter()
-                    .map(|(a, v)| format!("{}{}_", a.slug, a.text(*v)))
-                    .collect();
-                format!("{axes}a{}", p.alpha)
-            }
-        };
-        let files = ViewFiles {
-            raster: images.join(format!("{}.png", p.slug)),
-            heat: images.join(format!("{}_flip.png", p.slug)),
-            // One truth per α (and per plane count, light depth, tilt, IPD).
-            truth: images.join(format!("truth_{truth_name}.png")),
-        };
-        let views = compare_views(&truths[i], &rasters, exposure, marker, &files)?;
-        let split = match (&p.method, truths[i].as_slice()) {
-            (Some(_), [full]) => {
+        truncated.push(match (&p.method, truths[i].as_slice(), &last[i]) {
+            (Some(_), [_], Some(report)) if !dropped[i] => {
                 let (scene, _) = point_setup(&base, p, config)?;
                 let at = report.depth;
-                let truncated = truth_at_depth(&scene, config, at, &truth_cache, &mut summary)?;
-                Some(error_split(full, &truncated, &rasters[0], exposure, at)?)
+                Some(truth_at_depth(
+                    &scene,
+                    config,
+                    at,
+                    &truth_cache,
+                    &mut summary,
+                )?)
             }
             _ => None,
+        });
+    }
+    // Then every point's images compared and their pictures written, the points spread over
+    // the cores (each comparison runs on one): the rounds above are over, nothing is timed.
+    let compared: Vec<Option<Result<PointImages, HarnessError>>> = (0..todo.len())
+        .into_par_iter()
+        .map(|i| {
+            let report = last[i].as_ref().filter(|_| !dropped[i])?;
+            Some(compare_point(
+                todo[i],
+                &jobs[i].image,
+                &truths[i],
+                truncated[i].as_deref(),
+                report.depth,
+                exposure,
+                marker,
+                &images,
+            ))
+        })
+        .collect();
+    for ((i, p), compared) in todo.iter().enumerate().zip(compared) {
+        let Some(compared) = compared else {
+            continue;
         };
-        for r in &rasters {
-            let _ = std::fs::remove_file(r);
-        }
+        let PointImages {
+            views,
+            split,
+            files,
+            ipd,
+        } = compared?;
+        let report = last[i].take().expect("every point renders in every round");
+        let frames_ms = std::mem::take(&mut timed[i]);
         let rel = |q: &Path| {
             q.strip_prefix(out)
                 .unwrap_or(q)
