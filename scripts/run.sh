@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# The main job (README): installs missing system packages, builds mirrorbox in release mode,
+# The main job (README): installs missing system packages, builds mirrorbox in release mode
+# (without the viewer),
 # validates every bundled scene, reports the wgpu adapter, then runs every experiment of the
 # registry that the main job runs (crates/experiments, `mirrorbox experiment --main-job`: the
 # paper's Table 1 twice — two consecutive runs side by side — the exact methods' depth
@@ -56,7 +57,11 @@ run_step scripts/install-system-deps.sh
 # slower on the tracer (issue 56, docs/tracer-performance.md).
 unset RUSTC_WORKSPACE_WRAPPER CLIPPY_ARGS
 # --timings: target/cargo-timings/cargo-timing.html says which crates the build's time goes to.
-run_step cargo build --release --locked -p mirrorbox --timings
+# Without the viewer (`--no-default-features`): the main job draws no window, and the window's
+# crates (egui, winit, their fonts and protocols) were about a third of this build's compiler
+# time (docs/budgets.md). `mirrorbox view` in this binary says how to build it with the viewer;
+# `cargo build --release -p mirrorbox` then compiles only those crates and the CLI.
+run_step cargo build --release --locked -p mirrorbox --no-default-features --timings
 main_job_experiments=$("$bin" experiment --main-job)
 main_job_built=$(echo "$main_job_experiments" | grep -c . || true)
 if [ "$main_job_built" -ne "$main_job_in_source" ]; then

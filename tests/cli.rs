@@ -370,6 +370,8 @@ fn info_reports_the_adapter_and_its_timing_support() {
         ["rgba32float", "rgba16float"].contains(&v["color_format"].as_str().unwrap()),
         "{v}"
     );
+    // The tests' build has the viewer (the default features; scripts/run.sh's has not).
+    assert_eq!(v["viewer"], true, "{v}");
 }
 
 /// The commands that time frames compile their shaders afresh (Mesa's disk cache off: lavapipe

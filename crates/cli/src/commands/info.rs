@@ -37,6 +37,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             "warning": r.platform_warning(),
             "color_format": color_format.as_ref().ok().map(|f| f.name()),
             "color_format_error": color_format.as_ref().err(),
+            "viewer": cfg!(feature = "viewer"),
         });
         println!("{value}");
     } else {
@@ -48,6 +49,15 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             Ok(f) => println!("colour targets:   {f}"),
             Err(why) => println!("colour targets:   none: {why}"),
         }
+        // Whether `view` is in this binary (scripts/run.sh builds it without).
+        println!(
+            "viewer:           {}",
+            if cfg!(feature = "viewer") {
+                "built"
+            } else {
+                "not built (--no-default-features): `cargo build --release -p mirrorbox` builds it"
+            }
+        );
     }
     Ok(())
 }
