@@ -10,7 +10,7 @@
 //!   each rendering every point's warm-up frames and one timed frame, in an order shuffled
 //!   per round with a fixed seed — so drift of a shared machine hits every point alike. Each
 //!   record holds every frame, the median, its 95 % bootstrap interval and the minimum. A
-//!   [settling round](SETTLING_ROUNDS) renders every point once, untimed, before them.
+//!   [settling round](SETTLING_ROUNDS) renders every point's frame once, untimed, before them.
 //! - **Resume**: points whose key is already in `results.jsonl` are skipped. Points are
 //!   written once all rounds are done: an interrupted sweep keeps every point written
 //!   before, and measures the interrupted batch again.
@@ -346,12 +346,14 @@ fn io(path: &Path) -> impl FnOnce(std::io::Error) -> HarnessError + '_ {
     }
 }
 
-/// Untimed rounds before the timed ones: every point renders its warm-up and timed frames
-/// once, and none of it is kept. The first round after a sweep's shaders are compiled ran
+/// Untimed rounds before the timed ones: every point renders one frame (no warm-up before
+/// it), and none of it is kept. The first round after a sweep's shaders are compiled ran
 /// slower for some methods than for others — on lavapipe the paper's `auxiliary` n = 2 took
 /// 21–26 ms in the first round and about 15 ms after it while `portal` did not change (the
 /// `table1-runs` records of issue 54, frames kept in round order) — which biased the paired
-/// ratios.
+/// ratios. One frame per point settles it as well as its warm-up and timed frames did
+/// (table1, three runs each way interleaved on the 2-core Intel Xeon: per-point medians
+/// ×0.98, 0.94–1.04, within the runs' own spread; docs/budgets.md).
 pub const SETTLING_ROUNDS: u32 = 1;
 
 /// The seed of the per-round shuffles of interleaved timing.
@@ -1219,7 +1221,18 @@ pub fn run_sweep(
                     rounds: config.frames,
                 }
             });
-            let job = &jobs[i];
+            // The settling round draws one frame per point (no warm-up before it): what it
+            // settles is each point's first draw after its shaders are compiled.
+            let settling_job;
+            let job = if settling {
+                settling_job = RenderJob {
+                    warmup: 0,
+                    ..jobs[i].clone()
+                };
+                &settling_job
+            } else {
+                &jobs[i]
+            };
             let rendered = match &config.worker {
                 Some(exe) => worker::render_in_worker(exe, job, &p.label),
                 None => worker::render_scene(job, &scenes[i], &gpu).and_then(|rendered| {

@@ -10,9 +10,11 @@
 //! plots and the filmstrips of the stateful methods' worst frames stay in `OUT/`.
 
 use crate::HarnessError;
+use mirrorbox_image::metrics::Metrics;
 use mirrorbox_image::{RgbImage, read_image};
 use mirrorbox_raster::{Method, ParamValue};
 use mirrorbox_report::sequence::{FrameRecord, MotionInfo, ScenarioInfo, write_motion_report};
+use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -256,9 +258,18 @@ pub fn run_sequences(
                 .entry()
                 .accepts(&mirrorbox_raster::methods::feedback::HISTORY);
             let mut flips: Vec<(f64, u32)> = Vec::new();
-            for (k, summary) in (0..s.frames).zip(&summaries) {
-                let image = read_image(&images[k as usize])?;
-                let m = mirrorbox_image::metrics::compare(&truths[k as usize], &image, exposure)?;
+            // Every frame compared with its truth, the frames spread over the cores (the
+            // child has rendered them: nothing is timed here).
+            let metrics: Vec<Metrics> = (0..s.frames as usize)
+                .into_par_iter()
+                .map(|k| {
+                    let image = read_image(&images[k])?;
+                    Ok(mirrorbox_image::metrics::compare(
+                        &truths[k], &image, exposure,
+                    )?)
+                })
+                .collect::<Result<_, HarnessError>>()?;
+            for ((k, summary), m) in (0..s.frames).zip(&summaries).zip(metrics) {
                 device = summary["adapter"].as_str().unwrap_or("").to_string();
                 records.push(FrameRecord {
                     scenario: s.name.clone(),
