@@ -14,11 +14,6 @@ pub mod score;
 pub mod stereo;
 pub mod sweep;
 pub mod trace;
-#[cfg(feature = "viewer")]
-pub mod view;
-/// `view` in a binary built without the viewer (`--no-default-features`): it says so.
-#[cfg(not(feature = "viewer"))]
-#[path = "view_not_built.rs"]
 pub mod view;
 
 use crate::Failure;

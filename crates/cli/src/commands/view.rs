@@ -2,12 +2,14 @@
 //! it and their error (docs/viewer.md). `--script` drives it; `--frames N --screenshot
 //! OUT.png` takes one picture and closes.
 
+//!
+//! Built without the `viewer` feature (`cargo build --no-default-features`, as
+//! `scripts/run.sh` builds it: the main job draws no window, and the window's crates are about
+//! a third of a cold release build), the command takes the same arguments — its `--help`, and
+//! the CLI reference generated from it, are the same — and says how to build the viewer.
+
 use super::method_flags::{RenderOptions, method_value_parser};
-use super::{load, output_path, unit_interval};
 use crate::Failure;
-use mirrorbox_raster::RenderSettings;
-use mirrorbox_viewer::script::{self, Action, Step};
-use mirrorbox_viewer::{ViewError, ViewOptions};
 use std::path::PathBuf;
 
 #[derive(clap::Args)]
@@ -68,6 +70,12 @@ pub enum TruthDeviceArg {
     Gpu,
 }
 
+/// The largest window side (the viewer's; without it, nothing is opened).
+#[cfg(feature = "viewer")]
+const MAX_WINDOW_SIDE: u32 = mirrorbox_viewer::script::MAX_WINDOW_SIDE;
+#[cfg(not(feature = "viewer"))]
+const MAX_WINDOW_SIDE: u32 = u32::MAX;
+
 fn parse_size(text: &str) -> Result<(u32, u32), String> {
     let (w, h) = text
         .split_once('x')
@@ -75,18 +83,29 @@ fn parse_size(text: &str) -> Result<(u32, u32), String> {
     let side = |s: &str| {
         s.parse::<u32>()
             .ok()
-            .filter(|v| (64..=script::MAX_WINDOW_SIDE).contains(v))
-            .ok_or_else(|| {
-                format!(
-                    "each side must be in [64, {}], got {s:?}",
-                    script::MAX_WINDOW_SIDE
-                )
-            })
+            .filter(|v| (64..=MAX_WINDOW_SIDE).contains(v))
+            .ok_or_else(|| format!("each side must be in [64, {MAX_WINDOW_SIDE}], got {s:?}"))
     };
     Ok((side(w)?, side(h)?))
 }
 
+/// Without the viewer: says how to build it (exit 2), whatever the arguments.
+#[cfg(not(feature = "viewer"))]
+pub fn run(_: &Args) -> Result<(), Failure> {
+    Err(Failure::BadInput(
+        "this mirrorbox was built without the viewer (`--no-default-features`: scripts/run.sh \
+         builds it so, to keep the main job within its time budget); build it with the viewer \
+         with `cargo build --release -p mirrorbox`"
+            .into(),
+    ))
+}
+
+#[cfg(feature = "viewer")]
 pub fn run(args: &Args) -> Result<(), Failure> {
+    use super::{load, output_path, unit_interval};
+    use mirrorbox_raster::RenderSettings;
+    use mirrorbox_viewer::script::{self, Action, Step};
+    use mirrorbox_viewer::{ViewError, ViewOptions};
     let bad = Failure::BadInput;
     let entry = mirrorbox_raster::registry::find(&args.method)
         .ok_or_else(|| bad(format!("unknown method {:?}", args.method)))?;
