@@ -1295,7 +1295,12 @@ pub fn run_sweep(
     let compared: Vec<Option<Result<PointImages, HarnessError>>> = (0..todo.len())
         .into_par_iter()
         .map(|i| {
-            let report = last[i].as_ref().filter(|_| !dropped[i])?;
+            if dropped[i] {
+                return None;
+            }
+            let report = last[i]
+                .as_ref()
+                .expect("every point renders in every round");
             Some(compare_point(
                 todo[i],
                 &jobs[i].image,
