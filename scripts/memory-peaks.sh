@@ -24,7 +24,7 @@ methods=$("$bin" render --help | sed -n '/Possible values:/,/^$/p' | sed -n 's/^
 mkdir -p reports/memory
 mb() { awk -v b="$1" 'BEGIN { printf "%.0f", b / 1e6 }'; }
 # Processes at once (the machine's cores, at most 2: lavapipe renders on every core).
-jobs=$(($(nproc) < 2 ? 1 : 2))
+at_once=$(($(nproc) < 2 ? 1 : 2))
 # One row of the table into $tmp/row.N (a failure's message into $tmp/fail.N).
 peak_row() {
   local k=$1 scene=$2 method=$3 name json code peak gpu host
@@ -69,7 +69,7 @@ peak_row() {
     for method in $methods; do
       i=$((i + 1))
       peak_row "$i" "$scene" "$method" &
-      while [ "$(jobs -rp | wc -l)" -ge "$jobs" ]; do wait -n || true; done
+      while [ "$(jobs -rp | wc -l)" -ge "$at_once" ]; do wait -n || true; done
     done
   done
   wait

@@ -1,15 +1,14 @@
 #!/usr/bin/env bash
 # The main job (README): installs missing system packages, builds mirrorbox in release mode
-# (without the viewer),
-# validates every bundled scene, reports the wgpu adapter, then runs every experiment of the
-# registry that the main job runs (crates/experiments, `mirrorbox experiment --main-job`: the
-# paper's Table 1 twice — two consecutive runs side by side — the exact methods' depth
-# scaling, the symmetry planes, lighting, uneven mirrors, stereo, motion, the cross-method
-# frontier, the truth's cost against mirrored lights and every scene's memory peak), each
-# measuring every point again (cached ground truths are reused when present). It records each
-# step's time and peak memory in reports/main_job.json, writes the overview reports/index.html
-# and reports/README.md (`report --index`) and fills the generated regions of the README and
-# the book from the reports.
+# (without the viewer), validates every bundled scene, reports the wgpu adapter, then runs
+# every experiment of the registry that the main job runs (crates/experiments, `mirrorbox
+# experiment --main-job`: the paper's Table 1 twice — two consecutive runs side by side — the
+# exact methods' depth scaling, the symmetry planes, lighting, uneven mirrors, stereo, motion,
+# the cross-method frontier, the truth's cost against mirrored lights and every scene's memory
+# peak), each measuring every point again (cached ground truths are reused when present). It
+# records each step's time and peak memory in reports/main_job.json, writes the overview
+# reports/index.html and reports/README.md (`report --index`) and fills the generated regions
+# of the README and the book from the reports.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 export NODEVICE_SELECT=1

@@ -1,7 +1,6 @@
 //! `mirrorbox view SCENE`: a window with the method live, the traced truth refining beside
 //! it and their error (docs/viewer.md). `--script` drives it; `--frames N --screenshot
 //! OUT.png` takes one picture and closes.
-
 //!
 //! Built without the `viewer` feature (`cargo build --no-default-features`, as
 //! `scripts/run.sh` builds it: the main job draws no window, and the window's crates are about
