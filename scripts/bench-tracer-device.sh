@@ -4,7 +4,7 @@
 # machine has no Rust toolchain, no Mitsuba, no LLVM library for Dr.Jit and reaches no registry,
 # so everything travels, prepared here, in .bench/ (ignored; carried by the device tool, which
 # sends at most 64 MiB with the working tree: run scripts/gpu-tree.sh light first):
-#   scripts/bench-tracer-device.sh prepare   here: the stripped binary, Mitsuba's wheel for the
+#   scripts/bench-tracer-device.sh prepare   here: the stripped binary (built without the viewer), Mitsuba's wheel for the
 #       device's Python 3.12 cut to the one variant and the plugins the bench loads (found by
 #       tracing its file opens), Dr.Jit's wheel, and this machine's libLLVM with the libraries
 #       it needs that a bare image may lack
@@ -18,7 +18,7 @@ case ${1:-} in
 prepare)
   grep -qx '/.bench/' .git/info/exclude 2>/dev/null || printf '/.bench/\n' >>.git/info/exclude
   rm -rf "$d" && mkdir -p "$d"
-  (unset RUSTC_WORKSPACE_WRAPPER CLIPPY_ARGS CARGO_INCREMENTAL; cargo build --release --locked -q -p mirrorbox)
+  (unset RUSTC_WORKSPACE_WRAPPER CLIPPY_ARGS CARGO_INCREMENTAL; cargo build --release --locked -q -p mirrorbox --no-default-features)
   strip -o "$d/mirrorbox" target/release/mirrorbox && xz -T0 -6 "$d/mirrorbox"
   commit=$(git rev-parse --short HEAD)
   git diff --quiet HEAD -- crates shaders Cargo.toml Cargo.lock tools || commit="$commit+changes"

@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
 # Issue 57: what the device tool sends to a lent GPU machine is the checkout's tracked and
-# untracked-not-ignored files, at most 64 MiB with the carried .gpu/ and .gl/; the committed
-# reports alone are larger. scripts/gpu-measure.sh needs none of them (it writes new folders
-# under reports/gpu/), so for the length of the lease the reports leave git's index and are
+# untracked-not-ignored files, at most 64 MiB with the carried .gpu/ and .gl/ (or .bench/); the
+# committed reports alone are larger. scripts/gpu-measure.sh and scripts/bench-tracer-device.sh
+# need neither the reports (they write new files under reports/) nor docs/ (2.4 MB, which
+# .bench/'s 60 MB cannot spare), so for the length of the lease both leave git's index and are
 # ignored; nothing in the working tree is touched.
-#   scripts/gpu-tree.sh light     before the device calls: reports/ untracked and ignored
-#   scripts/gpu-tree.sh restore   after them: the index as HEAD has it, reports/ tracked again
+#   scripts/gpu-tree.sh light     before the device calls: reports/ and docs/ untracked, ignored
+#   scripts/gpu-tree.sh restore   after them: the index as HEAD has it, both tracked again
 #   scripts/gpu-tree.sh size      what would travel, in bytes (tracked + untracked, not ignored)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -16,11 +17,13 @@ light)
     echo "gpu-tree.sh: the index holds staged changes; commit or unstage them first" >&2
     exit 2
   fi
-  git rm -r --cached -q reports
-  grep -qx '/reports/' "$exclude" 2>/dev/null || printf '/reports/\n' >>"$exclude"
+  for p in reports docs; do
+    git rm -r --cached -q "$p"
+    grep -qx "/$p/" "$exclude" 2>/dev/null || printf '/%s/\n' "$p" >>"$exclude"
+  done
   ;;
 restore)
-  sed -i '/^\/reports\/$/d' "$exclude"
+  sed -i '/^\/reports\/$/d; /^\/docs\/$/d' "$exclude"
   git reset -q
   ;;
 size) ;;

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """The index of the tracer benches (issue 41): reports/tracer/bench.md and bench.json from
-every CPU kind's reports/tracer/bench-<cpu>-<width>.json (written by scripts/bench-tracer.sh
+every CPU kind's reports/tracer/bench-<cpu>-<width>-<N>cores.json (written by scripts/bench-tracer.sh
 on that CPU): a summary row per CPU with the per-round ratios and the goals, then each CPU's
 table. A result is a claim only on the CPU it was measured on.
 
@@ -60,7 +60,7 @@ def main():
             body = f"(`{name}` is missing: only the record's ratios above.)"
         benches.append((b, name, cells, met, body))
     lines = ["# The tracer against Mitsuba 3, per CPU", "",
-             "One record per CPU kind: `scripts/bench-tracer.sh` writes the one of the CPU it runs on, "
+             "One record per CPU kind, vector width and core count: `scripts/bench-tracer.sh` writes the one of the machine it runs on, "
              "and a result is a claim only on that CPU. Per round: the median of each round's Mitsuba ÷ "
              "mirrorbox (above 1: mirrorbox faster). Goals (issue 41): `whitted` ≥ 3×, `path` ≥ 2× "
              "Mitsuba's compiled kernel, on both scenes. Mitsuba's compiled kernel is its process's "
@@ -68,13 +68,13 @@ def main():
              "timed on (records before 2026-11-28's fourth session of issue 56: its first, a cold one). "
              "A goal is met when the 95 % interval of a row's per-round median lies above it (the "
              "records that have one), and undecided when the interval holds it.", "",
-             "| CPU | vector width | date | commit | rounds | Mitsuba baseline | mirrorbox timed | `mirror_box` whitted | `mirror_box` path | `mirror_room` whitted | `mirror_room` path | goals |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+             "| CPU | vector width | cores | date | commit | rounds | Mitsuba baseline | mirrorbox timed | `mirror_box` whitted | `mirror_box` path | `mirror_room` whitted | `mirror_room` path | goals |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for b, name, cells, met, _ in benches:
-        lines.append(f"| [{b.get('cpu', '?')}]({name}) | {b.get('simd', '?')} | {b.get('date', '?')} | {b.get('commit', '–')} | {b.get('rounds', '?')} | "
+        lines.append(f"| [{b.get('cpu', '?')}]({name}) | {b.get('simd', '?')} | {b.get('cores', '?')} | {b.get('date', '?')} | {b.get('commit', '–')} | {b.get('rounds', '?')} | "
                      f"{b.get('mitsuba_whitted', '–')} | {b.get('mirrorbox_timed', 'first render')} | " + " | ".join(cells) + f" | {met} |")
     for b, name, _, _, body in benches:
-        lines += ["", f"## {b.get('cpu', '?')} ({b.get('simd', '?')})", "", body]
+        lines += ["", f"## {b.get('cpu', '?')} ({b.get('simd', '?')}, {b.get('cores', '?')} cores)", "", body]
     open(os.path.join(out, "bench.md"), "w").write("\n".join(lines) + "\n")
     json.dump([b for b, *_ in benches], open(os.path.join(out, "bench.json"), "w"), indent=2)
 

@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
-"""One CPU's tracer bench record (issue 41, 56): reports/tracer/bench-<cpu>-<width>.md and
+"""One CPU's tracer bench record (issue 41, 56): reports/tracer/bench-<cpu>-<width>-<N>cores.md and
 .json from the rounds scripts/bench-tracer.sh measured (one JSON object per render: who,
 scene, integrator, round, seconds, first_seconds, ...), which it keeps beside them as
-bench-<cpu>-<width>-rounds.jsonl, so that a record can be made again from its rounds.
+bench-<cpu>-<width>-<N>cores-rounds.jsonl, so that a record can be made again from its rounds.
 
 Per scene and integrator: medians over rounds [min–max], the ratio of the medians, and per
 round the ratio of the two renders run back to back, with the 95 % interval of that median
@@ -78,7 +78,11 @@ for scene in ["mirror_box", "mirror_room"]:
         rows.append(f"| `{scene}` | {integ} | {o[0]:.3f} [{o[1]:.3f}–{o[2]:.3f}] | {of[0]:.3f} [{of[1]:.3f}–{of[2]:.3f}] | {rays/o[0]/1e6:.1f} | {m[0]:.3f} [{m[1]:.3f}–{m[2]:.3f}] | {f[0]:.3f} [{f[1]:.3f}–{f[2]:.3f}] | {ratio:.2f}× | {paired[0]:.2f}× [{paired[1]:.2f}–{paired[2]:.2f}] | {paired_first[0]:.2f}× [{paired_first[1]:.2f}–{paired_first[2]:.2f}] | {f[0]/of[0]:.2f}× | ≥ {goal:.0f}×: {met} |")
 note = os.environ.get("MIRRORBOX_BENCH_NOTE", "").strip()
 note = f" ({note})" if note else ""
-slug = re.sub(r"[^a-z0-9]+", "-", cpu.lower()).strip("-") + "-" + simd.lower().replace("-", "")
+# One record per CPU kind, vector width and core count: the ratios move with the cores (a
+# frame's fixed costs weigh more when 16 threads share it), so a 16-core run of a CPU kind
+# does not replace its 2-core record.
+slug = (re.sub(r"[^a-z0-9]+", "-", cpu.lower()).strip("-") + "-" + simd.lower().replace("-", "")
+        + f"-{os.cpu_count()}cores")
 summary["file"] = f"bench-{slug}.md"
 lines = [f"# The tracer against Mitsuba 3 on {cpu} ({simd})", "",
          f"Measured {summary['date']} (commit {commit}) with `scripts/bench-tracer.sh {rounds} {spp}` on {cpu} ({simd}), {os.cpu_count()} cores{note}: 640×360, {spp} spp; Mitsuba {mver} `llvm_ad_rgb`; the two renderers alternated, one process each per round; medians over {rounds} rounds [min–max]. A claim about this CPU only: other CPUs have their own files ([bench.md](bench.md)).",
