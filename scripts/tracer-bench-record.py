@@ -10,7 +10,8 @@ round the ratio of the two renders run back to back, with the 95 % interval of t
 rounds). A goal is met when the interval lies above it, not met when below it, and
 undecided when the interval holds it.
 
-The CPU is this machine's (/proc/cpuinfo): run it where the rounds were measured.
+The CPU is this machine's (/proc/cpuinfo): run it where the rounds were measured, or on a
+machine of the same CPU kind (the core count is the rounds' own: mirrorbox's threads).
 MIRRORBOX_BENCH_DATE overrides the record's date (default today), MIRRORBOX_BENCH_NOTE adds
 a sentence about where it ran.
 
@@ -24,6 +25,10 @@ runs = [json.loads(l) for l in open(runs_path)]
 cpu = next((l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.startswith("model name")), "?")
 flags = next((l.split(":", 1)[1].split() for l in open("/proc/cpuinfo") if l.startswith("flags")), [])
 simd = "AVX-512" if "avx512f" in flags else "AVX2" if "avx2" in flags else "SSE"
+# The cores are the threads mirrorbox rendered with (the bench gives both renderers every
+# core), so a record made again from its rounds on another machine keeps its own count.
+threads = {r.get("threads") for r in runs if r.get("who") == "mirrorbox"} - {None}
+cores = threads.pop() if len(threads) == 1 else os.cpu_count()
 # The goals and the rule that judges a row against its goal: the index's, one place for both.
 index = __import__("runpy").run_path("scripts/tracer-bench-index.py")
 GOALS, row_state = index["GOALS"], index["row_state"]
@@ -40,7 +45,7 @@ def median_interval(v):
             break
         j += 1
     return (v[j - 1], v[n - j]) if j > 0 else None
-rows, summary = [], {"date": os.environ.get("MIRRORBOX_BENCH_DATE") or datetime.date.today().isoformat(), "cpu": cpu, "cores": os.cpu_count(), "simd": simd,
+rows, summary = [], {"date": os.environ.get("MIRRORBOX_BENCH_DATE") or datetime.date.today().isoformat(), "cpu": cpu, "cores": cores, "simd": simd,
                      "rounds": int(rounds), "spp": int(spp), "mitsuba": mver, "commit": commit,
                      "mitsuba_whitted": f"lean Whitted; path with roulette from {rr_depth}", "path_rr_depth": int(rr_depth),
                      "mirrorbox_timed": "second render", 
@@ -82,10 +87,10 @@ note = f" ({note})" if note else ""
 # frame's fixed costs weigh more when 16 threads share it), so a 16-core run of a CPU kind
 # does not replace its 2-core record.
 slug = (re.sub(r"[^a-z0-9]+", "-", cpu.lower()).strip("-") + "-" + simd.lower().replace("-", "")
-        + f"-{os.cpu_count()}cores")
+        + f"-{cores}cores")
 summary["file"] = f"bench-{slug}.md"
 lines = [f"# The tracer against Mitsuba 3 on {cpu} ({simd})", "",
-         f"Measured {summary['date']} (commit {commit}) with `scripts/bench-tracer.sh {rounds} {spp}` on {cpu} ({simd}), {os.cpu_count()} cores{note}: 640×360, {spp} spp; Mitsuba {mver} `llvm_ad_rgb`; the two renderers alternated, one process each per round; medians over {rounds} rounds [min–max]. A claim about this CPU only: other CPUs have their own files ([bench.md](bench.md)).",
+         f"Measured {summary['date']} (commit {commit}) with `scripts/bench-tracer.sh {rounds} {spp}` on {cpu} ({simd}), {cores} cores{note}: 640×360, {spp} spp; Mitsuba {mver} `llvm_ad_rgb`; the two renderers alternated, one process each per round; medians over {rounds} rounds [min–max]. A claim about this CPU only: other CPUs have their own files ([bench.md](bench.md)).",
          "",
          "| scene | integrator | mirrorbox s (second render) | mirrorbox s (first render) | mirrorbox Mrays/s | Mitsuba s (compiled kernel: second render) | Mitsuba s (first render, JIT included) | Mitsuba ÷ mirrorbox | per round: Mitsuba ÷ mirrorbox | per round: Mitsuba ÷ mirrorbox's first render | first ÷ first | goal (per round) |",
          "|---|---|---|---|---|---|---|---|---|---|---|---|"] + rows + ["",

@@ -6,16 +6,25 @@ use crate::common::{repo, succeed};
 use serde_json::{Value, json};
 use std::path::Path;
 
-/// Fifteen rounds of one CPU: every scene and integrator with Mitsuba `mitsuba_s` and
-/// mirrorbox `ours(k)` seconds in round k.
+/// Fifteen rounds of one CPU, mirrorbox on two threads: every scene and integrator with
+/// Mitsuba ÷ mirrorbox `per_round(scene, integrator, k)` in round k.
 fn rounds(dir: &Path, per_round: &dyn Fn(&str, &str, u32) -> f64) -> std::path::PathBuf {
+    rounds_on(dir, 2, per_round)
+}
+
+/// [`rounds`] with mirrorbox on `threads` threads (the bench gives it every core).
+fn rounds_on(
+    dir: &Path,
+    threads: u32,
+    per_round: &dyn Fn(&str, &str, u32) -> f64,
+) -> std::path::PathBuf {
     let mut lines = Vec::new();
     for round in 1..=15u32 {
         for scene in ["mirror_box", "mirror_room"] {
             for integrator in ["whitted", "path"] {
                 let ratio = per_round(scene, integrator, round);
                 lines.push(json!({"who": "mirrorbox", "scene": scene, "integrator": integrator,
-                    "round": round, "seconds": 0.1, "first_seconds": 0.11, "rays": 1000, "threads": 2}));
+                    "round": round, "seconds": 0.1, "first_seconds": 0.11, "rays": 1000, "threads": threads}));
                 lines.push(json!({"who": "mitsuba", "scene": scene, "integrator": integrator,
                     "round": round, "seconds": 0.1 * ratio, "first_seconds": 0.5, "variant": "llvm_ad_rgb"}));
             }
@@ -116,4 +125,23 @@ fn a_goal_is_met_only_when_the_interval_of_the_median_clears_it() {
     std::fs::create_dir(&out).unwrap();
     let (_, row) = record(&rounds(dir.path(), &below), &out);
     assert!(row.ends_with("| not met |"), "{row}");
+}
+
+/// A record is one CPU kind's at one core count, the rounds' own (mirrorbox's threads), not the
+/// count of the machine that makes the record: a 16-core run made again on 2 cores keeps its
+/// name and its row, and does not replace that CPU kind's 2-core record.
+#[test]
+fn a_record_keeps_the_core_count_of_its_rounds() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    std::fs::create_dir(&out).unwrap();
+    // Seven threads: no machine that runs this test has seven cores.
+    let (b, row) = record(&rounds_on(dir.path(), 7, &|_, _, _| 2.0), &out);
+    assert_eq!(b["cores"], 7, "{b}");
+    let file = b["file"].as_str().unwrap();
+    assert!(file.ends_with("-7cores.md"), "{file}");
+    assert!(out.join(file).is_file(), "{file}");
+    assert!(row.contains(" | 7 | 2026-11-28 | "), "{row}");
+    let md = std::fs::read_to_string(out.join(file)).unwrap();
+    assert!(md.contains("), 7 cores"), "{md}");
 }
