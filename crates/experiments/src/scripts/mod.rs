@@ -38,7 +38,7 @@ pub const MEMORY_PEAKS: Experiment = Experiment {
 
 pub const TRACER_BENCH: Experiment = Experiment {
     name: "tracer-bench",
-    about: "the tracer against Mitsuba 3's compiled kernel, per round, one record per CPU kind",
+    about: "the tracer against Mitsuba 3's compiled kernel, per round, one record per CPU kind and core count",
     folder: "tracer",
     measure: Measure::Script("scripts/bench-tracer.sh", &["7", "16"]),
     section: None,
