@@ -4,10 +4,10 @@
 # machine has no Rust toolchain, no Mitsuba, no LLVM library for Dr.Jit and reaches no registry,
 # so everything travels, prepared here, in .bench/ (ignored; carried by the device tool, which
 # sends at most 64 MiB with the working tree: run scripts/gpu-tree.sh light first):
-#   scripts/bench-tracer-device.sh prepare   here: the stripped binary (built without the viewer), Mitsuba's wheel for the
-#       device's Python 3.12 cut to the one variant and the plugins the bench loads (found by
-#       tracing its file opens), Dr.Jit's wheel, and this machine's libLLVM with the libraries
-#       it needs that a bare image may lack
+#   scripts/bench-tracer-device.sh prepare   here: the stripped binary (built without the
+#       viewer), Mitsuba's wheel for the device's Python 3.12 cut to the one variant and the
+#       plugins the bench loads (found by tracing its file opens), Dr.Jit's wheel, and this
+#       machine's libLLVM with the libraries it needs that a bare image may lack
 #   scripts/bench-tracer-device.sh run ROUNDS SPP   there: unpacks them under /tmp, checks that
 #       both renderers draw a small image, then runs scripts/bench-tracer.sh; the record lands
 #       in reports/tracer/ (carry reports/tracer) and, with its rounds, under $OUT

@@ -15,10 +15,11 @@
 # tools/mitsuba/render.py's lean form of the contract (tested to give the general form's
 # image), `path` Mitsuba's own with the same max_depth and rr_depth as ours.
 #
-# A result is a claim only on the CPU it was measured on: each CPU kind keeps its own files,
-# reports/tracer/bench-<cpu>-<vector width>-<N>cores.md and .json (e.g. bench-amd-epyc-avx512-2cores.md),
-# and reports/tracer/bench.md (with bench.json) lists every CPU's file with its ratios and
-# the goals (per round: whitted >= 3x, path >= 2x Mitsuba's compiled kernel).
+# A result is a claim only on the CPU it was measured on: each CPU kind, vector width and core
+# count keeps its own files, reports/tracer/bench-<cpu>-<vector width>-<N>cores.md and .json
+# (e.g. bench-amd-epyc-avx512-2cores.md), and reports/tracer/bench.md (with bench.json) lists
+# every CPU's file with its ratios and the goals (per round: whitted >= 3x, path >= 2x
+# Mitsuba's compiled kernel).
 #
 # Usage: scripts/bench-tracer.sh [ROUNDS] [SPP]      (defaults: 5 rounds, 16 spp, 640×360)
 #

@@ -39,11 +39,16 @@ def verdict(ratios, intervals):
 def main():
     out = sys.argv[1] if len(sys.argv) > 1 else "reports/tracer"
     benches = []
-    for path in sorted(glob.glob(os.path.join(out, "bench-*.json"))):
+    records = []
+    for path in glob.glob(os.path.join(out, "bench-*.json")):
         try:
-            b = json.load(open(path))
+            records.append((path, json.load(open(path))))
         except (OSError, ValueError) as e:
             sys.exit(f"{path}: not a bench record ({e})")
+    # By CPU, vector width, then cores as a number (2 before 16), not by file name.
+    records.sort(key=lambda r: (str(r[1].get("cpu")), str(r[1].get("simd")),
+                                r[1].get("cores") if isinstance(r[1].get("cores"), int) else 0, r[0]))
+    for path, b in records:
         name = os.path.basename(path)[:-5] + ".md"
         ratios = {(r.get("scene"), r.get("integrator")): r.get("speedup_vs_mitsuba_paired", [None])[0]
                   for r in b.get("results", [])}

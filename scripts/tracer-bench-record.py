@@ -10,8 +10,10 @@ round the ratio of the two renders run back to back, with the 95 % interval of t
 rounds). A goal is met when the interval lies above it, not met when below it, and
 undecided when the interval holds it.
 
-The CPU is this machine's (/proc/cpuinfo): run it where the rounds were measured, or on a
-machine of the same CPU kind (the core count is the rounds' own: mirrorbox's threads).
+The CPU and its vector width are this machine's (/proc/cpuinfo): run it where the rounds were
+measured, or on a machine of the same CPU kind and vector width. The core count is the
+rounds' own: the threads mirrorbox rendered with (the bench gives it every core; a run with
+RAYON_NUM_THREADS set records that count), the same in every round or the record is refused.
 MIRRORBOX_BENCH_DATE overrides the record's date (default today), MIRRORBOX_BENCH_NOTE adds
 a sentence about where it ran.
 
@@ -26,9 +28,17 @@ cpu = next((l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.start
 flags = next((l.split(":", 1)[1].split() for l in open("/proc/cpuinfo") if l.startswith("flags")), [])
 simd = "AVX-512" if "avx512f" in flags else "AVX2" if "avx2" in flags else "SSE"
 # The cores are the threads mirrorbox rendered with (the bench gives both renderers every
-# core), so a record made again from its rounds on another machine keeps its own count.
-threads = {r.get("threads") for r in runs if r.get("who") == "mirrorbox"} - {None}
-cores = threads.pop() if len(threads) == 1 else os.cpu_count()
+# core), so a record made again from its rounds on another machine keeps its own count. Rounds
+# of several counts are not one record; rounds without the count (none are committed) are
+# this machine's.
+threads = {r.get("threads") for r in runs if r.get("who") == "mirrorbox"}
+if len(threads - {None}) > 1 or (None in threads and len(threads) > 1):
+    sys.exit(f"{runs_path}: mirrorbox's rounds have several thread counts {sorted(threads, key=str)}: "
+             "a record is one core count's (run scripts/bench-tracer.sh again)")
+cores = next(iter(threads)) if threads and None not in threads else os.cpu_count()
+if None in threads:
+    print(f"{runs_path}: no thread count in mirrorbox's rounds: recorded as this machine's {cores} cores",
+          file=sys.stderr)
 # The goals and the rule that judges a row against its goal: the index's, one place for both.
 index = __import__("runpy").run_path("scripts/tracer-bench-index.py")
 GOALS, row_state = index["GOALS"], index["row_state"]
@@ -89,7 +99,7 @@ note = f" ({note})" if note else ""
 slug = (re.sub(r"[^a-z0-9]+", "-", cpu.lower()).strip("-") + "-" + simd.lower().replace("-", "")
         + f"-{cores}cores")
 summary["file"] = f"bench-{slug}.md"
-lines = [f"# The tracer against Mitsuba 3 on {cpu} ({simd})", "",
+lines = [f"# The tracer against Mitsuba 3 on {cpu} ({simd}, {cores} cores)", "",
          f"Measured {summary['date']} (commit {commit}) with `scripts/bench-tracer.sh {rounds} {spp}` on {cpu} ({simd}), {cores} cores{note}: 640×360, {spp} spp; Mitsuba {mver} `llvm_ad_rgb`; the two renderers alternated, one process each per round; medians over {rounds} rounds [min–max]. A claim about this CPU only: other CPUs have their own files ([bench.md](bench.md)).",
          "",
          "| scene | integrator | mirrorbox s (second render) | mirrorbox s (first render) | mirrorbox Mrays/s | Mitsuba s (compiled kernel: second render) | Mitsuba s (first render, JIT included) | Mitsuba ÷ mirrorbox | per round: Mitsuba ÷ mirrorbox | per round: Mitsuba ÷ mirrorbox's first render | first ÷ first | goal (per round) |",

@@ -36,42 +36,47 @@ fn rounds_on(
     path
 }
 
-/// Runs the record and index scripts into `out`; the index's one summary row.
-fn record(runs: &Path, out: &Path) -> (Value, String) {
-    let script = |name: &str, args: &[&str]| {
-        succeed(
-            std::process::Command::new("python3")
-                .arg(repo().join("scripts").join(name))
-                .args(args)
-                .current_dir(repo())
-                .env("MIRRORBOX_BENCH_DATE", "2026-11-28"),
-            name,
-        )
-    };
-    let out_s = out.to_str().unwrap();
-    script(
+/// A bench script (`scripts/NAME`) run from the repository with `args`, not yet run.
+fn bench_script(name: &str, args: &[&str]) -> std::process::Command {
+    let mut cmd = std::process::Command::new("python3");
+    cmd.arg(repo().join("scripts").join(name))
+        .args(args)
+        .current_dir(repo())
+        .env("MIRRORBOX_BENCH_DATE", "2026-11-28");
+    cmd
+}
+
+/// The record script's command for the rounds `runs` into `out` (15 rounds, 16 spp).
+fn record_script(runs: &Path, out: &Path) -> std::process::Command {
+    let (runs, out) = (runs.to_str().unwrap(), out.to_str().unwrap());
+    bench_script(
         "tracer-bench-record.py",
-        &[
-            runs.to_str().unwrap(),
-            out_s,
-            "15",
-            "16",
-            "3.9.1",
-            "abc1234",
-            "5",
-        ],
-    );
-    script("tracer-bench-index.py", &[out_s]);
+        &[runs, out, "15", "16", "3.9.1", "abc1234", "5"],
+    )
+}
+
+/// The index of the records in `out` (bench.json) and its summary rows (bench.md).
+fn index(out: &Path) -> (Vec<Value>, Vec<String>) {
+    let name = "tracer-bench-index.py";
+    succeed(&mut bench_script(name, &[out.to_str().unwrap()]), name);
     let index: Vec<Value> =
         serde_json::from_str(&std::fs::read_to_string(out.join("bench.json")).unwrap()).unwrap();
-    assert_eq!(index.len(), 1, "{index:?}");
     let md = std::fs::read_to_string(out.join("bench.md")).unwrap();
-    let row = md
+    let rows = md
         .lines()
-        .find(|l| l.contains("abc1234"))
-        .unwrap()
-        .to_string();
-    (index[0].clone(), row)
+        .filter(|l| l.starts_with("| [") && l.contains("abc1234"))
+        .map(str::to_string)
+        .collect();
+    (index, rows)
+}
+
+/// Runs the record and index scripts into `out`; the index's one record and summary row.
+fn record(runs: &Path, out: &Path) -> (Value, String) {
+    succeed(&mut record_script(runs, out), "tracer-bench-record.py");
+    let (index, rows) = index(out);
+    assert_eq!(index.len(), 1, "{index:?}");
+    assert_eq!(rows.len(), 1, "{rows:?}");
+    (index[0].clone(), rows[0].clone())
 }
 
 #[test]
@@ -128,20 +133,65 @@ fn a_goal_is_met_only_when_the_interval_of_the_median_clears_it() {
 }
 
 /// A record is one CPU kind's at one core count, the rounds' own (mirrorbox's threads), not the
-/// count of the machine that makes the record: a 16-core run made again on 2 cores keeps its
-/// name and its row, and does not replace that CPU kind's 2-core record.
+/// count of the machine that makes the record: a 7-core run made on this machine keeps its
+/// count, and sits beside the same CPU kind's 12-core record instead of replacing it, listed
+/// by the count as a number (7 before 12, where the file names sort 12 first).
 #[test]
 fn a_record_keeps_the_core_count_of_its_rounds() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out");
     std::fs::create_dir(&out).unwrap();
     // Seven threads: no machine that runs this test has seven cores.
-    let (b, row) = record(&rounds_on(dir.path(), 7, &|_, _, _| 2.0), &out);
+    let seven = dir.path().join("seven");
+    let twelve = dir.path().join("twelve");
+    std::fs::create_dir(&seven).unwrap();
+    std::fs::create_dir(&twelve).unwrap();
+    let (b, row) = record(&rounds_on(&seven, 7, &|_, _, _| 2.0), &out);
     assert_eq!(b["cores"], 7, "{b}");
-    let file = b["file"].as_str().unwrap();
+    let file = b["file"].as_str().unwrap().to_string();
     assert!(file.ends_with("-7cores.md"), "{file}");
-    assert!(out.join(file).is_file(), "{file}");
     assert!(row.contains(" | 7 | 2026-11-28 | "), "{row}");
-    let md = std::fs::read_to_string(out.join(file)).unwrap();
+    let md = std::fs::read_to_string(out.join(&file)).unwrap();
+    assert!(
+        md.starts_with("# ") && md.lines().next().unwrap().ends_with(", 7 cores)"),
+        "{md}"
+    );
     assert!(md.contains("), 7 cores"), "{md}");
+    // The same CPU kind's 12-core rounds: a second record beside the first, listed after it.
+    succeed(
+        &mut record_script(&rounds_on(&twelve, 12, &|_, _, _| 2.0), &out),
+        "tracer-bench-record.py",
+    );
+    let (all, rows) = index(&out);
+    let cores: Vec<&Value> = all.iter().map(|b| &b["cores"]).collect();
+    assert_eq!(cores, [7, 12], "{all:?}");
+    assert_eq!(rows.len(), 2, "{rows:?}");
+    assert!(out.join(&file).is_file() && out.join(file.replace("-7cores", "-12cores")).is_file());
+}
+
+/// Rounds of several thread counts are not one record: refused, naming the counts, and nothing
+/// written.
+#[test]
+fn rounds_of_several_core_counts_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let runs = rounds_on(dir.path(), 2, &|_, _, _| 2.0);
+    let text = std::fs::read_to_string(&runs).unwrap();
+    let mixed = text.replacen("\"threads\":2", "\"threads\":16", 1);
+    assert_ne!(mixed, text);
+    std::fs::write(&runs, mixed).unwrap();
+    let out = dir.path().join("out");
+    std::fs::create_dir(&out).unwrap();
+    let result = record_script(&runs, &out).output().unwrap();
+    assert!(!result.status.success());
+    let stderr = String::from_utf8_lossy(&result.stderr);
+    assert!(
+        stderr.contains("several thread counts [16, 2]")
+            || stderr.contains("several thread counts [2, 16]"),
+        "{stderr}"
+    );
+    assert_eq!(
+        std::fs::read_dir(&out).unwrap().count(),
+        0,
+        "nothing written"
+    );
 }

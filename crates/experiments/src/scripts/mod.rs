@@ -38,7 +38,7 @@ pub const MEMORY_PEAKS: Experiment = Experiment {
 
 pub const TRACER_BENCH: Experiment = Experiment {
     name: "tracer-bench",
-    about: "the tracer against Mitsuba 3's compiled kernel, per round, one record per CPU kind and core count",
+    about: "the tracer against Mitsuba 3's compiled kernel, per round, one record per CPU kind, vector width and core count",
     folder: "tracer",
     measure: Measure::Script("scripts/bench-tracer.sh", &["7", "16"]),
     section: None,
@@ -122,7 +122,7 @@ const TRACER_BENCH_REGIONS: &[RegionSource] = &[
     RegionSource {
         id: "tracer-bench-summary",
         source: "tracer/bench.md",
-        about: "the tracer against Mitsuba 3: one row per CPU kind measured, with the goals",
+        about: "the tracer against Mitsuba 3: one row per CPU kind, vector width and core count measured, with the goals",
         generate: |reports| report_summary_region(&reports.join("tracer/bench.md")),
     },
 ];

@@ -273,7 +273,7 @@ fn exercise(scene: &Scene, gpu: &Gpu, render_too: bool, tally: &mut Tally) -> Ve
         // default, the cube-map probe, is the `cubemap` method (fuzzed itself): drawing it
         // twice more per mutant cost the test 70 s. `cubemap` draws 16² faces, not its
         // default 256²: the same passes and code for any face size (its own tests hold the
-        // sizes), and its 256² faces were 40 % of this test's time for a 12×8 image.
+        // sizes), and its 256² faces were 40 % of a child's render time for a 12×8 image.
         let method = match entry.name {
             "ssr" => Method::parse("ssr ssr-fallback=planar").expect("a registered fallback"),
             "cubemap" => Method::parse("cubemap cube-size=16").expect("a face size in range"),
