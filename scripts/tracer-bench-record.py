@@ -32,11 +32,12 @@ simd = "AVX-512" if "avx512f" in flags else "AVX2" if "avx2" in flags else "SSE"
 # of several counts are not one record; rounds without the count (none are committed) are
 # this machine's.
 threads = {r.get("threads") for r in runs if r.get("who") == "mirrorbox"}
-if len(threads - {None}) > 1 or (None in threads and len(threads) > 1):
+if len(threads) > 1:
     sys.exit(f"{runs_path}: mirrorbox's rounds have several thread counts {sorted(threads, key=str)}: "
              "a record is one core count's (run scripts/bench-tracer.sh again)")
-cores = next(iter(threads)) if threads and None not in threads else os.cpu_count()
-if None in threads:
+(count,) = threads or {None}
+cores = count if count is not None else os.cpu_count()
+if threads == {None}:
     print(f"{runs_path}: no thread count in mirrorbox's rounds: recorded as this machine's {cores} cores",
           file=sys.stderr)
 # The goals and the rule that judges a row against its goal: the index's, one place for both.
