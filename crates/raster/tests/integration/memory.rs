@@ -1,25 +1,25 @@
 //! The memory estimate (`mirrorbox_raster::memory`, issue 37) against wgpu's own counters:
 //! for every registered method at its defaults (and with shadow maps) on a few bundled
 //! scenes, the GPU bytes the device holds while the frame is alive
-//! (`RenderOutput::gpu_memory`, read on a fresh device so nothing else is counted) are at
-//! most the estimate's GPU part, and the estimate is not loose: at most the measurement plus
-//! what the estimate counts and the counters cannot see, part by part, plus a slack
-//! proportional to what is measured — not a fixed allowance (issue 50: the old
-//! `1.5 × measured + 1 MiB` was 28 render targets of 64×36, so an estimate counting a
-//! mirror-texture set twice passed). What the counters cannot see:
+//! (`RenderOutput::gpu_memory`, read on a fresh device so nothing else is counted) are held
+//! to the part of the estimate the counters can see, both ways. What they cannot see:
 //!
 //! - the readback buffer, freed before the counters are read: `views × H × ⌈16·W⌉₂₅₆` bytes;
 //! - [`WGPU_UNSEEN`]: the 64 KiB of `mirrorbox_raster::memory::WGPU_DEVICE_BYTES` for
 //!   timestamp queries, staging belts and bookkeeping;
-//! - the parts in [`UNSEEN_PARTS`]: those the counters do not hold while the frame lives, or
-//!   that the estimate counts at their largest on purpose;
+//! - the parts in [`UNSEEN_PARTS`], which the counters never hold.
 //!
-//! and [`SLACK_SHARE`] of the measured bytes covers layout rounding and uniform records
-//! counted at 256 bytes where lavapipe aligns them tighter. Measured at 64×36 on every row of
-//! both tests (Mesa 25.0.7 lavapipe, 2026-11-27): beyond what the counters cannot see the
-//! estimate exceeds them by 0.1–1.1 % of the measured bytes (at most 11 696 bytes, `feedback`
-//! in the lit room with shadow maps). A mirror-texture set counted twice adds ≥ 53 504 bytes
-//! (6.6 % of `naive`'s 805 380 on `mirror_box`), a render target 46 080 (5.7 %): both fail.
+//! The estimate's part they can see is at least the measured bytes (less
+//! [`UNDERCOUNT_ALLOWED`]): it bounds what a frame holds, so a part it leaves out fails
+//! (one shadow-map layer dropped from it: checked). Without the [`PARTLY_SEEN_PARTS`] too, it
+//! is at most the measured bytes plus [`SLACK_SHARE`] of them, for layout rounding and
+//! uniform records counted at 256 bytes where lavapipe aligns them tighter — not a fixed
+//! allowance (issue 50: the old `1.5 × measured + 1 MiB` was 28 render targets of 64×36, so an
+//! estimate counting a mirror-texture set twice passed). Measured at 64×36 on every row of
+//! both tests (Mesa 25.0.7 lavapipe, 2026-11-30): the estimate exceeds them by 0.0–1.1 % of the
+//! measured bytes (at most 11 408 bytes, `feedback` in the lit room with shadow maps). A
+//! mirror-texture set counted twice adds ≥ 53 504 bytes (6.6 % of `naive`'s 805 380 on
+//! `mirror_box`), a render target 46 080 (5.7 %): both fail.
 
 use mirrorbox_raster::memory::{MemoryEstimate, buffer_bytes};
 use mirrorbox_raster::{Gpu, METHODS, Method, RenderSettings, plan_frame, render_planned};
@@ -29,15 +29,19 @@ use mirrorbox_scene::Scene;
 /// `WGPU_DEVICE_BYTES`, its 512 KiB zero buffer, they do).
 const WGPU_UNSEEN: u64 = 64 << 10;
 
-/// Parts of an estimate the counters cannot be held to, with why.
-const UNSEEN_PARTS: [(&str, &str); 3] = [
-    (
-        mirrorbox_raster::methods::ray_query::ACCELERATION_STRUCTURES,
-        "wgpu's counters do not include acceleration structures",
-    ),
+/// Parts of an estimate the counters never hold while the frame lives, with why.
+const UNSEEN_PARTS: [(&str, &str); 1] = [(
+    mirrorbox_raster::methods::ray_query::ACCELERATION_STRUCTURES,
+    "wgpu's counters do not include acceleration structures",
+)];
+
+/// Parts the counters hold only some of while the frame lives, with why: they count towards
+/// the estimate's lower bound and not its upper one.
+const PARTLY_SEEN_PARTS: [(&str, &str); 2] = [
     (
         "the BLAS inputs and triangle records",
-        "ray-query drops the BLAS inputs once the acceleration structures are built",
+        "ray-query drops the BLAS inputs once the acceleration structures are built and keeps \
+         the triangle records",
     ),
     (
         "the path instances",
@@ -45,26 +49,64 @@ const UNSEEN_PARTS: [(&str, &str); 3] = [
     ),
 ];
 
+/// Bytes the counters may hold beyond what the estimate counts for them: the `cubemap`
+/// frames in the lit room measure up to 284 bytes more than their estimate (2026-11-30,
+/// 64×36, light images 2–7 deep; the scene buffers' part grows with the images as measured,
+/// so the rest is in the method's own buffers or textures, not found). Far below a part the
+/// estimate could miss: one shadow-map layer of this test's is 64 KiB.
+const UNDERCOUNT_ALLOWED: u64 = 1 << 10;
+
 /// The share of the measured bytes the estimate may exceed them by, beyond what they cannot
 /// see.
 const SLACK_SHARE: f64 = 0.02;
 
-/// The largest GPU estimate wgpu's counters (`measured` bytes) allow for a frame of `views`
-/// views of `w × h` pixels (see the module's documentation), and the part of `estimate`
-/// held to it: its GPU bytes without the [`UNSEEN_PARTS`].
-fn bound(estimate: &MemoryEstimate, measured: u64, views: u64, (w, h): (u32, u32)) -> (u64, u64) {
-    let readback = views * buffer_bytes((u64::from(w) * 16).next_multiple_of(256) * u64::from(h));
-    let unseen: u64 = estimate
+/// The GPU bytes of `estimate`'s parts named in `parts`.
+fn bytes_of(estimate: &MemoryEstimate, parts: &[(&str, &str)]) -> u64 {
+    estimate
         .parts
         .iter()
-        .filter(|p| UNSEEN_PARTS.iter().any(|(what, _)| *what == p.what))
+        .filter(|p| parts.iter().any(|(what, _)| *what == p.what))
         .map(|p| p.gpu_bytes)
-        .sum();
+        .sum()
+}
+
+/// Holds the estimate to the counters (`measured` bytes) of a frame of `views` views of
+/// `w × h` pixels, both ways. What it counts that the counters can see — its GPU bytes
+/// without the [`UNSEEN_PARTS`], the readback buffers and [`WGPU_UNSEEN`] — is at least the
+/// measured bytes less [`UNDERCOUNT_ALLOWED`] (the estimate bounds what a frame holds); without the [`PARTLY_SEEN_PARTS`]
+/// too, at most [`SLACK_SHARE`] of them more (it is not loose). `key` names the frame.
+/// Returns the bytes counted beyond the measured ones.
+fn hold_to_counters(
+    key: &str,
+    estimate: &MemoryEstimate,
+    measured: u64,
+    views: u64,
+    (w, h): (u32, u32),
+) -> u64 {
+    let readback = views * buffer_bytes((u64::from(w) * 16).next_multiple_of(256) * u64::from(h));
+    let seen = estimate
+        .gpu_bytes
+        .checked_sub(bytes_of(estimate, &UNSEEN_PARTS) + readback + WGPU_UNSEEN)
+        .unwrap_or_else(|| {
+            panic!("{key}: an estimate without its readback, wgpu's share: {estimate}")
+        });
+    assert!(
+        measured <= seen + UNDERCOUNT_ALLOWED,
+        "{key}: wgpu holds {measured} bytes, more than the {seen} the estimate counts for \
+         what its counters see and {UNDERCOUNT_ALLOWED} ({} in all; {:?})",
+        estimate.gpu_bytes,
+        estimate.parts
+    );
+    let exact = seen - bytes_of(estimate, &PARTLY_SEEN_PARTS);
     let slack = (SLACK_SHARE * measured as f64) as u64;
-    (
-        measured + readback + WGPU_UNSEEN + slack,
-        estimate.gpu_bytes - unseen,
-    )
+    assert!(
+        exact <= measured + slack,
+        "{key}: the estimate is loose: {exact} bytes for what the counters see (without the \
+         parts they see only some of), above the {measured} they hold plus {SLACK_SHARE} of \
+         them ({:?})",
+        estimate.parts
+    );
+    exact.saturating_sub(measured)
 }
 
 fn scene(name: &str, w: u32, h: u32) -> Scene {
@@ -76,14 +118,24 @@ fn scene(name: &str, w: u32, h: u32) -> Scene {
 #[test]
 fn gpu_estimate_bounds_wgpus_counters_for_every_method() {
     let mut rows = Vec::new();
-    for name in [
-        "mirror_box.json",
-        "mirror_box_lit.json",
-        "mirror_room_lit.json",
-        "symmetry_star.json",
-        "bumpy_pair.json",
+    // The light images' chains: the scene's own depth, except the lit room's 8 (4 mirrors:
+    // shading every fragment of its cube-map probes with each image's shadow map took 5–6.5 s
+    // a frame, 24 of this test's 30 s). At 3 it still has dozens of images, each with its
+    // shadow-map layer (the estimate is linear in their count; more than the device allows
+    // is refused, not split), and mirror_box_lit holds the 8-deep chains.
+    for (name, mirrored_lights) in [
+        ("mirror_box.json", None),
+        ("mirror_box_lit.json", None),
+        ("mirror_room_lit.json", Some(3)),
+        ("symmetry_star.json", None),
+        ("bumpy_pair.json", None),
     ] {
-        let s = scene(name, 64, 36);
+        let mut s = scene(name, 64, 36);
+        if let Some(depth) = mirrored_lights {
+            s.lighting.mirrored_lights = depth;
+            s.enumerate_light_images(s.lighting.images.min_throughput)
+                .expect("fewer light images than the scene's own");
+        }
         // Shadow maps are drawn only where the scene asks for shadows (elsewhere `map` is
         // `none` with a warning): measured only there.
         let variants: &[&str] = if s.lighting.shadows {
@@ -119,28 +171,14 @@ fn gpu_estimate_bounds_wgpus_counters_for_every_method() {
                 let out = render_planned(&gpu, &s, planned, &settings).unwrap();
                 let measured = out.gpu_memory.buffer_bytes + out.gpu_memory.texture_bytes;
                 let key = format!("{name} {} shadows={shadows}", entry.name);
-                assert!(
-                    measured <= estimate.gpu_bytes,
-                    "{key}: wgpu holds {measured} bytes, above the estimate's GPU part {} ({:?})",
-                    estimate.gpu_bytes,
-                    estimate.parts
-                );
-                let (limit, held) =
-                    bound(&estimate, measured, 1, (s.camera.width, s.camera.height));
-                assert!(
-                    held <= limit,
-                    "{key}: the estimate's GPU part {held} (without the UNSEEN_PARTS) is loose: \
-                     above {limit}, the {measured} bytes wgpu holds plus what it cannot see and \
-                     {SLACK_SHARE} of them ({:?})",
-                    estimate.parts
-                );
+                let size = (s.camera.width, s.camera.height);
+                let beyond = hold_to_counters(&key, &estimate, measured, 1, size);
                 rows.push(format!(
-                    "{key}: measured {measured}, estimate {} (×{:.2}, +{} bytes); held {held} ≤ {limit} \
-                     ({:.2} % of measured beyond what it cannot see)",
+                    "{key}: measured {measured}, estimate {} (×{:.2}); {beyond} bytes \
+                     ({:.2} % of measured) beyond them in what the counters see",
                     estimate.gpu_bytes,
                     estimate.gpu_bytes as f64 / measured as f64,
-                    estimate.gpu_bytes - measured,
-                    100.0 * (held as f64 - (limit - (SLACK_SHARE * measured as f64) as u64) as f64) / measured as f64
+                    100.0 * beyond as f64 / measured as f64
                 ));
             }
         }
@@ -177,21 +215,12 @@ fn pair_estimate_bounds_wgpus_counters() {
         )
         .unwrap();
         let measured = out.gpu_memory.buffer_bytes + out.gpu_memory.texture_bytes;
-        assert!(
-            measured <= estimate.gpu_bytes,
-            "{key}: {measured} > {}",
-            estimate.gpu_bytes
-        );
-        let (limit, held) = bound(&estimate, measured, 2, (s.camera.width, s.camera.height));
+        let size = (s.camera.width, s.camera.height);
+        let beyond = hold_to_counters(key, &estimate, measured, 2, size);
         println!(
-            "{key}: measured {measured}, estimate {} (held: {held} ≤ {limit})",
+            "{key}: measured {measured}, estimate {}; {beyond} bytes beyond them in what the \
+             counters see",
             estimate.gpu_bytes
-        );
-        assert!(
-            held <= limit,
-            "{key}: the estimate's GPU part {held} is loose: above {limit} for {measured} \
-             measured ({:?})",
-            estimate.parts
         );
     }
 }
