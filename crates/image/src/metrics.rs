@@ -213,6 +213,33 @@ fn gaussian_11() -> [f64; 11] {
     k.map(|v| v / sum)
 }
 
+/// Separable valid filtering of the `w × h` plane `src` by the 11 taps `k`: rows, then
+/// columns; `(w − 10) × (h − 10)` values. Each output is `Σₜ k[t]·x[t]` added in tap order
+/// from 0, as the direct sum over a window is; the taps are the outer loop, so that the
+/// inner one runs along a row over independent outputs, which the compiler vectorises (the
+/// direct sums, one output at a time, did not: SSIM was 6–9 % of a sweep's CPU time).
+fn gaussian_11_valid(k: &[f64; 11], src: &[f64], w: usize, h: usize) -> Vec<f64> {
+    let (vw, vh) = (w - 10, h - 10);
+    let mut rows = vec![0.0; vw * h];
+    for (row, line) in rows.chunks_exact_mut(vw).zip(src.chunks_exact(w)) {
+        for (t, &kt) in k.iter().enumerate() {
+            for (acc, &v) in row.iter_mut().zip(&line[t..t + vw]) {
+                *acc += kt * v;
+            }
+        }
+    }
+    let mut out = vec![0.0; vw * vh];
+    for (j, row) in out.chunks_exact_mut(vw).enumerate() {
+        for (t, &kt) in k.iter().enumerate() {
+            let line = &rows[(j + t) * vw..(j + t + 1) * vw];
+            for (acc, &v) in row.iter_mut().zip(line) {
+                *acc += kt * v;
+            }
+        }
+    }
+    out
+}
+
 /// Mean SSIM of two interleaved RGB 8-bit images (values taken as /255), averaged over the
 /// channels, on the valid region.
 pub fn ssim(a: &[u8], b: &[u8], w: usize, h: usize) -> f64 {
@@ -234,22 +261,7 @@ fn ssim_over(a: &[u8], b: &[u8], w: usize, h: usize, mask: Option<&[bool]>) -> f
         let xx: Vec<f64> = x.iter().map(|v| v * v).collect();
         let yy: Vec<f64> = y.iter().map(|v| v * v).collect();
         let xy: Vec<f64> = x.iter().zip(&y).map(|(p, q)| p * q).collect();
-        // Separable valid filtering: rows, then columns.
-        let filter = |src: &[f64]| -> Vec<f64> {
-            let mut rows = vec![0.0; vw * h];
-            for r in 0..h {
-                for i in 0..vw {
-                    rows[r * vw + i] = (0..11).map(|t| k[t] * src[r * w + i + t]).sum();
-                }
-            }
-            let mut out = vec![0.0; vw * vh];
-            for j in 0..vh {
-                for i in 0..vw {
-                    out[j * vw + i] = (0..11).map(|t| k[t] * rows[(j + t) * vw + i]).sum();
-                }
-            }
-            out
-        };
+        let filter = |src: &[f64]| gaussian_11_valid(&k, src, w, h);
         let (mx, my, mxx, myy, mxy) = (
             filter(&x),
             filter(&y),
@@ -300,6 +312,44 @@ pub fn flip_map(reference: &[u8], test: &[u8], w: u32, h: u32) -> Vec<f32> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The window filter gives the bits of the direct sum over each window, `Σₜ k[t]·x` one
+    /// output at a time in tap order (the code it replaced), on planes of SSIM's values.
+    #[test]
+    fn the_vectorised_window_filter_gives_the_direct_sums_bits() {
+        let k = gaussian_11();
+        let mut state = 0x2545_F491_4F6C_DD1Du64;
+        for (w, h) in [(11, 11), (12, 17), (37, 23), (640, 24)] {
+            let src: Vec<f64> = (0..w * h)
+                .map(|_| {
+                    state ^= state << 13;
+                    state ^= state >> 7;
+                    state ^= state << 17;
+                    let v = (state % 256) as f64 / 255.0;
+                    // A plane of values, of squares and of products, as SSIM filters.
+                    v * ((state >> 8) % 256) as f64 / 255.0
+                })
+                .collect();
+            let (vw, vh) = (w - 10, h - 10);
+            let mut rows = vec![0.0; vw * h];
+            for r in 0..h {
+                for i in 0..vw {
+                    rows[r * vw + i] = (0..11).map(|t| k[t] * src[r * w + i + t]).sum();
+                }
+            }
+            let direct: Vec<f64> = (0..vw * vh)
+                .map(|o| {
+                    let (j, i) = (o / vw, o % vw);
+                    (0..11).map(|t| k[t] * rows[(j + t) * vw + i]).sum()
+                })
+                .collect();
+            let filtered = gaussian_11_valid(&k, &src, w, h);
+            assert_eq!(filtered.len(), direct.len());
+            for (o, (a, b)) in filtered.iter().zip(&direct).enumerate() {
+                assert_eq!(a.to_bits(), b.to_bits(), "{w}×{h}, output {o}: {a} vs {b}");
+            }
+        }
+    }
 
     #[test]
     fn a_mask_restricts_the_error_to_its_pixels() {
