@@ -6,7 +6,8 @@
 //!
 //! Deterministic (a fixed seed). `MIRRORBOX_FUZZ_MUTANTS=N` runs N mutants instead of the CI
 //! default; `MIRRORBOX_FUZZ_SEED=S` another sequence. The fixed reproducers of the issue run
-//! first.
+//! first. The children compile shaders with `GALLIVM_PERF=nopt` unless it is set
+//! ([`CHILD_GALLIVM_PERF`]; set it empty to compile them optimised).
 
 use mirrorbox_raster::{Gpu, METHODS, Method, RenderSettings};
 use mirrorbox_scene::Scene;
@@ -336,13 +337,10 @@ pub(crate) fn env_number(name: &str, default: u64) -> u64 {
 const CHILDREN: usize = 2;
 
 /// The children's `GALLIVM_PERF` where the user set none: `nopt`, lavapipe's shader compiler
-/// without LLVM's optimisation passes. A child draws hundreds of 12×8 frames over every method
-/// and option its mutants reach, so on a fresh machine (Mesa's disk cache empty) its time is
-/// the compiling of each shader variant, not the drawing: one child of 102 mutants took
-/// 38.5–40.3 s cold and 3.0–3.1 s warm with the optimiser, 12.7–14.0 s cold and 3.1–3.3 s
-/// warm without it (docs/budgets.md). What the fuzz looks for — panics, wgpu's validation
-/// errors, refusals — is decided before the driver's compiler. Mesa keys its disk cache by
-/// this setting, so these shaders never stand in for the optimised ones other processes load.
+/// without LLVM's optimisation passes. A child draws hundreds of 12×8 frames, so on a fresh
+/// machine its time is compiling shaders, about three times as long optimised
+/// (docs/budgets.md); what it looks for is decided before the driver's compiler. Mesa keys its
+/// disk cache by this setting, so these shaders never stand in for optimised ones.
 const CHILD_GALLIVM_PERF: &str = "nopt";
 
 /// The issue's reproducers, then random mutants of every bundled scene, split over
@@ -358,14 +356,16 @@ fn no_scene_that_loads_crashes_the_tracer_or_a_raster_method() {
     // libtest's name of this test: the module path without the crate, then the function.
     let module = module_path!().split_once("::").map_or("", |(_, m)| m);
     let this_test = format!("{module}::no_scene_that_loads_crashes_the_tracer_or_a_raster_method");
-    let gallivm_perf =
-        std::env::var_os("GALLIVM_PERF").unwrap_or_else(|| CHILD_GALLIVM_PERF.into());
+    let user_set_gallivm_perf = std::env::var_os("GALLIVM_PERF").is_some();
     let children: Vec<_> = (0..CHILDREN)
         .map(|chunk| {
-            std::process::Command::new(std::env::current_exe().unwrap())
+            let mut child = std::process::Command::new(std::env::current_exe().unwrap());
+            if !user_set_gallivm_perf {
+                child.env("GALLIVM_PERF", CHILD_GALLIVM_PERF);
+            }
+            child
                 .args(["--exact", &this_test, "--nocapture", "--test-threads", "1"])
                 .env("MIRRORBOX_FUZZ_CHUNK", chunk.to_string())
-                .env("GALLIVM_PERF", &gallivm_perf)
                 .stdout(std::process::Stdio::piped())
                 .stderr(std::process::Stdio::piped())
                 .spawn()
