@@ -8,6 +8,7 @@
 //!
 //! Triangles are tested with [`crate::watertight`], not obvhs' own test (see there why).
 
+mod flat_surfaces;
 pub mod packet;
 mod wide;
 
@@ -15,7 +16,7 @@ use crate::cpu_features::{Vectorised, widest};
 use crate::watertight::WatertightRay;
 use glam::{Vec3, Vec3A};
 use mirrorbox_scene::limits::{MAX_COORDINATE, within_extent};
-use mirrorbox_scene::{Geometry, Ray, Surface};
+use mirrorbox_scene::{Geometry, Ray};
 use obvhs::BvhBuildParams;
 use obvhs::aabb::Aabb;
 use obvhs::bvh2::Bvh2;
@@ -42,7 +43,7 @@ pub struct Query {
     pub ray: Ray,
     pub t_min: f32,
     pub t_max: f32,
-    pub skip_mirror: Option<usize>,
+    pub skip_flat: Option<usize>,
     pub skip_triangle: Option<usize>,
 }
 
@@ -54,7 +55,7 @@ pub(crate) const NO_QUERY: Query = Query {
     },
     t_min: 0.0,
     t_max: 0.0,
-    skip_mirror: None,
+    skip_flat: None,
     skip_triangle: None,
 };
 
@@ -90,7 +91,7 @@ struct WideQuery<'a, const ANY_HIT: bool> {
     query: (f32, f32, Option<usize>, Option<usize>),
 }
 
-/// `ray` through the wide hierarchy with `(t_min, t_max, skip_mirror, skip_triangle)`: the
+/// `ray` through the wide hierarchy with `(t_min, t_max, skip_flat, skip_triangle)`: the
 /// closest hit, or with `ANY_HIT` the first, as `(t, triangle)`.
 fn wide_query<const ANY_HIT: bool>(
     bvh: &wide::WideBvh,
@@ -105,13 +106,13 @@ impl<const ANY_HIT: bool> Vectorised for WideQuery<'_, ANY_HIT> {
 
     #[inline(always)]
     fn run(self) -> Self::Output {
-        let (t_min, t_max, skip_mirror, skip_triangle) = self.query;
+        let (t_min, t_max, skip_flat, skip_triangle) = self.query;
         let r = &wide::WideRay::new(
             self.ray.origin,
             self.ray.dir,
             t_min,
             t_max,
-            skip_mirror,
+            skip_flat,
             skip_triangle,
         );
         let b = self.bvh;
@@ -131,8 +132,8 @@ impl<const ANY_HIT: bool> Vectorised for WideQuery<'_, ANY_HIT> {
 /// the watertight test specialised for the ray's axis permutation (six monomorphised
 /// traversals instead of indexing vectors by a run-time axis for every triangle).
 macro_rules! with_triangle_test {
-    ($bvh:expr, $wt:expr, $skip_mirror:expr, $skip_triangle:expr, |$test:ident| $body:expr) => {{
-        let skip = $skip_mirror.map_or(NOT_A_MIRROR, |m| m as u32);
+    ($bvh:expr, $wt:expr, $skip_flat:expr, $skip_triangle:expr, |$test:ident| $body:expr) => {{
+        let skip = $skip_flat.map_or(NO_ONE_FLAT, |m| m as u32);
         let skip_tri = $skip_triangle.map_or(u32::MAX, |t| t as u32);
         let slots = &$bvh.slots;
         let original = &$bvh.original;
@@ -141,8 +142,7 @@ macro_rules! with_triangle_test {
             ($kx:literal, $ky:literal, $kz:literal) => {{
                 let $test = |r: &obvhs::ray::Ray, slot: usize| {
                     let s = &slots[slot];
-                    if ((s.mirror == skip) & (skip != NOT_A_MIRROR)) | (original[slot] == skip_tri)
-                    {
+                    if ((s.flat == skip) & (skip != NO_ONE_FLAT)) | (original[slot] == skip_tri) {
                         return f32::INFINITY;
                     }
                     wt.intersect_axes::<$kx, $ky, $kz>(s.v[0], s.v[1], s.v[2], r.tmin, r.tmax)
@@ -162,19 +162,23 @@ macro_rules! with_triangle_test {
     }};
 }
 
-/// Marks a slot whose triangle is not on a mirror.
-const NOT_A_MIRROR: u32 = u32::MAX;
+/// Marks a node whose triangles are not all on one flat surface, and a query that skips
+/// none ([`flat_surfaces`]: every triangle is on one).
+const NO_ONE_FLAT: u32 = u32::MAX;
 
 #[derive(Clone, Copy)]
 struct Slot {
     v: [Vec3; 3],
-    mirror: u32,
+    /// The triangle's flat surface ([`flat_surfaces`]).
+    flat: u32,
 }
 
 pub struct SceneBvh {
     hierarchy: Hierarchy,
     slots: Vec<Slot>,
     original: Vec<u32>,
+    /// Per triangle (the scene's numbering), its flat surface ([`flat_surfaces`]).
+    flat: Vec<u32>,
     /// Time obvhs spent building the hierarchy.
     pub build_time: Duration,
     pub kind: BvhKind,
@@ -441,18 +445,12 @@ impl SceneBvh {
                 }
             }
         };
+        let flat = flat_surfaces::flat_surfaces(geometry);
         let slots: Vec<Slot> = original
             .iter()
-            .map(|&i| {
-                let i = i as usize;
-                let mirror = match geometry.surface(i) {
-                    Surface::Mirror { mirror, .. } => *mirror as u32,
-                    Surface::Diffuse { .. } => NOT_A_MIRROR,
-                };
-                Slot {
-                    v: geometry.triangles[i],
-                    mirror,
-                }
+            .map(|&i| Slot {
+                v: geometry.triangles[i as usize],
+                flat: flat[i as usize],
             })
             .collect();
         let hierarchy = match hierarchy {
@@ -475,11 +473,18 @@ impl SceneBvh {
             hierarchy,
             slots,
             original,
+            flat,
             build_time,
             kind,
             packets: true,
             packet_bvh: OnceLock::new(),
         }
+    }
+
+    /// The flat surface of `triangle` ([`flat_surfaces`]): what a ray leaving it may skip
+    /// (`skip_flat`). A mirror's flat surface is its index.
+    pub fn flat_surface(&self, triangle: usize) -> usize {
+        self.flat[triangle] as usize
     }
 
     /// This hierarchy with the packet kernel on (the default) or off: off,
@@ -496,16 +501,17 @@ impl SceneBvh {
 
     /// The closest triangle hit by `ray` with `t` in `[t_min, t_max]` (of equally close
     /// ones, the lowest index in the scene's numbering), ignoring the triangles
-    /// of mirror `skip_mirror` (the planar mirror a reflected ray is leaving cannot be hit
-    /// again by it, so skipping it replaces any self-intersection epsilon).
+    /// of flat surface `skip_flat` ([`SceneBvh::flat_surface`]: a mirror's index, or a
+    /// plane's diffuse triangles; the plane a ray is leaving cannot be hit again by it, so
+    /// skipping it replaces any self-intersection epsilon).
     pub fn closest_hit(
         &self,
         ray: &Ray,
         t_min: f32,
         t_max: f32,
-        skip_mirror: Option<usize>,
+        skip_flat: Option<usize>,
     ) -> Option<Hit> {
-        self.closest_hit_skipping(ray, t_min, t_max, skip_mirror, None)
+        self.closest_hit_skipping(ray, t_min, t_max, skip_flat, None)
     }
 
     /// [`SceneBvh::closest_hit`] that also ignores triangle `skip_triangle` (the planar
@@ -515,11 +521,11 @@ impl SceneBvh {
         ray: &Ray,
         t_min: f32,
         t_max: f32,
-        skip_mirror: Option<usize>,
+        skip_flat: Option<usize>,
         skip_triangle: Option<usize>,
     ) -> Option<Hit> {
         if let Hierarchy::Wide(w) = &self.hierarchy {
-            let q = (t_min, t_max, skip_mirror, skip_triangle);
+            let q = (t_min, t_max, skip_flat, skip_triangle);
             return wide_query::<false>(w, ray, q).map(|(t, triangle)| Hit {
                 t,
                 triangle: triangle as usize,
@@ -532,7 +538,7 @@ impl SceneBvh {
         // index among them instead, so the answer does not depend on the visiting order
         // (the packet kernel's rule too).
         let mut best = u32::MAX;
-        let found = with_triangle_test!(self, wt, skip_mirror, skip_triangle, |test| {
+        let found = with_triangle_test!(self, wt, skip_flat, skip_triangle, |test| {
             let original = &self.original;
             let keep_lowest = |r: &obvhs::ray::Ray, slot: usize| {
                 let t = test(r, slot);
@@ -559,7 +565,7 @@ impl SceneBvh {
 
 impl SceneBvh {
     /// The closest hit of every lane of `active` in `packet` (what
-    /// [`SceneBvh::closest_hit`] answers for each lane's ray and skipped mirror) into `out`;
+    /// [`SceneBvh::closest_hit`] answers for each lane's ray and skipped flat surface) into `out`;
     /// lanes outside `active` are left as they are. Traced together through the packet
     /// kernel ([`packet`]) unless it is off or cannot hold this hierarchy.
     pub fn closest_hits(
@@ -633,7 +639,7 @@ impl SceneBvh {
     }
 
     /// The lanes of `active` in `packet` whose segment is blocked: lane `i`'s ray hits
-    /// something in `[0, t_max[i])` other than its skipped mirror and triangle
+    /// something in `[0, t_max[i])` other than its skipped flat surface and triangle
     /// `skip_triangle[i]` ([`packet::NO_TRIANGLE`]: none) — what [`SceneBvh::occluded`]
     /// answers for each lane. Traced together through the packet kernel's any-hit mode
     /// unless it is off or cannot hold this hierarchy.
@@ -723,7 +729,7 @@ impl SceneBvh {
         let Hierarchy::Wide(w) = &self.hierarchy else {
             for (q, o) in queries.iter().zip(out.iter_mut()) {
                 *o = if ANY_HIT {
-                    self.occluded(&q.ray, q.t_min, q.t_max, q.skip_mirror, q.skip_triangle)
+                    self.occluded(&q.ray, q.t_min, q.t_max, q.skip_flat, q.skip_triangle)
                         .then_some(Hit {
                             t: 0.0,
                             triangle: usize::MAX,
@@ -733,7 +739,7 @@ impl SceneBvh {
                         &q.ray,
                         q.t_min,
                         q.t_max,
-                        q.skip_mirror,
+                        q.skip_flat,
                         q.skip_triangle,
                     )
                 };
@@ -746,7 +752,7 @@ impl SceneBvh {
                 q.ray.dir,
                 q.t_min,
                 q.t_max,
-                q.skip_mirror,
+                q.skip_flat,
                 q.skip_triangle,
             )
         };
@@ -768,7 +774,7 @@ impl SceneBvh {
             *o = hit(WideQuery::<ANY_HIT> {
                 bvh: w,
                 ray: &q.ray,
-                query: (q.t_min, q.t_max, q.skip_mirror, q.skip_triangle),
+                query: (q.t_min, q.t_max, q.skip_flat, q.skip_triangle),
             }
             .run());
         }
@@ -855,16 +861,16 @@ impl SceneBvh {
         ray: &Ray,
         t_min: f32,
         t_max: f32,
-        skip_mirror: Option<usize>,
+        skip_flat: Option<usize>,
         skip_triangle: Option<usize>,
     ) -> bool {
         if let Hierarchy::Wide(w) = &self.hierarchy {
-            let q = (t_min, t_max, skip_mirror, skip_triangle);
+            let q = (t_min, t_max, skip_flat, skip_triangle);
             return wide_query::<true>(w, ray, q).is_some();
         }
         let wt = WatertightRay::new(ray.origin, ray.dir);
         let r = obvhs::ray::Ray::new(Vec3A::from(ray.origin), Vec3A::from(ray.dir), t_min, t_max);
-        with_triangle_test!(self, wt, skip_mirror, skip_triangle, |test| {
+        with_triangle_test!(self, wt, skip_flat, skip_triangle, |test| {
             match &self.hierarchy {
                 Hierarchy::Empty => false,
                 Hierarchy::Cw(bvh) => !bvh.ray_traverse_miss(r, test),
@@ -878,6 +884,7 @@ impl SceneBvh {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use mirrorbox_scene::Surface;
     use mirrorbox_scene::load::parse_scene;
     use std::path::Path;
 
@@ -1050,14 +1057,16 @@ mod tests {
             let (mut hits, mut blocked) = (0, 0);
             let mut queries = Vec::new();
             for i in 0..4000usize {
-                let (ray, skip_mirror, skip_triangle) = match i % 4 {
+                let (ray, skip_flat, skip_triangle) = match i % 4 {
                     0 => (
                         cam.primary_ray(r() * cam.width as f32, r() * cam.height as f32),
                         None,
                         None,
                     ),
                     1 | 2 => {
-                        // From a point on triangle t (barycentric), into a random direction.
+                        // From a point on triangle t (barycentric), into a random direction,
+                        // skipping its mirror or the triangle (as Whitted's shadow legs) or
+                        // its flat surface (as `path`'s rays).
                         let t = (r() * g.triangles.len() as f32) as usize % g.triangles.len();
                         let [v0, v1, v2] = g.triangles[t];
                         let (a, b) = (r(), r());
@@ -1069,7 +1078,11 @@ mod tests {
                         let origin = v0 + a * (v1 - v0) + b * (v2 - v0);
                         let dir = Vec3::new(r() - 0.5, r() - 0.5, r() - 0.5).normalize_or(Vec3::Y);
                         let m = mirror_of(t);
-                        (Ray { origin, dir }, m, m.is_none().then_some(t))
+                        if i % 4 == 2 {
+                            (Ray { origin, dir }, Some(wide.flat_surface(t)), None)
+                        } else {
+                            (Ray { origin, dir }, m, m.is_none().then_some(t))
+                        }
                     }
                     _ => {
                         let (lo, hi) = g.bounds().unwrap();
@@ -1080,24 +1093,23 @@ mod tests {
                     }
                 };
                 let t_max = [f32::INFINITY, 0.7, 3.0][i % 3];
-                let want =
-                    binary.closest_hit_skipping(&ray, 0.0, t_max, skip_mirror, skip_triangle);
-                let got = wide.closest_hit_skipping(&ray, 0.0, t_max, skip_mirror, skip_triangle);
+                let want = binary.closest_hit_skipping(&ray, 0.0, t_max, skip_flat, skip_triangle);
+                let got = wide.closest_hit_skipping(&ray, 0.0, t_max, skip_flat, skip_triangle);
                 assert_eq!(
                     got.map(|h| (h.t.to_bits(), h.triangle)),
                     want.map(|h| (h.t.to_bits(), h.triangle)),
                     "ray {i}: {ray:?} to {t_max}"
                 );
                 hits += got.is_some() as usize;
-                let want = binary.occluded(&ray, 0.0, t_max, skip_mirror, skip_triangle);
-                let got = wide.occluded(&ray, 0.0, t_max, skip_mirror, skip_triangle);
+                let want = binary.occluded(&ray, 0.0, t_max, skip_flat, skip_triangle);
+                let got = wide.occluded(&ray, 0.0, t_max, skip_flat, skip_triangle);
                 assert_eq!(got, want, "ray {i}: {ray:?} to {t_max}");
                 blocked += got as usize;
                 queries.push(Query {
                     ray,
                     t_min: 0.0,
                     t_max,
-                    skip_mirror,
+                    skip_flat,
                     skip_triangle,
                 });
             }
@@ -1114,15 +1126,70 @@ mod tests {
             for (i, q) in queries.iter().enumerate() {
                 let (ray, t_max) = (q.ray, q.t_max);
                 let want =
-                    binary.closest_hit_skipping(&ray, 0.0, t_max, q.skip_mirror, q.skip_triangle);
+                    binary.closest_hit_skipping(&ray, 0.0, t_max, q.skip_flat, q.skip_triangle);
                 assert_eq!(
                     closest[i].map(|h: Hit| (h.t.to_bits(), h.triangle)),
                     want.map(|h| (h.t.to_bits(), h.triangle)),
                     "batch ray {i}: {ray:?} to {t_max}"
                 );
-                let want = binary.occluded(&ray, 0.0, t_max, q.skip_mirror, q.skip_triangle);
+                let want = binary.occluded(&ray, 0.0, t_max, q.skip_flat, q.skip_triangle);
                 assert_eq!(any[i].is_some(), want, "batch ray {i}: {ray:?} to {t_max}");
             }
+        }
+    }
+
+    /// A ray leaving one of the floor quad's two triangles and skipping its flat surface
+    /// skips the other too: from just below the floor (10⁻⁴, a self-intersection made large),
+    /// straight up, under the other triangle. Skipping only the triangle it leaves, it hits
+    /// the other one there; skipping the flat surface, nothing — in every hierarchy, closest
+    /// and any hit. The floor's flat surface is exactly the triangles in the plane y = 0: its
+    /// two, and the bottom face of the box standing on it.
+    #[test]
+    fn skipping_a_flat_surface_skips_every_triangle_on_its_plane() {
+        let scene = parse_scene(SCENE, Path::new("inline.json")).unwrap();
+        let g = &scene.geometry;
+        let floor = g
+            .parts
+            .iter()
+            .find(|p| {
+                p.triangles.len() == 2
+                    && !matches!(g.surface(p.triangles.start), Surface::Mirror { .. })
+            })
+            .expect("the floor quad")
+            .triangles
+            .clone();
+        let ray = Ray {
+            origin: Vec3::new(2.5, -1e-4, 2.5),
+            dir: Vec3::Y,
+        };
+        let wt = WatertightRay::new(ray.origin, ray.dir);
+        let under = floor
+            .clone()
+            .find(|&i| {
+                let t = g.triangles[i];
+                wt.intersect(t[0], t[1], t[2], 0.0, f32::INFINITY)
+                    .is_finite()
+            })
+            .expect("a floor triangle above the origin");
+        let left = floor.clone().find(|&i| i != under).unwrap();
+        for kind in [BvhKind::Cwbvh, BvhKind::Bvh2, BvhKind::Wide] {
+            let bvh = SceneBvh::build_with(g, kind);
+            let flat = bvh.flat_surface(left);
+            assert_eq!(flat, bvh.flat_surface(under), "{kind:?}");
+            let hit = bvh.closest_hit_skipping(&ray, 0.0, f32::INFINITY, None, Some(left));
+            assert_eq!(hit.map(|h| h.triangle), Some(under), "{kind:?}");
+            assert!(hit.unwrap().t < 2e-4);
+            assert!(bvh.occluded(&ray, 0.0, 1.0, None, Some(left)), "{kind:?}");
+            let skipped = bvh.closest_hit_skipping(&ray, 0.0, f32::INFINITY, Some(flat), None);
+            assert_eq!(skipped, None, "{kind:?}");
+            assert!(!bvh.occluded(&ray, 0.0, 1.0, Some(flat), None), "{kind:?}");
+            let on_floor = |i: usize| g.triangles[i].iter().all(|p| p.y.abs() < 1e-6);
+            let sharing: Vec<usize> = (0..g.triangles.len())
+                .filter(|&i| bvh.flat_surface(i) == flat)
+                .collect();
+            let in_plane: Vec<usize> = (0..g.triangles.len()).filter(|&i| on_floor(i)).collect();
+            assert_eq!(sharing, in_plane, "{kind:?}");
+            assert_eq!(sharing.len(), 4, "the floor's two, the box's bottom two");
         }
     }
 
@@ -1183,11 +1250,16 @@ mod tests {
                 let dir = Vec3::new(r() - 0.5, r() - 0.5, r() - 0.5).normalize_or(Vec3::Y);
                 let ray = Ray { origin, dir };
                 let t_max = [0.5, 2.0, f32::INFINITY][i % 3];
-                let skip_mirror = (i % 5 == 0).then_some(0);
-                let skip_triangle = (i % 7 == 0).then_some(i % scene.geometry.triangles.len());
-                let closest =
-                    bvh.closest_hit_skipping(&ray, 0.0, t_max, skip_mirror, skip_triangle);
-                let any = bvh.occluded(&ray, 0.0, t_max, skip_mirror, skip_triangle);
+                let n = scene.geometry.triangles.len();
+                // A mirror's flat surface, a diffuse plane's, or none.
+                let skip_flat = match i % 5 {
+                    0 => Some(0),
+                    1 => Some(bvh.flat_surface(i % n)),
+                    _ => None,
+                };
+                let skip_triangle = (i % 7 == 0).then_some(i % n);
+                let closest = bvh.closest_hit_skipping(&ray, 0.0, t_max, skip_flat, skip_triangle);
+                let any = bvh.occluded(&ray, 0.0, t_max, skip_flat, skip_triangle);
                 assert_eq!(
                     any,
                     closest.is_some(),
@@ -1286,7 +1358,12 @@ mod tests {
                 .map(|i| {
                     let origin = Vec3::new(r() * 4.0 - 2.0, r() * 2.5, r() * 4.0 - 2.0);
                     let dir = Vec3::new(r() - 0.5, r() - 0.5, r() - 0.5).normalize_or(Vec3::Y);
-                    (Ray { origin, dir }, (i % 3 == 0).then_some(0))
+                    let skip_flat = match i % 3 {
+                        0 => Some(0),
+                        1 => Some(bvh.flat_surface(i % scene.geometry.triangles.len())),
+                        _ => None,
+                    };
+                    (Ray { origin, dir }, skip_flat)
                 })
                 .collect();
             let n = coherent.len();
@@ -1334,18 +1411,23 @@ mod tests {
                 };
                 let dir = Vec3::new(r() - 0.5, r() - 0.5, r() - 0.5).normalize_or(Vec3::Y);
                 let ray = Ray { origin, dir };
-                let skip_mirror = i.is_multiple_of(5).then_some(0);
-                packet.set(lane, &ray, skip_mirror);
+                // The mirror, the flat surface of the triangle it starts on, or none.
+                let skip_flat = match (i % 5, start) {
+                    (0, _) => Some(0),
+                    (1 | 2, Some(t)) => Some(bvh.flat_surface(t)),
+                    _ => None,
+                };
+                packet.set(lane, &ray, skip_flat);
                 t_max[lane] = [0.5, 2.0, f32::INFINITY][i % 3];
                 skip_triangle[lane] = start.map_or(packet::NO_TRIANGLE, |t| t as u32);
-                asked.push((ray, skip_mirror, start));
+                asked.push((ray, skip_flat, start));
             }
             for active in [u32::MAX, 0x5555_5555, 0xffff_0000] {
                 let got = bvh.occluded_lanes(&packet, active, &t_max, &skip_triangle);
                 assert_eq!(got & !active, 0, "only active lanes answer");
                 for lane in packet::lanes(active) {
-                    let (ray, skip_mirror, start) = &asked[lane];
-                    let want = bvh.occluded(ray, 0.0, t_max[lane], *skip_mirror, *start);
+                    let (ray, skip_flat, start) = &asked[lane];
+                    let want = bvh.occluded(ray, 0.0, t_max[lane], *skip_flat, *start);
                     assert_eq!(
                         got >> lane & 1 == 1,
                         want,

@@ -17,7 +17,7 @@
 //! which differs. Box tests only prune, conservatively: the far distance is widened by
 //! `1 + 2γ₃` (Ize, "Robust BVH Ray Traversal", JCGT 2013), so rounding never skips a box.
 
-use super::{Hit, NOT_A_MIRROR, Slot};
+use super::{Hit, NO_ONE_FLAT, Slot};
 use crate::cpu_features::lane_bits;
 use crate::watertight::{WatertightRay, axes_of, shear_of};
 use glam::Vec3;
@@ -51,7 +51,7 @@ type Lanes = [f32; LANES];
 /// within the limits, but possible in principle) are traced one ray at a time.
 const STACK: usize = 128;
 
-/// A lane that skips no mirror (never equal to a slot's mirror or to [`NOT_A_MIRROR`]).
+/// A lane that skips no flat surface (never equal to a slot's or to [`NO_ONE_FLAT`]).
 const SKIP_NOTHING: u32 = u32::MAX - 1;
 
 /// No triangle: what a lane that skips none holds in an any-hit query's skipped triangles.
@@ -95,9 +95,9 @@ pub(super) struct PacketBvh {
     original: Vec<u32>,
     /// Whether every root-to-leaf path fits the traversal stack.
     fits_stack: bool,
-    /// Per node, the mirror every triangle below it belongs to ([`NOT_A_MIRROR`] where
-    /// they are not all on one mirror): a ray leaving that mirror skips the whole subtree.
-    node_mirror: Vec<u32>,
+    /// Per node, the flat surface every triangle below it is on ([`NO_ONE_FLAT`] where
+    /// they are not all on one): a ray leaving that surface skips the whole subtree.
+    node_flat: Vec<u32>,
     /// Per inner node, twice the step from its first child's box centre to its second's
     /// ([`children_gap`]): which child is nearer along a direction, without reading the
     /// children's boxes.
@@ -148,7 +148,7 @@ impl LaneHits {
     }
 }
 
-/// Up to [`LANES`] rays, structure of arrays, each with the mirror it skips.
+/// Up to [`LANES`] rays, structure of arrays, each with the flat surface it skips.
 #[derive(Clone)]
 pub struct RayPacket {
     origin: [Lanes; 3],
@@ -167,18 +167,18 @@ impl Default for RayPacket {
 }
 
 impl RayPacket {
-    /// Lane `lane` asks for the closest hit of `ray` in `[0, ∞)`, skipping mirror
-    /// `skip_mirror` (what [`super::SceneBvh::closest_hit`] asks).
-    pub fn set(&mut self, lane: usize, ray: &Ray, skip_mirror: Option<usize>) {
+    /// Lane `lane` asks for the closest hit of `ray` in `[0, ∞)`, skipping flat surface
+    /// `skip_flat` (what [`super::SceneBvh::closest_hit`] asks).
+    pub fn set(&mut self, lane: usize, ray: &Ray, skip_flat: Option<usize>) {
         for k in 0..3 {
             self.origin[k][lane] = ray.origin[k];
             self.dir[k][lane] = ray.dir[k];
         }
-        self.set_skip(lane, skip_mirror);
+        self.set_skip(lane, skip_flat);
     }
 
     /// Every lane's ray, from f64 lanes rounded to f32 (as `DVec3::as_vec3` rounds); the
-    /// skipped mirrors stay as they are. One loop over the lanes per component: vectorised.
+    /// skipped flat surfaces stay as they are. One loop over the lanes per component: vectorised.
     #[inline(always)]
     pub fn set_rays_f64(&mut self, origin: &[[f64; LANES]; 3], dir: &[[f64; LANES]; 3]) {
         for k in 0..3 {
@@ -214,18 +214,18 @@ impl RayPacket {
         &self.dir
     }
 
-    /// The lanes of `mask` skip mirror `mirror` from now on (a lane loop).
+    /// The lanes of `mask` skip flat surface `flat` from now on (a lane loop).
     #[inline(always)]
-    pub fn set_skip_lanes(&mut self, mask: LaneMask, mirror: usize) {
-        set_lanes(&mut self.skip, mask, mirror as u32);
+    pub fn set_skip_lanes(&mut self, mask: LaneMask, flat: usize) {
+        set_lanes(&mut self.skip, mask, flat as u32);
     }
 
-    /// Lane `lane` skips mirror `skip_mirror` from now on.
-    pub fn set_skip(&mut self, lane: usize, skip_mirror: Option<usize>) {
-        self.skip[lane] = skip_mirror.map_or(SKIP_NOTHING, |m| m as u32);
+    /// Lane `lane` skips flat surface `skip_flat` from now on.
+    pub fn set_skip(&mut self, lane: usize, skip_flat: Option<usize>) {
+        self.skip[lane] = skip_flat.map_or(SKIP_NOTHING, |m| m as u32);
     }
 
-    /// The ray and skipped mirror of lane `lane`, as [`RayPacket::set`] was given them.
+    /// The ray and skipped flat surface of lane `lane`, as [`RayPacket::set`] was given them.
     pub fn lane(&self, lane: usize) -> (Ray, Option<usize>) {
         let skip = (self.skip[lane] != SKIP_NOTHING).then_some(self.skip[lane] as usize);
         (
@@ -325,14 +325,14 @@ impl PacketBvh {
 
     fn from_parts(nodes: Vec<Node>, slots: Vec<Slot>, original: Vec<u32>) -> Self {
         let fits_stack = nodes.is_empty() || depth(&nodes, 0) < STACK;
-        let node_mirror = subtree_mirrors(&nodes, &slots);
+        let node_flat = subtree_flats(&nodes, &slots);
         let child_gap = nodes.iter().map(|n| children_gap(&nodes, n)).collect();
         PacketBvh {
             nodes,
             slots,
             original,
             fits_stack,
-            node_mirror,
+            node_flat,
             child_gap,
         }
     }
@@ -369,7 +369,7 @@ impl PacketBvh {
     }
 
     /// The lanes of `active` whose segment is blocked: whose ray hits a triangle at
-    /// `0 ≤ t < t_max[lane]` other than its skipped mirror's and `skip_triangle[lane]` (the
+    /// `0 ≤ t < t_max[lane]` other than its skipped flat surface's and `skip_triangle[lane]` (the
     /// scene's numbering; [`NO_TRIANGLE`] for none) — what
     /// [`super::SceneBvh::occluded`] answers. A lane stops at its first such hit (any hit
     /// will do), and so does the traversal once every lane has stopped.
@@ -468,9 +468,9 @@ impl PacketBvh {
         };
         loop {
             let node = &self.nodes[index];
-            let mirror = self.node_mirror[index];
+            let flat = self.node_flat[index];
             if node.count == 0 {
-                if box_any(node, mirror, p, q, best_t, active, &mut warm) {
+                if box_any(node, flat, p, q, best_t, active, &mut warm) {
                     let (a, b) = (node.first as usize, node.first as usize + 1);
                     let gap = &self.child_gap[index];
                     let along = (0..3).map(|k| gap[k] * lead_dir[k]).sum::<f32>();
@@ -481,7 +481,7 @@ impl PacketBvh {
                     continue;
                 }
             } else {
-                let hit = box_hits(node, mirror, p, q, best_t, active);
+                let hit = box_hits(node, flat, p, q, best_t, active);
                 if hit != 0 {
                     for &(code, members) in groups {
                         let h = hit & members;
@@ -591,7 +591,7 @@ impl PacketBvh {
             let all_positive = min(min(u, v), w) > 0.0;
             let all_negative = max(max(u, v), w) < 0.0;
             let asked = (hit >> i & 1 == 1)
-                & (s.mirror != p.skip[i])
+                & (s.flat != p.skip[i])
                 & (!ANY_HIT || triangle != skip_triangle[i]);
             zero[i] = asked & exact_zero;
             inside[i] = asked & (all_positive | all_negative);
@@ -687,13 +687,13 @@ fn any(mask: &Mask) -> bool {
 }
 
 /// The lanes of `group` whose ray meets the node's box no farther than their best hit,
-/// and does not skip `mirror`, the one mirror all of the node's triangles are on (if any):
-/// a ray leaving a mirror starts inside its boxes and would otherwise enter them all, to
-/// skip every triangle there (`mirror_room`: a quarter of the triangle tests).
+/// and does not skip `flat`, the one flat surface all of the node's triangles are on (if
+/// any): a ray leaving a mirror starts inside its boxes and would otherwise enter them all,
+/// to skip every triangle there (`mirror_room`: a quarter of the triangle tests).
 #[inline(always)]
 fn box_hits(
     node: &Node,
-    mirror: u32,
+    flat: u32,
     p: &RayPacket,
     q: &Prepared,
     best_t: &Lanes,
@@ -703,7 +703,7 @@ fn box_hits(
     // applied to the bits.
     let mut meets: LaneMask = 0;
     for i in 0..LANES {
-        meets |= (box_meets_lane(node, mirror, p, q, best_t, i) as LaneMask) << i;
+        meets |= (box_meets_lane(node, flat, p, q, best_t, i) as LaneMask) << i;
     }
     meets & group
 }
@@ -733,7 +733,7 @@ struct Warm {
 #[inline(always)]
 fn box_any(
     node: &Node,
-    mirror: u32,
+    flat: u32,
     p: &RayPacket,
     q: &Prepared,
     best_t: &Lanes,
@@ -741,7 +741,7 @@ fn box_any(
     warm: &mut Warm,
 ) -> bool {
     // The warm lane is always one of the group's (set from the group's bits below).
-    if box_meets_lane(node, mirror, p, q, best_t, warm.lane) {
+    if box_meets_lane(node, flat, p, q, best_t, warm.lane) {
         return true;
     }
     const CHUNKS: usize = LANES / BOX_CHUNK;
@@ -754,7 +754,7 @@ fn box_any(
         // The chunk's answers as bits (one `movmsk`), the group applied to the bits.
         let mut meets: LaneMask = 0;
         for j in 0..BOX_CHUNK {
-            meets |= (box_meets_lane(node, mirror, p, q, best_t, base + j) as LaneMask) << j;
+            meets |= (box_meets_lane(node, flat, p, q, best_t, base + j) as LaneMask) << j;
         }
         let met = meets & (group >> base);
         if met != 0 {
@@ -769,12 +769,12 @@ fn box_any(
 }
 
 /// Whether lane `i` meets the node's box no farther than its best hit and does not skip
-/// `mirror` (whether it is in the traversed group or not is the caller's business):
+/// `flat` (whether it is in the traversed group or not is the caller's business):
 /// [`box_hits`]'s and [`box_any`]'s test of one lane.
 #[inline(always)]
 fn box_meets_lane(
     node: &Node,
-    mirror: u32,
+    flat: u32,
     p: &RayPacket,
     q: &Prepared,
     best_t: &Lanes,
@@ -793,7 +793,7 @@ fn box_meets_lane(
     // `near ≤ far` and `near ≤ best`, in one comparison (the same answer for all values
     // but a NaN `far`, which finite boxes and `safe_inverse` never give; with one, `min`
     // returns `best` and the box is entered: pruning less, never more).
-    (near <= min(far, best_t[i])) & (mirror != p.skip[i])
+    (near <= min(far, best_t[i])) & (flat != p.skip[i])
 }
 
 /// The lanes set in `mask`, lowest first.
@@ -819,34 +819,34 @@ fn children_gap(nodes: &[Node], node: &Node) -> [f32; 3] {
     [gap(0), gap(1), gap(2)]
 }
 
-/// Per node, the mirror all the triangles below it are on, or [`NOT_A_MIRROR`] (children
+/// Per node, the flat surface all the triangles below it are on, or [`NO_ONE_FLAT`] (children
 /// before parents: an explicit post-order walk from the root).
-fn subtree_mirrors(nodes: &[Node], slots: &[Slot]) -> Vec<u32> {
-    let mut mirror = vec![NOT_A_MIRROR; nodes.len()];
+fn subtree_flats(nodes: &[Node], slots: &[Slot]) -> Vec<u32> {
+    let mut flat = vec![NO_ONE_FLAT; nodes.len()];
     if nodes.is_empty() {
-        return mirror;
+        return flat;
     }
     let mut stack = vec![(0usize, false)];
     while let Some((i, children_done)) = stack.pop() {
         let n = &nodes[i];
         if n.count > 0 {
             let leaf = &slots[n.first as usize..(n.first + n.count) as usize];
-            let first = leaf[0].mirror;
-            mirror[i] = if leaf.iter().all(|s| s.mirror == first) {
+            let first = leaf[0].flat;
+            flat[i] = if leaf.iter().all(|s| s.flat == first) {
                 first
             } else {
-                NOT_A_MIRROR
+                NO_ONE_FLAT
             };
         } else if children_done {
-            let (a, b) = (mirror[n.first as usize], mirror[n.first as usize + 1]);
-            mirror[i] = if a == b { a } else { NOT_A_MIRROR };
+            let (a, b) = (flat[n.first as usize], flat[n.first as usize + 1]);
+            flat[i] = if a == b { a } else { NO_ONE_FLAT };
         } else {
             stack.push((i, true));
             stack.push((n.first as usize, false));
             stack.push((n.first as usize + 1, false));
         }
     }
-    mirror
+    flat
 }
 
 /// Nodes on the longest root-to-leaf path below `index`.
@@ -864,18 +864,18 @@ fn depth(nodes: &[Node], index: usize) -> usize {
     deepest
 }
 
-const _: () = assert!(NOT_A_MIRROR != SKIP_NOTHING);
+const _: () = assert!(NO_ONE_FLAT != SKIP_NOTHING);
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bvh::{NOT_A_MIRROR, Slot};
+    use crate::bvh::{NO_ONE_FLAT, Slot};
 
-    /// Every node records the mirror all triangles below it are on, exactly: a subtree of
-    /// one mirror's triangles has it (so rays leaving that mirror skip it), a mixed one
-    /// has none.
+    /// Every node records the flat surface all triangles below it are on, exactly: a subtree
+    /// of one mirror's (or one plane's) triangles has it (so rays leaving that surface skip
+    /// it), a mixed one has none.
     #[test]
-    fn subtree_mirrors_are_the_mirror_of_every_triangle_below() {
+    fn subtree_flats_are_the_flat_surface_of_every_triangle_below() {
         let quad = |z: f32, x0: f32| {
             let [a, b, c, d] = [
                 Vec3::new(x0, 0.0, z),
@@ -885,18 +885,19 @@ mod tests {
             ];
             [[a, b, c], [a, c, d]]
         };
-        // Two mirrors of two quads each, far apart, and diffuse quads between them.
+        // Two mirrors of two quads each, far apart (flat surfaces 0 and 1), and diffuse quads
+        // between them, each on a plane of its own (2, 3, 4).
         let mut triangles = Vec::new();
-        let mut mirrors = Vec::new();
+        let mut flats = Vec::new();
         for (z, mirror) in [(-5.0, 0), (5.0, 1)] {
             for x0 in [0.0, 1.0] {
                 triangles.extend(quad(z, x0));
-                mirrors.extend([mirror; 2]);
+                flats.extend([mirror; 2]);
             }
         }
-        for z in [-1.0, 0.0, 1.0] {
+        for (z, plane) in [(-1.0, 2), (0.0, 3), (1.0, 4)] {
             triangles.extend(quad(z, 0.5));
-            mirrors.extend([NOT_A_MIRROR; 2]);
+            flats.extend([plane; 2]);
         }
         let tris: Vec<_> = triangles
             .iter()
@@ -908,7 +909,7 @@ mod tests {
             .collect();
         let bvh = PacketBvh::build(&tris, |i| Slot {
             v: triangles[i as usize],
-            mirror: mirrors[i as usize],
+            flat: flats[i as usize],
         });
         let below = |index: usize| {
             let mut found = Vec::new();
@@ -916,28 +917,27 @@ mod tests {
             while let Some(i) = stack.pop() {
                 let n = &bvh.nodes[i];
                 if n.count > 0 {
-                    found
-                        .extend((n.first..n.first + n.count).map(|s| bvh.slots[s as usize].mirror));
+                    found.extend((n.first..n.first + n.count).map(|s| bvh.slots[s as usize].flat));
                 } else {
                     stack.extend([n.first as usize, n.first as usize + 1]);
                 }
             }
             found
         };
-        let mut on_one = [0; 2];
+        let mut on_one = [0; 5];
         for index in 0..bvh.nodes.len() {
-            let mirrors = below(index);
-            let want = if mirrors.iter().all(|&m| m == mirrors[0]) {
-                mirrors[0]
+            let flats = below(index);
+            let want = if flats.iter().all(|&m| m == flats[0]) {
+                flats[0]
             } else {
-                NOT_A_MIRROR
+                NO_ONE_FLAT
             };
-            assert_eq!(bvh.node_mirror[index], want, "node {index}: {mirrors:?}");
-            if want != NOT_A_MIRROR {
+            assert_eq!(bvh.node_flat[index], want, "node {index}: {flats:?}");
+            if want != NO_ONE_FLAT {
                 on_one[want as usize] += 1;
             }
         }
-        assert!(on_one[0] > 0 && on_one[1] > 0, "{on_one:?}");
+        assert!(on_one.iter().all(|&n| n > 0), "{on_one:?}");
     }
 
     /// The lane-parallel shear and permutation are [`WatertightRay::new`]'s, bit for bit,

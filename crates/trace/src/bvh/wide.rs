@@ -7,9 +7,10 @@
 //! child with the largest surface area, as Wald et al.'s and obvhs's own collapses do — with
 //! the children's boxes stored as structure of arrays (`lo[axis][child]`), uncompressed f32.
 //! A leaf child names the first of its blocks (the binary leaf's triangles, up to [`BLOCK`]
-//! per block as structure of arrays, tested at once); per child, the one mirror every
-//! triangle below it is on, if any (a ray leaving that mirror skips the child, as the packet
-//! kernel skips such subtrees).
+//! per block as structure of arrays, tested at once); per child, the one flat surface every
+//! triangle below it is on, if any (a ray leaving that surface skips the child, as the packet
+//! kernel skips such subtrees; [`super::flat_surfaces`]: a mirror, or a plane's diffuse
+//! triangles).
 //!
 //! **Traversal**: the eight boxes of a node are tested at once (a branch-free loop over the
 //! children, compiled for AVX-512, AVX2 or SSE2 by [`crate::cpu_features::widest`]); the
@@ -29,7 +30,7 @@
 //! built ([`WideBvh::from_bvh2`] returns `None`) and the binary hierarchy is kept (assimp's
 //! `box_longline.obj`).
 
-use super::{NOT_A_MIRROR, Slot};
+use super::{NO_ONE_FLAT, Slot};
 use crate::cpu_features::lane_bits;
 use crate::watertight::{WatertightRay, shear_operands_branch_free};
 
@@ -44,8 +45,8 @@ const BLOCK: usize = LEAF_TRIANGLES as usize;
 /// Entries of the traversal stack.
 const STACK: usize = 256;
 
-/// What a ray that skips no mirror compares child mirrors with (never a child's mirror,
-/// [`NOT_A_MIRROR`] included).
+/// What a ray that skips no flat surface compares children's with (never a child's,
+/// [`NO_ONE_FLAT`] included).
 const SKIP_NOTHING: u32 = u32::MAX - 1;
 
 /// `1 + 2γ₃`: the packet kernel's robust far-distance factor.
@@ -82,8 +83,8 @@ struct WideNode {
     /// An inner child's node, or [`LEAF`] and a leaf child's first block (its blocks follow
     /// one another, the last with [`TriBlock::more`] false).
     child: [u32; WIDTH],
-    /// The mirror every triangle below the child is on, or [`NOT_A_MIRROR`].
-    mirror: [u32; WIDTH],
+    /// The flat surface every triangle below the child is on, or [`NO_ONE_FLAT`].
+    flat: [u32; WIDTH],
     /// Bit `i`: child `i` exists.
     occupied: u32,
 }
@@ -94,7 +95,7 @@ impl WideNode {
             lo: [[f32::INFINITY; WIDTH]; 3],
             hi: [[f32::NEG_INFINITY; WIDTH]; 3],
             child: [0; WIDTH],
-            mirror: [NOT_A_MIRROR; WIDTH],
+            flat: [NO_ONE_FLAT; WIDTH],
             occupied: 0,
         }
     }
@@ -106,7 +107,8 @@ impl WideNode {
 struct TriBlock {
     /// `v[corner][axis][lane]`.
     v: [[[f32; BLOCK]; 3]; 3],
-    mirror: [u32; BLOCK],
+    /// Each lane's flat surface.
+    flat: [u32; BLOCK],
     /// The scene's index of each lane's triangle.
     original: [u32; BLOCK],
     /// Lanes in use (from the first).
@@ -129,9 +131,9 @@ pub(super) struct WideRay {
     pub inv: [f32; 3],
     pub t_min: f32,
     pub t_max: f32,
-    /// The mirror it leaves ([`SKIP_NOTHING`] for none) and the triangle it skips
+    /// The flat surface it leaves ([`SKIP_NOTHING`] for none) and the triangle it skips
     /// (`u32::MAX` for none).
-    pub skip_mirror: u32,
+    pub skip_flat: u32,
     pub skip_triangle: u32,
 }
 
@@ -146,7 +148,7 @@ impl WideRay {
         dir: glam::Vec3,
         t_min: f32,
         t_max: f32,
-        skip_mirror: Option<usize>,
+        skip_flat: Option<usize>,
         skip_triangle: Option<usize>,
     ) -> Self {
         let d = dir.to_array();
@@ -183,7 +185,7 @@ impl WideRay {
             inv: [q[3], q[4], q[5]],
             t_min,
             t_max,
-            skip_mirror: skip_mirror.map_or(SKIP_NOTHING, |m| m as u32),
+            skip_flat: skip_flat.map_or(SKIP_NOTHING, |m| m as u32),
             skip_triangle: skip_triangle.map_or(u32::MAX, |t| t as u32),
         }
     }
@@ -205,7 +207,7 @@ impl WideBvh {
                 blocks,
             });
         }
-        let mirrors = binary_mirrors(bvh, slots);
+        let flats = binary_flats(bvh, slots);
         let area = |i: usize| {
             let d = b[i].aabb.max - b[i].aabb.min;
             d.x * d.y + d.y * d.z + d.z * d.x
@@ -241,7 +243,7 @@ impl WideBvh {
                     node.lo[k][i] = lo[k];
                     node.hi[k][i] = hi[k];
                 }
-                node.mirror[i] = mirrors[c];
+                node.flat[i] = flats[c];
                 node.occupied |= 1 << i;
                 if b[c].is_leaf() {
                     let first = b[c].first_index as usize;
@@ -253,7 +255,7 @@ impl WideBvh {
                     for (k, chunk) in chunks.enumerate() {
                         let mut block = TriBlock {
                             v: [[[0.0; BLOCK]; 3]; 3],
-                            mirror: [NOT_A_MIRROR; BLOCK],
+                            flat: [NO_ONE_FLAT; BLOCK],
                             original: [u32::MAX; BLOCK],
                             count: chunk.len() as u32,
                             more: k < last,
@@ -264,7 +266,7 @@ impl WideBvh {
                                     block.v[corner][axis][lane] = x;
                                 }
                             }
-                            block.mirror[lane] = slots[slot].mirror;
+                            block.flat[lane] = slots[slot].flat;
                             block.original[lane] = original[slot];
                         }
                         blocks.push(block);
@@ -310,12 +312,11 @@ impl WideBvh {
             near[i] = n;
             far[i] = min(f, best);
         }
-        let meets =
-            lane_bits::<WIDTH>(|i| (near[i] <= far[i]) & (node.mirror[i] != ray.skip_mirror));
+        let meets = lane_bits::<WIDTH>(|i| (near[i] <= far[i]) & (node.flat[i] != ray.skip_flat));
         (meets & node.occupied, near)
     }
 
-    /// The closest hit with `t` in `[t_min, t_max]`, skipping the ray's mirror and triangle:
+    /// The closest hit with `t` in `[t_min, t_max]`, skipping the ray's flat surface and triangle:
     /// `(t, triangle)` in the scene's numbering, of equally distant hits the lowest triangle.
     /// `ANY_HIT`: the first hit found with `t < t_max` instead (its `t` is not the closest).
     /// The ray's axis permutation is `A` (the watertight test's, [`WatertightRay::axes`]).
@@ -564,7 +565,7 @@ impl WideBvh {
     /// triangle. Each lane computes the scalar test's arithmetic
     /// ([`WatertightRay::intersect_axes`]) operation for operation, so the same bits; a lane
     /// with an exact zero edge function is finished by the scalar test (its f64
-    /// re-evaluation). Lanes beyond the block's count, on the mirror the ray leaves or on the
+    /// re-evaluation). Lanes beyond the block's count, on the flat surface the ray leaves or on the
     /// triangle it skips take no part. With `ANY_HIT`: some hit with `t < ray.t_max` (the
     /// first such lane, else the first exact-zero lane the scalar test confirms), or none.
     #[inline(always)]
@@ -595,7 +596,7 @@ impl WideBvh {
             let v = ax * cy - ay * cx;
             let w = bx * ay - by * ax;
             let asked = ((i as u32) < b.count)
-                & (b.mirror[i] != ray.skip_mirror)
+                & (b.flat[i] != ray.skip_flat)
                 & (b.original[i] != ray.skip_triangle);
             let exact_zero = (u == 0.0) | (v == 0.0) | (w == 0.0);
             zero |= ((asked & exact_zero) as u32) << i;
@@ -737,9 +738,9 @@ fn max(a: f32, b: f32) -> f32 {
     if a > b { a } else { b }
 }
 
-/// Per binary node, the mirror all triangles below it are on, or [`NOT_A_MIRROR`]: children
+/// Per binary node, the flat surface all triangles below it are on, or [`NO_ONE_FLAT`]: children
 /// before parents (a pre-order walk, reversed), without recursion (hierarchies may be deep).
-fn binary_mirrors(bvh: &obvhs::bvh2::Bvh2, slots: &[Slot]) -> Vec<u32> {
+fn binary_flats(bvh: &obvhs::bvh2::Bvh2, slots: &[Slot]) -> Vec<u32> {
     let b = &bvh.nodes;
     let mut order = Vec::with_capacity(b.len());
     let mut stack = vec![0usize];
@@ -750,26 +751,26 @@ fn binary_mirrors(bvh: &obvhs::bvh2::Bvh2, slots: &[Slot]) -> Vec<u32> {
             stack.extend([first, first + 1]);
         }
     }
-    let mut mirror = vec![NOT_A_MIRROR; b.len()];
+    let mut flat = vec![NO_ONE_FLAT; b.len()];
     for &i in order.iter().rev() {
-        mirror[i] = if b[i].is_leaf() {
+        flat[i] = if b[i].is_leaf() {
             let range = b[i].first_index as usize..(b[i].first_index + b[i].prim_count) as usize;
-            let first = slots[range.start].mirror;
-            if slots[range].iter().all(|s| s.mirror == first) {
+            let first = slots[range.start].flat;
+            if slots[range].iter().all(|s| s.flat == first) {
                 first
             } else {
-                NOT_A_MIRROR
+                NO_ONE_FLAT
             }
         } else {
             let first = b[i].first_index as usize;
-            if mirror[first] == mirror[first + 1] {
-                mirror[first]
+            if flat[first] == flat[first + 1] {
+                flat[first]
             } else {
-                NOT_A_MIRROR
+                NO_ONE_FLAT
             }
         };
     }
-    mirror
+    flat
 }
 
 #[cfg(test)]
@@ -777,11 +778,11 @@ mod tests {
     use super::*;
     use glam::Vec3;
 
-    /// One leaf block of `triangles`, lane `i` numbered `original[i]`, on no mirror.
+    /// One leaf block of `triangles`, lane `i` numbered `original[i]`, on no one flat surface.
     fn block_of(triangles: &[[Vec3; 3]], original: &[u32]) -> TriBlock {
         let mut block = TriBlock {
             v: [[[0.0; BLOCK]; 3]; 3],
-            mirror: [NOT_A_MIRROR; BLOCK],
+            flat: [NO_ONE_FLAT; BLOCK],
             original: [u32::MAX; BLOCK],
             count: triangles.len() as u32,
             more: false,

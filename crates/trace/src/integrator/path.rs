@@ -12,8 +12,11 @@
 //! - the background is a constant environment emitter, found by escaping rays;
 //! - **Russian roulette** from segment `rr_from` (Mitsuba's `rr_depth`) on, survival probability max(throughput) ≤ 0.95;
 //! - a shadow ray (to a point light, or to the sampled point on an emitter) is blocked by
-//!   any hit nearer than a relative 10⁻⁴ short of its end, other than the triangle it
-//!   leaves (an any-hit query).
+//!   any hit nearer than a relative 10⁻⁴ short of its end (an any-hit query);
+//! - every ray skips the **flat surface** it leaves ([`SceneBvh::flat_surface`]): the
+//!   mirror, or all the diffuse triangles on the plane of the one it leaves, not only that
+//!   triangle — a hit there can only be a self-intersection (issue 56: a ray leaving one of a
+//!   floor's two triangles no longer enters the other's leaf).
 //!
 //! **Every sample its own random stream** (issue 41), split off its pixel's stream in
 //! sample order ([`SplitMix64::split`]): so the samples of neighbouring pixels walk side by
@@ -88,7 +91,8 @@ pub struct PathTracer<'a> {
 /// AVX-512): everything in packets 1.12 s (`mirror_box`) and 2.24 s (`mirror_room`); 1:
 /// 0.73 s and 1.55 s; 2: 0.72 s and 1.64 s (with a packet kernel that skipped the diffuse
 /// triangle a ray leaves, since removed: the same on `mirror_box`, slower on `mirror_room`).
-/// Above 1 needs that kernel back.
+/// Above 1 the lanes now skip the flat surface they leave, as the kernel can (not measured
+/// since).
 const PACKET_VERTICES: u32 = 1;
 
 /// Likewise for the next-event shadow rays: those from a path's first diffuse vertex start
@@ -205,10 +209,9 @@ struct Walk {
     /// Solid-angle pdf of the BSDF sample that produced `ray`; None after the camera or a
     /// mirror.
     bsdf_pdf: Option<f32>,
-    /// The diffuse triangle `ray` leaves (skipped by its query), if any.
-    from_triangle: Option<usize>,
-    /// The mirror `ray` leaves (skipped by its query), if any.
-    from_mirror: Option<usize>,
+    /// The flat surface `ray` leaves ([`SceneBvh::flat_surface`]: a mirror, or the plane
+    /// of the diffuse triangle it leaves; skipped by its query), if any.
+    leaving: Option<usize>,
     /// Segments so far.
     segments: u32,
     /// Diffuse vertices passed so far.
@@ -224,8 +227,7 @@ impl Walk {
             rays: 0,
             bounces: 0,
             bsdf_pdf: None,
-            from_triangle: None,
-            from_mirror: None,
+            leaving: None,
             segments: 0,
             diffuse_vertices: 0,
         }
@@ -250,19 +252,19 @@ impl Walk {
 }
 
 /// A next-event shadow ray a path vertex asks for, and the radiance it adds when nothing
-/// blocks it: the ray from the shaded point (on triangle `from`, skipped) towards a point
-/// light or a point on an emitter, blocked by any hit in `[0, t_max)`.
+/// blocks it: the ray from the shaded point (on flat surface `leaving`, skipped) towards a
+/// point light or a point on an emitter, blocked by any hit in `[0, t_max)`.
 #[derive(Clone, Copy)]
 struct ShadowRay {
     ray: Ray,
     t_max: f32,
-    from: usize,
+    leaving: usize,
     contribution: Vec3,
 }
 
 impl PathTracer<'_> {
-    /// One vertex of a path: `hit` is the closest hit of `walk.ray` (skipping the mirror or
-    /// triangle it leaves). Adds what is seen there (the background, or an emitter's
+    /// One vertex of a path: `hit` is the closest hit of `walk.ray` (skipping the flat
+    /// surface it leaves). Adds what is seen there (the background, or an emitter's
     /// emission with its MIS weight), asks `shadow(k, ray)` for each next-event shadow ray
     /// — `k` the point light's index, or the number of lights for the emitter sample —
     /// whose contribution the caller adds, in the order asked, where it is unblocked; then
@@ -349,12 +351,12 @@ impl PathTracer<'_> {
                     }
                 }
                 w.bsdf_pdf = None;
-                w.from_mirror = Some(mirror);
-                w.from_triangle = None;
+                w.leaving = Some(mirror);
                 w.bounces += 1;
             }
             Interaction::Diffuse { albedo, .. } => {
                 let p = p.expect("a diffuse interaction comes with its point");
+                let leaving = self.bvh.flat_surface(hit.triangle);
                 let n = if front { n_f } else { -n_f };
                 let f = albedo * std::f32::consts::FRAC_1_PI;
                 let lights = &scene.lighting.lights;
@@ -368,7 +370,7 @@ impl PathTracer<'_> {
                             ShadowRay {
                                 ray,
                                 t_max,
-                                from: hit.triangle,
+                                leaving,
                                 contribution,
                             },
                         );
@@ -406,7 +408,7 @@ impl PathTracer<'_> {
                             ShadowRay {
                                 ray,
                                 t_max,
-                                from: hit.triangle,
+                                leaving,
                                 contribution,
                             },
                         );
@@ -416,8 +418,7 @@ impl PathTracer<'_> {
                 w.bsdf_pdf = Some(n.dot(dir) * std::f32::consts::FRAC_1_PI);
                 w.beta *= albedo; // f·cos/pdf = ρ/π·cos/(cos/π)
                 w.ray = Ray { origin: p, dir };
-                w.from_triangle = Some(hit.triangle);
-                w.from_mirror = None;
+                w.leaving = Some(leaving);
                 w.diffuse_vertices += 1;
             }
         }
@@ -447,16 +448,15 @@ impl PathTracer<'_> {
     ) -> PathResult {
         let mut w = Walk::start(ray);
         loop {
-            let hit = self.bvh.closest_hit_skipping(
-                &w.ray,
-                0.0,
-                f32::INFINITY,
-                w.from_mirror,
-                w.from_triangle,
-            );
+            let hit = self
+                .bvh
+                .closest_hit_skipping(&w.ray, 0.0, f32::INFINITY, w.leaving, None);
             unblocked.clear();
             let end = self.vertex::<false>(&mut w, hit, rng, |_, s| {
-                if !self.bvh.occluded(&s.ray, 0.0, s.t_max, None, Some(s.from)) {
+                if !self
+                    .bvh
+                    .occluded(&s.ray, 0.0, s.t_max, Some(s.leaving), None)
+                {
                     unblocked.push(s.contribution);
                 }
             });
@@ -532,7 +532,8 @@ impl PathTracer<'_> {
         let mut packet = RayPacket::default();
         let mut hits = LaneHits::default();
         let mut t_max = [0.0f32; LANES];
-        let mut from = [NO_TRIANGLE; LANES];
+        // The shadow rays skip the flat surface they leave, no single triangle.
+        let no_triangle = [NO_TRIANGLE; LANES];
         // A round's flat-mirror bounces, per lane (set for the lanes that have one).
         let mut normal = [[0.0f32; LANES]; 3];
         let mut offset = [0.0f32; LANES];
@@ -560,17 +561,14 @@ impl PathTracer<'_> {
             while active != 0 {
                 // Paths before their first diffuse vertex (camera rays and mirror chains)
                 // are coherent: their queries go to the packet kernel; later ones are
-                // scattered, and go one at a time to the single-ray hierarchy. (Before a
-                // diffuse vertex a ray leaves no diffuse triangle, so the packet kernel's
-                // closest hits need skip only mirrors; `PACKET_VERTICES` above 1 would need
-                // a kernel that skips a triangle per lane, as the any-hit one does.)
+                // scattered, and go one at a time to the single-ray hierarchy. (Every lane
+                // skips the flat surface it leaves, a mirror or a diffuse plane: the packet
+                // kernel's closest hits can take a lane after any vertex.)
                 let coherent = active & !scattered;
                 for lane in lanes(coherent) {
                     let w = &walks[lane];
-                    debug_assert!(
-                        w.diffuse_vertices < PACKET_VERTICES && w.from_triangle.is_none()
-                    );
-                    packet.set(lane, &w.ray, w.from_mirror);
+                    debug_assert!(w.diffuse_vertices < PACKET_VERTICES);
+                    packet.set(lane, &w.ray, w.leaving);
                 }
                 if coherent != 0 {
                     self.bvh
@@ -587,8 +585,8 @@ impl PathTracer<'_> {
                         ray: w.ray,
                         t_min: 0.0,
                         t_max: f32::INFINITY,
-                        skip_mirror: w.from_mirror,
-                        skip_triangle: w.from_triangle,
+                        skip_flat: w.leaving,
+                        skip_triangle: None,
                     };
                     lane_of[n] = lane;
                     n += 1;
@@ -685,8 +683,8 @@ impl PathTracer<'_> {
                             ray: s.ray,
                             t_min: 0.0,
                             t_max: s.t_max,
-                            skip_mirror: None,
-                            skip_triangle: Some(s.from),
+                            skip_flat: Some(s.leaving),
+                            skip_triangle: None,
                         };
                         of[n] = Some(answer);
                         n += 1;
@@ -705,16 +703,19 @@ impl PathTracer<'_> {
                 for k in 0..kinds {
                     let mut mask: LaneMask = 0;
                     for &(lane, _, s, _) in asked.iter().filter(|a| a.1 == k && a.3.is_none()) {
-                        packet.set(lane, &s.ray, None);
+                        packet.set(lane, &s.ray, Some(s.leaving));
                         t_max[lane] = s.t_max;
-                        from[lane] = s.from as u32;
                         mask |= 1 << lane;
                     }
                     let b = if mask == 0 {
                         0
                     } else {
-                        self.bvh
-                            .occluded_lanes_inline::<F32_LANES>(&packet, mask, &t_max, &from)
+                        self.bvh.occluded_lanes_inline::<F32_LANES>(
+                            &packet,
+                            mask,
+                            &t_max,
+                            &no_triangle,
+                        )
                     };
                     blocked.push(b);
                 }

@@ -120,7 +120,7 @@ impl<'a> Whitted<'a> {
                         ray,
                         t_min: 0.0,
                         t_max,
-                        skip_mirror: leg.a_mirror,
+                        skip_flat: leg.a_mirror,
                         skip_triangle,
                     };
                     of[n] = j;
