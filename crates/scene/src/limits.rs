@@ -16,13 +16,13 @@ pub const MAX_OBJ_FILE_BYTES: u64 = 256 << 20;
 /// subdivision level 7). See [`MEMORY_PER_TRIANGLE`].
 pub const MAX_TRIANGLES: usize = 1 << 22;
 /// Peak bytes per triangle of a scene, measured: `mirrorbox trace` of twelve spheres at
-/// subdivision level 7 (3.93 M triangles) on the development machine. With the packet kernel
-/// (2026-11-25; `--spp 4`) it peaked at 1.75 GB resident (geometry, the CWBVH of the
-/// single-ray queries, the BVH2 of the packets, the slots of each): 444 bytes each; with
-/// `--bvh bvh2` (one hierarchy for both) 1.16 GB; before the packet kernel 1.25 GB.
-/// `render --method naive` of it peaked at 0.98 GB. Used to say what a refused scene would
-/// have needed.
-pub const MEMORY_PER_TRIANGLE: u64 = 450;
+/// subdivision level 7 (3.93 M triangles) on the development machine. With the 8-wide
+/// hierarchy of the single-ray queries (the default since issue 56) and the BVH2 of the
+/// packets, it peaked at 2.72 GB resident (`whitted`, `--spp 4`) and 2.73 GB (`path`, 64×36,
+/// 2026-11-30): 695 bytes each. (On 2026-11-25, with obvhs's CWBVH for the single rays, 1.75
+/// GB; with `--bvh bvh2`, one hierarchy for both, 1.16 GB.) `render --method naive` of it
+/// peaked at 1.55 GB. Used to say what a refused scene would have needed.
+pub const MEMORY_PER_TRIANGLE: u64 = 700;
 /// Every position in a scene (vertices after their transform, mirror corners, camera, lights)
 /// lies within `±MAX_COORDINATE` scene units on every axis, so that every triangle, its
 /// bounds, the BVH and the products the intersection tests form stay finite in f32 (their

@@ -68,7 +68,8 @@ fn units(seed: u64) -> impl FnMut() -> f32 {
 
 /// Scattered rays, as `path`'s after a diffuse vertex: from the diffuse points the camera
 /// rays hit, in directions uniform over the hemisphere about the normal on the camera's side,
-/// skipping the triangle they leave (a fixed pseudo-random sequence).
+/// each with the triangle it leaves (its flat surface skipped, [`queries`]; a fixed
+/// pseudo-random sequence).
 fn scattered(scene: &Scene, bvh: &SceneBvh, camera_rays: &[Leaving]) -> Vec<(Ray, usize)> {
     let mut unit = units(0x9e37_79b9_7f4a_7c15);
     camera_rays

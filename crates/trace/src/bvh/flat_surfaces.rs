@@ -20,11 +20,18 @@
 //! (either orientation) within 10⁻⁶ rad and each one's corners lie within
 //! [`PLANE_TOLERANCE`] × their largest coordinate of the other's plane (f64 arithmetic).
 //! Each plane is tested against its first triangle only (no chains of near planes drifting
-//! apart); candidates are found through a grid of the planes' normals and offsets, and a
-//! plane that straddles a grid boundary is split into two flat surfaces there: a skip missed,
+//! apart). Candidates are found through a grid of the planes' normals and offsets, at most
+//! [`PLANES_PER_CELL`] per cell (a finely tessellated curved mesh puts many planes in one
+//! cell; without the cap its grouping would be quadratic). A plane that straddles a grid
+//! boundary, or finds its cell full, becomes a flat surface of its own there: a skip missed,
 //! never one too many.
+//!
+//! **Cost.** One pass over the triangles, before the hierarchy is built (so its working
+//! memory is gone when the build's peak comes): per plane a triangle index and a link, per
+//! grid cell one hash entry of a word and two indices — under 30 bytes per triangle where
+//! every triangle is a plane of its own, the result 4.
 
-use glam::{DVec3, Vec3};
+use glam::DVec3;
 use mirrorbox_scene::{Geometry, Surface};
 use std::collections::HashMap;
 
@@ -33,29 +40,39 @@ use std::collections::HashMap;
 /// corners about 10⁻⁷ off the plane of its triangles.)
 const PLANE_TOLERANCE: f64 = 16.0 * f32::EPSILON as f64;
 
-/// `1 − cos` of the largest angle between two normals of one plane (10⁻⁶ rad).
+/// `1 − |cos|` of the largest angle between two normals of one plane (10⁻⁶ rad).
 const NORMAL_TOLERANCE: f64 = 5e-13;
 
 /// Cells per unit of the grid that finds candidate planes (normal components and offsets).
 const GRID: f64 = 4096.0;
 
-/// A triangle's plane: its unit normal (largest component positive), a corner, its corners.
+/// Planes a grid cell holds; a triangle is compared with at most these.
+const PLANES_PER_CELL: usize = 8;
+
+/// The direction a plane's normal is turned towards for its grid cell: (1, √2, √3), which no
+/// normal with small integer components is perpendicular to (where a normal is nearly
+/// perpendicular, two triangles of its plane may fall in two cells: a skip missed). A rule such
+/// as "the largest component positive" would split a wall at 45° whenever rounding tips which
+/// of its two equal components is largest.
+const ORIENTATION: DVec3 = DVec3::new(1.0, std::f64::consts::SQRT_2, 1.732_050_807_568_877_2);
+
+/// No next plane in a cell.
+const END: u32 = u32::MAX;
+
+/// A triangle's plane: its unit normal (zero for a triangle without area), its corners, and
+/// the largest coordinate of its corners (at least the smallest positive f64).
 struct Plane {
     n: DVec3,
     corners: [DVec3; 3],
-    /// The largest coordinate of its corners (at least a tiny positive number).
     scale: f64,
 }
 
 impl Plane {
-    fn of(triangle: &[Vec3; 3]) -> Self {
-        let corners = triangle.map(|p| p.as_dvec3());
-        let mut n = (corners[1] - corners[0])
+    fn of(geometry: &Geometry, triangle: usize) -> Self {
+        let corners = geometry.triangles[triangle].map(|p| p.as_dvec3());
+        let n = (corners[1] - corners[0])
             .cross(corners[2] - corners[0])
             .normalize_or_zero();
-        if n[n.abs().max_position()] < 0.0 {
-            n = -n;
-        }
         let scale = corners
             .iter()
             .map(|p| p.abs().max_element())
@@ -63,7 +80,8 @@ impl Plane {
         Plane { n, corners, scale }
     }
 
-    /// Whether `other` lies on this plane (and this on `other`'s), within the tolerances.
+    /// Whether `other` lies on this plane and this on `other`'s, within the tolerances (never
+    /// for a triangle without area).
     fn holds(&self, other: &Plane) -> bool {
         let tolerance = PLANE_TOLERANCE * self.scale.max(other.scale);
         let on = |a: &Plane, b: &Plane| {
@@ -71,13 +89,24 @@ impl Plane {
                 .iter()
                 .all(|p| a.n.dot(*p - a.corners[0]).abs() <= tolerance)
         };
-        self.n.dot(other.n) >= 1.0 - NORMAL_TOLERANCE && on(self, other) && on(other, self)
+        self.n.dot(other.n).abs() >= 1.0 - NORMAL_TOLERANCE && on(self, other) && on(other, self)
     }
 
-    fn cell(&self) -> [i64; 4] {
-        let q = |x: f64| (x * GRID).round() as i64;
-        let offset = self.n.dot(self.corners[0]);
-        [q(self.n.x), q(self.n.y), q(self.n.z), q(offset)]
+    /// The grid cell of the plane: its normal oriented along [`ORIENTATION`], and its offset
+    /// along that normal, each quantised, hashed into one word (two cells that share a word
+    /// only share their candidates: [`Plane::holds`] decides).
+    fn cell(&self) -> u64 {
+        let n = if self.n.dot(ORIENTATION) < 0.0 {
+            -self.n
+        } else {
+            self.n
+        };
+        let q = |x: f64| (x * GRID).round() as i64 as u64;
+        [q(n.x), q(n.y), q(n.z), q(n.dot(self.corners[0]))]
+            .into_iter()
+            .fold(0u64, |h, v| {
+                (h.rotate_left(5) ^ v).wrapping_mul(0x517c_c1b7_2722_0a95)
+            })
     }
 }
 
@@ -93,26 +122,34 @@ pub(super) fn flat_surfaces(geometry: &Geometry) -> Vec<u32> {
         })
         .max()
         .unwrap_or(0);
-    let mut planes: Vec<Plane> = Vec::new();
-    let mut cells: HashMap<[i64; 4], Vec<u32>> = HashMap::new();
-    geometry
-        .triangles
-        .iter()
-        .enumerate()
-        .map(|(i, t)| match geometry.surface(i) {
+    // Per plane (numbered as the flat surfaces after the mirrors): its first triangle, and
+    // the next plane of its grid cell.
+    let mut first: Vec<u32> = Vec::new();
+    let mut next: Vec<u32> = Vec::new();
+    // Per grid cell: its first plane and how many it holds.
+    let mut cells: HashMap<u64, (u32, u32)> = HashMap::new();
+    (0..geometry.triangles.len())
+        .map(|i| match geometry.surface(i) {
             Surface::Mirror { mirror, .. } => *mirror as u32,
             Surface::Diffuse { .. } => {
-                let plane = Plane::of(t);
-                let cell = cells.entry(plane.cell()).or_default();
-                let index = match cell.iter().find(|&&p| planes[p as usize].holds(&plane)) {
-                    Some(&p) => p,
-                    None => {
-                        planes.push(plane);
-                        cell.push(planes.len() as u32 - 1);
-                        planes.len() as u32 - 1
+                let plane = Plane::of(geometry, i);
+                let new = first.len() as u32;
+                let cell = cells.entry(plane.cell()).or_insert((END, 0));
+                let mut candidate = cell.0;
+                while candidate != END {
+                    let other = Plane::of(geometry, first[candidate as usize] as usize);
+                    if other.holds(&plane) {
+                        return mirrors + candidate;
                     }
-                };
-                mirrors + index
+                    candidate = next[candidate as usize];
+                }
+                first.push(i as u32);
+                next.push(END);
+                if (cell.1 as usize) < PLANES_PER_CELL {
+                    next[new as usize] = cell.0;
+                    *cell = (new, cell.1 + 1);
+                }
+                mirrors + new
             }
         })
         .collect()
@@ -129,8 +166,8 @@ mod tests {
             .geometry
     }
 
-    /// The flat surfaces of a scene with two mirrors, a rotated floor quad, a rotated box, a
-    /// second quad 10⁻³ above the floor (parallel, not on its plane) and a sphere: each
+    /// The flat surfaces of a scene with two mirrors, a rotated floor quad, a wall at 45°, a
+    /// rotated box, a second quad 10⁻⁵ above the floor (parallel, not on its plane) and a sphere: each
     /// mirror's triangles are that mirror; the floor's two triangles share one flat surface,
     /// the quad above the floor has its own; each face of the box is one, the opposite faces
     /// apart; no sphere triangle shares one with a triangle of another object.
@@ -147,6 +184,8 @@ mod tests {
               "objects": [
                 { "type": "quad", "name": "floor", "size": [4, 4],
                   "transform": { "rotate_deg": [-90, 0, 0] } },
+                { "type": "quad", "name": "wall", "size": [1, 1],
+                  "transform": { "translate": [0, 1, 1], "rotate_deg": [0, -45, 0] } },
                 { "type": "quad", "name": "above", "size": [1, 1],
                   "transform": { "translate": [0, 0.00001, 0], "rotate_deg": [-90, 0, 0] } },
                 { "type": "box", "name": "box", "size": [0.8, 0.8, 0.8],
@@ -180,6 +219,8 @@ mod tests {
             flat[floor.start + 1],
             "the floor's two triangles"
         );
+        let wall = part("wall");
+        assert_eq!(flat[wall.start], flat[wall.start + 1], "a wall at 45°");
         let above = part("above");
         assert_eq!(flat[above.start], flat[above.start + 1]);
         assert_ne!(
