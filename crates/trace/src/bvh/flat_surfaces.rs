@@ -167,10 +167,11 @@ mod tests {
     }
 
     /// The flat surfaces of a scene with two mirrors, a rotated floor quad, a wall at 45°, a
-    /// rotated box, a second quad 10⁻⁵ above the floor (parallel, not on its plane) and a sphere: each
-    /// mirror's triangles are that mirror; the floor's two triangles share one flat surface,
-    /// the quad above the floor has its own; each face of the box is one, the opposite faces
-    /// apart; no sphere triangle shares one with a triangle of another object.
+    /// rotated box, a second quad 10⁻⁵ above the floor (parallel, not on its plane) and a
+    /// sphere: each mirror's triangles are that mirror; the floor's two triangles share one
+    /// flat surface, as do the wall's, the quad above the floor has its own; each face of the
+    /// box is one, the opposite faces apart; no sphere triangle shares one with a triangle of
+    /// another object.
     #[test]
     fn the_triangles_of_one_plane_share_a_flat_surface() {
         let geometry = scene_geometry(
