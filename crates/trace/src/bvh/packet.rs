@@ -57,8 +57,9 @@ const SKIP_NOTHING: u32 = u32::MAX - 1;
 /// No triangle: what a lane that skips none holds in an any-hit query's skipped triangles.
 pub const NO_TRIANGLE: u32 = u32::MAX;
 
-/// The closest-hit queries' skipped triangles: none.
-const NO_TRIANGLES: [u32; LANES] = [NO_TRIANGLE; LANES];
+/// No lane skips a triangle: the closest-hit queries' skipped triangles, and `path`'s shadow
+/// rays' (they skip the flat surface they leave instead).
+pub(crate) const NO_TRIANGLES: [u32; LANES] = [NO_TRIANGLE; LANES];
 
 /// An any-hit lane's `best_t` once it has hit something: below every box's near distance
 /// (never negative), so its box tests fail from then on.

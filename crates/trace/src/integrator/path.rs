@@ -33,7 +33,7 @@
 //! term of the contract is not physical and is not used here.
 
 use super::{Integrator, PathResult, Termination, face_normals};
-use crate::bvh::packet::{LANES, LaneHits, LaneMask, NO_TRIANGLE, RayPacket, first_lanes, lanes};
+use crate::bvh::packet::{LANES, LaneHits, LaneMask, NO_TRIANGLES, RayPacket, first_lanes, lanes};
 use crate::bvh::{Hit, NO_QUERY, Query, SceneBvh};
 use crate::cpu_features::{Vectorised, build_for, run_on};
 use crate::hit_point::on_triangle_plane;
@@ -533,8 +533,6 @@ impl PathTracer<'_> {
         let mut packet = RayPacket::default();
         let mut hits = LaneHits::default();
         let mut t_max = [0.0f32; LANES];
-        // The shadow rays skip the flat surface they leave, no single triangle.
-        let no_triangle = [NO_TRIANGLE; LANES];
         // A round's flat-mirror bounces, per lane (set for the lanes that have one).
         let mut normal = [[0.0f32; LANES]; 3];
         let mut offset = [0.0f32; LANES];
@@ -715,7 +713,7 @@ impl PathTracer<'_> {
                             &packet,
                             mask,
                             &t_max,
-                            &no_triangle,
+                            &NO_TRIANGLES,
                         )
                     };
                     blocked.push(b);
