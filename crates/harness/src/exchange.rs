@@ -148,18 +148,38 @@ pub fn read_view_list(path: &Path) -> Result<Vec<ViewSpec>, HarnessError> {
             list.views.len()
         )));
     }
-    for (i, v) in list.views.iter().enumerate() {
-        if !valid_name(&v.name) {
-            return Err(bad(format!(
-                "views[{i}].name {:?}: 1 to 64 letters, digits, '-' or '_'",
-                v.name
-            )));
-        }
-        if list.views[..i].iter().any(|w| w.name == v.name) {
-            return Err(bad(format!("views[{i}].name {:?} appears twice", v.name)));
-        }
+    let names: Vec<&str> = list.views.iter().map(|v| v.name.as_str()).collect();
+    if let Some(problem) = view_name_problem(&names) {
+        return Err(bad(problem));
     }
     Ok(list.views)
+}
+
+/// What is wrong with a list of view names, as `views[i].name …`, if anything: each is a
+/// [`valid_name`] (it becomes part of file names), given once, and none is another's name
+/// followed by `_floor` — view `a`'s floor truth is `truth/a_floor.exr`, which is view
+/// `a_floor`'s truth (`docs/exchange.md`).
+pub fn view_name_problem(names: &[&str]) -> Option<String> {
+    for (i, name) in names.iter().enumerate() {
+        if !valid_name(name) {
+            return Some(format!(
+                "views[{i}].name {name:?}: 1 to 64 letters, digits, '-' or '_'"
+            ));
+        }
+        if names[..i].contains(name) {
+            return Some(format!("views[{i}].name {name:?} appears twice"));
+        }
+    }
+    for (i, name) in names.iter().enumerate() {
+        if let Some(j) = names.iter().position(|n| format!("{n}_floor") == *name) {
+            return Some(format!(
+                "views[{i}].name {name:?}: the floor truth of views[{j}] {:?} has that name \
+                 (truth/{name}.exr); a view's name may not be another's followed by _floor",
+                names[j]
+            ));
+        }
+    }
+    None
 }
 
 /// A file-name-safe view, client or variant name.

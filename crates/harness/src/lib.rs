@@ -861,6 +861,17 @@ pub(crate) fn check_output_parent(out: &Path) -> Result<(), HarnessError> {
     })
 }
 
+/// Whether `path`, as a file we read names it (views.json's truths, a record's pictures),
+/// stays inside the folder it is relative to: not empty, relative, no `..` — so that joined
+/// to that folder it can neither read nor write outside it.
+pub(crate) fn is_inner_path(path: &str) -> bool {
+    use std::path::Component;
+    let p = Path::new(path);
+    p.components().any(|c| matches!(c, Component::Normal(_)))
+        && p.components()
+            .all(|c| matches!(c, Component::Normal(_) | Component::CurDir))
+}
+
 /// The method every floor point renders the mirror-free scene with: one scene pass.
 pub const FLOOR_METHOD: &str = "naive";
 

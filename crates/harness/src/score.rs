@@ -4,7 +4,7 @@
 //! written as the same records and report. A variant named `floor` drew the scene without its
 //! mirrors and is compared with the floor truth.
 
-use crate::exchange::{FORMAT_VERSION, ViewsFile, valid_name};
+use crate::exchange::{FORMAT_VERSION, MAX_VIEWS, ViewsFile, valid_name, view_name_problem};
 use crate::{HarnessError, ViewFiles, compare_views, io};
 use mirrorbox_report::{Record, SweepInfo, write_report};
 use serde::Deserialize;
@@ -36,7 +36,38 @@ pub struct Timing {
     /// report, not for the variant's name.
     #[serde(default)]
     pub notes: Option<String>,
+    #[serde(deserialize_with = "each_key_once")]
     pub views: BTreeMap<String, Vec<f64>>,
+}
+
+/// `timing.json`'s `views`, each view's key given once: a map read as serde reads one would
+/// keep the last of two `"camera"` entries and drop the other's frames unsaid.
+fn each_key_once<'de, D: serde::Deserializer<'de>>(
+    d: D,
+) -> Result<BTreeMap<String, Vec<f64>>, D::Error> {
+    struct Views;
+    impl<'de> serde::de::Visitor<'de> for Views {
+        type Value = BTreeMap<String, Vec<f64>>;
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            f.write_str("a map from view names to frame times in ms")
+        }
+        fn visit_map<A: serde::de::MapAccess<'de>>(
+            self,
+            mut map: A,
+        ) -> Result<Self::Value, A::Error> {
+            let mut out = BTreeMap::new();
+            while let Some((key, frames)) = map.next_entry::<String, Vec<f64>>()? {
+                if out.contains_key(&key) {
+                    return Err(serde::de::Error::custom(format!(
+                        "views: view {key:?} is given twice"
+                    )));
+                }
+                out.insert(key, frames);
+            }
+            Ok(out)
+        }
+    }
+    d.deserialize_map(Views)
 }
 
 /// How to score: the command line (for the report), our sweeps to set beside the run
@@ -84,7 +115,60 @@ pub fn read_views(export: &Path) -> Result<ViewsFile, HarnessError> {
             ),
         ));
     }
+    check_views(&views).map_err(|problem| refused(&path, problem))?;
     Ok(views)
+}
+
+/// What an export writes and `score` relies on, checked field by field: 1 to [`MAX_VIEWS`]
+/// views; names that are file-name safe, distinct and free of `_floor` clashes (they become
+/// parts of file names); sizes an image read can have; `truth` and `floor` inside the export
+/// folder (they are read from it).
+fn check_views(views: &ViewsFile) -> Result<(), String> {
+    if views.views.is_empty() || views.views.len() > MAX_VIEWS {
+        return Err(format!(
+            "views: {} views; 1 to {MAX_VIEWS} are read",
+            views.views.len()
+        ));
+    }
+    let names: Vec<&str> = views.views.iter().map(|v| v.name.as_str()).collect();
+    if let Some(problem) = view_name_problem(&names) {
+        return Err(problem);
+    }
+    let sides = mirrorbox_image::metrics::MIN_SIDE..=mirrorbox_image::MAX_IMAGE_SIDE;
+    for (i, v) in views.views.iter().enumerate() {
+        for (field, side) in [("width", v.width), ("height", v.height)] {
+            if !sides.contains(&side) {
+                return Err(format!(
+                    "views[{i}].{field} {side}: {} to {} pixels",
+                    sides.start(),
+                    sides.end()
+                ));
+            }
+        }
+        if u64::from(v.width) * u64::from(v.height) > mirrorbox_image::MAX_PIXELS {
+            return Err(format!(
+                "views[{i}]: {}×{} is more than {} pixels",
+                v.width,
+                v.height,
+                mirrorbox_image::MAX_PIXELS
+            ));
+        }
+        if v.ssaa == 0 {
+            return Err(format!(
+                "views[{i}].ssaa 0: a sub-pixel grid side of 1 or more"
+            ));
+        }
+        for (field, file) in [("truth", &v.truth), ("floor", &v.floor)] {
+            if !crate::is_inner_path(file) {
+                return Err(format!(
+                    "views[{i}].{field} {file:?}: a path inside the export folder (relative, \
+                     without ..), e.g. \"truth/{}.exr\"",
+                    v.name
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 fn read_timing(path: &Path, views: &ViewsFile) -> Result<Timing, HarnessError> {
@@ -530,6 +614,93 @@ mod tests {
         let mut doc = example;
         doc["unknown"] = serde_json::json!(1);
         assert!(serde_json::from_value::<Timing>(doc).is_err());
+    }
+
+    /// A views.json that an export could not have written is refused naming the field, in
+    /// the file: no view, a name that is no file name or that clashes, a size no image has,
+    /// a truth outside the export folder. (An empty list panicked, a name such as
+    /// `../../x` was used as a path.)
+    #[test]
+    fn a_views_json_is_checked_field_by_field() {
+        let dir = tempfile::tempdir().unwrap();
+        let good = crate::exchange::tests_support::sample_view();
+        let write = |views: &ViewsFile| {
+            std::fs::write(
+                dir.path().join("views.json"),
+                serde_json::to_string(views).unwrap(),
+            )
+            .unwrap();
+        };
+        write(&good);
+        assert!(read_views(dir.path()).is_ok());
+        let with = |edit: &dyn Fn(&mut ViewsFile)| {
+            let mut views = good.clone();
+            edit(&mut views);
+            views
+        };
+        let second = |views: &mut ViewsFile, name: &str| {
+            let mut v = views.views[0].clone();
+            v.name = name.into();
+            views.views.push(v);
+        };
+        for (views, needle) in [
+            (with(&|v| v.views.clear()), "views: 0 views; 1 to 64"),
+            (
+                with(&|v| {
+                    let one = v.views[0].clone();
+                    v.views = vec![one; MAX_VIEWS + 1];
+                }),
+                "views: 65 views",
+            ),
+            (
+                with(&|v| v.views[0].name = "../../../secret/x".into()),
+                "views[0].name \"../../../secret/x\"",
+            ),
+            (
+                with(&|v| v.views[0].name = "sub/cam".into()),
+                "views[0].name \"sub/cam\"",
+            ),
+            (
+                with(&|v| second(v, "camera")),
+                "views[1].name \"camera\" appears twice",
+            ),
+            (
+                with(&|v| second(v, "camera_floor")),
+                "views[1].name \"camera_floor\": the floor truth of views[0]",
+            ),
+            (with(&|v| v.views[0].width = 0), "views[0].width 0"),
+            (
+                with(&|v| v.views[0].height = 70_000),
+                "views[0].height 70000",
+            ),
+            (
+                with(&|v| v.views[0].truth = "../elsewhere/t.exr".into()),
+                "views[0].truth \"../elsewhere/t.exr\"",
+            ),
+            (
+                with(&|v| v.views[0].floor = "/etc/passwd".into()),
+                "views[0].floor \"/etc/passwd\"",
+            ),
+        ] {
+            write(&views);
+            let e = read_views(dir.path()).unwrap_err().to_string();
+            assert!(e.contains(needle), "{needle}: {e}");
+            assert!(e.contains("views.json"), "{e}");
+        }
+    }
+
+    /// A view given twice in timing.json's `views` is refused naming it, as a field given
+    /// twice at the top is (serde's map kept the last silently).
+    #[test]
+    fn a_view_given_twice_in_a_timing_file_is_refused() {
+        let s = schema("timing.schema.json");
+        let mut text = s["examples"][0].to_string();
+        let views = text.find("\"views\":{").unwrap() + "\"views\":{".len();
+        text.insert_str(views, r#""camera":[5],"#);
+        let e = serde_json::from_str::<Timing>(&text)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("view \"camera\" is given twice"), "{e}");
     }
 
     /// An export's views.json holds every field the schema requires, at every level.
