@@ -274,6 +274,102 @@ fn a_bad_run_is_refused_naming_the_file_and_nothing_is_written() {
     let _ = repo();
 }
 
+/// The export is an input too: a views.json an export could not have written (no view, a
+/// name used as a path) and a truth that is missing, of another size or not radiance are
+/// refused naming the export's file, exit 2, before anything is written. (An empty list
+/// panicked; the truths were read only while writing, failed with exit 1 naming `.partial`
+/// files, and a NaN in a truth gave `"rmse": null` records.)
+#[test]
+fn a_bad_export_is_refused_naming_its_file_before_anything_is_written() {
+    let tmp = tempfile::tempdir().unwrap();
+    let ex = tmp.path().join("export");
+    export(&ex);
+    let run = tmp.path().join("run");
+    our_run(&run);
+    let scored = tmp.path().join("scored");
+    let refused = |what: &str, needles: &[&str]| {
+        let out = mirrorbox(
+            &[
+                "score",
+                ex.to_str().unwrap(),
+                run.to_str().unwrap(),
+                "-o",
+                scored.to_str().unwrap(),
+            ],
+            &[],
+        );
+        assert_eq!(out.code, 2, "{what}: {}", out.stderr);
+        for needle in needles {
+            assert!(out.stderr.contains(needle), "{what}: {}", out.stderr);
+        }
+        assert!(!out.stderr.contains(".partial"), "{what}: {}", out.stderr);
+        assert!(
+            !scored.exists() && !tmp.path().join("scored.partial").exists(),
+            "{what}"
+        );
+    };
+    let views_file = ex.join("views.json");
+    let good_views = std::fs::read_to_string(&views_file).unwrap();
+    let mut views: Value = serde_json::from_str(&good_views).unwrap();
+    views["views"] = serde_json::json!([]);
+    std::fs::write(&views_file, views.to_string()).unwrap();
+    refused("no view", &["views.json", "views: 0 views; 1 to 64"]);
+    let mut views: Value = serde_json::from_str(&good_views).unwrap();
+    views["views"][0]["name"] = "../../x".into();
+    std::fs::write(&views_file, views.to_string()).unwrap();
+    refused(
+        "a name that is a path",
+        &["views.json", "views[0].name \"../../x\""],
+    );
+    std::fs::write(&views_file, &good_views).unwrap();
+    let truth = ex.join("truth/camera.exr");
+    let good_truth = std::fs::read(&truth).unwrap();
+    std::fs::remove_file(&truth).unwrap();
+    refused("a missing truth", &["views[0].truth", "truth/camera.exr"]);
+    let small = mirrorbox_image::RgbImage {
+        width: 32,
+        height: 18,
+        pixels: vec![[0.1; 3]; 32 * 18],
+    };
+    mirrorbox_image::write_exr(&truth, &small, &[]).unwrap();
+    refused(
+        "a truth of another size",
+        &["truth/camera.exr", "is 32×18; view \"camera\" is 64×36"],
+    );
+    for bad in [f32::NAN, f32::INFINITY] {
+        let mut img = mirrorbox_image::RgbImage {
+            width: 64,
+            height: 36,
+            pixels: vec![[0.1; 3]; 64 * 36],
+        };
+        img.pixels[64 * 3 + 7] = [bad, 0.1, 0.1];
+        mirrorbox_image::write_exr(&truth, &img, &[]).unwrap();
+        refused(
+            "a truth that is not radiance",
+            &["truth/camera.exr", "pixel (7, 3)"],
+        );
+    }
+    std::fs::write(&truth, &good_truth).unwrap();
+    let picture = ex.join("truth/camera.png");
+    std::fs::rename(&picture, tmp.path().join("aside.png")).unwrap();
+    refused(
+        "a truth without its picture",
+        &["views[0].truth", "truth/camera.png"],
+    );
+    std::fs::rename(tmp.path().join("aside.png"), &picture).unwrap();
+    // The floor truth is read for a variant named `floor` only.
+    let floor_variant = run.join("mirrorbox/floor");
+    std::fs::create_dir_all(&floor_variant).unwrap();
+    for f in ["camera.exr", "timing.json"] {
+        std::fs::copy(run.join("mirrorbox/naive").join(f), floor_variant.join(f)).unwrap();
+    }
+    std::fs::remove_file(ex.join("truth/camera_floor.exr")).unwrap();
+    refused(
+        "a missing floor truth",
+        &["views[0].floor", "truth/camera_floor.exr"],
+    );
+}
+
 #[test]
 fn a_bad_view_list_is_refused_naming_the_field() {
     let tmp = tempfile::tempdir().unwrap();

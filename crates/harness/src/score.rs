@@ -271,33 +271,68 @@ fn view_image(dir: &Path, view: &crate::exchange::ExportedView) -> Result<PathBu
             format!("no image of view {:?} ({0}.exr or {0}.png)", view.name),
         ));
     }
-    let img = mirrorbox_image::read_image(&path).map_err(|e| refused(&path, e))?;
+    // The image's errors name its file.
+    let img =
+        mirrorbox_image::read_image(&path).map_err(|e| HarnessError::Exchange(e.to_string()))?;
+    match radiance_problem(&img, view) {
+        Some(problem) => Err(refused(&path, problem)),
+        None => Ok(path),
+    }
+}
+
+/// What makes `img` no picture of `view`'s radiance, if anything: another size, or a pixel
+/// that is NaN, infinite or negative (its metrics would be NaN, its records `null`).
+fn radiance_problem(
+    img: &mirrorbox_image::RgbImage,
+    view: &crate::exchange::ExportedView,
+) -> Option<String> {
     if (img.width, img.height) != (view.width, view.height) {
-        return Err(refused(
-            &path,
-            format!(
-                "is {}×{}; view {:?} is {}×{}",
-                img.width, img.height, view.name, view.width, view.height
-            ),
+        return Some(format!(
+            "is {}×{}; view {:?} is {}×{}",
+            img.width, img.height, view.name, view.width, view.height
         ));
     }
-    if let Some((i, p)) = img
-        .pixels
+    let w = img.width as usize;
+    img.pixels
         .iter()
         .enumerate()
         .find(|(_, p)| p.iter().any(|c| !c.is_finite() || *c < 0.0))
-    {
-        let w = img.width as usize;
-        return Err(refused(
-            &path,
+        .map(|(i, p)| {
             format!(
                 "pixel ({}, {}) is {p:?}: radiance is finite and ≥ 0",
                 i % w,
                 i / w
-            ),
-        ));
+            )
+        })
+}
+
+/// Checks the export's truth `views[i].<field>` (`file`, relative to `export`) as a client's
+/// image is checked — readable, the view's size, radiance in every pixel — and its sRGB
+/// picture beside it (copied into the report): the export is an input like the run, read
+/// before anything is written.
+fn check_truth(
+    export: &Path,
+    i: usize,
+    field: &str,
+    file: &str,
+    view: &crate::exchange::ExportedView,
+) -> Result<(), HarnessError> {
+    let path = export.join(file);
+    let at = |e: &dyn std::fmt::Display| HarnessError::Exchange(format!("views[{i}].{field}: {e}"));
+    let img = mirrorbox_image::read_image(&path).map_err(|e| at(&e))?;
+    if let Some(problem) = radiance_problem(&img, view) {
+        return Err(at(&format!("{}: {problem}", path.display())));
     }
-    Ok(path)
+    let picture = path.with_extension("png");
+    if picture != path {
+        mirrorbox_files::open_regular(
+            &picture,
+            mirrorbox_image::MAX_IMAGE_FILE_BYTES,
+            "the truth's sRGB picture",
+        )
+        .map_err(|e| at(&e))?;
+    }
+    Ok(())
 }
 
 /// Scores `run` against `export` into `out` (see the module docs). Every input is read and
@@ -334,7 +369,16 @@ pub fn score(
     }
     let found = variants(run)?;
     crate::exchange::replaceable(out, "sweep.json", "score")?;
-    // Everything read and checked first.
+    // Everything read and checked first: the export's truths that the variants are compared
+    // with (the floor truths for variants named `floor`), then each variant's files.
+    for (i, v) in views.views.iter().enumerate() {
+        if found.iter().any(|(_, variant, _)| variant != "floor") {
+            check_truth(export, i, "truth", &v.truth, v)?;
+        }
+        if found.iter().any(|(_, variant, _)| variant == "floor") {
+            check_truth(export, i, "floor", &v.floor, v)?;
+        }
+    }
     let mut inputs = Vec::new();
     for (client, variant, dir) in &found {
         let timing = read_timing(&dir.join("timing.json"), &views)?;
