@@ -189,7 +189,32 @@ fn edge_cases_are_refused_with_a_clear_message_and_nothing_written() {
         ),
         (
             sweep(&["--width", "1"]),
-            vec!["the image width (--width or camera.width) must be at least 11 pixels in a sweep"],
+            vec![
+                "the image width (--width or camera.width) must be at least 11 pixels where an \
+                 image is compared with its truth",
+            ],
+        ),
+        // --ssaa of the commands that compare with a truth: s × s overflowed (a panic).
+        (
+            own(&["export-views", ok, "-o", sweep_out, "--ssaa", "70000"]),
+            vec!["--ssaa must be in [1, 8], got 70000"],
+        ),
+        (
+            own(&["export-views", ok, "-o", sweep_out, "--ssaa", "9"]),
+            vec!["--ssaa must be in [1, 8], got 9"],
+        ),
+        (
+            own(&[
+                "advise",
+                ok,
+                "--budget-ms",
+                "10",
+                "-o",
+                sweep_out,
+                "--ssaa",
+                "70000",
+            ]),
+            vec!["--ssaa must be in [1, 8], got 70000"],
         ),
         (
             sweep(&["--min-throughput", "nan"]),

@@ -984,7 +984,10 @@ fn base_scene(config: &SweepConfig) -> Result<(Scene, u32, u32), HarnessError> {
         if side < min {
             return Err(SettingError::new(
                 flag,
-                format!("at least {min} pixels in a sweep (SSIM's window)"),
+                format!(
+                    "at least {min} pixels where an image is compared with its truth \
+                     (SSIM's window)"
+                ),
                 side,
             )
             .into());

@@ -2,7 +2,7 @@
 //! frame budget on this device, found by a search that measures few candidates (issue 55,
 //! `mirrorbox_harness::advise`).
 
-use super::{grid_side, unit_interval};
+use super::unit_interval;
 use crate::Failure;
 use mirrorbox_harness::advise::{AdviseConfig, Metric, OverViews, advise_into, sentences, to_json};
 use mirrorbox_harness::{Event, SweepConfig};
@@ -18,8 +18,8 @@ pub struct Args {
     #[arg(long = "budget-ms", allow_negative_numbers = true)]
     budget_ms: f64,
     #[command(flatten)]
-    size: super::SizeArgs,
-    /// Supersampling s of the raster (the truth uses the same s×s sub-pixel grid).
+    size: super::TruthSizeArgs,
+    /// Supersampling s of the raster (the truth uses the same s×s sub-pixel grid), 1..8.
     #[arg(long, default_value_t = 1)]
     ssaa: u32,
     /// α: every mirror's reflectance, in [0, 1], as in a sweep.
@@ -99,7 +99,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             args.frames
         )));
     }
-    grid_side(args.ssaa * args.ssaa)?;
+    super::ssaa(args.ssaa)?;
     unit_interval("--alpha", Some(args.alpha))?;
     let over_views = OverViews::parse(&args.over_views).ok_or_else(|| {
         Failure::BadInput(format!(

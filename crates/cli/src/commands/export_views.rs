@@ -3,7 +3,7 @@
 //! needs, the contract's rules) and their truths with and without mirrors, for any renderer
 //! to draw and `mirrorbox score` to judge.
 
-use super::{grid_side, unit_interval};
+use super::unit_interval;
 use crate::Failure;
 use mirrorbox_harness::exchange::{ExportSettings, export_views, read_view_list};
 use std::path::PathBuf;
@@ -17,8 +17,8 @@ pub struct Args {
     #[arg(short, long)]
     output: PathBuf,
     #[command(flatten)]
-    size: super::SizeArgs,
-    /// Sub-pixel grid side s: each truth pixel is the mean of s × s samples, 1..16.
+    size: super::TruthSizeArgs,
+    /// Sub-pixel grid side s: each truth pixel is the mean of s × s samples, 1..8.
     #[arg(long, default_value_t = 1)]
     ssaa: u32,
     /// α: every mirror's reflectance, in [0, 1] (a sweep's α); default: the scene's.
@@ -31,7 +31,7 @@ pub struct Args {
 }
 
 pub fn run(args: &Args) -> Result<(), Failure> {
-    grid_side(args.ssaa * args.ssaa)?;
+    super::ssaa(args.ssaa)?;
     unit_interval("--alpha", args.alpha)?;
     let views = match &args.views {
         Some(path) => read_view_list(path).map_err(Failure::from)?,

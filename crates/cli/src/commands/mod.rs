@@ -38,8 +38,35 @@ pub fn unit_interval(flag: &str, value: Option<f32>) -> Result<Option<f32>, Fail
         .map_err(setting)
 }
 
+/// `--ssaa s`: the raster's supersampling (the truth's s×s sub-pixel grid), checked before
+/// anything is done with it: `s * s` of a large s overflowed.
+pub fn ssaa(value: u32) -> Result<u32, Failure> {
+    let max = mirrorbox_raster::MAX_SSAA;
+    if !(1..=max).contains(&value) {
+        return Err(setting(mirrorbox_scene::limits::SettingError::new(
+            "--ssaa",
+            format!("in [1, {max}]"),
+            value,
+        )));
+    }
+    Ok(value)
+}
+
+/// `--width` / `--height` of the commands that compare an image with its truth (`sweep`,
+/// `advise`, `export-views`): SSIM's window sets the smallest side.
+#[derive(clap::Args, Clone, Copy, Debug, Default)]
+pub struct TruthSizeArgs {
+    /// Image width in pixels, 11..16384 (SSIM's window needs 11; default: the scene
+    /// camera's; the vertical field of view is kept).
+    #[arg(long)]
+    pub width: Option<u32>,
+    /// Image height in pixels, 11..16384 (default: the scene camera's).
+    #[arg(long)]
+    pub height: Option<u32>,
+}
+
 /// `--width` / `--height`: the image size, where it differs from the scene camera's (every
-/// command that renders or exports a view).
+/// command that renders or exports a view without comparing it).
 #[derive(clap::Args, Clone, Copy, Debug, Default)]
 pub struct SizeArgs {
     /// Image width in pixels, 1..16384 (default: the scene camera's; the vertical field of

@@ -34,8 +34,8 @@ pub struct Args {
     )]
     alpha: String,
     #[command(flatten)]
-    size: super::SizeArgs,
-    /// Supersampling s of the raster (the truth uses the same s×s sub-pixel grid).
+    size: super::TruthSizeArgs,
+    /// Supersampling s of the raster (the truth uses the same s×s sub-pixel grid), 1..8.
     #[arg(long, default_value_t = 1)]
     ssaa: u32,
     /// Timed frames per point, one per interleaved round (after --warmup untimed ones each,
