@@ -385,6 +385,11 @@ fn a_bad_view_list_is_refused_naming_the_field() {
             r#"{"views": [{"name": "a", "position": [0,1,2], "look_at": [0,0,0]}, {"name": "a", "position": [0,1,2], "look_at": [0,0,0]}]}"#,
             "views[1].name \"a\" appears twice",
         ),
+        // View a's floor truth is truth/a_floor.exr: view a_floor's truth overwrote it.
+        (
+            r#"{"views": [{"name": "a", "position": [0,1,2], "look_at": [0,0,0]}, {"name": "a_floor", "position": [0,1,3], "look_at": [0,0,0]}]}"#,
+            "views[1].name \"a_floor\": the floor truth of views[0] \"a\" has that name",
+        ),
         (
             r#"{"views": [{"name": "a", "position": [0,1,2], "look_at": [0,1,2]}]}"#,
             "view \"a\": position and look_at",
