@@ -271,13 +271,30 @@ fn view_image(dir: &Path, view: &crate::exchange::ExportedView) -> Result<PathBu
             format!("no image of view {:?} ({0}.exr or {0}.png)", view.name),
         ));
     }
-    // The image's errors name its file.
-    let img =
-        mirrorbox_image::read_image(&path).map_err(|e| HarnessError::Exchange(e.to_string()))?;
+    // The image's errors name its file. Its size is compared by its header, before decoding.
+    let image_error = |e: mirrorbox_image::ImageError| HarnessError::Exchange(e.to_string());
+    let size = mirrorbox_image::image_size(&path).map_err(image_error)?;
+    if let Some(problem) = size_problem(size, view) {
+        return Err(refused(&path, problem));
+    }
+    let img = mirrorbox_image::read_image(&path).map_err(image_error)?;
     match radiance_problem(&img, view) {
         Some(problem) => Err(refused(&path, problem)),
         None => Ok(path),
     }
+}
+
+/// Why an image of `(width, height)` is not one of `view`, if it is not.
+fn size_problem(
+    (width, height): (u32, u32),
+    view: &crate::exchange::ExportedView,
+) -> Option<String> {
+    ((width, height) != (view.width, view.height)).then(|| {
+        format!(
+            "is {width}×{height}; view {:?} is {}×{}",
+            view.name, view.width, view.height
+        )
+    })
 }
 
 /// What makes `img` no picture of `view`'s radiance, if anything: another size, or a pixel
@@ -286,11 +303,8 @@ fn radiance_problem(
     img: &mirrorbox_image::RgbImage,
     view: &crate::exchange::ExportedView,
 ) -> Option<String> {
-    if (img.width, img.height) != (view.width, view.height) {
-        return Some(format!(
-            "is {}×{}; view {:?} is {}×{}",
-            img.width, img.height, view.name, view.width, view.height
-        ));
+    if let Some(problem) = size_problem((img.width, img.height), view) {
+        return Some(problem);
     }
     let w = img.width as usize;
     img.pixels
@@ -319,6 +333,10 @@ fn check_truth(
 ) -> Result<(), HarnessError> {
     let path = export.join(file);
     let at = |e: &dyn std::fmt::Display| HarnessError::Exchange(format!("views[{i}].{field}: {e}"));
+    let size = mirrorbox_image::image_size(&path).map_err(|e| at(&e))?;
+    if let Some(problem) = size_problem(size, view) {
+        return Err(at(&format!("{}: {problem}", path.display())));
+    }
     let img = mirrorbox_image::read_image(&path).map_err(|e| at(&e))?;
     if let Some(problem) = radiance_problem(&img, view) {
         return Err(at(&format!("{}: {problem}", path.display())));

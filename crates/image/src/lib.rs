@@ -234,6 +234,10 @@ pub fn read_image(path: &Path) -> Result<RgbImage, ImageError> {
     if ext.as_deref() == Some("exr") {
         read_exr(path)
     } else {
+        // The header first: the size it claims is checked before the pixels are decoded (a
+        // PNG of a few hundred KB may declare 16384² pixels of gigabytes).
+        let (width, height) = png_size(path)?;
+        check_size(path, width, height)?;
         let mut reader = image::ImageReader::open(path).map_err(|e| io_error(path, e))?;
         let mut limits = image::Limits::default();
         limits.max_image_width = Some(MAX_IMAGE_SIDE);
@@ -251,6 +255,48 @@ pub fn read_image(path: &Path) -> Result<RgbImage, ImageError> {
             pixels,
         })
     }
+}
+
+/// The size an EXR or PNG declares in its header, read without decoding a pixel: a caller
+/// that knows the size it wants (a view's) compares it before [`read_image`] decodes.
+pub fn image_size(path: &Path) -> Result<(u32, u32), ImageError> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    mirrorbox_files::open_regular(path, MAX_IMAGE_FILE_BYTES, "image file")
+        .map_err(|e| io_error(path, e.message))?;
+    match ext.as_deref() {
+        Some("exr") => exr_size(path),
+        Some("png") => png_size(path),
+        _ => Err(ImageError::UnsupportedType {
+            path: path.to_path_buf(),
+        }),
+    }
+}
+
+fn png_size(path: &Path) -> Result<(u32, u32), ImageError> {
+    image::ImageReader::open(path)
+        .map_err(|e| io_error(path, e))?
+        .into_dimensions()
+        .map_err(|e| io_error(path, e))
+}
+
+/// The first layer's size (the one [`read_image`] reads); every layer's is checked against
+/// the limits.
+fn exr_size(path: &Path) -> Result<(u32, u32), ImageError> {
+    let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| io_error(path, e))?;
+    let mut first = None;
+    for header in &meta.headers {
+        let size = header.layer_size;
+        let (w, h) = (
+            u32::try_from(size.width()).unwrap_or(u32::MAX),
+            u32::try_from(size.height()).unwrap_or(u32::MAX),
+        );
+        check_size(path, w, h)?;
+        first.get_or_insert((w, h));
+    }
+    first.ok_or_else(|| io_error(path, "an EXR without a layer"))
 }
 
 /// Largest image file read (an 8192² float RGBA EXR, uncompressed, is 1.07 GB).
@@ -277,15 +323,7 @@ fn check_size(path: &Path, width: u32, height: u32) -> Result<(), ImageError> {
 fn read_exr(path: &Path) -> Result<RgbImage, ImageError> {
     use exr::prelude::*;
     // The header first: the size it claims is checked before any pixel is allocated.
-    let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| io_error(path, e))?;
-    for header in &meta.headers {
-        let size = header.layer_size;
-        check_size(
-            path,
-            u32::try_from(size.width()).unwrap_or(u32::MAX),
-            u32::try_from(size.height()).unwrap_or(u32::MAX),
-        )?;
-    }
+    exr_size(path)?;
     let image = read_first_rgba_layer_from_file(
         path,
         |size, _| RgbImage::new(size.width() as u32, size.height() as u32),
@@ -320,6 +358,49 @@ mod tests {
         );
         // Only the file itself is left in the folder: no temporary file.
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    /// A PNG of a few bytes declaring more pixels than are read (16384 × 4097 > 2²⁶) is
+    /// refused by its header, before its pixels are decoded: the decoder, reached first,
+    /// allocated the declared image (a 783 KB file took 805 MB) and here fails on the missing
+    /// data instead.
+    #[test]
+    fn a_png_is_refused_by_the_size_its_header_declares() {
+        fn chunk(kind: &[u8; 4], data: &[u8]) -> Vec<u8> {
+            let crc_of = |bytes: &[u8]| {
+                let mut crc = !0u32;
+                for &b in bytes {
+                    crc ^= u32::from(b);
+                    for _ in 0..8 {
+                        crc = (crc >> 1) ^ (0xEDB8_8320 & (crc & 1).wrapping_neg());
+                    }
+                }
+                !crc
+            };
+            let mut typed = kind.to_vec();
+            typed.extend_from_slice(data);
+            let mut out = (data.len() as u32).to_be_bytes().to_vec();
+            out.extend_from_slice(&typed);
+            out.extend_from_slice(&crc_of(&typed).to_be_bytes());
+            out
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("huge.png");
+        let (w, h) = (
+            MAX_IMAGE_SIDE,
+            (MAX_PIXELS / u64::from(MAX_IMAGE_SIDE)) as u32 + 1,
+        );
+        let mut ihdr = w.to_be_bytes().to_vec();
+        ihdr.extend_from_slice(&h.to_be_bytes());
+        ihdr.extend_from_slice(&[8, 2, 0, 0, 0]); // 8-bit RGB
+        let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+        png.extend(chunk(b"IHDR", &ihdr));
+        png.extend(chunk(b"IDAT", &[0x78, 0x9c, 0x03, 0x00])); // far too little data
+        png.extend(chunk(b"IEND", &[]));
+        std::fs::write(&path, png).unwrap();
+        assert_eq!(image_size(&path).unwrap(), (w, h));
+        let e = read_image(&path).unwrap_err().to_string();
+        assert!(e.contains(&format!("a {w}×{h} image")), "{e}");
     }
 
     #[test]
