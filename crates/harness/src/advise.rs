@@ -424,8 +424,7 @@ pub fn advise(
 /// A round's records (the floor left out), from `folder/results.jsonl`.
 fn measured_in(folder: &Path) -> Result<Vec<Record>, HarnessError> {
     let results = folder.join("results.jsonl");
-    Ok(read_records(&results)
-        .map_err(crate::io(&results))?
+    Ok(read_records(&results)?
         .into_iter()
         .filter(|r| r.kind != "floor")
         .collect())

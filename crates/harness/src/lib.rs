@@ -1082,7 +1082,7 @@ pub fn run_sweep(
     let done_before = if fresh {
         Vec::new()
     } else {
-        read_records(&results).map_err(io(&results))?
+        read_records(&results)?
     };
     // With `drop_refused`, a refused point is left out and said instead.
     let mut refused: Vec<&str> = Vec::new();
@@ -1119,7 +1119,7 @@ pub fn run_sweep(
         std::fs::remove_file(&results).map_err(io(&results))?;
     }
     // Read again under the lock: the points done now (a subset of what was planned).
-    let existing = read_records(&results).map_err(io(&results))?;
+    let existing = read_records(&results)?;
     salvage(&results, &existing)?;
     let todo = still_to_do(&existing);
     let reused = all.len() - todo.len();
@@ -1431,7 +1431,7 @@ pub fn run_sweep(
         summary.computed += 1;
         progress(Event::Finished { record: &record });
     }
-    let records = read_records(&results).map_err(io(&results))?;
+    let records = read_records(&results)?;
     // Report the points of this configuration only (results.jsonl may hold others).
     let keys: Vec<&String> = all.iter().map(|p| &p.key).collect();
     let records: Vec<Record> = records

@@ -52,10 +52,7 @@ fn read_shard(dir: &Path) -> Result<ShardFolder, HarnessError> {
         ));
     }
     let results = dir.join("results.jsonl");
-    let records = read_records(&results).map_err(|source| HarnessError::Io {
-        path: results,
-        source,
-    })?;
+    let records = read_records(&results)?;
     Ok(ShardFolder {
         dir: dir.to_path_buf(),
         info,

@@ -30,8 +30,7 @@ pub fn load_sweep(dir: &Path) -> Result<Sweep, ReadmeError> {
         ))
     })?;
     let results = dir.join("results.jsonl");
-    let records =
-        read_records(&results).map_err(|e| ReadmeError(format!("{}: {e}", results.display())))?;
+    let records = read_records(&results).map_err(|e| ReadmeError(e.to_string()))?;
     if records.is_empty() {
         return Err(ReadmeError(format!(
             "{}: no records to quote",

@@ -12,21 +12,37 @@ use mirrorbox_files::{FileError, write_atomically};
 use std::fmt::Write as _;
 use std::path::Path;
 
-/// Reads `results.jsonl`; a line that does not parse (an interrupted write) is skipped, and
-/// a key written more than once (two sweeps, an older tool) counts once: its last record, at
-/// the place of its first — whatever the file holds, a report shows each point once.
-pub fn read_records(path: &Path) -> std::io::Result<Vec<Record>> {
-    let text = match std::fs::read_to_string(path) {
-        Ok(t) => t,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
-        Err(e) => return Err(e),
-    };
+/// Largest `results.jsonl` read: a record is a few KB, so this is some hundred thousand
+/// points; the bound keeps a wrong file from being read whole.
+pub const MAX_RESULTS_BYTES: u64 = 1 << 30;
+
+/// Reads `results.jsonl` (absent: no records). It must be a regular file of at most
+/// [`MAX_RESULTS_BYTES`], every line a record; a line that does not parse is refused naming
+/// the file, its line and why — except a last line without its newline, which an interrupted
+/// append leaves (a sweep appends each record with its newline in one write, and rewrites
+/// such a file with its complete records before it appends again): that one is skipped. A key
+/// written more than once (two sweeps, an older tool) counts once: its last record, at the
+/// place of its first — whatever the file holds, a report shows each point once.
+pub fn read_records(path: &Path) -> Result<Vec<Record>, FileError> {
+    if std::fs::symlink_metadata(path).is_err_and(|e| e.kind() == std::io::ErrorKind::NotFound) {
+        return Ok(Vec::new());
+    }
+    let text = mirrorbox_files::read_bounded_text(path, MAX_RESULTS_BYTES, "a results file")?;
     let mut records: Vec<Record> = Vec::new();
     let mut index = std::collections::HashMap::new();
-    for mut record in text
-        .lines()
-        .filter_map(|l| serde_json::from_str::<Record>(l).ok())
-    {
+    let lines = text.lines().count();
+    for (n, line) in text.lines().enumerate() {
+        let mut record = match serde_json::from_str::<Record>(line) {
+            Ok(record) => record,
+            Err(_) if n + 1 == lines && !text.ends_with('\n') => continue,
+            Err(e) => {
+                return Err(FileError {
+                    path: path.to_path_buf(),
+                    message: format!("line {}: not a sweep record ({e})", n + 1),
+                    refused: true,
+                });
+            }
+        };
         record.migrate();
         match index.get(&record.key) {
             Some(&i) => records[i] = record,
@@ -844,6 +860,42 @@ pub(crate) mod tests {
                 .unwrap()
                 .is_empty()
         );
+    }
+
+    /// Only an interrupted last line is skipped: a broken line with its newline, or one
+    /// followed by others, is refused naming the file, the line and why (they were dropped
+    /// silently); a device or a FIFO is refused before a byte is read (`/dev/zero` grew
+    /// without bound, a FIFO blocked).
+    #[test]
+    fn a_broken_line_or_a_file_that_is_no_file_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("results.jsonl");
+        let good = serde_json::to_string(&record(0, 1.0, 3, 0.1)).unwrap();
+        for text in [
+            format!("{good}\n{{\"key\": \"trunc\n"),
+            format!("{good}\nnot json\n{good}\n"),
+        ] {
+            std::fs::write(&p, text).unwrap();
+            let e = read_records(&p).unwrap_err();
+            assert!(e.refused);
+            let e = e.to_string();
+            assert!(
+                e.contains("results.jsonl: line 2: not a sweep record"),
+                "{e}"
+            );
+        }
+        let fifo = dir.path().join("fifo.jsonl");
+        assert!(
+            std::process::Command::new("mkfifo")
+                .arg(&fifo)
+                .status()
+                .unwrap()
+                .success()
+        );
+        for special in [Path::new("/dev/zero"), &fifo] {
+            let e = read_records(special).unwrap_err();
+            assert!(e.refused && e.message.contains("regular file"), "{e}");
+        }
     }
 
     /// A record older than the maps (issue 52) keeps its experiment's columns as fields of
