@@ -2223,6 +2223,37 @@ fn shards_merge_into_the_unsharded_sweep() {
         assert!(r.stderr.contains(message), "{all:?}: {}", r.stderr);
         assert!(!d.join("refused").exists(), "nothing written on refusal");
     }
+    // A record naming a picture outside its shard's images/ (merge copied `../x.txt` to
+    // outside its output), or one that is not there (merge left half a folder): refused,
+    // exit 2, before anything is written.
+    let i = (0..3).find(|i| !shard_keys[*i].is_empty()).unwrap();
+    let results = d.join(format!("s{i}/results.jsonl"));
+    let good = std::fs::read_to_string(&results).unwrap();
+    std::fs::write(d.join("x.txt"), "outside").unwrap();
+    std::fs::create_dir(d.join("nested")).unwrap();
+    for (picture, message) in [
+        (
+            "../x.txt",
+            "in its images/ folder (a relative path without ..)",
+        ),
+        ("images/missing.png", "which is not a file there"),
+    ] {
+        let mut lines: Vec<String> = good.lines().map(String::from).collect();
+        let mut record: Value = serde_json::from_str(&lines[0]).unwrap();
+        record["raster_image"] = picture.into();
+        lines[0] = record.to_string();
+        std::fs::write(&results, lines.join("\n") + "\n").unwrap();
+        let out = p("nested/merged");
+        let r = mirrorbox(&["merge", &out, &s0, &s1, &s2], &[]);
+        assert_eq!(r.code, 2, "{picture}: {}", r.stderr);
+        assert!(r.stderr.contains(message), "{picture}: {}", r.stderr);
+        assert!(r.stderr.contains(picture), "{picture}: {}", r.stderr);
+        assert!(
+            !d.join("nested/merged").exists() && !d.join("nested/x.txt").exists(),
+            "{picture}: nothing written"
+        );
+    }
+    std::fs::write(&results, good).unwrap();
 }
 
 /// `--time` places the camera on the scene's `camera.path`: at a key's time, `render` and

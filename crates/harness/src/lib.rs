@@ -872,6 +872,45 @@ pub(crate) fn is_inner_path(path: &str) -> bool {
             .all(|c| matches!(c, Component::Normal(_) | Component::CurDir))
 }
 
+/// Every picture a record names, relative to its sweep folder.
+pub(crate) fn record_pictures(r: &Record) -> Vec<&str> {
+    let mut out = vec![
+        r.truth_image.as_str(),
+        r.raster_image.as_str(),
+        r.heatmap_image.as_str(),
+    ];
+    if let Some(s) = &r.stereo {
+        out.extend([s.anaglyph_image.as_str(), s.truth_anaglyph_image.as_str()]);
+    }
+    out.retain(|p| !p.is_empty());
+    out
+}
+
+/// Checks the pictures a record of the sweep folder `dir` names before they are copied
+/// (`merge`, `score --with`): each is a file inside `dir/images/` — a record is an input, and
+/// `../x.txt` joined to the output folder wrote outside it.
+pub(crate) fn check_record_pictures(dir: &Path, r: &Record) -> Result<(), String> {
+    for picture in record_pictures(r) {
+        let path = Path::new(picture);
+        if !is_inner_path(picture) || !path.starts_with("images") || path.iter().count() < 2 {
+            return Err(format!(
+                "{}: point {:?} names the picture {picture:?}; a sweep's pictures are in its \
+                 images/ folder (a relative path without ..)",
+                dir.join("results.jsonl").display(),
+                r.key
+            ));
+        }
+        if !dir.join(path).is_file() {
+            return Err(format!(
+                "{}: point {:?} names the picture {picture:?}, which is not a file there",
+                dir.display(),
+                r.key
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// The method every floor point renders the mirror-free scene with: one scene pass.
 pub const FLOOR_METHOD: &str = "naive";
 

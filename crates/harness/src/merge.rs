@@ -4,7 +4,9 @@
 //!
 //! Refused, naming the folder: a folder that is not a shard, shards of different sweeps
 //! (their lists of every point's key differ), two shards with one index or count, a point
-//! measured twice, a point no shard measured. Nothing is written before every check passed.
+//! measured twice, a point no shard measured, a record naming a picture that is not a file in
+//! its shard's `images/`. Nothing is written before every check passed, and a folder a merge
+//! made is removed again if writing it fails.
 
 use crate::HarnessError;
 use mirrorbox_files::{FolderLock, write_atomically};
@@ -58,20 +60,6 @@ fn read_shard(dir: &Path) -> Result<ShardFolder, HarnessError> {
         info,
         records,
     })
-}
-
-/// Every picture a record names, relative to its sweep folder.
-fn pictures(r: &Record) -> Vec<&str> {
-    let mut out = vec![
-        r.truth_image.as_str(),
-        r.raster_image.as_str(),
-        r.heatmap_image.as_str(),
-    ];
-    if let Some(s) = &r.stereo {
-        out.extend([s.anaglyph_image.as_str(), s.truth_anaglyph_image.as_str()]);
-    }
-    out.retain(|p| !p.is_empty());
-    out
 }
 
 /// What a merge did.
@@ -172,15 +160,44 @@ pub fn merge(
         )
         .into());
     }
-    // Write: the folder, its pictures, the records in the sweep's order, the description.
+    // Every picture a record names is a file in its shard's images/, before anything is
+    // written.
+    for s in &shards {
+        for r in &s.records {
+            crate::check_record_pictures(&s.dir, r).map_err(|e| {
+                refused(
+                    &s.dir,
+                    format!("a shard whose pictures are files in its images/ folder ({e})"),
+                )
+            })?;
+        }
+    }
+    // Write: the folder, its pictures, the records in the sweep's order, the description. A
+    // folder made here is removed again if writing fails: nothing half-written is left.
     crate::check_output_parent(out)?;
+    let made = !out.exists();
+    let written = write_merged(out, &shards, command, sections);
+    if written.is_err() && made {
+        let _ = std::fs::remove_dir_all(out);
+    }
+    written
+}
+
+/// The writing half of [`merge`], its inputs checked.
+fn write_merged(
+    out: &Path,
+    shards: &[ShardFolder],
+    command: &str,
+    sections: &[mirrorbox_report::Section],
+) -> Result<Merged, HarnessError> {
+    let first = &shards[0];
     std::fs::create_dir_all(out.join("images")).map_err(|source| HarnessError::OutputFolder {
         path: out.to_path_buf(),
         source,
     })?;
     let _lock = FolderLock::try_acquire(out)?;
     let mut by_key: HashMap<&str, Record> = HashMap::new();
-    for s in &shards {
+    for s in shards {
         let device = format!("{} on {}", s.info.adapter_description(), s.info.cpu);
         for r in &s.records {
             by_key.insert(
@@ -190,7 +207,7 @@ pub fn merge(
                     ..r.clone()
                 },
             );
-            for picture in pictures(r) {
+            for picture in crate::record_pictures(r) {
                 let (from, to) = (s.dir.join(picture), out.join(picture));
                 if !to.exists() {
                     mirrorbox_files::write_atomically_with(&to, |tmp| {
