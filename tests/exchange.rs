@@ -370,6 +370,70 @@ fn a_bad_export_is_refused_naming_its_file_before_anything_is_written() {
     );
 }
 
+/// `score --with SWEEP` copies the pictures SWEEP's records name into its report: a name
+/// outside SWEEP's images/ (it copied any file, `../../secret`) or one that is not there is
+/// refused, exit 2, naming the record, before anything is written.
+#[test]
+fn a_with_sweep_naming_pictures_outside_its_images_is_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let ex = tmp.path().join("export");
+    export(&ex);
+    let run = tmp.path().join("run");
+    our_run(&run);
+    let sweep = tmp.path().join("sweep");
+    sweep_naive(&sweep);
+    let results = sweep.join("results.jsonl");
+    let good = std::fs::read_to_string(&results).unwrap();
+    std::fs::write(tmp.path().join("secret"), "not a picture").unwrap();
+    let scored = tmp.path().join("scored");
+    // SWEEP's records with their truth picture named `picture` (as they are: None).
+    let with = |picture: Option<&str>| {
+        let lines: Vec<String> = good
+            .lines()
+            .map(|l| {
+                let mut r: Value = serde_json::from_str(l).unwrap();
+                if let Some(picture) = picture {
+                    r["truth_image"] = picture.into();
+                }
+                r.to_string()
+            })
+            .collect();
+        std::fs::write(&results, lines.join("\n") + "\n").unwrap();
+        let path = |p: &Path| p.to_str().unwrap().to_string();
+        mirrorbox(
+            &[
+                "score",
+                &path(&ex),
+                &path(&run),
+                "-o",
+                &path(&scored),
+                "--with",
+                &path(&sweep),
+            ],
+            &[],
+        )
+    };
+    for (picture, message) in [
+        (
+            "../secret",
+            "in its images/ folder (a relative path without ..)",
+        ),
+        ("/etc/passwd", "in its images/ folder"),
+        ("images/missing.png", "which is not a file there"),
+    ] {
+        let out = with(Some(picture));
+        assert_eq!(out.code, 2, "{picture}: {}", out.stderr);
+        assert!(out.stderr.contains(message), "{picture}: {}", out.stderr);
+        assert!(out.stderr.contains(picture), "{picture}: {}", out.stderr);
+        assert!(
+            !scored.exists() && !tmp.path().join("scored.partial").exists(),
+            "{picture}"
+        );
+    }
+    let out = with(None);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+}
+
 #[test]
 fn a_bad_view_list_is_refused_naming_the_field() {
     let tmp = tempfile::tempdir().unwrap();

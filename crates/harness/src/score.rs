@@ -383,6 +383,10 @@ pub fn score(
                 ),
             ));
         }
+        // Their pictures are copied into the report: each must be a file in the sweep's images/.
+        for r in &sweep.records {
+            crate::check_record_pictures(dir, r).map_err(HarnessError::Exchange)?;
+        }
         ours.extend(sweep.records.into_iter().map(|r| (dir.clone(), r)));
     }
     let found = variants(run)?;
