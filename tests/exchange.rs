@@ -238,7 +238,23 @@ fn a_bad_run_is_refused_naming_the_file_and_nothing_is_written() {
         refused("timing", needle);
     }
     std::fs::write(&timing_file, timing(r#""camera":[1]"#)).unwrap();
-    // A run without variants, and an export without views.json.
+    // A run that is not there, a run without variants, and an export without views.json.
+    let out = mirrorbox(
+        &[
+            "score",
+            ex.to_str().unwrap(),
+            tmp.path().join("no-run").to_str().unwrap(),
+            "-o",
+            scored.to_str().unwrap(),
+        ],
+        &[],
+    );
+    assert_eq!(out.code, 2, "{}", out.stderr);
+    assert!(
+        out.stderr.contains("no-run: is not a folder"),
+        "{}",
+        out.stderr
+    );
     let empty = tmp.path().join("empty");
     std::fs::create_dir(&empty).unwrap();
     let out = mirrorbox(

@@ -223,6 +223,10 @@ fn read_timing(path: &Path, views: &ViewsFile) -> Result<Timing, HarnessError> {
 
 /// Every `RUN/<client>/<variant>/` folder, sorted.
 fn variants(run: &Path) -> Result<Vec<(String, String, PathBuf)>, HarnessError> {
+    // A mistyped RUN is the user's input (exit 2), not a failure to read.
+    if !run.is_dir() {
+        return Err(refused(run, "is not a folder (RUN/<client>/<variant>/)"));
+    }
     let list = |dir: &Path| -> Result<Vec<(String, PathBuf)>, HarnessError> {
         let mut out = Vec::new();
         for e in std::fs::read_dir(dir).map_err(io(dir))? {
