@@ -401,6 +401,8 @@ fn a_with_sweep_naming_pictures_outside_its_images_is_refused() {
     let results = sweep.join("results.jsonl");
     let good = std::fs::read_to_string(&results).unwrap();
     std::fs::write(tmp.path().join("secret"), "not a picture").unwrap();
+    // A link inside images/ to a file outside it: `is_file` followed it.
+    std::os::unix::fs::symlink(tmp.path().join("secret"), sweep.join("images/link.png")).unwrap();
     let scored = tmp.path().join("scored");
     // SWEEP's records with their truth picture named `picture` (as they are: None).
     let with = |picture: Option<&str>| {
@@ -436,6 +438,7 @@ fn a_with_sweep_naming_pictures_outside_its_images_is_refused() {
         ),
         ("/etc/passwd", "in its images/ folder"),
         ("images/missing.png", "which is not a file there"),
+        ("images/link.png", "not a link"),
     ] {
         let out = with(Some(picture));
         assert_eq!(out.code, 2, "{picture}: {}", out.stderr);

@@ -900,9 +900,12 @@ pub(crate) fn check_record_pictures(dir: &Path, r: &Record) -> Result<(), String
                 r.key
             ));
         }
-        if !dir.join(path).is_file() {
+        // A regular file, not a link: a link in images/ could name any file to be copied.
+        let regular = std::fs::symlink_metadata(dir.join(path)).is_ok_and(|m| m.is_file());
+        if !regular {
             return Err(format!(
-                "{}: point {:?} names the picture {picture:?}, which is not a file there",
+                "{}: point {:?} names the picture {picture:?}, which is not a file there (a \
+                 regular file, not a link)",
                 dir.display(),
                 r.key
             ));
