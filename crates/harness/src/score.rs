@@ -153,9 +153,13 @@ fn check_views(views: &ViewsFile) -> Result<(), String> {
                 mirrorbox_image::MAX_PIXELS
             ));
         }
-        if v.ssaa == 0 {
+        let grid_sides = 1..=mirrorbox_raster::MAX_SSAA;
+        if !grid_sides.contains(&v.ssaa) {
             return Err(format!(
-                "views[{i}].ssaa 0: a sub-pixel grid side of 1 or more"
+                "views[{i}].ssaa {}: a sub-pixel grid side of {} to {} (export-views' --ssaa)",
+                v.ssaa,
+                grid_sides.start(),
+                grid_sides.end()
             ));
         }
         for (field, file) in [("truth", &v.truth), ("floor", &v.floor)] {
@@ -739,6 +743,11 @@ mod tests {
                 "views[1].name \"camera_floor\": the floor truth of views[0]",
             ),
             (with(&|v| v.views[0].width = 0), "views[0].width 0"),
+            (
+                with(&|v| v.views[0].ssaa = 0),
+                "views[0].ssaa 0: a sub-pixel grid side of 1 to",
+            ),
+            (with(&|v| v.views[0].ssaa = 9), "views[0].ssaa 9"),
             (
                 with(&|v| v.views[0].height = 70_000),
                 "views[0].height 70000",
