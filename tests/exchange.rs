@@ -7,6 +7,19 @@ use crate::common::{mirrorbox, repo};
 use serde_json::Value;
 use std::path::Path;
 
+/// `mirrorbox score EXPORT RUN -o OUT` with `more` arguments.
+fn run_score(export: &Path, run: &Path, out: &Path, more: &[&str]) -> crate::common::Output {
+    let mut args = vec![
+        "score",
+        export.to_str().unwrap(),
+        run.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ];
+    args.extend_from_slice(more);
+    mirrorbox(&args, &[])
+}
+
 const SIZE: [&str; 4] = ["--width", "64", "--height", "36"];
 
 fn export(dir: &Path) {
@@ -181,18 +194,7 @@ fn a_bad_run_is_refused_naming_the_file_and_nothing_is_written() {
     let run = tmp.path().join("run");
     let variant = our_run(&run);
     let scored = tmp.path().join("scored");
-    let score = || {
-        mirrorbox(
-            &[
-                "score",
-                ex.to_str().unwrap(),
-                run.to_str().unwrap(),
-                "-o",
-                scored.to_str().unwrap(),
-            ],
-            &[],
-        )
-    };
+    let score = || run_score(&ex, &run, &scored, &[]);
     let refused = |what: &str, needle: &str| {
         let out = score();
         assert_eq!(out.code, 2, "{what}: {}", out.stderr);
@@ -239,16 +241,7 @@ fn a_bad_run_is_refused_naming_the_file_and_nothing_is_written() {
     }
     std::fs::write(&timing_file, timing(r#""camera":[1]"#)).unwrap();
     // A run that is not there, a run without variants, and an export without views.json.
-    let out = mirrorbox(
-        &[
-            "score",
-            ex.to_str().unwrap(),
-            tmp.path().join("no-run").to_str().unwrap(),
-            "-o",
-            scored.to_str().unwrap(),
-        ],
-        &[],
-    );
+    let out = run_score(&ex, &tmp.path().join("no-run"), &scored, &[]);
     assert_eq!(out.code, 2, "{}", out.stderr);
     assert!(
         out.stderr.contains("no-run: is not a folder"),
@@ -257,32 +250,14 @@ fn a_bad_run_is_refused_naming_the_file_and_nothing_is_written() {
     );
     let empty = tmp.path().join("empty");
     std::fs::create_dir(&empty).unwrap();
-    let out = mirrorbox(
-        &[
-            "score",
-            ex.to_str().unwrap(),
-            empty.to_str().unwrap(),
-            "-o",
-            scored.to_str().unwrap(),
-        ],
-        &[],
-    );
+    let out = run_score(&ex, &empty, &scored, &[]);
     assert_eq!(out.code, 2, "{}", out.stderr);
     assert!(
         out.stderr.contains("holds no <client>/<variant>/ folder"),
         "{}",
         out.stderr
     );
-    let out = mirrorbox(
-        &[
-            "score",
-            run.to_str().unwrap(),
-            run.to_str().unwrap(),
-            "-o",
-            scored.to_str().unwrap(),
-        ],
-        &[],
-    );
+    let out = run_score(&run, &run, &scored, &[]);
     assert_eq!(out.code, 2, "{}", out.stderr);
     assert!(out.stderr.contains("views.json"), "{}", out.stderr);
     // Now it scores.
@@ -304,16 +279,7 @@ fn a_bad_export_is_refused_naming_its_file_before_anything_is_written() {
     our_run(&run);
     let scored = tmp.path().join("scored");
     let refused = |what: &str, needles: &[&str]| {
-        let out = mirrorbox(
-            &[
-                "score",
-                ex.to_str().unwrap(),
-                run.to_str().unwrap(),
-                "-o",
-                scored.to_str().unwrap(),
-            ],
-            &[],
-        );
+        let out = run_score(&ex, &run, &scored, &[]);
         assert_eq!(out.code, 2, "{what}: {}", out.stderr);
         for needle in needles {
             assert!(out.stderr.contains(needle), "{what}: {}", out.stderr);
@@ -417,19 +383,7 @@ fn a_with_sweep_naming_pictures_outside_its_images_is_refused() {
             })
             .collect();
         std::fs::write(&results, lines.join("\n") + "\n").unwrap();
-        let path = |p: &Path| p.to_str().unwrap().to_string();
-        mirrorbox(
-            &[
-                "score",
-                &path(&ex),
-                &path(&run),
-                "-o",
-                &path(&scored),
-                "--with",
-                &path(&sweep),
-            ],
-            &[],
-        )
+        run_score(&ex, &run, &scored, &["--with", sweep.to_str().unwrap()])
     };
     for (picture, message) in [
         (
