@@ -27,6 +27,38 @@ pub fn coarse_space() -> usize {
         .sum()
 }
 
+/// Largest advice.json read (a few KB as written).
+const MAX_ADVICE_BYTES: u64 = 16 << 20;
+
+/// A field's name and the test of its type.
+type FieldCheck = (&'static str, fn(&Value) -> bool);
+
+/// The fields the section quotes, of the types `advise` writes them with (the field that is
+/// not, if one is not): a broken file was quoted as "null×null" and "α = ?".
+fn check_advice(v: &Value) -> Result<(), &'static str> {
+    let checks: [FieldCheck; 10] = [
+        ("scene", Value::is_string),
+        ("device", Value::is_string),
+        ("budget_ms", Value::is_number),
+        ("alpha", Value::is_number),
+        ("width", Value::is_u64),
+        ("height", Value::is_u64),
+        ("renders", Value::is_u64),
+        ("rounds", Value::is_u64),
+        ("seconds", Value::is_number),
+        ("measured", Value::is_array),
+    ];
+    for (field, is) in checks {
+        if !is(&v[field]) {
+            return Err(field);
+        }
+    }
+    if !(v["pick"].is_object() || v["pick"].is_null()) {
+        return Err("pick");
+    }
+    Ok(())
+}
+
 /// Every advice under `reports/<folder>/`, by folder name.
 fn advices(reports: &Path, folder: &str) -> Result<Vec<(String, Value)>, ReadmeError> {
     let dir = reports.join(folder);
@@ -35,13 +67,20 @@ fn advices(reports: &Path, folder: &str) -> Result<Vec<(String, Value)>, ReadmeE
         std::fs::read_dir(&dir).map_err(|e| ReadmeError(format!("{}: {e}", dir.display())))?;
     for e in entries.flatten() {
         let path = e.path().join("advice.json");
-        if !path.is_file() {
+        // A folder without one is no advice; one that is there is read, or refused.
+        if std::fs::symlink_metadata(&path).is_err() {
             continue;
         }
-        let text = std::fs::read_to_string(&path)
-            .map_err(|e| ReadmeError(format!("{}: {e}", path.display())))?;
+        let text = mirrorbox_files::read_bounded_text(&path, MAX_ADVICE_BYTES, "an advice file")
+            .map_err(|e| ReadmeError(e.to_string()))?;
         let v: Value = serde_json::from_str(&text)
             .map_err(|e| ReadmeError(format!("{}: {e}", path.display())))?;
+        check_advice(&v).map_err(|field| {
+            ReadmeError(format!(
+                "{}: {field}: not what `mirrorbox advise` writes",
+                path.display()
+            ))
+        })?;
         out.push((e.file_name().to_string_lossy().into_owned(), v));
     }
     // Scene, then budget, then the repeat after its first run, then the folder's name (two
@@ -417,5 +456,24 @@ mod tests {
             "{region}"
         );
         assert!(region.contains("| yes: 1.000e-2 against"), "{region}");
+    }
+
+    /// An advice.json that `advise` could not have written is refused naming the file and
+    /// the field, and one that is no file is refused too (they were quoted as "null×null,
+    /// α = ?", or passed over).
+    #[test]
+    fn a_broken_advice_is_refused_naming_its_field() {
+        let reports = tempfile::tempdir().unwrap();
+        write_advice(reports.path(), "a/box_1ms", &advice(1.0, false));
+        assert!(advise_region_of(reports.path(), "a").is_ok());
+        let mut broken = advice(2.0, false);
+        broken["width"] = json!(null);
+        write_advice(reports.path(), "a/box_2ms", &broken);
+        let e = advise_region_of(reports.path(), "a").unwrap_err().0;
+        assert!(e.contains("box_2ms/advice.json: width:"), "{e}");
+        std::fs::remove_dir_all(reports.path().join("a/box_2ms")).unwrap();
+        std::fs::create_dir_all(reports.path().join("a/box_3ms/advice.json")).unwrap();
+        let e = advise_region_of(reports.path(), "a").unwrap_err().0;
+        assert!(e.contains("box_3ms/advice.json"), "{e}");
     }
 }
