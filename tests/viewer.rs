@@ -327,6 +327,59 @@ fn a_bad_script_line_is_refused_before_any_window_opens() {
     );
 }
 
+/// A screenshot's side file `X.json` (of `X.png`) or a `save-camera` target that is the scene
+/// is refused before anything runs; before, the scene was replaced by the screenshot's
+/// metadata. So is a script's output in a folder that does not exist (it failed, exit 1 and
+/// no line named, after the window ran).
+#[test]
+fn outputs_that_would_overwrite_the_scene_or_miss_their_folder_are_refused_first() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("s.json");
+    std::fs::copy(repo().join("scenes/mirror_box.json"), &scene).unwrap();
+    let original = std::fs::read(&scene).unwrap();
+    let p = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
+    let (scene_arg, script) = (p("s.json"), p("t.json"));
+    let flag = mirrorbox(
+        &[
+            "view",
+            &scene_arg,
+            "--frames",
+            "1",
+            "--screenshot",
+            &p("s.png"),
+        ],
+        &[],
+    );
+    assert_eq!(flag.code, 2, "{}", flag.stderr);
+    assert!(
+        flag.stderr.contains("--screenshot") && flag.stderr.contains("it is the scene"),
+        "{}",
+        flag.stderr
+    );
+    let dotted = format!("{}/./s.png", dir.path().display());
+    let lines = [
+        (format!("screenshot {dotted}"), "it is the scene"),
+        (format!("save-camera {scene_arg}"), "it is the scene"),
+        (format!("screenshot {}", p("t.png")), "it is the script"),
+        (format!("screenshot {}", p("nope/a.png")), "does not exist"),
+        (
+            format!("save-camera {}", p("nope/a.json")),
+            "does not exist",
+        ),
+    ];
+    for (line, expected) in lines {
+        std::fs::write(&script, format!("frames 1\n{line}\n")).unwrap();
+        let out = mirrorbox(&["view", &scene_arg, "--script", &script], &[]);
+        assert_eq!(out.code, 2, "{line}: {}", out.stderr);
+        assert!(
+            out.stderr.contains("t.json:2:") && out.stderr.contains(expected),
+            "{line}: {}",
+            out.stderr
+        );
+    }
+    assert_eq!(std::fs::read(&scene).unwrap(), original);
+}
+
 #[test]
 fn without_a_display_the_viewer_says_what_it_needs() {
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_mirrorbox"));

@@ -98,6 +98,18 @@ impl Capture {
     }
 }
 
+/// Every file a screenshot to `path` may write (see the module docs), for the checks made
+/// before the window opens ([`crate::script::check_writes`]).
+pub fn files(path: &Path) -> [PathBuf; 5] {
+    [
+        path.to_path_buf(),
+        with_ending(path, ".method.exr"),
+        with_ending(path, ".truth.exr"),
+        with_ending(path, ".error.png"),
+        path.with_extension("json"),
+    ]
+}
+
 /// `shot.png` → `shot.method.exr`: the path without its extension, then `ending`.
 fn with_ending(path: &Path, ending: &str) -> PathBuf {
     let stem = path.with_extension("");

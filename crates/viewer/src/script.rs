@@ -100,6 +100,80 @@ pub fn parse_script(text: &str, file: &str) -> Result<Vec<Step>, ScriptError> {
     Ok(steps)
 }
 
+/// The file `path` resolves to, for comparing names: its folder canonicalized (links and
+/// `..` resolved) where that folder exists, else the path made absolute.
+fn resolved(path: &Path) -> PathBuf {
+    if let Ok(p) = path.canonicalize() {
+        return p;
+    }
+    let parent = path
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    match (parent.canonicalize(), path.file_name()) {
+        (Ok(dir), Some(name)) => dir.join(name),
+        _ => std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf()),
+    }
+}
+
+/// Checks the files `action` would write (a screenshot and its companions, a scene copy),
+/// before the window opens: their folder exists, none is a folder, and none is one of
+/// `inputs` (`(what, path)`: the scene file, the script). Without it a screenshot `s.png`
+/// replaced a scene `s.json` with its metadata, and a missing folder failed only after the
+/// window ran.
+pub fn check_writes(action: &Action, inputs: &[(&str, &Path)]) -> Result<(), String> {
+    let files = match action {
+        Action::Screenshot(png) => crate::screenshot::files(png).to_vec(),
+        Action::SaveCamera(json) => vec![json.clone()],
+        _ => return Ok(()),
+    };
+    let parent = files[0]
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    if !parent.is_dir() {
+        return Err(format!(
+            "{}: folder {} does not exist",
+            files[0].display(),
+            parent.display()
+        ));
+    }
+    for file in &files {
+        if file.is_dir() {
+            return Err(format!(
+                "{}: would write this file, but it is a folder",
+                file.display()
+            ));
+        }
+        for (what, input) in inputs {
+            if resolved(file) == resolved(input) {
+                return Err(format!(
+                    "{} would be written, but it is {what} ({}); choose another name",
+                    file.display(),
+                    input.display()
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// [`check_writes`] for every step of a script read from `file`, naming the line.
+pub fn check_script_writes(
+    steps: &[Step],
+    file: &str,
+    inputs: &[(&str, &Path)],
+) -> Result<(), ScriptError> {
+    for step in steps {
+        check_writes(&step.action, inputs).map_err(|message| ScriptError {
+            file: file.into(),
+            line: step.line,
+            message,
+        })?;
+    }
+    Ok(())
+}
+
 fn parse_action(line: &str) -> Result<Action, String> {
     let mut words = line.split_whitespace();
     let verb = words.next().unwrap_or("");

@@ -142,11 +142,17 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             args.out.display()
         )));
     }
+    let mut inputs = vec![("the scene", args.scene.as_path())];
+    if let Some(path) = &args.script {
+        inputs.push(("the script", path.as_path()));
+    }
     let (steps, script_name) = match (&args.script, args.frames) {
-        (Some(path), _) => (
-            Some(script::read_script(path).map_err(|e| bad(e.to_string()))?),
-            path.display().to_string(),
-        ),
+        (Some(path), _) => {
+            let steps = script::read_script(path).map_err(|e| bad(e.to_string()))?;
+            let name = path.display().to_string();
+            script::check_script_writes(&steps, &name, &inputs).map_err(|e| bad(e.to_string()))?;
+            (Some(steps), name)
+        }
         (None, Some(frames)) => {
             if !(1..=script::MAX_FRAMES).contains(&frames) {
                 return Err(bad(format!(
@@ -160,10 +166,10 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             }];
             if let Some(png) = &args.screenshot {
                 let png = output_path("--screenshot", png, "png")?;
-                steps.push(Step {
-                    line: 0,
-                    action: Action::Screenshot(png),
-                });
+                let action = Action::Screenshot(png.clone());
+                script::check_writes(&action, &inputs)
+                    .map_err(|e| bad(format!("--screenshot {}: {e}", png.display())))?;
+                steps.push(Step { line: 0, action });
             }
             (Some(steps), "--frames".to_string())
         }
