@@ -1791,6 +1791,33 @@ fn render_unrolled_reports_paths_and_clipping() {
 }
 
 /// Issue #13: small values print in scientific notation, never as `0.000000`.
+/// A NaN, infinite or negative pixel is refused, naming the file and the pixel (as `score`
+/// does); before, `compare` printed `RMSE NaN` with a `max |d|` of 0, exit 0.
+#[test]
+fn compare_refuses_an_image_that_is_not_radiance() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = dir.path().join("good.exr");
+    let image = mirrorbox_image::RgbImage::from_fn(16, 12, |_, _| [0.5; 3]);
+    mirrorbox_image::write_exr(&good, &image, &[]).unwrap();
+    for (name, bad) in [("nan", f32::NAN), ("inf", f32::INFINITY), ("neg", -1.0)] {
+        let path = dir.path().join(format!("{name}.exr"));
+        let mut image = image.clone();
+        image.pixels[17] = [0.5, bad, 0.5];
+        mirrorbox_image::write_exr(&path, &image, &[]).unwrap();
+        let (g, b) = (good.to_str().unwrap(), path.to_str().unwrap());
+        for args in [vec!["compare", g, b], vec!["compare", b, g, "--json"]] {
+            let out = mirrorbox(&args, &[]);
+            assert_eq!(out.code, 2, "{name}: {}{}", out.stdout, out.stderr);
+            assert!(
+                out.stderr.contains(&format!("{name}.exr: pixel (1, 1)"))
+                    && out.stderr.contains("finite and ≥ 0"),
+                "{name}: {}",
+                out.stderr
+            );
+        }
+    }
+}
+
 #[test]
 fn compare_prints_small_values_in_scientific_notation() {
     let dir = tempfile::tempdir().unwrap();

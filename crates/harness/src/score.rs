@@ -306,26 +306,12 @@ fn size_problem(
 }
 
 /// What makes `img` no picture of `view`'s radiance, if anything: another size, or a pixel
-/// that is NaN, infinite or negative (its metrics would be NaN, its records `null`).
+/// that is NaN, infinite or negative ([`mirrorbox_image::RgbImage::radiance_problem`]).
 fn radiance_problem(
     img: &mirrorbox_image::RgbImage,
     view: &crate::exchange::ExportedView,
 ) -> Option<String> {
-    if let Some(problem) = size_problem((img.width, img.height), view) {
-        return Some(problem);
-    }
-    let w = img.width as usize;
-    img.pixels
-        .iter()
-        .enumerate()
-        .find(|(_, p)| p.iter().any(|c| !c.is_finite() || *c < 0.0))
-        .map(|(i, p)| {
-            format!(
-                "pixel ({}, {}) is {p:?}: radiance is finite and ≥ 0",
-                i % w,
-                i / w
-            )
-        })
+    size_problem((img.width, img.height), view).or_else(|| img.radiance_problem())
 }
 
 /// Checks the export's truth `views[i].<field>` (`file`, relative to `export`) as a client's

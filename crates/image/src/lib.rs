@@ -47,6 +47,24 @@ impl RgbImage {
         self.pixels[(y * self.width + x) as usize]
     }
 
+    /// Why this is no picture of radiance, if it is not: the first pixel (row-major) that is
+    /// NaN, infinite or negative. Metrics of such an image are NaN (records `null`), and a NaN
+    /// hides in `max |d|`, so `compare` and `score` refuse it with this message.
+    pub fn radiance_problem(&self) -> Option<String> {
+        let w = self.width.max(1) as usize;
+        self.pixels
+            .iter()
+            .enumerate()
+            .find(|(_, p)| p.iter().any(|c| !c.is_finite() || *c < 0.0))
+            .map(|(i, p)| {
+                format!(
+                    "pixel ({}, {}) is {p:?}: radiance is finite and ≥ 0",
+                    i % w,
+                    i / w
+                )
+            })
+    }
+
     /// 8-bit sRGB bytes (RGB, row-major) after the contract's tone mapping.
     pub fn to_srgb8(&self, exposure: f32) -> Vec<u8> {
         self.pixels

@@ -82,7 +82,14 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         ])
         .map_err(|e| Failure::BadInput(e.to_string()))?;
     }
-    let read = |p: &PathBuf| read_image(p).map_err(|e| Failure::BadInput(e.to_string()));
+    // A NaN, infinite or negative pixel makes the metrics NaN (and hides in `max |d|`).
+    let read = |p: &PathBuf| {
+        let image = read_image(p).map_err(|e| Failure::BadInput(e.to_string()))?;
+        match image.radiance_problem() {
+            Some(problem) => Err(Failure::BadInput(format!("{}: {problem}", p.display()))),
+            None => Ok(image),
+        }
+    };
     let (r, t) = (read(&args.reference)?, read(&args.test)?);
     let m = compare(&r, &t, args.exposure).map_err(|e| {
         Failure::BadInput(format!(
