@@ -2350,6 +2350,51 @@ fn time_on_a_camera_path_renders_the_keyed_view() {
     );
 }
 
+/// A sequence whose later frame is refused (its time out of range, its output a folder)
+/// writes nothing: every frame is checked before the first runs. Before, frame 0 stayed on
+/// disk beside the exit 2.
+#[test]
+fn a_sequence_with_a_refused_frame_writes_no_frame() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
+    let size = ["--width", "16", "--height", "12"];
+    let late = ["--time", "999999999.5", "--sequence", "3", "--fps", "1"];
+    let (exr, png) = (d("t.exr"), d("r.png"));
+    let trace = ["trace", "scenes/mirror_box.json", "-o", &exr, "--spp", "1"];
+    let render = [
+        "render",
+        "scenes/mirror_box.json",
+        "-o",
+        &png,
+        "--method",
+        "unrolled",
+    ];
+    for command in [&trace[..], &render[..]] {
+        let mut args = command.to_vec();
+        args.extend(size);
+        args.extend(late);
+        let out = mirrorbox(&args, &[]);
+        assert_eq!(out.code, 2, "{}", out.stderr);
+        assert!(
+            out.stderr.contains("frame 0001: --time must be"),
+            "{}",
+            out.stderr
+        );
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+    }
+    std::fs::create_dir(d("t_0001.exr")).unwrap();
+    std::fs::create_dir(d("r_0002.exr")).unwrap();
+    for command in [&trace[..], &render[..]] {
+        let mut args = command.to_vec();
+        args.extend(size);
+        args.extend(["--sequence", "3"]);
+        let out = mirrorbox(&args, &[]);
+        assert_eq!(out.code, 2, "{}", out.stderr);
+        assert!(out.stderr.contains("a folder"), "{}", out.stderr);
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
+    }
+}
+
 /// `sweep --path` (issue 22): every method and the truth along the camera path, each frame
 /// against its own truth; `feedback` carries its state (one more reflection per frame);
 /// the report, plot and filmstrip are written; bad counts and flags that do not apply to a

@@ -154,32 +154,49 @@ impl TimeArgs {
             )));
         }
         let start = self.time.unwrap_or(0.0);
-        Ok(Some(
-            (0..n)
-                .map(|k| (start + f64::from(k) / self.fps, format!("{k:04}")))
-                .collect(),
-        ))
+        let frames: Vec<(f64, String)> = (0..n)
+            .map(|k| (start + f64::from(k) / self.fps, format!("{k:04}")))
+            .collect();
+        for (time, suffix) in &frames {
+            check_time(*time).map_err(|e| match e {
+                Failure::BadInput(m) => Failure::BadInput(format!("frame {suffix}: {m}")),
+                other => other,
+            })?;
+        }
+        Ok(Some(frames))
     }
 
     /// Runs `run_frame` once, or with `--sequence` once per frame: `with_frame(args, time,
     /// suffix)` gives that frame's arguments (its `--time`, its output `OUT_suffix`). Each
-    /// frame is written whole before the next starts.
+    /// frame is written whole before the next starts; `check_frame` (the frame's time and
+    /// outputs) passes for every frame before the first runs, so a refused frame leaves no
+    /// earlier frames on disk.
     pub fn run<A>(
         &self,
         args: &A,
         with_frame: impl Fn(&A, TimeArgs, &str) -> A,
+        check_frame: impl Fn(&A) -> Result<(), Failure>,
         run_frame: impl Fn(&A) -> Result<(), Failure>,
     ) -> Result<(), Failure> {
         let Some(frames) = self.sequence()? else {
             return run_frame(args);
         };
-        for (time, suffix) in frames {
-            let frame = TimeArgs {
-                time: Some(time),
-                sequence: None,
-                ..*self
-            };
-            run_frame(&with_frame(args, frame, &suffix))?;
+        let frames: Vec<A> = frames
+            .into_iter()
+            .map(|(time, suffix)| {
+                let frame = TimeArgs {
+                    time: Some(time),
+                    sequence: None,
+                    ..*self
+                };
+                with_frame(args, frame, &suffix)
+            })
+            .collect();
+        for frame in &frames {
+            check_frame(frame)?;
+        }
+        for frame in &frames {
+            run_frame(frame)?;
         }
         Ok(())
     }
@@ -189,11 +206,7 @@ impl TimeArgs {
         let Some(time) = self.time else {
             return Ok(scene);
         };
-        if !time.is_finite() || time.abs() > 1e9 {
-            return Err(Failure::BadInput(format!(
-                "--time must be a finite number of seconds within ±1e9, got {time}"
-            )));
-        }
+        check_time(time)?;
         scene
             .at_time(time)
             .map_err(|e| Failure::BadInput(format!("{}: camera.path: {e}", scene.source.display())))
@@ -203,6 +216,32 @@ impl TimeArgs {
     pub fn attribute(&self) -> Option<(&'static str, String)> {
         self.time.map(|t| ("mirrorbox.time", t.to_string()))
     }
+}
+
+/// Checks a sequence frame's `--time` against the scene (its camera path may give no view
+/// then), before any frame runs; `loaded` holds the scene, read once for all frames.
+pub fn check_frame_time(
+    time: TimeArgs,
+    path: &Path,
+    loaded: &std::cell::OnceCell<Scene>,
+) -> Result<(), Failure> {
+    if loaded.get().is_none() {
+        let _ = loaded.set(load(path)?);
+    }
+    match loaded.get() {
+        Some(scene) => time.apply(scene.clone()).map(drop),
+        None => Ok(()),
+    }
+}
+
+/// A `--time` (or a sequence frame's) out of range is exit 2.
+fn check_time(time: f64) -> Result<(), Failure> {
+    if !time.is_finite() || time.abs() > 1e9 {
+        return Err(Failure::BadInput(format!(
+            "--time must be a finite number of seconds within ±1e9, got {time}"
+        )));
+    }
+    Ok(())
 }
 
 /// A setting out of its range is the user's input (exit 2).

@@ -61,12 +61,17 @@ fn bad(message: String) -> Failure {
 /// method (`feedback`) continues each frame from the one before, as in an engine.
 pub fn run(args: &Args) -> Result<(), Failure> {
     let carry = RefCell::new(Carry::default());
+    let scene = std::cell::OnceCell::new();
     args.time.run(
         args,
         |args, time, suffix| Args {
             time,
             output: mirrorbox_files::with_stem_suffix(&args.output, suffix),
             ..args.clone()
+        },
+        |frame| {
+            check_frame_outputs(frame)?;
+            super::check_frame_time(frame.time, &frame.scene, &scene)
         },
         |args| run_frame(args, &mut carry.borrow_mut()),
     )
@@ -79,29 +84,38 @@ struct Carry {
     history: Option<FrameHistory>,
 }
 
-fn run_frame(args: &Args, carry: &mut Carry) -> Result<(), Failure> {
-    let entry = mirrorbox_raster::registry::find(&args.method)
-        .ok_or_else(|| bad(format!("unknown method {:?}", args.method)))?;
-    let method = args.options.0.configure(entry)?;
-    unit_interval("--alpha", args.alpha)?;
+/// Checks a frame's outputs (`-o`, its EXR and a stereo pair's pictures): their folders
+/// exist, none is a folder, no two are one file. Returns `-o`.
+fn check_frame_outputs(args: &Args) -> Result<PathBuf, Failure> {
     let png = output_path("-o", &args.output, "png")?;
     let exr = png.with_extension("exr");
-    let mut scene = args.time.apply(load(&args.scene)?)?;
-    let rig = args.stereo.rig(&scene)?;
-    let eyes: Vec<Option<Eye>> = match rig {
-        None => vec![None],
-        Some(_) => Eye::BOTH.map(Some).to_vec(),
+    let eyes: Vec<Option<Eye>> = if args.stereo.asked() {
+        Eye::BOTH.map(Some).to_vec()
+    } else {
+        vec![None]
     };
     let mut outputs = Vec::new();
     for eye in &eyes {
         outputs.push(("-o", eye_path(&png, *eye)));
         outputs.push(("-o (its EXR)", eye_path(&exr, *eye)));
     }
-    if rig.is_some() {
+    if args.stereo.asked() {
         outputs.push(("-o (side by side)", with_stem_suffix(&png, "sbs")));
         outputs.push(("-o (anaglyph)", with_stem_suffix(&png, "anaglyph")));
     }
     check_outputs(&outputs)?;
+    Ok(png)
+}
+
+fn run_frame(args: &Args, carry: &mut Carry) -> Result<(), Failure> {
+    let entry = mirrorbox_raster::registry::find(&args.method)
+        .ok_or_else(|| bad(format!("unknown method {:?}", args.method)))?;
+    let method = args.options.0.configure(entry)?;
+    unit_interval("--alpha", args.alpha)?;
+    let png = check_frame_outputs(args)?;
+    let exr = png.with_extension("exr");
+    let mut scene = args.time.apply(load(&args.scene)?)?;
+    let rig = args.stereo.rig(&scene)?;
     args.size.apply(&mut scene)?;
     if let Some(a) = args.alpha {
         scene

@@ -21,6 +21,12 @@ pub struct StereoArgs {
 }
 
 impl StereoArgs {
+    /// Whether a stereo pair is asked for (`--stereo` or `--ipd`): the outputs are each
+    /// eye's and the pair's pictures.
+    pub fn asked(&self) -> bool {
+        self.stereo || self.ipd.is_some()
+    }
+
     /// The rig to render, if any; exit 2 for `--stereo` on a mono camera or a bad `--ipd`.
     pub fn rig(&self, scene: &Scene) -> Result<Option<Stereo>, Failure> {
         if let Some(ipd) = self.ipd
@@ -30,7 +36,7 @@ impl StereoArgs {
                 "--ipd must be in [0, 1] scene units, got {ipd}"
             )));
         }
-        match (self.stereo || self.ipd.is_some(), scene.stereo, self.ipd) {
+        match (self.asked(), scene.stereo, self.ipd) {
             (false, _, _) => Ok(None),
             (true, Some(rig), None) => Ok(Some(rig)),
             (true, _, Some(ipd)) => Ok(Some(scene.stereo_rig(ipd))),

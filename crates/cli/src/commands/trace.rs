@@ -240,6 +240,7 @@ fn write_failed(e: impl ToString) -> Failure {
 /// One frame, or with `--sequence` one frame per time step (each written whole before the
 /// next starts; frame k into OUT_k).
 pub fn run(args: &Args) -> Result<(), Failure> {
+    let scene = std::cell::OnceCell::new();
     args.time.run(
         args,
         |args, time, suffix| Args {
@@ -247,25 +248,30 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             output: mirrorbox_files::with_stem_suffix(&args.output, suffix),
             ..args.clone()
         },
+        |frame| {
+            check_args(frame)?;
+            check_frame_outputs(frame)?;
+            super::check_frame_time(frame.time, &frame.scene, &scene)
+        },
         run_frame,
     )
 }
 
-fn run_frame(args: &Args) -> Result<(), Failure> {
-    use super::stereo::{eye_path, views};
+/// Checks a frame's outputs (`-o`, `--bounces`, their PNGs and a stereo pair's pictures):
+/// their folders exist, none is a folder, no two are one file. Returns `-o` and `--bounces`.
+fn check_frame_outputs(args: &Args) -> Result<(PathBuf, Option<PathBuf>), Failure> {
+    use super::stereo::eye_path;
     use mirrorbox_files::with_stem_suffix;
-    let (grid, whitted) = check_args(args)?;
     let exr_path = output_path("-o", &args.output, "exr")?;
     let bounces_path = args
         .bounces
         .as_deref()
         .map(|p| output_path("--bounces", p, "exr"))
         .transpose()?;
-    let mut scene = args.time.apply(load(&args.scene)?)?;
-    let rig = args.stereo.rig(&scene)?;
-    let eyes: Vec<Option<mirrorbox_scene::stereo::Eye>> = match rig {
-        None => vec![None],
-        Some(_) => mirrorbox_scene::stereo::Eye::BOTH.map(Some).to_vec(),
+    let eyes: Vec<Option<mirrorbox_scene::stereo::Eye>> = if args.stereo.asked() {
+        mirrorbox_scene::stereo::Eye::BOTH.map(Some).to_vec()
+    } else {
+        vec![None]
     };
     let mut outputs = Vec::new();
     for &eye in &eyes {
@@ -278,7 +284,7 @@ fn run_frame(args: &Args) -> Result<(), Failure> {
             outputs.push(("--bounces (its PNG)", b.with_extension("png")));
         }
     }
-    if rig.is_some() {
+    if args.stereo.asked() {
         outputs.push((
             "-o (side by side)",
             with_stem_suffix(&exr_path, "sbs").with_extension("png"),
@@ -289,6 +295,16 @@ fn run_frame(args: &Args) -> Result<(), Failure> {
         ));
     }
     check_outputs(&outputs)?;
+    Ok((exr_path, bounces_path))
+}
+
+fn run_frame(args: &Args) -> Result<(), Failure> {
+    use super::stereo::{eye_path, views};
+    use mirrorbox_files::with_stem_suffix;
+    let (grid, whitted) = check_args(args)?;
+    let (exr_path, bounces_path) = check_frame_outputs(args)?;
+    let mut scene = args.time.apply(load(&args.scene)?)?;
+    let rig = args.stereo.rig(&scene)?;
     args.size.apply(&mut scene)?;
     if let Some(r) = args.reflectance {
         scene
