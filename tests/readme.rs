@@ -321,3 +321,27 @@ fn every_image_of_the_book_resolves_inside_its_source() {
             .any(|l| l.starts_with("figures/"))
     );
 }
+
+/// A bad later file (an unterminated region) leaves the earlier files as they were: every
+/// file is filled before any is written. Before, the earlier file was already rewritten.
+#[test]
+fn a_bad_file_leaves_every_file_unwritten() {
+    let cli = read(&repo().join("docs/book/src/cli.md"));
+    let usage = cli
+        .find("Usage: mirrorbox render")
+        .expect("render's usage line");
+    let mut stale = cli.clone();
+    stale.insert_str(usage, "      --no-such-flag  typed by hand\n");
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = (dir.path().join("a.md"), dir.path().join("b.md"));
+    std::fs::write(&a, &stale).unwrap();
+    std::fs::write(&b, "# B\n\n<!-- generated: cli -->\nnever ended\n").unwrap();
+    let out = mirrorbox(&["readme", a.to_str().unwrap(), b.to_str().unwrap()], &[]);
+    assert_eq!(out.code, 2, "{}{}", out.stdout, out.stderr);
+    assert!(
+        out.stderr.contains("b.md") && out.stderr.contains("no file was written"),
+        "{}",
+        out.stderr
+    );
+    assert_eq!(std::fs::read_to_string(&a).unwrap(), stale);
+}

@@ -62,14 +62,26 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     // Every file is tried; bad input (a malformed region, a missing report) decides exit 2
     // over a stale region's exit 1.
     let (mut messages, mut bad_input) = (Vec::new(), false);
+    let mut fills = Vec::new();
     for file in &files {
         match one(file, args, &extra, &sources) {
-            Ok(()) => {}
+            Ok(fill) => fills.extend(fill),
             Err(Failure::BadInput(m)) => {
                 bad_input = true;
                 messages.push(m);
             }
             Err(Failure::Other(m)) => messages.push(m),
+        }
+    }
+    // Written only once every file is filled: a bad later file leaves the earlier ones as
+    // they were (no half-done run).
+    if bad_input && !fills.is_empty() {
+        messages.push("no file was written".into());
+    } else {
+        for fill in &fills {
+            if let Err(m) = fill.write(&args.reports) {
+                messages.push(m);
+            }
         }
     }
     if args.files.is_empty() {
@@ -216,13 +228,14 @@ pub fn cli_reference() -> String {
     format!("{}\n", out.trim_end())
 }
 
-/// Fills (or checks) one file; a malformed region or a missing report is bad input (exit 2).
+/// Checks one file, or computes its filled text (written by the caller once every file is
+/// filled); a malformed region or a missing report is bad input (exit 2).
 fn one(
     file: &Path,
     args: &Args,
     extra: &[Region],
     sources: &[RegionSource],
-) -> Result<(), Failure> {
+) -> Result<Option<Fill>, Failure> {
     let bad = |e: &dyn std::fmt::Display| Failure::BadInput(format!("{}: {e}", file.display()));
     let text = mirrorbox_files::read_bounded_text(file, MAX_README_BYTES, "a Markdown file")
         .map_err(|e| bad(&e))?;
@@ -235,7 +248,7 @@ fn one(
                 file.display(),
                 args.reports.display()
             );
-            return Ok(());
+            return Ok(None);
         }
         let lines: Vec<String> = stale
             .iter()
@@ -251,21 +264,38 @@ fn one(
         )));
     }
     let filled = fill_with(&text, &args.reports, extra, sources).map_err(|e| bad(&e))?;
-    if filled != text {
-        mirrorbox_files::write_atomically(file, filled.as_bytes())
-            .map_err(|e| Failure::Other(e.to_string()))?;
+    Ok(Some(Fill {
+        file: file.to_path_buf(),
+        changed: filled != text,
+        text: filled,
+    }))
+}
+
+/// A file's new text, computed before any file is written.
+struct Fill {
+    file: PathBuf,
+    text: String,
+    changed: bool,
+}
+
+impl Fill {
+    fn write(&self, reports: &Path) -> Result<(), String> {
+        if self.changed {
+            mirrorbox_files::write_atomically(&self.file, self.text.as_bytes())
+                .map_err(|e| e.to_string())?;
+        }
+        println!(
+            "{}: {} from {}",
+            self.file.display(),
+            if self.changed {
+                "generated regions filled"
+            } else {
+                "generated regions already up to date"
+            },
+            reports.display(),
+        );
+        Ok(())
     }
-    println!(
-        "{}: {} from {}",
-        file.display(),
-        if filled != text {
-            "generated regions filled"
-        } else {
-            "generated regions already up to date"
-        },
-        args.reports.display(),
-    );
-    Ok(())
 }
 
 /// A README is text of a few hundred KB at most; the bound keeps a mistaken path from being
