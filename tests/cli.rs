@@ -1557,6 +1557,44 @@ fn sweep_refuses_bad_arguments() {
     assert!(!out.exists(), "nothing is written on bad input");
 }
 
+/// `--out` naming a file, and `--truth-cache` naming a file or a folder whose parent does not
+/// exist, are refused naming the flag before any work (exit 2); before, a file was read as a
+/// folder (exit 1, "Not a directory") and a missing parent was created.
+#[test]
+fn sweep_refuses_output_folders_that_are_files_or_lack_a_parent() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
+    std::fs::write(p("afile"), "x").unwrap();
+    let cases = [
+        (p("afile"), None, "--out names a file"),
+        (p("s"), Some(p("nodir/c")), "--truth-cache: folder"),
+        (p("s"), Some(p("afile")), "--truth-cache names a file"),
+    ];
+    for (out, cache, message) in cases {
+        let mut args = vec![
+            "sweep",
+            "scenes/mirror_box.json",
+            "--out",
+            &out,
+            "--methods",
+            "naive",
+            "--alpha",
+            "0.7",
+            "--width",
+            "32",
+            "--height",
+            "18",
+        ];
+        if let Some(cache) = &cache {
+            args.extend(["--truth-cache", cache]);
+        }
+        let r = mirrorbox(&args, &[]);
+        assert_eq!(r.code, 2, "{args:?}: {}", r.stderr);
+        assert!(r.stderr.contains(message), "{args:?}: {}", r.stderr);
+    }
+    assert!(!dir.path().join("s").exists() && !dir.path().join("nodir").exists());
+}
+
 #[test]
 fn sweep_measures_the_exact_methods_by_depth() {
     let dir = tempfile::tempdir().unwrap();

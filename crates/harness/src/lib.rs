@@ -861,6 +861,32 @@ pub(crate) fn check_output_parent(out: &Path) -> Result<(), HarnessError> {
     })
 }
 
+/// Checks a folder the sweep writes into (`flag`: `--out`, `--truth-cache`), before any
+/// work: its parent exists (a mistyped folder is refused, not created with its parents) and
+/// it is not a file. Before, a file was read as a folder (exit 1, "Not a directory").
+pub(crate) fn check_output_folder(flag: &str, dir: &Path) -> Result<(), HarnessError> {
+    let refuse = |why: String| HarnessError::OutputFolder {
+        path: dir.to_path_buf(),
+        source: std::io::Error::other(why),
+    };
+    if dir.exists() && !dir.is_dir() {
+        return Err(refuse(format!(
+            "{flag} names a file; name a folder (created if missing)"
+        )));
+    }
+    let parent = dir
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    if !parent.is_dir() {
+        return Err(refuse(format!(
+            "{flag}: folder {} does not exist (only the last folder is created)",
+            parent.display()
+        )));
+    }
+    Ok(())
+}
+
 /// Whether `path`, as a file we read names it (views.json's truths, a record's pictures),
 /// stays inside the folder it is relative to: not empty, relative, no `..` — so that joined
 /// to that folder it can neither read nor write outside it.
@@ -1111,7 +1137,10 @@ pub fn run_sweep(
         .filter(|p| config.shard.is_none_or(|s| s.owns(&p.key)))
         .collect();
     let out = &config.out;
-    check_output_parent(out)?;
+    check_output_folder("--out", out)?;
+    if let Some(cache) = &config.truth_cache {
+        check_output_folder("--truth-cache", cache)?;
+    }
     let results = out.join("results.jsonl");
     let still_to_do = |done: &[Record]| -> Vec<&Point> {
         all.iter()
