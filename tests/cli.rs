@@ -2548,6 +2548,46 @@ fn a_sequence_sweep_compares_every_frame_with_its_truth() {
     }
 }
 
+/// `sweep --path` refuses what its child processes would refuse — the scene, the truth's and
+/// the render's settings, the size, every frame's time — and the flags that do not apply to a
+/// sequence, before any folder is made (exit 2). Before, they failed in a child (exit 1)
+/// after the folders were made, or were silently ignored.
+#[test]
+fn a_sequence_sweep_refuses_bad_settings_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("seq");
+    let out_s = out.to_str().unwrap();
+    let walk = "scenes/mirror_box_walk.json";
+    let cases: [(&str, &[&str], &str); 9] = [
+        ("nowhere.json", &[], "nowhere.json"),
+        (walk, &["--time", "NaN"], "--time"),
+        (walk, &["--time", "999999999.99"], "--time: frame 1"),
+        (walk, &["--min-throughput", "NaN"], "--min-throughput"),
+        (walk, &["--ssaa", "0"], "--ssaa"),
+        (walk, &["--frames", "0"], "--frames"),
+        (walk, &["--width", "5"], "at least"),
+        (walk, &["--memory-budget", "1G"], "cannot be used with"),
+        (walk, &["--isolate-renders"], "cannot be used with"),
+    ];
+    for (scene, bad, expected) in cases {
+        let mut args = vec![
+            "sweep",
+            scene,
+            "--out",
+            out_s,
+            "--methods",
+            "unrolled",
+            "--path",
+            "2",
+        ];
+        args.extend(bad);
+        let run = mirrorbox(&args, &[]);
+        assert_eq!(run.code, 2, "{args:?}: {}", run.stderr);
+        assert!(run.stderr.contains(expected), "{args:?}: {}", run.stderr);
+        assert!(!out.exists(), "{args:?}: nothing is written on bad input");
+    }
+}
+
 /// `mirrorbox import` (docs/gltf.md): the project's textured asset in a mirror box, written,
 /// then traced and rendered from the written file — the two-command path from an asset to an
 /// image; a second import over it replaces it whole. A broken glTF exits 2 naming the scene,

@@ -1037,7 +1037,31 @@ fn base_scene(config: &SweepConfig) -> Result<(Scene, u32, u32), HarnessError> {
     if let Some(view) = &config.camera {
         base = exchange::view_scene(&base, view)?;
     }
-    base.resize(config.width, config.height)?;
+    check_compared_scene(
+        &mut base,
+        (config.width, config.height),
+        RenderSettings {
+            method: Method::named(FLOOR_METHOD).expect("the floor method is registered"),
+            ssaa: config.ssaa,
+            frames: config.frames,
+            warmup: config.warmup,
+        },
+    )?;
+    marker_albedo(config, &base)?;
+    let (w, h) = (base.camera.width, base.camera.height);
+    Ok((base, w, h))
+}
+
+/// Sizes `scene` by `--width` / `--height` and checks what a sweep compares with its truth:
+/// each side at least SSIM's window, and `settings` (the floor method's, with the sweep's
+/// `--ssaa`, `--frames` and `--warmup`) in range. Shared by `sweep` and `sweep --path`, so
+/// both refuse the same input before any work.
+pub(crate) fn check_compared_scene(
+    base: &mut Scene,
+    (width, height): (Option<u32>, Option<u32>),
+    settings: RenderSettings,
+) -> Result<(), HarnessError> {
+    base.resize(width, height)?;
     let min = mirrorbox_image::metrics::MIN_SIDE;
     for (flag, side) in [
         (
@@ -1061,17 +1085,8 @@ fn base_scene(config: &SweepConfig) -> Result<(Scene, u32, u32), HarnessError> {
             .into());
         }
     }
-    let floor = Method::named(FLOOR_METHOD).expect("the floor method is registered");
-    RenderSettings {
-        method: floor,
-        ssaa: config.ssaa,
-        frames: config.frames,
-        warmup: config.warmup,
-    }
-    .check(&base)?;
-    marker_albedo(config, &base)?;
-    let (w, h) = (base.camera.width, base.camera.height);
-    Ok((base, w, h))
+    settings.check(base)?;
+    Ok(())
 }
 
 /// The resume keys of every point of `config` (the floor first), in sweep order, without

@@ -79,6 +79,35 @@ impl SequenceConfig {
                 return bad(format!("scenario {}: no method", s.name));
             }
         }
+        self.truth.check()?;
+        // What the child processes would refuse, refused here before any folder is made (as
+        // `sweep` refuses it): the scene, its size and the render settings, every frame's
+        // time. Before, a bad one failed in a child (exit 1) after the folders were made.
+        for s in &self.scenarios {
+            let mut scene = mirrorbox_scene::load_scene(&s.scene)?;
+            crate::check_compared_scene(
+                &mut scene,
+                (self.width, self.height),
+                mirrorbox_raster::RenderSettings {
+                    method: Method::named(crate::FLOOR_METHOD)
+                        .expect("the floor method is registered"),
+                    ssaa: self.ssaa,
+                    frames: self.timed,
+                    warmup: self.warmup,
+                },
+            )?;
+            for k in 0..s.frames {
+                let t = s.start + f64::from(k) / s.fps;
+                if !(t.is_finite() && t.abs() <= 1e9) {
+                    return bad(format!(
+                        "--time: frame {k} is at {t} s; path times are finite and within ±1e9"
+                    ));
+                }
+                scene
+                    .at_time(t)
+                    .map_err(|e| HarnessError::Sequence(format!("{}: {e}", s.scene.display())))?;
+            }
+        }
         Ok(())
     }
 }

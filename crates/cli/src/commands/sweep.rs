@@ -92,7 +92,7 @@ pub struct Args {
     #[arg(
         long,
         value_name = "N",
-        conflicts_with_all = ["symmetry_planes", "mirrored_lights", "bump_amplitude", "ipd", "camera_yaw", "alpha", "shard", "truth_cache"]
+        conflicts_with_all = ["symmetry_planes", "mirrored_lights", "bump_amplitude", "ipd", "camera_yaw", "alpha", "shard", "truth_cache", "isolate_renders", "memory_budget"]
     )]
     path: Option<u32>,
     /// Frames per second of path time for --path, in (0, 1000].
