@@ -107,7 +107,12 @@ mod tests {
 
     #[test]
     fn the_motion_preset_is_valid_and_bad_counts_are_refused() {
-        let c = sequences(Path::new("out"), "mirrorbox".into(), String::new());
+        let mut c = sequences(Path::new("out"), "mirrorbox".into(), String::new());
+        // Its scenes from the repository root, as `experiment` runs it (validate loads them).
+        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        for s in &mut c.scenarios {
+            s.scene = root.join(&s.scene);
+        }
         c.validate().unwrap();
         assert_eq!(c.scenarios.len(), 3);
         let mut bad = c.clone();

@@ -39,8 +39,12 @@ fn every_experiment_is_runnable_and_named_once() {
                 }
             }
             Measure::Sequences(sequences) => {
-                sequences(&e.default_out(), "mirrorbox".into(), String::new())
-                    .validate()
+                let mut c = sequences(&e.default_out(), "mirrorbox".into(), String::new());
+                // Its scenes from the repository root, as `experiment` runs it.
+                for s in &mut c.scenarios {
+                    s.scene = root().join(&s.scene);
+                }
+                c.validate()
                     .unwrap_or_else(|err| panic!("{}: {err}", e.name));
             }
             Measure::Script(script, _) => {
