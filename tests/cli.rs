@@ -2,7 +2,9 @@
 //! and messages as a user sees them.
 
 use crate::common;
-use crate::common::{Output, mirrorbox, pixels_differing_in_bits, repo, valid_scene};
+use crate::common::{
+    Output, assert_refused, mirrorbox, pixels_differing_in_bits, repo, valid_scene,
+};
 use serde_json::{Value, json};
 use std::path::Path;
 
@@ -1550,9 +1552,7 @@ fn sweep_refuses_bad_arguments() {
             "18",
         ];
         args.extend_from_slice(extra);
-        let r = mirrorbox(&args, &[]);
-        assert_eq!(r.code, 2, "{args:?}: {}", r.stderr);
-        assert!(r.stderr.contains(message), "{args:?}: {}", r.stderr);
+        assert_refused(&args, message);
     }
     assert!(!out.exists(), "nothing is written on bad input");
 }
@@ -2581,9 +2581,7 @@ fn a_sequence_sweep_refuses_bad_settings_before_any_work() {
             "2",
         ];
         args.extend(bad);
-        let run = mirrorbox(&args, &[]);
-        assert_eq!(run.code, 2, "{args:?}: {}", run.stderr);
-        assert!(run.stderr.contains(expected), "{args:?}: {}", run.stderr);
+        assert_refused(&args, expected);
         assert!(!out.exists(), "{args:?}: nothing is written on bad input");
     }
 }

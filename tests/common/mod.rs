@@ -33,6 +33,13 @@ pub fn mirrorbox(args: &[&str], envs: &[(&str, &str)]) -> Output {
     }
 }
 
+/// Runs `mirrorbox ARGS` and checks that it refused them: exit 2, `expected` in its message.
+pub fn assert_refused(args: &[&str], expected: &str) {
+    let run = mirrorbox(args, &[]);
+    assert_eq!(run.code, 2, "{args:?}: {}", run.stderr);
+    assert!(run.stderr.contains(expected), "{args:?}: {}", run.stderr);
+}
+
 /// A small valid two-mirror scene; each test breaks or extends one thing in it.
 pub fn valid_scene() -> Value {
     json!({
