@@ -2724,3 +2724,34 @@ fn a_sweep_leaves_out_the_methods_its_adapter_cannot_run_and_says_so() {
         "{report}"
     );
 }
+
+/// `experiment` refuses the options its kind of measure would ignore, before it runs
+/// anything: a sequence experiment takes no shard, a script experiment no `--out` or
+/// `--frames` (they were accepted and ignored); `--frames 0` names `--frames` (it named
+/// `--path`, a flag `experiment` does not have).
+#[test]
+fn an_experiment_refuses_options_it_would_ignore() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("motion");
+    let out_s = out.to_str().unwrap();
+    assert_refused(
+        &["experiment", "motion", "--out", out_s, "--shard", "0/2"],
+        "experiment motion does not apply --shard",
+    );
+    assert_refused(
+        &["experiment", "motion", "--out", out_s, "--frames", "0"],
+        "--frames must be 1 or more, got 0",
+    );
+    assert_refused(
+        &[
+            "experiment",
+            "lighting-trace-cost",
+            "--out",
+            out_s,
+            "--frames",
+            "3",
+        ],
+        "experiment lighting-trace-cost does not apply --out, --frames",
+    );
+    assert!(!out.exists(), "nothing is written");
+}

@@ -402,6 +402,22 @@ fn run_experiment(name: &str, args: &PresetArgs) -> Result<(), Failure> {
     use mirrorbox_experiments::Measure;
     let e = mirrorbox_experiments::find(name)
         .ok_or_else(|| bad(format!("no experiment named {name:?} in the registry")))?;
+    let unapplied = unapplied_options(args, &e.measure);
+    if !unapplied.is_empty() {
+        return Err(bad(format!(
+            "experiment {name} does not apply {}: {}",
+            unapplied.join(", "),
+            match e.measure {
+                Measure::Script(script, _) => {
+                    format!("it runs {script}, which writes its own report folder")
+                }
+                _ => "its sequences are rendered whole, in one process, into --out".into(),
+            }
+        )));
+    }
+    if args.frames == Some(0) {
+        return Err(bad("--frames must be 1 or more, got 0".into()));
+    }
     let out = args.out.clone().unwrap_or_else(|| e.default_out());
     match &e.measure {
         Measure::Sweeps(configs) => {
@@ -442,6 +458,36 @@ fn run_experiment(name: &str, args: &PresetArgs) -> Result<(), Failure> {
             }
         }
     }
+}
+
+/// The options given to `experiment` that its kind of measure would ignore (a script takes
+/// none of them; sequences take `--out` and `--frames`): refused rather than ignored unsaid,
+/// but for `--fresh` and `--truth-cache`, which mean nothing more to them than what they do.
+fn unapplied_options(
+    args: &PresetArgs,
+    measure: &mirrorbox_experiments::Measure,
+) -> Vec<&'static str> {
+    use mirrorbox_experiments::Measure;
+    let script = matches!(measure, Measure::Script(..));
+    let sweeps = matches!(measure, Measure::Sweeps(_));
+    let given = [
+        ("--out", script && args.out.is_some()),
+        ("--frames", script && args.frames.is_some()),
+        // `--fresh` and `--truth-cache` are the main job's for every experiment
+        // (scripts/run.sh): a script or a sequence measures afresh and traces its own truths
+        // anyway, so they are accepted everywhere.
+        ("--shard", !sweeps && args.shard.shard.is_some()),
+        ("--isolate-renders", !sweeps && args.isolate_renders),
+        (
+            "--memory-budget",
+            !sweeps
+                && args.memory.memory_budget != super::MemoryBudgetArgs::default().memory_budget,
+        ),
+    ];
+    given
+        .into_iter()
+        .filter_map(|(flag, on)| on.then_some(flag))
+        .collect()
 }
 
 fn run_sequences(config: &SequenceConfig) -> Result<(), Failure> {
