@@ -104,7 +104,7 @@ impl SequenceConfig {
                     ));
                 }
                 scene
-                    .at_time(t)
+                    .camera_at_time(t)
                     .map_err(|e| HarnessError::Sequence(format!("{}: {e}", s.scene.display())))?;
             }
         }

@@ -288,6 +288,15 @@ impl Scene {
         })
     }
 
+    /// The camera [`Scene::at_time`] would place, without copying the scene: what a check
+    /// of many frames' times needs.
+    pub fn camera_at_time(&self, time: f64) -> Result<Camera, camera_path::DegenerateView> {
+        match &self.camera_path {
+            None => Ok(self.camera.clone()),
+            Some(path) => path.camera_at(&self.camera, time),
+        }
+    }
+
     /// The scene seen by one eye of `stereo` (the scene's own rig, or another): its camera
     /// replaced by that eye's ([`stereo::Stereo::eye`]), no rig left.
     pub fn eye(&self, stereo: &stereo::Stereo, eye: stereo::Eye) -> Scene {

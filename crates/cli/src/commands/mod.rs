@@ -207,9 +207,19 @@ impl TimeArgs {
             return Ok(scene);
         };
         check_time(time)?;
+        scene.at_time(time).map_err(|e| path_error(&scene, e))
+    }
+
+    /// What [`TimeArgs::apply`] would refuse, without making the scene at that time.
+    pub fn check(&self, scene: &Scene) -> Result<(), Failure> {
+        let Some(time) = self.time else {
+            return Ok(());
+        };
+        check_time(time)?;
         scene
-            .at_time(time)
-            .map_err(|e| Failure::BadInput(format!("{}: camera.path: {e}", scene.source.display())))
+            .camera_at_time(time)
+            .map(drop)
+            .map_err(|e| path_error(scene, e))
     }
 
     /// The provenance attribute of an output, when a time was given.
@@ -228,10 +238,13 @@ pub fn check_frame_time(
     if loaded.get().is_none() {
         let _ = loaded.set(load(path)?);
     }
-    match loaded.get() {
-        Some(scene) => time.apply(scene.clone()).map(drop),
-        None => Ok(()),
-    }
+    let scene = loaded.get().expect("the scene was loaded just above");
+    time.check(scene)
+}
+
+/// A camera path that gives no view at a time (exit 2), naming the scene file.
+fn path_error(scene: &Scene, e: mirrorbox_scene::camera_path::DegenerateView) -> Failure {
+    Failure::BadInput(format!("{}: camera.path: {e}", scene.source.display()))
 }
 
 /// A `--time` (or a sequence frame's) out of range is exit 2.
