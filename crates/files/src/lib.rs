@@ -161,22 +161,25 @@ pub fn check_outputs(outputs: &[(&str, PathBuf)]) -> Result<(), FileError> {
     check_distinct(outputs)
 }
 
+/// `p` with its folder resolved (`..` and links), for telling whether two names write one
+/// file; made absolute as it is where its folder does not exist.
+pub fn in_resolved_folder(p: &Path) -> PathBuf {
+    let parent = p
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    match (parent.canonicalize(), p.file_name()) {
+        (Ok(dir), Some(name)) => dir.join(name),
+        _ => std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf()),
+    }
+}
+
 /// Refuses a set of paths in which two name the same file.
 pub fn check_distinct(outputs: &[(&str, PathBuf)]) -> Result<(), FileError> {
-    // The folders exist (outputs are checked first): resolve them, `..` and links included.
-    let absolute = |p: &Path| {
-        let parent = p
-            .parent()
-            .filter(|d| !d.as_os_str().is_empty())
-            .unwrap_or(Path::new("."));
-        match (parent.canonicalize(), p.file_name()) {
-            (Ok(dir), Some(name)) => dir.join(name),
-            _ => std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf()),
-        }
-    };
+    // The folders exist (outputs are checked first).
     for (i, (flag_a, a)) in outputs.iter().enumerate() {
         for (flag_b, b) in &outputs[..i] {
-            if absolute(a) == absolute(b) {
+            if in_resolved_folder(a) == in_resolved_folder(b) {
                 return Err(FileError::refused(
                     a,
                     format!(

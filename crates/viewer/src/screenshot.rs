@@ -98,8 +98,9 @@ impl Capture {
     }
 }
 
-/// Every file a screenshot to `path` may write (see the module docs), for the checks made
-/// before the window opens ([`crate::script::check_writes`]).
+/// Every file a screenshot to `path` may write (see the module docs): the PNG, the method's
+/// and the truth's EXR, the error map, the record — what [`save`] writes and what the checks
+/// made before the window opens ([`crate::script::check_writes`]) look at.
 pub fn files(path: &Path) -> [PathBuf; 5] {
     [
         path.to_path_buf(),
@@ -192,11 +193,12 @@ pub fn save(
     options: &ViewOptions,
 ) -> Result<(), String> {
     let err = |e: mirrorbox_image::ImageError| format!("{}: {e}", path.display());
-    mirrorbox_image::write_png_bytes(path, *w, *h, rgb).map_err(err)?;
+    let [png, method_exr, truth_exr, error_png, record_json] = files(path);
+    mirrorbox_image::write_png_bytes(&png, *w, *h, rgb).map_err(err)?;
     let camera = session.view_camera();
     if let Some(image) = method_image {
         mirrorbox_image::write_exr(
-            &with_ending(path, ".method.exr"),
+            &method_exr,
             image,
             &[("mirrorbox.method", session.method.key())],
         )
@@ -205,20 +207,15 @@ pub fn save(
     let truth = session.complete_truth();
     if let Some(level) = truth {
         mirrorbox_image::write_exr(
-            &with_ending(path, ".truth.exr"),
+            &truth_exr,
             &level.image,
             &[("mirrorbox.spp", (session.ssaa * session.ssaa).to_string())],
         )
         .map_err(err)?;
     }
     if let Some(e) = &session.error {
-        mirrorbox_image::write_png_bytes(
-            &with_ending(path, ".error.png"),
-            e.width,
-            e.height,
-            &e.heat_rgb8,
-        )
-        .map_err(err)?;
+        mirrorbox_image::write_png_bytes(&error_png, e.width, e.height, &e.heat_rgb8)
+            .map_err(err)?;
     }
     let frame = session.frame.as_ref();
     let record = json!({
@@ -250,6 +247,5 @@ pub fn save(
     });
     let mut text = serde_json::to_string_pretty(&record).map_err(|e| e.to_string())?;
     text.push('\n');
-    mirrorbox_files::write_atomically(&path.with_extension("json"), text.as_bytes())
-        .map_err(|e| e.to_string())
+    mirrorbox_files::write_atomically(&record_json, text.as_bytes()).map_err(|e| e.to_string())
 }

@@ -103,17 +103,8 @@ pub fn parse_script(text: &str, file: &str) -> Result<Vec<Step>, ScriptError> {
 /// The file `path` resolves to, for comparing names: its folder canonicalized (links and
 /// `..` resolved) where that folder exists, else the path made absolute.
 fn resolved(path: &Path) -> PathBuf {
-    if let Ok(p) = path.canonicalize() {
-        return p;
-    }
-    let parent = path
-        .parent()
-        .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    match (parent.canonicalize(), path.file_name()) {
-        (Ok(dir), Some(name)) => dir.join(name),
-        _ => std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf()),
-    }
+    path.canonicalize()
+        .unwrap_or_else(|_| mirrorbox_files::in_resolved_folder(path))
 }
 
 /// Checks the files `action` would write (a screenshot and its companions, a scene copy),
