@@ -161,14 +161,18 @@ pub fn check_outputs(outputs: &[(&str, PathBuf)]) -> Result<(), FileError> {
     check_distinct(outputs)
 }
 
+/// The folder a file `path` is in: its parent, or `.` for a bare file name (whose parent is
+/// the empty path).
+pub fn folder_of(path: &Path) -> &Path {
+    path.parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."))
+}
+
 /// `p` with its folder resolved (`..` and links), for telling whether two names write one
 /// file; made absolute as it is where its folder does not exist.
 pub fn in_resolved_folder(p: &Path) -> PathBuf {
-    let parent = p
-        .parent()
-        .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    match (parent.canonicalize(), p.file_name()) {
+    match (folder_of(p).canonicalize(), p.file_name()) {
         (Ok(dir), Some(name)) => dir.join(name),
         _ => std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf()),
     }

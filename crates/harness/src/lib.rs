@@ -845,10 +845,7 @@ fn compare_views(
 /// A sweep (or a merge) creates its own folder `out`, inside one that must exist (as every
 /// command's outputs): a mistyped path is refused, not created.
 pub(crate) fn check_output_parent(out: &Path) -> Result<(), HarnessError> {
-    let parent = out
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
+    let parent = mirrorbox_files::folder_of(out);
     if parent.is_dir() {
         return Ok(());
     }
@@ -874,10 +871,7 @@ pub(crate) fn check_output_folder(flag: &str, dir: &Path) -> Result<(), HarnessE
             "{flag} names a file; name a folder (created if missing)"
         )));
     }
-    let parent = dir
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
+    let parent = mirrorbox_files::folder_of(dir);
     if !parent.is_dir() {
         return Err(refuse(format!(
             "{flag}: folder {} does not exist (only the last folder is created)",

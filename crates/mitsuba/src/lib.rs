@@ -103,10 +103,7 @@ pub fn export(
     xml_path: &Path,
     settings: ExportSettings,
 ) -> Result<Vec<PathBuf>, FileError> {
-    let dir = xml_path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
+    let dir = mirrorbox_files::folder_of(xml_path);
     let mesh_dir = dir.join("meshes");
     std::fs::create_dir_all(&mesh_dir).map_err(|e| FileError {
         path: mesh_dir.clone(),

@@ -118,10 +118,7 @@ pub fn check_writes(action: &Action, inputs: &[(&str, &Path)]) -> Result<(), Str
         Action::SaveCamera(json) => vec![json.clone()],
         _ => return Ok(()),
     };
-    let parent = files[0]
-        .parent()
-        .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
+    let parent = mirrorbox_files::folder_of(&files[0]);
     if !parent.is_dir() {
         return Err(format!(
             "{}: folder {} does not exist",

@@ -4,7 +4,7 @@
 
 use super::output_path;
 use crate::Failure;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -35,12 +35,8 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             args.asset.display()
         ))
     })?;
-    let folder = std::fs::canonicalize(
-        out.parent()
-            .filter(|p| !p.as_os_str().is_empty())
-            .unwrap_or(Path::new(".")),
-    )
-    .map_err(|e| Failure::BadInput(format!("{}: {e}", out.display())))?;
+    let folder = std::fs::canonicalize(mirrorbox_files::folder_of(&out))
+        .map_err(|e| Failure::BadInput(format!("{}: {e}", out.display())))?;
     let reference = match asset.strip_prefix(&folder) {
         Ok(rel) => rel.to_string_lossy().into_owned(),
         Err(_) => asset.to_string_lossy().into_owned(),

@@ -292,10 +292,7 @@ pub fn output_path(flag: &str, path: &Path, ext: &str) -> Result<PathBuf, Failur
             path.display()
         )));
     }
-    let parent = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
+    let parent = mirrorbox_files::folder_of(path);
     if !parent.is_dir() {
         return Err(Failure::BadInput(format!(
             "{flag} {}: folder {} does not exist",
