@@ -279,16 +279,23 @@ fn view_image(dir: &Path, view: &crate::exchange::ExportedView) -> Result<PathBu
             format!("no image of view {:?} ({0}.exr or {0}.png)", view.name),
         ));
     }
-    // The image's errors name its file. Its size is compared by its header, before decoding.
-    let image_error = |e: mirrorbox_image::ImageError| HarnessError::Exchange(e.to_string());
-    let size = mirrorbox_image::image_size(&path).map_err(image_error)?;
+    check_view_picture(&path, view).map_err(HarnessError::Exchange)?;
+    Ok(path)
+}
+
+/// Checks the image at `path` as a picture of `view`'s radiance: readable, the view's size
+/// (compared by its header, before it is decoded), every pixel finite and ≥ 0
+/// ([`mirrorbox_image::RgbImage::radiance_problem`]). The error names the file.
+fn check_view_picture(path: &Path, view: &crate::exchange::ExportedView) -> Result<(), String> {
+    // The image's own errors name its file.
+    let size = mirrorbox_image::image_size(path).map_err(|e| e.to_string())?;
     if let Some(problem) = size_problem(size, view) {
-        return Err(refused(&path, problem));
+        return Err(format!("{}: {problem}", path.display()));
     }
-    let img = mirrorbox_image::read_image(&path).map_err(image_error)?;
-    match radiance_problem(&img, view) {
-        Some(problem) => Err(refused(&path, problem)),
-        None => Ok(path),
+    let img = mirrorbox_image::read_image(path).map_err(|e| e.to_string())?;
+    match img.radiance_problem() {
+        Some(problem) => Err(format!("{}: {problem}", path.display())),
+        None => Ok(()),
     }
 }
 
@@ -305,15 +312,6 @@ fn size_problem(
     })
 }
 
-/// What makes `img` no picture of `view`'s radiance, if anything: another size, or a pixel
-/// that is NaN, infinite or negative ([`mirrorbox_image::RgbImage::radiance_problem`]).
-fn radiance_problem(
-    img: &mirrorbox_image::RgbImage,
-    view: &crate::exchange::ExportedView,
-) -> Option<String> {
-    size_problem((img.width, img.height), view).or_else(|| img.radiance_problem())
-}
-
 /// Checks the export's truth `views[i].<field>` (`file`, relative to `export`) as a client's
 /// image is checked — readable, the view's size, radiance in every pixel — and its sRGB
 /// picture beside it (copied into the report): the export is an input like the run, read
@@ -327,14 +325,7 @@ fn check_truth(
 ) -> Result<(), HarnessError> {
     let path = export.join(file);
     let at = |e: &dyn std::fmt::Display| HarnessError::Exchange(format!("views[{i}].{field}: {e}"));
-    let size = mirrorbox_image::image_size(&path).map_err(|e| at(&e))?;
-    if let Some(problem) = size_problem(size, view) {
-        return Err(at(&format!("{}: {problem}", path.display())));
-    }
-    let img = mirrorbox_image::read_image(&path).map_err(|e| at(&e))?;
-    if let Some(problem) = radiance_problem(&img, view) {
-        return Err(at(&format!("{}: {problem}", path.display())));
-    }
+    check_view_picture(&path, view).map_err(|e| at(&e))?;
     let picture = path.with_extension("png");
     if picture != path {
         mirrorbox_files::open_regular(
