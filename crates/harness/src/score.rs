@@ -378,11 +378,13 @@ pub fn score(
     crate::exchange::replaceable(out, "sweep.json", "score")?;
     // Everything read and checked first: the export's truths that the variants are compared
     // with (the floor truths for variants named `floor`), then each variant's files.
+    let floor = found.iter().any(|(_, variant, _)| variant == "floor");
+    let mirrors = found.iter().any(|(_, variant, _)| variant != "floor");
     for (i, v) in views.views.iter().enumerate() {
-        if found.iter().any(|(_, variant, _)| variant != "floor") {
+        if mirrors {
             check_truth(export, i, "truth", &v.truth, v)?;
         }
-        if found.iter().any(|(_, variant, _)| variant == "floor") {
+        if floor {
             check_truth(export, i, "floor", &v.floor, v)?;
         }
     }
