@@ -30,11 +30,11 @@ pub fn read_records(path: &Path) -> Result<Vec<Record>, FileError> {
     let text = mirrorbox_files::read_bounded_text(path, MAX_RESULTS_BYTES, "a results file")?;
     let mut records: Vec<Record> = Vec::new();
     let mut index = std::collections::HashMap::new();
-    let lines = text.lines().count();
-    for (n, line) in text.lines().enumerate() {
+    let mut lines = text.lines().enumerate().peekable();
+    while let Some((n, line)) = lines.next() {
         let mut record = match serde_json::from_str::<Record>(line) {
             Ok(record) => record,
-            Err(_) if n + 1 == lines && !text.ends_with('\n') => continue,
+            Err(_) if lines.peek().is_none() && !text.ends_with('\n') => continue,
             Err(e) => {
                 return Err(FileError {
                     path: path.to_path_buf(),
