@@ -1248,12 +1248,38 @@ fn compare_reports_metrics_and_refuses_mismatched_sizes() {
             a.to_str().unwrap(),
             a.to_str().unwrap(),
             "--json",
+            "--heatmap",
+            heat.to_str().unwrap(),
         ],
         &[],
     );
+    assert_eq!(same.code, 0, "an image against itself: {}", same.stderr);
     let v: Value = serde_json::from_str(same.stdout.trim()).unwrap();
     assert_eq!(v["rmse"], 0.0);
     assert!(v["psnr"].is_null(), "identical images have infinite PSNR");
+    // The heat map must not overwrite an image being compared (the PNGs `trace` wrote).
+    let (a_png, b_png) = (a.with_extension("png"), b.with_extension("png"));
+    for (target, flag) in [(&a_png, "REFERENCE"), (&b_png, "TEST")] {
+        let before = std::fs::read(target).unwrap();
+        let out = mirrorbox(
+            &[
+                "compare",
+                a_png.to_str().unwrap(),
+                b_png.to_str().unwrap(),
+                "--heatmap",
+                target.to_str().unwrap(),
+            ],
+            &[],
+        );
+        assert_eq!(out.code, 2, "{}", out.stderr);
+        assert!(
+            out.stderr
+                .contains(&format!("--heatmap would overwrite {flag}")),
+            "{}",
+            out.stderr
+        );
+        assert_eq!(std::fs::read(target).unwrap(), before, "{flag} untouched");
+    }
     // A different size, and a file that is not there.
     let small = dir.path().join("small.exr");
     mirrorbox(
@@ -2565,7 +2591,7 @@ fn a_sequence_sweep_refuses_bad_settings_before_any_work() {
         (walk, &["--min-throughput", "NaN"], "--min-throughput"),
         (walk, &["--ssaa", "0"], "--ssaa"),
         (walk, &["--frames", "0"], "--frames"),
-        (walk, &["--width", "5"], "at least"),
+        (walk, &["--width", "5"], "--width must be in [11, 16384]"),
         (walk, &["--memory-budget", "1G"], "cannot be used with"),
         (walk, &["--isolate-renders"], "cannot be used with"),
     ];

@@ -429,7 +429,7 @@ fn a_bad_view_list_is_refused_naming_the_field() {
         ),
         (
             r#"{"views": [{"name": "a", "position": [0,1,2], "look_at": [0,1,2]}]}"#,
-            "view \"a\": position and look_at",
+            "views.json: views[0] (\"a\"): position and look_at must be finite and apart",
         ),
     ] {
         std::fs::write(&list, text).unwrap();

@@ -378,6 +378,25 @@ fn outputs_that_would_overwrite_the_scene_or_miss_their_folder_are_refused_first
         );
     }
     assert_eq!(std::fs::read(&scene).unwrap(), original);
+    // `--log`, written when the window closes, must not be the script (nor miss its folder).
+    let log_script = p("l.jsonl");
+    std::fs::write(&log_script, "frames 1\n").unwrap();
+    for (log, expected) in [
+        (log_script.clone(), "it is the script"),
+        (p("nope/l.jsonl"), "does not exist"),
+    ] {
+        let out = mirrorbox(
+            &["view", &scene_arg, "--script", &log_script, "--log", &log],
+            &[],
+        );
+        assert_eq!(out.code, 2, "{log}: {}", out.stderr);
+        assert!(
+            out.stderr.contains("--log") && out.stderr.contains(expected),
+            "{log}: {}",
+            out.stderr
+        );
+    }
+    assert_eq!(std::fs::read_to_string(&log_script).unwrap(), "frames 1\n");
 }
 
 #[test]

@@ -139,8 +139,9 @@ pub const CONTRACT_VERSION: u32 = 1;
 /// 1 to [`MAX_VIEWS`] views with distinct names of letters, digits, `-` and `_`.
 pub fn read_view_list(path: &Path) -> Result<Vec<ViewSpec>, HarnessError> {
     let bad = |message: String| HarnessError::Exchange(format!("{}: {message}", path.display()));
+    // A file error names the path itself.
     let text = mirrorbox_files::read_bounded_text(path, 1 << 20, "a view list")
-        .map_err(|e| bad(e.to_string()))?;
+        .map_err(|e| HarnessError::Exchange(e.to_string()))?;
     let list: ViewList = serde_json::from_str(&text).map_err(|e| bad(e.to_string()))?;
     if list.views.is_empty() || list.views.len() > MAX_VIEWS {
         return Err(bad(format!(
@@ -151,6 +152,14 @@ pub fn read_view_list(path: &Path) -> Result<Vec<ViewSpec>, HarnessError> {
     let names: Vec<&str> = list.views.iter().map(|v| v.name.as_str()).collect();
     if let Some(problem) = view_name_problem(&names) {
         return Err(bad(problem));
+    }
+    // What can be checked without the scene (its up and field of view fill the gaps, and
+    // [`view_scene`] checks the result).
+    for (i, v) in list.views.iter().enumerate() {
+        let forward = Vec3::from_array(v.look_at) - Vec3::from_array(v.position);
+        if let Some(problem) = camera_problem(forward, v.up.map(Vec3::from_array), v.fov_y_deg) {
+            return Err(bad(format!("views[{i}] ({:?}): {problem}", v.name)));
+        }
     }
     Ok(list.views)
 }
@@ -389,19 +398,30 @@ pub fn view_scene(base: &Scene, spec: &ViewSpec) -> Result<Scene, HarnessError> 
     if let Some(fov) = spec.fov_y_deg {
         c.fov_y_deg = fov;
     }
-    let forward = c.look_at - c.position;
-    let bad = |what: &str| HarnessError::Exchange(format!("view {:?}: {what}", spec.name));
-    if !forward.is_finite() || forward.length() < 1e-6 {
-        return Err(bad("position and look_at must be finite and apart"));
-    }
-    if !c.up.is_finite() || forward.normalize().cross(c.up).length() < 1e-6 {
-        return Err(bad("up must be finite and not along the view direction"));
-    }
-    if !(c.fov_y_deg > 0.0 && c.fov_y_deg < 180.0) {
-        return Err(bad("fov_y_deg must be in (0, 180)"));
+    if let Some(problem) = camera_problem(c.look_at - c.position, Some(c.up), Some(c.fov_y_deg)) {
+        return Err(HarnessError::Exchange(format!(
+            "view {:?}: {problem}",
+            spec.name
+        )));
     }
     c.up = c.up.normalize();
     Ok(scene)
+}
+
+/// What is wrong with a camera, if anything: its view direction `forward` (look-at minus
+/// position) finite and not zero, its `up` (where known) finite and not along it, its
+/// vertical field of view (where known) in (0, 180) degrees.
+fn camera_problem(forward: Vec3, up: Option<Vec3>, fov_y_deg: Option<f32>) -> Option<&'static str> {
+    if !forward.is_finite() || forward.length() < 1e-6 {
+        return Some("position and look_at must be finite and apart");
+    }
+    if up.is_some_and(|up| !up.is_finite() || forward.normalize().cross(up).length() < 1e-6) {
+        return Some("up must be finite and not along the view direction");
+    }
+    if fov_y_deg.is_some_and(|f| !(f > 0.0 && f < 180.0)) {
+        return Some("fov_y_deg must be in (0, 180)");
+    }
+    None
 }
 
 fn exported_view(scene: &Scene, spec: &ViewSpec, ssaa: u32) -> ExportedView {
@@ -513,6 +533,51 @@ mod tests {
             };
             assert!((ndc(0.1) - lo).abs() < 1e-4, "{}", ndc(0.1));
             assert!((ndc(100.0) - 1.0).abs() < 1e-4, "{}", ndc(100.0));
+        }
+    }
+
+    /// A view list's errors name the file once, then the field or the file's problem.
+    #[test]
+    fn a_view_list_error_names_the_file_once() {
+        let dir = tempfile::tempdir().unwrap();
+        let missing = dir.path().join("nothere.json");
+        let bad = dir.path().join("bad.json");
+        std::fs::write(&bad, r#"{"views": []}"#).unwrap();
+        let apart = dir.path().join("apart.json");
+        std::fs::write(
+            &apart,
+            r#"{"views": [{"name": "a", "position": [0, 1, 2], "look_at": [0, 1, 0]},
+                          {"name": "b", "position": [0, 1, 2], "look_at": [0, 1, 2]}]}"#,
+        )
+        .unwrap();
+        let up = dir.path().join("up.json");
+        std::fs::write(
+            &up,
+            r#"{"views": [{"name": "a", "position": [0, 1, 2], "look_at": [0, 1, 0],
+                           "up": [0, 0, 3]}]}"#,
+        )
+        .unwrap();
+        let fov = dir.path().join("fov.json");
+        std::fs::write(
+            &fov,
+            r#"{"views": [{"name": "a", "position": [0, 1, 2], "look_at": [0, 1, 0],
+                           "fov_y_deg": 180}]}"#,
+        )
+        .unwrap();
+        for (path, problem) in [
+            (&missing, "cannot read a view list"),
+            (&bad, "views: 0 views"),
+            (
+                &apart,
+                "views[1] (\"b\"): position and look_at must be finite and apart",
+            ),
+            (&up, "views[0] (\"a\"): up must be finite and not along"),
+            (&fov, "views[0] (\"a\"): fov_y_deg must be in (0, 180)"),
+        ] {
+            let message = read_view_list(path).unwrap_err().to_string();
+            let name = path.display().to_string();
+            assert_eq!(message.matches(&name).count(), 1, "{message}");
+            assert!(message.contains(problem), "{message}");
         }
     }
 }

@@ -1055,8 +1055,26 @@ pub(crate) fn check_compared_scene(
     (width, height): (Option<u32>, Option<u32>),
     settings: RenderSettings,
 ) -> Result<(), HarnessError> {
-    base.resize(width, height)?;
     let min = mirrorbox_image::metrics::MIN_SIDE;
+    // A side given as a flag is held to the range of these commands (their help's), not the
+    // general one a renderer would name.
+    for (flag, side) in [("--width", width), ("--height", height)] {
+        if let Some(side) =
+            side.filter(|s| !(min..=mirrorbox_scene::limits::MAX_IMAGE_SIDE).contains(s))
+        {
+            return Err(SettingError::new(
+                flag,
+                format!(
+                    "in [{min}, {}] pixels where an image is compared with its truth (SSIM's \
+                     window)",
+                    mirrorbox_scene::limits::MAX_IMAGE_SIDE
+                ),
+                side,
+            )
+            .into());
+        }
+    }
+    base.resize(width, height)?;
     for (flag, side) in [
         (
             "the image width (--width or camera.width)",
@@ -1627,6 +1645,42 @@ pub fn git_output(dir: &Path, args: &[&str]) -> Option<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A compared image's side: a flag is held to [11, 16384] under its own name, the scene
+    /// camera's (no flag) under the camera's field; both before any work.
+    #[test]
+    fn a_compared_side_is_refused_under_the_name_it_was_given() {
+        let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/mirror_box.json");
+        let settings = RenderSettings {
+            method: Method::named(FLOOR_METHOD).unwrap(),
+            ssaa: 1,
+            frames: 1,
+            warmup: 0,
+        };
+        let check = |base: &mut Scene, size| {
+            check_compared_scene(base, size, settings.clone()).map_err(|e| e.to_string())
+        };
+        let base = load_scene(&scene).unwrap();
+        for (size, expected) in [
+            (
+                (Some(0), None),
+                "--width must be in [11, 16384] pixels where an image is compared",
+            ),
+            ((None, Some(10)), "--height must be in [11, 16384]"),
+            ((Some(16385), None), "--width must be in [11, 16384]"),
+        ] {
+            let e = check(&mut base.clone(), size).unwrap_err();
+            assert!(e.contains(expected), "{size:?}: {e}");
+        }
+        let mut small = base.clone();
+        small.camera.width = 8;
+        let e = check(&mut small, (None, None)).unwrap_err();
+        assert!(
+            e.contains("camera.width) must be at least 11 pixels"),
+            "{e}"
+        );
+        assert_eq!(check(&mut small, (Some(11), Some(11))), Ok(()));
+    }
 
     /// A point its method refuses to render (`unrolled` at depth 256 in the four-mirror room
     /// at α = 1: 83 M triangles per frame, above the limit that `Unrolled::new` checks once the

@@ -506,16 +506,27 @@ impl App {
             r.config.present_mode = present_mode(vsync);
             r.surface.configure(&r.gpu.device, &r.config);
         }
+        // Numbered files never replace one that exists ([`crate::screenshot::unused_number`]).
         if actions.screenshot {
-            r.saved += 1;
-            r.pending_screenshot = Some(
-                self.options
-                    .out_dir
-                    .join(format!("mirrorbox-view-{}.png", r.saved)),
-            );
+            let out_dir = &self.options.out_dir;
+            let shot = |n: u32| out_dir.join(format!("mirrorbox-view-{n}.png"));
+            match crate::screenshot::unused_number(r.saved + 1, |n| {
+                crate::screenshot::files(&shot(n))
+            }) {
+                Some(n) => {
+                    r.saved = n;
+                    r.pending_screenshot = Some(shot(n));
+                }
+                None => {
+                    r.ui.status = format!(
+                        "no screenshot: mirrorbox-view-{}.png and the 10 000 after it exist in {}",
+                        r.saved + 1,
+                        out_dir.display()
+                    )
+                }
+            }
         }
         if actions.save_camera {
-            r.saved += 1;
             let stem = self
                 .options
                 .scene_path
@@ -527,13 +538,23 @@ impl App {
                 .scene_path
                 .parent()
                 .unwrap_or(std::path::Path::new("."));
-            let to = dir.join(format!("{stem}.view-{}.json", r.saved));
-            let camera = r.session.view_camera();
-            r.ui.status =
-                match crate::scene_copy::save_camera(&self.options.scene_path, &camera, &to) {
-                    Ok(()) => format!("camera saved to {}", to.display()),
-                    Err(e) => format!("cannot save the camera: {e}"),
-                };
+            let copy = |n: u32| dir.join(format!("{stem}.view-{n}.json"));
+            r.ui.status = match crate::screenshot::unused_number(r.saved + 1, |n| [copy(n)]) {
+                Some(n) => {
+                    r.saved = n;
+                    let to = copy(n);
+                    let camera = r.session.view_camera();
+                    match crate::scene_copy::save_camera(&self.options.scene_path, &camera, &to) {
+                        Ok(()) => format!("camera saved to {}", to.display()),
+                        Err(e) => format!("cannot save the camera: {e}"),
+                    }
+                }
+                None => format!(
+                    "camera not saved: {stem}.view-{}.json and the 10 000 after it exist in {}",
+                    r.saved + 1,
+                    dir.display()
+                ),
+            };
         }
         if actions.quit {
             event_loop.exit();

@@ -111,6 +111,21 @@ pub fn files(path: &Path) -> [PathBuf; 5] {
     ]
 }
 
+/// The first number from `from` on whose files `of(n)` are all absent, for the files a key
+/// writes under numbered names (`mirrorbox-view-N.png` and its companions, `scene.view-N.json`):
+/// a key never replaces an earlier session's file, nor an input that happens to bear such a
+/// name. Up to 10 000 numbers are tried; `None` past that.
+pub fn unused_number<I>(from: u32, of: impl Fn(u32) -> I) -> Option<u32>
+where
+    I: IntoIterator<Item = PathBuf>,
+{
+    (from..from.saturating_add(10_000)).find(|&n| {
+        of(n)
+            .into_iter()
+            .all(|f| std::fs::symlink_metadata(f).is_err())
+    })
+}
+
 /// `shot.png` → `shot.method.exr`: the path without its extension, then `ending`.
 fn with_ending(path: &Path, ending: &str) -> PathBuf {
     let stem = path.with_extension("");
@@ -248,4 +263,24 @@ pub fn save(
     let mut text = serde_json::to_string_pretty(&record).map_err(|e| e.to_string())?;
     text.push('\n');
     mirrorbox_files::write_atomically(&record_json, text.as_bytes()).map_err(|e| e.to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A numbered file is never one that exists: any of a screenshot's five files (an
+    /// earlier session's, or an input such as a scene named like its JSON) moves it on.
+    #[test]
+    fn a_numbered_screenshot_skips_every_number_with_a_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let shot = |n: u32| files(&dir.path().join(format!("mirrorbox-view-{n}.png")));
+        assert_eq!(unused_number(1, shot), Some(1));
+        std::fs::write(dir.path().join("mirrorbox-view-1.png"), b"").unwrap();
+        std::fs::write(dir.path().join("mirrorbox-view-2.json"), b"{}").unwrap();
+        std::fs::write(dir.path().join("mirrorbox-view-3.truth.exr"), b"").unwrap();
+        assert_eq!(unused_number(1, shot), Some(4));
+        assert_eq!(unused_number(5, shot), Some(5));
+        assert_eq!(unused_number(u32::MAX, shot), None, "no number left");
+    }
 }

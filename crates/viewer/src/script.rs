@@ -118,6 +118,12 @@ pub fn check_writes(action: &Action, inputs: &[(&str, &Path)]) -> Result<(), Str
         Action::SaveCamera(json) => vec![json.clone()],
         _ => return Ok(()),
     };
+    check_files(&files, inputs)
+}
+
+/// [`check_writes`] for files written together (the first one's folder is theirs): the
+/// folder exists, none is a folder, none is one of `inputs`. Also the check of `view --log`.
+pub fn check_files(files: &[PathBuf], inputs: &[(&str, &Path)]) -> Result<(), String> {
     let parent = mirrorbox_files::folder_of(&files[0]);
     if !parent.is_dir() {
         return Err(format!(
@@ -126,7 +132,7 @@ pub fn check_writes(action: &Action, inputs: &[(&str, &Path)]) -> Result<(), Str
             parent.display()
         ));
     }
-    for file in &files {
+    for file in files {
         if file.is_dir() {
             return Err(format!(
                 "{}: would write this file, but it is a folder",

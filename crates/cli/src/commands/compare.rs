@@ -74,13 +74,18 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         .map(|p| output_path("--heatmap", p, "png"))
         .transpose()?;
     if let Some(h) = &heatmap {
-        // The heat map must not overwrite an image being compared.
-        mirrorbox_files::check_distinct(&[
-            ("--heatmap", h.clone()),
-            ("REFERENCE", args.reference.clone()),
-            ("TEST", args.test.clone()),
-        ])
-        .map_err(|e| Failure::BadInput(e.to_string()))?;
+        // The heat map must not overwrite an image being compared (the two inputs may be
+        // one file: an image against itself is a valid, if empty, comparison).
+        for (flag, input) in [("REFERENCE", &args.reference), ("TEST", &args.test)] {
+            if mirrorbox_files::in_resolved_folder(h) == mirrorbox_files::in_resolved_folder(input)
+            {
+                return Err(Failure::BadInput(format!(
+                    "{}: --heatmap would overwrite {flag}, an image being compared; give it \
+                     another name",
+                    h.display()
+                )));
+            }
+        }
     }
     // A NaN, infinite or negative pixel makes the metrics NaN (and hides in `max |d|`).
     let read = |p: &PathBuf| {

@@ -176,7 +176,9 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         (None, None) => (None, String::new()),
     };
     if let Some(log) = &args.log {
-        output_path("--log", log, "jsonl")?;
+        // Written when the window closes: refused now if it would replace an input.
+        let log = output_path("--log", log, "jsonl")?;
+        script::check_files(&[log], &inputs).map_err(|e| bad(format!("--log {e}")))?;
     }
     let size = (scene.camera.width, scene.camera.height);
     let options = ViewOptions {

@@ -198,15 +198,30 @@ pub fn table1_section(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
     b
 }
 
+/// A sweep with no Table 1 to quote, named by its scene (its folder is named by the caller,
+/// [`in_folder`]).
+fn not_the_papers(s: &Sweep) -> ReadmeError {
+    let scene = match s.info.scene.as_str() {
+        "" => "no scene named".to_string(),
+        scene => format!("scene {scene}"),
+    };
+    ReadmeError(format!(
+        "a sweep of {scene}, not the paper's experiment (every n of Table 1 on {}): nothing \
+         to quote",
+        table1::PAPER_SCENE
+    ))
+}
+
+/// A region's error with the sweep folder it was made from in front.
+fn in_folder(dir: &Path, region: Result<String, ReadmeError>) -> Result<String, ReadmeError> {
+    region.map_err(|e| ReadmeError(format!("{}: {}", dir.display(), e.0)))
+}
+
 pub fn table1_region(s: &Sweep) -> Result<String, ReadmeError> {
     let mut blocks = vec![Block::Paragraph(measured_on(s))];
     let section = prose(table1_section(&s.info, &s.records));
     if section.is_empty() {
-        return Err(ReadmeError(format!(
-            "{}: not the paper's experiment (every n of Table 1 on {}), nothing to quote",
-            s.info.scene,
-            table1::PAPER_SCENE
-        )));
+        return Err(not_the_papers(s));
     }
     blocks.extend(section);
     if let Some(fl) = s.records.iter().find(|r| r.kind == "floor") {
@@ -221,13 +236,7 @@ fn table1_summary_region(s: &Sweep) -> Result<String, ReadmeError> {
     let table = prose(table1_section(&s.info, &s.records))
         .into_iter()
         .rfind(|b| matches!(b, Block::Table(..)))
-        .ok_or_else(|| {
-            ReadmeError(format!(
-                "{}: not the paper's experiment (every n of Table 1 on {}), nothing to quote",
-                s.info.scene,
-                table1::PAPER_SCENE
-            ))
-        })?;
+        .ok_or_else(|| not_the_papers(s))?;
     let mut blocks = vec![Block::Paragraph(measured_on(s)), table];
     if let Some(fl) = s.records.iter().find(|r| r.kind == "floor") {
         blocks.push(floor_paragraph(fl));
@@ -545,13 +554,19 @@ pub const REGIONS: &[mirrorbox_report::readme::RegionSource] = &[
         id: "table1",
         source: "table1",
         about: "the reproduction of Table 1, the exact methods beside it, the floor",
-        generate: |reports| table1_region(&load_sweep(&reports.join("table1"))?),
+        generate: |reports| {
+            let dir = reports.join("table1");
+            in_folder(&dir, table1_region(&load_sweep(&dir)?))
+        },
     },
     mirrorbox_report::readme::RegionSource {
         id: "table1-summary",
         source: "table1",
         about: "Table 1's methods at one glance: ms/frame, passes, reflections and error of each point",
-        generate: |reports| table1_summary_region(&load_sweep(&reports.join("table1"))?),
+        generate: |reports| {
+            let dir = reports.join("table1");
+            in_folder(&dir, table1_summary_region(&load_sweep(&dir)?))
+        },
     },
 ];
 
@@ -624,7 +639,8 @@ pub fn device_column(reports: &Path, folder: &str) -> Result<String, ReadmeError
 
 /// [`table1_region`] of the sweep in `reports/<folder>` (another device's Table 1).
 pub fn region_of(reports: &Path, folder: &str) -> Result<String, ReadmeError> {
-    table1_region(&load_sweep(&reports.join(folder))?)
+    let dir = reports.join(folder);
+    in_folder(&dir, table1_region(&load_sweep(&dir)?))
 }
 
 #[cfg(test)]
@@ -780,7 +796,28 @@ mod tests {
             write_report(other.path(), &info(scene), &records[..points], &[SECTION]).unwrap();
             let md = std::fs::read_to_string(other.path().join("report.md")).unwrap();
             assert!(!md.contains("Table 1"), "{scene}, {points} points: {md}");
+            // Nor a region to quote: its error names the scene (and the folder, below).
+            let sweep = Sweep {
+                info: info(scene),
+                records: records[..points].to_vec(),
+            };
+            let e = table1_region(&sweep).unwrap_err().0;
+            assert!(
+                e.starts_with(&format!("a sweep of scene {scene}, not")),
+                "{e}"
+            );
         }
+        let e = in_folder(Path::new("reports/x"), Err(ReadmeError("why".into())));
+        assert_eq!(e.unwrap_err().0, "reports/x: why");
+        let unnamed = Sweep {
+            info: info(""),
+            records: records[..3].to_vec(),
+        };
+        let e = table1_region(&unnamed).unwrap_err().0;
+        assert!(
+            e.starts_with("a sweep of no scene named, not the paper's"),
+            "{e}"
+        );
         for f in [
             "plot_flip_vs_ms.svg",
             "plot_relmse_vs_ms.svg",
