@@ -881,6 +881,51 @@ pub(crate) fn check_output_folder(flag: &str, dir: &Path) -> Result<(), HarnessE
     Ok(())
 }
 
+/// Refuses a sweep into a folder whose records were measured on another scene, size,
+/// sub-pixel grid or number of frames: a folder holds one scene at one size (its report's
+/// heading names one, and its pictures are named by method and axes alone, so a second
+/// scene's would replace the first's under the first's numbers). Before, such a sweep was
+/// accepted and `report` then mixed the two. More methods, values or α into the same folder
+/// are the resumable sweep's purpose, and stay accepted (`--fresh` starts the folder anew).
+fn check_same_sweep(
+    out: &Path,
+    records: &[Record],
+    base_hash: u64,
+    (width, height): (u32, u32),
+    config: &SweepConfig,
+) -> Result<(), HarnessError> {
+    let hash = format!("{base_hash:016x}");
+    let Some(r) = records.iter().find(|r| {
+        r.scene_hash != hash
+            || (r.width, r.height) != (width, height)
+            || r.ssaa != config.ssaa
+            || r.frames != config.frames
+    }) else {
+        return Ok(());
+    };
+    let described = |scene: &str, hash: &str, w: u32, h: u32, ssaa: u32, frames: u32| {
+        format!("{scene} (content {hash}) at {w}×{h}, ssaa {ssaa}, {frames} frames")
+    };
+    Err(HarnessError::OutputFolder {
+        path: out.to_path_buf(),
+        source: std::io::Error::other(format!(
+            "holds points of {} (results.jsonl, point {:?}); this sweep is of {}: one folder \
+             holds one scene at one size, grid and frame count — name another --out, or pass \
+             --fresh to discard its points",
+            described(&r.scene, &r.scene_hash, r.width, r.height, r.ssaa, r.frames),
+            r.key,
+            described(
+                &config.scene.display().to_string(),
+                &hash,
+                width,
+                height,
+                config.ssaa,
+                config.frames
+            ),
+        )),
+    })
+}
+
 /// Whether `path`, as a file we read names it (views.json's truths, a record's pictures),
 /// stays inside the folder it is relative to: not empty, relative, no `..` — so that joined
 /// to that folder it can neither read nor write outside it.
@@ -1182,6 +1227,7 @@ pub fn run_sweep(
     } else {
         read_records(&results)?
     };
+    check_same_sweep(out, &done_before, base_hash, (w, h), config)?;
     // With `drop_refused`, a refused point is left out and said instead.
     let mut refused: Vec<&str> = Vec::new();
     for p in still_to_do(&done_before) {
@@ -1716,6 +1762,52 @@ mod tests {
         let records = read_records(&out.path().join("sweep/results.jsonl")).unwrap();
         let keys: Vec<&str> = records.iter().map(|r| r.method_key()).collect();
         assert_eq!(keys, ["floor", "naive"]);
+    }
+
+    /// A folder holds one scene at one size: a second sweep into it at another size, frame
+    /// count or of another scene is refused before any work, its records untouched; one
+    /// that adds an α to the same scene and size is a resumed sweep, accepted.
+    #[test]
+    fn a_sweep_into_a_folder_of_another_scene_or_size_is_refused() {
+        let out = tempfile::tempdir().unwrap();
+        let scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
+        let config = |scene: &str, width: u32, frames: u32, alpha: f32| {
+            let mut c = SweepConfig::new(
+                scenes.join(scene),
+                out.path().join("sweep"),
+                vec![Method::parse("naive").unwrap()],
+                vec![alpha],
+            );
+            (c.width, c.height, c.frames, c.warmup) = (Some(width), Some(18), frames, 0);
+            c
+        };
+        run_sweep(&config("mirror_box.json", 32, 1, 0.5), false, &mut |_| {}).unwrap();
+        let results = out.path().join("sweep/results.jsonl");
+        let before = std::fs::read(&results).unwrap();
+        for (c, other) in [
+            (config("mirror_box.json", 40, 1, 0.5), "at 40×18"),
+            (config("mirror_box.json", 32, 2, 0.5), "2 frames"),
+            (
+                config("mirror_room.json", 32, 1, 0.5),
+                "scenes/mirror_room.json",
+            ),
+        ] {
+            let e = run_sweep(&c, false, &mut |_| {}).unwrap_err();
+            let text = e.to_string();
+            assert!(e.is_refusal(), "{text}");
+            assert!(
+                text.contains("holds points of") && text.contains("at 32×18, ssaa 1, 1 frames"),
+                "{text}"
+            );
+            assert!(
+                text.contains(other) && text.contains("one folder holds one scene"),
+                "{text}"
+            );
+            assert_eq!(std::fs::read(&results).unwrap(), before, "{text}");
+        }
+        let summary =
+            run_sweep(&config("mirror_box.json", 32, 1, 0.9), false, &mut |_| {}).unwrap();
+        assert_eq!(read_records(&results).unwrap().len(), 3, "{summary:?}");
     }
 
     /// Every point renders once in the settling round before its timed rounds, and only the
