@@ -218,48 +218,7 @@ fn controls(
         });
     for option in method.entry().options {
         let current = method.params().get(option).unwrap_or(option.default);
-        let changed: Option<ParamValue> = match (option.kind, current) {
-            (OptionKind::Count { min, max }, ParamValue::Count(mut v)) => ui
-                .add(
-                    egui::DragValue::new(&mut v)
-                        .range(min..=max.min(4096))
-                        .prefix(format!("{} ", option.name)),
-                )
-                .on_hover_text(option.help)
-                .changed()
-                .then_some(ParamValue::Count(v)),
-            (OptionKind::Real { min, max, .. }, ParamValue::Real(mut v)) => ui
-                .add(
-                    egui::DragValue::new(&mut v)
-                        .range(min..=max.unwrap_or(1e6))
-                        .speed(0.01)
-                        .prefix(format!("{} ", option.name)),
-                )
-                .on_hover_text(option.help)
-                .changed()
-                .then_some(ParamValue::Real(v)),
-            (OptionKind::Switch, ParamValue::Switch(mut v)) => ui
-                .checkbox(&mut v, option.name)
-                .on_hover_text(option.help)
-                .changed()
-                .then_some(ParamValue::Switch(v)),
-            (OptionKind::Choice { values }, ParamValue::Choice(v)) => {
-                let mut chosen = None;
-                egui::ComboBox::from_label(option.name)
-                    .selected_text(v)
-                    .show_ui(ui, |ui| {
-                        for &value in values {
-                            if ui.selectable_label(value == v, value).clicked() {
-                                chosen = Some(ParamValue::Choice(value));
-                            }
-                        }
-                    })
-                    .response
-                    .on_hover_text(option.help);
-                chosen
-            }
-            _ => None,
-        };
+        let changed = option_widget(ui, option, current);
         if let Some(value) = changed {
             match method.clone().with(option, value) {
                 Ok(m) => method = m,
@@ -391,6 +350,59 @@ const GRAPH_SECONDS: f64 = 10.0;
 /// The last seconds of frame times, newest on the right: the method's GPU time and the wall
 /// time between shown frames (which adds planning for a moved camera, the truth's share of
 /// the CPU and the window's own work).
+/// One registry option's widget; the new value where the user changed it this frame. A
+/// count's range is the option's own (`max-passes` goes to 1 000 000): a narrower one would
+/// clamp a value the command line accepts (the panel showed `max-passes 4096` for its
+/// default 5000).
+fn option_widget(
+    ui: &mut egui::Ui,
+    option: &'static mirrorbox_raster::OptionSpec,
+    current: ParamValue,
+) -> Option<ParamValue> {
+    match (option.kind, current) {
+        (OptionKind::Count { min, max }, ParamValue::Count(mut v)) => ui
+            .add(
+                egui::DragValue::new(&mut v)
+                    .range(min..=max)
+                    .prefix(format!("{} ", option.name)),
+            )
+            .on_hover_text(option.help)
+            .changed()
+            .then_some(ParamValue::Count(v)),
+        (OptionKind::Real { min, max, .. }, ParamValue::Real(mut v)) => ui
+            .add(
+                egui::DragValue::new(&mut v)
+                    .range(min..=max.unwrap_or(1e6))
+                    .speed(0.01)
+                    .prefix(format!("{} ", option.name)),
+            )
+            .on_hover_text(option.help)
+            .changed()
+            .then_some(ParamValue::Real(v)),
+        (OptionKind::Switch, ParamValue::Switch(mut v)) => ui
+            .checkbox(&mut v, option.name)
+            .on_hover_text(option.help)
+            .changed()
+            .then_some(ParamValue::Switch(v)),
+        (OptionKind::Choice { values }, ParamValue::Choice(v)) => {
+            let mut chosen = None;
+            egui::ComboBox::from_label(option.name)
+                .selected_text(v)
+                .show_ui(ui, |ui| {
+                    for &value in values {
+                        if ui.selectable_label(value == v, value).clicked() {
+                            chosen = Some(ParamValue::Choice(value));
+                        }
+                    }
+                })
+                .response
+                .on_hover_text(option.help);
+            chosen
+        }
+        _ => None,
+    }
+}
+
 fn frame_graph(ui: &mut egui::Ui, session: &Session) {
     let (rect, _) =
         ui.allocate_exact_size(Vec2::new(ui.available_width(), 70.0), egui::Sense::hover());
@@ -598,5 +610,36 @@ mod tests {
             METHODS[0].name,
             "after the last, the first"
         );
+    }
+
+    /// Every option of every method at its default, its least and its largest value, drawn
+    /// for a few frames of a headless egui context: the widget never changes a value by
+    /// itself (a range narrower than the option's clamped `max-passes` 5000 to 4096).
+    #[test]
+    fn an_option_widget_keeps_every_value_the_option_allows() {
+        let ctx = egui::Context::default();
+        for entry in METHODS {
+            for option in entry.options {
+                let values = match option.kind {
+                    OptionKind::Count { min, max } => {
+                        vec![
+                            option.default,
+                            ParamValue::Count(min),
+                            ParamValue::Count(max),
+                        ]
+                    }
+                    _ => vec![option.default],
+                };
+                for value in values {
+                    for _ in 0..3 {
+                        let mut output = ctx.run_ui(egui::RawInput::default(), |ui| {
+                            let changed = option_widget(ui, option, value);
+                            assert_eq!(changed, None, "{} {}: {value:?}", entry.name, option.name);
+                        });
+                        output.textures_delta.clear();
+                    }
+                }
+            }
+        }
     }
 }
