@@ -461,6 +461,62 @@ pub fn write_overview(
     others: &[OtherReport],
     lead: Lead,
 ) -> Result<usize, ReadmeError> {
+    let o = overview(reports, commit_of, about, others, lead)?;
+    o.write()?;
+    Ok(o.listed)
+}
+
+/// What [`write_overview`] would write: the files with their text, the frontier charts of an
+/// earlier overview it would remove, and how many reports it lists.
+pub struct Overview {
+    pub files: Vec<(PathBuf, String)>,
+    pub stale: Vec<PathBuf>,
+    pub listed: usize,
+}
+
+impl Overview {
+    /// Removes the stale charts, then writes the files.
+    pub fn write(&self) -> Result<(), ReadmeError> {
+        for path in &self.stale {
+            remove_stale(path).map_err(|e| ReadmeError(e.to_string()))?;
+        }
+        for (path, text) in &self.files {
+            write_atomically(path, text.as_bytes()).map_err(|e| ReadmeError(e.to_string()))?;
+        }
+        Ok(())
+    }
+
+    /// Where the files on disk differ from this overview (`report --index --check`): each
+    /// file that is missing or different, each stale chart still there.
+    pub fn differences(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        for (path, text) in &self.files {
+            match std::fs::read_to_string(path) {
+                Ok(on_disk) if on_disk == *text => {}
+                Ok(_) => out.push(format!("{}: differs from the records", path.display())),
+                Err(e) => out.push(format!("{}: {e}", path.display())),
+            }
+        }
+        for path in &self.stale {
+            out.push(format!(
+                "{}: a chart no report draws any more",
+                path.display()
+            ));
+        }
+        out
+    }
+}
+
+/// [`write_overview`]'s files, computed without writing.
+pub fn overview(
+    reports: &Path,
+    commit_of: &dyn Fn(&Path) -> String,
+    about: &dyn Fn(&str) -> Option<String>,
+    others: &[OtherReport],
+    lead: Lead,
+) -> Result<Overview, ReadmeError> {
+    let mut files: Vec<(PathBuf, String)> = Vec::new();
+    let mut stale: Vec<PathBuf> = Vec::new();
     let rel = |p: &Path| {
         p.strip_prefix(reports)
             .unwrap_or(p)
@@ -544,7 +600,7 @@ pub fn write_overview(
                     .iter()
                     .any(|c| c.file == name && c.chart.is_drawable())
             {
-                remove_stale(&e.path()).map_err(|e| ReadmeError(e.to_string()))?;
+                stale.push(e.path());
             }
         }
     }
@@ -595,8 +651,7 @@ pub fn write_overview(
             html.push_str("<h3>Every other device, size and α</h3>\n");
         }
         let svg = c.chart.to_svg();
-        write_atomically(&reports.join(&c.file), svg.as_bytes())
-            .map_err(|e| ReadmeError(e.to_string()))?;
+        files.push((reports.join(&c.file), svg.clone()));
         let _ = writeln!(md, "![{}]({})\n", c.chart.title, c.file);
         let _ = writeln!(html, "<div class=\"chart\">{svg}</div>");
     }
@@ -630,11 +685,13 @@ pub fn write_overview(
         );
     }
     html.push_str("</table></div>\n</body></html>\n");
-    write_atomically(&reports.join("README.md"), md.as_bytes())
-        .map_err(|e| ReadmeError(e.to_string()))?;
-    write_atomically(&reports.join("index.html"), html.as_bytes())
-        .map_err(|e| ReadmeError(e.to_string()))?;
-    Ok(entries.len())
+    files.push((reports.join("README.md"), md));
+    files.push((reports.join("index.html"), html));
+    Ok(Overview {
+        files,
+        stale,
+        listed: entries.len(),
+    })
 }
 
 #[cfg(test)]

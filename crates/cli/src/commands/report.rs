@@ -16,16 +16,36 @@ pub struct Args {
     /// `index.html`, `README.md` and the cross-method frontier charts `frontier_*.svg`.
     #[arg(long, value_name = "REPORTS")]
     index: Option<PathBuf>,
+    /// With --index: write nothing, and fail (exit 1) where the overview on disk differs from
+    /// the one the records give (a record committed without `report --index` after it).
+    #[arg(long, requires = "index")]
+    check: bool,
 }
 
 pub fn run(args: &Args) -> Result<(), Failure> {
     if let Some(reports) = &args.index {
         // What was found leads the overview, each finding with its figure, its links relative
-        // to `reports/` as written.
-        let findings = mirrorbox_experiments::findings::findings_with_figures(reports)
-            .map_err(|e| Failure::BadInput(format!("{}: the findings: {e}", reports.display())))?;
-        let lead = mirrorbox_experiments::findings::rebased(&findings, "", "../");
-        let n = mirrorbox_report::overview::write_overview(
+        // to `reports/` as written. The findings are the project's, computed from its
+        // experiments' folders: a folder of one's own sweeps, which holds none of them, gets
+        // the overview without them (before, it was refused for lacking `table1/`).
+        let experiments = mirrorbox_experiments::EXPERIMENTS
+            .iter()
+            .any(|e| reports.join(e.folder).exists());
+        let lead = if experiments {
+            let findings = mirrorbox_experiments::findings::findings_with_figures(reports)
+                .map_err(|e| {
+                    Failure::BadInput(format!("{}: the findings: {e}", reports.display()))
+                })?;
+            mirrorbox_experiments::findings::rebased(&findings, "", "../")
+        } else {
+            println!(
+                "{}: none of the experiments' folders (`mirrorbox experiment --list`): the \
+                 overview lists the reports without the project's findings",
+                reports.display()
+            );
+            String::new()
+        };
+        let overview = mirrorbox_report::overview::overview(
             reports,
             &records_commit,
             &about,
@@ -33,10 +53,29 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             mirrorbox_report::overview::Lead(&lead),
         )
         .map_err(|e| Failure::BadInput(format!("{}: {e}", reports.display())))?;
+        if args.check {
+            let differences = overview.differences();
+            if !differences.is_empty() {
+                return Err(Failure::Other(format!(
+                    "{}\nthe overview is not the records': run `mirrorbox report --index {}`",
+                    differences.join("\n"),
+                    reports.display()
+                )));
+            }
+            println!(
+                "{}: the overview agrees with the records ({})",
+                reports.display(),
+                crate::count(overview.listed, "report")
+            );
+            return Ok(());
+        }
+        overview
+            .write()
+            .map_err(|e| Failure::BadInput(format!("{}: {e}", reports.display())))?;
         println!(
             "{}: index.html and README.md list {}",
             reports.display(),
-            crate::count(n, "report")
+            crate::count(overview.listed, "report")
         );
     }
     for dir in &args.dirs {
