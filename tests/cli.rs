@@ -936,7 +936,7 @@ fn trace_on_the_gpu_writes_the_cpu_truth_and_caps_its_depth() {
                 .stdout
                 .contains("48x27, 4 spp (the 2×2 grid), whitted to 4096 reflections")
             && out.stdout.contains(
-                "(the GPU follows at most 4096 reflections; --max-depth 10000 was capped)"
+                "(the GPU follows at most 4096 reflections; the default depth 10000 was capped)"
             ),
         "{}",
         out.stdout
@@ -1280,6 +1280,51 @@ fn compare_reports_metrics_and_refuses_mismatched_sizes() {
         );
         assert_eq!(std::fs::read(target).unwrap(), before, "{flag} untouched");
     }
+    // The exposure the EXRs record (the scene camera's) is the default: a scene at exposure
+    // 4 is compared as `--exposure 4` would compare it; images made with different ones
+    // need the flag.
+    let mut bright: Value = serde_json::from_str(
+        &std::fs::read_to_string(repo().join("scenes/mirror_box.json")).unwrap(),
+    )
+    .unwrap();
+    bright["camera"]["exposure"] = serde_json::json!(4.0);
+    let bright_scene = dir.path().join("bright.json");
+    std::fs::write(&bright_scene, bright.to_string()).unwrap();
+    let (c, d) = (dir.path().join("c.exr"), dir.path().join("d.exr"));
+    for (p, r) in [(&c, "1"), (&d, "0.5")] {
+        let mut args = trace_args(p.to_str().unwrap(), &["--reflectance", r]);
+        args[1] = bright_scene.to_str().unwrap();
+        let out = mirrorbox(&args, &[]);
+        assert_eq!(out.code, 0, "{}", out.stderr);
+    }
+    let json = |extra: &[&str]| {
+        let mut args = vec![
+            "compare",
+            c.to_str().unwrap(),
+            d.to_str().unwrap(),
+            "--json",
+        ];
+        args.extend(extra);
+        let out = mirrorbox(&args, &[]);
+        assert_eq!(out.code, 0, "{}", out.stderr);
+        serde_json::from_str::<Value>(out.stdout.trim()).unwrap()
+    };
+    let (recorded, given, one) = (
+        json(&[]),
+        json(&["--exposure", "4"]),
+        json(&["--exposure", "1"]),
+    );
+    assert_eq!(recorded["exposure"], 4.0);
+    assert_eq!(recorded, given);
+    assert_ne!(recorded["flip_mean"], one["flip_mean"]);
+    let mixed = mirrorbox(&["compare", a.to_str().unwrap(), d.to_str().unwrap()], &[]);
+    assert_eq!(mixed.code, 2, "{}", mixed.stderr);
+    assert!(
+        mixed.stderr.contains("was made with exposure 4")
+            && mixed.stderr.contains("give --exposure"),
+        "{}",
+        mixed.stderr
+    );
     // A different size, and a file that is not there.
     let small = dir.path().join("small.exr");
     mirrorbox(
@@ -2014,30 +2059,47 @@ fn every_command_refuses_an_output_in_a_missing_folder() {
 #[test]
 fn report_rewrites_a_sweep_folder_from_its_records() {
     let from = repo().join("reports/gpu/table1");
-    let dir = tempfile::tempdir().unwrap();
+    let root = tempfile::tempdir().unwrap();
+    let dir = root.path().join("my_sweep");
+    std::fs::create_dir(&dir).unwrap();
     for f in ["sweep.json", "results.jsonl"] {
-        std::fs::copy(from.join(f), dir.path().join(f)).unwrap();
+        std::fs::copy(from.join(f), dir.as_path().join(f)).unwrap();
     }
     // The rows' images (their insets are made again from them).
-    std::fs::create_dir(dir.path().join("images")).unwrap();
+    std::fs::create_dir(dir.as_path().join("images")).unwrap();
     for e in std::fs::read_dir(from.join("images")).unwrap().flatten() {
         let name = e.file_name().to_string_lossy().into_owned();
         if !name.ends_with("_inset.png") {
-            std::fs::copy(e.path(), dir.path().join("images").join(&name)).unwrap();
+            std::fs::copy(e.path(), dir.as_path().join("images").join(&name)).unwrap();
         }
     }
-    let out = mirrorbox(&["report", dir.path().to_str().unwrap()], &[]);
+    let out = mirrorbox(&["report", dir.as_path().to_str().unwrap()], &[]);
     assert_eq!(out.code, 0, "stderr: {}", out.stderr);
     assert!(out.stdout.contains("from 15 records"), "{}", out.stdout);
     let want = std::fs::read_to_string(from.join("report.md")).unwrap();
-    let have = std::fs::read_to_string(dir.path().join("report.md")).unwrap();
+    let have = std::fs::read_to_string(dir.as_path().join("report.md")).unwrap();
     assert_eq!(
         have, want,
         "run `mirrorbox report reports/gpu/table1` after changing the report"
     );
     for f in ["report.html", "results.csv", "plot_flip_vs_ms.svg"] {
-        assert!(dir.path().join(f).is_file(), "{f} not written");
+        assert!(dir.as_path().join(f).is_file(), "{f} not written");
     }
+    // The overview of a folder of one's own sweeps: no experiment's folder, so no findings
+    // (before: refused for lacking `table1/`).
+    let index = mirrorbox(&["report", "--index", root.path().to_str().unwrap()], &[]);
+    assert_eq!(index.code, 0, "stderr: {}", index.stderr);
+    assert!(
+        index.stdout.contains("without the project's findings")
+            && index.stdout.contains("list 1 report"),
+        "{}",
+        index.stdout
+    );
+    let overview = std::fs::read_to_string(root.path().join("README.md")).unwrap();
+    assert!(
+        overview.contains("my_sweep") && !overview.contains("What was found"),
+        "{overview}"
+    );
 
     let empty = tempfile::tempdir().unwrap();
     let out = mirrorbox(&["report", empty.path().to_str().unwrap()], &[]);

@@ -12,9 +12,10 @@ pub struct Args {
     reference: PathBuf,
     /// Test image of the same size.
     test: PathBuf,
-    /// Exposure of the tone mapping for PSNR, SSIM and FLIP (the scene camera's; default 1).
-    #[arg(long, default_value_t = 1.0)]
-    exposure: f32,
+    /// Exposure of the tone mapping for PSNR, SSIM and FLIP. Default: the scene camera's
+    /// exposure that `trace` and `render` record in their EXRs (`mirrorbox.exposure`), else 1.
+    #[arg(long)]
+    exposure: Option<f32>,
     /// Print one JSON object.
     #[arg(long)]
     json: bool,
@@ -46,6 +47,53 @@ fn samples_per_pixel(path: &std::path::Path) -> Option<u64> {
     value("mirrorbox.spp").or_else(|| value("mirrorbox.ssaa").map(|s| s * s))
 }
 
+/// The exposure an image was made with: the `mirrorbox.exposure` that `trace` and `render`
+/// write into their EXRs (the scene camera's); `None` for other images (a PNG is already
+/// exposed and encoded).
+fn recorded_exposure(path: &std::path::Path) -> Option<f32> {
+    let attributes = mirrorbox_image::read_exr_attributes(path).ok()?;
+    attributes
+        .iter()
+        .find(|(k, _)| k == "mirrorbox.exposure")
+        .and_then(|(_, v)| v.parse::<f32>().ok())
+        .filter(|e| *e > 0.0 && e.is_finite())
+}
+
+/// The tone mapping's exposure: `--exposure`, else the one both images record, else 1. Images
+/// recording different exposures, or one recording an exposure other than 1 beside one that
+/// records none, are refused without `--exposure`: no one value fits both.
+fn exposure(args: &Args) -> Result<f32, Failure> {
+    if let Some(e) = args.exposure {
+        if !(e > 0.0 && e.is_finite()) {
+            return Err(Failure::BadInput(format!(
+                "--exposure must be a positive number, got {e}"
+            )));
+        }
+        return Ok(e);
+    }
+    let (r, t) = (
+        recorded_exposure(&args.reference),
+        recorded_exposure(&args.test),
+    );
+    match (r, t) {
+        (Some(a), Some(b)) if a == b => Ok(a),
+        (None, None) => Ok(1.0),
+        (Some(a), None) | (None, Some(a)) if a == 1.0 => Ok(1.0),
+        _ => {
+            let said = |p: &std::path::Path, e: Option<f32>| {
+                e.map_or(format!("{} records no exposure", p.display()), |e| {
+                    format!("{} was made with exposure {e}", p.display())
+                })
+            };
+            Err(Failure::BadInput(format!(
+                "{} and {}: give --exposure",
+                said(&args.reference, r),
+                said(&args.test, t)
+            )))
+        }
+    }
+}
+
 /// Refuses images sampled on different sub-pixel grids: a 4×4 box average and a pixel-centre
 /// sample differ wherever the image curves, and that difference would be read as the
 /// method's error (the shading contract: never from mismatched sampling).
@@ -62,12 +110,7 @@ fn check_same_grid(reference: &std::path::Path, test: &std::path::Path) -> Resul
 }
 
 pub fn run(args: &Args) -> Result<(), Failure> {
-    if !(args.exposure > 0.0 && args.exposure.is_finite()) {
-        return Err(Failure::BadInput(format!(
-            "--exposure must be a positive number, got {}",
-            args.exposure
-        )));
-    }
+    let exposure = exposure(args)?;
     let heatmap = args
         .heatmap
         .as_deref()
@@ -96,7 +139,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         }
     };
     let (r, t) = (read(&args.reference)?, read(&args.test)?);
-    let m = compare(&r, &t, args.exposure).map_err(|e| {
+    let m = compare(&r, &t, exposure).map_err(|e| {
         Failure::BadInput(format!(
             "{} vs {}: {e}",
             args.reference.display(),
@@ -106,8 +149,8 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     check_same_grid(&args.reference, &args.test)?;
     if let Some(path) = &heatmap {
         let map = flip_map(
-            &r.to_srgb8(args.exposure),
-            &t.to_srgb8(args.exposure),
+            &r.to_srgb8(exposure),
+            &t.to_srgb8(exposure),
             r.width,
             r.height,
         );
@@ -116,7 +159,9 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             .map_err(|e| Failure::Other(e.to_string()))?;
     }
     if args.json {
-        println!("{}", metrics_json(&m));
+        let mut v = metrics_json(&m);
+        v["exposure"] = serde_json::json!(exposure);
+        println!("{v}");
     } else {
         println!(
             "{} vs {} ({}x{}):",
@@ -130,7 +175,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             m.rmse, m.relmse, m.smape, m.max_abs
         );
         println!(
-            "  sRGB:    PSNR {:.2} dB  SSIM {:.6}  FLIP mean {:.4e} p95 {:.4e} p99 {:.4e} ({} px/deg)",
+            "  sRGB:    PSNR {:.2} dB  SSIM {:.6}  FLIP mean {:.4e} p95 {:.4e} p99 {:.4e} ({} px/deg; exposure {exposure})",
             m.psnr, m.ssim, m.flip_mean, m.flip_p95, m.flip_p99, FLIP_PIXELS_PER_DEGREE
         );
     }

@@ -185,6 +185,7 @@ fn run_frame(args: &Args, carry: &mut Carry) -> Result<(), Failure> {
                 "mirrorbox.scene_hash",
                 format!("{:016x}", view.content_hash()),
             ),
+            ("mirrorbox.exposure", view.camera.exposure.to_string()),
             ("mirrorbox.method", method.to_string()),
             ("mirrorbox.alpha", alpha.clone()),
             ("mirrorbox.ssaa", args.ssaa.to_string()),
@@ -302,15 +303,15 @@ fn summary(
             println!("stereo pair (both eyes in one frame; counts and times are the pair's):");
         }
         println!(
-            "rendered {} with {method_text}, alpha {alpha}: {}x{}, ssaa {}; {} passes ({} texture renders, {} reflections deep), {} draws per frame; depth {:?}, mirrors clipped by {}",
+            "rendered {} with {method_text}, alpha {alpha}: {}x{}, ssaa {}; {} ({}, {} reflections deep), {} per frame; depth {:?}, mirrors clipped by {}",
             args.scene.display(),
             scene.camera.width,
             scene.camera.height,
             args.ssaa,
-            s.passes,
-            s.texture_renders,
+            crate::count(s.passes, "pass"),
+            crate::count(s.texture_renders, "texture render"),
             s.depth,
-            s.draws,
+            crate::count(s.draws, "draw"),
             s.depth_format,
             s.clipping.name()
         );

@@ -445,6 +445,7 @@ fn stage_view(
             "mirrorbox.scene_hash",
             format!("{:016x}", scene.content_hash()),
         ),
+        ("mirrorbox.exposure", scene.camera.exposure.to_string()),
         (
             "mirrorbox.integrator",
             format!("{:?}", args.integrator).to_lowercase(),
@@ -585,7 +586,7 @@ fn report(
         return;
     }
     println!(
-        "traced {}: {w}x{h}, {} spp ({}x{} grid{}), {} rays, {mrays:.2} Mrays/s, deepest path {} bounces, {secs:.2} s on {} threads",
+        "traced {}: {w}x{h}, {} spp ({}x{} grid{}), {} rays, {mrays:.2} Mrays/s, deepest path {} bounces, {} on {}",
         args.scene.display(),
         grid.samples_per_pixel(),
         grid.per_axis,
@@ -593,7 +594,13 @@ fn report(
         if args.jitter { ", jittered" } else { "" },
         s.rays,
         s.deepest,
-        out.threads,
+        // A small render takes milliseconds: "0.00 s" beside its rate said nothing.
+        if secs < 1.0 {
+            format!("{:.1} ms", secs * 1e3)
+        } else {
+            format!("{secs:.2} s")
+        },
+        crate::count(out.threads, "thread"),
     );
     println!(
         "  {} paths ended: {} at diffuse surfaces, {} escaped, {} cut by {} {}, {} cut by --min-throughput {}{}",
@@ -708,6 +715,7 @@ fn trace_on_gpu(
                 "mirrorbox.scene_hash",
                 format!("{:016x}", view.content_hash()),
             ),
+            ("mirrorbox.exposure", view.camera.exposure.to_string()),
             (
                 "mirrorbox.integrator",
                 "whitted (gpu ray queries)".to_string(),
@@ -768,10 +776,12 @@ fn trace_on_gpu(
             whitted.min_throughput,
         );
         if whitted.max_depth > depth_cap {
-            println!(
-                "  (the GPU follows at most {depth_cap} reflections; --max-depth {} was capped)",
-                whitted.max_depth
-            );
+            // Named as the user gave it: the flag, or the default they did not change.
+            let asked = match args.max_depth {
+                Some(d) => format!("--max-depth {d} was capped"),
+                None => format!("the default depth {} was capped", whitted.max_depth),
+            };
+            println!("  (the GPU follows at most {depth_cap} reflections; {asked})");
         }
         println!(
             "  lighting: {}\n  trace {gpu_ms:.2} ms ({}); acceleration structures {build_ms:.2} ms; \
