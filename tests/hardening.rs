@@ -100,7 +100,7 @@ fn edge_cases_are_refused_with_a_clear_message_and_nothing_written() {
         // 6.5 M triangles in a 1.3 KB file: refused before tessellating, with the memory.
         (
             own(&["check", heavy]),
-            vec!["objects[12]", "at most 4194304", "GB"],
+            vec!["objects[12]", "at most 4194304", "GiB"],
         ),
         (own(&["render", heavy, "-o", png]), vec!["objects[12]"]),
         // Sizes that used to abort for memory.

@@ -116,10 +116,12 @@ fn die_quietly_on_closed_pipe() {
     }
 }
 
-/// `n thing` or `n things`.
+/// `n thing` or `n things` (`n passes` for a word ending in s, x, ch or sh).
 pub fn count(n: usize, thing: &str) -> String {
     if n == 1 {
         format!("1 {thing}")
+    } else if ["s", "x", "ch", "sh"].iter().any(|e| thing.ends_with(e)) {
+        format!("{n} {thing}es")
     } else {
         format!("{n} {thing}s")
     }

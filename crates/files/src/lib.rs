@@ -300,9 +300,16 @@ pub fn with_stem_suffix(path: &Path, suffix: &str) -> PathBuf {
     path.with_file_name(name)
 }
 
-/// `1.5 GB`, `36 KB`, `12 bytes` (decimal units, as disks and memory are sold).
+/// `1.5 GiB`, `35.2 KiB`, `12 bytes`: binary units, as `--memory-budget` reads them
+/// (`2G` is 2 GiB) and the plans' estimates and the reports' memory columns print them, so
+/// that one output never mixes the two kinds.
 pub fn human_bytes(n: u64) -> String {
-    const UNITS: [(&str, f64); 4] = [("TB", 1e12), ("GB", 1e9), ("MB", 1e6), ("KB", 1e3)];
+    const UNITS: [(&str, f64); 4] = [
+        ("TiB", (1u64 << 40) as f64),
+        ("GiB", (1u64 << 30) as f64),
+        ("MiB", (1u64 << 20) as f64),
+        ("KiB", 1024.0),
+    ];
     for (unit, size) in UNITS {
         if n as f64 >= size {
             return format!("{:.1} {unit}", n as f64 / size);
@@ -515,7 +522,9 @@ mod tests {
     #[test]
     fn sizes_read_as_people_say_them() {
         assert_eq!(human_bytes(12), "12 bytes");
-        assert_eq!(human_bytes(36_000), "36.0 KB");
-        assert_eq!(human_bytes(34_359_738_368), "34.4 GB");
+        assert_eq!(human_bytes(36_000), "35.2 KiB");
+        assert_eq!(human_bytes(34_359_738_368), "32.0 GiB");
+        assert_eq!(human_bytes(1023), "1023 bytes");
+        assert_eq!(human_bytes(1024), "1.0 KiB");
     }
 }

@@ -78,12 +78,12 @@ pub fn image_size(width: u32, height: u32) -> Result<(u32, u32), SettingError> {
         return Err(SettingError::new(
             "--width × --height",
             format!(
-                "at most {MAX_PIXELS} pixels (8192²; each float image of that size takes {:.1} GB)",
-                (MAX_PIXELS * 12) as f64 / 1e9
+                "at most {MAX_PIXELS} pixels (8192²; each float image of that size takes {})",
+                mirrorbox_files::human_bytes(MAX_PIXELS * 12)
             ),
             format!(
-                "{width}×{height} = {pixels} (would need {:.1} GB per image)",
-                (pixels * 12) as f64 / 1e9
+                "{width}×{height} = {pixels} (would need {} per image)",
+                mirrorbox_files::human_bytes(pixels * 12)
             ),
         ));
     }
@@ -124,7 +124,7 @@ mod tests {
         assert_eq!(e, "--width must be in [1, 16384] pixels, got 0");
         assert!(image_side("--height", 2_147_483_648u64 as u32).is_err());
         let e = image_size(16384, 16384).unwrap_err().to_string();
-        assert!(e.contains("3.2 GB per image"), "{e}");
+        assert!(e.contains("3.0 GiB per image"), "{e}");
     }
 
     #[test]

@@ -1491,7 +1491,7 @@ mod tests {
         let many = vec![sphere; 13].join(", ");
         let e = refused(&format!(r#", "objects": [ {many} ]"#));
         assert!(
-            e.contains("objects[12]") && e.contains("at most 4194304") && e.contains("GB"),
+            e.contains("objects[12]") && e.contains("at most 4194304") && e.contains("GiB"),
             "{e}"
         );
     }

@@ -56,7 +56,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         done.files
     );
     println!(
-        "next: draw each view of {0}/views.json from {0}/scene.gltf into RUN/<client>/<variant>/<view>.exr, then mirrorbox score {0} RUN",
+        "next: draw each view of {0}/views.json from {0}/scene.gltf into RUN/<client>/<variant>/<view>.exr, then mirrorbox score {0} RUN -o OUT",
         args.output.display()
     );
     Ok(())

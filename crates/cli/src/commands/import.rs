@@ -57,13 +57,13 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         .map_err(|e| Failure::Other(e.to_string()))?;
     let g = &loaded.geometry;
     println!(
-        "wrote {}: {} in a mirror box ({} triangles, {} textures, {} mirrors, {} lights)",
+        "wrote {}: {} in a mirror box ({}, {}, {}, {})",
         out.display(),
         args.asset.display(),
-        g.triangles.len(),
-        g.textures.len(),
-        loaded.mirrors.len(),
-        loaded.lighting.lights.len()
+        crate::count(g.triangles.len(), "triangle"),
+        crate::count(g.textures.len(), "texture"),
+        crate::count(loaded.mirrors.len(), "mirror"),
+        crate::count(loaded.lighting.lights.len(), "light")
     );
     for note in &g.obj_notes {
         println!("  note: {note}");

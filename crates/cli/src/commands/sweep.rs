@@ -575,10 +575,10 @@ fn execute(config: &SweepConfig, fresh: bool) -> Result<(), Failure> {
     }
     let summary = result?;
     println!(
-        "sweep done in {:.1} s (peak memory {}): {} points computed, {} reused{}; truths: {} traced, {} from cache; wrote {}",
+        "sweep done in {:.1} s (peak memory {}): {} computed, {} reused{}; truths: {} traced, {} from cache; wrote {}",
         started.elapsed().as_secs_f64(),
         super::peak_memory().unwrap_or_else(|| "unknown".into()),
-        summary.computed,
+        crate::count(summary.computed, "point"),
         summary.reused,
         match summary.unsupported {
             0 => String::new(),

@@ -121,7 +121,11 @@ pub fn section(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
                 mirrorbox_report::document::label(e),
                 sci(e.mirror_flip())
             )),
-            None => s.push_str("; none of our exact methods is as cheap."),
+            // Said only where our exact methods were measured beside it (`score --with`).
+            None if ours.iter().any(|o| info.exact_methods.contains(&o.method)) => {
+                s.push_str("; none of our exact methods is as cheap.")
+            }
+            None => s.push('.'),
         }
         findings.push(s);
     }
@@ -153,4 +157,49 @@ pub fn section(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
         ),
         Block::Bullets(findings),
     ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use mirrorbox_report::document::fixtures::record;
+
+    fn finding(records: &[Record]) -> String {
+        let info = SweepInfo {
+            exact_methods: vec!["portal".into()],
+            ..Default::default()
+        };
+        let blocks = section(&info, records);
+        blocks
+            .iter()
+            .find_map(|b| match b {
+                Block::Bullets(items) => items
+                    .iter()
+                    .find(|i| i.starts_with("**three-reflector**"))
+                    .cloned(),
+                _ => None,
+            })
+            .expect("a finding for the variant")
+    }
+
+    /// "None of our exact methods is as cheap" is said only where ours were measured beside
+    /// the variant: a score without `--with` has none to compare.
+    #[test]
+    fn the_exact_comparison_is_said_only_where_ours_were_measured() {
+        let mut variant = record(0, 2.0, 1, 0.05);
+        variant.method = "three-reflector".into();
+        variant.timing_order = mirrorbox_report::EXTERNAL_TIMING.into();
+        let alone = finding(std::slice::from_ref(&variant));
+        assert!(!alone.contains("exact"), "{alone}");
+        let mut portal = record(0, 5.0, 1, 0.001);
+        portal.method = "portal".into();
+        let beside = finding(&[variant.clone(), portal.clone()]);
+        assert!(
+            beside.ends_with("; none of our exact methods is as cheap."),
+            "{beside}"
+        );
+        portal.ms_median = 1.0;
+        let cheaper = finding(&[variant, portal]);
+        assert!(cheaper.contains("at no more cost our `portal"), "{cheaper}");
+    }
 }
