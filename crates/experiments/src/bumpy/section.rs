@@ -165,6 +165,28 @@ pub fn sentences(records: &[Record], bump_methods: &[String]) -> Vec<String> {
                 sci(distorts[0].metrics.flip_mean.min(flip(distorts[n - 1])))
             )),
         }
+        // The main method's best other trick, where it beats every distortion strength: a
+        // sentence naming only the distortions would hide it.
+        let other = at
+            .iter()
+            .copied()
+            .filter(|r| {
+                let v = variant_of(r, &main, bump_methods);
+                !v.contains(": ")
+                    && v != "flat"
+                    && !v.starts_with("distort ")
+                    && !winners.iter().any(|w| std::ptr::eq(*w, *r))
+            })
+            .min_by(|a, b| flip(a).total_cmp(&flip(b)));
+        if let Some(o) = other
+            && distorts.first().is_some_and(|d| flip(o) < flip(d))
+        {
+            s.push_str(&format!(
+                "; {} ({}) is closer than any distortion strength",
+                name(o),
+                sci(o.metrics.flip_mean)
+            ));
+        }
         s.push('.');
         out.push(s);
     }
@@ -484,6 +506,15 @@ mod tests {
         );
         assert!(
             s.contains("best distortion strength is `distort ×1` (1.500e-1)"),
+            "{s}"
+        );
+        assert!(!s.contains("closer than any distortion"), "{s}");
+        // Another trick of the method that beats every distortion strength is named too.
+        let mut more = records.clone();
+        more.push(record("bump=proxy", 5.0, 0.1));
+        let s = sentences(&more, &bump()).join("\n");
+        assert!(
+            s.contains("; `proxy at 2` (1.000e-1) is closer than any distortion strength."),
             "{s}"
         );
         assert!(uneven_section(&records, &bump()).len() >= 5);

@@ -123,16 +123,32 @@ pub fn sentences(records: &[Record]) -> Vec<String> {
         d.sort_by_key(|r| r.lights_depth());
         d
     };
-    if let (Some(first), Some(last)) = (direct.first(), direct.last())
-        && first.lights_depth() != last.lights_depth()
+    // The first depth with mirrored light to miss, against the same depth lit through the
+    // mirrors (its shading apart from that light: no shadows either), then the deepest. At
+    // the shallowest depth (k = 0) nothing is mirrored: what is left there is the shadows.
+    if let (Some(first), Some(second), Some(last)) = (direct.first(), direct.get(1), direct.last())
     {
+        let k = |r: &Record| r.lights_depth().unwrap_or(0);
+        let lit = points.iter().copied().find(|r| {
+            method_of(r) == method && k(r) == k(second) && lighting_of(r) == "mirrored, no shadows"
+        });
         out.push(format!(
-            "The error of ignoring mirrored light grows with the truth's depth: FLIP mean {} at \
-             k = {} to {} at k = {}.",
+            "The error of ignoring mirrored light (`{method}` with `lights=direct`, no shadows) \
+             appears at the first mirrored depth: FLIP mean {} at k = {} (no mirrored light to \
+             miss: what is left is the shadows), {} at k = {}{}{}.",
             sci(first.metrics.flip_mean),
-            first.lights_depth().unwrap_or(0),
-            sci(last.metrics.flip_mean),
-            last.lights_depth().unwrap_or(0)
+            k(first),
+            sci(second.metrics.flip_mean),
+            k(second),
+            lit.map_or(String::new(), |l| format!(
+                " (lit through the mirrors: {})",
+                sci(l.metrics.flip_mean)
+            )),
+            if k(last) == k(second) {
+                String::new()
+            } else {
+                format!(", {} at k = {}", sci(last.metrics.flip_mean), k(last))
+            }
         ));
     }
     out
@@ -394,7 +410,22 @@ mod tests {
             s.contains("mirrored, no shadows: FLIP mean 5.000e-2"),
             "{s}"
         );
-        assert!(s.contains("1.000e-2 at k = 0 to 2.000e-1 at k = 8"), "{s}");
+        assert!(
+            s.contains(
+                "1.000e-2 at k = 0 (no mirrored light to miss: what is left is the shadows), \
+                 2.000e-1 at k = 8 (lit through the mirrors: 5.000e-2)."
+            ),
+            "{s}"
+        );
+        // With a depth between: the first mirrored depth against its lit twin, then the deepest.
+        let mut deeper = records.clone();
+        deeper.push(record("unrolled", "lights=direct", 1, 0.15));
+        deeper.push(record("unrolled", "", 1, 0.03));
+        let s = sentences(&deeper).join("\n");
+        assert!(
+            s.contains("1.500e-1 at k = 1 (lit through the mirrors: 3.000e-2), 2.000e-1 at k = 8."),
+            "{s}"
+        );
         assert!(lighting_section(&records).len() >= 5);
         // Not a mirrored-lights sweep: no section.
         let mut plain = records[0].clone();
