@@ -10,7 +10,8 @@
 //!   is an annotation (a shaded band, or a note when it lies far below the data), never a
 //!   reason to stretch the axis;
 //! - reference curves (2^p, one full-scene pass) are dashed grey and named "reference: …";
-//! - point labels never overprint: a label that would touch another is left out;
+//! - point labels never overprint: a label that would touch another is left out, and so is
+//!   one that would lie as near another point as its own (it would read as that point's);
 //! - markers of series that coincide are drawn as rings around each other, and the legend says
 //!   which series it coincides with;
 //! - a footer names the scene, size, device, date and commit ([`Chart::footer`]);
@@ -432,6 +433,57 @@ impl Rect {
     }
 }
 
+/// Where a point's label goes, `lw` pixels wide beside the marker of radius `r` at `(xx, yy)`:
+/// the first of right-above, right-below, left-above, left-below that stays inside the plot,
+/// touches nothing `taken` (markers and placed labels; its own marker aside) and lies nearer
+/// its own point than any other of `markers` (else it would read as that point's label).
+/// `None`: the label is left out. Returns the text's baseline origin and its box.
+fn place_label(
+    (xx, yy): (f64, f64),
+    r: f64,
+    lw: f64,
+    markers: &[(f64, f64)],
+    taken: &[Rect],
+) -> Option<(f64, f64, Rect)> {
+    let candidates = [
+        (xx + r + 2.0, yy - r - 1.0),
+        (xx + r + 2.0, yy + r + 9.0),
+        (xx - r - 2.0 - lw, yy - r - 1.0),
+        (xx - r - 2.0 - lw, yy + r + 9.0),
+    ];
+    let own = Rect {
+        x0: xx - r,
+        y0: yy - r,
+        x1: xx + r,
+        y1: yy + r,
+    };
+    candidates.iter().find_map(|&(lx, ly)| {
+        let rect = Rect {
+            x0: lx,
+            y0: ly - 9.0,
+            x1: lx + lw,
+            y1: ly + 1.0,
+        };
+        let inside = rect.x0 >= LEFT
+            && rect.x1 <= LEFT + PLOT_W
+            && rect.y0 >= TOP
+            && rect.y1 <= TOP + PLOT_H;
+        let gap = |(px, py): (f64, f64)| {
+            let dx = (rect.x0 - px).max(px - rect.x1).max(0.0);
+            let dy = (rect.y0 - py).max(py - rect.y1).max(0.0);
+            dx.hypot(dy)
+        };
+        let mine = gap((xx, yy));
+        let ambiguous = markers.iter().any(|&m| m != (xx, yy) && gap(m) <= mine);
+        (inside
+            && !ambiguous
+            && !taken
+                .iter()
+                .any(|t| t.overlaps(&rect) && !(t.x0 == own.x0 && t.y0 == own.y0)))
+        .then_some((lx, ly, rect))
+    })
+}
+
 fn marker_svg(s: &mut String, style: &Style, x: f64, y: f64, r: f64, hollow: bool) {
     let c = style.color;
     let (fill, stroke) = if hollow {
@@ -743,14 +795,27 @@ impl Chart {
         enum Shows<'a> {
             Series(&'a Series),
             Reference(&'a Reference),
+            /// What a ring around a marker means, where a series' name does not say it.
+            Ring,
         }
         let mut legend: Vec<(String, Shows)> = Vec::new();
+        // Points drawn as rings (an earlier marker at the same place) in a series whose
+        // legend entry does not say which series it lies on.
+        let mut seen: Vec<(i64, i64)> = Vec::new();
+        let mut unexplained_rings = false;
         for (i, series) in self.series.iter().enumerate() {
             let mine: Vec<_> = visible(series).into_iter().map(key).collect();
             let same = self.series[..i].iter().find(|o| {
                 let theirs: Vec<_> = visible(o).into_iter().map(key).collect();
                 !mine.is_empty() && mine.iter().all(|k| theirs.contains(k))
             });
+            for k in &mine {
+                if seen.contains(k) {
+                    unexplained_rings |= same.is_none();
+                } else {
+                    seen.push(*k);
+                }
+            }
             let name = match same {
                 Some(o) => format!("{} (on {})", series.name, o.name),
                 None => series.name.clone(),
@@ -763,6 +828,12 @@ impl Chart {
                 Reference::Mark(n, _) => n.clone(),
             };
             legend.push((name, Shows::Reference(r)));
+        }
+        if unexplained_rings {
+            legend.push((
+                "ring: a point at the same place as an earlier one".into(),
+                Shows::Ring,
+            ));
         }
         let legend_chars = legend
             .iter()
@@ -988,6 +1059,8 @@ impl Chart {
         let mut occupied: Vec<((i64, i64), usize)> = Vec::new();
         let mut taken: Vec<Rect> = Vec::new();
         let mut label_queue: Vec<(f64, f64, f64, &str, &'static str)> = Vec::new();
+        // Every marker's centre: a label must lie nearer its own point than any other.
+        let mut markers: Vec<(f64, f64)> = Vec::new();
         for series in &self.series {
             for (k, &(x, y)) in series.points.iter().enumerate() {
                 if !(drawable(x, ax.log) && drawable(y, ay.log)) {
@@ -1023,6 +1096,7 @@ impl Chart {
                     x1: xx + r,
                     y1: yy + r,
                 });
+                markers.push((xx, yy));
                 if let Some(label) = series.labels.get(k).filter(|l| !l.is_empty()) {
                     label_queue.push((xx, yy, r, label, series.style.color));
                 }
@@ -1049,35 +1123,7 @@ impl Chart {
         }
         for (xx, yy, r, label, color) in label_queue {
             let lw = SMALL_CHAR_W * label.chars().count() as f64;
-            let candidates = [
-                (xx + r + 2.0, yy - r - 1.0),
-                (xx + r + 2.0, yy + r + 9.0),
-                (xx - r - 2.0 - lw, yy - r - 1.0),
-                (xx - r - 2.0 - lw, yy + r + 9.0),
-            ];
-            let place = candidates.iter().find_map(|&(lx, ly)| {
-                let rect = Rect {
-                    x0: lx,
-                    y0: ly - 9.0,
-                    x1: lx + lw,
-                    y1: ly + 1.0,
-                };
-                let inside = rect.x0 >= LEFT
-                    && rect.x1 <= LEFT + PLOT_W
-                    && rect.y0 >= TOP
-                    && rect.y1 <= TOP + PLOT_H;
-                let own = Rect {
-                    x0: xx - r,
-                    y0: yy - r,
-                    x1: xx + r,
-                    y1: yy + r,
-                };
-                (inside
-                    && !taken
-                        .iter()
-                        .any(|t| t.overlaps(&rect) && !(t.x0 == own.x0 && t.y0 == own.y0)))
-                .then_some((lx, ly, rect))
-            });
+            let place = place_label((xx, yy), r, lw, &markers, &taken);
             if let Some((lx, ly, rect)) = place {
                 taken.push(rect);
                 let _ = writeln!(
@@ -1117,6 +1163,14 @@ impl Chart {
                         s,
                         r#"<circle cx="{}" cy="{ly}" r="7" fill="none" stroke="black" stroke-width="2"/>"#,
                         lx + 12.0
+                    );
+                }
+                Shows::Ring => {
+                    let _ = writeln!(
+                        s,
+                        r#"<circle cx="{}" cy="{ly}" r="{:.1}" fill="none" stroke="{REFERENCE_GREY}" stroke-width="1.6"/>"#,
+                        lx + 12.0,
+                        MARKER_R + 1.5
                     );
                 }
                 Shows::Reference(_) => {
@@ -1408,6 +1462,52 @@ mod tests {
             svg.matches("fill=\"none\" stroke=\"#009E73\"").count(),
             2 + 1
         );
+        // The name says what its rings mean: no legend line for rings.
+        assert!(!svg.contains("ring: a point at the same place"), "{svg}");
+        // One point in common: a ring the names do not explain, so the legend does.
+        let a = Series::new(
+            "unrolled",
+            method_style("unrolled"),
+            vec![(1.0, 1.0), (2.0, 2.0)],
+        );
+        let b = Series::new(
+            "portal",
+            method_style("portal"),
+            vec![(1.0, 1.0), (3.0, 3.0)],
+        );
+        let svg = chart(vec![a, b]).to_svg();
+        assert!(!svg.contains("(on unrolled)"), "{svg}");
+        assert!(
+            svg.contains("ring: a point at the same place as an earlier one"),
+            "{svg}"
+        );
+    }
+
+    /// A label goes right-above its point unless another point lies as near that place as
+    /// its own; then the next place, and none where every place is ambiguous.
+    #[test]
+    fn a_label_never_lies_nearer_another_point() {
+        let (x, y, r, lw) = (LEFT + 200.0, TOP + 200.0, MARKER_R, 30.0);
+        let own = [(x, y)];
+        let (lx, ly, _) = place_label((x, y), r, lw, &own, &[]).unwrap();
+        assert!(lx > x && ly < y, "right-above: {lx} {ly}");
+        // A point where the right-above label would sit: right-below instead.
+        let above = [(x, y), (x + r + 2.0 + lw / 2.0, y - r - 5.0)];
+        let (lx, ly, _) = place_label((x, y), r, lw, &above, &[]).unwrap();
+        assert!(lx > x && ly > y, "right-below: {lx} {ly}");
+        // Points at every place: left out.
+        let all = [
+            (x, y),
+            (x + r + 2.0 + lw / 2.0, y - r - 5.0),
+            (x + r + 2.0 + lw / 2.0, y + r + 5.0),
+            (x - r - 2.0 - lw / 2.0, y - r - 5.0),
+            (x - r - 2.0 - lw / 2.0, y + r + 5.0),
+        ];
+        assert!(place_label((x, y), r, lw, &all, &[]).is_none());
+        // A point just beyond the label's far end is farther from it than its own: no matter.
+        let far = [(x, y), (x + r + 2.0 + lw + 3.0 * r, y - r - 5.0)];
+        let (lx, ly, _) = place_label((x, y), r, lw, &far, &[]).unwrap();
+        assert!(lx > x && ly < y, "right-above: {lx} {ly}");
     }
 
     #[test]
