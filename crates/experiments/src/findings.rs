@@ -312,8 +312,16 @@ fn bounce_cost(reports: &Path) -> Result<String, ReadmeError> {
                 "reports/{folder}: no per-bounce fit or floor"
             )));
         };
+        // Where one line does not fit, its slope is an average: say so, with the halves'.
+        let bent = g.bent().map_or(String::new(), |(a, b, mid)| {
+            format!(
+                "; an average: {} ms per reflection up to {mid} reflections, {} beyond",
+                ms(a, 2),
+                ms(b, 2)
+            )
+        });
         parts.push(format!(
-            "{} ms [{}–{}] on {device} ({:.1} % of its {} ms full-scene pass)",
+            "{} ms [{}–{}] on {device} ({:.1} % of its {} ms full-scene pass{bent})",
             ms(per_bounce, 2),
             ms(i.low, 2),
             ms(i.high, 2),

@@ -28,6 +28,19 @@ pub struct DepthScaling {
     /// Its 95 % bootstrap interval: every point's frames resampled, medians refitted
     /// (`None` where a point has too few frames).
     pub ms_per_bounce_interval: Option<mirrorbox_report::stats::Interval>,
+    /// Whether one straight line fits: the slopes of the shallower and the deeper half of
+    /// the points (sharing the middle one) and the reflections at the middle; `None` with
+    /// fewer than four points. Halves far apart make the one slope an average.
+    pub half_slopes: Option<(f64, f64, usize)>,
+}
+
+impl DepthScaling {
+    /// The halves' slopes where they differ by more than a fifth: the cost per reflection is
+    /// then not one number (on lavapipe it falls with depth).
+    pub fn bent(&self) -> Option<(f64, f64, usize)> {
+        self.half_slopes
+            .filter(|(a, b, _)| a.min(*b) > 0.0 && a.max(*b) / a.min(*b) > 1.2)
+    }
 }
 
 /// Groups the exact points by (method, α), each with at least two depths.
@@ -45,6 +58,7 @@ pub fn depth_scaling(exact: &[String], records: &[Record]) -> Vec<DepthScaling> 
                 points: vec![r.clone()],
                 ms_per_bounce: None,
                 ms_per_bounce_interval: None,
+                half_slopes: None,
             }),
         }
     }
@@ -58,6 +72,14 @@ pub fn depth_scaling(exact: &[String], records: &[Record]) -> Vec<DepthScaling> 
             .collect();
         g.ms_per_bounce = linear_fit(&pts).map(|(_, b)| b);
         g.ms_per_bounce_interval = slope_interval(&g.points);
+        if pts.len() >= 4 {
+            let mid = pts.len() / 2;
+            if let (Some((_, a)), Some((_, b))) =
+                (linear_fit(&pts[..=mid]), linear_fit(&pts[mid..]))
+            {
+                g.half_slopes = Some((a, b, g.points[mid].reflections));
+            }
+        }
     }
     out
 }
@@ -107,6 +129,13 @@ pub fn bounce_sentence(g: &DepthScaling, pass_ms: Option<f64>) -> String {
         g.points.len(),
         deepest
     );
+    if let Some((a, b, mid)) = g.bent() {
+        s.push_str(&format!(
+            "; not one straight line: {} ms per reflection up to {mid} reflections, {} ms beyond",
+            ms(a, 3),
+            ms(b, 3)
+        ));
+    }
     if let Some(p) = pass_ms.filter(|p| *p > 0.0) {
         s.push_str(&format!(
             "; one full-scene pass (the floor point: the scene without mirrors, rendered once) takes {} ms, \
@@ -188,5 +217,23 @@ mod tests {
         let g = &depth_scaling(&exact, &bare)[0];
         assert!(g.ms_per_bounce_interval.is_none());
         assert!(!bounce_sentence(g, None).contains("CI"));
+        // A straight line: the halves agree, and the sentence says nothing of them.
+        assert!(g.bent().is_none() && !bounce_sentence(g, None).contains("not one straight"));
+        // Cheaper per bounce when deep (lavapipe's shape): the one slope is an average.
+        let bent: Vec<Record> = [(1, 10.0), (4, 12.4), (16, 22.0), (64, 41.2), (256, 118.0)]
+            .iter()
+            .map(|&(d, ms)| point(d, ms, 0.5))
+            .collect();
+        let g = &depth_scaling(&exact, &bent)[0];
+        let (a, b, mid) = g.bent().expect("two slopes");
+        assert!(
+            (a - 0.8).abs() < 1e-9 && (b - 0.4).abs() < 1e-9 && mid == 16,
+            "{a} {b} {mid}"
+        );
+        assert!(
+            bounce_sentence(g, None).contains("not one straight line: 0.800 ms per reflection up to 16 reflections, 0.400 ms beyond"),
+            "{}",
+            bounce_sentence(g, None)
+        );
     }
 }
