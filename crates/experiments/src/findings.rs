@@ -37,6 +37,23 @@ fn load(reports: &Path, folder: &str) -> Result<Sweep, ReadmeError> {
     load_sweep(&reports.join(folder))
 }
 
+/// A Table 1 run's two points the findings compare: the paper's `auxiliary` n = 2 and
+/// `portal` at depth 64 (`folder` names the run in the error).
+fn paper_against_portal<'s>(
+    s: &'s Sweep,
+    folder: &str,
+) -> Result<(&'s Record, &'s Record), ReadmeError> {
+    match (
+        table1::point_at(&s.records, table1::PAPER_METHOD, Some(2), None),
+        table1::point_at(&s.records, "portal", None, Some(64)),
+    ) {
+        (Some(aux), Some(portal)) => Ok((aux, portal)),
+        _ => Err(ReadmeError(format!(
+            "reports/{folder} lacks auxiliary n=2 or portal depth=64"
+        ))),
+    }
+}
+
 /// The first runs of Table 1 whose records hold the error over the mirror pixels, and their
 /// devices (the H100's run predates that measure).
 const TABLE1_ERROR_RUNS: &[(&str, &str)] = &[
@@ -51,14 +68,7 @@ fn exact_error(reports: &Path) -> Result<String, ReadmeError> {
     let mut found = Vec::new();
     for (device, folder) in TABLE1_ERROR_RUNS {
         let s = load(reports, folder)?;
-        let (Some(aux), Some(portal)) = (
-            table1::point_at(&s.records, table1::PAPER_METHOD, Some(2), None),
-            table1::point_at(&s.records, "portal", None, Some(64)),
-        ) else {
-            return Err(ReadmeError(format!(
-                "reports/{folder} lacks auxiliary n=2 or portal depth=64"
-            )));
-        };
+        let (aux, portal) = paper_against_portal(&s, folder)?;
         if aux.mirror_metrics.is_none() || portal.mirror_metrics.is_none() {
             return Err(ReadmeError(format!(
                 "reports/{folder}: no error over the mirror pixels to quote"
@@ -114,14 +124,7 @@ fn exact_speed(reports: &Path) -> Result<String, ReadmeError> {
             if !hosts.contains(&host) {
                 hosts.push(host);
             }
-            let (Some(aux), Some(portal)) = (
-                table1::point_at(&s.records, table1::PAPER_METHOD, Some(2), None),
-                table1::point_at(&s.records, "portal", None, Some(64)),
-            ) else {
-                return Err(ReadmeError(format!(
-                    "reports/{folder} lacks auxiliary n=2 or portal depth=64"
-                )));
-            };
+            let (aux, portal) = paper_against_portal(&s, folder)?;
             if let Some(i) = paired_ratio(aux, portal) {
                 intervals.push((aux.ms_median / portal.ms_median, i));
             }
