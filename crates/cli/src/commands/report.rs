@@ -133,6 +133,29 @@ fn records_commit(path: &std::path::Path) -> String {
 /// What the registry's experiment writing the report folder `folder` (under `reports/`)
 /// measures.
 fn about(folder: &str) -> Option<String> {
+    // One of an experiment's runs in a folder of its own (`table1_runs/a_table1`).
+    let run_of = || {
+        let (parent, run) = folder.rsplit_once('/')?;
+        about_folder(parent).map(|a| format!("{a}: run `{run}`"))
+    };
+    let on_a_gpu = || {
+        // A lent GPU's run of an experiment: `gpu/<its folder>`, perhaps with the GPU, a run
+        // number or a size after it (`gpu/table1_h200_run2`, `gpu/table1_1080p`).
+        let mut name = folder.strip_prefix("gpu/")?;
+        loop {
+            if let Some(a) = about_folder(name) {
+                return Some(format!("{a}, on a lent GPU"));
+            }
+            name = ["_run2", "_h200", "_1080p"]
+                .iter()
+                .find_map(|s| name.strip_suffix(s))?;
+        }
+    };
+    about_folder(folder).or_else(on_a_gpu).or_else(run_of)
+}
+
+/// [`about`] of a folder the registry's rows name as they are.
+fn about_folder(folder: &str) -> Option<String> {
     use mirrorbox_experiments::{EXPERIMENTS, Measure};
     EXPERIMENTS.iter().find_map(|e| {
         let folders: Vec<std::path::PathBuf> = match &e.measure {
@@ -150,4 +173,34 @@ fn about(folder: &str) -> Option<String> {
             })
             .then(|| format!("{} (`{}`)", e.about, e.name))
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The overview names what a folder holds by the registry's row: as it is, a lent GPU's
+    /// run of it, or one of its runs.
+    #[test]
+    fn a_folder_is_named_by_its_experiment() {
+        let table1 = about("table1").unwrap();
+        assert!(table1.ends_with("(`table1`)"), "{table1}");
+        assert_eq!(
+            about("gpu/table1_h200_run2").unwrap(),
+            format!("{table1}, on a lent GPU")
+        );
+        assert_eq!(
+            about("gpu/table1").unwrap(),
+            format!("{table1}, on a lent GPU")
+        );
+        let run = about("table1_runs/a_table1").unwrap();
+        assert!(run.contains("(`table1-runs`): run `a_table1`"), "{run}");
+        // Another file of the GPU's folder: one of the `gpu` experiment's.
+        let other = about("gpu/not_an_experiment").unwrap();
+        assert!(
+            other.ends_with("(`gpu`): run `not_an_experiment`"),
+            "{other}"
+        );
+        assert_eq!(about("mine/sweep"), None);
+    }
 }
