@@ -45,6 +45,19 @@ pub fn depth_scaling(info: &SweepInfo, records: &[Record], floor: Option<&Record
                             g.points.iter().map(|r| (setting(r), r.ms_median)).collect(),
                         );
                         s.y_intervals = g.points.iter().map(|r| r.ms_interval).collect();
+                        // Where the scene runs out of reflections before the cap, the cap is
+                        // not what the point shows: say how many it does.
+                        s.labels = g
+                            .points
+                            .iter()
+                            .map(|r| {
+                                if (r.reflections as f64) < setting(r) {
+                                    format!("{} shown", r.reflections)
+                                } else {
+                                    String::new()
+                                }
+                            })
+                            .collect();
                         s
                     })
                     .collect(),
