@@ -246,13 +246,30 @@ fn room_front(reports: &Path) -> Result<String, ReadmeError> {
         .iter()
         .filter(|r| front.contains(&(r.ms_median, r.mirror_flip())))
         .map(|r| {
+            // Points off the front within 1 % of this one on both axes: without intervals,
+            // the front cannot tell them apart.
+            let near = |a: f64, b: f64| (a - b).abs() <= 0.01 * a.abs().max(b.abs());
+            let ties: Vec<String> = pts
+                .iter()
+                .filter(|o| {
+                    !std::ptr::eq(**o, *r)
+                        && near(o.ms_median, r.ms_median)
+                        && near(o.mirror_flip(), r.mirror_flip())
+                })
+                .map(|o| mirrorbox_report::document::label(o))
+                .collect();
             (
                 r.ms_median,
                 format!(
-                    "{} ({} ms, FLIP {})",
+                    "{} ({} ms, FLIP {}{})",
                     mirrorbox_report::document::label(r),
                     mirrorbox_report::document::f(r.ms_median, 3),
-                    sci(r.mirror_flip())
+                    sci(r.mirror_flip()),
+                    if ties.is_empty() {
+                        String::new()
+                    } else {
+                        format!("; {} within 1 % of both", ties.join(", "))
+                    }
                 ),
             )
         })
