@@ -68,6 +68,8 @@ pub fn sequences(out: &Path, exe: PathBuf, command: String) -> SequenceConfig {
         timed: 1,
         exe,
         command,
+        // The caller's `--fresh` (the main job passes it).
+        replace: false,
     }
 }
 

@@ -56,6 +56,37 @@ pub struct SequenceConfig {
     /// This executable (`mirrorbox`), run as the sequences' child processes.
     pub exe: PathBuf,
     pub command: String,
+    /// Whether an earlier sequence sweep's report in `out` may be replaced (`--fresh`): a
+    /// sequence sweep is not resumable and writes its folder anew.
+    pub replace: bool,
+}
+
+/// The files by which a folder holds a report: a sequence sweep's, then the others'.
+const SEQUENCE_FILES: [&str; 2] = ["frames.jsonl", "motion.json"];
+const OTHER_REPORT_FILES: [&str; 3] = ["results.jsonl", "sweep.json", "advice.json"];
+
+/// Refuses an output folder a sequence sweep would spoil: one holding another kind of report
+/// (its files would stay beside the new ones, and `report` would read them), or an earlier
+/// sequence sweep's without `replace` (`--fresh`). Before, an earlier sequence sweep's
+/// records were silently replaced.
+fn check_sequence_out(out: &Path, replace: bool) -> Result<(), HarnessError> {
+    let refuse = |why: String| HarnessError::OutputFolder {
+        path: out.to_path_buf(),
+        source: std::io::Error::other(why),
+    };
+    if let Some(f) = OTHER_REPORT_FILES.iter().find(|f| out.join(f).exists()) {
+        return Err(refuse(format!(
+            "holds another kind of report ({f}); a sequence sweep needs a folder of its own: \
+             name another --out"
+        )));
+    }
+    if !replace && let Some(f) = SEQUENCE_FILES.iter().find(|f| out.join(f).exists()) {
+        return Err(refuse(format!(
+            "holds an earlier sequence sweep ({f}), which this one would replace (a sequence \
+             sweep is not resumed): pass --fresh to replace it, or name another --out"
+        )));
+    }
+    Ok(())
 }
 
 impl SequenceConfig {
@@ -247,11 +278,21 @@ pub fn run_sequences(
 ) -> Result<Vec<FrameRecord>, HarnessError> {
     config.validate()?;
     crate::check_output_parent(&config.out)?;
+    check_sequence_out(&config.out, config.replace)?;
     let io = |path: &Path| {
         let path = path.to_path_buf();
         move |source| HarnessError::Io { path, source }
     };
     std::fs::create_dir_all(&config.out).map_err(io(&config.out))?;
+    // An earlier run's filmstrips (replaced, `--fresh`): its report named them, this one may not.
+    if let Ok(entries) = std::fs::read_dir(&config.out) {
+        for e in entries.flatten() {
+            let name = e.file_name().to_string_lossy().into_owned();
+            if name.starts_with("filmstrip_") && name.ends_with(".png") {
+                std::fs::remove_file(e.path()).map_err(io(&e.path()))?;
+            }
+        }
+    }
     let mut records = Vec::new();
     let mut scenarios = Vec::new();
     let mut device = String::new();
@@ -317,7 +358,9 @@ pub fn run_sequences(
                 flips.push((m.flip_mean, k));
             }
             if stateful {
-                let name = format!("filmstrip_{}_{}.png", s.name, method.name());
+                // Named by the method's key: two settings of one method (history=0..8) each
+                // keep their own strip.
+                let name = format!("filmstrip_{}_{}.png", s.name, slug(&method.key()));
                 flips.sort_by(|a, b| b.0.total_cmp(&a.0));
                 let mut worst: Vec<u32> = flips.iter().take(3).map(|f| f.1).collect();
                 worst.sort_unstable();
@@ -351,6 +394,7 @@ pub fn run_sequences(
     // The cache folder held only the scenarios' frames.
     let _ = std::fs::remove_dir(config.out.join("cache"));
     let info = MotionInfo {
+        draws: Some([config.warmup, config.timed]),
         commit: crate::source_commit(),
         records_commit: String::new(),
         command: config.command.clone(),
@@ -413,6 +457,20 @@ fn write_filmstrip(
     )?;
     staged.commit()?;
     Ok(())
+}
+
+/// A method key as part of a file name: letters, digits, `-`, `.` and `_` kept, anything else
+/// (spaces, `=`) as `_`.
+fn slug(key: &str) -> String {
+    key.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || matches!(c, '-' | '.') {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
 }
 
 #[cfg(test)]

@@ -64,6 +64,10 @@ pub struct MotionInfo {
     /// For a report without [`MotionInfo::commit`]: the commit that last committed it.
     #[serde(skip)]
     pub records_commit: String,
+    /// Each frame's untimed and timed draws (`--warmup`, `--frames`); absent in reports made
+    /// before they were recorded (the motion experiment's: one and one).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub draws: Option<[u32; 2]>,
 }
 
 /// The frames of `method` in `scenario`, in frame order.
@@ -106,15 +110,24 @@ pub fn document(info: &MotionInfo, records: &[FrameRecord]) -> String {
         md,
         "# Error over time: moving cameras, previous-frame feedback and cube maps\n"
     );
+    // The draws per frame as recorded (a report before they were: the motion experiment's
+    // one untimed and one timed draw).
+    let [untimed, timed] = info.draws.unwrap_or([1, 1]);
+    let draw = |n: u32, what: &str| match n {
+        1 => format!("one {what} draw"),
+        n => format!("{n} {what} draws"),
+    };
     let _ = writeln!(
         md,
         "Every method and the truth rendered frame by frame along the same camera path \
          (issue 22; docs/methods.md, \"Previous-frame feedback\" and \"Cube-map \
          reflections\"); each frame compared with the truth of that frame. The stateful \
          methods (`feedback`, `cubemap`) carry their textures from frame to frame as an \
-         engine would (`history=16`: they start from 16 frames drawn at the first view); \
-         the other methods have no state. Times: one GPU-timestamped draw per frame after \
-         one untimed draw; the table gives the median over the frames.\n"
+         engine would (`history=H`, as each one's name says: it starts from H frames drawn at \
+         the first view); the other methods have no state. Times: {} per frame after {} \
+         (the frame's time is their median); the table gives the median over the frames.\n",
+        draw(timed, "GPU-timestamped"),
+        draw(untimed, "untimed")
     );
     let _ = writeln!(
         md,
@@ -477,6 +490,7 @@ mod tests {
             &MotionInfo {
                 commit: String::new(),
                 records_commit: String::new(),
+                draws: Some([2, 5]),
                 command: "mirrorbox motion".into(),
                 date: "today".into(),
                 device: "test".into(),
@@ -501,5 +515,11 @@ mod tests {
             "{md}"
         );
         assert!(md.contains("unrolled depth=64 (exact)"), "{md}");
+        // The draws as recorded, not the motion experiment's one and one.
+        assert!(
+            md.contains("Times: 5 GPU-timestamped draws per frame after 2 untimed draws"),
+            "{md}"
+        );
+        assert!(!md.contains("history=16"), "{md}");
     }
 }

@@ -88,7 +88,8 @@ pub struct Args {
     /// camera path for N frames (frame k at --time + k / --fps), each method's frames in
     /// order in one process (so `feedback` carries its state), each frame against its own
     /// truth; writes frames.jsonl, report.md, a plot of FLIP against frame and a filmstrip
-    /// of feedback's worst frames. 1..1000.
+    /// of each stateful setting's worst frames. Not resumed: an earlier sequence sweep in
+    /// --out needs --fresh. 1..1000.
     #[arg(
         long,
         value_name = "N",
@@ -301,6 +302,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             exe: render_worker()
                 .ok_or_else(|| Failure::Other("cannot find this executable".into()))?,
             command: command_line(),
+            replace: args.fresh,
         };
         return run_sequences(&config);
     }
@@ -430,6 +432,7 @@ fn run_experiment(name: &str, args: &PresetArgs) -> Result<(), Failure> {
             let exe = render_worker()
                 .ok_or_else(|| Failure::Other("cannot find this executable".into()))?;
             let mut config = sequences(&out, exe, command_line());
+            config.replace = args.fresh;
             if let Some(n) = args.frames {
                 for s in &mut config.scenarios {
                     s.frames = n;
@@ -474,8 +477,9 @@ fn unapplied_options(
         ("--out", script && args.out.is_some()),
         ("--frames", script && args.frames.is_some()),
         // `--fresh` and `--truth-cache` are the main job's for every experiment
-        // (scripts/run.sh): a script or a sequence measures afresh and traces its own truths
-        // anyway, so they are accepted everywhere.
+        // (scripts/run.sh): a script measures afresh and traces its own truths anyway, and a
+        // sequence needs `--fresh` to replace its earlier report, so they are accepted
+        // everywhere.
         ("--shard", !sweeps && args.shard.shard.is_some()),
         ("--isolate-renders", !sweeps && args.isolate_renders),
         (
