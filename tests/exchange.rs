@@ -405,6 +405,33 @@ fn a_with_sweep_naming_pictures_outside_its_images_is_refused() {
     }
     let out = with(None);
     assert_eq!(out.code, 0, "{}", out.stderr);
+    // A sweep of another scene, or of another α than the export's: refused (before, its
+    // floor and points were set beside the variants as if comparable).
+    std::fs::remove_dir_all(&scored).unwrap();
+    for (field, value, message) in [
+        (
+            "scene",
+            Value::from("scenes/stereo_box.json"),
+            "not of the scene exported",
+        ),
+        ("alpha", Value::from(0.5), "not the export's α"),
+    ] {
+        let lines: Vec<String> = good
+            .lines()
+            .map(|l| {
+                let mut r: Value = serde_json::from_str(l).unwrap();
+                if r["kind"] == "point" || field == "scene" {
+                    r[field] = value.clone();
+                }
+                r.to_string()
+            })
+            .collect();
+        std::fs::write(&results, lines.join("\n") + "\n").unwrap();
+        let out = run_score(&ex, &run, &scored, &["--with", sweep.to_str().unwrap()]);
+        assert_eq!(out.code, 2, "{field}: {}", out.stderr);
+        assert!(out.stderr.contains(message), "{field}: {}", out.stderr);
+        assert!(!scored.exists(), "{field}: nothing written");
+    }
 }
 
 #[test]

@@ -386,7 +386,7 @@ fn write_export(
 }
 
 /// `base` seen from `spec`: its camera moved, checked (position and look-at apart, up not
-/// along the view, field of view in (0, 180)).
+/// along the view, field of view in (0, 170]).
 pub fn view_scene(base: &Scene, spec: &ViewSpec) -> Result<Scene, HarnessError> {
     let mut scene = base.clone();
     let c = &mut scene.camera;
@@ -410,7 +410,7 @@ pub fn view_scene(base: &Scene, spec: &ViewSpec) -> Result<Scene, HarnessError> 
 
 /// What is wrong with a camera, if anything: its view direction `forward` (look-at minus
 /// position) finite and not zero, its `up` (where known) finite and not along it, its
-/// vertical field of view (where known) in (0, 180) degrees.
+/// vertical field of view (where known) in (0, 170] degrees.
 fn camera_problem(forward: Vec3, up: Option<Vec3>, fov_y_deg: Option<f32>) -> Option<&'static str> {
     if !forward.is_finite() || forward.length() < 1e-6 {
         return Some("position and look_at must be finite and apart");
@@ -418,8 +418,8 @@ fn camera_problem(forward: Vec3, up: Option<Vec3>, fov_y_deg: Option<f32>) -> Op
     if up.is_some_and(|up| !up.is_finite() || forward.normalize().cross(up).length() < 1e-6) {
         return Some("up must be finite and not along the view direction");
     }
-    if fov_y_deg.is_some_and(|f| !(f > 0.0 && f < 180.0)) {
-        return Some("fov_y_deg must be in (0, 180)");
+    if fov_y_deg.is_some_and(|f| !mirrorbox_scene::limits::fov_ok(f)) {
+        return Some("fov_y_deg must be in (0, 170] (mirrorbox_scene::limits::MAX_FOV_Y_DEG)");
     }
     None
 }
@@ -572,7 +572,7 @@ mod tests {
                 "views[1] (\"b\"): position and look_at must be finite and apart",
             ),
             (&up, "views[0] (\"a\"): up must be finite and not along"),
-            (&fov, "views[0] (\"a\"): fov_y_deg must be in (0, 180)"),
+            (&fov, "views[0] (\"a\"): fov_y_deg must be in (0, 170]"),
         ] {
             let message = read_view_list(path).unwrap_err().to_string();
             let name = path.display().to_string();

@@ -175,12 +175,60 @@ pub fn merge(
     // Write: the folder, its pictures, the records in the sweep's order, the description. A
     // folder made here is removed again if writing fails: nothing half-written is left.
     crate::check_output_parent(out)?;
+    check_merge_out(out, &shards)?;
     let made = !out.exists();
     let written = write_merged(out, &shards, command, sections);
     if written.is_err() && made {
         let _ = std::fs::remove_dir_all(out);
     }
     written
+}
+
+/// Refuses an output folder a merge would spoil: one of the shards, or a folder holding
+/// anything but an earlier merge of the same sweep (replaced whole). Before, an unrelated
+/// sweep's records and same-named pictures were overwritten, and a shard could be its own
+/// merge's output.
+fn check_merge_out(out: &Path, shards: &[ShardFolder]) -> Result<(), HarnessError> {
+    let refused = |what: String| -> HarnessError {
+        SettingError::new("merge OUT", what, out.display().to_string()).into()
+    };
+    let resolved = |p: &Path| p.canonicalize().ok();
+    if let Some(o) = resolved(out)
+        && let Some(s) = shards
+            .iter()
+            .find(|s| resolved(&s.dir).as_ref() == Some(&o))
+    {
+        return Err(refused(format!(
+            "a folder apart from the shards (it is the shard {})",
+            s.dir.display()
+        )));
+    }
+    let Ok(mut entries) = std::fs::read_dir(out) else {
+        return Ok(()); // made by the merge
+    };
+    if entries.next().is_none() {
+        return Ok(());
+    }
+    let earlier = mirrorbox_files::read_bounded_text(
+        &out.join("sweep.json"),
+        MAX_SWEEP_JSON_BYTES,
+        "a sweep description",
+    )
+    .ok()
+    .and_then(|t| serde_json::from_str::<SweepInfo>(&t).ok());
+    let same_merge = earlier.is_some_and(|info| {
+        !info.shards.is_empty() && info.point_keys == shards[0].info.point_keys
+    }) && !["frames.jsonl", "advice.json"]
+        .iter()
+        .any(|f| out.join(f).exists());
+    if same_merge {
+        return Ok(());
+    }
+    Err(refused(
+        "a new or empty folder, or an earlier merge of these shards (it holds something else, \
+         which the merge would overwrite)"
+            .into(),
+    ))
 }
 
 /// The writing half of [`merge`], its inputs checked.

@@ -176,9 +176,21 @@ fn check_views(views: &ViewsFile) -> Result<(), String> {
 }
 
 fn read_timing(path: &Path, views: &ViewsFile) -> Result<Timing, HarnessError> {
+    // A file error names the path itself.
     let text = mirrorbox_files::read_bounded_text(path, 16 << 20, "a timing file")
-        .map_err(|e| refused(path, e))?;
-    let t: Timing = serde_json::from_str(&text).map_err(|e| refused(path, e))?;
+        .map_err(|e| HarnessError::Exchange(e.to_string()))?;
+    // JSON has no NaN or infinity: a client writing one gets serde's bare position, said
+    // here with what is read.
+    let t: Timing = serde_json::from_str(&text).map_err(|e| {
+        refused(
+            path,
+            format!(
+                "{e}: a timing file is {{\"format\": \"mirrorbox-timing\", \"version\": \
+                 {FORMAT_VERSION}, \"views\": {{VIEW: [ms, …]}}, …}}, each time a finite JSON \
+                 number ≥ 0 (docs/exchange.md)"
+            ),
+        )
+    })?;
     if t.format != "mirrorbox-timing" || t.version != FORMAT_VERSION {
         return Err(refused(
             path,
@@ -365,6 +377,40 @@ pub fn score(
                 format!(
                     "{}: {}×{} is not the size of any view of the export",
                     r.key, r.width, r.height
+                ),
+            ));
+        }
+        // Of the scene exported, at its α: another scene's floor and points, or another α's,
+        // were set beside the variants as if comparable (found by a review).
+        let same_file =
+            |a: &str, b: &str| match (Path::new(a).canonicalize(), Path::new(b).canonicalize()) {
+                (Ok(x), Ok(y)) => x == y,
+                _ => Path::new(a).file_name() == Path::new(b).file_name(),
+            };
+        if let Some(r) = sweep
+            .records
+            .iter()
+            .find(|r| !r.is_external() && !same_file(&r.scene, &views.source))
+        {
+            return Err(refused(
+                dir,
+                format!(
+                    "{}: a sweep of {}, not of the scene exported ({})",
+                    r.key, r.scene, views.source
+                ),
+            ));
+        }
+        if let Some(alpha) = views.alpha
+            && let Some(r) = sweep
+                .records
+                .iter()
+                .find(|r| r.kind == "point" && !r.is_external() && r.alpha != alpha)
+        {
+            return Err(refused(
+                dir,
+                format!(
+                    "{}: α = {}, not the export's α = {alpha} (sweep only that α beside it)",
+                    r.key, r.alpha
                 ),
             ));
         }
@@ -759,6 +805,34 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("view \"camera\" is given twice"), "{e}");
+    }
+
+    /// A time JSON cannot hold (NaN, 1e400) is refused with what a timing file is, not with
+    /// serde's position alone; a missing file names its path once.
+    #[test]
+    fn a_timing_file_json_cannot_read_says_what_is_read() {
+        let dir = tempfile::tempdir().unwrap();
+        let views = crate::exchange::tests_support::sample_view();
+        let s = schema("timing.schema.json");
+        let good = s["examples"][0].to_string();
+        let path = dir.path().join("timing.json");
+        for bad in ["NaN", "1e400"] {
+            let text = good.replacen(
+                "\"views\":{\"camera\":[",
+                &format!("\"views\":{{\"camera\":[{bad},"),
+                1,
+            );
+            assert_ne!(text, good);
+            std::fs::write(&path, text).unwrap();
+            let e = read_timing(&path, &views).unwrap_err().to_string();
+            assert!(
+                e.contains("each time a finite JSON number ≥ 0"),
+                "{bad}: {e}"
+            );
+        }
+        let missing = dir.path().join("nothere/timing.json");
+        let e = read_timing(&missing, &views).unwrap_err().to_string();
+        assert_eq!(e.matches("nothere/timing.json").count(), 1, "{e}");
     }
 
     /// An export's views.json holds every field the schema requires, at every level.
