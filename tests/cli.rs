@@ -303,8 +303,8 @@ fn obj_without_faces() {
 #[test]
 fn camera_errors() {
     assert_rejected(
-        |s| s["camera"]["fov_y_deg"] = json!(180),
-        &["camera.fov_y_deg: must be in (0, 180) degrees, got 180"],
+        |s| s["camera"]["fov_y_deg"] = json!(179.9),
+        &["camera.fov_y_deg: must be in (0, 170] degrees, got 179.9"],
     );
     assert_rejected(
         |s| s["camera"]["look_at"] = json!([0, 1, 3]),
@@ -2362,6 +2362,25 @@ fn shards_merge_into_the_unsharded_sweep() {
     );
     let report = std::fs::read_to_string(d.join("merged/report.md")).unwrap();
     assert!(report.contains("Merged from 3 shards"), "{report}");
+    // Merged again over the earlier merge: replaced, the same points.
+    let again = mirrorbox(&["merge", &p("merged"), &s0, &s1, &s2], &[]);
+    assert_eq!(again.code, 0, "{}", again.stderr);
+    assert_eq!(records(&d.join("merged")).len(), joined.len());
+    // OUT that is a shard, or holds another sweep: refused, nothing changed (before, the
+    // other sweep's records and same-named pictures were overwritten).
+    let full_records = std::fs::read(d.join("full/results.jsonl")).unwrap();
+    for (out, message) in [
+        (s0.clone(), "a folder apart from the shards"),
+        (p("full"), "an earlier merge of these shards"),
+    ] {
+        let r = mirrorbox(&["merge", &out, &s0, &s1, &s2], &[]);
+        assert_eq!(r.code, 2, "{out}: {}", r.stderr);
+        assert!(r.stderr.contains(message), "{out}: {}", r.stderr);
+    }
+    assert_eq!(
+        std::fs::read(d.join("full/results.jsonl")).unwrap(),
+        full_records
+    );
 
     for (args, message) in [
         (vec![s0.clone(), s0.clone()], "one folder per shard"),
@@ -2460,6 +2479,20 @@ fn time_on_a_camera_path_renders_the_keyed_view() {
     assert_eq!(bytes(&d("seq_0001.png")), bytes(&d("at_key_r.png")));
     assert_eq!(bytes(&d("seq_0000.png")), bytes(&d("between_r.png")));
     assert!(dir.path().join("seq_0002.png").is_file() && !dir.path().join("seq_0003.png").exists());
+    // Each frame's JSON says its time on the path.
+    render.push("--json");
+    let out = mirrorbox(&render, &[]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let times: Vec<f64> = out
+        .stdout
+        .lines()
+        .map(|l| {
+            serde_json::from_str::<Value>(l).unwrap()["time"]
+                .as_f64()
+                .unwrap()
+        })
+        .collect();
+    assert_eq!(times, [1.0, 2.0, 3.0], "{}", out.stdout);
     let out = mirrorbox(&["trace", walk, "--sequence", "0", "-o", &d("x.exr")], &[]);
     assert_eq!(out.code, 2, "{}", out.stderr);
     assert!(
@@ -2577,13 +2610,39 @@ fn a_sequence_sweep_compares_every_frame_with_its_truth() {
     for f in [
         "report.md",
         "plot_path.svg",
-        "filmstrip_path_feedback.png",
+        "filmstrip_path_feedback_history_0.png",
         "motion.json",
     ] {
         assert!(out.join(f).is_file(), "{f} missing");
     }
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
     assert!(report.contains("| feedback history=0 |"), "{report}");
+    // Not resumed: a second sequence sweep into the folder needs --fresh (before, it
+    // replaced the records unsaid), and an ordinary sweep's folder is refused as it is.
+    let before = std::fs::read(out.join("frames.jsonl")).unwrap();
+    let again = mirrorbox(&args, &[]);
+    assert_eq!(again.code, 2, "{}", again.stderr);
+    assert!(
+        again.stderr.contains("pass --fresh to replace it"),
+        "{}",
+        again.stderr
+    );
+    assert_eq!(std::fs::read(out.join("frames.jsonl")).unwrap(), before);
+    let ordinary = dir.path().join("ordinary");
+    std::fs::create_dir(&ordinary).unwrap();
+    std::fs::write(ordinary.join("results.jsonl"), "").unwrap();
+    let mut into = args.clone();
+    into[3] = ordinary.to_str().unwrap();
+    into.push("--fresh");
+    let refused = mirrorbox(&into, &[]);
+    assert_eq!(refused.code, 2, "{}", refused.stderr);
+    assert!(
+        refused
+            .stderr
+            .contains("another kind of report (results.jsonl)"),
+        "{}",
+        refused.stderr
+    );
 
     // Supersampling reaches both sides: the raster's s×s grid is the truth's s² samples
     // (an exact method stays at the floor).

@@ -31,7 +31,7 @@ pub struct Camera {
     pub look_at: Vec3,
     /// World up hint (unit); the true up is orthogonalized against the view direction.
     pub up: Vec3,
-    /// Vertical field of view in degrees, in (0, 180).
+    /// Vertical field of view in degrees, in (0, 170] ([`crate::limits::MAX_FOV_Y_DEG`]).
     pub fov_y_deg: f32,
     pub width: u32,
     pub height: u32,

@@ -497,8 +497,14 @@ impl Checker<'_> {
         }
         let fov_path = path.field("fov_y_deg");
         let fov = self.finite(&fov_path, frame.fov_y_deg)?;
-        if !(fov > 0.0 && fov < 180.0) {
-            return Err(self.invalid(&fov_path, format!("must be in (0, 180) degrees, got {fov}")));
+        if !crate::limits::fov_ok(fov) {
+            return Err(self.invalid(
+                &fov_path,
+                format!(
+                    "must be in (0, {}] degrees, got {fov}",
+                    crate::limits::MAX_FOV_Y_DEG
+                ),
+            ));
         }
         for (name, side) in [("width", c.width), ("height", c.height)] {
             if side == 0 || side > MAX_IMAGE_SIDE {
@@ -596,10 +602,13 @@ impl Checker<'_> {
                 Some(fov) => {
                     let fov_path = at.field("fov_y_deg");
                     let fov = self.finite(&fov_path, fov)?;
-                    if !(fov > 0.0 && fov < 180.0) {
+                    if !crate::limits::fov_ok(fov) {
                         return Err(self.invalid(
                             &fov_path,
-                            format!("must be in (0, 180) degrees, got {fov}"),
+                            format!(
+                                "must be in (0, {}] degrees, got {fov}",
+                                crate::limits::MAX_FOV_Y_DEG
+                            ),
                         ));
                     }
                     fov
@@ -1407,7 +1416,7 @@ mod tests {
             ),
             (
                 key("0", r#", "fov_y_deg": 180"#),
-                "camera.path[0].fov_y_deg: must be in (0, 180)",
+                "camera.path[0].fov_y_deg: must be in (0, 170]",
             ),
             (key("0", r#", "roll": 3"#), "roll"),
         ] {

@@ -254,6 +254,8 @@ fn summary(
     if args.json {
         let v = serde_json::json!({
             "scene": args.scene.display().to_string(),
+            // The camera path's time of this view (`--time`, or this frame's), if given.
+            "time": args.time.time,
             "stereo_pair": stereo,
             "scene_hash": format!("{:016x}", scene.content_hash()),
             "method": method.name(),
@@ -357,10 +359,10 @@ fn summary(
             peak_rss.map_or("unknown".into(), mirrorbox_raster::memory::format_bytes)
         );
         println!(
-            "  {:.2} ms/frame median, {:.2} min over {} frames ({}); CPU encode+submit {:.2} ms median; GPU memory {} in buffers, {} in textures; on {} ({}, {} targets); wrote {}",
+            "  {:.2} ms/frame median, {:.2} ms the least, over {} ({}); CPU encode+submit {:.2} ms median; GPU memory {} in buffers, {} in textures; on {} ({}, {} targets); wrote {}",
             t.median_ms(),
             t.min_ms(),
-            t.frames_ms.len(),
+            crate::count(t.frames_ms.len(), "frame"),
             t.source.name(),
             mirrorbox_report::stats::median(&t.encode_ms),
             mirrorbox_files::human_bytes(out.gpu_memory.buffer_bytes),

@@ -556,6 +556,8 @@ fn report(
     if args.json {
         let mut v = serde_json::json!({
             "scene": args.scene.display().to_string(),
+            // The camera path's time of this view (`--time`, or this frame's), if given.
+            "time": args.time.time,
             "eye": eye.map(|e| e.name()),
             "scene_hash": format!("{:016x}", scene.content_hash()),
             "width": w, "height": h, "spp": grid.samples_per_pixel(),
@@ -751,6 +753,7 @@ fn trace_on_gpu(
         if args.json {
             let v = serde_json::json!({
                 "scene": args.scene.display().to_string(),
+                "time": args.time.time,
                 "eye": eye.map(|e| e.name()),
                 "device": "gpu", "adapter": gpu.report.name, "backend": gpu.report.backend,
                 "width": w, "height": h, "spp": grid.samples_per_pixel(),
