@@ -208,15 +208,17 @@ impl AxisSpec {
         Ok(())
     }
 
-    /// Parses a flag's text: values comma separated, a whole-number axis also `a..=b`, the
-    /// none word where the axis has one; each checked.
+    /// Parses a flag's text: values comma separated, a whole-number axis also a range `a..=b`
+    /// or `a..b` (both ends included, as the methods' `--n 0..4` reads), the none word where
+    /// the axis has one; each checked.
     pub fn parse(&self, text: &str) -> Result<Vec<Option<f64>>, SettingError> {
         let bad = |got: &str| SettingError::new(self.flag, self.allowed(), format!("{got:?}"));
         let mut out = Vec::new();
         for part in text.split(',').map(str::trim) {
             if Some(part) == self.none_word {
                 out.push(None);
-            } else if let Some((a, b)) = part.split_once("..=").filter(|_| self.integer) {
+            } else if let Some((a, b)) = part.split_once("..").filter(|_| self.integer) {
+                let b = b.strip_prefix('=').unwrap_or(b);
                 let (a, b): (u64, u64) = (
                     a.trim().parse().map_err(|_| bad(part))?,
                     b.trim().parse().map_err(|_| bad(part))?,
@@ -281,6 +283,11 @@ mod tests {
         assert_eq!(
             SYMMETRY_PLANES.parse("0..=2,5").unwrap(),
             vec![Some(0.0), Some(1.0), Some(2.0), Some(5.0)]
+        );
+        // `a..b` reads as the methods' `--n 0..4` does: both ends included.
+        assert_eq!(
+            SYMMETRY_PLANES.parse("0..2").unwrap(),
+            SYMMETRY_PLANES.parse("0..=2").unwrap()
         );
         assert!(SYMMETRY_PLANES.parse("17").is_err());
         assert!(SYMMETRY_PLANES.parse("1.5").is_err());

@@ -302,6 +302,7 @@ pub fn export(
         "width": cam.width,
         "height": cam.height,
         "spp": settings.spp,
+        "not_exported": not_exported(scene),
     });
     let sidecar_path = dir.join("mirrorbox.json");
     write_atomically(&sidecar_path, format!("{sidecar:#}\n").as_bytes())?;
@@ -309,6 +310,30 @@ pub fn export(
     written.push(sidecar_path);
     written.push(xml_path.to_path_buf());
     Ok(written)
+}
+
+/// What the scene has that the export leaves out (Mitsuba's scene, and `render.py`'s
+/// integrators, have no counterpart), one phrase each: the export renders one still view lit
+/// directly, so a comparison with `trace` on such a scene differs by these. Recorded in
+/// `mirrorbox.json` and said by `export-mitsuba`.
+pub fn not_exported(scene: &Scene) -> Vec<String> {
+    let mut out = Vec::new();
+    if scene.stereo.is_some() {
+        out.push("camera.stereo (the head's view is exported)".to_string());
+    }
+    if scene.camera_path.is_some() {
+        out.push("camera.path (the still camera is exported)".to_string());
+    }
+    if scene.lighting.shadows {
+        out.push("lighting.shadows (render.py's whitted lights without shadows)".to_string());
+    }
+    if scene.lighting.mirrored_lights > 0 {
+        out.push(format!(
+            "lighting.mirrored_lights {} (image-source lighting, docs/mitsuba.md)",
+            scene.lighting.mirrored_lights
+        ));
+    }
+    out
 }
 
 /// A factor as `<rgb>`, or the factor × its texture as a `bitmap` reading an EXR written
@@ -415,6 +440,21 @@ fn xml_comment(s: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// What the export leaves out is named: nothing for a plain scene; the lit scene's
+    /// shadows and mirrored lights, the walk's camera path, the stereo scene's rig.
+    #[test]
+    fn what_the_export_leaves_out_is_named() {
+        let named = |file: &str| not_exported(&mirrorbox_scene::load::bundled_scene(file));
+        assert!(named("mirror_box.json").is_empty());
+        let lit = named("mirror_box_lit.json");
+        assert!(
+            lit.len() == 2 && lit[0].starts_with("lighting.shadows") && lit[1].contains(" 8 "),
+            "{lit:?}"
+        );
+        assert!(named("mirror_box_walk.json")[0].starts_with("camera.path"));
+        assert!(named("stereo_box.json")[0].starts_with("camera.stereo"));
+    }
 
     #[test]
     fn exported_meshes_hold_exactly_our_triangles() {

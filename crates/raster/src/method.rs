@@ -502,7 +502,8 @@ impl OptionSpec {
         self.check(value.ok_or_else(|| self.out_of_range(format!("{text:?}")))?)
     }
 
-    /// Parses a sweep axis: a range `A..B` (inclusive; counts only) or a list `a,b,c`.
+    /// Parses a sweep axis: a range `A..B` or `A..=B` (both ends included; counts only) or a
+    /// list `a,b,c`.
     pub fn parse_axis(&self, text: &str) -> Result<Vec<ParamValue>, String> {
         let axis = self.sweep.as_ref();
         let err = || match axis {
@@ -525,6 +526,7 @@ impl OptionSpec {
         };
         let values: Vec<ParamValue> = match (self.kind, text.split_once("..")) {
             (OptionKind::Count { .. }, Some((a, b))) => {
+                let b = b.strip_prefix('=').unwrap_or(b);
                 let a: u32 = a.trim().parse().map_err(|_| err())?;
                 let b: u32 = b.trim().parse().map_err(|_| err())?;
                 if a > b || b - a > 100_000 {

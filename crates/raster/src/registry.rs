@@ -398,6 +398,10 @@ mod tests {
         );
         assert_eq!(n.parse_axis("0..2").unwrap().len(), 3);
         assert_eq!(
+            n.parse_axis("0..=2").unwrap(),
+            n.parse_axis("0..2").unwrap()
+        );
+        assert_eq!(
             depth.parse_axis("0..4").unwrap_err(),
             "--depth \"0..4\": expected a range like 1..8 or a list like 1,4,16,64 of depths 1..=4096"
         );

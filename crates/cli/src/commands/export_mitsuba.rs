@@ -52,5 +52,9 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         xml.display(),
         written.len()
     );
+    // Said, not only recorded: a comparison with `trace` differs by these.
+    for left_out in mirrorbox_mitsuba::not_exported(&scene) {
+        println!("  not exported: {left_out}");
+    }
     Ok(())
 }

@@ -54,14 +54,15 @@ pub struct Args {
     /// Discard earlier results in --out and measure every point again (cached truths stay).
     #[arg(long)]
     fresh: bool,
-    /// Symmetry planes p, comma separated or a range `a..=b`: every point is measured on the
-    /// scene keeping its first p `symmetry_planes` (seed 001), for each p; each 0..=16 and at
-    /// most the scene's planes.
+    /// Symmetry planes p, comma separated or a range `a..=b` or `a..b` (both ends
+    /// included): every point is measured on the scene keeping its first p
+    /// `symmetry_planes` (seed 001), for each p; each 0..=16 and at most the scene's planes.
     #[arg(long)]
     symmetry_planes: Option<String>,
-    /// Mirrored-light depths k, comma separated or a range `a..=b`: every point is measured on
-    /// the scene lighting its surfaces through chains of up to k mirrors
-    /// (`lighting.mirrored_lights`, docs/shading.md), for each k; each 0..=64.
+    /// Mirrored-light depths k, comma separated or a range `a..=b` or `a..b` (both ends
+    /// included): every point is measured on the scene lighting its surfaces through chains
+    /// of up to k mirrors (`lighting.mirrored_lights`, docs/shading.md), for each k; each
+    /// 0..=64.
     #[arg(long)]
     mirrored_lights: Option<String>,
     /// Uneven-mirror tilts in degrees, comma separated: every point is measured on the scene
