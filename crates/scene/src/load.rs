@@ -171,6 +171,21 @@ impl Checker<'_> {
         }
     }
 
+    /// A vertical field of view at `path`: finite and in (0, [`crate::limits::MAX_FOV_Y_DEG`]].
+    fn fov(&self, path: &FieldPath, fov: f32) -> Result<f32> {
+        let fov = self.finite(path, fov)?;
+        if !crate::limits::fov_ok(fov) {
+            return Err(self.invalid(
+                path,
+                format!(
+                    "must be in (0, {}] degrees, got {fov}",
+                    crate::limits::MAX_FOV_Y_DEG
+                ),
+            ));
+        }
+        Ok(fov)
+    }
+
     fn finite(&self, path: &FieldPath, x: f32) -> Result<f32> {
         if x.is_finite() {
             Ok(x)
@@ -495,17 +510,7 @@ impl Checker<'_> {
                 "must not be parallel to the view direction (look_at − position)",
             ));
         }
-        let fov_path = path.field("fov_y_deg");
-        let fov = self.finite(&fov_path, frame.fov_y_deg)?;
-        if !crate::limits::fov_ok(fov) {
-            return Err(self.invalid(
-                &fov_path,
-                format!(
-                    "must be in (0, {}] degrees, got {fov}",
-                    crate::limits::MAX_FOV_Y_DEG
-                ),
-            ));
-        }
+        let fov = self.fov(&path.field("fov_y_deg"), frame.fov_y_deg)?;
         for (name, side) in [("width", c.width), ("height", c.height)] {
             if side == 0 || side > MAX_IMAGE_SIDE {
                 return Err(self.invalid(
@@ -599,20 +604,7 @@ impl Checker<'_> {
                 ));
             }
             let fov_y_deg = match k.fov_y_deg {
-                Some(fov) => {
-                    let fov_path = at.field("fov_y_deg");
-                    let fov = self.finite(&fov_path, fov)?;
-                    if !crate::limits::fov_ok(fov) {
-                        return Err(self.invalid(
-                            &fov_path,
-                            format!(
-                                "must be in (0, {}] degrees, got {fov}",
-                                crate::limits::MAX_FOV_Y_DEG
-                            ),
-                        ));
-                    }
-                    fov
-                }
+                Some(fov) => self.fov(&at.field("fov_y_deg"), fov)?,
                 None => camera.fov_y_deg,
             };
             checked.push(CameraKey {
