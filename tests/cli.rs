@@ -2575,7 +2575,7 @@ fn a_sequence_sweep_compares_every_frame_with_its_truth() {
         "--methods",
         "feedback,unrolled",
         "--history",
-        "0",
+        "0,1",
         "--depth",
         "4",
         "--path",
@@ -2591,7 +2591,7 @@ fn a_sequence_sweep_compares_every_frame_with_its_truth() {
         .lines()
         .map(|l| serde_json::from_str(l).unwrap())
         .collect();
-    assert_eq!(records.len(), 6, "two methods × three frames");
+    assert_eq!(records.len(), 9, "three methods × three frames");
     let of = |m: &str, field: &str| -> Vec<f64> {
         records
             .iter()
@@ -2610,7 +2610,9 @@ fn a_sequence_sweep_compares_every_frame_with_its_truth() {
     for f in [
         "report.md",
         "plot_path.svg",
+        // Two settings of feedback: a strip each, named by its key.
         "filmstrip_path_feedback_history_0.png",
+        "filmstrip_path_feedback_history_1.png",
         "motion.json",
     ] {
         assert!(out.join(f).is_file(), "{f} missing");

@@ -358,9 +358,20 @@ pub fn run_sequences(
                 flips.push((m.flip_mean, k));
             }
             if stateful {
-                // Named by the method's key: two settings of one method (history=0..8) each
-                // keep their own strip.
-                let name = format!("filmstrip_{}_{}.png", s.name, slug(&method.key()));
+                // Named by the method, or by its key where the scenario has other settings
+                // of it (history=0..8): each keeps its own strip.
+                let shared = s
+                    .methods
+                    .iter()
+                    .filter(|m| m.name() == method.name())
+                    .count()
+                    > 1;
+                let which = if shared {
+                    slug(&method.key())
+                } else {
+                    method.name().to_string()
+                };
+                let name = format!("filmstrip_{}_{which}.png", s.name);
                 flips.sort_by(|a, b| b.0.total_cmp(&a.0));
                 let mut worst: Vec<u32> = flips.iter().take(3).map(|f| f.1).collect();
                 worst.sort_unstable();
