@@ -37,6 +37,12 @@ fn client(r: &Record) -> &str {
     r.method.split('-').next().unwrap_or(&r.method)
 }
 
+/// The view an external record was drawn from: its key's second field
+/// (`client/variant|view|a…|w×h|ssaa…`, `mirrorbox score`).
+fn view_of(r: &Record) -> &str {
+    r.key.split('|').nth(1).unwrap_or_default()
+}
+
 pub fn section(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
     let variants: Vec<&Record> = records
         .iter()
@@ -45,6 +51,16 @@ pub fn section(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
     if variants.is_empty() {
         return Vec::new();
     }
+    // With several views, each row and finding names its view (they read alike otherwise).
+    let several_views = variants.iter().any(|r| view_of(r) != view_of(variants[0]));
+    let label = |r: &Record| {
+        let l = mirrorbox_report::document::label(r);
+        if several_views {
+            format!("{l} (view {})", view_of(r))
+        } else {
+            l
+        }
+    };
     let ours: Vec<&Record> = records
         .iter()
         .filter(|r| !external(r) && r.kind == "point")
@@ -53,9 +69,10 @@ pub fn section(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
     let mut rows = Vec::new();
     let mut findings = Vec::new();
     for r in &variants {
-        let floor = records
-            .iter()
-            .find(|f| external(f) && f.kind == "floor" && f.method == client(r));
+        // The client's floor of the same view.
+        let floor = records.iter().find(|f| {
+            external(f) && f.kind == "floor" && f.method == client(r) && view_of(f) == view_of(r)
+        });
         let equivalent = r.option("equivalent");
         let eq = equivalent.and_then(|m| ours.iter().find(|o| o.method == m));
         // The best of our exact methods that costs no more on its own device.
@@ -64,7 +81,7 @@ pub fn section(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
             .filter(|o| info.exact_methods.contains(&o.method) && o.ms_median <= r.ms_median)
             .min_by(|a, b| a.mirror_flip().total_cmp(&b.mirror_flip()));
         rows.push(vec![
-            mirrorbox_report::document::label(r),
+            label(r),
             short(&r.adapter, 60),
             floor.map_or("–".into(), |fl| sci(fl.metrics.flip_mean)),
             sci(r.mirror_flip()),
@@ -83,8 +100,13 @@ pub fn section(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
             }),
         ]);
         let mut s = format!(
-            "**{}** ({}): FLIP over the mirror pixels {}",
+            "**{}**{} ({}): FLIP over the mirror pixels {}",
             r.method,
+            if several_views {
+                format!(", view {}", view_of(r))
+            } else {
+                String::new()
+            },
             r.backend,
             sci(r.mirror_flip())
         );
@@ -199,7 +221,34 @@ mod tests {
             "{beside}"
         );
         portal.ms_median = 1.0;
-        let cheaper = finding(&[variant, portal]);
+        let cheaper = finding(&[variant.clone(), portal]);
         assert!(cheaper.contains("at no more cost our `portal"), "{cheaper}");
+    }
+
+    /// With two views, each variant's row and finding name the view, and each takes the
+    /// floor of its own view (before: the first view's floor for both, and two rows alike).
+    #[test]
+    fn each_view_of_a_variant_is_named_and_has_its_own_floor() {
+        let external = |method: &str, kind: &str, view: &str, flip: f64| {
+            let mut r = record(0, 2.0, 1, flip);
+            r.method = method.into();
+            r.kind = kind.into();
+            r.key = format!("three/x|{view}|a0.9|16x16|ssaa1");
+            r.timing_order = mirrorbox_report::EXTERNAL_TIMING.into();
+            r
+        };
+        let records = [
+            external("three-reflector", "point", "a", 0.05),
+            external("three-reflector", "point", "b", 0.06),
+            external("three", "floor", "a", 0.001),
+            external("three", "floor", "b", 0.002),
+        ];
+        let info = SweepInfo::default();
+        let blocks = section(&info, &records);
+        let text = mirrorbox_report::document::markdown(&blocks);
+        assert!(text.contains("**three-reflector**, view a"), "{text}");
+        assert!(text.contains("**three-reflector**, view b"), "{text}");
+        assert!(text.contains("its floor (no mirrors) 2.000e-3"), "{text}");
+        assert!(text.contains("(view b)"), "{text}");
     }
 }
