@@ -405,7 +405,7 @@ fn run_frame(args: &Args) -> Result<(), Failure> {
     }
     let written = staged.commit().map_err(write_failed)?;
     let total = started.elapsed();
-    for (eye, view, out, warm_up) in &traced {
+    for (i, (eye, view, out, warm_up)) in traced.iter().enumerate() {
         if let Some(e) = eye
             && !args.json
         {
@@ -416,7 +416,10 @@ fn run_frame(args: &Args) -> Result<(), Failure> {
             warm_up_seconds: warm_up,
             warm_up_forms: &forms,
         };
-        report(args, view, &bvh, out, grid, &timing, &written, *eye);
+        // The files, written together, are said once, after the last eye (the JSON of each
+        // eye lists them all).
+        let last = i + 1 == traced.len();
+        report(args, view, &bvh, out, grid, &timing, (&written, last), *eye);
     }
     Ok(())
 }
@@ -545,7 +548,7 @@ fn report(
     out: &TraceOutput,
     grid: SubpixelGrid,
     timing: &Timing,
-    written: &[PathBuf],
+    (written, said): (&[PathBuf], bool),
     eye: Option<mirrorbox_scene::stereo::Eye>,
 ) {
     let total = timing.total;
@@ -639,16 +642,23 @@ fn report(
         None => String::new(),
     };
     println!(
-        "  {:?} over {} triangles built in {:.1} ms{packet_build}; {} vectors; wrote {}",
+        "  {:?} over {} triangles built in {:.1} ms{packet_build}; {} vectors{}",
         bvh.kind,
         scene.geometry.triangles.len(),
         bvh.build_time.as_secs_f64() * 1e3,
         out.vectors.name(),
-        written
-            .iter()
-            .map(|p| p.display().to_string())
-            .collect::<Vec<_>>()
-            .join(", ")
+        if said {
+            format!(
+                "; wrote {}",
+                written
+                    .iter()
+                    .map(|p| p.display().to_string())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )
+        } else {
+            String::new()
+        }
     );
 }
 
