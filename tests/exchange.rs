@@ -229,6 +229,11 @@ fn a_bad_run_is_refused_naming_the_file_and_nothing_is_written() {
         refused("bad pixel", "pixel (5, 2)");
     }
     std::fs::write(&exr, &good).unwrap();
+    // An image of no view (a misnamed view's): it had been skipped unsaid.
+    let stray = variant.join("c.exr");
+    std::fs::write(&stray, &good).unwrap();
+    refused("an image of no view", "c.exr: an image of no view");
+    std::fs::remove_file(&stray).unwrap();
     // An unreadable timing file, one without the view, and a negative time.
     let timing_file = variant.join("timing.json");
     for (text, needle) in [

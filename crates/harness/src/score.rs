@@ -276,6 +276,38 @@ fn variants(run: &Path) -> Result<Vec<(String, String, PathBuf)>, HarnessError> 
     Ok(out)
 }
 
+/// Refuses an image in a variant folder that is no view's (`c.exr` where views.json has no
+/// view `c`): its view was misnamed, and it was skipped unsaid (a `timing.json` naming an
+/// unknown view is refused alike).
+fn check_no_stray_image(dir: &Path, views: &ViewsFile) -> Result<(), HarnessError> {
+    for e in std::fs::read_dir(dir).map_err(io(dir))? {
+        let path = e.map_err(io(dir))?.path();
+        let image = path
+            .extension()
+            .is_some_and(|x| x.eq_ignore_ascii_case("exr") || x.eq_ignore_ascii_case("png"));
+        let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned());
+        if image
+            && let Some(stem) = stem
+            && !views.views.iter().any(|v| v.name == stem)
+        {
+            return Err(refused(
+                &path,
+                format!(
+                    "an image of no view: views.json has {} (a variant folder holds \
+                     <view>.exr or <view>.png and timing.json)",
+                    views
+                        .views
+                        .iter()
+                        .map(|v| format!("{:?}", v.name))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// A view's image in a variant folder: `<view>.exr`, else `<view>.png`; checked for its size
 /// and for pixels that are not radiance (NaN, infinite, negative).
 fn view_image(dir: &Path, view: &crate::exchange::ExportedView) -> Result<PathBuf, HarnessError> {
@@ -441,6 +473,7 @@ pub fn score(
         for v in &views.views {
             images.push(view_image(dir, v)?);
         }
+        check_no_stray_image(dir, &views)?;
         inputs.push((client, variant, timing, images));
     }
     crate::exchange::in_staged_folder(out, |partial| {
