@@ -831,6 +831,7 @@ pub fn chart(
         references,
         floor: None,
         x_ticks_at_data: false,
+        x_whole: false,
         footer,
     }
 }

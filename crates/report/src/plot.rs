@@ -204,6 +204,8 @@ pub struct Chart {
     pub floor: Option<f64>,
     /// Ticks at the data's distinct x (n, depth, p) instead of round numbers.
     pub x_ticks_at_data: bool,
+    /// The x values are counts (frames): round ticks at whole numbers only, never 0.5.
+    pub x_whole: bool,
     /// Scene, size, device, date and commit; set by the report writer for every chart.
     pub footer: String,
 }
@@ -240,6 +242,7 @@ impl Chart {
             references: Vec::new(),
             floor: None,
             x_ticks_at_data: false,
+            x_whole: false,
             footer: String::new(),
         }
     }
@@ -904,7 +907,12 @@ impl Chart {
             }
             out
         } else {
-            ax.ticks()
+            let ticks = ax.ticks();
+            if self.x_whole {
+                ticks.into_iter().filter(|t| t.fract() == 0.0).collect()
+            } else {
+                ticks
+            }
         };
         for t in x_ticks {
             let x = px_of(t);
@@ -1479,6 +1487,28 @@ mod tests {
         assert!(!svg.contains("(on unrolled)"), "{svg}");
         assert!(
             svg.contains("ring: a point at the same place as an earlier one"),
+            "{svg}"
+        );
+    }
+
+    /// A count axis (frames) ticks whole numbers only: three frames read 0, 1, 2, not 0.5.
+    #[test]
+    fn a_count_axis_has_whole_ticks() {
+        let s = Series::new(
+            "m",
+            method_style("feedback"),
+            vec![(0.0, 1.0), (1.0, 2.0), (2.0, 3.0)],
+        );
+        let mut c = chart(vec![s]);
+        (c.x_log, c.references) = (false, Vec::new());
+        assert!(
+            c.to_svg().contains(">0.5</text>"),
+            "the plain axis ticks halves"
+        );
+        c.x_whole = true;
+        let svg = c.to_svg();
+        assert!(
+            !svg.contains(">0.5</text>") && svg.contains(">1</text>"),
             "{svg}"
         );
     }

@@ -249,6 +249,7 @@ pub fn chart(records: &[FrameRecord], scenario: &str) -> Chart {
     );
     Chart {
         y_log: true,
+        x_whole: true,
         series: methods
             .iter()
             .zip(styles)
