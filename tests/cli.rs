@@ -2176,6 +2176,30 @@ fn stereo_eyes_match_their_own_truth() {
         "{}",
         out.stderr
     );
+    // The stereo pair's option on one view is refused, not ignored.
+    let out = mirrorbox(
+        &[
+            "render",
+            scene,
+            "--method",
+            "naive",
+            "--stereo-mirrors",
+            "shared",
+            "-o",
+            &p("mono.png"),
+            "--width",
+            "32",
+            "--height",
+            "18",
+        ],
+        &[],
+    );
+    assert_eq!(out.code, 2, "{}", out.stderr);
+    assert!(
+        out.stderr.contains("an option of a stereo pair"),
+        "{}",
+        out.stderr
+    );
 }
 
 /// Issue 17: a stereo sweep renders both eyes as one frame against each eye's truth. At IPD 0

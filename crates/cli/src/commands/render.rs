@@ -111,6 +111,19 @@ fn run_frame(args: &Args, carry: &mut Carry) -> Result<(), Failure> {
     let entry = mirrorbox_raster::registry::find(&args.method)
         .ok_or_else(|| bad(format!("unknown method {:?}", args.method)))?;
     let method = args.options.0.configure(entry)?;
+    // A stereo pair's option on one view would change nothing: said, not ignored.
+    if !args.stereo.asked()
+        && method
+            .params()
+            .get(&mirrorbox_raster::stereo_mirrors::STEREO_MIRRORS)
+            == Some(mirrorbox_raster::ParamValue::Choice("shared"))
+    {
+        return Err(bad(
+            "--stereo-mirrors shared: an option of a stereo pair (--stereo or --ipd); this \
+             render is of one view, where it would change nothing"
+                .into(),
+        ));
+    }
     unit_interval("--alpha", args.alpha)?;
     let png = check_frame_outputs(args)?;
     let exr = png.with_extension("exr");
