@@ -735,6 +735,23 @@ fn document(info: &SweepInfo, records: &[Record], sections: &[Section]) -> Vec<B
     }
     b.extend(crate::split::split_section(records, &info.exact_methods));
     if !points.is_empty() {
+        // A stereo sweep's points differ by their IPD (or are mono), an uneven-mirror sweep's
+        // by their tilt: said in the point's cell, where label() alone reads alike.
+        let stereo = points
+            .iter()
+            .any(|r| r.axis(crate::axis::STEREO_IPD).is_some());
+        let point_name = |r: &Record| {
+            let mut name = label(r);
+            match r.axis(crate::axis::STEREO_IPD) {
+                Some(ipd) => name.push_str(&format!(", IPD {ipd}")),
+                None if stereo => name.push_str(", mono"),
+                None => {}
+            }
+            if let Some(t) = r.tilt_deg() {
+                name.push_str(&format!(", tilt {t}°"));
+            }
+            name
+        };
         b.push(Block::Heading(2, "All points".into()));
         b.push(Block::Table(
             [
@@ -769,9 +786,9 @@ fn document(info: &SweepInfo, records: &[Record], sections: &[Section]) -> Vec<B
                     let m = &r.metrics;
                     vec![
                         if reused(r) {
-                            format!("{} †", label(r))
+                            format!("{} †", point_name(r))
                         } else {
-                            label(r)
+                            point_name(r)
                         },
                         r.alpha.to_string(),
                         ms_cell(r, 2),
@@ -1019,6 +1036,20 @@ pub(crate) mod tests {
         write_report(dir.path(), &SweepInfo::default(), &[new], &[]).unwrap();
         let md = std::fs::read_to_string(dir.path().join("report.md")).unwrap();
         assert!(!md.contains('†'), "{md}");
+    }
+
+    /// A stereo sweep's points read apart in "All points": each names its IPD, or mono.
+    #[test]
+    fn all_points_name_a_stereo_points_ipd() {
+        let dir = tempfile::tempdir().unwrap();
+        let mono = record(2, 20.0, 3, 0.1);
+        let mut pair = record(2, 30.0, 6, 0.1);
+        pair.key = "pair".into();
+        pair.axes.insert(crate::axis::STEREO_IPD.into(), 0.1);
+        write_report(dir.path(), &SweepInfo::default(), &[mono, pair], &[]).unwrap();
+        let md = std::fs::read_to_string(dir.path().join("report.md")).unwrap();
+        assert!(md.contains("| auxiliary n=2, mono |"), "{md}");
+        assert!(md.contains("| auxiliary n=2, IPD 0.1 |"), "{md}");
     }
 
     /// A lent GPU's 1920×1080 images stay behind (issue 57): the report says they were not
