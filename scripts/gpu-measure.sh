@@ -246,7 +246,7 @@ for s in "$@"; do
   real-assets) step real-assets 90 "$bin" experiment real-assets --out reports/gpu/real_assets ;;
   table1-pair) step table1-pair 100 table1_pair ;;
   table1-pair-reversed) step table1-pair-reversed 100 table1_pair_reversed ;;
-  table1) step table1 120 "$bin" experiment table1 --out reports/gpu/table1 ;;
+  table1) step table1 120 "$bin" experiment table1 --fresh --out "reports/gpu/table1_$(gpu_slug)" ;;
   depth) step depth-scaling 120 "$bin" experiment depth-scaling --out reports/gpu/depth_scaling ;;
   room) step room 120 room ;;
   trace) step trace-threads 60 trace_threads ;;

@@ -2085,8 +2085,10 @@ fn report_rewrites_a_sweep_folder_from_its_records() {
     for f in ["report.html", "results.csv", "plot_flip_vs_ms.svg"] {
         assert!(dir.as_path().join(f).is_file(), "{f} not written");
     }
-    // The overview of a folder of one's own sweeps: no experiment's folder, so no findings
-    // (before: refused for lacking `table1/`).
+    // The overview of a folder of one's own sweeps: no Table 1 records, so no findings
+    // (before: refused for lacking `table1/`), even beside a folder named like an
+    // experiment's.
+    std::fs::create_dir(root.path().join("motion")).unwrap();
     let index = mirrorbox(&["report", "--index", root.path().to_str().unwrap()], &[]);
     assert_eq!(index.code, 0, "stderr: {}", index.stderr);
     assert!(
@@ -2386,10 +2388,27 @@ fn shards_merge_into_the_unsharded_sweep() {
     );
     let report = std::fs::read_to_string(d.join("merged/report.md")).unwrap();
     assert!(report.contains("Merged from 3 shards"), "{report}");
-    // Merged again over the earlier merge: replaced, the same points.
+    // Merged again over the earlier merge: replaced, the same points, and a shard's
+    // re-measured picture replaces the earlier merge's copy (it had been kept).
+    let k = (0..3).find(|k| !shard_keys[*k].is_empty()).unwrap();
+    let shard = d.join(format!("s{k}"));
+    let picture = records(&shard)[0]["raster_image"]
+        .as_str()
+        .unwrap()
+        .to_string();
+    let other = records(&shard)[0]["heatmap_image"]
+        .as_str()
+        .unwrap()
+        .to_string();
+    std::fs::copy(shard.join(&other), shard.join(&picture)).unwrap();
     let again = mirrorbox(&["merge", &p("merged"), &s0, &s1, &s2], &[]);
     assert_eq!(again.code, 0, "{}", again.stderr);
     assert_eq!(records(&d.join("merged")).len(), joined.len());
+    assert_eq!(
+        std::fs::read(d.join("merged").join(&picture)).unwrap(),
+        std::fs::read(shard.join(&other)).unwrap(),
+        "{picture}: the shard's new picture"
+    );
     // OUT that is a shard, or holds another sweep: refused, nothing changed (before, the
     // other sweep's records and same-named pictures were overwritten).
     let full_records = std::fs::read(d.join("full/results.jsonl")).unwrap();

@@ -246,8 +246,8 @@ fn room_front(reports: &Path) -> Result<String, ReadmeError> {
         .iter()
         .filter(|r| front.contains(&(r.ms_median, r.mirror_flip())))
         .map(|r| {
-            // Points off the front within 1 % of this one on both axes: without intervals,
-            // the front cannot tell them apart.
+            // Other points within 1 % of this one on both axes: without intervals, the front
+            // cannot tell them apart.
             let near = |a: f64, b: f64| (a - b).abs() <= 0.01 * a.abs().max(b.abs());
             let ties: Vec<String> = pts
                 .iter()

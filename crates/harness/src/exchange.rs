@@ -419,7 +419,7 @@ fn camera_problem(forward: Vec3, up: Option<Vec3>, fov_y_deg: Option<f32>) -> Op
         return Some("up must be finite and not along the view direction");
     }
     if fov_y_deg.is_some_and(|f| !mirrorbox_scene::limits::fov_ok(f)) {
-        return Some("fov_y_deg must be in (0, 170] (mirrorbox_scene::limits::MAX_FOV_Y_DEG)");
+        return Some("fov_y_deg must be in (0, 170] degrees");
     }
     None
 }

@@ -904,7 +904,12 @@ fn check_same_sweep(
         return Ok(());
     };
     let described = |scene: &str, hash: &str, w: u32, h: u32, ssaa: u32, frames: u32| {
-        format!("{scene} (content {hash}) at {w}×{h}, ssaa {ssaa}, {frames} frames")
+        let frames = if frames == 1 {
+            "1 frame".to_string()
+        } else {
+            format!("{frames} frames")
+        };
+        format!("{scene} (content {hash}) at {w}×{h}, ssaa {ssaa}, {frames}")
     };
     Err(HarnessError::OutputFolder {
         path: out.to_path_buf(),
@@ -1784,8 +1789,14 @@ mod tests {
         run_sweep(&config("mirror_box.json", 32, 1, 0.5), false, &mut |_| {}).unwrap();
         let results = out.path().join("sweep/results.jsonl");
         let before = std::fs::read(&results).unwrap();
+        let mut taller = config("mirror_box.json", 32, 1, 0.5);
+        taller.height = Some(20);
+        let mut finer = config("mirror_box.json", 32, 1, 0.5);
+        finer.ssaa = 2;
         for (c, other) in [
             (config("mirror_box.json", 40, 1, 0.5), "at 40×18"),
+            (taller, "at 32×20"),
+            (finer, "ssaa 2"),
             (config("mirror_box.json", 32, 2, 0.5), "2 frames"),
             (
                 config("mirror_room.json", 32, 1, 0.5),
@@ -1796,7 +1807,7 @@ mod tests {
             let text = e.to_string();
             assert!(e.is_refusal(), "{text}");
             assert!(
-                text.contains("holds points of") && text.contains("at 32×18, ssaa 1, 1 frames"),
+                text.contains("holds points of") && text.contains("at 32×18, ssaa 1, 1 frame"),
                 "{text}"
             );
             assert!(
@@ -1808,6 +1819,9 @@ mod tests {
         let summary =
             run_sweep(&config("mirror_box.json", 32, 1, 0.9), false, &mut |_| {}).unwrap();
         assert_eq!(read_records(&results).unwrap().len(), 3, "{summary:?}");
+        // `--fresh` (the main job's) discards the folder's points first: accepted.
+        run_sweep(&config("mirror_box.json", 40, 1, 0.5), true, &mut |_| {}).unwrap();
+        assert_eq!(read_records(&results).unwrap().len(), 2);
     }
 
     /// Every point renders once in the settling round before its timed rounds, and only the

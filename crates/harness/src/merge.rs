@@ -226,7 +226,8 @@ fn check_merge_out(out: &Path, shards: &[ShardFolder]) -> Result<(), HarnessErro
     }
     Err(refused(
         "a new or empty folder, or an earlier merge of these shards (it holds something else, \
-         which the merge would overwrite)"
+         which the merge would mix its files with; a merge stopped half-way leaves such a \
+         folder: remove it)"
             .into(),
     ))
 }
@@ -245,6 +246,7 @@ fn write_merged(
     })?;
     let _lock = FolderLock::try_acquire(out)?;
     let mut by_key: HashMap<&str, Record> = HashMap::new();
+    let mut copied: std::collections::HashSet<PathBuf> = std::collections::HashSet::new();
     for s in shards {
         let device = format!("{} on {}", s.info.adapter_description(), s.info.cpu);
         for r in &s.records {
@@ -257,7 +259,9 @@ fn write_merged(
             );
             for picture in crate::record_pictures(r) {
                 let (from, to) = (s.dir.join(picture), out.join(picture));
-                if !to.exists() {
+                // Once per merge (points share pictures), over an earlier merge's copy: a
+                // re-measured shard's picture replaces it.
+                if copied.insert(to.clone()) {
                     mirrorbox_files::write_atomically_with(&to, |tmp| {
                         std::fs::copy(&from, tmp)
                             .map(|_| ())

@@ -284,15 +284,6 @@ pub fn run_sequences(
         move |source| HarnessError::Io { path, source }
     };
     std::fs::create_dir_all(&config.out).map_err(io(&config.out))?;
-    // An earlier run's filmstrips (replaced, `--fresh`): its report named them, this one may not.
-    if let Ok(entries) = std::fs::read_dir(&config.out) {
-        for e in entries.flatten() {
-            let name = e.file_name().to_string_lossy().into_owned();
-            if name.starts_with("filmstrip_") && name.ends_with(".png") {
-                std::fs::remove_file(e.path()).map_err(io(&e.path()))?;
-            }
-        }
-    }
     let mut records = Vec::new();
     let mut scenarios = Vec::new();
     let mut device = String::new();
@@ -425,6 +416,24 @@ pub fn run_sequences(
         scenarios,
     };
     write_motion_report(&config.out, &info, &records)?;
+    // An earlier run's filmstrips (replaced, `--fresh`) that this report does not name: only
+    // now, so that a run failing before its report leaves the earlier one whole.
+    let named: Vec<&str> = info
+        .scenarios
+        .iter()
+        .flat_map(|s| s.filmstrips.iter().map(|(_, name, _)| name.as_str()))
+        .collect();
+    if let Ok(entries) = std::fs::read_dir(&config.out) {
+        for e in entries.flatten() {
+            let name = e.file_name().to_string_lossy().into_owned();
+            if name.starts_with("filmstrip_")
+                && name.ends_with(".png")
+                && !named.contains(&name.as_str())
+            {
+                std::fs::remove_file(e.path()).map_err(io(&e.path()))?;
+            }
+        }
+    }
     Ok(records)
 }
 

@@ -519,7 +519,7 @@ impl App {
                 }
                 None => {
                     r.ui.status = format!(
-                        "no screenshot: mirrorbox-view-{}.png and the 10 000 after it exist in {}",
+                        "no screenshot: mirrorbox-view-{}.png and the 9 999 after it exist in {}",
                         r.saved + 1,
                         out_dir.display()
                     )
@@ -550,7 +550,7 @@ impl App {
                     }
                 }
                 None => format!(
-                    "camera not saved: {stem}.view-{}.json and the 10 000 after it exist in {}",
+                    "camera not saved: {stem}.view-{}.json and the 9 999 after it exist in {}",
                     r.saved + 1,
                     dir.display()
                 ),

@@ -26,11 +26,10 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     if let Some(reports) = &args.index {
         // What was found leads the overview, each finding with its figure, its links relative
         // to `reports/` as written. The findings are the project's, computed from its
-        // experiments' folders: a folder of one's own sweeps, which holds none of them, gets
-        // the overview without them (before, it was refused for lacking `table1/`).
-        let experiments = mirrorbox_experiments::EXPERIMENTS
-            .iter()
-            .any(|e| reports.join(e.folder).exists());
+        // experiments' records, the first of them Table 1's: a folder without
+        // `table1/sweep.json` (one's own sweeps, whatever their folders are called) gets the
+        // overview without them (before, it was refused for lacking it).
+        let experiments = reports.join("table1/sweep.json").is_file();
         let lead = if experiments {
             let findings = mirrorbox_experiments::findings::findings_with_figures(reports)
                 .map_err(|e| {
@@ -39,8 +38,8 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             mirrorbox_experiments::findings::rebased(&findings, "", "../")
         } else {
             println!(
-                "{}: none of the experiments' folders (`mirrorbox experiment --list`): the \
-                 overview lists the reports without the project's findings",
+                "{}: no table1/ records (`mirrorbox experiment table1`): the overview lists the \
+                 reports without the project's findings",
                 reports.display()
             );
             String::new()
@@ -146,7 +145,7 @@ fn about(folder: &str) -> Option<String> {
             if let Some(a) = about_folder(name) {
                 return Some(format!("{a}, on a lent GPU"));
             }
-            name = ["_run2", "_h200", "_1080p"]
+            name = ["_run2", "_1080p", "_h100", "_h200", "_gpu"]
                 .iter()
                 .find_map(|s| name.strip_suffix(s))?;
         }
