@@ -2411,8 +2411,20 @@ fn shards_merge_into_the_unsharded_sweep() {
     );
     // OUT that is a shard, or holds another sweep: refused, nothing changed (before, the
     // other sweep's records and same-named pictures were overwritten).
+    // An earlier merge of another sweep (its point keys differ): refused as well.
+    let other_merge = d.join("other_merge");
+    std::fs::create_dir(&other_merge).unwrap();
+    let mut info: Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("merged/sweep.json")).unwrap())
+            .unwrap();
+    info["point_keys"] = serde_json::json!(["another sweep's point"]);
+    std::fs::write(other_merge.join("sweep.json"), info.to_string()).unwrap();
     let full_records = std::fs::read(d.join("full/results.jsonl")).unwrap();
     for (out, message) in [
+        (
+            other_merge.to_str().unwrap().to_string(),
+            "an earlier merge of these shards",
+        ),
         (s0.clone(), "a folder apart from the shards"),
         (p("full"), "an earlier merge of these shards"),
     ] {
