@@ -424,15 +424,8 @@ fn frontier_chart(
     chart
 }
 
-/// Writes `reports/index.html`, `reports/README.md` and the frontier SVGs from every report
-/// under `reports`; `commit_of(path)` (a sweep folder, or a measurement's file) names the commit of one that did not record the
-/// one that measured it (the commit that committed its records). Returns the number of
-/// reports listed.
-/// `about(folder)`: what the experiment that writes `folder` (relative to `reports`)
-/// measures, from the experiment registry, where it knows the folder.
-/// `others`: the reports that are not sweep folders (a sequence sweep's, a script's).
 /// The figure check of the overview's frontier charts ([`crate::plot::Chart::lint`]), drawn
-/// from the sweep folders under `reports` as [`write_overview`] draws them, without writing.
+/// from the sweep folders under `reports` as [`overview`] draws them, without writing.
 pub fn lint_frontiers(reports: &Path) -> Result<Vec<String>, ReadmeError> {
     let mut sweeps = Vec::new();
     for dir in sweep_folders(reports) {
@@ -450,24 +443,14 @@ pub fn lint_frontiers(reports: &Path) -> Result<Vec<String>, ReadmeError> {
         .collect())
 }
 
-/// `write_overview`'s lead: Markdown (links relative to `reports/`) set first on both pages —
-/// what was found, before the charts.
+/// [`overview`]'s lead: Markdown (links relative to `reports/`) set first on both pages — what
+/// was found, before the charts.
 pub struct Lead<'a>(pub &'a str);
 
-pub fn write_overview(
-    reports: &Path,
-    commit_of: &dyn Fn(&Path) -> String,
-    about: &dyn Fn(&str) -> Option<String>,
-    others: &[OtherReport],
-    lead: Lead,
-) -> Result<usize, ReadmeError> {
-    let o = overview(reports, commit_of, about, others, lead)?;
-    o.write()?;
-    Ok(o.listed)
-}
-
-/// What [`write_overview`] would write: the files with their text, the frontier charts of an
-/// earlier overview it would remove, and how many reports it lists.
+/// The overview [`overview`] computes: the files with their text (`reports/index.html`,
+/// `reports/README.md`, the frontier SVGs), the frontier charts of an earlier overview it
+/// removes, and how many reports it lists. [`Overview::write`] writes it,
+/// [`Overview::differences`] compares it with the files on disk.
 pub struct Overview {
     pub files: Vec<(PathBuf, String)>,
     pub stale: Vec<PathBuf>,
@@ -507,7 +490,12 @@ impl Overview {
     }
 }
 
-/// [`write_overview`]'s files, computed without writing.
+/// The overview of every report under `reports`, computed without writing.
+/// `commit_of(path)` (a sweep folder, or a measurement's file) names the commit of one that
+/// did not record the one that measured it (the commit that committed its records).
+/// `about(folder)`: what the experiment that writes `folder` (relative to `reports`)
+/// measures, from the experiment registry, where it knows the folder.
+/// `others`: the reports that are not sweep folders (a sequence sweep's, a script's).
 pub fn overview(
     reports: &Path,
     commit_of: &dyn Fn(&Path) -> String,
