@@ -300,22 +300,29 @@ pub fn with_stem_suffix(path: &Path, suffix: &str) -> PathBuf {
     path.with_file_name(name)
 }
 
+/// `n` bytes in the largest binary unit it reaches (KiB, MiB, GiB, TiB) and that unit; `None`
+/// below 1 KiB. The one table of [`human_bytes`] and the memory plans' `format_bytes`.
+pub fn binary_unit(n: u64) -> Option<(f64, &'static str)> {
+    const UNITS: [(&str, u64); 4] = [
+        ("TiB", 1 << 40),
+        ("GiB", 1 << 30),
+        ("MiB", 1 << 20),
+        ("KiB", 1 << 10),
+    ];
+    UNITS
+        .iter()
+        .find(|(_, size)| n >= *size)
+        .map(|&(unit, size)| (n as f64 / size as f64, unit))
+}
+
 /// `1.5 GiB`, `35.2 KiB`, `12 bytes`: binary units, as `--memory-budget` reads them
 /// (`2G` is 2 GiB) and the plans' estimates and the reports' memory columns print them, so
 /// that one output never mixes the two kinds.
 pub fn human_bytes(n: u64) -> String {
-    const UNITS: [(&str, f64); 4] = [
-        ("TiB", (1u64 << 40) as f64),
-        ("GiB", (1u64 << 30) as f64),
-        ("MiB", (1u64 << 20) as f64),
-        ("KiB", 1024.0),
-    ];
-    for (unit, size) in UNITS {
-        if n as f64 >= size {
-            return format!("{:.1} {unit}", n as f64 / size);
-        }
+    match binary_unit(n) {
+        Some((v, unit)) => format!("{v:.1} {unit}"),
+        None => format!("{n} bytes"),
     }
-    format!("{n} bytes")
 }
 
 /// An output folder held by this process: the advisory lock on `DIR/.mirrorbox.lock`

@@ -219,23 +219,11 @@ impl std::error::Error for OverMemoryBudget {}
 
 /// Bytes in binary units: `512 B`, `1.50 KiB`, `118 MiB`, `2.00 GiB`.
 pub fn format_bytes(n: u64) -> String {
-    const UNITS: [(&str, u64); 4] = [
-        ("TiB", 1 << 40),
-        ("GiB", 1 << 30),
-        ("MiB", 1 << 20),
-        ("KiB", 1 << 10),
-    ];
-    for (unit, size) in UNITS {
-        if n >= size {
-            let v = n as f64 / size as f64;
-            return if v >= 100.0 {
-                format!("{v:.0} {unit}")
-            } else {
-                format!("{v:.2} {unit}")
-            };
-        }
+    match mirrorbox_files::binary_unit(n) {
+        Some((v, unit)) if v >= 100.0 => format!("{v:.0} {unit}"),
+        Some((v, unit)) => format!("{v:.2} {unit}"),
+        None => format!("{n} B"),
     }
-    format!("{n} B")
 }
 
 /// Most bytes `--memory-budget` accepts (1 TiB): beyond it the check means nothing.
