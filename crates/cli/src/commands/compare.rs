@@ -34,35 +34,39 @@ pub fn metrics_json(m: &Metrics) -> serde_json::Value {
     })
 }
 
-/// The samples per pixel an image written by `trace` (`mirrorbox.spp`) or `render`
-/// (`mirrorbox.ssaa`, an s×s grid) was taken with; `None` for other images.
-fn samples_per_pixel(path: &std::path::Path) -> Option<u64> {
-    let attributes = mirrorbox_image::read_exr_attributes(path).ok()?;
+/// What `trace` and `render` record in their EXRs that a comparison needs, read once per
+/// image (a PNG records nothing: it is already exposed and encoded).
+#[derive(Clone, Copy, Default)]
+struct Recorded {
+    /// The samples per pixel: `mirrorbox.spp` (trace), or `mirrorbox.ssaa` s as s² (render).
+    spp: Option<u64>,
+    /// The scene camera's exposure, `mirrorbox.exposure`.
+    exposure: Option<f32>,
+}
+
+fn recorded(path: &std::path::Path) -> Recorded {
+    let Ok(attributes) = mirrorbox_image::read_exr_attributes(path) else {
+        return Recorded::default();
+    };
     let value = |key: &str| {
         attributes
             .iter()
             .find(|(k, _)| k == key)
-            .and_then(|(_, v)| v.parse::<u64>().ok())
+            .map(|(_, v)| v.as_str())
     };
-    value("mirrorbox.spp").or_else(|| value("mirrorbox.ssaa").map(|s| s * s))
-}
-
-/// The exposure an image was made with: the `mirrorbox.exposure` that `trace` and `render`
-/// write into their EXRs (the scene camera's); `None` for other images (a PNG is already
-/// exposed and encoded).
-fn recorded_exposure(path: &std::path::Path) -> Option<f32> {
-    let attributes = mirrorbox_image::read_exr_attributes(path).ok()?;
-    attributes
-        .iter()
-        .find(|(k, _)| k == "mirrorbox.exposure")
-        .and_then(|(_, v)| v.parse::<f32>().ok())
-        .filter(|e| *e > 0.0 && e.is_finite())
+    let count = |key: &str| value(key).and_then(|v| v.parse::<u64>().ok());
+    Recorded {
+        spp: count("mirrorbox.spp").or_else(|| count("mirrorbox.ssaa").map(|s| s * s)),
+        exposure: value("mirrorbox.exposure")
+            .and_then(|v| v.parse::<f32>().ok())
+            .filter(|e| *e > 0.0 && e.is_finite()),
+    }
 }
 
 /// The tone mapping's exposure: `--exposure`, else the one both images record, else 1. Images
 /// recording different exposures, or one recording an exposure other than 1 beside one that
 /// records none, are refused without `--exposure`: no one value fits both.
-fn exposure(args: &Args) -> Result<f32, Failure> {
+fn exposure(args: &Args, reference: Recorded, test: Recorded) -> Result<f32, Failure> {
     if let Some(e) = args.exposure {
         if !(e > 0.0 && e.is_finite()) {
             return Err(Failure::BadInput(format!(
@@ -71,10 +75,7 @@ fn exposure(args: &Args) -> Result<f32, Failure> {
         }
         return Ok(e);
     }
-    let (r, t) = (
-        recorded_exposure(&args.reference),
-        recorded_exposure(&args.test),
-    );
+    let (r, t) = (reference.exposure, test.exposure);
     match (r, t) {
         (Some(a), Some(b)) if a == b => Ok(a),
         (None, None) => Ok(1.0),
@@ -97,20 +98,21 @@ fn exposure(args: &Args) -> Result<f32, Failure> {
 /// Refuses images sampled on different sub-pixel grids: a 4×4 box average and a pixel-centre
 /// sample differ wherever the image curves, and that difference would be read as the
 /// method's error (the shading contract: never from mismatched sampling).
-fn check_same_grid(reference: &std::path::Path, test: &std::path::Path) -> Result<(), Failure> {
-    match (samples_per_pixel(reference), samples_per_pixel(test)) {
+fn check_same_grid(args: &Args, reference: Recorded, test: Recorded) -> Result<(), Failure> {
+    match (reference.spp, test.spp) {
         (Some(a), Some(b)) if a != b => Err(Failure::BadInput(format!(
             "{} was taken with {a} samples per pixel and {} with {b}: compare images of the \
              same sub-pixel grid (trace --spp s² against render --ssaa s)",
-            reference.display(),
-            test.display()
+            args.reference.display(),
+            args.test.display()
         ))),
         _ => Ok(()),
     }
 }
 
 pub fn run(args: &Args) -> Result<(), Failure> {
-    let exposure = exposure(args)?;
+    let (reference, test) = (recorded(&args.reference), recorded(&args.test));
+    let exposure = exposure(args, reference, test)?;
     let heatmap = args
         .heatmap
         .as_deref()
@@ -146,7 +148,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             args.test.display()
         ))
     })?;
-    check_same_grid(&args.reference, &args.test)?;
+    check_same_grid(args, reference, test)?;
     if let Some(path) = &heatmap {
         let map = flip_map(
             &r.to_srgb8(exposure),
