@@ -881,6 +881,13 @@ pub(crate) fn check_output_folder(flag: &str, dir: &Path) -> Result<(), HarnessE
     Ok(())
 }
 
+/// The files by which a folder holds a report, by kind: a sweep's (`sweep`, `merge`,
+/// `score`), a sequence sweep's (`sweep --path`), an advice's. The checks that refuse a
+/// folder of another kind ([`merge`], [`sequence`]) name them from here.
+pub(crate) const SWEEP_FILES: [&str; 2] = ["results.jsonl", "sweep.json"];
+pub(crate) const SEQUENCE_FILES: [&str; 2] = ["frames.jsonl", "motion.json"];
+pub(crate) const ADVICE_FILES: [&str; 1] = ["advice.json"];
+
 /// Refuses a sweep into a folder whose records were measured on another scene, size,
 /// sub-pixel grid or number of frames: a folder holds one scene at one size (its report's
 /// heading names one, and its pictures are named by method and axes alone, so a second

@@ -218,8 +218,9 @@ fn check_merge_out(out: &Path, shards: &[ShardFolder]) -> Result<(), HarnessErro
     .and_then(|t| serde_json::from_str::<SweepInfo>(&t).ok());
     let same_merge = earlier.is_some_and(|info| {
         !info.shards.is_empty() && info.point_keys == shards[0].info.point_keys
-    }) && !["frames.jsonl", "advice.json"]
+    }) && !crate::SEQUENCE_FILES
         .iter()
+        .chain(&crate::ADVICE_FILES)
         .any(|f| out.join(f).exists());
     if same_merge {
         return Ok(());

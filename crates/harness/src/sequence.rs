@@ -61,10 +61,6 @@ pub struct SequenceConfig {
     pub replace: bool,
 }
 
-/// The files by which a folder holds a report: a sequence sweep's, then the others'.
-const SEQUENCE_FILES: [&str; 2] = ["frames.jsonl", "motion.json"];
-const OTHER_REPORT_FILES: [&str; 3] = ["results.jsonl", "sweep.json", "advice.json"];
-
 /// Refuses an output folder a sequence sweep would spoil: one holding another kind of report
 /// (its files would stay beside the new ones, and `report` would read them), or an earlier
 /// sequence sweep's without `replace` (`--fresh`). Before, an earlier sequence sweep's
@@ -74,7 +70,12 @@ fn check_sequence_out(out: &Path, replace: bool) -> Result<(), HarnessError> {
         path: out.to_path_buf(),
         source: std::io::Error::other(why),
     };
-    if let Some(f) = OTHER_REPORT_FILES.iter().find(|f| out.join(f).exists()) {
+    use crate::{ADVICE_FILES, SEQUENCE_FILES, SWEEP_FILES};
+    if let Some(f) = SWEEP_FILES
+        .iter()
+        .chain(&ADVICE_FILES)
+        .find(|f| out.join(f).exists())
+    {
         return Err(refuse(format!(
             "holds another kind of report ({f}); a sequence sweep needs a folder of its own: \
              name another --out"
