@@ -2179,7 +2179,7 @@ fn stereo_eyes_match_their_own_truth() {
         out.stderr
     );
     // The stereo pair's option on one view is refused, not ignored.
-    let out = mirrorbox(
+    assert_refused(
         &[
             "render",
             scene,
@@ -2194,13 +2194,7 @@ fn stereo_eyes_match_their_own_truth() {
             "--height",
             "18",
         ],
-        &[],
-    );
-    assert_eq!(out.code, 2, "{}", out.stderr);
-    assert!(
-        out.stderr.contains("an option of a stereo pair"),
-        "{}",
-        out.stderr
+        "an option of a stereo pair",
     );
 }
 
@@ -2428,9 +2422,7 @@ fn shards_merge_into_the_unsharded_sweep() {
         (s0.clone(), "a folder apart from the shards"),
         (p("full"), "an earlier merge of these shards"),
     ] {
-        let r = mirrorbox(&["merge", &out, &s0, &s1, &s2], &[]);
-        assert_eq!(r.code, 2, "{out}: {}", r.stderr);
-        assert!(r.stderr.contains(message), "{out}: {}", r.stderr);
+        assert_refused(&["merge", &out, &s0, &s1, &s2], message);
     }
     assert_eq!(
         std::fs::read(d.join("full/results.jsonl")).unwrap(),
@@ -2677,13 +2669,7 @@ fn a_sequence_sweep_compares_every_frame_with_its_truth() {
     // Not resumed: a second sequence sweep into the folder needs --fresh (before, it
     // replaced the records unsaid), and an ordinary sweep's folder is refused as it is.
     let before = std::fs::read(out.join("frames.jsonl")).unwrap();
-    let again = mirrorbox(&args, &[]);
-    assert_eq!(again.code, 2, "{}", again.stderr);
-    assert!(
-        again.stderr.contains("pass --fresh to replace it"),
-        "{}",
-        again.stderr
-    );
+    assert_refused(&args, "pass --fresh to replace it");
     assert_eq!(std::fs::read(out.join("frames.jsonl")).unwrap(), before);
     let ordinary = dir.path().join("ordinary");
     std::fs::create_dir(&ordinary).unwrap();
@@ -2691,15 +2677,7 @@ fn a_sequence_sweep_compares_every_frame_with_its_truth() {
     let mut into = args.clone();
     into[3] = ordinary.to_str().unwrap();
     into.push("--fresh");
-    let refused = mirrorbox(&into, &[]);
-    assert_eq!(refused.code, 2, "{}", refused.stderr);
-    assert!(
-        refused
-            .stderr
-            .contains("another kind of report (results.jsonl)"),
-        "{}",
-        refused.stderr
-    );
+    assert_refused(&into, "another kind of report (results.jsonl)");
 
     // Supersampling reaches both sides: the raster's s×s grid is the truth's s² samples
     // (an exact method stays at the floor).
