@@ -533,11 +533,7 @@ impl App {
                 .file_stem()
                 .map(|s| s.to_string_lossy().into_owned())
                 .unwrap_or_else(|| "scene".into());
-            let dir = self
-                .options
-                .scene_path
-                .parent()
-                .unwrap_or(std::path::Path::new("."));
+            let dir = mirrorbox_files::folder_of(&self.options.scene_path);
             let copy = |n: u32| dir.join(format!("{stem}.view-{n}.json"));
             r.ui.status = match crate::screenshot::unused_number(r.saved + 1, |n| [copy(n)]) {
                 Some(n) => {
