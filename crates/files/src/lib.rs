@@ -178,6 +178,13 @@ pub fn in_resolved_folder(p: &Path) -> PathBuf {
     }
 }
 
+/// The file `path` resolves to, for telling whether two names are one file: wholly
+/// canonicalized (links and `..` resolved) where it exists, else [`in_resolved_folder`].
+pub fn resolved(path: &Path) -> PathBuf {
+    path.canonicalize()
+        .unwrap_or_else(|_| in_resolved_folder(path))
+}
+
 /// Refuses a set of paths in which two name the same file.
 pub fn check_distinct(outputs: &[(&str, PathBuf)]) -> Result<(), FileError> {
     // The folders exist (outputs are checked first).

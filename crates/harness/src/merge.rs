@@ -192,11 +192,10 @@ fn check_merge_out(out: &Path, shards: &[ShardFolder]) -> Result<(), HarnessErro
     let refused = |what: String| -> HarnessError {
         SettingError::new("merge OUT", what, out.display().to_string()).into()
     };
-    let resolved = |p: &Path| p.canonicalize().ok();
-    if let Some(o) = resolved(out)
-        && let Some(s) = shards
-            .iter()
-            .find(|s| resolved(&s.dir).as_ref() == Some(&o))
+    let o = mirrorbox_files::resolved(out);
+    if let Some(s) = shards
+        .iter()
+        .find(|s| mirrorbox_files::resolved(&s.dir) == o)
     {
         return Err(refused(format!(
             "a folder apart from the shards (it is the shard {})",

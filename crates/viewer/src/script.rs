@@ -100,13 +100,6 @@ pub fn parse_script(text: &str, file: &str) -> Result<Vec<Step>, ScriptError> {
     Ok(steps)
 }
 
-/// The file `path` resolves to, for comparing names: its folder canonicalized (links and
-/// `..` resolved) where that folder exists, else the path made absolute.
-fn resolved(path: &Path) -> PathBuf {
-    path.canonicalize()
-        .unwrap_or_else(|_| mirrorbox_files::in_resolved_folder(path))
-}
-
 /// Checks the files `action` would write (a screenshot and its companions, a scene copy),
 /// before the window opens: their folder exists, none is a folder, and none is one of
 /// `inputs` (`(what, path)`: the scene file, the script). Without it a screenshot `s.png`
@@ -140,7 +133,7 @@ pub fn check_files(files: &[PathBuf], inputs: &[(&str, &Path)]) -> Result<(), St
             ));
         }
         for (what, input) in inputs {
-            if resolved(file) == resolved(input) {
+            if mirrorbox_files::resolved(file) == mirrorbox_files::resolved(input) {
                 return Err(format!(
                     "{} would be written, but it is {what} ({}); choose another name",
                     file.display(),
