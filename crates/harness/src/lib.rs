@@ -858,14 +858,19 @@ pub(crate) fn check_output_parent(out: &Path) -> Result<(), HarnessError> {
     })
 }
 
+/// An output folder refused, and why (exit 2, the folder named first).
+pub(crate) fn folder_refused(dir: &Path, why: String) -> HarnessError {
+    HarnessError::OutputFolder {
+        path: dir.to_path_buf(),
+        source: std::io::Error::other(why),
+    }
+}
+
 /// Checks a folder the sweep writes into (`flag`: `--out`, `--truth-cache`), before any
 /// work: its parent exists (a mistyped folder is refused, not created with its parents) and
 /// it is not a file. Before, a file was read as a folder (exit 1, "Not a directory").
 pub(crate) fn check_output_folder(flag: &str, dir: &Path) -> Result<(), HarnessError> {
-    let refuse = |why: String| HarnessError::OutputFolder {
-        path: dir.to_path_buf(),
-        source: std::io::Error::other(why),
-    };
+    let refuse = |why: String| folder_refused(dir, why);
     if dir.exists() && !dir.is_dir() {
         return Err(refuse(format!(
             "{flag} names a file; name a folder (created if missing)"
@@ -918,9 +923,9 @@ fn check_same_sweep(
         };
         format!("{scene} (content {hash}) at {w}×{h}, ssaa {ssaa}, {frames}")
     };
-    Err(HarnessError::OutputFolder {
-        path: out.to_path_buf(),
-        source: std::io::Error::other(format!(
+    Err(folder_refused(
+        out,
+        format!(
             "holds points of {} (results.jsonl, point {:?}); this sweep is of {}: one folder \
              holds one scene at one size, grid and frame count — name another --out, or pass \
              --fresh to discard its points",
@@ -934,8 +939,8 @@ fn check_same_sweep(
                 config.ssaa,
                 config.frames
             ),
-        )),
-    })
+        ),
+    ))
 }
 
 /// Whether `path`, as a file we read names it (views.json's truths, a record's pictures),

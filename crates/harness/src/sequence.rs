@@ -66,10 +66,7 @@ pub struct SequenceConfig {
 /// sequence sweep's without `replace` (`--fresh`). Before, an earlier sequence sweep's
 /// records were silently replaced.
 fn check_sequence_out(out: &Path, replace: bool) -> Result<(), HarnessError> {
-    let refuse = |why: String| HarnessError::OutputFolder {
-        path: out.to_path_buf(),
-        source: std::io::Error::other(why),
-    };
+    let refuse = |why: String| crate::folder_refused(out, why);
     use crate::{ADVICE_FILES, SEQUENCE_FILES, SWEEP_FILES};
     if let Some(f) = SWEEP_FILES
         .iter()
