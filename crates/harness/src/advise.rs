@@ -1007,7 +1007,10 @@ fn write_advice(advice: &Advice, config: &AdviseConfig, out: &Path) -> Result<()
     if advice.pick.is_some() {
         md.push_str("\nThe pick | the truth | FLIP of the pick against the truth:\n\n![pick](pick.png) ![truth](truth.png) ![FLIP](pick_flip.png)\n");
     }
-    md.push_str("\n![the candidates measured](front.svg)\n\n| candidate | ms/frame [95 % CI] | error | within budget |\n|---|---|---|---|\n");
+    md.push_str(&format!(
+        "\n![the candidates measured](front.svg)\n\n| candidate | {} | error | within budget |\n|---|---|---|---|\n",
+        mirrorbox_report::document::ms_heading("ms/frame", &advice.measured)
+    ));
     for r in &advice.measured {
         md.push_str(&format!(
             "| `{}` | {} | {} | {} |\n",

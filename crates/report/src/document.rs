@@ -103,6 +103,25 @@ pub fn ms_cell(r: &Record, digits: usize) -> String {
     }
 }
 
+/// The heading of a column of [`ms_cell`]s: "`label` [95 % CI]" where every record has an
+/// interval, "`label` (min)" where none has one (fewer than
+/// [`crate::stats::MIN_FRAMES_FOR_INTERVAL`] frames: the median and the fastest frame), and
+/// both where the column mixes them — a heading never promises intervals its cells lack.
+pub fn ms_heading<'a>(label: &str, records: impl IntoIterator<Item = &'a Record>) -> String {
+    let (mut with, mut without) = (false, false);
+    for r in records {
+        match r.ms_interval {
+            Some(_) => with = true,
+            None => without = true,
+        }
+    }
+    match (with, without) {
+        (_, false) => format!("{label} [95 % CI]"),
+        (false, true) => format!("{label} (min)"),
+        (true, true) => format!("{label} [95 % CI] or (min)"),
+    }
+}
+
 /// Decimals for a value printed with its interval `[low, high]`: two significant digits of
 /// the interval's width — what the interval can tell apart, and no more (an interval from six
 /// frames does not know a fourth digit). A zero-width interval gets three significant digits
@@ -347,4 +366,27 @@ pub mod fixtures {
 /// A point's place on its method's axis: n, the depth, or the symmetry planes p.
 pub fn setting(r: &Record) -> f64 {
     r.n.or(r.depth).or(r.planes()).map_or(0.0, f64::from)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A column's heading names what its cells hold: intervals, the fastest frame, or both.
+    #[test]
+    fn ms_heading_promises_only_what_the_cells_hold() {
+        let with = Record {
+            ms_interval: Some([0.9, 1.1]),
+            ..fixtures::record(0, 1.0, 1, 0.1)
+        };
+        let without = Record {
+            ms_interval: None,
+            ..fixtures::record(1, 2.0, 1, 0.1)
+        };
+        assert!(ms_cell(&with, 2).contains('['));
+        assert!(ms_cell(&without, 2).contains("(min "));
+        assert_eq!(ms_heading("ms", [&with]), "ms [95 % CI]");
+        assert_eq!(ms_heading("ms", [&without]), "ms (min)");
+        assert_eq!(ms_heading("ms", [&with, &without]), "ms [95 % CI] or (min)");
+    }
 }

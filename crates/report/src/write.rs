@@ -3,7 +3,7 @@
 
 use crate::document::{
     Block, FLOOR_FACTOR, MIB, Section, at_or_under_floor, distinct, escape_html, f, label,
-    markdown, ms, ms_cell, remove_stale, sci, setting,
+    markdown, ms, ms_cell, ms_heading, remove_stale, sci, setting,
 };
 use crate::plot::{Chart, Series};
 use crate::{Record, SweepInfo, value};
@@ -69,27 +69,32 @@ fn timings_by_device(devices: &[String], records: &[Record]) -> Vec<Block> {
         ),
     ];
     for d in devices {
-        out.push(Block::Heading(3, format!("On {d}")));
-        out.push(Block::Table(
-            ["point", "α", "ms/frame median [95 % CI]", "FLIP mean"]
-                .map(String::from)
-                .to_vec(),
+        let on = || {
             records
                 .iter()
                 .filter(|r| r.device.as_deref() == Some(d.as_str()))
-                .map(|r| {
-                    vec![
-                        if r.kind == "floor" {
-                            "floor (no mirrors)".into()
-                        } else {
-                            label(r)
-                        },
-                        r.alpha.to_string(),
-                        ms_cell(r, 2),
-                        sci(r.metrics.flip_mean),
-                    ]
-                })
-                .collect(),
+        };
+        out.push(Block::Heading(3, format!("On {d}")));
+        out.push(Block::Table(
+            vec![
+                "point".into(),
+                "α".into(),
+                ms_heading("ms/frame median", on()),
+                "FLIP mean".into(),
+            ],
+            on().map(|r| {
+                vec![
+                    if r.kind == "floor" {
+                        "floor (no mirrors)".into()
+                    } else {
+                        label(r)
+                    },
+                    r.alpha.to_string(),
+                    ms_cell(r, 2),
+                    sci(r.metrics.flip_mean),
+                ]
+            })
+            .collect(),
         ));
     }
     out
@@ -753,11 +758,12 @@ fn document(info: &SweepInfo, records: &[Record], sections: &[Section]) -> Vec<B
             name
         };
         b.push(Block::Heading(2, "All points".into()));
+        let ms_column = ms_heading("ms/frame median", points.iter().copied());
         b.push(Block::Table(
             [
                 "point",
                 "α",
-                "ms/frame median [95 % CI]",
+                ms_column.as_str(),
                 "min",
                 "CPU plan ms",
                 "CPU encode ms",

@@ -7,7 +7,7 @@
 //! rasterizer.
 
 use mirrorbox_report::Record;
-use mirrorbox_report::document::{Block, f, markdown, ms_cell, sci};
+use mirrorbox_report::document::{Block, f, markdown, ms_cell, ms_heading, sci};
 use mirrorbox_report::plot::{Chart, Series, method_style};
 use mirrorbox_report::readme::{ReadmeError, RegionSource, measured_on};
 use mirrorbox_report::{Sweep, load_sweep};
@@ -276,12 +276,13 @@ pub fn lighting_section(records: &[Record]) -> Vec<Block> {
     }
     let mut rows: Vec<&Record> = points.clone();
     rows.sort_by_key(|r| (method_of(r), variant_order(r), r.lights_depth()));
+    let ms_column = ms_heading("ms/frame median", rows.iter().copied());
     out.push(Block::Table(
         [
             "method",
             "lighting",
             "k",
-            "ms/frame median [95 % CI]",
+            ms_column.as_str(),
             "passes",
             "FLIP mean",
             "RMSE",

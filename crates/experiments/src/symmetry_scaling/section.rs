@@ -2,7 +2,7 @@
 //! the region that quotes it.
 
 use super::planes::variant;
-use mirrorbox_report::document::{Block, f, markdown, ms_cell, sci, setting};
+use mirrorbox_report::document::{Block, f, markdown, ms_cell, ms_heading, sci, setting};
 use mirrorbox_report::plot::{Chart, Reference, Series};
 use mirrorbox_report::readme::{ReadmeError, RegionSource, measured_on, prose};
 use mirrorbox_report::{Record, Sweep, SweepInfo, load_sweep, value};
@@ -23,6 +23,7 @@ pub fn symmetry_section(records: &[Record]) -> Vec<Block> {
     if groups.is_empty() {
         return Vec::new();
     }
+    let ms_column = ms_heading("ms/frame median", groups.iter().flat_map(|g| &g.points));
     let styles = mirrorbox_report::plot::styles_for(
         &groups.iter().map(|g| g.method.as_str()).collect::<Vec<_>>(),
     );
@@ -76,7 +77,7 @@ pub fn symmetry_section(records: &[Record]) -> Vec<Block> {
                 "copies drawn / 2^p",
                 "triangles",
                 "bake ms (CPU, once)",
-                "ms/frame median [95 % CI]",
+                ms_column.as_str(),
                 "FLIP mean",
             ]
             .map(String::from)

@@ -3,7 +3,8 @@
 
 use super::rows::{self as table1, Row};
 use mirrorbox_report::document::{
-    Block, f, interval_digits, label, markdown, ms, ms_cell, ms_digits, paired_ratio, sci,
+    Block, f, interval_digits, label, markdown, ms, ms_cell, ms_digits, ms_heading, paired_ratio,
+    sci,
 };
 use mirrorbox_report::readme::{ReadmeError, measured_on, prose};
 use mirrorbox_report::stats;
@@ -59,12 +60,13 @@ fn exact_comparison(info: &SweepInfo, records: &[Record], rows: &[Row], alpha: f
             sci(r.metrics.relmse),
         ]
     };
+    let ms_column = ms_heading("ms/frame median", aux.iter().chain(&exact).copied());
     let mut out = vec![
         Block::Heading(3, format!("The exact methods beside it (α = {alpha})")),
         Block::Table(
             [
                 "method",
-                "ms/frame median [95 % CI]",
+                ms_column.as_str(),
                 "passes",
                 "draws",
                 "reflections shown",
