@@ -234,12 +234,16 @@ fn a_bad_run_is_refused_naming_the_file_and_nothing_is_written() {
     std::fs::write(&stray, &good).unwrap();
     refused("an image of no view", "c.exr: an image of no view");
     std::fs::remove_file(&stray).unwrap();
-    // An unreadable timing file, one without the view, and a negative time.
+    // An unreadable timing file, one without the view, a negative time and a 0.
     let timing_file = variant.join("timing.json");
     for (text, needle) in [
         ("{not json".to_string(), "timing.json"),
         (timing(r#""other":[1]"#), "no frames for view \"camera\""),
-        (timing(r#""camera":[1,-2]"#), "-2 ms is not a time"),
+        (timing(r#""camera":[1,-2]"#), "-2 ms is not a frame's time"),
+        (
+            timing(r#""camera":[1,0]"#),
+            "0 ms is not a frame's time (finite, > 0",
+        ),
     ] {
         std::fs::write(&timing_file, text).unwrap();
         refused("timing", needle);

@@ -187,7 +187,7 @@ fn read_timing(path: &Path, views: &ViewsFile) -> Result<Timing, HarnessError> {
             format!(
                 "{e}: a timing file is {{\"format\": \"mirrorbox-timing\", \"version\": \
                  {FORMAT_VERSION}, \"views\": {{VIEW: [ms, …]}}, …}}, each time a finite JSON \
-                 number ≥ 0 (docs/exchange.md)"
+                 number > 0 (docs/exchange.md)"
             ),
         )
     })?;
@@ -217,10 +217,17 @@ fn read_timing(path: &Path, views: &ViewsFile) -> Result<Timing, HarnessError> {
                 ),
             ));
         }
-        if let Some(bad) = frames.iter().find(|ms| !ms.is_finite() || **ms < 0.0) {
+        // A 0 is no frame's time but a timer too coarse for one frame; it would make a
+        // median of 0 and speed ratios of infinity.
+        if let Some(bad) = frames.iter().find(|ms| !ms.is_finite() || **ms <= 0.0) {
             return Err(refused(
                 path,
-                format!("views.{}: {bad} ms is not a time (finite, ≥ 0)", v.name),
+                format!(
+                    "views.{}: {bad} ms is not a frame's time (finite, > 0; a timer too coarse \
+                     for one frame reads 0: time several frames together and give each their \
+                     mean)",
+                    v.name
+                ),
             ));
         }
     }
@@ -859,7 +866,7 @@ mod tests {
             std::fs::write(&path, text).unwrap();
             let e = read_timing(&path, &views).unwrap_err().to_string();
             assert!(
-                e.contains("each time a finite JSON number ≥ 0"),
+                e.contains("each time a finite JSON number > 0"),
                 "{bad}: {e}"
             );
         }
