@@ -333,12 +333,8 @@ fn bounce_cost(reports: &Path) -> Result<String, ReadmeError> {
             )));
         };
         // Where one line does not fit, its slope is an average: say so, with the halves'.
-        let bent = g.bent().map_or(String::new(), |(a, b, mid)| {
-            format!(
-                "; an average: {} ms per reflection up to {mid} reflections, {} beyond",
-                ms(a, 2),
-                ms(b, 2)
-            )
+        let bent = g.bent().map_or(String::new(), |h| {
+            format!("; an average: {}", h.describe(2))
         });
         parts.push(format!(
             "{} ms [{}–{}] on {device} ({:.1} % of its {} ms full-scene pass{bent})",

@@ -28,18 +28,70 @@ pub struct DepthScaling {
     /// Its 95 % bootstrap interval: every point's frames resampled, medians refitted
     /// (`None` where a point has too few frames).
     pub ms_per_bounce_interval: Option<mirrorbox_report::stats::Interval>,
-    /// Whether one straight line fits: the slopes of the shallower and the deeper half of
-    /// the points (sharing the middle one) and the reflections at the middle; `None` with
-    /// fewer than four points. Halves far apart make the one slope an average.
-    pub half_slopes: Option<(f64, f64, usize)>,
+    /// Whether one straight line fits; `None` with fewer than four points. Halves far apart
+    /// make the one slope an average.
+    pub half_slopes: Option<HalfSlopes>,
 }
 
+/// The least-squares slopes of the shallower and the deeper half of a method's points
+/// (sharing the middle one).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HalfSlopes {
+    /// ms per reflection up to the middle point.
+    pub shallow: f64,
+    /// ms per reflection beyond it.
+    pub deep: f64,
+    /// The reflections shown at the middle point.
+    pub mid: usize,
+    /// The 95 % bootstrap interval of `deep − shallow` (every point's frames resampled, both
+    /// halves refitted); `None` where a point has too few frames.
+    pub difference_interval: Option<mirrorbox_report::stats::Interval>,
+}
+
+/// How far apart the halves' slopes must be shown to be before a report says the cost per
+/// reflection is not one number: the 95 % interval of their difference wholly beyond a tenth
+/// of the slope over every point, either way. (A ratio of the slopes would not do: where the
+/// shallow half's slope is uncertain its resampled ratio crowds near 0 and excludes 1.)
+/// Records without frames (no interval) are held to the slopes themselves a fifth apart.
+pub const BENT_BY: f64 = 0.1;
+const BENT_BY_WITHOUT_INTERVAL: f64 = 1.2;
+
 impl DepthScaling {
-    /// The halves' slopes where they differ by more than a fifth: the cost per reflection is
-    /// then not one number (on lavapipe it falls with depth).
-    pub fn bent(&self) -> Option<(f64, f64, usize)> {
-        self.half_slopes
-            .filter(|(a, b, _)| a.min(*b) > 0.0 && a.max(*b) / a.min(*b) > 1.2)
+    /// The halves where their slopes are shown apart ([`BENT_BY`]): the cost per reflection
+    /// is then not one number (on lavapipe it falls with depth).
+    pub fn bent(&self) -> Option<HalfSlopes> {
+        let h = self.half_slopes?;
+        let all = self.ms_per_bounce?;
+        if h.shallow.min(h.deep) <= 0.0 || all <= 0.0 {
+            return None;
+        }
+        let apart = match h.difference_interval {
+            Some(i) => i.low > BENT_BY * all || i.high < -BENT_BY * all,
+            None => !(1.0 / BENT_BY_WITHOUT_INTERVAL..=BENT_BY_WITHOUT_INTERVAL)
+                .contains(&(h.deep / h.shallow)),
+        };
+        apart.then_some(h)
+    }
+}
+
+impl HalfSlopes {
+    /// "0.58 ms per reflection up to 32 reflections, 0.38 ms beyond, a difference of −0.19 ms
+    /// [95 % CI −0.25 to −0.13]", with `digits` decimals.
+    pub fn describe(&self, digits: usize) -> String {
+        let interval = self.difference_interval.map_or(String::new(), |i| {
+            format!(
+                " [95 % CI {} to {}]",
+                signed(i.low, digits),
+                signed(i.high, digits)
+            )
+        });
+        format!(
+            "{} ms per reflection up to {} reflections, {} ms beyond, a difference of {} ms{interval}",
+            ms(self.shallow, digits),
+            self.mid,
+            ms(self.deep, digits),
+            signed(self.deep - self.shallow, digits)
+        )
     }
 }
 
@@ -74,19 +126,38 @@ pub fn depth_scaling(exact: &[String], records: &[Record]) -> Vec<DepthScaling> 
         g.ms_per_bounce_interval = slope_interval(&g.points);
         if pts.len() >= 4 {
             let mid = pts.len() / 2;
-            if let (Some((_, a)), Some((_, b))) =
-                (linear_fit(&pts[..=mid]), linear_fit(&pts[mid..]))
-            {
-                g.half_slopes = Some((a, b, g.points[mid].reflections));
+            if let Some((shallow, deep)) = half_slopes(&pts, mid) {
+                g.half_slopes = Some(HalfSlopes {
+                    shallow,
+                    deep,
+                    mid: g.points[mid].reflections,
+                    difference_interval: resampled(&g.points, |pts| {
+                        half_slopes(pts, mid).map_or(f64::NAN, |(a, b)| b - a)
+                    }),
+                });
             }
         }
     }
     out
 }
 
+/// The slopes of `pts[..=mid]` and `pts[mid..]`.
+fn half_slopes(pts: &[(f64, f64)], mid: usize) -> Option<(f64, f64)> {
+    Some((linear_fit(&pts[..=mid])?.1, linear_fit(&pts[mid..])?.1))
+}
+
 /// The 95 % bootstrap interval of the least-squares slope of median ms/frame against the
 /// reflections shown.
 fn slope_interval(points: &[Record]) -> Option<mirrorbox_report::stats::Interval> {
+    resampled(points, |pts| linear_fit(pts).map_or(f64::NAN, |(_, b)| b))
+}
+
+/// The 95 % bootstrap interval of `statistic` of the points (reflections shown, median
+/// ms/frame), every point's frames resampled; `None` where a point has too few frames.
+fn resampled(
+    points: &[Record],
+    statistic: impl Fn(&[(f64, f64)]) -> f64,
+) -> Option<mirrorbox_report::stats::Interval> {
     use mirrorbox_report::stats::{BOOTSTRAP_SEED, MIN_FRAMES_FOR_INTERVAL, bootstrap, median};
     if points
         .iter()
@@ -103,13 +174,24 @@ fn slope_interval(points: &[Record]) -> Option<mirrorbox_report::stats::Interval
                 .zip(resampled)
                 .map(|(r, frames)| (r.reflections as f64, median(frames)))
                 .collect();
-            linear_fit(&pts).map_or(f64::NAN, |(_, b)| b)
+            statistic(&pts)
         },
         BOOTSTRAP_SEED,
     )
 }
 
 use mirrorbox_report::document::{ms, ms_digits};
+
+/// `x` with `digits` decimals and a true minus sign where negative.
+fn signed(x: f64, digits: usize) -> String {
+    let s = format!("{:.digits$}", x.abs());
+    let zero = s.chars().all(|c| c == '0' || c == '.');
+    if x < 0.0 && !zero {
+        format!("−{s}")
+    } else {
+        s
+    }
+}
 
 /// A sentence on the cost of one more bounce against one full-scene pass (`pass_ms`).
 pub fn bounce_sentence(g: &DepthScaling, pass_ms: Option<f64>) -> String {
@@ -129,12 +211,8 @@ pub fn bounce_sentence(g: &DepthScaling, pass_ms: Option<f64>) -> String {
         g.points.len(),
         deepest
     );
-    if let Some((a, b, mid)) = g.bent() {
-        s.push_str(&format!(
-            "; not one straight line: {} ms per reflection up to {mid} reflections, {} ms beyond",
-            ms(a, 3),
-            ms(b, 3)
-        ));
+    if let Some(h) = g.bent() {
+        s.push_str(&format!("; not one straight line: {}", h.describe(3)));
     }
     if let Some(p) = pass_ms.filter(|p| *p > 0.0) {
         s.push_str(&format!(
@@ -225,15 +303,31 @@ mod tests {
             .map(|&(d, ms)| point(d, ms, 0.5))
             .collect();
         let g = &depth_scaling(&exact, &bent)[0];
-        let (a, b, mid) = g.bent().expect("two slopes");
+        let h = g.bent().expect("two slopes");
         assert!(
-            (a - 0.8).abs() < 1e-9 && (b - 0.4).abs() < 1e-9 && mid == 16,
-            "{a} {b} {mid}"
+            (h.shallow - 0.8).abs() < 1e-9 && (h.deep - 0.4).abs() < 1e-9 && h.mid == 16,
+            "{h:?}"
         );
+        let i = h.difference_interval.expect("9 frames per point");
+        let all = g.ms_per_bounce.unwrap();
+        assert!(i.contains(-0.4) && i.high < -BENT_BY * all, "{i:?} {all}");
         assert!(
-            bounce_sentence(g, None).contains("not one straight line: 0.800 ms per reflection up to 16 reflections, 0.400 ms beyond"),
+            bounce_sentence(g, None).contains(
+                "not one straight line: 0.800 ms per reflection up to 16 reflections, 0.400 ms \
+                 beyond, a difference of −0.400 ms [95 % CI −"
+            ),
             "{}",
             bounce_sentence(g, None)
         );
+        // The same bend in frames too noisy to show it: the interval holds a straight line,
+        // and the sentence claims no bend.
+        let noisy: Vec<Record> = [(1, 10.0), (4, 12.4), (16, 22.0), (64, 41.2), (256, 118.0)]
+            .iter()
+            .map(|&(d, ms)| point(d, ms, 40.0))
+            .collect();
+        let g = &depth_scaling(&exact, &noisy)[0];
+        let h = g.half_slopes.expect("five points");
+        assert!((h.deep / h.shallow - 0.5).abs() < 1e-9);
+        assert!(g.bent().is_none(), "{:?}", h.difference_interval);
     }
 }
