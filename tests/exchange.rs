@@ -414,33 +414,71 @@ fn a_with_sweep_naming_pictures_outside_its_images_is_refused() {
     }
     let out = with(None);
     assert_eq!(out.code, 0, "{}", out.stderr);
-    // A sweep of another scene, or of another α than the export's: refused (before, its
-    // floor and points were set beside the variants as if comparable).
+    // A sweep of another scene (by content: another hash, even under the exported file's
+    // name), or of another α than the export's: refused (before, its floor and points were
+    // set beside the variants as if comparable). The same scene under another path is the
+    // exported one.
     std::fs::remove_dir_all(&scored).unwrap();
-    for (field, value, message) in [
-        (
-            "scene",
-            Value::from("scenes/stereo_box.json"),
-            "not of the scene exported",
-        ),
-        ("alpha", Value::from(0.5), "not the export's α"),
-    ] {
+    let changed = |field: &str, value: &Value, all: bool| {
         let lines: Vec<String> = good
             .lines()
             .map(|l| {
                 let mut r: Value = serde_json::from_str(l).unwrap();
-                if r["kind"] == "point" || field == "scene" {
+                if r["kind"] == "point" || all {
                     r[field] = value.clone();
                 }
                 r.to_string()
             })
             .collect();
         std::fs::write(&results, lines.join("\n") + "\n").unwrap();
-        let out = run_score(&ex, &run, &scored, &["--with", sweep.to_str().unwrap()]);
+        run_score(&ex, &run, &scored, &["--with", sweep.to_str().unwrap()])
+    };
+    for (field, value, message) in [
+        (
+            "scene_hash",
+            Value::from("00000000deadbeef"),
+            "not of the scene exported",
+        ),
+        ("alpha", Value::from(0.5), "not the export's α"),
+    ] {
+        let out = changed(field, &value, field != "alpha");
         assert_eq!(out.code, 2, "{field}: {}", out.stderr);
         assert!(out.stderr.contains(message), "{field}: {}", out.stderr);
         assert!(!scored.exists(), "{field}: nothing written");
     }
+    let out = changed("scene", &Value::from("elsewhere/a_copy.json"), true);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+}
+
+/// An export without `--alpha` of a scene whose mirrors share one grey reflectance says that
+/// reflectance as its α (`score` labels its records with it and holds `--with` sweeps to it);
+/// one whose mirrors differ says none.
+#[test]
+fn an_export_without_alpha_says_the_scenes_own() {
+    let tmp = tempfile::tempdir().unwrap();
+    let alpha_of = |scene: &str| {
+        let dir = tmp.path().join(scene.replace('/', "_"));
+        let mut args = vec!["export-views", scene, "-o", dir.to_str().unwrap()];
+        args.extend(SIZE);
+        let out = mirrorbox(&args, &[]);
+        assert_eq!(out.code, 0, "{}", out.stderr);
+        let doc: Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join("views.json")).unwrap())
+                .unwrap();
+        assert!(
+            doc["sweep_scene_hashes"]
+                .as_array()
+                .is_some_and(|h| !h.is_empty())
+        );
+        doc["alpha"].clone()
+    };
+    assert_eq!(alpha_of("scenes/mirror_box.json"), Value::from(0.9));
+    let uneven = tmp.path().join("uneven.json");
+    let box_scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/mirror_box.json");
+    let text = std::fs::read_to_string(box_scene).unwrap();
+    let text = text.replacen("[0.9, 0.9, 0.9]", "[0.8, 0.8, 0.8]", 1);
+    std::fs::write(&uneven, text).unwrap();
+    assert_eq!(alpha_of(uneven.to_str().unwrap()), Value::Null);
 }
 
 #[test]

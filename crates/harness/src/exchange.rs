@@ -113,7 +113,15 @@ pub struct ViewsFile {
     pub scene: String,
     /// The scene file exported, as given.
     pub source: String,
+    /// Every mirror's reflectance: the export's `--alpha`, else the scene's own where its
+    /// mirrors share one grey reflectance; `None` where they do not.
     pub alpha: Option<f32>,
+    /// The scene hashes (`Record::scene_hash`) a sweep of the exported scene at the export's
+    /// size records: with the scene's own camera and with each view's (`sweep --camera`).
+    /// `score --with` takes a sweep beside the run only if it has one of them. Empty in
+    /// exports written before it was kept (then the scene file's name is compared).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub sweep_scene_hashes: Vec<String>,
     pub contract: Contract,
     pub views: Vec<ExportedView>,
 }
@@ -228,6 +236,8 @@ pub fn export_views(
     config.height = settings.height;
     config.ssaa = settings.ssaa.max(1);
     let (mut base, _, _) = crate::base_scene(&config)?;
+    // What a sweep of this scene hashes, before the export's α (a sweep sets α per point).
+    let unlit = base.clone();
     if let Some(a) = settings.alpha {
         base.set_reflectance(Vec3::splat(a))
             .map_err(|source| HarnessError::LightImages {
@@ -246,7 +256,9 @@ pub fn export_views(
     in_staged_folder(dir, |partial| {
         let truth_dir = partial.join("truth");
         std::fs::create_dir_all(&truth_dir).map_err(io(&truth_dir))?;
-        write_export(&base, &files, partial, &config, settings, scene_path)
+        write_export(
+            &base, &unlit, &files, partial, &config, settings, scene_path,
+        )
     })
 }
 
@@ -291,8 +303,19 @@ pub(crate) fn replaceable(dir: &Path, marker: &str, what: &str) -> Result<(), Ha
     Ok(())
 }
 
+/// The one grey reflectance every mirror of `scene` has, if any.
+fn uniform_alpha(scene: &Scene) -> Option<f32> {
+    let first = scene.mirrors.first()?.reflectance;
+    let grey = first.x == first.y && first.y == first.z;
+    (grey && scene.mirrors.iter().all(|m| m.reflectance == first)).then_some(first.x)
+}
+
+/// `base` is the scene exported (α set, light images enumerated); `unlit` the same before
+/// them, as a sweep's base scene is.
+#[allow(clippy::too_many_arguments)]
 fn write_export(
     base: &Scene,
+    unlit: &Scene,
     files: &gltf_export::GltfFiles,
     out: &Path,
     config: &SweepConfig,
@@ -327,6 +350,13 @@ fn write_export(
     } else {
         settings.views.clone()
     };
+    let mut sweep_scene_hashes = vec![format!("{:016x}", unlit.content_hash())];
+    for spec in &specs {
+        let hash = format!("{:016x}", view_scene(unlit, spec)?.content_hash());
+        if !sweep_scene_hashes.contains(&hash) {
+            sweep_scene_hashes.push(hash);
+        }
+    }
     let mut summary = Summary::default();
     let mut views = Vec::with_capacity(specs.len());
     let truth_dir = out.join("truth");
@@ -361,7 +391,8 @@ fn write_export(
         gltf: "scene.gltf".into(),
         scene: "scene.json".into(),
         source: scene_path.display().to_string(),
-        alpha: settings.alpha,
+        alpha: settings.alpha.or_else(|| uniform_alpha(base)),
+        sweep_scene_hashes,
         contract: Contract {
             document: "docs/shading.md".into(),
             version: CONTRACT_VERSION,
@@ -486,6 +517,7 @@ pub(crate) mod tests_support {
             scene: "scene.json".into(),
             source: "scenes/mirror_box.json".into(),
             alpha: Some(0.9),
+            sweep_scene_hashes: vec!["0123456789abcdef".into()],
             contract: Contract {
                 document: "docs/shading.md".into(),
                 version: CONTRACT_VERSION,

@@ -420,22 +420,37 @@ pub fn score(
             ));
         }
         // Of the scene exported, at its α: another scene's floor and points, or another α's,
-        // were set beside the variants as if comparable (found by a review).
+        // were set beside the variants as if comparable (found by a review). The scene by its
+        // content (an edited scene, or another of the same file name, is not the exported
+        // one); by its file where the export predates the hashes.
         let same_file =
             |a: &str, b: &str| match (Path::new(a).canonicalize(), Path::new(b).canonicalize()) {
                 (Ok(x), Ok(y)) => x == y,
                 _ => Path::new(a).file_name() == Path::new(b).file_name(),
             };
+        let of_the_export = |r: &Record| match views.sweep_scene_hashes.as_slice() {
+            [] => same_file(&r.scene, &views.source),
+            hashes => hashes.contains(&r.scene_hash),
+        };
         if let Some(r) = sweep
             .records
             .iter()
-            .find(|r| !r.is_external() && !same_file(&r.scene, &views.source))
+            .find(|r| !r.is_external() && !of_the_export(r))
         {
             return Err(refused(
                 dir,
                 format!(
-                    "{}: a sweep of {}, not of the scene exported ({})",
-                    r.key, r.scene, views.source
+                    "{}: a sweep of {} (scene hash {}), not of the scene exported ({}, at its \
+                     size with its own camera or a view's: {})",
+                    r.key,
+                    r.scene,
+                    r.scene_hash,
+                    views.source,
+                    if views.sweep_scene_hashes.is_empty() {
+                        "compared by file name: an export without scene hashes".to_string()
+                    } else {
+                        views.sweep_scene_hashes.join(", ")
+                    }
                 ),
             ));
         }
