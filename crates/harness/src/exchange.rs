@@ -312,7 +312,6 @@ fn uniform_alpha(scene: &Scene) -> Option<f32> {
 
 /// `base` is the scene exported (α set, light images enumerated); `unlit` the same before
 /// them, as a sweep's base scene is.
-#[allow(clippy::too_many_arguments)]
 fn write_export(
     base: &Scene,
     unlit: &Scene,
