@@ -318,7 +318,10 @@ fn bounce_cost(reports: &Path) -> Result<String, ReadmeError> {
         let s = load(reports, folder)?;
         let groups = crate::depth_scaling::exact::depth_scaling(&s.info.exact_methods, &s.records);
         let floor = s.records.iter().find(|r| r.kind == "floor");
-        let Some(g) = groups.iter().find(|g| g.method == "portal") else {
+        let Some(g) = groups
+            .iter()
+            .find(|g| g.method == "portal" && g.variant.is_empty())
+        else {
             return Err(ReadmeError(format!(
                 "reports/{folder} holds no portal depth sweep"
             )));

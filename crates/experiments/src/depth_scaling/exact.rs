@@ -16,10 +16,14 @@ pub fn is_exact(exact: &[String], r: &Record) -> bool {
     r.kind == "point" && exact.contains(&r.method) && r.depth.is_some()
 }
 
-/// One method's cost against depth at one α.
+/// One method's cost against depth at one α, every other setting alike.
 #[derive(Clone, Debug, PartialEq)]
 pub struct DepthScaling {
     pub method: String,
+    /// What else sets these points apart from the method's other points of the sweep: its
+    /// options but the depth, and the scene axes (`shadows=map, mirrored_lights=1`); empty
+    /// where nothing does.
+    pub variant: String,
     pub alpha: f32,
     /// Points in depth order.
     pub points: Vec<Record>,
@@ -95,17 +99,43 @@ impl HalfSlopes {
     }
 }
 
-/// Groups the exact points by (method, α), each with at least two depths.
+/// What sets `r` apart besides its method, depth and α: its other options and its scene axes.
+fn variant_of(r: &Record) -> String {
+    let mut words: Vec<String> = r
+        .method_options
+        .split_whitespace()
+        .map(str::to_string)
+        .collect();
+    words.extend(r.axes.iter().map(|(k, v)| format!("{k}={v}")));
+    words.join(", ")
+}
+
+impl DepthScaling {
+    /// The method, with its variant where it has one: a series' and a row's name.
+    pub fn name(&self) -> String {
+        if self.variant.is_empty() {
+            self.method.clone()
+        } else {
+            format!("{} ({})", self.method, self.variant)
+        }
+    }
+}
+
+/// Groups the exact points by (method, variant, α), each with at least two depths: points
+/// that differ in anything but the depth cap (the lighting sweep's shadows and mirrored
+/// lights, all at one depth) are no cost against depth.
 pub fn depth_scaling(exact: &[String], records: &[Record]) -> Vec<DepthScaling> {
     let mut out: Vec<DepthScaling> = Vec::new();
     for r in records.iter().filter(|r| is_exact(exact, r)) {
+        let variant = variant_of(r);
         match out
             .iter_mut()
-            .find(|g| g.method == r.method && g.alpha == r.alpha)
+            .find(|g| g.method == r.method && g.variant == variant && g.alpha == r.alpha)
         {
             Some(g) => g.points.push(r.clone()),
             None => out.push(DepthScaling {
                 method: r.method.clone(),
+                variant,
                 alpha: r.alpha,
                 points: vec![r.clone()],
                 ms_per_bounce: None,
@@ -114,7 +144,10 @@ pub fn depth_scaling(exact: &[String], records: &[Record]) -> Vec<DepthScaling> 
             }),
         }
     }
-    out.retain(|g| g.points.len() >= 2);
+    out.retain(|g| {
+        let depths: std::collections::BTreeSet<_> = g.points.iter().map(|r| r.depth).collect();
+        depths.len() >= 2
+    });
     for g in &mut out {
         g.points.sort_by_key(|r| r.depth);
         let pts: Vec<(f64, f64)> = g
@@ -196,7 +229,7 @@ fn signed(x: f64, digits: usize) -> String {
 /// A sentence on the cost of one more bounce against one full-scene pass (`pass_ms`).
 pub fn bounce_sentence(g: &DepthScaling, pass_ms: Option<f64>) -> String {
     let Some(b) = g.ms_per_bounce else {
-        return format!("{}: too few distinct depths to fit.", g.method);
+        return format!("{}: too few distinct depths to fit.", g.name());
     };
     let deepest = g.points.iter().map(|r| r.reflections).max().unwrap_or(0);
     let interval = g.ms_per_bounce_interval.map_or(String::new(), |i| {
@@ -205,7 +238,7 @@ pub fn bounce_sentence(g: &DepthScaling, pass_ms: Option<f64>) -> String {
     });
     let mut s = format!(
         "{}, α = {}: {} ms{interval} per extra reflection (least-squares over {} depths, up to {} reflections shown)",
-        g.method,
+        g.name(),
         g.alpha,
         ms(b, 3),
         g.points.len(),
@@ -329,5 +362,33 @@ mod tests {
         let h = g.half_slopes.expect("five points");
         assert!((h.deep / h.shallow - 0.5).abs() < 1e-9);
         assert!(g.bent().is_none(), "{:?}", h.difference_interval);
+        // Points that differ in anything but the depth are apart: one depth under several
+        // lightings is no cost against depth (the lighting sweep had 30 such rows), and two
+        // depth sweeps of one method, with and without shadow maps, are two lines.
+        let with = |r: &Record, options: &str, k: f64| {
+            let mut r = r.clone();
+            r.method_options = options.into();
+            r.axes.insert("mirrored_lights".into(), k);
+            r
+        };
+        let one_depth: Vec<Record> = (0..3)
+            .map(|k| with(&records[3], "shadows=map", k as f64))
+            .chain([with(&records[3], "", 0.0)])
+            .collect();
+        assert!(depth_scaling(&exact, &one_depth).is_empty());
+        let two: Vec<Record> = records
+            .iter()
+            .map(|r| with(r, "shadows=map", 1.0))
+            .chain(records.iter().cloned())
+            .collect();
+        let names: Vec<String> = depth_scaling(&exact, &two)
+            .iter()
+            .map(|g| g.name())
+            .collect();
+        assert_eq!(
+            names,
+            ["unrolled (shadows=map, mirrored_lights=1)", "unrolled"],
+            "{names:?}"
+        );
     }
 }

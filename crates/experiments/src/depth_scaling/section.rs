@@ -36,9 +36,9 @@ pub fn depth_scaling(info: &SweepInfo, records: &[Record], floor: Option<&Record
                     .zip(styles)
                     .map(|(g, style)| {
                         let name = if alphas.len() > 1 {
-                            format!("{}, α={}", g.method, g.alpha)
+                            format!("{}, α={}", g.name(), g.alpha)
                         } else {
-                            g.method.clone()
+                            g.name()
                         };
                         let mut s = Series::new(
                             name,
@@ -89,11 +89,11 @@ pub fn depth_scaling(info: &SweepInfo, records: &[Record], floor: Option<&Record
             .to_vec(),
             groups
                 .iter()
-                .flat_map(|g| &g.points)
-                .map(|r| {
+                .flat_map(|g| g.points.iter().map(move |r| (g, r)))
+                .map(|(g, r)| {
                     let opt = |v: Option<usize>| v.map_or("–".into(), |x| x.to_string());
                     vec![
-                        r.method.clone(),
+                        g.name(),
                         r.alpha.to_string(),
                         opt(r.depth.map(|d| d as usize)),
                         r.reflections.to_string(),
