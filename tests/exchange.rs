@@ -234,6 +234,11 @@ fn a_bad_run_is_refused_naming_the_file_and_nothing_is_written() {
     std::fs::write(&stray, &good).unwrap();
     refused("an image of no view", "c.exr: an image of no view");
     std::fs::remove_file(&stray).unwrap();
+    // Two images of one view: the PNG had been ignored unsaid.
+    let png = variant.join("camera.png");
+    std::fs::write(&png, b"not read").unwrap();
+    refused("exr and png", "two images of view \"camera\"");
+    std::fs::remove_file(&png).unwrap();
     // An unreadable timing file, one without the view, a negative time and a 0.
     let timing_file = variant.join("timing.json");
     for (text, needle) in [
@@ -243,6 +248,10 @@ fn a_bad_run_is_refused_naming_the_file_and_nothing_is_written() {
         (
             timing(r#""camera":[1,0]"#),
             "0 ms is not a frame's time (finite, > 0",
+        ),
+        (
+            timing(r#""camera":[1]"#).replace(r#""equivalent":"naive""#, r#""equivalent":"nave""#),
+            "equivalent: \"nave\" is no mirrorbox method",
         ),
     ] {
         std::fs::write(&timing_file, text).unwrap();
@@ -271,6 +280,26 @@ fn a_bad_run_is_refused_naming_the_file_and_nothing_is_written() {
     assert!(out.stderr.contains("views.json"), "{}", out.stderr);
     // Now it scores.
     assert_eq!(score().code, 0);
+    // A sweep's folder as OUT is refused, not replaced: a sweep has a sweep.json too.
+    let sweep = tmp.path().join("sweep");
+    sweep_naive(&sweep);
+    let before = std::fs::read(sweep.join("results.jsonl")).unwrap();
+    let out = run_score(&ex, &run, &sweep, &[]);
+    assert_eq!(out.code, 2, "{}", out.stderr);
+    assert!(
+        out.stderr.contains("holds a sweep of") && out.stderr.contains("not an earlier score"),
+        "{}",
+        out.stderr
+    );
+    assert_eq!(std::fs::read(sweep.join("results.jsonl")).unwrap(), before);
+    // And an earlier score is no sweep to set beside a run.
+    let out = run_score(&ex, &run, &scored, &["--with", scored.to_str().unwrap()]);
+    assert_eq!(out.code, 2, "{}", out.stderr);
+    assert!(
+        out.stderr.contains("an earlier score, not a sweep of ours"),
+        "{}",
+        out.stderr
+    );
     let _ = repo();
 }
 

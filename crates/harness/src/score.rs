@@ -241,6 +241,22 @@ fn read_timing(path: &Path, views: &ViewsFile) -> Result<Timing, HarnessError> {
             format!("views.{extra}: no such view in views.json"),
         ));
     }
+    // A misspelt method would match none of ours, and the comparison would say "–" unsaid.
+    if let Some(e) = &t.equivalent
+        && mirrorbox_raster::registry::find(e).is_none()
+    {
+        return Err(refused(
+            path,
+            format!(
+                "equivalent: {e:?} is no mirrorbox method; one of {} (or leave it out)",
+                mirrorbox_raster::METHODS
+                    .iter()
+                    .map(|m| m.name)
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        ));
+    }
     Ok(t)
 }
 
@@ -319,11 +335,18 @@ fn check_no_stray_image(dir: &Path, views: &ViewsFile) -> Result<(), HarnessErro
 /// and for pixels that are not radiance (NaN, infinite, negative).
 fn view_image(dir: &Path, view: &crate::exchange::ExportedView) -> Result<PathBuf, HarnessError> {
     let exr = dir.join(format!("{}.exr", view.name));
-    let path = if exr.is_file() {
-        exr
-    } else {
-        dir.join(format!("{}.png", view.name))
-    };
+    let png = dir.join(format!("{}.png", view.name));
+    if exr.is_file() && png.is_file() {
+        // One would be scored and the other ignored unsaid.
+        return Err(refused(
+            dir,
+            format!(
+                "two images of view {:?} ({0}.exr and {0}.png): keep the one to score",
+                view.name
+            ),
+        ));
+    }
+    let path = if exr.is_file() { exr } else { png };
     if !path.is_file() {
         return Err(refused(
             dir,
@@ -389,6 +412,10 @@ fn check_truth(
     Ok(())
 }
 
+/// The `backend` of a score's `sweep.json`: what tells an earlier score (replaced) from a sweep
+/// (refused) in its output folder.
+const SCORE_BACKEND: &str = "external (mirrorbox score)";
+
 /// Scores `run` against `export` into `out` (see the module docs). Every input is read and
 /// checked before anything is written; the report goes to `out.partial` and is moved into
 /// place at the end (an earlier score in `out` is replaced).
@@ -405,6 +432,13 @@ pub fn score(
     let mut ours: Vec<(PathBuf, Record)> = Vec::new();
     for dir in &settings.with {
         let sweep = mirrorbox_report::load_sweep(dir).map_err(|e| refused(dir, e))?;
+        if sweep.info.backend == SCORE_BACKEND {
+            return Err(refused(
+                dir,
+                "an earlier score, not a sweep of ours: --with takes a `mirrorbox sweep`'s \
+                 folder (its variants would be listed twice)",
+            ));
+        }
         if let Some(r) = sweep.records.iter().find(|r| {
             !views
                 .views
@@ -476,6 +510,19 @@ pub fn score(
     }
     let found = variants(run)?;
     crate::exchange::replaceable(out, "sweep.json", "score")?;
+    // A sweep folder has a sweep.json too: replacing it would lose its records and cached
+    // truths (found by a review). Only an earlier score's is replaced.
+    if let Ok(earlier) = mirrorbox_report::load_sweep(out)
+        && earlier.info.backend != SCORE_BACKEND
+    {
+        return Err(refused(
+            out,
+            format!(
+                "holds a sweep of {} ({}), not an earlier score: give a new or empty folder",
+                earlier.info.scene, earlier.info.backend
+            ),
+        ));
+    }
     // Everything read and checked first: the export's truths that the variants are compared
     // with (the floor truths for variants named `floor`), then each variant's files.
     let floor = found.iter().any(|(_, variant, _)| variant == "floor");
@@ -667,7 +714,7 @@ pub fn score(
             date: crate::now_rfc3339(),
             cpu: crate::cpu_description(),
             adapter: devices.join("; "),
-            backend: "external (mirrorbox score)".into(),
+            backend: SCORE_BACKEND.into(),
             device_type: "external".into(),
             driver: drivers.join("; "),
             versions: format!(
