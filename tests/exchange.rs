@@ -468,6 +468,16 @@ fn a_with_sweep_naming_pictures_outside_its_images_is_refused() {
             Value::from("00000000deadbeef"),
             "not of the scene exported",
         ),
+        (
+            "ssaa",
+            Value::from(2),
+            "ssaa 2; view \"camera\" is 64×36, ssaa 1",
+        ),
+        (
+            "axes",
+            serde_json::json!({"camera_yaw_deg": 10.0}),
+            "swept along camera_yaw_deg",
+        ),
         ("alpha", Value::from(0.5), "not the export's α"),
     ] {
         let out = changed(field, &value, field != "alpha");
@@ -477,6 +487,40 @@ fn a_with_sweep_naming_pictures_outside_its_images_is_refused() {
     }
     let out = changed("scene", &Value::from("elsewhere/a_copy.json"), true);
     assert_eq!(out.code, 0, "{}", out.stderr);
+    // An export of a view elsewhere, under the scene camera's name: no sweep shows it.
+    std::fs::write(&results, &good).unwrap();
+    let list = tmp.path().join("list.json");
+    std::fs::write(
+        &list,
+        r#"{"views": [{"name": "camera", "position": [0.5, 1.2, 3], "look_at": [0, 1, 0]}]}"#,
+    )
+    .unwrap();
+    let elsewhere = tmp.path().join("elsewhere");
+    let mut args = vec![
+        "export-views",
+        "scenes/mirror_box.json",
+        "-o",
+        elsewhere.to_str().unwrap(),
+        "--alpha",
+        "0.9",
+        "--views",
+        list.to_str().unwrap(),
+    ];
+    args.extend(SIZE);
+    let out = mirrorbox(&args, &[]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let out = run_score(
+        &elsewhere,
+        &run,
+        &scored,
+        &["--with", sweep.to_str().unwrap()],
+    );
+    assert_eq!(out.code, 2, "{}", out.stderr);
+    assert!(
+        out.stderr.contains("no view of the export is the scene's own camera"),
+        "{}",
+        out.stderr
+    );
 }
 
 /// An export without `--alpha` of a scene whose mirrors share one grey reflectance says that
@@ -494,11 +538,7 @@ fn an_export_without_alpha_says_the_scenes_own() {
         let doc: Value =
             serde_json::from_str(&std::fs::read_to_string(dir.join("views.json")).unwrap())
                 .unwrap();
-        assert!(
-            doc["sweep_scene_hashes"]
-                .as_array()
-                .is_some_and(|h| !h.is_empty())
-        );
+        assert!(doc["sweep_scene_hash"].is_string() && doc["views"][0]["scene_camera"] == true);
         doc["alpha"].clone()
     };
     assert_eq!(alpha_of("scenes/mirror_box.json"), Value::from(0.9));

@@ -85,6 +85,10 @@ pub struct ExportedView {
     pub floor: String,
     /// The scene's content hash at this view (the truth's key).
     pub scene_hash: String,
+    /// Whether this view is the scene's own camera, the one a `mirrorbox sweep` shows:
+    /// `score --with` sets our sweep beside this view only.
+    #[serde(default)]
+    pub scene_camera: bool,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -116,12 +120,11 @@ pub struct ViewsFile {
     /// Every mirror's reflectance: the export's `--alpha`, else the scene's own where its
     /// mirrors share one grey reflectance; `None` where they do not.
     pub alpha: Option<f32>,
-    /// The scene hashes (`Record::scene_hash`) a sweep of the exported scene at the export's
-    /// size records: with the scene's own camera and with each view's (`sweep --camera`).
-    /// `score --with` takes a sweep beside the run only if it has one of them. Empty in
-    /// exports written before it was kept (then the scene file's name is compared).
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub sweep_scene_hashes: Vec<String>,
+    /// The scene hash (`Record::scene_hash`) a `mirrorbox sweep` of the exported scene at the
+    /// export's size records, which `score --with` holds a sweep to. `None` in exports
+    /// written before it was kept (their sweeps are compared by the scene's file name).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sweep_scene_hash: Option<String>,
     pub contract: Contract,
     pub views: Vec<ExportedView>,
 }
@@ -349,13 +352,6 @@ fn write_export(
     } else {
         settings.views.clone()
     };
-    let mut sweep_scene_hashes = vec![format!("{:016x}", unlit.content_hash())];
-    for spec in &specs {
-        let hash = format!("{:016x}", view_scene(unlit, spec)?.content_hash());
-        if !sweep_scene_hashes.contains(&hash) {
-            sweep_scene_hashes.push(hash);
-        }
-    }
     let mut summary = Summary::default();
     let mut views = Vec::with_capacity(specs.len());
     let truth_dir = out.join("truth");
@@ -381,7 +377,9 @@ fn write_export(
                 std::fs::rename(&from, &to).map_err(io(&to))?;
             }
         }
-        views.push(exported_view(&scene, spec, config.ssaa));
+        let mut view = exported_view(&scene, spec, config.ssaa);
+        view.scene_camera = same_camera(&scene.camera, &unlit.camera);
+        views.push(view);
     }
     let l = &base.lighting;
     let doc = ViewsFile {
@@ -391,7 +389,7 @@ fn write_export(
         scene: "scene.json".into(),
         source: scene_path.display().to_string(),
         alpha: settings.alpha.or_else(|| uniform_alpha(base)),
-        sweep_scene_hashes,
+        sweep_scene_hash: Some(format!("{:016x}", unlit.content_hash())),
         contract: Contract {
             document: "docs/shading.md".into(),
             version: CONTRACT_VERSION,
@@ -413,6 +411,15 @@ fn write_export(
         files: 4 + files.images.len() + 6 * specs.len(),
         truths_traced: summary.truths_traced,
     })
+}
+
+/// Whether two cameras see alike: the same position, look-at and field of view, and ups
+/// along one direction (a view's up is normalised, the scene's may not be).
+fn same_camera(a: &mirrorbox_scene::camera::Camera, b: &mirrorbox_scene::camera::Camera) -> bool {
+    a.position == b.position
+        && a.look_at == b.look_at
+        && a.fov_y_deg == b.fov_y_deg
+        && a.up.normalize().abs_diff_eq(b.up.normalize(), 1e-6)
 }
 
 /// `base` seen from `spec`: its camera moved, checked (position and look-at apart, up not
@@ -482,6 +489,7 @@ fn exported_view(scene: &Scene, spec: &ViewSpec, ssaa: u32) -> ExportedView {
         truth: format!("truth/{}.exr", spec.name),
         floor: format!("truth/{}_floor.exr", spec.name),
         scene_hash: format!("{:016x}", scene.content_hash()),
+        scene_camera: false,
     }
 }
 
@@ -516,7 +524,7 @@ pub(crate) mod tests_support {
             scene: "scene.json".into(),
             source: "scenes/mirror_box.json".into(),
             alpha: Some(0.9),
-            sweep_scene_hashes: vec!["0123456789abcdef".into()],
+            sweep_scene_hash: None,
             contract: Contract {
                 document: "docs/shading.md".into(),
                 version: CONTRACT_VERSION,

@@ -412,6 +412,52 @@ fn check_truth(
     Ok(())
 }
 
+/// Why our record `r` (a `score --with` sweep's) is not of the exported scene at one of its
+/// views, if it is not: by the scene hash a sweep of it records and the views at the scene's
+/// own camera ([`crate::exchange::ExportedView::scene_camera`]), else (an export written
+/// before the hash was kept) by the scene file's name.
+fn not_of_the_export(views: &ViewsFile, r: &Record) -> Option<String> {
+    let Some(hash) = &views.sweep_scene_hash else {
+        let same_file = match (
+            Path::new(&r.scene).canonicalize(),
+            Path::new(&views.source).canonicalize(),
+        ) {
+            (Ok(x), Ok(y)) => x == y,
+            _ => Path::new(&r.scene).file_name() == Path::new(&views.source).file_name(),
+        };
+        return (!same_file).then(|| {
+            format!(
+                "a sweep of {}, not of the scene exported ({})",
+                r.scene, views.source
+            )
+        });
+    };
+    if &r.scene_hash != hash {
+        return Some(format!(
+            "a sweep of {} (scene hash {}), not of the scene exported ({}, {hash})",
+            r.scene, r.scene_hash, views.source
+        ));
+    }
+    let Some(v) = views.views.iter().find(|v| v.scene_camera) else {
+        return Some(
+            "no view of the export is the scene's own camera, the one a sweep shows".into(),
+        );
+    };
+    if (v.width, v.height, v.ssaa) != (r.width, r.height, r.ssaa) {
+        return Some(format!(
+            "{}×{}, ssaa {}; view {:?} is {}×{}, ssaa {}",
+            r.width, r.height, r.ssaa, v.name, v.width, v.height, v.ssaa
+        ));
+    }
+    (!r.axes.is_empty()).then(|| {
+        format!(
+            "swept along {} (a camera turn, a tilt, lights): not view {:?} as exported",
+            r.axes.keys().cloned().collect::<Vec<_>>().join(", "),
+            v.name
+        )
+    })
+}
+
 /// The `backend` of a score's `sweep.json`: what tells an earlier score (replaced) from a sweep
 /// (refused) in its output folder.
 const SCORE_BACKEND: &str = "external (mirrorbox score)";
@@ -453,40 +499,15 @@ pub fn score(
                 ),
             ));
         }
-        // Of the scene exported, at its α: another scene's floor and points, or another α's,
-        // were set beside the variants as if comparable (found by a review). The scene by its
-        // content (an edited scene, or another of the same file name, is not the exported
-        // one); by its file where the export predates the hashes.
-        let same_file =
-            |a: &str, b: &str| match (Path::new(a).canonicalize(), Path::new(b).canonicalize()) {
-                (Ok(x), Ok(y)) => x == y,
-                _ => Path::new(a).file_name() == Path::new(b).file_name(),
-            };
-        let of_the_export = |r: &Record| match views.sweep_scene_hashes.as_slice() {
-            [] => same_file(&r.scene, &views.source),
-            hashes => hashes.contains(&r.scene_hash),
-        };
-        if let Some(r) = sweep
-            .records
-            .iter()
-            .find(|r| !r.is_external() && !of_the_export(r))
-        {
-            return Err(refused(
-                dir,
-                format!(
-                    "{}: a sweep of {} (scene hash {}), not of the scene exported ({}, at its \
-                     size with its own camera or a view's: {})",
-                    r.key,
-                    r.scene,
-                    r.scene_hash,
-                    views.source,
-                    if views.sweep_scene_hashes.is_empty() {
-                        "compared by file name: an export without scene hashes".to_string()
-                    } else {
-                        views.sweep_scene_hashes.join(", ")
-                    }
-                ),
-            ));
+        // Of the scene exported, at a view's camera, size and ssaa, and its α: another
+        // scene's floor and points, another view's, or another α's, were set beside the
+        // variants as if comparable (found by reviews). The scene by its content (an edited
+        // scene, or another of the same file name, is not the exported one); by its file
+        // where the export predates the hashes.
+        for r in sweep.records.iter().filter(|r| !r.is_external()) {
+            if let Some(problem) = not_of_the_export(&views, r) {
+                return Err(refused(dir, format!("{}: {problem}", r.key)));
+            }
         }
         if let Some(alpha) = views.alpha
             && let Some(r) = sweep
