@@ -517,7 +517,8 @@ fn a_with_sweep_naming_pictures_outside_its_images_is_refused() {
     );
     assert_eq!(out.code, 2, "{}", out.stderr);
     assert!(
-        out.stderr.contains("no view of the export is the scene's own camera"),
+        out.stderr
+            .contains("no view of the export is the scene's own camera"),
         "{}",
         out.stderr
     );

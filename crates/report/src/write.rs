@@ -343,6 +343,23 @@ fn split(r: &Record, value: impl Fn(&crate::ErrorSplit) -> Option<f64>) -> Strin
         .map_or(String::new(), |v| v.to_string())
 }
 
+/// A text cell of results.csv (RFC 4180): quoted, with its quotes doubled, where it holds a
+/// comma, a quote or a line break — a client's timing text ("… gl.finish(), interleaved")
+/// had split into cells of its own.
+fn csv_cell(text: &str) -> std::borrow::Cow<'_, str> {
+    if text.contains([',', '"', '\n', '\r']) {
+        csv_quoted(text).into()
+    } else {
+        text.into()
+    }
+}
+
+/// A text cell always quoted (the adapter, the scene, the method's options: the columns
+/// results.csv has always quoted), its quotes doubled.
+fn csv_quoted(text: &str) -> String {
+    format!("\"{}\"", text.replace('"', "\"\""))
+}
+
 fn write_csv(path: &Path, records: &[Record]) -> Result<(), FileError> {
     let mut s = String::from(
         "kind,method,n,depth,alpha,width,height,ssaa,ms_median,ms_ci_low,ms_ci_high,ms_min,timing_order,timing_source,frames,passes,draws,texture_renders,reflections,\
@@ -354,9 +371,9 @@ fn write_csv(path: &Path, records: &[Record]) -> Result<(), FileError> {
         let opt = |v: Option<u32>| v.map_or(String::new(), |x| x.to_string());
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},\"{}\",{},\"{}\",{},{},{},{},{},{},{},\"{}\",{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
-            r.kind,
-            r.method,
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            csv_cell(&r.kind),
+            csv_cell(&r.method),
             opt(r.n),
             opt(r.depth),
             r.alpha,
@@ -367,8 +384,8 @@ fn write_csv(path: &Path, records: &[Record]) -> Result<(), FileError> {
             r.ms_interval.map_or(String::new(), |i| i[0].to_string()),
             r.ms_interval.map_or(String::new(), |i| i[1].to_string()),
             r.ms_min,
-            r.timing_order,
-            r.timing_source,
+            csv_cell(&r.timing_order),
+            csv_cell(&r.timing_source),
             r.frames,
             r.passes,
             r.draws,
@@ -383,17 +400,17 @@ fn write_csv(path: &Path, records: &[Record]) -> Result<(), FileError> {
             m.flip_mean,
             m.flip_p95,
             m.flip_p99,
-            r.adapter.replace('"', "'"),
-            r.backend,
-            r.scene.replace('"', "'"),
-            r.scene_hash,
-            r.color_format,
+            csv_quoted(&r.adapter),
+            csv_cell(&r.backend),
+            csv_quoted(&r.scene),
+            csv_cell(&r.scene_hash),
+            csv_cell(&r.color_format),
             r.peak_memory_bytes.map_or(String::new(), |b| b.to_string()),
             r.plan_ms.map_or(String::new(), |ms| ms.to_string()),
             r.encode_ms.map_or(String::new(), |ms| ms.to_string()),
             r.gpu_buffer_bytes.map_or(String::new(), |b| b.to_string()),
             r.gpu_texture_bytes.map_or(String::new(), |b| b.to_string()),
-            r.method_options,
+            csv_quoted(&r.method_options),
             opt(r.planes()),
             r.value(value::COPIES_DRAWN)
                 .map_or(String::new(), |c| c.to_string()),
@@ -1112,5 +1129,69 @@ pub(crate) mod tests {
         let columns = |l: &str| l.split(',').count();
         let header = columns(csv.lines().next().unwrap());
         assert!(csv.lines().skip(1).all(|l| columns(l) == header), "{csv}");
+    }
+
+    /// RFC 4180's reading of a CSV text: rows of cells, a quoted cell's `""` one quote.
+    fn parse_csv(text: &str) -> Vec<Vec<String>> {
+        let (mut rows, mut row, mut cell) = (Vec::new(), Vec::new(), String::new());
+        let (mut quoted, mut chars) = (false, text.chars().peekable());
+        while let Some(c) = chars.next() {
+            match (quoted, c) {
+                (true, '"') if chars.peek() == Some(&'"') => {
+                    chars.next();
+                    cell.push('"');
+                }
+                (true, '"') => quoted = false,
+                (true, c) => cell.push(c),
+                (false, '"') => quoted = true,
+                (false, ',') => row.push(std::mem::take(&mut cell)),
+                (false, '\n') => {
+                    row.push(std::mem::take(&mut cell));
+                    rows.push(std::mem::take(&mut row));
+                }
+                (false, c) => cell.push(c),
+            }
+        }
+        rows
+    }
+
+    /// Text a client wrote (its timing, its engine) comes back from results.csv cell for
+    /// cell, commas, quotes and line breaks included: the web engines' timing text had split
+    /// into four more cells than the header's.
+    #[test]
+    fn every_text_cell_of_the_csv_reads_back_as_written() {
+        let dir = tempfile::tempdir().unwrap();
+        let text = "a, \"b\"\nc";
+        let mut r = record(1, 45.0, 7, 0.05);
+        r.kind = text.into();
+        r.method = text.into();
+        r.timing_order = text.into();
+        r.timing_source = text.into();
+        r.adapter = text.into();
+        r.backend = text.into();
+        r.scene = text.into();
+        r.scene_hash = text.into();
+        r.color_format = text.into();
+        r.method_options = text.into();
+        write_report(dir.path(), &SweepInfo::default(), &[r], &[]).unwrap();
+        let rows = parse_csv(&std::fs::read_to_string(dir.path().join("results.csv")).unwrap());
+        assert_eq!(rows.len(), 2);
+        let header = &rows[0];
+        assert_eq!(rows[1].len(), header.len(), "{rows:?}");
+        for column in [
+            "kind",
+            "method",
+            "timing_order",
+            "timing_source",
+            "adapter",
+            "backend",
+            "scene",
+            "scene_hash",
+            "color_format",
+            "method_options",
+        ] {
+            let i = header.iter().position(|h| h == column).unwrap();
+            assert_eq!(rows[1][i], text, "{column}");
+        }
     }
 }
