@@ -191,9 +191,13 @@ fn web_engines(reports: &Path) -> Result<String, ReadmeError> {
         ratios.push(theirs.mirror_flip() / ours.mirror_flip());
         if texture.is_empty() {
             let said: Vec<String> = [
+                // The client's `target` is the texel type of Reflector's render target (at
+                // the canvas size: clients/web/README.md), not its resolution.
                 theirs.option("target").map(|t| match t {
-                    "half" | "full" => format!("a {t}-resolution target"),
-                    t => format!("target {t}"),
+                    "half" => "a half-float target".to_string(),
+                    "float" => "a float target".to_string(),
+                    "byte" => "an 8-bit target".to_string(),
+                    t => format!("target type {t}"),
                 }),
                 theirs.option("msaa").map(|m| format!("{m}× MSAA")),
             ]
@@ -217,7 +221,7 @@ fn web_engines(reports: &Path) -> Result<String, ReadmeError> {
         .fold(0.0f64, f64::max);
     Ok(format!(
         "**three.js' `Reflector` draws the paper's Algorithm 1** (one mirror texture per mirror, \
-         one bounce): over the mirror pixels its error is {lo:.2}–{hi:.2}× that of our `naive` \
+         as our `naive` does): over the mirror pixels its error is {lo:.2}–{hi:.2}× that of our `naive` \
          on mirror_box, mirror_room and textured_box (headless Chromium on SwiftShader, \
          320×180, α = 0.9), and on the same software rasterizer its no-mirror floor is ours \
          within {:.1} % — so the extra error is in how it draws its mirror texture{}, not in the \
