@@ -354,8 +354,8 @@ fn bounce_cost(reports: &Path) -> Result<String, ReadmeError> {
     }
     Ok(format!(
         "**An exact mirror's next bounce is cheap**: one more reflection of `portal` along a \
-         path costs {} (mirror_box, 640×360, depth 1…1024, least squares with a 95 % interval; \
-         [figure](depth_scaling/plot_ms_vs_depth.svg)).",
+         path costs {} (mirror_box, 640×360, depth 1…1024, least squares with a 95 % interval \
+         of the timing noise, not of the fit; [figure](depth_scaling/plot_ms_vs_depth.svg)).",
         parts.join(", ")
     ))
 }

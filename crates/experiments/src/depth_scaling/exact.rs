@@ -30,7 +30,8 @@ pub struct DepthScaling {
     /// ms/frame per extra reflection shown (fit over every point).
     pub ms_per_bounce: Option<f64>,
     /// Its 95 % bootstrap interval: every point's frames resampled, medians refitted
-    /// (`None` where a point has too few frames).
+    /// (`None` where a point has too few frames). It holds the timing noise only, not how
+    /// far the points lie off one line ([`DepthScaling::bent`] says where they do).
     pub ms_per_bounce_interval: Option<mirrorbox_report::stats::Interval>,
     /// Whether one straight line fits; `None` with fewer than four points. Halves far apart
     /// make the one slope an average.
@@ -234,7 +235,7 @@ pub fn bounce_sentence(g: &DepthScaling, pass_ms: Option<f64>) -> String {
     let deepest = g.points.iter().map(|r| r.reflections).max().unwrap_or(0);
     let interval = g.ms_per_bounce_interval.map_or(String::new(), |i| {
         let d = ms_digits(b, 3);
-        format!(" [95 % CI {:.d$}–{:.d$}]", i.low, i.high)
+        format!(" [95 % CI {:.d$}–{:.d$}, frames resampled]", i.low, i.high)
     });
     let mut s = format!(
         "{}, α = {}: {} ms{interval} per extra reflection (least-squares over {} depths, up to {} reflections shown)",
