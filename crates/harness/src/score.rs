@@ -643,7 +643,13 @@ pub fn score(
                     } else {
                         BTreeMap::new()
                     },
-                    values: BTreeMap::new(),
+                    values: if v.scene_camera {
+                        [(mirrorbox_report::value::SCENE_CAMERA.to_string(), 1.0)]
+                            .into_iter()
+                            .collect()
+                    } else {
+                        BTreeMap::new()
+                    },
                     legacy: Default::default(),
                     stereo: None,
                     device: None,

@@ -283,6 +283,9 @@ pub mod value {
     pub const BAKE_MS: &str = "bake_ms";
     /// The share of the mirror pixels whose first reflection is off screen, in [0, 1].
     pub const REFLECTION_OFFSCREEN_SHARE: &str = "reflection_offscreen_share";
+    /// 1 for a scored variant's view at the scene's own camera, the one our sweeps show
+    /// (`mirrorbox score`; absent in scores made before it was kept).
+    pub const SCENE_CAMERA: &str = "scene_camera";
 }
 
 /// A point's error against the truth, split at the reflection count `reflections` it shows

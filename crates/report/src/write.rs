@@ -446,6 +446,52 @@ fn write_csv(path: &Path, records: &[Record]) -> Result<(), FileError> {
 }
 
 /// What the comparison cannot resolve: raster vs trace without mirrors.
+/// Whose floor `fl` is: a scored client's and view's (its key, `client/floor|view|…`), or
+/// ours on its adapter.
+fn floor_name(fl: &Record) -> String {
+    if fl.is_external() {
+        let mut fields = fl.key.split('|');
+        let client = fields.next().unwrap_or_default();
+        let client = client.split('/').next().unwrap_or(client);
+        match fields.next() {
+            Some(view) if !view.is_empty() => format!("{client}, view {view}"),
+            _ => client.to_string(),
+        }
+    } else {
+        format!("mirrorbox on {}", fl.adapter)
+    }
+}
+
+/// Several floors (a score's clients and views, and ours): each in a row, each error read
+/// against its own renderer's, and which one the figures shade.
+fn floors_table(floors: &[&Record], shaded: &Record) -> Vec<Block> {
+    vec![
+        Block::Paragraph(format!(
+            "Raster vs trace on the scene without its mirrors (nothing to truncate, same \
+             sub-pixel grid), for each renderer and view: read each error against its own \
+             renderer's floor. The figures shade the floor of {}.",
+            floor_name(shaded)
+        )),
+        Block::Table(
+            ["floor of", "RMSE", "relMSE", "FLIP mean", "SSIM"]
+                .map(String::from)
+                .to_vec(),
+            floors
+                .iter()
+                .map(|fl| {
+                    vec![
+                        floor_name(fl),
+                        sci(fl.metrics.rmse),
+                        sci(fl.metrics.relmse),
+                        sci(fl.metrics.flip_mean),
+                        f(fl.metrics.ssim, 6),
+                    ]
+                })
+                .collect(),
+        ),
+    ]
+}
+
 pub fn floor_paragraph(fl: &Record) -> Block {
     Block::Paragraph(format!(
         "Raster vs trace on the scene without its mirrors (nothing to truncate, same sub-pixel grid): \
@@ -494,7 +540,14 @@ fn document(info: &SweepInfo, records: &[Record], sections: &[Section]) -> Vec<B
         )));
     }
     let points: Vec<&Record> = records.iter().filter(|r| r.kind == "point").collect();
-    let floor = records.iter().find(|r| r.kind == "floor");
+    // A score may hold several floors (each client's, each view's, and ours): the figures'
+    // band and the at-floor test take ours where there is one, and the report names it.
+    let floors: Vec<&Record> = records.iter().filter(|r| r.kind == "floor").collect();
+    let floor = floors
+        .iter()
+        .find(|r| !r.is_external())
+        .or(floors.first())
+        .copied();
     let latest_run = records.iter().filter_map(|r| r.run.as_deref()).max();
     let reused = |r: &Record| latest_run.is_some() && r.run.as_deref() != latest_run;
     // A merged sweep's shards are separate runs by design (below).
@@ -532,7 +585,11 @@ fn document(info: &SweepInfo, records: &[Record], sections: &[Section]) -> Vec<B
 
     if let Some(fl) = floor {
         b.push(Block::Heading(2, "Floor of the comparison".into()));
-        b.push(floor_paragraph(fl));
+        if floors.len() == 1 {
+            b.push(floor_paragraph(fl));
+        } else {
+            b.extend(floors_table(&floors, fl));
+        }
     }
     // The experiments' own sections (the registry's), each empty for another's records.
     for section in sections {
@@ -669,11 +726,14 @@ fn document(info: &SweepInfo, records: &[Record], sections: &[Section]) -> Vec<B
     let mirror_flip = |r: &Record| r.mirror_metrics.as_ref().map(|m| m.flip_mean);
     if !points.is_empty() && !mixed_devices && !has_scene_axis && !all_at_floor {
         b.push(Block::Heading(2, "Error against time".into()));
-        b.push(Block::Paragraph(
+        b.push(Block::Paragraph(format!(
             "Each method's points joined along its swept setting (n or the depth cap, labelled); \
-             the shaded band is the comparison's floor (raster vs trace without mirrors)."
-                .into(),
-        ));
+             the shaded band is {} (raster vs trace without mirrors).",
+            match floor {
+                Some(fl) if floors.len() > 1 => format!("the floor of {}", floor_name(fl)),
+                _ => "the comparison's floor".to_string(),
+            }
+        )));
         b.push(Block::Chart(
             "plot_flip_vs_ms.svg".into(),
             Box::new(Chart {
@@ -1129,6 +1189,40 @@ pub(crate) mod tests {
         let columns = |l: &str| l.split(',').count();
         let header = columns(csv.lines().next().unwrap());
         assert!(csv.lines().skip(1).all(|l| columns(l) == header), "{csv}");
+    }
+
+    /// A score's several floors (each client's and view's, and ours) are each named in the
+    /// floor section, and the figures say whose they shade: ours (before: the first floor
+    /// found, unnamed).
+    #[test]
+    fn several_floors_are_each_named_and_the_shaded_one_is_said() {
+        let dir = tempfile::tempdir().unwrap();
+        let floor = |key: &str, flip: f64, external: bool| {
+            let mut r = record(0, 1.0, 1, flip);
+            r.kind = "floor".into();
+            r.key = key.into();
+            r.adapter = "our adapter".into();
+            if external {
+                r.timing_order = crate::EXTERNAL_TIMING.into();
+            }
+            r
+        };
+        let records = [
+            floor("three/floor|camera|a0.9|16x16|ssaa1", 0.5, true),
+            floor("floor|16x16", 0.001, false),
+            record(1, 2.0, 3, 0.1),
+            record(2, 3.0, 5, 0.05),
+        ];
+        write_report(dir.path(), &SweepInfo::default(), &records, &[]).unwrap();
+        let md = std::fs::read_to_string(dir.path().join("report.md")).unwrap();
+        assert!(
+            md.contains("| three, view camera |") && md.contains("| mirrorbox on our adapter |"),
+            "{md}"
+        );
+        assert!(
+            md.contains("the shaded band is the floor of mirrorbox on our adapter"),
+            "{md}"
+        );
     }
 
     /// RFC 4180's reading of a CSV text: rows of cells, a quoted cell's `""` one quote.

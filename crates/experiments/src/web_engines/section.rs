@@ -1,5 +1,6 @@
 //! A scored run's section (`mirrorbox score`, issue 53): each external variant beside its
-//! client's floor, our equivalent on the same view and the best exact method at its cost —
+//! client's floor, our equivalent at the scene's own camera and the best exact method at
+//! its cost —
 //! one table and one finding per variant, computed from the records. Empty for any report
 //! without external records (`timing_order` "external").
 
@@ -31,10 +32,12 @@ fn external(r: &Record) -> bool {
     r.is_external()
 }
 
-/// The client of an external record: its method up to the first `-` (`three-reflector`), or
-/// the whole method for its floor.
+/// The client of an external record: its key's first field up to the `/`
+/// (`client/variant|view|…`, `mirrorbox score`). Not its method cut at a `-`: a client's
+/// name may hold one (`me-gpu`'s floor had been taken for `me`'s).
 fn client(r: &Record) -> &str {
-    r.method.split('-').next().unwrap_or(&r.method)
+    let first = r.key.split('|').next().unwrap_or_default();
+    first.split('/').next().unwrap_or(first)
 }
 
 /// The view an external record was drawn from: its key's second field
@@ -71,14 +74,38 @@ pub fn section(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
     for r in &variants {
         // The client's floor of the same view.
         let floor = records.iter().find(|f| {
-            external(f) && f.kind == "floor" && f.method == client(r) && view_of(f) == view_of(r)
+            external(f) && f.kind == "floor" && client(f) == client(r) && view_of(f) == view_of(r)
         });
-        let equivalent = r.option("equivalent");
-        let eq = equivalent.and_then(|m| ours.iter().find(|o| o.method == m));
+        // Our points of the equivalent method at the variant's size: one is its equivalent;
+        // several settings of it (two cube sizes) are none, and are named instead.
+        // Ours show the scene's own camera: set beside that view only. With one view, `score
+        // --with` has held ours to it (and scores made before the flag was kept had one).
+        let at_our_camera =
+            !several_views || r.value(mirrorbox_report::value::SCENE_CAMERA) == Some(1.0);
+        let candidates: Vec<&Record> =
+            r.option("equivalent")
+                .filter(|_| at_our_camera)
+                .map_or(Vec::new(), |m| {
+                    ours.iter()
+                        .filter(|o| {
+                            o.method == m
+                                && (o.width, o.height, o.ssaa) == (r.width, r.height, r.ssaa)
+                        })
+                        .copied()
+                        .collect()
+                });
+        let eq = match candidates.as_slice() {
+            [one] => Some(*one),
+            _ => None,
+        };
         // The best of our exact methods that costs no more on its own device.
         let exact = ours
             .iter()
-            .filter(|o| info.exact_methods.contains(&o.method) && o.ms_median <= r.ms_median)
+            .filter(|o| {
+                at_our_camera
+                    && info.exact_methods.contains(&o.method)
+                    && o.ms_median <= r.ms_median
+            })
             .min_by(|a, b| a.mirror_flip().total_cmp(&b.mirror_flip()));
         rows.push(vec![
             label(r),
@@ -87,9 +114,15 @@ pub fn section(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
             sci(r.mirror_flip()),
             sci(r.metrics.flip_mean),
             ms_cell(r, 3),
-            eq.map_or("–".into(), |e| {
-                format!("{} {}", e.method, sci(e.mirror_flip()))
-            }),
+            match (eq, candidates.len()) {
+                (Some(e), _) => format!(
+                    "{} {}",
+                    mirrorbox_report::document::label(e),
+                    sci(e.mirror_flip())
+                ),
+                (None, 0) => "–".into(),
+                (None, n) => format!("{n} settings: none"),
+            },
             eq.map_or("–".into(), |e| ms_cell(e, 3)),
             exact.map_or("–".into(), |e| {
                 format!(
@@ -112,10 +145,21 @@ pub fn section(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
         );
         if let Some(e) = eq {
             s.push_str(&format!(
-                ", {}× that of our `{}` ({}) on the same view",
+                ", {}× that of our `{}` ({}) at the scene's own camera",
                 f(r.mirror_flip() / e.mirror_flip(), 2),
-                e.method,
+                mirrorbox_report::document::label(e),
                 sci(e.mirror_flip())
+            ));
+        } else if candidates.len() > 1 {
+            s.push_str(&format!(
+                "; our `{}` was swept at {} settings here ({}), so none is its equivalent",
+                candidates[0].method,
+                candidates.len(),
+                candidates
+                    .iter()
+                    .map(|c| mirrorbox_report::document::label(c))
+                    .collect::<Vec<_>>()
+                    .join(", ")
             ));
         }
         if let Some(fl) = floor {
@@ -131,7 +175,7 @@ pub fn section(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
         if let Some(e) = eq {
             s.push_str(&format!(
                 " against our `{}`'s {} ms ({}) on {}",
-                e.method,
+                mirrorbox_report::document::label(e),
                 f(e.ms_median, 3),
                 clock(e),
                 short(&e.adapter, 40)
@@ -144,7 +188,9 @@ pub fn section(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
                 sci(e.mirror_flip())
             )),
             // Said only where our exact methods were measured beside it (`score --with`).
-            None if ours.iter().any(|o| info.exact_methods.contains(&o.method)) => {
+            None if at_our_camera
+                && ours.iter().any(|o| info.exact_methods.contains(&o.method)) =>
+            {
                 s.push_str("; none of our exact methods is as cheap.")
             }
             None => s.push('.'),
@@ -156,8 +202,8 @@ pub fn section(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
         Block::Paragraph(
             "Each variant a client drew (`mirrorbox score`, docs/exchange.md), its client's \
              floor (the scene without mirrors: shading and rasterization alone), our \
-             equivalent on the same view, and the best of our exact methods that costs no \
-             more. Times come from different clocks where the devices or timing sources \
+             equivalent at the scene's own camera (the view our sweeps show), and the best of \
+             our exact methods that costs no more. Times come from different clocks where the devices or timing sources \
              differ (named in each finding)."
                 .into(),
         ),
@@ -250,5 +296,73 @@ mod tests {
         assert!(text.contains("**three-reflector**, view b"), "{text}");
         assert!(text.contains("its floor (no mirrors) 2.000e-3"), "{text}");
         assert!(text.contains("(view b)"), "{text}");
+    }
+
+    /// A scored record of `client/variant` at `view`.
+    fn scored(client: &str, variant: &str, view: &str, flip: f64) -> Record {
+        let mut r = record(0, 2.0, 1, flip);
+        r.method = if variant == "floor" {
+            client.into()
+        } else {
+            format!("{client}-{variant}")
+        };
+        r.kind = if variant == "floor" { "floor" } else { "point" }.into();
+        r.key = format!("{client}/{variant}|{view}|a0.9|16x16|ssaa1");
+        r.timing_order = mirrorbox_report::EXTERNAL_TIMING.into();
+        r
+    }
+
+    fn text(records: &[Record]) -> String {
+        mirrorbox_report::document::markdown(&section(&SweepInfo::default(), records))
+    }
+
+    /// A client's floor is its own, found by its name in the key, not by its method cut at a
+    /// `-` (`me-gpu`'s variants had been given `me`'s floor).
+    #[test]
+    fn a_client_with_a_dash_in_its_name_has_its_own_floor() {
+        let t = text(&[
+            scored("me-gpu", "grey", "camera", 0.3),
+            scored("me", "floor", "camera", 0.0),
+            scored("me-gpu", "floor", "camera", 0.55),
+        ]);
+        assert!(
+            t.contains("**me-gpu-grey**") && t.contains("its floor (no mirrors) 5.500e-1"),
+            "{t}"
+        );
+    }
+
+    /// Our equivalent is ours of that method at the variant's size, named with its setting;
+    /// several settings of it are none, and said; a view elsewhere than the scene's own
+    /// camera (which ours show) gets none.
+    #[test]
+    fn our_equivalent_is_one_setting_at_the_scene_camera_or_none() {
+        let mut variant = scored("three", "cubecamera", "camera", 0.4);
+        variant.method_options = "equivalent=cubemap".into();
+        let ours = |options: &str| {
+            let mut r = record(0, 9.0, 1, 0.5);
+            r.method = "cubemap".into();
+            r.method_options = options.into();
+            r
+        };
+        let one = text(&[variant.clone(), ours("cube-size=256")]);
+        assert!(one.contains("that of our `cubemap cube-size=256"), "{one}");
+        let two = text(&[variant.clone(), ours("cube-size=256"), ours("cube-size=32")]);
+        assert!(
+            two.contains("our `cubemap` was swept at 2 settings here")
+                && !two.contains("that of our"),
+            "{two}"
+        );
+        // Two views: the one at the scene's camera is compared, the other not.
+        let mut elsewhere = variant.clone();
+        elsewhere.key = "three/cubecamera|side|a0.9|16x16|ssaa1".into();
+        variant
+            .values
+            .insert(mirrorbox_report::value::SCENE_CAMERA.into(), 1.0);
+        let views = text(&[variant, elsewhere, ours("cube-size=256")]);
+        assert_eq!(views.matches("that of our `cubemap").count(), 1, "{views}");
+        assert!(
+            views.contains("**three-cubecamera**, view camera ("),
+            "{views}"
+        );
     }
 }
