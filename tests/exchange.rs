@@ -36,6 +36,11 @@ fn export(dir: &Path) {
     assert_eq!(out.code, 0, "{}", out.stderr);
 }
 
+/// `RUN/mirrorbox/naive/`, where [`our_run`] writes.
+fn variant_dir(run: &Path) -> std::path::PathBuf {
+    run.join("mirrorbox/naive")
+}
+
 fn timing(views: &str) -> String {
     format!(
         r#"{{"format":"mirrorbox-timing","version":1,"engine":"mirrorbox","engine_version":"test",
@@ -278,6 +283,17 @@ fn a_bad_run_is_refused_naming_the_file_and_nothing_is_written() {
     let out = run_score(&run, &run, &scored, &[]);
     assert_eq!(out.code, 2, "{}", out.stderr);
     assert!(out.stderr.contains("views.json"), "{}", out.stderr);
+    // Two variants whose pictures would share a file (`x_y/z` and `x/y_z`).
+    for (client, variant) in [("x_y", "z"), ("x", "y_z")] {
+        let copy = run.join(client).join(variant);
+        std::fs::create_dir_all(&copy).unwrap();
+        for f in ["camera.exr", "timing.json"] {
+            std::fs::copy(variant_dir(&run).join(f), copy.join(f)).unwrap();
+        }
+    }
+    refused("shared pictures", "would share images/x_y_z_camera.png");
+    std::fs::remove_dir_all(run.join("x_y")).unwrap();
+    std::fs::remove_dir_all(run.join("x")).unwrap();
     // Now it scores.
     assert_eq!(score().code, 0);
     // A sweep's folder as OUT is refused, not replaced: a sweep has a sweep.json too.

@@ -260,6 +260,48 @@ fn read_timing(path: &Path, views: &ViewsFile) -> Result<Timing, HarnessError> {
     Ok(t)
 }
 
+/// The stem of the report's pictures of `client/variant` at `view` (`images/<stem>.png`, with
+/// `_flip` and `_inset` beside it).
+fn picture_stem(client: &str, variant: &str, view: &str) -> String {
+    format!("{client}_{variant}_{view}")
+}
+
+/// Refuses a run whose pictures would share a file in the report: names may hold `_`, so
+/// `a_b/c` and `a/b_c` (or a view `x_flip` beside `x`'s heat map) would write one file and
+/// both rows would show it.
+fn check_picture_names(
+    found: &[(String, String, PathBuf)],
+    views: &ViewsFile,
+) -> Result<(), HarnessError> {
+    let mut seen: BTreeMap<String, (String, String)> = BTreeMap::new();
+    for (client, variant, dir) in found {
+        for v in &views.views {
+            let stem = picture_stem(client, variant, &v.name);
+            for file in [
+                format!("{stem}.png"),
+                format!("{stem}_flip.png"),
+                format!("{stem}_inset.png"),
+            ] {
+                let this = (format!("{client}/{variant}"), v.name.clone());
+                if let Some((other, view)) = seen.insert(file.clone(), this.clone())
+                    && (&other, &view) != (&this.0, &this.1)
+                {
+                    return Err(refused(
+                        dir,
+                        format!(
+                            "its pictures of view {:?} and those of {other} at view {view:?} \
+                             would share images/{file} in the report: rename a client, variant \
+                             or view",
+                            v.name
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Every `RUN/<client>/<variant>/` folder, sorted.
 fn variants(run: &Path) -> Result<Vec<(String, String, PathBuf)>, HarnessError> {
     // A mistyped RUN is the user's input (exit 2), not a failure to read.
@@ -530,6 +572,7 @@ pub fn score(
         ours.extend(sweep.records.into_iter().map(|r| (dir.clone(), r)));
     }
     let found = variants(run)?;
+    check_picture_names(&found, &views)?;
     crate::exchange::replaceable(out, "sweep.json", "score")?;
     // A sweep folder has a sweep.json too: replacing it would lose its records and cached
     // truths (found by a review). Only an earlier score's is replaced.
@@ -582,7 +625,7 @@ pub fn score(
             for (vi, (v, image)) in views.views.iter().zip(images).enumerate() {
                 let floor = variant.as_str() == "floor";
                 let truth = export.join(if floor { &v.floor } else { &v.truth });
-                let slug = format!("{client}_{variant}_{}", v.name);
+                let slug = picture_stem(client, variant, &v.name);
                 let files = ViewFiles {
                     raster: images_dir.join(format!("{slug}.png")),
                     heat: images_dir.join(format!("{slug}_flip.png")),
