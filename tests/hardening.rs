@@ -286,6 +286,19 @@ fn a_fifo_as_obj_file_is_refused_instead_of_blocking() {
     assert_refused(&args, &r, &["objects[0].path", "FIFO"]);
 }
 
+/// `compare` reads an EXR's recorded attributes before its pixels: a FIFO named as an image
+/// had blocked there, before the pixel reader's own check.
+#[test]
+fn a_fifo_as_compared_image_is_refused_instead_of_blocking() {
+    let dir = tempfile::tempdir().unwrap();
+    let fifo = dir.path().join("a.exr");
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+    assert!(made.is_ok_and(|s| s.success()), "mkfifo");
+    let args = ["compare", fifo.to_str().unwrap(), fifo.to_str().unwrap()];
+    let r = mirrorbox(&args, &[]);
+    assert_refused(&args, &r, &["a.exr", "FIFO"]);
+}
+
 /// An output named like an existing folder is refused before the trace, nothing written.
 /// (A write that fails later leaves nothing either: every output is staged and renamed
 /// together, `mirrorbox_files::StagedFiles`.)

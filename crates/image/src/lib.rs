@@ -215,7 +215,12 @@ fn exr_file(
 
 /// The text attributes of an EXR header (the ones [`write_exr`] stores).
 pub fn read_exr_attributes(path: &Path) -> Result<Vec<(String, String)>, ImageError> {
-    let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| io_error(path, e))?;
+    // A regular file of a bounded size, opened without blocking (a FIFO named as an image
+    // had blocked `compare` here, before `read_image`'s own check).
+    let file = mirrorbox_files::open_regular(path, MAX_IMAGE_FILE_BYTES, "image file")
+        .map_err(|e| io_error(path, e.message))?;
+    let meta = exr::meta::MetaData::read_from_buffered(std::io::BufReader::new(file), false)
+        .map_err(|e| io_error(path, e))?;
     let mut out: Vec<(String, String)> = meta
         .headers
         .iter()

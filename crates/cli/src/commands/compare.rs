@@ -56,7 +56,8 @@ fn recorded(path: &std::path::Path) -> Recorded {
     };
     let count = |key: &str| value(key).and_then(|v| v.parse::<u64>().ok());
     Recorded {
-        spp: count("mirrorbox.spp").or_else(|| count("mirrorbox.ssaa").map(|s| s * s)),
+        spp: count("mirrorbox.spp")
+            .or_else(|| count("mirrorbox.ssaa").and_then(|s| s.checked_mul(s))),
         exposure: value("mirrorbox.exposure")
             .and_then(|v| v.parse::<f32>().ok())
             .filter(|e| *e > 0.0 && e.is_finite()),
