@@ -403,8 +403,9 @@ fn timing_commands_turn_mesas_shader_cache_off_unless_told_otherwise() {
     };
     let (mesa, unset) = info(None);
     if !mesa {
-        // Another driver: nothing of Mesa's to report.
+        // Another driver: nothing of Mesa's to report, and the rest of the test is Mesa's.
         assert_eq!(unset, None);
+        eprintln!("not Mesa: the shader-cache half of this test does not apply to this driver");
         return;
     }
     assert_eq!(unset.as_deref(), Some("Mesa's disk shader cache off"));

@@ -91,7 +91,9 @@ fn assert_golden(name: &str, actual: &RgbImage) {
         .join("tests/golden")
         .join(format!("{name}.png"));
     if std::env::var_os("MIRRORBOX_BLESS").is_some() {
+        // Blessed, not compared: said, so that the run is not read as a pass.
         write_png(&path, actual, 1.0).unwrap();
+        eprintln!("MIRRORBOX_BLESS: wrote {} (not compared)", path.display());
         return;
     }
     if !path.exists() {
