@@ -2450,17 +2450,29 @@ fn shards_merge_into_the_unsharded_sweep() {
             "in its images/ folder (a relative path without ..)",
         ),
         ("images/missing.png", "which is not a file there"),
+        // A record that is no point of the sweep: it had been dropped unsaid.
+        ("a stray key", "is none of them"),
     ] {
         let mut lines: Vec<String> = good.lines().map(String::from).collect();
         let mut record: Value = serde_json::from_str(&lines[0]).unwrap();
-        record["raster_image"] = picture.into();
+        if picture == "a stray key" {
+            let mut stray = record.clone();
+            stray["key"] = "not a point of this sweep".into();
+            lines.push(stray.to_string());
+        } else {
+            record["raster_image"] = picture.into();
+        }
         lines[0] = record.to_string();
         std::fs::write(&results, lines.join("\n") + "\n").unwrap();
         let out = p("nested/merged");
         let r = mirrorbox(&["merge", &out, &s0, &s1, &s2], &[]);
         assert_eq!(r.code, 2, "{picture}: {}", r.stderr);
         assert!(r.stderr.contains(message), "{picture}: {}", r.stderr);
-        assert!(r.stderr.contains(picture), "{picture}: {}", r.stderr);
+        assert!(
+            picture == "a stray key" || r.stderr.contains(picture),
+            "{picture}: {}",
+            r.stderr
+        );
         assert!(
             !d.join("nested/merged").exists() && !d.join("nested/x.txt").exists(),
             "{picture}: nothing written"

@@ -126,10 +126,20 @@ pub fn merge(
             ));
         }
     }
-    // Every point exactly once.
+    // Every point exactly once, and no other (a record outside the sweep's points had been
+    // dropped unsaid, its pictures copied all the same).
     let mut seen: HashMap<&str, &Path> = HashMap::new();
     for s in &shards {
         for r in &s.records {
+            if !first.info.point_keys.contains(&r.key) {
+                return Err(refused(
+                    &s.dir,
+                    format!(
+                        "a shard of the sweep's points only ({:?} is none of them)",
+                        r.key
+                    ),
+                ));
+            }
             if let Some(other) = seen.insert(r.key.as_str(), &s.dir) {
                 return Err(refused(
                     &s.dir,
@@ -172,16 +182,15 @@ pub fn merge(
             })?;
         }
     }
-    // Write: the folder, its pictures, the records in the sweep's order, the description. A
-    // folder made here is removed again if writing fails: nothing half-written is left.
+    // Write: the folder, its pictures, the records in the sweep's order, the description —
+    // into OUT.partial, which then takes OUT's place: a merge that fails leaves no folder
+    // half-written, and an earlier merge in OUT whole (it had had new pictures under its old
+    // records).
     crate::check_output_parent(out)?;
     check_merge_out(out, &shards)?;
-    let made = !out.exists();
-    let written = write_merged(out, &shards, command, sections);
-    if written.is_err() && made {
-        let _ = std::fs::remove_dir_all(out);
-    }
-    written
+    crate::exchange::in_staged_folder(out, |partial| {
+        write_merged(partial, &shards, command, sections)
+    })
 }
 
 /// Refuses an output folder a merge would spoil: one of the shards, or a folder holding
@@ -259,8 +268,7 @@ fn write_merged(
             );
             for picture in crate::record_pictures(r) {
                 let (from, to) = (s.dir.join(picture), out.join(picture));
-                // Once per merge (points share pictures), over an earlier merge's copy: a
-                // re-measured shard's picture replaces it.
+                // Once per merge: points share pictures.
                 if copied.insert(to.clone()) {
                     mirrorbox_files::write_atomically_with(&to, |tmp| {
                         std::fs::copy(&from, tmp)
@@ -300,7 +308,15 @@ fn write_merged(
             .collect(),
         ..first.info.clone()
     };
-    info.shards.sort_by(|a, b| a.shard.cmp(&b.shard));
+    // By shard number: "10/12" after "2/12".
+    let index = |s: &ShardInfo| {
+        s.shard
+            .split('/')
+            .next()
+            .and_then(|i| i.parse::<u32>().ok())
+    };
+    info.shards
+        .sort_by(|a, b| index(a).cmp(&index(b)).then_with(|| a.shard.cmp(&b.shard)));
     let mut devices: Vec<String> = Vec::new();
     for s in &info.shards {
         let d = format!("{} on {}", s.device, s.cpu);
