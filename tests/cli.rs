@@ -2670,6 +2670,8 @@ fn a_sequence_sweep_compares_every_frame_with_its_truth() {
     ] {
         assert!(out.join(f).is_file(), "{f} missing");
     }
+    // The strips are drawn in cache/ and moved beside the report; nothing is left there.
+    assert!(!out.join("cache").exists(), "cache/ left behind");
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
     assert!(report.contains("| feedback history=0 |"), "{report}");
     // Not resumed: a second sequence sweep into the folder needs --fresh (before, it

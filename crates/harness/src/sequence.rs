@@ -282,6 +282,14 @@ pub fn run_sequences(
         move |source| HarnessError::Io { path, source }
     };
     std::fs::create_dir_all(&config.out).map_err(io(&config.out))?;
+    // The filmstrips are drawn here and moved beside the report once it is written: drawn
+    // straight into OUT, a run failing later had left an earlier report beside some of this
+    // run's strips of the same names.
+    let strips_dir = config.out.join("cache").join("filmstrips");
+    if strips_dir.exists() {
+        std::fs::remove_dir_all(&strips_dir).map_err(io(&strips_dir))?;
+    }
+    std::fs::create_dir_all(&strips_dir).map_err(io(&strips_dir))?;
     let mut records = Vec::new();
     let mut scenarios = Vec::new();
     let mut device = String::new();
@@ -329,6 +337,21 @@ pub fn run_sequences(
                 })
                 .collect::<Result<_, HarnessError>>()?;
             for ((k, summary), m) in (0..s.frames).zip(&summaries).zip(metrics) {
+                // The child's summary, every field it must give (a missing one had become a
+                // NaN or a 0 in the records unsaid).
+                let field = |name: &str| {
+                    summary[name].as_f64().ok_or_else(|| {
+                        HarnessError::Worker(format!(
+                            "{}, frame {k}: the render's --json summary has no number {name:?}",
+                            s.name
+                        ))
+                    })
+                };
+                let (ms, passes, reflections) = (
+                    field("ms_per_frame_median")?,
+                    field("passes")?,
+                    field("depth")?,
+                );
                 device = summary["adapter"].as_str().unwrap_or("").to_string();
                 records.push(FrameRecord {
                     scenario: s.name.clone(),
@@ -340,9 +363,9 @@ pub fn run_sequences(
                     flip_p95: m.flip_p95,
                     relmse: m.relmse,
                     psnr: m.psnr,
-                    ms: summary["ms_per_frame_median"].as_f64().unwrap_or(f64::NAN),
-                    passes: summary["passes"].as_u64().unwrap_or(0) as usize,
-                    reflections: summary["depth"].as_u64().unwrap_or(0) as usize,
+                    ms,
+                    passes: passes as usize,
+                    reflections: reflections as usize,
                 });
                 flips.push((m.flip_mean, k));
             }
@@ -368,7 +391,7 @@ pub fn run_sequences(
                     .iter()
                     .map(|&k| Ok((truths[k as usize].clone(), read_image(&images[k as usize])?)))
                     .collect::<Result<_, HarnessError>>()?;
-                write_filmstrip(&config.out.join(&name), &rows, exposure)?;
+                write_filmstrip(&strips_dir.join(&name), &rows, exposure)?;
                 filmstrips.push((method.key(), name, worst));
             }
             progress(&format!(
@@ -391,8 +414,6 @@ pub fn run_sequences(
             filmstrips,
         });
     }
-    // The cache folder held only the scenarios' frames.
-    let _ = std::fs::remove_dir(config.out.join("cache"));
     let info = MotionInfo {
         draws: Some([config.warmup, config.timed]),
         commit: crate::source_commit(),
@@ -414,13 +435,21 @@ pub fn run_sequences(
         scenarios,
     };
     write_motion_report(&config.out, &info, &records)?;
-    // An earlier run's filmstrips (replaced, `--fresh`) that this report does not name: only
-    // now, so that a run failing before its report leaves the earlier one whole.
+    // This run's filmstrips beside its report, and an earlier run's (replaced, `--fresh`)
+    // that it does not name gone: only now, so that a run failing before its report leaves
+    // the earlier one whole.
     let named: Vec<&str> = info
         .scenarios
         .iter()
         .flat_map(|s| s.filmstrips.iter().map(|(_, name, _)| name.as_str()))
         .collect();
+    for name in &named {
+        let to = config.out.join(name);
+        std::fs::rename(strips_dir.join(name), &to).map_err(io(&to))?;
+    }
+    std::fs::remove_dir(&strips_dir).map_err(io(&strips_dir))?;
+    // The cache folder held only the scenarios' frames and the strips.
+    let _ = std::fs::remove_dir(config.out.join("cache"));
     if let Ok(entries) = std::fs::read_dir(&config.out) {
         for e in entries.flatten() {
             let name = e.file_name().to_string_lossy().into_owned();
