@@ -229,7 +229,9 @@ pub fn render_scene(job: &RenderJob, scene: &Scene, gpu: &Gpu) -> Result<Rendere
         warmup: job.warmup,
     };
     // The point's own peak, when several points render in one process (the sweep's default).
-    reset_peak_memory();
+    // Where the kernel refuses the reset, the peak read later would be the process's so far,
+    // growing point by point: none is recorded then.
+    let own_peak = reset_peak_memory();
     // Planning is the CPU's share of a frame (reflection paths, the paper's recursion):
     // timed on its own, since GPU timestamps do not see it.
     let started = std::time::Instant::now();
@@ -261,7 +263,7 @@ pub fn render_scene(job: &RenderJob, scene: &Scene, gpu: &Gpu) -> Result<Rendere
             color_format: out.color_format.name().into(),
             adapter: gpu.report.name.clone(),
             backend: gpu.report.backend.clone(),
-            peak_memory_bytes: peak_memory_bytes(),
+            peak_memory_bytes: own_peak.then(peak_memory_bytes).flatten(),
             plan_ms,
             encode_ms: out.timing.encode_ms.clone(),
             gpu_buffer_bytes: out.gpu_memory.buffer_bytes,
