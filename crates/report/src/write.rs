@@ -162,7 +162,7 @@ pub fn write_report(
     sections: &[Section],
 ) -> Result<(), FileError> {
     write_csv(&dir.join("results.csv"), records)?;
-    let blocks = document(info, records, sections);
+    let blocks = without_empty_chart_sections(document(info, records, sections));
     // Each truth | raster | FLIP row is followed by its 4× inset where its images are there.
     // A row none of whose images was kept (a lent GPU's 1920×1080 images stay behind: too
     // large to bring back) says so instead of linking files that are not there.
@@ -316,6 +316,38 @@ pub fn write_report(
     }
     write_atomically(&dir.join("report.md"), markdown(&blocks).as_bytes())?;
     write_atomically(&dir.join("report.html"), html.as_bytes())
+}
+
+/// `blocks` without the sections (a heading up to the next of its level or above) that hold
+/// only charts and their captions and draw none of the charts: a score's one variant, or a
+/// sweep with nothing swept, had left a heading and a caption over no figure.
+fn without_empty_chart_sections(blocks: Vec<Block>) -> Vec<Block> {
+    let mut keep = vec![true; blocks.len()];
+    for (i, b) in blocks.iter().enumerate() {
+        let Block::Heading(level, _) = b else {
+            continue;
+        };
+        let end = blocks[i + 1..]
+            .iter()
+            .position(|b| matches!(b, Block::Heading(l, _) if l <= level))
+            .map_or(blocks.len(), |k| i + 1 + k);
+        let body = &blocks[i + 1..end];
+        let charts_only = body
+            .iter()
+            .all(|b| matches!(b, Block::Chart(..) | Block::Paragraph(_)));
+        let any_chart = body.iter().any(|b| matches!(b, Block::Chart(..)));
+        let none_drawn = !body
+            .iter()
+            .any(|b| matches!(b, Block::Chart(_, c) if c.is_drawable()));
+        if charts_only && any_chart && none_drawn {
+            keep[i..end].iter_mut().for_each(|k| *k = false);
+        }
+    }
+    blocks
+        .into_iter()
+        .zip(keep)
+        .filter_map(|(b, k)| k.then_some(b))
+        .collect()
 }
 
 /// Escaped text with Markdown's inline code (`x`) as `<code>`: the report's sentences are
@@ -885,8 +917,17 @@ fn document(info: &SweepInfo, records: &[Record], sections: &[Section]) -> Vec<B
                         r.peak_memory_bytes
                             .map_or("–".into(), |b| f(b as f64 / MIB, 0)),
                         format!("{}, {}", r.timing_source, r.timing_order),
-                        r.passes.to_string(),
-                        r.draws.to_string(),
+                        // An outside renderer's passes and draws are not known.
+                        if r.is_external() {
+                            "–".into()
+                        } else {
+                            r.passes.to_string()
+                        },
+                        if r.is_external() {
+                            "–".into()
+                        } else {
+                            r.draws.to_string()
+                        },
                         sci(m.rmse),
                         sci(m.relmse),
                         sci(m.smape),
@@ -1223,6 +1264,41 @@ pub(crate) mod tests {
             md.contains("the shaded band is the floor of mirrorbox on our adapter"),
             "{md}"
         );
+    }
+
+    /// A section of charts none of which can be drawn goes whole, heading and caption; one
+    /// with a drawn chart, or with a table, stays.
+    #[test]
+    fn a_section_whose_charts_are_all_undrawn_goes_whole() {
+        use crate::plot::{Chart, Series, method_style};
+        let chart = |xs: &[f64]| {
+            let mut c = Chart::new("t", "x", "y");
+            c.series = vec![Series::new(
+                "s",
+                method_style("naive"),
+                xs.iter().map(|&x| (x, 1.0)).collect(),
+            )];
+            Box::new(c)
+        };
+        let blocks = vec![
+            Block::Heading(2, "empty".into()),
+            Block::Paragraph("caption".into()),
+            Block::Chart("a.svg".into(), chart(&[1.0])),
+            Block::Heading(2, "drawn".into()),
+            Block::Chart("b.svg".into(), chart(&[1.0, 2.0])),
+            Block::Heading(2, "table".into()),
+            Block::Table(vec!["h".into()], vec![]),
+        ];
+        let kept: Vec<String> = without_empty_chart_sections(blocks)
+            .iter()
+            .map(|b| match b {
+                Block::Heading(_, h) => h.clone(),
+                Block::Paragraph(p) => p.clone(),
+                Block::Chart(f, _) => f.clone(),
+                _ => "other".into(),
+            })
+            .collect();
+        assert_eq!(kept, ["drawn", "b.svg", "table", "other"]);
     }
 
     /// RFC 4180's reading of a CSV text: rows of cells, a quoted cell's `""` one quote.
