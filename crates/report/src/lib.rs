@@ -522,6 +522,12 @@ pub struct ShardInfo {
 impl SweepInfo {
     /// The footer of every chart: scene, size, device, date, commit — what a figure printed
     /// alone must say about where its numbers come from.
+    /// Whether these are a score's records (`mirrorbox score`: outside renderers' images
+    /// compared here), not a sweep's.
+    pub fn is_score(&self) -> bool {
+        self.device_type == "external"
+    }
+
     pub fn footer(&self) -> String {
         let size = self.resolution.split(',').next().unwrap_or_default().trim();
         let date = self.date.get(..10).unwrap_or(&self.date);
@@ -532,10 +538,12 @@ impl SweepInfo {
         } else {
             "commit not recorded".to_string()
         };
-        format!(
-            "{} · {size} · {} ({}) on {} · {date} · {commit}",
-            self.scene, self.adapter, self.backend, self.cpu
-        )
+        let device = if self.is_score() {
+            format!("{} (the clients'), scored on {}", self.adapter, self.cpu)
+        } else {
+            format!("{} ({}) on {}", self.adapter, self.backend, self.cpu)
+        };
+        format!("{} · {size} · {device} · {date} · {commit}", self.scene)
     }
 
     /// "adapter NAME (backend, type[, driver D])": the device a sweep's timings belong to.

@@ -549,17 +549,47 @@ fn color_formats(records: &[Record]) -> String {
 }
 
 fn document(info: &SweepInfo, records: &[Record], sections: &[Section]) -> Vec<Block> {
+    // A score's devices are its clients' (the scoring machine only compared images), and
+    // ours where a sweep is set beside them.
+    let device = if info.is_score() {
+        let ours = distinct(
+            records
+                .iter()
+                .filter(|r| !r.is_external())
+                .map(|r| format!("{} ({})", r.adapter, r.backend)),
+        );
+        format!(
+            "Devices: the clients' — {}; scored on {}{}; colour targets: {}",
+            info.adapter_description(),
+            info.cpu,
+            if ours.is_empty() {
+                String::new()
+            } else {
+                format!("; our points on {}", ours.join(", "))
+            },
+            color_formats(records)
+        )
+    } else {
+        format!(
+            "Device: {} — {}; colour targets: {}",
+            info.cpu,
+            info.adapter_description(),
+            color_formats(records)
+        )
+    };
     let mut b = vec![
-        Block::Heading(1, format!("mirrorbox sweep: {}", info.scene)),
+        Block::Heading(
+            1,
+            format!(
+                "mirrorbox {}: {}",
+                if info.is_score() { "score" } else { "sweep" },
+                info.scene
+            ),
+        ),
         Block::Bullets(vec![
             format!("Resolution: {}", info.resolution),
             format!("Ground truth: {}", info.truth),
-            format!(
-                "Device: {} — {}; colour targets: {}",
-                info.cpu,
-                info.adapter_description(),
-                color_formats(records)
-            ),
+            device,
             format!("Versions: {}", info.versions),
             format!("Date: {}", info.date),
             format!("Command: `{}`", info.command),
