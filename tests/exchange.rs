@@ -255,6 +255,13 @@ fn a_bad_run_is_refused_naming_the_file_and_nothing_is_written() {
             "0 ms is not a frame's time (finite, > 0",
         ),
         (
+            timing(r#""camera":[1]"#).replace(
+                r#""views":{"#,
+                r#""scene_hashes":{"camera":"0000000000000000"},"views":{"#,
+            ),
+            "the run was drawn from another export",
+        ),
+        (
             timing(r#""camera":[1]"#).replace(r#""equivalent":"naive""#, r#""equivalent":"nave""#),
             "equivalent: \"nave\" is no mirrorbox method",
         ),

@@ -47,7 +47,8 @@ def main():
     (folder / "timing.json").write_text(json.dumps({
         "format": "mirrorbox-timing", "version": 1, "engine": "mirrorbox render (minimal client)",
         "engine_version": "1", "device": "this machine's default adapter", "equivalent": EQUIVALENT,
-        "timing": "wall clock around one `mirrorbox render` process per frame", "views": times}, indent=1))
+        "timing": "wall clock around one `mirrorbox render` process per frame", "views": times,
+        "scene_hashes": {view["name"]: view["scene_hash"] for view in views}}, indent=1))
     print(f"wrote {folder}: {len(views)} view(s); next: mirrorbox score {a.export} {a.run} -o OUT")
 
 

@@ -382,6 +382,8 @@ async function main() {
           ...(spec.equivalent[name] ? { equivalent: spec.equivalent[name] } : {}),
           notes: notes.trim(),
           views: Object.fromEntries(views.views.map((v) => [v.name, results[v.name].times[name].map((ms) => Number(ms.toFixed(4)))])),
+          // Which export the run was drawn from: score refuses it against another.
+          scene_hashes: Object.fromEntries(views.views.map((v) => [v.name, v.scene_hash])),
         };
         writeAtomic(path.join(dir, 'timing.json'), `${JSON.stringify(timing, null, 2)}\n`);
       }

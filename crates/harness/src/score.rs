@@ -38,6 +38,11 @@ pub struct Timing {
     pub notes: Option<String>,
     #[serde(deserialize_with = "each_key_once")]
     pub views: BTreeMap<String, Vec<f64>>,
+    /// Each view's `scene_hash` as the client read it from views.json: where given, `score`
+    /// holds the run to the export it was drawn from (a run of another export's views of the
+    /// same names and sizes had been scored against this one's truths).
+    #[serde(default)]
+    pub scene_hashes: BTreeMap<String, String>,
 }
 
 /// `timing.json`'s `views`, each view's key given once: a map read as serde reads one would
@@ -240,6 +245,27 @@ fn read_timing(path: &Path, views: &ViewsFile) -> Result<Timing, HarnessError> {
             path,
             format!("views.{extra}: no such view in views.json"),
         ));
+    }
+    for (view, hash) in &t.scene_hashes {
+        match views.views.iter().find(|v| &v.name == view) {
+            None => {
+                return Err(refused(
+                    path,
+                    format!("scene_hashes.{view}: no such view in views.json"),
+                ));
+            }
+            Some(v) if &v.scene_hash != hash => {
+                return Err(refused(
+                    path,
+                    format!(
+                        "scene_hashes.{view}: {hash}, but this export's view {view:?} is {}: \
+                         the run was drawn from another export",
+                        v.scene_hash
+                    ),
+                ));
+            }
+            Some(_) => {}
+        }
     }
     // A misspelt method would match none of ours, and the comparison would say "–" unsaid.
     if let Some(e) = &t.equivalent
