@@ -244,8 +244,16 @@ fn a_bad_run_is_refused_naming_the_file_and_nothing_is_written() {
     std::fs::write(&png, b"not read").unwrap();
     refused("exr and png", "two images of view \"camera\"");
     std::fs::remove_file(&png).unwrap();
-    // An unreadable timing file, one without the view, a negative time and a 0.
+    // No timing file (a run nested a level too deep looks so): the layout is said.
     let timing_file = variant.join("timing.json");
+    let timing_text = std::fs::read(&timing_file).unwrap();
+    std::fs::remove_file(&timing_file).unwrap();
+    refused(
+        "no timing",
+        "no timing.json: a variant folder RUN/<client>/<variant>/",
+    );
+    std::fs::write(&timing_file, timing_text).unwrap();
+    // An unreadable timing file, one without the view, a negative time and a 0.
     for (text, needle) in [
         ("{not json".to_string(), "timing.json"),
         (timing(r#""other":[1]"#), "no frames for view \"camera\""),

@@ -627,7 +627,16 @@ pub fn score(
     }
     let mut inputs = Vec::new();
     for (client, variant, dir) in &found {
-        let timing = read_timing(&dir.join("timing.json"), &views)?;
+        let timing_file = dir.join("timing.json");
+        if !timing_file.exists() {
+            // A run nested a level too deep, or a variant without its times.
+            return Err(refused(
+                dir,
+                "no timing.json: a variant folder RUN/<client>/<variant>/ holds <view>.exr (or \
+                 .png) and timing.json (docs/exchange.md)",
+            ));
+        }
+        let timing = read_timing(&timing_file, &views)?;
         let mut images = Vec::new();
         for v in &views.views {
             images.push(view_image(dir, v)?);
@@ -708,7 +717,9 @@ pub fn score(
                         .collect::<Vec<_>>()
                         .join(" "),
                     axes: if views.views.len() > 1 {
-                        [("view".to_string(), vi as f64)].into_iter().collect()
+                        [(mirrorbox_report::axis::VIEW.to_string(), vi as f64)]
+                            .into_iter()
+                            .collect()
                     } else {
                         BTreeMap::new()
                     },

@@ -355,7 +355,15 @@ fn read_exr(path: &Path) -> Result<RgbImage, ImageError> {
             img.pixels[pos.y() * w + pos.x()] = [r, g, b];
         },
     )
-    .map_err(|e| io_error(path, e))?;
+    .map_err(|e| match e {
+        // The EXR crate's words for a file without R, G and B (a Y-only or a layered one).
+        exr::error::Error::Invalid(m) if m.contains("no layer") => io_error(
+            path,
+            "an EXR with R, G and B channels is read (float or half; A ignored); this one has \
+             none in its first layer",
+        ),
+        e => io_error(path, e),
+    })?;
     Ok(image.layer_data.channel_data.pixels)
 }
 
@@ -365,6 +373,25 @@ mod tests {
 
     fn gradient() -> RgbImage {
         RgbImage::from_fn(7, 5, |x, y| [x as f32 * 0.25, y as f32 * 0.5, 3.5])
+    }
+
+    /// An EXR without R, G and B (here luminance only) is refused saying what is read, not
+    /// with the EXR crate's "no layer … matched your specified requirements".
+    #[test]
+    fn an_exr_without_rgb_says_what_is_read() {
+        use exr::prelude::*;
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("y.exr");
+        let y = AnyChannel::new("Y", FlatSamples::F32(vec![0.5; 4 * 3]));
+        Image::from_channels((4, 3), AnyChannels::sort(SmallVec::from_vec(vec![y])))
+            .write()
+            .to_file(&path)
+            .unwrap();
+        let e = read_image(&path).unwrap_err().to_string();
+        assert!(
+            e.contains("y.exr") && e.contains("R, G and B channels"),
+            "{e}"
+        );
     }
 
     #[test]

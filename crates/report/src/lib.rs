@@ -312,6 +312,9 @@ pub mod axis {
     pub const MIRRORED_LIGHTS: &str = "mirrored_lights";
     pub const BUMP_DEG: &str = "bump_deg";
     pub const STEREO_IPD: &str = "stereo_ipd";
+    /// A scored variant's view, by its index in the export's views.json (`mirrorbox score`,
+    /// exports of several views); its name is the record key's second field.
+    pub const VIEW: &str = "view";
 }
 
 impl Record {

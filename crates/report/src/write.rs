@@ -894,6 +894,12 @@ fn document(info: &SweepInfo, records: &[Record], sections: &[Section]) -> Vec<B
             if let Some(t) = r.tilt_deg() {
                 name.push_str(&format!(", tilt {t}°"));
             }
+            // A scored variant of an export of several views: its view's name, from its key.
+            if r.axis(crate::axis::VIEW).is_some()
+                && let Some(view) = r.key.split('|').nth(1)
+            {
+                name.push_str(&format!(", view {view}"));
+            }
             name
         };
         b.push(Block::Heading(2, "All points".into()));
@@ -1294,6 +1300,20 @@ pub(crate) mod tests {
             md.contains("the shaded band is the floor of mirrorbox on our adapter"),
             "{md}"
         );
+    }
+
+    /// A scored variant of an export of several views names its view in "All points" (two
+    /// views' rows had read alike).
+    #[test]
+    fn a_scored_point_names_its_view() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut r = record(0, 2.0, 1, 0.1);
+        r.key = "three/reflector|left|a0.9|16x16|ssaa1".into();
+        r.timing_order = crate::EXTERNAL_TIMING.into();
+        r.axes.insert(crate::axis::VIEW.into(), 1.0);
+        write_report(dir.path(), &SweepInfo::default(), &[r], &[]).unwrap();
+        let md = std::fs::read_to_string(dir.path().join("report.md")).unwrap();
+        assert!(md.contains(", view left |"), "{md}");
     }
 
     /// A section of charts none of which can be drawn goes whole, heading and caption; one
