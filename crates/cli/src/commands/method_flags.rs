@@ -29,6 +29,31 @@ fn arg(option: &'static OptionSpec, sweep: bool) -> Arg {
         (Some(axis), true) => ("LIST", axis.default.to_string()),
         _ => ("VALUE", option.default.to_string()),
     };
+    // A sweep takes a list only for the methods that sweep the option; the others that
+    // accept it take one value (`--history 0,4` is refused for cubemap).
+    let methods = match (&option.sweep, sweep) {
+        (Some(_), true) => {
+            let by = |sweeps: bool| {
+                METHODS
+                    .iter()
+                    .filter(|e| {
+                        e.accepts(option)
+                            && e.swept.is_some_and(|s| s.name == option.name) == sweeps
+                    })
+                    .map(|e| e.name)
+                    .collect::<Vec<_>>()
+            };
+            match (by(true), by(false)) {
+                (list, one) if one.is_empty() => list.join(" or "),
+                (list, one) => format!(
+                    "a list for {}, one value for {}",
+                    list.join(" or "),
+                    one.join(" or ")
+                ),
+            }
+        }
+        _ => methods,
+    };
     arg.action(ArgAction::Set)
         .value_name(value_name)
         .help(format!(
