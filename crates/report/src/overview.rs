@@ -241,8 +241,10 @@ pub fn pareto_steps(points: &[(f64, f64)]) -> (Points, Points) {
 }
 
 /// The frontier charts of the sweeps in `sweeps`: per scene of [`FRONTIER_SCENES`], per device,
-/// size and α with at least two methods. The lavapipe chart with the most points of a scene is
-/// `frontier_<scene>.svg`; the others are named by device, size and α.
+/// size and α with at least two methods. The headline of a scene, `frontier_<scene>.svg`, is a
+/// real GPU's chart where one was measured (else lavapipe's, else another CPU rasterizer's),
+/// the one with the most methods, then the most points; the others are named by device, size
+/// and α.
 pub(crate) fn frontiers(sweeps: &[(String, Sweep)]) -> Vec<Frontier> {
     let mut out = Vec::new();
     for scene in FRONTIER_SCENES {
