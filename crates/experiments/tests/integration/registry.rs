@@ -165,3 +165,26 @@ fn every_experiment_module_has_its_row() {
     }
     assert_eq!(consts, EXPERIMENTS.len(), "one const per row");
 }
+
+/// Every registered raster method, and the truth, has a colour and marker no other has in
+/// the reports' figures: a method missing from `plot::method_style`'s table gets one from a
+/// hash, which may repeat another's (the report crate cannot see the registry; this crate
+/// sees both).
+#[test]
+fn every_registered_method_has_a_style_of_its_own() {
+    use mirrorbox_report::plot::method_style;
+    let names: Vec<&str> = mirrorbox_raster::METHODS
+        .iter()
+        .map(|e| e.name)
+        .chain(["truth"])
+        .collect();
+    for (i, a) in names.iter().enumerate() {
+        for b in &names[..i] {
+            let (sa, sb) = (method_style(a), method_style(b));
+            assert!(
+                (sa.color, sa.marker) != (sb.color, sb.marker),
+                "{a} and {b} share a style: give the new one its own in plot::method_style"
+            );
+        }
+    }
+}
