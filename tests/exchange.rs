@@ -309,6 +309,17 @@ fn a_bad_run_is_refused_naming_the_file_and_nothing_is_written() {
     refused("shared pictures", "would share images/x_y_z_camera.png");
     std::fs::remove_dir_all(run.join("x_y")).unwrap();
     std::fs::remove_dir_all(run.join("x")).unwrap();
+    // A client named as the report's own pictures begin.
+    let reserved = run.join("truth").join("v");
+    std::fs::create_dir_all(&reserved).unwrap();
+    for f in ["camera.exr", "timing.json"] {
+        std::fs::copy(variant_dir(&run).join(f), reserved.join(f)).unwrap();
+    }
+    refused(
+        "reserved client",
+        "client name \"truth\" is the report's own",
+    );
+    std::fs::remove_dir_all(run.join("truth")).unwrap();
     // Now it scores.
     assert_eq!(score().code, 0);
     // A sweep's folder as OUT is refused, not replaced: a sweep has a sweep.json too.
@@ -323,6 +334,17 @@ fn a_bad_run_is_refused_naming_the_file_and_nothing_is_written() {
         out.stderr
     );
     assert_eq!(std::fs::read(sweep.join("results.jsonl")).unwrap(), before);
+    // Also a sweep stopped before its first point (no records to load): its sweep.json says
+    // it is no score.
+    std::fs::write(sweep.join("results.jsonl"), "").unwrap();
+    let out = run_score(&ex, &run, &sweep, &[]);
+    assert_eq!(out.code, 2, "{}", out.stderr);
+    assert!(
+        out.stderr.contains("not an earlier score"),
+        "{}",
+        out.stderr
+    );
+    std::fs::write(sweep.join("results.jsonl"), &before).unwrap();
     // And an earlier score is no sweep to set beside a run.
     let out = run_score(&ex, &run, &scored, &["--with", scored.to_str().unwrap()]);
     assert_eq!(out.code, 2, "{}", out.stderr);

@@ -272,8 +272,10 @@ pub(crate) fn in_staged_folder<T>(
     dir: &Path,
     write: impl FnOnce(&Path) -> Result<T, HarnessError>,
 ) -> Result<T, HarnessError> {
-    let partial = PathBuf::from(format!("{}.partial", dir.display()));
+    let partial = staging_folder(dir);
     if partial.exists() {
+        // A stale stage goes; one another process is writing is refused.
+        drop(mirrorbox_files::FolderLock::try_acquire(&partial)?);
         std::fs::remove_dir_all(&partial).map_err(io(&partial))?;
     }
     std::fs::create_dir_all(&partial).map_err(io(&partial))?;
@@ -289,6 +291,26 @@ pub(crate) fn in_staged_folder<T>(
     }
     std::fs::rename(&partial, dir).map_err(io(dir))?;
     Ok(done)
+}
+
+/// Where [`in_staged_folder`] stages `dir`: `dir.partial`, replaced on each run.
+pub(crate) fn staging_folder(dir: &Path) -> PathBuf {
+    PathBuf::from(format!("{}.partial", dir.display()))
+}
+
+/// Refuses an input folder that is `out`'s staging folder, which writing `out` would delete
+/// before reading it.
+pub(crate) fn not_the_stage_of(out: &Path, input: &Path) -> Result<(), HarnessError> {
+    let stage = staging_folder(out);
+    if stage.exists() && mirrorbox_files::resolved(input) == mirrorbox_files::resolved(&stage) {
+        return Err(HarnessError::Exchange(format!(
+            "{}: the folder where {} is staged (it is replaced first): rename it or choose \
+             another output folder",
+            input.display(),
+            out.display()
+        )));
+    }
+    Ok(())
 }
 
 /// Whether [`in_staged_folder`] may write `dir`: its parent exists, and it is absent, empty,

@@ -188,6 +188,16 @@ pub fn merge(
     // records).
     crate::check_output_parent(out)?;
     check_merge_out(out, &shards)?;
+    for s in &shards {
+        crate::exchange::not_the_stage_of(out, &s.dir)?;
+    }
+    // OUT's lock, held through the staging and the swap: a merge does not replace a folder
+    // another process is writing (a sweep resumed into it, another merge).
+    let _out_lock = if out.is_dir() {
+        Some(FolderLock::try_acquire(out)?)
+    } else {
+        None
+    };
     crate::exchange::in_staged_folder(out, |partial| {
         write_merged(partial, &shards, command, sections)
     })
@@ -308,15 +318,7 @@ fn write_merged(
             .collect(),
         ..first.info.clone()
     };
-    // By shard number: "10/12" after "2/12".
-    let index = |s: &ShardInfo| {
-        s.shard
-            .split('/')
-            .next()
-            .and_then(|i| i.parse::<u32>().ok())
-    };
-    info.shards
-        .sort_by(|a, b| index(a).cmp(&index(b)).then_with(|| a.shard.cmp(&b.shard)));
+    sort_by_shard_number(&mut info.shards);
     let mut devices: Vec<String> = Vec::new();
     for s in &info.shards {
         let d = format!("{} on {}", s.device, s.cpu);
@@ -334,4 +336,34 @@ fn write_merged(
         points: records.len(),
         devices,
     })
+}
+
+/// Shards in the order of their numbers: "10/12" after "2/12" (as text it came first).
+fn sort_by_shard_number(shards: &mut [ShardInfo]) {
+    let index = |s: &ShardInfo| {
+        s.shard
+            .split('/')
+            .next()
+            .and_then(|i| i.parse::<u32>().ok())
+    };
+    shards.sort_by(|a, b| index(a).cmp(&index(b)).then_with(|| a.shard.cmp(&b.shard)));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shards_are_listed_by_number() {
+        let mut shards: Vec<ShardInfo> = ["10/12", "2/12", "0/12"]
+            .iter()
+            .map(|s| ShardInfo {
+                shard: s.to_string(),
+                ..Default::default()
+            })
+            .collect();
+        sort_by_shard_number(&mut shards);
+        let order: Vec<&str> = shards.iter().map(|s| s.shard.as_str()).collect();
+        assert_eq!(order, ["0/12", "2/12", "10/12"]);
+    }
 }

@@ -300,6 +300,23 @@ fn check_picture_names(
     views: &ViewsFile,
 ) -> Result<(), HarnessError> {
     let mut seen: BTreeMap<String, (String, String)> = BTreeMap::new();
+    for (client, _, dir) in found {
+        // The report's own pictures begin so: `truth_<view>.png`, `with<k>_…` (a `--with`
+        // sweep's).
+        let reserved = client == "truth"
+            || client
+                .strip_prefix("with")
+                .is_some_and(|k| !k.is_empty() && k.bytes().all(|b| b.is_ascii_digit()));
+        if reserved {
+            return Err(refused(
+                dir,
+                format!(
+                    "client name {client:?} is the report's own (its truth pictures are \
+                     truth_<view>.png, a --with sweep's with<k>_…): rename the client"
+                ),
+            ));
+        }
+    }
     for (client, variant, dir) in found {
         for v in &views.views {
             let stem = picture_stem(client, variant, &v.name);
@@ -481,32 +498,45 @@ fn check_truth(
 }
 
 /// Why our record `r` (a `score --with` sweep's) is not of the exported scene at one of its
-/// views, if it is not: by the scene hash a sweep of it records and the views at the scene's
-/// own camera ([`crate::exchange::ExportedView::scene_camera`]), else (an export written
-/// before the hash was kept) by the scene file's name.
+/// views, if it is not. The scene by the hash a sweep of it records (else, in an export
+/// written before the hash was kept, by the scene file's name); the view by the one at the
+/// scene's own camera ([`crate::exchange::ExportedView::scene_camera`]; else, in an older
+/// export, any of its size); and, for every export, the view's size and ssaa and no scene
+/// axis.
 fn not_of_the_export(views: &ViewsFile, r: &Record) -> Option<String> {
-    let Some(hash) = &views.sweep_scene_hash else {
-        let same_file = match (
-            Path::new(&r.scene).canonicalize(),
-            Path::new(&views.source).canonicalize(),
-        ) {
-            (Ok(x), Ok(y)) => x == y,
-            _ => Path::new(&r.scene).file_name() == Path::new(&views.source).file_name(),
-        };
-        return (!same_file).then(|| {
-            format!(
-                "a sweep of {}, not of the scene exported ({})",
-                r.scene, views.source
-            )
-        });
-    };
-    if &r.scene_hash != hash {
-        return Some(format!(
-            "a sweep of {} (scene hash {}), not of the scene exported ({}, {hash})",
-            r.scene, r.scene_hash, views.source
-        ));
+    match &views.sweep_scene_hash {
+        Some(hash) if &r.scene_hash != hash => {
+            return Some(format!(
+                "a sweep of {} (scene hash {}), not of the scene exported ({}, {hash})",
+                r.scene, r.scene_hash, views.source
+            ));
+        }
+        Some(_) => {}
+        None => {
+            let same_file = match (
+                Path::new(&r.scene).canonicalize(),
+                Path::new(&views.source).canonicalize(),
+            ) {
+                (Ok(x), Ok(y)) => x == y,
+                _ => Path::new(&r.scene).file_name() == Path::new(&views.source).file_name(),
+            };
+            if !same_file {
+                return Some(format!(
+                    "a sweep of {}, not of the scene exported ({})",
+                    r.scene, views.source
+                ));
+            }
+        }
     }
-    let Some(v) = views.views.iter().find(|v| v.scene_camera) else {
+    let view = if views.sweep_scene_hash.is_some() {
+        views.views.iter().find(|v| v.scene_camera)
+    } else {
+        views
+            .views
+            .iter()
+            .find(|v| (v.width, v.height) == (r.width, r.height))
+    };
+    let Some(v) = view else {
         return Some(
             "no view of the export is the scene's own camera, the one a sweep shows".into(),
         );
@@ -601,17 +631,38 @@ pub fn score(
     check_picture_names(&found, &views)?;
     crate::exchange::replaceable(out, "sweep.json", "score")?;
     // A sweep folder has a sweep.json too: replacing it would lose its records and cached
-    // truths (found by a review). Only an earlier score's is replaced.
-    if let Ok(earlier) = mirrorbox_report::load_sweep(out)
-        && earlier.info.backend != SCORE_BACKEND
+    // truths (found by a review). Only an earlier score's is replaced, told by its sweep.json
+    // alone (a sweep stopped before its first point has no records to load).
+    let description = out.join("sweep.json");
+    if description.is_file() {
+        let earlier = mirrorbox_files::read_bounded_text(&description, 16 << 20, "sweep.json")
+            .ok()
+            .and_then(|t| serde_json::from_str::<SweepInfo>(&t).ok());
+        match earlier {
+            Some(info) if info.backend == SCORE_BACKEND => {}
+            Some(info) => {
+                return Err(refused(
+                    out,
+                    format!(
+                        "holds a sweep of {} ({}), not an earlier score: give a new or empty \
+                         folder",
+                        info.scene, info.backend
+                    ),
+                ));
+            }
+            None => {
+                return Err(refused(
+                    out,
+                    "holds a sweep.json that is no earlier score's: give a new or empty folder",
+                ));
+            }
+        }
+    }
+    for input in [export, run]
+        .into_iter()
+        .chain(settings.with.iter().map(PathBuf::as_path))
     {
-        return Err(refused(
-            out,
-            format!(
-                "holds a sweep of {} ({}), not an earlier score: give a new or empty folder",
-                earlier.info.scene, earlier.info.backend
-            ),
-        ));
+        crate::exchange::not_the_stage_of(out, input)?;
     }
     // Everything read and checked first: the export's truths that the variants are compared
     // with (the floor truths for variants named `floor`), then each variant's files.

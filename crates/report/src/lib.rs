@@ -523,14 +523,15 @@ pub struct ShardInfo {
 }
 
 impl SweepInfo {
-    /// The footer of every chart: scene, size, device, date, commit — what a figure printed
-    /// alone must say about where its numbers come from.
     /// Whether these are a score's records (`mirrorbox score`: outside renderers' images
     /// compared here), not a sweep's.
     pub fn is_score(&self) -> bool {
         self.device_type == "external"
     }
 
+    /// The footer of every chart: scene, size, device, date, commit — what a figure printed
+    /// alone must say about where its numbers come from. (A score's writer adds our points'
+    /// device, which its description does not hold.)
     pub fn footer(&self) -> String {
         let size = self.resolution.split(',').next().unwrap_or_default().trim();
         let date = self.date.get(..10).unwrap_or(&self.date);

@@ -194,7 +194,12 @@ pub fn write_report(
         with_insets.extend(inset);
     }
     let mut blocks = with_insets;
-    let footer = info.footer();
+    let mut footer = info.footer();
+    if info.is_score()
+        && let Some(ours) = ours_devices(records)
+    {
+        footer.push_str(&format!(" · our points on {ours}"));
+    }
     for b in &mut blocks {
         if let Block::Chart(_, chart) = b {
             chart.footer = footer.clone();
@@ -477,7 +482,17 @@ fn write_csv(path: &Path, records: &[Record]) -> Result<(), FileError> {
     write_atomically(path, s.as_bytes())
 }
 
-/// What the comparison cannot resolve: raster vs trace without mirrors.
+/// The devices of a score's own points (a `--with` sweep's), if it has any.
+fn ours_devices(records: &[Record]) -> Option<String> {
+    let ours = distinct(
+        records
+            .iter()
+            .filter(|r| !r.is_external())
+            .map(|r| format!("{} ({})", r.adapter, r.backend)),
+    );
+    (!ours.is_empty()).then(|| ours.join(", "))
+}
+
 /// Whose floor `fl` is: a scored client's and view's (its key, `client/floor|view|…`), or
 /// ours on its adapter.
 fn floor_name(fl: &Record) -> String {
@@ -524,6 +539,7 @@ fn floors_table(floors: &[&Record], shaded: &Record) -> Vec<Block> {
     ]
 }
 
+/// What the comparison cannot resolve: raster vs trace without mirrors.
 pub fn floor_paragraph(fl: &Record) -> Block {
     Block::Paragraph(format!(
         "Raster vs trace on the scene without its mirrors (nothing to truncate, same sub-pixel grid): \
@@ -552,21 +568,16 @@ fn document(info: &SweepInfo, records: &[Record], sections: &[Section]) -> Vec<B
     // A score's devices are its clients' (the scoring machine only compared images), and
     // ours where a sweep is set beside them.
     let device = if info.is_score() {
-        let ours = distinct(
-            records
-                .iter()
-                .filter(|r| !r.is_external())
-                .map(|r| format!("{} ({})", r.adapter, r.backend)),
-        );
         format!(
-            "Devices: the clients' — {}; scored on {}{}; colour targets: {}",
-            info.adapter_description(),
-            info.cpu,
-            if ours.is_empty() {
+            "Devices: the clients' — {}{}; scored on {}{}; colour targets: {}",
+            info.adapter,
+            if info.driver.trim().is_empty() {
                 String::new()
             } else {
-                format!("; our points on {}", ours.join(", "))
+                format!(" (driver {})", info.driver.trim())
             },
+            info.cpu,
+            ours_devices(records).map_or(String::new(), |o| format!("; our points on {o}")),
             color_formats(records)
         )
     } else {

@@ -16,8 +16,10 @@ pub struct Args {
     /// earlier score there is replaced.
     #[arg(short, long)]
     output: PathBuf,
-    /// A sweep folder of our own methods on the same views, set beside the run's variants in
-    /// the report (repeatable): e.g. the equivalents measured on the same device.
+    /// A sweep folder of our own methods set beside the run's variants in the report
+    /// (repeatable): e.g. the equivalents measured on the same device. It must be of the
+    /// scene exported, at its α, at the size and ssaa of its view at the scene's own camera,
+    /// with no scene axis swept (docs/exchange.md).
     #[arg(long)]
     with: Vec<PathBuf>,
 }

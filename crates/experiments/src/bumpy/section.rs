@@ -200,7 +200,10 @@ pub fn table(records: &[Record], bump_methods: &[String], relmse: bool) -> Block
     let amps = amplitudes(&pts);
     let main = main_method(&pts);
     let tricks = distinct(pts.iter().map(|r| variant_of(r, &main, bump_methods)));
-    let mut header = vec!["trick".to_string(), "ms/frame median [95 % CI]".into()];
+    let mut header = vec![
+        "trick".to_string(),
+        mirrorbox_report::document::ms_heading("ms/frame median", pts.iter().copied()),
+    ];
     header.extend(amps.iter().map(|a| format!("FLIP at {a}°")));
     if relmse {
         header.extend(amps.iter().map(|a| format!("relMSE at {a}°")));

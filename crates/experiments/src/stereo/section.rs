@@ -88,10 +88,14 @@ fn px(v: Option<f64>) -> String {
 pub fn cost_table(records: &[Record]) -> Block {
     let pts = pairs(records);
     let widest = ipds(&pts).last().copied().unwrap_or(0.0);
+    let timed = || records.iter().filter(|r| r.kind == "point");
     let header = vec![
         "method, mirrors".to_string(),
-        "mono ms/frame [95 % CI]".into(),
-        format!("stereo pair ms/frame at IPD {widest} [95 % CI]"),
+        mirrorbox_report::document::ms_heading("mono ms/frame", timed()),
+        mirrorbox_report::document::ms_heading(
+            &format!("stereo pair ms/frame at IPD {widest}"),
+            timed(),
+        ),
         "pair ÷ two mono frames".into(),
         "scene passes per pair".into(),
     ];

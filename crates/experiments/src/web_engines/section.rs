@@ -4,7 +4,7 @@
 //! one table and one finding per variant, computed from the records. Empty for any report
 //! without external records (`timing_order` "external").
 
-use mirrorbox_report::document::{Block, f, ms_cell, sci};
+use mirrorbox_report::document::{Block, distinct, f, ms_cell, sci};
 use mirrorbox_report::{Record, SweepInfo};
 
 /// `text` cut to `n` characters, with an ellipsis where cut (a device string can run to
@@ -151,15 +151,25 @@ pub fn section(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
                 sci(e.mirror_flip())
             ));
         } else if candidates.len() > 1 {
-            s.push_str(&format!(
-                "; our `{}` was swept at {} settings here ({}), so none is its equivalent",
-                candidates[0].method,
-                candidates.len(),
+            // Named by setting, and by device where two `--with` sweeps share a setting.
+            let labels: Vec<String> = candidates
+                .iter()
+                .map(|c| mirrorbox_report::document::label(c))
+                .collect();
+            let named: Vec<String> = if distinct(labels.iter().cloned()).len() == labels.len() {
+                labels
+            } else {
                 candidates
                     .iter()
-                    .map(|c| mirrorbox_report::document::label(c))
-                    .collect::<Vec<_>>()
-                    .join(", ")
+                    .zip(labels)
+                    .map(|(c, l)| format!("{l} on {}", short(&c.adapter, 40)))
+                    .collect()
+            };
+            s.push_str(&format!(
+                "; our `{}` was measured {} times here ({}), so none is its equivalent",
+                candidates[0].method,
+                candidates.len(),
+                named.join(", ")
             ));
         }
         if let Some(fl) = floor {
@@ -167,7 +177,7 @@ pub fn section(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
                 "; its floor (no mirrors) {}",
                 sci(fl.metrics.flip_mean)
             ));
-            if let Some(of) = our_floor {
+            if let Some(of) = our_floor.filter(|_| at_our_camera) {
                 s.push_str(&format!(", ours {}", sci(of.metrics.flip_mean)));
             }
         }
@@ -197,6 +207,7 @@ pub fn section(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
         }
         findings.push(s);
     }
+    let ms_column = mirrorbox_report::document::ms_heading("ms/frame", variants.iter().copied());
     vec![
         Block::Heading(2, "External renderers against the truth".into()),
         Block::Paragraph(
@@ -214,7 +225,7 @@ pub fn section(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
                 "client's floor FLIP",
                 "FLIP over mirror pixels",
                 "FLIP over image",
-                "ms/frame [95 % CI]",
+                ms_column.as_str(),
                 "our equivalent: mirror FLIP",
                 "our equivalent: ms/frame",
                 "our best exact at no more cost",
@@ -348,8 +359,7 @@ mod tests {
         assert!(one.contains("that of our `cubemap cube-size=256"), "{one}");
         let two = text(&[variant.clone(), ours("cube-size=256"), ours("cube-size=32")]);
         assert!(
-            two.contains("our `cubemap` was swept at 2 settings here")
-                && !two.contains("that of our"),
+            two.contains("our `cubemap` was measured 2 times here") && !two.contains("that of our"),
             "{two}"
         );
         // Two views: the one at the scene's camera is compared, the other not.
