@@ -1562,32 +1562,4 @@ mod tests {
         assert!(drawn < 3, "{svg}");
         assert!(svg.contains(">far</text>"));
     }
-
-    #[test]
-    fn every_method_has_its_own_style() {
-        let methods = [
-            "naive",
-            "auxiliary",
-            "path-textures",
-            "portal",
-            "unrolled",
-            "symmetry",
-            "symmetry-pruned",
-            "symmetry-baked",
-            "feedback",
-            "cubemap",
-            "ssr",
-            "ray-query",
-            "truth",
-        ];
-        for (i, a) in methods.iter().enumerate() {
-            for b in &methods[..i] {
-                let (sa, sb) = (method_style(a), method_style(b));
-                assert!(
-                    (sa.color, sa.marker) != (sb.color, sb.marker),
-                    "{a} and {b} share a style"
-                );
-            }
-        }
-    }
 }
