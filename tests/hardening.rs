@@ -6,6 +6,7 @@ use crate::common;
 use crate::common::{Output, mirrorbox};
 use serde_json::{Value, json};
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 
 fn scene() -> Value {
     common::valid_scene()
@@ -294,8 +295,30 @@ fn a_fifo_as_compared_image_is_refused_instead_of_blocking() {
     let fifo = dir.path().join("a.exr");
     let made = std::process::Command::new("mkfifo").arg(&fifo).status();
     assert!(made.is_ok_and(|s| s.success()), "mkfifo");
+    // Should the check regress, a writer opens the FIFO again and again after a while, so
+    // that each blocked read gets an end of file instead of hanging the test; a writer's open
+    // succeeds only while a reader waits, and says so.
+    let (writer, unblocked) = (fifo.clone(), std::sync::Arc::new(AtomicBool::new(false)));
+    let said = unblocked.clone();
+    std::thread::spawn(move || {
+        std::thread::sleep(std::time::Duration::from_secs(10));
+        loop {
+            if std::fs::OpenOptions::new()
+                .write(true)
+                .open(&writer)
+                .is_ok()
+            {
+                said.store(true, Ordering::SeqCst);
+            }
+            std::thread::sleep(std::time::Duration::from_millis(100));
+        }
+    });
     let args = ["compare", fifo.to_str().unwrap(), fifo.to_str().unwrap()];
     let r = mirrorbox(&args, &[]);
+    assert!(
+        !unblocked.load(Ordering::SeqCst),
+        "compare waited on the FIFO until a writer opened it"
+    );
     assert_refused(&args, &r, &["a.exr", "FIFO"]);
 }
 
