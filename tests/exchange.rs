@@ -602,6 +602,38 @@ fn an_export_without_alpha_says_the_scenes_own() {
     let text = text.replacen("[0.9, 0.9, 0.9]", "[0.8, 0.8, 0.8]", 1);
     std::fs::write(&uneven, text).unwrap();
     assert_eq!(alpha_of(uneven.to_str().unwrap()), Value::Null);
+    // A sweep (one α for every mirror) is no view of that export's scene: refused beside it.
+    let sweep = tmp.path().join("sweep");
+    let mut args = vec![
+        "sweep",
+        uneven.to_str().unwrap(),
+        "--methods",
+        "naive",
+        "--alpha",
+        "0.8",
+        "--frames",
+        "1",
+        "--out",
+        sweep.to_str().unwrap(),
+    ];
+    args.extend(SIZE);
+    let done = mirrorbox(&args, &[]);
+    assert_eq!(done.code, 0, "{}", done.stderr);
+    let run = tmp.path().join("run");
+    our_run(&run);
+    let export = tmp.path().join(uneven.to_str().unwrap().replace('/', "_"));
+    let out = run_score(
+        &export,
+        &run,
+        &tmp.path().join("scored"),
+        &["--with", sweep.to_str().unwrap()],
+    );
+    assert_eq!(out.code, 2, "{}", out.stderr);
+    assert!(
+        out.stderr.contains("have different reflectances"),
+        "{}",
+        out.stderr
+    );
 }
 
 #[test]

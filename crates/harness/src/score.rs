@@ -621,6 +621,24 @@ pub fn score(
                 ),
             ));
         }
+        // An export that keeps the hashes says its α wherever its mirrors share one: without
+        // one they differ, and no sweep (one α for every mirror) shows its scene.
+        if views.alpha.is_none()
+            && views.sweep_scene_hash.is_some()
+            && let Some(r) = sweep
+                .records
+                .iter()
+                .find(|r| r.kind == "point" && !r.is_external())
+        {
+            return Err(refused(
+                dir,
+                format!(
+                    "{}: a sweep sets one α for every mirror (here {}), and the export's mirrors \
+                     have different reflectances: export with --alpha to compare a sweep",
+                    r.key, r.alpha
+                ),
+            ));
+        }
         // Their pictures are copied into the report: each must be a file in the sweep's images/.
         for r in &sweep.records {
             crate::check_record_pictures(dir, r).map_err(HarnessError::Exchange)?;
