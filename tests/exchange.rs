@@ -23,6 +23,11 @@ fn run_score(export: &Path, run: &Path, out: &Path, more: &[&str]) -> crate::com
 const SIZE: [&str; 4] = ["--width", "64", "--height", "36"];
 
 fn export(dir: &Path) {
+    export_with(dir, &[]);
+}
+
+/// [`export`] with more flags (a view list).
+fn export_with(dir: &Path, more: &[&str]) {
     let mut args = vec![
         "export-views",
         "scenes/mirror_box.json",
@@ -31,6 +36,7 @@ fn export(dir: &Path) {
         "--alpha",
         "0.9",
     ];
+    args.extend(more);
     args.extend(SIZE);
     let out = mirrorbox(&args, &[]);
     assert_eq!(out.code, 0, "{}", out.stderr);
@@ -549,19 +555,7 @@ fn a_with_sweep_naming_pictures_outside_its_images_is_refused() {
     )
     .unwrap();
     let elsewhere = tmp.path().join("elsewhere");
-    let mut args = vec![
-        "export-views",
-        "scenes/mirror_box.json",
-        "-o",
-        elsewhere.to_str().unwrap(),
-        "--alpha",
-        "0.9",
-        "--views",
-        list.to_str().unwrap(),
-    ];
-    args.extend(SIZE);
-    let out = mirrorbox(&args, &[]);
-    assert_eq!(out.code, 0, "{}", out.stderr);
+    export_with(&elsewhere, &["--views", list.to_str().unwrap()]);
     let out = run_score(
         &elsewhere,
         &run,
