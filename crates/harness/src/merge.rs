@@ -15,10 +15,6 @@ use mirrorbox_scene::limits::SettingError;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-/// `sweep.json` is a few KB per thousand points; the bound keeps a wrong path from being read
-/// whole.
-const MAX_SWEEP_JSON_BYTES: u64 = 64 << 20;
-
 /// Most shard folders one merge reads.
 pub const MAX_MERGED_SHARDS: usize = 100_000;
 
@@ -38,9 +34,12 @@ struct ShardFolder {
 
 fn read_shard(dir: &Path) -> Result<ShardFolder, HarnessError> {
     let info_path = dir.join("sweep.json");
-    let text =
-        mirrorbox_files::read_bounded_text(&info_path, MAX_SWEEP_JSON_BYTES, "a sweep description")
-            .map_err(|e| refused(dir, format!("a shard's folder (sweep.json: {e})")))?;
+    let text = mirrorbox_files::read_bounded_text(
+        &info_path,
+        mirrorbox_report::MAX_SWEEP_JSON_BYTES,
+        "a sweep description",
+    )
+    .map_err(|e| refused(dir, format!("a shard's folder (sweep.json: {e})")))?;
     let info: SweepInfo = serde_json::from_str(&text).map_err(|e| {
         refused(
             dir,
@@ -227,13 +226,7 @@ fn check_merge_out(out: &Path, shards: &[ShardFolder]) -> Result<(), HarnessErro
     if entries.next().is_none() {
         return Ok(());
     }
-    let earlier = mirrorbox_files::read_bounded_text(
-        &out.join("sweep.json"),
-        MAX_SWEEP_JSON_BYTES,
-        "a sweep description",
-    )
-    .ok()
-    .and_then(|t| serde_json::from_str::<SweepInfo>(&t).ok());
+    let earlier = mirrorbox_report::read_sweep_info(out).ok();
     let same_merge = earlier.is_some_and(|info| {
         !info.shards.is_empty() && info.point_keys == shards[0].info.point_keys
     }) && !crate::SEQUENCE_FILES

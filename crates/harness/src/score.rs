@@ -556,10 +556,6 @@ fn not_of_the_export(views: &ViewsFile, r: &Record) -> Option<String> {
     })
 }
 
-/// The `backend` of a score's `sweep.json`: what tells an earlier score (replaced) from a sweep
-/// (refused) in its output folder.
-const SCORE_BACKEND: &str = "external (mirrorbox score)";
-
 /// Scores `run` against `export` into `out` (see the module docs). Every input is read and
 /// checked before anything is written; the report goes to `out.partial` and is moved into
 /// place at the end (an earlier score in `out` is replaced).
@@ -576,7 +572,7 @@ pub fn score(
     let mut ours: Vec<(PathBuf, Record)> = Vec::new();
     for dir in &settings.with {
         let sweep = mirrorbox_report::load_sweep(dir).map_err(|e| refused(dir, e))?;
-        if sweep.info.backend == SCORE_BACKEND {
+        if sweep.info.is_score() {
             return Err(refused(
                 dir,
                 "an earlier score, not a sweep of ours: --with takes a `mirrorbox sweep`'s \
@@ -653,11 +649,8 @@ pub fn score(
     // alone (a sweep stopped before its first point has no records to load).
     let description = out.join("sweep.json");
     if description.is_file() {
-        let earlier = mirrorbox_files::read_bounded_text(&description, 16 << 20, "sweep.json")
-            .ok()
-            .and_then(|t| serde_json::from_str::<SweepInfo>(&t).ok());
-        match earlier {
-            Some(info) if info.backend == SCORE_BACKEND => {}
+        match mirrorbox_report::read_sweep_info(out).ok() {
+            Some(info) if info.is_score() => {}
             Some(info) => {
                 return Err(refused(
                     out,
@@ -890,7 +883,7 @@ pub fn score(
             date: crate::now_rfc3339(),
             cpu: crate::cpu_description(),
             adapter: devices.join("; "),
-            backend: SCORE_BACKEND.into(),
+            backend: "external (mirrorbox score)".into(),
             device_type: "external".into(),
             driver: drivers.join("; "),
             versions: format!(

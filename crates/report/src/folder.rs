@@ -8,8 +8,9 @@ use crate::error::ReadmeError;
 use crate::{Record, SweepInfo, read_records, write_report};
 use std::path::Path;
 
-/// `sweep.json` is a few KB; the bound keeps a wrong path from being read whole.
-const MAX_SWEEP_JSON_BYTES: u64 = 1 << 20;
+/// `sweep.json` is a few KB, or more where it lists every point's key (a sharded sweep's,
+/// `mirrorbox merge`'s bound); the bound keeps a wrong path from being read whole.
+pub const MAX_SWEEP_JSON_BYTES: u64 = 64 << 20;
 
 /// A sweep folder's records and facts.
 pub struct Sweep {
@@ -17,18 +18,24 @@ pub struct Sweep {
     pub records: Vec<Record>,
 }
 
-/// Reads `dir/sweep.json` and `dir/results.jsonl`; a folder without records is an error.
-pub fn load_sweep(dir: &Path) -> Result<Sweep, ReadmeError> {
+/// Reads `dir/sweep.json` alone: what a folder's sweep (or score, or merge) says of itself,
+/// whether or not it has records yet.
+pub fn read_sweep_info(dir: &Path) -> Result<SweepInfo, ReadmeError> {
     let info_path = dir.join("sweep.json");
     let text =
         mirrorbox_files::read_bounded_text(&info_path, MAX_SWEEP_JSON_BYTES, "a sweep description")
             .map_err(|e| ReadmeError(e.to_string()))?;
-    let info: SweepInfo = serde_json::from_str(&text).map_err(|e| {
+    serde_json::from_str(&text).map_err(|e| {
         ReadmeError(format!(
             "{}: not a sweep description ({e}); regenerate the report with its sweep",
             info_path.display()
         ))
-    })?;
+    })
+}
+
+/// Reads `dir/sweep.json` and `dir/results.jsonl`; a folder without records is an error.
+pub fn load_sweep(dir: &Path) -> Result<Sweep, ReadmeError> {
+    let info = read_sweep_info(dir)?;
     let results = dir.join("results.jsonl");
     let records = read_records(&results).map_err(|e| ReadmeError(e.to_string()))?;
     if records.is_empty() {

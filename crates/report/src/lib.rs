@@ -22,7 +22,7 @@ mod write;
 
 pub use document::{Block, Section};
 
-pub use folder::{Sweep, load_sweep, rewrite_report};
+pub use folder::{MAX_SWEEP_JSON_BYTES, Sweep, load_sweep, read_sweep_info, rewrite_report};
 pub use readme::read_lines;
 pub use write::{floor_paragraph, read_records, write_report};
 
