@@ -409,6 +409,22 @@ impl Record {
         self.timing_order == EXTERNAL_TIMING
     }
 
+    /// A scored variant's client, from its key (`client/variant|view|…`, `mirrorbox score`);
+    /// `None` for our own records. Not its method cut at a `-`: a client's name may hold one.
+    pub fn scored_client(&self) -> Option<&str> {
+        let first = self.key.split('|').next()?;
+        self.is_external()
+            .then(|| first.split('/').next().unwrap_or(first))
+    }
+
+    /// A scored variant's view, from its key's second field; `None` for our own records.
+    pub fn scored_view(&self) -> Option<&str> {
+        self.key
+            .split('|')
+            .nth(1)
+            .filter(|v| self.is_external() && !v.is_empty())
+    }
+
     /// The value of raster option `name` among the record's non-default options.
     pub fn option(&self, name: &str) -> Option<&str> {
         self.method_options.split_whitespace().find_map(|w| {

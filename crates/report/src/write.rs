@@ -496,16 +496,10 @@ fn ours_devices(records: &[Record]) -> Option<String> {
 /// Whose floor `fl` is: a scored client's and view's (its key, `client/floor|view|…`), or
 /// ours on its adapter.
 fn floor_name(fl: &Record) -> String {
-    if fl.is_external() {
-        let mut fields = fl.key.split('|');
-        let client = fields.next().unwrap_or_default();
-        let client = client.split('/').next().unwrap_or(client);
-        match fields.next() {
-            Some(view) if !view.is_empty() => format!("{client}, view {view}"),
-            _ => client.to_string(),
-        }
-    } else {
-        format!("mirrorbox on {}", fl.adapter)
+    match (fl.scored_client(), fl.scored_view()) {
+        (Some(client), Some(view)) => format!("{client}, view {view}"),
+        (Some(client), None) => client.to_string(),
+        (None, _) => format!("mirrorbox on {}", fl.adapter),
     }
 }
 
@@ -907,7 +901,7 @@ fn document(info: &SweepInfo, records: &[Record], sections: &[Section]) -> Vec<B
             }
             // A scored variant of an export of several views: its view's name, from its key.
             if r.axis(crate::axis::VIEW).is_some()
-                && let Some(view) = r.key.split('|').nth(1)
+                && let Some(view) = r.scored_view()
             {
                 name.push_str(&format!(", view {view}"));
             }

@@ -32,18 +32,9 @@ fn external(r: &Record) -> bool {
     r.is_external()
 }
 
-/// The client of an external record: its key's first field up to the `/`
-/// (`client/variant|view|…`, `mirrorbox score`). Not its method cut at a `-`: a client's
-/// name may hold one (`me-gpu`'s floor had been taken for `me`'s).
-fn client(r: &Record) -> &str {
-    let first = r.key.split('|').next().unwrap_or_default();
-    first.split('/').next().unwrap_or(first)
-}
-
-/// The view an external record was drawn from: its key's second field
-/// (`client/variant|view|a…|w×h|ssaa…`, `mirrorbox score`).
+/// The view an external record was drawn from ("" where its key names none).
 fn view_of(r: &Record) -> &str {
-    r.key.split('|').nth(1).unwrap_or_default()
+    r.scored_view().unwrap_or_default()
 }
 
 pub fn section(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
@@ -74,7 +65,10 @@ pub fn section(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
     for r in &variants {
         // The client's floor of the same view.
         let floor = records.iter().find(|f| {
-            external(f) && f.kind == "floor" && client(f) == client(r) && view_of(f) == view_of(r)
+            external(f)
+                && f.kind == "floor"
+                && f.scored_client() == r.scored_client()
+                && view_of(f) == view_of(r)
         });
         // Our points of the equivalent method at the variant's size: one is its equivalent;
         // several settings of it (two cube sizes) are none, and are named instead.
