@@ -240,7 +240,7 @@ pub fn export_views(
     config.ssaa = settings.ssaa.max(1);
     let (mut base, _, _) = crate::base_scene(&config)?;
     // What a sweep of this scene hashes, before the export's α (a sweep sets α per point).
-    let unlit = base.clone();
+    let sweep_scene_hash = format!("{:016x}", base.content_hash());
     if let Some(a) = settings.alpha {
         base.set_reflectance(Vec3::splat(a))
             .map_err(|source| HarnessError::LightImages {
@@ -260,7 +260,13 @@ pub fn export_views(
         let truth_dir = partial.join("truth");
         std::fs::create_dir_all(&truth_dir).map_err(io(&truth_dir))?;
         write_export(
-            &base, &unlit, &files, partial, &config, settings, scene_path,
+            &base,
+            &sweep_scene_hash,
+            &files,
+            partial,
+            &config,
+            settings,
+            scene_path,
         )
     })
 }
@@ -335,11 +341,11 @@ fn uniform_alpha(scene: &Scene) -> Option<f32> {
     (grey && scene.mirrors.iter().all(|m| m.reflectance == first)).then_some(first.x)
 }
 
-/// `base` is the scene exported (α set, light images enumerated); `unlit` the same before
-/// them, as a sweep's base scene is.
+/// `base` is the scene exported (α set, light images enumerated; its camera the scene's own);
+/// `sweep_scene_hash` the hash a sweep of it records, taken before them.
 fn write_export(
     base: &Scene,
-    unlit: &Scene,
+    sweep_scene_hash: &str,
     files: &gltf_export::GltfFiles,
     out: &Path,
     config: &SweepConfig,
@@ -400,7 +406,7 @@ fn write_export(
             }
         }
         let mut view = exported_view(&scene, spec, config.ssaa);
-        view.scene_camera = same_camera(&scene.camera, &unlit.camera);
+        view.scene_camera = same_camera(&scene.camera, &base.camera);
         views.push(view);
     }
     let l = &base.lighting;
@@ -411,7 +417,7 @@ fn write_export(
         scene: "scene.json".into(),
         source: scene_path.display().to_string(),
         alpha: settings.alpha.or_else(|| uniform_alpha(base)),
-        sweep_scene_hash: Some(format!("{:016x}", unlit.content_hash())),
+        sweep_scene_hash: Some(sweep_scene_hash.to_string()),
         contract: Contract {
             document: "docs/shading.md".into(),
             version: CONTRACT_VERSION,
