@@ -482,6 +482,15 @@ fn write_csv(path: &Path, records: &[Record]) -> Result<(), FileError> {
     write_atomically(path, s.as_bytes())
 }
 
+/// A count of `r`'s frame, "–" for an outside renderer's (its passes and draws are not known).
+fn unknown_outside(r: &Record, count: usize) -> String {
+    if r.is_external() {
+        "–".into()
+    } else {
+        count.to_string()
+    }
+}
+
 /// The devices of a score's own points (a `--with` sweep's), if it has any.
 fn ours_devices(records: &[Record]) -> Option<String> {
     let ours = distinct(
@@ -958,17 +967,8 @@ fn document(info: &SweepInfo, records: &[Record], sections: &[Section]) -> Vec<B
                         r.peak_memory_bytes
                             .map_or("–".into(), |b| f(b as f64 / MIB, 0)),
                         format!("{}, {}", r.timing_source, r.timing_order),
-                        // An outside renderer's passes and draws are not known.
-                        if r.is_external() {
-                            "–".into()
-                        } else {
-                            r.passes.to_string()
-                        },
-                        if r.is_external() {
-                            "–".into()
-                        } else {
-                            r.draws.to_string()
-                        },
+                        unknown_outside(r, r.passes),
+                        unknown_outside(r, r.draws),
                         sci(m.rmse),
                         sci(m.relmse),
                         sci(m.smape),
