@@ -28,10 +28,6 @@ fn clock(r: &Record) -> String {
     short(t, 40)
 }
 
-fn external(r: &Record) -> bool {
-    r.is_external()
-}
-
 /// The view an external record was drawn from ("" where its key names none).
 fn view_of(r: &Record) -> &str {
     r.scored_view().unwrap_or_default()
@@ -40,7 +36,7 @@ fn view_of(r: &Record) -> &str {
 pub fn section(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
     let variants: Vec<&Record> = records
         .iter()
-        .filter(|r| external(r) && r.kind == "point")
+        .filter(|r| r.is_external() && r.kind == "point")
         .collect();
     if variants.is_empty() {
         return Vec::new();
@@ -57,25 +53,27 @@ pub fn section(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
     };
     let ours: Vec<&Record> = records
         .iter()
-        .filter(|r| !external(r) && r.kind == "point")
+        .filter(|r| !r.is_external() && r.kind == "point")
         .collect();
-    let our_floor = records.iter().find(|r| !external(r) && r.kind == "floor");
+    let our_floor = records
+        .iter()
+        .find(|r| !r.is_external() && r.kind == "floor");
     let mut rows = Vec::new();
     let mut findings = Vec::new();
     for r in &variants {
         // The client's floor of the same view.
         let floor = records.iter().find(|f| {
-            external(f)
+            f.is_external()
                 && f.kind == "floor"
                 && f.scored_client() == r.scored_client()
                 && view_of(f) == view_of(r)
         });
-        // Our points of the equivalent method at the variant's size: one is its equivalent;
-        // several settings of it (two cube sizes) are none, and are named instead.
         // Ours show the scene's own camera: set beside that view only. With one view, `score
         // --with` has held ours to it (and scores made before the flag was kept had one).
         let at_our_camera =
             !several_views || r.value(mirrorbox_report::value::SCENE_CAMERA) == Some(1.0);
+        // Our points of the equivalent method at the variant's size: one is its equivalent;
+        // several settings of it (two cube sizes) are none, and are named instead.
         let candidates: Vec<&Record> =
             r.option("equivalent")
                 .filter(|_| at_our_camera)
