@@ -62,6 +62,15 @@ pub const BENT_BY: f64 = 0.1;
 const BENT_BY_WITHOUT_INTERVAL: f64 = 1.2;
 
 impl DepthScaling {
+    /// The method, with its variant where it has one: a series' and a row's name.
+    pub fn name(&self) -> String {
+        if self.variant.is_empty() {
+            self.method.clone()
+        } else {
+            format!("{} ({})", self.method, self.variant)
+        }
+    }
+
     /// The halves where their slopes are shown apart ([`BENT_BY`]): the cost per reflection
     /// is then not one number (on lavapipe it falls with depth).
     pub fn bent(&self) -> Option<HalfSlopes> {
@@ -109,17 +118,6 @@ fn variant_of(r: &Record) -> String {
         .collect();
     words.extend(r.axes.iter().map(|(k, v)| format!("{k}={v}")));
     words.join(", ")
-}
-
-impl DepthScaling {
-    /// The method, with its variant where it has one: a series' and a row's name.
-    pub fn name(&self) -> String {
-        if self.variant.is_empty() {
-            self.method.clone()
-        } else {
-            format!("{} ({})", self.method, self.variant)
-        }
-    }
 }
 
 /// Groups the exact points by (method, variant, α), each with at least two depths: points
