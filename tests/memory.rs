@@ -92,23 +92,36 @@ fn every_scene_and_method_peaks_under_two_gigabytes() {
         .flat_map(|s| methods().into_iter().map(move |m| (s.clone(), m)))
         .collect();
     let results: Mutex<Vec<Option<Outcome>>> = Mutex::new(jobs.iter().map(|_| None).collect());
-    let next = AtomicUsize::new(0);
-    // Lavapipe's start-up waits as much as it computes: a few processes at a time.
-    std::thread::scope(|scope| {
-        for _ in 0..4 {
-            scope.spawn(|| {
-                loop {
-                    let i = next.fetch_add(1, Ordering::Relaxed);
-                    let Some((scene, method)) = jobs.get(i) else {
-                        break;
-                    };
-                    let out = dir.path().join(format!("{i}.png"));
-                    let outcome = render(scene, method, &out);
-                    results.lock().unwrap()[i] = Some(outcome);
-                }
-            });
-        }
-    });
+    let run = |i: usize| {
+        let (scene, method) = &jobs[i];
+        let outcome = render(scene, method, &dir.path().join(format!("{i}.png")));
+        results.lock().unwrap()[i] = Some(outcome);
+    };
+    // Lavapipe's start-up waits as much as it computes: a few processes at a time. But with
+    // Mesa's shader cache empty (a fresh machine), processes started together each compiled
+    // the pipelines they share: the first scene's renders go one at a time (each method's
+    // pipelines compiled once), and each later scene's first render alone (that scene's
+    // own), before the rest four at a time. Cold: 118-121 -> 81 s of CPU (docs/budgets.md).
+    let per_scene = methods().len();
+    for (nth, scene) in (0..jobs.len()).step_by(per_scene).enumerate() {
+        let end = (scene + per_scene).min(jobs.len());
+        let alone = if nth == 0 { end } else { scene + 1 };
+        (scene..alone).for_each(run);
+        let next = AtomicUsize::new(alone);
+        std::thread::scope(|scope| {
+            for _ in 0..4 {
+                scope.spawn(|| {
+                    loop {
+                        let i = next.fetch_add(1, Ordering::Relaxed);
+                        if i >= end {
+                            break;
+                        }
+                        run(i);
+                    }
+                });
+            }
+        });
+    }
     let mut table = format!(
         "Every bundled scene × every method at its defaults, {}×{}, one `render` each.\n\n\
          | scene | method | peak RSS (MB) | estimate (MB) |\n|---|---|---:|---:|\n",
