@@ -6,7 +6,7 @@ use crate::document::{
     markdown, ms, ms_cell, ms_heading, remove_stale, sci, setting,
 };
 use crate::plot::{Chart, Series};
-use crate::{Record, SweepInfo, value};
+use crate::{Record, SweepInfo};
 use base64::Engine;
 use mirrorbox_files::{FileError, write_atomically};
 use std::fmt::Write as _;
@@ -397,18 +397,43 @@ fn csv_quoted(text: &str) -> String {
     format!("\"{}\"", text.replace('"', "\"\""))
 }
 
+/// `results.csv`: one row per point. The fixed columns every point has, then one column per
+/// scene axis ([`Record::axes`]: `planes`, `yaw_deg`, …) and per extra value
+/// ([`Record::values`]: `copies_drawn`, `reflection_offscreen_share`, …) that some point of
+/// the sweep has, named by its key in the records and sorted by name, then the stereo and
+/// error-split columns. Before, those were a fixed list under names of their own
+/// (`symmetry_planes`, `bump_amplitude_deg`), empty in every other sweep, and a sweep of the
+/// camera's yaw had no column for it.
 fn write_csv(path: &Path, records: &[Record]) -> Result<(), FileError> {
+    let keys = |map: fn(&Record) -> &std::collections::BTreeMap<String, f64>| {
+        let mut keys: Vec<&str> = records
+            .iter()
+            .flat_map(|r| map(r).keys().map(String::as_str))
+            .collect();
+        keys.sort_unstable();
+        keys.dedup();
+        keys
+    };
+    let axes = keys(|r| &r.axes);
+    let values = keys(|r| &r.values);
     let mut s = String::from(
         "kind,method,n,depth,alpha,width,height,ssaa,ms_median,ms_ci_low,ms_ci_high,ms_min,timing_order,timing_source,frames,passes,draws,texture_renders,reflections,\
-         rmse,relmse,smape,max_abs,psnr,ssim,flip_mean,flip_p95,flip_p99,adapter,backend,scene,scene_hash,color_format,peak_memory_bytes,plan_ms,encode_ms,gpu_buffer_bytes,gpu_texture_bytes,method_options,symmetry_planes,copies_drawn,copies_total,bake_ms,mirrored_lights,bump_amplitude_deg,stereo_ipd,marker_disparity_px,truth_marker_disparity_px,\
+         rmse,relmse,smape,max_abs,psnr,ssim,flip_mean,flip_p95,flip_p99,adapter,backend,scene,scene_hash,color_format,peak_memory_bytes,plan_ms,encode_ms,gpu_buffer_bytes,gpu_texture_bytes,method_options",
+    );
+    for key in axes.iter().chain(&values) {
+        let _ = write!(s, ",{}", csv_cell(key));
+    }
+    s.push_str(
+        ",marker_disparity_px,truth_marker_disparity_px,\
          mirror_flip_mean,truncation_flip_mean,approximation_flip_mean,truncation_mirror_flip_mean,approximation_mirror_flip_mean,truncation_relmse,approximation_relmse\n",
     );
+    let cell = |v: Option<&f64>| v.map_or(String::new(), |x| x.to_string());
     for r in records {
         let m = &r.metrics;
         let opt = |v: Option<u32>| v.map_or(String::new(), |x| x.to_string());
-        let _ = writeln!(
+        let _ = write!(
             s,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             csv_cell(&r.kind),
             csv_cell(&r.method),
             opt(r.n),
@@ -448,18 +473,16 @@ fn write_csv(path: &Path, records: &[Record]) -> Result<(), FileError> {
             r.gpu_buffer_bytes.map_or(String::new(), |b| b.to_string()),
             r.gpu_texture_bytes.map_or(String::new(), |b| b.to_string()),
             csv_quoted(&r.method_options),
-            opt(r.planes()),
-            r.value(value::COPIES_DRAWN)
-                .map_or(String::new(), |c| c.to_string()),
-            r.value(value::COPIES_TOTAL)
-                .map_or(String::new(), |c| c.to_string()),
-            r.value(value::BAKE_MS)
-                .map_or(String::new(), |ms| ms.to_string()),
-            opt(r.lights_depth()),
-            r.tilt_deg().map_or(String::new(), |a| a.to_string()),
-            r.stereo
-                .as_ref()
-                .map_or(String::new(), |st| st.ipd.to_string()),
+        );
+        for key in &axes {
+            let _ = write!(s, ",{}", cell(r.axes.get(*key)));
+        }
+        for key in &values {
+            let _ = write!(s, ",{}", cell(r.values.get(*key)));
+        }
+        let _ = writeln!(
+            s,
+            ",{},{},{},{},{},{},{},{},{}",
             r.stereo
                 .as_ref()
                 .and_then(|s| s.disparity(false))
@@ -1029,6 +1052,7 @@ fn document(info: &SweepInfo, records: &[Record], sections: &[Section]) -> Vec<B
 pub(crate) mod tests {
     use super::*;
     use crate::document::fixtures::record;
+    use crate::value;
 
     #[test]
     fn interrupted_lines_are_skipped_when_reading() {
@@ -1258,8 +1282,7 @@ pub(crate) mod tests {
         let csv = std::fs::read_to_string(dir.path().join("results.csv")).unwrap();
         assert!(csv.lines().next().unwrap().contains(
             ",color_format,peak_memory_bytes,plan_ms,encode_ms,gpu_buffer_bytes,gpu_texture_bytes,\
-             method_options,symmetry_planes,copies_drawn,copies_total,bake_ms,mirrored_lights,\
-             bump_amplitude_deg,stereo_ipd,marker_disparity_px,truth_marker_disparity_px,"
+             method_options,marker_disparity_px,truth_marker_disparity_px,"
         ));
         assert!(
             csv.lines()
@@ -1378,6 +1401,41 @@ pub(crate) mod tests {
             }
         }
         rows
+    }
+
+    /// The CSV has a column for every scene axis and extra value some point has, named by the
+    /// records' key, in every row (empty where the point has none); none for what no point has.
+    #[test]
+    fn the_csv_has_a_column_per_axis_and_value_the_points_have() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut a = record(0, 20.0, 3, 0.1);
+        a.axes.insert("yaw_deg".into(), 15.0);
+        a.values.insert(value::COPIES_DRAWN.into(), 4.0);
+        let mut b = record(1, 45.0, 7, 0.05);
+        b.axes.insert("planes".into(), 2.0);
+        b.axes.insert("yaw_deg".into(), -30.0);
+        write_report(dir.path(), &SweepInfo::default(), &[a, b], &[]).unwrap();
+        let rows = parse_csv(&std::fs::read_to_string(dir.path().join("results.csv")).unwrap());
+        let header = &rows[0];
+        assert!(rows.iter().all(|row| row.len() == header.len()), "{rows:?}");
+        let column = |name: &str| header.iter().position(|h| h == name);
+        let (planes, yaw, copies) = (
+            column("planes").unwrap(),
+            column("yaw_deg").unwrap(),
+            column("copies_drawn").unwrap(),
+        );
+        assert!(column("method_options").unwrap() < planes && planes < yaw && yaw < copies);
+        assert_eq!(
+            [&rows[1][planes], &rows[1][yaw], &rows[1][copies]],
+            ["", "15", "4"]
+        );
+        assert_eq!(
+            [&rows[2][planes], &rows[2][yaw], &rows[2][copies]],
+            ["2", "-30", ""]
+        );
+        for absent in ["symmetry_planes", "bump_deg", "copies_total", "stereo_ipd"] {
+            assert_eq!(column(absent), None, "{absent}: {header:?}");
+        }
     }
 
     /// Text a client wrote (its timing, its engine) comes back from results.csv cell for
