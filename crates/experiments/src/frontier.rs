@@ -7,6 +7,10 @@ use mirrorbox_harness::{SweepConfig, swept};
 use mirrorbox_raster::Method;
 use std::path::{Path, PathBuf};
 
+/// The scenes of the frontier (file stems under `scenes/`), in the overview's order: its
+/// charts (`frontier_<scene>.svg`) are drawn for these.
+pub const SCENES: [&str; 2] = ["mirror_box", "mirror_room"];
+
 /// Every method of the paper and its successors at the settings given, 320×180, α = 1, five
 /// timed frames after one warm-up.
 fn sweep(scene: &str, out: &Path, n: &[u32], depths: &[u32], path_textures: bool) -> SweepConfig {
@@ -51,21 +55,10 @@ pub const FRONTIER: Experiment = Experiment {
         } else {
             beside(out, "_room")
         };
+        let [box_scene, room_scene] = SCENES.map(|s| format!("scenes/{s}.json"));
         vec![
-            sweep(
-                "scenes/mirror_box.json",
-                out,
-                &[0, 1, 2, 3],
-                &[1, 4, 16, 64],
-                true,
-            ),
-            sweep(
-                "scenes/mirror_room.json",
-                &room,
-                &[0, 1],
-                &[1, 2, 4, 8, 16],
-                false,
-            ),
+            sweep(&box_scene, out, &[0, 1, 2, 3], &[1, 4, 16, 64], true),
+            sweep(&room_scene, &room, &[0, 1], &[1, 2, 4, 8, 16], false),
         ]
     }),
     section: None,

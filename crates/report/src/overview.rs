@@ -19,9 +19,6 @@ use mirrorbox_files::write_atomically;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-/// The scenes the overview draws a frontier for: the two bundled mirror scenes.
-pub const FRONTIER_SCENES: [&str; 2] = ["mirror_box", "mirror_room"];
-
 /// One report folder under `reports/`.
 struct Entry {
     /// Relative to `reports/`.
@@ -240,14 +237,15 @@ pub fn pareto_steps(points: &[(f64, f64)]) -> (Points, Points) {
     (front, steps)
 }
 
-/// The frontier charts of the sweeps in `sweeps`: per scene of [`FRONTIER_SCENES`], per device,
+/// The frontier charts of the sweeps in `sweeps`: per scene of `scenes` (file stems: the
+/// experiments' frontier scenes, `mirrorbox_experiments::frontier::SCENES`), per device,
 /// size and α with at least two methods. The headline of a scene, `frontier_<scene>.svg`, is a
 /// real GPU's chart where one was measured (else lavapipe's, else another CPU rasterizer's),
 /// the one with the most methods, then the most points; the others are named by device, size
 /// and α.
-pub(crate) fn frontiers(sweeps: &[(String, Sweep)]) -> Vec<Frontier> {
+pub(crate) fn frontiers(sweeps: &[(String, Sweep)], scenes: &[&str]) -> Vec<Frontier> {
     let mut out = Vec::new();
-    for scene in FRONTIER_SCENES {
+    for &scene in scenes {
         // (device slug, device text, size, α) → records.
         let mut groups: Vec<(GroupKey, Vec<&Record>, &SweepInfo)> = Vec::new();
         for (_, sweep) in sweeps {
@@ -428,12 +426,12 @@ fn frontier_chart(
 
 /// The figure check of the overview's frontier charts ([`crate::plot::Chart::lint`]), drawn
 /// from the sweep folders under `reports` as [`overview`] draws them, without writing.
-pub fn lint_frontiers(reports: &Path) -> Result<Vec<String>, ReadmeError> {
+pub fn lint_frontiers(reports: &Path, scenes: &[&str]) -> Result<Vec<String>, ReadmeError> {
     let mut sweeps = Vec::new();
     for dir in sweep_folders(reports) {
         sweeps.push((dir.display().to_string(), load_sweep(&dir)?));
     }
-    Ok(frontiers(&sweeps)
+    Ok(frontiers(&sweeps, scenes)
         .iter()
         .filter(|c| c.chart.is_drawable())
         .flat_map(|c| {
@@ -498,11 +496,13 @@ impl Overview {
 /// `about(folder)`: what the experiment that writes `folder` (relative to `reports`)
 /// measures, from the experiment registry, where it knows the folder.
 /// `others`: the reports that are not sweep folders (a sequence sweep's, a script's).
+/// `frontier_scenes`: the scenes (file stems) a frontier chart is drawn for.
 pub fn overview(
     reports: &Path,
     commit_of: &dyn Fn(&Path) -> String,
     about: &dyn Fn(&str) -> Option<String>,
     others: &[OtherReport],
+    frontier_scenes: &[&str],
     lead: Lead,
 ) -> Result<Overview, ReadmeError> {
     let mut files: Vec<(PathBuf, String)> = Vec::new();
@@ -579,7 +579,7 @@ pub fn overview(
         });
     }
 
-    let charts = frontiers(&sweeps);
+    let charts = frontiers(&sweeps, frontier_scenes);
     // Frontier files of an earlier overview that this one does not draw.
     if let Ok(dir) = std::fs::read_dir(reports) {
         for e in dir.flatten() {
@@ -631,7 +631,7 @@ pub fn overview(
     let drawable: Vec<&Frontier> = charts.iter().filter(|c| c.chart.is_drawable()).collect();
     let (headlines, others): (Vec<&Frontier>, Vec<&Frontier>) =
         drawable.into_iter().partition(|c| {
-            FRONTIER_SCENES
+            frontier_scenes
                 .iter()
                 .any(|s| c.file == format!("frontier_{s}.svg"))
         });

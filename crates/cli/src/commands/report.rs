@@ -49,6 +49,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             &records_commit,
             &about,
             &mirrorbox_experiments::other_reports(),
+            &mirrorbox_experiments::frontier::SCENES,
             mirrorbox_report::overview::Lead(&lead),
         )
         .map_err(|e| Failure::BadInput(format!("{}: {e}", reports.display())))?;

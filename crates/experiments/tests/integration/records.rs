@@ -141,7 +141,13 @@ fn every_committed_report_is_rewritten_byte_for_byte() {
         );
     }
     // And the overview's frontier charts.
-    problems.extend(mirrorbox_report::overview::lint_frontiers(&root().join("reports")).unwrap());
+    problems.extend(
+        mirrorbox_report::overview::lint_frontiers(
+            &root().join("reports"),
+            &mirrorbox_experiments::frontier::SCENES,
+        )
+        .unwrap(),
+    );
     assert!(
         problems.is_empty(),
         "{} figure problems:\n{}",
