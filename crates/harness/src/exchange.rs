@@ -272,17 +272,26 @@ pub fn export_views(
 }
 
 /// Runs `write` on `dir.partial` (made empty first), then puts that folder in `dir`'s place,
-/// replacing what was there; where `write` fails, removes it: a folder of the exchange is
-/// written whole or not at all.
+/// replacing what was there; where `write` fails, removes it: a folder of the exchange (an
+/// export, a score, a merge, an advice) is written whole or not at all, and an earlier one in
+/// `dir` stays whole until the new one is. The earlier folder is moved aside to
+/// `dir.partial-earlier` before the new one is moved in and only then removed, so that a
+/// process stopped between the two leaves one of them whole under a name that says which.
 pub(crate) fn in_staged_folder<T>(
     dir: &Path,
     write: impl FnOnce(&Path) -> Result<T, HarnessError>,
 ) -> Result<T, HarnessError> {
     let partial = staging_folder(dir);
+    let aside = PathBuf::from(format!("{}-earlier", partial.display()));
     if partial.exists() {
         // A stale stage goes; one another process is writing is refused.
         drop(mirrorbox_files::FolderLock::try_acquire(&partial)?);
         std::fs::remove_dir_all(&partial).map_err(io(&partial))?;
+    }
+    if aside.exists() && !dir.exists() {
+        // A run stopped between moving the earlier folder aside and moving its own in: the
+        // earlier one goes back.
+        std::fs::rename(&aside, dir).map_err(io(dir))?;
     }
     std::fs::create_dir_all(&partial).map_err(io(&partial))?;
     let done = match write(&partial) {
@@ -292,10 +301,20 @@ pub(crate) fn in_staged_folder<T>(
             return Err(e);
         }
     };
-    if dir.exists() {
-        std::fs::remove_dir_all(dir).map_err(io(dir))?;
+    if aside.exists() {
+        std::fs::remove_dir_all(&aside).map_err(io(&aside))?;
     }
-    std::fs::rename(&partial, dir).map_err(io(dir))?;
+    if dir.exists() {
+        std::fs::rename(dir, &aside).map_err(io(dir))?;
+    }
+    if let Err(e) = std::fs::rename(&partial, dir) {
+        // Put the earlier folder back.
+        let _ = std::fs::rename(&aside, dir);
+        return Err(io(dir)(e));
+    }
+    if aside.exists() {
+        std::fs::remove_dir_all(&aside).map_err(io(&aside))?;
+    }
     Ok(done)
 }
 
@@ -571,6 +590,79 @@ pub(crate) mod tests_support {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The files under `dir` with their bytes, relative paths sorted.
+    fn contents(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
+        let mut out = Vec::new();
+        let mut todo = vec![dir.to_path_buf()];
+        while let Some(d) = todo.pop() {
+            for e in std::fs::read_dir(&d).unwrap().flatten() {
+                if e.path().is_dir() {
+                    todo.push(e.path());
+                } else {
+                    let rel = e.path().strip_prefix(dir).unwrap().to_path_buf();
+                    out.push((rel, std::fs::read(e.path()).unwrap()));
+                }
+            }
+        }
+        out.sort();
+        out
+    }
+
+    /// A write that fails half-way leaves the earlier folder as it was and no stage behind; one
+    /// that succeeds replaces the folder whole (no file of the earlier one left) and leaves
+    /// neither the stage nor the earlier folder's copy; a stale stage is cleared first.
+    #[test]
+    fn a_staged_folder_is_written_whole_or_not_at_all() {
+        let root = tempfile::tempdir().unwrap();
+        let dir = root.path().join("out");
+        std::fs::create_dir_all(dir.join("images")).unwrap();
+        std::fs::write(dir.join("records.jsonl"), "earlier\n").unwrap();
+        std::fs::write(dir.join("images/a.png"), [1, 2, 3]).unwrap();
+        let earlier = contents(&dir);
+        let failed = in_staged_folder(&dir, |partial| -> Result<(), HarnessError> {
+            std::fs::create_dir_all(partial.join("images")).unwrap();
+            std::fs::write(partial.join("images/a.png"), [9, 9]).unwrap();
+            std::fs::write(partial.join("records.jsonl"), "half\n").unwrap();
+            Err(HarnessError::Exchange("failed half-way".into()))
+        });
+        assert!(failed.is_err());
+        assert_eq!(contents(&dir), earlier);
+        let names = |root: &Path| -> Vec<String> {
+            let mut n: Vec<String> = std::fs::read_dir(root)
+                .unwrap()
+                .flatten()
+                .map(|e| e.file_name().to_string_lossy().into_owned())
+                .collect();
+            n.sort();
+            n
+        };
+        assert_eq!(names(root.path()), ["out"]);
+        // A stale stage (a process stopped while writing) is cleared, not mixed in.
+        std::fs::create_dir_all(staging_folder(&dir)).unwrap();
+        std::fs::write(staging_folder(&dir).join("stale.txt"), "x").unwrap();
+        in_staged_folder(&dir, |partial| {
+            std::fs::write(partial.join("records.jsonl"), "new\n").map_err(io(partial))
+        })
+        .unwrap();
+        assert_eq!(
+            contents(&dir),
+            [(PathBuf::from("records.jsonl"), b"new\n".to_vec())]
+        );
+        assert_eq!(names(root.path()), ["out"]);
+        // A run stopped after moving the earlier folder aside: the next puts it back first,
+        // and a write that fails then leaves it in place.
+        std::fs::rename(&dir, format!("{}-earlier", staging_folder(&dir).display())).unwrap();
+        let kept = in_staged_folder(&dir, |_| -> Result<(), HarnessError> {
+            Err(HarnessError::Exchange("failed".into()))
+        });
+        assert!(kept.is_err());
+        assert_eq!(
+            contents(&dir),
+            [(PathBuf::from("records.jsonl"), b"new\n".to_vec())]
+        );
+        assert_eq!(names(root.path()), ["out"]);
+    }
 
     /// A point on the view axis at `near` lands on the near end of each depth range and one
     /// at `far` on the far end; the camera's position maps to the origin.
