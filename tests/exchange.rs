@@ -628,6 +628,18 @@ fn an_export_without_alpha_says_the_scenes_own() {
         "{}",
         out.stderr
     );
+    // Scored alone, its records say their α is per mirror, not the 1 they carry.
+    let scored = tmp.path().join("scored_alone");
+    let out = run_score(&export, &run, &scored, &[]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let records = std::fs::read_to_string(scored.join("results.jsonl")).unwrap();
+    assert!(records.lines().all(|l| {
+        let r: Value = serde_json::from_str(l).unwrap();
+        r["values"]["alpha_per_mirror"] == 1.0
+    }));
+    let md = std::fs::read_to_string(scored.join("report.md")).unwrap();
+    assert!(md.contains("| per mirror |"), "{md}");
+    assert!(!md.contains("| 1 |"), "{md}");
 }
 
 #[test]

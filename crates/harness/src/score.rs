@@ -718,6 +718,8 @@ pub fn score(
             .filter_map(|(_, r)| r.run.clone())
             .max()
             .unwrap_or_else(crate::now_rfc3339);
+        // An export that keeps the hashes says its α wherever its mirrors share one.
+        let per_mirror = views.alpha.is_none() && views.sweep_scene_hash.is_some();
         for (client, variant, timing, images) in &inputs {
             for (vi, (v, image)) in views.views.iter().zip(images).enumerate() {
                 let floor = variant.as_str() == "floor";
@@ -785,18 +787,21 @@ pub fn score(
                     } else {
                         BTreeMap::new()
                     },
-                    values: if v.scene_camera {
-                        [(mirrorbox_report::value::SCENE_CAMERA.to_string(), 1.0)]
-                            .into_iter()
-                            .collect()
-                    } else {
-                        BTreeMap::new()
-                    },
+                    values: [
+                        (mirrorbox_report::value::SCENE_CAMERA, v.scene_camera),
+                        (mirrorbox_report::value::ALPHA_PER_MIRROR, per_mirror),
+                    ]
+                    .into_iter()
+                    .filter(|&(_, on)| on)
+                    .map(|(name, _)| (name.to_string(), 1.0))
+                    .collect(),
                     legacy: Default::default(),
                     stereo: None,
                     device: None,
                     n: None,
                     depth: None,
+                    // Where the mirrors differ (`per_mirror`) or an older export kept no α,
+                    // 1 stands for none; the reports say "per mirror" for the first.
                     alpha: views.alpha.unwrap_or(1.0),
                     width: v.width,
                     height: v.height,

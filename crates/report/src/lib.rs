@@ -286,6 +286,10 @@ pub mod value {
     /// 1 for a scored variant's view at the scene's own camera, the one our sweeps show
     /// (`mirrorbox score`; absent in scores made before it was kept).
     pub const SCENE_CAMERA: &str = "scene_camera";
+    /// 1 for a scored variant of an export whose mirrors differ in reflectance: no one α
+    /// stands for them, so the record's `alpha` (1) is none, and reports say "per mirror"
+    /// ([`crate::Record::alpha_text`]).
+    pub const ALPHA_PER_MIRROR: &str = "alpha_per_mirror";
 }
 
 /// A point's error against the truth, split at the reflection count `reflections` it shows
@@ -336,6 +340,16 @@ impl Record {
     /// The steepest tilt of the point's uneven mirrors, degrees (a `--bump-amplitude` sweep).
     pub fn tilt_deg(&self) -> Option<f32> {
         self.axis(axis::BUMP_DEG).map(|v| v as f32)
+    }
+
+    /// The point's α as reports print it: the number, or "per mirror" where the mirrors'
+    /// reflectances differ ([`value::ALPHA_PER_MIRROR`]).
+    pub fn alpha_text(&self) -> String {
+        if self.value(value::ALPHA_PER_MIRROR) == Some(1.0) {
+            "per mirror".into()
+        } else {
+            self.alpha.to_string()
+        }
     }
 
     /// The value `name` of [`Record::values`], if the point has it.

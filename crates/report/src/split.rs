@@ -115,7 +115,7 @@ pub fn split_section(records: &[Record], exact_methods: &[String]) -> Vec<Block>
         .map(|(r, s)| {
             vec![
                 label(r),
-                r.alpha.to_string(),
+                r.alpha_text(),
                 s.reflections.to_string(),
                 sci(total(r)),
                 sci(truncation(s)),

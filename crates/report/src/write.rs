@@ -89,7 +89,7 @@ fn timings_by_device(devices: &[String], records: &[Record]) -> Vec<Block> {
                     } else {
                         label(r)
                     },
-                    r.alpha.to_string(),
+                    r.alpha_text(),
                     ms_cell(r, 2),
                     sci(r.metrics.flip_mean),
                 ]
@@ -804,7 +804,10 @@ fn document(info: &SweepInfo, records: &[Record], sections: &[Section]) -> Vec<B
             .collect()
     };
     let alpha_note = if alphas.len() == 1 {
-        format!(", α = {}", points.first().map_or(0.0, |r| r.alpha))
+        format!(
+            ", α = {}",
+            points.first().map_or("–".into(), |r| r.alpha_text())
+        )
     } else {
         String::new()
     };
@@ -978,7 +981,7 @@ fn document(info: &SweepInfo, records: &[Record], sections: &[Section]) -> Vec<B
                         } else {
                             point_name(r)
                         },
-                        r.alpha.to_string(),
+                        r.alpha_text(),
                         ms_cell(r, 2),
                         ms(r.ms_min, 2),
                         r.plan_ms.map_or("–".into(), |ms| f(ms, 2)),
@@ -1034,11 +1037,14 @@ fn document(info: &SweepInfo, records: &[Record], sections: &[Section]) -> Vec<B
                 b.push(Block::Paragraph(format!(
                     "{}, α = {}: FLIP mean {}",
                     label(r),
-                    r.alpha,
+                    r.alpha_text(),
                     sci(r.metrics.flip_mean)
                 )));
                 b.push(Block::Images(vec![
-                    (format!("truth (α={})", r.alpha), r.truth_image.clone()),
+                    (
+                        format!("truth (α={})", r.alpha_text()),
+                        r.truth_image.clone(),
+                    ),
                     (label(r), r.raster_image.clone()),
                     ("FLIP error".into(), r.heatmap_image.clone()),
                 ]));
