@@ -397,6 +397,12 @@ fn csv_quoted(text: &str) -> String {
     format!("\"{}\"", text.replace('"', "\"\""))
 }
 
+/// results.csv's fixed columns before the axes' and values' and after them.
+const CSV_HEAD: &str = "kind,method,n,depth,alpha,width,height,ssaa,ms_median,ms_ci_low,ms_ci_high,ms_min,timing_order,timing_source,frames,passes,draws,texture_renders,reflections,\
+     rmse,relmse,smape,max_abs,psnr,ssim,flip_mean,flip_p95,flip_p99,adapter,backend,scene,scene_hash,color_format,peak_memory_bytes,plan_ms,encode_ms,gpu_buffer_bytes,gpu_texture_bytes,method_options";
+const CSV_TAIL: &str = "marker_disparity_px,truth_marker_disparity_px,\
+     mirror_flip_mean,truncation_flip_mean,approximation_flip_mean,truncation_mirror_flip_mean,approximation_mirror_flip_mean,truncation_relmse,approximation_relmse";
+
 /// `results.csv`: one row per point. The fixed columns every point has, then one column per
 /// scene axis ([`Record::axes`]: `planes`, `yaw_deg`, …) and per extra value
 /// ([`Record::values`]: `copies_drawn`, `reflection_offscreen_share`, …) that some point of
@@ -414,19 +420,22 @@ fn write_csv(path: &Path, records: &[Record]) -> Result<(), FileError> {
         keys.dedup();
         keys
     };
-    let axes = keys(|r| &r.axes);
-    let values = keys(|r| &r.values);
-    let mut s = String::from(
-        "kind,method,n,depth,alpha,width,height,ssaa,ms_median,ms_ci_low,ms_ci_high,ms_min,timing_order,timing_source,frames,passes,draws,texture_renders,reflections,\
-         rmse,relmse,smape,max_abs,psnr,ssim,flip_mean,flip_p95,flip_p99,adapter,backend,scene,scene_hash,color_format,peak_memory_bytes,plan_ms,encode_ms,gpu_buffer_bytes,gpu_texture_bytes,method_options",
-    );
+    // A key named as a fixed column, or a value named as an axis, would give two columns one
+    // name: it gets none of its own (no record has such a key today).
+    let fixed: Vec<&str> = CSV_HEAD.split(',').chain(CSV_TAIL.split(',')).collect();
+    let axes: Vec<&str> = keys(|r| &r.axes)
+        .into_iter()
+        .filter(|a| !fixed.contains(a))
+        .collect();
+    let values: Vec<&str> = keys(|r| &r.values)
+        .into_iter()
+        .filter(|v| !axes.contains(v) && !fixed.contains(v))
+        .collect();
+    let mut s = String::from(CSV_HEAD);
     for key in axes.iter().chain(&values) {
         let _ = write!(s, ",{}", csv_cell(key));
     }
-    s.push_str(
-        ",marker_disparity_px,truth_marker_disparity_px,\
-         mirror_flip_mean,truncation_flip_mean,approximation_flip_mean,truncation_mirror_flip_mean,approximation_mirror_flip_mean,truncation_relmse,approximation_relmse\n",
-    );
+    let _ = writeln!(s, ",{CSV_TAIL}");
     let cell = |v: Option<&f64>| v.map_or(String::new(), |x| x.to_string());
     for r in records {
         let m = &r.metrics;
@@ -590,7 +599,85 @@ fn color_formats(records: &[Record]) -> String {
     }
 }
 
+/// The report of a sweep (or a score) as blocks, in reading order: the header, how its runs
+/// and devices combine, the floor, the experiments' own sections, the error charts, the
+/// error split, every point's row and the image rows.
 fn document(info: &SweepInfo, records: &[Record], sections: &[Section]) -> Vec<Block> {
+    let mut b = header(info, records);
+    let points: Vec<&Record> = records.iter().filter(|r| r.kind == "point").collect();
+    // A score may hold several floors (each client's, each view's, and ours): the figures'
+    // band and the at-floor test take ours where there is one, and the report names it.
+    let floors: Vec<&Record> = records.iter().filter(|r| r.kind == "floor").collect();
+    let floor = floors
+        .iter()
+        .find(|r| !r.is_external())
+        .or(floors.first())
+        .copied();
+    let latest_run = records.iter().filter_map(|r| r.run.as_deref()).max();
+    let reused = |r: &Record| latest_run.is_some() && r.run.as_deref() != latest_run;
+    if !info.shards.is_empty() {
+        b.extend(shards_section(info));
+    }
+    // A merged sweep timed on several devices: times are read per device, never across.
+    let devices = distinct(records.iter().filter_map(|r| r.device.clone()));
+    let mixed_devices = devices.len() > 1;
+    if mixed_devices {
+        b.extend(timings_by_device(&devices, records));
+    }
+    // A merged sweep's shards are separate runs by design (above).
+    let earlier: Vec<&Record> = records
+        .iter()
+        .filter(|r| info.shards.is_empty() && reused(r))
+        .collect();
+    if !earlier.is_empty() {
+        b.push(reused_paragraph(&earlier, records.len(), latest_run));
+    }
+    if let Some(fl) = floor {
+        b.push(Block::Heading(2, "Floor of the comparison".into()));
+        if floors.len() == 1 {
+            b.push(floor_paragraph(fl));
+        } else {
+            b.extend(floors_table(&floors, fl));
+        }
+    }
+    // The experiments' own sections (the registry's), each empty for another's records.
+    for section in sections {
+        b.extend(section(info, records));
+    }
+    let variants = Variants::of(&points);
+    // A sweep with a scene axis (lighting, tilt, IPD) draws its own charts in its section:
+    // joining its points here would join unrelated settings.
+    let has_scene_axis = points
+        .iter()
+        .any(|r| r.lights_depth().is_some() || r.tilt_deg().is_some() || r.stereo.is_some());
+    // Errors at the floor are not resolved: a chart of them would rank noise.
+    let all_at_floor = !points.is_empty()
+        && floor.is_some_and(|fl| points.iter().all(|r| at_or_under_floor(r, fl)));
+    if all_at_floor && let Some(fl) = floor {
+        b.push(Block::Heading(2, "Error against time".into()));
+        b.push(Block::Paragraph(format!(
+            "Every point's error is at the comparison's floor (FLIP mean ≤ {FLOOR_FACTOR}× the \
+             floor's {}): the methods are exact on this scene, and their errors are not \
+             compared or charted. Their cost is.",
+            sci(fl.metrics.flip_mean)
+        )));
+    }
+    if !points.is_empty() && !has_scene_axis && !all_at_floor {
+        if !mixed_devices {
+            b.extend(error_against_time(&variants, floor, floors.len()));
+        }
+        b.extend(error_against_setting(&variants, floor));
+    }
+    b.extend(crate::split::split_section(records, &info.exact_methods));
+    if !points.is_empty() {
+        b.extend(all_points(&points, &reused));
+        b.extend(image_rows(&variants));
+    }
+    b
+}
+
+/// The report's title and what it ran on; the adapters that left methods out.
+fn header(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
     // A score's devices are its clients' (the scoring machine only compared images), and
     // ours where a sweep is set beside them.
     let device = if info.is_score() {
@@ -638,141 +725,147 @@ fn document(info: &SweepInfo, records: &[Record], sections: &[Section]) -> Vec<B
             info.unsupported.join("; ")
         )));
     }
-    let points: Vec<&Record> = records.iter().filter(|r| r.kind == "point").collect();
-    // A score may hold several floors (each client's, each view's, and ours): the figures'
-    // band and the at-floor test take ours where there is one, and the report names it.
-    let floors: Vec<&Record> = records.iter().filter(|r| r.kind == "floor").collect();
-    let floor = floors
+    b
+}
+
+/// The note on points reused from earlier runs (`earlier`, of `total`), marked † below.
+fn reused_paragraph(earlier: &[&Record], total: usize, latest_run: Option<&str>) -> Block {
+    let mut runs: Vec<&str> = earlier
         .iter()
-        .find(|r| !r.is_external())
-        .or(floors.first())
-        .copied();
-    let latest_run = records.iter().filter_map(|r| r.run.as_deref()).max();
-    let reused = |r: &Record| latest_run.is_some() && r.run.as_deref() != latest_run;
-    // A merged sweep's shards are separate runs by design (below).
-    let earlier: Vec<&Record> = records
-        .iter()
-        .filter(|r| info.shards.is_empty() && reused(r))
+        .map(|r| r.run.as_deref().unwrap_or("an unrecorded run"))
         .collect();
-    if !info.shards.is_empty() {
-        b.extend(shards_section(info));
-    }
-    // A merged sweep timed on several devices: times are read per device, never across.
-    let devices = distinct(records.iter().filter_map(|r| r.device.clone()));
-    let mixed_devices = devices.len() > 1;
-    if mixed_devices {
-        b.extend(timings_by_device(&devices, records));
-    }
-    if !earlier.is_empty() {
-        let mut runs: Vec<&str> = earlier
-            .iter()
-            .map(|r| r.run.as_deref().unwrap_or("an unrecorded run"))
-            .collect();
-        runs.sort_unstable();
-        runs.dedup();
-        b.push(Block::Paragraph(format!(
-            "† {} of {} points were reused from earlier runs of this sweep ({}) rather than measured \
-             in the latest ({}): their frames were interleaved with that run's points, on the machine \
-             of that day, so compare their times with this run's only with care; no paired ratio is \
-             computed across runs. Run with `--fresh` to measure every point together.",
-            earlier.len(),
-            records.len(),
-            runs.join(", "),
-            latest_run.unwrap_or_default()
-        )));
-    }
+    runs.sort_unstable();
+    runs.dedup();
+    Block::Paragraph(format!(
+        "† {} of {} points were reused from earlier runs of this sweep ({}) rather than measured \
+         in the latest ({}): their frames were interleaved with that run's points, on the machine \
+         of that day, so compare their times with this run's only with care; no paired ratio is \
+         computed across runs. Run with `--fresh` to measure every point together.",
+        earlier.len(),
+        total,
+        runs.join(", "),
+        latest_run.unwrap_or_default()
+    ))
+}
 
-    if let Some(fl) = floor {
-        b.push(Block::Heading(2, "Floor of the comparison".into()));
-        if floors.len() == 1 {
-            b.push(floor_paragraph(fl));
-        } else {
-            b.extend(floors_table(&floors, fl));
-        }
-    }
-    // The experiments' own sections (the registry's), each empty for another's records.
-    for section in sections {
-        b.extend(section(info, records));
-    }
+/// A sweep's points by method variant and α, each group with its fixed style: what every
+/// chart and the image rows of [`document`] draw from.
+struct Variants<'a> {
+    points: &'a [&'a Record],
+    /// (variant, α) in the order of the points.
+    groups: Vec<(String, f32)>,
+    styles: Vec<crate::plot::Style>,
+    /// The distinct α (bits).
+    alphas: Vec<u32>,
+}
 
-    let mut groups: Vec<(String, f32)> = Vec::new();
-    for r in &points {
-        let group = (crate::document::variant(r), r.alpha);
-        if !groups.contains(&group) {
-            groups.push(group);
-        }
-    }
-    // One series per method variant and α, joined along its one swept setting (n or depth);
-    // a sweep with a scene axis (lighting, tilt, IPD) draws its own charts in its section:
-    // joining its points here would join unrelated settings.
-    let has_scene_axis = points
-        .iter()
-        .any(|r| r.lights_depth().is_some() || r.tilt_deg().is_some() || r.stereo.is_some());
-    let alphas = distinct(points.iter().map(|r| r.alpha.to_bits()));
-    // Each method its fixed style; an outside renderer's variant its equivalent's colour in a
-    // style of its own (dashed or hollow), so that it reads beside what it is meant to match.
-    let bases: Vec<(String, usize)> = groups
-        .iter()
-        .map(|(m, a)| {
-            let r = points
-                .iter()
-                .find(|r| &crate::document::variant(r) == m && r.alpha == *a);
-            match r {
-                Some(r) if r.is_external() => {
-                    (r.option("equivalent").unwrap_or(&r.method).to_string(), 1)
-                }
-                _ => (
-                    m.split_whitespace().next().unwrap_or_default().to_string(),
-                    0,
-                ),
+impl<'a> Variants<'a> {
+    fn of(points: &'a [&'a Record]) -> Self {
+        let mut groups: Vec<(String, f32)> = Vec::new();
+        for r in points {
+            let group = (crate::document::variant(r), r.alpha);
+            if !groups.contains(&group) {
+                groups.push(group);
             }
-        })
-        .collect();
-    let styles: Vec<crate::plot::Style> = bases
-        .iter()
-        .enumerate()
-        .map(|(i, (base, external))| {
-            // Ours count among ours (the first keeps the method's own style); an outside
-            // variant takes the odd variants, hollow markers.
-            let k = bases[..i]
-                .iter()
-                .filter(|(b, e)| b == base && e == external)
-                .count();
-            crate::plot::method_style(base).variant(k * (1 + external) + external)
-        })
-        .collect();
-    // `keep`: which of a group's points the chart shows; `ms_on_x`: x is the median time,
-    // drawn with its 95 % interval as an error bar.
-    let series = |keep: &dyn Fn(&Record) -> bool,
-                  x: &dyn Fn(&Record) -> f64,
-                  y: &dyn Fn(&Record) -> Option<f64>,
-                  ms_on_x: bool|
-     -> Vec<Series> {
-        groups
+        }
+        // Each method its fixed style; an outside renderer's variant its equivalent's colour
+        // in a style of its own (dashed or hollow), so that it reads beside what it is meant
+        // to match.
+        let bases: Vec<(String, usize)> = groups
             .iter()
-            .zip(&styles)
-            .filter_map(|((m, a), style)| {
-                let mut pts: Vec<&&Record> = points
+            .map(|(m, a)| {
+                let r = points
                     .iter()
-                    .filter(|r| &crate::document::variant(r) == m && r.alpha == *a && keep(r))
-                    .filter(|r| y(r).is_some())
+                    .find(|r| &crate::document::variant(r) == m && r.alpha == *a);
+                match r {
+                    Some(r) if r.is_external() => {
+                        (r.option("equivalent").unwrap_or(&r.method).to_string(), 1)
+                    }
+                    _ => (
+                        m.split_whitespace().next().unwrap_or_default().to_string(),
+                        0,
+                    ),
+                }
+            })
+            .collect();
+        let styles = bases
+            .iter()
+            .enumerate()
+            .map(|(i, (base, external))| {
+                // Ours count among ours (the first keeps the method's own style); an outside
+                // variant takes the odd variants, hollow markers.
+                let k = bases[..i]
+                    .iter()
+                    .filter(|(b, e)| b == base && e == external)
+                    .count();
+                crate::plot::method_style(base).variant(k * (1 + external) + external)
+            })
+            .collect();
+        Variants {
+            points,
+            groups,
+            styles,
+            alphas: distinct(points.iter().map(|r| r.alpha.to_bits())),
+        }
+    }
+
+    /// The points of group (`m`, `a`), by their swept setting.
+    fn of_group(&self, m: &str, a: f32) -> Vec<&'a Record> {
+        let mut pts: Vec<&Record> = self
+            .points
+            .iter()
+            .copied()
+            .filter(|r| crate::document::variant(r) == m && r.alpha == a)
+            .collect();
+        pts.sort_by(|p, q| setting(p).total_cmp(&setting(q)));
+        pts
+    }
+
+    /// ", α = …" for chart titles where every point has one α.
+    fn alpha_note(&self) -> String {
+        if self.alphas.len() == 1 {
+            format!(
+                ", α = {}",
+                self.points.first().map_or("–".into(), |r| r.alpha_text())
+            )
+        } else {
+            String::new()
+        }
+    }
+
+    /// One series per method variant and α, joined along its one swept setting (n or depth):
+    /// `keep`, which of a group's points the chart shows; `ms_on_x`, x is the median time,
+    /// drawn with its 95 % interval as an error bar.
+    fn series(
+        &self,
+        keep: &dyn Fn(&Record) -> bool,
+        x: &dyn Fn(&Record) -> f64,
+        y: &dyn Fn(&Record) -> Option<f64>,
+        ms_on_x: bool,
+    ) -> Vec<Series> {
+        self.groups
+            .iter()
+            .zip(&self.styles)
+            .filter_map(|((m, a), style)| {
+                let pts: Vec<&Record> = self
+                    .of_group(m, *a)
+                    .into_iter()
+                    .filter(|r| keep(r) && y(r).is_some())
                     .collect();
                 if pts.is_empty() {
                     return None;
                 }
-                pts.sort_by(|p, q| setting(p).total_cmp(&setting(q)));
-                let name = if alphas.len() > 1 {
+                let name = if self.alphas.len() > 1 {
                     format!("{m}, α={a}")
                 } else {
                     m.clone()
                 };
                 // A value the log axes cannot show (an error of exactly 0) is named in the
                 // legend, not drawn.
-                let (shown, zero): (Vec<&&Record>, Vec<&&Record>) = pts.iter().partition(|r| {
+                let (pts, zero): (Vec<&Record>, Vec<&Record>) = pts.iter().partition(|r| {
                     let (px, py) = (x(r), y(r).unwrap_or(f64::NAN));
                     px.is_finite() && px > 0.0 && py.is_finite() && py > 0.0
                 });
-                let pts = shown;
                 if pts.is_empty() {
                     return None;
                 }
@@ -802,91 +895,84 @@ fn document(info: &SweepInfo, records: &[Record], sections: &[Section]) -> Vec<B
                 Some(s)
             })
             .collect()
-    };
-    let alpha_note = if alphas.len() == 1 {
-        format!(
-            ", α = {}",
-            points.first().map_or("–".into(), |r| r.alpha_text())
-        )
-    } else {
-        String::new()
-    };
-    let any = |_: &Record| true;
-    // Errors at the floor are not resolved: a chart of them would rank noise.
-    let at_floor = |r: &Record| floor.is_some_and(|fl| at_or_under_floor(r, fl));
-    let all_at_floor = !points.is_empty() && points.iter().all(|r| at_floor(r));
-    if all_at_floor && let Some(fl) = floor {
-        b.push(Block::Heading(2, "Error against time".into()));
-        b.push(Block::Paragraph(format!(
-            "Every point's error is at the comparison's floor (FLIP mean ≤ {FLOOR_FACTOR}× the \
-             floor's {}): the methods are exact on this scene, and their errors are not \
-             compared or charted. Their cost is.",
-            sci(fl.metrics.flip_mean)
-        )));
     }
-    let flip = |r: &Record| Some(r.metrics.flip_mean);
-    let mirror_flip = |r: &Record| r.mirror_metrics.as_ref().map(|m| m.flip_mean);
-    if !points.is_empty() && !mixed_devices && !has_scene_axis && !all_at_floor {
-        b.push(Block::Heading(2, "Error against time".into()));
-        b.push(Block::Paragraph(format!(
+}
+
+fn flip(r: &Record) -> Option<f64> {
+    Some(r.metrics.flip_mean)
+}
+
+/// "Error against time": FLIP over the image and over the mirror pixels, and relMSE, against
+/// ms/frame, the floor shaded (`floors`: how many the sweep has, to say whose is shaded).
+fn error_against_time(v: &Variants, floor: Option<&Record>, floors: usize) -> Vec<Block> {
+    let any = |_: &Record| true;
+    let ms = |r: &Record| r.ms_median;
+    let alpha_note = v.alpha_note();
+    let chart = |file: &str, y: &dyn Fn(&Record) -> Option<f64>, band, title, y_label| {
+        Block::Chart(
+            file.into(),
+            Box::new(Chart {
+                x_log: true,
+                y_log: true,
+                series: v.series(&any, &ms, y, true),
+                floor: band,
+                ..Chart::new(
+                    format!("{title} vs cost{alpha_note}"),
+                    "ms/frame (median, 95 % CI bars)",
+                    y_label,
+                )
+            }),
+        )
+    };
+    vec![
+        Block::Heading(2, "Error against time".into()),
+        Block::Paragraph(format!(
             "Each method's points joined along its swept setting (n or the depth cap, labelled); \
              the shaded band is {} (raster vs trace without mirrors).",
             match floor {
-                Some(fl) if floors.len() > 1 => format!("the floor of {}", floor_name(fl)),
+                Some(fl) if floors > 1 => format!("the floor of {}", floor_name(fl)),
                 _ => "the comparison's floor".to_string(),
             }
-        )));
-        b.push(Block::Chart(
-            "plot_flip_vs_ms.svg".into(),
-            Box::new(Chart {
-                x_log: true,
-                y_log: true,
-                series: series(&any, &|r| r.ms_median, &flip, true),
-                floor: floor.map(|fl| fl.metrics.flip_mean),
-                ..Chart::new(
-                    format!("FLIP over the image vs cost{alpha_note}"),
-                    "ms/frame (median, 95 % CI bars)",
-                    "FLIP mean over the image (lower is better)",
-                )
-            }),
-        ));
-        b.push(Block::Chart(
-            "plot_mirror_flip_vs_ms.svg".into(),
-            Box::new(Chart {
-                x_log: true,
-                y_log: true,
-                series: series(&any, &|r| r.ms_median, &mirror_flip, true),
-                ..Chart::new(
-                    format!("FLIP over the mirror pixels vs cost{alpha_note}"),
-                    "ms/frame (median, 95 % CI bars)",
-                    "FLIP mean over the mirror pixels",
-                )
-            }),
-        ));
-        b.push(Block::Chart(
-            "plot_relmse_vs_ms.svg".into(),
-            Box::new(Chart {
-                x_log: true,
-                y_log: true,
-                series: series(&any, &|r| r.ms_median, &|r| Some(r.metrics.relmse), true),
-                floor: floor.map(|fl| fl.metrics.relmse),
-                ..Chart::new(
-                    format!("relMSE over the image (linear radiance) vs cost{alpha_note}"),
-                    "ms/frame (median, 95 % CI bars)",
-                    "relMSE over the image",
-                )
-            }),
-        ));
-    }
-    if !points.is_empty() && !has_scene_axis && !all_at_floor {
-        let with_n = |r: &Record| r.n.is_some();
-        let with_depth = |r: &Record| r.depth.is_some();
-        b.push(Block::Heading(2, "Error against the swept setting".into()));
-        b.push(Block::Chart(
+        )),
+        chart(
+            "plot_flip_vs_ms.svg",
+            &flip,
+            floor.map(|fl| fl.metrics.flip_mean),
+            "FLIP over the image",
+            "FLIP mean over the image (lower is better)",
+        ),
+        chart(
+            "plot_mirror_flip_vs_ms.svg",
+            &|r| r.mirror_metrics.as_ref().map(|m| m.flip_mean),
+            None,
+            "FLIP over the mirror pixels",
+            "FLIP mean over the mirror pixels",
+        ),
+        chart(
+            "plot_relmse_vs_ms.svg",
+            &|r| Some(r.metrics.relmse),
+            floor.map(|fl| fl.metrics.relmse),
+            "relMSE over the image (linear radiance)",
+            "relMSE over the image",
+        ),
+    ]
+}
+
+/// "Error against the swept setting": FLIP against n and against the depth cap.
+fn error_against_setting(v: &Variants, floor: Option<&Record>) -> Vec<Block> {
+    let alpha_note = v.alpha_note();
+    vec![
+        Block::Heading(2, "Error against the swept setting".into()),
+        Block::Chart(
             "plot_flip_vs_n.svg".into(),
             Box::new(Chart {
                 y_log: true,
-                series: series(&with_n, &|r| f64::from(r.n.unwrap_or(0)), &flip, false),
+                series: v.series(
+                    &|r| r.n.is_some(),
+                    &|r| f64::from(r.n.unwrap_or(0)),
+                    &flip,
+                    false,
+                ),
                 floor: floor.map(|fl| fl.metrics.flip_mean),
                 x_ticks_at_data: true,
                 ..Chart::new(
@@ -895,14 +981,14 @@ fn document(info: &SweepInfo, records: &[Record], sections: &[Section]) -> Vec<B
                     "FLIP mean over the image",
                 )
             }),
-        ));
-        b.push(Block::Chart(
+        ),
+        Block::Chart(
             "plot_flip_vs_depth.svg".into(),
             Box::new(Chart {
                 x_log: true,
                 y_log: true,
-                series: series(
-                    &with_depth,
+                series: v.series(
+                    &|r| r.depth.is_some(),
                     &|r| f64::from(r.depth.unwrap_or(0)),
                     &flip,
                     false,
@@ -915,140 +1001,143 @@ fn document(info: &SweepInfo, records: &[Record], sections: &[Section]) -> Vec<B
                     "FLIP mean over the image",
                 )
             }),
-        ));
-    }
-    b.extend(crate::split::split_section(records, &info.exact_methods));
-    if !points.is_empty() {
-        // A stereo sweep's points differ by their IPD (or are mono), an uneven-mirror sweep's
-        // by their tilt: said in the point's cell, where label() alone reads alike.
-        let stereo = points
-            .iter()
-            .any(|r| r.axis(crate::axis::STEREO_IPD).is_some());
-        let point_name = |r: &Record| {
-            let mut name = label(r);
-            match r.axis(crate::axis::STEREO_IPD) {
-                Some(ipd) => name.push_str(&format!(", IPD {ipd}")),
-                None if stereo => name.push_str(", mono"),
-                None => {}
-            }
-            if let Some(t) = r.tilt_deg() {
-                name.push_str(&format!(", tilt {t}°"));
-            }
-            // A scored variant of an export of several views: its view's name, from its key.
-            if r.axis(crate::axis::VIEW).is_some()
-                && let Some(view) = r.scored_view()
-            {
-                name.push_str(&format!(", view {view}"));
-            }
-            name
-        };
-        b.push(Block::Heading(2, "All points".into()));
-        let ms_column = ms_heading("ms/frame median", points.iter().copied());
-        b.push(Block::Table(
-            [
-                "point",
-                "α",
-                ms_column.as_str(),
-                "min",
-                "CPU plan ms",
-                "CPU encode ms",
-                "GPU MiB (buffers + textures)",
-                "peak RSS MiB",
-                "timing",
-                "passes",
-                "draws",
-                "RMSE",
-                "relMSE",
-                "SMAPE",
-                "PSNR dB",
-                "SSIM",
-                "FLIP mean",
-                "p95",
-                "p99",
-                "mirror px %",
-                "FLIP mean over mirror px",
-                "its p95",
+        ),
+    ]
+}
+
+/// "All points": one row per point, its times, memory, counts and errors; `reused` marks
+/// with † a point from an earlier run.
+fn all_points(points: &[&Record], reused: &dyn Fn(&Record) -> bool) -> Vec<Block> {
+    // A stereo sweep's points differ by their IPD (or are mono), an uneven-mirror sweep's by
+    // their tilt: said in the point's cell, where label() alone reads alike.
+    let stereo = points
+        .iter()
+        .any(|r| r.axis(crate::axis::STEREO_IPD).is_some());
+    let point_name = |r: &Record| {
+        let mut name = label(r);
+        match r.axis(crate::axis::STEREO_IPD) {
+            Some(ipd) => name.push_str(&format!(", IPD {ipd}")),
+            None if stereo => name.push_str(", mono"),
+            None => {}
+        }
+        if let Some(t) = r.tilt_deg() {
+            name.push_str(&format!(", tilt {t}°"));
+        }
+        // A scored variant of an export of several views: its view's name, from its key.
+        if r.axis(crate::axis::VIEW).is_some()
+            && let Some(view) = r.scored_view()
+        {
+            name.push_str(&format!(", view {view}"));
+        }
+        name
+    };
+    let ms_column = ms_heading("ms/frame median", points.iter().copied());
+    let header = [
+        "point",
+        "α",
+        ms_column.as_str(),
+        "min",
+        "CPU plan ms",
+        "CPU encode ms",
+        "GPU MiB (buffers + textures)",
+        "peak RSS MiB",
+        "timing",
+        "passes",
+        "draws",
+        "RMSE",
+        "relMSE",
+        "SMAPE",
+        "PSNR dB",
+        "SSIM",
+        "FLIP mean",
+        "p95",
+        "p99",
+        "mirror px %",
+        "FLIP mean over mirror px",
+        "its p95",
+    ]
+    .map(String::from)
+    .to_vec();
+    let rows = points
+        .iter()
+        .map(|r| {
+            let m = &r.metrics;
+            vec![
+                if reused(r) {
+                    format!("{} †", point_name(r))
+                } else {
+                    point_name(r)
+                },
+                r.alpha_text(),
+                ms_cell(r, 2),
+                ms(r.ms_min, 2),
+                r.plan_ms.map_or("–".into(), |ms| f(ms, 2)),
+                r.encode_ms.map_or("–".into(), |ms| f(ms, 2)),
+                match (r.gpu_buffer_bytes, r.gpu_texture_bytes) {
+                    (Some(b), Some(t)) => f((b + t) as f64 / MIB, 1),
+                    _ => "–".into(),
+                },
+                r.peak_memory_bytes
+                    .map_or("–".into(), |b| f(b as f64 / MIB, 0)),
+                format!("{}, {}", r.timing_source, r.timing_order),
+                unknown_outside(r, r.passes),
+                unknown_outside(r, r.draws),
+                sci(m.rmse),
+                sci(m.relmse),
+                sci(m.smape),
+                m.psnr.map_or("∞".into(), |p| f(p, 2)),
+                f(m.ssim, 5),
+                sci(m.flip_mean),
+                f(m.flip_p95, 4),
+                f(m.flip_p99, 4),
+                r.mirror_pixel_share.map_or("–".into(), |s| f(100.0 * s, 1)),
+                r.mirror_metrics
+                    .as_ref()
+                    .map_or("–".into(), |m| sci(m.flip_mean)),
+                r.mirror_metrics
+                    .as_ref()
+                    .map_or("–".into(), |m| f(m.flip_p95, 4)),
             ]
-            .map(String::from)
-            .to_vec(),
-            points
-                .iter()
-                .map(|r| {
-                    let m = &r.metrics;
-                    vec![
-                        if reused(r) {
-                            format!("{} †", point_name(r))
-                        } else {
-                            point_name(r)
-                        },
-                        r.alpha_text(),
-                        ms_cell(r, 2),
-                        ms(r.ms_min, 2),
-                        r.plan_ms.map_or("–".into(), |ms| f(ms, 2)),
-                        r.encode_ms.map_or("–".into(), |ms| f(ms, 2)),
-                        match (r.gpu_buffer_bytes, r.gpu_texture_bytes) {
-                            (Some(b), Some(t)) => f((b + t) as f64 / MIB, 1),
-                            _ => "–".into(),
-                        },
-                        r.peak_memory_bytes
-                            .map_or("–".into(), |b| f(b as f64 / MIB, 0)),
-                        format!("{}, {}", r.timing_source, r.timing_order),
-                        unknown_outside(r, r.passes),
-                        unknown_outside(r, r.draws),
-                        sci(m.rmse),
-                        sci(m.relmse),
-                        sci(m.smape),
-                        m.psnr.map_or("∞".into(), |p| f(p, 2)),
-                        f(m.ssim, 5),
-                        sci(m.flip_mean),
-                        f(m.flip_p95, 4),
-                        f(m.flip_p99, 4),
-                        r.mirror_pixel_share.map_or("–".into(), |s| f(100.0 * s, 1)),
-                        r.mirror_metrics
-                            .as_ref()
-                            .map_or("–".into(), |m| sci(m.flip_mean)),
-                        r.mirror_metrics
-                            .as_ref()
-                            .map_or("–".into(), |m| f(m.flip_p95, 4)),
-                    ]
-                })
-                .collect(),
-        ));
-        b.push(Block::Paragraph(
+        })
+        .collect();
+    vec![
+        Block::Heading(2, "All points".into()),
+        Block::Table(header, rows),
+        Block::Paragraph(
             "The whole image's FLIP percentiles are 0 where fewer than 5 % of its pixels differ: \
              a method's error lives in the mirrors. The last three columns are over the mirror \
              pixels only (the pixels whose primary ray in the truth first meets a mirror's \
              front; – in records measured before they were)."
                 .into(),
-        ));
-        b.push(Block::Heading(2, "Truth | raster | FLIP error".into()));
-        for (m, a) in &groups {
-            let mut pts: Vec<&&Record> = points
-                .iter()
-                .filter(|r| &crate::document::variant(r) == m && r.alpha == *a)
-                .collect();
-            pts.sort_by(|p, q| setting(p).total_cmp(&setting(q)));
-            let chosen: Vec<&&Record> = match pts.len() {
-                0 => vec![],
-                1 => vec![pts[0]],
-                n => vec![pts[0], pts[n - 1]],
-            };
-            for r in chosen {
-                b.push(Block::Paragraph(format!(
-                    "{}, α = {}: FLIP mean {}",
-                    label(r),
-                    r.alpha_text(),
-                    sci(r.metrics.flip_mean)
-                )));
-                b.push(Block::Images(vec![
-                    (
-                        format!("truth (α={})", r.alpha_text()),
-                        r.truth_image.clone(),
-                    ),
-                    (label(r), r.raster_image.clone()),
-                    ("FLIP error".into(), r.heatmap_image.clone()),
-                ]));
-            }
+        ),
+    ]
+}
+
+/// "Truth | raster | FLIP error": each variant's first and last point by its setting.
+fn image_rows(v: &Variants) -> Vec<Block> {
+    let mut b = vec![Block::Heading(2, "Truth | raster | FLIP error".into())];
+    for (m, a) in &v.groups {
+        let pts = v.of_group(m, *a);
+        let chosen: Vec<&Record> = match pts.len() {
+            0 => vec![],
+            1 => vec![pts[0]],
+            n => vec![pts[0], pts[n - 1]],
+        };
+        for r in chosen {
+            b.push(Block::Paragraph(format!(
+                "{}, α = {}: FLIP mean {}",
+                label(r),
+                r.alpha_text(),
+                sci(r.metrics.flip_mean)
+            )));
+            b.push(Block::Images(vec![
+                (
+                    format!("truth (α={})", r.alpha_text()),
+                    r.truth_image.clone(),
+                ),
+                (label(r), r.raster_image.clone()),
+                ("FLIP error".into(), r.heatmap_image.clone()),
+            ]));
         }
     }
     b
