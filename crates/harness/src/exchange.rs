@@ -271,18 +271,28 @@ pub fn export_views(
     })
 }
 
-/// Runs `write` on `dir.partial` (made empty first), then puts that folder in `dir`'s place,
-/// replacing what was there; where `write` fails, removes it: a folder of the exchange (an
-/// export, a score, a merge, an advice) is written whole or not at all, and an earlier one in
-/// `dir` stays whole until the new one is. The earlier folder is moved aside to
-/// `dir.partial-earlier` before the new one is moved in and only then removed, so that a
-/// process stopped between the two leaves one of them whole under a name that says which.
+/// Runs `write` on `dir.partial` (made empty first, and locked until its files are in
+/// place), then puts that folder in `dir`'s place, replacing what was there; where `write`
+/// fails, removes it: a folder of the exchange (an export, a score, a merge, an advice) is
+/// written whole or not at all, and an earlier one in `dir` stays whole until the new one is.
+/// The earlier folder is marked ([`EARLIER_MARK`]) and moved aside to `dir.partial-earlier`
+/// before the new one is moved in, and removed only after, by way of the stage's name: a
+/// process stopped at any step leaves the earlier folder whole (put back by the next run) or
+/// the new one in place. A `dir.partial-earlier` without the mark is not ours, and is refused.
 pub(crate) fn in_staged_folder<T>(
     dir: &Path,
     write: impl FnOnce(&Path) -> Result<T, HarnessError>,
 ) -> Result<T, HarnessError> {
     let partial = staging_folder(dir);
-    let aside = PathBuf::from(format!("{}-earlier", partial.display()));
+    let aside = earlier_folder(dir);
+    let ours = |folder: &Path| folder.join(EARLIER_MARK).is_file();
+    if aside.exists() && !ours(&aside) {
+        return Err(HarnessError::Exchange(format!(
+            "{}: exists and is not an earlier {} moved aside by mirrorbox; rename it or choose              another output folder",
+            aside.display(),
+            dir.display()
+        )));
+    }
     if partial.exists() {
         // A stale stage goes; one another process is writing is refused.
         drop(mirrorbox_files::FolderLock::try_acquire(&partial)?);
@@ -292,42 +302,63 @@ pub(crate) fn in_staged_folder<T>(
         // A run stopped between moving the earlier folder aside and moving its own in: the
         // earlier one goes back.
         std::fs::rename(&aside, dir).map_err(io(dir))?;
+        let _ = std::fs::remove_file(dir.join(EARLIER_MARK));
     }
     std::fs::create_dir_all(&partial).map_err(io(&partial))?;
+    let stage_lock = mirrorbox_files::FolderLock::try_acquire(&partial)?;
     let done = match write(&partial) {
         Ok(done) => done,
         Err(e) => {
+            drop(stage_lock);
             let _ = std::fs::remove_dir_all(&partial);
             return Err(e);
         }
     };
-    if aside.exists() {
-        std::fs::remove_dir_all(&aside).map_err(io(&aside))?;
-    }
     if dir.exists() {
+        if aside.exists() {
+            // Ours (checked above): an earlier run stopped before removing it.
+            std::fs::remove_dir_all(&aside).map_err(io(&aside))?;
+        }
+        std::fs::write(dir.join(EARLIER_MARK), "").map_err(io(dir))?;
         std::fs::rename(dir, &aside).map_err(io(dir))?;
     }
     if let Err(e) = std::fs::rename(&partial, dir) {
         // Put the earlier folder back.
-        let _ = std::fs::rename(&aside, dir);
+        if std::fs::rename(&aside, dir).is_ok() {
+            let _ = std::fs::remove_file(dir.join(EARLIER_MARK));
+        }
         return Err(io(dir)(e));
     }
-    if aside.exists() {
-        std::fs::remove_dir_all(&aside).map_err(io(&aside))?;
+    drop(stage_lock);
+    // The earlier folder is removed under the stage's name, which the next run clears if this
+    // one stops half-way (it is never put back from there); a failure here loses nothing.
+    if aside.exists() && std::fs::rename(&aside, &partial).is_ok() {
+        let _ = std::fs::remove_dir_all(&partial);
     }
     Ok(done)
 }
+
+/// The file that marks a folder [`in_staged_folder`] moved aside as mirrorbox's.
+const EARLIER_MARK: &str = ".mirrorbox-earlier";
 
 /// Where [`in_staged_folder`] stages `dir`: `dir.partial`, replaced on each run.
 pub(crate) fn staging_folder(dir: &Path) -> PathBuf {
     PathBuf::from(format!("{}.partial", dir.display()))
 }
 
-/// Refuses an input folder that is `out`'s staging folder, which writing `out` would delete
-/// before reading it.
+/// Where [`in_staged_folder`] keeps `dir`'s earlier contents while it swaps them.
+fn earlier_folder(dir: &Path) -> PathBuf {
+    PathBuf::from(format!("{}.partial-earlier", dir.display()))
+}
+
+/// Refuses an input folder that is `out`'s staging folder or its earlier contents moved
+/// aside, which writing `out` would delete before reading it.
 pub(crate) fn not_the_stage_of(out: &Path, input: &Path) -> Result<(), HarnessError> {
-    let stage = staging_folder(out);
-    if stage.exists() && mirrorbox_files::resolved(input) == mirrorbox_files::resolved(&stage) {
+    let resolved = mirrorbox_files::resolved(input);
+    let staged = [staging_folder(out), earlier_folder(out)]
+        .iter()
+        .any(|stage| stage.exists() && resolved == mirrorbox_files::resolved(stage));
+    if staged {
         return Err(HarnessError::Exchange(format!(
             "{}: the folder where {} is staged (it is replaced first): rename it or choose \
              another output folder",
@@ -591,7 +622,8 @@ pub(crate) mod tests_support {
 mod tests {
     use super::*;
 
-    /// The files under `dir` with their bytes, relative paths sorted.
+    /// The files under `dir` with their bytes, relative paths sorted; the lock file (the
+    /// stage's, held while it is written, as a sweep folder's) left out.
     fn contents(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
         let mut out = Vec::new();
         let mut todo = vec![dir.to_path_buf()];
@@ -599,7 +631,7 @@ mod tests {
             for e in std::fs::read_dir(&d).unwrap().flatten() {
                 if e.path().is_dir() {
                     todo.push(e.path());
-                } else {
+                } else if e.file_name() != mirrorbox_files::LOCK_FILE {
                     let rel = e.path().strip_prefix(dir).unwrap().to_path_buf();
                     out.push((rel, std::fs::read(e.path()).unwrap()));
                 }
@@ -652,7 +684,8 @@ mod tests {
         assert_eq!(names(root.path()), ["out"]);
         // A run stopped after moving the earlier folder aside: the next puts it back first,
         // and a write that fails then leaves it in place.
-        std::fs::rename(&dir, format!("{}-earlier", staging_folder(&dir).display())).unwrap();
+        std::fs::write(dir.join(EARLIER_MARK), "").unwrap();
+        std::fs::rename(&dir, earlier_folder(&dir)).unwrap();
         let kept = in_staged_folder(&dir, |_| -> Result<(), HarnessError> {
             Err(HarnessError::Exchange("failed".into()))
         });
@@ -662,6 +695,28 @@ mod tests {
             [(PathBuf::from("records.jsonl"), b"new\n".to_vec())]
         );
         assert_eq!(names(root.path()), ["out"]);
+        // A folder of that name that mirrorbox did not move aside is the user's: refused,
+        // untouched, before anything is written.
+        let theirs = earlier_folder(&dir);
+        std::fs::create_dir(&theirs).unwrap();
+        std::fs::write(theirs.join("notes.txt"), "mine").unwrap();
+        let refused = in_staged_folder(&dir, |_| -> Result<(), HarnessError> {
+            panic!("written despite the refusal")
+        });
+        assert!(
+            refused
+                .unwrap_err()
+                .to_string()
+                .contains("is not an earlier")
+        );
+        assert_eq!(
+            contents(&theirs),
+            [(PathBuf::from("notes.txt"), b"mine".to_vec())]
+        );
+        assert_eq!(
+            contents(&dir),
+            [(PathBuf::from("records.jsonl"), b"new\n".to_vec())]
+        );
     }
 
     /// A point on the view axis at `near` lands on the near end of each depth range and one

@@ -256,7 +256,7 @@ fn write_merged(
         path: out.to_path_buf(),
         source,
     })?;
-    let _lock = FolderLock::try_acquire(out)?;
+    // (The stage `out` is locked by `in_staged_folder` while this writes it.)
     let mut by_key: HashMap<&str, Record> = HashMap::new();
     let mut copied: std::collections::HashSet<PathBuf> = std::collections::HashSet::new();
     for s in shards {
