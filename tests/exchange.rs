@@ -633,13 +633,27 @@ fn an_export_without_alpha_says_the_scenes_own() {
     let out = run_score(&export, &run, &scored, &[]);
     assert_eq!(out.code, 0, "{}", out.stderr);
     let records = std::fs::read_to_string(scored.join("results.jsonl")).unwrap();
+    assert!(records.lines().count() >= 1, "{records}");
     assert!(records.lines().all(|l| {
         let r: Value = serde_json::from_str(l).unwrap();
         r["values"]["alpha_per_mirror"] == 1.0
     }));
     let md = std::fs::read_to_string(scored.join("report.md")).unwrap();
-    assert!(md.contains("| per mirror |"), "{md}");
-    assert!(!md.contains("| 1 |"), "{md}");
+    // Every row of "All points" says so in its α column, and no sentence says α = 1.
+    let table: Vec<&str> = md
+        .split("## All points")
+        .nth(1)
+        .unwrap()
+        .lines()
+        .skip_while(|l| !l.starts_with('|'))
+        .take_while(|l| l.starts_with('|'))
+        .skip(2)
+        .collect();
+    assert!(!table.is_empty(), "{md}");
+    for row in table {
+        assert_eq!(row.split('|').nth(2).unwrap().trim(), "per mirror", "{row}");
+    }
+    assert!(!md.contains("α = 1") && !md.contains("α=1"), "{md}");
 }
 
 #[test]

@@ -8,8 +8,11 @@ use mirrorbox_raster::Method;
 use std::path::{Path, PathBuf};
 
 /// The scenes of the frontier (file stems under `scenes/`), in the overview's order: its
-/// charts (`frontier_<scene>.svg`) are drawn for these.
-pub const SCENES: [&str; 2] = ["mirror_box", "mirror_room"];
+/// charts (`frontier_<scene>.svg`) are drawn for these. Each sweeps with its own settings
+/// (below, by name).
+pub const SCENES: [&str; 2] = [BOX, ROOM];
+const BOX: &str = "mirror_box";
+const ROOM: &str = "mirror_room";
 
 /// Every method of the paper and its successors at the settings given, 320×180, α = 1, five
 /// timed frames after one warm-up.
@@ -55,10 +58,10 @@ pub const FRONTIER: Experiment = Experiment {
         } else {
             beside(out, "_room")
         };
-        let [box_scene, room_scene] = SCENES.map(|s| format!("scenes/{s}.json"));
+        let file = |stem: &str| format!("scenes/{stem}.json");
         vec![
-            sweep(&box_scene, out, &[0, 1, 2, 3], &[1, 4, 16, 64], true),
-            sweep(&room_scene, &room, &[0, 1], &[1, 2, 4, 8, 16], false),
+            sweep(&file(BOX), out, &[0, 1, 2, 3], &[1, 4, 16, 64], true),
+            sweep(&file(ROOM), &room, &[0, 1], &[1, 2, 4, 8, 16], false),
         ]
     }),
     section: None,

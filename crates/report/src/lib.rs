@@ -286,9 +286,9 @@ pub mod value {
     /// 1 for a scored variant's view at the scene's own camera, the one our sweeps show
     /// (`mirrorbox score`; absent in scores made before it was kept).
     pub const SCENE_CAMERA: &str = "scene_camera";
-    /// 1 for a scored variant of an export whose mirrors differ in reflectance: no one α
-    /// stands for them, so the record's `alpha` (1) is none, and reports say "per mirror"
-    /// ([`crate::Record::alpha_text`]).
+    /// 1 for a scored variant of an export whose mirrors share no one grey reflectance (they
+    /// differ, or are tinted): no one α stands for them, so the record's `alpha` (1) is none,
+    /// and reports say "per mirror" ([`crate::Record::alpha_text`]).
     pub const ALPHA_PER_MIRROR: &str = "alpha_per_mirror";
 }
 
