@@ -777,67 +777,8 @@ impl Chart {
             }
         });
         let (ax, ay) = self.axes();
-        // Legend entries: series (with a note where one coincides with an earlier one), then
-        // references.
-        let px_of = |x: f64| LEFT + ax.t(x) * PLOT_W;
-        let py_of = |y: f64| TOP + (1.0 - ay.t(y)) * PLOT_H;
-        let key = |(x, y): (f64, f64)| {
-            (
-                (px_of(x) / 2.0).round() as i64,
-                (py_of(y) / 2.0).round() as i64,
-            )
-        };
-        let visible = |s: &Series| -> Vec<(f64, f64)> {
-            s.points
-                .iter()
-                .copied()
-                .filter(|(x, y)| drawable(*x, ax.log) && drawable(*y, ay.log))
-                .collect()
-        };
-        // Each entry: its name, and the series or the reference it shows.
-        enum Shows<'a> {
-            Series(&'a Series),
-            Reference(&'a Reference),
-            /// What a ring around a marker means, where a series' name does not say it.
-            Ring,
-        }
-        let mut legend: Vec<(String, Shows)> = Vec::new();
-        // Points drawn as rings (an earlier marker at the same place) in a series whose
-        // legend entry does not say which series it lies on.
-        let mut seen: Vec<(i64, i64)> = Vec::new();
-        let mut unexplained_rings = false;
-        for (i, series) in self.series.iter().enumerate() {
-            let mine: Vec<_> = visible(series).into_iter().map(key).collect();
-            let same = self.series[..i].iter().find(|o| {
-                let theirs: Vec<_> = visible(o).into_iter().map(key).collect();
-                !mine.is_empty() && mine.iter().all(|k| theirs.contains(k))
-            });
-            for k in &mine {
-                if seen.contains(k) {
-                    unexplained_rings |= same.is_none();
-                } else {
-                    seen.push(*k);
-                }
-            }
-            let name = match same {
-                Some(o) => format!("{} (on {})", series.name, o.name),
-                None => series.name.clone(),
-            };
-            legend.push((name, Shows::Series(series)));
-        }
-        for r in &self.references {
-            let name = match r {
-                Reference::Level(n, _) | Reference::Curve(n, _) => format!("reference: {n}"),
-                Reference::Mark(n, _) => n.clone(),
-            };
-            legend.push((name, Shows::Reference(r)));
-        }
-        if unexplained_rings {
-            legend.push((
-                "ring: a point at the same place as an earlier one".into(),
-                Shows::Ring,
-            ));
-        }
+        let f = Frame { ax, ay };
+        let legend = self.legend(&f);
         let legend_chars = legend
             .iter()
             .map(|(n, _)| n.chars().count())
@@ -869,15 +810,96 @@ impl Chart {
             esc(&self.title)
         );
         // The floor band first, under everything.
-        let mut floor_note = self.floor.filter(|f| !drawable(*f, ay.log)).map(|f| {
+        let floor_note = self.floor_band(&mut s, &f);
+        self.grid_and_axes(&mut s, &f);
+        let mut below = TOP + PLOT_H + 54.0;
+        if let Some(note) = floor_note {
+            let _ = writeln!(
+                s,
+                r##"<text x="{LEFT}" y="{below:.1}" font-size="10" fill="#555">{}</text>"##,
+                esc(&note)
+            );
+        }
+        below += 16.0;
+        for line in &footer_lines {
+            let _ = writeln!(
+                s,
+                r##"<text x="10" y="{below:.1}" font-size="10" fill="#777">{}</text>"##,
+                esc(line)
+            );
+            below += 12.0;
+        }
+        // Clip the data to the plot area: reference lines, then series lines, error bars,
+        // markers (rings where an earlier marker sits) and labels that touch no other.
+        let _ = writeln!(
+            s,
+            r#"<clipPath id="plot"><rect x="{LEFT}" y="{TOP}" width="{PLOT_W}" height="{PLOT_H}"/></clipPath><g clip-path="url(#plot)">"#
+        );
+        self.reference_lines(&mut s, &f);
+        self.series_lines(&mut s, &f);
+        self.error_bars(&mut s, &f);
+        self.markers_and_labels(&mut s, &f);
+        s.push_str("</g>\n");
+        legend_svg(&mut s, &legend);
+        s.push_str("</svg>\n");
+        s
+    }
+
+    /// The legend's entries: each series (with a note where it coincides with an earlier
+    /// one), then the references, then what a ring means where no series' name says it.
+    fn legend(&self, f: &Frame) -> Vec<(String, Shows<'_>)> {
+        let mut legend: Vec<(String, Shows)> = Vec::new();
+        // Points drawn as rings (an earlier marker at the same place) in a series whose
+        // legend entry does not say which series it lies on.
+        let mut seen: Vec<(i64, i64)> = Vec::new();
+        let mut unexplained_rings = false;
+        for (i, series) in self.series.iter().enumerate() {
+            let mine: Vec<_> = f.visible(series).into_iter().map(|p| f.key(p)).collect();
+            let same = self.series[..i].iter().find(|o| {
+                let theirs: Vec<_> = f.visible(o).into_iter().map(|p| f.key(p)).collect();
+                !mine.is_empty() && mine.iter().all(|k| theirs.contains(k))
+            });
+            for k in &mine {
+                if seen.contains(k) {
+                    unexplained_rings |= same.is_none();
+                } else {
+                    seen.push(*k);
+                }
+            }
+            let name = match same {
+                Some(o) => format!("{} (on {})", series.name, o.name),
+                None => series.name.clone(),
+            };
+            legend.push((name, Shows::Series(series)));
+        }
+        for r in &self.references {
+            let name = match r {
+                Reference::Level(n, _) | Reference::Curve(n, _) => format!("reference: {n}"),
+                Reference::Mark(n, _) => n.clone(),
+            };
+            legend.push((name, Shows::Reference(r)));
+        }
+        if unexplained_rings {
+            legend.push((
+                "ring: a point at the same place as an earlier one".into(),
+                Shows::Ring,
+            ));
+        }
+        legend
+    }
+
+    /// The floor's band (grey, under everything) where the y axis shows it; else the note
+    /// that says where it is, returned for the space under the plot.
+    fn floor_band(&self, s: &mut String, f: &Frame) -> Option<String> {
+        let mut floor_note = self.floor.filter(|v| !drawable(*v, f.ay.log)).map(|v| {
             format!(
                 "floor of the comparison (no mirrors): {}, every difference above it is the method's",
-                fmt_tick(f)
+                fmt_tick(v)
             )
         });
-        if let Some(f) = self.floor.filter(|f| drawable(*f, ay.log)) {
-            if ay.t(f) > 0.0 {
-                let yf = py_of(f.min(ay.hi));
+        if let Some(v) = self.floor.filter(|v| drawable(*v, f.ay.log)) {
+            if f.ay.t(v) > 0.0 {
+                let yf = f.py(v.min(f.ay.hi));
                 let _ = writeln!(
                     s,
                     r##"<rect x="{LEFT}" y="{yf:.1}" width="{PLOT_W}" height="{:.1}" fill="#000" fill-opacity="0.07"/>"##,
@@ -888,26 +910,31 @@ impl Chart {
                     r##"<text x="{:.1}" y="{:.1}" font-size="10" fill="#555" text-anchor="end">floor (no mirrors) {}: not resolved below</text>"##,
                     LEFT + PLOT_W - 4.0,
                     (yf + 11.0).min(TOP + PLOT_H - 3.0),
-                    fmt_tick(f)
+                    fmt_tick(v)
                 );
             } else {
                 floor_note = Some(format!(
                     "floor of the comparison (no mirrors): {}, below the axis",
-                    fmt_tick(f)
+                    fmt_tick(v)
                 ));
             }
         }
+        floor_note
+    }
+
+    /// The grid lines with their tick labels, the plot's frame and the axis labels.
+    fn grid_and_axes(&self, s: &mut String, f: &Frame) {
         let x_ticks: Vec<f64> = if self.x_ticks_at_data {
             // Thinned so that labels ~40 px apart never touch.
             let mut out: Vec<f64> = Vec::new();
             for x in self.distinct_x() {
-                if out.last().is_none_or(|&l| px_of(x) - px_of(l) >= 28.0) {
+                if out.last().is_none_or(|&l| f.px(x) - f.px(l) >= 28.0) {
                     out.push(x);
                 }
             }
             out
         } else {
-            let ticks = ax.ticks();
+            let ticks = f.ax.ticks();
             if self.x_whole {
                 ticks.into_iter().filter(|t| t.fract() == 0.0).collect()
             } else {
@@ -915,7 +942,7 @@ impl Chart {
             }
         };
         for t in x_ticks {
-            let x = px_of(t);
+            let x = f.px(t);
             let _ = writeln!(
                 s,
                 r##"<line x1="{x:.1}" y1="{TOP}" x2="{x:.1}" y2="{:.1}" stroke="#e5e5e5"/><text x="{x:.1}" y="{:.1}" text-anchor="middle">{}</text>"##,
@@ -924,8 +951,8 @@ impl Chart {
                 fmt_tick(t)
             );
         }
-        for t in ay.ticks() {
-            let y = py_of(t);
+        for t in f.ay.ticks() {
+            let y = f.py(t);
             let _ = writeln!(
                 s,
                 r##"<line x1="{LEFT}" y1="{y:.1}" x2="{:.1}" y2="{y:.1}" stroke="#e5e5e5"/><text x="{:.1}" y="{:.1}" text-anchor="end">{}</text>"##,
@@ -953,29 +980,10 @@ impl Chart {
             TOP + PLOT_H / 2.0,
             esc(&self.axis_label(&self.y_label, |s| &s.y_intervals))
         );
-        let mut below = TOP + PLOT_H + 54.0;
-        if let Some(note) = floor_note {
-            let _ = writeln!(
-                s,
-                r##"<text x="{LEFT}" y="{below:.1}" font-size="10" fill="#555">{}</text>"##,
-                esc(&note)
-            );
-        }
-        below += 16.0;
-        for line in &footer_lines {
-            let _ = writeln!(
-                s,
-                r##"<text x="10" y="{below:.1}" font-size="10" fill="#777">{}</text>"##,
-                esc(line)
-            );
-            below += 12.0;
-        }
+    }
 
-        // Clip the data to the plot area.
-        let _ = writeln!(
-            s,
-            r#"<clipPath id="plot"><rect x="{LEFT}" y="{TOP}" width="{PLOT_W}" height="{PLOT_H}"/></clipPath><g clip-path="url(#plot)">"#
-        );
+    /// The reference levels and curves, grey, each its own dash.
+    fn reference_lines(&self, s: &mut String, f: &Frame) {
         let lines = self
             .references
             .iter()
@@ -983,38 +991,28 @@ impl Chart {
         for (i, r) in lines.enumerate() {
             let dash = REFERENCE_DASHES[i % REFERENCE_DASHES.len()];
             let pts: Vec<(f64, f64)> = match r {
-                Reference::Level(_, y) if drawable(*y, ay.log) => {
-                    vec![(ax.lo, *y), (ax.hi, *y)]
+                Reference::Level(_, y) if drawable(*y, f.ay.log) => {
+                    vec![(f.ax.lo, *y), (f.ax.hi, *y)]
                 }
                 Reference::Level(..) => Vec::new(),
-                Reference::Curve(_, pts) => pts
-                    .iter()
-                    .copied()
-                    .filter(|(x, y)| drawable(*x, ax.log) && drawable(*y, ay.log))
-                    .collect(),
+                Reference::Curve(_, pts) => pts.iter().copied().filter(|&p| f.shows(p)).collect(),
                 Reference::Mark(..) => Vec::new(),
             };
             if pts.len() >= 2 {
-                let p: Vec<String> = pts
-                    .iter()
-                    .map(|&(x, y)| format!("{:.1},{:.1}", px_of(x), py_of(y)))
-                    .collect();
                 let _ = writeln!(
                     s,
                     r#"<polyline points="{}" fill="none" stroke="{REFERENCE_GREY}" stroke-width="1.5" stroke-dasharray="{dash}"/>"#,
-                    p.join(" ")
+                    f.polyline(&pts)
                 );
             }
         }
-        // Lines, then error bars, then markers (rings where an earlier marker sits), then
-        // labels that touch no other.
+    }
+
+    /// Each joined series' line, in its style.
+    fn series_lines(&self, s: &mut String, f: &Frame) {
         for series in &self.series {
-            let pts = visible(series);
+            let pts = f.visible(series);
             if series.joined && pts.len() >= 2 {
-                let p: Vec<String> = pts
-                    .iter()
-                    .map(|&(x, y)| format!("{:.1},{:.1}", px_of(x), py_of(y)))
-                    .collect();
                 let dash = if series.style.dash.is_empty() {
                     String::new()
                 } else {
@@ -1023,22 +1021,26 @@ impl Chart {
                 let _ = writeln!(
                     s,
                     r#"<polyline points="{}" fill="none" stroke="{}" stroke-width="1.8"{dash}/>"#,
-                    p.join(" "),
+                    f.polyline(&pts),
                     series.style.color
                 );
             }
         }
+    }
+
+    /// Each point's intervals as capped bars, in its series' colour.
+    fn error_bars(&self, s: &mut String, f: &Frame) {
         for series in &self.series {
             let color = series.style.color;
             for (k, &(x, y)) in series.points.iter().enumerate() {
-                if !(drawable(x, ax.log) && drawable(y, ay.log)) {
+                if !f.shows((x, y)) {
                     continue;
                 }
                 if let Some([lo, hi]) = series.x_intervals.get(k).copied().flatten()
-                    && drawable(lo, ax.log)
-                    && drawable(hi, ax.log)
+                    && drawable(lo, f.ax.log)
+                    && drawable(hi, f.ax.log)
                 {
-                    let (x0, x1, yy) = (px_of(lo), px_of(hi), py_of(y));
+                    let (x0, x1, yy) = (f.px(lo), f.px(hi), f.py(y));
                     let _ = writeln!(
                         s,
                         r#"<path d="M{x0:.1},{yy:.1}H{x1:.1}M{x0:.1},{:.1}V{:.1}M{x1:.1},{:.1}V{:.1}" stroke="{color}" stroke-width="1.2" fill="none"/>"#,
@@ -1049,10 +1051,10 @@ impl Chart {
                     );
                 }
                 if let Some([lo, hi]) = series.y_intervals.get(k).copied().flatten()
-                    && drawable(lo, ay.log)
-                    && drawable(hi, ay.log)
+                    && drawable(lo, f.ay.log)
+                    && drawable(hi, f.ay.log)
                 {
-                    let (y0, y1, xx) = (py_of(lo), py_of(hi), px_of(x));
+                    let (y0, y1, xx) = (f.py(lo), f.py(hi), f.px(x));
                     let _ = writeln!(
                         s,
                         r#"<path d="M{xx:.1},{y0:.1}V{y1:.1}M{:.1},{y0:.1}H{:.1}M{:.1},{y1:.1}H{:.1}" stroke="{color}" stroke-width="1.2" fill="none"/>"#,
@@ -1064,6 +1066,11 @@ impl Chart {
                 }
             }
         }
+    }
+
+    /// The markers (a ring around an earlier marker at the same place, so both show), the
+    /// marks' rings over them, then the labels, each where it covers no marker or label.
+    fn markers_and_labels(&self, s: &mut String, f: &Frame) {
         let mut occupied: Vec<((i64, i64), usize)> = Vec::new();
         let mut taken: Vec<Rect> = Vec::new();
         let mut label_queue: Vec<(f64, f64, f64, &str, &'static str)> = Vec::new();
@@ -1071,10 +1078,10 @@ impl Chart {
         let mut markers: Vec<(f64, f64)> = Vec::new();
         for series in &self.series {
             for (k, &(x, y)) in series.points.iter().enumerate() {
-                if !(drawable(x, ax.log) && drawable(y, ay.log)) {
+                if !f.shows((x, y)) {
                     continue;
                 }
-                let spot = key((x, y));
+                let spot = f.key((x, y));
                 let under = match occupied.iter_mut().find(|(p, _)| *p == spot) {
                     Some((_, n)) => {
                         *n += 1;
@@ -1086,8 +1093,7 @@ impl Chart {
                     }
                 };
                 let r = MARKER_R + 2.6 * under as f64;
-                // A marker over an earlier one is a ring around it, so both show.
-                let (xx, yy) = (px_of(x), py_of(y));
+                let (xx, yy) = (f.px(x), f.py(y));
                 if under > 0 {
                     let _ = writeln!(
                         s,
@@ -1096,7 +1102,7 @@ impl Chart {
                         series.style.color
                     );
                 } else {
-                    marker_svg(&mut s, &series.style, xx, yy, r, series.style.hollow);
+                    marker_svg(s, &series.style, xx, yy, r, series.style.hollow);
                 }
                 taken.push(Rect {
                     x0: xx - r,
@@ -1113,10 +1119,9 @@ impl Chart {
         // The marks' rings, over the markers; no label may cover them.
         for r in &self.references {
             if let Reference::Mark(_, (x, y)) = r
-                && drawable(*x, ax.log)
-                && drawable(*y, ay.log)
+                && f.shows((*x, *y))
             {
-                let (xx, yy) = (px_of(*x), py_of(*y));
+                let (xx, yy) = (f.px(*x), f.py(*y));
                 let _ = writeln!(
                     s,
                     r#"<circle cx="{xx:.1}" cy="{yy:.1}" r="{MARK_R}" fill="none" stroke="black" stroke-width="2"/>"#
@@ -1141,67 +1146,120 @@ impl Chart {
                 );
             }
         }
-        s.push_str("</g>\n");
+    }
+}
 
-        // The legend.
-        let lx = LEFT + PLOT_W + 14.0;
-        let mut ly = TOP + 10.0;
-        let mut references_drawn = 0;
-        for (name, shows) in &legend {
-            match shows {
-                Shows::Series(series) => {
-                    let st = &series.style;
-                    if series.joined {
-                        let dash = if st.dash.is_empty() {
-                            String::new()
-                        } else {
-                            format!(r#" stroke-dasharray="{}""#, st.dash)
-                        };
-                        let _ = writeln!(
-                            s,
-                            r#"<line x1="{lx}" y1="{ly}" x2="{}" y2="{ly}" stroke="{}" stroke-width="1.8"{dash}/>"#,
-                            lx + 24.0,
-                            st.color
-                        );
-                    }
-                    marker_svg(&mut s, st, lx + 12.0, ly, MARKER_R, st.hollow);
-                }
-                Shows::Reference(Reference::Mark(..)) => {
+/// A chart's data-to-pixel mapping onto its plot area.
+struct Frame {
+    ax: Axis,
+    ay: Axis,
+}
+
+impl Frame {
+    fn px(&self, x: f64) -> f64 {
+        LEFT + self.ax.t(x) * PLOT_W
+    }
+
+    fn py(&self, y: f64) -> f64 {
+        TOP + (1.0 - self.ay.t(y)) * PLOT_H
+    }
+
+    /// Whether the axes can show the point (a log axis no value ≤ 0).
+    fn shows(&self, (x, y): (f64, f64)) -> bool {
+        drawable(x, self.ax.log) && drawable(y, self.ay.log)
+    }
+
+    /// The 2-px cell a point's marker falls in: points in one cell are drawn as rings.
+    fn key(&self, (x, y): (f64, f64)) -> (i64, i64) {
+        (
+            (self.px(x) / 2.0).round() as i64,
+            (self.py(y) / 2.0).round() as i64,
+        )
+    }
+
+    /// The points of `s` the axes can show.
+    fn visible(&self, s: &Series) -> Vec<(f64, f64)> {
+        s.points
+            .iter()
+            .copied()
+            .filter(|&p| self.shows(p))
+            .collect()
+    }
+
+    /// An SVG polyline's `points` for `pts`.
+    fn polyline(&self, pts: &[(f64, f64)]) -> String {
+        pts.iter()
+            .map(|&(x, y)| format!("{:.1},{:.1}", self.px(x), self.py(y)))
+            .collect::<Vec<_>>()
+            .join(" ")
+    }
+}
+
+/// What a legend entry shows beside its name.
+enum Shows<'a> {
+    Series(&'a Series),
+    Reference(&'a Reference),
+    /// What a ring around a marker means, where a series' name does not say it.
+    Ring,
+}
+
+/// The legend, right of the plot: each entry's line or marker, then its name.
+fn legend_svg(s: &mut String, legend: &[(String, Shows)]) {
+    let lx = LEFT + PLOT_W + 14.0;
+    let mut ly = TOP + 10.0;
+    let mut references_drawn = 0;
+    for (name, shows) in legend {
+        match shows {
+            Shows::Series(series) => {
+                let st = &series.style;
+                if series.joined {
+                    let dash = if st.dash.is_empty() {
+                        String::new()
+                    } else {
+                        format!(r#" stroke-dasharray="{}""#, st.dash)
+                    };
                     let _ = writeln!(
                         s,
-                        r#"<circle cx="{}" cy="{ly}" r="7" fill="none" stroke="black" stroke-width="2"/>"#,
-                        lx + 12.0
+                        r#"<line x1="{lx}" y1="{ly}" x2="{}" y2="{ly}" stroke="{}" stroke-width="1.8"{dash}/>"#,
+                        lx + 24.0,
+                        st.color
                     );
                 }
-                Shows::Ring => {
-                    let _ = writeln!(
-                        s,
-                        r#"<circle cx="{}" cy="{ly}" r="{:.1}" fill="none" stroke="{REFERENCE_GREY}" stroke-width="1.6"/>"#,
-                        lx + 12.0,
-                        MARKER_R + 1.5
-                    );
-                }
-                Shows::Reference(_) => {
-                    let dash = REFERENCE_DASHES[references_drawn % REFERENCE_DASHES.len()];
-                    references_drawn += 1;
-                    let _ = writeln!(
-                        s,
-                        r#"<line x1="{lx}" y1="{ly}" x2="{}" y2="{ly}" stroke="{REFERENCE_GREY}" stroke-width="1.5" stroke-dasharray="{dash}"/>"#,
-                        lx + 24.0
-                    );
-                }
+                marker_svg(s, st, lx + 12.0, ly, MARKER_R, st.hollow);
             }
-            let _ = writeln!(
-                s,
-                r#"<text x="{}" y="{}">{}</text>"#,
-                lx + 30.0,
-                ly + 4.0,
-                esc(name)
-            );
-            ly += LEGEND_ROW;
+            Shows::Reference(Reference::Mark(..)) => {
+                let _ = writeln!(
+                    s,
+                    r#"<circle cx="{}" cy="{ly}" r="7" fill="none" stroke="black" stroke-width="2"/>"#,
+                    lx + 12.0
+                );
+            }
+            Shows::Ring => {
+                let _ = writeln!(
+                    s,
+                    r#"<circle cx="{}" cy="{ly}" r="{:.1}" fill="none" stroke="{REFERENCE_GREY}" stroke-width="1.6"/>"#,
+                    lx + 12.0,
+                    MARKER_R + 1.5
+                );
+            }
+            Shows::Reference(_) => {
+                let dash = REFERENCE_DASHES[references_drawn % REFERENCE_DASHES.len()];
+                references_drawn += 1;
+                let _ = writeln!(
+                    s,
+                    r#"<line x1="{lx}" y1="{ly}" x2="{}" y2="{ly}" stroke="{REFERENCE_GREY}" stroke-width="1.5" stroke-dasharray="{dash}"/>"#,
+                    lx + 24.0
+                );
+            }
         }
-        s.push_str("</svg>\n");
-        s
+        let _ = writeln!(
+            s,
+            r#"<text x="{}" y="{}">{}</text>"#,
+            lx + 30.0,
+            ly + 4.0,
+            esc(name)
+        );
+        ly += LEGEND_ROW;
     }
 }
 
