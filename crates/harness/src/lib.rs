@@ -1365,84 +1365,11 @@ pub fn run_sweep(
             scenes.push(scene);
         }
     }
-    // Interleaved timing: `frames` rounds; in each, every point renders its warm-up frames
-    // and one timed frame, the points in an order shuffled per round (fixed seed). Drift of a
-    // shared machine then spreads over every point alike instead of landing on a few.
-    let mut timed: Vec<Vec<f64>> = vec![Vec::new(); todo.len()];
-    // Per point: the last round's report; its image waits on disk (not in memory).
-    let mut last: Vec<Option<RenderReport>> = todo.iter().map(|_| None).collect();
-    let mut peaks: Vec<Option<u64>> = vec![None; todo.len()];
-    let mut plans: Vec<Vec<f64>> = vec![Vec::new(); todo.len()];
-    let mut encodes: Vec<Vec<f64>> = vec![Vec::new(); todo.len()];
-    // Points their method refused to render ([`SweepConfig::drop_refused`]).
-    let mut dropped = vec![false; todo.len()];
-    let mut order: Vec<usize> = (0..todo.len()).collect();
-    let mut rng = mirrorbox_report::stats::Rng::new(INTERLEAVE_SEED);
-    for round in 0..SETTLING_ROUNDS + config.frames {
-        let settling = round < SETTLING_ROUNDS;
-        let round = round.saturating_sub(SETTLING_ROUNDS);
-        rng.shuffle(&mut order);
-        for &i in &order {
-            let p = todo[i];
-            if dropped[i] {
-                continue;
-            }
-            progress(if settling {
-                Event::Settling { label: &p.label }
-            } else {
-                Event::Timing {
-                    label: &p.label,
-                    round: round + 1,
-                    rounds: config.frames,
-                }
-            });
-            // The settling round draws one frame per point (no warm-up before it): what it
-            // settles is each point's first draw after its shaders are compiled.
-            let settling_job;
-            let job = if settling {
-                settling_job = RenderJob {
-                    warmup: 0,
-                    ..jobs[i].clone()
-                };
-                &settling_job
-            } else {
-                &jobs[i]
-            };
-            let rendered = match &config.worker {
-                Some(exe) => worker::render_in_worker(exe, job, &p.label),
-                None => worker::render_scene(job, &scenes[i], &gpu).and_then(|rendered| {
-                    // Only the last round's image is compared; the others are not written.
-                    if !settling && round + 1 == config.frames {
-                        worker::write_images(job, rendered)
-                    } else {
-                        Ok(rendered.report)
-                    }
-                }),
-            };
-            let report = match (rendered, &p.method) {
-                (Ok(report), _) => report,
-                (Err(e), Some(method)) if config.drop_refused && refused_by_method(&e) => {
-                    progress(Event::Refused {
-                        label: &p.label,
-                        method,
-                        reason: &e.to_string(),
-                    });
-                    dropped[i] = true;
-                    summary.refused += 1;
-                    continue;
-                }
-                (Err(e), _) => return Err(e),
-            };
-            peaks[i] = peaks[i].max(report.peak_memory_bytes);
-            if settling {
-                continue;
-            }
-            timed[i].extend(&report.frames_ms);
-            plans[i].push(report.plan_ms);
-            encodes[i].extend(&report.encode_ms);
-            last[i] = Some(report);
-        }
-    }
+    let Rounds {
+        mut timing,
+        mut last,
+        dropped,
+    } = time_in_rounds(&todo, &jobs, &scenes, &gpu, config, &mut summary, progress)?;
     // Every point shares the base scene's camera, hence its exposure.
     let exposure = base.camera.exposure;
     let marker = marker_albedo(config, &base)?;
@@ -1492,94 +1419,19 @@ pub fn run_sweep(
         let Some(compared) = compared else {
             continue;
         };
-        let PointImages {
-            views,
-            split,
-            files,
-            ipd,
-        } = compared?;
         let report = last[i].take().expect("every point renders in every round");
-        let frames_ms = std::mem::take(&mut timed[i]);
-        let rel = |q: &Path| {
-            q.strip_prefix(out)
-                .unwrap_or(q)
-                .to_string_lossy()
-                .into_owned()
-        };
-        let s = &report;
-        let interval = mirrorbox_report::stats::median_interval(&frames_ms);
-        let record = Record {
-            key: p.key.clone(),
-            kind: if p.method.is_some() { "point" } else { "floor" }.into(),
-            scene: config.scene.display().to_string(),
-            scene_hash: format!("{base_hash:016x}"),
-            method: p.method.as_ref().map_or("floor", |m| m.name()).into(),
-            method_options: p
-                .method
-                .as_ref()
-                .map_or(String::new(), Method::variant_options),
-            axes: p
-                .axes
-                .iter()
-                .map(|(a, v)| (a.name.to_string(), *v))
-                .collect(),
-            values: [
-                (value::COPIES_DRAWN, s.copies.map(|c| c.drawn as f64)),
-                (value::COPIES_TOTAL, s.copies.map(|c| c.total as f64)),
-                (value::BAKE_MS, s.bake_ms),
-                (
-                    value::REFLECTION_OFFSCREEN_SHARE,
-                    views.reflection_offscreen_share,
-                ),
-            ]
-            .into_iter()
-            .filter_map(|(name, v)| Some((name.to_string(), v?)))
-            .collect(),
-            legacy: Default::default(),
-            n: p.method.as_ref().and_then(|m| m.count_of("n")),
-            depth: p.method.as_ref().and_then(|m| m.count_of("depth")),
-            alpha: p.alpha,
-            width: w,
-            height: h,
-            ssaa: config.ssaa,
-            ms_median: mirrorbox_report::stats::median(&frames_ms),
-            ms_min: frames_ms.iter().copied().fold(f64::INFINITY, f64::min),
-            ms_interval: interval.map(|i| [i.low, i.high]),
-            frames_ms,
-            timing_order: "interleaved".into(),
-            run: Some(run_started.clone()),
-            peak_memory_bytes: peaks[i],
-            plan_ms: Some(mirrorbox_report::stats::median(&plans[i])),
-            encode_ms: Some(mirrorbox_report::stats::median(&encodes[i])),
-            gpu_buffer_bytes: Some(s.gpu_buffer_bytes),
-            gpu_texture_bytes: Some(s.gpu_texture_bytes),
-            timing_source: s.timing_source.clone(),
-            frames: config.frames,
-            passes: s.passes,
-            draws: s.draws,
-            texture_renders: s.texture_renders,
-            reflections: s.depth,
-            triangles: Some(s.triangles),
-            paths: s.paths_kept,
-            paths_pruned: s.paths_pruned,
-            metrics: views.metrics,
-            mirror_metrics: views.mirror_metrics,
-            mirror_pixel_share: views.mirror_pixel_share,
-            split,
-            adapter: s.adapter.clone(),
-            backend: s.backend.clone(),
-            color_format: s.color_format.clone(),
-            truth_image: rel(&files.truth),
-            raster_image: rel(&files.raster),
-            heatmap_image: rel(&files.heat),
-            device: None,
-            stereo: views.eyes.map(|eyes| mirrorbox_report::StereoRecord {
-                ipd: ipd.unwrap_or(0.0),
-                eyes,
-                anaglyph_image: rel(&with_stem_suffix(&files.raster, "anaglyph")),
-                truth_anaglyph_image: rel(&with_stem_suffix(&files.truth, "anaglyph")),
-            }),
-        };
+        let record = point_record(
+            p,
+            config,
+            &PointRun {
+                scene_hash: base_hash,
+                size: (w, h),
+                run: &run_started,
+            },
+            &report,
+            std::mem::take(&mut timing[i]),
+            compared?,
+        );
         let line = serde_json::to_string(&record)?;
         let mut f = std::fs::OpenOptions::new()
             .create(true)
@@ -1599,7 +1451,248 @@ pub fn run_sweep(
         .into_iter()
         .filter(|r| keys.contains(&&r.key))
         .collect();
-    let info = SweepInfo {
+    let info = sweep_info(config, &gpu, (w, h), point_keys, unsupported);
+    write_atomically(
+        &out.join("sweep.json"),
+        serde_json::to_string_pretty(&info)?.as_bytes(),
+    )?;
+    write_report(out, &info, &records, &config.sections)?;
+    Ok(summary)
+}
+
+/// Each point's timing over the rounds, its last round's report (its image waits on disk,
+/// not in memory), and whether its method refused to render it
+/// ([`SweepConfig::drop_refused`]).
+struct Rounds {
+    timing: Vec<PointTiming>,
+    last: Vec<Option<RenderReport>>,
+    dropped: Vec<bool>,
+}
+
+/// Times the points `todo` (their render `jobs`, and their `scenes` where rendered in this
+/// process) interleaved: `frames` rounds after the settling ones; in each, every point renders
+/// its warm-up frames and one timed frame, the points in an order shuffled per round (fixed
+/// seed). Drift of a shared machine then spreads over every point alike instead of landing
+/// on a few.
+fn time_in_rounds(
+    todo: &[&Point],
+    jobs: &[RenderJob],
+    scenes: &[Scene],
+    gpu: &Gpu,
+    config: &SweepConfig,
+    summary: &mut Summary,
+    progress: &mut dyn FnMut(Event),
+) -> Result<Rounds, HarnessError> {
+    let mut timing: Vec<PointTiming> = todo.iter().map(|_| PointTiming::default()).collect();
+    let mut last: Vec<Option<RenderReport>> = todo.iter().map(|_| None).collect();
+    let mut dropped = vec![false; todo.len()];
+    let mut order: Vec<usize> = (0..todo.len()).collect();
+    let mut rng = mirrorbox_report::stats::Rng::new(INTERLEAVE_SEED);
+    for round in 0..SETTLING_ROUNDS + config.frames {
+        let settling = round < SETTLING_ROUNDS;
+        let round = round.saturating_sub(SETTLING_ROUNDS);
+        rng.shuffle(&mut order);
+        for &i in &order {
+            let p = todo[i];
+            if dropped[i] {
+                continue;
+            }
+            progress(if settling {
+                Event::Settling { label: &p.label }
+            } else {
+                Event::Timing {
+                    label: &p.label,
+                    round: round + 1,
+                    rounds: config.frames,
+                }
+            });
+            // The settling round draws one frame per point (no warm-up before it): what it
+            // settles is each point's first draw after its shaders are compiled.
+            let settling_job;
+            let job = if settling {
+                settling_job = RenderJob {
+                    warmup: 0,
+                    ..jobs[i].clone()
+                };
+                &settling_job
+            } else {
+                &jobs[i]
+            };
+            let rendered = match &config.worker {
+                Some(exe) => worker::render_in_worker(exe, job, &p.label),
+                None => worker::render_scene(job, &scenes[i], gpu).and_then(|rendered| {
+                    // Only the last round's image is compared; the others are not written.
+                    if !settling && round + 1 == config.frames {
+                        worker::write_images(job, rendered)
+                    } else {
+                        Ok(rendered.report)
+                    }
+                }),
+            };
+            let report = match (rendered, &p.method) {
+                (Ok(report), _) => report,
+                (Err(e), Some(method)) if config.drop_refused && refused_by_method(&e) => {
+                    progress(Event::Refused {
+                        label: &p.label,
+                        method,
+                        reason: &e.to_string(),
+                    });
+                    dropped[i] = true;
+                    summary.refused += 1;
+                    continue;
+                }
+                (Err(e), _) => return Err(e),
+            };
+            timing[i].peak = timing[i].peak.max(report.peak_memory_bytes);
+            if settling {
+                continue;
+            }
+            timing[i].frames_ms.extend(&report.frames_ms);
+            timing[i].plans_ms.push(report.plan_ms);
+            timing[i].encodes_ms.extend(&report.encode_ms);
+            last[i] = Some(report);
+        }
+    }
+    Ok(Rounds {
+        timing,
+        last,
+        dropped,
+    })
+}
+
+/// A point's timing over the rounds: its timed frames, peak memory, and CPU plan and encode
+/// times.
+#[derive(Default)]
+struct PointTiming {
+    frames_ms: Vec<f64>,
+    peak: Option<u64>,
+    plans_ms: Vec<f64>,
+    encodes_ms: Vec<f64>,
+}
+
+/// What every point of one run shares in its record.
+struct PointRun<'a> {
+    scene_hash: u64,
+    size: (u32, u32),
+    /// When the run started (and its shard): points are timed together only within one.
+    run: &'a str,
+}
+
+/// Point `p`'s record: its last round's `report`, its `timing` over the rounds and its
+/// images as compared.
+fn point_record(
+    p: &Point,
+    config: &SweepConfig,
+    run: &PointRun,
+    report: &RenderReport,
+    timing: PointTiming,
+    compared: PointImages,
+) -> Record {
+    let PointImages {
+        views,
+        split,
+        files,
+        ipd,
+    } = compared;
+    let PointTiming {
+        frames_ms,
+        peak,
+        plans_ms,
+        encodes_ms,
+    } = timing;
+    let rel = |q: &Path| {
+        q.strip_prefix(&config.out)
+            .unwrap_or(q)
+            .to_string_lossy()
+            .into_owned()
+    };
+    let s = report;
+    let interval = mirrorbox_report::stats::median_interval(&frames_ms);
+    Record {
+        key: p.key.clone(),
+        kind: if p.method.is_some() { "point" } else { "floor" }.into(),
+        scene: config.scene.display().to_string(),
+        scene_hash: format!("{:016x}", run.scene_hash),
+        method: p.method.as_ref().map_or("floor", |m| m.name()).into(),
+        method_options: p
+            .method
+            .as_ref()
+            .map_or(String::new(), Method::variant_options),
+        axes: p
+            .axes
+            .iter()
+            .map(|(a, v)| (a.name.to_string(), *v))
+            .collect(),
+        values: [
+            (value::COPIES_DRAWN, s.copies.map(|c| c.drawn as f64)),
+            (value::COPIES_TOTAL, s.copies.map(|c| c.total as f64)),
+            (value::BAKE_MS, s.bake_ms),
+            (
+                value::REFLECTION_OFFSCREEN_SHARE,
+                views.reflection_offscreen_share,
+            ),
+        ]
+        .into_iter()
+        .filter_map(|(name, v)| Some((name.to_string(), v?)))
+        .collect(),
+        legacy: Default::default(),
+        n: p.method.as_ref().and_then(|m| m.count_of("n")),
+        depth: p.method.as_ref().and_then(|m| m.count_of("depth")),
+        alpha: p.alpha,
+        width: run.size.0,
+        height: run.size.1,
+        ssaa: config.ssaa,
+        ms_median: mirrorbox_report::stats::median(&frames_ms),
+        ms_min: frames_ms.iter().copied().fold(f64::INFINITY, f64::min),
+        ms_interval: interval.map(|i| [i.low, i.high]),
+        frames_ms,
+        timing_order: "interleaved".into(),
+        run: Some(run.run.to_string()),
+        peak_memory_bytes: peak,
+        plan_ms: Some(mirrorbox_report::stats::median(&plans_ms)),
+        encode_ms: Some(mirrorbox_report::stats::median(&encodes_ms)),
+        gpu_buffer_bytes: Some(s.gpu_buffer_bytes),
+        gpu_texture_bytes: Some(s.gpu_texture_bytes),
+        timing_source: s.timing_source.clone(),
+        frames: config.frames,
+        passes: s.passes,
+        draws: s.draws,
+        texture_renders: s.texture_renders,
+        reflections: s.depth,
+        triangles: Some(s.triangles),
+        paths: s.paths_kept,
+        paths_pruned: s.paths_pruned,
+        metrics: views.metrics,
+        mirror_metrics: views.mirror_metrics,
+        mirror_pixel_share: views.mirror_pixel_share,
+        split,
+        adapter: s.adapter.clone(),
+        backend: s.backend.clone(),
+        color_format: s.color_format.clone(),
+        truth_image: rel(&files.truth),
+        raster_image: rel(&files.raster),
+        heatmap_image: rel(&files.heat),
+        device: None,
+        stereo: views.eyes.map(|eyes| mirrorbox_report::StereoRecord {
+            ipd: ipd.unwrap_or(0.0),
+            eyes,
+            anaglyph_image: rel(&with_stem_suffix(&files.raster, "anaglyph")),
+            truth_anaglyph_image: rel(&with_stem_suffix(&files.truth, "anaglyph")),
+        }),
+    }
+}
+
+/// The description of a sweep's run ([`SweepInfo`], `sweep.json`): its command, machine,
+/// adapter, versions, scene, size and truth; `point_keys`, every point's key where the run is
+/// a shard; `unsupported`, why this adapter left methods out.
+fn sweep_info(
+    config: &SweepConfig,
+    gpu: &Gpu,
+    (w, h): (u32, u32),
+    point_keys: Vec<String>,
+    unsupported: Vec<String>,
+) -> SweepInfo {
+    SweepInfo {
         command: config.command.clone(),
         date: now_rfc3339(),
         cpu: cpu_description(),
@@ -1643,13 +1736,7 @@ pub fn run_sweep(
         point_keys,
         shards: Vec::new(),
         unsupported,
-    };
-    write_atomically(
-        &out.join("sweep.json"),
-        serde_json::to_string_pretty(&info)?.as_bytes(),
-    )?;
-    write_report(out, &info, &records, &config.sections)?;
-    Ok(summary)
+    }
 }
 
 /// The commit of the checkout the running binary was built in (`git describe --always`, run
