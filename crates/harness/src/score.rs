@@ -4,7 +4,9 @@
 //! written as the same records and report. A variant named `floor` drew the scene without its
 //! mirrors and is compared with the floor truth.
 
-use crate::exchange::{FORMAT_VERSION, MAX_VIEWS, ViewsFile, valid_name, view_name_problem};
+use crate::exchange::{
+    ExportedView, FORMAT_VERSION, MAX_VIEWS, ViewsFile, valid_name, view_name_problem,
+};
 use crate::{HarnessError, ViewFiles, compare_views, io};
 use mirrorbox_report::{Record, SweepInfo, write_report};
 use serde::Deserialize;
@@ -556,21 +558,12 @@ fn not_of_the_export(views: &ViewsFile, r: &Record) -> Option<String> {
     })
 }
 
-/// Scores `run` against `export` into `out` (see the module docs). Every input is read and
-/// checked before anything is written; the report goes to `out.partial` and is moved into
-/// place at the end (an earlier score in `out` is replaced).
-pub fn score(
-    export: &Path,
-    run: &Path,
-    out: &Path,
-    settings: &ScoreSettings,
-) -> Result<Scored, HarnessError> {
-    let command = settings.command.as_str();
-    let views = read_views(export)?;
-    // Our own sweeps of the same views, set beside the run's variants in one report: their
-    // records as they are (their own truth, device and timing), checked to be of this scene.
+/// Our own sweeps (`--with`), set beside the run's variants in one report: their records as
+/// they are (their own truth, device and timing), each with its folder, checked to be of the
+/// export's scene, views and α, and their pictures files of their folders.
+fn our_sweeps(views: &ViewsFile, with: &[PathBuf]) -> Result<Vec<(PathBuf, Record)>, HarnessError> {
     let mut ours: Vec<(PathBuf, Record)> = Vec::new();
-    for dir in &settings.with {
+    for dir in with {
         let sweep = mirrorbox_report::load_sweep(dir).map_err(|e| refused(dir, e))?;
         if sweep.info.is_score() {
             return Err(refused(
@@ -599,7 +592,7 @@ pub fn score(
         // scene, or another of the same file name, is not the exported one); by its file
         // where the export predates the hashes.
         for r in sweep.records.iter().filter(|r| !r.is_external()) {
-            if let Some(problem) = not_of_the_export(&views, r) {
+            if let Some(problem) = not_of_the_export(views, r) {
                 return Err(refused(dir, format!("{}: {problem}", r.key)));
             }
         }
@@ -641,9 +634,12 @@ pub fn score(
         }
         ours.extend(sweep.records.into_iter().map(|r| (dir.clone(), r)));
     }
-    let found = variants(run)?;
-    check_picture_names(&found, &views)?;
-    crate::exchange::replaceable(out, "sweep.json", "score")?;
+    Ok(ours)
+}
+
+/// Refuses a score's output folder that holds a sweep (or any sweep.json but an earlier
+/// score's).
+fn check_not_a_sweep(out: &Path) -> Result<(), HarnessError> {
     // A sweep folder has a sweep.json too: replacing it would lose its records and cached
     // truths (found by a review). Only an earlier score's is replaced, told by its sweep.json
     // alone (a sweep stopped before its first point has no records to load).
@@ -669,6 +665,168 @@ pub fn score(
             }
         }
     }
+    Ok(())
+}
+
+/// What every scored view of one score shares: the export, the stage the score is written
+/// into, the export's views, the run's time and whether its mirrors' α is per mirror.
+struct ScoreStage<'a> {
+    export: &'a Path,
+    stage: &'a Path,
+    views: &'a ViewsFile,
+    run: &'a str,
+    per_mirror: bool,
+}
+
+/// The record of a variant's (`client`, `variant`, its `timing`) picture `image` of view `vi`:
+/// compared with the export's truth (its floor truth for a variant named `floor`), its
+/// pictures written into the stage's images/.
+fn scored_record(
+    ctx: &ScoreStage,
+    (client, variant, timing): (&str, &str, &Timing),
+    vi: usize,
+    v: &ExportedView,
+    image: &PathBuf,
+) -> Result<Record, HarnessError> {
+    let (export, partial, views) = (ctx.export, ctx.stage, ctx.views);
+    let images_dir = partial.join("images");
+    let floor = variant == "floor";
+    let truth = export.join(if floor { &v.floor } else { &v.truth });
+    let slug = picture_stem(client, variant, &v.name);
+    let files = ViewFiles {
+        raster: images_dir.join(format!("{slug}.png")),
+        heat: images_dir.join(format!("{slug}_flip.png")),
+        truth: images_dir.join(format!(
+            "truth_{}{}.png",
+            v.name,
+            if floor { "_floor" } else { "" }
+        )),
+    };
+    let compared = compare_views(
+        std::slice::from_ref(&truth),
+        std::slice::from_ref(image),
+        v.camera.exposure,
+        None,
+        &files,
+    )?;
+    let frames_ms = timing.views[&v.name].clone();
+    let interval = mirrorbox_report::stats::median_interval(&frames_ms);
+    let rel = |p: &Path| {
+        p.strip_prefix(partial)
+            .unwrap_or(p)
+            .to_string_lossy()
+            .into_owned()
+    };
+    let png = image
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+    Ok(Record {
+        key: format!(
+            "{client}/{variant}|{}|a{}|{}x{}|ssaa{}",
+            v.name,
+            views.alpha.map_or("-".to_string(), |a| a.to_string()),
+            v.width,
+            v.height,
+            v.ssaa
+        ),
+        kind: if floor { "floor" } else { "point" }.into(),
+        scene: views.source.clone(),
+        scene_hash: v.scene_hash.clone(),
+        method: if floor {
+            client.to_string()
+        } else {
+            format!("{client}-{variant}")
+        },
+        // The variant's short knobs (its name in legends and tables), then the
+        // method it is meant to match; every parameter is in variants.md.
+        method_options: timing
+            .parameters
+            .iter()
+            .map(|(k, v)| (k, v.to_string().trim_matches('"').to_string()))
+            .filter(|(k, v)| is_knob(k, v))
+            .map(|(k, v)| format!("{k}={v}"))
+            .chain(timing.equivalent.iter().map(|e| format!("equivalent={e}")))
+            .collect::<Vec<_>>()
+            .join(" "),
+        axes: if views.views.len() > 1 {
+            [(mirrorbox_report::axis::VIEW.to_string(), vi as f64)]
+                .into_iter()
+                .collect()
+        } else {
+            BTreeMap::new()
+        },
+        values: [
+            (mirrorbox_report::value::SCENE_CAMERA, v.scene_camera),
+            (mirrorbox_report::value::ALPHA_PER_MIRROR, ctx.per_mirror),
+        ]
+        .into_iter()
+        .filter(|&(_, on)| on)
+        .map(|(name, _)| (name.to_string(), 1.0))
+        .collect(),
+        legacy: Default::default(),
+        stereo: None,
+        device: None,
+        n: None,
+        depth: None,
+        // Where the mirrors differ (`per_mirror`) or an older export kept no α,
+        // 1 stands for none; the reports say "per mirror" for the first.
+        alpha: views.alpha.unwrap_or(1.0),
+        width: v.width,
+        height: v.height,
+        ssaa: v.ssaa,
+        ms_median: mirrorbox_report::stats::median(&frames_ms),
+        ms_min: frames_ms.iter().copied().fold(f64::INFINITY, f64::min),
+        ms_interval: interval.map(|i| [i.low, i.high]),
+        frames: frames_ms.len() as u32,
+        frames_ms,
+        timing_order: mirrorbox_report::EXTERNAL_TIMING.into(),
+        run: Some(ctx.run.to_string()),
+        peak_memory_bytes: None,
+        plan_ms: None,
+        encode_ms: None,
+        gpu_buffer_bytes: None,
+        gpu_texture_bytes: None,
+        timing_source: timing.timing.clone(),
+        passes: 0,
+        draws: 0,
+        texture_renders: 0,
+        reflections: 0,
+        triangles: None,
+        paths: None,
+        paths_pruned: None,
+        metrics: compared.metrics,
+        mirror_metrics: compared.mirror_metrics,
+        mirror_pixel_share: compared.mirror_pixel_share,
+        split: None,
+        adapter: timing.device.clone(),
+        backend: format!("{} {}", timing.engine, timing.engine_version),
+        color_format: if png {
+            "png8 (sRGB)".into()
+        } else {
+            "exr (float)".into()
+        },
+        truth_image: rel(&files.truth),
+        raster_image: rel(&files.raster),
+        heatmap_image: rel(&files.heat),
+    })
+}
+
+/// Scores `run` against `export` into `out` (see the module docs). Every input is read and
+/// checked before anything is written; the report goes to `out.partial` and is moved into
+/// place at the end (an earlier score in `out` is replaced).
+pub fn score(
+    export: &Path,
+    run: &Path,
+    out: &Path,
+    settings: &ScoreSettings,
+) -> Result<Scored, HarnessError> {
+    let command = settings.command.as_str();
+    let views = read_views(export)?;
+    let ours = our_sweeps(&views, &settings.with)?;
+    let found = variants(run)?;
+    check_picture_names(&found, &views)?;
+    crate::exchange::replaceable(out, "sweep.json", "score")?;
+    check_not_a_sweep(out)?;
     for input in [export, run]
         .into_iter()
         .chain(settings.with.iter().map(PathBuf::as_path))
@@ -720,127 +878,22 @@ pub fn score(
             .unwrap_or_else(crate::now_rfc3339);
         // An export that keeps the hashes says its α wherever its mirrors share one.
         let per_mirror = views.alpha.is_none() && views.sweep_scene_hash.is_some();
+        let stage = ScoreStage {
+            export,
+            stage: partial,
+            views: &views,
+            run: &run_started,
+            per_mirror,
+        };
         for (client, variant, timing, images) in &inputs {
             for (vi, (v, image)) in views.views.iter().zip(images).enumerate() {
-                let floor = variant.as_str() == "floor";
-                let truth = export.join(if floor { &v.floor } else { &v.truth });
-                let slug = picture_stem(client, variant, &v.name);
-                let files = ViewFiles {
-                    raster: images_dir.join(format!("{slug}.png")),
-                    heat: images_dir.join(format!("{slug}_flip.png")),
-                    truth: images_dir.join(format!(
-                        "truth_{}{}.png",
-                        v.name,
-                        if floor { "_floor" } else { "" }
-                    )),
-                };
-                let compared = compare_views(
-                    std::slice::from_ref(&truth),
-                    std::slice::from_ref(image),
-                    v.camera.exposure,
-                    None,
-                    &files,
-                )?;
-                let frames_ms = timing.views[&v.name].clone();
-                let interval = mirrorbox_report::stats::median_interval(&frames_ms);
-                let rel = |p: &Path| {
-                    p.strip_prefix(partial)
-                        .unwrap_or(p)
-                        .to_string_lossy()
-                        .into_owned()
-                };
-                let png = image
-                    .extension()
-                    .is_some_and(|e| e.eq_ignore_ascii_case("png"));
-                records.push(Record {
-                    key: format!(
-                        "{client}/{variant}|{}|a{}|{}x{}|ssaa{}",
-                        v.name,
-                        views.alpha.map_or("-".to_string(), |a| a.to_string()),
-                        v.width,
-                        v.height,
-                        v.ssaa
-                    ),
-                    kind: if floor { "floor" } else { "point" }.into(),
-                    scene: views.source.clone(),
-                    scene_hash: v.scene_hash.clone(),
-                    method: if floor {
-                        client.to_string()
-                    } else {
-                        format!("{client}-{variant}")
-                    },
-                    // The variant's short knobs (its name in legends and tables), then the
-                    // method it is meant to match; every parameter is in variants.md.
-                    method_options: timing
-                        .parameters
-                        .iter()
-                        .map(|(k, v)| (k, v.to_string().trim_matches('"').to_string()))
-                        .filter(|(k, v)| is_knob(k, v))
-                        .map(|(k, v)| format!("{k}={v}"))
-                        .chain(timing.equivalent.iter().map(|e| format!("equivalent={e}")))
-                        .collect::<Vec<_>>()
-                        .join(" "),
-                    axes: if views.views.len() > 1 {
-                        [(mirrorbox_report::axis::VIEW.to_string(), vi as f64)]
-                            .into_iter()
-                            .collect()
-                    } else {
-                        BTreeMap::new()
-                    },
-                    values: [
-                        (mirrorbox_report::value::SCENE_CAMERA, v.scene_camera),
-                        (mirrorbox_report::value::ALPHA_PER_MIRROR, per_mirror),
-                    ]
-                    .into_iter()
-                    .filter(|&(_, on)| on)
-                    .map(|(name, _)| (name.to_string(), 1.0))
-                    .collect(),
-                    legacy: Default::default(),
-                    stereo: None,
-                    device: None,
-                    n: None,
-                    depth: None,
-                    // Where the mirrors differ (`per_mirror`) or an older export kept no α,
-                    // 1 stands for none; the reports say "per mirror" for the first.
-                    alpha: views.alpha.unwrap_or(1.0),
-                    width: v.width,
-                    height: v.height,
-                    ssaa: v.ssaa,
-                    ms_median: mirrorbox_report::stats::median(&frames_ms),
-                    ms_min: frames_ms.iter().copied().fold(f64::INFINITY, f64::min),
-                    ms_interval: interval.map(|i| [i.low, i.high]),
-                    frames: frames_ms.len() as u32,
-                    frames_ms,
-                    timing_order: mirrorbox_report::EXTERNAL_TIMING.into(),
-                    run: Some(run_started.clone()),
-                    peak_memory_bytes: None,
-                    plan_ms: None,
-                    encode_ms: None,
-                    gpu_buffer_bytes: None,
-                    gpu_texture_bytes: None,
-                    timing_source: timing.timing.clone(),
-                    passes: 0,
-                    draws: 0,
-                    texture_renders: 0,
-                    reflections: 0,
-                    triangles: None,
-                    paths: None,
-                    paths_pruned: None,
-                    metrics: compared.metrics,
-                    mirror_metrics: compared.mirror_metrics,
-                    mirror_pixel_share: compared.mirror_pixel_share,
-                    split: None,
-                    adapter: timing.device.clone(),
-                    backend: format!("{} {}", timing.engine, timing.engine_version),
-                    color_format: if png {
-                        "png8 (sRGB)".into()
-                    } else {
-                        "exr (float)".into()
-                    },
-                    truth_image: rel(&files.truth),
-                    raster_image: rel(&files.raster),
-                    heatmap_image: rel(&files.heat),
-                });
+                records.push(scored_record(
+                    &stage,
+                    (client, variant, timing),
+                    vi,
+                    v,
+                    image,
+                )?);
             }
         }
         // Our records' pictures come along (`images/with<k>_…`), so that their rows show.
