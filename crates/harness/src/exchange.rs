@@ -276,9 +276,10 @@ pub fn export_views(
 /// fails, removes it: a folder of the exchange (an export, a score, a merge, an advice) is
 /// written whole or not at all, and an earlier one in `dir` stays whole until the new one is.
 /// The earlier folder is marked ([`EARLIER_MARK`]) and moved aside to `dir.partial-earlier`
-/// before the new one is moved in, and removed only after, by way of the stage's name: a
-/// process stopped at any step leaves the earlier folder whole (put back by the next run) or
-/// the new one in place. A `dir.partial-earlier` without the mark is not ours, and is refused.
+/// before the new one is moved in, then unmarked and removed: a process stopped at any step
+/// leaves the earlier folder whole or the new one in place. A run that finds a marked aside
+/// and no `dir` puts it back and stops (the command's checks of `dir` ran before it was
+/// back); a `dir.partial-earlier` without the mark is not ours, and is refused untouched.
 pub(crate) fn in_staged_folder<T>(
     dir: &Path,
     write: impl FnOnce(&Path) -> Result<T, HarnessError>,
@@ -288,39 +289,62 @@ pub(crate) fn in_staged_folder<T>(
     let ours = |folder: &Path| folder.join(EARLIER_MARK).is_file();
     if aside.exists() && !ours(&aside) {
         return Err(HarnessError::Exchange(format!(
-            "{}: exists and is not an earlier {} moved aside by mirrorbox; rename it or choose              another output folder",
+            "{}: exists and is not an earlier {} moved aside by mirrorbox; rename it or choose \
+             another output folder",
             aside.display(),
             dir.display()
         )));
     }
     if partial.exists() {
-        // A stale stage goes; one another process is writing is refused.
-        drop(mirrorbox_files::FolderLock::try_acquire(&partial)?);
+        // A stale stage goes, removed under its lock; one another process is writing is
+        // refused.
+        let stale = mirrorbox_files::FolderLock::try_acquire(&partial)?;
         std::fs::remove_dir_all(&partial).map_err(io(&partial))?;
+        drop(stale);
     }
     if aside.exists() && !dir.exists() {
         // A run stopped between moving the earlier folder aside and moving its own in: the
-        // earlier one goes back.
+        // earlier one goes back, and this run stops there, so that the command's own checks
+        // of its output folder (made before this) see what is in it now.
         std::fs::rename(&aside, dir).map_err(io(dir))?;
         let _ = std::fs::remove_file(dir.join(EARLIER_MARK));
+        return Err(HarnessError::Exchange(format!(
+            "{}: put back from {} (a run stopped while replacing it); run the command again",
+            dir.display(),
+            aside.display()
+        )));
+    }
+    // An earlier run's leftover aside (ours, and `dir` in place): unmarked first, so that a
+    // removal cut short is never put back.
+    let remove_aside = || {
+        let _ = std::fs::remove_file(aside.join(EARLIER_MARK));
+        let _ = std::fs::remove_dir_all(&aside);
+    };
+    if aside.exists() {
+        remove_aside();
     }
     std::fs::create_dir_all(&partial).map_err(io(&partial))?;
     let stage_lock = mirrorbox_files::FolderLock::try_acquire(&partial)?;
     let done = match write(&partial) {
         Ok(done) => done,
         Err(e) => {
-            drop(stage_lock);
             let _ = std::fs::remove_dir_all(&partial);
+            drop(stage_lock);
             return Err(e);
         }
     };
     if dir.exists() {
         if aside.exists() {
-            // Ours (checked above): an earlier run stopped before removing it.
-            std::fs::remove_dir_all(&aside).map_err(io(&aside))?;
+            return Err(HarnessError::Exchange(format!(
+                "{}: could not be removed; remove it and run the command again",
+                aside.display()
+            )));
         }
         std::fs::write(dir.join(EARLIER_MARK), "").map_err(io(dir))?;
-        std::fs::rename(dir, &aside).map_err(io(dir))?;
+        if let Err(e) = std::fs::rename(dir, &aside) {
+            let _ = std::fs::remove_file(dir.join(EARLIER_MARK));
+            return Err(io(dir)(e));
+        }
     }
     if let Err(e) = std::fs::rename(&partial, dir) {
         // Put the earlier folder back.
@@ -330,11 +354,8 @@ pub(crate) fn in_staged_folder<T>(
         return Err(io(dir)(e));
     }
     drop(stage_lock);
-    // The earlier folder is removed under the stage's name, which the next run clears if this
-    // one stops half-way (it is never put back from there); a failure here loses nothing.
-    if aside.exists() && std::fs::rename(&aside, &partial).is_ok() {
-        let _ = std::fs::remove_dir_all(&partial);
-    }
+    // A failure here loses nothing: the new folder is in place.
+    remove_aside();
     Ok(done)
 }
 
@@ -682,14 +703,14 @@ mod tests {
             [(PathBuf::from("records.jsonl"), b"new\n".to_vec())]
         );
         assert_eq!(names(root.path()), ["out"]);
-        // A run stopped after moving the earlier folder aside: the next puts it back first,
-        // and a write that fails then leaves it in place.
+        // A run stopped after moving the earlier folder aside: the next puts it back and
+        // stops, writing nothing (the command's own checks of OUT ran before it was back).
         std::fs::write(dir.join(EARLIER_MARK), "").unwrap();
         std::fs::rename(&dir, earlier_folder(&dir)).unwrap();
         let kept = in_staged_folder(&dir, |_| -> Result<(), HarnessError> {
-            Err(HarnessError::Exchange("failed".into()))
+            panic!("written before the earlier folder was checked again")
         });
-        assert!(kept.is_err());
+        assert!(kept.unwrap_err().to_string().contains("put back"));
         assert_eq!(
             contents(&dir),
             [(PathBuf::from("records.jsonl"), b"new\n".to_vec())]

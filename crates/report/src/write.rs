@@ -420,20 +420,28 @@ fn write_csv(path: &Path, records: &[Record]) -> Result<(), FileError> {
         keys.dedup();
         keys
     };
+    let axes = keys(|r| &r.axes);
+    let values = keys(|r| &r.values);
     // A key named as a fixed column, or a value named as an axis, would give two columns one
-    // name: it gets none of its own (no record has such a key today).
+    // name: its column says which map it is from (no record has such a key today).
     let fixed: Vec<&str> = CSV_HEAD.split(',').chain(CSV_TAIL.split(',')).collect();
-    let axes: Vec<&str> = keys(|r| &r.axes)
-        .into_iter()
-        .filter(|a| !fixed.contains(a))
-        .collect();
-    let values: Vec<&str> = keys(|r| &r.values)
-        .into_iter()
-        .filter(|v| !axes.contains(v) && !fixed.contains(v))
-        .collect();
+    let column = |key: &str, taken: bool, map: &str| {
+        if taken || fixed.contains(&key) {
+            format!("{map}.{key}")
+        } else {
+            key.to_string()
+        }
+    };
     let mut s = String::from(CSV_HEAD);
-    for key in axes.iter().chain(&values) {
-        let _ = write!(s, ",{}", csv_cell(key));
+    for key in &axes {
+        let _ = write!(s, ",{}", csv_cell(&column(key, false, "axes")));
+    }
+    for key in &values {
+        let _ = write!(
+            s,
+            ",{}",
+            csv_cell(&column(key, axes.contains(key), "values"))
+        );
     }
     let _ = writeln!(s, ",{CSV_TAIL}");
     let cell = |v: Option<&f64>| v.map_or(String::new(), |x| x.to_string());
@@ -1531,6 +1539,24 @@ pub(crate) mod tests {
         for absent in ["symmetry_planes", "bump_deg", "copies_total", "stereo_ipd"] {
             assert_eq!(column(absent), None, "{absent}: {header:?}");
         }
+        // A key named as a fixed column, or a value named as an axis, keeps a column of its
+        // own, named with its map.
+        let mut c = record(2, 30.0, 5, 0.07);
+        c.axes.insert("alpha".into(), 0.5);
+        c.axes.insert("planes".into(), 1.0);
+        c.values.insert("planes".into(), 3.0);
+        write_report(dir.path(), &SweepInfo::default(), &[c], &[]).unwrap();
+        let rows = parse_csv(&std::fs::read_to_string(dir.path().join("results.csv")).unwrap());
+        let header = &rows[0];
+        let at = |name: &str| header.iter().position(|h| h == name).unwrap();
+        assert_eq!(
+            header.iter().filter(|h| *h == "alpha").count(),
+            1,
+            "{header:?}"
+        );
+        assert_eq!(rows[1][at("axes.alpha")], "0.5");
+        assert_eq!(rows[1][at("planes")], "1");
+        assert_eq!(rows[1][at("values.planes")], "3");
     }
 
     /// Text a client wrote (its timing, its engine) comes back from results.csv cell for
