@@ -84,14 +84,12 @@ fn our_run(run: &Path) -> std::path::PathBuf {
 
 /// `sweep` of `naive` at the export's size and α into `out`: its point's record.
 fn sweep_naive(out: &Path) -> Value {
-    let mut args = vec![
-        "sweep",
-        "scenes/mirror_box.json",
-        "--methods",
-        "naive",
-        "--alpha",
-        "0.9",
-    ];
+    sweep_naive_of("scenes/mirror_box.json", "0.9", out)
+}
+
+/// `sweep SCENE` of `naive` at α `alpha` and the exports' size into `out`: its point's record.
+fn sweep_naive_of(scene: &str, alpha: &str, out: &Path) -> Value {
+    let mut args = vec!["sweep", scene, "--methods", "naive", "--alpha", alpha];
     args.extend(["--frames", "1", "--out", out.to_str().unwrap()]);
     args.extend(SIZE);
     let done = mirrorbox(&args, &[]);
@@ -598,21 +596,7 @@ fn an_export_without_alpha_says_the_scenes_own() {
     assert_eq!(alpha_of(uneven.to_str().unwrap()), Value::Null);
     // A sweep (one α for every mirror) is no view of that export's scene: refused beside it.
     let sweep = tmp.path().join("sweep");
-    let mut args = vec![
-        "sweep",
-        uneven.to_str().unwrap(),
-        "--methods",
-        "naive",
-        "--alpha",
-        "0.8",
-        "--frames",
-        "1",
-        "--out",
-        sweep.to_str().unwrap(),
-    ];
-    args.extend(SIZE);
-    let done = mirrorbox(&args, &[]);
-    assert_eq!(done.code, 0, "{}", done.stderr);
+    sweep_naive_of(uneven.to_str().unwrap(), "0.8", &sweep);
     let run = tmp.path().join("run");
     our_run(&run);
     let export = tmp.path().join(uneven.to_str().unwrap().replace('/', "_"));
@@ -630,14 +614,14 @@ fn an_export_without_alpha_says_the_scenes_own() {
     );
     // Scored alone, its records say their α is per mirror, not the 1 they carry.
     let scored = tmp.path().join("scored_alone");
-    let out = run_score(&export, &run, &scored, &[]);
-    assert_eq!(out.code, 0, "{}", out.stderr);
-    let records = std::fs::read_to_string(scored.join("results.jsonl")).unwrap();
-    assert!(records.lines().count() >= 1, "{records}");
-    assert!(records.lines().all(|l| {
-        let r: Value = serde_json::from_str(l).unwrap();
-        r["values"]["alpha_per_mirror"] == 1.0
-    }));
+    let records = score(&export, &run, &scored);
+    assert!(!records.is_empty());
+    assert!(
+        records
+            .iter()
+            .all(|r| r["values"]["alpha_per_mirror"] == 1.0),
+        "{records:?}"
+    );
     let md = std::fs::read_to_string(scored.join("report.md")).unwrap();
     // Every row of "All points" says so in its α column, and no sentence says α = 1.
     let table: Vec<&str> = md
