@@ -1415,6 +1415,11 @@ pub fn run_sweep(
             ))
         })
         .collect();
+    let point_run = PointRun {
+        scene_hash: base_hash,
+        size: (w, h),
+        run: &run_started,
+    };
     for ((i, p), compared) in todo.iter().enumerate().zip(compared) {
         let Some(compared) = compared else {
             continue;
@@ -1423,11 +1428,7 @@ pub fn run_sweep(
         let record = point_record(
             p,
             config,
-            &PointRun {
-                scene_hash: base_hash,
-                size: (w, h),
-                run: &run_started,
-            },
+            &point_run,
             &report,
             std::mem::take(&mut timing[i]),
             compared?,
