@@ -126,8 +126,14 @@ fn records_commit(path: &std::path::Path) -> String {
     } else {
         dir
     };
-    mirrorbox_harness::git_output(&dir, &["log", "-1", "--format=%h", "--", &file])
-        .unwrap_or_default()
+    // Seven hex digits, as every committed report has: git's own `%h` grows with the
+    // repository's object count (eight past 16 384 objects), which would change every
+    // report's footer with no record changed.
+    mirrorbox_harness::git_output(
+        &dir,
+        &["log", "-1", "--abbrev=7", "--format=%h", "--", &file],
+    )
+    .unwrap_or_default()
 }
 
 /// What the registry's experiment writing the report folder `folder` (under `reports/`)
@@ -202,5 +208,17 @@ mod tests {
             "{other}"
         );
         assert_eq!(about("mine/sweep"), None);
+    }
+
+    /// A report's footer names its records' commit in seven hex digits whatever the
+    /// repository's size: this repository holds more than 16 384 objects, where git's own
+    /// `%h` gives eight and every committed footer would change.
+    #[test]
+    fn the_records_commit_has_seven_hex_digits() {
+        let bench =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../reports/tracer/bench.md");
+        let commit = records_commit(&bench);
+        assert_eq!(commit.len(), 7, "{commit:?}");
+        assert!(commit.chars().all(|c| c.is_ascii_hexdigit()), "{commit:?}");
     }
 }
