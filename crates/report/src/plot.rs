@@ -288,6 +288,10 @@ const BOTTOM: f64 = 92.0;
 /// Half-length of an error bar's end caps, px.
 const ERROR_CAP: f64 = 4.0;
 const MARKER_R: f64 = 4.0;
+/// How far past the plot's frame the data's clip reaches: a marker on the frame (a point at
+/// x = 0 on an axis starting there) is drawn whole, not cut in half. The axes hold every
+/// point, so only markers and their rings reach into it.
+const CLIP_MARGIN: f64 = 2.5 * MARKER_R;
 
 fn esc(s: &str) -> String {
     s.replace('&', "&amp;")
@@ -487,6 +491,17 @@ fn place_label(
     })
 }
 
+/// The points of a reference's line as the frame shows them: a level across the plot, a
+/// curve's visible points; none for a mark, or a level off a log axis. Fewer than two: no
+/// line, and no legend entry.
+fn reference_line(r: &Reference, f: &Frame) -> Vec<(f64, f64)> {
+    match r {
+        Reference::Level(_, y) if drawable(*y, f.ay.log) => vec![(f.ax.lo, *y), (f.ax.hi, *y)],
+        Reference::Level(..) | Reference::Mark(..) => Vec::new(),
+        Reference::Curve(_, pts) => pts.iter().copied().filter(|&p| f.shows(p)).collect(),
+    }
+}
+
 fn marker_svg(s: &mut String, style: &Style, x: f64, y: f64, r: f64, hollow: bool) {
     let c = style.color;
     let (fill, stroke) = if hollow {
@@ -528,6 +543,40 @@ fn marker_svg(s: &mut String, style: &Style, x: f64, y: f64, r: f64, hollow: boo
                 p.join(" ")
             )
         }
+        // Hollow, a plus or a cross is its outline (a thin stroke alone read as the filled
+        // one where points are not joined: two variants alike).
+        Marker::Cross | Marker::Plus if hollow => {
+            let (arm, half) = (r * 1.35, r * 0.45);
+            let turn = if style.marker == Marker::Cross {
+                std::f64::consts::FRAC_PI_4
+            } else {
+                0.0
+            };
+            let outline = [
+                (half, half),
+                (arm, half),
+                (arm, -half),
+                (half, -half),
+                (half, -arm),
+                (-half, -arm),
+                (-half, -half),
+                (-arm, -half),
+                (-arm, half),
+                (-half, half),
+                (-half, arm),
+                (half, arm),
+            ];
+            let (sin, cos) = turn.sin_cos();
+            let p: Vec<String> = outline
+                .iter()
+                .map(|(a, b)| format!("{:.1},{:.1}", x + a * cos - b * sin, y + a * sin + b * cos))
+                .collect();
+            writeln!(
+                s,
+                r#"<polygon points="{}" fill="{fill}" {stroke}/>"#,
+                p.join(" ")
+            )
+        }
         Marker::Cross | Marker::Plus => {
             let k = r * 1.1;
             let d = if style.marker == Marker::Cross {
@@ -554,7 +603,7 @@ fn marker_svg(s: &mut String, style: &Style, x: f64, y: f64, r: f64, hollow: boo
             writeln!(
                 s,
                 r#"<path d="{d}" stroke="{c}" stroke-width="{}" fill="none"/>"#,
-                if hollow { 1.4 } else { 2.2 }
+                2.2
             )
         }
     };
@@ -809,9 +858,11 @@ impl Chart {
             (LEFT + PLOT_W / 2.0).max(title_w / 2.0 + 8.0),
             esc(&self.title)
         );
-        // The floor band first, under everything.
-        let floor_note = self.floor_band(&mut s, &f);
+        // The floor band first, under everything; its label over the grid lines.
+        let mut floor_label = String::new();
+        let floor_note = self.floor_band(&mut s, &mut floor_label, &f);
         self.grid_and_axes(&mut s, &f);
+        s.push_str(&floor_label);
         let mut below = TOP + PLOT_H + 54.0;
         if let Some(note) = floor_note {
             let _ = writeln!(
@@ -833,7 +884,11 @@ impl Chart {
         // markers (rings where an earlier marker sits) and labels that touch no other.
         let _ = writeln!(
             s,
-            r#"<clipPath id="plot"><rect x="{LEFT}" y="{TOP}" width="{PLOT_W}" height="{PLOT_H}"/></clipPath><g clip-path="url(#plot)">"#
+            r#"<clipPath id="plot"><rect x="{:.1}" y="{:.1}" width="{:.1}" height="{:.1}"/></clipPath><g clip-path="url(#plot)">"#,
+            LEFT - CLIP_MARGIN,
+            TOP - CLIP_MARGIN,
+            PLOT_W + 2.0 * CLIP_MARGIN,
+            PLOT_H + 2.0 * CLIP_MARGIN
         );
         self.reference_lines(&mut s, &f);
         self.series_lines(&mut s, &f);
@@ -873,6 +928,9 @@ impl Chart {
             legend.push((name, Shows::Series(series)));
         }
         for r in &self.references {
+            if !matches!(r, Reference::Mark(..)) && reference_line(r, f).len() < 2 {
+                continue;
+            }
             let name = match r {
                 Reference::Level(n, _) | Reference::Curve(n, _) => format!("reference: {n}"),
                 Reference::Mark(n, _) => n.clone(),
@@ -888,9 +946,10 @@ impl Chart {
         legend
     }
 
-    /// The floor's band (grey, under everything) where the y axis shows it; else the note
-    /// that says where it is, returned for the space under the plot.
-    fn floor_band(&self, s: &mut String, f: &Frame) -> Option<String> {
+    /// The floor's band (grey, under everything) where the y axis shows it, with its label in
+    /// `label` (drawn after the grid, which would cross it); else the note that says where it
+    /// is, returned for the space under the plot.
+    fn floor_band(&self, s: &mut String, label: &mut String, f: &Frame) -> Option<String> {
         let mut floor_note = self.floor.filter(|v| !drawable(*v, f.ay.log)).map(|v| {
             format!(
                 "floor of the comparison (no mirrors): {}, every difference above it is the method's",
@@ -906,8 +965,8 @@ impl Chart {
                     TOP + PLOT_H - yf
                 );
                 let _ = writeln!(
-                    s,
-                    r##"<text x="{:.1}" y="{:.1}" font-size="10" fill="#555" text-anchor="end">floor (no mirrors) {}: not resolved below</text>"##,
+                    label,
+                    r##"<text x="{:.1}" y="{:.1}" font-size="10" fill="#555" text-anchor="end" stroke="white" stroke-width="3" paint-order="stroke">floor (no mirrors) {}: not resolved below</text>"##,
                     LEFT + PLOT_W - 4.0,
                     (yf + 11.0).min(TOP + PLOT_H - 3.0),
                     fmt_tick(v)
@@ -982,29 +1041,21 @@ impl Chart {
         );
     }
 
-    /// The reference levels and curves, grey, each its own dash.
+    /// The reference levels and curves, grey, each its own dash: the `i`-th drawn takes the
+    /// `i`-th dash, as its legend entry does (one that draws nothing has neither).
     fn reference_lines(&self, s: &mut String, f: &Frame) {
         let lines = self
             .references
             .iter()
-            .filter(|r| !matches!(r, Reference::Mark(..)));
-        for (i, r) in lines.enumerate() {
+            .map(|r| reference_line(r, f))
+            .filter(|pts| pts.len() >= 2);
+        for (i, pts) in lines.enumerate() {
             let dash = REFERENCE_DASHES[i % REFERENCE_DASHES.len()];
-            let pts: Vec<(f64, f64)> = match r {
-                Reference::Level(_, y) if drawable(*y, f.ay.log) => {
-                    vec![(f.ax.lo, *y), (f.ax.hi, *y)]
-                }
-                Reference::Level(..) => Vec::new(),
-                Reference::Curve(_, pts) => pts.iter().copied().filter(|&p| f.shows(p)).collect(),
-                Reference::Mark(..) => Vec::new(),
-            };
-            if pts.len() >= 2 {
-                let _ = writeln!(
-                    s,
-                    r#"<polyline points="{}" fill="none" stroke="{REFERENCE_GREY}" stroke-width="1.5" stroke-dasharray="{dash}"/>"#,
-                    f.polyline(&pts)
-                );
-            }
+            let _ = writeln!(
+                s,
+                r#"<polyline points="{}" fill="none" stroke="{REFERENCE_GREY}" stroke-width="1.5" stroke-dasharray="{dash}"/>"#,
+                f.polyline(&pts)
+            );
         }
     }
 
@@ -1455,6 +1506,99 @@ mod tests {
             "{:?}",
             c.lint()
         );
+    }
+
+    /// Every marker's hollow form is an outline with an inside (white fill), not the filled
+    /// form drawn thinner: a plus or cross drawn as two thin strokes read as the filled one
+    /// where points are not joined (two variants alike).
+    #[test]
+    fn every_hollow_marker_is_an_outline_apart_from_its_filled_form() {
+        for marker in Marker::ALL {
+            let style = Style {
+                marker,
+                ..method_style("cubemap")
+            };
+            let (mut filled, mut hollow) = (String::new(), String::new());
+            marker_svg(&mut filled, &style, 50.0, 50.0, MARKER_R, false);
+            marker_svg(&mut hollow, &style, 50.0, 50.0, MARKER_R, true);
+            assert!(hollow.contains(r#"fill="white""#), "{marker:?}: {hollow}");
+            let shape = |svg: &str| svg.split_whitespace().next().unwrap().to_string();
+            if matches!(marker, Marker::Plus | Marker::Cross) {
+                assert_ne!(shape(&filled), shape(&hollow), "{marker:?}");
+            }
+        }
+    }
+
+    /// A point on the frame (x = 0 where the axis starts at 0) is drawn whole: the data's clip
+    /// reaches a marker's size past the plot's frame.
+    #[test]
+    fn a_marker_on_the_frame_is_not_cut() {
+        let mut c = chart(vec![Series::new(
+            "a",
+            method_style("auxiliary"),
+            vec![(0.0, 0.5), (10.0, 0.1)],
+        )]);
+        c.x_log = false;
+        let svg = c.to_svg();
+        let clip = svg
+            .split("<clipPath id=\"plot\"><rect x=\"")
+            .nth(1)
+            .unwrap();
+        let clip_x: f64 = clip.split('"').next().unwrap().parse().unwrap();
+        let cx: f64 = svg
+            .split("<circle cx=\"")
+            .nth(1)
+            .unwrap()
+            .split('"')
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap();
+        assert!(
+            (cx - LEFT).abs() < 0.1,
+            "the point at 0 sits on the frame: {cx}"
+        );
+        assert!(
+            clip_x <= cx - 2.0 * MARKER_R,
+            "clip from {clip_x}, marker at {cx}"
+        );
+    }
+
+    /// A reference that draws no line (a curve with one visible point) has no legend entry,
+    /// and the next one takes the first dash in plot and legend alike.
+    #[test]
+    fn a_reference_drawn_as_no_line_is_not_in_the_legend() {
+        let mut c = chart(vec![Series::new(
+            "a",
+            method_style("auxiliary"),
+            vec![(1.0, 0.5), (10.0, 0.1)],
+        )]);
+        c.references = vec![
+            Reference::Curve("Pareto front".into(), vec![(1.0, 0.5)]),
+            Reference::Curve("budget".into(), vec![(5.0, 0.1), (5.0, 0.5)]),
+        ];
+        let svg = c.to_svg();
+        assert!(!svg.contains("Pareto front"), "{svg}");
+        assert!(svg.contains("reference: budget"), "{svg}");
+        let dash = format!("stroke-dasharray=\"{}\"", REFERENCE_DASHES[0]);
+        assert_eq!(svg.matches(&dash).count(), 2, "{svg}");
+    }
+
+    /// The floor band's label is drawn after the grid lines, which would cross it.
+    #[test]
+    fn the_floor_label_lies_over_the_grid() {
+        let mut c = chart(vec![Series::new(
+            "a",
+            method_style("auxiliary"),
+            vec![(1.0, 0.5), (10.0, 0.1)],
+        )]);
+        c.floor = Some(0.2);
+        let svg = c.to_svg();
+        let label = svg
+            .find("floor (no mirrors) 0.2")
+            .expect("a band with its label");
+        let last_grid = svg.rfind(r##"stroke="#e5e5e5""##).unwrap();
+        assert!(label > last_grid, "{svg}");
     }
 
     #[test]

@@ -843,13 +843,15 @@ impl<'a> Variants<'a> {
 
     /// One series per method variant and α, joined along its one swept setting (n or depth):
     /// `keep`, which of a group's points the chart shows; `ms_on_x`, x is the median time,
-    /// drawn with its 95 % interval as an error bar.
+    /// drawn with its 95 % interval as an error bar; `x_log`, whether the x axis is
+    /// logarithmic (a linear one shows x = 0: n = 0 auxiliary mirrors). The y axis is.
     fn series(
         &self,
         keep: &dyn Fn(&Record) -> bool,
         x: &dyn Fn(&Record) -> f64,
         y: &dyn Fn(&Record) -> Option<f64>,
         ms_on_x: bool,
+        x_log: bool,
     ) -> Vec<Series> {
         self.groups
             .iter()
@@ -872,7 +874,7 @@ impl<'a> Variants<'a> {
                 // legend, not drawn.
                 let (pts, zero): (Vec<&Record>, Vec<&Record>) = pts.iter().partition(|r| {
                     let (px, py) = (x(r), y(r).unwrap_or(f64::NAN));
-                    px.is_finite() && px > 0.0 && py.is_finite() && py > 0.0
+                    px.is_finite() && (px > 0.0 || !x_log) && py.is_finite() && py > 0.0
                 });
                 if pts.is_empty() {
                     return None;
@@ -922,7 +924,7 @@ fn error_against_time(v: &Variants, floor: Option<&Record>, floors: usize) -> Ve
             Box::new(Chart {
                 x_log: true,
                 y_log: true,
-                series: v.series(&any, &ms, y, true),
+                series: v.series(&any, &ms, y, true, true),
                 floor: band,
                 ..Chart::new(
                     format!("{title} vs cost{alpha_note}"),
@@ -936,7 +938,8 @@ fn error_against_time(v: &Variants, floor: Option<&Record>, floors: usize) -> Ve
         Block::Heading(2, "Error against time".into()),
         Block::Paragraph(format!(
             "Each method's points joined along its swept setting (n or the depth cap, labelled); \
-             the shaded band is {} (raster vs trace without mirrors).",
+             the shaded band is {} (raster vs trace without mirrors), where the y axis reaches \
+             it; a note under a chart gives it where it lies below the axis.",
             match floor {
                 Some(fl) if floors > 1 => format!("the floor of {}", floor_name(fl)),
                 _ => "the comparison's floor".to_string(),
@@ -980,6 +983,7 @@ fn error_against_setting(v: &Variants, floor: Option<&Record>) -> Vec<Block> {
                     &|r| f64::from(r.n.unwrap_or(0)),
                     &flip,
                     false,
+                    false,
                 ),
                 floor: floor.map(|fl| fl.metrics.flip_mean),
                 x_ticks_at_data: true,
@@ -1000,6 +1004,7 @@ fn error_against_setting(v: &Variants, floor: Option<&Record>) -> Vec<Block> {
                     &|r| f64::from(r.depth.unwrap_or(0)),
                     &flip,
                     false,
+                    true,
                 ),
                 floor: floor.map(|fl| fl.metrics.flip_mean),
                 x_ticks_at_data: true,
@@ -1397,6 +1402,30 @@ pub(crate) mod tests {
         let columns = |l: &str| l.split(',').count();
         let header = columns(csv.lines().next().unwrap());
         assert!(csv.lines().skip(1).all(|l| columns(l) == header), "{csv}");
+    }
+
+    /// n = 0 (no auxiliary mirror: the seed's Algorithm 1) is drawn on the linear n axis with
+    /// the other n, not named as "not drawn" in the legend as a log axis would have to.
+    #[test]
+    fn n_zero_is_drawn_on_the_linear_n_axis() {
+        let dir = tempfile::tempdir().unwrap();
+        let records = [
+            record(0, 1.0, 1, 0.2),
+            record(1, 2.0, 3, 0.1),
+            record(2, 3.0, 5, 0.05),
+        ];
+        write_report(dir.path(), &SweepInfo::default(), &records, &[]).unwrap();
+        let svg = std::fs::read_to_string(dir.path().join("plot_flip_vs_n.svg")).unwrap();
+        assert!(!svg.contains("not drawn"), "{svg}");
+        assert!(svg.contains(">0</text>"), "a tick at n = 0: {svg}");
+        assert_eq!(
+            svg.matches("<circle").count(),
+            4,
+            "three points and the legend's: {svg}"
+        );
+        // The log axis of time keeps its rule: nothing at 0 there to leave out.
+        let ms = std::fs::read_to_string(dir.path().join("plot_flip_vs_ms.svg")).unwrap();
+        assert!(!ms.contains("not drawn"), "{ms}");
     }
 
     /// A score's several floors (each client's and view's, and ours) are each named in the

@@ -53,7 +53,7 @@ pub fn depth_scaling(info: &SweepInfo, records: &[Record], floor: Option<&Record
                             .iter()
                             .map(|r| {
                                 if (r.reflections as f64) < setting(r) {
-                                    format!("{} shown", r.reflections)
+                                    format!("{} reflections shown", r.reflections)
                                 } else {
                                     String::new()
                                 }
