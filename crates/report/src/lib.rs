@@ -292,6 +292,20 @@ pub mod value {
     pub const ALPHA_PER_MIRROR: &str = "alpha_per_mirror";
 }
 
+/// The time bars one chart draws for all of its `points`: their 95 % intervals where every
+/// point has one; else, where every point was timed on two frames or more, each point's
+/// fastest to slowest frame (sweeps of five frames have no 95 % interval; a chart showed
+/// their medians bare); else the intervals some have. One kind per chart: the axis label
+/// says which ([`plot::Chart`]).
+pub fn ms_bars_for<'a>(points: impl IntoIterator<Item = &'a Record> + Clone) -> plot::Bars {
+    let all = |f: &dyn Fn(&Record) -> bool| points.clone().into_iter().all(f);
+    if !all(&|r| r.ms_interval.is_some()) && all(&|r| r.frames_ms.len() >= 2) {
+        plot::Bars::FrameRange
+    } else {
+        plot::Bars::Ci95
+    }
+}
+
 /// A point's error against the truth, split at the reflection count `reflections` it shows
 /// (the method's `FrameStats::depth`): **truncation**, the truth traced with at most that
 /// many reflections (the terminal radiance beyond, as `trace --max-depth`) against the full
@@ -394,6 +408,22 @@ impl Record {
         for (name, value) in legacy {
             if let Some(v) = value {
                 self.axes.entry(name.to_string()).or_insert(v);
+            }
+        }
+    }
+
+    /// The bars of this point's time in a chart drawn with `bars` ([`ms_bars_for`]).
+    pub fn ms_bars(&self, bars: plot::Bars) -> Option<[f64; 2]> {
+        match bars {
+            plot::Bars::Ci95 => self.ms_interval,
+            plot::Bars::FrameRange => {
+                let lo = self.frames_ms.iter().copied().fold(f64::INFINITY, f64::min);
+                let hi = self
+                    .frames_ms
+                    .iter()
+                    .copied()
+                    .fold(f64::NEG_INFINITY, f64::max);
+                (self.frames_ms.len() >= 2 && lo.is_finite() && hi.is_finite()).then_some([lo, hi])
             }
         }
     }

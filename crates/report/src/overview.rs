@@ -374,7 +374,8 @@ fn frontier_chart(
                 pts.iter().map(|r| (r.ms_median, error(r))).collect(),
             );
             s.joined = false;
-            s.x_intervals = pts.iter().map(|r| r.ms_interval).collect();
+            s.bars = crate::ms_bars_for(records.iter().copied());
+            s.x_intervals = pts.iter().map(|r| r.ms_bars(s.bars)).collect();
             s.labels = pts
                 .iter()
                 .map(|r| {

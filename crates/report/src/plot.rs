@@ -154,6 +154,19 @@ pub struct Series {
     /// Joined by a line, in the order given: only when the points are one variable swept
     /// (n, depth, p, tilt, IPD), never across methods or unrelated settings.
     pub joined: bool,
+    /// What the intervals are: the axis label says it ([`CI_BARS`], [`RANGE_BARS`]).
+    pub bars: Bars,
+}
+
+/// What a series' error bars show.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Bars {
+    /// The 95 % interval of the median (six frames or more).
+    #[default]
+    Ci95,
+    /// Each point's fastest to slowest frame: points timed on too few frames for a 95 %
+    /// interval (with 5, [min, max] holds the median 94 % of the time).
+    FrameRange,
 }
 
 impl Series {
@@ -167,6 +180,7 @@ impl Series {
             y_intervals: Vec::new(),
             style,
             joined: true,
+            bars: Bars::Ci95,
         }
     }
 }
@@ -189,6 +203,8 @@ const MARK_R: f64 = 12.5;
 /// What an axis label adds when its points carry their 95 % intervals as bars
 /// (`"ms/frame (median, 95 % CI bars)"`); [`Chart::axis_label`] drops it where none is drawn.
 pub const CI_BARS: &str = ", 95 % CI bars";
+/// What [`CI_BARS`] becomes where the bars are each point's range of frames ([`Bars::FrameRange`]).
+pub const RANGE_BARS: &str = ", bars: fastest to slowest frame";
 
 pub struct Chart {
     pub title: String,
@@ -213,16 +229,21 @@ pub struct Chart {
 impl Chart {
     /// An axis label as drawn: a label that promises interval bars ([`CI_BARS`]) keeps the
     /// promise only where some series draws an interval on that axis (issue 54: every
-    /// frontier chart said "95 % CI bars" and drew none).
+    /// frontier chart said "95 % CI bars" and drew none), and says "fastest to slowest frame"
+    /// ([`RANGE_BARS`]) where the bars drawn are ranges of frames.
     fn axis_label(&self, label: &str, intervals: fn(&Series) -> &Vec<Option<[f64; 2]>>) -> String {
-        let drawn = self
+        let drawn: Vec<Bars> = self
             .series
             .iter()
-            .any(|s| intervals(s).iter().any(Option::is_some));
-        if drawn {
-            label.to_string()
-        } else {
+            .filter(|s| intervals(s).iter().any(Option::is_some))
+            .map(|s| s.bars)
+            .collect();
+        if drawn.is_empty() {
             label.replace(CI_BARS, "")
+        } else if drawn.contains(&Bars::FrameRange) {
+            label.replace(CI_BARS, RANGE_BARS)
+        } else {
+            label.to_string()
         }
     }
 

@@ -900,7 +900,8 @@ impl<'a> Variants<'a> {
                     .map(|r| crate::document::swept_label(r))
                     .collect();
                 if ms_on_x {
-                    s.x_intervals = pts.iter().map(|r| r.ms_interval).collect();
+                    s.bars = crate::ms_bars_for(self.points.iter().copied());
+                    s.x_intervals = pts.iter().map(|r| r.ms_bars(s.bars)).collect();
                 }
                 Some(s)
             })
@@ -1426,6 +1427,53 @@ pub(crate) mod tests {
         // The log axis of time keeps its rule: nothing at 0 there to leave out.
         let ms = std::fs::read_to_string(dir.path().join("plot_flip_vs_ms.svg")).unwrap();
         assert!(!ms.contains("not drawn"), "{ms}");
+    }
+
+    /// Points timed on too few frames for a 95 % interval (five) are drawn with each one's
+    /// fastest to slowest frame as its bar, and the axis says so; where every point has its
+    /// interval, the intervals are the bars. Before, such charts showed bare medians.
+    #[test]
+    fn points_without_an_interval_show_their_range_of_frames() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut records = [
+            record(0, 1.0, 1, 0.2),
+            record(1, 2.0, 3, 0.1),
+            record(2, 3.0, 5, 0.05),
+        ];
+        for r in &mut records {
+            r.frames_ms = [0.9, 1.0, 1.1, 1.2, 1.4].map(|f| f * r.ms_median).to_vec();
+        }
+        write_report(dir.path(), &SweepInfo::default(), &records, &[]).unwrap();
+        let svg = std::fs::read_to_string(dir.path().join("plot_flip_vs_ms.svg")).unwrap();
+        assert!(
+            svg.contains(">ms/frame (median, bars: fastest to slowest frame)<"),
+            "{svg}"
+        );
+        assert_eq!(
+            svg.matches("<path d=\"M").count(),
+            3,
+            "one bar a point: {svg}"
+        );
+        assert_eq!(
+            records[1].ms_bars(crate::plot::Bars::FrameRange),
+            Some([1.8, 2.8])
+        );
+        // Every point with its interval: the intervals, and the axis says 95 %.
+        for r in &mut records {
+            r.ms_interval = Some([0.95 * r.ms_median, 1.05 * r.ms_median]);
+        }
+        assert_eq!(crate::ms_bars_for(&records), crate::plot::Bars::Ci95);
+        write_report(dir.path(), &SweepInfo::default(), &records, &[]).unwrap();
+        let svg = std::fs::read_to_string(dir.path().join("plot_flip_vs_ms.svg")).unwrap();
+        assert!(svg.contains(">ms/frame (median, 95 % CI bars)<"), "{svg}");
+        // One frame each and no interval: no bars, and the axis promises none.
+        for r in &mut records {
+            (r.ms_interval, r.frames_ms) = (None, vec![r.ms_median]);
+        }
+        write_report(dir.path(), &SweepInfo::default(), &records, &[]).unwrap();
+        let svg = std::fs::read_to_string(dir.path().join("plot_flip_vs_ms.svg")).unwrap();
+        assert!(svg.contains(">ms/frame (median)<"), "{svg}");
+        assert_eq!(svg.matches("<path d=\"M").count(), 0, "{svg}");
     }
 
     /// A score's several floors (each client's and view's, and ours) are each named in the

@@ -45,7 +45,9 @@ pub fn depth_scaling(info: &SweepInfo, records: &[Record], floor: Option<&Record
                             style,
                             g.points.iter().map(|r| (setting(r), r.ms_median)).collect(),
                         );
-                        s.y_intervals = g.points.iter().map(|r| r.ms_interval).collect();
+                        s.bars =
+                            mirrorbox_report::ms_bars_for(groups.iter().flat_map(|g| &g.points));
+                        s.y_intervals = g.points.iter().map(|r| r.ms_bars(s.bars)).collect();
                         // Where the scene runs out of reflections before the cap, the cap is
                         // not what the point shows: say how many it does.
                         s.labels = g

@@ -120,7 +120,7 @@ fn depth_blocks(pts: &[&Record]) -> Vec<Block> {
     let mut cost = Chart::new(
         "Cost against the depth cap",
         "depth cap (reflections followed)",
-        "ms/frame (median)",
+        "ms/frame (median, 95 % CI bars)",
     );
     cost.x_log = true;
     cost.y_log = true;
@@ -144,7 +144,8 @@ fn depth_blocks(pts: &[&Record]) -> Vec<Block> {
             of.iter().map(|r| (d(r), r.mirror_flip())).collect(),
         ));
         let mut s = Series::new(m, style, of.iter().map(|r| (d(r), r.ms_median)).collect());
-        s.y_intervals = of.iter().map(|r| r.ms_interval).collect();
+        s.bars = mirrorbox_report::ms_bars_for(pts.iter().copied());
+        s.y_intervals = of.iter().map(|r| r.ms_bars(s.bars)).collect();
         cost.series.push(s);
         // The last doubling's factor says how the cost grows: near 1 where a bounce costs
         // little beside the frame, near 2 where it grows linearly with the depth, far above

@@ -207,7 +207,8 @@ pub fn lighting_section(records: &[Record]) -> Vec<Block> {
                     .map(|r| r.n.map_or(String::new(), |n| format!("n={n}")))
                     .collect();
             }
-            s.x_intervals = at.iter().map(|r| r.ms_interval).collect();
+            s.bars = mirrorbox_report::ms_bars_for(points.iter().copied());
+            s.x_intervals = at.iter().map(|r| r.ms_bars(s.bars)).collect();
             error_vs_ms.push(s);
         }
     }

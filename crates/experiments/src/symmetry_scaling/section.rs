@@ -36,7 +36,8 @@ pub fn symmetry_section(records: &[Record]) -> Vec<Block> {
                 style,
                 g.points.iter().map(|r| (setting(r), r.ms_median)).collect(),
             );
-            s.y_intervals = g.points.iter().map(|r| r.ms_interval).collect();
+            s.bars = mirrorbox_report::ms_bars_for(groups.iter().flat_map(|g| &g.points));
+            s.y_intervals = g.points.iter().map(|r| r.ms_bars(s.bars)).collect();
             s
         })
         .collect();
