@@ -462,7 +462,8 @@ impl Rect {
 }
 
 /// Where a point's label goes, `lw` pixels wide beside the marker of radius `r` at `(xx, yy)`:
-/// the first of right-above, right-below, left-above, left-below that stays inside the plot,
+/// the first of right-above, right-below, left-above, left-below, right, left, above and below
+/// that stays inside the plot,
 /// touches nothing `taken` (markers and placed labels; its own marker aside) and lies nearer
 /// its own point than any other of `markers` (else it would read as that point's label).
 /// `None`: the label is left out. Returns the text's baseline origin and its box.
@@ -473,11 +474,17 @@ fn place_label(
     markers: &[(f64, f64)],
     taken: &[Rect],
 ) -> Option<(f64, f64, Rect)> {
+    // The four corners first, then beside and over and under the marker: a label the
+    // corners could not take (the frontier's crowded fronts) finds a place more often.
     let candidates = [
         (xx + r + 2.0, yy - r - 1.0),
         (xx + r + 2.0, yy + r + 9.0),
         (xx - r - 2.0 - lw, yy - r - 1.0),
         (xx - r - 2.0 - lw, yy + r + 9.0),
+        (xx + r + 3.0, yy + 4.0),
+        (xx - r - 3.0 - lw, yy + 4.0),
+        (xx - lw / 2.0, yy - r - 3.0),
+        (xx - lw / 2.0, yy + r + 11.0),
     ];
     let own = Rect {
         x0: xx - r,
@@ -1757,6 +1764,23 @@ mod tests {
             (x - r - 2.0 - lw / 2.0, y + r + 5.0),
         ];
         assert!(place_label((x, y), r, lw, &all, &[]).is_none());
+        // The four corners taken by other labels (each reaching 6 px from the marker's
+        // centre): beside the marker, on the right.
+        let corner = |x0: f64, y0: f64| Rect {
+            x0,
+            y0,
+            x1: x0 + lw,
+            y1: y0 + 8.0,
+        };
+        let corners = [
+            corner(x + r + 2.0, y - 14.0),
+            corner(x + r + 2.0, y + 6.0),
+            corner(x - r - 2.0 - lw, y - 14.0),
+            corner(x - r - 2.0 - lw, y + 6.0),
+        ];
+        assert!(place_label((x, y), r, lw, &own, &corners[..2]).is_some_and(|(lx, _, _)| lx < x));
+        let (lx, ly, _) = place_label((x, y), r, lw, &own, &corners).unwrap();
+        assert!(lx > x && (ly - (y + 4.0)).abs() < 1e-9, "right: {lx} {ly}");
         // A point just beyond the label's far end is farther from it than its own: no matter.
         let far = [(x, y), (x + r + 2.0 + lw + 3.0 * r, y - r - 5.0)];
         let (lx, ly, _) = place_label((x, y), r, lw, &far, &[]).unwrap();
