@@ -459,11 +459,41 @@ impl Rect {
     fn overlaps(&self, o: &Rect) -> bool {
         self.x0 < o.x1 && o.x0 < self.x1 && self.y0 < o.y1 && o.y0 < self.y1
     }
+
+    /// Whether the segment from `a` to `b` passes through the box's inside (its edges alone
+    /// do not count): Liang–Barsky's clip of the segment's parameter to each slab.
+    fn crossed_by(&self, a: (f64, f64), b: (f64, f64)) -> bool {
+        let (mut t0, mut t1) = (0.0f64, 1.0f64);
+        for (p, q) in [
+            (a.0 - b.0, a.0 - self.x0),
+            (b.0 - a.0, self.x1 - a.0),
+            (a.1 - b.1, a.1 - self.y0),
+            (b.1 - a.1, self.y1 - a.1),
+        ] {
+            if p == 0.0 {
+                if q <= 0.0 {
+                    return false;
+                }
+            } else {
+                let t = q / p;
+                if p < 0.0 {
+                    t0 = t0.max(t);
+                } else {
+                    t1 = t1.min(t);
+                }
+            }
+        }
+        t0 < t1
+    }
 }
+
+/// A straight piece of a drawn line, in pixels: from, to.
+type Stroke = ((f64, f64), (f64, f64));
 
 /// Where a point's label goes, `lw` pixels wide beside the marker of radius `r` at `(xx, yy)`:
 /// the first of right-above, right-below, left-above, left-below, right, left, above and below
-/// that stays inside the plot,
+/// that stays inside the plot, crosses none of `strokes` (other series' lines, reference lines,
+/// error bars),
 /// touches nothing `taken` (markers and placed labels; its own marker aside) and lies nearer
 /// its own point than any other of `markers` (else it would read as that point's label).
 /// `None`: the label is left out. Returns the text's baseline origin and its box.
@@ -473,6 +503,7 @@ fn place_label(
     lw: f64,
     markers: &[(f64, f64)],
     taken: &[Rect],
+    strokes: &[Stroke],
 ) -> Option<(f64, f64, Rect)> {
     // The four corners first, then beside and over and under the marker: a label the
     // corners could not take (the frontier's crowded fronts) finds a place more often.
@@ -514,7 +545,8 @@ fn place_label(
             && !ambiguous
             && !taken
                 .iter()
-                .any(|t| t.overlaps(&rect) && !(t.x0 == own.x0 && t.y0 == own.y0)))
+                .any(|t| t.overlaps(&rect) && !(t.x0 == own.x0 && t.y0 == own.y0))
+            && !strokes.iter().any(|&(a, b)| rect.crossed_by(a, b)))
         .then_some((lx, ly, rect))
     })
 }
@@ -1147,15 +1179,50 @@ impl Chart {
         }
     }
 
+    /// The lines drawn, as pixel segments with the series whose line they are (`None`: a
+    /// reference line or an error bar, which no label may cross).
+    fn strokes(&self, f: &Frame) -> Vec<(Option<usize>, Stroke)> {
+        let px = |(x, y): (f64, f64)| (f.px(x), f.py(y));
+        let mut out = Vec::new();
+        for (i, series) in self.series.iter().enumerate() {
+            let pts = f.visible(series);
+            if series.joined {
+                out.extend(pts.windows(2).map(|w| (Some(i), (px(w[0]), px(w[1])))));
+            }
+            for (k, &(x, y)) in series.points.iter().enumerate() {
+                if !f.shows((x, y)) {
+                    continue;
+                }
+                if let Some([lo, hi]) = series.x_intervals.get(k).copied().flatten()
+                    && drawable(lo, f.ax.log)
+                    && drawable(hi, f.ax.log)
+                {
+                    out.push((None, (px((lo, y)), px((hi, y)))));
+                }
+                if let Some([lo, hi]) = series.y_intervals.get(k).copied().flatten()
+                    && drawable(lo, f.ay.log)
+                    && drawable(hi, f.ay.log)
+                {
+                    out.push((None, (px((x, lo)), px((x, hi)))));
+                }
+            }
+        }
+        for r in &self.references {
+            let pts = reference_line(r, f);
+            out.extend(pts.windows(2).map(|w| (None, (px(w[0]), px(w[1])))));
+        }
+        out
+    }
+
     /// The markers (a ring around an earlier marker at the same place, so both show), the
     /// marks' rings over them, then the labels, each where it covers no marker or label.
     fn markers_and_labels(&self, s: &mut String, f: &Frame) {
         let mut occupied: Vec<((i64, i64), usize)> = Vec::new();
         let mut taken: Vec<Rect> = Vec::new();
-        let mut label_queue: Vec<(f64, f64, f64, &str, &'static str)> = Vec::new();
+        let mut label_queue: Vec<(usize, f64, f64, f64, &str, &'static str)> = Vec::new();
         // Every marker's centre: a label must lie nearer its own point than any other.
         let mut markers: Vec<(f64, f64)> = Vec::new();
-        for series in &self.series {
+        for (i, series) in self.series.iter().enumerate() {
             for (k, &(x, y)) in series.points.iter().enumerate() {
                 if !f.shows((x, y)) {
                     continue;
@@ -1191,7 +1258,7 @@ impl Chart {
                 });
                 markers.push((xx, yy));
                 if let Some(label) = series.labels.get(k).filter(|l| !l.is_empty()) {
-                    label_queue.push((xx, yy, r, label, series.style.color));
+                    label_queue.push((i, xx, yy, r, label, series.style.color));
                 }
             }
         }
@@ -1213,9 +1280,18 @@ impl Chart {
                 });
             }
         }
-        for (xx, yy, r, label, color) in label_queue {
+        // What a label must not cross: every series' line but its own (a label beside its own
+        // point touches its own line, and reads as that line's), the reference lines and every
+        // error bar (issue: "n=1" on the other α's line, "d=64" on a CI bar).
+        let strokes = self.strokes(f);
+        for (i, xx, yy, r, label, color) in label_queue {
             let lw = SMALL_CHAR_W * label.chars().count() as f64;
-            let place = place_label((xx, yy), r, lw, &markers, &taken);
+            let others: Vec<Stroke> = strokes
+                .iter()
+                .filter(|(owner, _)| *owner != Some(i))
+                .map(|&(_, st)| st)
+                .collect();
+            let place = place_label((xx, yy), r, lw, &markers, &taken, &others);
             if let Some((lx, ly, rect)) = place {
                 taken.push(rect);
                 let _ = writeln!(
@@ -1749,11 +1825,11 @@ mod tests {
     fn a_label_never_lies_nearer_another_point() {
         let (x, y, r, lw) = (LEFT + 200.0, TOP + 200.0, MARKER_R, 30.0);
         let own = [(x, y)];
-        let (lx, ly, _) = place_label((x, y), r, lw, &own, &[]).unwrap();
+        let (lx, ly, _) = place_label((x, y), r, lw, &own, &[], &[]).unwrap();
         assert!(lx > x && ly < y, "right-above: {lx} {ly}");
         // A point where the right-above label would sit: right-below instead.
         let above = [(x, y), (x + r + 2.0 + lw / 2.0, y - r - 5.0)];
-        let (lx, ly, _) = place_label((x, y), r, lw, &above, &[]).unwrap();
+        let (lx, ly, _) = place_label((x, y), r, lw, &above, &[], &[]).unwrap();
         assert!(lx > x && ly > y, "right-below: {lx} {ly}");
         // Points at every place: left out.
         let all = [
@@ -1763,7 +1839,7 @@ mod tests {
             (x - r - 2.0 - lw / 2.0, y - r - 5.0),
             (x - r - 2.0 - lw / 2.0, y + r + 5.0),
         ];
-        assert!(place_label((x, y), r, lw, &all, &[]).is_none());
+        assert!(place_label((x, y), r, lw, &all, &[], &[]).is_none());
         // The four corners taken by other labels (each reaching 6 px from the marker's
         // centre): beside the marker, on the right.
         let corner = |x0: f64, y0: f64| Rect {
@@ -1778,12 +1854,34 @@ mod tests {
             corner(x - r - 2.0 - lw, y - 14.0),
             corner(x - r - 2.0 - lw, y + 6.0),
         ];
-        assert!(place_label((x, y), r, lw, &own, &corners[..2]).is_some_and(|(lx, _, _)| lx < x));
-        let (lx, ly, _) = place_label((x, y), r, lw, &own, &corners).unwrap();
+        assert!(
+            place_label((x, y), r, lw, &own, &corners[..2], &[]).is_some_and(|(lx, _, _)| lx < x)
+        );
+        let (lx, ly, _) = place_label((x, y), r, lw, &own, &corners, &[]).unwrap();
         assert!(lx > x && (ly - (y + 4.0)).abs() < 1e-9, "right: {lx} {ly}");
+        // Another series' line (or a reference line, or an error bar) through the right-above
+        // place: right-below instead; lines along the box's edges do not count.
+        let line: Stroke = ((x - 100.0, y - r - 5.0), (x + 100.0, y - r - 5.0));
+        let (lx, ly, _) = place_label((x, y), r, lw, &own, &[], &[line]).unwrap();
+        assert!(lx > x && ly > y, "right-below: {lx} {ly}");
+        let b = Rect {
+            x0: 0.0,
+            y0: 0.0,
+            x1: 10.0,
+            y1: 10.0,
+        };
+        assert!(b.crossed_by((-5.0, 5.0), (15.0, 5.0)), "through");
+        assert!(b.crossed_by((2.0, 2.0), (3.0, 3.0)), "inside");
+        assert!(
+            b.crossed_by((-5.0, -5.0), (5.0, 5.0)),
+            "into a corner's inside"
+        );
+        assert!(!b.crossed_by((-5.0, 10.0), (15.0, 10.0)), "along an edge");
+        assert!(!b.crossed_by((-5.0, 0.0), (0.0, -5.0)), "past a corner");
+        assert!(!b.crossed_by((20.0, 0.0), (20.0, 10.0)), "beside");
         // A point just beyond the label's far end is farther from it than its own: no matter.
         let far = [(x, y), (x + r + 2.0 + lw + 3.0 * r, y - r - 5.0)];
-        let (lx, ly, _) = place_label((x, y), r, lw, &far, &[]).unwrap();
+        let (lx, ly, _) = place_label((x, y), r, lw, &far, &[], &[]).unwrap();
         assert!(lx > x && ly < y, "right-above: {lx} {ly}");
     }
 
