@@ -281,6 +281,10 @@ pub fn uneven_section(records: &[Record], bump_methods: &[String]) -> Vec<Block>
         })
         .cloned()
         .collect();
+    // A trick's variant of its host's style by its place among every host's tricks, so that
+    // it looks the same in each host's chart (`march` was the fifth of naive's and the first
+    // of auxiliary's).
+    let families = distinct(pts.iter().map(|r| family(&trick_of(r, bump_methods))));
     for (chart_index, m) in methods
         .iter()
         .filter(|m| !flat_only.contains(m))
@@ -289,10 +293,8 @@ pub fn uneven_section(records: &[Record], bump_methods: &[String]) -> Vec<Block>
         let mine: Vec<&Record> = pts.iter().copied().filter(|r| &method_of(r) == m).collect();
         let base = mine.first().map_or(String::new(), |r| r.method.clone());
         let mut series = Vec::new();
-        for (k, fam) in distinct(mine.iter().map(|r| family(&trick_of(r, bump_methods))))
-            .iter()
-            .enumerate()
-        {
+        for fam in distinct(mine.iter().map(|r| family(&trick_of(r, bump_methods)))).iter() {
+            let k = families.iter().position(|f| f == fam).unwrap_or(0);
             let settings = distinct(
                 mine.iter()
                     .filter(|r| &family(&trick_of(r, bump_methods)) == fam)
@@ -485,6 +487,33 @@ mod tests {
             variant_of(&exact, &main, &bump()),
             "unrolled depth=64: flat (no texture to read)"
         );
+    }
+
+    /// A trick is drawn alike in every host's chart: `march` as the fifth of one host's
+    /// tricks and the only one of another's had taken two styles.
+    #[test]
+    fn a_trick_has_one_style_in_every_chart() {
+        let mut records = Vec::new();
+        for tilt in [0.0, 5.0] {
+            for options in ["bump=flat", "bump=distort", "bump=proxy", ""] {
+                records.push(record(options, tilt, 0.1));
+            }
+            let mut other = record("", tilt, 0.2);
+            other.n = Some(4);
+            other.key = format!("n4 {tilt}");
+            records.push(other);
+        }
+        let blocks = uneven_section(&records, &bump());
+        let march: Vec<_> = blocks
+            .iter()
+            .filter_map(|b| match b {
+                Block::Chart(_, c) => c.series.iter().find(|s| s.name.starts_with("march")),
+                _ => None,
+            })
+            .map(|s| (s.style.marker, s.style.dash, s.style.hollow))
+            .collect();
+        assert_eq!(march.len(), 2, "march in both hosts' charts");
+        assert_eq!(march[0], march[1]);
     }
 
     #[test]
