@@ -31,7 +31,7 @@
 # scripts/many_mirrors_report.py writes OUT/report.md and OUT/report.svg from it.
 #
 # The binary is not built here: build it first (cargo build --release --locked -p
-# mirrorbox); the record names the commit (git describe --always --dirty) and the binary's
+# mirrorbox); the record names the commit (seven hex digits, "-dirty" with changes) and the binary's
 # modification time.
 #
 # Usage: scripts/bench-many-mirrors.sh [--n "100 1000 10000 20000"] [--reps 3]
@@ -121,7 +121,13 @@ cmd_line() {  # the command $1 on scene $2, as words
 
 cpu=$(grep -m1 '^model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ *//' || true)
 # Before the record is emptied: emptying a committed raw.jsonl would itself make the tree dirty.
-commit=$(git describe --always --dirty 2>/dev/null || echo unknown)
+# The first seven hex digits (git's own abbreviation grows with the repository), "-dirty" with
+# changes to tracked files.
+commit=$(git rev-parse HEAD 2>/dev/null | cut -c1-7 || true)
+[ -n "$commit" ] || commit=unknown
+if [ "$commit" != unknown ] && ! git diff --quiet HEAD 2>/dev/null; then
+  commit="$commit-dirty"
+fi
 : > "$raw"
 record kind meta date "$(date -u +%Y-%m-%dT%H:%M:%SZ)" cpu "${cpu:-unknown}" \
   cores "json:$(nproc)" cpus_in_cpuinfo "json:$(grep -c '^processor' /proc/cpuinfo || true)" \

@@ -20,7 +20,7 @@ prepare)
   rm -rf "$d" && mkdir -p "$d"
   (unset RUSTC_WORKSPACE_WRAPPER CLIPPY_ARGS CARGO_INCREMENTAL; cargo build --release --locked -q -p mirrorbox --no-default-features)
   strip -o "$d/mirrorbox" target/release/mirrorbox && xz -T0 -6 "$d/mirrorbox"
-  commit=$(git rev-parse --short=7 HEAD)
+  commit=$(git rev-parse HEAD | cut -c1-7)
   git diff --quiet HEAD -- crates shaders Cargo.toml Cargo.lock tools || commit="$commit+changes"
   echo "$commit" >"$d/commit.txt"
   work=$(mktemp -d)

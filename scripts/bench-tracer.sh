@@ -60,7 +60,9 @@ if [ -n "${MIRRORBOX_SOURCE_COMMIT:-}" ]; then
 elif [ -n "${MIRRORBOX_BENCH_BIN:-}" ]; then
   commit="unknown (a prebuilt binary)" # not HEAD's: nothing says the binary was built from it
 else
-  commit=$(git rev-parse --short=7 HEAD 2>/dev/null || echo unknown)
+  # The first seven hex digits, as every record has (git's own abbreviation grows).
+  commit=$(git rev-parse HEAD 2>/dev/null | cut -c1-7 || true)
+  [ -n "$commit" ] || commit=unknown
   git diff --quiet HEAD -- crates shaders Cargo.toml Cargo.lock tools 2>/dev/null || commit="$commit+changes"
 fi
 # Whitted follows mirror chains to 10 000 reflections (cut by the throughput); path traces

@@ -12,7 +12,7 @@ mkdir -p reports/lighting
 tmp=$(mktemp reports/lighting/.trace_cost.XXXXXX)
 work=$(mktemp -d)
 trap 'rm -rf "$work" "$tmp"' EXIT
-commit=$(git rev-parse --short=7 HEAD)
+commit=$(git rev-parse HEAD | cut -c1-7)
 git diff --quiet HEAD -- crates shaders Cargo.toml Cargo.lock || commit="$commit+changes"
 cpu=$(grep -m1 '^model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ *//')
 today=$(date -u +%F)

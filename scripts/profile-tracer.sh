@@ -24,7 +24,7 @@ bin=target/release/mirrorbox
 unset RUSTC_WORKSPACE_WRAPPER CLIPPY_ARGS
 # Always built (a no-op when current), so that the profile's commit is the build profiled.
 cargo build --release --locked -p mirrorbox >&2
-commit=$(git rev-parse --short=7 HEAD)
+commit=$(git rev-parse HEAD | cut -c1-7)
 git diff --quiet HEAD -- crates shaders Cargo.toml Cargo.lock || commit="$commit+changes"
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT

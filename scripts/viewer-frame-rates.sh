@@ -58,7 +58,7 @@ for round in $(seq "$rounds"); do
   done
 done
 "$bin" info > "$work/info.txt"
-commit=$(git rev-parse --short=7 HEAD)
+commit=$(git rev-parse HEAD | cut -c1-7)
 git diff --quiet HEAD -- crates shaders || commit="$commit+changes"
 baseline_commit=${BASELINE_COMMIT:-}
 if [ -n "${KEEP_LOGS:-}" ]; then

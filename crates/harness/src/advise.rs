@@ -778,7 +778,8 @@ pub fn chart(
             pts.iter().map(|r| (r.ms_median, metric.of(r))).collect(),
         );
         s.joined = false;
-        s.x_intervals = pts.iter().map(|r| r.ms_interval).collect();
+        s.bars = mirrorbox_report::ms_bars_for(&advice.measured);
+        s.x_intervals = pts.iter().map(|r| r.ms_bars(s.bars)).collect();
         s.labels = pts.iter().map(|r| setting_label(r)).collect();
         series.push(s);
     }

@@ -295,8 +295,9 @@ pub mod value {
 /// The time bars one chart draws for all of its `points`: their 95 % intervals where every
 /// point has one; else, where every point was timed on two frames or more, each point's
 /// fastest to slowest frame (sweeps of five frames have no 95 % interval; a chart showed
-/// their medians bare); else the intervals some have. One kind per chart: the axis label
-/// says which ([`plot::Chart`]).
+/// their medians bare); else the intervals some have (a point of one frame, or an outside
+/// renderer's without its frames, keeps the chart on intervals: no range for it to draw). One
+/// kind per chart: the axis label says which ([`plot::Chart`]).
 pub fn ms_bars_for<'a>(points: impl IntoIterator<Item = &'a Record> + Clone) -> plot::Bars {
     let all = |f: &dyn Fn(&Record) -> bool| points.clone().into_iter().all(f);
     if !all(&|r| r.ms_interval.is_some()) && all(&|r| r.frames_ms.len() >= 2) {

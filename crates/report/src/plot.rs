@@ -309,9 +309,10 @@ const BOTTOM: f64 = 92.0;
 /// Half-length of an error bar's end caps, px.
 const ERROR_CAP: f64 = 4.0;
 const MARKER_R: f64 = 4.0;
-/// How far past the plot's frame the data's clip reaches: a marker on the frame (a point at
-/// x = 0 on an axis starting there) is drawn whole, not cut in half. The axes hold every
-/// point, so only markers and their rings reach into it.
+/// How far past the plot's frame the markers' clip reaches: a marker on the frame (a point at
+/// x = 0 on an axis starting there) is drawn whole, not cut in half. Lines and error bars keep
+/// the frame's own clip; a mark's ring and the rings of three or more points at one place are
+/// larger and still cut there.
 const CLIP_MARGIN: f64 = 2.5 * MARKER_R;
 
 fn esc(s: &str) -> String {
@@ -552,13 +553,26 @@ fn place_label(
 }
 
 /// The points of a reference's line as the frame shows them: a level across the plot, a
-/// curve's visible points; none for a mark, or a level off a log axis. Fewer than two: no
-/// line, and no legend entry.
+/// curve's drawable points; none for a mark, a level off a log axis, or a line no piece of
+/// which crosses the plot (a budget left or right of every point: it drew nothing and had a
+/// legend row). None: no line, and no legend entry.
 fn reference_line(r: &Reference, f: &Frame) -> Vec<(f64, f64)> {
-    match r {
+    let pts: Vec<(f64, f64)> = match r {
         Reference::Level(_, y) if drawable(*y, f.ay.log) => vec![(f.ax.lo, *y), (f.ax.hi, *y)],
         Reference::Level(..) | Reference::Mark(..) => Vec::new(),
         Reference::Curve(_, pts) => pts.iter().copied().filter(|&p| f.shows(p)).collect(),
+    };
+    let plot = Rect {
+        x0: LEFT,
+        y0: TOP,
+        x1: LEFT + PLOT_W,
+        y1: TOP + PLOT_H,
+    };
+    let px = |(x, y): (f64, f64)| (f.px(x), f.py(y));
+    if pts.windows(2).any(|w| plot.crossed_by(px(w[0]), px(w[1]))) {
+        pts
+    } else {
+        Vec::new()
     }
 }
 
@@ -825,10 +839,16 @@ impl Chart {
         let bounds = |i: &[Option<[f64; 2]>]| -> Vec<f64> {
             i.iter().flatten().flatten().copied().collect()
         };
+        // The x axis holds the reference curves too: a budget faster than every point is
+        // where the figure's question is (the advisor's; it had been drawn nowhere).
         let xs: Vec<f64> = self
             .series
             .iter()
             .flat_map(|s| s.points.iter().map(|p| p.0).chain(bounds(&s.x_intervals)))
+            .chain(self.references.iter().flat_map(|r| match r {
+                Reference::Curve(_, pts) => pts.iter().map(|p| p.0).collect(),
+                _ => Vec::new(),
+            }))
             .collect();
         let ax = Axis::new(xs.iter().copied(), self.x_log);
         let ys: Vec<f64> = self
@@ -940,19 +960,25 @@ impl Chart {
             );
             below += 12.0;
         }
-        // Clip the data to the plot area: reference lines, then series lines, error bars,
-        // markers (rings where an earlier marker sits) and labels that touch no other.
+        // Clip the lines to the plot area: reference lines, then series lines and error bars;
+        // then the markers (rings where an earlier marker sits) and labels that touch no
+        // other, clipped a marker's size further out, so that one on the frame is whole.
         let _ = writeln!(
             s,
-            r#"<clipPath id="plot"><rect x="{:.1}" y="{:.1}" width="{:.1}" height="{:.1}"/></clipPath><g clip-path="url(#plot)">"#,
+            r#"<clipPath id="plot"><rect x="{LEFT}" y="{TOP}" width="{PLOT_W}" height="{PLOT_H}"/></clipPath><g clip-path="url(#plot)">"#
+        );
+        self.reference_lines(&mut s, &f);
+        self.series_lines(&mut s, &f);
+        self.error_bars(&mut s, &f);
+        s.push_str("</g>\n");
+        let _ = writeln!(
+            s,
+            r#"<clipPath id="marks"><rect x="{:.1}" y="{:.1}" width="{:.1}" height="{:.1}"/></clipPath><g clip-path="url(#marks)">"#,
             LEFT - CLIP_MARGIN,
             TOP - CLIP_MARGIN,
             PLOT_W + 2.0 * CLIP_MARGIN,
             PLOT_H + 2.0 * CLIP_MARGIN
         );
-        self.reference_lines(&mut s, &f);
-        self.series_lines(&mut s, &f);
-        self.error_bars(&mut s, &f);
         self.markers_and_labels(&mut s, &f);
         s.push_str("</g>\n");
         legend_svg(&mut s, &legend);
@@ -988,7 +1014,7 @@ impl Chart {
             legend.push((name, Shows::Series(series)));
         }
         for r in &self.references {
-            if !matches!(r, Reference::Mark(..)) && reference_line(r, f).len() < 2 {
+            if !matches!(r, Reference::Mark(..)) && reference_line(r, f).is_empty() {
                 continue;
             }
             let name = match r {
@@ -1108,7 +1134,7 @@ impl Chart {
             .references
             .iter()
             .map(|r| reference_line(r, f))
-            .filter(|pts| pts.len() >= 2);
+            .filter(|pts| !pts.is_empty());
         for (i, pts) in lines.enumerate() {
             let dash = REFERENCE_DASHES[i % REFERENCE_DASHES.len()];
             let _ = writeln!(
@@ -1645,7 +1671,7 @@ mod tests {
         c.x_log = false;
         let svg = c.to_svg();
         let clip = svg
-            .split("<clipPath id=\"plot\"><rect x=\"")
+            .split("<clipPath id=\"marks\"><rect x=\"")
             .nth(1)
             .unwrap();
         let clip_x: f64 = clip.split('"').next().unwrap().parse().unwrap();
@@ -1677,15 +1703,33 @@ mod tests {
             method_style("auxiliary"),
             vec![(1.0, 0.5), (10.0, 0.1)],
         )]);
+        c.y_log = true;
         c.references = vec![
             Reference::Curve("Pareto front".into(), vec![(1.0, 0.5)]),
+            // Below every point on a log axis: off the y axis, drawn nowhere.
+            Reference::Curve("early budget".into(), vec![(0.5, 1e-9), (20.0, 1e-9)]),
+            Reference::Mark("the pick".into(), (10.0, 0.1)),
             Reference::Curve("budget".into(), vec![(5.0, 0.1), (5.0, 0.5)]),
+            Reference::Level("one full-scene pass".into(), 0.3),
         ];
         let svg = c.to_svg();
         assert!(!svg.contains("Pareto front"), "{svg}");
+        assert!(!svg.contains("early budget"), "{svg}");
         assert!(svg.contains("reference: budget"), "{svg}");
-        let dash = format!("stroke-dasharray=\"{}\"", REFERENCE_DASHES[0]);
-        assert_eq!(svg.matches(&dash).count(), 2, "{svg}");
+        // The budget takes the first dash and the level the second, a mark between them none:
+        // each twice, in the plot and in the legend.
+        for dash in &REFERENCE_DASHES[..2] {
+            let dash = format!("stroke-dasharray=\"{dash}\"");
+            assert_eq!(svg.matches(&dash).count(), 2, "{dash}: {svg}");
+        }
+        // A budget faster than every point widens the x axis to it and is drawn.
+        c.references = vec![Reference::Curve(
+            "budget".into(),
+            vec![(0.2, 0.1), (0.2, 0.5)],
+        )];
+        let (ax, _) = c.axes();
+        assert!(ax.contains(0.2), "{} – {}", ax.lo, ax.hi);
+        assert!(c.to_svg().contains("reference: budget"));
     }
 
     /// The floor band's label is drawn after the grid lines, which would cross it.
@@ -1878,6 +1922,9 @@ mod tests {
         );
         assert!(!b.crossed_by((-5.0, 10.0), (15.0, 10.0)), "along an edge");
         assert!(!b.crossed_by((-5.0, 0.0), (0.0, -5.0)), "past a corner");
+        assert!(!b.crossed_by((-5.0, 5.0), (5.0, -5.0)), "touching a corner");
+        assert!(b.crossed_by((4.0, 4.0), (4.0, 4.0)), "a point inside");
+        assert!(!b.crossed_by((0.0, 4.0), (0.0, 4.0)), "a point on an edge");
         assert!(!b.crossed_by((20.0, 0.0), (20.0, 10.0)), "beside");
         // A point just beyond the label's far end is farther from it than its own: no matter.
         let far = [(x, y), (x + r + 2.0 + lw + 3.0 * r, y - r - 5.0)];

@@ -843,7 +843,8 @@ impl<'a> Variants<'a> {
 
     /// One series per method variant and α, joined along its one swept setting (n or depth):
     /// `keep`, which of a group's points the chart shows; `ms_on_x`, x is the median time,
-    /// drawn with its 95 % interval as an error bar; `x_log`, whether the x axis is
+    /// drawn with its bars ([`crate::ms_bars_for`]: the 95 % intervals, or the frames' range
+    /// where a point has no interval); `x_log`, whether the x axis is
     /// logarithmic (a linear one shows x = 0: n = 0 auxiliary mirrors). The y axis is.
     fn series(
         &self,

@@ -126,14 +126,13 @@ fn records_commit(path: &std::path::Path) -> String {
     } else {
         dir
     };
-    // Seven hex digits, as every committed report has: git's own `%h` grows with the
-    // repository's object count (eight past 16 384 objects), which would change every
-    // report's footer with no record changed.
-    mirrorbox_harness::git_output(
-        &dir,
-        &["log", "-1", "--abbrev=7", "--format=%h", "--", &file],
-    )
-    .unwrap_or_default()
+    // The first seven hex digits of the full hash, as every committed report has: git's own
+    // `%h` (and `--abbrev=7`, a least length) grows with the repository's object count (eight
+    // past 16 384 objects) and where seven are ambiguous, which would change report footers
+    // with no record changed.
+    mirrorbox_harness::git_output(&dir, &["log", "-1", "--format=%H", "--", &file])
+        .map(|full| full.chars().take(7).collect())
+        .unwrap_or_default()
 }
 
 /// What the registry's experiment writing the report folder `folder` (under `reports/`)
@@ -210,15 +209,37 @@ mod tests {
         assert_eq!(about("mine/sweep"), None);
     }
 
-    /// A report's footer names its records' commit in seven hex digits whatever the
-    /// repository's size: this repository holds more than 16 384 objects, where git's own
-    /// `%h` gives eight and every committed footer would change.
+    /// A report's footer names its records' commit by the first seven hex digits of its hash,
+    /// whatever git's own abbreviation: a repository of its own whose `core.abbrev` is 12
+    /// (git's grows past seven with the object count; this repository's gives eight).
     #[test]
     fn the_records_commit_has_seven_hex_digits() {
-        let bench =
-            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../reports/tracer/bench.md");
-        let commit = records_commit(&bench);
-        assert_eq!(commit.len(), 7, "{commit:?}");
-        assert!(commit.chars().all(|c| c.is_ascii_hexdigit()), "{commit:?}");
+        let dir = tempfile::tempdir().unwrap();
+        let git = |args: &[&str]| {
+            let out = std::process::Command::new("git")
+                .args([
+                    "-c",
+                    "user.name=t",
+                    "-c",
+                    "user.email=t@t",
+                    "-c",
+                    "core.abbrev=12",
+                ])
+                .args(args)
+                .current_dir(dir.path())
+                .output()
+                .expect("git runs");
+            assert!(out.status.success(), "git {args:?}: {out:?}");
+            String::from_utf8(out.stdout).unwrap().trim().to_string()
+        };
+        git(&["init", "-q"]);
+        git(&["config", "core.abbrev", "12"]);
+        std::fs::write(dir.path().join("results.jsonl"), "{}\n").unwrap();
+        git(&["add", "results.jsonl"]);
+        git(&["commit", "-q", "-m", "records"]);
+        assert_eq!(git(&["log", "-1", "--format=%h"]).len(), 12);
+        let full = git(&["rev-parse", "HEAD"]);
+        let commit = records_commit(&dir.path().join("results.jsonl"));
+        assert_eq!(commit, full[..7], "{commit:?}");
     }
 }

@@ -282,8 +282,9 @@ pub fn uneven_section(records: &[Record], bump_methods: &[String]) -> Vec<Block>
         .cloned()
         .collect();
     // A trick's variant of its host's style by its place among every host's tricks, so that
-    // it looks the same in each host's chart (`march` was the fifth of naive's and the first
-    // of auxiliary's).
+    // it looks the same in the charts of hosts of one method (`march` had been the fifth of
+    // auxiliary n=2's tricks and the first of auxiliary n=4's: two styles). Each host keeps
+    // its method's colour and marker family, so hosts of other methods differ.
     let families = distinct(pts.iter().map(|r| family(&trick_of(r, bump_methods))));
     for (chart_index, m) in methods
         .iter()
