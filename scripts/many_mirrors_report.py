@@ -24,12 +24,14 @@ import statistics
 import sys
 
 RESOLUTION_S = 0.01
-# Per command: colour, marker (circle, square, triangle, diamond), in the plot and legend.
+# Per command: colour and marker, in the plot and legend. The methods' and the truth's are
+# their styles in every report (crates/report/src/plot.rs, `method_style`: naive, unrolled,
+# truth); `check` is no method, black.
 STYLE = {
-    "check": ("#1b9e77", "circle"),
-    "trace": ("#d95f02", "square"),
-    "naive": ("#7570b3", "triangle"),
-    "unrolled": ("#e7298a", "diamond"),
+    "check": ("#000000", "square"),
+    "trace": ("#333333", "cross"),
+    "naive": ("#E69F00", "triangle-down"),
+    "unrolled": ("#0072B2", "plus"),
 }
 DEFAULT_STYLE = ("#666666", "circle")
 
@@ -170,15 +172,29 @@ def marker(shape, x, y, colour, r=4.0, hollow=False):
     if shape == "triangle":
         return (f'<polygon points="{x:.1f},{y - r * 1.2:.1f} {x - r * 1.1:.1f},{y + r * 0.8:.1f} '
                 f'{x + r * 1.1:.1f},{y + r * 0.8:.1f}" {a}/>')
+    if shape == "triangle-down":
+        return (f'<polygon points="{x:.1f},{y + r * 1.2:.1f} {x - r * 1.1:.1f},{y - r * 0.8:.1f} '
+                f'{x + r * 1.1:.1f},{y - r * 0.8:.1f}" {a}/>')
     if shape == "diamond":
         return (f'<polygon points="{x:.1f},{y - r * 1.3:.1f} {x + r:.1f},{y:.1f} '
                 f'{x:.1f},{y + r * 1.3:.1f} {x - r:.1f},{y:.1f}" {a}/>')
+    if shape in ("plus", "cross"):
+        k = r * 1.3
+        d = (f"M{x - k:.1f},{y:.1f} L{x + k:.1f},{y:.1f} M{x:.1f},{y - k:.1f} L{x:.1f},{y + k:.1f}"
+             if shape == "plus" else
+             f"M{x - r:.1f},{y - r:.1f} L{x + r:.1f},{y + r:.1f} M{x - r:.1f},{y + r:.1f} "
+             f"L{x + r:.1f},{y - r:.1f}")
+        return f'<path d="{d}" stroke="{colour}" stroke-width="2.2" fill="none"/>'
     return f'<circle cx="{x:.1f}" cy="{y:.1f}" r="{r:.1f}" {a}/>'
 
 
 def cross_mark(x, y, colour, r=4.0):
-    return (f'<path d="M{x - r:.1f},{y - r:.1f} L{x + r:.1f},{y + r:.1f} M{x - r:.1f},{y + r:.1f} '
-            f'L{x + r:.1f},{y - r:.1f}" stroke="{colour}" stroke-width="1.8" fill="none"/>')
+    """A failed, timed-out or skipped run: a crossed circle (the truth's marker is a cross)."""
+    k = r * 0.7
+    return (f'<circle cx="{x:.1f}" cy="{y:.1f}" r="{r + 1:.1f}" fill="white" stroke="{colour}" '
+            f'stroke-width="1.2"/><path d="M{x - k:.1f},{y - k:.1f} L{x + k:.1f},{y + k:.1f} '
+            f'M{x - k:.1f},{y + k:.1f} L{x + k:.1f},{y - k:.1f}" stroke="{colour}" '
+            f'stroke-width="1.4" fill="none"/>')
 
 
 def esc(s):
