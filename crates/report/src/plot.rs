@@ -434,6 +434,23 @@ fn linear_ticks(lo: f64, hi: f64) -> Vec<f64> {
     out
 }
 
+/// An axis's tick labels: [`fmt_tick`]'s, but on a log axis where some tick needs the
+/// exponent form (below 0.01), every tick below 1 takes it too, so that one axis does not read
+/// "0.1, 0.01, 1e-3" (two notations for one scale).
+fn tick_labels(ticks: &[f64], log: bool) -> Vec<String> {
+    let exponent = log && ticks.iter().any(|&t| t != 0.0 && t.abs() < 1e-2);
+    ticks
+        .iter()
+        .map(|&t| {
+            if exponent && t != 0.0 && t.abs() < 1.0 {
+                format!("{t:.1e}").replace(".0e", "e")
+            } else {
+                fmt_tick(t)
+            }
+        })
+        .collect()
+}
+
 /// A tick or annotation value, with as few digits as it needs.
 pub fn fmt_tick(v: f64) -> String {
     if v == 0.0 {
@@ -1086,25 +1103,26 @@ impl Chart {
                 ticks
             }
         };
-        for t in x_ticks {
+        let x_labels = tick_labels(&x_ticks, f.ax.log);
+        for (t, label) in x_ticks.into_iter().zip(x_labels) {
             let x = f.px(t);
             let _ = writeln!(
                 s,
-                r##"<line x1="{x:.1}" y1="{TOP}" x2="{x:.1}" y2="{:.1}" stroke="#e5e5e5"/><text x="{x:.1}" y="{:.1}" text-anchor="middle">{}</text>"##,
+                r##"<line x1="{x:.1}" y1="{TOP}" x2="{x:.1}" y2="{:.1}" stroke="#e5e5e5"/><text x="{x:.1}" y="{:.1}" text-anchor="middle">{label}</text>"##,
                 TOP + PLOT_H,
                 TOP + PLOT_H + 16.0,
-                fmt_tick(t)
             );
         }
-        for t in f.ay.ticks() {
+        let y_ticks = f.ay.ticks();
+        let y_labels = tick_labels(&y_ticks, f.ay.log);
+        for (t, label) in y_ticks.into_iter().zip(y_labels) {
             let y = f.py(t);
             let _ = writeln!(
                 s,
-                r##"<line x1="{LEFT}" y1="{y:.1}" x2="{:.1}" y2="{y:.1}" stroke="#e5e5e5"/><text x="{:.1}" y="{:.1}" text-anchor="end">{}</text>"##,
+                r##"<line x1="{LEFT}" y1="{y:.1}" x2="{:.1}" y2="{y:.1}" stroke="#e5e5e5"/><text x="{:.1}" y="{:.1}" text-anchor="end">{label}</text>"##,
                 LEFT + PLOT_W,
                 LEFT - 6.0,
                 y + 4.0,
-                fmt_tick(t)
             );
         }
         let _ = writeln!(
@@ -1463,6 +1481,23 @@ mod tests {
         assert!(ay.ticks().contains(&5e-4), "{:?}", ay.ticks());
         // The decades stay the only ticks between them.
         assert!(!ay.ticks().contains(&0.02), "{:?}", ay.ticks());
+    }
+
+    /// One notation per log axis: where a tick needs the exponent form, every tick below 1
+    /// has it ("5e-1 … 1e-3", not "0.5 … 0.01, 1e-3"); ticks from 1 up keep theirs, and an axis
+    /// that needs no exponent keeps plain decimals.
+    #[test]
+    fn a_log_axis_writes_its_ticks_in_one_notation() {
+        assert_eq!(
+            tick_labels(&[1e-3, 0.01, 0.1, 0.5, 1.0, 20.0], true),
+            ["1e-3", "1e-2", "1e-1", "5e-1", "1", "20"]
+        );
+        assert_eq!(tick_labels(&[0.01, 0.1, 0.5], true), ["0.01", "0.1", "0.5"]);
+        assert_eq!(tick_labels(&[1.5e-3, 2e-3], true), ["1.5e-3", "2e-3"]);
+        assert_eq!(
+            tick_labels(&[0.0, 0.005, 0.01], false),
+            ["0", "5e-3", "0.01"]
+        );
     }
 
     /// The figure check flags what a reviewer would send back, and nothing in a clean chart.
