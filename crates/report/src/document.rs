@@ -285,6 +285,18 @@ pub fn markdown(blocks: &[Block]) -> String {
     md
 }
 
+/// A variant's name in a legend beside `others` (the chart's variants): a bare method name
+/// (its defaults) where the chart also has the method with options says so, "ssr (defaults)":
+/// alone beside "ssr ssr-fallback=none" it read as ssr in general.
+pub fn legend_name(variant: &str, others: &[&str]) -> String {
+    let prefix = format!("{variant} ");
+    if !variant.contains(' ') && others.iter().any(|o| o.starts_with(&prefix)) {
+        format!("{variant} (defaults)")
+    } else {
+        variant.to_string()
+    }
+}
+
 pub fn variant(r: &Record) -> String {
     // An outside renderer's variant (`mirrorbox score`) is named by its method alone: its
     // knobs are in its report's table and variants.md, not in every legend.
@@ -373,6 +385,22 @@ mod tests {
     use super::*;
 
     /// A column's heading names what its cells hold: intervals, the fastest frame, or both.
+    /// A method at its defaults is named so in a legend only beside its own variants with
+    /// options: "ssr (defaults)" beside "ssr ssr-fallback=none", "ssr" alone, and a
+    /// variant with options or another method's prefix ("ssr" beside "ssr-x y") as it is.
+    #[test]
+    fn a_method_at_its_defaults_says_so_beside_its_variants() {
+        let chart = ["ssr", "ssr ssr-fallback=none", "portal depth=64", "naive"];
+        assert_eq!(legend_name("ssr", &chart), "ssr (defaults)");
+        assert_eq!(
+            legend_name("ssr ssr-fallback=none", &chart),
+            "ssr ssr-fallback=none"
+        );
+        assert_eq!(legend_name("naive", &chart), "naive");
+        assert_eq!(legend_name("ssr", &["ssr", "portal depth=8"]), "ssr");
+        assert_eq!(legend_name("ssr", &["ssr", "ssr-x y"]), "ssr");
+    }
+
     #[test]
     fn ms_heading_promises_only_what_the_cells_hold() {
         let with = Record {

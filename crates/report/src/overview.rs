@@ -368,8 +368,9 @@ fn frontier_chart(
             let mut pts: Vec<&&Record> =
                 records.iter().filter(|r| &series_name(r) == name).collect();
             pts.sort_by(|a, b| a.ms_median.total_cmp(&b.ms_median));
+            let others: Vec<&str> = names.iter().map(String::as_str).collect();
             let mut s = Series::new(
-                name.clone(),
+                crate::document::legend_name(name, &others),
                 style,
                 pts.iter().map(|r| (r.ms_median, error(r))).collect(),
             );

@@ -866,10 +866,12 @@ impl<'a> Variants<'a> {
                 if pts.is_empty() {
                     return None;
                 }
+                let others: Vec<&str> = self.groups.iter().map(|(o, _)| o.as_str()).collect();
+                let m = crate::document::legend_name(m, &others);
                 let name = if self.alphas.len() > 1 {
                     format!("{m}, α={a}")
                 } else {
-                    m.clone()
+                    m
                 };
                 // A value the log axes cannot show (an error of exactly 0) is named in the
                 // legend, not drawn.
