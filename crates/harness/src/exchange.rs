@@ -125,6 +125,11 @@ pub struct ViewsFile {
     /// written before it was kept (their sweeps are compared by the scene's file name).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub sweep_scene_hash: Option<String>,
+    /// Not in the file: the export's mirrors have different reflectances, so no one α stands
+    /// for them (`alpha` is `None` for that reason, not for want of it). Set where the export
+    /// is written and by [`crate::score::read_views`].
+    #[serde(skip)]
+    pub mirrors_differ: bool,
     pub contract: Contract,
     pub views: Vec<ExportedView>,
 }
@@ -406,7 +411,7 @@ pub(crate) fn replaceable(dir: &Path, marker: &str, what: &str) -> Result<(), Ha
 }
 
 /// The one grey reflectance every mirror of `scene` has, if any.
-fn uniform_alpha(scene: &Scene) -> Option<f32> {
+pub(crate) fn uniform_alpha(scene: &Scene) -> Option<f32> {
     let first = scene.mirrors.first()?.reflectance;
     let grey = first.x == first.y && first.y == first.z;
     (grey && scene.mirrors.iter().all(|m| m.reflectance == first)).then_some(first.x)
@@ -481,14 +486,16 @@ fn write_export(
         views.push(view);
     }
     let l = &base.lighting;
+    let alpha = settings.alpha.or_else(|| uniform_alpha(base));
     let doc = ViewsFile {
         format: "mirrorbox-views".into(),
         version: FORMAT_VERSION,
         gltf: "scene.gltf".into(),
         scene: "scene.json".into(),
         source: scene_path.display().to_string(),
-        alpha: settings.alpha.or_else(|| uniform_alpha(base)),
+        alpha,
         sweep_scene_hash: Some(sweep_scene_hash.to_string()),
+        mirrors_differ: alpha.is_none(),
         contract: Contract {
             document: "docs/shading.md".into(),
             version: CONTRACT_VERSION,
@@ -624,6 +631,7 @@ pub(crate) mod tests_support {
             source: "scenes/mirror_box.json".into(),
             alpha: Some(0.9),
             sweep_scene_hash: None,
+            mirrors_differ: false,
             contract: Contract {
                 document: "docs/shading.md".into(),
                 version: CONTRACT_VERSION,

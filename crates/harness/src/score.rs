@@ -123,6 +123,18 @@ pub fn read_views(export: &Path) -> Result<ViewsFile, HarnessError> {
         ));
     }
     check_views(&views).map_err(|problem| refused(&path, problem))?;
+    let mut views = views;
+    views.mirrors_differ = views.alpha.is_none() && views.sweep_scene_hash.is_some();
+    // An export older than the scene hashes left `alpha` out where it was not given, whether
+    // or not its mirrors shared one (their scores said α = 1): the exported scene says which.
+    // One that does not load keeps the old reading (no α kept: 1 in the records).
+    if views.alpha.is_none()
+        && views.sweep_scene_hash.is_none()
+        && let Ok(scene) = mirrorbox_scene::load_scene(&export.join(&views.scene))
+    {
+        views.alpha = crate::exchange::uniform_alpha(&scene);
+        views.mirrors_differ = views.alpha.is_none();
+    }
     Ok(views)
 }
 
@@ -610,10 +622,9 @@ fn our_sweeps(views: &ViewsFile, with: &[PathBuf]) -> Result<Vec<(PathBuf, Recor
                 ),
             ));
         }
-        // An export that keeps the hashes says its α wherever its mirrors share one: without
-        // one they differ, and no sweep (one α for every mirror) shows its scene.
-        if views.alpha.is_none()
-            && views.sweep_scene_hash.is_some()
+        // Where the export's mirrors differ ([`read_views`]), no sweep (one α for every
+        // mirror) shows its scene.
+        if views.mirrors_differ
             && let Some(r) = sweep
                 .records
                 .iter()
@@ -768,8 +779,8 @@ fn scored_record(
         device: None,
         n: None,
         depth: None,
-        // Where the mirrors differ (`per_mirror`) or an older export kept no α,
-        // 1 stands for none; the reports say "per mirror" for the first.
+        // Where the mirrors differ (`per_mirror`), or an older export kept no α and its scene
+        // does not load, 1 stands for none; the reports say "per mirror" for the first.
         alpha: views.alpha.unwrap_or(1.0),
         width: v.width,
         height: v.height,
@@ -876,8 +887,7 @@ pub fn score(
             .filter_map(|(_, r)| r.run.clone())
             .max()
             .unwrap_or_else(crate::now_rfc3339);
-        // An export that keeps the hashes says its α wherever its mirrors share one.
-        let per_mirror = views.alpha.is_none() && views.sweep_scene_hash.is_some();
+        let per_mirror = views.mirrors_differ;
         let stage = ScoreStage {
             export,
             stage: partial,
@@ -1048,6 +1058,44 @@ mod tests {
     /// the file: no view, a name that is no file name or that clashes, a size no image has,
     /// a truth outside the export folder. (An empty list panicked, a name such as
     /// `../../x` was used as a path.)
+    /// An export older than the scene hashes, without `alpha`: its scene says the α (the
+    /// mirrors' one grey reflectance), or that the mirrors differ; one whose scene is gone
+    /// keeps no α. An export with the hashes and no α has mirrors that differ.
+    #[test]
+    fn an_older_export_takes_its_alpha_from_its_scene() {
+        let dir = tempfile::tempdir().unwrap();
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        let scene = std::fs::read_to_string(root.join("scenes/mirror_box.json")).unwrap();
+        let mut views = crate::exchange::tests_support::sample_view();
+        (views.alpha, views.sweep_scene_hash) = (None, None);
+        std::fs::write(
+            dir.path().join("views.json"),
+            serde_json::to_string(&views).unwrap(),
+        )
+        .unwrap();
+        let read = || read_views(dir.path()).unwrap();
+        assert_eq!(
+            (read().alpha, read().mirrors_differ),
+            (None, false),
+            "no scene"
+        );
+        std::fs::write(dir.path().join("scene.json"), &scene).unwrap();
+        assert_eq!((read().alpha, read().mirrors_differ), (Some(0.9), false));
+        let tinted = scene.replacen("[0.9, 0.9, 0.9]", "[0.9, 0.8, 0.9]", 1);
+        assert_ne!(tinted, scene);
+        std::fs::write(dir.path().join("scene.json"), &tinted).unwrap();
+        assert_eq!((read().alpha, read().mirrors_differ), (None, true));
+        // With the hashes, no α is the mirrors differing, whatever the scene file.
+        views.sweep_scene_hash = Some("00".into());
+        std::fs::write(
+            dir.path().join("views.json"),
+            serde_json::to_string(&views).unwrap(),
+        )
+        .unwrap();
+        std::fs::write(dir.path().join("scene.json"), &scene).unwrap();
+        assert_eq!((read().alpha, read().mirrors_differ), (None, true));
+    }
+
     #[test]
     fn a_views_json_is_checked_field_by_field() {
         let dir = tempfile::tempdir().unwrap();
