@@ -505,8 +505,33 @@ impl Rect {
     }
 }
 
-/// A straight piece of a drawn line, in pixels: from, to.
+/// A straight piece of a drawn line: from, to (in pixels, or in data coordinates where said).
 type Stroke = ((f64, f64), (f64, f64));
+
+/// A series' error bars the frame draws, in data coordinates, each from its low end to its
+/// high one and whether it lies across x (at the point's y) or across y (at its x), point by
+/// point (a point the frame does not show, or an end an axis cannot, draws none).
+fn bars(series: &Series, f: &Frame) -> Vec<(bool, Stroke)> {
+    let mut out = Vec::new();
+    for (k, &(x, y)) in series.points.iter().enumerate() {
+        if !f.shows((x, y)) {
+            continue;
+        }
+        if let Some([lo, hi]) = series.x_intervals.get(k).copied().flatten()
+            && drawable(lo, f.ax.log)
+            && drawable(hi, f.ax.log)
+        {
+            out.push((true, ((lo, y), (hi, y))));
+        }
+        if let Some([lo, hi]) = series.y_intervals.get(k).copied().flatten()
+            && drawable(lo, f.ay.log)
+            && drawable(hi, f.ay.log)
+        {
+            out.push((false, ((x, lo), (x, hi))));
+        }
+    }
+    out
+}
 
 /// Where a point's label goes, `lw` pixels wide beside the marker of radius `r` at `(xx, yy)`:
 /// the first of right-above, right-below, left-above, left-below, right, left, above and below
@@ -1187,38 +1212,30 @@ impl Chart {
     fn error_bars(&self, s: &mut String, f: &Frame) {
         for series in &self.series {
             let color = series.style.color;
-            for (k, &(x, y)) in series.points.iter().enumerate() {
-                if !f.shows((x, y)) {
-                    continue;
-                }
-                if let Some([lo, hi]) = series.x_intervals.get(k).copied().flatten()
-                    && drawable(lo, f.ax.log)
-                    && drawable(hi, f.ax.log)
-                {
-                    let (x0, x1, yy) = (f.px(lo), f.px(hi), f.py(y));
-                    let _ = writeln!(
-                        s,
-                        r#"<path d="M{x0:.1},{yy:.1}H{x1:.1}M{x0:.1},{:.1}V{:.1}M{x1:.1},{:.1}V{:.1}" stroke="{color}" stroke-width="1.2" fill="none"/>"#,
-                        yy - ERROR_CAP,
-                        yy + ERROR_CAP,
-                        yy - ERROR_CAP,
-                        yy + ERROR_CAP
-                    );
-                }
-                if let Some([lo, hi]) = series.y_intervals.get(k).copied().flatten()
-                    && drawable(lo, f.ay.log)
-                    && drawable(hi, f.ay.log)
-                {
-                    let (y0, y1, xx) = (f.py(lo), f.py(hi), f.px(x));
-                    let _ = writeln!(
-                        s,
-                        r#"<path d="M{xx:.1},{y0:.1}V{y1:.1}M{:.1},{y0:.1}H{:.1}M{:.1},{y1:.1}H{:.1}" stroke="{color}" stroke-width="1.2" fill="none"/>"#,
-                        xx - ERROR_CAP,
-                        xx + ERROR_CAP,
-                        xx - ERROR_CAP,
-                        xx + ERROR_CAP
-                    );
-                }
+            for (across_x, ((x0, y0), (x1, y1))) in bars(series, f) {
+                let (x0, y0, x1, y1) = (f.px(x0), f.py(y0), f.px(x1), f.py(y1));
+                // The caps across the bar at both ends.
+                let d = if across_x {
+                    format!(
+                        "M{x0:.1},{y0:.1}H{x1:.1}M{x0:.1},{:.1}V{:.1}M{x1:.1},{:.1}V{:.1}",
+                        y0 - ERROR_CAP,
+                        y0 + ERROR_CAP,
+                        y0 - ERROR_CAP,
+                        y0 + ERROR_CAP
+                    )
+                } else {
+                    format!(
+                        "M{x0:.1},{y0:.1}V{y1:.1}M{:.1},{y0:.1}H{:.1}M{:.1},{y1:.1}H{:.1}",
+                        x0 - ERROR_CAP,
+                        x0 + ERROR_CAP,
+                        x0 - ERROR_CAP,
+                        x0 + ERROR_CAP
+                    )
+                };
+                let _ = writeln!(
+                    s,
+                    r#"<path d="{d}" stroke="{color}" stroke-width="1.2" fill="none"/>"#
+                );
             }
         }
     }
@@ -1233,23 +1250,11 @@ impl Chart {
             if series.joined {
                 out.extend(pts.windows(2).map(|w| (Some(i), (px(w[0]), px(w[1])))));
             }
-            for (k, &(x, y)) in series.points.iter().enumerate() {
-                if !f.shows((x, y)) {
-                    continue;
-                }
-                if let Some([lo, hi]) = series.x_intervals.get(k).copied().flatten()
-                    && drawable(lo, f.ax.log)
-                    && drawable(hi, f.ax.log)
-                {
-                    out.push((None, (px((lo, y)), px((hi, y)))));
-                }
-                if let Some([lo, hi]) = series.y_intervals.get(k).copied().flatten()
-                    && drawable(lo, f.ay.log)
-                    && drawable(hi, f.ay.log)
-                {
-                    out.push((None, (px((x, lo)), px((x, hi)))));
-                }
-            }
+            out.extend(
+                bars(series, f)
+                    .into_iter()
+                    .map(|(_, (a, b))| (None, (px(a), px(b)))),
+            );
         }
         for r in &self.references {
             let pts = reference_line(r, f);
@@ -1578,6 +1583,11 @@ mod tests {
         }
     }
 
+    /// [`chart`] with one series, "a", in auxiliary's style.
+    fn chart_of(points: Vec<(f64, f64)>) -> Chart {
+        chart(vec![Series::new("a", method_style("auxiliary"), points)])
+    }
+
     fn width(svg: &str) -> f64 {
         svg.split("width=\"")
             .nth(1)
@@ -1593,11 +1603,7 @@ mod tests {
     /// its own dash, the same in the plot and in its legend row.
     #[test]
     fn each_reference_has_its_own_dash_in_plot_and_legend() {
-        let mut c = chart(vec![Series::new(
-            "a",
-            method_style("auxiliary"),
-            vec![(1.0, 0.5), (10.0, 0.1)],
-        )]);
+        let mut c = chart_of(vec![(1.0, 0.5), (10.0, 0.1)]);
         c.references.push(Reference::Curve(
             "budget".into(),
             vec![(5.0, 0.1), (5.0, 0.5)],
@@ -1614,11 +1620,7 @@ mod tests {
     /// flagged by the figure check.
     #[test]
     fn a_mark_rings_its_point_and_takes_no_dash() {
-        let mut c = chart(vec![Series::new(
-            "a",
-            method_style("auxiliary"),
-            vec![(1.0, 0.5), (10.0, 0.1)],
-        )]);
+        let mut c = chart_of(vec![(1.0, 0.5), (10.0, 0.1)]);
         c.y_log = true;
         c.references = vec![Reference::Mark("the pick: a".into(), (10.0, 0.1))];
         c.references.push(Reference::Curve(
@@ -1698,11 +1700,7 @@ mod tests {
     /// reaches a marker's size past the plot's frame.
     #[test]
     fn a_marker_on_the_frame_is_not_cut() {
-        let mut c = chart(vec![Series::new(
-            "a",
-            method_style("auxiliary"),
-            vec![(0.0, 0.5), (10.0, 0.1)],
-        )]);
+        let mut c = chart_of(vec![(0.0, 0.5), (10.0, 0.1)]);
         c.x_log = false;
         let svg = c.to_svg();
         let clip = svg
@@ -1733,11 +1731,7 @@ mod tests {
     /// and the next one takes the first dash in plot and legend alike.
     #[test]
     fn a_reference_drawn_as_no_line_is_not_in_the_legend() {
-        let mut c = chart(vec![Series::new(
-            "a",
-            method_style("auxiliary"),
-            vec![(1.0, 0.5), (10.0, 0.1)],
-        )]);
+        let mut c = chart_of(vec![(1.0, 0.5), (10.0, 0.1)]);
         c.y_log = true;
         c.references = vec![
             Reference::Curve("Pareto front".into(), vec![(1.0, 0.5)]),
@@ -1770,11 +1764,7 @@ mod tests {
     /// The floor band's label is drawn after the grid lines, which would cross it.
     #[test]
     fn the_floor_label_lies_over_the_grid() {
-        let mut c = chart(vec![Series::new(
-            "a",
-            method_style("auxiliary"),
-            vec![(1.0, 0.5), (10.0, 0.1)],
-        )]);
+        let mut c = chart_of(vec![(1.0, 0.5), (10.0, 0.1)]);
         c.floor = Some(0.2);
         let svg = c.to_svg();
         let label = svg
