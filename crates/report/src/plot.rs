@@ -1588,8 +1588,9 @@ mod tests {
         chart(vec![Series::new("a", method_style("auxiliary"), points)])
     }
 
-    fn width(svg: &str) -> f64 {
-        svg.split("width=\"")
+    /// The number in quotes right after the first `prefix` in `svg` (an attribute's value).
+    fn number_after(svg: &str, prefix: &str) -> f64 {
+        svg.split(prefix)
             .nth(1)
             .unwrap()
             .split('"')
@@ -1597,6 +1598,10 @@ mod tests {
             .unwrap()
             .parse()
             .unwrap()
+    }
+
+    fn width(svg: &str) -> f64 {
+        number_after(svg, "width=\"")
     }
 
     /// Two references (the advisor's Pareto front and its budget) are told apart: each has
@@ -1703,20 +1708,8 @@ mod tests {
         let mut c = chart_of(vec![(0.0, 0.5), (10.0, 0.1)]);
         c.x_log = false;
         let svg = c.to_svg();
-        let clip = svg
-            .split("<clipPath id=\"marks\"><rect x=\"")
-            .nth(1)
-            .unwrap();
-        let clip_x: f64 = clip.split('"').next().unwrap().parse().unwrap();
-        let cx: f64 = svg
-            .split("<circle cx=\"")
-            .nth(1)
-            .unwrap()
-            .split('"')
-            .next()
-            .unwrap()
-            .parse()
-            .unwrap();
+        let clip_x = number_after(&svg, "<clipPath id=\"marks\"><rect x=\"");
+        let cx = number_after(&svg, "<circle cx=\"");
         assert!(
             (cx - LEFT).abs() < 0.1,
             "the point at 0 sits on the frame: {cx}"
