@@ -310,9 +310,9 @@ const BOTTOM: f64 = 92.0;
 const ERROR_CAP: f64 = 4.0;
 const MARKER_R: f64 = 4.0;
 /// How far past the plot's frame the markers' clip reaches: a marker on the frame (a point at
-/// x = 0 on an axis starting there) is drawn whole, not cut in half. Lines and error bars keep
-/// the frame's own clip; a mark's ring and the rings of three or more points at one place are
-/// larger and still cut there.
+/// x = 0 on an axis starting there) is drawn whole, not cut in half. Lines, error bars and
+/// the rings of coinciding points keep the frame's own clip (rings grow over the tick
+/// labels); a mark's ring is larger than the margin and is cut there.
 const CLIP_MARGIN: f64 = 2.5 * MARKER_R;
 
 fn esc(s: &str) -> String {
@@ -503,6 +503,13 @@ impl Rect {
         }
         t0 < t1
     }
+}
+
+/// Whether a marker at `a` would hide most of one at `b` (pixels): their centres nearer than
+/// a marker's radius. The later is then drawn as a ring around the place (the same place
+/// alone had been ringed, and a point 1–3 px from another vanished under it).
+fn hides(a: (f64, f64), b: (f64, f64)) -> bool {
+    (a.0 - b.0).hypot(a.1 - b.1) < MARKER_R
 }
 
 /// A straight piece of a drawn line: from, to (in pixels, or in data coordinates where said).
@@ -1021,7 +1028,13 @@ impl Chart {
             PLOT_W + 2.0 * CLIP_MARGIN,
             PLOT_H + 2.0 * CLIP_MARGIN
         );
-        self.markers_and_labels(&mut s, &f);
+        let mut rings = String::new();
+        self.markers_and_labels(&mut s, &mut rings, &f);
+        s.push_str("</g>\n");
+        // The coincidence rings inside the frame: around a point on it (x = 0) they grow
+        // over the tick labels.
+        let _ = writeln!(s, r#"<g clip-path="url(#plot)">"#);
+        s.push_str(&rings);
         s.push_str("</g>\n");
         legend_svg(&mut s, &legend);
         s.push_str("</svg>\n");
@@ -1034,7 +1047,7 @@ impl Chart {
         let mut legend: Vec<(String, Shows)> = Vec::new();
         // Points drawn as rings (an earlier marker at the same place) in a series whose
         // legend entry does not say which series it lies on.
-        let mut seen: Vec<(i64, i64)> = Vec::new();
+        let mut seen: Vec<(f64, f64)> = Vec::new();
         let mut unexplained_rings = false;
         for (i, series) in self.series.iter().enumerate() {
             let mine: Vec<_> = f.visible(series).into_iter().map(|p| f.key(p)).collect();
@@ -1042,11 +1055,12 @@ impl Chart {
                 let theirs: Vec<_> = f.visible(o).into_iter().map(|p| f.key(p)).collect();
                 !mine.is_empty() && mine.iter().all(|k| theirs.contains(k))
             });
-            for k in &mine {
-                if seen.contains(k) {
+            for p in f.visible(series) {
+                let at = (f.px(p.0), f.py(p.1));
+                if seen.iter().any(|&q| hides(q, at)) {
                     unexplained_rings |= same.is_none();
                 } else {
-                    seen.push(*k);
+                    seen.push(at);
                 }
             }
             let name = match same {
@@ -1263,10 +1277,12 @@ impl Chart {
         out
     }
 
-    /// The markers (a ring around an earlier marker at the same place, so both show), the
-    /// marks' rings over them, then the labels, each where it covers no marker or label.
-    fn markers_and_labels(&self, s: &mut String, f: &Frame) {
-        let mut occupied: Vec<((i64, i64), usize)> = Vec::new();
+    /// The markers (a ring, into `rings`, around an earlier marker at the same place, so both
+    /// show), the marks' rings over them, then the labels, each where it covers no marker or
+    /// label.
+    fn markers_and_labels(&self, s: &mut String, rings: &mut String, f: &Frame) {
+        // The centres of the markers drawn whole, with how many points lie on each.
+        let mut occupied: Vec<((f64, f64), usize)> = Vec::new();
         let mut taken: Vec<Rect> = Vec::new();
         let mut label_queue: Vec<(usize, f64, f64, f64, &str, &'static str)> = Vec::new();
         // Every marker's centre: a label must lie nearer its own point than any other.
@@ -1276,22 +1292,21 @@ impl Chart {
                 if !f.shows((x, y)) {
                     continue;
                 }
-                let spot = f.key((x, y));
-                let under = match occupied.iter_mut().find(|(p, _)| *p == spot) {
+                let (xx, yy) = (f.px(x), f.py(y));
+                let under = match occupied.iter_mut().find(|(p, _)| hides(*p, (xx, yy))) {
                     Some((_, n)) => {
                         *n += 1;
                         *n - 1
                     }
                     None => {
-                        occupied.push((spot, 1));
+                        occupied.push(((xx, yy), 1));
                         0
                     }
                 };
                 let r = MARKER_R + 2.6 * under as f64;
-                let (xx, yy) = (f.px(x), f.py(y));
                 if under > 0 {
                     let _ = writeln!(
-                        s,
+                        rings,
                         r#"<circle cx="{xx:.1}" cy="{yy:.1}" r="{:.1}" fill="none" stroke="{}" stroke-width="1.6"/>"#,
                         r + 1.5,
                         series.style.color
@@ -1699,6 +1714,28 @@ mod tests {
                 assert_ne!(shape(&filled), shape(&hollow), "{marker:?}");
             }
         }
+    }
+
+    /// A point a pixel or two from another's marker is drawn as a ring around it, and the
+    /// legend says what a ring is: before, only points at the same place were, and naive's
+    /// marker vanished under auxiliary n=0's 1–3 px away.
+    #[test]
+    fn a_point_under_another_marker_is_ringed() {
+        let mut c = chart_of(vec![(1.0, 0.5), (10.0, 0.1)]);
+        c.series.push(Series::new(
+            "b",
+            method_style("naive"),
+            vec![(1.02, 0.5), (3.0, 0.3)],
+        ));
+        let svg = c.to_svg();
+        let ring = format!(
+            r#"r="{:.1}" fill="none" stroke="{}""#,
+            MARKER_R + 2.6 + 1.5,
+            method_style("naive").color
+        );
+        assert_eq!(svg.matches(&ring).count(), 1, "{svg}");
+        assert!(svg.contains("ring: a point at the same place"), "{svg}");
+        assert!(hides((0.0, 0.0), (3.9, 0.0)) && !hides((0.0, 0.0), (4.0, 0.0)));
     }
 
     /// A point on the frame (x = 0 where the axis starts at 0) is drawn whole: the data's clip
