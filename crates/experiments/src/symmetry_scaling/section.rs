@@ -27,12 +27,13 @@ pub fn symmetry_section(records: &[Record]) -> Vec<Block> {
     let styles = mirrorbox_report::plot::styles_for(
         &groups.iter().map(|g| g.method.as_str()).collect::<Vec<_>>(),
     );
+    let names: Vec<&str> = groups.iter().map(|g| g.name.as_str()).collect();
     let series: Vec<Series> = groups
         .iter()
         .zip(styles)
         .map(|(g, style)| {
             let mut s = Series::new(
-                g.name.clone(),
+                mirrorbox_report::document::legend_name(&g.name, &names),
                 style,
                 g.points.iter().map(|r| (setting(r), r.ms_median)).collect(),
             );
