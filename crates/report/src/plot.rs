@@ -1281,8 +1281,14 @@ impl Chart {
     /// show), the marks' rings over them, then the labels, each where it covers no marker or
     /// label.
     fn markers_and_labels(&self, s: &mut String, rings: &mut String, f: &Frame) {
-        // The centres of the markers drawn whole, with how many points lie on each.
-        let mut occupied: Vec<((f64, f64), usize)> = Vec::new();
+        // A marker drawn whole: its centre, how many points lie on it, and the labels queued
+        // there (with their places in `label_queue`).
+        struct Place<'l> {
+            centre: (f64, f64),
+            points: usize,
+            labels: Vec<(&'l str, usize)>,
+        }
+        let mut occupied: Vec<Place> = Vec::new();
         let mut taken: Vec<Rect> = Vec::new();
         let mut label_queue: Vec<(usize, f64, f64, f64, &str, &'static str)> = Vec::new();
         // Every marker's centre: a label must lie nearer its own point than any other.
@@ -1293,17 +1299,34 @@ impl Chart {
                     continue;
                 }
                 let (xx, yy) = (f.px(x), f.py(y));
-                let under = match occupied.iter_mut().find(|(p, _)| hides(*p, (xx, yy))) {
-                    Some((_, n)) => {
-                        *n += 1;
-                        *n - 1
-                    }
+                let label = series.labels.get(k).filter(|l| !l.is_empty());
+                let spot = match occupied.iter().position(|p| hides(p.centre, (xx, yy))) {
+                    Some(at) => at,
                     None => {
-                        occupied.push(((xx, yy), 1));
-                        0
+                        occupied.push(Place {
+                            centre: (xx, yy),
+                            points: 0,
+                            labels: Vec::new(),
+                        });
+                        occupied.len() - 1
                     }
                 };
+                let place = &mut occupied[spot];
+                let under = place.points;
+                place.points += 1;
                 let r = MARKER_R + 2.6 * under as f64;
+                // A label the place has already (two series' d=2 there) is said once, placed
+                // beside the outermost ring.
+                let label = match label.and_then(|l| place.labels.iter().find(|(t, _)| *t == l)) {
+                    Some(&(_, queued)) => {
+                        label_queue[queued].3 = r;
+                        None
+                    }
+                    None => label,
+                };
+                if let Some(l) = label {
+                    place.labels.push((l, label_queue.len()));
+                }
                 if under > 0 {
                     let _ = writeln!(
                         rings,
@@ -1321,7 +1344,7 @@ impl Chart {
                     y1: yy + r,
                 });
                 markers.push((xx, yy));
-                if let Some(label) = series.labels.get(k).filter(|l| !l.is_empty()) {
+                if let Some(label) = label {
                     label_queue.push((i, xx, yy, r, label, series.style.color));
                 }
             }
@@ -1736,6 +1759,11 @@ mod tests {
         assert_eq!(svg.matches(&ring).count(), 1, "{svg}");
         assert!(svg.contains("ring: a point at the same place"), "{svg}");
         assert!(hides((0.0, 0.0), (3.9, 0.0)) && !hides((0.0, 0.0), (4.0, 0.0)));
+        // Both points at one place labelled alike: the label is said once.
+        c.series[1].points[0] = (1.0, 0.5);
+        c.series[0].labels = vec!["d=2".into(), String::new()];
+        c.series[1].labels = vec!["d=2".into(), String::new()];
+        assert_eq!(c.to_svg().matches(">d=2</text>").count(), 1);
     }
 
     /// A point on the frame (x = 0 where the axis starts at 0) is drawn whole: the data's clip
