@@ -767,6 +767,7 @@ pub fn chart(
         }
     }
     let mut series = Vec::new();
+    let bars = mirrorbox_report::ms_bars_for(&advice.measured);
     for m in methods {
         let mut pts: Vec<&Record> = advice.measured.iter().filter(|r| r.method == m).collect();
         pts.sort_by(|a, b| a.ms_median.total_cmp(&b.ms_median));
@@ -778,7 +779,7 @@ pub fn chart(
             pts.iter().map(|r| (r.ms_median, metric.of(r))).collect(),
         );
         s.joined = false;
-        s.bars = mirrorbox_report::ms_bars_for(&advice.measured);
+        s.bars = bars;
         s.x_intervals = pts.iter().map(|r| r.ms_bars(s.bars)).collect();
         s.labels = pts.iter().map(|r| setting_label(r)).collect();
         series.push(s);

@@ -112,7 +112,7 @@ pub fn read_views(export: &Path) -> Result<ViewsFile, HarnessError> {
     let path = export.join("views.json");
     let text = mirrorbox_files::read_bounded_text(&path, 16 << 20, "views.json")
         .map_err(|e| refused(&path, e))?;
-    let views: ViewsFile = serde_json::from_str(&text).map_err(|e| refused(&path, e))?;
+    let mut views: ViewsFile = serde_json::from_str(&text).map_err(|e| refused(&path, e))?;
     if views.format != "mirrorbox-views" || views.version != FORMAT_VERSION {
         return Err(refused(
             &path,
@@ -123,7 +123,6 @@ pub fn read_views(export: &Path) -> Result<ViewsFile, HarnessError> {
         ));
     }
     check_views(&views).map_err(|problem| refused(&path, problem))?;
-    let mut views = views;
     views.mirrors_differ = views.alpha.is_none() && views.sweep_scene_hash.is_some();
     // An export older than the scene hashes left `alpha` out where it was not given, whether
     // or not its mirrors shared one (their scores said α = 1): the exported scene says which.

@@ -361,6 +361,8 @@ fn frontier_chart(
     let all: Vec<(f64, f64)> = records.iter().map(|r| (r.ms_median, error(r))).collect();
     let (front, steps) = pareto_steps(&all);
     let on_front = |r: &Record| front.contains(&(r.ms_median, error(r)));
+    let variants: Vec<&str> = names.iter().map(String::as_str).collect();
+    let bars = crate::ms_bars_for(records.iter().copied());
     let series: Vec<Series> = names
         .iter()
         .zip(styles)
@@ -368,14 +370,13 @@ fn frontier_chart(
             let mut pts: Vec<&&Record> =
                 records.iter().filter(|r| &series_name(r) == name).collect();
             pts.sort_by(|a, b| a.ms_median.total_cmp(&b.ms_median));
-            let others: Vec<&str> = names.iter().map(String::as_str).collect();
             let mut s = Series::new(
-                crate::document::legend_name(name, &others),
+                crate::document::legend_name(name, &variants),
                 style,
                 pts.iter().map(|r| (r.ms_median, error(r))).collect(),
             );
             s.joined = false;
-            s.bars = crate::ms_bars_for(records.iter().copied());
+            s.bars = bars;
             s.x_intervals = pts.iter().map(|r| r.ms_bars(s.bars)).collect();
             s.labels = pts
                 .iter()

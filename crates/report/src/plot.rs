@@ -443,7 +443,7 @@ fn tick_labels(ticks: &[f64], log: bool) -> Vec<String> {
         .iter()
         .map(|&t| {
             if exponent && t != 0.0 && t.abs() < 1.0 {
-                format!("{t:.1e}").replace(".0e", "e")
+                exponent_form(t)
             } else {
                 fmt_tick(t)
             }
@@ -456,12 +456,16 @@ pub fn fmt_tick(v: f64) -> String {
     if v == 0.0 {
         "0".into()
     } else if v.abs() >= 1e4 || v.abs() < 1e-2 {
-        let s = format!("{v:.1e}");
-        s.replace(".0e", "e")
+        exponent_form(v)
     } else {
         let s = format!("{v:.3}");
         s.trim_end_matches('0').trim_end_matches('.').to_string()
     }
+}
+
+/// `v` as "5e-3" or "1.5e-3": one decimal of mantissa, none where it is 0.
+fn exponent_form(v: f64) -> String {
+    format!("{v:.1e}").replace(".0e", "e")
 }
 
 /// An axis-aligned box in pixels, for keeping labels apart.
@@ -1050,12 +1054,13 @@ impl Chart {
         let mut seen: Vec<(f64, f64)> = Vec::new();
         let mut unexplained_rings = false;
         for (i, series) in self.series.iter().enumerate() {
-            let mine: Vec<_> = f.visible(series).into_iter().map(|p| f.key(p)).collect();
+            let visible = f.visible(series);
+            let mine: Vec<_> = visible.iter().map(|&p| f.key(p)).collect();
             let same = self.series[..i].iter().find(|o| {
                 let theirs: Vec<_> = f.visible(o).into_iter().map(|p| f.key(p)).collect();
                 !mine.is_empty() && mine.iter().all(|k| theirs.contains(k))
             });
-            for p in f.visible(series) {
+            for p in visible {
                 let at = (f.px(p.0), f.py(p.1));
                 if seen.iter().any(|&q| hides(q, at)) {
                     unexplained_rings |= same.is_none();

@@ -854,6 +854,9 @@ impl<'a> Variants<'a> {
         ms_on_x: bool,
         x_log: bool,
     ) -> Vec<Series> {
+        // One legend name scheme and one kind of time bars for the whole chart.
+        let variants: Vec<&str> = self.groups.iter().map(|(o, _)| o.as_str()).collect();
+        let bars = crate::ms_bars_for(self.points.iter().copied());
         self.groups
             .iter()
             .zip(&self.styles)
@@ -866,8 +869,7 @@ impl<'a> Variants<'a> {
                 if pts.is_empty() {
                     return None;
                 }
-                let others: Vec<&str> = self.groups.iter().map(|(o, _)| o.as_str()).collect();
-                let m = crate::document::legend_name(m, &others);
+                let m = crate::document::legend_name(m, &variants);
                 let name = if self.alphas.len() > 1 {
                     format!("{m}, α={a}")
                 } else {
@@ -903,7 +905,7 @@ impl<'a> Variants<'a> {
                     .map(|r| crate::document::swept_label(r))
                     .collect();
                 if ms_on_x {
-                    s.bars = crate::ms_bars_for(self.points.iter().copied());
+                    s.bars = bars;
                     s.x_intervals = pts.iter().map(|r| r.ms_bars(s.bars)).collect();
                 }
                 Some(s)

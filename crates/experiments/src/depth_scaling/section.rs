@@ -27,6 +27,7 @@ pub fn depth_scaling(info: &SweepInfo, records: &[Record], floor: Option<&Record
                 &groups.iter().map(|g| g.method.as_str()).collect::<Vec<_>>(),
             );
             let alphas = distinct(groups.iter().map(|g| g.alpha.to_bits()));
+            let bars = mirrorbox_report::ms_bars_for(groups.iter().flat_map(|g| &g.points));
             Box::new(Chart {
                 x_log: true,
                 y_log: true,
@@ -45,8 +46,7 @@ pub fn depth_scaling(info: &SweepInfo, records: &[Record], floor: Option<&Record
                             style,
                             g.points.iter().map(|r| (setting(r), r.ms_median)).collect(),
                         );
-                        s.bars =
-                            mirrorbox_report::ms_bars_for(groups.iter().flat_map(|g| &g.points));
+                        s.bars = bars;
                         s.y_intervals = g.points.iter().map(|r| r.ms_bars(s.bars)).collect();
                         // Where the scene runs out of reflections before the cap, the cap is
                         // not what the point shows: say how many it does.

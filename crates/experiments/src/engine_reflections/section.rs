@@ -126,6 +126,7 @@ fn depth_blocks(pts: &[&Record]) -> Vec<Block> {
     cost.y_log = true;
     cost.x_ticks_at_data = true;
     let mut sentences = Vec::new();
+    let bars = mirrorbox_report::ms_bars_for(pts.iter().copied());
     for m in DEPTH_SWEPT {
         let mut of: Vec<&Record> = pts
             .iter()
@@ -144,7 +145,7 @@ fn depth_blocks(pts: &[&Record]) -> Vec<Block> {
             of.iter().map(|r| (d(r), r.mirror_flip())).collect(),
         ));
         let mut s = Series::new(m, style, of.iter().map(|r| (d(r), r.ms_median)).collect());
-        s.bars = mirrorbox_report::ms_bars_for(pts.iter().copied());
+        s.bars = bars;
         s.y_intervals = of.iter().map(|r| r.ms_bars(s.bars)).collect();
         cost.series.push(s);
         // The last doubling's factor says how the cost grows: near 1 where a bounce costs

@@ -171,6 +171,7 @@ pub fn lighting_section(records: &[Record]) -> Vec<Block> {
     // one setting is one marker.
     let kinds = distinct(points.iter().map(|r| r.method.clone()));
     let mut error_vs_ms: Vec<Series> = Vec::new();
+    let bars = mirrorbox_report::ms_bars_for(points.iter().copied());
     for kind in &kinds {
         let mut mine: Vec<&Record> = points
             .iter()
@@ -207,7 +208,7 @@ pub fn lighting_section(records: &[Record]) -> Vec<Block> {
                     .map(|r| r.n.map_or(String::new(), |n| format!("n={n}")))
                     .collect();
             }
-            s.bars = mirrorbox_report::ms_bars_for(points.iter().copied());
+            s.bars = bars;
             s.x_intervals = at.iter().map(|r| r.ms_bars(s.bars)).collect();
             error_vs_ms.push(s);
         }

@@ -28,6 +28,7 @@ pub fn symmetry_section(records: &[Record]) -> Vec<Block> {
         &groups.iter().map(|g| g.method.as_str()).collect::<Vec<_>>(),
     );
     let names: Vec<&str> = groups.iter().map(|g| g.name.as_str()).collect();
+    let bars = mirrorbox_report::ms_bars_for(groups.iter().flat_map(|g| &g.points));
     let series: Vec<Series> = groups
         .iter()
         .zip(styles)
@@ -37,7 +38,7 @@ pub fn symmetry_section(records: &[Record]) -> Vec<Block> {
                 style,
                 g.points.iter().map(|r| (setting(r), r.ms_median)).collect(),
             );
-            s.bars = mirrorbox_report::ms_bars_for(groups.iter().flat_map(|g| &g.points));
+            s.bars = bars;
             s.y_intervals = g.points.iter().map(|r| r.ms_bars(s.bars)).collect();
             s
         })
