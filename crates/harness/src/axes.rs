@@ -324,6 +324,12 @@ mod tests {
             ]
         );
         assert_eq!(CAMERA_YAW.text(-22.5), "-22.5");
+        // The reports label each axis in words of their own (mirrorbox_report::axis::label):
+        // an axis added here gets its words there, not the `name=value` of an unknown one.
+        for a in AXES {
+            let label = mirrorbox_report::axis::label(a.name, 1.0);
+            assert!(!label.starts_with(a.name), "{}: {label}", a.name);
+        }
     }
 
     #[test]

@@ -206,6 +206,42 @@ pub fn swept_label(r: &Record) -> String {
         .join(" ")
 }
 
+/// Each point's label in one series: its swept setting ([`swept_label`]) and its scene axes
+/// ([`crate::axis::label`]), each kept only where it varies among the series' points — a part
+/// every point shares says nothing about which point is which, and an axis left out had left
+/// the points of a camera-turn sweep without a word. A series of one point, or of points
+/// alike in every part, is labelled by its swept setting alone.
+pub fn point_labels(pts: &[&Record]) -> Vec<String> {
+    let names = distinct(pts.iter().flat_map(|r| r.axes.keys().cloned()));
+    let columns: Vec<Vec<String>> = std::iter::once(pts.iter().map(|r| swept_label(r)).collect())
+        .chain(names.iter().map(|n| {
+            pts.iter()
+                .map(|r| {
+                    r.axis(n)
+                        .map_or(String::new(), |v| crate::axis::label(n, v))
+                })
+                .collect()
+        }))
+        .collect();
+    let varying: Vec<&Vec<String>> = columns
+        .iter()
+        .filter(|c| c.iter().any(|v| v != &c[0]))
+        .collect();
+    if varying.is_empty() {
+        return columns[0].clone();
+    }
+    (0..pts.len())
+        .map(|i| {
+            varying
+                .iter()
+                .map(|c| c[i].as_str())
+                .filter(|v| !v.is_empty())
+                .collect::<Vec<_>>()
+                .join(", ")
+        })
+        .collect()
+}
+
 /// Text for HTML, in an element or an attribute: `&`, `<`, `>` and `"` escaped.
 pub fn escape_html(s: &str) -> String {
     s.replace('&', "&amp;")
@@ -399,6 +435,25 @@ mod tests {
         assert_eq!(legend_name("naive", &chart), "naive");
         assert_eq!(legend_name("ssr", &["ssr", "portal depth=8"]), "ssr");
         assert_eq!(legend_name("ssr", &["ssr", "ssr-x y"]), "ssr");
+    }
+
+    /// A label says what tells a series' points apart: the camera turn where only it varies,
+    /// the swept n where only it does, both where both do; n alone for one point.
+    #[test]
+    fn point_labels_name_what_varies_within_the_series() {
+        let turned = |n: u32, yaw: f64| {
+            let mut r = fixtures::record(n, 1.0, 1, 0.1);
+            r.axes.insert(crate::axis::YAW_DEG.into(), yaw);
+            r
+        };
+        let (a, b, c) = (turned(2, -22.5), turned(2, 45.0), turned(3, 45.0));
+        assert_eq!(point_labels(&[&a, &b]), ["yaw -22.5°", "yaw 45°"]);
+        assert_eq!(point_labels(&[&b, &c]), ["n=2", "n=3"]);
+        assert_eq!(point_labels(&[&a, &c]), ["n=2, yaw -22.5°", "n=3, yaw 45°"]);
+        assert_eq!(point_labels(&[&a]), ["n=2"]);
+        assert_eq!(point_labels(&[&b, &b]), ["n=2", "n=2"]);
+        let plain = fixtures::record(1, 1.0, 1, 0.1);
+        assert_eq!(point_labels(&[&plain, &a]), ["n=1", "n=2, yaw -22.5°"]);
     }
 
     #[test]

@@ -334,6 +334,22 @@ pub mod axis {
     /// A scored variant's view, by its index in the export's views.json (`mirrorbox score`,
     /// exports of several views); its name is the record key's second field.
     pub const VIEW: &str = "view";
+    /// The camera's turn about the vertical, degrees (a `--camera-yaw` sweep, issue 39).
+    pub const YAW_DEG: &str = "yaw_deg";
+
+    /// A point's value of axis `name` as a chart labels it: `p=3`, `k=2`, `tilt 5°`,
+    /// `yaw 22.5°`, `IPD 0.064`, `view 1`; `name=value` for an axis added later.
+    pub fn label(name: &str, value: f64) -> String {
+        match name {
+            PLANES => format!("p={value}"),
+            MIRRORED_LIGHTS => format!("k={value}"),
+            BUMP_DEG => format!("tilt {value}°"),
+            YAW_DEG => format!("yaw {value}°"),
+            STEREO_IPD => format!("IPD {value}"),
+            VIEW => format!("view {value}"),
+            other => format!("{other}={value}"),
+        }
+    }
 }
 
 impl Record {

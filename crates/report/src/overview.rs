@@ -353,11 +353,7 @@ fn frontier_chart(
         _ => r.metrics.flip_mean,
     };
     let names = distinct(records.iter().map(|r| series_name(r)));
-    let bases: Vec<String> = names
-        .iter()
-        .map(|n| n.split_whitespace().next().unwrap_or_default().to_string())
-        .collect();
-    let styles = styles_for(&bases.iter().map(String::as_str).collect::<Vec<_>>());
+    let styles = styles_for(&names.iter().map(String::as_str).collect::<Vec<_>>());
     let all: Vec<(f64, f64)> = records.iter().map(|r| (r.ms_median, error(r))).collect();
     let (front, steps) = pareto_steps(&all);
     let on_front = |r: &Record| front.contains(&(r.ms_median, error(r)));

@@ -2,8 +2,10 @@
 //!
 //! Rules every chart follows (issue 38), enforced here rather than by each report section:
 //! - a method has one colour and one marker in every report ([`method_style`]); a variant of a
-//!   method (its options, α, a lighting or stereo variant) keeps them and changes the dash and
-//!   the marker's fill ([`Style::variant`]); the colours are Okabe and Ito's colour-blind-safe set;
+//!   method (its options, α, a lighting or stereo variant) keeps the colour and changes the
+//!   dash, the marker's fill and from its third variant the marker ([`Style::variant`]), the
+//!   one its key gives it in every report ([`keyed_styles`]); the colours are Okabe and Ito's
+//!   colour-blind-safe set;
 //! - a series is joined by a line only when its points are one variable swept
 //!   ([`Series::joined`]); otherwise it is markers only;
 //! - log axes are tight to the data (not rounded out to whole decades); the comparison's floor
@@ -126,17 +128,86 @@ pub fn method_style(method: &str) -> Style {
     }
 }
 
-/// The styles of a chart's series, given each series' method in order: the method's style,
-/// its `k`-th variant for the `k`-th series of the same method.
-pub fn styles_for(methods: &[&str]) -> Vec<Style> {
-    methods
+/// The variants' styles in the order they are tried: filled markers first (ours), then hollow
+/// ones (an outside renderer's, and ours where the filled ones run out). Index 0, the method's
+/// own style, is its defaults'.
+const FILLED_VARIANTS: [usize; 5] = [2, 4, 7, 9, 11];
+const HOLLOW_VARIANTS: [usize; 6] = [1, 3, 5, 6, 8, 10];
+
+/// What decides a series' style: its method, its variant's key (its options, a lighting
+/// variant, "α=0.7"; empty at the method's defaults), and whether an outside renderer
+/// (`mirrorbox score`) drew it.
+#[derive(Clone, Copy, Debug)]
+pub struct StyleKey<'a> {
+    pub method: &'a str,
+    pub variant: &'a str,
+    pub outside: bool,
+}
+
+/// The styles of a chart's series: the method's own style for its defaults, and for a variant
+/// the [`Style::variant`] its key hashes to — the same variant keeps its style in every chart
+/// of every report ("auxiliary n=2" is one marker and dash wherever it is drawn), where an
+/// index by order had given it whatever place its chart's other variants left. No two series
+/// of one chart share a look (colour, marker and fill; any method's): a taken one passes on to
+/// the next free one (filled markers for ours, hollow for an outside renderer's, then the
+/// others).
+pub fn keyed_styles(keys: &[StyleKey]) -> Vec<Style> {
+    // What a reader tells markers apart by where no line shows the dash.
+    let look = |s: &Style| (s.color, s.marker, s.hollow);
+    let mut styles: Vec<Option<Style>> = vec![None; keys.len()];
+    let mut taken = Vec::new();
+    // The methods' defaults first: each keeps its own style whatever variants come before it.
+    for (i, key) in keys.iter().enumerate() {
+        let s = method_style(key.method);
+        if key.variant.is_empty() && !key.outside && !taken.contains(&look(&s)) {
+            taken.push(look(&s));
+            styles[i] = Some(s);
+        }
+    }
+    for (i, key) in keys.iter().enumerate() {
+        if styles[i].is_some() {
+            continue;
+        }
+        let (first, second): (&[usize], &[usize]) = if key.outside {
+            (&HOLLOW_VARIANTS, &FILLED_VARIANTS)
+        } else {
+            (&FILLED_VARIANTS, &HOLLOW_VARIANTS)
+        };
+        // FNV-1a: fixed across runs and platforms, unlike std's hasher.
+        let h = key.variant.bytes().fold(0x811c_9dc5_u32, |h, b| {
+            (h ^ u32::from(b)).wrapping_mul(0x0100_0193)
+        });
+        let at = h as usize % first.len();
+        let base = method_style(key.method);
+        let candidates = first[at..].iter().chain(&first[..at]).chain(second);
+        let s = candidates
+            .map(|&k| base.variant(k))
+            .find(|s| !taken.contains(&look(s)))
+            // Every style of the method taken (12 variants in one chart): the preferred one
+            // again; the legend still names them apart.
+            .unwrap_or(base.variant(first[at]));
+        taken.push(look(&s));
+        styles[i] = Some(s);
+    }
+    styles.into_iter().flatten().collect()
+}
+
+/// The styles of a chart's series named "method options…" (a record's variant,
+/// `document::variant`): [`keyed_styles`] with the words after the method as the key.
+pub fn styles_for(names: &[&str]) -> Vec<Style> {
+    let keys: Vec<StyleKey> = names
         .iter()
-        .enumerate()
-        .map(|(i, m)| {
-            let k = methods[..i].iter().filter(|o| *o == m).count();
-            method_style(m).variant(k)
+        .map(|n| {
+            let n = n.trim();
+            let (method, variant) = n.split_once(' ').unwrap_or((n, ""));
+            StyleKey {
+                method,
+                variant: variant.trim(),
+                outside: false,
+            }
         })
-        .collect()
+        .collect();
+    keyed_styles(&keys)
 }
 
 pub struct Series {
@@ -1593,6 +1664,65 @@ mod tests {
         assert!(c.lint().join("\n").contains("without its domain"));
         c.title = "Error vs depth".into();
         assert!(c.lint().join("\n").contains("names no metric"));
+    }
+
+    /// A variant keeps its style whatever else its chart holds, the defaults keep the
+    /// method's own, an outside renderer's is hollow, and no two series of a chart look alike.
+    #[test]
+    fn a_variant_keeps_its_style_in_every_chart() {
+        let key = |method, variant| StyleKey {
+            method,
+            variant,
+            outside: false,
+        };
+        let n2 = key("auxiliary", "max-passes=9");
+        let alone = keyed_styles(&[n2])[0];
+        let among = keyed_styles(&[
+            key("auxiliary", "res=0.5"),
+            key("portal", ""),
+            key("auxiliary", ""),
+            n2,
+        ])[3];
+        assert_eq!(alone, among);
+        assert_ne!(alone, method_style("auxiliary"));
+        assert_eq!(
+            styles_for(&["ssr ssr-fallback=none", "ssr"])[1],
+            method_style("ssr")
+        );
+        assert_eq!(
+            styles_for(&["ssr ssr-fallback=none"])[0],
+            styles_for(&["ssr", "ssr ssr-fallback=planar", "ssr ssr-fallback=none"])[2]
+        );
+        let outside = keyed_styles(&[StyleKey {
+            method: "unrolled",
+            variant: "three.js",
+            outside: true,
+        }])[0];
+        assert!(outside.hollow);
+        assert_eq!(outside.color, method_style("unrolled").color);
+        // Eleven series of three methods sharing a colour (ssr, symmetry, feedback; 14 looks
+        // in all): every look distinct.
+        let names: Vec<String> = (0..3)
+            .flat_map(|i| {
+                [
+                    format!("ssr opt={i}"),
+                    format!("feedback history={i}"),
+                    format!("symmetry draws={i}"),
+                ]
+            })
+            .chain(["ssr".into(), "feedback".into()])
+            .collect();
+        let styles = styles_for(&names.iter().map(String::as_str).collect::<Vec<_>>());
+        for (i, a) in styles.iter().enumerate() {
+            for b in &styles[..i] {
+                assert!(
+                    (a.color, a.marker, a.hollow) != (b.color, b.marker, b.hollow),
+                    "{i}: {a:?}"
+                );
+            }
+        }
+        assert_eq!(styles[9], method_style("ssr"));
+        assert_eq!(styles[10], method_style("feedback"));
     }
 
     /// An axis label claims interval bars only where some series draws one on that axis.

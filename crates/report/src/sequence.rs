@@ -241,12 +241,7 @@ fn findings(records: &[FrameRecord], scenario: &str, still: bool) -> Vec<String>
 /// FLIP against frame, one series per method (log y).
 pub fn chart(records: &[FrameRecord], scenario: &str) -> Chart {
     let methods = methods(records, scenario);
-    let styles = styles_for(
-        &methods
-            .iter()
-            .map(|m| m.split_whitespace().next().unwrap_or_default())
-            .collect::<Vec<_>>(),
-    );
+    let styles = styles_for(&methods);
     Chart {
         y_log: true,
         x_whole: true,

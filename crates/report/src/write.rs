@@ -776,44 +776,54 @@ impl<'a> Variants<'a> {
                 groups.push(group);
             }
         }
-        // Each method its fixed style; an outside renderer's variant its equivalent's colour
-        // in a style of its own (dashed or hollow), so that it reads beside what it is meant
-        // to match.
-        let bases: Vec<(String, usize)> = groups
+        // Each method its fixed style, each variant (its options, and its α where the chart
+        // has several) the style its key gives it in every report; an outside renderer's
+        // variant its equivalent's colour with hollow markers, so that it reads beside what it
+        // is meant to match.
+        let alphas = distinct(points.iter().map(|r| r.alpha.to_bits()));
+        let keys: Vec<(String, String, bool)> = groups
             .iter()
             .map(|(m, a)| {
                 let r = points
                     .iter()
                     .find(|r| &crate::document::variant(r) == m && r.alpha == *a);
+                let alpha = if alphas.len() > 1 {
+                    format!("α={a}")
+                } else {
+                    String::new()
+                };
                 match r {
-                    Some(r) if r.is_external() => {
-                        (r.option("equivalent").unwrap_or(&r.method).to_string(), 1)
-                    }
-                    _ => (
-                        m.split_whitespace().next().unwrap_or_default().to_string(),
-                        0,
+                    Some(r) if r.is_external() => (
+                        r.option("equivalent").unwrap_or(&r.method).to_string(),
+                        format!("{} {alpha}", r.method).trim().to_string(),
+                        true,
                     ),
+                    _ => {
+                        let (method, options) = m.split_once(' ').unwrap_or((m, ""));
+                        (
+                            method.to_string(),
+                            format!("{options} {alpha}").trim().to_string(),
+                            false,
+                        )
+                    }
                 }
             })
             .collect();
-        let styles = bases
-            .iter()
-            .enumerate()
-            .map(|(i, (base, external))| {
-                // Ours count among ours (the first keeps the method's own style); an outside
-                // variant takes the odd variants, hollow markers.
-                let k = bases[..i]
-                    .iter()
-                    .filter(|(b, e)| b == base && e == external)
-                    .count();
-                crate::plot::method_style(base).variant(k * (1 + external) + external)
-            })
-            .collect();
+        let styles = crate::plot::keyed_styles(
+            &keys
+                .iter()
+                .map(|(method, variant, outside)| crate::plot::StyleKey {
+                    method,
+                    variant,
+                    outside: *outside,
+                })
+                .collect::<Vec<_>>(),
+        );
         Variants {
             points,
             groups,
             styles,
-            alphas: distinct(points.iter().map(|r| r.alpha.to_bits())),
+            alphas,
         }
     }
 
@@ -900,10 +910,7 @@ impl<'a> Variants<'a> {
                 // across another variable.
                 s.joined = s.points.windows(2).all(|w| w[1].0 > w[0].0)
                     && pts.iter().all(|r| r.axes.is_empty());
-                s.labels = pts
-                    .iter()
-                    .map(|r| crate::document::swept_label(r))
-                    .collect();
+                s.labels = crate::document::point_labels(&pts);
                 if ms_on_x {
                     s.bars = bars;
                     s.x_intervals = pts.iter().map(|r| r.ms_bars(s.bars)).collect();

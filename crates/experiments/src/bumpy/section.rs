@@ -9,7 +9,7 @@ use mirrorbox_report::Record;
 use mirrorbox_report::document::{
     Block, distinct, join_words, lowest_with_ties, markdown, ms_cell, sci,
 };
-use mirrorbox_report::plot::{Chart, Series, method_style};
+use mirrorbox_report::plot::{Chart, Series, StyleKey, keyed_styles};
 use mirrorbox_report::readme::{ReadmeError, RegionSource, measured_on};
 use mirrorbox_report::{Sweep, SweepInfo, load_sweep};
 
@@ -281,11 +281,18 @@ pub fn uneven_section(records: &[Record], bump_methods: &[String]) -> Vec<Block>
         })
         .cloned()
         .collect();
-    // A trick's variant of its host's style by its place among every host's tricks, so that
-    // it looks the same in the charts of hosts of one method (`march` had been the fifth of
-    // auxiliary n=2's tricks and the first of auxiliary n=4's: two styles). Each host keeps
+    // A trick's style is its host method's keyed by the trick's family (`keyed_styles`), the
+    // default `march` the method's own: the same in the charts of every host of one method and
+    // in every report (`march` had been the fifth of auxiliary n=2's tricks and the first of
+    // auxiliary n=4's: two styles; then a place among one report's tricks). Each host keeps
     // its method's colour and marker family, so hosts of other methods differ.
-    let families = distinct(pts.iter().map(|r| family(&trick_of(r, bump_methods))));
+    let trick_key = |fam: &str| {
+        if fam == "march" {
+            String::new()
+        } else {
+            fam.to_string()
+        }
+    };
     for (chart_index, m) in methods
         .iter()
         .filter(|m| !flat_only.contains(m))
@@ -294,8 +301,31 @@ pub fn uneven_section(records: &[Record], bump_methods: &[String]) -> Vec<Block>
         let mine: Vec<&Record> = pts.iter().copied().filter(|r| &method_of(r) == m).collect();
         let base = mine.first().map_or(String::new(), |r| r.method.clone());
         let mut series = Vec::new();
-        for fam in distinct(mine.iter().map(|r| family(&trick_of(r, bump_methods)))).iter() {
-            let k = families.iter().position(|f| f == fam).unwrap_or(0);
+        let fams = distinct(mine.iter().map(|r| family(&trick_of(r, bump_methods))));
+        let flat_bases: Vec<String> = flat_only
+            .iter()
+            .map(|f| {
+                pts.iter()
+                    .find(|r| &method_of(r) == f)
+                    .map_or(f.clone(), |r| r.method.clone())
+            })
+            .collect();
+        let fam_keys: Vec<String> = fams.iter().map(|f| trick_key(f)).collect();
+        let keys: Vec<StyleKey> = fam_keys
+            .iter()
+            .map(|k| StyleKey {
+                method: &base,
+                variant: k,
+                outside: false,
+            })
+            .chain(flat_bases.iter().map(|b| StyleKey {
+                method: b,
+                variant: "",
+                outside: false,
+            }))
+            .collect();
+        let styles = keyed_styles(&keys);
+        for (fam, &style) in fams.iter().zip(&styles) {
             let settings = distinct(
                 mine.iter()
                     .filter(|r| &family(&trick_of(r, bump_methods)) == fam)
@@ -319,17 +349,10 @@ pub fn uneven_section(records: &[Record], bump_methods: &[String]) -> Vec<Block>
             } else {
                 best.clone()
             };
-            series.push(Series::new(
-                name,
-                method_style(&base).variant(k),
-                curve(&of(best)),
-            ));
+            series.push(Series::new(name, style, curve(&of(best))));
         }
-        for f in &flat_only {
+        for (f, &style) in flat_only.iter().zip(&styles[fams.len()..]) {
             let rs: Vec<&Record> = pts.iter().copied().filter(|r| &method_of(r) == f).collect();
-            let style = rs
-                .first()
-                .map_or(method_style(f), |r| method_style(&r.method));
             series.push(Series::new(format!("{f}: flat"), style, curve(&rs)));
         }
         let file = if chart_index == 0 {

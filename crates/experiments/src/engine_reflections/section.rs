@@ -12,11 +12,11 @@
 //! The report knows the methods' names and options (`ssr-fallback`), not the rasterizer.
 
 use mirrorbox_report::document::{Block, distinct, f, ms_cell, sci};
-use mirrorbox_report::plot::{Chart, Series, method_style};
+use mirrorbox_report::plot::{Chart, Series, Style, StyleKey, keyed_styles};
 use mirrorbox_report::{Record, value};
 
 /// The yaw axis' name in a record's `axes` (the harness's `CAMERA_YAW`).
-const YAW: &str = "yaw_deg";
+const YAW: &str = mirrorbox_report::axis::YAW_DEG;
 /// The exact methods whose depth is swept here.
 const DEPTH_SWEPT: [&str; 4] = ["ray-query", "unrolled", "portal", "path-textures"];
 
@@ -29,24 +29,57 @@ fn fallback(r: &Record) -> String {
     r.option("ssr-fallback").unwrap_or("cubemap").to_string()
 }
 
-/// `ssr`'s style per fallback, the variants the overview gives them in key order (`none`,
-/// the default `cubemap`, `planar`): square, hollow square, triangle.
-fn ssr_style(fallback: &str) -> mirrorbox_report::plot::Style {
-    let base = method_style("ssr");
-    match fallback {
-        "cubemap" => base.variant(1),
-        "planar" => base.variant(2),
-        _ => base,
-    }
+/// A point's method as its key names it (`cubemap cube-size=128 history=16`,
+/// `ssr ssr-fallback=none`, `auxiliary n=2`), without the depth: the table's column and the
+/// depth charts' x.
+fn key_name(r: &Record) -> String {
+    r.method_key()
+        .split_whitespace()
+        .filter(|w| !w.starts_with("depth="))
+        .collect::<Vec<_>>()
+        .join(" ")
 }
 
-/// A point's name in a legend or a row: the method, with `ssr`'s fallback and `auxiliary`'s n.
-fn name(r: &Record) -> String {
-    match r.method.as_str() {
-        "ssr" => format!("ssr, fallback {}", fallback(r)),
-        "auxiliary" => format!("auxiliary n={}", r.n.unwrap_or(0)),
-        m => m.to_string(),
-    }
+/// A point's name in a legend or a row: [`key_name`], `(defaults)` added where a variant of
+/// the method with options is among `others` (`ssr (defaults)` beside `ssr
+/// ssr-fallback=none`, as the report's generic charts name them).
+fn name(r: &Record, others: &[&str]) -> String {
+    mirrorbox_report::document::legend_name(&key_name(r), others)
+}
+
+/// The points' names ([`key_name`]), each once.
+fn variants_of(pts: &[&Record]) -> Vec<String> {
+    distinct(pts.iter().map(|r| key_name(r)))
+}
+
+/// The style of a point's series: its method, keyed by its options ([`keyed_styles`]) — the
+/// count `n` apart, as in the generic charts, where it is a series' swept setting.
+fn style_key(r: &Record) -> (String, String, bool) {
+    let options: Vec<&str> = r
+        .method_key()
+        .split_whitespace()
+        .skip(1)
+        .filter(|w| !w.starts_with("depth=") && !w.starts_with("n="))
+        .collect();
+    (r.method.clone(), options.join(" "), r.is_external())
+}
+
+/// [`keyed_styles`] of the points' [`style_key`]s.
+fn styles_of<'a>(fixed: impl Iterator<Item = &'a str>, pts: &[&Record]) -> Vec<Style> {
+    let keys: Vec<(String, String, bool)> = fixed
+        .map(|m| (m.to_string(), String::new(), false))
+        .chain(pts.iter().map(|r| style_key(r)))
+        .collect();
+    keyed_styles(
+        &keys
+            .iter()
+            .map(|(method, variant, outside)| StyleKey {
+                method,
+                variant,
+                outside: *outside,
+            })
+            .collect::<Vec<_>>(),
+    )
 }
 
 /// Spearman's rank correlation of `(x, y)` (ties at their mean rank).
@@ -127,24 +160,35 @@ fn depth_blocks(pts: &[&Record]) -> Vec<Block> {
     cost.x_ticks_at_data = true;
     let mut sentences = Vec::new();
     let bars = mirrorbox_report::ms_bars_for(pts.iter().copied());
-    for m in DEPTH_SWEPT {
-        let mut of: Vec<&Record> = pts
-            .iter()
-            .copied()
-            .filter(|r| r.method == m && r.depth.is_some())
-            .collect();
-        of.sort_by_key(|r| r.depth);
-        if of.is_empty() {
-            continue;
-        }
+    // The depth-swept methods, one series each, and the one-setting points, each its own
+    // series at the depth it shows (not joined: no variable is swept).
+    let swept: Vec<(&str, Vec<&Record>)> = DEPTH_SWEPT
+        .iter()
+        .map(|&m| {
+            let mut of: Vec<&Record> = pts
+                .iter()
+                .copied()
+                .filter(|r| r.method == m && r.depth.is_some())
+                .collect();
+            of.sort_by_key(|r| r.depth);
+            (m, of)
+        })
+        .filter(|(_, of)| !of.is_empty())
+        .collect();
+    let single: Vec<&Record> = pts
+        .iter()
+        .copied()
+        .filter(|r| !DEPTH_SWEPT.contains(&r.method.as_str()))
+        .collect();
+    let styles = styles_of(swept.iter().map(|(m, _)| *m), &single);
+    for ((m, of), &style) in swept.iter().zip(&styles) {
         let d = |r: &Record| f64::from(r.depth.unwrap_or(0));
-        let style = method_style(m);
         error.series.push(Series::new(
-            m,
+            *m,
             style,
             of.iter().map(|r| (d(r), r.mirror_flip())).collect(),
         ));
-        let mut s = Series::new(m, style, of.iter().map(|r| (d(r), r.ms_median)).collect());
+        let mut s = Series::new(*m, style, of.iter().map(|r| (d(r), r.ms_median)).collect());
         s.bars = bars;
         s.y_intervals = of.iter().map(|r| r.ms_bars(s.bars)).collect();
         cost.series.push(s);
@@ -167,33 +211,12 @@ fn depth_blocks(pts: &[&Record]) -> Vec<Block> {
             ));
         }
     }
-    // The one-setting methods, each a point at the depth it shows (not joined: no variable
-    // is swept).
-    // Each its own style: a method's second setting (auxiliary n = 1, a second cube size)
-    // its next variant.
-    let mut seen: Vec<&str> = Vec::new();
-    for r in pts
-        .iter()
-        .copied()
-        .filter(|r| !DEPTH_SWEPT.contains(&r.method.as_str()))
-    {
+    // Named as the report's other charts name them, "(defaults)" beside a variant.
+    let variants = variants_of(&single);
+    let variants: Vec<&str> = variants.iter().map(String::as_str).collect();
+    for (r, &style) in single.iter().zip(&styles[swept.len()..]) {
         let depth = r.reflections.max(1) as f64;
-        let k = seen.iter().filter(|m| **m == r.method).count();
-        seen.push(&r.method);
-        let style = if r.method == "ssr" {
-            ssr_style(&fallback(r))
-        } else {
-            method_style(&r.method).variant(k)
-        };
-        // Its count where it has one (auxiliary n=1), else the method as its key names it,
-        // every option included (two cube sizes).
-        let label = if r.method == "ssr" {
-            name(r)
-        } else if r.n.is_some() {
-            mirrorbox_report::document::label(r)
-        } else {
-            r.method_key().to_string()
-        };
+        let label = name(r, &variants);
         for (chart, y) in [(&mut error, r.mirror_flip()), (&mut cost, r.ms_median)] {
             let mut s = Series::new(label.clone(), style, vec![(depth, y)]);
             s.joined = false;
@@ -233,11 +256,21 @@ fn screen_blocks(pts: &[&Record], truth: &str) -> Vec<Block> {
         "FLIP mean over the mirror pixels",
     );
     let fallbacks = distinct(ssr.iter().map(|r| fallback(r)));
-    let mut bullets = Vec::new();
-    for fb in ["none", "cubemap", "planar"]
+    let shown: Vec<&str> = ["none", "cubemap", "planar"]
+        .into_iter()
+        .filter(|f| fallbacks.iter().any(|g| g == f))
+        .collect();
+    // Each fallback's series named and drawn as the report's other charts have it: the
+    // variant's name (`ssr ssr-fallback=none`, `ssr (defaults)`) and its keyed style.
+    let firsts: Vec<&Record> = shown
         .iter()
-        .filter(|f| fallbacks.iter().any(|g| g == *f))
-    {
+        .filter_map(|fb| ssr.iter().copied().find(|r| fallback(r) == *fb))
+        .collect();
+    let variants = variants_of(&firsts);
+    let names: Vec<&str> = variants.iter().map(String::as_str).collect();
+    let styles = styles_of(std::iter::empty(), &firsts);
+    let mut bullets = Vec::new();
+    for ((fb, variant), style) in shown.iter().zip(&variants).zip(styles) {
         let mut of: Vec<&Record> = ssr.iter().copied().filter(|r| fallback(r) == *fb).collect();
         of.sort_by(|a, b| {
             a.value(value::REFLECTION_OFFSCREEN_SHARE)
@@ -253,12 +286,13 @@ fn screen_blocks(pts: &[&Record], truth: &str) -> Vec<Block> {
                 )
             })
             .collect();
-        let mut s = Series::new(format!("ssr, fallback {fb}"), ssr_style(fb), xy.clone());
+        let legend = mirrorbox_report::document::legend_name(variant, &names);
+        let mut s = Series::new(legend, style, xy.clone());
         // Each point is a camera turn: x is not a swept variable, so no line.
         s.joined = false;
         s.labels = of
             .iter()
-            .map(|r| format!("{}°", r.axis(YAW).unwrap_or(0.0)))
+            .map(|r| mirrorbox_report::axis::label(YAW, r.axis(YAW).unwrap_or(0.0)))
             .collect();
         chart.series.push(s);
         let median = |mut v: Vec<f64>| {
@@ -301,10 +335,12 @@ fn table(pts: &[&Record], screen: bool) -> Block {
     for h in ["FLIP mean", "FLIP, mirror pixels", "ms/frame", "passes"] {
         header.push(h.into());
     }
+    let variants = variants_of(pts);
+    let variants: Vec<&str> = variants.iter().map(String::as_str).collect();
     let rows = pts
         .iter()
         .map(|r| {
-            let mut row = vec![format!("`{}`", name(r))];
+            let mut row = vec![format!("`{}`", name(r, &variants))];
             if screen {
                 row.push(r.axis(YAW).map_or("–".into(), |y| format!("{y}°")));
                 row.push(

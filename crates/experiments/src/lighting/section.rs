@@ -8,7 +8,7 @@
 
 use mirrorbox_report::Record;
 use mirrorbox_report::document::{Block, f, markdown, ms_cell, ms_heading, sci};
-use mirrorbox_report::plot::{Chart, Series, method_style};
+use mirrorbox_report::plot::{Chart, Series, StyleKey, keyed_styles};
 use mirrorbox_report::readme::{ReadmeError, RegionSource, measured_on};
 use mirrorbox_report::{Sweep, load_sweep};
 
@@ -42,6 +42,19 @@ pub fn lighting_of(r: &Record) -> String {
         .option("shadow-bias")
         .map_or(String::new(), |b| format!(", bias {b}"));
     format!("{lights}, shadow maps {size}²{bias}")
+}
+
+/// [`lighting_of`] of a point with no lighting option: the scene's own lights, no shadows.
+const DEFAULT_LIGHTING: &str = "mirrored, no shadows";
+
+/// A lighting variant's key for its style in a chart ([`keyed_styles`]): the method's own
+/// style at the default lighting, and one style per variant in every report.
+fn style_key(variant: &str) -> &str {
+    if variant == DEFAULT_LIGHTING {
+        ""
+    } else {
+        variant
+    }
 }
 
 /// Where a variant's rows go: direct before mirrored, no shadows before shadow maps, maps by
@@ -179,10 +192,18 @@ pub fn lighting_section(records: &[Record]) -> Vec<Block> {
             .filter(|r| &r.method == kind && r.lights_depth() == Some(k_max))
             .collect();
         mine.sort_by_key(|r| variant_order(r));
-        for (k, v) in distinct(mine.iter().map(|r| lighting_of(r)))
-            .iter()
-            .enumerate()
-        {
+        let lightings = distinct(mine.iter().map(|r| lighting_of(r)));
+        let styles = keyed_styles(
+            &lightings
+                .iter()
+                .map(|v| StyleKey {
+                    method: kind,
+                    variant: style_key(v),
+                    outside: false,
+                })
+                .collect::<Vec<_>>(),
+        );
+        for (v, style) in lightings.iter().zip(styles) {
             let mut at: Vec<&Record> = mine
                 .iter()
                 .copied()
@@ -197,7 +218,7 @@ pub fn lighting_section(records: &[Record]) -> Vec<Block> {
             };
             let mut s = Series::new(
                 name,
-                method_style(kind).variant(k),
+                style,
                 at.iter()
                     .map(|r| (r.ms_median, r.metrics.flip_mean))
                     .collect(),
@@ -238,10 +259,20 @@ pub fn lighting_section(records: &[Record]) -> Vec<Block> {
     ];
     if let Some(method) = reference_method(&points) {
         let base = method.split_whitespace().next().unwrap_or_default();
+        let styles = keyed_styles(
+            &variants
+                .iter()
+                .map(|v| StyleKey {
+                    method: base,
+                    variant: style_key(v),
+                    outside: false,
+                })
+                .collect::<Vec<_>>(),
+        );
         let series: Vec<Series> = variants
             .iter()
-            .enumerate()
-            .map(|(i, v)| {
+            .zip(styles)
+            .map(|(v, style)| {
                 let mut pts: Vec<&Record> = points
                     .iter()
                     .copied()
@@ -250,7 +281,7 @@ pub fn lighting_section(records: &[Record]) -> Vec<Block> {
                 pts.sort_by_key(|r| r.lights_depth());
                 Series::new(
                     v.clone(),
-                    method_style(base).variant(i),
+                    style,
                     pts.iter()
                         .map(|r| {
                             (
@@ -376,10 +407,8 @@ mod tests {
         let r = record("auxiliary", "lights=mirrored max-passes=9", 4, 0.1);
         assert_eq!(method_of(&r), "auxiliary max-passes=9");
         assert_eq!(lighting_of(&r), "mirrored, no shadows");
-        assert_eq!(
-            lighting_of(&record("portal", "", 0, 0.1)),
-            "mirrored, no shadows"
-        );
+        assert_eq!(lighting_of(&record("portal", "", 0, 0.1)), DEFAULT_LIGHTING);
+        assert_eq!(style_key(&lighting_of(&record("portal", "", 0, 0.1))), "");
         let r = record("unrolled", "shadows=map shadow-map-size=256", 8, 0.1);
         assert_eq!(method_of(&r), "unrolled depth=64");
         assert_eq!(lighting_of(&r), "mirrored, shadow maps 256²");

@@ -11,7 +11,7 @@
 
 use mirrorbox_report::Record;
 use mirrorbox_report::document::{Block, distinct, f, markdown, ms_cell, sci};
-use mirrorbox_report::plot::{Chart, Series, method_style, styles_for};
+use mirrorbox_report::plot::{Chart, Series, StyleKey, keyed_styles, method_style};
 use mirrorbox_report::readme::{ReadmeError, RegionSource, measured_on};
 use mirrorbox_report::{Sweep, load_sweep};
 
@@ -261,15 +261,22 @@ fn chart(records: &[Record], name: &str, title: &str, y_label: &str, y_log: bool
         }
     };
     let variants = distinct(pts.iter().map(|r| variant_of(r)));
-    let methods: Vec<String> = variants
+    // Each variant the style its method and options (`stereo-mirrors=shared`) have in every
+    // report.
+    let firsts: Vec<&Record> = variants
         .iter()
-        .map(|v| {
-            pts.iter()
-                .find(|r| &variant_of(r) == v)
-                .map_or(String::new(), |r| r.method.clone())
-        })
+        .filter_map(|v| pts.iter().copied().find(|r| &variant_of(r) == v))
         .collect();
-    let styles = styles_for(&methods.iter().map(String::as_str).collect::<Vec<_>>());
+    let styles = keyed_styles(
+        &firsts
+            .iter()
+            .map(|r| StyleKey {
+                method: &r.method,
+                variant: &r.method_options,
+                outside: false,
+            })
+            .collect::<Vec<_>>(),
+    );
     let mut series: Vec<Series> = variants
         .iter()
         .zip(styles)
