@@ -766,13 +766,26 @@ pub fn chart(
             methods.push(&r.method);
         }
     }
+    let coords: Vec<(f64, f64)> = advice
+        .measured
+        .iter()
+        .map(|r| (r.ms_median, metric.of(r)))
+        .collect();
+    let (front, steps) = mirrorbox_report::overview::pareto_steps(&coords);
+    // Labels on the front and the pick only: the chart's question is which settings are worth
+    // their time, and a crowded search (40 points) had labels a reader could not tie to their
+    // points; the table lists every one.
+    let labelled = |r: &Record| {
+        front.contains(&(r.ms_median, metric.of(r)))
+            || advice.pick.as_ref().is_some_and(|p| p.key == r.key)
+    };
     let mut series = Vec::new();
     let bars = mirrorbox_report::ms_bars_for(&advice.measured);
     for m in methods {
         let mut pts: Vec<&Record> = advice.measured.iter().filter(|r| r.method == m).collect();
         pts.sort_by(|a, b| a.ms_median.total_cmp(&b.ms_median));
         // Variants of one method (ssr's fallbacks, cubemap's history) share its style: one
-        // series per method, labelled per point.
+        // series per method, labelled per point on the front.
         let mut s = Series::new(
             m,
             method_style(m),
@@ -781,15 +794,18 @@ pub fn chart(
         s.joined = false;
         s.bars = bars;
         s.x_intervals = pts.iter().map(|r| r.ms_bars(s.bars)).collect();
-        s.labels = pts.iter().map(|r| setting_label(r)).collect();
+        s.labels = pts
+            .iter()
+            .map(|r| {
+                if labelled(r) {
+                    setting_label(r)
+                } else {
+                    String::new()
+                }
+            })
+            .collect();
         series.push(s);
     }
-    let coords: Vec<(f64, f64)> = advice
-        .measured
-        .iter()
-        .map(|r| (r.ms_median, metric.of(r)))
-        .collect();
-    let (_, steps) = mirrorbox_report::overview::pareto_steps(&coords);
     let errors: Vec<f64> = coords.iter().map(|c| c.1).filter(|e| *e > 0.0).collect();
     let (lo, hi) = (
         errors.iter().copied().fold(f64::INFINITY, f64::min),
@@ -1184,6 +1200,30 @@ mod tests {
                 .starts_with("portal depth=21|")
         );
         assert_eq!(advice.rounds, 10);
+    }
+
+    /// The chart labels the points on the Pareto front and the pick, not those behind it.
+    #[test]
+    fn the_chart_labels_the_front_and_the_pick_only() {
+        let (mut advice, _) = search_model_with(3.05, 0.0, 0.0, true);
+        // Slower and worse than every portal depth: behind the front.
+        advice
+            .measured
+            .push(candidate("auxiliary n=2", 9.0, 9.5, 0.9));
+        let chart = chart(&advice, Metric::Flip, "model", String::new());
+        let behind = chart.series.iter().find(|s| s.name == "auxiliary").unwrap();
+        assert_eq!(behind.labels, [""]);
+        let portal = chart.series.iter().find(|s| s.name == "portal").unwrap();
+        assert!(
+            portal.labels.iter().all(|l| l.starts_with("depth=")),
+            "{:?}",
+            portal.labels
+        );
+        // The pick keeps its label though it is off the front.
+        advice.pick = advice.measured.last().cloned();
+        let chart = super::chart(&advice, Metric::Flip, "model", String::new());
+        let picked = chart.series.iter().find(|s| s.name == "auxiliary").unwrap();
+        assert_eq!(picked.labels, ["n=2"]);
     }
 
     /// Exhaustive: every coarse depth in one round, and no bisection though the budget lies
