@@ -293,14 +293,18 @@ pub mod value {
 }
 
 /// The time bars one chart draws for all of its `points`: their 95 % intervals where every
-/// point has one; else, where every point was timed on two frames or more, each point's
-/// fastest to slowest frame (sweeps of five frames have no 95 % interval; a chart showed
-/// their medians bare); else the intervals some have (a point of one frame, or an outside
-/// renderer's without its frames, keeps the chart on intervals: no range for it to draw). One
-/// kind per chart: the axis label says which ([`plot::Chart`]).
+/// point has one; else each point's fastest to slowest frame where that draws more bars —
+/// some point has frames but no interval (sweeps of five frames have no 95 % interval; a chart
+/// showed their medians bare) and no point with an interval lacks frames. A point with
+/// neither (one frame, or an outside renderer's record without its frames) draws no bar
+/// either way, so it no longer holds a chart of ranged points on intervals. One kind per
+/// chart: the axis label says which ([`plot::Chart`]).
 pub fn ms_bars_for<'a>(points: impl IntoIterator<Item = &'a Record> + Clone) -> plot::Bars {
-    let all = |f: &dyn Fn(&Record) -> bool| points.clone().into_iter().all(f);
-    if !all(&|r| r.ms_interval.is_some()) && all(&|r| r.frames_ms.len() >= 2) {
+    let any = |f: &dyn Fn(&Record) -> bool| points.clone().into_iter().any(f);
+    let ranged = |r: &Record| r.frames_ms.len() >= 2;
+    let gains = any(&|r| r.ms_interval.is_none() && ranged(r));
+    let loses = any(&|r| r.ms_interval.is_some() && !ranged(r));
+    if gains && !loses {
         plot::Bars::FrameRange
     } else {
         plot::Bars::Ci95

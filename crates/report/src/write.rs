@@ -1478,6 +1478,17 @@ pub(crate) mod tests {
         write_report(dir.path(), &SweepInfo::default(), &records, &[]).unwrap();
         let svg = std::fs::read_to_string(dir.path().join("plot_flip_vs_ms.svg")).unwrap();
         assert!(svg.contains(">ms/frame (median, 95 % CI bars)<"), "{svg}");
+        // One point without its frames or an interval (an outside renderer's) among points
+        // with frames alone: the others keep their ranges; it draws none.
+        for r in &mut records {
+            r.ms_interval = None;
+        }
+        records[2].frames_ms.clear();
+        assert_eq!(crate::ms_bars_for(&records), crate::plot::Bars::FrameRange);
+        assert_eq!(records[2].ms_bars(crate::plot::Bars::FrameRange), None);
+        // A point with an interval but without frames keeps the chart on intervals.
+        records[2].ms_interval = Some([2.9, 3.1]);
+        assert_eq!(crate::ms_bars_for(&records), crate::plot::Bars::Ci95);
         // One frame each and no interval: no bars, and the axis promises none.
         for r in &mut records {
             (r.ms_interval, r.frames_ms) = (None, vec![r.ms_median]);
