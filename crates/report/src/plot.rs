@@ -3,7 +3,7 @@
 //! Rules every chart follows (issue 38), enforced here rather than by each report section:
 //! - a method has one colour and one marker in every report ([`method_style`]); a variant of a
 //!   method (its options, α, a lighting or stereo variant) keeps the colour and changes the
-//!   dash, the marker's fill and from its third variant the marker ([`Style::variant`]), the
+//!   dash, the marker's fill and from its third variant the marker ([`method_variant`]), the
 //!   one its key gives it in every report ([`keyed_styles`]); the colours are Okabe and Ito's
 //!   colour-blind-safe set;
 //! - a series is joined by a line only when its points are one variable swept
@@ -71,44 +71,44 @@ pub struct Style {
 
 const DASHES: [&str; 6] = ["", "7 4", "2 3", "8 3 2 3", "12 3", "2 2 6 2"];
 
-impl Style {
-    /// The `k`-th variant of a method: same colour, another dash, hollow markers for odd
-    /// `k`, and from the third variant on the next markers of [`Marker::ALL`] (so that
-    /// variants drawn as points alone, where no dash shows, stay apart: `ssr`'s fallbacks).
-    pub fn variant(self, k: usize) -> Style {
-        let at = Marker::ALL
-            .iter()
-            .position(|m| *m == self.marker)
-            .unwrap_or(0);
-        Style {
-            dash: DASHES[k % DASHES.len()],
-            // Eight distinct (dash, fill) pairs before one repeats.
-            hollow: (k + k / DASHES.len()) % 2 == 1,
-            marker: Marker::ALL[(at + k / 2) % Marker::ALL.len()],
-            ..self
-        }
-    }
-}
-
-/// The fixed style of every raster method (and the truth), the same in every report. A name
-/// not in the table (a method added later) gets a style from its name's hash, in grey's place
-/// never: the table is the place to give a new method its own.
-pub fn method_style(method: &str) -> Style {
+/// A method's colour, its own marker, and the markers its variants take besides it: no other
+/// method of its colour has any of them as its own or its variants', so that a variant of one
+/// method never looks like another method or its variants (`ssr`'s planar fallback had taken
+/// `feedback`'s diamond). A name not in the table (a method added later) gets a colour and a
+/// marker from its name's hash, in grey's place never, and no markers besides: the table is
+/// the place to give a new method its own.
+fn method_entry(method: &str) -> (&'static str, Marker, &'static [Marker]) {
     use Marker::*;
-    let (color, marker) = match method {
-        "naive" => (COLORS[4], TriangleDown),
-        "auxiliary" => (COLORS[1], Circle),
-        "path-textures" => (COLORS[3], Diamond),
-        "portal" => (COLORS[2], Square),
-        "unrolled" => (COLORS[0], Plus),
-        "symmetry" => (COLORS[5], Circle),
-        "symmetry-pruned" => (COLORS[3], TriangleUp),
-        "symmetry-baked" => (COLORS[4], Square),
-        "feedback" => (COLORS[5], Diamond),
-        "cubemap" => (COLORS[3], Cross),
-        "ssr" => (COLORS[5], Square),
-        "ray-query" => (COLORS[6], TriangleUp),
-        "truth" => (COLORS[6], Cross),
+    match method {
+        "naive" => (COLORS[4], TriangleDown, &[Circle, TriangleUp, Diamond]),
+        "symmetry-baked" => (COLORS[4], Square, &[Cross, Plus]),
+        "auxiliary" => (
+            COLORS[1],
+            Circle,
+            &[Square, TriangleUp, Diamond, TriangleDown, Cross, Plus],
+        ),
+        "path-textures" => (COLORS[3], Diamond, &[Circle]),
+        "symmetry-pruned" => (COLORS[3], TriangleUp, &[Square]),
+        "cubemap" => (COLORS[3], Cross, &[TriangleDown, Plus]),
+        "portal" => (
+            COLORS[2],
+            Square,
+            &[Circle, TriangleUp, Diamond, TriangleDown, Cross, Plus],
+        ),
+        "unrolled" => (
+            COLORS[0],
+            Plus,
+            &[Circle, Square, TriangleUp, Diamond, TriangleDown, Cross],
+        ),
+        "symmetry" => (COLORS[5], Circle, &[Plus]),
+        "feedback" => (COLORS[5], Diamond, &[TriangleDown]),
+        "ssr" => (COLORS[5], Square, &[TriangleUp, Cross]),
+        "ray-query" => (
+            COLORS[6],
+            TriangleUp,
+            &[Circle, Square, Diamond, TriangleDown, Plus],
+        ),
+        "truth" => (COLORS[6], Cross, &[]),
         other => {
             let h = other
                 .bytes()
@@ -117,9 +117,15 @@ pub fn method_style(method: &str) -> Style {
             (
                 COLORS[h as usize % 6],
                 markers[(h / 7) as usize % markers.len()],
+                &[],
             )
         }
-    };
+    }
+}
+
+/// The fixed style of every raster method (and the truth), the same in every report.
+pub fn method_style(method: &str) -> Style {
+    let (color, marker, _) = method_entry(method);
     Style {
         color,
         marker,
@@ -128,14 +134,30 @@ pub fn method_style(method: &str) -> Style {
     }
 }
 
-/// The variants' styles in the order they are tried: filled markers first (ours), then hollow
-/// ones (an outside renderer's, and ours where the filled ones run out). Index 0, the method's
-/// own style, is its defaults'.
-const FILLED_VARIANTS: [usize; 5] = [2, 4, 7, 9, 11];
-const HOLLOW_VARIANTS: [usize; 6] = [1, 3, 5, 6, 8, 10];
+/// How many looks a method's points can take where no line shows the dash: its markers
+/// (its own and its variants', [`method_entry`]), filled and hollow.
+fn point_looks(method: &str) -> usize {
+    2 * (1 + method_entry(method).2.len())
+}
 
-/// What decides a series' style: its method, its variant's key (its options, a lighting
-/// variant, "α=0.7"; empty at the method's defaults), and whether an outside renderer
+/// The `k`-th variant of `method`: its colour; hollow for odd `k`; the marker its own for
+/// k = 0, 1, then the next of the method's variant markers every two `k` (so that variants
+/// drawn as points alone, where no dash shows, stay apart: `ssr`'s fallbacks); the dash one
+/// of six in turn. k = 0 is [`method_style`].
+pub fn method_variant(method: &str, k: usize) -> Style {
+    let (color, own, more) = method_entry(method);
+    let markers = 1 + more.len();
+    let at = (k / 2) % markers;
+    Style {
+        color,
+        marker: if at == 0 { own } else { more[at - 1] },
+        dash: DASHES[k % DASHES.len()],
+        hollow: k % 2 == 1,
+    }
+}
+
+/// What decides a series' style: its method, its variant's key (its options and count, a
+/// lighting variant, "α=0.7"; empty at the method's defaults), and whether an outside renderer
 /// (`mirrorbox score`) drew it.
 #[derive(Clone, Copy, Debug)]
 pub struct StyleKey<'a> {
@@ -145,22 +167,23 @@ pub struct StyleKey<'a> {
 }
 
 /// The styles of a chart's series: the method's own style for its defaults, and for a variant
-/// the [`Style::variant`] its key hashes to — the same variant keeps its style in every chart
+/// the [`method_variant`] its key hashes to — the same variant keeps its style in every chart
 /// of every report ("auxiliary n=2" is one marker and dash wherever it is drawn), where an
-/// index by order had given it whatever place its chart's other variants left. No two series
-/// of one chart share a look (colour, marker and fill; any method's): a taken one passes on to
-/// the next free one (filled markers for ours, hollow for an outside renderer's, then the
-/// others).
+/// index by order had given it whatever place its chart's other variants left. A variant takes
+/// only its own method's markers ([`method_entry`]), so another method's series never moves
+/// it. No two series of one chart share a look (marker and fill; the dash too once a method's
+/// looks run out): a key whose look another variant of its method took passes on to the next
+/// free one (hollow first for an outside renderer's).
 pub fn keyed_styles(keys: &[StyleKey]) -> Vec<Style> {
     // What a reader tells markers apart by where no line shows the dash.
     let look = |s: &Style| (s.color, s.marker, s.hollow);
     let mut styles: Vec<Option<Style>> = vec![None; keys.len()];
-    let mut taken = Vec::new();
+    let mut taken: Vec<Style> = Vec::new();
     // The methods' defaults first: each keeps its own style whatever variants come before it.
     for (i, key) in keys.iter().enumerate() {
         let s = method_style(key.method);
-        if key.variant.is_empty() && !key.outside && !taken.contains(&look(&s)) {
-            taken.push(look(&s));
+        if key.variant.is_empty() && !key.outside && !taken.iter().any(|t| look(t) == look(&s)) {
+            taken.push(s);
             styles[i] = Some(s);
         }
     }
@@ -168,25 +191,39 @@ pub fn keyed_styles(keys: &[StyleKey]) -> Vec<Style> {
         if styles[i].is_some() {
             continue;
         }
-        let (first, second): (&[usize], &[usize]) = if key.outside {
-            (&HOLLOW_VARIANTS, &FILLED_VARIANTS)
-        } else {
-            (&FILLED_VARIANTS, &HOLLOW_VARIANTS)
-        };
+        let looks = point_looks(key.method);
         // FNV-1a: fixed across runs and platforms, unlike std's hasher.
         let h = key.variant.bytes().fold(0x811c_9dc5_u32, |h, b| {
             (h ^ u32::from(b)).wrapping_mul(0x0100_0193)
-        });
-        let at = h as usize % first.len();
-        let base = method_style(key.method);
-        let candidates = first[at..].iter().chain(&first[..at]).chain(second);
-        let s = candidates
-            .map(|&k| base.variant(k))
-            .find(|s| !taken.contains(&look(s)))
-            // Every style of the method taken (12 variants in one chart): the preferred one
-            // again; the legend still names them apart.
-            .unwrap_or(base.variant(first[at]));
-        taken.push(look(&s));
+        }) as usize;
+        // The variants' places, from the one the key hashes to: every look but the method's
+        // own; for an outside renderer's the hollow ones first.
+        let rotated = |mut v: Vec<usize>| {
+            if !v.is_empty() {
+                let n = v.len();
+                v.rotate_left(h % n);
+            }
+            v
+        };
+        let slots: Vec<usize> = if key.outside {
+            let mut v = rotated((1..looks).filter(|k| k % 2 == 1).collect());
+            v.extend((1..looks).filter(|k| k % 2 == 0));
+            v
+        } else {
+            rotated((1..looks).collect())
+        };
+        let s = slots
+            .iter()
+            .map(|&k| method_variant(key.method, k))
+            .find(|s| !taken.iter().any(|t| look(t) == look(s)))
+            .or_else(|| {
+                // Every look taken: another dash, for a joined series.
+                (looks..looks + 12)
+                    .map(|k| method_variant(key.method, k))
+                    .find(|s| !taken.contains(s))
+            })
+            .unwrap_or(method_variant(key.method, 1));
+        taken.push(s);
         styles[i] = Some(s);
     }
     styles.into_iter().flatten().collect()
@@ -1657,7 +1694,7 @@ mod tests {
             "{lint}"
         );
         // A variant of the method is told apart.
-        c.series[1].style = style.variant(1);
+        c.series[1].style = method_variant("portal", 1);
         assert!(!c.lint().join("\n").contains("drawn alike"));
         // A title without the metric's domain, or without any metric.
         c.title = "FLIP vs cost".into();
@@ -1723,6 +1760,67 @@ mod tests {
         }
         assert_eq!(styles[9], method_style("ssr"));
         assert_eq!(styles[10], method_style("feedback"));
+        // The variants that share charts in the committed reports take distinct places by
+        // their keys alone, so that neither moves the other.
+        for pair in [
+            ["ssr ssr-fallback=none", "ssr ssr-fallback=planar"],
+            [
+                "cubemap cube-size=128 history=16",
+                "cubemap cube-size=512 history=16",
+            ],
+            ["auxiliary n=1", "auxiliary n=2"],
+            ["auxiliary n=2", "auxiliary n=3"],
+        ] {
+            let both = styles_for(&pair);
+            assert_eq!(both[0], styles_for(&pair[..1])[0], "{pair:?}");
+            assert_eq!(both[1], styles_for(&pair[1..])[0], "{pair:?}");
+        }
+    }
+
+    /// A method's variants take markers no other method of its colour has, so that a variant
+    /// never looks like another method's series.
+    #[test]
+    fn the_methods_of_one_colour_own_disjoint_markers() {
+        let methods = [
+            "naive",
+            "auxiliary",
+            "path-textures",
+            "portal",
+            "unrolled",
+            "symmetry",
+            "symmetry-pruned",
+            "symmetry-baked",
+            "feedback",
+            "cubemap",
+            "ssr",
+            "ray-query",
+            "truth",
+        ];
+        for (i, a) in methods.iter().enumerate() {
+            let (ca, ma, more_a) = method_entry(a);
+            assert!(!more_a.contains(&ma), "{a}");
+            for b in &methods[..i] {
+                let (cb, mb, more_b) = method_entry(b);
+                if ca != cb {
+                    continue;
+                }
+                let own_a: Vec<Marker> =
+                    std::iter::once(ma).chain(more_a.iter().copied()).collect();
+                assert!(
+                    !own_a.contains(&mb) && !more_b.iter().any(|m| own_a.contains(m)),
+                    "{a} and {b} share a marker"
+                );
+            }
+            // Every variant of the method within its looks is its own.
+            let looks: Vec<Style> = (0..point_looks(a)).map(|k| method_variant(a, k)).collect();
+            for (k, s) in looks.iter().enumerate() {
+                assert!(
+                    !looks[..k]
+                        .iter()
+                        .any(|t| (t.marker, t.hollow) == (s.marker, s.hollow))
+                );
+            }
+        }
     }
 
     /// An axis label claims interval bars only where some series draws one on that axis.

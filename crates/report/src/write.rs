@@ -787,10 +787,11 @@ impl<'a> Variants<'a> {
                 let r = points
                     .iter()
                     .find(|r| &crate::document::variant(r) == m && r.alpha == *a);
-                let alpha = if alphas.len() > 1 {
-                    format!("α={a}")
-                } else {
+                // The sweep's first α keeps the method's style; each other α is a variant.
+                let alpha = if alphas.first() == Some(&a.to_bits()) {
                     String::new()
+                } else {
+                    format!("α={a}")
                 };
                 match r {
                     Some(r) if r.is_external() => (

@@ -9,7 +9,7 @@ use mirrorbox_report::Record;
 use mirrorbox_report::document::{
     Block, distinct, join_words, lowest_with_ties, markdown, ms_cell, sci,
 };
-use mirrorbox_report::plot::{Chart, Series, StyleKey, keyed_styles};
+use mirrorbox_report::plot::{Chart, Marker, Series, Style, StyleKey, keyed_styles, method_style};
 use mirrorbox_report::readme::{ReadmeError, RegionSource, measured_on};
 use mirrorbox_report::{Sweep, SweepInfo, load_sweep};
 
@@ -25,6 +25,26 @@ const TRICK_OPTIONS: [&str; 5] = [
 /// The method a point measured without its trick options: `auxiliary n=2`.
 pub fn method_of(r: &Record) -> String {
     r.method_without(&TRICK_OPTIONS)
+}
+
+/// A trick family's style in its host method's colour: one marker and dash per family in every
+/// chart (`march`, the default, solid with a filled circle); a family added later gets the
+/// circle, hollow, dashed.
+fn trick_style(host: &str, family: &str) -> Style {
+    let (marker, dash, hollow) = match family {
+        "march" => (Marker::Circle, "", false),
+        "flat" => (Marker::Cross, "2 3", false),
+        "distort" => (Marker::Square, "7 4", false),
+        "distort-distance" => (Marker::Diamond, "8 3 2 3", false),
+        "proxy" => (Marker::TriangleUp, "12 3", false),
+        _ => (Marker::Circle, "2 2 6 2", true),
+    };
+    Style {
+        color: method_style(host).color,
+        marker,
+        dash,
+        hollow,
+    }
 }
 
 /// The trick in words, from the options (absent options are at their defaults: `march`,
@@ -281,18 +301,9 @@ pub fn uneven_section(records: &[Record], bump_methods: &[String]) -> Vec<Block>
         })
         .cloned()
         .collect();
-    // A trick's style is its host method's keyed by the trick's family (`keyed_styles`), the
-    // default `march` the method's own: the same in the charts of every host of one method and
-    // in every report (`march` had been the fifth of auxiliary n=2's tricks and the first of
-    // auxiliary n=4's: two styles; then a place among one report's tricks). Each host keeps
-    // its method's colour and marker family, so hosts of other methods differ.
-    let trick_key = |fam: &str| {
-        if fam == "march" {
-            String::new()
-        } else {
-            fam.to_string()
-        }
-    };
+    // A trick has one marker and dash in every chart and report (`trick_style`), in its host
+    // method's colour: each chart is one host's tricks, so the marker says the trick, not the
+    // method (`flat` had been a cross, a square and a triangle in three charts).
     for (chart_index, m) in methods
         .iter()
         .filter(|m| !flat_only.contains(m))
@@ -310,21 +321,18 @@ pub fn uneven_section(records: &[Record], bump_methods: &[String]) -> Vec<Block>
                     .map_or(f.clone(), |r| r.method.clone())
             })
             .collect();
-        let fam_keys: Vec<String> = fams.iter().map(|f| trick_key(f)).collect();
-        let keys: Vec<StyleKey> = fam_keys
-            .iter()
-            .map(|k| StyleKey {
-                method: &base,
-                variant: k,
-                outside: false,
-            })
-            .chain(flat_bases.iter().map(|b| StyleKey {
-                method: b,
-                variant: "",
-                outside: false,
-            }))
-            .collect();
-        let styles = keyed_styles(&keys);
+        // The methods shown flat beside the host's tricks keep their own styles.
+        let flat_styles = keyed_styles(
+            &flat_bases
+                .iter()
+                .map(|b| StyleKey {
+                    method: b,
+                    variant: "",
+                    outside: false,
+                })
+                .collect::<Vec<_>>(),
+        );
+        let styles: Vec<Style> = fams.iter().map(|f| trick_style(&base, f)).collect();
         for (fam, &style) in fams.iter().zip(&styles) {
             let settings = distinct(
                 mine.iter()
@@ -351,7 +359,7 @@ pub fn uneven_section(records: &[Record], bump_methods: &[String]) -> Vec<Block>
             };
             series.push(Series::new(name, style, curve(&of(best))));
         }
-        for (f, &style) in flat_only.iter().zip(&styles[fams.len()..]) {
+        for (f, &style) in flat_only.iter().zip(&flat_styles) {
             let rs: Vec<&Record> = pts.iter().copied().filter(|r| &method_of(r) == f).collect();
             series.push(Series::new(format!("{f}: flat"), style, curve(&rs)));
         }
@@ -470,6 +478,26 @@ mod tests {
 
     fn bump() -> Vec<String> {
         vec!["auxiliary".into(), "path-textures".into()]
+    }
+
+    /// A trick looks the same under every host but for the host's colour, and no two tricks
+    /// alike.
+    #[test]
+    fn a_trick_has_one_marker_and_dash_under_every_host() {
+        let families = ["march", "flat", "distort", "distort-distance", "proxy"];
+        for f in families {
+            let (a, b) = (trick_style("auxiliary", f), trick_style("naive", f));
+            assert_eq!((a.marker, a.dash, a.hollow), (b.marker, b.dash, b.hollow));
+            assert_eq!(a.color, method_style("auxiliary").color);
+        }
+        for (i, f) in families.iter().enumerate() {
+            for g in &families[..i] {
+                assert_ne!(
+                    trick_style("naive", f).marker,
+                    trick_style("naive", g).marker
+                );
+            }
+        }
     }
 
     fn record(options: &str, a: f32, flip: f64) -> Record {

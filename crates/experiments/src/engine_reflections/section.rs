@@ -52,15 +52,12 @@ fn variants_of(pts: &[&Record]) -> Vec<String> {
     distinct(pts.iter().map(|r| key_name(r)))
 }
 
-/// The style of a point's series: its method, keyed by its options ([`keyed_styles`]) — the
-/// count `n` apart, as in the generic charts, where it is a series' swept setting.
+/// The style of a point's series: its method, keyed by the rest of its name ([`key_name`]:
+/// its count and options), so that `auxiliary n=2` has one style in every chart that names a
+/// series so ([`keyed_styles`]).
 fn style_key(r: &Record) -> (String, String, bool) {
-    let options: Vec<&str> = r
-        .method_key()
-        .split_whitespace()
-        .skip(1)
-        .filter(|w| !w.starts_with("depth=") && !w.starts_with("n="))
-        .collect();
+    let name = key_name(r);
+    let options: Vec<&str> = name.split_whitespace().skip(1).collect();
     (r.method.clone(), options.join(" "), r.is_external())
 }
 

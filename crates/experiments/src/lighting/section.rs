@@ -47,14 +47,22 @@ pub fn lighting_of(r: &Record) -> String {
 /// [`lighting_of`] of a point with no lighting option: the scene's own lights, no shadows.
 const DEFAULT_LIGHTING: &str = "mirrored, no shadows";
 
-/// A lighting variant's key for its style in a chart ([`keyed_styles`]): the method's own
-/// style at the default lighting, and one style per variant in every report.
-fn style_key(variant: &str) -> &str {
-    if variant == DEFAULT_LIGHTING {
+/// The key of a series' style ([`keyed_styles`]) named `method` (`auxiliary n=2`, or the
+/// method alone where its counts are the series' points) and lit by `variant`: the words after
+/// the method and the lighting where not the default — so that `auxiliary n=2` at the default
+/// lighting has the style it has in every chart, and each lighting variant one of its own.
+fn style_key(method: &str, variant: &str) -> String {
+    let count = method
+        .split_whitespace()
+        .skip(1)
+        .collect::<Vec<_>>()
+        .join(" ");
+    let lighting = if variant == DEFAULT_LIGHTING {
         ""
     } else {
         variant
-    }
+    };
+    format!("{count} {lighting}").trim().to_string()
 }
 
 /// Where a variant's rows go: direct before mirrored, no shadows before shadow maps, maps by
@@ -193,29 +201,40 @@ pub fn lighting_section(records: &[Record]) -> Vec<Block> {
             .collect();
         mine.sort_by_key(|r| variant_order(r));
         let lightings = distinct(mine.iter().map(|r| lighting_of(r)));
+        // Each lighting's points and the method they name: `auxiliary n=2` where they share
+        // a count, else the method alone (the counts label the points).
+        let groups: Vec<(&String, Vec<&Record>, String)> = lightings
+            .iter()
+            .map(|v| {
+                let mut at: Vec<&Record> = mine
+                    .iter()
+                    .copied()
+                    .filter(|r| &lighting_of(r) == v)
+                    .collect();
+                at.sort_by_key(|r| (r.n, r.depth));
+                let counts = distinct(at.iter().map(|r| method_of(r)));
+                let named = if counts.len() == 1 {
+                    counts[0].clone()
+                } else {
+                    kind.clone()
+                };
+                (v, at, named)
+            })
+            .collect();
+        let keys: Vec<String> = groups.iter().map(|(v, _, m)| style_key(m, v)).collect();
         let styles = keyed_styles(
-            &lightings
+            &keys
                 .iter()
-                .map(|v| StyleKey {
+                .map(|k| StyleKey {
                     method: kind,
-                    variant: style_key(v),
+                    variant: k,
                     outside: false,
                 })
                 .collect::<Vec<_>>(),
         );
-        for (v, style) in lightings.iter().zip(styles) {
-            let mut at: Vec<&Record> = mine
-                .iter()
-                .copied()
-                .filter(|r| &lighting_of(r) == v)
-                .collect();
-            at.sort_by_key(|r| (r.n, r.depth));
+        for ((v, at, named), style) in groups.into_iter().zip(styles) {
             let counts = distinct(at.iter().map(|r| method_of(r)));
-            let name = if counts.len() == 1 {
-                format!("{}, {v}", counts[0])
-            } else {
-                format!("{kind}, {v}")
-            };
+            let name = format!("{named}, {v}");
             let mut s = Series::new(
                 name,
                 style,
@@ -259,12 +278,15 @@ pub fn lighting_section(records: &[Record]) -> Vec<Block> {
     ];
     if let Some(method) = reference_method(&points) {
         let base = method.split_whitespace().next().unwrap_or_default();
+        // One method per chart (its title names it): the lighting alone keys the style, so
+        // that a lighting variant looks the same in every report's chart.
+        let keys: Vec<String> = variants.iter().map(|v| style_key(base, v)).collect();
         let styles = keyed_styles(
-            &variants
+            &keys
                 .iter()
-                .map(|v| StyleKey {
+                .map(|k| StyleKey {
                     method: base,
-                    variant: style_key(v),
+                    variant: k,
                     outside: false,
                 })
                 .collect::<Vec<_>>(),
@@ -408,7 +430,17 @@ mod tests {
         assert_eq!(method_of(&r), "auxiliary max-passes=9");
         assert_eq!(lighting_of(&r), "mirrored, no shadows");
         assert_eq!(lighting_of(&record("portal", "", 0, 0.1)), DEFAULT_LIGHTING);
-        assert_eq!(style_key(&lighting_of(&record("portal", "", 0, 0.1))), "");
+        assert_eq!(
+            style_key(
+                "portal depth=64",
+                &lighting_of(&record("portal", "", 0, 0.1))
+            ),
+            "depth=64"
+        );
+        assert_eq!(
+            style_key("auxiliary", "direct only, no shadows"),
+            "direct only, no shadows"
+        );
         let r = record("unrolled", "shadows=map shadow-map-size=256", 8, 0.1);
         assert_eq!(method_of(&r), "unrolled depth=64");
         assert_eq!(lighting_of(&r), "mirrored, shadow maps 256²");

@@ -261,18 +261,29 @@ fn chart(records: &[Record], name: &str, title: &str, y_label: &str, y_log: bool
         }
     };
     let variants = distinct(pts.iter().map(|r| variant_of(r)));
-    // Each variant the style its method and options (`stereo-mirrors=shared`) have in every
-    // report.
+    // Each variant the style its name has in every report: its method, keyed by its count
+    // and options (`n=2 stereo-mirrors=shared`; `auxiliary n=2` per eye as elsewhere).
     let firsts: Vec<&Record> = variants
         .iter()
         .filter_map(|v| pts.iter().copied().find(|r| &variant_of(r) == v))
         .collect();
+    let keys: Vec<String> = firsts
+        .iter()
+        .map(|r| {
+            let name = r.method_without(&[]);
+            name.split_whitespace()
+                .skip(1)
+                .collect::<Vec<_>>()
+                .join(" ")
+        })
+        .collect();
     let styles = keyed_styles(
         &firsts
             .iter()
-            .map(|r| StyleKey {
+            .zip(&keys)
+            .map(|(r, key)| StyleKey {
                 method: &r.method,
-                variant: &r.method_options,
+                variant: key,
                 outside: false,
             })
             .collect::<Vec<_>>(),
