@@ -163,12 +163,18 @@ pub fn join_words(words: &[String]) -> String {
 /// runs of the same sweep is of that order.
 pub const TIE_TOLERANCE: f64 = 0.02;
 
+/// A point's name in a row or caption: its variant with its count (`auxiliary n=2`,
+/// `portal depth=8`, `symmetry p=3`) or its swept option (`cubemap cube-size=128
+/// history=16`), and `k=…` for a mirrored-lights depth.
 pub fn label(r: &Record) -> String {
     let name = variant(r);
     let at = match (r.n, r.depth, r.planes()) {
         (Some(n), _, _) => format!("{name} n={n}"),
         (None, Some(d), _) => format!("{name} depth={d}"),
         (None, None, Some(p)) => format!("{name} p={p}"),
+        // A swept option (cubemap's cube-size) is in the key, not the options: the key names
+        // the point whole, where two cube sizes had read alike.
+        _ if !r.is_external() && !swept_label(r).is_empty() => r.method_key().to_string(),
         _ => name,
     };
     match r.lights_depth() {
@@ -454,6 +460,18 @@ mod tests {
         assert_eq!(point_labels(&[&b, &b]), ["n=2", "n=2"]);
         let plain = fixtures::record(1, 1.0, 1, 0.1);
         assert_eq!(point_labels(&[&plain, &a]), ["n=1", "n=2, yaw -22.5°"]);
+    }
+
+    /// Two points of a swept option (cube sizes) are named apart, as their key names them.
+    #[test]
+    fn a_label_names_the_swept_option() {
+        let mut r = fixtures::record(0, 1.0, 1, 0.1);
+        (r.n, r.method) = (None, "cubemap".into());
+        r.method_options = "history=16".into();
+        r.key = "cubemap cube-size=128 history=16|alpha=1|320x180".into();
+        assert_eq!(label(&r), "cubemap cube-size=128 history=16");
+        r.key = "cubemap history=16|alpha=1|320x180".into();
+        assert_eq!(label(&r), "cubemap history=16");
     }
 
     #[test]
