@@ -30,6 +30,8 @@ use std::fmt::Write;
 const COLORS: [&str; 7] = [
     "#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#333333",
 ];
+/// The x axis of a chart against the depth cap, the same words in every report.
+pub const DEPTH_CAP_AXIS: &str = "depth cap (most mirrors along a path)";
 /// Reference curves and floors.
 const REFERENCE_GREY: &str = "#888888";
 /// The dash of the i-th reference (cycled), in the plot and its legend alike: two references

@@ -17,6 +17,11 @@ use mirrorbox_report::{Record, value};
 
 /// The yaw axis' name in a record's `axes` (the harness's `CAMERA_YAW`).
 const YAW: &str = mirrorbox_report::axis::YAW_DEG;
+/// The depth charts' x: the depth-swept methods at their cap, the others at the reflections
+/// they show.
+const DEPTH_AXIS: &str =
+    "depth cap (most mirrors along a path); the others at the reflections they show";
+
 /// The exact methods whose depth is swept here.
 const DEPTH_SWEPT: [&str; 4] = ["ray-query", "unrolled", "portal", "path-textures"];
 
@@ -141,7 +146,7 @@ fn depth_blocks(pts: &[&Record]) -> Vec<Block> {
     let mut out = Vec::new();
     let mut error = Chart::new(
         "FLIP over the mirror pixels against the depth cap",
-        "depth cap (reflections followed)",
+        DEPTH_AXIS,
         "FLIP mean over the mirror pixels",
     );
     error.x_log = true;
@@ -149,7 +154,7 @@ fn depth_blocks(pts: &[&Record]) -> Vec<Block> {
     error.x_ticks_at_data = true;
     let mut cost = Chart::new(
         "Cost against the depth cap",
-        "depth cap (reflections followed)",
+        DEPTH_AXIS,
         "ms/frame (median, 95 % CI bars)",
     );
     cost.x_log = true;
