@@ -71,23 +71,26 @@ pub struct Style {
     pub hollow: bool,
 }
 
-const DASHES: [&str; 6] = ["", "7 4", "2 3", "8 3 2 3", "12 3", "2 2 6 2"];
+/// Solid, dashed, dotted, dash-dot, long dash, dash-dot-dot: each told from the others at a
+/// glance ("2 2 6 2" had read as the dash-dot).
+const DASHES: [&str; 6] = ["", "7 4", "2 3", "8 3 2 3", "12 3", "12 3 2 3 2 3"];
 
 /// A method's colour, its own marker, and the markers its variants take besides it: no other
 /// method of its colour has any of them as its own or its variants', so that a variant of one
 /// method never looks like another method or its variants (`ssr`'s planar fallback had taken
-/// `feedback`'s diamond). A name not in the table (a method added later) gets a colour and a
+/// `feedback`'s diamond); nor does a variant take the marker of a method whose colour is near
+/// its own (orange `naive` and vermilion `auxiliary`: no triangle down, no circle). A name not in the table (a method added later) gets a colour and a
 /// marker from its name's hash, in grey's place never, and no markers besides: the table is
 /// the place to give a new method its own.
 fn method_entry(method: &str) -> (&'static str, Marker, &'static [Marker]) {
     use Marker::*;
     match method {
-        "naive" => (COLORS[4], TriangleDown, &[Circle, TriangleUp, Diamond]),
+        "naive" => (COLORS[4], TriangleDown, &[TriangleUp, Diamond]),
         "symmetry-baked" => (COLORS[4], Square, &[Cross, Plus]),
         "auxiliary" => (
             COLORS[1],
             Circle,
-            &[Square, TriangleUp, Diamond, TriangleDown, Cross, Plus],
+            &[Square, TriangleUp, Diamond, Cross, Plus],
         ),
         "path-textures" => (COLORS[3], Diamond, &[Circle]),
         "symmetry-pruned" => (COLORS[3], TriangleUp, &[Square]),
@@ -103,8 +106,8 @@ fn method_entry(method: &str) -> (&'static str, Marker, &'static [Marker]) {
             &[Circle, Square, TriangleUp, Diamond, TriangleDown, Cross],
         ),
         "symmetry" => (COLORS[5], Circle, &[Plus]),
-        "feedback" => (COLORS[5], Diamond, &[TriangleDown]),
-        "ssr" => (COLORS[5], Square, &[TriangleUp, Cross]),
+        "feedback" => (COLORS[5], Diamond, &[Cross]),
+        "ssr" => (COLORS[5], Square, &[TriangleUp, TriangleDown]),
         "ray-query" => (
             COLORS[6],
             TriangleUp,
@@ -587,7 +590,21 @@ struct Rect {
     y1: f64,
 }
 
+/// Pixels kept clear beside a placed label: two labels side by side had read as one
+/// ("d=4d=4").
+const LABEL_GAP: f64 = 4.0;
+
 impl Rect {
+    /// A placed label's box with [`LABEL_GAP`] around it, as later labels must keep clear of it.
+    fn spaced(self) -> Rect {
+        Rect {
+            x0: self.x0 - LABEL_GAP,
+            y0: self.y0 - 1.0,
+            x1: self.x1 + LABEL_GAP,
+            y1: self.y1 + 1.0,
+        }
+    }
+
     fn overlaps(&self, o: &Rect) -> bool {
         self.x0 < o.x1 && o.x0 < self.x1 && self.y0 < o.y1 && o.y0 < self.y1
     }
@@ -1495,7 +1512,7 @@ impl Chart {
                 .collect();
             let place = place_label((xx, yy), r, lw, &markers, &taken, &others);
             if let Some((lx, ly, rect)) = place {
-                taken.push(rect);
+                taken.push(rect.spaced());
                 let _ = writeln!(
                     s,
                     r#"<text x="{lx:.1}" y="{ly:.1}" font-size="10" fill="{color}">{}</text>"#,
@@ -2248,6 +2265,30 @@ mod tests {
         let far = [(x, y), (x + r + 2.0 + lw + 3.0 * r, y - r - 5.0)];
         let (lx, ly, _) = place_label((x, y), r, lw, &far, &[], &[]).unwrap();
         assert!(lx > x && ly < y, "right-above: {lx} {ly}");
+    }
+
+    /// A label keeps a gap from one placed before it: a second label that would start where
+    /// the first ends goes elsewhere.
+    #[test]
+    fn labels_side_by_side_keep_a_gap() {
+        let (r, lw) = (MARKER_R, 20.0);
+        let (x, y) = (LEFT + 100.0, TOP + 100.0);
+        let (_, _, first) = place_label((x, y), r, lw, &[(x, y)], &[], &[]).unwrap();
+        // A second point whose right-above label would begin one pixel after the first's end.
+        let second = (first.x1 + 1.0 - r - 2.0, y);
+        let markers = [(x, y), second];
+        let (lx, ly, _) = place_label(second, r, lw, &markers, &[first], &[]).unwrap();
+        assert_eq!(
+            (lx, ly),
+            (second.0 + r + 2.0, y - r - 1.0),
+            "abutting is allowed unspaced"
+        );
+        let (lx, ly, _) = place_label(second, r, lw, &markers, &[first.spaced()], &[]).unwrap();
+        assert_ne!(
+            (lx, ly),
+            (second.0 + r + 2.0, y - r - 1.0),
+            "spaced: not beside the first"
+        );
     }
 
     #[test]

@@ -37,7 +37,7 @@ fn trick_style(host: &str, family: &str) -> Style {
         "distort" => (Marker::Square, "7 4", false),
         "distort-distance" => (Marker::Diamond, "8 3 2 3", false),
         "proxy" => (Marker::TriangleUp, "12 3", false),
-        _ => (Marker::Circle, "2 2 6 2", true),
+        _ => (Marker::Circle, "12 3 2 3 2 3", true),
     };
     Style {
         color: method_style(host).color,

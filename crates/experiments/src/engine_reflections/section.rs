@@ -57,13 +57,10 @@ fn variants_of(pts: &[&Record]) -> Vec<String> {
     distinct(pts.iter().map(|r| key_name(r)))
 }
 
-/// The style of a point's series: its method, keyed by the rest of its name ([`key_name`]:
-/// its count and options), so that `auxiliary n=2` has one style in every chart that names a
-/// series so ([`keyed_styles`]).
+/// The style of a point's series: its method, keyed by its options ([`keyed_styles`]), as
+/// the generic charts key a variant whose counts are its points.
 fn style_key(r: &Record) -> (String, String, bool) {
-    let name = key_name(r);
-    let options: Vec<&str> = name.split_whitespace().skip(1).collect();
-    (r.method.clone(), options.join(" "), r.is_external())
+    (r.method.clone(), r.method_options.clone(), r.is_external())
 }
 
 /// [`keyed_styles`] of the points' [`style_key`]s.
@@ -177,12 +174,35 @@ fn depth_blocks(pts: &[&Record]) -> Vec<Block> {
         })
         .filter(|(_, of)| !of.is_empty())
         .collect();
+    // The other methods by variant (method and options), each a series along its count or
+    // swept option (auxiliary's n, cubemap's cube size), labelled as the generic charts label
+    // them; joined where the reflections shown grow with it.
     let single: Vec<&Record> = pts
         .iter()
         .copied()
         .filter(|r| !DEPTH_SWEPT.contains(&r.method.as_str()))
         .collect();
-    let styles = styles_of(swept.iter().map(|(m, _)| *m), &single);
+    let variants = distinct(
+        single
+            .iter()
+            .map(|r| mirrorbox_report::document::variant(r)),
+    );
+    let groups: Vec<Vec<&Record>> = variants
+        .iter()
+        .map(|v| {
+            let mut of: Vec<&Record> = single
+                .iter()
+                .copied()
+                .filter(|r| &mirrorbox_report::document::variant(r) == v)
+                .collect();
+            of.sort_by_key(|r| (r.reflections, r.n));
+            of
+        })
+        .collect();
+    let styles = styles_of(
+        swept.iter().map(|(m, _)| *m),
+        &groups.iter().map(|g| g[0]).collect::<Vec<_>>(),
+    );
     for ((m, of), &style) in swept.iter().zip(&styles) {
         let d = |r: &Record| f64::from(r.depth.unwrap_or(0));
         error.series.push(Series::new(
@@ -214,14 +234,25 @@ fn depth_blocks(pts: &[&Record]) -> Vec<Block> {
         }
     }
     // Named as the report's other charts name them, "(defaults)" beside a variant.
-    let variants = variants_of(&single);
-    let variants: Vec<&str> = variants.iter().map(String::as_str).collect();
-    for (r, &style) in single.iter().zip(&styles[swept.len()..]) {
-        let depth = r.reflections.max(1) as f64;
-        let label = name(r, &variants);
-        for (chart, y) in [(&mut error, r.mirror_flip()), (&mut cost, r.ms_median)] {
-            let mut s = Series::new(label.clone(), style, vec![(depth, y)]);
-            s.joined = false;
+    let names: Vec<&str> = variants.iter().map(String::as_str).collect();
+    for ((v, of), &style) in variants.iter().zip(&groups).zip(&styles[swept.len()..]) {
+        let depth = |r: &Record| r.reflections.max(1) as f64;
+        let legend = mirrorbox_report::document::legend_name(v, &names);
+        let labels = mirrorbox_report::document::point_labels(of);
+        for (chart, y) in [
+            (
+                &mut error,
+                &(|r: &Record| r.mirror_flip()) as &dyn Fn(&Record) -> f64,
+            ),
+            (&mut cost, &|r: &Record| r.ms_median),
+        ] {
+            let mut s = Series::new(
+                legend.clone(),
+                style,
+                of.iter().map(|r| (depth(r), y(r))).collect(),
+            );
+            s.joined = of.len() > 1 && s.points.windows(2).all(|w| w[1].0 > w[0].0);
+            s.labels = labels.clone();
             chart.series.push(s);
         }
     }
@@ -229,7 +260,8 @@ fn depth_blocks(pts: &[&Record]) -> Vec<Block> {
         "`ray-query` follows every mirror pixel's chain on the GPU; `unrolled` and `portal` \
          draw every reflection path of the scene as raster work; `auxiliary n=2` is the \
          paper's; `ssr` shows one bounce, what is on screen, and its fallback elsewhere. The \
-         one-setting methods are single points at the reflections they show."
+         methods without a depth cap sit at the reflections they show, one series per variant \
+         along its count or swept option (labelled: auxiliary's n, a cube size)."
             .into(),
     ));
     out.push(Block::Chart(
