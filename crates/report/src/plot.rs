@@ -1187,6 +1187,9 @@ impl Chart {
                 let theirs: Vec<_> = f.visible(o).into_iter().map(|p| f.key(p)).collect();
                 !mine.is_empty() && mine.iter().all(|k| theirs.contains(k))
             });
+            // The legend draws a line where the plot draws one: a joined series of one
+            // visible point is a marker alone (its legend had shown a line).
+            let line = series.joined && visible.len() >= 2;
             for p in visible {
                 let at = (f.px(p.0), f.py(p.1));
                 if seen.iter().any(|&q| hides(q, at)) {
@@ -1199,7 +1202,7 @@ impl Chart {
                 Some(o) => format!("{} (on {})", series.name, o.name),
                 None => series.name.clone(),
             };
-            legend.push((name, Shows::Series(series)));
+            legend.push((name, Shows::Series(series, line)));
         }
         for r in &self.references {
             if !matches!(r, Reference::Mark(..)) && reference_line(r, f).is_empty() {
@@ -1571,7 +1574,8 @@ impl Frame {
 
 /// What a legend entry shows beside its name.
 enum Shows<'a> {
-    Series(&'a Series),
+    /// A series, and whether the plot draws its line.
+    Series(&'a Series, bool),
     Reference(&'a Reference),
     /// What a ring around a marker means, where a series' name does not say it.
     Ring,
@@ -1584,9 +1588,9 @@ fn legend_svg(s: &mut String, legend: &[(String, Shows)]) {
     let mut references_drawn = 0;
     for (name, shows) in legend {
         match shows {
-            Shows::Series(series) => {
+            Shows::Series(series, line) => {
                 let st = &series.style;
-                if series.joined {
+                if *line {
                     let dash = if st.dash.is_empty() {
                         String::new()
                     } else {
@@ -2265,6 +2269,26 @@ mod tests {
         let far = [(x, y), (x + r + 2.0 + lw + 3.0 * r, y - r - 5.0)];
         let (lx, ly, _) = place_label((x, y), r, lw, &far, &[], &[]).unwrap();
         assert!(lx > x && ly < y, "right-above: {lx} {ly}");
+    }
+
+    /// The legend shows a line only for a series the plot draws one for: a joined series of
+    /// one point is a marker alone in both.
+    #[test]
+    fn a_legend_line_only_where_the_plot_draws_one() {
+        let mut c = chart_of(vec![(1.0, 0.5), (10.0, 0.1)]);
+        let one = Series::new("one point", method_style("naive"), vec![(5.0, 0.2)]);
+        assert!(one.joined);
+        c.series.push(one);
+        let svg = c.to_svg();
+        // The first series: its polyline and its legend line; the second: neither (the
+        // fixture's reference draws a grey polyline of its own).
+        let lines_of = |colour: &str| {
+            svg.matches(&format!(r#"stroke="{colour}" stroke-width="1.8""#))
+                .count()
+        };
+        assert_eq!(lines_of(method_style("auxiliary").color), 2, "{svg}");
+        assert_eq!(lines_of(method_style("naive").color), 0, "{svg}");
+        assert_eq!(svg.matches(r#"stroke-width="1.8""#).count(), 2, "{svg}");
     }
 
     /// A label keeps a gap from one placed before it: a second label that would start where
