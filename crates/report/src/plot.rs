@@ -32,6 +32,10 @@ const COLORS: [&str; 7] = [
 ];
 /// The x axis of a chart against the depth cap, the same words in every report.
 pub const DEPTH_CAP_AXIS: &str = "depth cap (most mirrors along a path)";
+/// The least distance between two tick labels' centres, pixels: a y label's height with a
+/// little air, and an x label's width ("5e-16").
+const Y_TICK_GAP: f64 = 13.0;
+const X_TICK_GAP: f64 = 34.0;
 /// Reference curves and floors.
 const REFERENCE_GREY: &str = "#888888";
 /// The dash of the i-th reference (cycled), in the plot and its legend alike: two references
@@ -161,6 +165,28 @@ pub fn method_variant(method: &str, k: usize) -> Style {
     }
 }
 
+/// The settings a sweep varies along one series (auxiliary's n, the depth cap, the symmetry
+/// planes p, a history length, a cube size): where a chart draws one series per setting, the
+/// setting tells them apart; where it draws one, the series looks as the method's series
+/// along that setting does in the charts that sweep it.
+const SETTINGS: [&str; 5] = ["n", "depth", "p", "history", "cube-size"];
+
+/// A variant key's words as (options, settings) ([`SETTINGS`]), each in the order given, the
+/// words split at spaces and commas (`n=2, mirrored, shadow maps 256²`).
+fn split_settings(variant: &str) -> (String, String) {
+    let (mut options, mut settings) = (Vec::new(), Vec::new());
+    for w in variant.split([' ', ',']).filter(|w| !w.is_empty()) {
+        if w.split_once('=')
+            .is_some_and(|(n, _)| SETTINGS.contains(&n))
+        {
+            settings.push(w);
+        } else {
+            options.push(w);
+        }
+    }
+    (options.join(" "), settings.join(" "))
+}
+
 /// What decides a series' style: its method, its variant's key (its options and count, a
 /// lighting variant, "α=0.7"; empty at the method's defaults), and whether an outside renderer
 /// (`mirrorbox score`) drew it.
@@ -174,12 +200,36 @@ pub struct StyleKey<'a> {
 /// The styles of a chart's series: the method's own style for its defaults, and for a variant
 /// the [`method_variant`] its key hashes to — the same variant keeps its style in every chart
 /// of every report ("auxiliary n=2" is one marker and dash wherever it is drawn), where an
-/// index by order had given it whatever place its chart's other variants left. A variant takes
+/// index by order had given it whatever place its chart's other variants left. A setting in
+/// the key ([`SETTINGS`]: `n=2`, `cube-size=128`) counts only where the chart holds the same
+/// variant at another setting. A variant takes
 /// only its own method's markers ([`method_entry`]), so another method's series never moves
 /// it. No two series of one chart share a look (marker and fill; the dash too once a method's
 /// looks run out): a key whose look another variant of its method took passes on to the next
 /// free one (hollow first for an outside renderer's).
 pub fn keyed_styles(keys: &[StyleKey]) -> Vec<Style> {
+    // Each key as (options, settings): the settings count only where the chart has another
+    // series of the same method and options at other settings.
+    let parts: Vec<(String, String)> = keys.iter().map(|k| split_settings(k.variant)).collect();
+    let variants: Vec<String> = keys
+        .iter()
+        .zip(&parts)
+        .map(|(k, (options, settings))| {
+            let apart = keys.iter().zip(&parts).any(|(o, (oo, os))| {
+                (o.method, o.outside) == (k.method, k.outside) && oo == options && os != settings
+            });
+            if apart {
+                format!("{options} {settings}").trim().to_string()
+            } else {
+                options.clone()
+            }
+        })
+        .collect();
+    let keys: Vec<StyleKey> = keys
+        .iter()
+        .zip(&variants)
+        .map(|(k, variant)| StyleKey { variant, ..*k })
+        .collect();
     // What a reader tells markers apart by where no line shows the dash.
     let look = |s: &Style| (s.color, s.marker, s.hollow);
     let mut styles: Vec<Option<Style>> = vec![None; keys.len()];
@@ -197,10 +247,22 @@ pub fn keyed_styles(keys: &[StyleKey]) -> Vec<Style> {
             continue;
         }
         let looks = point_looks(key.method);
-        // FNV-1a: fixed across runs and platforms, unlike std's hasher.
-        let h = key.variant.bytes().fold(0x811c_9dc5_u32, |h, b| {
-            (h ^ u32::from(b)).wrapping_mul(0x0100_0193)
-        }) as usize;
+        // FNV-1a: fixed across runs and platforms, unlike std's hasher. A variant that is
+        // the method at another α (a scene's, not the method's, setting) keeps the method's
+        // marker first, hollow and dashed (Table 1's α = 0.7 had taken other methods' shapes).
+        let alpha_only = key.variant.split_whitespace().all(|w| w.starts_with("α="));
+        let h = if alpha_only {
+            0
+        } else {
+            let h = key.variant.bytes().fold(0x811c_9dc5_u32, |h, b| {
+                (h ^ u32::from(b)).wrapping_mul(0x0100_0193)
+            });
+            // MurmurHash3's finaliser: keys a byte apart (`n=1`, `n=2`) had fallen on
+            // neighbouring places, alike markers side by side.
+            let h = (h ^ (h >> 16)).wrapping_mul(0x85eb_ca6b);
+            let h = (h ^ (h >> 13)).wrapping_mul(0xc2b2_ae35);
+            (h ^ (h >> 16)) as usize
+        };
         // The variants' places, from the one the key hashes to: every look but the method's
         // own; for an outside renderer's the hollow ones first.
         let rotated = |mut v: Vec<usize>| {
@@ -447,7 +509,7 @@ struct Axis {
 impl Axis {
     /// Tight to the values: a log axis pads 4 % of its span in decades on each side (at least a
     /// factor 1.15), a linear one 6 %, starting at 0 where the values are non-negative and
-    /// close to it.
+    /// close to it, and 6 % below 0 where some value is 0.
     fn new(values: impl Iterator<Item = f64>, log: bool) -> Axis {
         let (mut lo, mut hi) = values
             .filter(|x| drawable(*x, log))
@@ -469,7 +531,11 @@ impl Axis {
             } else {
                 lo.abs().max(1.0) * 0.1
             };
-            lo = if lo >= 0.0 && lo - pad < 0.0 || (lo > 0.0 && lo < span * 0.25) {
+            lo = if lo == 0.0 && span > 0.0 {
+                // Values at 0 itself: the axis pads below it too, so that their markers (and
+                // the rings of points coinciding there) are drawn whole, not cut by the frame.
+                -pad
+            } else if lo >= 0.0 && lo - pad < 0.0 || (lo > 0.0 && lo < span * 0.25) {
                 0.0
             } else {
                 lo - pad
@@ -488,6 +554,39 @@ impl Axis {
     fn contains(&self, v: f64) -> bool {
         drawable(v, self.log) && (-1e-9..=1.0 + 1e-9).contains(&self.t(v))
     }
+    /// [`Axis::ticks`] as drawn on an axis `len` pixels long: a 2× or 5× step beyond the
+    /// outer decades is left out where its label would come within `gap` pixels of a kept
+    /// one (the outermost first, which keeps the far points in reach of a tick: 16 decades in
+    /// the plot's height had printed "1e-15", "5e-16" and "2e-16" over one another).
+    fn ticks_drawn(&self, len: f64, gap: f64) -> Vec<f64> {
+        let ticks = self.ticks();
+        if !self.log {
+            return ticks;
+        }
+        let decade = |v: f64| (v.log10() - v.log10().round()).abs() < 1e-9;
+        let decades: Vec<f64> = ticks.iter().copied().filter(|&v| decade(v)).collect();
+        let (Some(&first), Some(&last)) = (decades.first(), decades.last()) else {
+            return ticks;
+        };
+        let px = |v: f64| self.t(v) * len;
+        let mut kept = decades.clone();
+        let below: Vec<f64> = ticks.iter().copied().filter(|&v| v < first).collect();
+        let mut above: Vec<f64> = ticks.iter().copied().filter(|&v| v > last).collect();
+        above.reverse();
+        for side in [below, above] {
+            let mut side_kept: Vec<f64> = Vec::new();
+            for v in side {
+                let clear = |o: f64| (px(v) - px(o)).abs() >= gap;
+                if side_kept.iter().all(|&o| clear(o)) && kept.iter().all(|&o| clear(o)) {
+                    side_kept.push(v);
+                }
+            }
+            kept.extend(side_kept);
+        }
+        kept.sort_by(f64::total_cmp);
+        kept
+    }
+
     fn ticks(&self) -> Vec<f64> {
         if self.log {
             // Decades; where fewer than two fall inside, the 2× and 5× steps as well.
@@ -532,16 +631,18 @@ impl Axis {
 fn linear_ticks(lo: f64, hi: f64) -> Vec<f64> {
     let raw = (hi - lo) / 5.0;
     let mag = 10f64.powf(raw.log10().floor());
+    // The round step nearest a fifth of the span, not the first above it: an axis padded
+    // below 0 (0 to 1.06 wide) had got steps of 0.5, two ticks.
     let step = [1.0, 2.0, 5.0, 10.0]
         .iter()
         .map(|m| m * mag)
-        .find(|s| *s >= raw)
+        .find(|s| *s >= raw * 0.75)
         .unwrap_or(raw);
     let mut t = (lo / step).ceil() * step;
     let mut out = Vec::new();
     while t <= hi + 1e-12 * hi.abs().max(1.0) {
-        // Snap to the step's decimals (0.1 + 0.2 is not 0.3 in binary).
-        out.push((t / step).round() * step);
+        // Snap to the step's decimals (0.1 + 0.2 is not 0.3 in binary); + 0.0 makes a −0 0.
+        out.push((t / step).round() * step + 0.0);
         t += step;
     }
     out
@@ -981,7 +1082,11 @@ impl Chart {
             axes.push(("x", &ax, true));
         }
         for (name, axis, is_x) in axes {
-            let ticks = axis.ticks();
+            let ticks = if is_x {
+                axis.ticks_drawn(PLOT_W, X_TICK_GAP)
+            } else {
+                axis.ticks_drawn(PLOT_H, Y_TICK_GAP)
+            };
             let (Some(&first), Some(&last)) = (ticks.first(), ticks.last()) else {
                 out.push(format!("the {name} axis has no tick"));
                 continue;
@@ -1223,6 +1328,20 @@ impl Chart {
         legend
     }
 
+    /// The floor band's label where the plot shows the band: its text, and the right end and
+    /// baseline it is drawn at.
+    fn floor_label(&self, f: &Frame) -> Option<(String, f64, f64)> {
+        let v = self
+            .floor
+            .filter(|v| drawable(*v, f.ay.log) && f.ay.t(*v) > 0.0)?;
+        let yf = f.py(v.min(f.ay.hi));
+        Some((
+            format!("floor (no mirrors) {}: not resolved below", fmt_tick(v)),
+            LEFT + PLOT_W - 4.0,
+            (yf + 11.0).min(TOP + PLOT_H - 3.0),
+        ))
+    }
+
     /// The floor's band (grey, under everything) where the y axis shows it, with its label in
     /// `label` (drawn after the grid, which would cross it); else the note that says where it
     /// is, returned for the space under the plot.
@@ -1234,7 +1353,7 @@ impl Chart {
             )
         });
         if let Some(v) = self.floor.filter(|v| drawable(*v, f.ay.log)) {
-            if f.ay.t(v) > 0.0 {
+            if let Some((text, x, y)) = self.floor_label(f) {
                 let yf = f.py(v.min(f.ay.hi));
                 let _ = writeln!(
                     s,
@@ -1243,10 +1362,7 @@ impl Chart {
                 );
                 let _ = writeln!(
                     label,
-                    r##"<text x="{:.1}" y="{:.1}" font-size="10" fill="#555" text-anchor="end" stroke="white" stroke-width="3" paint-order="stroke">floor (no mirrors) {}: not resolved below</text>"##,
-                    LEFT + PLOT_W - 4.0,
-                    (yf + 11.0).min(TOP + PLOT_H - 3.0),
-                    fmt_tick(v)
+                    r##"<text x="{x:.1}" y="{y:.1}" font-size="10" fill="#555" text-anchor="end" stroke="white" stroke-width="3" paint-order="stroke">{text}</text>"##,
                 );
             } else {
                 floor_note = Some(format!(
@@ -1270,7 +1386,7 @@ impl Chart {
             }
             out
         } else {
-            let ticks = f.ax.ticks();
+            let ticks = f.ax.ticks_drawn(PLOT_W, X_TICK_GAP);
             if self.x_whole {
                 ticks.into_iter().filter(|t| t.fract() == 0.0).collect()
             } else {
@@ -1287,7 +1403,7 @@ impl Chart {
                 TOP + PLOT_H + 16.0,
             );
         }
-        let y_ticks = f.ay.ticks();
+        let y_ticks = f.ay.ticks_drawn(PLOT_H, Y_TICK_GAP);
         let y_labels = tick_labels(&y_ticks, f.ay.log);
         for (t, label) in y_ticks.into_iter().zip(y_labels) {
             let y = f.py(t);
@@ -1424,7 +1540,20 @@ impl Chart {
             labels: Vec<(&'l str, usize)>,
         }
         let mut occupied: Vec<Place> = Vec::new();
-        let mut taken: Vec<Rect> = Vec::new();
+        // The floor's label is there first: a point's label had been drawn over it.
+        let mut taken: Vec<Rect> = self
+            .floor_label(f)
+            .map(|(text, x, y)| {
+                Rect {
+                    x0: x - SMALL_CHAR_W * text.chars().count() as f64,
+                    y0: y - 9.0,
+                    x1: x,
+                    y1: y + 1.0,
+                }
+                .spaced()
+            })
+            .into_iter()
+            .collect();
         let mut label_queue: Vec<(usize, f64, f64, f64, &str, &'static str)> = Vec::new();
         // Every marker's centre: a label must lie nearer its own point than any other.
         let mut markers: Vec<(f64, f64)> = Vec::new();
@@ -1785,19 +1914,32 @@ mod tests {
         assert_eq!(styles[10], method_style("feedback"));
         // The variants that share charts in the committed reports take distinct places by
         // their keys alone, so that neither moves the other.
+        let pair = ["ssr ssr-fallback=none", "ssr ssr-fallback=planar"];
+        let both = styles_for(&pair);
+        assert_eq!(both[0], styles_for(&pair[..1])[0]);
+        assert_eq!(both[1], styles_for(&pair[1..])[0]);
+        // A setting (n, a cube size) keys a series only beside the same method at another
+        // setting: alone, `auxiliary n=2` looks as `auxiliary` along n does.
         for pair in [
-            ["ssr ssr-fallback=none", "ssr ssr-fallback=planar"],
+            ["auxiliary n=1", "auxiliary n=2"],
             [
                 "cubemap cube-size=128 history=16",
                 "cubemap cube-size=512 history=16",
             ],
-            ["auxiliary n=1", "auxiliary n=2"],
-            ["auxiliary n=2", "auxiliary n=3"],
         ] {
+            let method = pair[0].split(' ').next().unwrap();
+            assert_eq!(styles_for(&pair[..1])[0], method_style(method));
             let both = styles_for(&pair);
-            assert_eq!(both[0], styles_for(&pair[..1])[0], "{pair:?}");
-            assert_eq!(both[1], styles_for(&pair[1..])[0], "{pair:?}");
+            assert_ne!(both[0], both[1], "{pair:?}");
         }
+        assert_eq!(
+            styles_for(&["auxiliary n=2 res=0.5"])[0],
+            styles_for(&["auxiliary res=0.5"])[0]
+        );
+        // The method at another α keeps its marker, hollow.
+        let at_alpha = styles_for(&["portal", "portal α=0.7"])[1];
+        assert_eq!(at_alpha.marker, method_style("portal").marker);
+        assert!(at_alpha.hollow);
     }
 
     /// A method's variants take markers no other method of its colour has, so that a variant
@@ -2022,23 +2164,77 @@ mod tests {
         assert_eq!(c.to_svg().matches(">d=2</text>").count(), 1);
     }
 
-    /// A point on the frame (x = 0 where the axis starts at 0) is drawn whole: the data's clip
-    /// reaches a marker's size past the plot's frame.
+    /// No point's label is drawn over the floor band's label: points just above the floor at
+    /// the plot's right end, at a run of heights, label themselves elsewhere or not at all.
     #[test]
-    fn a_marker_on_the_frame_is_not_cut() {
+    fn a_label_keeps_off_the_floor_label() {
+        for k in 0..12 {
+            let y = 0.0105 * 1.04f64.powi(k);
+            let mut c = chart_of(vec![(1.0, 0.5), (9.0, y), (10.0, y * 1.02)]);
+            c.series[0].labels = vec!["n=0".into(), "long label 1".into(), "long label 2".into()];
+            let f = {
+                let (ax, ay) = c.axes();
+                Frame { ax, ay }
+            };
+            let (text, x1, base) = c.floor_label(&f).unwrap();
+            let floor = Rect {
+                x0: x1 - SMALL_CHAR_W * text.chars().count() as f64,
+                y0: base - 9.0,
+                x1,
+                y1: base + 1.0,
+            };
+            let svg = c.to_svg();
+            for label in ["long label 1", "long label 2"] {
+                let Some(at) = svg.find(&format!(">{label}</text>")) else {
+                    continue;
+                };
+                let tag = &svg[svg[..at].rfind("<text").unwrap()..at];
+                let (lx, ly) = (number_after(tag, "x=\""), number_after(tag, "y=\""));
+                let rect = Rect {
+                    x0: lx,
+                    y0: ly - 9.0,
+                    x1: lx + SMALL_CHAR_W * label.len() as f64,
+                    y1: ly + 1.0,
+                };
+                assert!(!rect.overlaps(&floor), "{k}: {label} at {lx} {ly}");
+            }
+        }
+    }
+
+    /// Sixteen decades in the plot's height: the 2× and 5× steps beyond the outer decades are
+    /// kept only where their labels clear the others, the outermost first, so that the lowest
+    /// point stays within a factor 2.5 of a tick.
+    #[test]
+    fn tick_labels_do_not_crowd_a_long_log_axis() {
+        let ay = Axis::new([2.5e-16, 1.5].into_iter(), true);
+        let ticks = ay.ticks_drawn(PLOT_H, Y_TICK_GAP);
+        let px: Vec<f64> = ticks.iter().map(|&t| ay.t(t) * PLOT_H).collect();
+        assert!(
+            px.windows(2).all(|w| w[1] - w[0] >= Y_TICK_GAP),
+            "{ticks:?} at {px:?}"
+        );
+        assert!(ticks[0] <= 2.5e-16 * 2.5, "{ticks:?}");
+        assert!(ticks.len() < ay.ticks().len(), "{:?}", ay.ticks());
+    }
+
+    /// A point at x = 0 is drawn whole with the rings around it: the linear axis pads below 0
+    /// (it had started at 0, and the point sat on the frame, its rings cut); the 0 tick is
+    /// drawn, and no tick below it. The data's clip still reaches a marker's size past the
+    /// frame.
+    #[test]
+    fn a_marker_at_zero_is_not_cut() {
         let mut c = chart_of(vec![(0.0, 0.5), (10.0, 0.1)]);
         c.x_log = false;
         let svg = c.to_svg();
         let clip_x = number_after(&svg, "<clipPath id=\"marks\"><rect x=\"");
         let cx = number_after(&svg, "<circle cx=\"");
         assert!(
-            (cx - LEFT).abs() < 0.1,
-            "the point at 0 sits on the frame: {cx}"
+            cx - LEFT > MARKER_R + 2.6 + 1.5,
+            "the point at 0 and a ring around it inside the frame: {cx}"
         );
-        assert!(
-            clip_x <= cx - 2.0 * MARKER_R,
-            "clip from {clip_x}, marker at {cx}"
-        );
+        assert!(clip_x <= LEFT - MARKER_R, "clip from {clip_x}");
+        assert!(svg.contains(r#"text-anchor="middle">0</text>"#), "{svg}");
+        assert!(!svg.contains(r#"text-anchor="middle">-"#), "{svg}");
     }
 
     /// A reference that draws no line (a curve with one visible point) has no legend entry,
@@ -2190,14 +2386,16 @@ mod tests {
         );
         let mut c = chart(vec![s]);
         (c.x_log, c.references) = (false, Vec::new());
+        // The x axis' tick labels are centred under their ticks (the y axis' end-anchored).
+        let x_tick = |v: &str| format!(r#"text-anchor="middle">{v}</text>"#);
         assert!(
-            c.to_svg().contains(">0.5</text>"),
+            c.to_svg().contains(&x_tick("0.5")),
             "the plain axis ticks halves"
         );
         c.x_whole = true;
         let svg = c.to_svg();
         assert!(
-            !svg.contains(">0.5</text>") && svg.contains(">1</text>"),
+            !svg.contains(&x_tick("0.5")) && svg.contains(&x_tick("1")),
             "{svg}"
         );
     }
