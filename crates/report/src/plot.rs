@@ -1635,7 +1635,17 @@ impl Chart {
         // point touches its own line, and reads as that line's), the reference lines and every
         // error bar (issue: "n=1" on the other α's line, "d=64" on a CI bar).
         let strokes = self.strokes(f);
+        // A label said at one x is not said again at that x (the fallbacks of one camera turn
+        // share its x, its off-screen share: three "yaw 45°" had stood in one column; the α
+        // series' "n=0" at n = 0).
+        let mut said: Vec<(&str, f64)> = Vec::new();
         for (i, xx, yy, r, label, color) in label_queue {
+            if said
+                .iter()
+                .any(|&(t, x)| t == label && (x - xx).abs() < 1.0)
+            {
+                continue;
+            }
             let lw = SMALL_CHAR_W * label.chars().count() as f64;
             let others: Vec<Stroke> = strokes
                 .iter()
@@ -1644,6 +1654,7 @@ impl Chart {
                 .collect();
             let place = place_label((xx, yy), r, lw, &markers, &taken, &others);
             if let Some((lx, ly, rect)) = place {
+                said.push((label, xx));
                 taken.push(rect.spaced());
                 let _ = writeln!(
                     s,
@@ -2487,6 +2498,20 @@ mod tests {
         assert_eq!(lines_of(method_style("auxiliary").color), 2, "{svg}");
         assert_eq!(lines_of(method_style("naive").color), 0, "{svg}");
         assert_eq!(svg.matches(r#"stroke-width="1.8""#).count(), 2, "{svg}");
+    }
+
+    /// A label is said once per x: a second series' point at the same x with the same label
+    /// is left unlabelled; at another x, or with another label, it is labelled.
+    #[test]
+    fn a_label_is_said_once_at_one_x() {
+        let mut c = chart_of(vec![(1.0, 0.5), (10.0, 0.02)]);
+        c.series[0].labels = vec!["yaw 45°".into(), "yaw 0°".into()];
+        let mut b = Series::new("b", method_style("naive"), vec![(1.0, 0.1), (10.0, 0.2)]);
+        b.labels = vec!["yaw 45°".into(), "yaw 90°".into()];
+        c.series.push(b);
+        let svg = c.to_svg();
+        assert_eq!(svg.matches(">yaw 45°</text>").count(), 1, "{svg}");
+        assert_eq!(svg.matches(">yaw 90°</text>").count(), 1, "{svg}");
     }
 
     /// A label keeps a gap from one placed before it: a second label that would start where
