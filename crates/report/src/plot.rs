@@ -833,6 +833,69 @@ fn place_label(
     })
 }
 
+/// Where a point's label goes when no place beside its marker is free ([`place_label`]): a
+/// little away from it, in one of eight directions at two distances, joined to the marker by a
+/// thin leader line in the series' colour — a label that would have been left out (a swept
+/// cube size under two other methods' points, a crowded front) is said, and the leader ties
+/// it to its point. The box keeps the same rules (inside the plot, clear of everything
+/// `taken`, across none of `strokes`), and the leader crosses nothing `taken` but the label.
+/// Returns the text's baseline origin, its box and the leader's ends.
+#[allow(clippy::type_complexity)]
+fn place_label_away(
+    (xx, yy): (f64, f64),
+    r: f64,
+    lw: f64,
+    taken: &[Rect],
+    strokes: &[Stroke],
+) -> Option<(f64, f64, Rect, Stroke)> {
+    let own = Rect {
+        x0: xx - r,
+        y0: yy - r,
+        x1: xx + r,
+        y1: yy + r,
+    };
+    [14.0, 26.0].iter().find_map(|&d| {
+        let e = d * std::f64::consts::FRAC_1_SQRT_2;
+        // Baseline origins: right, left, above, below, then the four diagonals.
+        let candidates = [
+            (xx + r + d, yy + 4.0),
+            (xx - r - d - lw, yy + 4.0),
+            (xx - lw / 2.0, yy - r - d),
+            (xx - lw / 2.0, yy + r + d + 9.0),
+            (xx + r + e, yy - r - e),
+            (xx + r + e, yy + r + e + 9.0),
+            (xx - r - e - lw, yy - r - e),
+            (xx - r - e - lw, yy + r + e + 9.0),
+        ];
+        candidates.iter().find_map(|&(lx, ly)| {
+            let rect = Rect {
+                x0: lx,
+                y0: ly - 9.0,
+                x1: lx + lw,
+                y1: ly + 1.0,
+            };
+            // The leader: from the marker's edge to the box's nearest point.
+            let near = (xx.clamp(rect.x0, rect.x1), yy.clamp(rect.y0, rect.y1));
+            let (dx, dy) = (near.0 - xx, near.1 - yy);
+            let len = dx.hypot(dy);
+            if len <= r {
+                return None;
+            }
+            let from = (xx + dx / len * (r + 1.0), yy + dy / len * (r + 1.0));
+            let inside = rect.x0 >= LEFT
+                && rect.x1 <= LEFT + PLOT_W
+                && rect.y0 >= TOP
+                && rect.y1 <= TOP + PLOT_H;
+            let mine = |t: &Rect| t.x0 == own.x0 && t.y0 == own.y0;
+            (inside
+                && !taken.iter().any(|t| t.overlaps(&rect))
+                && !taken.iter().any(|t| !mine(t) && t.crossed_by(from, near))
+                && !strokes.iter().any(|&(a, b)| rect.crossed_by(a, b)))
+            .then_some((lx, ly, rect, (from, near)))
+        })
+    })
+}
+
 /// The points of a reference's line as the frame shows them: a level across the plot, a
 /// curve's drawable points; none for a mark, a level off a log axis, or a line no piece of
 /// which crosses the plot (a budget left or right of every point: it drew nothing and had a
@@ -1652,10 +1715,21 @@ impl Chart {
                 .filter(|(owner, _)| *owner != Some(i))
                 .map(|&(_, st)| st)
                 .collect();
-            let place = place_label((xx, yy), r, lw, &markers, &taken, &others);
-            if let Some((lx, ly, rect)) = place {
+            let place = place_label((xx, yy), r, lw, &markers, &taken, &others)
+                .map(|p| (p, None))
+                .or_else(|| {
+                    place_label_away((xx, yy), r, lw, &taken, &others)
+                        .map(|(lx, ly, rect, leader)| ((lx, ly, rect), Some(leader)))
+                });
+            if let Some(((lx, ly, rect), leader)) = place {
                 said.push((label, xx));
                 taken.push(rect.spaced());
+                if let Some(((x0, y0), (x1, y1))) = leader {
+                    let _ = writeln!(
+                        s,
+                        r#"<line x1="{x0:.1}" y1="{y0:.1}" x2="{x1:.1}" y2="{y1:.1}" stroke="{color}" stroke-width="0.8"/>"#
+                    );
+                }
                 let _ = writeln!(
                     s,
                     r#"<text x="{lx:.1}" y="{ly:.1}" font-size="10" fill="{color}">{}</text>"#,
@@ -2512,6 +2586,48 @@ mod tests {
         let svg = c.to_svg();
         assert_eq!(svg.matches(">yaw 45°</text>").count(), 1, "{svg}");
         assert_eq!(svg.matches(">yaw 90°</text>").count(), 1, "{svg}");
+    }
+
+    /// A point whose places beside its marker are all taken gets its label a little away,
+    /// with a leader line from its marker; where those are taken too, none.
+    #[test]
+    fn a_crowded_label_goes_away_on_a_leader() {
+        let (r, lw) = (MARKER_R, 30.0);
+        let (x, y) = (LEFT + 200.0, TOP + 150.0);
+        // Other points close around it: every place beside its marker lies as near one of
+        // them as its own, so would read as theirs.
+        let markers: Vec<(f64, f64)> = std::iter::once((x, y))
+            .chain((0..8).map(|k| {
+                // Between the eight directions a leader may take.
+                let a = (f64::from(k) + 0.5) * std::f64::consts::FRAC_PI_4;
+                (x + 14.0 * a.cos(), y + 14.0 * a.sin())
+            }))
+            .collect();
+        let near: Vec<Rect> = markers[1..]
+            .iter()
+            .map(|&(mx, my)| Rect {
+                x0: mx - r,
+                y0: my - r,
+                x1: mx + r,
+                y1: my + r,
+            })
+            .collect();
+        assert!(place_label((x, y), r, lw, &markers, &near, &[]).is_none());
+        let (_, _, rect, (from, to)) = place_label_away((x, y), r, lw, &near, &[]).unwrap();
+        assert!(!near.iter().any(|t| t.overlaps(&rect)));
+        assert!(
+            (from.0 - x).hypot(from.1 - y) > r,
+            "the leader starts at the marker's edge"
+        );
+        assert!(to.0 >= rect.x0 && to.0 <= rect.x1 && to.1 >= rect.y0 && to.1 <= rect.y1);
+        // Everything around taken: no label.
+        let all = [Rect {
+            x0: LEFT,
+            y0: TOP,
+            x1: LEFT + PLOT_W,
+            y1: TOP + PLOT_H,
+        }];
+        assert!(place_label_away((x, y), r, lw, &all, &[]).is_none());
     }
 
     /// A label keeps a gap from one placed before it: a second label that would start where
