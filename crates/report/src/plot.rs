@@ -296,6 +296,20 @@ pub fn keyed_styles(keys: &[StyleKey]) -> Vec<Style> {
     styles.into_iter().flatten().collect()
 }
 
+/// [`keyed_styles`] of our own series, each given as (method, variant key).
+pub fn our_styles(keys: &[(&str, &str)]) -> Vec<Style> {
+    keyed_styles(
+        &keys
+            .iter()
+            .map(|&(method, variant)| StyleKey {
+                method,
+                variant,
+                outside: false,
+            })
+            .collect::<Vec<_>>(),
+    )
+}
+
 /// The styles of a chart's series named "method options…" (a record's variant,
 /// `document::variant`): [`keyed_styles`] with the words after the method as the key.
 pub fn styles_for(names: &[&str]) -> Vec<Style> {

@@ -9,7 +9,7 @@ use mirrorbox_report::Record;
 use mirrorbox_report::document::{
     Block, distinct, join_words, lowest_with_ties, markdown, ms_cell, sci,
 };
-use mirrorbox_report::plot::{Chart, Marker, Series, Style, StyleKey, keyed_styles, method_style};
+use mirrorbox_report::plot::{Chart, Marker, Series, Style, method_style, our_styles};
 use mirrorbox_report::readme::{ReadmeError, RegionSource, measured_on};
 use mirrorbox_report::{Sweep, SweepInfo, load_sweep};
 
@@ -322,14 +322,10 @@ pub fn uneven_section(records: &[Record], bump_methods: &[String]) -> Vec<Block>
             })
             .collect();
         // The methods shown flat beside the host's tricks keep their own styles.
-        let flat_styles = keyed_styles(
+        let flat_styles = our_styles(
             &flat_bases
                 .iter()
-                .map(|b| StyleKey {
-                    method: b,
-                    variant: "",
-                    outside: false,
-                })
+                .map(|b| (b.as_str(), ""))
                 .collect::<Vec<_>>(),
         );
         let styles: Vec<Style> = fams.iter().map(|f| trick_style(&base, f)).collect();

@@ -8,7 +8,7 @@
 
 use mirrorbox_report::Record;
 use mirrorbox_report::document::{Block, f, markdown, ms_cell, ms_heading, sci};
-use mirrorbox_report::plot::{Chart, Series, StyleKey, keyed_styles};
+use mirrorbox_report::plot::{Chart, Series, our_styles};
 use mirrorbox_report::readme::{ReadmeError, RegionSource, measured_on};
 use mirrorbox_report::{Sweep, load_sweep};
 
@@ -222,14 +222,10 @@ pub fn lighting_section(records: &[Record]) -> Vec<Block> {
             })
             .collect();
         let keys: Vec<String> = groups.iter().map(|(v, _, m)| style_key(m, v)).collect();
-        let styles = keyed_styles(
+        let styles = our_styles(
             &keys
                 .iter()
-                .map(|k| StyleKey {
-                    method: kind,
-                    variant: k,
-                    outside: false,
-                })
+                .map(|k| (kind.as_str(), k.as_str()))
                 .collect::<Vec<_>>(),
         );
         for ((v, at, named), style) in groups.into_iter().zip(styles) {
@@ -281,16 +277,7 @@ pub fn lighting_section(records: &[Record]) -> Vec<Block> {
         // One method per chart (its title names it): the lighting alone keys the style, so
         // that a lighting variant looks the same in every report's chart.
         let keys: Vec<String> = variants.iter().map(|v| style_key(base, v)).collect();
-        let styles = keyed_styles(
-            &keys
-                .iter()
-                .map(|k| StyleKey {
-                    method: base,
-                    variant: k,
-                    outside: false,
-                })
-                .collect::<Vec<_>>(),
-        );
+        let styles = our_styles(&keys.iter().map(|k| (base, k.as_str())).collect::<Vec<_>>());
         let series: Vec<Series> = variants
             .iter()
             .zip(styles)

@@ -11,7 +11,7 @@
 
 use mirrorbox_report::Record;
 use mirrorbox_report::document::{Block, distinct, f, markdown, ms_cell, sci};
-use mirrorbox_report::plot::{Chart, Series, StyleKey, keyed_styles, method_style};
+use mirrorbox_report::plot::{Chart, Series, method_style, our_styles};
 use mirrorbox_report::readme::{ReadmeError, RegionSource, measured_on};
 use mirrorbox_report::{Sweep, load_sweep};
 
@@ -277,15 +277,11 @@ fn chart(records: &[Record], name: &str, title: &str, y_label: &str, y_log: bool
                 .join(" ")
         })
         .collect();
-    let styles = keyed_styles(
+    let styles = our_styles(
         &firsts
             .iter()
             .zip(&keys)
-            .map(|(r, key)| StyleKey {
-                method: &r.method,
-                variant: key,
-                outside: false,
-            })
+            .map(|(r, key)| (r.method.as_str(), key.as_str()))
             .collect::<Vec<_>>(),
     );
     let mut series: Vec<Series> = variants
