@@ -82,8 +82,9 @@ const DASHES: [&str; 6] = ["", "7 4", "2 3", "8 3 2 3", "12 3", "12 3 2 3 2 3"];
 /// A method's colour, its own marker, and the markers its variants take besides it: no other
 /// method of its colour has any of them as its own or its variants', so that a variant of one
 /// method never looks like another method or its variants (`ssr`'s planar fallback had taken
-/// `feedback`'s diamond); nor does a variant take the marker of a method whose colour is near
-/// its own (orange `naive` and vermilion `auxiliary`: no triangle down, no circle). A name not in the table (a method added later) gets a colour and a
+/// `feedback`'s diamond); nor does a variant take the own marker of a method whose colour is
+/// near its own (orange and vermilion, blue and sky blue: the palette's pairs a reader can
+/// confuse at a marker's size; tested). A name not in the table (a method added later) gets a colour and a
 /// marker from its name's hash, in grey's place never, and no markers besides: the table is
 /// the place to give a new method its own.
 fn method_entry(method: &str) -> (&'static str, Marker, &'static [Marker]) {
@@ -91,11 +92,7 @@ fn method_entry(method: &str) -> (&'static str, Marker, &'static [Marker]) {
     match method {
         "naive" => (COLORS[4], TriangleDown, &[TriangleUp, Diamond]),
         "symmetry-baked" => (COLORS[4], Square, &[Cross, Plus]),
-        "auxiliary" => (
-            COLORS[1],
-            Circle,
-            &[Square, TriangleUp, Diamond, Cross, Plus],
-        ),
+        "auxiliary" => (COLORS[1], Circle, &[TriangleUp, Diamond, Cross, Plus]),
         "path-textures" => (COLORS[3], Diamond, &[Circle]),
         "symmetry-pruned" => (COLORS[3], TriangleUp, &[Square]),
         "cubemap" => (COLORS[3], Cross, &[TriangleDown, Plus]),
@@ -104,14 +101,10 @@ fn method_entry(method: &str) -> (&'static str, Marker, &'static [Marker]) {
             Square,
             &[Circle, TriangleUp, Diamond, TriangleDown, Cross, Plus],
         ),
-        "unrolled" => (
-            COLORS[0],
-            Plus,
-            &[Circle, Square, TriangleUp, Diamond, TriangleDown, Cross],
-        ),
-        "symmetry" => (COLORS[5], Circle, &[Plus]),
+        "unrolled" => (COLORS[0], Plus, &[TriangleUp, TriangleDown, Cross]),
+        "symmetry" => (COLORS[5], Circle, &[TriangleDown]),
         "feedback" => (COLORS[5], Diamond, &[Cross]),
-        "ssr" => (COLORS[5], Square, &[TriangleUp, TriangleDown]),
+        "ssr" => (COLORS[5], Square, &[TriangleUp]),
         "ray-query" => (
             COLORS[6],
             TriangleUp,
@@ -199,14 +192,16 @@ pub struct StyleKey<'a> {
 
 /// The styles of a chart's series: the method's own style for its defaults, and for a variant
 /// the [`method_variant`] its key hashes to — the same variant keeps its style in every chart
-/// of every report ("auxiliary n=2" is one marker and dash wherever it is drawn), where an
-/// index by order had given it whatever place its chart's other variants left. A setting in
-/// the key ([`SETTINGS`]: `n=2`, `cube-size=128`) counts only where the chart holds the same
-/// variant at another setting. A variant takes
-/// only its own method's markers ([`method_entry`]), so another method's series never moves
-/// it. No two series of one chart share a look (marker and fill; the dash too once a method's
-/// looks run out): a key whose look another variant of its method took passes on to the next
-/// free one (hollow first for an outside renderer's).
+/// of every report where no other variant of its method hashed to its place first
+/// ("auxiliary n=2" is one marker and dash wherever it is drawn), where an index by order had
+/// given it whatever place its chart's other variants left. A setting in the key
+/// ([`SETTINGS`]: `n=2`, `cube-size=128`) counts only where the chart holds the same variant
+/// at another setting. A key of α alone takes the method's marker, hollow, first (a second
+/// other α the next place). A variant takes only its own method's markers
+/// ([`method_entry`]), so another method's series never moves it. While the method's looks
+/// last, no two series of one chart share one (marker and fill; then the dash tells them
+/// apart, and past that the legend alone): a key whose look another variant of its method
+/// took passes on to the next free one (hollow first for an outside renderer's).
 pub fn keyed_styles(keys: &[StyleKey]) -> Vec<Style> {
     // Each key as (options, settings): the settings count only where the chart has another
     // series of the same method and options at other settings.
@@ -523,7 +518,8 @@ struct Axis {
 impl Axis {
     /// Tight to the values: a log axis pads 4 % of its span in decades on each side (at least a
     /// factor 1.15), a linear one 6 %, starting at 0 where the values are non-negative and
-    /// close to it, and 6 % below 0 where some value is 0.
+    /// close to it, and 6 % below 0 where the least value is 0 and the span is not (so that
+    /// markers at 0 are drawn whole).
     fn new(values: impl Iterator<Item = f64>, log: bool) -> Axis {
         let (mut lo, mut hi) = values
             .filter(|x| drawable(*x, log))
@@ -852,7 +848,8 @@ fn place_label(
 /// thin leader line in the series' colour — a label that would have been left out (a swept
 /// cube size under two other methods' points, a crowded front) is said, and the leader ties
 /// it to its point. The box keeps the same rules (inside the plot, clear of everything
-/// `taken`, across none of `strokes`), and the leader crosses nothing `taken` but the label.
+/// `taken`, across none of `strokes`), and the leader crosses nothing `taken` but the point's
+/// own marker.
 /// Returns the text's baseline origin, its box and the leader's ends.
 #[allow(clippy::type_complexity)]
 fn place_label_away(
@@ -1963,13 +1960,13 @@ mod tests {
             variant,
             outside: false,
         };
-        let n2 = key("auxiliary", "max-passes=9");
-        let alone = keyed_styles(&[n2])[0];
+        let passes = key("auxiliary", "max-passes=9");
+        let alone = keyed_styles(&[passes])[0];
         let among = keyed_styles(&[
             key("auxiliary", "res=0.5"),
             key("portal", ""),
             key("auxiliary", ""),
-            n2,
+            passes,
         ])[3];
         assert_eq!(alone, among);
         assert_ne!(alone, method_style("auxiliary"));
@@ -2041,6 +2038,10 @@ mod tests {
         assert!(at_alpha.hollow);
     }
 
+    /// The palette's pairs a reader can confuse at a marker's size (indices into `COLORS`):
+    /// orange and vermilion, blue and sky blue.
+    const NEAR_COLOURS: [(usize, usize); 2] = [(4, 1), (0, 5)];
+
     /// A method's variants take markers no other method of its colour has, so that a variant
     /// never looks like another method's series.
     #[test]
@@ -2073,6 +2074,17 @@ mod tests {
                 assert!(
                     !own_a.contains(&mb) && !more_b.iter().any(|m| own_a.contains(m)),
                     "{a} and {b} share a marker"
+                );
+            }
+            // No variant takes the own marker of a method of a near colour.
+            for b in &methods {
+                let (cb, mb, _) = method_entry(b);
+                let near = NEAR_COLOURS.iter().any(|&(i, j)| {
+                    (ca, cb) == (COLORS[i], COLORS[j]) || (ca, cb) == (COLORS[j], COLORS[i])
+                });
+                assert!(
+                    !(near && more_a.contains(&mb)),
+                    "{a}'s variants take {b}'s marker"
                 );
             }
             // Every variant of the method within its looks is its own.
@@ -2283,6 +2295,7 @@ mod tests {
                 y1: base + 1.0,
             };
             let svg = c.to_svg();
+            assert!(svg.contains(">n=0</text>"), "labels are drawn: {svg}");
             for label in ["long label 1", "long label 2"] {
                 let Some(at) = svg.find(&format!(">{label}</text>")) else {
                     continue;

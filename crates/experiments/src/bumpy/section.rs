@@ -301,9 +301,21 @@ pub fn uneven_section(records: &[Record], bump_methods: &[String]) -> Vec<Block>
         })
         .cloned()
         .collect();
-    // A trick has one marker and dash in every chart and report (`trick_style`), in its host
-    // method's colour: each chart is one host's tricks, so the marker says the trick, not the
-    // method (`flat` had been a cross, a square and a triangle in three charts).
+    let flat_bases: Vec<String> = flat_only
+        .iter()
+        .map(|f| {
+            pts.iter()
+                .find(|r| &method_of(r) == f)
+                .map_or(f.clone(), |r| r.method.clone())
+        })
+        .collect();
+    // The methods shown flat beside the host's tricks keep their own styles.
+    let flat_styles = our_styles(
+        &flat_bases
+            .iter()
+            .map(|b| (b.as_str(), ""))
+            .collect::<Vec<_>>(),
+    );
     for (chart_index, m) in methods
         .iter()
         .filter(|m| !flat_only.contains(m))
@@ -313,21 +325,9 @@ pub fn uneven_section(records: &[Record], bump_methods: &[String]) -> Vec<Block>
         let base = mine.first().map_or(String::new(), |r| r.method.clone());
         let mut series = Vec::new();
         let fams = distinct(mine.iter().map(|r| family(&trick_of(r, bump_methods))));
-        let flat_bases: Vec<String> = flat_only
-            .iter()
-            .map(|f| {
-                pts.iter()
-                    .find(|r| &method_of(r) == f)
-                    .map_or(f.clone(), |r| r.method.clone())
-            })
-            .collect();
-        // The methods shown flat beside the host's tricks keep their own styles.
-        let flat_styles = our_styles(
-            &flat_bases
-                .iter()
-                .map(|b| (b.as_str(), ""))
-                .collect::<Vec<_>>(),
-        );
+        // A trick has one marker and dash in every chart and report (`trick_style`), in its host
+        // method's colour: each chart is one host's tricks, so the marker says the trick, not the
+        // method (`flat` had been a cross, a square and a triangle in three charts).
         let styles: Vec<Style> = fams.iter().map(|f| trick_style(&base, f)).collect();
         for (fam, &style) in fams.iter().zip(&styles) {
             let settings = distinct(

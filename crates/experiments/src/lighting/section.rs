@@ -203,7 +203,7 @@ pub fn lighting_section(records: &[Record]) -> Vec<Block> {
         let lightings = distinct(mine.iter().map(|r| lighting_of(r)));
         // Each lighting's points and the method they name: `auxiliary n=2` where they share
         // a count, else the method alone (the counts label the points).
-        let groups: Vec<(&String, Vec<&Record>, String)> = lightings
+        let groups: Vec<(&String, Vec<&Record>, String, bool)> = lightings
             .iter()
             .map(|v| {
                 let mut at: Vec<&Record> = mine
@@ -218,18 +218,17 @@ pub fn lighting_section(records: &[Record]) -> Vec<Block> {
                 } else {
                     kind.clone()
                 };
-                (v, at, named)
+                (v, at, named, counts.len() > 1)
             })
             .collect();
-        let keys: Vec<String> = groups.iter().map(|(v, _, m)| style_key(m, v)).collect();
+        let keys: Vec<String> = groups.iter().map(|(v, _, m, _)| style_key(m, v)).collect();
         let styles = our_styles(
             &keys
                 .iter()
                 .map(|k| (kind.as_str(), k.as_str()))
                 .collect::<Vec<_>>(),
         );
-        for ((v, at, named), style) in groups.into_iter().zip(styles) {
-            let counts = distinct(at.iter().map(|r| method_of(r)));
+        for ((v, at, named, counted), style) in groups.into_iter().zip(styles) {
             let name = format!("{named}, {v}");
             let mut s = Series::new(
                 name,
@@ -238,7 +237,7 @@ pub fn lighting_section(records: &[Record]) -> Vec<Block> {
                     .map(|r| (r.ms_median, r.metrics.flip_mean))
                     .collect(),
             );
-            if counts.len() > 1 {
+            if counted {
                 s.labels = at
                     .iter()
                     .map(|r| r.n.map_or(String::new(), |n| format!("n={n}")))
