@@ -407,6 +407,77 @@ pub fn section(info: &mirrorbox_report::SweepInfo, records: &[Record]) -> Vec<Bl
 mod tests {
     use super::*;
 
+    /// A point measured with `key` (method and options, then a count), at `reflections`.
+    fn point(key: &str, reflections: usize, flip: f64) -> Record {
+        let mut r = mirrorbox_report::document::fixtures::record(0, 5.0, 1, flip);
+        let mut words = key.split_whitespace();
+        r.method = words.next().unwrap().into();
+        r.n = None;
+        let mut options = Vec::new();
+        for w in words {
+            match w.split_once('=') {
+                Some(("n", v)) => r.n = v.parse().ok(),
+                Some(("depth", v)) => r.depth = v.parse().ok(),
+                _ => options.push(w),
+            }
+        }
+        r.method_options = options.join(" ");
+        r.key = format!("{key}|alpha=1|320x180");
+        r.reflections = reflections;
+        r
+    }
+
+    /// The depth charts: a depth-swept method joined along the depth; the paper's auxiliary
+    /// mirrors one series along n, joined and labelled as the generic charts draw them; ssr's
+    /// fallbacks named as the generic charts name them, its defaults in its own style; the
+    /// table's rows named by their keys without the depth.
+    #[test]
+    fn the_depth_charts_draw_each_variant_along_its_count() {
+        let records = [
+            point("ray-query depth=1", 1, 0.1),
+            point("ray-query depth=4", 4, 0.01),
+            point("auxiliary n=1", 2, 0.05),
+            point("auxiliary n=2", 4, 0.02),
+            point("ssr", 1, 0.3),
+            point("ssr ssr-fallback=none", 1, 0.4),
+        ];
+        let blocks = engine_reflections_section(&records, "truth");
+        let Some(Block::Chart(_, error)) = blocks
+            .iter()
+            .find(|b| matches!(b, Block::Chart(f, _) if f == "engine_error_depth.svg"))
+        else {
+            panic!("no depth chart");
+        };
+        let names: Vec<&str> = error.series.iter().map(|s| s.name.as_str()).collect();
+        assert_eq!(
+            names,
+            [
+                "ray-query",
+                "auxiliary",
+                "ssr (defaults)",
+                "ssr ssr-fallback=none"
+            ]
+        );
+        let aux = &error.series[1];
+        assert!(aux.joined && aux.points == [(2.0, 0.05), (4.0, 0.02)]);
+        assert_eq!(aux.labels, ["n=1", "n=2"]);
+        assert_eq!(
+            error.series[2].style,
+            mirrorbox_report::plot::method_style("ssr")
+        );
+        assert_ne!(error.series[3].style, error.series[2].style);
+        let Some(Block::Table(_, rows)) = blocks.iter().find(|b| matches!(b, Block::Table(..)))
+        else {
+            panic!("no table");
+        };
+        let first: Vec<&str> = rows.iter().map(|r| r[0].as_str()).collect();
+        assert!(
+            first.contains(&"`ray-query`") && first.contains(&"`auxiliary n=2`"),
+            "{first:?}"
+        );
+        assert!(first.contains(&"`ssr (defaults)`"), "{first:?}");
+    }
+
     #[test]
     fn rank_correlation() {
         let rising = [(0.1, 1.0), (0.2, 4.0), (0.5, 9.0), (0.9, 20.0)];
