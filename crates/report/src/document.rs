@@ -27,6 +27,9 @@ pub enum Block {
     Chart(String, Box<Chart>),
 }
 
+/// The x axis of a chart against the depth cap, the same words in every report.
+pub const DEPTH_CAP_AXIS: &str = "depth cap (most mirrors along a path)";
+
 /// Bytes in a mebibyte (the tables' memory unit).
 pub(crate) const MIB: f64 = 1024.0 * 1024.0;
 

@@ -30,8 +30,6 @@ use std::fmt::Write;
 const COLORS: [&str; 7] = [
     "#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#333333",
 ];
-/// The x axis of a chart against the depth cap, the same words in every report.
-pub const DEPTH_CAP_AXIS: &str = "depth cap (most mirrors along a path)";
 /// The least distance between two tick labels' centres, pixels: a y label's height with a
 /// little air, and an x label's width ("5e-16").
 const Y_TICK_GAP: f64 = 13.0;

@@ -1024,7 +1024,7 @@ fn error_against_setting(v: &Variants, floor: Option<&Record>) -> Vec<Block> {
                 x_ticks_at_data: true,
                 ..Chart::new(
                     format!("FLIP over the image vs depth cap{alpha_note}"),
-                    crate::plot::DEPTH_CAP_AXIS,
+                    crate::document::DEPTH_CAP_AXIS,
                     "FLIP mean over the image",
                 )
             }),

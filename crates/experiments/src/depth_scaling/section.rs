@@ -69,7 +69,7 @@ pub fn depth_scaling(info: &SweepInfo, records: &[Record], floor: Option<&Record
                     .unwrap_or_default(),
                 ..Chart::new(
                     "Cost of the exact methods vs depth cap",
-                    mirrorbox_report::plot::DEPTH_CAP_AXIS,
+                    mirrorbox_report::document::DEPTH_CAP_AXIS,
                     "ms/frame (median, 95 % CI bars)",
                 )
             })

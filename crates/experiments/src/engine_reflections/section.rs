@@ -19,8 +19,12 @@ use mirrorbox_report::{Record, value};
 const YAW: &str = mirrorbox_report::axis::YAW_DEG;
 /// The depth charts' x: the depth-swept methods at their cap, the others at the reflections
 /// they show.
-const DEPTH_AXIS: &str =
-    "depth cap (most mirrors along a path); the others at the reflections they show";
+fn depth_axis() -> String {
+    format!(
+        "{}; the others at the reflections they show",
+        mirrorbox_report::document::DEPTH_CAP_AXIS
+    )
+}
 
 /// The exact methods whose depth is swept here.
 const DEPTH_SWEPT: [&str; 4] = ["ray-query", "unrolled", "portal", "path-textures"];
@@ -143,7 +147,7 @@ fn depth_blocks(pts: &[&Record]) -> Vec<Block> {
     let mut out = Vec::new();
     let mut error = Chart::new(
         "FLIP over the mirror pixels against the depth cap",
-        DEPTH_AXIS,
+        depth_axis(),
         "FLIP mean over the mirror pixels",
     );
     error.x_log = true;
@@ -151,7 +155,7 @@ fn depth_blocks(pts: &[&Record]) -> Vec<Block> {
     error.x_ticks_at_data = true;
     let mut cost = Chart::new(
         "Cost against the depth cap",
-        DEPTH_AXIS,
+        depth_axis(),
         "ms/frame (median, 95 % CI bars)",
     );
     cost.x_log = true;
