@@ -704,6 +704,31 @@ struct Rect {
 const LABEL_GAP: f64 = 4.0;
 
 impl Rect {
+    /// The square a marker of radius `r` at `(x, y)` covers.
+    fn around((x, y): (f64, f64), r: f64) -> Rect {
+        Rect {
+            x0: x - r,
+            y0: y - r,
+            x1: x + r,
+            y1: y + r,
+        }
+    }
+
+    /// A label's box, `lw` pixels wide, its text's baseline starting at `(lx, ly)`.
+    fn text_at(lx: f64, ly: f64, lw: f64) -> Rect {
+        Rect {
+            x0: lx,
+            y0: ly - 9.0,
+            x1: lx + lw,
+            y1: ly + 1.0,
+        }
+    }
+
+    /// Whether the box lies within the plot's frame.
+    fn inside_plot(&self) -> bool {
+        self.x0 >= LEFT && self.x1 <= LEFT + PLOT_W && self.y0 >= TOP && self.y1 <= TOP + PLOT_H
+    }
+
     /// A placed label's box with [`LABEL_GAP`] around it, as later labels must keep clear of it.
     fn spaced(self) -> Rect {
         Rect {
@@ -807,23 +832,10 @@ fn place_label(
         (xx - lw / 2.0, yy - r - 3.0),
         (xx - lw / 2.0, yy + r + 11.0),
     ];
-    let own = Rect {
-        x0: xx - r,
-        y0: yy - r,
-        x1: xx + r,
-        y1: yy + r,
-    };
+    let own = Rect::around((xx, yy), r);
     candidates.iter().find_map(|&(lx, ly)| {
-        let rect = Rect {
-            x0: lx,
-            y0: ly - 9.0,
-            x1: lx + lw,
-            y1: ly + 1.0,
-        };
-        let inside = rect.x0 >= LEFT
-            && rect.x1 <= LEFT + PLOT_W
-            && rect.y0 >= TOP
-            && rect.y1 <= TOP + PLOT_H;
+        let rect = Rect::text_at(lx, ly, lw);
+        let inside = rect.inside_plot();
         let gap = |(px, py): (f64, f64)| {
             let dx = (rect.x0 - px).max(px - rect.x1).max(0.0);
             let dy = (rect.y0 - py).max(py - rect.y1).max(0.0);
@@ -857,12 +869,7 @@ fn place_label_away(
     taken: &[Rect],
     strokes: &[Stroke],
 ) -> Option<(f64, f64, Rect, Stroke)> {
-    let own = Rect {
-        x0: xx - r,
-        y0: yy - r,
-        x1: xx + r,
-        y1: yy + r,
-    };
+    let own = Rect::around((xx, yy), r);
     [14.0, 26.0].iter().find_map(|&d| {
         let e = d * std::f64::consts::FRAC_1_SQRT_2;
         // Baseline origins: right, left, above, below, then the four diagonals.
@@ -877,12 +884,7 @@ fn place_label_away(
             (xx - r - e - lw, yy + r + e + 9.0),
         ];
         candidates.iter().find_map(|&(lx, ly)| {
-            let rect = Rect {
-                x0: lx,
-                y0: ly - 9.0,
-                x1: lx + lw,
-                y1: ly + 1.0,
-            };
+            let rect = Rect::text_at(lx, ly, lw);
             // The leader: from the marker's edge to the box's nearest point.
             let near = (xx.clamp(rect.x0, rect.x1), yy.clamp(rect.y0, rect.y1));
             let (dx, dy) = (near.0 - xx, near.1 - yy);
@@ -891,10 +893,7 @@ fn place_label_away(
                 return None;
             }
             let from = (xx + dx / len * (r + 1.0), yy + dy / len * (r + 1.0));
-            let inside = rect.x0 >= LEFT
-                && rect.x1 <= LEFT + PLOT_W
-                && rect.y0 >= TOP
-                && rect.y1 <= TOP + PLOT_H;
+            let inside = rect.inside_plot();
             let mine = |t: &Rect| t.x0 == own.x0 && t.y0 == own.y0;
             (inside
                 && !taken.iter().any(|t| t.overlaps(&rect))
@@ -1673,12 +1672,7 @@ impl Chart {
                 } else {
                     marker_svg(s, &series.style, xx, yy, r, series.style.hollow);
                 }
-                taken.push(Rect {
-                    x0: xx - r,
-                    y0: yy - r,
-                    x1: xx + r,
-                    y1: yy + r,
-                });
+                taken.push(Rect::around((xx, yy), r));
                 markers.push((xx, yy));
                 if let Some(label) = label {
                     label_queue.push((i, xx, yy, r, label, series.style.color));
@@ -1695,12 +1689,7 @@ impl Chart {
                     s,
                     r#"<circle cx="{xx:.1}" cy="{yy:.1}" r="{MARK_R}" fill="none" stroke="black" stroke-width="2"/>"#
                 );
-                taken.push(Rect {
-                    x0: xx - MARK_R,
-                    y0: yy - MARK_R,
-                    x1: xx + MARK_R,
-                    y1: yy + MARK_R,
-                });
+                taken.push(Rect::around((xx, yy), MARK_R));
             }
         }
         // What a label must not cross: every series' line but its own (a label beside its own
