@@ -516,8 +516,7 @@ struct Axis {
 impl Axis {
     /// Tight to the values: a log axis pads 4 % of its span in decades on each side (at least a
     /// factor 1.15), a linear one 6 %, starting at 0 where the values are non-negative and
-    /// close to it, and 6 % below 0 where the least value is 0 and the span is not (so that
-    /// markers at 0 are drawn whole).
+    /// close to it — and then 6 % below 0, so that markers at or near 0 are drawn whole.
     fn new(values: impl Iterator<Item = f64>, log: bool) -> Axis {
         let (mut lo, mut hi) = values
             .filter(|x| drawable(*x, log))
@@ -539,12 +538,10 @@ impl Axis {
             } else {
                 lo.abs().max(1.0) * 0.1
             };
-            lo = if lo == 0.0 && span > 0.0 {
-                // Values at 0 itself: the axis pads below it too, so that their markers (and
-                // the rings of points coinciding there) are drawn whole, not cut by the frame.
-                -pad
-            } else if lo >= 0.0 && lo - pad < 0.0 || (lo > 0.0 && lo < span * 0.25) {
-                0.0
+            lo = if lo >= 0.0 && lo - pad < 0.0 || (lo > 0.0 && lo < span * 0.25) {
+                // From 0, and a little below it, so that markers at or near 0 (and the rings
+                // of points coinciding there) are drawn whole, not cut by the frame.
+                if span > 0.0 { -pad } else { 0.0 }
             } else {
                 lo - pad
             };
@@ -898,10 +895,41 @@ fn place_label_away(
             (inside
                 && !taken.iter().any(|t| t.overlaps(&rect))
                 && !taken.iter().any(|t| !mine(t) && t.crossed_by(from, near))
-                && !strokes.iter().any(|&(a, b)| rect.crossed_by(a, b)))
+                && !strokes.iter().any(|&(a, b)| rect.crossed_by(a, b))
+                // Nor within 2 px of another line or bar: a leader across an error bar read
+                // as the label of the bar's point, and one ending at a bar's cap as a whisker.
+                && !strokes
+                    .iter()
+                    .any(|&(a, b)| segments_distance((from, near), (a, b)) < 2.0))
             .then_some((lx, ly, rect, (from, near)))
         })
     })
+}
+
+/// The least distance between two segments, pixels (0 where they cross).
+fn segments_distance((p0, p1): Stroke, (q0, q1): Stroke) -> f64 {
+    let cross = |o: (f64, f64), a: (f64, f64), b: (f64, f64)| {
+        (a.0 - o.0) * (b.1 - o.1) - (a.1 - o.1) * (b.0 - o.0)
+    };
+    let (d1, d2) = (cross(q0, q1, p0), cross(q0, q1, p1));
+    let (d3, d4) = (cross(p0, p1, q0), cross(p0, p1, q1));
+    if d1 * d2 < 0.0 && d3 * d4 < 0.0 {
+        return 0.0;
+    }
+    let to_segment = |p: (f64, f64), (a, b): Stroke| {
+        let (dx, dy) = (b.0 - a.0, b.1 - a.1);
+        let len2 = dx * dx + dy * dy;
+        let t = if len2 > 0.0 {
+            (((p.0 - a.0) * dx + (p.1 - a.1) * dy) / len2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        (p.0 - a.0 - t * dx).hypot(p.1 - a.1 - t * dy)
+    };
+    to_segment(p0, (q0, q1))
+        .min(to_segment(p1, (q0, q1)))
+        .min(to_segment(q0, (p0, p1)))
+        .min(to_segment(q1, (p0, p1)))
 }
 
 /// The points of a reference's line as the frame shows them: a level across the plot, a
@@ -1728,9 +1756,19 @@ impl Chart {
                         r#"<line x1="{x0:.1}" y1="{y0:.1}" x2="{x1:.1}" y2="{y1:.1}" stroke="{color}" stroke-width="0.8"/>"#
                     );
                 }
+                // Anchored at the box's side nearest the point: the box's width is an
+                // estimate, so a label left of its point had ended short of it (by 35 px for
+                // a long one).
+                let (ax, anchor) = if rect.x1 <= xx {
+                    (rect.x1, "end")
+                } else if rect.x0 >= xx {
+                    (lx, "start")
+                } else {
+                    ((rect.x0 + rect.x1) / 2.0, "middle")
+                };
                 let _ = writeln!(
                     s,
-                    r#"<text x="{lx:.1}" y="{ly:.1}" font-size="10" fill="{color}">{}</text>"#,
+                    r#"<text x="{ax:.1}" y="{ly:.1}" font-size="10" fill="{color}" text-anchor="{anchor}">{}</text>"#,
                     esc(label)
                 );
             }
@@ -2642,6 +2680,55 @@ mod tests {
             y1: TOP + PLOT_H,
         }];
         assert!(place_label_away((x, y), r, lw, &all, &[]).is_none());
+    }
+
+    /// Segments' distance: 0 where they cross or touch, else the nearest ends' gap.
+    #[test]
+    fn segments_distance_is_zero_where_they_meet() {
+        let d = |a: Stroke, b: Stroke| segments_distance(a, b);
+        assert_eq!(
+            d(((0.0, 0.0), (10.0, 10.0)), ((0.0, 10.0), (10.0, 0.0))),
+            0.0
+        );
+        assert_eq!(
+            d(((0.0, 0.0), (10.0, 0.0)), ((10.0, 0.0), (20.0, 0.0))),
+            0.0
+        );
+        assert!((d(((0.0, 0.0), (10.0, 0.0)), ((0.0, 3.0), (10.0, 3.0))) - 3.0).abs() < 1e-12);
+        assert!((d(((0.0, 0.0), (1.0, 0.0)), ((4.0, 4.0), (4.0, 9.0))) - 5.0).abs() < 1e-12);
+    }
+
+    /// A leader keeps 2 px from every other line and bar: with a bar across the first away
+    /// place's way, the label goes elsewhere, its leader clear of the bar.
+    #[test]
+    fn a_leader_keeps_off_other_lines_and_bars() {
+        let (r, lw) = (MARKER_R, 30.0);
+        let (x, y) = (LEFT + 200.0, TOP + 150.0);
+        let (_, _, _, first) = place_label_away((x, y), r, lw, &[], &[]).unwrap();
+        // A vertical bar across the first leader's middle.
+        let mid = ((first.0.0 + first.1.0) / 2.0, (first.0.1 + first.1.1) / 2.0);
+        let bar = ((mid.0, mid.1 - 30.0), (mid.0, mid.1 + 30.0));
+        let (_, _, rect, leader) = place_label_away((x, y), r, lw, &[], &[bar]).unwrap();
+        assert!(segments_distance(leader, bar) >= 2.0, "{leader:?}");
+        assert!(!rect.crossed_by(bar.0, bar.1));
+    }
+
+    /// A label left of its point ends at its box's right edge (text-anchor end), whatever
+    /// the estimate of its width: a long one had ended 35 px short of its marker.
+    #[test]
+    fn a_label_left_of_its_point_is_anchored_at_its_end() {
+        // The point at the plot's right end: only the places left of it are inside.
+        let mut c = chart_of(vec![(1.0, 0.5), (10.0, 0.1)]);
+        c.series[0].labels = vec![String::new(), "590 reflections shown".into()];
+        let svg = c.to_svg();
+        let at = svg.find(">590 reflections shown</text>").unwrap();
+        let tag = &svg[svg[..at].rfind("<text").unwrap()..at];
+        assert!(tag.contains(r#"text-anchor="end""#), "{tag}");
+        let cx = number_after(
+            &svg[svg.find("<circle cx=\"").unwrap() + 1..],
+            "<circle cx=\"",
+        );
+        assert!(number_after(tag, "x=\"") < cx, "{tag} left of {cx}");
     }
 
     /// A label keeps a gap from one placed before it: a second label that would start where
