@@ -781,14 +781,16 @@ impl<'a> Variants<'a> {
         // variant its equivalent's colour with hollow markers, so that it reads beside what it
         // is meant to match.
         let alphas = distinct(points.iter().map(|r| r.alpha.to_bits()));
+        let largest_alpha = points.iter().map(|r| r.alpha).fold(f32::MIN, f32::max);
         let keys: Vec<(String, String, bool)> = groups
             .iter()
             .map(|(m, a)| {
                 let r = points
                     .iter()
                     .find(|r| &crate::document::variant(r) == m && r.alpha == *a);
-                // The sweep's first α keeps the method's style; each other α is a variant.
-                let alpha = if alphas.first() == Some(&a.to_bits()) {
+                // The largest α (the plain scene, α = 1 where it is swept) keeps the method's
+                // style, whatever the records' order; each other α is a variant.
+                let alpha = if *a == largest_alpha {
                     String::new()
                 } else {
                     format!("α={a}")
@@ -1440,6 +1442,22 @@ pub(crate) mod tests {
         // The log axis of time keeps its rule: nothing at 0 there to leave out.
         let ms = std::fs::read_to_string(dir.path().join("plot_flip_vs_ms.svg")).unwrap();
         assert!(!ms.contains("not drawn"), "{ms}");
+    }
+
+    /// The largest α keeps the method's own style whatever the records' order; another α
+    /// keeps the method's marker, hollow.
+    #[test]
+    fn the_plain_alpha_keeps_the_method_style() {
+        let mut low = record(1, 1.0, 1, 0.2);
+        low.alpha = 0.7;
+        let mut plain = record(1, 2.0, 1, 0.1);
+        plain.alpha = 1.0;
+        let points = [&low, &plain];
+        let v = Variants::of(&points);
+        let at = |a: f32| v.groups.iter().position(|g| g.1 == a).unwrap();
+        assert_eq!(v.styles[at(1.0)], crate::plot::method_style("auxiliary"));
+        let other = v.styles[at(0.7)];
+        assert!(other.hollow && other.marker == crate::plot::method_style("auxiliary").marker);
     }
 
     /// Points timed on too few frames for a 95 % interval (five) are drawn with each one's
