@@ -1053,10 +1053,6 @@ mod tests {
         assert!(serde_json::from_value::<Timing>(doc).is_err());
     }
 
-    /// A views.json that an export could not have written is refused naming the field, in
-    /// the file: no view, a name that is no file name or that clashes, a size no image has,
-    /// a truth outside the export folder. (An empty list panicked, a name such as
-    /// `../../x` was used as a path.)
     /// An export older than the scene hashes, without `alpha`: its scene says the α (the
     /// mirrors' one grey reflectance), or that the mirrors differ; one whose scene is gone
     /// keeps no α. An export with the hashes and no α has mirrors that differ.
@@ -1095,6 +1091,10 @@ mod tests {
         assert_eq!((read().alpha, read().mirrors_differ), (None, true));
     }
 
+    /// A views.json that an export could not have written is refused naming the field, in
+    /// the file: no view, a name that is no file name or that clashes, a size no image has,
+    /// a truth outside the export folder. (An empty list panicked, a name such as
+    /// `../../x` was used as a path.)
     #[test]
     fn a_views_json_is_checked_field_by_field() {
         let dir = tempfile::tempdir().unwrap();

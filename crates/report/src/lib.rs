@@ -301,7 +301,7 @@ pub mod value {
 /// chart: the axis label says which ([`plot::Chart`]).
 pub fn ms_bars_for<'a>(points: impl IntoIterator<Item = &'a Record> + Clone) -> plot::Bars {
     let any = |f: &dyn Fn(&Record) -> bool| points.clone().into_iter().any(f);
-    let ranged = |r: &Record| r.frames_ms.len() >= 2;
+    let ranged = |r: &Record| r.ms_bars(plot::Bars::FrameRange).is_some();
     let gains = any(&|r| r.ms_interval.is_none() && ranged(r));
     let loses = any(&|r| r.ms_interval.is_some() && !ranged(r));
     if gains && !loses {

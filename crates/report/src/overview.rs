@@ -353,11 +353,11 @@ fn frontier_chart(
         _ => r.metrics.flip_mean,
     };
     let names = distinct(records.iter().map(|r| series_name(r)));
-    let styles = styles_for(&names.iter().map(String::as_str).collect::<Vec<_>>());
     let all: Vec<(f64, f64)> = records.iter().map(|r| (r.ms_median, error(r))).collect();
     let (front, steps) = pareto_steps(&all);
     let on_front = |r: &Record| front.contains(&(r.ms_median, error(r)));
     let variants: Vec<&str> = names.iter().map(String::as_str).collect();
+    let styles = styles_for(&variants);
     let bars = crate::ms_bars_for(records.iter().copied());
     let series: Vec<Series> = names
         .iter()

@@ -687,6 +687,11 @@ fn exponent_form(v: f64) -> String {
     format!("{v:.1e}").replace(".0e", "e")
 }
 
+/// A 10-px label's width as the layout reckons it (an estimate: no font is measured).
+fn text_width(text: &str) -> f64 {
+    SMALL_CHAR_W * text.chars().count() as f64
+}
+
 /// An axis-aligned box in pixels, for keeping labels apart.
 #[derive(Clone, Copy)]
 struct Rect {
@@ -721,9 +726,18 @@ impl Rect {
         }
     }
 
+    /// The plot's frame.
+    const PLOT: Rect = Rect {
+        x0: LEFT,
+        y0: TOP,
+        x1: LEFT + PLOT_W,
+        y1: TOP + PLOT_H,
+    };
+
     /// Whether the box lies within the plot's frame.
     fn inside_plot(&self) -> bool {
-        self.x0 >= LEFT && self.x1 <= LEFT + PLOT_W && self.y0 >= TOP && self.y1 <= TOP + PLOT_H
+        let p = Rect::PLOT;
+        self.x0 >= p.x0 && self.x1 <= p.x1 && self.y0 >= p.y0 && self.y1 <= p.y1
     }
 
     /// A placed label's box with [`LABEL_GAP`] around it, as later labels must keep clear of it.
@@ -942,14 +956,11 @@ fn reference_line(r: &Reference, f: &Frame) -> Vec<(f64, f64)> {
         Reference::Level(..) | Reference::Mark(..) => Vec::new(),
         Reference::Curve(_, pts) => pts.iter().copied().filter(|&p| f.shows(p)).collect(),
     };
-    let plot = Rect {
-        x0: LEFT,
-        y0: TOP,
-        x1: LEFT + PLOT_W,
-        y1: TOP + PLOT_H,
-    };
     let px = |(x, y): (f64, f64)| (f.px(x), f.py(y));
-    if pts.windows(2).any(|w| plot.crossed_by(px(w[0]), px(w[1]))) {
+    if pts
+        .windows(2)
+        .any(|w| Rect::PLOT.crossed_by(px(w[0]), px(w[1])))
+    {
         pts
     } else {
         Vec::new()
@@ -1643,13 +1654,8 @@ impl Chart {
         let mut taken: Vec<Rect> = self
             .floor_label(f)
             .map(|(text, x, y)| {
-                Rect {
-                    x0: x - SMALL_CHAR_W * text.chars().count() as f64,
-                    y0: y - 9.0,
-                    x1: x,
-                    y1: y + 1.0,
-                }
-                .spaced()
+                let w = text_width(&text);
+                Rect::text_at(x - w, y, w).spaced()
             })
             .into_iter()
             .collect();
@@ -1735,7 +1741,7 @@ impl Chart {
             {
                 continue;
             }
-            let lw = SMALL_CHAR_W * label.chars().count() as f64;
+            let lw = text_width(label);
             let others: Vec<Stroke> = strokes
                 .iter()
                 .filter(|(owner, _)| *owner != Some(i))

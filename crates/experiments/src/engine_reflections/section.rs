@@ -61,28 +61,22 @@ fn variants_of(pts: &[&Record]) -> Vec<String> {
     distinct(pts.iter().map(|r| key_name(r)))
 }
 
-/// The style of a point's series: its method, keyed by its options ([`keyed_styles`]), as
-/// the generic charts key a variant whose counts are its points.
-fn style_key(r: &Record) -> (String, String, bool) {
-    (r.method.clone(), r.method_options.clone(), r.is_external())
-}
-
-/// [`keyed_styles`] of the points' [`style_key`]s.
-fn styles_of<'a>(fixed: impl Iterator<Item = &'a str>, pts: &[&Record]) -> Vec<Style> {
-    let keys: Vec<(String, String, bool)> = fixed
-        .map(|m| (m.to_string(), String::new(), false))
-        .chain(pts.iter().map(|r| style_key(r)))
+/// [`keyed_styles`] of the `fixed` methods at their defaults, then of each of `pts` keyed by
+/// its options, as the generic charts key a variant whose counts are its points.
+fn styles_of<'a>(fixed: impl Iterator<Item = &'a str>, pts: &[&'a Record]) -> Vec<Style> {
+    let keys: Vec<StyleKey> = fixed
+        .map(|method| StyleKey {
+            method,
+            variant: "",
+            outside: false,
+        })
+        .chain(pts.iter().map(|r| StyleKey {
+            method: &r.method,
+            variant: &r.method_options,
+            outside: r.is_external(),
+        }))
         .collect();
-    keyed_styles(
-        &keys
-            .iter()
-            .map(|(method, variant, outside)| StyleKey {
-                method,
-                variant,
-                outside: *outside,
-            })
-            .collect::<Vec<_>>(),
-    )
+    keyed_styles(&keys)
 }
 
 /// Spearman's rank correlation of `(x, y)` (ties at their mean rank).
@@ -163,8 +157,7 @@ fn depth_blocks(pts: &[&Record]) -> Vec<Block> {
     cost.x_ticks_at_data = true;
     let mut sentences = Vec::new();
     let bars = mirrorbox_report::ms_bars_for(pts.iter().copied());
-    // The depth-swept methods, one series each, and the one-setting points, each its own
-    // series at the depth it shows (not joined: no variable is swept).
+    // The depth-swept methods, one series each along the depth.
     let swept: Vec<(&str, Vec<&Record>)> = DEPTH_SWEPT
         .iter()
         .map(|&m| {
@@ -240,25 +233,20 @@ fn depth_blocks(pts: &[&Record]) -> Vec<Block> {
     // Named as the report's other charts name them, "(defaults)" beside a variant.
     let names: Vec<&str> = variants.iter().map(String::as_str).collect();
     for ((v, of), &style) in variants.iter().zip(&groups).zip(&styles[swept.len()..]) {
-        let depth = |r: &Record| r.reflections.max(1) as f64;
         let legend = mirrorbox_report::document::legend_name(v, &names);
         let labels = mirrorbox_report::document::point_labels(of);
-        for (chart, y) in [
-            (
-                &mut error,
-                &(|r: &Record| r.mirror_flip()) as &dyn Fn(&Record) -> f64,
-            ),
-            (&mut cost, &|r: &Record| r.ms_median),
-        ] {
-            let mut s = Series::new(
-                legend.clone(),
-                style,
-                of.iter().map(|r| (depth(r), y(r))).collect(),
-            );
+        let series = |y: fn(&Record) -> f64| {
+            let points = of
+                .iter()
+                .map(|r| (r.reflections.max(1) as f64, y(r)))
+                .collect();
+            let mut s = Series::new(legend.clone(), style, points);
             s.joined = of.len() > 1 && s.points.windows(2).all(|w| w[1].0 > w[0].0);
             s.labels = labels.clone();
-            chart.series.push(s);
-        }
+            s
+        };
+        error.series.push(series(Record::mirror_flip));
+        cost.series.push(series(|r| r.ms_median));
     }
     out.push(Block::Paragraph(
         "`ray-query` follows every mirror pixel's chain on the GPU; `unrolled` and `portal` \

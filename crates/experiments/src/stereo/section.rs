@@ -11,7 +11,7 @@
 
 use mirrorbox_report::Record;
 use mirrorbox_report::document::{Block, distinct, f, markdown, ms_cell, sci};
-use mirrorbox_report::plot::{Chart, Series, method_style, our_styles};
+use mirrorbox_report::plot::{Chart, Series, method_style, styles_for};
 use mirrorbox_report::readme::{ReadmeError, RegionSource, measured_on};
 use mirrorbox_report::{Sweep, load_sweep};
 
@@ -267,23 +267,8 @@ fn chart(records: &[Record], name: &str, title: &str, y_label: &str, y_log: bool
         .iter()
         .filter_map(|v| pts.iter().copied().find(|r| &variant_of(r) == v))
         .collect();
-    let keys: Vec<String> = firsts
-        .iter()
-        .map(|r| {
-            let name = r.method_without(&[]);
-            name.split_whitespace()
-                .skip(1)
-                .collect::<Vec<_>>()
-                .join(" ")
-        })
-        .collect();
-    let styles = our_styles(
-        &firsts
-            .iter()
-            .zip(&keys)
-            .map(|(r, key)| (r.method.as_str(), key.as_str()))
-            .collect::<Vec<_>>(),
-    );
+    let names: Vec<String> = firsts.iter().map(|r| r.method_without(&[])).collect();
+    let styles = styles_for(&names.iter().map(String::as_str).collect::<Vec<_>>());
     let mut series: Vec<Series> = variants
         .iter()
         .zip(styles)
