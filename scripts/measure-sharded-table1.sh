@@ -19,7 +19,7 @@ for r in $(seq 1 "$rounds"); do
   t0=$(date +%s.%N)
   "$bin" experiment table1 --out "$work/unsharded" >/dev/null 2>&1
   t1=$(date +%s.%N)
-  MIRRORBOX=$bin SWEEP_COMMAND=table1 deploy/slurm/submit.sh 4 2 "$work/runs" >/dev/null
+  MIRRORBOX=$bin SWEEP_COMMAND=experiment deploy/slurm/submit.sh 4 2 "$work/runs" table1 >/dev/null
   while [ -n "$(squeue -h -o %i)" ]; do sleep 1; done
   t2=$(date +%s.%N)
   times="$times $t0,$t1,$t2"

@@ -706,6 +706,10 @@ fn trace_depth_counts_reflections_and_path_length_counts_segments() {
             "whitted follows at most --max-depth",
         ),
         (&["--rr-from", "2"][..], "--integrator path"),
+        (
+            &["--integrator", "path", "--mirrored-lights", "3"][..],
+            "--mirrored-lights is the `whitted` integrator's",
+        ),
     ] {
         let out = mirrorbox(&trace_args(exr_s, extra), &[]);
         assert_eq!(out.code, 2, "{extra:?}: {}", out.stderr);
@@ -1965,6 +1969,8 @@ fn alpha_and_reflectance_are_one_flag_everywhere() {
             vec!["trace", s, "-o", o, flag, "-1"],
             vec!["render", s, "-o", png, flag, "-1"],
             vec!["export-mitsuba", s, "-o", xml, flag, "-1"],
+            vec!["advise", s, "--budget-ms", "5", flag, "-1"],
+            vec!["export-views", s, "-o", o, flag, "-1"],
         ] {
             let r = mirrorbox(&args, &[]);
             assert_eq!(r.code, 2, "{args:?}: {}", r.stderr);
@@ -2447,7 +2453,7 @@ fn shards_merge_into_the_unsharded_sweep() {
     for (picture, message) in [
         (
             "../x.txt",
-            "in its images/ folder (a relative path without ..)",
+            "is not a path inside the sweep folder (relative, without `..`)",
         ),
         ("images/missing.png", "which is not a file there"),
         // A record that is no point of the sweep: it had been dropped unsaid.
@@ -2588,7 +2594,8 @@ fn a_sequence_with_a_refused_frame_writes_no_frame() {
         let out = mirrorbox(&args, &[]);
         assert_eq!(out.code, 2, "{}", out.stderr);
         assert!(
-            out.stderr.contains("frame 0001: --time must be"),
+            out.stderr
+                .contains("frame 0001, at --time 999999999.5 + 1 / --fps 1: --time must be"),
             "{}",
             out.stderr
         );
@@ -2944,4 +2951,51 @@ fn an_experiment_refuses_options_it_would_ignore() {
         "experiment lighting-trace-cost does not apply --out, --frames",
     );
     assert!(!out.exists(), "nothing is written");
+}
+
+/// `export-mitsuba` refusing a scene part-way (a glTF texture whose sampler wraps one way
+/// along u and another along v, which Mitsuba's bitmap cannot) exits 2 naming the scene file,
+/// the object and the sampler's fields, and leaves nothing: no XML, no sidecar, no meshes
+/// (the meshes before the textured one had been written, and stayed).
+#[test]
+fn export_mitsuba_refused_part_way_leaves_no_file() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("wrap.gltf"),
+        r#"{"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}], "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1}, "material": 0}]}], "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "metallicFactor": 0}}], "textures": [{"source": 0, "sampler": 0}], "samplers": [{"wrapS": 10497, "wrapT": 33071}], "images": [{"uri": "data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAIAAAACCAIAAAD91JpzAAAAEElEQVR4nGNocFAAIgYIBQAaDgOBnA45xwAAAABJRU5ErkJggg=="}], "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}, {"bufferView": 0, "byteOffset": 36, "componentType": 5126, "count": 3, "type": "VEC2"}], "bufferViews": [{"buffer": 0, "byteLength": 60}], "buffers": [{"uri": "data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAAAAAAAAAAAAAIA/AAAAAAAAAAAAAIA/", "byteLength": 60}]}"#,
+    )
+    .unwrap();
+    let scene = dir.path().join("wrap.json");
+    std::fs::write(
+        &scene,
+        r#"{"camera": {"position": [0, 0, 3], "look_at": [0, 0, 0], "fov_y_deg": 55, "width": 8, "height": 8},
+            "objects": [{"type": "box", "name": "first box"}, {"type": "gltf", "name": "g", "path": "wrap.gltf"}]}"#,
+    )
+    .unwrap();
+    let out_dir = dir.path().join("out");
+    std::fs::create_dir(&out_dir).unwrap();
+    let xml = out_dir.join("scene.xml");
+    let run = mirrorbox(
+        &[
+            "export-mitsuba",
+            scene.to_str().unwrap(),
+            "-o",
+            xml.to_str().unwrap(),
+        ],
+        &[],
+    );
+    assert_eq!(run.code, 2, "{}", run.stderr);
+    for needle in [
+        "wrap.json",
+        "g: glTF mesh 0",
+        "wrapS and wrapT",
+        "repeat along u and clamp along v",
+    ] {
+        assert!(run.stderr.contains(needle), "{needle}: {}", run.stderr);
+    }
+    let left: Vec<_> = std::fs::read_dir(&out_dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    assert!(left.is_empty(), "left behind: {left:?}");
 }

@@ -257,11 +257,16 @@ fn a_bad_run_is_refused_naming_the_file_and_nothing_is_written() {
         "no timing.json: a variant folder RUN/<client>/<variant>/",
     );
     std::fs::write(&timing_file, timing_text).unwrap();
-    // An unreadable timing file, one without the view, a negative time and a 0.
+    // An unreadable timing file, one without the view, a negative time, a huge one and a 0.
     for (text, needle) in [
         ("{not json".to_string(), "timing.json"),
         (timing(r#""other":[1]"#), "no frames for view \"camera\""),
         (timing(r#""camera":[1,-2]"#), "-2 ms is not a frame's time"),
+        // 1e300 ms had been accepted, and the figures' log axis then hung on it.
+        (
+            timing(r#""camera":[1e300]"#),
+            "ms is not a frame's time (finite, > 0, at most",
+        ),
         (
             timing(r#""camera":[1,0]"#),
             "0 ms is not a frame's time (finite, > 0",
@@ -481,11 +486,12 @@ fn a_with_sweep_naming_pictures_outside_its_images_is_refused() {
         run_score(&ex, &run, &scored, &["--with", sweep.to_str().unwrap()])
     };
     for (picture, message) in [
+        // Refused as the sweep's records are read, by every command that reads them.
         (
             "../secret",
-            "in its images/ folder (a relative path without ..)",
+            "is not a path inside the sweep folder (relative, without `..`)",
         ),
-        ("/etc/passwd", "in its images/ folder"),
+        ("/etc/passwd", "is not a path inside the sweep folder"),
         ("images/missing.png", "which is not a file there"),
         ("images/link.png", "not a link"),
     ] {
@@ -662,7 +668,14 @@ fn a_bad_view_list_is_refused_naming_the_field() {
         ),
         (
             r#"{"views": [{"name": "a", "position": [0,1,2], "look_at": [0,1,2]}]}"#,
-            "views.json: views[0] (\"a\"): position and look_at must be finite and apart",
+            "views.json: views[0] (\"a\"): position and look_at must be apart",
+        ),
+        // Looking straight down without an up: only the scene's camera (up +y) shows the
+        // problem, and the file and the view are named all the same.
+        (
+            r#"{"views": [{"name": "top", "position": [0,5,0], "look_at": [0,0,0]}]}"#,
+            "views.json: views[0]: view \"top\": up must be finite and not along the view \
+             direction (up is the scene camera's: the view gives none)",
         ),
     ] {
         std::fs::write(&list, text).unwrap();

@@ -345,3 +345,209 @@ fn a_bad_file_leaves_every_file_unwritten() {
     );
     assert_eq!(std::fs::read_to_string(&a).unwrap(), stale);
 }
+
+/// The Markdown files a user reads: every `*.md` of the repository but the generated reports,
+/// build outputs and installed packages.
+fn markdown_files() -> Vec<PathBuf> {
+    fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
+        let skip = ["target", "reports", "node_modules", ".venv", ".git"];
+        for entry in std::fs::read_dir(dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display())) {
+            let path = entry.unwrap().path();
+            let name = path.file_name().unwrap().to_str().unwrap_or("");
+            if path.is_dir() {
+                // mdBook's output (docs/book/book) is built, not written.
+                if !skip.contains(&name) && !path.ends_with("docs/book/book") {
+                    walk(&path, out);
+                }
+            } else if name.ends_with(".md") {
+                out.push(path);
+            }
+        }
+    }
+    let mut files = Vec::new();
+    walk(&repo(), &mut files);
+    files.sort();
+    files
+}
+
+/// The commands a Markdown text shows, with their line numbers: each line of a fenced block
+/// (a line ending in `\` joined to the next), and each code span of a paragraph (a span may
+/// break across lines). Generated regions are records of past runs, quoted as they ran, and
+/// left out.
+fn shown_commands(text: &str) -> Vec<(usize, String)> {
+    let mut out = Vec::new();
+    let (mut generated, mut fenced) = (false, false);
+    let mut paragraph: Vec<&str> = Vec::new();
+    let mut first_line = 0;
+    let mut continued = String::new();
+    let spans = |paragraph: &mut Vec<&str>, first_line: usize, out: &mut Vec<_>| {
+        let text = paragraph.join("\n");
+        let mut rest = text.as_str();
+        while let Some(open) = rest.find('`') {
+            let Some(close) = rest[open + 1..].find('`') else {
+                break;
+            };
+            let line = first_line + text[..text.len() - rest.len() + open].matches('\n').count();
+            out.push((line, rest[open + 1..open + 1 + close].to_string()));
+            rest = &rest[open + close + 2..];
+        }
+        paragraph.clear();
+    };
+    for (i, line) in text.lines().enumerate() {
+        let number = i + 1;
+        if line.contains("<!-- generated:") {
+            spans(&mut paragraph, first_line, &mut out);
+            generated = true;
+        } else if line.contains("<!-- end generated") {
+            generated = false;
+        } else if generated {
+        } else if line.trim_start().starts_with("```") {
+            spans(&mut paragraph, first_line, &mut out);
+            fenced = !fenced;
+        } else if fenced {
+            match line.trim_end().strip_suffix('\\') {
+                Some(head) => continued.push_str(head),
+                None => out.push((number, std::mem::take(&mut continued) + line)),
+            }
+        } else if line.trim().is_empty() {
+            spans(&mut paragraph, first_line, &mut out);
+        } else {
+            if paragraph.is_empty() {
+                first_line = number;
+            }
+            paragraph.push(line);
+        }
+    }
+    spans(&mut paragraph, first_line, &mut out);
+    out
+}
+
+/// What is wrong with the `mirrorbox` calls in one command: a subcommand the program lacks,
+/// a long option its subcommand's `--help` does not list, an experiment not in the registry.
+fn wrong_calls(
+    command: &str,
+    options: &std::collections::BTreeMap<String, String>,
+    experiments: &[&str],
+) -> Vec<String> {
+    let words: Vec<&str> = command.split_whitespace().collect();
+    let mut wrong = Vec::new();
+    for (i, word) in words.iter().enumerate() {
+        if *word != "mirrorbox" && !word.ends_with("/mirrorbox") {
+            continue;
+        }
+        let Some(sub) = words.get(i + 1) else {
+            continue;
+        };
+        let is_name = |w: &str| {
+            w.starts_with(|c: char| c.is_ascii_lowercase())
+                && w.chars()
+                    .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-')
+        };
+        if !is_name(sub) {
+            continue;
+        }
+        let Some(help) = options.get(*sub) else {
+            wrong.push(format!("`{sub}` is not a subcommand"));
+            continue;
+        };
+        // The call's words, up to the end of the shell command.
+        let args: Vec<&str> = words[i + 2..]
+            .iter()
+            .take_while(|w| !["|", "&&", "||", ";", "#"].contains(w) && !w.starts_with('>'))
+            .copied()
+            .collect();
+        for arg in &args {
+            if let Some(flag) = arg.strip_prefix("--") {
+                let flag: String = flag
+                    .chars()
+                    .take_while(|c| c.is_ascii_alphanumeric() || *c == '-')
+                    .collect();
+                let listed = help.match_indices(&format!("--{flag}")).any(|(at, _)| {
+                    !help[at + 2 + flag.len()..]
+                        .starts_with(|c: char| c.is_ascii_alphanumeric() || c == '-')
+                });
+                if !listed {
+                    wrong.push(format!("`{sub}` has no --{flag}"));
+                }
+            }
+        }
+        if *sub == "experiment"
+            && let Some(name) = args.first().filter(|a| is_name(a))
+            && !experiments.contains(name)
+        {
+            wrong.push(format!("no experiment `{name}`"));
+        }
+    }
+    wrong
+}
+
+/// Every `mirrorbox` command the docs show is one the program takes: its subcommand, its long
+/// options and an experiment's name. The preset subcommands (`mirrorbox table1`) had been
+/// removed while a chapter and the Slurm docs still showed them.
+#[test]
+fn every_command_the_docs_show_is_one_the_program_takes() {
+    let top = mirrorbox(&["--help"], &[]).stdout;
+    let listed = top
+        .split("Commands:")
+        .nth(1)
+        .and_then(|s| s.split("Options:").next())
+        .expect("--help lists the commands");
+    let options: std::collections::BTreeMap<String, String> = listed
+        .lines()
+        .filter_map(|l| l.strip_prefix("  ")?.split_whitespace().next())
+        .map(|sub| (sub.to_string(), mirrorbox(&[sub, "--help"], &[]).stdout))
+        .collect();
+    assert!(options.len() > 10 && options["trace"].contains("--spp"));
+    let experiments: Vec<&str> = mirrorbox_experiments::EXPERIMENTS
+        .iter()
+        .map(|e| e.name)
+        .collect();
+    let mut wrong = Vec::new();
+    let files = markdown_files();
+    for file in &files {
+        let name = file.strip_prefix(repo()).unwrap().display().to_string();
+        for (line, command) in shown_commands(&read(file)) {
+            for w in wrong_calls(&command, &options, &experiments) {
+                wrong.push(format!("{name}:{line}: {w}: {command}"));
+            }
+        }
+    }
+    assert!(files.len() > 30, "{} Markdown files", files.len());
+    assert!(
+        wrong.is_empty(),
+        "commands the program does not take:\n  {}",
+        wrong.join("\n  ")
+    );
+}
+
+#[test]
+fn commands_are_found_in_spans_blocks_and_across_lines() {
+    let text = "Run `mirrorbox\ntrace x` and `a`.\n\n```sh\nmirrorbox sweep s \\\n  --frames 3\n```\n\
+                <!-- generated: r -->\n`mirrorbox table1`\n<!-- end generated: r -->\n";
+    assert_eq!(
+        shown_commands(text),
+        vec![
+            (1, "mirrorbox\ntrace x".to_string()),
+            (2, "a".to_string()),
+            (6, "mirrorbox sweep s   --frames 3".to_string()),
+        ]
+    );
+    let options = [("sweep", "--frames <N>\n--shard"), ("experiment", "--out")]
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .into();
+    let calls = |c| wrong_calls(c, &options, &["table1"]);
+    assert!(calls("target/release/mirrorbox sweep a --frames 3 | tee --fr").is_empty());
+    assert_eq!(
+        calls("mirrorbox table1 --out x"),
+        ["`table1` is not a subcommand"]
+    );
+    assert_eq!(calls("mirrorbox sweep --fram 2"), ["`sweep` has no --fram"]);
+    assert_eq!(
+        calls("mirrorbox sweep --frames-x"),
+        ["`sweep` has no --frames-x"]
+    );
+    assert_eq!(
+        calls("mirrorbox experiment cluster"),
+        ["no experiment `cluster`"]
+    );
+}

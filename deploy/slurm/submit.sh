@@ -3,6 +3,7 @@
 # at once, then the merge as a job that starts when every task succeeded.
 #   deploy/slurm/submit.sh SHARDS CONCURRENT SWEEP_DIR [sweep arguments...]
 # e.g. deploy/slurm/submit.sh 4 2 /shared/runs/box scenes/mirror_box.json --methods auxiliary
+# or, an experiment of the registry: SWEEP_COMMAND=experiment deploy/slurm/submit.sh 4 2 DIR table1
 # Prints the array's and the merge's job ids. MIRRORBOX and SWEEP_COMMAND pass through.
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)

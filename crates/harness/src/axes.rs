@@ -213,6 +213,13 @@ impl AxisSpec {
     /// the axis has one; each checked.
     pub fn parse(&self, text: &str) -> Result<Vec<Option<f64>>, SettingError> {
         let bad = |got: &str| SettingError::new(self.flag, self.allowed(), format!("{got:?}"));
+        let too_many = || {
+            SettingError::new(
+                self.flag,
+                format!("at most {MAX_AXIS_VALUES} values in all"),
+                "more",
+            )
+        };
         let mut out = Vec::new();
         for part in text.split(',').map(str::trim) {
             if Some(part) == self.none_word {
@@ -223,18 +230,31 @@ impl AxisSpec {
                     a.trim().parse().map_err(|_| bad(part))?,
                     b.trim().parse().map_err(|_| bad(part))?,
                 );
-                if b < a || b - a > 10_000 {
+                if b < a || b - a > MAX_AXIS_VALUES as u64 {
                     return Err(bad(part));
+                }
+                // Each end checked before the range is spelled out.
+                self.check(&[Some(a as f64), Some(b as f64)])?;
+                if out.len() as u64 + (b - a + 1) > MAX_AXIS_VALUES as u64 {
+                    return Err(too_many());
                 }
                 out.extend((a..=b).map(|v| Some(v as f64)));
             } else {
                 out.push(Some(part.parse::<f64>().map_err(|_| bad(part))?));
+            }
+            if out.len() > MAX_AXIS_VALUES {
+                return Err(too_many());
             }
         }
         self.check(&out)?;
         Ok(out)
     }
 }
+
+/// Most values one axis flag may list, ranges spelled out: bounded before a long list of
+/// ranges is expanded (5 000 ranges of 10 000 had taken 790 MB before the first value was
+/// refused).
+pub const MAX_AXIS_VALUES: usize = 10_000;
 
 /// One axis of a sweep and the values it takes (`None`: the axis not applied, e.g. `mono`).
 #[derive(Clone)]
@@ -303,6 +323,19 @@ mod tests {
         assert!(MIRRORED_LIGHTS.parse("mono").is_err());
         let e = MIRRORED_LIGHTS.parse("x").unwrap_err().to_string();
         assert!(e.contains("--mirrored-lights"), "{e}");
+        // A long list of ranges is bounded before it is spelled out: an end out of range is
+        // refused by itself, and the values in all at MAX_AXIS_VALUES.
+        let e = SYMMETRY_PLANES.parse("0..10000").unwrap_err().to_string();
+        assert!(e.contains("got 10000"), "{e}");
+        let k = MIRRORED_LIGHTS.max as u64;
+        let many = vec![format!("0..{k}"); MAX_AXIS_VALUES / (k as usize + 1) + 1].join(",");
+        let e = MIRRORED_LIGHTS.parse(&many).unwrap_err().to_string();
+        assert!(
+            e.contains(&format!("at most {MAX_AXIS_VALUES} values")),
+            "{e}"
+        );
+        let fit = vec![format!("0..{k}"); MAX_AXIS_VALUES / (k as usize + 1)].join(",");
+        assert!(MIRRORED_LIGHTS.parse(&fit).is_ok());
     }
 
     #[test]

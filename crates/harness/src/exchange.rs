@@ -172,12 +172,25 @@ pub fn read_view_list(path: &Path) -> Result<Vec<ViewSpec>, HarnessError> {
     // What can be checked without the scene (its up and field of view fill the gaps, and
     // [`view_scene`] checks the result).
     for (i, v) in list.views.iter().enumerate() {
-        let forward = Vec3::from_array(v.look_at) - Vec3::from_array(v.position);
-        if let Some(problem) = camera_problem(forward, v.up.map(Vec3::from_array), v.fov_y_deg) {
+        let (position, look_at) = (Vec3::from_array(v.position), Vec3::from_array(v.look_at));
+        if let Some(problem) =
+            camera_problem(position, look_at, v.up.map(Vec3::from_array), v.fov_y_deg)
+        {
             return Err(bad(format!("views[{i}] ({:?}): {problem}", v.name)));
         }
     }
     Ok(list.views)
+}
+
+/// Every view of a `--views FILE` (read by [`read_view_list`]) applied to `scene` and checked
+/// ([`view_scene`]) before any work: a problem only the scene shows (a view without `up`
+/// looking along the scene camera's) is refused naming the file and the view.
+pub fn check_views(path: &Path, views: &[ViewSpec], scene: &Scene) -> Result<(), HarnessError> {
+    for (i, v) in views.iter().enumerate() {
+        view_scene(scene, v)
+            .map_err(|e| HarnessError::Exchange(format!("{}: views[{i}]: {e}", path.display())))?;
+    }
+    Ok(())
 }
 
 /// What is wrong with a list of view names, as `views[i].name …`, if anything: each is a
@@ -541,9 +554,14 @@ pub fn view_scene(base: &Scene, spec: &ViewSpec) -> Result<Scene, HarnessError> 
     if let Some(fov) = spec.fov_y_deg {
         c.fov_y_deg = fov;
     }
-    if let Some(problem) = camera_problem(c.look_at - c.position, Some(c.up), Some(c.fov_y_deg)) {
+    if let Some(problem) = camera_problem(c.position, c.look_at, Some(c.up), Some(c.fov_y_deg)) {
+        let up = if spec.up.is_none() && problem.starts_with("up") {
+            " (up is the scene camera's: the view gives none)"
+        } else {
+            ""
+        };
         return Err(HarnessError::Exchange(format!(
-            "view {:?}: {problem}",
+            "view {:?}: {problem}{up}",
             spec.name
         )));
     }
@@ -551,18 +569,32 @@ pub fn view_scene(base: &Scene, spec: &ViewSpec) -> Result<Scene, HarnessError> 
     Ok(scene)
 }
 
-/// What is wrong with a camera, if anything: its view direction `forward` (look-at minus
-/// position) finite and not zero, its `up` (where known) finite and not along it, its
-/// vertical field of view (where known) in (0, 170] degrees.
-fn camera_problem(forward: Vec3, up: Option<Vec3>, fov_y_deg: Option<f32>) -> Option<&'static str> {
-    if !forward.is_finite() || forward.length() < 1e-6 {
-        return Some("position and look_at must be finite and apart");
+/// What is wrong with a camera, if anything: its position and look-at inside the scene
+/// extent (as a scene file's camera: [`mirrorbox_scene::limits::within_extent`]) and apart,
+/// its `up` (where known) finite and not along the view direction, its vertical field of
+/// view (where known) in (0, 170] degrees.
+fn camera_problem(
+    position: Vec3,
+    look_at: Vec3,
+    up: Option<Vec3>,
+    fov_y_deg: Option<f32>,
+) -> Option<String> {
+    use mirrorbox_scene::limits::{MAX_COORDINATE, within_extent};
+    if !within_extent(position) || !within_extent(look_at) {
+        return Some(format!(
+            "position and look_at must lie within the scene extent, every coordinate within \
+             ±{MAX_COORDINATE:e}"
+        ));
+    }
+    let forward = look_at - position;
+    if forward.length() < 1e-6 {
+        return Some("position and look_at must be apart".into());
     }
     if up.is_some_and(|up| !up.is_finite() || forward.normalize().cross(up).length() < 1e-6) {
-        return Some("up must be finite and not along the view direction");
+        return Some("up must be finite and not along the view direction".into());
     }
     if fov_y_deg.is_some_and(|f| !mirrorbox_scene::limits::fov_ok(f)) {
-        return Some("fov_y_deg must be in (0, 170] degrees");
+        return Some("fov_y_deg must be in (0, 170] degrees".into());
     }
     None
 }
@@ -800,6 +832,13 @@ mod tests {
                            "up": [0, 0, 3]}]}"#,
         )
         .unwrap();
+        // A scene file's camera is refused beyond the scene extent: a view's is too.
+        let far = dir.path().join("far.json");
+        std::fs::write(
+            &far,
+            r#"{"views": [{"name": "a", "position": [1e9, 1, 2], "look_at": [0, 1, 0]}]}"#,
+        )
+        .unwrap();
         let fov = dir.path().join("fov.json");
         std::fs::write(
             &fov,
@@ -812,10 +851,15 @@ mod tests {
             (&bad, "views: 0 views"),
             (
                 &apart,
-                "views[1] (\"b\"): position and look_at must be finite and apart",
+                "views[1] (\"b\"): position and look_at must be apart",
             ),
             (&up, "views[0] (\"a\"): up must be finite and not along"),
             (&fov, "views[0] (\"a\"): fov_y_deg must be in (0, 170]"),
+            (
+                &far,
+                "views[0] (\"a\"): position and look_at must lie within the scene extent, \
+                 every coordinate within ±1e6",
+            ),
         ] {
             let message = read_view_list(path).unwrap_err().to_string();
             let name = path.display().to_string();

@@ -15,6 +15,9 @@ use std::path::{Path, PathBuf};
 
 /// Most frames one view's timing may list.
 pub const MAX_FRAMES: usize = 10_000;
+/// Most milliseconds one frame may take: a day. Any larger is a unit slip, not a frame, and an
+/// unbounded one overflowed the figures' axes.
+pub const MAX_FRAME_MS: f64 = 86_400_000.0;
 /// Most clients × variants one run may hold.
 pub const MAX_VARIANTS: usize = 256;
 
@@ -237,13 +240,16 @@ fn read_timing(path: &Path, views: &ViewsFile) -> Result<Timing, HarnessError> {
         }
         // A 0 is no frame's time but a timer too coarse for one frame; it would make a
         // median of 0 and speed ratios of infinity.
-        if let Some(bad) = frames.iter().find(|ms| !ms.is_finite() || **ms <= 0.0) {
+        if let Some(bad) = frames
+            .iter()
+            .find(|ms| !ms.is_finite() || **ms <= 0.0 || **ms > MAX_FRAME_MS)
+        {
             return Err(refused(
                 path,
                 format!(
-                    "views.{}: {bad} ms is not a frame's time (finite, > 0; a timer too coarse \
-                     for one frame reads 0: time several frames together and give each their \
-                     mean)",
+                    "views.{}: {bad} ms is not a frame's time (finite, > 0, at most \
+                     {MAX_FRAME_MS} ms, a day; a timer too coarse for one frame reads 0: time \
+                     several frames together and give each their mean)",
                     v.name
                 ),
             ));

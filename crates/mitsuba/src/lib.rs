@@ -33,7 +33,7 @@
 //! `tools/mitsuba/render.py` reads (Mitsuba's own `path` cannot use it: see the docs).
 
 use glam::Vec3;
-use mirrorbox_files::{FileError, write_atomically};
+use mirrorbox_files::{FileError, StagedFiles};
 use mirrorbox_scene::{Scene, Surface};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -97,7 +97,9 @@ fn rgb(v: Vec3) -> String {
 }
 
 /// Writes `xml_path` and its meshes (under `meshes/` beside it) and `mirrorbox.json`;
-/// returns every file written. Each file is written to a temporary name and renamed.
+/// returns every file written. Every file is staged under a temporary name and renamed into
+/// place once all are written: a scene refused part-way (a texture Mitsuba cannot wrap)
+/// leaves no file, and no `meshes/` folder that the export made.
 pub fn export(
     scene: &Scene,
     xml_path: &Path,
@@ -105,12 +107,30 @@ pub fn export(
 ) -> Result<Vec<PathBuf>, FileError> {
     let dir = mirrorbox_files::folder_of(xml_path);
     let mesh_dir = dir.join("meshes");
+    let made_mesh_dir = !mesh_dir.is_dir();
     std::fs::create_dir_all(&mesh_dir).map_err(|e| FileError {
         path: mesh_dir.clone(),
         message: format!("cannot create the folder: {e}"),
         refused: false,
     })?;
-    let mut written = Vec::new();
+    let mut staged = StagedFiles::new();
+    let result = export_staged(scene, xml_path, &mesh_dir, settings, &mut staged)
+        .and_then(|()| staged.commit());
+    if result.is_err() && made_mesh_dir {
+        // Empty by now (the staged files are dropped with their temporary names).
+        let _ = std::fs::remove_dir(&mesh_dir);
+    }
+    result
+}
+
+fn export_staged(
+    scene: &Scene,
+    xml_path: &Path,
+    mesh_dir: &Path,
+    settings: ExportSettings,
+    staged: &mut StagedFiles,
+) -> Result<(), FileError> {
+    let dir = mirrorbox_files::folder_of(xml_path);
     let cam = &scene.camera;
     let mut xml = String::new();
     let _ = writeln!(xml, "<?xml version=\"1.0\" encoding=\"utf-8\"?>");
@@ -208,25 +228,23 @@ pub fn export(
                 let _ = writeln!(obj, "f {a} {b} {c}");
             }
         }
-        let path = mesh_dir.join(&file);
-        write_atomically(&path, obj.as_bytes())?;
-        written.push(path);
-        let colour = |name: &str, what: &str, factor: Vec3, map, written: &mut Vec<PathBuf>| {
+        stage_bytes(staged, &mesh_dir.join(&file), obj.as_bytes())?;
+        let colour = |name: &str, what: &str, factor: Vec3, map, staged: &mut StagedFiles| {
             colour_xml(
                 g,
-                &mesh_dir,
+                mesh_dir,
                 (i, &part.name),
                 (name, what),
                 factor,
                 map,
-                written,
+                staged,
             )
         };
         let bsdf = match &g.surfaces[part.surface as usize] {
             Surface::Diffuse { albedo, maps, .. } => format!(
                 "    <bsdf type=\"twosided\">\n      <bsdf type=\"diffuse\">\n        \
                  {}\n      </bsdf>\n    </bsdf>",
-                colour("reflectance", "albedo", *albedo, maps.albedo, &mut written)?
+                colour("reflectance", "albedo", *albedo, maps.albedo, staged)?
             ),
             Surface::Mirror {
                 reflectance,
@@ -245,12 +263,7 @@ pub fn export(
                         let name = format!("{i:03}_{}_normals.exr", slug(&part.name));
                         let path = mesh_dir.join(&name);
                         let (image, tiling) = normal_texture(m, b);
-                        mirrorbox_image::write_exr(&path, &image, &[]).map_err(|e| FileError {
-                            path: path.clone(),
-                            message: e.to_string(),
-                            refused: false,
-                        })?;
-                        written.push(path);
+                        stage_exr(staged, &path, &image)?;
                         format!(
                             "<bsdf type=\"normalmap\">\n        \
                              <texture name=\"normalmap\" type=\"bitmap\">\n          \
@@ -274,13 +287,7 @@ pub fn export(
         let emitter = match &g.surfaces[part.surface as usize] {
             Surface::Diffuse { emission, maps, .. } if *emission != Vec3::ZERO => format!(
                 "\n    <emitter type=\"area\">\n      {}\n    </emitter>",
-                colour(
-                    "radiance",
-                    "emission",
-                    *emission,
-                    maps.emission,
-                    &mut written
-                )?
+                colour("radiance", "emission", *emission, maps.emission, staged)?
             ),
             _ => String::new(),
         };
@@ -304,12 +311,30 @@ pub fn export(
         "spp": settings.spp,
         "not_exported": not_exported(scene),
     });
-    let sidecar_path = dir.join("mirrorbox.json");
-    write_atomically(&sidecar_path, format!("{sidecar:#}\n").as_bytes())?;
-    write_atomically(xml_path, xml.as_bytes())?;
-    written.push(sidecar_path);
-    written.push(xml_path.to_path_buf());
-    Ok(written)
+    stage_bytes(
+        staged,
+        &dir.join("mirrorbox.json"),
+        format!("{sidecar:#}\n").as_bytes(),
+    )?;
+    stage_bytes(staged, xml_path, xml.as_bytes())
+}
+
+fn stage_bytes(staged: &mut StagedFiles, path: &Path, bytes: &[u8]) -> Result<(), FileError> {
+    staged.stage_with(path, |tmp| {
+        std::fs::write(tmp, bytes).map_err(|e| e.to_string())
+    })
+}
+
+fn stage_exr(
+    staged: &mut StagedFiles,
+    path: &Path,
+    image: &mirrorbox_image::RgbImage,
+) -> Result<(), FileError> {
+    mirrorbox_image::stage_exr(staged, path, image, &[]).map_err(|e| FileError {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+        refused: false,
+    })
 }
 
 /// What the scene has that the export leaves out (Mitsuba's scene, and `render.py`'s
@@ -346,16 +371,19 @@ fn colour_xml(
     (name, what): (&str, &str),
     factor: Vec3,
     map: Option<mirrorbox_scene::texture::TextureMap>,
-    written: &mut Vec<PathBuf>,
+    staged: &mut StagedFiles,
 ) -> Result<String, FileError> {
     let Some(m) = map else {
         return Ok(format!("<rgb name=\"{name}\" value=\"{}\"/>", rgb(factor)));
     };
-    let file = format!("{:03}_{}_{what}.exr", part.0, slug(part.1));
-    let path = mesh_dir.join(&file);
-    bitmap_exr(&g.textures[m.texture as usize], factor, &path)?;
-    written.push(path);
     let wrap = mitsuba_wrap(&m, part.1)?;
+    let file = format!("{:03}_{}_{what}.exr", part.0, slug(part.1));
+    bitmap_exr(
+        &g.textures[m.texture as usize],
+        factor,
+        &mesh_dir.join(&file),
+        staged,
+    )?;
     // Mitsuba's OBJ loader turns `vt` (u, 1 − v) back into (u, v) and its bitmap reads row 0
     // at v = 0, so the contract's transform applies as it is. `to_uv` is a 2D transform
     // extracted from a 4×4 matrix: its translation is read from the 4th column (a 3×3 matrix
@@ -377,6 +405,7 @@ fn bitmap_exr(
     texture: &mirrorbox_scene::texture::Texture,
     factor: Vec3,
     path: &Path,
+    staged: &mut StagedFiles,
 ) -> Result<(), FileError> {
     use mirrorbox_scene::texture::srgb_to_linear;
     let image = mirrorbox_image::RgbImage::from_fn(texture.width, texture.height, |x, y| {
@@ -387,11 +416,7 @@ fn bitmap_exr(
             factor.z * srgb_to_linear(t[2]),
         ]
     });
-    mirrorbox_image::write_exr(path, &image, &[]).map_err(|e| FileError {
-        path: path.to_path_buf(),
-        message: e.to_string(),
-        refused: false,
-    })
+    stage_exr(staged, path, &image)
 }
 
 /// Mitsuba's bitmap has one wrap mode for both axes: a map whose axes differ is refused.
@@ -409,7 +434,8 @@ fn mitsuba_wrap(
         return Err(FileError {
             path: PathBuf::from(part),
             message: format!(
-                "a texture wraps {} along u and {} along v: Mitsuba's bitmap has one wrap mode for both",
+                "a texture wraps {} along u and {} along v (its sampler's wrapS and wrapT): \
+                 Mitsuba's bitmap has one wrap mode for both",
                 name(m.wrap[0]),
                 name(m.wrap[1])
             ),

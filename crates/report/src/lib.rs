@@ -357,6 +357,28 @@ pub mod axis {
 }
 
 impl Record {
+    /// The first image field that is not a path inside the sweep folder (relative, every part
+    /// a plain name: no root, no `..`), with its name: a report reads, embeds and writes
+    /// beside these, so one naming `/etc/passwd` or `../..` must be refused, not followed.
+    /// An empty path (no image) is inside.
+    pub fn image_outside_folder(&self) -> Option<(&'static str, &str)> {
+        let inside = |p: &str| {
+            std::path::Path::new(p)
+                .components()
+                .all(|c| matches!(c, std::path::Component::Normal(_)))
+        };
+        let mut fields = vec![
+            ("truth_image", self.truth_image.as_str()),
+            ("raster_image", self.raster_image.as_str()),
+            ("heatmap_image", self.heatmap_image.as_str()),
+        ];
+        if let Some(s) = &self.stereo {
+            fields.push(("stereo.anaglyph_image", &s.anaglyph_image));
+            fields.push(("stereo.truth_anaglyph_image", &s.truth_anaglyph_image));
+        }
+        fields.into_iter().find(|(_, p)| !inside(p))
+    }
+
     /// The value of scene axis `name` ([`axis`]) at this point.
     pub fn axis(&self, name: &str) -> Option<f64> {
         self.axes.get(name).copied()

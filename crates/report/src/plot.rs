@@ -529,8 +529,9 @@ impl Axis {
         if log {
             let (a, b) = (lo.log10(), hi.log10());
             let pad = ((b - a) * 0.04).max(0.06);
-            lo = 10f64.powf(a - pad);
-            hi = 10f64.powf(b + pad);
+            // Kept finite: a record's 1e300 padded to infinity had asked for 2^31 ticks.
+            lo = 10f64.powf(a - pad).max(f64::MIN_POSITIVE);
+            hi = 10f64.powf(b + pad).min(f64::MAX);
         } else {
             let span = hi - lo;
             let pad = if span > 0.0 {
@@ -546,6 +547,7 @@ impl Axis {
                 lo - pad
             };
             hi += pad;
+            (lo, hi) = (lo.max(-f64::MAX), hi.min(f64::MAX));
         }
         Axis { lo, hi, log }
     }
@@ -635,6 +637,9 @@ impl Axis {
 /// About five round ticks (1, 2 or 5 × a power of ten apart) from `lo` to `hi`.
 fn linear_ticks(lo: f64, hi: f64) -> Vec<f64> {
     let raw = (hi - lo) / 5.0;
+    if !(raw.is_finite() && raw > 0.0) {
+        return Vec::new();
+    }
     let mag = 10f64.powf(raw.log10().floor());
     // The round step nearest a fifth of the span, not the first above it: an axis padded
     // below 0 (0 to 1.06 wide) had got steps of 0.5, two ticks.
@@ -643,14 +648,18 @@ fn linear_ticks(lo: f64, hi: f64) -> Vec<f64> {
         .map(|m| m * mag)
         .find(|s| *s >= raw * 0.75)
         .unwrap_or(raw);
-    let mut t = (lo / step).ceil() * step;
-    let mut out = Vec::new();
-    while t <= hi + 1e-12 * hi.abs().max(1.0) {
-        // Snap to the step's decimals (0.1 + 0.2 is not 0.3 in binary); + 0.0 makes a −0 0.
-        out.push((t / step).round() * step + 0.0);
-        t += step;
+    // The k-th step by multiplication, not by adding steps: far from 0 (a record's 1e20 and
+    // 1e20 + 1) an added step is lost in rounding and the loop never ended.
+    let first = (lo / step).ceil();
+    let last = ((hi + 1e-12 * hi.abs().max(1.0)) / step).floor();
+    if !(first.is_finite() && last.is_finite() && last - first <= 50.0) {
+        return Vec::new();
     }
-    out
+    // A multiple of the step snaps to its decimals (0.1 + 0.2 is not 0.3 in binary); + 0.0
+    // makes a −0 0.
+    (first as i64..=last as i64)
+        .map(|k| k as f64 * step + 0.0)
+        .collect()
 }
 
 /// An axis's tick labels: [`fmt_tick`]'s, but on a log axis where some tick needs the
@@ -2149,6 +2158,31 @@ mod tests {
     }
 
     use super::*;
+
+    /// Values at the ends of f64 (a record's or an outside client's) give an axis with a
+    /// bounded number of finite ticks, at once: a timing of 1e300 ms had padded the log axis
+    /// to infinity and asked for 2^31 ticks, and linear steps far from 0 were lost in rounding
+    /// and never reached the axis's end.
+    #[test]
+    fn an_axis_of_extreme_values_has_few_finite_ticks() {
+        for (values, log) in [
+            (vec![1e300], true),
+            (vec![1e-300, 1e300], true),
+            (vec![f64::MAX], true),
+            (vec![f64::MAX, -f64::MAX], false),
+            (vec![1e20, 1e20 + 1e5], false),
+            (vec![1e300], false),
+        ] {
+            let axis = Axis::new(values.iter().copied(), log);
+            let ticks = axis.ticks_drawn(400.0, 12.0);
+            assert!(
+                ticks.len() <= 700 && ticks.iter().all(|t| t.is_finite()),
+                "{values:?}: {} ticks",
+                ticks.len()
+            );
+            assert!(axis.lo.is_finite() && axis.hi.is_finite() && axis.lo < axis.hi);
+        }
+    }
 
     fn chart(series: Vec<Series>) -> Chart {
         Chart {

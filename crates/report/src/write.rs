@@ -16,6 +16,9 @@ use std::path::Path;
 /// points; the bound keeps a wrong file from being read whole.
 pub const MAX_RESULTS_BYTES: u64 = 1 << 30;
 
+/// Largest image a report embeds in its HTML (a 4K PNG is some tens of MB).
+const MAX_EMBEDDED_BYTES: u64 = 256 << 20;
+
 /// Reads `results.jsonl` (absent: no records). It must be a regular file of at most
 /// [`MAX_RESULTS_BYTES`], every line a record; a line that does not parse is refused naming
 /// the file, its line and why — except a last line without its newline, which an interrupted
@@ -43,6 +46,17 @@ pub fn read_records(path: &Path) -> Result<Vec<Record>, FileError> {
                 });
             }
         };
+        if let Some((field, image)) = record.image_outside_folder() {
+            return Err(FileError {
+                path: path.to_path_buf(),
+                message: format!(
+                    "line {}: {field} {image:?} is not a path inside the sweep folder \
+                     (relative, without `..`)",
+                    n + 1
+                ),
+                refused: true,
+            });
+        }
         record.migrate();
         match index.get(&record.key) {
             Some(&i) => records[i] = record,
@@ -268,7 +282,10 @@ pub fn write_report(
                 }
                 html.push_str("</tr><tr>");
                 for (cap, p) in images {
-                    let src = match std::fs::read(dir.join(p)) {
+                    // Bounded and regular: a FIFO named by a record had blocked the report.
+                    let png =
+                        mirrorbox_files::read_bounded(&dir.join(p), MAX_EMBEDDED_BYTES, "an image");
+                    let src = match png {
                         Ok(bytes) => format!(
                             "data:image/png;base64,{}",
                             base64::engine::general_purpose::STANDARD.encode(bytes)
@@ -1225,6 +1242,49 @@ pub(crate) mod tests {
         for special in [Path::new("/dev/zero"), &fifo] {
             let e = read_records(special).unwrap_err();
             assert!(e.refused && e.message.contains("regular file"), "{e}");
+        }
+    }
+
+    /// A record's image outside its sweep folder (absolute, or up through `..`) is refused
+    /// naming the line and the field: `report` had embedded `/etc/passwd` in its HTML and
+    /// written an inset beside whatever a `..` path named. Inside, it reads.
+    #[test]
+    fn an_image_outside_the_sweep_folder_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("results.jsonl");
+        let good = record(0, 1.0, 3, 0.1);
+        for (field, image, refused) in [
+            ("raster_image", "/etc/passwd", true),
+            ("truth_image", "../../etc/passwd", true),
+            ("heatmap_image", "images/../../x.png", true),
+            ("raster_image", "images/naive.png", false),
+            ("heatmap_image", "", false),
+        ] {
+            let mut r = good.clone();
+            r.key = "second".into();
+            match field {
+                "raster_image" => r.raster_image = image.into(),
+                "truth_image" => r.truth_image = image.into(),
+                _ => r.heatmap_image = image.into(),
+            }
+            let line = serde_json::to_string(&r).unwrap();
+            std::fs::write(
+                &p,
+                format!("{}\n{line}\n", serde_json::to_string(&good).unwrap()),
+            )
+            .unwrap();
+            match read_records(&p) {
+                Err(e) if refused => {
+                    assert!(
+                        e.refused
+                            && e.to_string()
+                                .contains(&format!("line 2: {field} {image:?}")),
+                        "{e}"
+                    );
+                }
+                Ok(records) if !refused => assert_eq!(records.len(), 2),
+                other => panic!("{field} {image:?}: {other:?}"),
+            }
         }
     }
 

@@ -473,9 +473,24 @@ impl Reader<'_> {
             ));
         }
         let count = a.count();
+        // In u64 and checked: a byteOffset near 2^64 must not wrap past the bounds check.
+        let first_end = match (a.offset() as u64).checked_add(size as u64) {
+            Some(e) if e <= bytes.len() as u64 => e,
+            _ => {
+                return Err(err(
+                    format!("{here}.byteOffset"),
+                    format!(
+                        "is {}: a {size}-byte element from there does not fit bufferView {} ({} bytes)",
+                        a.offset(),
+                        view.index(),
+                        bytes.len()
+                    ),
+                ));
+            }
+        };
         let end = (count as u64).checked_sub(1).map_or(Some(0), |last| {
             last.checked_mul(stride as u64)
-                .and_then(|x| x.checked_add((a.offset() + size) as u64))
+                .and_then(|x| x.checked_add(first_end))
         });
         match end {
             Some(end) if end <= bytes.len() as u64 => {}
@@ -1176,5 +1191,40 @@ mod tests {
         );
         assert_eq!(percent_decode("a%2"), None);
         assert_eq!(percent_decode("a%zz"), None);
+    }
+
+    /// An accessor's byteOffset near 2^64 is refused naming it: `offset + element size` had
+    /// wrapped around in release builds, passed the bounds check and panicked on the slice.
+    #[test]
+    fn a_byte_offset_past_the_buffer_is_refused_not_wrapped() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("far.gltf");
+        for (offset, field) in [
+            (u64::MAX - 3, "accessors[0].byteOffset"),
+            (36, "accessors[0].byteOffset"),
+            (4, "accessors[0].count"),
+        ] {
+            std::fs::write(
+                &path,
+                format!(
+                    r#"{{"asset": {{"version": "2.0"}}, "scenes": [{{"nodes": [0]}}], "nodes": [{{"mesh": 0}}],
+                    "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0}}}}]}}],
+                    "accessors": [{{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                                    "min": [0, 0, 0], "max": [1, 1, 0], "byteOffset": {offset}}}],
+                    "bufferViews": [{{"buffer": 0, "byteLength": 36}}],
+                    "buffers": [{{"uri": "data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA", "byteLength": 36}}]}}"#
+                ),
+            )
+            .unwrap();
+            let options = GltfOptions {
+                scene: None,
+                triangle_budget: 1 << 10,
+                texel_budget: 1 << 10,
+                transform: Mat4::IDENTITY,
+                curved_mirrors: CurvedMirrors::Refuse,
+            };
+            let e = load_gltf(&path, &options).err().expect("refused");
+            assert!(e.to_string().contains(field), "{offset}: {e}");
+        }
     }
 }

@@ -294,7 +294,9 @@ impl Checker<'_> {
         }
         // After the objects: a glTF object may hold the camera.
         let frame = self.camera_frame(&FieldPath::root("camera"), &file.camera, &assets)?;
-        let camera = self.camera(&FieldPath::root("camera"), &file.camera, &frame)?;
+        let camera = self
+            .camera(&FieldPath::root("camera"), &file.camera, &frame)
+            .map_err(|e| gltf_camera_error(e, file.camera.gltf.is_some()))?;
         let planes = self.symmetry_planes(&file.symmetry_planes)?;
         let symmetry = if planes.is_empty() {
             None
@@ -943,10 +945,15 @@ impl Checker<'_> {
             })
             .collect();
         if let Some(p) = world.iter().flatten().find(|p| !within_extent(**p)) {
+            // The transform where there is one; else the object's own geometry is out.
+            let (field, verb) = match o.transform {
+                Some(_) => (&transform_path, "places"),
+                None => (path, "has"),
+            };
             return Err(self.invalid(
-                &transform_path,
+                field,
                 format!(
-                    "places the vertex {} outside the scene extent: every coordinate must be within ±{MAX_COORDINATE:e}",
+                    "{verb} the vertex {} outside the scene extent: every coordinate must be within ±{MAX_COORDINATE:e}",
                     show(*p)
                 ),
             ));
@@ -1277,6 +1284,31 @@ fn show(v: Vec3) -> String {
     format!("[{}, {}, {}]", v.x, v.y, v.z)
 }
 
+/// A problem of the camera's frame where a glTF object's camera gave it (`camera.gltf`): the
+/// scene file has no `camera.position`, `look_at`, `up` or `fov_y_deg` to blame, so the
+/// error names `camera.index`, the glTF camera chosen, and which of its values is wrong.
+fn gltf_camera_error(e: SceneError, from_gltf: bool) -> SceneError {
+    match e {
+        SceneError::Invalid {
+            file,
+            path,
+            message,
+        } if from_gltf
+            && ["position", "look_at", "up", "fov_y_deg"]
+                .iter()
+                .any(|f| path == format!("camera.{f}")) =>
+        {
+            let value = path.trim_start_matches("camera.").to_string();
+            SceneError::Invalid {
+                file,
+                path: "camera.index".into(),
+                message: format!("the glTF camera's {value} (camera.gltf's asset): {message}"),
+            }
+        }
+        e => e,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1471,7 +1503,7 @@ mod tests {
         );
         let e =
             refused(r#", "objects": [ { "type": "sphere", "radius": 2e6, "subdivisions": 0 } ]"#);
-        assert!(e.contains("objects[0].transform"), "{e}");
+        assert!(e.contains("objects[0]: has the vertex"), "{e}");
         let e = refused(
             r#", "mirrors": [ { "center": [0, 0, -2], "normal": [0, 0, 1], "up": [0, 1, 0], "width": 3e6, "height": 1 } ]"#,
         );
@@ -1530,6 +1562,39 @@ mod tests {
             obj_triangle_count(b"f 1 2 3\nv 1 2 3\n  f 1 2 3 4 5\nf 1 2"),
             1 + 3
         );
+    }
+
+    /// A mesh vertex outside the scene extent is the transform's fault only where there is
+    /// one: without, the object itself is named (it had named a `transform` the file lacks).
+    #[test]
+    fn a_far_vertex_names_the_transform_or_the_object() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(
+            dir.path().join("far.obj"),
+            "v 0 0 0\nv 2e6 0 0\nv 0 1 0\nf 1 2 3\n",
+        )
+        .unwrap();
+        std::fs::write(
+            dir.path().join("near.obj"),
+            "v 0 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\n",
+        )
+        .unwrap();
+        for (object, says) in [
+            (r#""path": "far.obj""#, "objects[0]: has the vertex"),
+            (
+                r#""path": "near.obj", "transform": {"scale": 1e6}"#,
+                "objects[0].transform: places the vertex",
+            ),
+        ] {
+            let text = format!(r#"{{ {CAMERA}, "objects": [ {{ "type": "mesh", {object} }} ] }}"#);
+            let e = parse_scene(&text, &dir.path().join("s.json"))
+                .unwrap_err()
+                .to_string();
+            assert!(
+                e.contains(says) && e.contains("outside the scene extent"),
+                "{e}"
+            );
+        }
     }
 
     #[test]
@@ -1749,6 +1814,32 @@ mod tests {
             let e = scene(camera).err().unwrap().to_string();
             assert!(e.contains(words), "{camera}: {e}");
         }
+        // A glTF camera outside the scene extent: the file has no camera.position to blame,
+        // so the camera chosen is named, and its value.
+        let tmp = tempfile::tempdir().unwrap();
+        std::fs::write(
+            tmp.path().join("far.gltf"),
+            r#"{"asset": {"version": "2.0"}, "scenes": [{"nodes": [0, 1]}],
+                "nodes": [{"mesh": 0}, {"camera": 0, "translation": [0, 0, 2e6]}],
+                "cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.1}}],
+                "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+                "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                               "min": [0, 0, 0], "max": [1, 1, 0]}],
+                "bufferViews": [{"buffer": 0, "byteLength": 36}],
+                "buffers": [{"uri": "data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA", "byteLength": 36}]}"#,
+        )
+        .unwrap();
+        let e = parse_scene(
+            r#"{ "camera": { "gltf": "far.gltf", "width": 64, "height": 36 },
+                 "objects": [ { "type": "gltf", "path": "far.gltf" } ] }"#,
+            &tmp.path().join("s.json"),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("camera.index: the glTF camera's position (camera.gltf's asset): must lie"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -22,8 +22,14 @@ pub struct Args {
     /// Supersampling s of the raster (the truth uses the same s×s sub-pixel grid), 1..8.
     #[arg(long, default_value_t = 1)]
     ssaa: u32,
-    /// α: every mirror's reflectance, in [0, 1], as in a sweep.
-    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
+    /// α: every mirror's reflectance, in [0, 1], as in a sweep. `--reflectance` is the same
+    /// flag.
+    #[arg(
+        long,
+        visible_alias = "reflectance",
+        default_value_t = 1.0,
+        allow_negative_numbers = true
+    )]
     alpha: f32,
     /// The error to minimise: flip (FLIP mean over the mirror pixels) or relmse (over the
     /// image).
@@ -114,10 +120,8 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         Some(path) => {
             let views = mirrorbox_harness::exchange::read_view_list(path)
                 .map_err(|e| Failure::BadInput(e.to_string()))?;
-            for v in &views {
-                mirrorbox_harness::exchange::view_scene(&scene, v)
-                    .map_err(|e| Failure::BadInput(format!("{}: {e}", path.display())))?;
-            }
+            mirrorbox_harness::exchange::check_views(path, &views, &scene)
+                .map_err(|e| Failure::BadInput(e.to_string()))?;
             views
         }
         None => Vec::new(),

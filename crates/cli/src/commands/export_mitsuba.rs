@@ -41,7 +41,8 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     }
     let written = export(&scene, &xml, ExportSettings { spp: args.spp }).map_err(|e| {
         if e.refused {
-            Failure::BadInput(e.to_string())
+            // The part's name says which object; the scene file says where it is.
+            Failure::BadInput(format!("{}: {e}", args.scene.display()))
         } else {
             Failure::Other(e.to_string())
         }

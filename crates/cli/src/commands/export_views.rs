@@ -5,7 +5,7 @@
 
 use super::unit_interval;
 use crate::Failure;
-use mirrorbox_harness::exchange::{ExportSettings, export_views, read_view_list};
+use mirrorbox_harness::exchange::{ExportSettings, check_views, export_views, read_view_list};
 use std::path::PathBuf;
 
 #[derive(clap::Args)]
@@ -22,7 +22,8 @@ pub struct Args {
     #[arg(long, default_value_t = 1)]
     ssaa: u32,
     /// α: every mirror's reflectance, in [0, 1] (a sweep's α); default: the scene's.
-    #[arg(long, allow_negative_numbers = true)]
+    /// `--reflectance` is the same flag.
+    #[arg(long, visible_alias = "reflectance", allow_negative_numbers = true)]
     alpha: Option<f32>,
     /// A view list (JSON: {"views": [{"name", "position", "look_at", "up"?, "fov_y_deg"?}]}),
     /// e.g. a camera path; default: the scene's camera, named "camera".
@@ -34,7 +35,12 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     super::ssaa(args.ssaa)?;
     unit_interval("--alpha", args.alpha)?;
     let views = match &args.views {
-        Some(path) => read_view_list(path).map_err(Failure::from)?,
+        Some(path) => {
+            let views = read_view_list(path).map_err(Failure::from)?;
+            // Against the scene too, naming the file, before any truth is traced.
+            check_views(path, &views, &super::load(&args.scene)?).map_err(Failure::from)?;
+            views
+        }
         None => Vec::new(),
     };
     let settings = ExportSettings {

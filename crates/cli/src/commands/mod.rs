@@ -157,9 +157,13 @@ impl TimeArgs {
         let frames: Vec<(f64, String)> = (0..n)
             .map(|k| (start + f64::from(k) / self.fps, format!("{k:04}")))
             .collect();
-        for (time, suffix) in &frames {
+        for (k, (time, suffix)) in frames.iter().enumerate() {
+            // The frame's time comes from three flags: say which made it.
             check_time(*time).map_err(|e| match e {
-                Failure::BadInput(m) => Failure::BadInput(format!("frame {suffix}: {m}")),
+                Failure::BadInput(m) => Failure::BadInput(format!(
+                    "frame {suffix}, at --time {start} + {k} / --fps {}: {m}",
+                    self.fps
+                )),
                 other => other,
             })?;
         }

@@ -216,6 +216,13 @@ fn check_args(args: &Args) -> Result<(SubpixelGrid, WhittedSettings), Failure> {
                     .into(),
             ));
         }
+        Integrator::Path if args.mirrored_lights.is_some() => {
+            return Err(Failure::BadInput(
+                "--mirrored-lights is the `whitted` integrator's: `path` finds light through \
+                 mirrors by its own sampling, and never from point lights"
+                    .into(),
+            ));
+        }
         Integrator::Whitted if args.max_segments.is_some() || args.rr_from.is_some() => {
             return Err(Failure::BadInput(
                 "--max-segments and --rr-from are the `path` integrator's (--integrator path); \
