@@ -379,6 +379,80 @@ impl Record {
         fields.into_iter().find(|(_, p)| !inside(p))
     }
 
+    /// The first number outside what a measurement can be, as `field value (allowed)`: α in
+    /// [0, 1], times in [0, a day] ms, errors ≥ 0 (SSIM in [−1, 1]), the mirror pixels' share
+    /// in [0, 1]. A report drawn from a hand-edited `results.jsonl` had taken them all.
+    pub fn out_of_range(&self) -> Option<String> {
+        const DAY_MS: f64 = 86_400_000.0;
+        let ms = |x: f64| (0.0..=DAY_MS).contains(&x);
+        let mut checks: Vec<(String, f64, bool, &str)> = vec![
+            (
+                "alpha".into(),
+                f64::from(self.alpha),
+                (0.0..=1.0).contains(&self.alpha),
+                "[0, 1]",
+            ),
+            (
+                "ms_median".into(),
+                self.ms_median,
+                ms(self.ms_median),
+                "[0, 86400000] ms",
+            ),
+            (
+                "ms_min".into(),
+                self.ms_min,
+                ms(self.ms_min),
+                "[0, 86400000] ms",
+            ),
+        ];
+        if let Some(&f) = self.frames_ms.iter().find(|&&f| !ms(f)) {
+            checks.push(("frames_ms".into(), f, false, "[0, 86400000] ms"));
+        }
+        if let Some(share) = self.mirror_pixel_share {
+            checks.push((
+                "mirror_pixel_share".into(),
+                share,
+                (0.0..=1.0).contains(&share),
+                "[0, 1]",
+            ));
+        }
+        for (name, m) in [
+            ("metrics", Some(&self.metrics)),
+            ("mirror_metrics", self.mirror_metrics.as_ref()),
+        ] {
+            let Some(m) = m else { continue };
+            for (metric, v) in [
+                ("rmse", m.rmse),
+                ("relmse", m.relmse),
+                ("smape", m.smape),
+                ("max_abs", m.max_abs),
+                ("flip_mean", m.flip_mean),
+                ("flip_p95", m.flip_p95),
+                ("flip_p99", m.flip_p99),
+            ] {
+                checks.push((format!("{name}.{metric}"), v, v >= 0.0, "≥ 0"));
+            }
+            checks.push((
+                format!("{name}.ssim"),
+                m.ssim,
+                (-1.0..=1.0).contains(&m.ssim),
+                "[−1, 1]",
+            ));
+        }
+        checks
+            .into_iter()
+            .find(|(_, _, ok, _)| !ok)
+            .map(|(field, v, _, allowed)| {
+                // 1e300 in full would be three hundred digits.
+                let v = if v.abs() < 1e15 {
+                    v.to_string()
+                } else {
+                    format!("{v:e}")
+                };
+                format!("{field} {v} (allowed: {allowed})")
+            })
+    }
+
     /// The value of scene axis `name` ([`axis`]) at this point.
     pub fn axis(&self, name: &str) -> Option<f64> {
         self.axes.get(name).copied()

@@ -46,6 +46,13 @@ pub fn read_records(path: &Path) -> Result<Vec<Record>, FileError> {
                 });
             }
         };
+        if let Some(problem) = record.out_of_range() {
+            return Err(FileError {
+                path: path.to_path_buf(),
+                message: format!("line {}: {problem}", n + 1),
+                refused: true,
+            });
+        }
         if let Some((field, image)) = record.image_outside_folder() {
             return Err(FileError {
                 path: path.to_path_buf(),
@@ -1286,6 +1293,41 @@ pub(crate) mod tests {
                 other => panic!("{field} {image:?}: {other:?}"),
             }
         }
+    }
+
+    /// A number no measurement can be (a negative time, α 5, a negative error) is refused
+    /// naming the line, the field and what is allowed; the record as written reads.
+    #[test]
+    fn a_record_out_of_range_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("results.jsonl");
+        let good = record(0, 1.0, 3, 0.1);
+        type Edit = fn(&mut Record);
+        let edits: [(Edit, &str); 5] = [
+            (
+                |r| r.ms_median = -1.0,
+                "line 1: ms_median -1 (allowed: [0, 86400000] ms)",
+            ),
+            (|r| r.alpha = 5.0, "line 1: alpha 5 (allowed: [0, 1])"),
+            (
+                |r| r.metrics.flip_mean = -1.0,
+                "line 1: metrics.flip_mean -1 (allowed: ≥ 0)",
+            ),
+            (
+                |r| r.frames_ms = vec![1.0, 1e300],
+                "line 1: frames_ms 1e300",
+            ),
+            (|r| r.metrics.ssim = 2.0, "line 1: metrics.ssim 2"),
+        ];
+        for (edit, says) in edits {
+            let mut r = good.clone();
+            edit(&mut r);
+            std::fs::write(&p, serde_json::to_string(&r).unwrap() + "\n").unwrap();
+            let e = read_records(&p).unwrap_err();
+            assert!(e.refused && e.to_string().contains(says), "{e}");
+        }
+        std::fs::write(&p, serde_json::to_string(&good).unwrap() + "\n").unwrap();
+        assert_eq!(read_records(&p).unwrap().len(), 1);
     }
 
     /// A record older than the maps (issue 52) keeps its experiment's columns as fields of
