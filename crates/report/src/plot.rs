@@ -879,7 +879,8 @@ fn place_label(
 /// cube size under two other methods' points, a crowded front) is said, and the leader ties
 /// it to its point. The box keeps the same rules (inside the plot, clear of everything
 /// `taken`, across none of `strokes`), and the leader crosses nothing `taken` but the point's
-/// own marker.
+/// own marker — and, `through_own_place`, anything drawn over its own point (a coinciding
+/// unlabelled point's marker, the pick's ring).
 /// Returns the text's baseline origin, its box and the leader's ends.
 #[allow(clippy::type_complexity)]
 fn place_label_away(
@@ -888,6 +889,7 @@ fn place_label_away(
     lw: f64,
     taken: &[Rect],
     strokes: &[Stroke],
+    through_own_place: bool,
 ) -> Option<(f64, f64, Rect, Stroke)> {
     let own = Rect::around((xx, yy), r);
     [14.0, 26.0].iter().find_map(|&d| {
@@ -914,7 +916,13 @@ fn place_label_away(
             }
             let from = (xx + dx / len * (r + 1.0), yy + dy / len * (r + 1.0));
             let inside = rect.inside_plot();
-            let mine = |t: &Rect| t.x0 == own.x0 && t.y0 == own.y0;
+            // The leader leaves through whatever is drawn over its own point: its marker, a
+            // coinciding point's, the pick's ring (it had barred every leader of a ringed
+            // point, so the advisor's pick went unlabelled).
+            let mine = |t: &Rect| {
+                (t.x0 == own.x0 && t.y0 == own.y0)
+                    || (through_own_place && t.x0 <= xx && xx <= t.x1 && t.y0 <= yy && yy <= t.y1)
+            };
             (inside
                 && !taken.iter().any(|t| t.overlaps(&rect))
                 && !taken.iter().any(|t| !mine(t) && t.crossed_by(from, near))
@@ -1669,8 +1677,9 @@ impl Chart {
             .into_iter()
             .collect();
         let mut label_queue: Vec<(usize, f64, f64, f64, &str, &'static str)> = Vec::new();
-        // Every marker's centre: a label must lie nearer its own point than any other.
-        let mut markers: Vec<(f64, f64)> = Vec::new();
+        // Every marker's centre, and whether it has a label: a label must lie nearer its own
+        // point than any other.
+        let mut markers: Vec<((f64, f64), bool)> = Vec::new();
         for (i, series) in self.series.iter().enumerate() {
             for (k, &(x, y)) in series.points.iter().enumerate() {
                 if !f.shows((x, y)) {
@@ -1716,7 +1725,7 @@ impl Chart {
                     marker_svg(s, &series.style, xx, yy, r, series.style.hollow);
                 }
                 taken.push(Rect::around((xx, yy), r));
-                markers.push((xx, yy));
+                markers.push(((xx, yy), label.is_some()));
                 if let Some(label) = label {
                     label_queue.push((i, xx, yy, r, label, series.style.color));
                 }
@@ -1756,10 +1765,21 @@ impl Chart {
                 .filter(|(owner, _)| *owner != Some(i))
                 .map(|&(_, st)| st)
                 .collect();
-            let place = place_label((xx, yy), r, lw, &markers, &taken, &others)
+            // A point at the same place without a label of its own (a ring around this one)
+            // is no other point to mistake the label for: it had kept every label off a
+            // coinciding pair. Coinciding points with labels of their own still are.
+            let rivals: Vec<(f64, f64)> = markers
+                .iter()
+                .filter(|&&(m, labelled)| labelled || !hides(m, (xx, yy)))
+                .map(|&(m, _)| m)
+                .collect();
+            let place = place_label((xx, yy), r, lw, &rivals, &taken, &others)
                 .map(|p| (p, None))
                 .or_else(|| {
-                    place_label_away((xx, yy), r, lw, &taken, &others)
+                    // Through what is drawn over its own place, unless another labelled point
+                    // is there too (whose label it would then be mistaken for).
+                    let alone = rivals.iter().all(|&m| m == (xx, yy) || !hides(m, (xx, yy)));
+                    place_label_away((xx, yy), r, lw, &taken, &others, alone)
                         .map(|(lx, ly, rect, leader)| ((lx, ly, rect), Some(leader)))
                 });
             if let Some(((lx, ly, rect), leader)) = place {
@@ -2705,7 +2725,7 @@ mod tests {
             })
             .collect();
         assert!(place_label((x, y), r, lw, &markers, &near, &[]).is_none());
-        let (_, _, rect, (from, to)) = place_label_away((x, y), r, lw, &near, &[]).unwrap();
+        let (_, _, rect, (from, to)) = place_label_away((x, y), r, lw, &near, &[], false).unwrap();
         assert!(!near.iter().any(|t| t.overlaps(&rect)));
         assert!(
             (from.0 - x).hypot(from.1 - y) > r,
@@ -2719,7 +2739,7 @@ mod tests {
             x1: LEFT + PLOT_W,
             y1: TOP + PLOT_H,
         }];
-        assert!(place_label_away((x, y), r, lw, &all, &[]).is_none());
+        assert!(place_label_away((x, y), r, lw, &all, &[], false).is_none());
     }
 
     /// Segments' distance: 0 where they cross or touch, else the nearest ends' gap.
@@ -2744,11 +2764,11 @@ mod tests {
     fn a_leader_keeps_off_other_lines_and_bars() {
         let (r, lw) = (MARKER_R, 30.0);
         let (x, y) = (LEFT + 200.0, TOP + 150.0);
-        let (_, _, _, first) = place_label_away((x, y), r, lw, &[], &[]).unwrap();
+        let (_, _, _, first) = place_label_away((x, y), r, lw, &[], &[], false).unwrap();
         // A vertical bar across the first leader's middle.
         let mid = ((first.0.0 + first.1.0) / 2.0, (first.0.1 + first.1.1) / 2.0);
         let bar = ((mid.0, mid.1 - 30.0), (mid.0, mid.1 + 30.0));
-        let (_, _, rect, leader) = place_label_away((x, y), r, lw, &[], &[bar]).unwrap();
+        let (_, _, rect, leader) = place_label_away((x, y), r, lw, &[], &[bar], false).unwrap();
         assert!(segments_distance(leader, bar) >= 2.0, "{leader:?}");
         assert!(!rect.crossed_by(bar.0, bar.1));
     }
@@ -2793,6 +2813,25 @@ mod tests {
             (second.0 + r + 2.0, y - r - 1.0),
             "spaced: not beside the first"
         );
+    }
+
+    /// A labelled point with an unlabelled one at the same place (drawn as a ring around it),
+    /// at the plot's left edge, is labelled: the other point had counted as a rival nearer to
+    /// every place on the right, and its marker had barred every leader (an advisor's front
+    /// point and its pick went unlabelled). With both labelled, the rule stands (below).
+    #[test]
+    fn a_point_with_an_unlabelled_twin_is_labelled() {
+        let mut own = Series::new(
+            "own",
+            method_style("naive"),
+            vec![(1.0, 1.0), (100.0, 10.0)],
+        );
+        own.labels = vec!["texture-scale=0.5".into(), String::new()];
+        own.joined = false;
+        let mut twin = Series::new("twin", method_style("auxiliary"), vec![(1.01, 1.0)]);
+        twin.joined = false;
+        let svg = chart(vec![own, twin]).to_svg();
+        assert!(svg.contains(">texture-scale=0.5</text>"), "{svg}");
     }
 
     #[test]
