@@ -775,3 +775,105 @@ fn three_reflector_scores_within_its_stated_bounds() {
         "Reflector {theirs} against its floor {floor_flip}"
     );
 }
+
+/// The mistakes a client makes that score as a large error and nothing else are said: a
+/// picture upside down, an EXR holding sRGB-encoded values (scored as given, exit 0, a
+/// warning and a line in variants.md); and the pictures that cannot be read as the docs say
+/// are refused: a 16-bit PNG (it had been cut to 8 bits unsaid), an EXR of unsigned integers
+/// (scored as radiance), a file named in another case (named in the error).
+#[test]
+fn a_picture_upside_down_or_srgb_encoded_is_said_and_an_unreadable_one_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let ex = tmp.path().join("export");
+    export(&ex);
+    let run = tmp.path().join("run");
+    let variant = our_run(&run);
+    let exr = variant.join("camera.exr");
+    let good = mirrorbox_image::read_image(&exr).unwrap();
+    let (w, h) = (good.width as usize, good.height as usize);
+    let write = |img: &mirrorbox_image::RgbImage| {
+        mirrorbox_image::write_exr(&exr, img, &[]).unwrap();
+    };
+    let mut flipped = good.clone();
+    for y in 0..h {
+        flipped.pixels[y * w..(y + 1) * w]
+            .copy_from_slice(&good.pixels[(h - 1 - y) * w..(h - y) * w]);
+    }
+    let mut encoded = good.clone();
+    for p in &mut encoded.pixels {
+        *p = p.map(mirrorbox_image::srgb::encode);
+    }
+    for (picture, says) in [
+        (&good, None),
+        (&flipped, Some("upside down?")),
+        (&encoded, Some("sRGB-encoded?")),
+    ] {
+        write(picture);
+        let scored = tmp.path().join("scored");
+        let out = run_score(&ex, &run, &scored, &[]);
+        assert_eq!(out.code, 0, "{}", out.stderr);
+        let variants = std::fs::read_to_string(scored.join("variants.md")).unwrap();
+        match says {
+            None => assert!(
+                !out.stderr.contains("warning") && !variants.contains("mis-encoded"),
+                "{}",
+                out.stderr
+            ),
+            Some(says) => {
+                assert!(
+                    out.stderr
+                        .contains(&format!("warning: {}: {says}", exr.display())),
+                    "{}",
+                    out.stderr
+                );
+                assert!(variants.contains(says), "{variants}");
+            }
+        }
+    }
+    write(&good);
+    // A 16-bit PNG in its place.
+    std::fs::remove_file(&exr).unwrap();
+    let png = variant.join("camera.png");
+    image::ImageBuffer::<image::Rgb<u16>, _>::from_pixel(
+        w as u32,
+        h as u32,
+        image::Rgb([30000u16; 3]),
+    )
+    .save(&png)
+    .unwrap();
+    let out = run_score(&ex, &run, &tmp.path().join("s16"), &[]);
+    assert_eq!(out.code, 2, "{}", out.stderr);
+    assert!(
+        out.stderr.contains("a PNG is read as 8-bit RGB or RGBA")
+            && out.stderr.contains("camera.png"),
+        "{}",
+        out.stderr
+    );
+    assert!(!tmp.path().join("s16").exists());
+    // Named in another case.
+    std::fs::rename(&png, variant.join("Camera.PNG")).unwrap();
+    let out = run_score(&ex, &run, &tmp.path().join("case"), &[]);
+    assert_eq!(out.code, 2, "{}", out.stderr);
+    assert!(
+        out.stderr.contains("Camera.PNG differs only in case"),
+        "{}",
+        out.stderr
+    );
+    std::fs::remove_file(variant.join("Camera.PNG")).unwrap();
+    // An EXR of unsigned integers.
+    {
+        use exr::prelude::*;
+        let channels = SpecificChannels::rgb(|_: Vec2<usize>| (1u32, 1u32, 1u32));
+        Image::from_channels((w, h), channels)
+            .write()
+            .to_file(&exr)
+            .unwrap();
+    }
+    let out = run_score(&ex, &run, &tmp.path().join("u32"), &[]);
+    assert_eq!(out.code, 2, "{}", out.stderr);
+    assert!(
+        out.stderr.contains("holds unsigned integers"),
+        "{}",
+        out.stderr
+    );
+}

@@ -8,23 +8,31 @@ what `mirrorbox sweep` measures for `naive` (tests/exchange.rs checks it).
 
 usage: client.py EXPORT RUN [--mirrorbox PATH] [--frames N]
 """
-import argparse, json, os, pathlib, subprocess, time
+import argparse, json, os, pathlib, subprocess, tempfile
 
 CLIENT, VARIANT, EQUIVALENT = "minimal", "naive", "naive"
 
 
-def draw(export, view, out, mirrorbox):
-    """Your renderer: view (from views.json) into out, linear radiance (EXR) or 8-bit sRGB (PNG)."""
+def draw(export, view, out, mirrorbox, frames):
+    """Your renderer: view (from views.json) into out — linear radiance (EXR), or 8-bit sRGB
+    (PNG), top row first — drawn `frames` times after a warm-up; returns each warm frame's ms."""
     scene = json.loads((export / "scene.json").read_text())
     cam = view["camera"]
     scene["camera"].update(position=cam["position"], look_at=cam["look_at"], up=cam["up"],
                            fov_y_deg=cam["fov_y_deg"], width=view["width"], height=view["height"])
-    view_scene = export / f".view_{view['name']}.json"  # beside scene.gltf, which it names
-    view_scene.write_text(json.dumps(scene))
-    subprocess.run([mirrorbox, "render", str(view_scene), "--method", "naive", "--ssaa", str(view["ssaa"]),
-                    "-o", str(out.with_suffix(".png"))], check=True, capture_output=True)
-    view_scene.unlink()
+    for obj in scene.get("objects", []):  # the glTF by its absolute path: the scene is elsewhere
+        if "path" in obj:
+            obj["path"] = str((export / obj["path"]).resolve())
+    with tempfile.TemporaryDirectory() as tmp:
+        view_scene = pathlib.Path(tmp) / "view.json"
+        view_scene.write_text(json.dumps(scene))
+        done = subprocess.run([mirrorbox, "render", str(view_scene), "--method", "naive",
+                               "--ssaa", str(view["ssaa"]), "--frames", str(frames), "--json",
+                               "-o", str(out.with_suffix(".png"))],
+                              check=True, capture_output=True, text=True)
     out.with_suffix(".png").unlink()  # `render` writes the linear EXR beside its PNG
+    # The GPU's own time of each warm frame (timestamp queries), not the process's start-up.
+    return json.loads(done.stdout.strip().splitlines()[-1])["frames_ms"]
 
 
 def main():
@@ -37,17 +45,12 @@ def main():
     views = json.loads((a.export / "views.json").read_text())["views"]
     folder = a.run / CLIENT / VARIANT
     folder.mkdir(parents=True, exist_ok=True)
-    times = {}
-    for view in views:
-        times[view["name"]] = []
-        for _ in range(a.frames):  # every frame draws the view again; the last one is kept
-            start = time.perf_counter()
-            draw(a.export, view, folder / f"{view['name']}.exr", a.mirrorbox)
-            times[view["name"]].append(1000 * (time.perf_counter() - start))
+    times = {view["name"]: draw(a.export, view, folder / f"{view['name']}.exr", a.mirrorbox, a.frames)
+             for view in views}
     (folder / "timing.json").write_text(json.dumps({
         "format": "mirrorbox-timing", "version": 1, "engine": "mirrorbox render (minimal client)",
         "engine_version": "1", "device": "this machine's default adapter", "equivalent": EQUIVALENT,
-        "timing": "wall clock around one `mirrorbox render` process per frame", "views": times,
+        "timing": "GPU timestamps of warm frames (mirrorbox render --frames N --json)", "views": times,
         "scene_hashes": {view["name"]: view["scene_hash"] for view in views}}, indent=1))
     print(f"wrote {folder}: {len(views)} view(s); next: mirrorbox score {a.export} {a.run} -o OUT")
 

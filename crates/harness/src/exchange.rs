@@ -22,7 +22,7 @@ pub const MAX_VIEWS: usize = 64;
 /// What a client must do to draw what the truth shows (`docs/shading.md`, in short). Written
 /// into `views.json`; every rule is one a client can check in its own code.
 pub const CLIENT_RULES: &[&str] = &[
-    "Write linear radiance: no tone mapping, no exposure, no sRGB encoding, no dithering (EXR float, or an 8-bit PNG sRGB-encoded from the linear value, its quantisation stated).",
+    "Write linear radiance: no tone mapping, no exposure, no dithering; an EXR (float or half) holds it as it is, an 8-bit PNG holds it sRGB-encoded (its quantisation stated), top row first.",
     "Diffuse surfaces are Lambertian and two-sided, shaded with their face normal (the glTF NORMAL attribute): L = E·[front] + ρ/π · Σ I·max(0, n·l)/r² + ρ·A, with ρ the base colour (× its texture, decoded from sRGB), E the emissive factor × strength (× its texture), I a point light's colour × intensity read as W/sr (glTF candela), A the scene's extras.mirrorbox.ambient.",
     "No shadows and no light reflected by mirrors onto surfaces, unless views.json's lighting says otherwise; no indirect light; no specular term on diffuse surfaces.",
     "A mirror (metallic 1, roughness 0, extras.mirrorbox_mirror) reflects reflectance × the radiance of the reflected ray, at every angle (no Fresnel); its back is diffuse with back_albedo.",

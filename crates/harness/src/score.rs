@@ -93,6 +93,59 @@ pub struct ScoreSettings {
 pub struct Scored {
     pub records: usize,
     pub variants: usize,
+    /// Pictures that are much nearer their truth upside down or decoded from sRGB
+    /// ([`picture_hint`]): scored as given, and said (variants.md, the command's output).
+    pub hints: Vec<String>,
+}
+
+/// How much nearer its truth a picture must come, transformed, to be called mis-encoded.
+const HINT_FACTOR: f64 = 3.0;
+
+/// A client's picture that comes much nearer its truth (by [`HINT_FACTOR`], in mean absolute
+/// difference of linear radiance) upside down, or — an EXR — decoded from sRGB: the two
+/// mistakes a client makes that score as a large error and nothing else (row 0 is the top;
+/// an EXR holds linear radiance: docs/exchange.md). Said, not refused: a renderer may be that
+/// far off.
+fn picture_hint(truth: &Path, image: &Path) -> Result<Option<String>, HarnessError> {
+    let t =
+        mirrorbox_image::read_image(truth).map_err(|e| HarnessError::Exchange(e.to_string()))?;
+    let p =
+        mirrorbox_image::read_image(image).map_err(|e| HarnessError::Exchange(e.to_string()))?;
+    let w = t.width as usize;
+    let distance = |at: &dyn Fn(usize) -> [f32; 3]| -> f64 {
+        let sum: f64 = (0..t.pixels.len())
+            .map(|i| {
+                let (a, b) = (t.pixels[i], at(i));
+                (0..3).map(|c| f64::from((a[c] - b[c]).abs())).sum::<f64>()
+            })
+            .sum();
+        sum / (3 * t.pixels.len()).max(1) as f64
+    };
+    let given = distance(&|i| p.pixels[i]);
+    let flipped = distance(&|i| {
+        let (x, y) = (i % w, i / w);
+        p.pixels[(t.height as usize - 1 - y) * w + x]
+    });
+    let is_exr = image
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+    let decoded = is_exr.then(|| distance(&|i| p.pixels[i].map(mirrorbox_image::srgb::decode)));
+    let name = image.display();
+    Ok(if given > HINT_FACTOR * flipped {
+        Some(format!(
+            "{name}: upside down? Flipped vertically it is {:.1}× nearer the truth; images are \
+             stored top row first",
+            given / flipped.max(f64::MIN_POSITIVE)
+        ))
+    } else {
+        decoded.filter(|&d| given > HINT_FACTOR * d).map(|d| {
+            format!(
+                "{name}: sRGB-encoded? Decoded from sRGB it is {:.1}× nearer the truth; an EXR \
+                 holds linear radiance",
+                given / d.max(f64::MIN_POSITIVE)
+            )
+        })
+    })
 }
 
 /// A parameter short enough to name a variant by: at most [`MAX_KNOB_CHARS`] characters, no
@@ -452,9 +505,26 @@ fn view_image(dir: &Path, view: &crate::exchange::ExportedView) -> Result<PathBu
     }
     let path = if exr.is_file() { exr } else { png };
     if !path.is_file() {
+        // Names are matched exactly: one that differs only in case is named (`Camera.EXR`).
+        let wanted = [format!("{}.exr", view.name), format!("{}.png", view.name)];
+        let near: Vec<String> = std::fs::read_dir(dir)
+            .into_iter()
+            .flatten()
+            .flatten()
+            .filter_map(|e| e.file_name().into_string().ok())
+            .filter(|n| wanted.iter().any(|w| w.eq_ignore_ascii_case(n)))
+            .collect();
+        let hint = if near.is_empty() {
+            String::new()
+        } else {
+            format!("; {} differs only in case", near.join(", "))
+        };
         return Err(refused(
             dir,
-            format!("no image of view {:?} ({0}.exr or {0}.png)", view.name),
+            format!(
+                "no image of view {:?} ({0}.exr or {0}.png){hint}",
+                view.name
+            ),
         ));
     }
     check_view_picture(&path, view).map_err(HarnessError::Exchange)?;
@@ -819,7 +889,9 @@ fn scored_record(
         color_format: if png {
             "png8 (sRGB)".into()
         } else {
-            "exr (float)".into()
+            // Read before (the image was), so the type is known to be float or half.
+            let samples = mirrorbox_image::exr_rgb_samples(image).unwrap_or("float");
+            format!("exr ({samples})")
         },
         truth_image: rel(&files.truth),
         raster_image: rel(&files.raster),
@@ -900,6 +972,7 @@ pub fn score(
             run: &run_started,
             per_mirror,
         };
+        let mut hints = Vec::new();
         for (client, variant, timing, images) in &inputs {
             for (vi, (v, image)) in views.views.iter().zip(images).enumerate() {
                 records.push(scored_record(
@@ -909,6 +982,12 @@ pub fn score(
                     v,
                     image,
                 )?);
+                let truth = export.join(if *variant == "floor" {
+                    &v.floor
+                } else {
+                    &v.truth
+                });
+                hints.extend(picture_hint(&truth, image)?);
             }
         }
         // Our records' pictures come along (`images/with<k>_…`), so that their rows show.
@@ -1006,11 +1085,18 @@ pub fn score(
             }
             variants_md.push('\n');
         }
+        if !hints.is_empty() {
+            variants_md.push_str("## Pictures that look mis-encoded\n\n");
+            for h in &hints {
+                variants_md.push_str(&format!("- {h}\n"));
+            }
+        }
         let variants_file = partial.join("variants.md");
         std::fs::write(&variants_file, variants_md).map_err(io(&variants_file))?;
         Ok(Scored {
             records: records.len(),
             variants: inputs.len(),
+            hints,
         })
     })
 }

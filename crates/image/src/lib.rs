@@ -269,6 +269,19 @@ pub fn read_image(path: &Path) -> Result<RgbImage, ImageError> {
         reader.limits(limits);
         let decoded = reader.decode().map_err(|e| io_error(path, e))?;
         check_size(path, decoded.width(), decoded.height())?;
+        // 8-bit RGB or RGBA only: a 16-bit PNG had been cut to 8 bits and a grey one taken as
+        // colour, both without a word.
+        use image::ColorType;
+        if !matches!(decoded.color(), ColorType::Rgb8 | ColorType::Rgba8) {
+            return Err(io_error(
+                path,
+                format!(
+                    "a PNG is read as 8-bit RGB or RGBA, sRGB-encoded (alpha ignored); this one \
+                     is {:?}",
+                    decoded.color()
+                ),
+            ));
+        }
         let img = decoded.to_rgb8();
         let (w, h) = img.dimensions();
         let pixels = img.pixels().map(|p| p.0.map(srgb::decode8)).collect();
@@ -343,10 +356,45 @@ fn check_size(path: &Path, width: u32, height: u32) -> Result<(), ImageError> {
     Ok(())
 }
 
+/// The sample type of an EXR's R, G and B channels (its first layer): `"float"`, or `"half"`
+/// where any is half. Unsigned-integer channels are refused: read as floats they had been
+/// scored as radiance.
+pub fn exr_rgb_samples(path: &Path) -> Result<&'static str, ImageError> {
+    use exr::meta::attribute::SampleType;
+    let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| io_error(path, e))?;
+    let header = meta
+        .headers
+        .first()
+        .ok_or_else(|| io_error(path, "an EXR without a layer"))?;
+    let mut half = false;
+    for channel in &header.channels.list {
+        let name = channel.name.to_string();
+        let base = name.rsplit('.').next().unwrap_or(&name);
+        if !["R", "G", "B"].contains(&base) {
+            continue;
+        }
+        match channel.sample_type {
+            SampleType::U32 => {
+                return Err(io_error(
+                    path,
+                    format!(
+                        "channel {name} holds unsigned integers; an EXR's R, G and B are read \
+                         as float or half (linear radiance)"
+                    ),
+                ));
+            }
+            SampleType::F16 => half = true,
+            SampleType::F32 => {}
+        }
+    }
+    Ok(if half { "half" } else { "float" })
+}
+
 fn read_exr(path: &Path) -> Result<RgbImage, ImageError> {
     use exr::prelude::*;
     // The header first: the size it claims is checked before any pixel is allocated.
     exr_size(path)?;
+    exr_rgb_samples(path)?;
     let image = read_first_rgba_layer_from_file(
         path,
         |size, _| RgbImage::new(size.width() as u32, size.height() as u32),

@@ -578,13 +578,20 @@ fn floor_name(fl: &Record) -> String {
 
 /// Several floors (a score's clients and views, and ours): each in a row, each error read
 /// against its own renderer's, and which one the figures shade.
-fn floors_table(floors: &[&Record], shaded: &Record) -> Vec<Block> {
+fn floors_table(floors: &[&Record], shaded: Option<&Record>) -> Vec<Block> {
+    let shading = match shaded {
+        Some(fl) => format!("The figures shade the floor of {}.", floor_name(fl)),
+        None => "No floor of mirrorbox's own is in this report (`score --with SWEEP` sets one \
+                 beside): the figures shade none, and no point is called exact by its own \
+                 renderer's floor, which says how closely that renderer follows the shading \
+                 contract, not how exact its mirrors are."
+            .into(),
+    };
     vec![
         Block::Paragraph(format!(
             "Raster vs trace on the scene without its mirrors (nothing to truncate, same \
              sub-pixel grid), for each renderer and view: read each error against its own \
-             renderer's floor. The figures shade the floor of {}.",
-            floor_name(shaded)
+             renderer's floor. {shading}"
         )),
         Block::Table(
             ["floor of", "RMSE", "relMSE", "FLIP mean", "SSIM"]
@@ -638,13 +645,11 @@ fn document(info: &SweepInfo, records: &[Record], sections: &[Section]) -> Vec<B
     let mut b = header(info, records);
     let points: Vec<&Record> = records.iter().filter(|r| r.kind == "point").collect();
     // A score may hold several floors (each client's, each view's, and ours): the figures'
-    // band and the at-floor test take ours where there is one, and the report names it.
+    // band and the at-floor test take ours, and only ours. A client's floor says how closely
+    // it follows the shading contract; taken as the comparison's, a client that drew no
+    // mirrors, or everything 30 % too bright, had its points called exact.
     let floors: Vec<&Record> = records.iter().filter(|r| r.kind == "floor").collect();
-    let floor = floors
-        .iter()
-        .find(|r| !r.is_external())
-        .or(floors.first())
-        .copied();
+    let floor = floors.iter().find(|r| !r.is_external()).copied();
     let latest_run = records.iter().filter_map(|r| r.run.as_deref()).max();
     let reused = |r: &Record| latest_run.is_some() && r.run.as_deref() != latest_run;
     if !info.shards.is_empty() {
@@ -664,12 +669,11 @@ fn document(info: &SweepInfo, records: &[Record], sections: &[Section]) -> Vec<B
     if !earlier.is_empty() {
         b.push(reused_paragraph(&earlier, records.len(), latest_run));
     }
-    if let Some(fl) = floor {
+    if !floors.is_empty() {
         b.push(Block::Heading(2, "Floor of the comparison".into()));
-        if floors.len() == 1 {
-            b.push(floor_paragraph(fl));
-        } else {
-            b.extend(floors_table(&floors, fl));
+        match floor {
+            Some(fl) if floors.len() == 1 => b.push(floor_paragraph(fl)),
+            _ => b.extend(floors_table(&floors, floor)),
         }
     }
     // The experiments' own sections (the registry's), each empty for another's records.
@@ -1433,6 +1437,37 @@ pub(crate) mod tests {
         b.device = a.device.clone();
         let md = markdown(&document(&SweepInfo::default(), &[a, b], &[]));
         assert!(!md.contains("Timings by device") && md.contains("Error against time"));
+    }
+
+    /// A client's own floor is no comparison floor: a client that drew no mirrors (its mirror
+    /// point 0.33, its floor 0.44) had been told "the methods are exact on this scene". Ours,
+    /// where the report has it, still is.
+    #[test]
+    fn a_clients_floor_never_calls_its_points_exact() {
+        let external = |r: &mut Record| r.timing_order = crate::EXTERNAL_TIMING.into();
+        let mut point = record(0, 20.0, 3, 0.33);
+        point.key = "client/mirrors".into();
+        external(&mut point);
+        let mut client_floor = record(0, 20.0, 3, 0.44);
+        client_floor.key = "client/floor".into();
+        client_floor.kind = "floor".into();
+        external(&mut client_floor);
+        let md = markdown(&document(
+            &SweepInfo::default(),
+            &[point.clone(), client_floor.clone()],
+            &[],
+        ));
+        assert!(!md.contains("exact on this scene"), "{md}");
+        assert!(md.contains("No floor of mirrorbox's own"), "{md}");
+        let mut ours = record(0, 1.0, 1, 0.5);
+        ours.key = "floor".into();
+        ours.kind = "floor".into();
+        let md = markdown(&document(
+            &SweepInfo::default(),
+            &[point, client_floor, ours],
+            &[],
+        ));
+        assert!(md.contains("exact on this scene"), "{md}");
     }
 
     #[test]

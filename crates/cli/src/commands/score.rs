@@ -32,6 +32,9 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     };
     let done = mirrorbox_harness::score::score(&args.export, &args.run, &args.output, &settings)
         .map_err(Failure::from)?;
+    for hint in &done.hints {
+        eprintln!("warning: {hint}");
+    }
     println!(
         "scored {} variant(s) of {} against {}: {} records; wrote {}",
         done.variants,
