@@ -766,17 +766,33 @@ pub fn chart(
             methods.push(&r.method);
         }
     }
+    // An error of exactly 0 (an exact method at a small size) has no place on the log axis:
+    // such points are drawn on a line of their own a little below the least error, named in
+    // the legend (they had been left out, the pick among them, and the front drawn without
+    // them passed through points they beat).
+    let least = advice
+        .measured
+        .iter()
+        .map(|r| metric.of(r))
+        .filter(|e| *e > 0.0)
+        .fold(f64::INFINITY, f64::min);
+    let zero_at = if least.is_finite() { least / 3.0 } else { 1e-6 };
+    let any_zero = advice.measured.iter().any(|r| metric.of(r) == 0.0);
+    let error_of = |r: &Record| {
+        let e = metric.of(r);
+        if e == 0.0 { zero_at } else { e }
+    };
     let coords: Vec<(f64, f64)> = advice
         .measured
         .iter()
-        .map(|r| (r.ms_median, metric.of(r)))
+        .map(|r| (r.ms_median, error_of(r)))
         .collect();
     let (front, steps) = mirrorbox_report::overview::pareto_steps(&coords);
     // Labels on the front and the pick only: the chart's question is which settings are worth
     // their time, and a crowded search (40 points) had labels a reader could not tie to their
     // points; the table lists every one.
     let labelled = |r: &Record| {
-        front.contains(&(r.ms_median, metric.of(r)))
+        front.contains(&(r.ms_median, error_of(r)))
             || advice.pick.as_ref().is_some_and(|p| p.key == r.key)
     };
     let mut series = Vec::new();
@@ -789,7 +805,7 @@ pub fn chart(
         let mut s = Series::new(
             m,
             method_style(m),
-            pts.iter().map(|r| (r.ms_median, metric.of(r))).collect(),
+            pts.iter().map(|r| (r.ms_median, error_of(r))).collect(),
         );
         s.joined = false;
         s.bars = bars;
@@ -806,7 +822,7 @@ pub fn chart(
             .collect();
         series.push(s);
     }
-    let errors: Vec<f64> = coords.iter().map(|c| c.1).filter(|e| *e > 0.0).collect();
+    let errors: Vec<f64> = coords.iter().map(|c| c.1).collect();
     let (lo, hi) = (
         errors.iter().copied().fold(f64::INFINITY, f64::min),
         errors.iter().copied().fold(0.0, f64::max),
@@ -815,6 +831,12 @@ pub fn chart(
         "Pareto front of the candidates".into(),
         steps,
     )];
+    if any_zero {
+        references.push(Reference::Level(
+            "error exactly 0: the points on this line".into(),
+            zero_at,
+        ));
+    }
     if lo.is_finite() {
         references.push(Reference::Curve(
             format!(
@@ -824,12 +846,11 @@ pub fn chart(
             vec![(advice.budget_ms, lo), (advice.budget_ms, hi)],
         ));
     }
-    // The figure's answer: the pick, ringed (an error of exactly 0 has no place on the log
-    // axis: such a pick gets no ring, and the chart names its series' zero in the legend).
-    if let Some(pick) = advice.pick.as_ref().filter(|p| metric.of(p) > 0.0) {
+    // The figure's answer: the pick, ringed (on the line of zeros where its error is 0).
+    if let Some(pick) = advice.pick.as_ref() {
         references.push(Reference::Mark(
             format!("the pick: {}", pick.method_key()),
-            (pick.ms_median, metric.of(pick)),
+            (pick.ms_median, error_of(pick)),
         ));
     }
     Chart {
@@ -1224,6 +1245,50 @@ mod tests {
         let chart = super::chart(&advice, Metric::Flip, "model", String::new());
         let picked = chart.series.iter().find(|s| s.name == "auxiliary").unwrap();
         assert_eq!(picked.labels, ["n=2"]);
+    }
+
+    /// An error of exactly 0 is drawn on a line of its own below the least error, the pick
+    /// ringed there and the front through it: such points had been left out (the pick among
+    /// them) and the front drawn past points they beat.
+    #[test]
+    fn points_of_error_zero_are_drawn_on_a_line_of_their_own() {
+        let (mut advice, _) = search_model_with(3.05, 0.0, 0.0, true);
+        let exact = candidate("ray-query depth=32", 0.5, 0.6, 0.0);
+        advice.measured.push(exact.clone());
+        advice.pick = Some(exact);
+        let chart = chart(&advice, Metric::Flip, "model", String::new());
+        let problems = chart.lint();
+        assert!(
+            !problems
+                .iter()
+                .any(|p| p.contains("cannot be drawn") || p.contains("no point drawn")),
+            "{problems:?}"
+        );
+        let least = advice
+            .measured
+            .iter()
+            .map(|r| Metric::Flip.of(r))
+            .filter(|e| *e > 0.0)
+            .fold(f64::INFINITY, f64::min);
+        let rq = chart.series.iter().find(|s| s.name == "ray-query").unwrap();
+        assert!(
+            rq.points[0].1 > 0.0 && rq.points[0].1 < least,
+            "{:?}",
+            rq.points
+        );
+        assert_eq!(rq.labels, ["depth=32"]);
+        // The front ends at the exact point: nothing slower is on it.
+        let portal = chart.series.iter().find(|s| s.name == "portal").unwrap();
+        assert!(
+            portal.labels.iter().all(|l| l.is_empty()),
+            "{:?}",
+            portal.labels
+        );
+        assert!(
+            chart
+                .to_svg()
+                .contains("error exactly 0: the points on this line")
+        );
     }
 
     /// Exhaustive: every coarse depth in one round, and no bisection though the budget lies

@@ -1445,18 +1445,26 @@ pub fn run_sweep(
         summary.computed += 1;
         progress(Event::Finished { record: &record });
     }
+    // Every record of the folder, as `mirrorbox report` writes it: the sweep's report had
+    // shown this configuration's points only, and `report` then all of them (the points of
+    // an earlier configuration are marked as reused from an earlier run).
     let records = read_records(&results)?;
-    // Report the points of this configuration only (results.jsonl may hold others).
-    let keys: Vec<&String> = all.iter().map(|p| &p.key).collect();
-    let records: Vec<Record> = records
-        .into_iter()
-        .filter(|r| keys.contains(&&r.key))
-        .collect();
-    let info = sweep_info(config, &gpu, (w, h), point_keys, unsupported);
-    write_atomically(
-        &out.join("sweep.json"),
-        serde_json::to_string_pretty(&info)?.as_bytes(),
-    )?;
+    // A run that measured nothing keeps the description of the run that did: a resumed
+    // sweep had stamped the reused points with its own date and commit.
+    let kept = (summary.computed == 0)
+        .then(|| mirrorbox_report::folder::read_sweep_info(out).ok())
+        .flatten();
+    let info = match kept {
+        Some(info) => info,
+        None => {
+            let info = sweep_info(config, &gpu, (w, h), point_keys, unsupported);
+            write_atomically(
+                &out.join("sweep.json"),
+                serde_json::to_string_pretty(&info)?.as_bytes(),
+            )?;
+            info
+        }
+    };
     write_report(out, &info, &records, &config.sections)?;
     Ok(summary)
 }
@@ -1889,6 +1897,14 @@ mod tests {
         run_sweep(&config("mirror_box.json", 32, 1, 0.5), false, &mut |_| {}).unwrap();
         let results = out.path().join("sweep/results.jsonl");
         let before = std::fs::read(&results).unwrap();
+        // The same sweep again measures nothing, and keeps the description (date, commit,
+        // command) of the run that measured its points.
+        let info = out.path().join("sweep/sweep.json");
+        let described = std::fs::read(&info).unwrap();
+        std::thread::sleep(std::time::Duration::from_millis(1100));
+        let again = run_sweep(&config("mirror_box.json", 32, 1, 0.5), false, &mut |_| {}).unwrap();
+        assert_eq!(again.computed, 0);
+        assert_eq!(std::fs::read(&info).unwrap(), described);
         let mut taller = config("mirror_box.json", 32, 1, 0.5);
         taller.height = Some(20);
         let mut finer = config("mirror_box.json", 32, 1, 0.5);
@@ -1919,6 +1935,9 @@ mod tests {
         let summary =
             run_sweep(&config("mirror_box.json", 32, 1, 0.9), false, &mut |_| {}).unwrap();
         assert_eq!(read_records(&results).unwrap().len(), 3, "{summary:?}");
+        // Its report holds every point of the folder, α 0.5's too, as `report` writes it.
+        let csv = std::fs::read_to_string(out.path().join("sweep/results.csv")).unwrap();
+        assert_eq!(csv.lines().count(), 1 + 3, "{csv}");
         // `--fresh` (the main job's) discards the folder's points first: accepted.
         run_sweep(&config("mirror_box.json", 40, 1, 0.5), true, &mut |_| {}).unwrap();
         assert_eq!(read_records(&results).unwrap().len(), 2);

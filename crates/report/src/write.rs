@@ -1182,10 +1182,14 @@ fn image_rows(v: &Variants) -> Vec<Block> {
         };
         for r in chosen {
             b.push(Block::Paragraph(format!(
-                "{}, α = {}: FLIP mean {}",
+                "{}, α = {}: FLIP mean {} over the image{}",
                 label(r),
                 r.alpha_text(),
-                sci(r.metrics.flip_mean)
+                sci(r.metrics.flip_mean),
+                r.mirror_metrics.as_ref().map_or(String::new(), |m| format!(
+                    ", {} over the mirror pixels",
+                    sci(m.flip_mean)
+                ))
             )));
             b.push(Block::Images(vec![
                 (

@@ -167,7 +167,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         println!("{v}");
     } else {
         println!(
-            "{} vs {} ({}x{}):",
+            "{} vs {} ({}x{}, over the whole image):",
             args.test.display(),
             args.reference.display(),
             r.width,
@@ -181,6 +181,9 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             "  sRGB:    PSNR {:.2} dB  SSIM {:.6}  FLIP mean {:.4e} p95 {:.4e} p99 {:.4e} ({} px/deg; exposure {exposure})",
             m.psnr, m.ssim, m.flip_mean, m.flip_p95, m.flip_p99, FLIP_PIXELS_PER_DEGREE
         );
+        if let Some(path) = &heatmap {
+            println!("  wrote the FLIP map {}", path.display());
+        }
     }
     Ok(())
 }

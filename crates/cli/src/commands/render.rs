@@ -31,10 +31,11 @@ pub struct Args {
     size: super::SizeArgs,
     #[command(flatten)]
     time: super::TimeArgs,
-    /// Supersampling factor s: renders at s× and box-filters down, the tracer's `--spp s²` grid.
+    /// Supersampling factor s, 1..8: renders at s× and box-filters down, the tracer's
+    /// `--spp s²` grid.
     #[arg(long, default_value_t = 1)]
     ssaa: u32,
-    /// Timed frames (after --warmup untimed ones).
+    /// Timed frames, 1..10000 (after --warmup untimed ones).
     #[arg(long, default_value_t = 1)]
     frames: u32,
     /// Untimed frames rendered first (driver caches, pipeline compilation), 0..1000.

@@ -38,8 +38,9 @@ pub struct Args {
     /// Supersampling s of the raster (the truth uses the same s×s sub-pixel grid), 1..8.
     #[arg(long, default_value_t = 1)]
     ssaa: u32,
-    /// Timed frames per point, one per interleaved round (after --warmup untimed ones each,
-    /// and an untimed settling round of every point first).
+    /// Timed frames per point, 1..10000, one per interleaved round (after --warmup untimed
+    /// ones each, and an untimed settling round of every point first); 6 or more give each
+    /// median a 95 % interval.
     #[arg(long, default_value_t = 5)]
     frames: u32,
     /// Untimed frames rendered first (driver caches, pipeline compilation), 0..1000.
