@@ -425,7 +425,7 @@ fn csv_quoted(text: &str) -> String {
 const CSV_HEAD: &str = "kind,method,n,depth,alpha,width,height,ssaa,ms_median,ms_ci_low,ms_ci_high,ms_min,timing_order,timing_source,frames,passes,draws,texture_renders,reflections,\
      rmse,relmse,smape,max_abs,psnr,ssim,flip_mean,flip_p95,flip_p99,adapter,backend,scene,scene_hash,color_format,peak_memory_bytes,plan_ms,encode_ms,gpu_buffer_bytes,gpu_texture_bytes,method_options";
 const CSV_TAIL: &str = "marker_disparity_px,truth_marker_disparity_px,\
-     mirror_flip_mean,truncation_flip_mean,approximation_flip_mean,truncation_mirror_flip_mean,approximation_mirror_flip_mean,truncation_relmse,approximation_relmse";
+     mirror_flip_mean,mirror_flip_p95,mirror_relmse,mirror_pixel_share,truncation_flip_mean,approximation_flip_mean,truncation_mirror_flip_mean,approximation_mirror_flip_mean,truncation_relmse,approximation_relmse";
 
 /// `results.csv`: one row per point. The fixed columns every point has, then one column per
 /// scene axis ([`Record::axes`]: `planes`, `yaw_deg`, …) and per extra value
@@ -515,6 +515,11 @@ fn write_csv(path: &Path, records: &[Record]) -> Result<(), FileError> {
             r.gpu_texture_bytes.map_or(String::new(), |b| b.to_string()),
             csv_quoted(&r.method_options),
         );
+        let mirror = |f: fn(&crate::MetricValues) -> f64| {
+            r.mirror_metrics
+                .as_ref()
+                .map_or(String::new(), |m| f(m).to_string())
+        };
         for key in &axes {
             let _ = write!(s, ",{}", cell(r.axes.get(*key)));
         }
@@ -523,7 +528,7 @@ fn write_csv(path: &Path, records: &[Record]) -> Result<(), FileError> {
         }
         let _ = writeln!(
             s,
-            ",{},{},{},{},{},{},{},{},{}",
+            ",{},{},{},{},{},{},{},{},{},{},{},{}",
             r.stereo
                 .as_ref()
                 .and_then(|s| s.disparity(false))
@@ -532,9 +537,11 @@ fn write_csv(path: &Path, records: &[Record]) -> Result<(), FileError> {
                 .as_ref()
                 .and_then(|s| s.disparity(true))
                 .map_or(String::new(), |d| d.to_string()),
-            r.mirror_metrics
-                .as_ref()
-                .map_or(String::new(), |m| m.flip_mean.to_string()),
+            mirror(|m| m.flip_mean),
+            mirror(|m| m.flip_p95),
+            mirror(|m| m.relmse),
+            r.mirror_pixel_share
+                .map_or(String::new(), |v| v.to_string()),
             split(r, |s| Some(s.truncation.flip_mean)),
             split(r, |s| Some(s.approximation.flip_mean)),
             split(r, |s| s.truncation_mirror.as_ref().map(|m| m.flip_mean)),
