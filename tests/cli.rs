@@ -1592,7 +1592,8 @@ fn sweep_refuses_bad_arguments() {
         ),
         (
             &["--methods", "naive,auxiliary", "--fragment-clipping"],
-            "--fragment-clipping applies to --method unrolled, symmetry or symmetry-pruned only",
+            "--fragment-clipping applies to --methods unrolled, symmetry or symmetry-pruned only \
+             (none of the methods swept)",
         ),
         (
             &["--methods", "portal", "--depth", "0,4"],
@@ -1604,7 +1605,7 @@ fn sweep_refuses_bad_arguments() {
         ),
         (
             &["--methods", "naive", "--n", "5"],
-            "--n applies to --method auxiliary only",
+            "--n applies to --methods auxiliary only (none of the methods swept)",
         ),
     ];
     for (extra, message) in cases {

@@ -140,8 +140,9 @@ impl SweepOptions {
     pub fn unused_by(&self, entries: &[&'static MethodEntry]) -> Option<String> {
         self.given.0.iter().find_map(|(o, _)| {
             (!entries.iter().any(|e| e.accepts(o))).then(|| {
+                // Named as the sweep names its methods (`--methods`), not as `render` does.
                 format!(
-                    "--{} applies to --method {} only",
+                    "--{} applies to --methods {} only (none of the methods swept)",
                     o.name,
                     methods_accepting(o)
                 )
