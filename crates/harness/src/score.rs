@@ -15,9 +15,7 @@ use std::path::{Path, PathBuf};
 
 /// Most frames one view's timing may list.
 pub const MAX_FRAMES: usize = 10_000;
-/// Most milliseconds one frame may take: a day. Any larger is a unit slip, not a frame, and an
-/// unbounded one overflowed the figures' axes.
-pub const MAX_FRAME_MS: f64 = 86_400_000.0;
+pub use mirrorbox_report::MAX_FRAME_MS;
 /// Most clients × variants one run may hold.
 pub const MAX_VARIANTS: usize = 256;
 
@@ -764,6 +762,16 @@ struct ScoreStage<'a> {
     per_mirror: bool,
 }
 
+/// The truth a variant's picture of view `v` is scored against: the view's, or its floor
+/// truth for a variant named `floor`.
+fn truth_of(export: &Path, variant: &str, v: &ExportedView) -> PathBuf {
+    export.join(if variant == "floor" {
+        &v.floor
+    } else {
+        &v.truth
+    })
+}
+
 /// The record of a variant's (`client`, `variant`, its `timing`) picture `image` of view `vi`:
 /// compared with the export's truth (its floor truth for a variant named `floor`), its
 /// pictures written into the stage's images/.
@@ -777,7 +785,7 @@ fn scored_record(
     let (export, partial, views) = (ctx.export, ctx.stage, ctx.views);
     let images_dir = partial.join("images");
     let floor = variant == "floor";
-    let truth = export.join(if floor { &v.floor } else { &v.truth });
+    let truth = truth_of(export, variant, v);
     let slug = picture_stem(client, variant, &v.name);
     let files = ViewFiles {
         raster: images_dir.join(format!("{slug}.png")),
@@ -889,7 +897,7 @@ fn scored_record(
         color_format: if png {
             "png8 (sRGB)".into()
         } else {
-            // Read before (the image was), so the type is known to be float or half.
+            // The image was read before (`check_view_picture`): its type is float or half.
             let samples = mirrorbox_image::exr_rgb_samples(image).unwrap_or("float");
             format!("exr ({samples})")
         },
@@ -982,12 +990,7 @@ pub fn score(
                     v,
                     image,
                 )?);
-                let truth = export.join(if *variant == "floor" {
-                    &v.floor
-                } else {
-                    &v.truth
-                });
-                hints.extend(picture_hint(&truth, image)?);
+                hints.extend(picture_hint(&truth_of(export, variant, v), image)?);
             }
         }
         // Our records' pictures come along (`images/with<k>_…`), so that their rows show.
