@@ -1520,7 +1520,7 @@ fn sweep_resumes_without_recomputing_finished_points() {
     assert!(
         again
             .stdout
-            .contains("0 points computed, 6 reused; truths: 0 traced, 0 from cache"),
+            .contains("0 points computed, 6 reused; truths: 0 traced, 0 from the cache"),
         "{}",
         again.stdout
     );
@@ -1541,7 +1541,7 @@ fn sweep_resumes_without_recomputing_finished_points() {
         resumed
             .stdout
             // Each point reads its truth and the truth cut at its reflections (the split).
-            .contains("4 points computed, 2 reused; truths: 0 traced, 8 from cache"),
+            .contains("4 points computed, 2 reused; truths: 0 traced, 8 from the cache"),
         "{}",
         resumed.stdout
     );

@@ -831,6 +831,17 @@ fn a_picture_upside_down_or_srgb_encoded_is_said_and_an_unreadable_one_refused()
         }
     }
     write(&good);
+    // A JPEG beside it: a format score does not read.
+    std::fs::write(variant.join("camera.jpg"), b"not read").unwrap();
+    let out = run_score(&ex, &run, &tmp.path().join("jpg"), &[]);
+    assert_eq!(out.code, 2, "{}", out.stderr);
+    assert!(
+        out.stderr
+            .contains("camera.jpg: a picture score does not read"),
+        "{}",
+        out.stderr
+    );
+    std::fs::remove_file(variant.join("camera.jpg")).unwrap();
     // A 16-bit PNG in its place.
     std::fs::remove_file(&exr).unwrap();
     let png = variant.join("camera.png");

@@ -458,8 +458,21 @@ fn variants(run: &Path) -> Result<Vec<(String, String, PathBuf)>, HarnessError> 
 /// view `c`): its view was misnamed, and it was skipped unsaid (a `timing.json` naming an
 /// unknown view is refused alike).
 fn check_no_stray_image(dir: &Path, views: &ViewsFile) -> Result<(), HarnessError> {
+    // Pictures in a format score does not read (a client writing JPEG) are refused, not
+    // left unread beside a missing view.
+    const UNREAD: [&str; 8] = ["jpg", "jpeg", "hdr", "tif", "tiff", "webp", "bmp", "pfm"];
     for e in std::fs::read_dir(dir).map_err(io(dir))? {
         let path = e.map_err(io(dir))?.path();
+        if path
+            .extension()
+            .is_some_and(|x| UNREAD.iter().any(|u| x.eq_ignore_ascii_case(u)))
+        {
+            return Err(refused(
+                &path,
+                "a picture score does not read: a view's picture is <view>.exr (linear \
+                 radiance) or <view>.png (8-bit sRGB)",
+            ));
+        }
         let image = path
             .extension()
             .is_some_and(|x| x.eq_ignore_ascii_case("exr") || x.eq_ignore_ascii_case("png"));

@@ -1164,6 +1164,19 @@ fn all_points(points: &[&Record], reused: &dyn Fn(&Record) -> bool) -> Vec<Block
             ]
         })
         .collect();
+    // Without intervals the time cell is "median (min …)" already: a "min" column beside it
+    // said the same number twice.
+    let (mut header, mut rows): (Vec<String>, Vec<Vec<String>>) = (header, rows);
+    if points.iter().all(|r| r.ms_interval.is_none()) {
+        let at = header
+            .iter()
+            .position(|h| h == "min")
+            .expect("the min column");
+        header.remove(at);
+        for row in &mut rows {
+            row.remove(at);
+        }
+    }
     vec![
         Block::Heading(2, "All points".into()),
         Block::Table(header, rows),
@@ -1479,6 +1492,35 @@ pub(crate) mod tests {
             &[],
         ));
         assert!(md.contains("exact on this scene"), "{md}");
+    }
+
+    /// Times without intervals (fewer than 6 frames) are "median (min …)" in their cell: no
+    /// "min" column repeats the minimum beside them; with intervals it is there.
+    #[test]
+    fn the_min_column_is_there_only_beside_intervals() {
+        let mut a = record(0, 20.0, 3, 0.1);
+        let mut b = record(1, 30.0, 5, 0.05);
+        (a.ms_interval, b.ms_interval) = (None, None);
+        let md = markdown(&document(
+            &SweepInfo::default(),
+            &[a.clone(), b.clone()],
+            &[],
+        ));
+        let head = |md: &str| {
+            md.lines()
+                .find(|l| l.starts_with("| point |"))
+                .unwrap()
+                .to_string()
+        };
+        assert!(
+            head(&md).contains("ms/frame median (min) | CPU plan ms"),
+            "{}",
+            head(&md)
+        );
+        a.ms_interval = Some([19.0, 21.0]);
+        b.ms_interval = Some([29.0, 31.0]);
+        let md = markdown(&document(&SweepInfo::default(), &[a, b], &[]));
+        assert!(head(&md).contains("[95 % CI] | min |"), "{}", head(&md));
     }
 
     #[test]

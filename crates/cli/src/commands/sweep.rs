@@ -586,7 +586,7 @@ fn execute(config: &SweepConfig, fresh: bool) -> Result<(), Failure> {
     }
     let summary = result?;
     println!(
-        "sweep done in {:.1} s (peak memory {}): {} computed, {} reused{}; truths: {} traced, {} from cache; wrote {}",
+        "sweep done in {:.1} s (peak memory {}): {} computed, {} reused{}; truths: {} traced, {} from the cache (traced before, in this run or an earlier one); wrote {}",
         started.elapsed().as_secs_f64(),
         super::peak_memory().unwrap_or_else(|| "unknown".into()),
         crate::count(summary.computed, "point"),
