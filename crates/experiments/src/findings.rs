@@ -18,7 +18,9 @@ use std::path::Path;
 /// The Table 1 runs of one device, in the order they ran, and what to call the device.
 const TABLE1_RUNS: &[(&str, &[&str])] = &[
     (
-        "lavapipe (2 CPU cores)",
+        // The runs with the timing commands' default: every shader compiled afresh. With
+        // Mesa's disk cache warm, `portal` had come out slower (the Table 1 chapter).
+        "lavapipe (2 CPU cores, Mesa's shader cache off)",
         crate::table1::section::LAVAPIPE_RUNS,
     ),
     ("an NVIDIA H100", &["gpu/table1"]),
@@ -146,10 +148,12 @@ fn exact_speed(reports: &Path) -> Result<String, ReadmeError> {
                 table1::speed_verdict(intervals[0].1)
             ),
             (table1::RunsVerdict::Agree { .. }, runs) => format!(
-                "on {device}, {:.2}× as fast, the median of {runs} runs ({:.2}–{:.2}×{}; {})",
+                "on {device}, {:.2}× as fast, the median of {runs} runs (their medians {}{}; {})",
                 mirrorbox_report::stats::median(&ratios),
-                ratios.iter().copied().fold(f64::INFINITY, f64::min),
-                ratios.iter().copied().fold(0.0, f64::max),
+                spread(
+                    ratios.iter().copied().fold(f64::INFINITY, f64::min),
+                    ratios.iter().copied().fold(0.0, f64::max)
+                ),
                 match hosts.len() {
                     1 => String::new(),
                     n => format!(", on {n} host CPUs: {}", hosts.join(", ")),
@@ -169,6 +173,15 @@ fn exact_speed(reports: &Path) -> Result<String, ReadmeError> {
          [GPUs](../docs/book/src/gpu.md)).",
         parts.join("; ")
     ))
+}
+
+/// The runs' medians from `lo` to `hi`, with the decimals that tell them apart ("1.38× to
+/// 1.38×" had said nothing), or the one value where they agree to four.
+fn spread(lo: f64, hi: f64) -> String {
+    match (2..=4).find(|&d| format!("{lo:.d$}") != format!("{hi:.d$}")) {
+        Some(d) => format!("{lo:.d$}× to {hi:.d$}×"),
+        None => format!("all {lo:.2}×"),
+    }
 }
 
 /// three.js' `Reflector` against our `naive` on each scene, and the floors on one device.
@@ -224,13 +237,17 @@ fn web_engines(reports: &Path) -> Result<String, ReadmeError> {
          as our `naive` does): over the mirror pixels its error is {lo:.2}–{hi:.2}× that of our `naive` \
          on mirror_box, mirror_room and textured_box (headless Chromium on SwiftShader, \
          320×180, α = 0.9), and on the same software rasterizer its no-mirror floor is ours \
-         within {:.1} % — so the extra error is in how it draws its mirror texture{}, not in the \
-         shading ([figure](web_engines_room/plot_mirror_flip_vs_ms.svg)).",
-        100.0 * floor_gap,
+         within {:.1} % — so the extra error comes with its mirrors, not with the shading of \
+         the rest of the scene{} ([figure](web_engines_room/plot_mirror_flip_vs_ms.svg)).",
+        // Rounded up: "within" must hold (a gap of 1.505 % had read "within 1.5 %").
+        (1000.0 * floor_gap).ceil() / 10.0,
         if texture.is_empty() {
             String::new()
         } else {
-            format!(" ({texture})")
+            format!(
+                " (it draws its mirror texture with {texture}; which of them costs what is \
+                 not measured)"
+            )
         }
     ))
 }
@@ -380,11 +397,12 @@ fn ssr_offscreen(reports: &Path) -> Result<String, ReadmeError> {
         "**Screen-space reflections fail where the screen lacks the reflection**: without a \
          fallback, `ssr`'s FLIP over the mirror pixels of the mirror room ranges {} to {} over \
          {} camera turns, rank-correlated with the share of reflections off screen (Spearman's \
-         ρ {:.2}; {}, one-bounce truth; [figure](engine_reflections_ssr_room/ssr_offscreen.svg)).",
+         ρ {:.2}; {}, {}, one-bounce truth; [figure](engine_reflections_ssr_room/ssr_offscreen.svg)).",
         sci(lo),
         sci(hi),
         none.len(),
         rho,
+        measured_at(&s),
         s.info.adapter
     ))
 }
@@ -418,11 +436,18 @@ fn symmetry(reports: &Path) -> Result<String, ReadmeError> {
     let pruning = group(PRUNED_METHOD)
         .and_then(pruning_sentence)
         .map_or(String::new(), |p| format!("; {}", p.trim_end_matches('.')));
+    // The like-for-like comparison of the culling: the pruned copies' time at the same p
+    // (most of the baked mesh's lead is the cells it leaves out).
+    let pruned_ms = group(PRUNED_METHOD)
+        .and_then(|g| g.points.iter().find(|p| p.planes() == b.planes()))
+        .map_or(String::new(), |p| {
+            format!(", taking {} ms there", ms(p.ms_median, 2))
+        });
     Ok(format!(
         "**Symmetry planes: the CPU's split-and-mirror mesh against the seed's 2^p copies** — at \
          p = {}, drawing the baked mesh once (`{BAKED_METHOD}`, {} ms) is {:.0}× [{:.0}–{:.0}×] \
          as fast as the seed's instanced copies (`{SEED_METHOD}`, {} ms), paired by round: {} \
-         (one run){pruning} ({}, {}; [figure](symmetry_scaling/plot_ms_vs_planes.svg)).",
+         (one run){pruning}{pruned_ms} ({}, {}, {}; [figure](symmetry_scaling/plot_ms_vs_planes.svg)).",
         b.planes().unwrap_or(0),
         ms(b.ms_median, 2),
         o.ms_median / b.ms_median,
@@ -431,6 +456,7 @@ fn symmetry(reports: &Path) -> Result<String, ReadmeError> {
         ms(o.ms_median, 2),
         table1::speed_verdict(i),
         s.info.scene,
+        measured_at(&s),
         s.info.adapter
     ))
 }
@@ -442,8 +468,10 @@ fn stereo(reports: &Path) -> Result<String, ReadmeError> {
         ReadmeError("reports/stereo holds no per-eye and shared pair with a marker".into())
     })?;
     Ok(format!(
-        "**Stereo: sharing one set of mirror textures between the eyes flattens the mirror** — {sentence} ({}, {}; [figure](stereo/plot_stereo_disparity_vs_ipd.svg)).",
-        s.info.scene, s.info.adapter
+        "**Stereo: sharing one set of mirror textures between the eyes flattens the mirror** — {sentence} ({}, {}, {}; [figure](stereo/plot_stereo_disparity_vs_ipd.svg)).",
+        s.info.scene,
+        measured_at(&s),
+        s.info.adapter
     ))
 }
 
@@ -456,9 +484,10 @@ fn lighting(reports: &Path) -> Result<String, ReadmeError> {
         .find(|t| t.starts_with("The error of ignoring mirrored light"))
         .ok_or_else(|| ReadmeError("reports/lighting holds no k sweep of lights=direct".into()))?;
     Ok(format!(
-        "**Light through mirrors matters** (FLIP over the image): {} ({}, {}; [figure](lighting/plot_lighting_error_vs_k.svg)).",
+        "**Light through mirrors matters** (FLIP over the image): {} ({}, {}, {}; [figure](lighting/plot_lighting_error_vs_k.svg)).",
         lowercase_first(grows.trim_end_matches('.')),
         s.info.scene,
+        measured_at(&s),
         s.info.adapter
     ))
 }
@@ -470,11 +499,36 @@ fn uneven(reports: &Path) -> Result<String, ReadmeError> {
         .pop()
         .ok_or_else(|| ReadmeError("reports/uneven_mirrors holds no tilt".into()))?;
     Ok(format!(
-        "**Uneven mirrors: how far the engines' tricks stay from the truth** (FLIP over the image) — {} ({}, {}; [figure](uneven_mirrors/plot_uneven_error_vs_tilt.svg)).",
+        "**Uneven mirrors: how far the engines' tricks stay from the truth** (FLIP over the image) — {} ({}, {}, {}; [figure](uneven_mirrors/plot_uneven_error_vs_tilt.svg)).",
         lowercase_first(steepest.trim_end_matches('.')),
         s.info.scene,
+        measured_at(&s),
         s.info.adapter
     ))
+}
+
+/// Where a sweep's points were measured, as a finding's closing parenthesis says it: the
+/// image size and the α its points share (`320x180, α = 0.9`), so that no finding's numbers
+/// read as the scene file's own size or α.
+fn measured_at(s: &Sweep) -> String {
+    let size = s
+        .info
+        .resolution
+        .split(',')
+        .next()
+        .unwrap_or_default()
+        .trim()
+        .to_string();
+    let alphas = mirrorbox_report::document::distinct(
+        s.records
+            .iter()
+            .filter(|r| r.kind == "point")
+            .map(|r| r.alpha_text()),
+    );
+    match alphas.as_slice() {
+        [a] => format!("{size}, α = {a}"),
+        _ => size,
+    }
 }
 
 /// A report's sentence continued after a dash or colon: its first letter in lower case.

@@ -282,9 +282,16 @@ impl RunsVerdict {
             RunsVerdict::Agree {
                 verdict,
                 shared: Some((low, high)),
-            } => format!(
-                "{verdict} in all {runs} runs, their paired intervals sharing {low:.2}–{high:.2}×"
-            ),
+            } => {
+                // Enough decimals to tell the ends apart ("1.38–1.38×" had said nothing).
+                let d = (2..=4)
+                    .find(|&d| format!("{low:.d$}") != format!("{high:.d$}"))
+                    .unwrap_or(2);
+                format!(
+                    "{verdict} in all {runs} runs, their paired intervals sharing \
+                     {low:.d$}–{high:.d$}×"
+                )
+            }
             RunsVerdict::Agree {
                 verdict,
                 shared: None,
@@ -312,6 +319,14 @@ mod tests {
         assert_eq!(speed_verdict(i(1.1, 1.3)), "faster");
         assert_eq!(speed_verdict(i(0.7, 0.9)), "slower");
         assert_eq!(speed_verdict(i(0.9, 1.1)), "not shown apart");
+        // Ends that two decimals would print alike get more (the H200's "1.38–1.38×").
+        assert!(
+            RunsVerdict::of(&[i(1.3806, 1.3822), i(1.3801, 1.3830)])
+                .sentence(2)
+                .ends_with("sharing 1.381–1.382×"),
+            "{}",
+            RunsVerdict::of(&[i(1.3806, 1.3822), i(1.3801, 1.3830)]).sentence(2)
+        );
         let agree = RunsVerdict::of(&[i(1.2, 1.5), i(1.4, 1.9)]);
         assert_eq!(
             agree.sentence(2),
