@@ -114,10 +114,15 @@ pub fn export(
         refused: false,
     })?;
     let mut staged = StagedFiles::new();
-    let result = export_staged(scene, xml_path, &mesh_dir, settings, &mut staged)
-        .and_then(|()| staged.commit());
+    let result = match export_staged(scene, xml_path, &mesh_dir, settings, &mut staged) {
+        Ok(()) => staged.commit(),
+        Err(e) => {
+            drop(staged); // removes what it staged
+            Err(e)
+        }
+    };
     if result.is_err() && made_mesh_dir {
-        // Empty by now (the staged files are dropped with their temporary names).
+        // Empty by now: the staged files went with their temporary names.
         let _ = std::fs::remove_dir(&mesh_dir);
     }
     result
