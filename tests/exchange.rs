@@ -831,16 +831,19 @@ fn a_picture_upside_down_or_srgb_encoded_is_said_and_an_unreadable_one_refused()
         }
     }
     write(&good);
+    // Each refused exit 2, naming the file and why, and writing nothing.
+    let refused = |name: &str, says: &[&str]| {
+        let scored = tmp.path().join(name);
+        let out = run_score(&ex, &run, &scored, &[]);
+        assert_eq!(out.code, 2, "{name}: {}", out.stderr);
+        for s in says {
+            assert!(out.stderr.contains(s), "{name}: {s}: {}", out.stderr);
+        }
+        assert!(!scored.exists(), "{name}");
+    };
     // A JPEG beside it: a format score does not read.
     std::fs::write(variant.join("camera.jpg"), b"not read").unwrap();
-    let out = run_score(&ex, &run, &tmp.path().join("jpg"), &[]);
-    assert_eq!(out.code, 2, "{}", out.stderr);
-    assert!(
-        out.stderr
-            .contains("camera.jpg: a picture score does not read"),
-        "{}",
-        out.stderr
-    );
+    refused("jpg", &["camera.jpg: a picture score does not read"]);
     std::fs::remove_file(variant.join("camera.jpg")).unwrap();
     // A 16-bit PNG in its place.
     std::fs::remove_file(&exr).unwrap();
@@ -852,24 +855,10 @@ fn a_picture_upside_down_or_srgb_encoded_is_said_and_an_unreadable_one_refused()
     )
     .save(&png)
     .unwrap();
-    let out = run_score(&ex, &run, &tmp.path().join("s16"), &[]);
-    assert_eq!(out.code, 2, "{}", out.stderr);
-    assert!(
-        out.stderr.contains("a PNG is read as 8-bit RGB or RGBA")
-            && out.stderr.contains("camera.png"),
-        "{}",
-        out.stderr
-    );
-    assert!(!tmp.path().join("s16").exists());
+    refused("s16", &["a PNG is read as 8-bit RGB or RGBA", "camera.png"]);
     // Named in another case.
     std::fs::rename(&png, variant.join("Camera.PNG")).unwrap();
-    let out = run_score(&ex, &run, &tmp.path().join("case"), &[]);
-    assert_eq!(out.code, 2, "{}", out.stderr);
-    assert!(
-        out.stderr.contains("Camera.PNG differs only in case"),
-        "{}",
-        out.stderr
-    );
+    refused("case", &["Camera.PNG differs only in case"]);
     std::fs::remove_file(variant.join("Camera.PNG")).unwrap();
     // An EXR of unsigned integers.
     {
@@ -880,11 +869,5 @@ fn a_picture_upside_down_or_srgb_encoded_is_said_and_an_unreadable_one_refused()
             .to_file(&exr)
             .unwrap();
     }
-    let out = run_score(&ex, &run, &tmp.path().join("u32"), &[]);
-    assert_eq!(out.code, 2, "{}", out.stderr);
-    assert!(
-        out.stderr.contains("holds unsigned integers"),
-        "{}",
-        out.stderr
-    );
+    refused("u32", &["holds unsigned integers"]);
 }
