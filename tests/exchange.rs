@@ -841,9 +841,20 @@ fn a_picture_upside_down_or_srgb_encoded_is_said_and_an_unreadable_one_refused()
         }
         assert!(!scored.exists(), "{name}");
     };
-    // A JPEG beside it: a format score does not read.
+    // A JPEG beside it is no view's picture, and harmless.
     std::fs::write(variant.join("camera.jpg"), b"not read").unwrap();
-    refused("jpg", &["camera.jpg: a picture score does not read"]);
+    let out = run_score(&ex, &run, &tmp.path().join("beside"), &[]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    // The view's picture as a JPEG only: named.
+    std::fs::rename(&exr, tmp.path().join("kept.exr")).unwrap();
+    refused(
+        "jpg",
+        &[
+            "no image of view \"camera\"",
+            "camera.jpg is in a format score does not read",
+        ],
+    );
+    std::fs::rename(tmp.path().join("kept.exr"), &exr).unwrap();
     std::fs::remove_file(variant.join("camera.jpg")).unwrap();
     // A 16-bit PNG in its place.
     std::fs::remove_file(&exr).unwrap();
@@ -855,7 +866,7 @@ fn a_picture_upside_down_or_srgb_encoded_is_said_and_an_unreadable_one_refused()
     )
     .save(&png)
     .unwrap();
-    refused("s16", &["a PNG is read as 8-bit RGB or RGBA", "camera.png"]);
+    refused("s16", &["a PNG is read as 8 bits a channel", "camera.png"]);
     // Named in another case.
     std::fs::rename(&png, variant.join("Camera.PNG")).unwrap();
     refused("case", &["Camera.PNG differs only in case"]);

@@ -404,6 +404,8 @@ fn shown_commands(text: &str) -> Vec<(usize, String)> {
         } else if line.trim_start().starts_with("```") {
             spans(&mut paragraph, first_line, &mut out);
             fenced = !fenced;
+            // A block's last line ending in `\` continues nothing after the block.
+            continued.clear();
         } else if fenced {
             match line.trim_end().strip_suffix('\\') {
                 Some(head) => continued.push_str(head),

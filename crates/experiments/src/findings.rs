@@ -183,8 +183,8 @@ fn exact_speed(reports: &Path) -> Result<String, ReadmeError> {
 /// The runs' medians from `lo` to `hi`, with the decimals that tell them apart ("1.38× to
 /// 1.38×" had said nothing), or the one value where they agree to four.
 fn spread(lo: f64, hi: f64) -> String {
-    match (2..=4).find(|&d| format!("{lo:.d$}") != format!("{hi:.d$}")) {
-        Some(d) => format!("{lo:.d$}× to {hi:.d$}×"),
+    match mirrorbox_report::document::apart(lo, hi) {
+        Some((lo, hi)) => format!("{lo}× to {hi}×"),
         None => format!("all {lo:.2}×"),
     }
 }

@@ -1449,22 +1449,19 @@ pub fn run_sweep(
     // shown this configuration's points only, and `report` then all of them (the points of
     // an earlier configuration are marked as reused from an earlier run).
     let records = read_records(&results)?;
-    // A run that measured nothing keeps the description of the run that did: a resumed
-    // sweep had stamped the reused points with its own date and commit.
-    let kept = (summary.computed == 0)
-        .then(|| mirrorbox_report::folder::read_sweep_info(out).ok())
-        .flatten();
-    let info = match kept {
-        Some(info) => info,
-        None => {
-            let info = sweep_info(config, &gpu, (w, h), point_keys, unsupported);
-            write_atomically(
-                &out.join("sweep.json"),
-                serde_json::to_string_pretty(&info)?.as_bytes(),
-            )?;
-            info
-        }
-    };
+    // This run's description; where it measured nothing, with the date and commit of the
+    // run that measured the points (a resumed sweep had stamped them with its own). The rest
+    // is this run's: its command, shard and the methods its adapter left out.
+    let mut info = sweep_info(config, &gpu, (w, h), point_keys, unsupported);
+    if summary.computed == 0
+        && let Ok(before) = mirrorbox_report::folder::read_sweep_info(out)
+    {
+        (info.date, info.commit) = (before.date, before.commit);
+    }
+    write_atomically(
+        &out.join("sweep.json"),
+        serde_json::to_string_pretty(&info)?.as_bytes(),
+    )?;
     write_report(out, &info, &records, &config.sections)?;
     Ok(summary)
 }
@@ -1897,14 +1894,16 @@ mod tests {
         run_sweep(&config("mirror_box.json", 32, 1, 0.5), false, &mut |_| {}).unwrap();
         let results = out.path().join("sweep/results.jsonl");
         let before = std::fs::read(&results).unwrap();
-        // The same sweep again measures nothing, and keeps the description (date, commit,
-        // command) of the run that measured its points.
+        // The same sweep again measures nothing, and keeps the date and commit of the run
+        // that measured its points.
         let info = out.path().join("sweep/sweep.json");
-        let described = std::fs::read(&info).unwrap();
+        let described =
+            mirrorbox_report::folder::read_sweep_info(&info.with_file_name("")).unwrap();
         std::thread::sleep(std::time::Duration::from_millis(1100));
         let again = run_sweep(&config("mirror_box.json", 32, 1, 0.5), false, &mut |_| {}).unwrap();
         assert_eq!(again.computed, 0);
-        assert_eq!(std::fs::read(&info).unwrap(), described);
+        let now = mirrorbox_report::folder::read_sweep_info(&info.with_file_name("")).unwrap();
+        assert_eq!((now.date, now.commit), (described.date, described.commit));
         let mut taller = config("mirror_box.json", 32, 1, 0.5);
         taller.height = Some(20);
         let mut finer = config("mirror_box.json", 32, 1, 0.5);

@@ -458,21 +458,8 @@ fn variants(run: &Path) -> Result<Vec<(String, String, PathBuf)>, HarnessError> 
 /// view `c`): its view was misnamed, and it was skipped unsaid (a `timing.json` naming an
 /// unknown view is refused alike).
 fn check_no_stray_image(dir: &Path, views: &ViewsFile) -> Result<(), HarnessError> {
-    // Pictures in a format score does not read (a client writing JPEG) are refused, not
-    // left unread beside a missing view.
-    const UNREAD: [&str; 8] = ["jpg", "jpeg", "hdr", "tif", "tiff", "webp", "bmp", "pfm"];
     for e in std::fs::read_dir(dir).map_err(io(dir))? {
         let path = e.map_err(io(dir))?.path();
-        if path
-            .extension()
-            .is_some_and(|x| UNREAD.iter().any(|u| x.eq_ignore_ascii_case(u)))
-        {
-            return Err(refused(
-                &path,
-                "a picture score does not read: a view's picture is <view>.exr (linear \
-                 radiance) or <view>.png (8-bit sRGB)",
-            ));
-        }
         let image = path
             .extension()
             .is_some_and(|x| x.eq_ignore_ascii_case("exr") || x.eq_ignore_ascii_case("png"));
@@ -516,19 +503,50 @@ fn view_image(dir: &Path, view: &crate::exchange::ExportedView) -> Result<PathBu
     }
     let path = if exr.is_file() { exr } else { png };
     if !path.is_file() {
-        // Names are matched exactly: one that differs only in case is named (`Camera.EXR`).
+        // The view's picture under another name is named: one that differs only in case
+        // (`Camera.EXR`), or one in a format score does not read (a client's `camera.jpg`).
         let wanted = [format!("{}.exr", view.name), format!("{}.png", view.name)];
-        let near: Vec<String> = std::fs::read_dir(dir)
+        let names: Vec<String> = std::fs::read_dir(dir)
             .into_iter()
             .flatten()
             .flatten()
             .filter_map(|e| e.file_name().into_string().ok())
+            .collect();
+        let near: Vec<&String> = names
+            .iter()
             .filter(|n| wanted.iter().any(|w| w.eq_ignore_ascii_case(n)))
             .collect();
-        let hint = if near.is_empty() {
-            String::new()
+        let unread: Vec<&String> = names
+            .iter()
+            .filter(|n| {
+                n.rsplit_once('.').is_some_and(|(stem, ext)| {
+                    stem == view.name
+                        && !["exr", "png", "json"]
+                            .iter()
+                            .any(|k| ext.eq_ignore_ascii_case(k))
+                })
+            })
+            .collect();
+        let hint = if !near.is_empty() {
+            format!(
+                "; {} differs only in case",
+                near.iter()
+                    .map(|n| n.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )
+        } else if !unread.is_empty() {
+            format!(
+                "; {} is in a format score does not read (a picture is EXR, linear radiance, \
+                 or PNG, 8-bit sRGB)",
+                unread
+                    .iter()
+                    .map(|n| n.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )
         } else {
-            format!("; {} differs only in case", near.join(", "))
+            String::new()
         };
         return Err(refused(
             dir,

@@ -269,15 +269,18 @@ pub fn read_image(path: &Path) -> Result<RgbImage, ImageError> {
         reader.limits(limits);
         let decoded = reader.decode().map_err(|e| io_error(path, e))?;
         check_size(path, decoded.width(), decoded.height())?;
-        // 8-bit RGB or RGBA only: a 16-bit PNG had been cut to 8 bits and a grey one taken as
-        // colour, both without a word.
+        // 8-bit only (grey or colour, alpha ignored): a 16-bit PNG had been cut to 8 bits
+        // without a word.
         use image::ColorType;
-        if !matches!(decoded.color(), ColorType::Rgb8 | ColorType::Rgba8) {
+        if !matches!(
+            decoded.color(),
+            ColorType::Rgb8 | ColorType::Rgba8 | ColorType::L8 | ColorType::La8
+        ) {
             return Err(io_error(
                 path,
                 format!(
-                    "a PNG is read as 8-bit RGB or RGBA, sRGB-encoded (alpha ignored); this one \
-                     is {:?}",
+                    "a PNG is read as 8 bits a channel, sRGB-encoded (RGB, RGBA or grey; alpha \
+                     ignored); this one is {:?}",
                     decoded.color()
                 ),
             ));

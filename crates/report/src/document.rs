@@ -41,6 +41,14 @@ pub fn f(v: f64, digits: usize) -> String {
     }
 }
 
+/// `a` and `b` with the fewest decimals (2 to 4) that print them apart, or `None` where they
+/// agree to four: "1.38–1.38×" had said nothing of 1.3807 and 1.3813.
+pub fn apart(a: f64, b: f64) -> Option<(String, String)> {
+    (2..=4)
+        .find(|&d| format!("{a:.d$}") != format!("{b:.d$}"))
+        .map(|d| (format!("{a:.d$}"), format!("{b:.d$}")))
+}
+
 /// Decimals for a time: at least `digits`, and enough for three significant digits below 100
 /// (a GPU frame of 0.403 ms must not print as "0.4"), at most six.
 pub fn ms_digits(v: f64, digits: usize) -> usize {

@@ -530,7 +530,8 @@ impl Axis {
             let (a, b) = (lo.log10(), hi.log10());
             let pad = ((b - a) * 0.04).max(0.06);
             // Kept finite: a record's 1e300 padded to infinity had asked for 2^31 ticks.
-            lo = 10f64.powf(a - pad).max(f64::MIN_POSITIVE);
+            // (Down to the least subnormal: a value below f64::MIN_POSITIVE stays inside.)
+            lo = 10f64.powf(a - pad).max(f64::from_bits(1));
             hi = 10f64.powf(b + pad).min(f64::MAX);
         } else {
             let span = hi - lo;
@@ -1778,7 +1779,8 @@ impl Chart {
                 .or_else(|| {
                     // Through what is drawn over its own place, unless another labelled point
                     // is there too (whose label it would then be mistaken for).
-                    let alone = rivals.iter().all(|&m| m == (xx, yy) || !hides(m, (xx, yy)));
+                    // (The point itself is among the rivals: alone is one there.)
+                    let alone = rivals.iter().filter(|&&m| hides(m, (xx, yy))).count() <= 1;
                     place_label_away((xx, yy), r, lw, &taken, &others, alone)
                         .map(|(lx, ly, rect, leader)| ((lx, ly, rect), Some(leader)))
                 });
@@ -2191,6 +2193,7 @@ mod tests {
             (vec![f64::MAX], true),
             (vec![f64::MAX, -f64::MAX], false),
             (vec![1e20, 1e20 + 1e5], false),
+            (vec![1e-310, 1e-3], true),
             (vec![1e300], false),
         ] {
             let axis = Axis::new(values.iter().copied(), log);

@@ -289,15 +289,26 @@ pub fn write_report(
                 }
                 html.push_str("</tr><tr>");
                 for (cap, p) in images {
-                    // Bounded and regular: a FIFO named by a record had blocked the report.
-                    let png =
-                        mirrorbox_files::read_bounded(&dir.join(p), MAX_EMBEDDED_BYTES, "an image");
+                    // Bounded and regular (a FIFO named by a record had blocked the report), and
+                    // inside the folder once links are followed (`images/x.png` linking to
+                    // `/etc/passwd` is not embedded).
+                    let file = dir.join(p);
+                    let inside = match (std::fs::canonicalize(&file), std::fs::canonicalize(dir)) {
+                        (Ok(file), Ok(folder)) => file.starts_with(folder),
+                        _ => false,
+                    };
+                    let png = inside
+                        .then(|| {
+                            mirrorbox_files::read_bounded(&file, MAX_EMBEDDED_BYTES, "an image")
+                                .ok()
+                        })
+                        .flatten();
                     let src = match png {
-                        Ok(bytes) => format!(
+                        Some(bytes) => format!(
                             "data:image/png;base64,{}",
                             base64::engine::general_purpose::STANDARD.encode(bytes)
                         ),
-                        Err(_) => p.clone(),
+                        None => p.clone(),
                     };
                     let bar = if cap.starts_with("FLIP") || cap.contains(": FLIP") {
                         crate::image_rows::colour_bar_html()
@@ -425,7 +436,8 @@ fn csv_quoted(text: &str) -> String {
 const CSV_HEAD: &str = "kind,method,n,depth,alpha,width,height,ssaa,ms_median,ms_ci_low,ms_ci_high,ms_min,timing_order,timing_source,frames,passes,draws,texture_renders,reflections,\
      rmse,relmse,smape,max_abs,psnr,ssim,flip_mean,flip_p95,flip_p99,adapter,backend,scene,scene_hash,color_format,peak_memory_bytes,plan_ms,encode_ms,gpu_buffer_bytes,gpu_texture_bytes,method_options";
 const CSV_TAIL: &str = "marker_disparity_px,truth_marker_disparity_px,\
-     mirror_flip_mean,mirror_flip_p95,mirror_relmse,mirror_pixel_share,truncation_flip_mean,approximation_flip_mean,truncation_mirror_flip_mean,approximation_mirror_flip_mean,truncation_relmse,approximation_relmse";
+     mirror_flip_mean,truncation_flip_mean,approximation_flip_mean,truncation_mirror_flip_mean,approximation_mirror_flip_mean,truncation_relmse,approximation_relmse,\
+     mirror_flip_p95,mirror_relmse,mirror_pixel_share";
 
 /// `results.csv`: one row per point. The fixed columns every point has, then one column per
 /// scene axis ([`Record::axes`]: `planes`, `yaw_deg`, …) and per extra value
@@ -538,16 +550,17 @@ fn write_csv(path: &Path, records: &[Record]) -> Result<(), FileError> {
                 .and_then(|s| s.disparity(true))
                 .map_or(String::new(), |d| d.to_string()),
             mirror(|m| m.flip_mean),
-            mirror(|m| m.flip_p95),
-            mirror(|m| m.relmse),
-            r.mirror_pixel_share
-                .map_or(String::new(), |v| v.to_string()),
             split(r, |s| Some(s.truncation.flip_mean)),
             split(r, |s| Some(s.approximation.flip_mean)),
             split(r, |s| s.truncation_mirror.as_ref().map(|m| m.flip_mean)),
             split(r, |s| s.approximation_mirror.as_ref().map(|m| m.flip_mean)),
             split(r, |s| Some(s.truncation.relmse)),
             split(r, |s| Some(s.approximation.relmse)),
+            // After the split's columns, so that the earlier columns keep their places.
+            mirror(|m| m.flip_p95),
+            mirror(|m| m.relmse),
+            r.mirror_pixel_share
+                .map_or(String::new(), |v| v.to_string()),
         );
     }
     write_atomically(path, s.as_bytes())
@@ -1321,6 +1334,27 @@ pub(crate) mod tests {
                 other => panic!("{field} {image:?}: {other:?}"),
             }
         }
+    }
+
+    /// An image inside the folder is embedded in report.html; one that only links out of it
+    /// (`images/r.png` → a file elsewhere) is not: `report` had embedded a link's target.
+    #[test]
+    fn an_image_linking_out_of_the_folder_is_not_embedded() {
+        use base64::Engine;
+        let root = tempfile::tempdir().unwrap();
+        let dir = root.path().join("sweep");
+        std::fs::create_dir_all(dir.join("images")).unwrap();
+        std::fs::write(root.path().join("secret.png"), b"SECRET-OUTSIDE").unwrap();
+        std::os::unix::fs::symlink(root.path().join("secret.png"), dir.join("images/r.png"))
+            .unwrap();
+        std::fs::write(dir.join("images/t.png"), b"INSIDE-TRUTH").unwrap();
+        let mut r = record(0, 1.0, 3, 0.1);
+        (r.raster_image, r.truth_image) = ("images/r.png".into(), "images/t.png".into());
+        write_report(&dir, &SweepInfo::default(), &[r], &[]).unwrap();
+        let html = std::fs::read_to_string(dir.join("report.html")).unwrap();
+        let b64 = |b: &[u8]| base64::engine::general_purpose::STANDARD.encode(b);
+        assert!(html.contains(&b64(b"INSIDE-TRUTH")));
+        assert!(!html.contains(&b64(b"SECRET-OUTSIDE")));
     }
 
     /// A number no measurement can be (a negative time, α 5, a negative error) is refused

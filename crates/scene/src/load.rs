@@ -296,7 +296,7 @@ impl Checker<'_> {
         let frame = self.camera_frame(&FieldPath::root("camera"), &file.camera, &assets)?;
         let camera = self
             .camera(&FieldPath::root("camera"), &file.camera, &frame)
-            .map_err(|e| gltf_camera_error(e, file.camera.gltf.is_some()))?;
+            .map_err(|e| gltf_camera_error(e, &file.camera))?;
         let planes = self.symmetry_planes(&file.symmetry_planes)?;
         let symmetry = if planes.is_empty() {
             None
@@ -1286,14 +1286,20 @@ fn show(v: Vec3) -> String {
 
 /// A problem of the camera's frame where a glTF object's camera gave it (`camera.gltf`): the
 /// scene file has no `camera.position`, `look_at`, `up` or `fov_y_deg` to blame, so the
-/// error names `camera.index`, the glTF camera chosen, and which of its values is wrong.
-fn gltf_camera_error(e: SceneError, from_gltf: bool) -> SceneError {
+/// error names the field that chose the camera (`camera.index`, or `camera.gltf` where the
+/// index is left at 0) and which of the camera's values is wrong.
+fn gltf_camera_error(e: SceneError, camera: &CameraDesc) -> SceneError {
+    let chosen_by = if camera.index.is_some() {
+        "camera.index"
+    } else {
+        "camera.gltf"
+    };
     match e {
         SceneError::Invalid {
             file,
             path,
             message,
-        } if from_gltf
+        } if camera.gltf.is_some()
             && ["position", "look_at", "up", "fov_y_deg"]
                 .iter()
                 .any(|f| path == format!("camera.{f}")) =>
@@ -1301,7 +1307,7 @@ fn gltf_camera_error(e: SceneError, from_gltf: bool) -> SceneError {
             let value = path.trim_start_matches("camera.").to_string();
             SceneError::Invalid {
                 file,
-                path: "camera.index".into(),
+                path: chosen_by.into(),
                 message: format!("the glTF camera's {value} (camera.gltf's asset): {message}"),
             }
         }
@@ -1837,7 +1843,7 @@ mod tests {
         .unwrap_err()
         .to_string();
         assert!(
-            e.contains("camera.index: the glTF camera's position (camera.gltf's asset): must lie"),
+            e.contains("camera.gltf: the glTF camera's position (camera.gltf's asset): must lie"),
             "{e}"
         );
     }

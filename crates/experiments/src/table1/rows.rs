@@ -284,13 +284,11 @@ impl RunsVerdict {
                 shared: Some((low, high)),
             } => {
                 // Enough decimals to tell the ends apart ("1.38–1.38×" had said nothing).
-                let d = (2..=4)
-                    .find(|&d| format!("{low:.d$}") != format!("{high:.d$}"))
-                    .unwrap_or(2);
-                format!(
-                    "{verdict} in all {runs} runs, their paired intervals sharing \
-                     {low:.d$}–{high:.d$}×"
-                )
+                let shared = match mirrorbox_report::document::apart(*low, *high) {
+                    Some((low, high)) => format!("{low}–{high}×"),
+                    None => format!("{low:.2}×"),
+                };
+                format!("{verdict} in all {runs} runs, their paired intervals sharing {shared}")
             }
             RunsVerdict::Agree {
                 verdict,
