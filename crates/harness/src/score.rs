@@ -503,51 +503,7 @@ fn view_image(dir: &Path, view: &crate::exchange::ExportedView) -> Result<PathBu
     }
     let path = if exr.is_file() { exr } else { png };
     if !path.is_file() {
-        // The view's picture under another name is named: one that differs only in case
-        // (`Camera.EXR`), or one in a format score does not read (a client's `camera.jpg`).
-        let wanted = [format!("{}.exr", view.name), format!("{}.png", view.name)];
-        let names: Vec<String> = std::fs::read_dir(dir)
-            .into_iter()
-            .flatten()
-            .flatten()
-            .filter_map(|e| e.file_name().into_string().ok())
-            .collect();
-        let near: Vec<&String> = names
-            .iter()
-            .filter(|n| wanted.iter().any(|w| w.eq_ignore_ascii_case(n)))
-            .collect();
-        let unread: Vec<&String> = names
-            .iter()
-            .filter(|n| {
-                n.rsplit_once('.').is_some_and(|(stem, ext)| {
-                    stem == view.name
-                        && !["exr", "png", "json"]
-                            .iter()
-                            .any(|k| ext.eq_ignore_ascii_case(k))
-                })
-            })
-            .collect();
-        let hint = if !near.is_empty() {
-            format!(
-                "; {} differs only in case",
-                near.iter()
-                    .map(|n| n.as_str())
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            )
-        } else if !unread.is_empty() {
-            format!(
-                "; {} is in a format score does not read (a picture is EXR, linear radiance, \
-                 or PNG, 8-bit sRGB)",
-                unread
-                    .iter()
-                    .map(|n| n.as_str())
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            )
-        } else {
-            String::new()
-        };
+        let hint = picture_elsewhere(dir, &view.name);
         return Err(refused(
             dir,
             format!(
@@ -558,6 +514,48 @@ fn view_image(dir: &Path, view: &crate::exchange::ExportedView) -> Result<PathBu
     }
     check_view_picture(&path, view).map_err(HarnessError::Exchange)?;
     Ok(path)
+}
+
+/// Where `dir` has no picture of view `name`, the one it has under another name, as a hint
+/// for the refusal: one that differs only in case (`Camera.EXR`), or one in a format score
+/// does not read (a client's `camera.jpg`); empty where there is none.
+fn picture_elsewhere(dir: &Path, name: &str) -> String {
+    let wanted = [format!("{name}.exr"), format!("{name}.png")];
+    let names: Vec<String> = std::fs::read_dir(dir)
+        .into_iter()
+        .flatten()
+        .flatten()
+        .filter_map(|e| e.file_name().into_string().ok())
+        .collect();
+    let near: Vec<&str> = names
+        .iter()
+        .map(String::as_str)
+        .filter(|n| wanted.iter().any(|w| w.eq_ignore_ascii_case(n)))
+        .collect();
+    if !near.is_empty() {
+        return format!("; {} differs only in case", near.join(", "));
+    }
+    let unread: Vec<&str> = names
+        .iter()
+        .map(String::as_str)
+        .filter(|n| {
+            n.rsplit_once('.').is_some_and(|(stem, ext)| {
+                stem == name
+                    && !["exr", "png", "json"]
+                        .iter()
+                        .any(|k| ext.eq_ignore_ascii_case(k))
+            })
+        })
+        .collect();
+    if unread.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "; {} is in a format score does not read (a picture is EXR, linear radiance, or \
+             PNG, 8-bit sRGB)",
+            unread.join(", ")
+        )
+    }
 }
 
 /// Checks the image at `path` as a picture of `view`'s radiance: readable, the view's size

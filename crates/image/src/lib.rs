@@ -324,7 +324,16 @@ fn png_size(path: &Path) -> Result<(u32, u32), ImageError> {
 /// The first layer's size (the one [`read_image`] reads); every layer's is checked against
 /// the limits.
 fn exr_size(path: &Path) -> Result<(u32, u32), ImageError> {
-    let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| io_error(path, e))?;
+    sized(path, &exr_meta(path)?)
+}
+
+/// An EXR's header, read once for its size and its channels' sample types.
+fn exr_meta(path: &Path) -> Result<exr::meta::MetaData, ImageError> {
+    exr::meta::MetaData::read_from_file(path, false).map_err(|e| io_error(path, e))
+}
+
+/// [`exr_size`] of a header read.
+fn sized(path: &Path, meta: &exr::meta::MetaData) -> Result<(u32, u32), ImageError> {
     let mut first = None;
     for header in &meta.headers {
         let size = header.layer_size;
@@ -363,8 +372,12 @@ fn check_size(path: &Path, width: u32, height: u32) -> Result<(), ImageError> {
 /// where any is half. Unsigned-integer channels are refused: read as floats they had been
 /// scored as radiance.
 pub fn exr_rgb_samples(path: &Path) -> Result<&'static str, ImageError> {
+    rgb_samples(path, &exr_meta(path)?)
+}
+
+/// [`exr_rgb_samples`] of a header read.
+fn rgb_samples(path: &Path, meta: &exr::meta::MetaData) -> Result<&'static str, ImageError> {
     use exr::meta::attribute::SampleType;
-    let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| io_error(path, e))?;
     let header = meta
         .headers
         .first()
@@ -396,8 +409,9 @@ pub fn exr_rgb_samples(path: &Path) -> Result<&'static str, ImageError> {
 fn read_exr(path: &Path) -> Result<RgbImage, ImageError> {
     use exr::prelude::*;
     // The header first: the size it claims is checked before any pixel is allocated.
-    exr_size(path)?;
-    exr_rgb_samples(path)?;
+    let meta = exr_meta(path)?;
+    sized(path, &meta)?;
+    rgb_samples(path, &meta)?;
     let image = read_first_rgba_layer_from_file(
         path,
         |size, _| RgbImage::new(size.width() as u32, size.height() as u32),
