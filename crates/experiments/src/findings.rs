@@ -92,12 +92,11 @@ fn exact_error(reports: &Path) -> Result<String, ReadmeError> {
         .map(|((device, s, aux, portal), r)| {
             // When and from which code each run is: the runs compared can be days and many
             // commits apart, and the exact method's small error moves with both.
-            let when = s.info.date.get(..10).unwrap_or(&s.info.date);
-            let commit = s.info.commit.get(..7).unwrap_or(&s.info.commit);
             format!(
-                "on {device} {r:.0}× (`portal` {}, `auxiliary` {}; measured {when} at {commit})",
+                "on {device} {r:.0}× (`portal` {}, `auxiliary` {}; {})",
                 sci(portal.mirror_flip()),
-                sci(aux.mirror_flip())
+                sci(aux.mirror_flip()),
+                day_and_commit(s)
             )
         })
         .collect();
@@ -365,13 +364,15 @@ fn bounce_cost(reports: &Path) -> Result<String, ReadmeError> {
         let bent = g.bent().map_or(String::new(), |h| {
             format!("; an average: {}", h.describe(2))
         });
+        // Each device's run its own day and code: the two are not one experiment.
         parts.push(format!(
-            "{} ms [{}–{}] on {device} ({:.1} % of its {} ms full-scene pass{bent})",
+            "{} ms [{}–{}] on {device} ({:.1} % of its {} ms full-scene pass{bent}; {})",
             ms(per_bounce, 2),
             ms(i.low, 2),
             ms(i.high, 2),
             100.0 * per_bounce / pass,
-            ms(pass, 2)
+            ms(pass, 2),
+            day_and_commit(&s)
         ));
     }
     Ok(format!(
@@ -398,10 +399,25 @@ fn ssr_offscreen(reports: &Path) -> Result<String, ReadmeError> {
     })?;
     let lo = none.iter().map(|p| p.1).fold(f64::INFINITY, f64::min);
     let hi = none.iter().map(|p| p.1).fold(0.0, f64::max);
+    // The turns' span, so that a reader sees what "camera turns" covered.
+    let yaws: Vec<f64> = s
+        .records
+        .iter()
+        .filter(|r| r.method == "ssr" && r.option("ssr-fallback") == Some("none"))
+        .filter_map(|r| r.axis(mirrorbox_report::axis::YAW_DEG))
+        .collect();
+    let span = match (
+        yaws.iter().copied().reduce(f64::min),
+        yaws.iter().copied().reduce(f64::max),
+    ) {
+        // A true minus sign, as the other findings print theirs.
+        (Some(a), Some(b)) if a < b => format!(" from {a}° to {b}°").replace('-', "−"),
+        _ => String::new(),
+    };
     Ok(format!(
         "**Screen-space reflections fail where the screen lacks the reflection**: without a \
          fallback, `ssr`'s FLIP over the mirror pixels of the mirror room ranges {} to {} over \
-         {} camera turns, rank-correlated with the share of reflections off screen (Spearman's \
+         {} camera turns{span}, rank-correlated with the share of reflections off screen (Spearman's \
          ρ {:.2}; {}, {}, one-bounce truth; [figure](engine_reflections_ssr_room/ssr_offscreen.svg)).",
         sci(lo),
         sci(hi),
@@ -413,7 +429,9 @@ fn ssr_offscreen(reports: &Path) -> Result<String, ReadmeError> {
 }
 
 /// Baking the symmetry copies on the CPU against the seed's instanced copies, paired by
-/// round at the most planes measured, and how many copies pruning keeps.
+/// round at the most planes measured, and how many copies pruning keeps. Times to three
+/// significant digits: the paired interval spans tens of per cent, and "1714.77 ms" claimed
+/// more than the run measured.
 fn symmetry(reports: &Path) -> Result<String, ReadmeError> {
     use crate::symmetry_scaling::planes::{
         BAKED_METHOD, PRUNED_METHOD, SEED_METHOD, plane_scaling, pruning_sentence,
@@ -446,7 +464,7 @@ fn symmetry(reports: &Path) -> Result<String, ReadmeError> {
     let pruned_ms = group(PRUNED_METHOD)
         .and_then(|g| g.points.iter().find(|p| p.planes() == b.planes()))
         .map_or(String::new(), |p| {
-            format!(", taking {} ms there", ms(p.ms_median, 2))
+            format!(", taking {} ms there", ms(p.ms_median, 0))
         });
     Ok(format!(
         "**Symmetry planes: the CPU's split-and-mirror mesh against the seed's 2^p copies** — at \
@@ -454,11 +472,11 @@ fn symmetry(reports: &Path) -> Result<String, ReadmeError> {
          as fast as the seed's instanced copies (`{SEED_METHOD}`, {} ms), paired by round: {} \
          (one run){pruning}{pruned_ms} ({}, {}, {}; [figure](symmetry_scaling/plot_ms_vs_planes.svg)).",
         b.planes().unwrap_or(0),
-        ms(b.ms_median, 2),
+        ms(b.ms_median, 0),
         o.ms_median / b.ms_median,
         i.low,
         i.high,
-        ms(o.ms_median, 2),
+        ms(o.ms_median, 0),
         table1::speed_verdict(i),
         s.info.scene,
         measured_at(&s),
@@ -515,6 +533,14 @@ fn uneven(reports: &Path) -> Result<String, ReadmeError> {
 /// Where a sweep's points were measured, as a finding's closing parenthesis says it: the
 /// image size and the α its points share (`320x180, α = 0.9`), so that no finding's numbers
 /// read as the scene file's own size or α.
+/// "measured DAY at COMMIT": when a run was made and from which code, for findings that set
+/// runs of different days side by side.
+fn day_and_commit(s: &Sweep) -> String {
+    let day = s.info.date.get(..10).unwrap_or(&s.info.date);
+    let commit = s.info.commit.get(..7).unwrap_or(&s.info.commit);
+    format!("measured {day} at {commit}")
+}
+
 fn measured_at(s: &Sweep) -> String {
     let size = s
         .info
