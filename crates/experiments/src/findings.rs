@@ -342,7 +342,7 @@ fn bounce_cost(reports: &Path) -> Result<String, ReadmeError> {
     ] {
         let s = load(reports, folder)?;
         let groups = crate::depth_scaling::exact::depth_scaling(&s.info.exact_methods, &s.records);
-        let floor = s.records.iter().find(|r| r.kind == "floor");
+        let floor = Record::our_floor(&s.records);
         let Some(g) = groups
             .iter()
             .find(|g| g.method == "portal" && g.variant.is_empty())

@@ -567,6 +567,15 @@ impl Record {
             .map_or(self.metrics.flip_mean, |m| m.flip_mean)
     }
 
+    /// Our own floor among `records` (the scene without mirrors, rendered by us): a scored
+    /// folder holds the clients' floors too, and the first floor found had been a client's
+    /// (a web report's "one full-scene pass" was Babylon's wall-clock time).
+    pub fn our_floor(records: &[Record]) -> Option<&Record> {
+        records
+            .iter()
+            .find(|r| r.kind == "floor" && !r.is_external())
+    }
+
     /// A variant an outside renderer drew, scored through the exchange (`mirrorbox score`).
     pub fn is_external(&self) -> bool {
         self.timing_order == EXTERNAL_TIMING

@@ -9,7 +9,7 @@ use mirrorbox_report::{Record, Sweep, SweepInfo, load_sweep};
 /// The section: every sweep's records are offered it; empty where no exact method was swept
 /// over depth.
 pub fn section(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
-    let floor = records.iter().find(|r| r.kind == "floor");
+    let floor = Record::our_floor(records);
     depth_scaling(info, records, floor)
 }
 
@@ -121,7 +121,7 @@ pub fn depth_scaling(info: &SweepInfo, records: &[Record], floor: Option<&Record
 
 /// The depth-scaling section's cost per bounce (and with `table`, every point).
 fn depth_scaling_region(s: &Sweep, table: bool) -> Result<String, ReadmeError> {
-    let floor = s.records.iter().find(|r| r.kind == "floor");
+    let floor = Record::our_floor(&s.records);
     let section = prose(depth_scaling(&s.info, &s.records, floor));
     let bullets: Vec<Block> = section
         .into_iter()
@@ -162,3 +162,42 @@ pub const REGIONS: &[RegionSource] = &[
         generate: |reports| region_of(reports, "depth_scaling", true),
     },
 ];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use mirrorbox_report::document::fixtures::record;
+
+    /// "One full-scene pass" is our floor's time: a scored folder lists the clients' floors
+    /// too, and the first of them (Babylon's 2.10 ms, wall clock) had stood for ours.
+    #[test]
+    fn a_pass_is_our_floor_not_a_clients() {
+        let point = |depth: u32| {
+            let mut r = record(0, 10.0 + 0.5 * depth as f64, 1, 0.01);
+            r.method = "unrolled".into();
+            r.depth = Some(depth);
+            r.reflections = depth as usize;
+            r
+        };
+        let floor = |ms: f64, external: bool| {
+            let mut r = record(0, ms, 1, 0.0);
+            r.kind = "floor".into();
+            r.method = "floor".into();
+            if external {
+                r.timing_order = mirrorbox_report::EXTERNAL_TIMING.into();
+            }
+            r
+        };
+        let info = SweepInfo {
+            exact_methods: vec!["unrolled".into()],
+            ..Default::default()
+        };
+        let mut records = vec![floor(2.1, true), floor(5.0, false)];
+        records.extend([1, 4, 16, 64].map(point));
+        let text = mirrorbox_report::document::markdown(&section(&info, &records));
+        assert!(
+            text.contains("takes 5.00 ms, so one more bounce costs 10.0 %"),
+            "{text}"
+        );
+    }
+}

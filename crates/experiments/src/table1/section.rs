@@ -226,7 +226,7 @@ pub fn table1_region(s: &Sweep) -> Result<String, ReadmeError> {
         return Err(not_the_papers(s));
     }
     blocks.extend(section);
-    if let Some(fl) = s.records.iter().find(|r| r.kind == "floor") {
+    if let Some(fl) = Record::our_floor(&s.records) {
         blocks.push(floor_paragraph(fl));
     }
     Ok(markdown(&blocks))
@@ -240,7 +240,7 @@ fn table1_summary_region(s: &Sweep) -> Result<String, ReadmeError> {
         .rfind(|b| matches!(b, Block::Table(..)))
         .ok_or_else(|| not_the_papers(s))?;
     let mut blocks = vec![Block::Paragraph(measured_on(s)), table];
-    if let Some(fl) = s.records.iter().find(|r| r.kind == "floor") {
+    if let Some(fl) = Record::our_floor(&s.records) {
         blocks.push(floor_paragraph(fl));
     }
     Ok(markdown(&blocks))

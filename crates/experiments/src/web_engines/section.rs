@@ -28,6 +28,17 @@ fn clock(r: &Record) -> String {
     short(t, 40)
 }
 
+/// `r`'s time as a multiple of `floor`'s, the same renderer's pass without mirrors at the same
+/// size on the same clock. Across renderers only this compares: on one device (SwiftShader)
+/// the browser's wall clock and our GPU timestamps put the same no-mirror pass 3–6× apart.
+fn passes(r: &Record, floor: Option<&Record>) -> Option<f64> {
+    floor
+        .filter(|fl| {
+            fl.ms_median > 0.0 && (fl.width, fl.height, fl.ssaa) == (r.width, r.height, r.ssaa)
+        })
+        .map(|fl| r.ms_median / fl.ms_median)
+}
+
 /// The view an external record was drawn from ("" where its key names none).
 fn view_of(r: &Record) -> &str {
     r.scored_view().unwrap_or_default()
@@ -55,9 +66,7 @@ pub fn section(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
         .iter()
         .filter(|r| !r.is_external() && r.kind == "point")
         .collect();
-    let our_floor = records
-        .iter()
-        .find(|r| !r.is_external() && r.kind == "floor");
+    let our_floor = Record::our_floor(records);
     let mut rows = Vec::new();
     let mut findings = Vec::new();
     for r in &variants {
@@ -90,15 +99,24 @@ pub fn section(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
             [one] => Some(*one),
             _ => None,
         };
-        // The best of our exact methods that costs no more on its own device.
+        // The best of our exact methods that costs no more: in passes of each side's own floor
+        // where both floors were measured, else in ms where both times are of one clock;
+        // otherwise the costs do not compare and nothing is said.
+        let variant_passes = passes(r, floor);
+        let by_passes =
+            variant_passes.is_some() && ours.iter().any(|o| passes(o, our_floor).is_some());
+        let comparable = by_passes || ours.iter().any(|o| clock(o) == clock(r));
+        let costs_no_more = |o: &Record| match (variant_passes, passes(o, our_floor)) {
+            (Some(v), Some(p)) => p <= v,
+            _ => !by_passes && clock(o) == clock(r) && o.ms_median <= r.ms_median,
+        };
         let exact = ours
             .iter()
-            .filter(|o| {
-                at_our_camera
-                    && info.exact_methods.contains(&o.method)
-                    && o.ms_median <= r.ms_median
-            })
+            .filter(|o| at_our_camera && info.exact_methods.contains(&o.method) && costs_no_more(o))
             .min_by(|a, b| a.mirror_flip().total_cmp(&b.mirror_flip()));
+        let in_passes = |x: Option<f64>, whose: &str| {
+            x.map_or(String::new(), |x| format!(", {}× {whose} floor", f(x, 2)))
+        };
         rows.push(vec![
             label(r),
             short(&r.adapter, 60),
@@ -173,27 +191,44 @@ pub fn section(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
                 s.push_str(&format!(", ours {}", sci(of.metrics.flip_mean)));
             }
         }
-        s.push_str(&format!("; {} ms/frame ({})", f(r.ms_median, 3), clock(r)));
+        s.push_str(&format!(
+            "; {} ms/frame ({}{})",
+            f(r.ms_median, 3),
+            clock(r),
+            in_passes(variant_passes, "its")
+        ));
         if let Some(e) = eq {
             s.push_str(&format!(
-                " against our `{}`'s {} ms ({}) on {}",
+                " against our `{}`'s {} ms ({}{}) on {}",
                 mirrorbox_report::document::label(e),
                 f(e.ms_median, 3),
                 clock(e),
+                in_passes(passes(e, our_floor), "our"),
                 short(&e.adapter, 40)
             ));
         }
+        let measure = if by_passes {
+            " (in passes of each side's own floor)"
+        } else {
+            ""
+        };
         match exact {
             Some(e) => s.push_str(&format!(
-                "; at no more cost our `{}` reaches {}.",
+                "; at no more cost{measure} our `{}` reaches {}{}.",
                 mirrorbox_report::document::label(e),
-                sci(e.mirror_flip())
+                sci(e.mirror_flip()),
+                passes(e, our_floor)
+                    .map_or(String::new(), |p| format!(" at {}× our floor", f(p, 2)))
             )),
-            // Said only where our exact methods were measured beside it (`score --with`).
+            // Said only where our exact methods were measured beside it (`score --with`) and
+            // their cost compares with the variant's.
             None if at_our_camera
+                && comparable
                 && ours.iter().any(|o| info.exact_methods.contains(&o.method)) =>
             {
-                s.push_str("; none of our exact methods is as cheap.")
+                s.push_str(&format!(
+                    "; none of our exact methods is as cheap{measure}."
+                ))
             }
             None => s.push('.'),
         }
@@ -206,8 +241,12 @@ pub fn section(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
             "Each variant a client drew (`mirrorbox score`, docs/exchange.md), its client's \
              floor (the scene without mirrors: shading and rasterization alone), our \
              equivalent at the scene's own camera (the view our sweeps show), and the best of \
-             our exact methods that costs no more. Times come from different clocks where the devices or timing sources \
-             differ (named in each finding)."
+             our exact methods that costs no more. Times come from different clocks where the \
+             devices or timing sources differ (named in each finding), and two clocks on one \
+             device can put the same pass severalfold apart: so \"no more cost\" is counted in \
+             passes of each side's own floor (a variant's time over its client's floor, ours \
+             over our floor) where both floors were measured, and in ms only where one clock \
+             timed both."
                 .into(),
         ),
         Block::Table(
@@ -272,6 +311,70 @@ mod tests {
         portal.ms_median = 1.0;
         let cheaper = finding(&[variant.clone(), portal]);
         assert!(cheaper.contains("at no more cost our `portal"), "{cheaper}");
+    }
+
+    /// Across clocks, "no more cost" is counted in passes of each side's own floor: the
+    /// browser's wall clock put SwiftShader's no-mirror pass at 1.8 ms where our GPU
+    /// timestamps put it at 5.4 ms, and raw ms had made every exact method "too dear". With
+    /// no floors, times of two clocks are not compared at all.
+    #[test]
+    fn costs_across_clocks_compare_in_passes_of_each_floor() {
+        let mut variant = scored("three", "reflector", "camera", 0.05);
+        variant.ms_median = 8.0;
+        variant.timing_source = "wall clock (gl.finish)".into();
+        let mut client_floor = scored("three", "floor", "camera", 0.001);
+        client_floor.ms_median = 2.0;
+        client_floor.timing_source = variant.timing_source.clone();
+        let mut ours_floor = record(0, 5.0, 1, 0.001);
+        ours_floor.kind = "floor".into();
+        ours_floor.method = "floor".into();
+        let portal = |ms: f64| {
+            let mut r = record(0, ms, 1, 0.001);
+            r.method = "portal".into();
+            r
+        };
+        let find = |records: &[Record]| {
+            let info = SweepInfo {
+                exact_methods: vec!["portal".into()],
+                ..Default::default()
+            };
+            mirrorbox_report::document::markdown(&section(&info, records))
+        };
+        // 15 ms is 3 of our passes, the variant 4 of its own: no dearer.
+        let cheaper = find(&[
+            variant.clone(),
+            client_floor.clone(),
+            ours_floor.clone(),
+            portal(15.0),
+        ]);
+        assert!(
+            cheaper.contains("at no more cost (in passes of each side's own floor) our `portal")
+                && cheaper.contains("reaches 1.000e-3 at 3.00× our floor."),
+            "{cheaper}"
+        );
+        assert!(
+            cheaper.contains("8.000 ms/frame (wall clock, 4.00× its floor)"),
+            "{cheaper}"
+        );
+        // 25 ms is 5 passes: dearer, though fewer ms than nothing else would say.
+        let dearer = find(&[
+            variant.clone(),
+            client_floor.clone(),
+            ours_floor,
+            portal(25.0),
+        ]);
+        assert!(
+            dearer.contains(
+                "none of our exact methods is as cheap (in passes of each side's own floor)"
+            ),
+            "{dearer}"
+        );
+        // No floors and two clocks: no verdict, either way.
+        let apart = find(&[variant, portal(1.0)]);
+        assert!(
+            !apart.contains("no more cost our") && !apart.contains("as cheap"),
+            "{apart}"
+        );
     }
 
     /// With two views, each variant's row and finding name the view, and each takes the
