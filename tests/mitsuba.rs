@@ -69,8 +69,10 @@ fn both_of(
     ];
     // Whitted's cut counts reflections; path's counts segments (Mitsuba's max_depth), with
     // Russian roulette kept out of the comparison.
+    // Jittered, as render.py jitters Mitsuba's `path`: both then estimate the pixel's box
+    // filter over the pixel's area (the unjittered grid is a quadrature of its own).
     if integrator == "path" {
-        trace.extend(["--max-segments", depth, "--rr-from", "1000000"]);
+        trace.extend(["--max-segments", depth, "--rr-from", "1000000", "--jitter"]);
     } else {
         trace.extend(["--max-depth", depth]);
     }
@@ -234,10 +236,12 @@ fn block_differences(a: &RgbImage, b: &RgbImage, k: u32) -> Vec<f64> {
 /// Monte Carlo: the two image means must agree within a tolerance set by measured noise.
 /// At this size and 256 spp the image mean of one render varies by 0.020 % (ours) and
 /// 0.063 % (Mitsuba) between seeds (standard deviations over 4 seeds each, measured
-/// 2026-11-21), so one difference carries ~0.066 % of noise: the 1 % tolerance is ~15σ — a
-/// real disagreement of 1 % fails, noise never does. The block t statistic is printed as a
-/// diagnostic only: Mitsuba's sampler correlates neighbouring pixels, so blocks are not
-/// independent enough for a strict test (see docs/mitsuba.md for the open ~0.1 % question).
+/// 2026-11-21), so one difference carries ~0.066 % of noise: the 0.5 % tolerance is ~7σ — a
+/// real disagreement of 0.5 % fails, noise does not. The block t statistic is held loosely
+/// (|t| < 4.5): Mitsuba's sampler correlates neighbouring pixels, so blocks are not
+/// independent enough for a strict test. Both renderers jitter their samples (render.py's
+/// `path`, our `--jitter`): Mitsuba's unjittered sampler had put `mirror_room` 0.12 % low
+/// (docs/mitsuba.md).
 #[test]
 fn path_agrees_with_mitsuba_within_monte_carlo_noise() {
     let Some(py) = python() else { return };
@@ -363,4 +367,36 @@ fn uneven_mirrors_agree_with_mitsuba() {
             "{scene}: the bump changes little ({flat_mean} against {mean})"
         );
     }
+}
+
+/// `tools/mitsuba/agreement.py`, which writes docs/mitsuba.md's table, runs against the
+/// current CLI (it had called `trace` with flags since renamed, and failed on every scene).
+#[test]
+fn the_agreement_table_script_runs() {
+    let Some(py) = python() else { return };
+    let out = Command::new(&py)
+        .args([
+            "tools/mitsuba/agreement.py",
+            "scenes/single_mirror.json",
+            "--width",
+            "16",
+            "--height",
+            "12",
+            "--whitted-spp",
+            "1",
+            "--path-spp",
+            "4",
+            "--bin",
+            env!("CARGO_BIN_EXE_mirrorbox"),
+        ])
+        .current_dir(repo())
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(stdout.contains("| single_mirror.json | "), "{stdout}");
 }

@@ -13,7 +13,9 @@ Integrators:
                 area-emitter lookup only where the scene has area emitters.
   whitted-bsdf  the same contract in Mitsuba's general form (sampler draws for `bsdf.sample`,
                 `sample_direction` and `bsdf.eval` per light): the same image, kept to show it.
-  path          Mitsuba's own `path` integrator (adds diffuse interreflection; no ambient term).
+  path          Mitsuba's own `path` integrator (adds diffuse interreflection; no ambient term),
+                its stratified sampler jittered (unjittered, every dimension is a stratum's
+                centre: a fixed quadrature, biased).
 
 Writes a float32 RGB EXR and prints one JSON line with the timings. The first render of a
 JIT variant (llvm_*) includes kernel compilation; --runs K renders K more times and reports
@@ -169,13 +171,33 @@ def define_whitted_lean():
     mi.register_integrator("mirrorbox_whitted_lean", lambda props: WhittedLean(props))
 
 
+def refuse(message):
+    """Bad input: a clear message and exit 2, as mirrorbox's commands do."""
+    print(f"render.py: {message}", file=sys.stderr)
+    sys.exit(2)
+
+
 def main():
     args = parse_args()
+    # Our contract is RGB; a spectral variant would read every <rgb> as a spectrum.
+    if not args.variant.endswith("_rgb"):
+        refuse(f"--variant {args.variant}: an RGB variant (llvm_ad_rgb, scalar_rgb, ...)")
     mi.set_variant(args.variant)
     scene_dir = os.path.dirname(os.path.abspath(args.scene))
-    with open(os.path.join(scene_dir, "mirrorbox.json")) as f:
-        extra = json.load(f)
+    sidecar = os.path.join(scene_dir, "mirrorbox.json")
+    try:
+        with open(sidecar) as f:
+            extra = json.load(f)
+    except (OSError, ValueError) as e:
+        refuse(f"{sidecar}: cannot read the export's sidecar ({e}); export with `mirrorbox export-mitsuba`")
+    # The sidecar is the XML's own (one export per folder; exports before the field: unknown).
+    xml = os.path.basename(args.scene)
+    if extra.get("xml", xml) != xml:
+        refuse(f"{sidecar} belongs to {extra['xml']}, not {xml}: give each export a folder of its own")
     spp = args.spp or extra["spp"]
+    # The stratified sampler rounds to a square: the record must say what was rendered.
+    if spp < 1 or int(spp ** 0.5) ** 2 != spp:
+        refuse(f"--spp {spp}: a perfect square (1, 4, 9, 16, ...), as the stratified sampler takes")
     if args.integrator in ("whitted", "whitted-bsdf"):
         if args.integrator == "whitted":
             define_whitted_lean()
@@ -189,8 +211,12 @@ def main():
                 integrator[f"{name}_{c}"] = float(v)
     else:
         integrator = {"type": "path", "max_depth": args.max_depth, "rr_depth": args.rr_depth}
+    # `whitted` keeps the unjittered grid (ours, sample for sample); `path` needs jitter: the
+    # unjittered stratified sampler puts every random dimension at its strata's centres, a
+    # fixed quadrature that left mirror_room's image mean 0.12 % low (docs/mitsuba.md).
+    jitter = args.integrator == "path"
     t0 = time.perf_counter()
-    scene = mi.load_file(args.scene, spp=spp)
+    scene = mi.load_file(args.scene, spp=spp, jitter="true" if jitter else "false")
     load_seconds = time.perf_counter() - t0
     integrator = mi.load_dict(integrator)
 
@@ -203,12 +229,16 @@ def main():
 
     image, first = render()
     times = [render()[1] for _ in range(args.runs)] if args.runs > 0 else []
-    mi.Bitmap(image).write(args.output)
+    bitmap = mi.Bitmap(image)
+    # The camera's exposure, as `trace` records it: `mirrorbox compare` reads it from here.
+    bitmap.metadata()["mirrorbox.exposure"] = str(extra.get("exposure", 1.0))
+    bitmap.write(args.output)
+    width, height = scene.sensors()[0].film().crop_size()
     print(json.dumps({
         "output": args.output, "variant": args.variant, "integrator": args.integrator,
-        "spp": spp, "max_depth": args.max_depth,
+        "spp": spp, "jitter": jitter, "max_depth": args.max_depth,
         "rr_depth": args.rr_depth if args.integrator == "path" else None,
-        "width": extra["width"], "height": extra["height"],
+        "width": int(width), "height": int(height),
         "load_seconds": load_seconds, "first_render_seconds": first,
         "render_seconds": min(times) if times else first, "runs": len(times),
         "threads": os.cpu_count(),

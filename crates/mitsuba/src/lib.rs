@@ -106,6 +106,7 @@ pub fn export(
     settings: ExportSettings,
 ) -> Result<Vec<PathBuf>, FileError> {
     let dir = mirrorbox_files::folder_of(xml_path);
+    refuse_another_export(dir, xml_path)?;
     let mesh_dir = dir.join("meshes");
     let made_mesh_dir = !mesh_dir.is_dir();
     std::fs::create_dir_all(&mesh_dir).map_err(|e| FileError {
@@ -149,6 +150,11 @@ fn export_staged(
     );
     let _ = writeln!(xml, "<scene version=\"3.0.0\">");
     let _ = writeln!(xml, "  <default name=\"spp\" value=\"{}\"/>", settings.spp);
+    // Unjittered for `whitted`: its sub-pixel grid is then ours, sample for sample. `path`
+    // must load it with `jitter=true` (render.py does): unjittered, the stratified sampler
+    // gives every random dimension its strata's centres, a fixed quadrature whose error does
+    // not average out (`mirror_room`'s image mean 0.12 % low, docs/mitsuba.md).
+    let _ = writeln!(xml, "  <default name=\"jitter\" value=\"false\"/>");
     let _ = writeln!(xml, "  <default name=\"max_depth\" value=\"66\"/>");
     let _ = writeln!(
         xml,
@@ -162,7 +168,7 @@ fn export_staged(
          <float name=\"far_clip\" value=\"1000000\"/>\n    <transform name=\"to_world\">\n      \
          <lookat origin=\"{}\" target=\"{}\" up=\"{}\"/>\n    </transform>\n    \
          <sampler type=\"stratified\">\n      <integer name=\"sample_count\" value=\"$spp\"/>\n      \
-         <boolean name=\"jitter\" value=\"false\"/>\n    </sampler>\n    <film type=\"hdrfilm\">\n      \
+         <boolean name=\"jitter\" value=\"$jitter\"/>\n    </sampler>\n    <film type=\"hdrfilm\">\n      \
          <integer name=\"width\" value=\"{}\"/>\n      <integer name=\"height\" value=\"{}\"/>\n      \
          <string name=\"pixel_format\" value=\"rgb\"/>\n      \
          <string name=\"component_format\" value=\"float32\"/>\n      <rfilter type=\"box\"/>\n    \
@@ -305,6 +311,8 @@ fn export_staged(
     }
     let _ = writeln!(xml, "</scene>");
     let sidecar = serde_json::json!({
+        // The XML this sidecar belongs to: render.py refuses another's.
+        "xml": xml_name(xml_path),
         "scene": scene.source.display().to_string(),
         "scene_hash": format!("{:016x}", scene.content_hash()),
         "ambient": scene.lighting.ambient.to_array(),
@@ -322,6 +330,46 @@ fn export_staged(
         format!("{sidecar:#}\n").as_bytes(),
     )?;
     stage_bytes(staged, xml_path, xml.as_bytes())
+}
+
+/// The XML's file name, as the sidecar records it.
+fn xml_name(xml_path: &Path) -> String {
+    xml_path
+        .file_name()
+        .map_or(String::new(), |n| n.to_string_lossy().into_owned())
+}
+
+/// One export per folder: its `mirrorbox.json` and `meshes/` have fixed names, so a second
+/// XML written beside another would take the first one's sidecar and meshes (the first then
+/// rendered the second's scene, unsaid). Replacing the same XML is allowed.
+fn refuse_another_export(dir: &Path, xml_path: &Path) -> Result<(), FileError> {
+    let sidecar = dir.join("mirrorbox.json");
+    let Ok(text) = std::fs::read_to_string(&sidecar) else {
+        return Ok(());
+    };
+    let other = serde_json::from_str::<serde_json::Value>(&text)
+        .ok()
+        .and_then(|v| v.get("xml").and_then(|x| x.as_str()).map(String::from));
+    match other {
+        Some(other) if other == xml_name(xml_path) => Ok(()),
+        // An export from before the sidecar named its XML: which one is not known.
+        None if dir.join("meshes").is_dir() && !xml_path.is_file() => Err(FileError {
+            path: sidecar,
+            message: "this folder holds another export (its mirrorbox.json and meshes/ \
+                      would be replaced): give each export a folder of its own"
+                .into(),
+            refused: true,
+        }),
+        None => Ok(()),
+        Some(other) => Err(FileError {
+            path: sidecar,
+            message: format!(
+                "this folder holds the export of {other} (its mirrorbox.json and meshes/ \
+                 would be replaced): give each export a folder of its own"
+            ),
+            refused: true,
+        }),
+    }
 }
 
 fn stage_bytes(staged: &mut StagedFiles, path: &Path, bytes: &[u8]) -> Result<(), FileError> {
@@ -527,5 +575,36 @@ mod tests {
                 .unwrap()
                 .all(|e| { !e.unwrap().path().to_string_lossy().ends_with(".tmp") })
         );
+    }
+
+    /// A second XML in a folder that holds an export is refused, naming the first (both
+    /// share `mirrorbox.json` and `meshes/`: the first had rendered the second's scene); the
+    /// same XML again replaces it.
+    #[test]
+    fn a_folder_holds_one_export() {
+        let scene = mirrorbox_scene::load::bundled_scene("single_mirror.json");
+        let dir = tempfile::tempdir().unwrap();
+        let settings = || ExportSettings { spp: 4 };
+        export(&scene, &dir.path().join("a.xml"), settings()).unwrap();
+        export(&scene, &dir.path().join("a.xml"), settings()).expect("the same XML again");
+        let e = export(&scene, &dir.path().join("b.xml"), settings()).unwrap_err();
+        assert!(
+            e.refused && e.to_string().contains("the export of a.xml"),
+            "{e}"
+        );
+        assert!(!dir.path().join("b.xml").exists());
+    }
+
+    /// The sampler's jitter is a default the renderer sets: off for `whitted` (our grid),
+    /// on for `path` (render.py), never written as a fixed `false`.
+    #[test]
+    fn the_samplers_jitter_is_a_parameter() {
+        let scene = mirrorbox_scene::load::bundled_scene("single_mirror.json");
+        let dir = tempfile::tempdir().unwrap();
+        let xml = dir.path().join("scene.xml");
+        export(&scene, &xml, ExportSettings { spp: 4 }).unwrap();
+        let text = std::fs::read_to_string(&xml).unwrap();
+        assert!(text.contains("<default name=\"jitter\" value=\"false\"/>"));
+        assert!(text.contains("<boolean name=\"jitter\" value=\"$jitter\"/>"));
     }
 }
