@@ -168,7 +168,14 @@ fn the_viewer_shows_what_render_and_trace_write_and_survives_switching_and_resiz
         bj = p("b.scene.json"),
     );
     std::fs::write(d.join("tour.txt"), script).unwrap();
-    let scene = "scenes/mirror_box.json";
+    // The scene copied beside the outputs: `save-camera` writes beside its scene.
+    std::fs::copy(
+        repo().join("scenes/mirror_box.json"),
+        d.join("mirror_box.json"),
+    )
+    .unwrap();
+    let scene_path = p("mirror_box.json");
+    let scene = scene_path.as_str();
     let size = ["--width", "320", "--height", "180"];
     let env = [("DISPLAY", x.display.as_str())];
     let mut view = vec!["view", scene, "--method", "auxiliary", "--no-vsync"];
@@ -366,6 +373,10 @@ fn outputs_that_would_overwrite_the_scene_or_miss_their_folder_are_refused_first
             format!("save-camera {}", p("nope/a.json")),
             "does not exist",
         ),
+        (
+            format!("save-camera {}", repo().join("a.json").display()),
+            "beside its scene",
+        ),
     ];
     for (line, expected) in lines {
         std::fs::write(&script, format!("frames 1\n{line}\n")).unwrap();
@@ -519,6 +530,12 @@ fn held_keys_and_a_mouse_drag_move_the_camera() {
     let [x0, y0] = at(0);
     xdotool(&x.display, &["mousemove", "--window", &window, &x0, &y0]);
     xdotool(&x.display, &["windowfocus", "--sync", &window]);
+    // Tab four times, once round the layouts: egui had taken Tab as a focus step, and with a
+    // panel widget focused it claimed every later key (W then did nothing).
+    xdotool(
+        &x.display,
+        &["key", "--delay", "150", "Tab", "Tab", "Tab", "Tab"],
+    );
     xdotool(&x.display, &["keydown", "w", "sleep", "1.5", "keyup", "w"]);
     wait_for(&shot("b.json"), &mut viewer);
     let [x1, y1] = at(80);
@@ -613,5 +630,61 @@ fn feedback_grows_one_reflection_per_frame_in_the_viewer() {
         exr(&p("f.method.exr")),
         exr(&p("render.exr")),
         "the viewer's frame with {shown} reflections is render --history {history}"
+    );
+}
+
+/// With the truth off, a moved camera has no complete truth: the old view's traced image was
+/// called "complete" against the new frame (a false error map, FLIP and truth EXR). A refused
+/// method draws nothing, yet `wait-truth` ends when the truth is traced (it had failed,
+/// saying the truth was not complete). A screenshot over an earlier one removes the
+/// companions it does not write.
+#[test]
+fn a_moved_camera_is_never_scored_against_an_old_truth() {
+    let Some(x) = display_or_skip() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let p = |name: &str| d.join(name).to_str().unwrap().to_string();
+    std::fs::write(
+        d.join("tour.txt"),
+        format!(
+            "wait-truth 120\nscreenshot {a}\nscreenshot {b}\ntruth off\nwalk 0.5 0 0\n\
+             turn 30 0\nframes 3\nscreenshot {b}\ntruth on\nmethod auxiliary n=4 max-passes=2\n\
+             wait-truth 120\nscreenshot {c}\nexit\n",
+            a = p("a.png"),
+            b = p("b.png"),
+            c = p("c.png"),
+        ),
+    )
+    .unwrap();
+    let script = p("tour.txt");
+    let view = [
+        "view",
+        "scenes/mirror_box.json",
+        "--method",
+        "auxiliary",
+        "--no-vsync",
+        "--width",
+        "48",
+        "--height",
+        "27",
+        "--script",
+        &script,
+    ];
+    run_ok(&view, &[("DISPLAY", x.display.as_str())]);
+    let meta = |name: &str| -> Value {
+        serde_json::from_str(&std::fs::read_to_string(d.join(name)).unwrap()).unwrap()
+    };
+    let (a, b, c) = (meta("a.json"), meta("b.json"), meta("c.json"));
+    assert_eq!(a["truth_complete"], true, "{a}");
+    assert!(a["metrics"].is_object() && d.join("a.truth.exr").is_file());
+    assert_eq!(b["truth_complete"], false, "{b}");
+    assert!(b["metrics"].is_null(), "{b}");
+    assert!(
+        !d.join("b.truth.exr").exists() && !d.join("b.error.png").exists(),
+        "the first b's truth and error map were left beside the second"
+    );
+    assert_eq!(
+        c["truth_complete"], false,
+        "a refused method has no frame: {c}"
     );
 }

@@ -42,8 +42,10 @@ struct Running {
     cursor: (f64, f64),
     last_step: Instant,
     frames_drawn: u64,
-    /// Screenshots and camera copies the keys ask for, numbered.
-    saved: u32,
+    /// The last number of a screenshot the keys took, and of a camera copy: each its own
+    /// count (one shared count had skipped numbers of both).
+    shots_saved: u32,
+    cameras_saved: u32,
     pending_screenshot: Option<PathBuf>,
     /// egui textures to free after the next submitted frame.
     pending_free: Vec<egui::TextureId>,
@@ -61,7 +63,9 @@ pub struct App {
     waiting_truth: Option<(Instant, usize)>,
     /// End of a `seconds` step.
     drawing_until: Option<Instant>,
-    pub log: Vec<serde_json::Value>,
+    /// The frames' records for `--log`, the latest [`crate::MAX_LOG_FRAMES`]; kept only where
+    /// a log was asked for (about 2 KB a frame).
+    pub log: std::collections::VecDeque<serde_json::Value>,
     pub outcome: Result<(), ViewError>,
 }
 
@@ -77,7 +81,7 @@ impl App {
             frames_left: 0,
             waiting_truth: None,
             drawing_until: None,
-            log: Vec::new(),
+            log: std::collections::VecDeque::new(),
             outcome: Ok(()),
         }
     }
@@ -221,7 +225,8 @@ impl App {
             cursor: (0.0, 0.0),
             last_step: Instant::now(),
             frames_drawn: 0,
-            saved: 0,
+            shots_saved: 0,
+            cameras_saved: 0,
             pending_screenshot: None,
             pending_free: Vec::new(),
         })
@@ -249,8 +254,17 @@ impl App {
             self.drawing_until = None;
         }
         if let Some((deadline, line)) = self.waiting_truth {
-            if r.session.complete_truth().is_some() {
+            if r.session.view_truth().is_some() {
                 self.waiting_truth = None;
+            } else if !r.session.truth_enabled {
+                let file = self.options.script_name.clone();
+                self.fail(
+                    event_loop,
+                    ViewError::Failed(format!(
+                        "{file}:{line}: wait-truth: the truth is off (`truth on` before it)"
+                    )),
+                );
+                return false;
             } else if Instant::now() > deadline {
                 let file = self.options.script_name.clone();
                 let device = r.session.truth_device();
@@ -344,7 +358,7 @@ impl App {
         let now = Instant::now();
         let dt = now.duration_since(r.last_step).as_secs_f32().min(0.25);
         r.last_step = now;
-        if !r.egui_ctx.egui_wants_keyboard_input() {
+        if !r.egui_ctx.text_edit_focused() {
             move_camera(&mut r.session, &r.held, dt, r.ui.speed);
         }
         let phase_start = Instant::now();
@@ -353,7 +367,18 @@ impl App {
             return;
         }
         let updated = Instant::now();
-        let raw_input = r.egui_state.take_egui_input(&r.window);
+        let mut raw_input = r.egui_state.take_egui_input(&r.window);
+        // Tab is the layout key, not egui's focus step: a focused panel widget had made egui
+        // claim every later key, and no key of the viewer's worked again.
+        raw_input.events.retain(|e| {
+            !matches!(
+                e,
+                egui::Event::Key {
+                    key: egui::Key::Tab,
+                    ..
+                }
+            )
+        });
         let mut actions = PanelActions::default();
         let full_output = r.egui_ctx.run_ui(raw_input, |ui| {
             actions = panel::show(ui, &mut r.session, &mut r.ui, &r.gpu, &mut r.renderer);
@@ -455,15 +480,17 @@ impl App {
         }
         r.frames_drawn += 1;
         let panes = r.ui.panes_px.clone();
-        self.log.push(screenshot::frame_record(
-            r.frames_drawn,
-            &phases,
-            &r.session,
-            &panes,
-            (r.config.width, r.config.height),
-        ));
-        if self.log.len() > crate::MAX_LOG_FRAMES {
-            self.log.remove(0);
+        if self.options.log.is_some() {
+            self.log.push_back(screenshot::frame_record(
+                r.frames_drawn,
+                &phases,
+                &r.session,
+                &panes,
+                (r.config.width, r.config.height),
+            ));
+            if self.log.len() > crate::MAX_LOG_FRAMES {
+                self.log.pop_front();
+            }
         }
         if let Some((path, target)) = capture {
             // The method's linear image, read back at the screenshot's pace.
@@ -507,20 +534,23 @@ impl App {
             r.surface.configure(&r.gpu.device, &r.config);
         }
         // Numbered files never replace one that exists ([`crate::screenshot::unused_number`]).
-        if actions.screenshot {
+        if actions.screenshot && r.pending_screenshot.is_some() {
+            // A script's screenshot waits for this frame: the key's would have replaced it.
+            r.ui.status = "no screenshot: one is being taken".into();
+        } else if actions.screenshot {
             let out_dir = &self.options.out_dir;
             let shot = |n: u32| out_dir.join(format!("mirrorbox-view-{n}.png"));
-            match crate::screenshot::unused_number(r.saved + 1, |n| {
+            match crate::screenshot::unused_number(r.shots_saved + 1, |n| {
                 crate::screenshot::files(&shot(n))
             }) {
                 Some(n) => {
-                    r.saved = n;
+                    r.shots_saved = n;
                     r.pending_screenshot = Some(shot(n));
                 }
                 None => {
                     r.ui.status = format!(
                         "no screenshot: mirrorbox-view-{}.png and the 9 999 after it exist in {}",
-                        r.saved + 1,
+                        r.shots_saved + 1,
                         out_dir.display()
                     )
                 }
@@ -535,9 +565,10 @@ impl App {
                 .unwrap_or_else(|| "scene".into());
             let dir = mirrorbox_files::folder_of(&self.options.scene_path);
             let copy = |n: u32| dir.join(format!("{stem}.view-{n}.json"));
-            r.ui.status = match crate::screenshot::unused_number(r.saved + 1, |n| [copy(n)]) {
+            r.ui.status = match crate::screenshot::unused_number(r.cameras_saved + 1, |n| [copy(n)])
+            {
                 Some(n) => {
-                    r.saved = n;
+                    r.cameras_saved = n;
                     let to = copy(n);
                     let camera = r.session.view_camera();
                     match crate::scene_copy::save_camera(&self.options.scene_path, &camera, &to) {
@@ -547,7 +578,7 @@ impl App {
                 }
                 None => format!(
                     "camera not saved: {stem}.view-{}.json and the 9 999 after it exist in {}",
-                    r.saved + 1,
+                    r.cameras_saved + 1,
                     dir.display()
                 ),
             };
@@ -643,7 +674,7 @@ impl ApplicationHandler for App {
         let Some(r) = self.running.as_mut() else {
             return;
         };
-        let response = r.egui_state.on_window_event(&r.window, &event);
+        let _ = r.egui_state.on_window_event(&r.window, &event);
         match event {
             WindowEvent::CloseRequested => event_loop.exit(),
             // A zero size is a minimised window: nothing to configure until it comes back.
@@ -654,7 +685,9 @@ impl ApplicationHandler for App {
                 r.window.request_redraw();
             }
             WindowEvent::RedrawRequested => self.redraw(event_loop),
-            WindowEvent::KeyboardInput { event, .. } if !response.consumed => {
+            // The viewer's keys, unless a text field of the panel (a slider's typed value)
+            // has them: egui reports every key as its own while any widget has focus.
+            WindowEvent::KeyboardInput { event, .. } if !r.egui_ctx.text_edit_focused() => {
                 let PhysicalKey::Code(code) = event.physical_key else {
                     return;
                 };

@@ -72,6 +72,10 @@ pub struct TruthRequest {
 #[derive(Clone)]
 pub struct TruthLevel {
     pub generation: u64,
+    /// What was traced: the view's camera and grid. A level is the truth of a frame only if
+    /// this is the frame's (with the truth off no new request is made, so a generation alone
+    /// had called a moved camera's frame "complete" against the old view's image).
+    pub request: TruthRequest,
     /// 0 … `level_count() - 1`; the last is the full-size image on the full grid.
     pub level: usize,
     pub complete: bool,
@@ -275,6 +279,7 @@ fn work(scene: &Scene, shared: &Shared, gpu_tracer: GpuTracer) {
             };
             let finished = TruthLevel {
                 generation,
+                request: request.clone(),
                 level,
                 complete: level + 1 == level_count(),
                 image: Arc::new(image),

@@ -227,7 +227,13 @@ fn controls(
         }
     }
     session.method = method;
-    ui.add(egui::Slider::new(&mut session.ssaa, 1..=4).text("SSAA"));
+    // Edits clamp, the shown value does not: egui's default wrote a script's `ssaa 8` back
+    // to the slider's end every frame.
+    ui.add(
+        egui::Slider::new(&mut session.ssaa, 1..=mirrorbox_raster::MAX_SSAA)
+            .clamping(egui::SliderClamping::Edits)
+            .text("SSAA"),
+    );
     if let Some(e) = &session.method_error {
         ui.colored_label(Color32::from_rgb(255, 110, 90), e);
     }
@@ -307,7 +313,11 @@ fn controls(
     );
     let mut fov = session.camera.fov_y_deg();
     if ui
-        .add(egui::Slider::new(&mut fov, 10.0..=120.0).text("fov °"))
+        .add(
+            egui::Slider::new(&mut fov, 10.0..=120.0)
+                .clamping(egui::SliderClamping::Edits)
+                .text("fov °"),
+        )
         .changed()
     {
         session.camera.set_fov(fov);

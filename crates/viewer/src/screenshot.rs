@@ -198,6 +198,17 @@ pub fn frame_record(
     })
 }
 
+/// Removes `file` if it is there.
+fn remove_stale(file: &Path) -> Result<(), String> {
+    match std::fs::remove_file(file) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(format!(
+            "{}: cannot remove an earlier screenshot's file: {e}",
+            file.display()
+        )),
+        _ => Ok(()),
+    }
+}
+
 /// Writes a screenshot and its companions (see the module docs); every file atomically.
 pub fn save(
     path: &Path,
@@ -221,16 +232,28 @@ pub fn save(
     }
     let truth = session.complete_truth();
     if let Some(level) = truth {
+        let side = level.request.grid_side;
         mirrorbox_image::write_exr(
             &truth_exr,
             &level.image,
-            &[("mirrorbox.spp", (session.ssaa * session.ssaa).to_string())],
+            &[("mirrorbox.spp", (side * side).to_string())],
         )
         .map_err(err)?;
     }
     if let Some(e) = &session.error {
         mirrorbox_image::write_png_bytes(&error_png, e.width, e.height, &e.heat_rgb8)
             .map_err(err)?;
+    }
+    // A companion not written this time would be an earlier shot's at the same path, beside
+    // a record that says it is not there.
+    for (file, written) in [
+        (&method_exr, method_image.is_some()),
+        (&truth_exr, truth.is_some()),
+        (&error_png, session.error.is_some()),
+    ] {
+        if !written {
+            remove_stale(file)?;
+        }
     }
     let frame = session.frame.as_ref();
     let record = json!({

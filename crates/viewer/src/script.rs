@@ -12,7 +12,7 @@
 //! | `truth on\|off` | the live truth (off: the method has the CPU to itself, for timing) |
 //! | `walk FORWARD RIGHT UP` | move the camera by these scene units along the view |
 //! | `turn YAW PITCH` | turn by degrees (positive: right, up) |
-//! | `look X Y Z AT X Y Z` | place the camera at a point looking at another |
+//! | `look X Y Z at X Y Z` | place the camera at a point looking at another |
 //! | `reset-camera` | back to the scene's camera |
 //! | `resize W H` | ask for a window of W × H pixels |
 //! | `screenshot PATH.png` | the window as shown, with the method, truth and heat map beside it (see the viewer's docs) |
@@ -56,12 +56,23 @@ pub struct Step {
     pub action: Action,
 }
 
+/// A script's problem at `file:line`; line 0 is the file as a whole (it could not be read),
+/// whose message names the file itself.
 #[derive(Debug, thiserror::Error, PartialEq, Eq)]
-#[error("{file}:{line}: {message}")]
+#[error("{}{message}", where_in(file, *line))]
 pub struct ScriptError {
     pub file: String,
     pub line: usize,
     pub message: String,
+}
+
+/// `file:line: ` before a message, nothing for line 0 (the message names the file).
+fn where_in(file: &str, line: usize) -> String {
+    if line == 0 {
+        String::new()
+    } else {
+        format!("{file}:{line}: ")
+    }
 }
 
 /// Reads and parses a script file (at most [`MAX_SCRIPT_BYTES`]).
@@ -111,8 +122,18 @@ pub fn check_writes(action: &Action, inputs: &[(&str, &Path)]) -> Result<(), Str
         Action::SaveCamera(json) => vec![json.clone()],
         _ => return Ok(()),
     };
-    check_files(&files, inputs)
+    check_files(&files, inputs)?;
+    // A scene copy goes beside the scene, whose relative paths it keeps.
+    if let (Action::SaveCamera(json), Some((_, scene))) =
+        (action, inputs.iter().find(|(what, _)| *what == SCENE_INPUT))
+    {
+        crate::scene_copy::beside(scene, json)?;
+    }
+    Ok(())
 }
+
+/// The name of the scene file among [`check_writes`]'s `inputs`.
+pub const SCENE_INPUT: &str = "the scene";
 
 /// [`check_writes`] for files written together (the first one's folder is theirs): the
 /// folder exists, none is a folder, none is one of `inputs`. Also the check of `view --log`.

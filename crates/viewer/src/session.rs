@@ -412,11 +412,18 @@ impl Session {
         }
     }
 
-    /// The complete truth of the view the method's frame shows, if the tracer has it.
+    /// The complete truth of the view the method's frame shows, if the tracer has it: traced
+    /// for this camera on this grid, whether or not the truth is on now.
     pub fn complete_truth(&self) -> Option<&TruthLevel> {
+        let level = self.view_truth()?;
+        (self.frame.as_ref()?.camera == level.request.camera).then_some(level)
+    }
+
+    /// The complete truth of the current view and grid, if traced, whatever the method drew
+    /// (a refused method draws nothing; a script's `wait-truth` still ends).
+    pub fn view_truth(&self) -> Option<&TruthLevel> {
         let level = self.truth_shown.as_ref().filter(|l| l.complete)?;
-        let frame = self.frame.as_ref()?;
-        (level.generation == self.truth.generation() && frame.camera == self.view_camera())
+        (level.request.camera == self.view_camera() && level.request.grid_side == self.ssaa)
             .then_some(level)
     }
 
@@ -492,7 +499,6 @@ impl Session {
         self.truth.wait_complete(timeout).is_some()
     }
 
-    /// Which level the truth pane shows, in words.
     /// Where the live truth is traced, in words (and why not on the GPU, where that failed).
     pub fn truth_device(&self) -> String {
         match self.truth.device() {
@@ -501,6 +507,7 @@ impl Session {
         }
     }
 
+    /// Which level the truth pane shows, in words.
     pub fn truth_progress(&self) -> String {
         match &self.truth_shown {
             _ if !self.truth_enabled => "off".into(),
@@ -508,7 +515,7 @@ impl Session {
                 "complete: {}×{}, {} spp, traced in {:.0} ms",
                 l.image.width,
                 l.image.height,
-                self.ssaa * self.ssaa,
+                l.request.grid_side * l.request.grid_side,
                 l.trace_time.as_secs_f64() * 1e3
             ),
             Some(l) => format!(

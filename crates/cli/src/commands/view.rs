@@ -24,11 +24,11 @@ pub struct Args {
     #[arg(long, visible_alias = "reflectance", allow_negative_numbers = true)]
     alpha: Option<f32>,
     #[command(flatten)]
-    size: super::SizeArgs,
+    size: super::TruthSizeArgs,
     /// Start at the camera the scene's `camera.path` gives at this many seconds.
     #[arg(long, allow_negative_numbers = true)]
     time: Option<f64>,
-    /// Supersampling factor s of the method, 1..4; the live truth uses the same s×s grid.
+    /// Supersampling factor s of the method, 1..8; the live truth uses the same s×s grid.
     #[arg(long, default_value_t = 1)]
     ssaa: u32,
     /// Window size WIDTHxHEIGHT in pixels (default: the panel and four panes of the view).
@@ -37,7 +37,8 @@ pub struct Args {
     /// Timed actions that drive the viewer, one per line (see docs/viewer.md).
     #[arg(long, conflicts_with_all = ["frames", "screenshot"])]
     script: Option<PathBuf>,
-    /// Draw N frames, then close (with --screenshot: take it after the N-th frame).
+    /// Draw N frames, then close (with --screenshot: one more frame, whose window is saved:
+    /// N + 1 frames in all, which `feedback` and `cubemap` show as one more reflection).
     #[arg(long)]
     frames: Option<u32>,
     /// Save the window (PNG) with the method and truth EXRs beside it, after --frames.
@@ -50,7 +51,8 @@ pub struct Args {
     /// Present without waiting for the display's refresh (default: vsync on).
     #[arg(long)]
     no_vsync: bool,
-    /// Folder the screenshot and save-camera keys write into (default: the current folder).
+    /// Folder the screenshot key (P) writes into (default: the current folder); the camera key
+    /// (C) writes beside the scene, whose relative paths its copy keeps.
     #[arg(long, default_value = ".")]
     out: PathBuf,
     /// Where the live truth is traced: cpu (the tracer), gpu (ray queries on the adapter,
@@ -110,15 +112,27 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         .ok_or_else(|| bad(format!("unknown method {:?}", args.method)))?;
     let method = args.options.0.configure(entry)?;
     let alpha = unit_interval("--alpha", args.alpha)?;
-    if !(1..=4).contains(&args.ssaa) {
-        return Err(bad(format!("--ssaa must be in [1, 4], got {}", args.ssaa)));
-    }
+    // The limit of every command, the script's `ssaa` and the panel's slider.
+    super::ssaa(args.ssaa)?;
     let at = super::TimeArgs {
         time: args.time,
         ..Default::default()
     };
     let mut scene = at.apply(load(&args.scene)?)?;
-    args.size.apply(&mut scene)?;
+    super::SizeArgs {
+        width: args.size.width,
+        height: args.size.height,
+    }
+    .apply(&mut scene)?;
+    // The error pane's metrics need SSIM's window: a smaller view had waited for them forever.
+    let min = mirrorbox_image::metrics::MIN_SIDE;
+    let (w, h) = (scene.camera.width, scene.camera.height);
+    if w < min || h < min {
+        return Err(bad(format!(
+            "the view is {w}×{h} pixels; the viewer compares it with its truth, which needs at \
+             least {min} on each side (SSIM's window): give --width and --height of {min} or more"
+        )));
+    }
     if let Some(alpha) = alpha {
         scene
             .set_reflectance(glam::Vec3::splat(alpha))
@@ -142,7 +156,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             args.out.display()
         )));
     }
-    let mut inputs = vec![("the scene", args.scene.as_path())];
+    let mut inputs = vec![(script::SCENE_INPUT, args.scene.as_path())];
     if let Some(path) = &args.script {
         inputs.push(("the script", path.as_path()));
     }
