@@ -1745,9 +1745,10 @@ impl Chart {
                 taken.push(Rect::around((xx, yy), MARK_R));
             }
         }
-        // What a label must not cross: every series' line but its own (a label beside its own
-        // point touches its own line, and reads as that line's), the reference lines and every
-        // error bar (issue: "n=1" on the other α's line, "d=64" on a CI bar).
+        // What a label must not cross: every series' line, its own where a place allows (a
+        // label beside its own point may touch its own line, and reads as that line's), the
+        // reference lines and every error bar (issue: "n=1" on the other α's line, "d=64" on
+        // a CI bar).
         let strokes = self.strokes(f);
         // A label said at one x is not said again at that x (the fallbacks of one camera turn
         // share its x, its off-screen share: three "yaw 45°" had stood in one column; the α
@@ -1766,6 +1767,7 @@ impl Chart {
                 .filter(|(owner, _)| *owner != Some(i))
                 .map(|&(_, st)| st)
                 .collect();
+            let all: Vec<Stroke> = strokes.iter().map(|&(_, st)| st).collect();
             // A point at the same place without a label of its own (a ring around this one)
             // is no other point to mistake the label for: it had kept every label off a
             // coinciding pair. Coinciding points with labels of their own still are.
@@ -1774,16 +1776,21 @@ impl Chart {
                 .filter(|&&(m, labelled)| labelled || !hides(m, (xx, yy)))
                 .map(|&(m, _)| m)
                 .collect();
-            let place = place_label((xx, yy), r, lw, &rivals, &taken, &others)
-                .map(|p| (p, None))
-                .or_else(|| {
-                    // Through what is drawn over its own place, unless another labelled point
-                    // is there too (whose label it would then be mistaken for).
-                    // (The point itself is among the rivals: alone is one there.)
-                    let alone = rivals.iter().filter(|&&m| hides(m, (xx, yy))).count() <= 1;
-                    place_label_away((xx, yy), r, lw, &taken, &others, alone)
-                        .map(|(lx, ly, rect, leader)| ((lx, ly, rect), Some(leader)))
-                });
+            // Through what is drawn over its own place, unless another labelled point is
+            // there too (whose label it would then be mistaken for). (The point itself is
+            // among the rivals: alone is one there.)
+            let alone = rivals.iter().filter(|&&m| hides(m, (xx, yy))).count() <= 1;
+            // Clear of its own line too where a place allows (a label struck through by its
+            // own line in about a hundred figures), beside its point, else away with a
+            // leader; only then across its own line, as before.
+            let place = [&all, &others].into_iter().find_map(|strokes| {
+                place_label((xx, yy), r, lw, &rivals, &taken, strokes)
+                    .map(|p| (p, None))
+                    .or_else(|| {
+                        place_label_away((xx, yy), r, lw, &taken, strokes, alone)
+                            .map(|(lx, ly, rect, leader)| ((lx, ly, rect), Some(leader)))
+                    })
+            });
             if let Some(((lx, ly, rect), leader)) = place {
                 said.push((label, xx));
                 taken.push(rect.spaced());
@@ -2774,6 +2781,56 @@ mod tests {
         let (_, _, rect, leader) = place_label_away((x, y), r, lw, &[], &[bar], false).unwrap();
         assert!(segments_distance(leader, bar) >= 2.0, "{leader:?}");
         assert!(!rect.crossed_by(bar.0, bar.1));
+    }
+
+    /// A label keeps off its own series' line where a place allows: from the first point the
+    /// line climbs through the first place tried (right, above), and the label had been
+    /// drawn there, struck through (about a hundred figures).
+    #[test]
+    fn a_label_keeps_off_its_own_line() {
+        let mut c = chart_of(vec![(1.0, 0.02), (2.1, 0.1), (30.0, 0.25)]);
+        c.series[0].labels = vec!["first".into(), String::new(), String::new()];
+        let svg = c.to_svg();
+        let at = svg.find(">first</text>").expect("the label is drawn");
+        let tag = &svg[svg[..at].rfind("<text").unwrap()..at];
+        let (x, y, lw) = (
+            number_after(tag, "x=\""),
+            number_after(tag, "y=\""),
+            text_width("first"),
+        );
+        let x0 = if tag.contains(r#"text-anchor="end""#) {
+            x - lw
+        } else if tag.contains(r#"text-anchor="middle""#) {
+            x - lw / 2.0
+        } else {
+            x
+        };
+        let rect = Rect::text_at(x0, y, lw);
+        let color = tag
+            .split("fill=\"")
+            .nth(1)
+            .unwrap()
+            .split('"')
+            .next()
+            .unwrap();
+        let line = svg
+            .split("<polyline points=\"")
+            .find(|l| l.contains(&format!(r#"stroke="{color}" stroke-width="1.8""#)))
+            .expect("the series' line");
+        let pts: Vec<(f64, f64)> = line
+            .split('"')
+            .next()
+            .unwrap()
+            .split(' ')
+            .map(|p| {
+                let (a, b) = p.split_once(',').unwrap();
+                (a.parse().unwrap(), b.parse().unwrap())
+            })
+            .collect();
+        assert!(
+            !pts.windows(2).any(|w| rect.crossed_by(w[0], w[1])),
+            "{tag} across {pts:?}"
+        );
     }
 
     /// A label left of its point ends at its box's right edge (text-anchor end), whatever
