@@ -521,18 +521,33 @@ fn uneven(reports: &Path) -> Result<String, ReadmeError> {
     let steepest = crate::bumpy::section::sentences(&s.records, &s.info.bump_methods)
         .pop()
         .ok_or_else(|| ReadmeError("reports/uneven_mirrors holds no tilt".into()))?;
+    // One figure per base method: the finding names tricks of several bases, and the first
+    // figure alone had not shown two of the three it called closest.
+    let figures: Vec<String> =
+        crate::bumpy::section::uneven_section(&s.records, &s.info.bump_methods)
+            .iter()
+            .filter_map(|b| match b {
+                Block::Chart(file, chart) => {
+                    let base = chart
+                        .title
+                        .split_once("tilt: ")
+                        .and_then(|(_, t)| t.split_once("'s tricks"))
+                        .map_or(file.as_str(), |(m, _)| m);
+                    Some(format!("[{base}](uneven_mirrors/{file})"))
+                }
+                _ => None,
+            })
+            .collect();
     Ok(format!(
-        "**Uneven mirrors: how far the engines' tricks stay from the truth** (FLIP over the image) — {} ({}, {}, {}; [figure](uneven_mirrors/plot_uneven_error_vs_tilt.svg)).",
+        "**Uneven mirrors: how far the engines' tricks stay from the truth** (FLIP over the image) — {} ({}, {}, {}; each base method's tricks: {}).",
         lowercase_first(steepest.trim_end_matches('.')),
         s.info.scene,
         measured_at(&s),
-        s.info.adapter
+        s.info.adapter,
+        figures.join(", ")
     ))
 }
 
-/// Where a sweep's points were measured, as a finding's closing parenthesis says it: the
-/// image size and the α its points share (`320x180, α = 0.9`), so that no finding's numbers
-/// read as the scene file's own size or α.
 /// "measured DAY at COMMIT": when a run was made and from which code, for findings that set
 /// runs of different days side by side.
 fn day_and_commit(s: &Sweep) -> String {
@@ -541,6 +556,9 @@ fn day_and_commit(s: &Sweep) -> String {
     format!("measured {day} at {commit}")
 }
 
+/// Where a sweep's points were measured, as a finding's closing parenthesis says it: the
+/// image size and the α its points share (`320x180, α = 0.9`), so that no finding's numbers
+/// read as the scene file's own size or α.
 fn measured_at(s: &Sweep) -> String {
     let size = s
         .info

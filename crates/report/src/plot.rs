@@ -1449,7 +1449,7 @@ impl Chart {
         }
         if unexplained_rings {
             legend.push((
-                "ring: a point at the same place as an earlier one".into(),
+                "ring: a point hidden by an earlier one's marker".into(),
                 Shows::Ring,
             ));
         }
@@ -2361,7 +2361,10 @@ mod tests {
             method_style("naive").color
         );
         assert_eq!(svg.matches(&ring).count(), 1, "{svg}");
-        assert!(svg.contains("ring: a point at the same place"), "{svg}");
+        assert!(
+            svg.contains("ring: a point hidden by an earlier one"),
+            "{svg}"
+        );
         assert!(hides((0.0, 0.0), (3.9, 0.0)) && !hides((0.0, 0.0), (4.0, 0.0)));
         // Both points at one place labelled alike: the label is said once.
         c.series[1].points[0] = (1.0, 0.5);
@@ -2563,7 +2566,10 @@ mod tests {
             2 + 1
         );
         // The name says what its rings mean: no legend line for rings.
-        assert!(!svg.contains("ring: a point at the same place"), "{svg}");
+        assert!(
+            !svg.contains("ring: a point hidden by an earlier one"),
+            "{svg}"
+        );
         // One point in common: a ring the names do not explain, so the legend does.
         let a = Series::new(
             "unrolled",
@@ -2578,7 +2584,7 @@ mod tests {
         let svg = chart(vec![a, b]).to_svg();
         assert!(!svg.contains("(on unrolled)"), "{svg}");
         assert!(
-            svg.contains("ring: a point at the same place as an earlier one"),
+            svg.contains("ring: a point hidden by an earlier one's marker"),
             "{svg}"
         );
     }
