@@ -246,7 +246,11 @@ fn depth_blocks(pts: &[&Record]) -> Vec<Block> {
             s
         };
         error.series.push(series(Record::mirror_flip));
-        cost.series.push(series(|r| r.ms_median));
+        // Every median with its bars, as the swept methods' (the axis says they are there).
+        let mut timed = series(|r| r.ms_median);
+        timed.bars = bars;
+        timed.y_intervals = of.iter().map(|r| r.ms_bars(bars)).collect();
+        cost.series.push(timed);
     }
     out.push(Block::Paragraph(
         "`ray-query` follows every mirror pixel's chain on the GPU; `unrolled` and `portal` \
@@ -414,6 +418,7 @@ mod tests {
             }
         }
         r.method_options = options.join(" ");
+        r.ms_interval = Some([4.5, 5.5]);
         r.key = format!("{key}|alpha=1|320x180");
         r.reflections = reflections;
         r
@@ -468,6 +473,22 @@ mod tests {
             "{first:?}"
         );
         assert!(first.contains(&"`ssr (defaults)`"), "{first:?}");
+        // The cost chart: every median with its bars, the methods without a depth cap too
+        // (their medians had been drawn bare under an axis that says "bars").
+        let Some(Block::Chart(_, cost)) = blocks
+            .iter()
+            .find(|b| matches!(b, Block::Chart(f, _) if f == "engine_ms_depth.svg"))
+        else {
+            panic!("no cost chart");
+        };
+        for s in &cost.series {
+            assert!(
+                s.y_intervals.len() == s.points.len() && s.y_intervals.iter().all(Option::is_some),
+                "{}: {:?}",
+                s.name,
+                s.y_intervals
+            );
+        }
     }
 
     #[test]
