@@ -581,7 +581,13 @@ impl Axis {
         let below: Vec<f64> = ticks.iter().copied().filter(|&v| v < first).collect();
         let mut above: Vec<f64> = ticks.iter().copied().filter(|&v| v > last).collect();
         above.reverse();
-        for side in [below, above] {
+        // The steps between two decades (an axis of at most two, [`Axis::ticks`]).
+        let between: Vec<f64> = ticks
+            .iter()
+            .copied()
+            .filter(|&v| v > first && v < last && !decade(v))
+            .collect();
+        for side in [below, above, between] {
             let mut side_kept: Vec<f64> = Vec::new();
             for v in side {
                 let clear = |o: f64| (px(v) - px(o)).abs() >= gap;
@@ -609,9 +615,12 @@ impl Axis {
             if let [first, .., last] = decades[..] {
                 // Beyond the outer decades, the 2× and 5× steps too: no point lies more than
                 // a factor 2.5 past the outermost tick (issue 54: points below the lowest).
+                // Across at most two decades, between them too: "1" and "10" alone had left a
+                // 2 ms budget and its points 1.8–2.2 ms with no tick near.
+                let few = decades.len() <= 2;
                 let mut out: Vec<f64> = (a..=b)
                     .flat_map(|e| [2.0, 5.0].map(|m| m * 10f64.powi(e)))
-                    .filter(|&v| (v < first || v > last) && self.contains(v))
+                    .filter(|&v| (few || v < first || v > last) && self.contains(v))
                     .chain(decades)
                     .collect();
                 out.sort_by(f64::total_cmp);
@@ -1954,6 +1963,24 @@ mod tests {
         assert!(ay.ticks().contains(&5e-4), "{:?}", ay.ticks());
         // The decades stay the only ticks between them.
         assert!(!ay.ticks().contains(&0.02), "{:?}", ay.ticks());
+    }
+
+    /// An axis of at most two decades is ticked between them too: an advice's front from 0.8
+    /// to 25 ms had "1" and "10" only, and its 2 ms budget no tick near.
+    #[test]
+    fn a_short_log_axis_is_ticked_between_its_decades() {
+        let mut c = Chart::new("FLIP vs cost", "ms", "FLIP");
+        (c.x_log, c.y_log) = (true, true);
+        c.series.push(Series::new(
+            "portal",
+            method_style("portal"),
+            vec![(0.8, 0.1), (2.0, 0.01), (25.0, 1e-3)],
+        ));
+        let (ax, _) = c.axes();
+        let drawn = ax.ticks_drawn(PLOT_W, 24.0);
+        for t in [1.0, 2.0, 5.0, 10.0, 20.0] {
+            assert!(drawn.contains(&t), "{t} not in {drawn:?}");
+        }
     }
 
     /// One notation per log axis: where a tick needs the exponent form, every tick below 1
