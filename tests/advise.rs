@@ -209,6 +209,16 @@ fn advise_names_the_closest_when_nothing_fits_and_the_best_when_everything_does(
     assert!(svg.contains(&format!(">the pick: {pick}</text>")), "{svg}");
     let rings = svg.matches(r#"fill="none" stroke="black" stroke-width="2"/>"#);
     assert_eq!(rings.count(), 2, "{svg}");
+    // Its footer names the code that measured (the first round's), as every figure's does.
+    let round: Value = serde_json::from_str(
+        &std::fs::read_to_string(out.join("search/round-1/sweep.json")).unwrap(),
+    )
+    .unwrap();
+    let commit = round["commit"].as_str().unwrap();
+    assert!(
+        !commit.is_empty() && svg.contains(commit.get(..10).unwrap_or(commit)),
+        "{commit}: {svg}"
+    );
     assert!(!dir.path().join("huge.partial").exists());
     let _ = repo();
 }

@@ -1021,13 +1021,23 @@ fn write_advice(advice: &Advice, config: &AdviseConfig, out: &Path) -> Result<()
         Some(how) => format!(" · {} views, {}", advice.views.len(), how.name()),
         None => String::new(),
     };
+    // The code that measured: the first round's sweep names it (every figure's footer does).
+    let commit = advice
+        .folders
+        .first()
+        .and_then(|f| mirrorbox_report::read_sweep_info(f).ok())
+        .map(|i| i.commit)
+        .filter(|c| !c.is_empty())
+        .map_or(String::new(), |c| {
+            format!(" · commit {}", c.get(..10).unwrap_or(&c))
+        });
     let footer = match &info {
         Some((adapter, w, h, a, run)) => format!(
-            "{}{views} · {w}x{h} · α = {a} · {adapter} · measured {}",
+            "{}{views} · {w}x{h} · α = {a} · {adapter} · measured {}{commit}",
             scene.display(),
             run.as_deref().unwrap_or("at an unrecorded time")
         ),
-        None => format!("{}{views}", scene.display()),
+        None => format!("{}{views}{commit}", scene.display()),
     };
     let stem = scene
         .file_stem()
