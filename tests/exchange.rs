@@ -176,6 +176,37 @@ fn an_export_traces_back_to_its_truth_and_our_render_scores_as_the_sweep_does() 
     );
     let minimal = &score(&ex, &minimal_run, &tmp.path().join("minimal-scored"))[0];
     assert_eq!(minimal["key"], "minimal/naive|camera|a0.9|64x36|ssaa1");
+    // Its timing names the adapter that drew, as `render` reports it.
+    let timing: Value = serde_json::from_str(
+        &std::fs::read_to_string(minimal_run.join("minimal/naive/timing.json")).unwrap(),
+    )
+    .unwrap();
+    assert_eq!(timing["device"], minimal["adapter"], "{timing}");
+    // A bad --frames is refused (exit 2); a renderer that fails is named with its own
+    // status; neither leaves a folder for `score` to refuse.
+    let failed_run = tmp.path().join("failed-run");
+    let client = |args: &[&str]| {
+        std::process::Command::new("python3")
+            .arg(repo().join("clients/minimal/client.py"))
+            .args([ex.as_os_str(), failed_run.as_os_str()])
+            .args(args)
+            .output()
+            .unwrap()
+    };
+    let bad = client(&[
+        "--frames",
+        "101",
+        "--mirrorbox",
+        env!("CARGO_BIN_EXE_mirrorbox"),
+    ]);
+    assert_eq!(bad.status.code(), Some(2));
+    let failing = client(&["--frames", "1", "--mirrorbox", "false"]);
+    let stderr = String::from_utf8_lossy(&failing.stderr);
+    assert!(
+        !failing.status.success() && stderr.contains("mirrorbox render exited 1"),
+        "{stderr}"
+    );
+    assert!(!failed_run.join("minimal").exists());
     // Drawn from the scene read back from the glTF (mirrors rebuilt from their rectangles),
     // the raster differs from the sweep's in the last bits only (every metric within 1e-6 of it).
     for (name, want) in swept["metrics"].as_object().unwrap() {
@@ -703,17 +734,23 @@ fn a_bad_view_list_is_refused_naming_the_field() {
     }
 }
 
-/// The web client (clients/web: three.js 0.187 in headless Chromium on SwiftShader) draws
-/// mirror_box through the exchange: its floor (no mirrors) stays within 10⁻² FLIP of the
-/// floor truth (measured 5.2·10⁻³ at 64×36: SwiftShader snaps vertices to 1/16 pixel), and
-/// its `Reflector` — two levels of reflection, as `naive` — within 2.5× `naive`'s error over
-/// the mirror pixels (measured 1.7×: its half-float, 4× MSAA target), and above its floor.
+/// The web clients (clients/web: three.js 0.187 and Babylon.js 9.28 in headless Chromium on
+/// SwiftShader) draw mirror_box through the exchange: each floor (no mirrors) stays within
+/// 10⁻² FLIP of the floor truth (three measured 5.2·10⁻³ at 64×36: SwiftShader snaps vertices
+/// to 1/16 pixel), so both follow the shading contract; three's `Reflector` — two levels of
+/// reflection, as `naive` — within 2.5× `naive`'s error over the mirror pixels (measured 1.7×:
+/// its half-float, 4× MSAA target), and above its floor; Babylon's `MirrorTexture` above its
+/// floor and below 0.5 (a mirror it drew black or left diffuse would not be). An export lit
+/// with shadows is refused before any browser starts (its lighting would score as theirs).
 #[test]
-fn three_reflector_scores_within_its_stated_bounds() {
+fn web_clients_score_within_their_stated_bounds() {
     let web = repo().join("clients/web");
     let present = mirrorbox_testing::on_path("node")
         && mirrorbox_testing::on_path("chromium-headless-shell")
         && web.join("node_modules/three/package.json").is_file()
+        && web
+            .join("node_modules/@babylonjs/core/package.json")
+            .is_file()
         && web
             .join("node_modules/puppeteer-core/package.json")
             .is_file();
@@ -733,9 +770,9 @@ fn three_reflector_scores_within_its_stated_bounds() {
         .args([ex.as_os_str(), run.as_os_str()])
         .args([
             "--clients",
-            "three",
+            "three,babylon",
             "--variants",
-            "floor,reflector",
+            "floor,reflector,mirrortexture",
             "--frames",
             "1",
             "--warmup",
@@ -750,7 +787,13 @@ fn three_reflector_scores_within_its_stated_bounds() {
         String::from_utf8_lossy(&out.stderr)
     );
     let scored = score(&ex, &run, &tmp.path().join("scored"));
-    let floor = scored.iter().find(|r| r["kind"] == "floor").unwrap();
+    let floor_of = |client: &str| {
+        scored
+            .iter()
+            .find(|r| r["kind"] == "floor" && r["method"] == client)
+            .unwrap_or_else(|| panic!("no {client} floor"))
+    };
+    let floor = floor_of("three");
     let reflector = scored
         .iter()
         .find(|r| r["method"] == "three-reflector")
@@ -774,6 +817,48 @@ fn three_reflector_scores_within_its_stated_bounds() {
         theirs > floor_flip,
         "Reflector {theirs} against its floor {floor_flip}"
     );
+    let babylon_floor = floor_of("babylon")["metrics"]["flip_mean"]
+        .as_f64()
+        .unwrap();
+    assert!(
+        babylon_floor <= 1e-2,
+        "Babylon's floor FLIP {babylon_floor}"
+    );
+    let mirror_texture = scored
+        .iter()
+        .find(|r| r["method"] == "babylon-mirrortexture")
+        .unwrap();
+    let babylon = mirror_flip(mirror_texture);
+    assert!(
+        babylon > babylon_floor && babylon < 0.5,
+        "MirrorTexture {babylon} against its floor {babylon_floor}"
+    );
+    // A lit export: refused, exit 2, nothing written.
+    let lit = tmp.path().join("lit");
+    let out = mirrorbox(
+        &[
+            "export-views",
+            "scenes/mirror_box_lit.json",
+            "-o",
+            lit.to_str().unwrap(),
+            "--width",
+            "32",
+            "--height",
+            "18",
+        ],
+        &[],
+    );
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let lit_run = tmp.path().join("lit_run");
+    let out = std::process::Command::new("node")
+        .arg(web.join("run.mjs"))
+        .args([lit.as_os_str(), lit_run.as_os_str()])
+        .output()
+        .expect("node runs");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("--allow-unsupported-lighting"), "{stderr}");
+    assert!(!lit_run.exists());
 }
 
 /// The mistakes a client makes that score as a large error and nothing else are said: a

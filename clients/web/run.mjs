@@ -115,7 +115,8 @@ const ALL_VARIANTS = [...new Set(Object.values(CLIENTS).flatMap((c) => c.variant
 const USAGE = `usage: node clients/web/run.mjs EXPORT_DIR RUN_DIR [--clients three,babylon]
        [--variants ${ALL_VARIANTS.join(',')}]
        [--frames 9] [--warmup 2] [--chromium /usr/bin/chromium-headless-shell]
-       [--cube-size 256] [--reflector-samples 4] [--mirror-type half] [--seed 1] [--timeout 600]`;
+       [--cube-size 256] [--reflector-samples 4] [--mirror-type half] [--seed 1] [--timeout 600]
+       [--allow-unsupported-lighting]   (score an export lit with shadows or through mirrors anyway)`;
 
 function fail(message, code = 1) {
   console.error(`run.mjs: ${message}`);
@@ -125,7 +126,7 @@ function fail(message, code = 1) {
 function parseArgs(argv) {
   const opts = {
     clients: Object.keys(CLIENTS), variants: null, frames: 9, warmup: 2, chromium: '/usr/bin/chromium-headless-shell',
-    cubeSize: 256, reflectorSamples: 4, mirrorType: 'half', seed: 1, timeout: 600,
+    cubeSize: 256, reflectorSamples: 4, mirrorType: 'half', seed: 1, timeout: 600, allowLighting: false,
   };
   const positional = [];
   const integer = (flag, v, min) => {
@@ -137,6 +138,7 @@ function parseArgs(argv) {
     const a = argv[i];
     if (a === '-h' || a === '--help') { console.log(USAGE); process.exit(0); }
     if (!a.startsWith('--')) { positional.push(a); continue; }
+    if (a === '--allow-unsupported-lighting') { opts.allowLighting = true; continue; }
     const v = argv[++i];
     if (v === undefined) fail(`${a} needs a value\n${USAGE}`);
     switch (a) {
@@ -183,6 +185,7 @@ function readExport(dir) {
     return p;
   };
   const views = JSON.parse(fs.readFileSync(need('views.json'), 'utf8'));
+  Object.defineProperty(views, 'dir', { value: dir, enumerable: false });
   if (views.format !== 'mirrorbox-views' || views.version !== 1) fail(`${dir}/views.json is not mirrorbox-views version 1`);
   if (!Array.isArray(views.views) || views.views.length === 0) fail(`${dir}/views.json lists no views`);
   const gltf = JSON.parse(fs.readFileSync(need(views.gltf || 'scene.gltf'), 'utf8'));
@@ -235,6 +238,17 @@ function serve(exportDir, failures) {
   return new Promise((resolve) => server.listen(0, '127.0.0.1', () => resolve(server)));
 }
 
+// The mirrors a client must find: the meshes (one per glTF primitive, as three.js' and Babylon's
+// loaders make them) of every node whose primitive's material is a mirror.
+function countMirrors(views) {
+  const gltf = JSON.parse(fs.readFileSync(path.join(views.dir, views.gltf || 'scene.gltf'), 'utf8'));
+  const mirror = (gltf.materials || []).map((m) => Boolean(m.extras && m.extras.mirrorbox_mirror));
+  const meshes = gltf.meshes || [];
+  return (gltf.nodes || [])
+    .filter((n) => Number.isInteger(n.mesh) && meshes[n.mesh])
+    .reduce((sum, n) => sum + meshes[n.mesh].primitives.filter((p) => mirror[p.material]).length, 0);
+}
+
 function writeAtomic(file, data) {
   const tmp = `${file}.tmp-${process.pid}`;
   fs.writeFileSync(tmp, data);
@@ -244,9 +258,14 @@ function writeAtomic(file, data) {
 async function main() {
   const opts = parseArgs(process.argv.slice(2));
   const views = readExport(opts.exportDir);
-  if (views.contract.lighting !== 'direct, no shadows') {
-    console.error(`warning: views.json's lighting is "${views.contract.lighting}": these clients draw direct light `
-      + 'without shadows or light through mirrors, so their floor includes that difference');
+  // These clients draw direct light without shadows or light through mirrors: another
+  // lighting would be scored as their error (their floor's too), so it is refused unless asked
+  // for, and then said in every variant's timing.json.
+  const unsupportedLighting = views.contract.lighting !== 'direct, no shadows';
+  if (unsupportedLighting && !opts.allowLighting) {
+    fail(`views.json's lighting is "${views.contract.lighting}": these clients draw direct light without shadows `
+      + 'or light through mirrors, so the score would count that as their error; export a scene without '
+      + 'lighting.shadows and lighting.mirrored_lights, or give --allow-unsupported-lighting', 2);
   }
   const versions = {};
   for (const { name } of opts.plan) {
@@ -255,7 +274,9 @@ async function main() {
     versions[name] = JSON.parse(fs.readFileSync(pkg, 'utf8')).version;
   }
   if (!fs.existsSync(opts.chromium)) fail(`no Chromium at ${opts.chromium} (give --chromium PATH)`);
-  const { default: puppeteer } = await import('puppeteer-core');
+  const { default: puppeteer } = await import('puppeteer-core').catch((e) => fail(
+    `puppeteer-core cannot be loaded from ${HERE}/node_modules (${e.message.split('\n')[0]}): run scripts/install-web-clients.sh`));
+  const mirrorsInExport = countMirrors(views);
 
   const failures = [];
   const consoleErrors = [];
@@ -334,6 +355,14 @@ async function main() {
           console.error(`warning: scene.gltf's extras.mirrorbox.${key} ${JSON.stringify(a)} differs from views.json's ${JSON.stringify(b)}; using views.json's`);
         }
       }
+      // Every mirror of the export found: a mirror the client did not recognise (its extra
+      // lost) would be drawn as a diffuse surface and scored as the method's error.
+      for (const v of variants) {
+        if (info.mirrors[v] !== mirrorsInExport) {
+          throw new Error(`the ${client} client found ${info.mirrors[v]} mirrors in variant ${v}; the export has `
+            + `${mirrorsInExport} (meshes whose material has extras.mirrorbox_mirror)`);
+        }
+      }
       console.log(`${spec.engine} ${versions[client]} on ${info.device} (${info.driver.split(';')[0]}); mirrors: ${info.mirrors[variants[0]]}; subpixel bits: ${info.subpixelBits}; loaded in ${((Date.now() - t0) / 1000).toFixed(1)} s`);
 
       const results = {}; // view -> { times, images }
@@ -341,7 +370,10 @@ async function main() {
         const t1 = Date.now();
         const r = await page.evaluate((v, f, w) => window.mirrorbox.runView(v, f, w), view, opts.frames, opts.warmup);
         check();
-        if (r.cameraDiff > 1e-5) console.error(`warning: view ${view.name}: ${spec.engine}'s camera differs from views.json's matrices by ${r.cameraDiff}`);
+        // The camera is the export's or the images are of another view: an error, not a warning.
+        if (!(r.cameraDiff <= 1e-5)) {
+          throw new Error(`view ${view.name}: ${spec.engine}'s camera differs from views.json's matrices by ${r.cameraDiff} (at most 1e-5)`);
+        }
         results[view.name] = r;
         const med = (a) => a.slice().sort((x, y) => x - y)[a.length >> 1];
         const summary = variants.map((n) => `${n} ${med(r.times[n]).toFixed(2)} ms`).join(', ');
@@ -354,13 +386,18 @@ async function main() {
     await browser.close();
     browser = null;
 
-    // Every client drew every view: write each file under a temporary name, then rename it.
+    // Every client drew every view: each client's folder is written whole under a temporary
+    // name, then put in place of an earlier run's (whose other variants would have been scored
+    // beside these).
     for (const { name: client } of opts.plan) {
       const spec = CLIENTS[client];
       const { info, results, variants } = drawn[client];
       const syncMs = Math.max(...Object.values(results).map((r) => r.syncMs));
+      const final = path.join(opts.runDir, client);
+      const staged = `${final}.tmp-${process.pid}`;
+      fs.rmSync(staged, { recursive: true, force: true });
       for (const name of variants) {
-        const dir = path.join(opts.runDir, client, name);
+        const dir = path.join(staged, name);
         fs.mkdirSync(dir, { recursive: true });
         for (const view of views.views) {
           const floats = new Float32Array(new Uint8Array(Buffer.from(results[view.name].images[name], 'base64')).buffer);
@@ -368,7 +405,12 @@ async function main() {
         }
         const own = spec.parameters(name, opts);
         const parameters = own.parameters;
-        const notes = `${own.notes ?? ''} Timing: ${opts.frames} timed frames after ${opts.warmup} warm-up `
+        if (unsupportedLighting) parameters.lighting = 'unsupported';
+        const lit = unsupportedLighting
+          ? ` The export's lighting ("${views.contract.lighting}") is not drawn: direct light only, no shadows, `
+            + 'no light through mirrors (--allow-unsupported-lighting).'
+          : '';
+        const notes = `${own.notes ?? ''}${lit} Timing: ${opts.frames} timed frames after ${opts.warmup} warm-up `
           + `frames per view; the wait for the GPU (finish + 1×1 readback) costs ${syncMs.toFixed(3)} ms alone.`;
         const timing = {
           format: 'mirrorbox-timing',
@@ -387,7 +429,9 @@ async function main() {
         };
         writeAtomic(path.join(dir, 'timing.json'), `${JSON.stringify(timing, null, 2)}\n`);
       }
-      console.log(`wrote ${path.join(opts.runDir, client)}/{${variants.join(',')}}`);
+      fs.rmSync(final, { recursive: true, force: true });
+      fs.renameSync(staged, final);
+      console.log(`wrote ${final}/{${variants.join(',')}}`);
     }
     console.log(`done in ${((Date.now() - started) / 1000).toFixed(1)} s`);
   } catch (err) {

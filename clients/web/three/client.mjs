@@ -107,8 +107,9 @@ function cubeMirrorMaterial(info, cubeTarget, normal) {
     shader.vertexShader = swap(shader.vertexShader, '#include <envmap_vertex>',
       '#include <envmap_vertex>\n\tvMbWorldPosition = ( modelMatrix * vec4( transformed, 1.0 ) ).xyz;');
     shader.vertexShader = `varying vec3 vMbWorldPosition;\n${shader.vertexShader}`;
+    // Checked as the outer swap: a renamed line would have left the per-vertex reflection, unsaid.
     shader.fragmentShader = swap(shader.fragmentShader, '#include <envmap_fragment>',
-      THREE.ShaderChunk.envmap_fragment.replace('vec3 reflectVec = vReflect;',
+      swap(THREE.ShaderChunk.envmap_fragment, 'vec3 reflectVec = vReflect;',
         'vec3 reflectVec = reflect( normalize( vMbWorldPosition - cameraPosition ), mbMirrorNormal );'));
     shader.fragmentShader = `varying vec3 vMbWorldPosition;\nuniform vec3 mbMirrorNormal;\n${shader.fragmentShader}`;
   };

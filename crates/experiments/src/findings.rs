@@ -249,8 +249,10 @@ fn web_engines(reports: &Path) -> Result<String, ReadmeError> {
             String::new()
         } else {
             format!(
-                " (it draws its mirror texture with {texture}; which of them costs what is \
-                 not measured)"
+                " (it draws its mirror texture with {texture}: at 160×90 without the MSAA its \
+                 error was lower, the MSAA smoothing the reflection's edges where the \
+                 one-sample truth is sharp (clients/web/README.md); these records do not split \
+                 it)"
             )
         }
     ))

@@ -1,7 +1,8 @@
 //! The planar reflections web engines ship, scored against the truth through the exchange
-//! (issue 53, `docs/exchange.md`): three.js' `Reflector` and a `CubeCamera` probe (and each
-//! engine's no-mirror floor), drawn in headless Chromium by `clients/web`, beside our
-//! equivalents (`naive`, `cubemap`) and the exact methods swept on the same software
+//! (issue 53, `docs/exchange.md`): three.js' `Reflector` and `CubeCamera` probes, Babylon.js'
+//! `MirrorTexture` and `ReflectionProbe` (and each engine's no-mirror floor), drawn in headless
+//! Chromium by `clients/web`, beside our equivalents (`naive`, `cubemap`, `feedback`) and the
+//! exact methods swept on the same software
 //! rasterizer (SwiftShader, loaded by wgpu from Chromium's Vulkan ICD), on mirror_box,
 //! mirror_room and textured_box at 320×180, α = 0.9. Run by `scripts/measure-web-engines.sh`.
 
@@ -45,7 +46,7 @@ fn findings(reports: &Path) -> Result<String, ReadmeError> {
 
 pub const WEB_ENGINES: Experiment = Experiment {
     name: "web-engines",
-    about: "three.js' planar reflections in headless Chromium, scored through the exchange beside our equivalents on the same software rasterizer",
+    about: "three.js' and Babylon.js' planar reflections in headless Chromium, scored through the exchange beside our equivalents on the same software rasterizer",
     folder: "web_engines",
     measure: Measure::Script("scripts/measure-web-engines.sh", &[]),
     section: Some(section::section),
