@@ -21,7 +21,8 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 seconds() { # BVH
   RAYON_NUM_THREADS=1 "$bin" trace "scenes/$scene.json" -o "$work/out.exr" --integrator path \
-    --spp 16 --max-segments 10 --bvh "$1" --json > "$work/run.json" 2>/dev/null
+    --spp 16 --max-segments 10 --bvh "$1" --json > "$work/run.json" 2>"$work/err" ||
+    { cat "$work/err" >&2; exit 1; } # a failed render says why
   python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['render_seconds'])" "$work/run.json"
 }
 : > "$work/rounds"

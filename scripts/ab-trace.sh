@@ -45,7 +45,7 @@ seconds() {
   local bin=$1
   shift
   RAYON_NUM_THREADS=1 "$bin" trace "scenes/$scene.json" -o "$work/out.exr" --json "$@" \
-    > "$work/run.json" 2>/dev/null
+    > "$work/run.json" 2>"$work/err" || { cat "$work/err" >&2; exit 1; } # a failed render says why
   python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['render_seconds'])" "$work/run.json"
 }
 # Round r runs the builds from index r mod N on (two builds: A then B in even rounds, B then

@@ -86,7 +86,8 @@ for round in $(seq "$rounds"); do
       # One untimed render first (--warm-up 1): the timed render is the process's second, as
       # Mitsuba's compiled-kernel time is its second render; the first render's time is kept too.
       "$bin" trace "scenes/$s.json" -o "$work/ours.exr" --spp "$spp" --integrator "$integrator" \
-        "${ours_cut[@]}" --warm-up 1 --json > "$work/ours.json" 2>/dev/null
+        "${ours_cut[@]}" --warm-up 1 --json > "$work/ours.json" 2>"$work/err" ||
+        { cat "$work/err" >&2; exit 1; } # a failed render says why (it had ended the run unsaid)
       # Parsed after the render, not through a pipe: a Python started beside the render
       # took one of the two cores during it (0.15 s instead of 0.10 s for mirror_box).
       python3 -c "import json,sys; r=json.load(sys.stdin); print(json.dumps({'who':'mirrorbox','scene':'$s','integrator':'$integrator','round':$round,'seconds':r['render_seconds'],'first_seconds':r['warm_up_seconds'][0],'rays':r['rays'],'threads':r['threads']}))" < "$work/ours.json" >> "$work/runs.jsonl"
@@ -95,7 +96,8 @@ for round in $(seq "$rounds"); do
       fresh_home="$work/home.$round.$s.$integrator"
       mkdir -p "$fresh_home"
       HOME="$fresh_home" "$py" tools/mitsuba/render.py "$work/$s/scene.xml" -o "$work/mitsuba.exr" --integrator "$integrator" \
-        --max-depth "$depth" --rr-depth "$rr_depth" --runs 1 > "$work/mitsuba.json" 2>/dev/null
+        --max-depth "$depth" --rr-depth "$rr_depth" --runs 1 > "$work/mitsuba.json" 2>"$work/err" ||
+        { cat "$work/err" >&2; exit 1; }
       python3 -c "import json,sys; r=json.loads(sys.stdin.read().strip().splitlines()[-1]); print(json.dumps({'who':'mitsuba','scene':'$s','integrator':'$integrator','round':$round,'seconds':r['render_seconds'],'first_seconds':r['first_render_seconds'],'variant':r['variant']}))" < "$work/mitsuba.json" >> "$work/runs.jsonl"
     done
   done

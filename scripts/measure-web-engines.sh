@@ -9,11 +9,12 @@
 #      every variant — three.js: floor, reflector, cubecamera; Babylon.js: floor,
 #      mirrortexture, probe — into target/web-engines/<scene>/run;
 #   3. our equivalents (naive for the Reflector; feedback at history 0 for the MirrorTexture,
-#      one texture per mirror per frame; cubemap at 256², history 0, for the probes) and the
-#      exact methods swept on SwiftShader's Vulkan —
+#      one texture per mirror per frame; cubemap at 256² for the probes, with the frames the
+#      engines' cubes drew before their saved image as its history: warm-up 2 + FRAMES) and
+#      the exact methods swept on SwiftShader's Vulkan —
 #      the same software rasterizer the browser runs on, loaded by wgpu from Chromium's own
 #      ICD file — so that milliseconds compare like with like;
-#   4. `mirrorbox score … --with <our sweep>` writes reports/web_engines[_room|_textured].
+#   4. `mirrorbox score … --with <our sweeps>` writes reports/web_engines[_room|_textured].
 # Usage: scripts/measure-web-engines.sh [FRAMES]   (timed frames per point, default 9)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -44,7 +45,14 @@ for entry in mirror_box: mirror_room:_room textured_box:_textured; do
   [ "$scene" = mirror_room ] && depths=1,2,4,8
   VK_DRIVER_FILES=$icd "$bin" sweep "scenes/$scene.json" --alpha 0.9 --width 320 --height 180 \
     --frames "$frames" --warmup 2 --out "$dir/ours" \
-    --methods naive,feedback,cubemap,portal,unrolled --depth "$depths" --history 0 --cube-size 256
+    --methods naive,feedback,portal,unrolled --depth "$depths" --history 0
+  # The engines' cubes refresh every frame, and their saved image is drawn after the warm-up
+  # and timed frames: our cubemap with that much history (the clients' `history` knob).
+  rm -rf "$dir/ours_cube"
+  VK_DRIVER_FILES=$icd "$bin" sweep "scenes/$scene.json" --alpha 0.9 --width 320 --height 180 \
+    --frames "$frames" --warmup 2 --out "$dir/ours_cube" \
+    --methods cubemap --history $((frames + 2)) --cube-size 256
   echo "== $scene: score"
-  "$bin" score "$dir/export" "$dir/run" --with "$dir/ours" -o "reports/web_engines$suffix"
+  "$bin" score "$dir/export" "$dir/run" --with "$dir/ours" --with "$dir/ours_cube" \
+    -o "reports/web_engines$suffix"
 done

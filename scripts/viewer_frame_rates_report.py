@@ -4,7 +4,11 @@ named WHICH.METHOD.ROUND.jsonl, WHICH being now or before) and `mirrorbox info` 
 Usage: viewer_frame_rates_report.py LOGS SCENE ROUNDS OUT COMMIT [BASELINE_COMMIT]
 """
 import json, sys, glob, os, statistics, datetime, platform
-work, scene, rounds, out, commit, baseline_commit = sys.argv[1:]
+if len(sys.argv) not in (6, 7):
+    sys.exit(__doc__.strip().splitlines()[-1].strip())
+# BASELINE_COMMIT is optional, as the usage says (five arguments had raised ValueError).
+work, scene, rounds, out, commit = sys.argv[1:6]
+baseline_commit = sys.argv[6] if len(sys.argv) == 7 else ""
 
 # The goals of issue 42: walking within 15 % of standing; standing within the GPU frame
 # plus the window's paint and present plus 3 ms; at least these frame rates, standing and

@@ -41,7 +41,10 @@ const CLIENTS = {
           + 'while it renders. A facing Reflector met in its view renders its own view nested: two levels.';
       }
       if (name === 'cubecamera') {
-        Object.assign(parameters, { cube_size: opts.cubeSize, cube_type: 'half' });
+        // Its cubes refresh every frame from the previous frame's: the saved image (one draw
+        // after warm-up and timed frames) shows that many frames of history, as our cubemap at
+        // --history warmup + frames.
+        Object.assign(parameters, { cube_size: opts.cubeSize, cube_type: 'half', history: opts.warmup + opts.frames });
         notes += ' Each mirror has a CubeCamera at its centre, updated every frame with the mirror hidden; '
           + 'the mirror is a MeshBasicMaterial with the cube as envMap (MultiplyOperation, colour = '
           + 'reflectance), its reflection vector per fragment (patched: as shipped it is per vertex); the '
@@ -98,7 +101,10 @@ const CLIENTS = {
           + 'the mirrors inside it textured with what their textures hold), which shows terminal there instead.' + back;
       }
       if (name === 'probe') {
-        Object.assign(parameters, { cube_size: opts.cubeSize, cube_type: 'half', refresh: 'every_frame', invert_z: false });
+        Object.assign(parameters, {
+          cube_size: opts.cubeSize, cube_type: 'half', refresh: 'every_frame', invert_z: false,
+          history: opts.warmup + opts.frames, // as three's cubecamera (above)
+        });
         notes += ` Each mirror has a ReflectionProbe at its centre (${opts.cubeSize}² faces, half float, no mip-maps, `
           + 'near/far the camera\'s, no clip plane), renderList every other mesh (the other mirrors and their backs included), '
           + 'refreshed every frame, its cube cleared to terminal before the first. The mirror is a StandardMaterial with the '

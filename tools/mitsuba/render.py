@@ -34,8 +34,12 @@ LLVM19 = "/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1"
 if "DRJIT_LIBLLVM_PATH" not in os.environ and os.path.exists(LLVM19):
     os.environ["DRJIT_LIBLLVM_PATH"] = LLVM19  # Mitsuba 3.9's JIT needs LLVM >= 16
 
-import drjit as dr  # noqa: E402
-import mitsuba as mi  # noqa: E402
+try:
+    import drjit as dr  # noqa: E402
+    import mitsuba as mi  # noqa: E402
+except ImportError as e:  # no LLVM at all, or not the venv's Python
+    sys.exit(f"render.py: cannot import Mitsuba 3 ({e}): run tools/mitsuba/setup.sh and use its "
+             ".venv/bin/python")
 
 
 def parse_args():
@@ -182,6 +186,13 @@ def main():
     # Our contract is RGB; a spectral variant would read every <rgb> as a spectrum.
     if not args.variant.endswith("_rgb"):
         refuse(f"--variant {args.variant}: an RGB variant (llvm_ad_rgb, scalar_rgb, ...)")
+    # Without LLVM >= 16 Dr.Jit falls back to the system's (15 here), which crashes the JIT
+    # with a dump of LLVM's, or fails to import: say so instead.
+    if args.variant.startswith("llvm") and not os.path.exists(os.environ.get("DRJIT_LIBLLVM_PATH", "")):
+        where = os.environ.get("DRJIT_LIBLLVM_PATH") or LLVM19
+        print(f"render.py: {args.variant} needs LLVM >= 16, and {where} is missing: run tools/mitsuba/setup.sh "
+              "(Debian's libllvm19), set DRJIT_LIBLLVM_PATH to it, or give --variant scalar_rgb", file=sys.stderr)
+        sys.exit(1)
     mi.set_variant(args.variant)
     scene_dir = os.path.dirname(os.path.abspath(args.scene))
     sidecar = os.path.join(scene_dir, "mirrorbox.json")
