@@ -328,7 +328,7 @@ fn a_bad_script_line_is_refused_before_any_window_opens() {
         out.stderr.contains("s.txt:2:")
             && out
                 .stderr
-                .contains("the width must be a whole number in [1, 8192]"),
+                .contains("the width must be a whole number in [64, 8192]"),
         "{}",
         out.stderr
     );

@@ -25,6 +25,22 @@ const LOOK_DEG_PER_PIXEL: f32 = 0.15;
 /// The panel's width in points.
 pub const PANEL_WIDTH: f32 = 300.0;
 
+/// The height the panel's widgets need, logical pixels: a default window is never lower (a
+/// 160×90 view's window had cut the panel off at 188 px).
+const PANEL_MIN_HEIGHT: f64 = 640.0;
+
+/// The default window for a `size` view at display `scale`, physical pixels: the panel beside
+/// two panes across and two down, the panes at the view's size, at least the panel's height,
+/// and no side above [`crate::script::MAX_WINDOW_SIDE`] (the panes scale down to fit; a 9000
+/// pixel view had asked the surface for more than the device takes).
+pub fn default_window((w, h): (u32, u32), scale: f64) -> (u32, u32) {
+    let panel = ((f64::from(PANEL_WIDTH) + 20.0) * scale).ceil() as u64;
+    let width = panel + 2 * u64::from(w);
+    let height = (2 * u64::from(h) + 8).max((PANEL_MIN_HEIGHT * scale).ceil() as u64);
+    let side = |v: u64| v.min(u64::from(crate::script::MAX_WINDOW_SIDE)) as u32;
+    (side(width), side(height))
+}
+
 struct Running {
     window: Arc<Window>,
     instance: wgpu::Instance,
@@ -96,8 +112,7 @@ impl App {
     fn start(&mut self, event_loop: &ActiveEventLoop) -> Result<Running, ViewError> {
         let o = &self.options;
         let (w, h) = o.size;
-        let panel_px = (PANEL_WIDTH + 20.0) as u32;
-        let default = o.window.unwrap_or((panel_px + 2 * w, 2 * h + 8));
+        let default = o.window.unwrap_or_else(|| default_window(o.size, 1.0));
         let attributes = Window::default_attributes()
             .with_title(format!("mirrorbox view — {}", o.scene_path.display()))
             .with_inner_size(PhysicalSize::new(default.0, default.1));
@@ -106,6 +121,13 @@ impl App {
                 .create_window(attributes)
                 .map_err(|e| ViewError::Failed(format!("cannot open a window: {e}")))?,
         );
+        // The panel is laid out in logical pixels: on a HiDPI display it takes scale × its
+        // width, and the default window grows by as much (the panes had shrunk to 20×11).
+        let scale = window.scale_factor();
+        if o.window.is_none() && scale != 1.0 {
+            let (sw, sh) = default_window((w, h), scale);
+            let _ = window.request_inner_size(PhysicalSize::new(sw, sh));
+        }
         let display = self.display.clone();
         let for_surface = window.clone();
         let (selected, surface) = mirrorbox_raster::adapter::select_adapter_presenting(
@@ -753,5 +775,21 @@ impl ApplicationHandler for App {
                 event_loop.set_control_flow(ControlFlow::Wait);
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A small view's window keeps the panel's height, a HiDPI display widens the panel's
+    /// part by its scale, and a huge view's window stays within the largest side.
+    #[test]
+    fn the_default_window_fits_the_panel_and_the_device() {
+        assert_eq!(default_window((640, 360), 1.0), (320 + 1280, 728));
+        assert_eq!(default_window((160, 90), 1.0), (320 + 320, 640));
+        assert_eq!(default_window((160, 90), 2.0), (640 + 320, 1280));
+        let max = crate::script::MAX_WINDOW_SIDE;
+        assert_eq!(default_window((9000, 64), 1.0), (max, 640));
     }
 }

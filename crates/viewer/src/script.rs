@@ -25,8 +25,10 @@ use std::path::{Path, PathBuf};
 /// Most actions a script may hold, and most frames one `frames` line may ask for.
 pub const MAX_ACTIONS: usize = 10_000;
 pub const MAX_FRAMES: u32 = 100_000;
-/// Largest window side a script may ask for.
+/// Largest window side a script (`resize`) or `--window` may ask for.
 pub const MAX_WINDOW_SIDE: u32 = 8192;
+/// Smallest window side, as `--window` takes it (`resize 1 1` had been taken: panes of 0 px).
+pub const MIN_WINDOW_SIDE: u32 = 64;
 /// Largest script file read.
 pub const MAX_SCRIPT_BYTES: u64 = 1 << 20;
 
@@ -303,8 +305,8 @@ fn parse_action(line: &str) -> Result<Action, String> {
         "resize" => {
             count(2, "a width and a height in pixels")?;
             Action::Resize(
-                whole(args[0], "the width", 1, MAX_WINDOW_SIDE)?,
-                whole(args[1], "the height", 1, MAX_WINDOW_SIDE)?,
+                whole(args[0], "the width", MIN_WINDOW_SIDE, MAX_WINDOW_SIDE)?,
+                whole(args[1], "the height", MIN_WINDOW_SIDE, MAX_WINDOW_SIDE)?,
             )
         }
         "screenshot" => {

@@ -76,6 +76,11 @@ pub enum TruthDeviceArg {
 const MAX_WINDOW_SIDE: u32 = mirrorbox_viewer::script::MAX_WINDOW_SIDE;
 #[cfg(not(feature = "viewer"))]
 const MAX_WINDOW_SIDE: u32 = u32::MAX;
+/// The smallest window side.
+#[cfg(feature = "viewer")]
+const MIN_WINDOW_SIDE: u32 = mirrorbox_viewer::script::MIN_WINDOW_SIDE;
+#[cfg(not(feature = "viewer"))]
+const MIN_WINDOW_SIDE: u32 = 64;
 
 fn parse_size(text: &str) -> Result<(u32, u32), String> {
     let (w, h) = text
@@ -84,8 +89,10 @@ fn parse_size(text: &str) -> Result<(u32, u32), String> {
     let side = |s: &str| {
         s.parse::<u32>()
             .ok()
-            .filter(|v| (64..=MAX_WINDOW_SIDE).contains(v))
-            .ok_or_else(|| format!("each side must be in [64, {MAX_WINDOW_SIDE}], got {s:?}"))
+            .filter(|v| (MIN_WINDOW_SIDE..=MAX_WINDOW_SIDE).contains(v))
+            .ok_or_else(|| {
+                format!("each side must be in [{MIN_WINDOW_SIDE}, {MAX_WINDOW_SIDE}], got {s:?}")
+            })
     };
     Ok((side(w)?, side(h)?))
 }
