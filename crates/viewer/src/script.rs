@@ -383,7 +383,7 @@ mod tests {
             ("method auxiliary n=99", "--n must be"),
             (
                 "resize 0 10",
-                "the width must be a whole number in [1, 8192]",
+                "the width must be a whole number in [64, 8192]",
             ),
             ("walk 1 nan 0", "right must be a number"),
             ("screenshot out.jpg", "must end in .png"),
