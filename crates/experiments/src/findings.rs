@@ -555,7 +555,12 @@ fn uneven(reports: &Path) -> Result<String, ReadmeError> {
 fn day_and_commit(s: &Sweep) -> String {
     let day = s.info.date.get(..10).unwrap_or(&s.info.date);
     let commit = s.info.commit.get(..7).unwrap_or(&s.info.commit);
-    format!("measured {day} at {commit}")
+    // Runs older than the field have none: said so ("at )" had been printed).
+    if commit.is_empty() {
+        format!("measured {day}, its commit not recorded")
+    } else {
+        format!("measured {day} at {commit}")
+    }
 }
 
 /// Where a sweep's points were measured, as a finding's closing parenthesis says it: the
