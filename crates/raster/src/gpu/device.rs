@@ -166,7 +166,9 @@ impl Gpu {
             }
         })?;
         let timestamps = selected.report.timestamp_query;
-        let features = (wanted | wgpu::Features::TIMESTAMP_QUERY) & selected.adapter.features();
+        let features = (wanted | wgpu::Features::TIMESTAMP_QUERY)
+            & selected.adapter.features()
+            & !unsafe_on(selected.adapter.get_info().backend);
         let (device, queue) =
             pollster::block_on(selected.adapter.request_device(&wgpu::DeviceDescriptor {
                 label: Some("mirrorbox"),
@@ -266,6 +268,19 @@ impl Gpu {
             .poll(wgpu::PollType::wait_indefinitely())
             .map(|_| ())
             .map_err(|e| RasterError::Gpu(e.to_string()))
+    }
+}
+
+/// Features a backend has but draws wrongly, left off so that the methods take their other
+/// path. GL: wgpu-hal 30 tracks the enabled clip distances per command buffer, which GL keeps
+/// across them; after a method whose last pipeline clipped (`unrolled`), every later draw
+/// without clip distances ran with them enabled and drew an almost empty frame (a `sweep` of
+/// `naive,unrolled` on GL: the floor's FLIP 1.6e-1 instead of 7.7e-4). Without the feature the
+/// methods clip in the fragment shader (the same images, tested on Vulkan).
+pub fn unsafe_on(backend: wgpu::Backend) -> wgpu::Features {
+    match backend {
+        wgpu::Backend::Gl => wgpu::Features::CLIP_DISTANCES,
+        _ => wgpu::Features::empty(),
     }
 }
 
