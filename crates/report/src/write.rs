@@ -101,7 +101,7 @@ fn timings_by_device(devices: &[String], records: &[Record]) -> Vec<Block> {
                 "point".into(),
                 "α".into(),
                 ms_heading("ms/frame median", on()),
-                "FLIP mean".into(),
+                "FLIP mean (image)".into(),
             ],
             on().map(|r| {
                 vec![
@@ -1126,7 +1126,7 @@ fn all_points(points: &[&Record], reused: &dyn Fn(&Record) -> bool) -> Vec<Block
         "SMAPE",
         "PSNR dB",
         "SSIM",
-        "FLIP mean",
+        "FLIP mean (image)",
         "p95",
         "p99",
         "mirror px %",

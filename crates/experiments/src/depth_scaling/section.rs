@@ -85,7 +85,7 @@ pub fn depth_scaling(info: &SweepInfo, records: &[Record], floor: Option<&Record
                 "draws",
                 "triangles",
                 ms_column.as_str(),
-                "FLIP mean",
+                "FLIP mean (image)",
             ]
             .map(String::from)
             .to_vec(),

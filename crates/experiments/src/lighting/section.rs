@@ -325,7 +325,7 @@ pub fn lighting_section(records: &[Record]) -> Vec<Block> {
             "k",
             ms_column.as_str(),
             "passes",
-            "FLIP mean",
+            "FLIP mean (image)",
             "RMSE",
             "SSIM",
         ]

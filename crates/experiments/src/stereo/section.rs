@@ -338,7 +338,7 @@ pub fn stereo_section(records: &[Record]) -> Vec<Block> {
             records,
             "plot_stereo_error_vs_ipd.svg",
             "FLIP over the image (both eyes) vs interpupillary distance",
-            "FLIP mean",
+            "FLIP mean over the image",
             true,
         ),
     ];

@@ -81,7 +81,7 @@ pub fn symmetry_section(records: &[Record]) -> Vec<Block> {
                 "triangles",
                 "bake ms (CPU, once)",
                 ms_column.as_str(),
-                "FLIP mean",
+                "FLIP mean (image)",
             ]
             .map(String::from)
             .to_vec(),

@@ -11,10 +11,11 @@
 //!   exactly two reflections, the paper's Figure 2.
 //! - `auxiliary` (§3.1): n auxiliary mirrors coincide with real ones, alternating sides by
 //!   label parity, so chains can use a mirror again. With two mirrors (the paper's setting)
-//!   odd labels lie on mirror 1, even on mirror 2: the queue holds n + 2 mirrors and chains
-//!   reach n + 2 reflections. With more mirrors every mirror pairs with its [`partner`] —
-//!   the mirror it faces most directly — and each pair gets the paper's n auxiliary
-//!   mirrors, odd labels on the pair's first mirror in scene order, even on the other, so
+//!   odd labels lie on Mirror 1, the one the viewer looks into, even on Mirror 2: the queue
+//!   holds n + 2 mirrors and chains reach n + 2 reflections. With more mirrors every mirror
+//!   pairs with its [`partner`] — the mirror it faces most directly — and each pair gets the
+//!   paper's n auxiliary mirrors, odd labels on the pair's Mirror 1 (the one the camera sees
+//!   larger, [`seen_directly`]; the first in scene order on a tie), even on the other, so
 //!   mirror i holds ⌈n/2⌉ or ⌊n/2⌋ copies ([`auxiliary_copies`]). Each instance hides only
 //!   itself, so every camera recurses into *every* unhidden instance it sees.
 //!
@@ -27,8 +28,8 @@
 //! the camera sees and b on the other (a = 1 + ⌈n/2⌉, b = 1 + ⌊n/2⌋ when it looks into
 //! mirror 1), there is one plane chain per length and the sum is a + a·b + a·b·(a−1) +
 //! a·b·(a−1)·(b−1) + …: 3, 7, 15, 46, 139 passes for n = 0…4 on `mirror_box`. The growth is
-//! factorial, which is what the paper's Table 1 (25, 61, 142, 435, 1330 ms) shows: divided
-//! by these counts it is 8.3–9.6 ms per pass. Counting visits each plane chain once and
+//! factorial; the paper's Table 1 (25, 61, 142, 435, 1330 ms) gives no pass counts, and
+//! divided by these counts (assuming its recursion is this one) it is 8.3–9.6 ms per pass. Counting visits each plane chain once and
 //! stops after `--max-passes` of them, so a refusal costs at most that many visibility
 //! tests, however large the plan.
 
@@ -174,22 +175,50 @@ pub fn partner(scene: &Scene, i: usize) -> Option<usize> {
     })
 }
 
+/// Each scene mirror's footprint on screen seen directly from the camera, in pixels (0 where
+/// the camera does not see it): which mirror of a pair the viewer looks into.
+pub fn seen_directly(scene: &Scene, width: u32, height: u32) -> Vec<u64> {
+    let mirrors: Vec<MirrorInstance> = (0..scene.mirrors.len())
+        .map(|i| MirrorInstance {
+            mirror: i,
+            label: format!("mirror {}", i + 1),
+        })
+        .collect();
+    let planner = Planner::new(scene, &mirrors, width, height);
+    let mut area = vec![0; scene.mirrors.len()];
+    for (i, rect) in planner.visible(&planner.main_view(width, height), None, &[]) {
+        area[i] = u64::from(rect.w) * u64::from(rect.h);
+    }
+    area
+}
+
 /// Whether the paper's auxiliary label `k` (1…n) of mirror `i`'s pair lies on `i`: odd labels
-/// on the pair's first mirror in scene order, even ones on the other.
-fn label_lies_on(scene: &Scene, i: usize, k: u32) -> bool {
-    let first = partner(scene, i).is_some_and(|p| i < p);
+/// on the pair's "Mirror 1", even ones on the other. Mirror 1 is the one the viewer looks
+/// into (§2: "the texture of Mirror 1 is given by an auxiliary camera looking out of it";
+/// each auxiliary goes "at the other side opposite to the previous one"): of the two, the one
+/// with the larger footprint `seen` from the camera ([`seen_directly`]), the first in scene
+/// order where they tie. By scene order alone, a camera looking into a pair's second mirror
+/// had got n + 1 reflections for odd n (n = 1 the same image as `naive`).
+fn label_lies_on(scene: &Scene, seen: &[u64], i: usize, k: u32) -> bool {
+    let first = partner(scene, i).is_some_and(|p| match seen[i].cmp(&seen[p]) {
+        std::cmp::Ordering::Equal => i < p,
+        larger => larger == std::cmp::Ordering::Greater,
+    });
     (k % 2 == 1) == first
 }
 
-/// Auxiliary copies of each scene mirror for `n` auxiliary mirrors per pair: ⌈n/2⌉ on a
-/// pair's first mirror, ⌊n/2⌋ on the other (none on a lone mirror).
-pub fn auxiliary_copies(scene: &Scene, n: u32) -> Vec<u32> {
+/// Auxiliary copies of each scene mirror for `n` auxiliary mirrors per pair, the camera's
+/// footprints `seen` ([`seen_directly`]): ⌈n/2⌉ on a pair's Mirror 1, ⌊n/2⌋ on the other
+/// (none on a lone mirror).
+pub fn auxiliary_copies(scene: &Scene, seen: &[u64], n: u32) -> Vec<u32> {
     (0..scene.mirrors.len())
         .map(|i| {
             if partner(scene, i).is_none() {
                 0
             } else {
-                (1..=n).filter(|&k| label_lies_on(scene, i, k)).count() as u32
+                (1..=n)
+                    .filter(|&k| label_lies_on(scene, seen, i, k))
+                    .count() as u32
             }
         })
         .collect()
@@ -198,7 +227,12 @@ pub fn auxiliary_copies(scene: &Scene, n: u32) -> Vec<u32> {
 /// The rendering queue of a method: the scene's mirrors, then (`auxiliary`) the copies by
 /// label, each label's in scene order — for two mirrors "auxiliary 1" on mirror 1,
 /// "auxiliary 2" on mirror 2, … as in the paper.
-pub fn instances(scene: &Scene, queue: Queue) -> Result<Vec<MirrorInstance>, PlanError> {
+pub fn instances(
+    scene: &Scene,
+    queue: Queue,
+    width: u32,
+    height: u32,
+) -> Result<Vec<MirrorInstance>, PlanError> {
     let mut instances: Vec<MirrorInstance> = (0..scene.mirrors.len())
         .map(|i| MirrorInstance {
             mirror: i,
@@ -209,9 +243,10 @@ pub fn instances(scene: &Scene, queue: Queue) -> Result<Vec<MirrorInstance>, Pla
         if n > 0 && scene.mirrors.len() < 2 {
             return Err(PlanError::NoMirrorToAlternateWith(scene.mirrors.len()));
         }
+        let seen = seen_directly(scene, width, height);
         for k in 1..=n {
             for mirror in 0..scene.mirrors.len() {
-                if label_lies_on(scene, mirror, k) {
+                if label_lies_on(scene, &seen, mirror, k) {
                     instances.push(MirrorInstance {
                         mirror,
                         label: format!("auxiliary {k}"),
@@ -426,7 +461,7 @@ pub fn count_passes(
     height: u32,
     max_passes: usize,
 ) -> Result<PassCount, PlanError> {
-    let instances = instances(scene, queue)?;
+    let instances = instances(scene, queue, width, height)?;
     let planner = Planner::new(scene, &instances, width, height);
     Ok(planner.count_passes(&planner.main_view(width, height), max_passes))
 }
@@ -440,7 +475,7 @@ pub fn plan(
     height: u32,
     max_passes: usize,
 ) -> Result<Plan, PlanError> {
-    let instances = instances(scene, queue)?;
+    let instances = instances(scene, queue, width, height)?;
     let planner = Planner::new(scene, &instances, width, height);
     let main = planner.main_view(width, height);
     let count = planner.count_passes(&main, max_passes);
@@ -645,13 +680,42 @@ mod tests {
     #[test]
     fn auxiliary_zero_is_the_naive_queue() {
         let s = scene("mirror_box.json");
+        let queue = |s: &Scene, queue| instances(s, queue, 320, 180);
         assert_eq!(
-            instances(&s, Queue::Auxiliary { n: 0 }).unwrap(),
-            instances(&s, Queue::SceneMirrors).unwrap()
+            queue(&s, Queue::Auxiliary { n: 0 }).unwrap(),
+            queue(&s, Queue::SceneMirrors).unwrap()
         );
-        let q = instances(&s, Queue::Auxiliary { n: 3 }).unwrap();
+        let q = queue(&s, Queue::Auxiliary { n: 3 }).unwrap();
         let sides: Vec<usize> = q.iter().map(|i| i.mirror).collect();
         assert_eq!(sides, vec![0, 1, 0, 1, 0]);
+    }
+
+    /// The paper's Mirror 1 is the mirror the viewer looks into, not the scene file's first:
+    /// with mirror_box's two mirrors listed the other way round, the odd labels follow the
+    /// mirror the camera sees, and n = 1, 2, 3 reach 3, 4, 5 reflections as before (by file
+    /// order they had reached 2, 4, 4: n = 1 was `naive`).
+    #[test]
+    fn odd_labels_lie_on_the_mirror_the_camera_looks_into() {
+        let s = scene("mirror_box.json");
+        let mut swapped = s.clone();
+        swapped.mirrors.reverse();
+        let sides = |s: &Scene| -> Vec<usize> {
+            instances(s, Queue::Auxiliary { n: 3 }, 320, 180)
+                .unwrap()
+                .iter()
+                .map(|i| i.mirror)
+                .collect()
+        };
+        assert_eq!(sides(&swapped), vec![0, 1, 1, 0, 1]);
+        for n in 1..=3 {
+            let depth_of = |s: &Scene| {
+                plan(s, Queue::Auxiliary { n }, 320, 180, 5000)
+                    .unwrap()
+                    .depth
+            };
+            assert_eq!(depth_of(&swapped), depth_of(&s), "n = {n}");
+            assert_eq!(depth_of(&s), n as usize + 2, "n = {n}");
+        }
     }
 
     #[test]
@@ -683,7 +747,8 @@ mod tests {
         assert_eq!(names, ["north", "south", "west", "east"]);
         let partners: Vec<Option<usize>> = (0..4).map(|i| partner(&room, i)).collect();
         assert_eq!(partners, [Some(1), Some(0), Some(3), Some(2)]);
-        let copies: Vec<Vec<u32>> = (0..=4).map(|n| auxiliary_copies(&room, n)).collect();
+        let seen = seen_directly(&room, 320, 180);
+        let copies: Vec<Vec<u32>> = (0..=4).map(|n| auxiliary_copies(&room, &seen, n)).collect();
         assert_eq!(
             copies,
             [
@@ -702,12 +767,12 @@ mod tests {
         let single = scene("single_mirror.json");
         assert_eq!(partner(&single, 0), None);
         assert_eq!(
-            instances(&single, Queue::Auxiliary { n: 1 }).unwrap_err(),
+            instances(&single, Queue::Auxiliary { n: 1 }, 320, 180).unwrap_err(),
             PlanError::NoMirrorToAlternateWith(1)
         );
         assert_eq!(
-            instances(&single, Queue::Auxiliary { n: 0 }).unwrap(),
-            instances(&single, Queue::SceneMirrors).unwrap()
+            instances(&single, Queue::Auxiliary { n: 0 }, 320, 180).unwrap(),
+            instances(&single, Queue::SceneMirrors, 320, 180).unwrap()
         );
     }
 
@@ -843,7 +908,7 @@ pub fn plan_path_textures(
     height: u32,
     max_passes: usize,
 ) -> Result<Plan, PlanError> {
-    let instances = instances(scene, Queue::SceneMirrors)?;
+    let instances = instances(scene, Queue::SceneMirrors, width, height)?;
     let planner = Planner::new(scene, &instances, width, height);
     let main = planner.main_view(width, height);
     let mut budget = max_passes.saturating_sub(1);
