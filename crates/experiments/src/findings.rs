@@ -471,7 +471,8 @@ fn symmetry(reports: &Path) -> Result<String, ReadmeError> {
     Ok(format!(
         "**Symmetry planes: the CPU's split-and-mirror mesh against the seed's 2^p copies** — at \
          p = {}, drawing the baked mesh once (`{BAKED_METHOD}`, {} ms) is {:.0}× [{:.0}–{:.0}×] \
-         as fast as the seed's instanced copies (`{SEED_METHOD}`, {} ms), paired by round: {} \
+         as fast as the seed's 2^p copies drawn in one instanced draw per winding \
+         (`{SEED_METHOD}`, {} ms; the seed's own code draws each copy apart), paired by round: {} \
          (one run){pruning}{pruned_ms} ({}, {}, {}; [figure](symmetry_scaling/plot_ms_vs_planes.svg)).",
         b.planes().unwrap_or(0),
         ms(b.ms_median, 0),

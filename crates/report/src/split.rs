@@ -48,19 +48,26 @@ fn findings(points: &[(&Record, &ErrorSplit)], exact_methods: &[String]) -> Vec<
                 )
             };
             let error = span(of.iter().map(|(r, _)| total(r)), sci);
+            // Which FLIP [`flip`] took: over the mirror pixels where every point kept them
+            // (a scene without mirror pixels, the symmetry planes', had been said to be).
+            let over = if of.iter().all(|(r, _)| r.mirror_metrics.is_some()) {
+                "FLIP over the mirror pixels"
+            } else {
+                "FLIP over the image"
+            };
             let exact = of
                 .iter()
                 .all(|(r, _)| exact_methods.contains(&r.method) && r.method_options.is_empty());
             if exact {
                 format!(
-                    "`{v}` (exact): of its error {error} (FLIP over the mirror pixels), \
+                    "`{v}` (exact): of its error {error} ({over}), \
                      approximation {approx} — the samples its rasterizer decides within its \
                      sub-pixel grid of an edge — and {truncation_words}."
                 )
             } else if of.iter().all(|(r, s)| approximation(s) > total(r)) {
                 format!(
                     "`{v}`: against the truth cut at the reflections it shows, its error is \
-                     {approx} (FLIP over the mirror pixels) — above its error against the full \
+                     {approx} ({over}) — above its error against the full \
                      truth ({error}): where the cut truth shows the terminal radiance, it shows \
                      something nearer the full truth; {truncation_words}."
                 )
@@ -73,7 +80,7 @@ fn findings(points: &[(&Record, &ErrorSplit)], exact_methods: &[String]) -> Vec<
                     |x| format!("{:.0} %", 100.0 * x),
                 );
                 format!(
-                    "`{v}`: approximation {approx} (FLIP over the mirror pixels), {share} of its \
+                    "`{v}`: approximation {approx} ({over}), {share} of its \
                      error ({error}); {truncation_words}."
                 )
             }
@@ -206,7 +213,7 @@ mod tests {
         );
         assert!(
             findings[1].starts_with(
-                "`portal` (exact): of its error 2.000e-3 (FLIP over the mirror pixels), \
+                "`portal` (exact): of its error 2.000e-3 (FLIP over the image), \
                  approximation 4.000e-5 "
             ),
             "{findings:?}"
