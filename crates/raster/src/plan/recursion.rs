@@ -599,6 +599,15 @@ mod tests {
             matches!(e, PlanError::TooManyPasses { limit: 5000, .. }),
             "{e}"
         );
+        // Coloured mirrors: the cut is on the reflectances' product per channel, as the
+        // tracer's. A red and a green mirror: red, green, red leaves (1e-3, 1e-6, 1e-9) and
+        // one more green 1e-6 < 1e-4, so the paths end at 3 mirrors; the product of each
+        // mirror's largest channel (1 · 1 · …) had kept them to the depth limit, 16.
+        let mut coloured = s.clone();
+        coloured.mirrors[0].reflectance = glam::Vec3::new(1.0, 1e-3, 1e-3);
+        coloured.mirrors[1].reflectance = glam::Vec3::new(1e-3, 1.0, 1e-3);
+        let p = plan_path_textures(&coloured, limits(16), 320, 180, 5000).unwrap();
+        assert_eq!(p.depth, 3);
     }
 
     /// The pass counts of the paper's auxiliary method on `mirror_box` (see the module docs
@@ -862,7 +871,7 @@ impl Planner<'_> {
         instance: usize,
         rect: Rect,
         mirrors: u32,
-        attenuation: f32,
+        attenuation: glam::Vec3,
         limits: PathTextureLimits,
         budget: &mut usize,
     ) -> Option<TextureNode> {
@@ -875,11 +884,14 @@ impl Planner<'_> {
         let mut children = Vec::new();
         if mirrors < limits.depth {
             for (i, r) in self.visible(&view, Some(&plane), &[instance]) {
-                let next = attenuation * self.scene.mirrors[i].reflectance.max_element();
+                // Per channel, as the tracer's throughput and `portal`'s paths: the product's
+                // largest channel, not the product of each mirror's largest (the same for
+                // grey mirrors; for coloured ones that had kept paths the truth cuts).
+                let next = attenuation * self.scene.mirrors[i].reflectance;
                 let Some(r) = intersect(r, rect) else {
                     continue;
                 };
-                if next < limits.min_attenuation {
+                if next.max_element() < limits.min_attenuation {
                     continue;
                 }
                 children.push(self.path_node(&view, i, r, mirrors + 1, next, limits, budget)?);
@@ -914,8 +926,8 @@ pub fn plan_path_textures(
     let mut budget = max_passes.saturating_sub(1);
     let mut roots = Vec::new();
     for (i, rect) in planner.visible(&main, None, &[]) {
-        let attenuation = scene.mirrors[i].reflectance.max_element();
-        if attenuation < limits.min_attenuation {
+        let attenuation = scene.mirrors[i].reflectance;
+        if attenuation.max_element() < limits.min_attenuation {
             continue;
         }
         let Some(node) = planner.path_node(&main, i, rect, 1, attenuation, limits, &mut budget)
