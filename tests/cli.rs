@@ -2905,7 +2905,7 @@ fn a_sweep_leaves_out_the_methods_its_adapter_cannot_run_and_says_so() {
     assert_eq!(out.code, 0, "{}", out.stderr);
     assert!(
         out.stderr.contains("ray-query depth=1")
-            && out.stderr.contains("left out: --method ray-query needs"),
+            && out.stderr.contains("left out: `--method ray-query` (and `trace --device gpu`, which traces with it) needs ray queries"),
         "{}",
         out.stderr
     );

@@ -87,7 +87,7 @@ impl MethodEntry {
         } else {
             Err(RasterError::MissingFeature {
                 method: self.name,
-                feature: format!("{missing:?}"),
+                feature: crate::gpu::feature_names(missing),
                 adapter: format!("{} ({})", gpu.report.name, gpu.report.backend),
             })
         }

@@ -26,12 +26,51 @@ pub enum RasterError {
         adapter: String,
         advice: &'static str,
     },
-    #[error("--method {method} needs the adapter feature {feature}, which {adapter} lacks")]
+    #[error("{} needs {feature}, which {adapter} lacks", needed_by(method))]
     MissingFeature {
         method: &'static str,
         feature: String,
         adapter: String,
     },
+}
+
+/// Who needs a method's feature, in the words of the command the user typed: `ray-query` is
+/// also `trace --device gpu`'s tracer (whose users never wrote `--method`).
+fn needed_by(method: &str) -> String {
+    if method == "ray-query" {
+        "`--method ray-query` (and `trace --device gpu`, which traces with it)".into()
+    } else {
+        format!("`--method {method}`")
+    }
+}
+
+/// Adapter features in words, for messages: the ones the methods need named, any other by
+/// wgpu's name (its `Debug` had printed the struct: `Features { features_wgpu: … }`).
+pub fn feature_names(features: wgpu::Features) -> String {
+    let known = [
+        (
+            wgpu::Features::EXPERIMENTAL_RAY_QUERY,
+            "ray queries (EXPERIMENTAL_RAY_QUERY)",
+        ),
+        (
+            wgpu::Features::CLIP_DISTANCES,
+            "clip distances (CLIP_DISTANCES)",
+        ),
+        (
+            wgpu::Features::TIMESTAMP_QUERY,
+            "timestamp queries (TIMESTAMP_QUERY)",
+        ),
+    ];
+    let mut names: Vec<String> = known
+        .iter()
+        .filter(|(f, _)| features.contains(*f))
+        .map(|(_, name)| name.to_string())
+        .collect();
+    let rest = known.iter().fold(features, |left, (f, _)| left - *f);
+    if !rest.is_empty() {
+        names.push(format!("{rest:?}"));
+    }
+    names.join(", ")
 }
 
 impl RasterError {
