@@ -156,8 +156,13 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         if let Event::Finished { record } = e
             && record.kind != "floor"
         {
+            // The verdict is on the interval's upper end (a fit must hold with 95 %
+            // confidence): said with it, or a median under the budget read "over budget".
+            let upper = record
+                .ms_interval
+                .map_or(String::new(), |[_, hi]| format!(" (95 % up to {hi:.3})"));
             eprintln!(
-                "  {:<34} {:>9.3} ms/frame  {}",
+                "  {:<34} {:>9.3} ms/frame{upper}  {}",
                 record.method_key(),
                 record.ms_median,
                 if mirrorbox_harness::advise::within(record, args.budget_ms) {

@@ -383,10 +383,19 @@ fn repeat_region(first: &Sweep, second: &Sweep) -> Result<String, ReadmeError> {
             rows,
         ),
         Block::Paragraph(format!(
-            "The intervals overlap on {overlapping} of {} rows; the first run {}, the second {}.",
+            "The intervals overlap on {overlapping} of {} rows; {}.",
             a.len(),
-            order(ordered(&a)),
-            order(ordered(&b))
+            // Said once where both runs agree ("the first run keeps the order …, the second
+            // keeps the order …" had read as a stutter).
+            match (ordered(&a), ordered(&b)) {
+                (x, y) if x == y => format!(
+                    "both runs' times {} (each row's median above the one before)",
+                    order(x)
+                        .replace("keeps", "keep")
+                        .replace("does NOT keep", "do NOT keep")
+                ),
+                (x, y) => format!("the first run {}, the second {}", order(x), order(y)),
+            }
         )),
     ];
     blocks.extend(verdicts_held(first, second));
