@@ -1247,6 +1247,12 @@ fn compare_reports_metrics_and_refuses_mismatched_sizes() {
     }
     assert!(v["rmse"].as_f64().unwrap() > 0.0 && v["ssim"].as_f64().unwrap() < 1.0);
     assert!(heat.is_file());
+    // Two reflectances are two scenes: said, as the difference is not a method's.
+    assert!(
+        out.stderr.contains("show different scenes"),
+        "{}",
+        out.stderr
+    );
     let same = mirrorbox(
         &[
             "compare",
@@ -1259,6 +1265,7 @@ fn compare_reports_metrics_and_refuses_mismatched_sizes() {
         &[],
     );
     assert_eq!(same.code, 0, "an image against itself: {}", same.stderr);
+    assert!(!same.stderr.contains("different scenes"), "{}", same.stderr);
     let v: Value = serde_json::from_str(same.stdout.trim()).unwrap();
     assert_eq!(v["rmse"], 0.0);
     assert!(v["psnr"].is_null(), "identical images have infinite PSNR");

@@ -36,12 +36,15 @@ pub fn metrics_json(m: &Metrics) -> serde_json::Value {
 
 /// What `trace` and `render` record in their EXRs that a comparison needs, read once per
 /// image (a PNG records nothing: it is already exposed and encoded).
-#[derive(Clone, Copy, Default)]
+#[derive(Clone, Default)]
 struct Recorded {
     /// The samples per pixel: `mirrorbox.spp` (trace), or `mirrorbox.ssaa` s as s² (render).
     spp: Option<u64>,
     /// The scene camera's exposure, `mirrorbox.exposure`.
     exposure: Option<f32>,
+    /// The content hash of the scene drawn (`mirrorbox.scene_hash`: its reflectances and
+    /// `--alpha` included, its cut depth not).
+    scene_hash: Option<String>,
 }
 
 fn recorded(path: &std::path::Path) -> Recorded {
@@ -61,13 +64,14 @@ fn recorded(path: &std::path::Path) -> Recorded {
         exposure: value("mirrorbox.exposure")
             .and_then(|v| v.parse::<f32>().ok())
             .filter(|e| *e > 0.0 && e.is_finite()),
+        scene_hash: value("mirrorbox.scene_hash").map(String::from),
     }
 }
 
 /// The tone mapping's exposure: `--exposure`, else the one both images record, else 1. Images
 /// recording different exposures, or one recording an exposure other than 1 beside one that
 /// records none, are refused without `--exposure`: no one value fits both.
-fn exposure(args: &Args, reference: Recorded, test: Recorded) -> Result<f32, Failure> {
+fn exposure(args: &Args, reference: &Recorded, test: &Recorded) -> Result<f32, Failure> {
     if let Some(e) = args.exposure {
         if !(e > 0.0 && e.is_finite()) {
             return Err(Failure::BadInput(format!(
@@ -99,7 +103,7 @@ fn exposure(args: &Args, reference: Recorded, test: Recorded) -> Result<f32, Fai
 /// Refuses images sampled on different sub-pixel grids: a 4×4 box average and a pixel-centre
 /// sample differ wherever the image curves, and that difference would be read as the
 /// method's error (the shading contract: never from mismatched sampling).
-fn check_same_grid(args: &Args, reference: Recorded, test: Recorded) -> Result<(), Failure> {
+fn check_same_grid(args: &Args, reference: &Recorded, test: &Recorded) -> Result<(), Failure> {
     match (reference.spp, test.spp) {
         (Some(a), Some(b)) if a != b => Err(Failure::BadInput(format!(
             "{} was taken with {a} samples per pixel and {} with {b}: compare images of the \
@@ -111,9 +115,28 @@ fn check_same_grid(args: &Args, reference: Recorded, test: Recorded) -> Result<(
     }
 }
 
+/// A warning where both images record the scene they show and the scenes differ (another
+/// scene file, or the same at another `--alpha`): the numbers are then not one method's
+/// error. A warning, not a refusal: comparing two scenes on purpose is allowed.
+fn scenes_warning(args: &Args, reference: &Recorded, test: &Recorded) -> Option<String> {
+    match (&reference.scene_hash, &test.scene_hash) {
+        (Some(a), Some(b)) if a != b => Some(format!(
+            "warning: {} and {} show different scenes (scene hashes {a} and {b}: another scene \
+             file, or its mirrors at another reflectance, --alpha): the difference is not only \
+             the method's",
+            args.reference.display(),
+            args.test.display()
+        )),
+        _ => None,
+    }
+}
+
 pub fn run(args: &Args) -> Result<(), Failure> {
     let (reference, test) = (recorded(&args.reference), recorded(&args.test));
-    let exposure = exposure(args, reference, test)?;
+    let exposure = exposure(args, &reference, &test)?;
+    if let Some(w) = scenes_warning(args, &reference, &test) {
+        eprintln!("{w}");
+    }
     let heatmap = args
         .heatmap
         .as_deref()
@@ -149,7 +172,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             args.test.display()
         ))
     })?;
-    check_same_grid(args, reference, test)?;
+    check_same_grid(args, &reference, &test)?;
     if let Some(path) = &heatmap {
         let map = flip_map(
             &r.to_srgb8(exposure),
