@@ -374,10 +374,14 @@ fn frontier_chart(
             s.joined = false;
             s.bars = bars;
             s.x_intervals = pts.iter().map(|r| r.ms_bars(s.bars)).collect();
+            // The front's points are labelled, and every point of a series of several (two
+            // cube sizes had been two crosses alike, unnamed); the placement leaves out a
+            // label with no free place.
+            let several = pts.len() > 1;
             s.labels = pts
                 .iter()
                 .map(|r| {
-                    if on_front(r) {
+                    if on_front(r) || several {
                         crate::document::swept_label(r)
                     } else {
                         String::new()
