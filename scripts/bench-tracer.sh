@@ -14,7 +14,8 @@
 # Mitsuba's side is the fastest formulation of the same picture (issue 41): `whitted` is
 # tools/mitsuba/render.py's lean form of the contract (tested to give the general form's
 # image), `path` Mitsuba's own with the same max_depth and rr_depth as ours (its sampler
-# jittered since 2026-12-01, as render.py now loads it: unjittered it was a biased quadrature).
+# independent since 2026-12-01, the export's second sensor: the unjittered grid before was a
+# biased quadrature, and ×1.12 cheaper; docs/tracer-performance.md, twenty-sixth session).
 #
 # A result is a claim only on the CPU it was measured on: each CPU kind, vector width and core
 # count keeps its own files, reports/tracer/bench-<cpu>-<vector width>-<N>cores.md and .json

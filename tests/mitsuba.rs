@@ -69,8 +69,8 @@ fn both_of(
     ];
     // Whitted's cut counts reflections; path's counts segments (Mitsuba's max_depth), with
     // Russian roulette kept out of the comparison.
-    // Jittered, as render.py jitters Mitsuba's `path`: both then estimate the pixel's box
-    // filter over the pixel's area (the unjittered grid is a quadrature of its own).
+    // Jittered, as Mitsuba's `path` samples independently (render.py): both then estimate
+    // the pixel's box filter over its area (the unjittered grid is a quadrature of its own).
     if integrator == "path" {
         trace.extend(["--max-segments", depth, "--rr-from", "1000000", "--jitter"]);
     } else {
@@ -239,8 +239,8 @@ fn block_differences(a: &RgbImage, b: &RgbImage, k: u32) -> Vec<f64> {
 /// 2026-11-21), so one difference carries ~0.066 % of noise: the 0.5 % tolerance is ~7σ — a
 /// real disagreement of 0.5 % fails, noise does not. The block t statistic is held loosely
 /// (|t| < 4.5): Mitsuba's sampler correlates neighbouring pixels, so blocks are not
-/// independent enough for a strict test. Both renderers jitter their samples (render.py's
-/// `path`, our `--jitter`): Mitsuba's unjittered sampler had put `mirror_room` 0.12 % low
+/// independent enough for a strict test. Both renderers take unbiased samples (render.py's
+/// `path` an independent sampler, ours `--jitter`): Mitsuba's unjittered grid had put `mirror_room` 0.12 % low
 /// (docs/mitsuba.md).
 #[test]
 fn path_agrees_with_mitsuba_within_monte_carlo_noise() {

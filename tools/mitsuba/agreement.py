@@ -67,8 +67,8 @@ def main():
                 os.makedirs(os.path.dirname(xml), exist_ok=True)  # outputs' folders must exist
                 run([args.bin, "export-mitsuba", scene, "-o", xml, "--spp", str(spp)] + size)
                 ours = os.path.join(d, integ, "ours.exr")
-                # path: segments as Mitsuba's max_depth, no roulette, jittered as render.py
-                # jitters Mitsuba's; whitted: reflections, the unjittered grid of both.
+                # path: segments as Mitsuba's max_depth, no roulette, jittered (Mitsuba's
+                # samples independently, render.py); whitted: reflections, the grid of both.
                 cut = (["--max-segments", str(depth), "--rr-from", "1000000", "--jitter"]
                        if integ == "path" else ["--max-depth", str(depth)])
                 run([args.bin, "trace", scene, "-o", ours, "--spp", str(spp), "--integrator", integ]

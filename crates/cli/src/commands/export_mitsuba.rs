@@ -14,7 +14,7 @@ pub struct Args {
     output: PathBuf,
     #[command(flatten)]
     size: super::SizeArgs,
-    /// Samples per pixel (a perfect square: Mitsuba's stratified grid; unjittered for whitted, where it is ours, jittered for path).
+    /// Samples per pixel (a perfect square: Mitsuba's stratified grid; unjittered for whitted, where it is ours; a second sensor samples independently for path).
     #[arg(long, default_value_t = 16)]
     spp: u32,
     /// α: override every mirror's reflectance, in [0, 1]. `--reflectance` is the same flag.
