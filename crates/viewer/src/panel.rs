@@ -357,9 +357,6 @@ fn controls(
 /// Seconds of frame times the graph spans.
 const GRAPH_SECONDS: f64 = 10.0;
 
-/// The last seconds of frame times, newest on the right: the method's GPU time and the wall
-/// time between shown frames (which adds planning for a moved camera, the truth's share of
-/// the CPU and the window's own work).
 /// One registry option's widget; the new value where the user changed it this frame. A
 /// count's range is the option's own (`max-passes` goes to 1 000 000): a narrower one would
 /// clamp a value the command line accepts (the panel showed `max-passes 4096` for its
@@ -413,6 +410,9 @@ fn option_widget(
     }
 }
 
+/// The last seconds of frame times, newest on the right: the method's GPU time and the wall
+/// time between shown frames (which adds planning for a moved camera, the truth's share of
+/// the CPU and the window's own work).
 fn frame_graph(ui: &mut egui::Ui, session: &Session) {
     let (rect, _) =
         ui.allocate_exact_size(Vec2::new(ui.available_width(), 70.0), egui::Sense::hover());

@@ -142,8 +142,9 @@ fn panes_json(panes: &[(&'static str, [u32; 4])]) -> serde_json::Value {
 
 /// Where a frame's CPU time went, in milliseconds.
 pub struct Phases {
-    /// The session's update: building the method's frame (a changed view), drawing it and
-    /// reading it back (the GPU frame and the copy), converting and uploading the panes.
+    /// The session's update: building the method's frame (a changed view), drawing it (the
+    /// GPU frame; its image is read back only when a screenshot or the error view asks), and
+    /// the truth's and error's panes.
     pub update: crate::session::UpdatePhases,
     /// egui: the panel's layout and tessellation.
     pub ui: f64,
