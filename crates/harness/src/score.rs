@@ -1026,6 +1026,13 @@ pub fn score(
         for (k, dir) in settings.with.iter().enumerate() {
             for (_, r) in ours.iter().filter(|(d, _)| d == dir) {
                 let mut r = r.clone();
+                // Each sweep's records known as its own: their floors are two timings, and
+                // keys alike (every sweep's floor has one) had kept only the last sweep's.
+                r.values
+                    .insert(mirrorbox_report::value::WITH_SWEEP.into(), k as f64);
+                if k > 0 {
+                    r.key = format!("{}|with={k}", r.key);
+                }
                 for image in [
                     &mut r.truth_image,
                     &mut r.raster_image,

@@ -294,6 +294,9 @@ pub mod value {
     /// differ, or are tinted): no one α stands for them, so the record's `alpha` (1) is none,
     /// and reports say "per mirror" ([`crate::Record::alpha_text`]).
     pub const ALPHA_PER_MIRROR: &str = "alpha_per_mirror";
+    /// Which `score --with` sweep a record of ours came from (0 the first): each sweep has
+    /// its own floor, timed in its own rounds, and a time is set against that one.
+    pub const WITH_SWEEP: &str = "with_sweep";
 }
 
 /// The time bars one chart draws for all of its `points`: their 95 % intervals where every
@@ -576,6 +579,21 @@ impl Record {
             .find(|r| r.kind == "floor" && !r.is_external())
     }
 
+    /// The floor `self` is timed beside: a client's own for its variants, else ours of the
+    /// same `score --with` sweep ([`value::WITH_SWEEP`]), at the same size. Two sweeps' floors
+    /// are two timings (14 % apart on the web report's box): a time over another sweep's
+    /// floor had mixed them.
+    pub fn floor_beside<'a>(&self, records: &'a [Record]) -> Option<&'a Record> {
+        let size = (self.width, self.height, self.ssaa);
+        records.iter().find(|f| {
+            f.kind == "floor"
+                && (f.width, f.height, f.ssaa) == size
+                && f.is_external() == self.is_external()
+                && f.scored_client() == self.scored_client()
+                && f.value(value::WITH_SWEEP) == self.value(value::WITH_SWEEP)
+        })
+    }
+
     /// A variant an outside renderer drew, scored through the exchange (`mirrorbox score`).
     pub fn is_external(&self) -> bool {
         self.timing_order == EXTERNAL_TIMING
@@ -848,5 +866,31 @@ mod structure {
         let uses = |m: &str| graph.iter().find(|(n, _)| n == m).unwrap().1.clone();
         assert!(uses("readme").contains(&"document".to_string()));
         assert!(!uses("document").contains(&"write".to_string()));
+    }
+}
+
+#[cfg(test)]
+mod floors {
+    use super::*;
+    use crate::document::fixtures::record;
+
+    /// A point's floor is its own `score --with` sweep's (two sweeps' floors are two timings),
+    /// a client's variant its client's, never another size's.
+    #[test]
+    fn a_point_is_timed_beside_its_own_sweeps_floor() {
+        let floor = |ms: f64, with: f64| {
+            let mut r = record(0, ms, 1, 0.0);
+            r.kind = "floor".into();
+            r.values.insert(value::WITH_SWEEP.into(), with);
+            r
+        };
+        let mut point = record(0, 20.0, 1, 0.1);
+        point.values.insert(value::WITH_SWEEP.into(), 1.0);
+        let mut small = floor(1.0, 1.0);
+        small.width /= 2;
+        let records = [floor(5.0, 0.0), small, floor(7.0, 1.0)];
+        assert_eq!(point.floor_beside(&records).map(|f| f.ms_median), Some(7.0));
+        point.values.remove(value::WITH_SWEEP);
+        assert_eq!(point.floor_beside(&records), None);
     }
 }

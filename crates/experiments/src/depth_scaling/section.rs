@@ -113,7 +113,12 @@ pub fn depth_scaling(info: &SweepInfo, records: &[Record], floor: Option<&Record
     out.push(Block::Bullets(
         groups
             .iter()
-            .map(|g| super::exact::bounce_sentence(g, floor.map(|fl| fl.ms_median)))
+            .map(|g| {
+                // The floor timed beside the group's own points (a score's second `--with`
+                // sweep has its own), else the one given.
+                let beside = g.points.first().and_then(|p| p.floor_beside(records));
+                super::exact::bounce_sentence(g, beside.or(floor).map(|fl| fl.ms_median))
+            })
             .collect(),
     ));
     out

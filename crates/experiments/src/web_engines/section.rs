@@ -29,12 +29,15 @@ fn clock(r: &Record) -> String {
 }
 
 /// `r`'s time as a multiple of `floor`'s, the same renderer's pass without mirrors at the same
-/// size on the same clock. Across renderers only this compares: on one device (SwiftShader)
-/// the browser's wall clock and our GPU timestamps put the same no-mirror pass 3–6× apart.
+/// size on the same clock (ours: [`Record::floor_beside`], its own sweep's). Across renderers
+/// only this compares: on one device (SwiftShader) the browser's wall clock and our GPU
+/// timestamps put the same no-mirror pass severalfold apart (each report's floors).
 fn passes(r: &Record, floor: Option<&Record>) -> Option<f64> {
     floor
         .filter(|fl| {
-            fl.ms_median > 0.0 && (fl.width, fl.height, fl.ssaa) == (r.width, r.height, r.ssaa)
+            fl.ms_median > 0.0
+                && (fl.width, fl.height, fl.ssaa) == (r.width, r.height, r.ssaa)
+                && clock(fl) == clock(r)
         })
         .map(|fl| r.ms_median / fl.ms_median)
 }
@@ -103,10 +106,13 @@ pub fn section(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
         // where both floors were measured, else in ms where both times are of one clock;
         // otherwise the costs do not compare and nothing is said.
         let variant_passes = passes(r, floor);
-        let by_passes =
-            variant_passes.is_some() && ours.iter().any(|o| passes(o, our_floor).is_some());
+        let by_passes = variant_passes.is_some()
+            && ours
+                .iter()
+                .any(|o| passes(o, o.floor_beside(records)).is_some());
         let comparable = by_passes || ours.iter().any(|o| clock(o) == clock(r));
-        let costs_no_more = |o: &Record| match (variant_passes, passes(o, our_floor)) {
+        let costs_no_more = |o: &Record| match (variant_passes, passes(o, o.floor_beside(records)))
+        {
             (Some(v), Some(p)) => p <= v,
             _ => !by_passes && clock(o) == clock(r) && o.ms_median <= r.ms_median,
         };
@@ -203,7 +209,7 @@ pub fn section(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
                 mirrorbox_report::document::label(e),
                 f(e.ms_median, 3),
                 clock(e),
-                in_passes(passes(e, our_floor), "our"),
+                in_passes(passes(e, e.floor_beside(records)), "our"),
                 short(&e.adapter, 40)
             ));
         }
@@ -217,7 +223,7 @@ pub fn section(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
                 "; at no more cost{measure} our `{}` reaches {}{}.",
                 mirrorbox_report::document::label(e),
                 sci(e.mirror_flip()),
-                passes(e, our_floor)
+                passes(e, e.floor_beside(records))
                     .map_or(String::new(), |p| format!(" at {}× our floor", f(p, 2)))
             )),
             // Said only where our exact methods were measured beside it (`score --with`) and
