@@ -295,6 +295,10 @@ async function main() {
     process.exit(1);
   }, opts.timeout * 1000);
   const started = Date.now();
+  // Clients whose folder was put in place, and staged folders not yet: what a failure says
+  // and removes.
+  const written = [];
+  const stagedDirs = [];
   try {
     browser = await puppeteer.launch({
       executablePath: opts.chromium,
@@ -402,6 +406,7 @@ async function main() {
       const final = path.join(opts.runDir, client);
       const staged = `${final}.tmp-${process.pid}`;
       fs.rmSync(staged, { recursive: true, force: true });
+      stagedDirs.push(staged);
       for (const name of variants) {
         const dir = path.join(staged, name);
         fs.mkdirSync(dir, { recursive: true });
@@ -437,12 +442,17 @@ async function main() {
       }
       fs.rmSync(final, { recursive: true, force: true });
       fs.renameSync(staged, final);
+      stagedDirs.pop();
+      written.push(client);
       console.log(`wrote ${final}/{${variants.join(',')}}`);
     }
     console.log(`done in ${((Date.now() - started) / 1000).toFixed(1)} s`);
   } catch (err) {
     console.error(`run.mjs: ${err.message.split('\n').join('\nrun.mjs: ')}`);
-    console.error('run.mjs: failed; nothing written');
+    for (const dir of stagedDirs) fs.rmSync(dir, { recursive: true, force: true });
+    console.error(written.length
+      ? `run.mjs: failed after writing ${written.join(', ')}'s folder; the rest not written`
+      : 'run.mjs: failed; nothing written');
     if (browser) await browser.close().catch(() => {});
     process.exitCode = 1;
   } finally {

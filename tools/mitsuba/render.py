@@ -187,8 +187,15 @@ def main():
     if not args.variant.endswith("_rgb"):
         refuse(f"--variant {args.variant}: an RGB variant (llvm_ad_rgb, scalar_rgb, ...)")
     # Without LLVM >= 16 Dr.Jit falls back to the system's (15 here), which crashes the JIT
-    # with a dump of LLVM's, or fails to import: say so instead.
-    if args.variant.startswith("llvm") and not os.path.exists(os.environ.get("DRJIT_LIBLLVM_PATH", "")):
+    # with a dump of LLVM's: said instead, where neither DRJIT_LIBLLVM_PATH names a library nor
+    # one of LLVM 16 or later lies in the usual folders (Dr.Jit finds those on its own).
+    import glob
+    newer = [p for d in ("/usr/lib", "/usr/lib64", "/usr/local/lib", "/usr/lib/x86_64-linux-gnu",
+                         "/usr/lib/aarch64-linux-gnu")
+             for p in glob.glob(os.path.join(d, "libLLVM*.so*"))
+             if any(f"-{v}" in p or f".so.{v}" in p for v in range(16, 40))]
+    named = os.environ.get("DRJIT_LIBLLVM_PATH")
+    if args.variant.startswith("llvm") and (named and not os.path.exists(named) or not named and not newer):
         where = os.environ.get("DRJIT_LIBLLVM_PATH") or LLVM19
         print(f"render.py: {args.variant} needs LLVM >= 16, and {where} is missing: run tools/mitsuba/setup.sh "
               "(Debian's libllvm19), set DRJIT_LIBLLVM_PATH to it, or give --variant scalar_rgb", file=sys.stderr)

@@ -225,7 +225,7 @@ fn web_engines(reports: &Path) -> Result<String, ReadmeError> {
         }
         if let (Some(a), Some(b)) = (
             find(&|r| r.is_external() && r.kind == "floor" && r.method == "three"),
-            find(&|r| !r.is_external() && r.kind == "floor"),
+            Record::our_floor(&s.records),
         ) {
             floors.push((a.metrics.flip_mean, b.metrics.flip_mean));
         }
@@ -390,24 +390,28 @@ fn bounce_cost(reports: &Path) -> Result<String, ReadmeError> {
 fn ssr_offscreen(reports: &Path) -> Result<String, ReadmeError> {
     let s = load(reports, "engine_reflections_ssr_room")?;
     let share = mirrorbox_report::value::REFLECTION_OFFSCREEN_SHARE;
-    let none: Vec<(f64, f64)> = s
+    // Each turn once: its off-screen share, its error and its yaw (the span said is of the
+    // same points as the count and ρ).
+    let turns: Vec<(f64, f64, Option<f64>)> = s
         .records
         .iter()
         .filter(|r| r.method == "ssr" && r.option("ssr-fallback") == Some("none"))
-        .filter_map(|r| Some((r.value(share)?, r.mirror_flip())))
+        .filter_map(|r| {
+            Some((
+                r.value(share)?,
+                r.mirror_flip(),
+                r.axis(mirrorbox_report::axis::YAW_DEG),
+            ))
+        })
         .collect();
+    let none: Vec<(f64, f64)> = turns.iter().map(|&(s, e, _)| (s, e)).collect();
     let rho = crate::engine_reflections::section::spearman(&none).ok_or_else(|| {
         ReadmeError("reports/engine_reflections_ssr_room: too few ssr turns".into())
     })?;
     let lo = none.iter().map(|p| p.1).fold(f64::INFINITY, f64::min);
     let hi = none.iter().map(|p| p.1).fold(0.0, f64::max);
     // The turns' span, so that a reader sees what "camera turns" covered.
-    let yaws: Vec<f64> = s
-        .records
-        .iter()
-        .filter(|r| r.method == "ssr" && r.option("ssr-fallback") == Some("none"))
-        .filter_map(|r| r.axis(mirrorbox_report::axis::YAW_DEG))
-        .collect();
+    let yaws: Vec<f64> = turns.iter().filter_map(|&(_, _, y)| y).collect();
     let span = match (
         yaws.iter().copied().reduce(f64::min),
         yaws.iter().copied().reduce(f64::max),
@@ -431,9 +435,9 @@ fn ssr_offscreen(reports: &Path) -> Result<String, ReadmeError> {
 }
 
 /// Baking the symmetry copies on the CPU against the seed's instanced copies, paired by
-/// round at the most planes measured, and how many copies pruning keeps. Times to three
-/// significant digits: the paired interval spans tens of per cent, and "1714.77 ms" claimed
-/// more than the run measured.
+/// round at the most planes measured, and how many copies pruning keeps. Times to at least
+/// three significant digits and no decimals above 100 ms: the paired interval spans tens of
+/// per cent, and "1714.77 ms" claimed more than the run measured.
 fn symmetry(reports: &Path) -> Result<String, ReadmeError> {
     use crate::symmetry_scaling::planes::{
         BAKED_METHOD, PRUNED_METHOD, SEED_METHOD, plane_scaling, pruning_sentence,
@@ -471,7 +475,7 @@ fn symmetry(reports: &Path) -> Result<String, ReadmeError> {
     Ok(format!(
         "**Symmetry planes: the CPU's split-and-mirror mesh against the seed's 2^p copies** — at \
          p = {}, drawing the baked mesh once (`{BAKED_METHOD}`, {} ms) is {:.0}× [{:.0}–{:.0}×] \
-         as fast as the seed's 2^p copies drawn in one instanced draw per winding \
+         as fast as the seed's 2^p copies drawn by instancing \
          (`{SEED_METHOD}`, {} ms; the seed's own code draws each copy apart), paired by round: {} \
          (one run){pruning}{pruned_ms} ({}, {}, {}; [figure](symmetry_scaling/plot_ms_vs_planes.svg)).",
         b.planes().unwrap_or(0),
@@ -555,7 +559,12 @@ fn uneven(reports: &Path) -> Result<String, ReadmeError> {
 /// runs of different days side by side.
 fn day_and_commit(s: &Sweep) -> String {
     let day = s.info.date.get(..10).unwrap_or(&s.info.date);
-    let commit = s.info.commit.get(..7).unwrap_or(&s.info.commit);
+    // Seven hex digits, and the mark of a changed tree kept (`-dirty`: not that commit's code).
+    let full = &s.info.commit;
+    let commit = match full.split_once('-') {
+        Some((hash, rest)) => format!("{}-{rest}", hash.get(..7).unwrap_or(hash)),
+        None => full.get(..7).unwrap_or(full).to_string(),
+    };
     // Runs older than the field have none: said so ("at )" had been printed).
     if commit.is_empty() {
         format!("measured {day}, its commit not recorded")

@@ -1028,9 +1028,7 @@ fn write_advice(advice: &Advice, config: &AdviseConfig, out: &Path) -> Result<()
         .and_then(|f| mirrorbox_report::read_sweep_info(f).ok())
         .map(|i| i.commit)
         .filter(|c| !c.is_empty())
-        .map_or(String::new(), |c| {
-            format!(" · commit {}", c.get(..10).unwrap_or(&c))
-        });
+        .map_or(String::new(), |c| format!(" · commit {c}"));
     let footer = match &info {
         Some((adapter, w, h, a, run)) => format!(
             "{}{views} · {w}x{h} · α = {a} · {adapter} · measured {}{commit}",

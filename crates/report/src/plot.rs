@@ -562,9 +562,9 @@ impl Axis {
     fn contains(&self, v: f64) -> bool {
         drawable(v, self.log) && (-1e-9..=1.0 + 1e-9).contains(&self.t(v))
     }
-    /// [`Axis::ticks`] as drawn on an axis `len` pixels long: a 2× or 5× step beyond the
-    /// outer decades is left out where its label would come within `gap` pixels of a kept
-    /// one (the outermost first, which keeps the far points in reach of a tick: 16 decades in
+    /// [`Axis::ticks`] as drawn on an axis `len` pixels long: a 2× or 5× step (beyond the
+    /// outer decades, or between the two of a short axis) is left out where its label would
+    /// come within `gap` pixels of a kept one (the outermost first, which keeps the far points in reach of a tick: 16 decades in
     /// the plot's height had printed "1e-15", "5e-16" and "2e-16" over one another).
     fn ticks_drawn(&self, len: f64, gap: f64) -> Vec<f64> {
         let ticks = self.ticks();
@@ -603,7 +603,8 @@ impl Axis {
 
     fn ticks(&self) -> Vec<f64> {
         if self.log {
-            // Decades; where fewer than two fall inside, the 2× and 5× steps as well.
+            // Decades; where fewer than two fall inside, the 2× and 5× steps as well; where two,
+            // those between them too (below).
             let (a, b) = (
                 self.lo.log10().floor() as i32,
                 self.hi.log10().ceil() as i32,

@@ -49,11 +49,17 @@ fn findings(points: &[(&Record, &ErrorSplit)], exact_methods: &[String]) -> Vec<
             };
             let error = span(of.iter().map(|(r, _)| total(r)), sci);
             // Which FLIP [`flip`] took: over the mirror pixels where every point kept them
-            // (a scene without mirror pixels, the symmetry planes', had been said to be).
-            let over = if of.iter().all(|(r, _)| r.mirror_metrics.is_some()) {
+            // (a scene without mirror pixels, the symmetry planes', had been said to be), over
+            // the image where none did, and said to be mixed otherwise.
+            let mirror = |(r, s): &&(&Record, &ErrorSplit)| {
+                r.mirror_metrics.is_some() && s.approximation_mirror.is_some()
+            };
+            let over = if of.iter().all(mirror) {
                 "FLIP over the mirror pixels"
-            } else {
+            } else if !of.iter().any(mirror) {
                 "FLIP over the image"
+            } else {
+                "FLIP over the mirror pixels where kept, else over the image"
             };
             let exact = of
                 .iter()

@@ -388,12 +388,12 @@ fn repeat_region(first: &Sweep, second: &Sweep) -> Result<String, ReadmeError> {
             // Said once where both runs agree ("the first run keeps the order …, the second
             // keeps the order …" had read as a stutter).
             match (ordered(&a), ordered(&b)) {
-                (x, y) if x == y => format!(
-                    "both runs' times {} (each row's median above the one before)",
-                    order(x)
-                        .replace("keeps", "keep")
-                        .replace("does NOT keep", "do NOT keep")
-                ),
+                (true, true) => "both runs' times keep the order of the pass counts (each \
+                                 row's median above the one before)"
+                    .to_string(),
+                (false, false) => {
+                    "neither run's times keep the order of the pass counts".to_string()
+                }
                 (x, y) => format!("the first run {}, the second {}", order(x), order(y)),
             }
         )),

@@ -175,8 +175,9 @@ pub fn partner(scene: &Scene, i: usize) -> Option<usize> {
     })
 }
 
-/// Each scene mirror's footprint on screen seen directly from the camera, in pixels (0 where
-/// the camera does not see it): which mirror of a pair the viewer looks into.
+/// Each scene mirror's footprint seen directly from the camera: the area in pixels of the
+/// screen rectangle bounding it (not occlusion-tested; 0 where the camera does not see it):
+/// which mirror of a pair the viewer looks into.
 pub fn seen_directly(scene: &Scene, width: u32, height: u32) -> Vec<u64> {
     let mirrors: Vec<MirrorInstance> = (0..scene.mirrors.len())
         .map(|i| MirrorInstance {
@@ -225,8 +226,9 @@ pub fn auxiliary_copies(scene: &Scene, seen: &[u64], n: u32) -> Vec<u32> {
 }
 
 /// The rendering queue of a method: the scene's mirrors, then (`auxiliary`) the copies by
-/// label, each label's in scene order — for two mirrors "auxiliary 1" on mirror 1,
-/// "auxiliary 2" on mirror 2, … as in the paper.
+/// label, each label's in scene order — for two mirrors "auxiliary 1" on the paper's Mirror 1
+/// (the one the camera looks into, [`label_lies_on`]), "auxiliary 2" on Mirror 2, … as in the
+/// paper.
 pub fn instances(
     scene: &Scene,
     queue: Queue,
