@@ -373,14 +373,22 @@ fn summary(
             peak_rss.map_or("unknown".into(), mirrorbox_raster::memory::format_bytes)
         );
         println!(
-            "  {:.2} ms/frame median, {:.2} ms the least, over {} ({}); CPU encode+submit {:.2} ms median; GPU memory {} in buffers, {} in textures; on {} ({}, {} targets); wrote {}",
+            "  {:.2} ms/frame median, {:.2} ms the least, over {} ({}); CPU encode+submit {:.2} ms median; GPU memory {}; on {} ({}, {} targets); wrote {}",
             t.median_ms(),
             t.min_ms(),
             crate::count(t.frames_ms.len(), "frame"),
             t.source.name(),
             mirrorbox_report::stats::median(&t.encode_ms),
-            mirrorbox_files::human_bytes(out.gpu_memory.buffer_bytes),
-            mirrorbox_files::human_bytes(out.gpu_memory.texture_bytes),
+            // wgpu's GL backend keeps no allocation counters: its 0 is no measurement.
+            if gpu.report.backend == "gl" {
+                "not counted by the GL backend".to_string()
+            } else {
+                format!(
+                    "{} in buffers, {} in textures",
+                    mirrorbox_files::human_bytes(out.gpu_memory.buffer_bytes),
+                    mirrorbox_files::human_bytes(out.gpu_memory.texture_bytes)
+                )
+            },
             gpu.report.name,
             gpu.report.backend,
             out.color_format,
