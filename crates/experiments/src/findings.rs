@@ -535,10 +535,15 @@ fn uneven(reports: &Path) -> Result<String, ReadmeError> {
             .iter()
             .filter_map(|b| match b {
                 Block::Chart(file, chart) => {
+                    // The base method, as the chart's title names it ("…: auxiliary n=4's
+                    // tricks, …" or "…: auxiliary n=4 with its march trick").
                     let base = chart
                         .title
                         .split_once("tilt: ")
-                        .and_then(|(_, t)| t.split_once("'s tricks"))
+                        .and_then(|(_, t)| {
+                            t.split_once("'s tricks")
+                                .or_else(|| t.split_once(" with its "))
+                        })
                         .map_or(file.as_str(), |(m, _)| m);
                     Some(format!("[{base}](uneven_mirrors/{file})"))
                 }

@@ -374,7 +374,13 @@ pub fn uneven_section(records: &[Record], bump_methods: &[String]) -> Vec<Block>
                 series,
                 x_ticks_at_data: true,
                 ..Chart::new(
-                    format!("FLIP over the image vs tilt: {m}'s tricks, each at its best setting"),
+                    // One trick measured is no choice of settings: said as what it is.
+                    match fams.as_slice() {
+                        [one] => format!("FLIP over the image vs tilt: {m} with its {one} trick"),
+                        _ => format!(
+                            "FLIP over the image vs tilt: {m}'s tricks, each at its best setting"
+                        ),
+                    },
                     "the bump's steepest tilt (degrees)",
                     "FLIP mean over the image",
                 )
