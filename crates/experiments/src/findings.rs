@@ -564,17 +564,10 @@ fn uneven(reports: &Path) -> Result<String, ReadmeError> {
 /// runs of different days side by side.
 fn day_and_commit(s: &Sweep) -> String {
     let day = s.info.date.get(..10).unwrap_or(&s.info.date);
-    // Seven hex digits, and the mark of a changed tree kept (`-dirty`: not that commit's code).
-    let full = &s.info.commit;
-    let commit = match full.split_once('-') {
-        Some((hash, rest)) => format!("{}-{rest}", hash.get(..7).unwrap_or(hash)),
-        None => full.get(..7).unwrap_or(full).to_string(),
-    };
     // Runs older than the field have none: said so ("at )" had been printed).
-    if commit.is_empty() {
-        format!("measured {day}, its commit not recorded")
-    } else {
-        format!("measured {day} at {commit}")
+    match s.info.measured_by(7) {
+        Some(commit) => format!("measured {day} at {commit}"),
+        None => format!("measured {day}, its commit not recorded"),
     }
 }
 

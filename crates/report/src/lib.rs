@@ -735,6 +735,18 @@ impl SweepInfo {
         self.device_type == "external"
     }
 
+    /// The commit that measured, its hash cut to `digits` with a changed tree's `-dirty` kept
+    /// (not that commit's code); `None` where the sweep recorded none.
+    pub fn measured_by(&self, digits: usize) -> Option<String> {
+        let full = &self.commit;
+        let cut = |hash: &str| hash.get(..digits).unwrap_or(hash).to_string();
+        match full.split_once('-') {
+            _ if full.is_empty() => None,
+            Some((hash, rest)) => Some(format!("{}-{rest}", cut(hash))),
+            None => Some(cut(full)),
+        }
+    }
+
     /// The footer of every chart: scene, size, device, date, commit — what a figure printed
     /// alone must say about where its numbers come from. (A score's writer adds our points'
     /// device, which its description does not hold.)
@@ -892,5 +904,29 @@ mod floors {
         assert_eq!(point.floor_beside(&records).map(|f| f.ms_median), Some(7.0));
         point.values.remove(value::WITH_SWEEP);
         assert_eq!(point.floor_beside(&records), None);
+    }
+}
+
+#[cfg(test)]
+mod commits {
+    use super::SweepInfo;
+
+    /// A measuring commit is cut to its digits with `-dirty` kept, and is none where the
+    /// sweep recorded none.
+    #[test]
+    fn a_dirty_commit_keeps_its_mark() {
+        let info = |commit: &str| SweepInfo {
+            commit: commit.into(),
+            ..Default::default()
+        };
+        assert_eq!(
+            info("245f368d8b-dirty").measured_by(7).as_deref(),
+            Some("245f368-dirty")
+        );
+        assert_eq!(
+            info("245f368d8b").measured_by(7).as_deref(),
+            Some("245f368")
+        );
+        assert_eq!(info("").measured_by(7), None);
     }
 }
