@@ -3045,3 +3045,56 @@ fn a_gl_sweep_after_a_clipping_method_draws_every_method_whole() {
         assert!(flip < 0.05, "{} drew FLIP {flip} on GL", r["key"]);
     }
 }
+
+/// `trace`'s flags that another integrator or scene would ignore or misuse are refused, and a
+/// sequence writes each frame's bounce map: `--min-throughput` with `path` (recorded, never
+/// applied), `--max-segments 0` (the same image as 1), `--mirrored-lights` on uneven mirrors
+/// (the scene file's own field refuses it; the flag had changed the truth), and one `--bounces`
+/// file that every frame of `--sequence` had overwritten.
+#[test]
+fn trace_refuses_flags_that_would_do_nothing_or_wrong_and_a_sequence_keeps_each_bounce_map() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("t.exr");
+    let o = out.to_str().unwrap();
+    let size = ["--width", "16", "--height", "12"];
+    let with = |extra: &[&'static str], scene: &'static str| {
+        let mut a = vec!["trace", scene, "-o", o];
+        a.extend(size);
+        a.extend_from_slice(extra);
+        a
+    };
+    crate::common::assert_refused(
+        &with(
+            &["--integrator", "path", "--min-throughput", "0.9"],
+            "scenes/mirror_box.json",
+        ),
+        "--min-throughput is the `whitted` integrator's",
+    );
+    crate::common::assert_refused(
+        &with(
+            &["--integrator", "path", "--max-segments", "0"],
+            "scenes/mirror_box.json",
+        ),
+        "--max-segments must be at least 1",
+    );
+    crate::common::assert_refused(
+        &with(&["--mirrored-lights", "2"], "scenes/bumpy_single.json"),
+        "--mirrored-lights must be 0",
+    );
+    assert!(!out.exists());
+    let bounces = dir.path().join("b.exr");
+    let b = bounces.to_str().unwrap();
+    let mut seq = with(
+        &["--sequence", "2", "--fps", "2"],
+        "scenes/mirror_box_walk.json",
+    );
+    seq.extend(["--bounces", b]);
+    let run = mirrorbox(&seq, &[]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    for k in ["0000", "0001"] {
+        assert!(
+            dir.path().join(format!("b_{k}.exr")).is_file(),
+            "frame {k}'s bounce map"
+        );
+    }
+}

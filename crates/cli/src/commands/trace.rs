@@ -117,8 +117,9 @@ pub struct Args {
     /// rr_depth) [default: 5].
     #[arg(long)]
     rr_from: Option<u32>,
-    /// Stop a path when its throughput's largest channel would fall below this, in [0, 1).
-    #[arg(long, default_value_t = 1e-4, allow_negative_numbers = true)]
+    /// whitted: stop a path when its throughput's largest channel would fall below this, in
+    /// [0, 1) (`path` ends its paths by --max-segments and Russian roulette instead).
+    #[arg(long, default_value_t = DEFAULT_MIN_THROUGHPUT, allow_negative_numbers = true)]
     min_throughput: f32,
     /// Stratified random sub-pixel positions instead of the fixed grid.
     #[arg(long)]
@@ -172,6 +173,8 @@ pub struct Args {
 const DEFAULT_MAX_DEPTH: u32 = 10_000;
 const DEFAULT_MAX_SEGMENTS: u32 = 10_000;
 const DEFAULT_RR_FROM: u32 = 5;
+/// The throughput below which `whitted` ends a path (`--min-throughput`), as the tracer's own.
+const DEFAULT_MIN_THROUGHPUT: f32 = 1e-4;
 
 impl Args {
     /// The integrator's cut of a path's length, as (flag, record key, value): whitted's
@@ -223,6 +226,21 @@ fn check_args(args: &Args) -> Result<(SubpixelGrid, WhittedSettings), Failure> {
                     .into(),
             ));
         }
+        // The path integrator ends paths by its length and Russian roulette, not by a
+        // throughput cut: the flag had been taken, recorded, and done nothing.
+        Integrator::Path if args.min_throughput != DEFAULT_MIN_THROUGHPUT => {
+            return Err(Failure::BadInput(
+                "--min-throughput is the `whitted` integrator's cut: `path` ends paths by \
+                 --max-segments and Russian roulette (--rr-from)"
+                    .into(),
+            ));
+        }
+        Integrator::Path if args.max_segments == Some(0) => {
+            return Err(Failure::BadInput(
+                "--max-segments must be at least 1 (a path's first segment is the camera ray)"
+                    .into(),
+            ));
+        }
         Integrator::Whitted if args.max_segments.is_some() || args.rr_from.is_some() => {
             return Err(Failure::BadInput(
                 "--max-segments and --rr-from are the `path` integrator's (--integrator path); \
@@ -253,6 +271,11 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         |args, time, suffix| Args {
             time,
             output: mirrorbox_files::with_stem_suffix(&args.output, suffix),
+            // Each frame's own bounce map (one file had been overwritten frame after frame).
+            bounces: args
+                .bounces
+                .as_ref()
+                .map(|b| mirrorbox_files::with_stem_suffix(b, suffix)),
             ..args.clone()
         },
         |frame| {
@@ -323,6 +346,15 @@ fn run_frame(args: &Args) -> Result<(), Failure> {
         if k > max {
             return Err(Failure::BadInput(format!(
                 "--mirrored-lights must be in [0, {max}], got {k}"
+            )));
+        }
+        // As the scene file's own field (docs/shading.md): uneven mirrors keep no light
+        // images; the override had been taken and had changed the truth.
+        if k > 0 && scene.has_bumps() {
+            return Err(Failure::BadInput(format!(
+                "--mirrored-lights must be 0: {} has uneven mirrors (a bump), which keep no \
+                 mirrored light sources (docs/shading.md)",
+                args.scene.display()
             )));
         }
         scene.lighting.mirrored_lights = k;
@@ -469,10 +501,6 @@ fn stage_view(
             },
             args.length_cut().2.to_string(),
         ),
-        (
-            "mirrorbox.min_throughput",
-            whitted.min_throughput.to_string(),
-        ),
         ("mirrorbox.reflectance", reflectance),
         (
             "mirrorbox.render_seconds",
@@ -482,6 +510,20 @@ fn stage_view(
         ("mirrorbox.deepest_path", out.stats.deepest.to_string()),
         ("mirrorbox.lighting", scene.lighting.describe()),
     ];
+    // The cut each integrator applies, and what else its image depends on.
+    match args.integrator {
+        Integrator::Whitted => attributes.push((
+            "mirrorbox.min_throughput",
+            whitted.min_throughput.to_string(),
+        )),
+        Integrator::Path => {
+            attributes.push(("mirrorbox.seed", args.seed.to_string()));
+            attributes.push((
+                "mirrorbox.rr_from",
+                args.rr_from.unwrap_or(DEFAULT_RR_FROM).to_string(),
+            ));
+        }
+    }
     attributes.extend(args.time.attribute());
     if let Some(e) = eye {
         let c = &scene.camera;
@@ -615,23 +657,25 @@ fn report(
         crate::count(out.threads, "thread"),
     );
     println!(
-        "  {} paths ended: {} at diffuse surfaces, {} escaped, {} cut by {} {}, {} cut by --min-throughput {}{}",
+        "  {} paths ended: {} at diffuse surfaces, {} escaped, {} cut by {} {}, {}",
         s.paths,
         s.diffuse,
         s.escaped,
         s.cut_by_depth,
         args.length_cut().0,
         args.length_cut().2,
-        s.cut_by_throughput,
-        args.min_throughput,
+        // Each integrator's own second cut (path has no throughput cut).
         if args.integrator == Integrator::Path {
             format!(
-                ", {} by Russian roulette from --rr-from {}",
+                "{} by Russian roulette from --rr-from {}",
                 s.cut_by_roulette,
                 args.rr_from.unwrap_or(DEFAULT_RR_FROM)
             )
         } else {
-            String::new()
+            format!(
+                "{} cut by --min-throughput {}",
+                s.cut_by_throughput, args.min_throughput
+            )
         }
     );
     if scene.has_bumps() {
