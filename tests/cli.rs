@@ -3081,6 +3081,14 @@ fn trace_refuses_flags_that_would_do_nothing_or_wrong_and_a_sequence_keeps_each_
         &with(&["--mirrored-lights", "2"], "scenes/bumpy_single.json"),
         "--mirrored-lights must be 0",
     );
+    // The CPU tracer's knobs with the GPU's trace: refused before any device is opened.
+    crate::common::assert_refused(
+        &with(
+            &["--device", "gpu", "--bvh", "cwbvh"],
+            "scenes/mirror_box.json",
+        ),
+        "--bvh, --kernel and --simd are the CPU tracer's",
+    );
     assert!(!out.exists());
     let bounces = dir.path().join("b.exr");
     let b = bounces.to_str().unwrap();

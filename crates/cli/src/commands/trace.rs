@@ -10,7 +10,7 @@ use mirrorbox_trace::{
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Bvh {
     Cwbvh,
     Bvh2,
@@ -744,6 +744,14 @@ fn trace_on_gpu(
         return Err(refuse(
             "--warm-up",
             "is CPU only (the GPU trace times one frame of its own)",
+        ));
+    }
+    // The CPU tracer's hierarchy, kernel and vector build: the GPU has its own (they had been
+    // taken and ignored, unlike --jitter and --warm-up).
+    if args.bvh != Bvh::Wide || args.kernel != Kernel::Packet || args.simd != Simd::Widest {
+        return Err(refuse(
+            "--bvh, --kernel and --simd",
+            "are the CPU tracer's (the GPU traces through its own acceleration structures)",
         ));
     }
     let per_axis = (grid.samples_per_pixel() as f64).sqrt().round() as u32;
