@@ -779,7 +779,7 @@ fn trace_on_gpu(
     for (eye, view) in views(scene, rig) {
         let out = mirrorbox_raster::render(&gpu, &view, &settings)?;
         let exr = eye_path(exr_path, eye);
-        let attributes = vec![
+        let mut attributes = vec![
             ("mirrorbox.version", env!("CARGO_PKG_VERSION").to_string()),
             ("mirrorbox.scene", args.scene.display().to_string()),
             (
@@ -802,7 +802,19 @@ fn trace_on_gpu(
             ),
             ("mirrorbox.adapter", gpu.report.name.clone()),
             ("mirrorbox.lighting", view.lighting.describe()),
+            // As the CPU trace records them: the grid, the reflectance asked for, the time
+            // and the eye (the GPU's EXRs had lacked them).
+            ("mirrorbox.sampling", format!("{per_axis}x{per_axis} grid")),
+            (
+                "mirrorbox.reflectance",
+                args.reflectance
+                    .map_or("as in scene".to_string(), |r| r.to_string()),
+            ),
         ];
+        attributes.extend(args.time.attribute());
+        if let Some(e) = eye {
+            attributes.push(("mirrorbox.eye", e.name().to_string()));
+        }
         stage_exr(&mut staged, &exr, &out.image, &attributes).map_err(write_failed)?;
         stage_png(
             &mut staged,
