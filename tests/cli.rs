@@ -1005,6 +1005,44 @@ fn trace_on_the_gpu_writes_the_cpu_truth_and_caps_its_depth() {
     );
     assert!(deep <= 1e-4 && shallow <= 1e-4, "{deep} {shallow}");
     assert!(depth > 1e-3, "--max-depth 8 changed nothing: {depth}");
+    assert_eq!(get("mirrorbox.sampling").as_deref(), Some("2x2 grid"));
+
+    // A stereo pair: each eye's EXR says which, and the pair's side-by-side and anaglyph are
+    // written as the CPU trace writes them (the GPU had written neither).
+    let pair = path("pair.exr");
+    let out = mirrorbox(
+        &[
+            "trace",
+            "scenes/stereo_box.json",
+            "-o",
+            &pair,
+            "--width",
+            "24",
+            "--height",
+            "14",
+            "--device",
+            "gpu",
+            "--stereo",
+            "--max-depth",
+            "8",
+        ],
+        &[],
+    );
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    for f in [
+        "pair_sbs.png",
+        "pair_anaglyph.png",
+        "pair_left.exr",
+        "pair_right.exr",
+    ] {
+        assert!(dir.path().join(f).is_file(), "{f} missing");
+    }
+    let left = mirrorbox_image::read_exr_attributes(&dir.path().join("pair_left.exr")).unwrap();
+    assert!(
+        left.iter()
+            .any(|(k, v)| k == "mirrorbox.eye" && v == "left"),
+        "{left:?}"
+    );
 }
 
 // ---------------------------------------------------------------------------------------

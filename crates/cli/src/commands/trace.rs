@@ -258,6 +258,27 @@ fn check_args(args: &Args) -> Result<(SubpixelGrid, WhittedSettings), Failure> {
     Ok((SubpixelGrid::new(s), whitted))
 }
 
+/// A stereo pair's side-by-side and red–cyan PNGs (`OUT_sbs.png`, `OUT_anaglyph.png`), from
+/// the two eyes' linear images at `left`'s camera exposure: the CPU's trace and the GPU's both.
+fn stage_stereo_pngs(
+    staged: &mut StagedFiles,
+    exr_path: &Path,
+    left: &mirrorbox_scene::Scene,
+    left_image: &mirrorbox_image::RgbImage,
+    right_image: &mirrorbox_image::RgbImage,
+) -> Result<(), Failure> {
+    use mirrorbox_files::with_stem_suffix;
+    let e = left.camera.exposure;
+    let (a, b) = (left_image.to_srgb8(e), right_image.to_srgb8(e));
+    let (w, h) = (left.camera.width, left.camera.height);
+    let sbs = mirrorbox_image::stereo::side_by_side(&a, &b, w, h);
+    let sbs_path = with_stem_suffix(exr_path, "sbs").with_extension("png");
+    stage_png_bytes(staged, &sbs_path, 2 * w, h, &sbs).map_err(write_failed)?;
+    let ana = mirrorbox_image::stereo::anaglyph(&a, &b);
+    let ana_path = with_stem_suffix(exr_path, "anaglyph").with_extension("png");
+    stage_png_bytes(staged, &ana_path, w, h, &ana).map_err(write_failed)
+}
+
 fn write_failed(e: impl ToString) -> Failure {
     Failure::Other(e.to_string())
 }
@@ -330,7 +351,6 @@ fn check_frame_outputs(args: &Args) -> Result<(PathBuf, Option<PathBuf>), Failur
 
 fn run_frame(args: &Args) -> Result<(), Failure> {
     use super::stereo::{eye_path, views};
-    use mirrorbox_files::with_stem_suffix;
     let (grid, whitted) = check_args(args)?;
     let (exr_path, bounces_path) = check_frame_outputs(args)?;
     let mut scene = args.time.apply(load(&args.scene)?)?;
@@ -432,15 +452,7 @@ fn run_frame(args: &Args) -> Result<(), Failure> {
         traced.push((eye, view, out, warm_up));
     }
     if let [(_, l, left, _), (_, _, right, _)] = &traced[..] {
-        let e = l.camera.exposure;
-        let (a, b) = (left.image.to_srgb8(e), right.image.to_srgb8(e));
-        let (w, h) = (l.camera.width, l.camera.height);
-        let sbs = mirrorbox_image::stereo::side_by_side(&a, &b, w, h);
-        let sbs_path = with_stem_suffix(&exr_path, "sbs").with_extension("png");
-        stage_png_bytes(&mut staged, &sbs_path, 2 * w, h, &sbs).map_err(write_failed)?;
-        let ana = mirrorbox_image::stereo::anaglyph(&a, &b);
-        let ana_path = with_stem_suffix(&exr_path, "anaglyph").with_extension("png");
-        stage_png_bytes(&mut staged, &ana_path, w, h, &ana).map_err(write_failed)?;
+        stage_stereo_pngs(&mut staged, &exr_path, l, &left.image, &right.image)?;
     }
     let written = staged.commit().map_err(write_failed)?;
     let total = started.elapsed();
@@ -824,6 +836,10 @@ fn trace_on_gpu(
         )
         .map_err(write_failed)?;
         done.push((eye, view, out));
+    }
+    // The pair's side-by-side and anaglyph, as the CPU trace writes them (the GPU had not).
+    if let [(_, l, left), (_, _, right)] = &done[..] {
+        stage_stereo_pngs(&mut staged, exr_path, l, &left.image, &right.image)?;
     }
     let written = staged.commit().map_err(write_failed)?;
     let total = started.elapsed().as_secs_f64();
