@@ -45,6 +45,9 @@ struct Recorded {
     /// The content hash of the scene drawn (`mirrorbox.scene_hash`: its reflectances and
     /// `--alpha` included, its cut depth not).
     scene_hash: Option<String>,
+    /// An image of something other than radiance (`mirrorbox.aov`: `bounces`, trace's mean
+    /// bounce counts).
+    aov: Option<String>,
 }
 
 fn recorded(path: &std::path::Path) -> Recorded {
@@ -65,6 +68,7 @@ fn recorded(path: &std::path::Path) -> Recorded {
             .and_then(|v| v.parse::<f32>().ok())
             .filter(|e| *e > 0.0 && e.is_finite()),
         scene_hash: value("mirrorbox.scene_hash").map(String::from),
+        aov: value("mirrorbox.aov").map(String::from),
     }
 }
 
@@ -133,6 +137,17 @@ fn scenes_warning(args: &Args, reference: &Recorded, test: &Recorded) -> Option<
 
 pub fn run(args: &Args) -> Result<(), Failure> {
     let (reference, test) = (recorded(&args.reference), recorded(&args.test));
+    // A bounce map carries its radiance image's keys (scene, spp, exposure): it had been
+    // scored as an image of the scene.
+    for (path, r) in [(&args.reference, &reference), (&args.test, &test)] {
+        if let Some(aov) = &r.aov {
+            return Err(Failure::BadInput(format!(
+                "{}: holds trace's {aov} (mirrorbox.aov), not radiance: compare images of the \
+                 scene",
+                path.display()
+            )));
+        }
+    }
     let exposure = exposure(args, &reference, &test)?;
     if let Some(w) = scenes_warning(args, &reference, &test) {
         eprintln!("{w}");

@@ -567,7 +567,10 @@ fn stage_bounces(
     deepest: u32,
     attributes: &[(&str, String)],
 ) -> Result<(), Failure> {
-    stage_exr(staged, path, image, attributes).map_err(write_failed)?;
+    // Said to be counts, not radiance: `compare` refuses it as an image of the scene.
+    let mut attributes = attributes.to_vec();
+    attributes.push(("mirrorbox.aov", "bounces".to_string()));
+    stage_exr(staged, path, image, &attributes).map_err(write_failed)?;
     let scale = (1.0 + deepest.max(1) as f32).ln();
     let bytes: Vec<u8> = image
         .pixels
