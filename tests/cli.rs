@@ -727,6 +727,16 @@ fn trace_depth_counts_reflections_and_path_length_counts_segments() {
     let v: serde_json::Value = serde_json::from_str(out.stdout.trim()).unwrap();
     assert!(v["ended"]["max_segments"].as_u64().unwrap() > 0, "{v}");
     assert!(v["ended"].get("max_depth").is_none(), "{v}");
+    // What was traced, and with which cuts, beside the counts.
+    assert_eq!(
+        (
+            &v["device"],
+            &v["integrator"],
+            &v["settings"]["max_segments"]
+        ),
+        (&json!("cpu"), &json!("path"), &json!(3)),
+        "{v}"
+    );
     let attrs = mirrorbox_image::read_exr_attributes(&exr).unwrap();
     assert!(
         attrs
@@ -975,6 +985,7 @@ fn trace_on_the_gpu_writes_the_cpu_truth_and_caps_its_depth() {
     let v: Value = serde_json::from_str(out.stdout.trim()).unwrap();
     assert_eq!(v["device"], "gpu");
     assert_eq!(v["max_depth"], 8);
+    assert_eq!(v["scene_hash"].as_str().map(str::len), Some(16), "{v}");
     assert_eq!(
         (v["width"].as_u64(), v["spp"].as_u64()),
         (Some(48), Some(4))

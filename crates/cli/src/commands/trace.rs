@@ -651,6 +651,22 @@ fn report(
         });
         // Cut by `max_depth` (whitted's reflections) or `max_segments` (path's length).
         v["ended"][args.length_cut().1] = s.cut_by_depth.into();
+        // What was traced and with which cuts, beside the counts ("ended" counts paths).
+        v["device"] = "cpu".into();
+        v["integrator"] = format!("{:?}", args.integrator).to_lowercase().into();
+        v["jitter"] = args.jitter.into();
+        v["reflectance"] = args.reflectance.map_or("as in scene".into(), Into::into);
+        v["settings"] = match args.integrator {
+            Integrator::Whitted => serde_json::json!({
+                "max_depth": args.length_cut().2,
+                "min_throughput": args.min_throughput,
+            }),
+            Integrator::Path => serde_json::json!({
+                "max_segments": args.length_cut().2,
+                "rr_from": args.rr_from.unwrap_or(DEFAULT_RR_FROM),
+                "seed": args.seed,
+            }),
+        };
         println!("{v}");
         return;
     }
@@ -855,7 +871,9 @@ fn trace_on_gpu(
                 "scene": args.scene.display().to_string(),
                 "time": args.time.time,
                 "eye": eye.map(|e| e.name()),
+                "scene_hash": format!("{:016x}", view.content_hash()),
                 "device": "gpu", "adapter": gpu.report.name, "backend": gpu.report.backend,
+                "integrator": "whitted",
                 "width": w, "height": h, "spp": grid.samples_per_pixel(),
                 "max_depth": whitted.max_depth.min(depth_cap),
                 "trace_ms": gpu_ms, "timing": out.timing.source.name(),
