@@ -203,6 +203,18 @@ pub fn check_distinct(outputs: &[(&str, PathBuf)]) -> Result<(), FileError> {
     Ok(())
 }
 
+/// Removes `path` if it exists: a file an earlier run wrote that this one does not (a stale
+/// figure, a screenshot's companion), which must not pass for a current one.
+pub fn remove_stale(path: &Path) -> Result<(), FileError> {
+    match std::fs::remove_file(path) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(FileError::io(
+            path,
+            format!("could not remove the stale file: {e}"),
+        )),
+        _ => Ok(()),
+    }
+}
+
 /// Writes `bytes` to `path` atomically ([`write_atomically_with`]).
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), FileError> {
     write_atomically_with(path, |tmp| {

@@ -7,9 +7,7 @@
 
 use crate::Record;
 use crate::plot::Chart;
-use mirrorbox_files::FileError;
 use std::fmt::Write as _;
-use std::path::Path;
 
 /// A report section: the blocks it adds to a sweep's report, or none where the sweep's
 /// records are not its experiment's (every section is offered every sweep).
@@ -276,17 +274,7 @@ pub fn is_flip_row(images: &[(String, String)]) -> bool {
 pub const COLOUR_BAR_MD: &str =
     "FLIP per pixel: black 0 → purple → red → orange → yellow → white 1.";
 
-/// Removes `path` if it exists: a file an earlier report wrote that this one does not.
-pub(crate) fn remove_stale(path: &Path) -> Result<(), FileError> {
-    match std::fs::remove_file(path) {
-        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(FileError {
-            path: path.to_path_buf(),
-            message: format!("could not remove the stale file: {e}"),
-            refused: false,
-        }),
-        _ => Ok(()),
-    }
-}
+pub(crate) use mirrorbox_files::remove_stale;
 
 /// The blocks as Markdown (charts and images as links to their files).
 pub fn markdown(blocks: &[Block]) -> String {

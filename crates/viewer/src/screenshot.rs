@@ -199,17 +199,6 @@ pub fn frame_record(
     })
 }
 
-/// Removes `file` if it is there.
-fn remove_stale(file: &Path) -> Result<(), String> {
-    match std::fs::remove_file(file) {
-        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(format!(
-            "{}: cannot remove an earlier screenshot's file: {e}",
-            file.display()
-        )),
-        _ => Ok(()),
-    }
-}
-
 /// Writes a screenshot and its companions (see the module docs); every file atomically.
 pub fn save(
     path: &Path,
@@ -253,7 +242,7 @@ pub fn save(
         (&error_png, session.error.is_some()),
     ] {
         if !written {
-            remove_stale(file)?;
+            mirrorbox_files::remove_stale(file).map_err(|e| e.to_string())?;
         }
     }
     let frame = session.frame.as_ref();
