@@ -579,10 +579,10 @@ impl Record {
             .find(|r| r.kind == "floor" && !r.is_external())
     }
 
-    /// The floor `self` is timed beside: a client's own for its variants, else ours of the
-    /// same `score --with` sweep ([`value::WITH_SWEEP`]), at the same size. Two sweeps' floors
-    /// are two timings (14 % apart on the web report's box): a time over another sweep's
-    /// floor had mixed them.
+    /// The floor `self` is timed beside: a client's own of the same view for its variants,
+    /// else ours of the same `score --with` sweep ([`value::WITH_SWEEP`]), at the same size.
+    /// Two sweeps' floors are two timings (14 % apart on the web report's box): a time over
+    /// another sweep's floor had mixed them.
     pub fn floor_beside<'a>(&self, records: &'a [Record]) -> Option<&'a Record> {
         let size = (self.width, self.height, self.ssaa);
         records.iter().find(|f| {
@@ -590,6 +590,7 @@ impl Record {
                 && (f.width, f.height, f.ssaa) == size
                 && f.is_external() == self.is_external()
                 && f.scored_client() == self.scored_client()
+                && f.scored_view() == self.scored_view()
                 && f.value(value::WITH_SWEEP) == self.value(value::WITH_SWEEP)
         })
     }

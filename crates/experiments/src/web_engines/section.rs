@@ -74,12 +74,7 @@ pub fn section(info: &SweepInfo, records: &[Record]) -> Vec<Block> {
     let mut findings = Vec::new();
     for r in &variants {
         // The client's floor of the same view.
-        let floor = records.iter().find(|f| {
-            f.is_external()
-                && f.kind == "floor"
-                && f.scored_client() == r.scored_client()
-                && view_of(f) == view_of(r)
-        });
+        let floor = r.floor_beside(records);
         // Ours show the scene's own camera: set beside that view only. With one view, `score
         // --with` has held ours to it (and scores made before the flag was kept had one).
         let at_our_camera =
