@@ -175,16 +175,21 @@ pub fn partner(scene: &Scene, i: usize) -> Option<usize> {
     })
 }
 
-/// Each scene mirror's footprint seen directly from the camera: the area in pixels of the
-/// screen rectangle bounding it (not occlusion-tested; 0 where the camera does not see it):
-/// which mirror of a pair the viewer looks into.
-pub fn seen_directly(scene: &Scene, width: u32, height: u32) -> Vec<u64> {
-    let mirrors: Vec<MirrorInstance> = (0..scene.mirrors.len())
+/// The scene's mirrors as instances, in scene order: "mirror 1", "mirror 2", …
+fn scene_mirrors(scene: &Scene) -> Vec<MirrorInstance> {
+    (0..scene.mirrors.len())
         .map(|i| MirrorInstance {
             mirror: i,
             label: format!("mirror {}", i + 1),
         })
-        .collect();
+        .collect()
+}
+
+/// Each scene mirror's footprint seen directly from the camera: the area in pixels of the
+/// screen rectangle bounding it (not occlusion-tested; 0 where the camera does not see it):
+/// which mirror of a pair the viewer looks into.
+pub fn seen_directly(scene: &Scene, width: u32, height: u32) -> Vec<u64> {
+    let mirrors = scene_mirrors(scene);
     let planner = Planner::new(scene, &mirrors, width, height);
     let mut area = vec![0; scene.mirrors.len()];
     for (i, rect) in planner.visible(&planner.main_view(width, height), None, &[]) {
@@ -235,12 +240,7 @@ pub fn instances(
     width: u32,
     height: u32,
 ) -> Result<Vec<MirrorInstance>, PlanError> {
-    let mut instances: Vec<MirrorInstance> = (0..scene.mirrors.len())
-        .map(|i| MirrorInstance {
-            mirror: i,
-            label: format!("mirror {}", i + 1),
-        })
-        .collect();
+    let mut instances = scene_mirrors(scene);
     if let Queue::Auxiliary { n } = queue {
         if n > 0 && scene.mirrors.len() < 2 {
             return Err(PlanError::NoMirrorToAlternateWith(scene.mirrors.len()));
@@ -525,12 +525,7 @@ pub struct MirrorCamera {
 /// tie). A mirror behind the camera (the paper's box, looking into one mirror) is reached
 /// through the mirror in front. Mirrors no chain reaches have no camera.
 pub fn feedback_cameras(scene: &Scene, width: u32, height: u32) -> (Mat4, Vec<MirrorCamera>) {
-    let instances: Vec<MirrorInstance> = (0..scene.mirrors.len())
-        .map(|i| MirrorInstance {
-            mirror: i,
-            label: format!("mirror {}", i + 1),
-        })
-        .collect();
+    let instances = scene_mirrors(scene);
     let planner = Planner::new(scene, &instances, width, height);
     let mut cameras: Vec<MirrorCamera> = Vec::new();
     let mut frontier: Vec<(ReflectedView, Option<Plane>)> =
