@@ -119,7 +119,7 @@ pub struct Args {
     rr_from: Option<u32>,
     /// whitted: stop a path when its throughput's largest channel would fall below this, in
     /// [0, 1) (`path` ends its paths by --max-segments and Russian roulette instead).
-    #[arg(long, default_value_t = DEFAULT_MIN_THROUGHPUT, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = WhittedSettings::default().min_throughput, allow_negative_numbers = true)]
     min_throughput: f32,
     /// Stratified random sub-pixel positions instead of the fixed grid.
     #[arg(long)]
@@ -173,8 +173,6 @@ pub struct Args {
 const DEFAULT_MAX_DEPTH: u32 = 10_000;
 const DEFAULT_MAX_SEGMENTS: u32 = 10_000;
 const DEFAULT_RR_FROM: u32 = 5;
-/// The throughput below which `whitted` ends a path (`--min-throughput`), as the tracer's own.
-const DEFAULT_MIN_THROUGHPUT: f32 = 1e-4;
 
 impl Args {
     /// The integrator's cut of a path's length, as (flag, record key, value): whitted's
@@ -228,7 +226,7 @@ fn check_args(args: &Args) -> Result<(SubpixelGrid, WhittedSettings), Failure> {
         }
         // The path integrator ends paths by its length and Russian roulette, not by a
         // throughput cut: the flag had been taken, recorded, and done nothing.
-        Integrator::Path if args.min_throughput != DEFAULT_MIN_THROUGHPUT => {
+        Integrator::Path if args.min_throughput != WhittedSettings::default().min_throughput => {
             return Err(Failure::BadInput(
                 "--min-throughput is the `whitted` integrator's cut: `path` ends paths by \
                  --max-segments and Russian roulette (--rr-from)"
@@ -835,7 +833,7 @@ fn trace_on_gpu(
             ("mirrorbox.lighting", view.lighting.describe()),
             // As the CPU trace records them: the grid, the reflectance asked for, the time
             // and the eye (the GPU's EXRs had lacked them).
-            ("mirrorbox.sampling", format!("{per_axis}x{per_axis} grid")),
+            ("mirrorbox.sampling", Sampling::Grid(grid).describe()),
             (
                 "mirrorbox.reflectance",
                 args.reflectance
