@@ -191,10 +191,11 @@ function readExport(dir) {
     return p;
   };
   const views = JSON.parse(fs.readFileSync(need('views.json'), 'utf8'));
-  Object.defineProperty(views, 'dir', { value: dir, enumerable: false });
   if (views.format !== 'mirrorbox-views' || views.version !== 1) fail(`${dir}/views.json is not mirrorbox-views version 1`);
   if (!Array.isArray(views.views) || views.views.length === 0) fail(`${dir}/views.json lists no views`);
   const gltf = JSON.parse(fs.readFileSync(need(views.gltf || 'scene.gltf'), 'utf8'));
+  // Read here once: the mirrors every client must find (checked after each draws).
+  Object.defineProperty(views, 'mirrorCount', { value: countMirrors(gltf), enumerable: false });
   for (const x of [...(gltf.buffers || []), ...(gltf.images || [])]) {
     if (x.uri && !x.uri.startsWith('data:')) need(decodeURIComponent(x.uri));
   }
@@ -246,8 +247,7 @@ function serve(exportDir, failures) {
 
 // The mirrors a client must find: the meshes (one per glTF primitive, as three.js' and Babylon's
 // loaders make them) of every node whose primitive's material is a mirror.
-function countMirrors(views) {
-  const gltf = JSON.parse(fs.readFileSync(path.join(views.dir, views.gltf || 'scene.gltf'), 'utf8'));
+function countMirrors(gltf) {
   const mirror = (gltf.materials || []).map((m) => Boolean(m.extras && m.extras.mirrorbox_mirror));
   const meshes = gltf.meshes || [];
   return (gltf.nodes || [])
@@ -282,7 +282,7 @@ async function main() {
   if (!fs.existsSync(opts.chromium)) fail(`no Chromium at ${opts.chromium} (give --chromium PATH)`);
   const { default: puppeteer } = await import('puppeteer-core').catch((e) => fail(
     `puppeteer-core cannot be loaded from ${HERE}/node_modules (${e.message.split('\n')[0]}): run scripts/install-web-clients.sh`));
-  const mirrorsInExport = countMirrors(views);
+  const mirrorsInExport = views.mirrorCount;
 
   const failures = [];
   const consoleErrors = [];
