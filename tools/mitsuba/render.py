@@ -175,6 +175,20 @@ def define_whitted_lean():
     mi.register_integrator("mirrorbox_whitted_lean", lambda props: WhittedLean(props))
 
 
+def llvm_found():
+    """Whether Dr.Jit has an LLVM >= 16: the one DRJIT_LIBLLVM_PATH names, else one in the
+    usual folders (Dr.Jit finds those itself; the system's 15 crashes its JIT)."""
+    named = os.environ.get("DRJIT_LIBLLVM_PATH")
+    if named:
+        return os.path.exists(named)
+    import glob
+    folders = ("/usr/lib", "/usr/lib64", "/usr/local/lib", "/usr/lib/x86_64-linux-gnu",
+               "/usr/lib/aarch64-linux-gnu")
+    return any(f"-{v}" in p or f".so.{v}" in p
+               for d in folders for p in glob.glob(os.path.join(d, "libLLVM*.so*"))
+               for v in range(16, 40))
+
+
 def refuse(message):
     """Bad input: a clear message and exit 2, as mirrorbox's commands do."""
     print(f"render.py: {message}", file=sys.stderr)
@@ -189,13 +203,7 @@ def main():
     # Without LLVM >= 16 Dr.Jit falls back to the system's (15 here), which crashes the JIT
     # with a dump of LLVM's: said instead, where neither DRJIT_LIBLLVM_PATH names a library nor
     # one of LLVM 16 or later lies in the usual folders (Dr.Jit finds those on its own).
-    import glob
-    newer = [p for d in ("/usr/lib", "/usr/lib64", "/usr/local/lib", "/usr/lib/x86_64-linux-gnu",
-                         "/usr/lib/aarch64-linux-gnu")
-             for p in glob.glob(os.path.join(d, "libLLVM*.so*"))
-             if any(f"-{v}" in p or f".so.{v}" in p for v in range(16, 40))]
-    named = os.environ.get("DRJIT_LIBLLVM_PATH")
-    if args.variant.startswith("llvm") and (named and not os.path.exists(named) or not named and not newer):
+    if args.variant.startswith("llvm") and not llvm_found():
         where = os.environ.get("DRJIT_LIBLLVM_PATH") or LLVM19
         print(f"render.py: {args.variant} needs LLVM >= 16, and {where} is missing: run tools/mitsuba/setup.sh "
               "(Debian's libllvm19), set DRJIT_LIBLLVM_PATH to it, or give --variant scalar_rgb", file=sys.stderr)
