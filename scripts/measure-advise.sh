@@ -11,10 +11,11 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 . scripts/lib/advice.sh
+. scripts/lib/reports-aside.sh
 bin=${MIRRORBOX:-target/release/mirrorbox}
 out=reports/advise
-rm -rf "$out"
-mkdir -p "$out"
+# The committed advice stays until this run has made all of its own (a failed run puts it back).
+set_reports_aside "$out"
 advise() { # SCENE BUDGET_MS [SUFFIX] [FLAGS...]
   local scene=$1 budget=$2 suffix=${3:-}
   shift 3 || shift $#
@@ -34,3 +35,4 @@ advise mirror_room 12 _exhaustive --exhaustive
 for budget in 2 4 8; do advise tilted_pair "$budget" ""; done
 # The engine: every frame 40 ms and more here; 6 timed rounds per candidate.
 for budget in 60 120 400; do advise imported/engine_box "$budget" "" --frames 6; done
+keep_new_reports

@@ -17,8 +17,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bin=${MIRRORBOX:-target/release/mirrorbox}
 out=reports/table1_runs
-cache=$(mktemp -d)
-trap 'rm -rf "$cache"' EXIT
+. scripts/lib/reports-aside.sh
 run() { # NAME EXPERIMENT [ENV=VALUE...]
   local name=$1 experiment=$2
   shift 2
@@ -27,8 +26,10 @@ run() { # NAME EXPERIMENT [ENV=VALUE...]
     --truth-cache target/truth-cache >/dev/null
   rm -rf "$out/$name/images" "$out/$name/cache"
 }
-rm -rf "$out"
-mkdir -p "$out"
+# The committed runs stay until this run has made all of its own (a failed run puts them back).
+set_reports_aside "$out"
+cache=$(mktemp -d)
+on_exit 'rm -rf "$cache"'
 run a_table1 table1
 run b_repeat table1-repeat
 run c_repeat table1-repeat
@@ -40,3 +41,4 @@ for round in 0 1; do
   run "cache_$((round * 3 + 2))_warm" table1 "${on[@]}"
   run "cache_$((round * 3 + 3))_off" table1 MESA_SHADER_CACHE_DISABLE=true
 done
+keep_new_reports

@@ -12,6 +12,7 @@ mod memory;
 mod mitsuba;
 mod readme;
 mod reports_html;
+mod scripts;
 mod slurm;
 mod tracer_bench;
 mod viewer;

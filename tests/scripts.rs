@@ -1,0 +1,95 @@
+//! The measuring scripts' shared shell: a committed report folder is replaced whole or not at
+//! all (scripts/lib/reports-aside.sh, sourced by measure-advise.sh and measure-table1-runs.sh).
+
+use crate::common::repo;
+use std::path::Path;
+use std::process::Command;
+
+/// Runs `body` in bash in `dir` after sourcing the library; the exit code.
+fn run_with_library(dir: &Path, body: &str) -> (i32, String) {
+    let lib = repo().join("scripts/lib/reports-aside.sh");
+    let script = format!("set -euo pipefail\n. '{}'\n{body}\n", lib.display());
+    let out = Command::new("bash")
+        .arg("-c")
+        .arg(script)
+        .current_dir(dir)
+        .output()
+        .expect("run bash");
+    let code = out.status.code().unwrap_or(-1);
+    (code, String::from_utf8_lossy(&out.stderr).into_owned())
+}
+
+/// A folder `out` of committed reports holding `old.txt`.
+fn committed(dir: &Path) {
+    std::fs::create_dir_all(dir.join("out")).unwrap();
+    std::fs::write(dir.join("out/old.txt"), "committed").unwrap();
+}
+
+#[test]
+fn a_run_that_fails_or_is_killed_leaves_the_committed_reports_as_they_were() {
+    for end in [
+        "false",
+        "kill -TERM $$; sleep 5",
+        "kill -INT $$; sleep 5",
+        "exit 3",
+    ] {
+        let dir = tempfile::tempdir().unwrap();
+        committed(dir.path());
+        let body = format!(
+            "set_reports_aside out\non_exit 'touch cleaned'\necho new > out/new.txt\n{end}\nkeep_new_reports"
+        );
+        let (code, stderr) = run_with_library(dir.path(), &body);
+        assert_ne!(code, 0, "{end}: {stderr}");
+        assert!(dir.path().join("out/old.txt").exists(), "{end}: {stderr}");
+        assert!(
+            !dir.path().join("out/new.txt").exists(),
+            "{end}: half-made output kept"
+        );
+        assert!(!dir.path().join("out.previous").exists(), "{end}");
+        assert!(
+            dir.path().join("cleaned").exists(),
+            "{end}: on_exit not run"
+        );
+        assert!(stderr.contains("the earlier reports are back"), "{stderr}");
+    }
+}
+
+#[test]
+fn a_run_that_finishes_replaces_the_reports_whole() {
+    let dir = tempfile::tempdir().unwrap();
+    committed(dir.path());
+    let body =
+        "set_reports_aside out\non_exit 'touch cleaned'\necho new > out/new.txt\nkeep_new_reports";
+    let (code, stderr) = run_with_library(dir.path(), body);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(dir.path().join("out/new.txt").exists());
+    assert!(!dir.path().join("out/old.txt").exists(), "an old file kept");
+    assert!(!dir.path().join("out.previous").exists());
+    assert!(dir.path().join("cleaned").exists(), "on_exit not run");
+}
+
+#[test]
+fn a_first_run_that_fails_leaves_nothing_half_made() {
+    let dir = tempfile::tempdir().unwrap();
+    let (code, stderr) = run_with_library(
+        dir.path(),
+        "set_reports_aside out\necho new > out/new.txt\nfalse",
+    );
+    assert_ne!(code, 0);
+    assert!(!dir.path().join("out").exists(), "{stderr}");
+    assert!(stderr.contains("partial output is removed"), "{stderr}");
+}
+
+#[test]
+fn the_measuring_scripts_use_it() {
+    for script in ["measure-advise.sh", "measure-table1-runs.sh"] {
+        let text = std::fs::read_to_string(repo().join("scripts").join(script)).unwrap();
+        let aside = text.find("set_reports_aside \"$out\"");
+        let kept = text.rfind("keep_new_reports");
+        assert!(
+            matches!((aside, kept), (Some(a), Some(k)) if a < k),
+            "{script}: its reports are not set aside, then kept at its end"
+        );
+        assert!(!text.contains("rm -rf \"$out\"\n"), "{script}");
+    }
+}
