@@ -20,8 +20,9 @@
 //!   texels decoded and scaled by the strength, `(s·m.x, s·m.y, m.z)`, stored as
 //!   `(n + 1)/2` (Mitsuba computes `2·texel − 1` and normalizes after bilinear filtering,
 //!   as the contract does, so the export is exact) and tiled by the bitmap's `to_uv`; a
-//!   ripple is baked into a map of 48 texels per wavelength at the texel centres
-//!   (bilinear between them: an approximation of relative size ~(π/48)²/2);
+//!   ripple is baked into a map of 48 texels per wavelength at the texel centres over the
+//!   whole mirror, clamped at its edges (bilinear between them: an approximation of
+//!   relative size ~(π/48)²/2);
 //! - a textured diffuse part (`docs/shading.md`, "Textures") → its OBJ with texture
 //!   coordinates `(u, 1 − v)` (Mitsuba's OBJ loader turns them back into glTF's `(u, v)`,
 //!   row 0 at `v = 0`), and a `bitmap` per texture: an EXR beside the meshes holding the
@@ -290,6 +291,13 @@ fn export_staged(
                         let name = format!("{i:03}_{}_normals.exr", slug(&part.name));
                         let path = mesh_dir.join(&name);
                         let (image, tiling) = normal_texture(m, b);
+                        // A ripple is baked over the whole mirror once: its edges must not
+                        // blend with the opposite edge's texels (a normal map tiles).
+                        let wrap = if b.ripple.is_some() {
+                            "clamp"
+                        } else {
+                            "repeat"
+                        };
                         stage_exr(staged, &path, &image)?;
                         format!(
                             "<bsdf type=\"normalmap\">\n        \
@@ -297,7 +305,7 @@ fn export_staged(
                              <string name=\"filename\" value=\"meshes/{name}\"/>\n          \
                              <boolean name=\"raw\" value=\"true\"/>\n          \
                              <string name=\"filter_type\" value=\"bilinear\"/>\n          \
-                             <string name=\"wrap_mode\" value=\"repeat\"/>\n          \
+                             <string name=\"wrap_mode\" value=\"{wrap}\"/>\n          \
                              <transform name=\"to_uv\"><scale x=\"{}\" y=\"{}\"/></transform>\n        \
                              </texture>\n        {conductor}\n      </bsdf>",
                             tiling[0], tiling[1]
@@ -609,6 +617,26 @@ mod tests {
             "{e}"
         );
         assert!(!dir.path().join("b.xml").exists());
+    }
+
+    /// A ripple is baked over the whole mirror once, so its map is clamped at the edges; a
+    /// scene's normal map tiles (`repeat`, as the contract's lookup wraps it).
+    #[test]
+    fn a_baked_ripple_is_clamped_and_a_normal_map_repeats() {
+        for (file, wrap) in [
+            ("bumpy_pair.json", "clamp"),
+            ("bumpy_single.json", "repeat"),
+        ] {
+            let scene = mirrorbox_scene::load::bundled_scene(file);
+            let dir = tempfile::tempdir().unwrap();
+            let xml = dir.path().join("scene.xml");
+            export(&scene, &xml, ExportSettings { spp: 4 }).unwrap();
+            let text = std::fs::read_to_string(&xml).unwrap();
+            let normalmaps = text.matches("<bsdf type=\"normalmap\">").count();
+            let wraps = format!("<string name=\"wrap_mode\" value=\"{wrap}\"/>");
+            assert!(normalmaps > 0, "{file}");
+            assert_eq!(text.matches(&wraps).count(), normalmaps, "{file}: {text}");
+        }
     }
 
     /// Two sensors of one camera: the first samples our grid unjittered (`whitted`), the
