@@ -267,7 +267,7 @@ pub fn read_image(path: &Path) -> Result<RgbImage, ImageError> {
         limits.max_image_height = Some(MAX_IMAGE_SIDE);
         limits.max_alloc = Some(MAX_PIXELS * 16);
         reader.limits(limits);
-        let decoded = reader.decode().map_err(|e| io_error(path, e))?;
+        let decoded = reader.decode().map_err(|e| decode_error(path, e))?;
         check_size(path, decoded.width(), decoded.height())?;
         // 8-bit only (grey or colour, alpha ignored): a 16-bit PNG had been cut to 8 bits
         // without a word.
@@ -318,7 +318,55 @@ fn png_size(path: &Path) -> Result<(u32, u32), ImageError> {
     image::ImageReader::open(path)
         .map_err(|e| io_error(path, e))?
         .into_dimensions()
-        .map_err(|e| io_error(path, e))
+        .map_err(|e| decode_error(path, e))
+}
+
+/// What a file's first bytes say it is, where they say so: the signatures of the formats a
+/// renderer is likely to write (OpenEXR, PNG, JPEG, Radiance HDR, TIFF).
+fn sniffed_format(path: &Path) -> Option<&'static str> {
+    use std::io::Read as _;
+    let mut head = [0u8; 8];
+    let file = mirrorbox_files::open_regular(path, MAX_IMAGE_FILE_BYTES, "image file").ok()?;
+    let n = file.take(8).read(&mut head).ok()?;
+    let head = &head[..n];
+    [
+        (&b"\x76\x2f\x31\x01"[..], "an OpenEXR file"),
+        (&b"\x89PNG\r\n\x1a\n"[..], "a PNG file"),
+        (&b"\xff\xd8\xff"[..], "a JPEG file"),
+        (&b"#?RADIAN"[..], "a Radiance HDR file"),
+        (&b"#?RGBE"[..], "a Radiance HDR file"),
+        (&b"II*\0"[..], "a TIFF file"),
+        (&b"MM\0*"[..], "a TIFF file"),
+    ]
+    .into_iter()
+    .find(|(magic, _)| head.starts_with(magic))
+    .map(|(_, what)| what)
+}
+
+/// A decoder's refusal of `path`, said in what the file is where its first bytes show it is
+/// of another format than its extension (a PNG saved as `camera.exr`: the EXR crate's words
+/// had been "file identifier missing").
+fn decode_error(path: &Path, e: impl ToString) -> ImageError {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    let named = match ext.as_deref() {
+        Some("exr") => "an OpenEXR file",
+        Some("png") => "a PNG file",
+        _ => "",
+    };
+    match sniffed_format(path) {
+        Some(what) if what != named => io_error(
+            path,
+            format!(
+                "is {what} by its first bytes, not what its extension says ({}); an image is \
+                 read as .exr (linear radiance) or .png (8-bit sRGB), named after its format",
+                ext.as_deref().unwrap_or("none")
+            ),
+        ),
+        _ => io_error(path, e),
+    }
 }
 
 /// The first layer's size (the one [`read_image`] reads); every layer's is checked against
@@ -329,7 +377,7 @@ fn exr_size(path: &Path) -> Result<(u32, u32), ImageError> {
 
 /// An EXR's header, read once for its size and its channels' sample types.
 fn exr_meta(path: &Path) -> Result<exr::meta::MetaData, ImageError> {
-    exr::meta::MetaData::read_from_file(path, false).map_err(|e| io_error(path, e))
+    exr::meta::MetaData::read_from_file(path, false).map_err(|e| decode_error(path, e))
 }
 
 /// [`exr_size`] of a header read.
@@ -406,12 +454,58 @@ fn rgb_samples(path: &Path, meta: &exr::meta::MetaData) -> Result<&'static str, 
     Ok(if half { "half" } else { "float" })
 }
 
+/// Refuses an EXR whose first layer has no channels named `R`, `G` and `B`, naming the ones
+/// it has: a luminance-only file, or one whose channels carry a layer's prefix (Blender's
+/// `View Layer.Combined.R`), which the reader does not take for R, G and B.
+fn has_rgb(path: &Path, meta: &exr::meta::MetaData) -> Result<(), ImageError> {
+    let header = meta
+        .headers
+        .first()
+        .ok_or_else(|| io_error(path, "an EXR without a layer"))?;
+    let names: Vec<String> = header
+        .channels
+        .list
+        .iter()
+        .map(|c| c.name.to_string())
+        .collect();
+    if ["R", "G", "B"].iter().all(|c| names.iter().any(|n| n == c)) {
+        return Ok(());
+    }
+    let prefixed = ["R", "G", "B"]
+        .iter()
+        .all(|c| names.iter().any(|n| n.ends_with(&format!(".{c}"))));
+    let shown: Vec<&str> = names.iter().take(8).map(String::as_str).collect();
+    Err(io_error(
+        path,
+        format!(
+            "an EXR's channels R, G and B are read (float or half; A ignored); its first layer \
+             has {}{}{}",
+            if shown.is_empty() {
+                "none".to_string()
+            } else {
+                shown.join(", ")
+            },
+            if names.len() > shown.len() {
+                ", …"
+            } else {
+                ""
+            },
+            if prefixed {
+                ": write them without the layer's prefix, as R, G and B"
+            } else {
+                ""
+            }
+        ),
+    ))
+}
+
 fn read_exr(path: &Path) -> Result<RgbImage, ImageError> {
     use exr::prelude::*;
     // The header first: the size it claims is checked before any pixel is allocated.
     let meta = exr_meta(path)?;
     sized(path, &meta)?;
     rgb_samples(path, &meta)?;
+    has_rgb(path, &meta)?;
     let image = read_first_rgba_layer_from_file(
         path,
         |size, _| RgbImage::new(size.width() as u32, size.height() as u32),
@@ -420,15 +514,7 @@ fn read_exr(path: &Path) -> Result<RgbImage, ImageError> {
             img.pixels[pos.y() * w + pos.x()] = [r, g, b];
         },
     )
-    .map_err(|e| match e {
-        // The EXR crate's words for a file without R, G and B (a Y-only or a layered one).
-        exr::error::Error::Invalid(m) if m.contains("no layer") => io_error(
-            path,
-            "an EXR with R, G and B channels is read (float or half; A ignored); this one has \
-             none in its first layer",
-        ),
-        e => io_error(path, e),
-    })?;
+    .map_err(|e| io_error(path, e))?;
     Ok(image.layer_data.channel_data.pixels)
 }
 
@@ -454,9 +540,71 @@ mod tests {
             .unwrap();
         let e = read_image(&path).unwrap_err().to_string();
         assert!(
-            e.contains("y.exr") && e.contains("R, G and B channels"),
+            e.contains("y.exr") && e.contains("channels R, G and B") && e.contains("has Y"),
             "{e}"
         );
+    }
+
+    /// An EXR whose channels carry a layer's prefix (as Blender writes them) is refused
+    /// naming its channels and what to do, not "has none".
+    #[test]
+    fn an_exr_with_prefixed_channels_names_them() {
+        use exr::prelude::*;
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("blender.exr");
+        let channel = |c: &str| {
+            AnyChannel::new(
+                Text::new_or_panic(format!("View Layer.Combined.{c}").as_str()),
+                FlatSamples::F32(vec![0.5; 12]),
+            )
+        };
+        Image::from_channels(
+            (4, 3),
+            AnyChannels::sort(SmallVec::from_vec(vec![
+                channel("R"),
+                channel("G"),
+                channel("B"),
+            ])),
+        )
+        .write()
+        .to_file(&path)
+        .unwrap();
+        let e = read_image(&path).unwrap_err().to_string();
+        assert!(
+            e.contains("View Layer.Combined.R") && e.contains("without the layer's prefix"),
+            "{e}"
+        );
+    }
+
+    /// A file of one format named as the other is said to be so, by its first bytes.
+    #[test]
+    fn a_file_named_as_another_format_is_said_so() {
+        let dir = tempfile::tempdir().unwrap();
+        let png = dir.path().join("a.png");
+        let exr = dir.path().join("a.exr");
+        write_png(&png, &gradient(), 1.0).unwrap();
+        write_exr(&exr, &gradient(), &[]).unwrap();
+        let (png_as_exr, exr_as_png) = (dir.path().join("p.exr"), dir.path().join("e.png"));
+        std::fs::copy(&png, &png_as_exr).unwrap();
+        std::fs::copy(&exr, &exr_as_png).unwrap();
+        for (path, what) in [
+            (&png_as_exr, "a PNG file"),
+            (&exr_as_png, "an OpenEXR file"),
+        ] {
+            for e in [
+                read_image(path).unwrap_err().to_string(),
+                image_size(path).unwrap_err().to_string(),
+            ] {
+                assert!(
+                    e.contains(what) && e.contains("not what its extension says"),
+                    "{e}"
+                );
+            }
+        }
+        // A file of its own format but broken keeps the decoder's words.
+        std::fs::write(&png_as_exr, b"\x76\x2f\x31\x01 and then nothing").unwrap();
+        let e = read_image(&png_as_exr).unwrap_err().to_string();
+        assert!(!e.contains("not what its extension says"), "{e}");
     }
 
     #[test]
