@@ -268,6 +268,23 @@ fn a_bad_run_is_refused_naming_the_file_and_nothing_is_written() {
         mirrorbox_image::write_exr(&exr, &img, &[]).unwrap();
         refused("bad pixel", "pixel (5, 2)");
     }
+    // A PNG saved under the EXR's name: said so (the EXR crate had said "file identifier
+    // missing").
+    let png_bytes = tmp.path().join("as.png");
+    mirrorbox_image::write_png(&png_bytes, &small, 1.0).unwrap();
+    std::fs::copy(&png_bytes, &exr).unwrap();
+    refused("png as exr", "is a PNG file by its first bytes");
+    // A picture without an extension, and one misnamed alone: each named in the refusal.
+    std::fs::remove_file(&exr).unwrap();
+    std::fs::write(variant.join("camera"), &good).unwrap();
+    refused(
+        "no extension",
+        "camera is in a format score does not read, or has no extension",
+    );
+    std::fs::remove_file(variant.join("camera")).unwrap();
+    std::fs::write(variant.join("cam.exr"), &good).unwrap();
+    refused("misnamed alone", "cam.exr: an image of no view");
+    std::fs::remove_file(variant.join("cam.exr")).unwrap();
     std::fs::write(&exr, &good).unwrap();
     // An image of no view (a misnamed view's): it had been skipped unsaid.
     let stray = variant.join("c.exr");
@@ -349,6 +366,26 @@ fn a_bad_run_is_refused_naming_the_file_and_nothing_is_written() {
     refused("shared pictures", "would share images/x_y_z_camera.png");
     std::fs::remove_dir_all(run.join("x_y")).unwrap();
     std::fs::remove_dir_all(run.join("x")).unwrap();
+    // Two variants that would be one method (`x-y/z` and `x/y-z`), and a variant named as
+    // one of ours (`path/textures`): their rows had been told apart by nothing.
+    let copy_variant = |client: &str, variant: &str| {
+        let copy = run.join(client).join(variant);
+        std::fs::create_dir_all(&copy).unwrap();
+        for f in ["camera.exr", "timing.json"] {
+            std::fs::copy(variant_dir(&run).join(f), copy.join(f)).unwrap();
+        }
+    };
+    copy_variant("x-y", "z");
+    copy_variant("x", "y-z");
+    refused("one method", "would both be method \"x-y-z\"");
+    std::fs::remove_dir_all(run.join("x-y")).unwrap();
+    std::fs::remove_dir_all(run.join("x")).unwrap();
+    copy_variant("path", "textures");
+    refused("our method's name", "the name of mirrorbox's own method");
+    std::fs::remove_dir_all(run.join("path")).unwrap();
+    // A client's hidden staging folder (being written, or left by a killed client) is no
+    // client: it had been refused as a name with a dot.
+    copy_variant(".x.tmp-123", "v");
     // A client named as the report's own pictures begin.
     let reserved = run.join("truth").join("v");
     std::fs::create_dir_all(&reserved).unwrap();
@@ -954,7 +991,10 @@ fn a_picture_upside_down_or_srgb_encoded_is_said_and_an_unreadable_one_refused()
     refused("s16", &["a PNG is read as 8 bits a channel", "camera.png"]);
     // Named in another case.
     std::fs::rename(&png, variant.join("Camera.PNG")).unwrap();
-    refused("case", &["Camera.PNG differs only in case"]);
+    refused(
+        "case",
+        &["Camera.PNG: an image of no view (it differs only in case from view \"camera\")"],
+    );
     std::fs::remove_file(variant.join("Camera.PNG")).unwrap();
     // An EXR of unsigned integers.
     {

@@ -404,7 +404,9 @@ async function main() {
       const { info, results, variants } = drawn[client];
       const syncMs = Math.max(...Object.values(results).map((r) => r.syncMs));
       const final = path.join(opts.runDir, client);
-      const staged = `${final}.tmp-${process.pid}`;
+      // Hidden (a leading dot): `mirrorbox score` takes it for no client while it is written,
+      // nor after a killed run left it.
+      const staged = path.join(opts.runDir, `.${client}.tmp-${process.pid}`);
       fs.rmSync(staged, { recursive: true, force: true });
       stagedDirs.push(staged);
       for (const name of variants) {

@@ -356,6 +356,47 @@ fn read_timing(path: &Path, views: &ViewsFile) -> Result<Timing, HarnessError> {
     Ok(t)
 }
 
+/// The method name of `client/variant` in the records and the report: the client's own for
+/// its `floor` variant (its no-mirror floor), else `<client>-<variant>`.
+fn method_name(client: &str, variant: &str) -> String {
+    if variant == "floor" {
+        client.to_string()
+    } else {
+        format!("{client}-{variant}")
+    }
+}
+
+/// Refuses a run in which two variants would be one method in the report (`a-b/c` and
+/// `a/b-c` are both `a-b-c`: their rows and points would be told apart by nothing), or a
+/// variant would take the name of one of mirrorbox's methods (`path/textures`), which a
+/// `--with` sweep's points carry.
+fn check_method_names(found: &[(String, String, PathBuf)]) -> Result<(), HarnessError> {
+    let mut seen: BTreeMap<String, String> = BTreeMap::new();
+    for (client, variant, dir) in found {
+        let name = method_name(client, variant);
+        if mirrorbox_raster::registry::find(&name).is_some() {
+            return Err(refused(
+                dir,
+                format!(
+                    "{client}/{variant} would be method {name:?} in the report, the name of \
+                     mirrorbox's own method: rename the client or the variant"
+                ),
+            ));
+        }
+        let this = format!("{client}/{variant}");
+        if let Some(other) = seen.insert(name.clone(), this.clone()) {
+            return Err(refused(
+                dir,
+                format!(
+                    "{this} and {other} would both be method {name:?} in the report: rename a \
+                     client or variant"
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// The stem of the report's pictures of `client/variant` at `view` (`images/<stem>.png`, with
 /// `_flip` and `_inset` beside it).
 fn picture_stem(client: &str, variant: &str, view: &str) -> String {
@@ -415,7 +456,8 @@ fn check_picture_names(
     Ok(())
 }
 
-/// Every `RUN/<client>/<variant>/` folder, sorted.
+/// Every `RUN/<client>/<variant>/` folder, sorted; hidden folders (a name beginning with
+/// `.`) are no client's or variant's.
 fn variants(run: &Path) -> Result<Vec<(String, String, PathBuf)>, HarnessError> {
     // A mistyped RUN is the user's input (exit 2), not a failure to read.
     if !run.is_dir() {
@@ -425,8 +467,10 @@ fn variants(run: &Path) -> Result<Vec<(String, String, PathBuf)>, HarnessError> 
         let mut out = Vec::new();
         for e in std::fs::read_dir(dir).map_err(io(dir))? {
             let e = e.map_err(io(dir))?;
-            if e.path().is_dir() {
-                let name = e.file_name().to_string_lossy().into_owned();
+            let name = e.file_name().to_string_lossy().into_owned();
+            // A hidden entry is a client's staging (`.three.tmp-…`, a run being written or
+            // one that was killed), not a client or a variant.
+            if e.path().is_dir() && !name.starts_with('.') {
                 if !valid_name(&name) {
                     return Err(refused(
                         &e.path(),
@@ -468,10 +512,16 @@ fn check_no_stray_image(dir: &Path, views: &ViewsFile) -> Result<(), HarnessErro
             && let Some(stem) = stem
             && !views.views.iter().any(|v| v.name == stem)
         {
+            let case = views
+                .views
+                .iter()
+                .find(|v| v.name.eq_ignore_ascii_case(&stem))
+                .map(|v| format!(" (it differs only in case from view {:?})", v.name))
+                .unwrap_or_default();
             return Err(refused(
                 &path,
                 format!(
-                    "an image of no view: views.json has {} (a variant folder holds \
+                    "an image of no view{case}: views.json has {} (a variant folder holds \
                      <view>.exr or <view>.png and timing.json)",
                     views
                         .views
@@ -517,44 +567,51 @@ fn view_image(dir: &Path, view: &crate::exchange::ExportedView) -> Result<PathBu
 }
 
 /// Where `dir` has no picture of view `name`, the one it has under another name, as a hint
-/// for the refusal: one that differs only in case (`Camera.EXR`), or one in a format score
-/// does not read (a client's `camera.jpg`); empty where there is none.
+/// for the refusal: one in a format score does not read (a client's `camera.jpg`) or
+/// without an extension; else what the folder holds. (An EXR or PNG of another name, one
+/// that differs only in case among them, was refused before: `check_no_stray_image`.)
 fn picture_elsewhere(dir: &Path, name: &str) -> String {
-    let wanted = [format!("{name}.exr"), format!("{name}.png")];
     let names: Vec<String> = std::fs::read_dir(dir)
         .into_iter()
         .flatten()
         .flatten()
         .filter_map(|e| e.file_name().into_string().ok())
         .collect();
-    let near: Vec<&str> = names
-        .iter()
-        .map(String::as_str)
-        .filter(|n| wanted.iter().any(|w| w.eq_ignore_ascii_case(n)))
-        .collect();
-    if !near.is_empty() {
-        return format!("; {} differs only in case", near.join(", "));
-    }
     let unread: Vec<&str> = names
         .iter()
         .map(String::as_str)
         .filter(|n| {
-            n.rsplit_once('.').is_some_and(|(stem, ext)| {
-                stem == name
-                    && !["exr", "png", "json"]
-                        .iter()
-                        .any(|k| ext.eq_ignore_ascii_case(k))
-            })
+            *n == name
+                || n.rsplit_once('.').is_some_and(|(stem, ext)| {
+                    stem == name
+                        && !["exr", "png", "json"]
+                            .iter()
+                            .any(|k| ext.eq_ignore_ascii_case(k))
+                })
         })
         .collect();
-    if unread.is_empty() {
-        String::new()
-    } else {
-        format!(
-            "; {} is in a format score does not read (a picture is EXR, linear radiance, or \
-             PNG, 8-bit sRGB)",
+    if !unread.is_empty() {
+        return format!(
+            "; {} is in a format score does not read, or has no extension (a picture is \
+             <view>.exr, linear radiance, or <view>.png, 8-bit sRGB)",
             unread.join(", ")
-        )
+        );
+    }
+    // Nothing like it: what the folder does hold, so that a misnamed picture is seen.
+    let mut others: Vec<&str> = names
+        .iter()
+        .map(String::as_str)
+        .filter(|n| *n != "timing.json")
+        .collect();
+    others.sort_unstable();
+    match others.len() {
+        0 => "; the folder holds only timing.json".to_string(),
+        n if n <= 6 => format!("; the folder holds {}", others.join(", ")),
+        n => format!(
+            "; the folder holds {} and {} more",
+            others[..6].join(", "),
+            n - 6
+        ),
     }
 }
 
@@ -855,11 +912,7 @@ fn scored_record(
         kind: if floor { "floor" } else { "point" }.into(),
         scene: views.source.clone(),
         scene_hash: v.scene_hash.clone(),
-        method: if floor {
-            client.to_string()
-        } else {
-            format!("{client}-{variant}")
-        },
+        method: method_name(client, variant),
         // The variant's short knobs (its name in legends and tables), then the
         // method it is meant to match; every parameter is in variants.md.
         method_options: timing
@@ -950,6 +1003,7 @@ pub fn score(
     let ours = our_sweeps(&views, &settings.with)?;
     let found = variants(run)?;
     check_picture_names(&found, &views)?;
+    check_method_names(&found)?;
     crate::exchange::replaceable(out, "sweep.json", "score")?;
     check_not_a_sweep(out)?;
     for input in [export, run]
@@ -982,11 +1036,12 @@ pub fn score(
             ));
         }
         let timing = read_timing(&timing_file, &views)?;
+        // A stray image first: `cam.exr` beside no `camera.exr` is named as what it is.
+        check_no_stray_image(dir, &views)?;
         let mut images = Vec::new();
         for v in &views.views {
             images.push(view_image(dir, v)?);
         }
-        check_no_stray_image(dir, &views)?;
         inputs.push((client, variant, timing, images));
     }
     crate::exchange::in_staged_folder(out, |partial| {
@@ -1178,6 +1233,19 @@ mod tests {
                     "{p} is optional"
                 );
             }
+        }
+        // null where the schema allows it (as absent), and nowhere else.
+        for p in &properties {
+            let nullable = s["properties"][p.as_str()]["type"]
+                .as_array()
+                .is_some_and(|t| t.iter().any(|t| t == "null"));
+            let mut doc = example.clone();
+            doc[p.as_str()] = serde_json::Value::Null;
+            assert_eq!(
+                serde_json::from_value::<Timing>(doc).is_ok(),
+                nullable,
+                "{p}: null"
+            );
         }
         let mut doc = example;
         doc["unknown"] = serde_json::json!(1);

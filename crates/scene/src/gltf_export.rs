@@ -67,7 +67,10 @@ pub fn camera_frame(scene: &Scene) -> (Vec3, Vec3, Vec3) {
 pub fn export(scene: &Scene) -> Result<GltfFiles, ExportError> {
     if scene.stereo.is_some() {
         return Err(ExportError::Unsupported(
-            "a stereo camera is not in the exchange: export each eye as a view".into(),
+            "a stereo camera is not in the exchange (a view has no field for an off-axis eye's \
+             shifted image); a parallel or toe-in eye can be a view: export the scene without \
+             `camera.stereo`, with --views giving each eye's position and look-at"
+                .into(),
         ));
     }
     if scene.bumps.iter().any(Option::is_some) {
