@@ -40,6 +40,13 @@ fn bad_advise_input_exits_2_and_writes_nothing() {
     let out_s = out.to_str().unwrap();
     let bad_scene = dir.path().join("bad.json");
     std::fs::write(&bad_scene, "{").unwrap();
+    let mut scene: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(repo().join("scenes/mirror_box.json")).unwrap(),
+    )
+    .unwrap();
+    scene["mirrors"] = serde_json::json!([]);
+    let no_mirrors = dir.path().join("no_mirrors.json");
+    std::fs::write(&no_mirrors, scene.to_string()).unwrap();
     for (args, says) in [
         (
             vec![
@@ -50,7 +57,7 @@ fn bad_advise_input_exits_2_and_writes_nothing() {
                 "-o",
                 out_s,
             ],
-            "--budget-ms: a frame time in ms above 0, got 0",
+            "--budget-ms: a frame time in ms from 0.000001 to 3600000, got 0",
         ),
         (
             vec![
@@ -61,7 +68,7 @@ fn bad_advise_input_exits_2_and_writes_nothing() {
                 "-o",
                 out_s,
             ],
-            "--budget-ms: a frame time in ms above 0, got -3",
+            "--budget-ms: a frame time in ms from 0.000001 to 3600000, got -3",
         ),
         (
             vec![
@@ -92,6 +99,28 @@ fn bad_advise_input_exits_2_and_writes_nothing() {
         (
             vec![
                 "advise",
+                "scenes/mirror_box.json",
+                "--budget-ms",
+                "1e-300",
+                "-o",
+                out_s,
+            ],
+            "--budget-ms: a frame time in ms from 0.000001 to 3600000, got 1e-300",
+        ),
+        (
+            vec![
+                "advise",
+                no_mirrors.to_str().unwrap(),
+                "--budget-ms",
+                "5",
+                "-o",
+                out_s,
+            ],
+            "the scene has no mirrors",
+        ),
+        (
+            vec![
+                "advise",
                 bad_scene.to_str().unwrap(),
                 "--budget-ms",
                 "5",
@@ -109,6 +138,12 @@ fn bad_advise_input_exits_2_and_writes_nothing() {
     // A folder holding something else is refused, not overwritten.
     std::fs::create_dir(&out).unwrap();
     std::fs::write(out.join("mine.txt"), "keep").unwrap();
+    let r = advise(&out, "5");
+    assert_eq!(r.code, 2, "{}", r.stderr);
+    assert!(r.stderr.contains("holds no earlier advice"), "{}", r.stderr);
+    assert!(out.join("mine.txt").is_file());
+    // So is one whose advice.json is not an advice (it had been replaced whole).
+    std::fs::write(out.join("advice.json"), "{}").unwrap();
     let r = advise(&out, "5");
     assert_eq!(r.code, 2, "{}", r.stderr);
     assert!(r.stderr.contains("holds no earlier advice"), "{}", r.stderr);

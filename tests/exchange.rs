@@ -438,6 +438,42 @@ fn a_bad_run_is_refused_naming_the_file_and_nothing_is_written() {
 /// refused naming the export's file, exit 2, before anything is written. (An empty list
 /// panicked; the truths were read only while writing, failed with exit 1 naming `.partial`
 /// files, and a NaN in a truth gave `"rmse": null` records.)
+/// A folder is replaced only when it holds an earlier export: a user's own `views.json` (a
+/// `--views` list kept beside their notes) had been taken for one, and the folder replaced
+/// whole. An earlier export is replaced.
+#[test]
+fn an_export_replaces_only_an_earlier_export() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("mine");
+    std::fs::create_dir(&dir).unwrap();
+    std::fs::write(dir.join("notes.txt"), "keep").unwrap();
+    let list = r#"{"views":[{"name":"a","position":[0,1.5,0],"look_at":[0,1.5,-1]}]}"#;
+    std::fs::write(dir.join("views.json"), list).unwrap();
+    let mut args = vec![
+        "export-views",
+        "scenes/mirror_box.json",
+        "-o",
+        dir.to_str().unwrap(),
+    ];
+    args.extend(SIZE);
+    let out = mirrorbox(&args, &[]);
+    assert_eq!(out.code, 2, "{}", out.stderr);
+    assert!(
+        out.stderr
+            .contains("holds no earlier export (its views.json)"),
+        "{}",
+        out.stderr
+    );
+    assert!(dir.join("notes.txt").is_file());
+    assert_eq!(
+        std::fs::read_to_string(dir.join("views.json")).unwrap(),
+        list
+    );
+    let earlier = tmp.path().join("earlier");
+    export(&earlier);
+    export(&earlier);
+}
+
 #[test]
 fn a_bad_export_is_refused_naming_its_file_before_anything_is_written() {
     let tmp = tempfile::tempdir().unwrap();

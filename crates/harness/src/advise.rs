@@ -884,7 +884,9 @@ pub fn advise_into(
     out: &Path,
     progress: &mut dyn FnMut(Event),
 ) -> Result<Advice, HarnessError> {
-    crate::exchange::replaceable(out, "advice.json", "advice")?;
+    crate::exchange::replaceable(out, "advice.json", "advice", |v| {
+        v["budget_ms"].is_number() && v["measured"].is_array()
+    })?;
     // The rounds' folders name `OUT.partial`; the files keep working after the move.
     crate::exchange::in_staged_folder(out, |partial| {
         let mut config = config.clone();

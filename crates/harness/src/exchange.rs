@@ -245,7 +245,7 @@ pub fn export_views(
     dir: &Path,
     settings: &ExportSettings,
 ) -> Result<Exported, HarnessError> {
-    replaceable(dir, "views.json", "export")?;
+    replaceable(dir, "views.json", "export", is_views_file)?;
     let mut config = SweepConfig::new(
         scene_path.to_path_buf(),
         dir.to_path_buf(),
@@ -409,18 +409,44 @@ pub(crate) fn not_the_stage_of(out: &Path, input: &Path) -> Result<(), HarnessEr
 }
 
 /// Whether [`in_staged_folder`] may write `dir`: its parent exists, and it is absent, empty,
-/// or holds an earlier output of the same command (its `marker` file, e.g. `views.json`).
-/// Checked before any work, so that a mistyped folder costs nothing.
-pub(crate) fn replaceable(dir: &Path, marker: &str, what: &str) -> Result<(), HarnessError> {
+/// or holds an earlier output of the same command: its `marker` file (e.g. `views.json`), a
+/// JSON object that `ours` recognises as that command's. A file of the marker's name alone
+/// is not enough: a folder holding a user's own `views.json` (a `--views` list) had been
+/// replaced whole, the user's files with it. Checked before any work, so that a mistyped
+/// folder costs nothing.
+pub(crate) fn replaceable(
+    dir: &Path,
+    marker: &str,
+    what: &str,
+    ours: fn(&serde_json::Value) -> bool,
+) -> Result<(), HarnessError> {
     crate::check_output_parent(dir)?;
     let empty = std::fs::read_dir(dir).is_ok_and(|mut d| d.next().is_none());
-    if dir.exists() && !dir.join(marker).is_file() && !empty {
+    if !dir.exists() || empty {
+        return Ok(());
+    }
+    let earlier = mirrorbox_files::open_regular(&dir.join(marker), MAX_MARKER_BYTES, marker)
+        .ok()
+        .and_then(|f| {
+            serde_json::from_reader::<_, serde_json::Value>(std::io::BufReader::new(f)).ok()
+        })
+        .is_some_and(|v| ours(&v));
+    if !earlier {
         return Err(HarnessError::Exchange(format!(
-            "{}: exists and holds no earlier {what} ({marker}); give a new or empty folder",
+            "{}: exists and holds no earlier {what} (its {marker}); give a new or empty folder",
             dir.display()
         )));
     }
     Ok(())
+}
+
+/// The largest marker file [`replaceable`] reads (an advice's `advice.json` with every
+/// candidate of a long search is a few hundred KB).
+const MAX_MARKER_BYTES: u64 = 64 << 20;
+
+/// Whether `v` is an export's `views.json` (for [`replaceable`]).
+pub(crate) fn is_views_file(v: &serde_json::Value) -> bool {
+    v["format"] == "mirrorbox-views"
 }
 
 /// The one grey reflectance every mirror of `scene` has, if any.

@@ -1004,7 +1004,8 @@ pub fn score(
     let found = variants(run)?;
     check_picture_names(&found, &views)?;
     check_method_names(&found)?;
-    crate::exchange::replaceable(out, "sweep.json", "score")?;
+    // Which sweep.json is a score's, check_not_a_sweep says (naming a sweep's).
+    crate::exchange::replaceable(out, "sweep.json", "score", serde_json::Value::is_object)?;
     check_not_a_sweep(out)?;
     for input in [export, run]
         .into_iter()

@@ -76,11 +76,21 @@ fn offered() -> Vec<&'static str> {
         .collect()
 }
 
+/// The budgets `advise` takes: from a nanosecond (in which nothing renders: the way to ask
+/// for the cheapest; 1e-300 had printed a 300-digit ratio) to an hour (everything fits).
+const MIN_BUDGET_MS: f64 = 1e-6;
+const MAX_BUDGET_MS: f64 = 3_600_000.0;
+
 pub fn run(args: &Args) -> Result<(), Failure> {
-    if !(args.budget_ms.is_finite() && args.budget_ms > 0.0) {
+    if !(MIN_BUDGET_MS..=MAX_BUDGET_MS).contains(&args.budget_ms) {
         return Err(Failure::BadInput(format!(
-            "--budget-ms: a frame time in ms above 0, got {}",
-            args.budget_ms
+            "--budget-ms: a frame time in ms from {MIN_BUDGET_MS} to {MAX_BUDGET_MS}, got {}",
+            // 1e-300 in full is 300 digits.
+            if args.budget_ms != 0.0 && !(1e-3..1e9).contains(&args.budget_ms.abs()) {
+                format!("{:e}", args.budget_ms)
+            } else {
+                args.budget_ms.to_string()
+            }
         )));
     }
     let metric = Metric::parse(&args.metric).ok_or_else(|| {
@@ -116,6 +126,13 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     // The scene as `check` reads it, and every view of it: a clear error (exit 2) before any
     // search.
     let scene = super::load(&args.scene)?;
+    if scene.mirrors.is_empty() {
+        // Every method draws it alike: a search would rank timing noise.
+        return Err(Failure::BadInput(format!(
+            "{}: the scene has no mirrors; advise chooses how to draw mirrors",
+            args.scene.display()
+        )));
+    }
     let views = match &args.views {
         Some(path) => {
             let views = mirrorbox_harness::exchange::read_view_list(path)
