@@ -322,6 +322,54 @@ fn a_fifo_as_compared_image_is_refused_instead_of_blocking() {
     assert_refused(&args, &r, &["a.exr", "FIFO"]);
 }
 
+/// `compare` refuses images whose comparison would need more memory than its budget, from
+/// their headers, before reading a pixel: the 2 GiB default refuses a 4480² pair (2.2 GB
+/// by 112 bytes a pixel; an 8192² pair had needed 7 GB and been killed), and a budget of
+/// 1 MiB a 128² pair; a 64² pair fits it.
+#[test]
+fn compare_refuses_what_its_memory_budget_cannot_hold() {
+    let dir = tempfile::tempdir().unwrap();
+    let png = |side: u32| {
+        let path = dir.path().join(format!("{side}.png"));
+        // Written row by row by the PNG encoder: a flat grey compresses to a few KB.
+        let img = mirrorbox_image::RgbImage {
+            width: side,
+            height: side,
+            pixels: vec![[0.2; 3]; (side * side) as usize],
+        };
+        mirrorbox_image::write_png(&path, &img, 1.0).unwrap();
+        path
+    };
+    let big = png(4480);
+    let args = ["compare", big.to_str().unwrap(), big.to_str().unwrap()];
+    let r = mirrorbox(&args, &[]);
+    assert_refused(
+        &args,
+        &r,
+        &[
+            "comparing 4480×4480 images needs about 2.2 GB",
+            "--memory-budget",
+        ],
+    );
+    let (small, fits) = (png(128), png(64));
+    for (image, refused) in [(&small, true), (&fits, false)] {
+        let args = [
+            "compare",
+            image.to_str().unwrap(),
+            image.to_str().unwrap(),
+            "--memory-budget",
+            "1M",
+        ];
+        let r = mirrorbox(&args, &[]);
+        assert_eq!(
+            r.code,
+            if refused { 2 } else { 0 },
+            "{args:?}: {}",
+            r.stderr
+        );
+    }
+}
+
 /// An output named like an existing folder is refused before the trace, nothing written.
 /// (A write that fails later leaves nothing either: every output is staged and renamed
 /// together, `mirrorbox_files::StagedFiles`.)

@@ -119,8 +119,16 @@ impl StagedFiles {
         Ok(())
     }
 
-    /// Renames every staged file into place; returns their paths.
+    /// Renames every staged file into place; returns their paths. A destination that is a
+    /// folder is refused before any file is renamed (the files renamed before it had stayed,
+    /// an export's meshes without its XML).
     pub fn commit(mut self) -> Result<Vec<PathBuf>, FileError> {
+        if let Some((_, path)) = self.staged.iter().find(|(_, path)| path.is_dir()) {
+            return Err(FileError::refused(
+                path,
+                "would be written as a file, but it is a folder",
+            ));
+        }
         let staged = std::mem::take(&mut self.staged);
         let mut done = Vec::with_capacity(staged.len());
         let mut pending = staged.into_iter();
@@ -521,6 +529,24 @@ mod tests {
         assert_eq!(staged.commit().unwrap(), vec![a.clone(), b.clone()]);
         assert!(a.is_file() && b.is_file());
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
+
+        // A destination that is a folder: refused before any file is renamed.
+        let (c, d) = (dir.path().join("c.obj"), dir.path().join("d.json"));
+        std::fs::create_dir(&d).unwrap();
+        let mut staged = StagedFiles::new();
+        for p in [&c, &d] {
+            staged
+                .stage_with(p, |t| std::fs::write(t, "x").map_err(|e| e.to_string()))
+                .unwrap();
+        }
+        let e = staged.commit().unwrap_err();
+        assert!(e.refused && e.to_string().contains("d.json"), "{e}");
+        assert!(!c.exists(), "renamed before the refusal");
+        assert_eq!(
+            std::fs::read_dir(dir.path()).unwrap().count(),
+            3,
+            "a, b, d/"
+        );
     }
 
     #[test]

@@ -216,7 +216,9 @@ fn gaussian_11() -> [f64; 11] {
 /// Separable valid filtering of the `w × h` plane `src` by the 11 taps `k`: rows, then
 /// columns; `(w − 10) × (h − 10)` values. Each output is `Σₜ k[t]·x[t]` added in tap order
 /// from −0.0, as `Iterator::sum` over the window adds it; the taps are the outer loop, so
-/// that the inner one runs along a row over independent outputs and vectorises.
+/// that the inner one runs along a row over independent outputs and vectorises. The
+/// reference [`ssim_over`] streams row by row, held by the tests to a direct sum.
+#[cfg(test)]
 fn gaussian_11_valid(k: &[f64; 11], src: &[f64], w: usize, h: usize) -> Vec<f64> {
     debug_assert_eq!(src.len(), w * h);
     let (vw, vh) = (w - 10, h - 10);
@@ -251,40 +253,70 @@ pub fn ssim(a: &[u8], b: &[u8], w: usize, h: usize) -> f64 {
 
 /// [`ssim`] averaged over the valid windows centred on a pixel `mask` keeps (all without
 /// one); NaN where it keeps none of them.
+///
+/// Row by row: each source row's five planes (x, y, x², y², xy) filtered along the row into a
+/// ring of the last 11, and each output row filtered down the ring and summed as it is made —
+/// memory of 11 rows, not of ten whole planes (an 8192² comparison had needed 8 GB). The
+/// arithmetic is [`gaussian_11_valid`]'s, term for term and in its order, and the windows are
+/// summed in the same row-major order: the same bits as filtering whole planes (tested).
 fn ssim_over(a: &[u8], b: &[u8], w: usize, h: usize, mask: Option<&[bool]>) -> f64 {
     let k = gaussian_11();
     let (c1, c2) = ((0.01f64).powi(2), (0.03f64).powi(2));
     let (vw, vh) = (w - 10, h - 10);
     let mut total = 0.0;
     for c in 0..3 {
-        let plane = |img: &[u8]| -> Vec<f64> {
-            (0..w * h).map(|i| img[3 * i + c] as f64 / 255.0).collect()
-        };
-        let (x, y) = (plane(a), plane(b));
-        let xx: Vec<f64> = x.iter().map(|v| v * v).collect();
-        let yy: Vec<f64> = y.iter().map(|v| v * v).collect();
-        let xy: Vec<f64> = x.iter().zip(&y).map(|(p, q)| p * q).collect();
-        let filter = |src: &[f64]| gaussian_11_valid(&k, src, w, h);
-        let (mx, my, mxx, myy, mxy) = (
-            filter(&x),
-            filter(&y),
-            filter(&xx),
-            filter(&yy),
-            filter(&xy),
-        );
+        // The five planes of one source row, and the ring of filtered rows: [plane][slot][col].
+        let mut line = vec![0.0f64; 5 * w];
+        let mut ring = vec![-0.0f64; 5 * 11 * vw];
+        let mut out = vec![-0.0f64; 5 * vw];
         let (mut sum, mut windows) = (0.0, 0usize);
-        for i in 0..vw * vh {
-            // The window's centre pixel.
-            let centre = (i / vw + 5) * w + i % vw + 5;
-            if mask.is_some_and(|m| !m[centre]) {
+        for r in 0..h {
+            for i in 0..w {
+                let x = a[3 * (r * w + i) + c] as f64 / 255.0;
+                let y = b[3 * (r * w + i) + c] as f64 / 255.0;
+                for (q, v) in [x, y, x * x, y * y, x * y].into_iter().enumerate() {
+                    line[q * w + i] = v;
+                }
+            }
+            let slot = r % 11;
+            for q in 0..5 {
+                let src = &line[q * w..(q + 1) * w];
+                let row = &mut ring[(q * 11 + slot) * vw..(q * 11 + slot + 1) * vw];
+                row.fill(-0.0);
+                for (t, &kt) in k.iter().enumerate() {
+                    for (acc, &v) in row.iter_mut().zip(&src[t..t + vw]) {
+                        *acc += kt * v;
+                    }
+                }
+            }
+            if r < 10 || vw == 0 {
                 continue;
             }
-            let (ux, uy) = (mx[i], my[i]);
-            let (vx, vy, cxy) = (mxx[i] - ux * ux, myy[i] - uy * uy, mxy[i] - ux * uy);
-            sum += ((2.0 * ux * uy + c1) * (2.0 * cxy + c2))
-                / ((ux * ux + uy * uy + c1) * (vx + vy + c2));
-            windows += 1;
+            let j = r - 10;
+            for q in 0..5 {
+                let o = &mut out[q * vw..(q + 1) * vw];
+                o.fill(-0.0);
+                for (t, &kt) in k.iter().enumerate() {
+                    let s = (q * 11 + (j + t) % 11) * vw;
+                    for (acc, &v) in o.iter_mut().zip(&ring[s..s + vw]) {
+                        *acc += kt * v;
+                    }
+                }
+            }
+            for col in 0..vw {
+                // The window's centre pixel.
+                let centre = (j + 5) * w + col + 5;
+                if mask.is_some_and(|m| !m[centre]) {
+                    continue;
+                }
+                let [ux, uy, mxx, myy, mxy] = [0, 1, 2, 3, 4].map(|q| out[q * vw + col]);
+                let (vx, vy, cxy) = (mxx - ux * ux, myy - uy * uy, mxy - ux * uy);
+                sum += ((2.0 * ux * uy + c1) * (2.0 * cxy + c2))
+                    / ((ux * ux + uy * uy + c1) * (vx + vy + c2));
+                windows += 1;
+            }
         }
+        debug_assert!(vh == 0 || windows <= vw * vh);
         total += sum / windows as f64;
     }
     total / 3.0
@@ -306,6 +338,12 @@ fn flip_stats(map: &[f32]) -> (f64, f64, f64) {
 }
 
 /// FLIP's per-pixel error map (row-major, values in [0, 1]).
+/// Host memory a comparison of two images needs per pixel, bytes: FLIP's filtered colour
+/// images (nv_flip's C++, ~76 bytes a pixel) and our linear and sRGB copies of both images
+/// with the FLIP map (~30); measured with heaptrack at 1024² (106 bytes a pixel at the peak)
+/// and by peak RSS at 4096² (1.75 GB, 104), with a margin. SSIM streams its planes.
+pub const COMPARE_BYTES_PER_PIXEL: u64 = 112;
+
 pub fn flip_map(reference: &[u8], test: &[u8], w: u32, h: u32) -> Vec<f32> {
     let r = nv_flip::FlipImageRgb8::with_data(w, h, reference);
     let t = nv_flip::FlipImageRgb8::with_data(w, h, test);
@@ -353,6 +391,78 @@ mod tests {
             assert_eq!(filtered.len(), direct.len());
             for (o, (a, b)) in filtered.iter().zip(&direct).enumerate() {
                 assert_eq!(a.to_bits(), b.to_bits(), "{w}×{h}, output {o}: {a} vs {b}");
+            }
+        }
+    }
+
+    /// The whole-plane SSIM that [`ssim_over`] streams (the reference for its bits).
+    fn ssim_over_planes(a: &[u8], b: &[u8], w: usize, h: usize, mask: Option<&[bool]>) -> f64 {
+        let k = gaussian_11();
+        let (c1, c2) = ((0.01f64).powi(2), (0.03f64).powi(2));
+        let (vw, vh) = (w - 10, h - 10);
+        let mut total = 0.0;
+        for c in 0..3 {
+            let plane = |img: &[u8]| -> Vec<f64> {
+                (0..w * h).map(|i| img[3 * i + c] as f64 / 255.0).collect()
+            };
+            let (x, y) = (plane(a), plane(b));
+            let xx: Vec<f64> = x.iter().map(|v| v * v).collect();
+            let yy: Vec<f64> = y.iter().map(|v| v * v).collect();
+            let xy: Vec<f64> = x.iter().zip(&y).map(|(p, q)| p * q).collect();
+            let filter = |src: &[f64]| gaussian_11_valid(&k, src, w, h);
+            let (mx, my, mxx, myy, mxy) = (
+                filter(&x),
+                filter(&y),
+                filter(&xx),
+                filter(&yy),
+                filter(&xy),
+            );
+            let (mut sum, mut windows) = (0.0, 0usize);
+            for i in 0..vw * vh {
+                // The window's centre pixel.
+                let centre = (i / vw + 5) * w + i % vw + 5;
+                if mask.is_some_and(|m| !m[centre]) {
+                    continue;
+                }
+                let (ux, uy) = (mx[i], my[i]);
+                let (vx, vy, cxy) = (mxx[i] - ux * ux, myy[i] - uy * uy, mxy[i] - ux * uy);
+                sum += ((2.0 * ux * uy + c1) * (2.0 * cxy + c2))
+                    / ((ux * ux + uy * uy + c1) * (vx + vy + c2));
+                windows += 1;
+            }
+            total += sum / windows as f64;
+        }
+        total / 3.0
+    }
+    /// Streamed row by row, SSIM is the whole planes' to the bit, with and without a mask,
+    /// at sizes down to the one window.
+    #[test]
+    fn ssim_by_rows_is_ssim_by_planes_to_the_bit() {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut byte = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 24) as u8
+        };
+        for (w, h) in [(11, 11), (12, 30), (37, 23), (64, 36)] {
+            let a: Vec<u8> = (0..3 * w * h).map(|_| byte()).collect();
+            // b: a, partly disturbed (so the structure term is not 1 everywhere).
+            let b: Vec<u8> = a
+                .iter()
+                .map(|&v| if byte() % 3 == 0 { byte() } else { v })
+                .collect();
+            let mask: Vec<bool> = (0..w * h).map(|_| byte() % 2 == 0).collect();
+            for m in [None, Some(mask.as_slice())] {
+                let (rows, planes) = (
+                    ssim_over(&a, &b, w, h, m),
+                    ssim_over_planes(&a, &b, w, h, m),
+                );
+                assert_eq!(
+                    rows.to_bits(),
+                    planes.to_bits(),
+                    "{w}×{h}: {rows} vs {planes}"
+                );
             }
         }
     }

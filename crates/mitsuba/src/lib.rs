@@ -116,7 +116,8 @@ pub fn export(
     std::fs::create_dir_all(&mesh_dir).map_err(|e| FileError {
         path: mesh_dir.clone(),
         message: format!("cannot create the folder: {e}"),
-        refused: false,
+        // A file of its name is the user's to move (exit 2), not a failure.
+        refused: mesh_dir.exists(),
     })?;
     let mut staged = StagedFiles::new();
     let result = match export_staged(scene, xml_path, &mesh_dir, settings, &mut staged) {
@@ -368,9 +369,12 @@ fn xml_name(xml_path: &Path) -> String {
 /// rendered the second's scene, unsaid). Replacing the same XML is allowed.
 fn refuse_another_export(dir: &Path, xml_path: &Path) -> Result<(), FileError> {
     let sidecar = dir.join("mirrorbox.json");
-    let Ok(text) = std::fs::read_to_string(&sidecar) else {
+    if !sidecar.exists() {
         return Ok(());
-    };
+    }
+    // Bounded (a sidecar is a few hundred bytes), and a folder or FIFO of its name refused
+    // here, before any mesh is written.
+    let text = mirrorbox_files::read_bounded_text(&sidecar, 1 << 20, "an export's mirrorbox.json")?;
     let other = serde_json::from_str::<serde_json::Value>(&text)
         .ok()
         .and_then(|v| v.get("xml").and_then(|x| x.as_str()).map(String::from));
@@ -637,6 +641,18 @@ mod tests {
             assert!(normalmaps > 0, "{file}");
             assert_eq!(text.matches(&wraps).count(), normalmaps, "{file}: {text}");
         }
+    }
+
+    /// A folder where the export writes its sidecar is refused (exit 2) before any mesh is
+    /// written: the meshes had been left without their XML.
+    #[test]
+    fn a_folder_in_the_sidecars_place_is_refused_leaving_nothing() {
+        let scene = mirrorbox_scene::load::bundled_scene("single_mirror.json");
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::create_dir(dir.path().join("mirrorbox.json")).unwrap();
+        let e = export(&scene, &dir.path().join("x.xml"), ExportSettings { spp: 4 }).unwrap_err();
+        assert!(e.refused, "{e}");
+        assert!(!dir.path().join("meshes").exists() && !dir.path().join("x.xml").exists());
     }
 
     /// Two sensors of one camera: the first samples our grid unjittered (`whitted`), the

@@ -348,8 +348,74 @@ pub fn read_motion(dir: &Path) -> Result<(MotionInfo, Vec<FrameRecord>), String>
             serde_json::from_str(l)
                 .map_err(|e| format!("{}:{}: {e}", dir.join("frames.jsonl").display(), i + 1))
         })
-        .collect::<Result<_, _>>()?;
+        .collect::<Result<Vec<FrameRecord>, _>>()?;
+    check_motion(dir, &info, &records)?;
     Ok((info, records))
+}
+
+/// Most frames of one scenario a motion report holds (`sweep --path` renders at most 3600).
+const MAX_SEQUENCE_FRAMES: u32 = 1 << 16;
+
+/// Refuses a motion report whose records cannot be of a sweep: a scenario name that is not a
+/// file name's part (it names `plot_<scenario>.svg`: `/../../x` had written outside the
+/// folder), a frame of no scenario or twice, a metric or time that is no measurement, or no
+/// frame at all. The error names the file and the record.
+fn check_motion(dir: &Path, info: &MotionInfo, records: &[FrameRecord]) -> Result<(), String> {
+    let info_file = dir.join("motion.json");
+    let frames_file = dir.join("frames.jsonl");
+    for (i, s) in info.scenarios.iter().enumerate() {
+        let ok = (1..=64).contains(&s.name.len())
+            && s.name
+                .bytes()
+                .all(|b| b.is_ascii_alphanumeric() || b == b'-' || b == b'_');
+        if !ok {
+            return Err(format!(
+                "{}: scenarios[{i}].name {:?}: 1 to 64 letters, digits, '-' or '_'",
+                info_file.display(),
+                s.name
+            ));
+        }
+    }
+    if records.is_empty() {
+        return Err(format!("{}: no frame records", frames_file.display()));
+    }
+    let mut seen = std::collections::BTreeSet::new();
+    for (i, r) in records.iter().enumerate() {
+        let at = |what: String| format!("{}: record {}: {what}", frames_file.display(), i + 1);
+        if !info.scenarios.iter().any(|s| s.name == r.scenario) {
+            return Err(at(format!(
+                "scenario {:?} is none of motion.json's",
+                r.scenario
+            )));
+        }
+        if r.frame >= MAX_SEQUENCE_FRAMES {
+            return Err(at(format!(
+                "frame {} (frames 0..{MAX_SEQUENCE_FRAMES} are read)",
+                r.frame
+            )));
+        }
+        if !seen.insert((r.scenario.as_str(), r.method.as_str(), r.frame)) {
+            return Err(at(format!(
+                "frame {} of {:?} in {:?} a second time",
+                r.frame, r.method, r.scenario
+            )));
+        }
+        let measures = [
+            ("flip_mean", r.flip_mean),
+            ("flip_p95", r.flip_p95),
+            ("relmse", r.relmse),
+        ];
+        if let Some((name, v)) = measures.iter().find(|(_, v)| !(v.is_finite() && *v >= 0.0)) {
+            return Err(at(format!("{name} {v} (finite and ≥ 0)")));
+        }
+        if !(r.ms.is_finite() && r.ms > 0.0 && r.time.is_finite()) {
+            return Err(at(format!(
+                "ms {} and time {} (ms finite and > 0, time finite)",
+                r.ms, r.time
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// A README's summary of a sequence sweep measured by `command`, its report at `report`:
@@ -453,6 +519,95 @@ mod tests {
             ms: 1.0,
             passes: 3,
             reflections: frame as usize + 1,
+        }
+    }
+
+    fn info(name: &str) -> MotionInfo {
+        MotionInfo {
+            commit: String::new(),
+            records_commit: String::new(),
+            draws: None,
+            command: "mirrorbox sweep --path".into(),
+            date: "today".into(),
+            device: "test".into(),
+            cpu: "test".into(),
+            width: 8,
+            height: 8,
+            truth: "whitted".into(),
+            scenarios: vec![ScenarioInfo {
+                name: name.into(),
+                description: "A still camera:".into(),
+                scene: "scenes/mirror_box.json".into(),
+                frames: 2,
+                fps: 30.0,
+                step: 0.0,
+                filmstrips: Vec::new(),
+            }],
+        }
+    }
+
+    /// A motion report is read back only if its records can be a sweep's: a scenario name
+    /// that would put its figure outside the folder, and records that are no measurement,
+    /// are refused naming the file and record.
+    #[test]
+    fn a_motion_report_that_no_sweep_wrote_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let good = vec![
+            record("still", "naive", 0, 0.1),
+            record("still", "naive", 1, 0.1),
+        ];
+        write_motion_report(dir.path(), &info("still"), &good).unwrap();
+        assert!(read_motion(dir.path()).is_ok());
+        let cases: Vec<(MotionInfo, Vec<FrameRecord>, &str)> = vec![
+            (
+                info("/../../x"),
+                good.clone(),
+                "scenarios[0].name \"/../../x\"",
+            ),
+            (info("still"), Vec::new(), "no frame records"),
+            (
+                info("still"),
+                vec![record("walk", "naive", 0, 0.1)],
+                "scenario \"walk\" is none of motion.json's",
+            ),
+            (
+                info("still"),
+                vec![good[0].clone(), good[0].clone()],
+                "record 2: frame 0 of \"naive\" in \"still\" a second time",
+            ),
+            (
+                info("still"),
+                vec![record("still", "naive", 0, -1.0)],
+                "record 1: flip_mean -1",
+            ),
+            (
+                info("still"),
+                vec![FrameRecord {
+                    ms: -3.0,
+                    ..good[0].clone()
+                }],
+                "ms -3",
+            ),
+            (
+                info("still"),
+                vec![record("still", "naive", 4_000_000_000, 0.1)],
+                "frame 4000000000",
+            ),
+        ];
+        for (info, records, says) in cases {
+            // Written as a hand would edit them (the writer itself writes no such report).
+            std::fs::write(
+                dir.path().join("motion.json"),
+                serde_json::to_string(&info).unwrap(),
+            )
+            .unwrap();
+            let lines: Vec<String> = records
+                .iter()
+                .map(|r| serde_json::to_string(r).unwrap())
+                .collect();
+            std::fs::write(dir.path().join("frames.jsonl"), lines.join("\n")).unwrap();
+            let e = read_motion(dir.path()).unwrap_err();
+            assert!(e.contains(says), "{says}: {e}");
         }
     }
 

@@ -22,6 +22,35 @@ pub struct Args {
     /// Write the FLIP error map as a heat-map PNG.
     #[arg(long, value_name = "OUT.png")]
     heatmap: Option<PathBuf>,
+    /// Refuse images whose comparison would need more host memory than SIZE (about 112 bytes
+    /// a pixel: 1.9 GB at 4096²), before reading them: 2G, 512M, 1.5GB or plain bytes (K, M,
+    /// G, T are powers of 1024), 1M..1T.
+    #[arg(
+        long = "memory-budget",
+        value_name = "SIZE",
+        default_value = "2G",
+        value_parser = super::parse_memory_budget
+    )]
+    memory_budget: u64,
+}
+
+/// Refuses a comparison of images of `(width, height)` above `budget` bytes, naming what it
+/// would need: an 8192² pair had needed 7 GB, and been killed.
+fn check_compare_memory((width, height): (u32, u32), budget: u64) -> Result<(), Failure> {
+    let need =
+        u64::from(width) * u64::from(height) * mirrorbox_image::metrics::COMPARE_BYTES_PER_PIXEL;
+    if need > budget {
+        let gb = |b: u64| b as f64 / 1e9;
+        return Err(Failure::BadInput(format!(
+            "comparing {width}×{height} images needs about {:.1} GB of memory ({} bytes a \
+             pixel, FLIP's filters most of it), above --memory-budget ({:.1} GB): raise it or \
+             compare crops",
+            gb(need),
+            mirrorbox_image::metrics::COMPARE_BYTES_PER_PIXEL,
+            gb(budget)
+        )));
+    }
+    Ok(())
 }
 
 /// Metrics as JSON (an infinite PSNR, for identical images, is `null`).
@@ -170,6 +199,11 @@ pub fn run(args: &Args) -> Result<(), Failure> {
                 )));
             }
         }
+    }
+    // The sizes first (headers only): their memory is checked before a pixel is read.
+    for p in [&args.reference, &args.test] {
+        let size = mirrorbox_image::image_size(p).map_err(|e| Failure::BadInput(e.to_string()))?;
+        check_compare_memory(size, args.memory_budget)?;
     }
     // A NaN, infinite or negative pixel makes the metrics NaN (and hides in `max |d|`).
     let read = |p: &PathBuf| {
