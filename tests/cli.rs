@@ -2480,9 +2480,17 @@ fn shards_merge_into_the_unsharded_sweep() {
         ),
         (s0.clone(), "a folder apart from the shards"),
         (p("full"), "an earlier merge of these shards"),
+        // A file in OUT's place: it had been taken for a folder to make, and the finished
+        // merge left beside it as `.partial`.
+        (p("a_file"), "a folder; this is a file"),
     ] {
+        if out.ends_with("a_file") {
+            std::fs::write(&out, "mine").unwrap();
+        }
         assert_refused(&["merge", &out, &s0, &s1, &s2], message);
     }
+    assert!(!d.join("a_file.partial").exists());
+    assert_eq!(std::fs::read_to_string(d.join("a_file")).unwrap(), "mine");
     assert_eq!(
         std::fs::read(d.join("full/results.jsonl")).unwrap(),
         full_records

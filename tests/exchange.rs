@@ -274,8 +274,15 @@ fn a_bad_run_is_refused_naming_the_file_and_nothing_is_written() {
     mirrorbox_image::write_png(&png_bytes, &small, 1.0).unwrap();
     std::fs::copy(&png_bytes, &exr).unwrap();
     refused("png as exr", "is a PNG file by its first bytes");
-    // A picture without an extension, and one misnamed alone: each named in the refusal.
+    // A folder in the picture's place: said so.
     std::fs::remove_file(&exr).unwrap();
+    std::fs::create_dir(&exr).unwrap();
+    refused(
+        "a folder",
+        "view \"camera\"'s picture is not a regular file",
+    );
+    std::fs::remove_dir(&exr).unwrap();
+    // A picture without an extension, and one misnamed alone: each named in the refusal.
     std::fs::write(variant.join("camera"), &good).unwrap();
     refused(
         "no extension",
@@ -500,6 +507,10 @@ fn a_bad_export_is_refused_naming_its_file_before_anything_is_written() {
     views["views"] = serde_json::json!([]);
     std::fs::write(&views_file, views.to_string()).unwrap();
     refused("no view", &["views.json", "views: 0 views; 1 to 64"]);
+    let mut views: Value = serde_json::from_str(&good_views).unwrap();
+    views["alpha"] = serde_json::json!(5);
+    std::fs::write(&views_file, views.to_string()).unwrap();
+    refused("alpha", &["views.json", "alpha 5: a reflectance, 0 to 1"]);
     let mut views: Value = serde_json::from_str(&good_views).unwrap();
     views["views"][0]["name"] = "../../x".into();
     std::fs::write(&views_file, views.to_string()).unwrap();

@@ -351,17 +351,23 @@ pub(crate) fn in_staged_folder<T>(
             return Err(e);
         }
     };
+    // From here a failure leaves the earlier folder as it was and removes the staged one (a
+    // complete `.partial` had been left beside an output that was a file).
+    let fail = |e: HarnessError| {
+        let _ = std::fs::remove_dir_all(&partial);
+        e
+    };
     if dir.exists() {
         if aside.exists() {
-            return Err(HarnessError::Exchange(format!(
+            return Err(fail(HarnessError::Exchange(format!(
                 "{}: could not be removed; remove it and run the command again",
                 aside.display()
-            )));
+            ))));
         }
-        std::fs::write(dir.join(EARLIER_MARK), "").map_err(io(dir))?;
+        std::fs::write(dir.join(EARLIER_MARK), "").map_err(|e| fail(io(dir)(e)))?;
         if let Err(e) = std::fs::rename(dir, &aside) {
             let _ = std::fs::remove_file(dir.join(EARLIER_MARK));
-            return Err(io(dir)(e));
+            return Err(fail(io(dir)(e)));
         }
     }
     if let Err(e) = std::fs::rename(&partial, dir) {
@@ -369,7 +375,7 @@ pub(crate) fn in_staged_folder<T>(
         if std::fs::rename(&aside, dir).is_ok() {
             let _ = std::fs::remove_file(dir.join(EARLIER_MARK));
         }
-        return Err(io(dir)(e));
+        return Err(fail(io(dir)(e)));
     }
     drop(stage_lock);
     // A failure here loses nothing: the new folder is in place.

@@ -220,6 +220,9 @@ fn check_merge_out(out: &Path, shards: &[ShardFolder]) -> Result<(), HarnessErro
             s.dir.display()
         )));
     }
+    if out.exists() && !out.is_dir() {
+        return Err(refused("a folder; this is a file".into()));
+    }
     let Ok(mut entries) = std::fs::read_dir(out) else {
         return Ok(()); // made by the merge
     };

@@ -196,6 +196,12 @@ pub fn read_views(export: &Path) -> Result<ViewsFile, HarnessError> {
 /// parts of file names); sizes an image read can have; `truth` and `floor` inside the export
 /// folder (they are read from it).
 fn check_views(views: &ViewsFile) -> Result<(), String> {
+    // A reflectance (the records carry it as the points' α).
+    if let Some(a) = views.alpha
+        && !(0.0..=1.0).contains(&a)
+    {
+        return Err(format!("alpha {a}: a reflectance, 0 to 1, or null"));
+    }
     if views.views.is_empty() || views.views.len() > MAX_VIEWS {
         return Err(format!(
             "views: {} views; 1 to {MAX_VIEWS} are read",
@@ -547,6 +553,20 @@ fn view_image(dir: &Path, view: &crate::exchange::ExportedView) -> Result<PathBu
             dir,
             format!(
                 "two images of view {:?} ({0}.exr and {0}.png): keep the one to score",
+                view.name
+            ),
+        ));
+    }
+    // A folder, device or FIFO of a picture's name is named as such (a folder `camera.exr`
+    // had been said to differ only in case).
+    if let Some(odd) = [&exr, &png]
+        .into_iter()
+        .find(|p| p.exists() && !p.is_file())
+    {
+        return Err(refused(
+            odd,
+            format!(
+                "view {:?}'s picture is not a regular file (a folder, a device or a FIFO)",
                 view.name
             ),
         ));

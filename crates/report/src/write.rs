@@ -182,6 +182,11 @@ pub fn write_report(
     records: &[Record],
     sections: &[Section],
 ) -> Result<(), FileError> {
+    // A folder in a report file's place is refused before any file is written (results.csv
+    // and report.md had been rewritten before report.html failed).
+    mirrorbox_files::check_outputs(
+        &["results.csv", "report.md", "report.html"].map(|f| ("report", dir.join(f))),
+    )?;
     write_csv(&dir.join("results.csv"), records)?;
     let blocks = without_empty_chart_sections(document(info, records, sections));
     // Each truth | raster | FLIP row is followed by its 4× inset where its images are there.
@@ -1471,6 +1476,10 @@ pub(crate) mod tests {
             .filter(|n| n.ends_with(".tmp"))
             .collect();
         assert!(leftovers.is_empty(), "{leftovers:?}");
+        // Refused before any file is written: no results.csv beside it (one had been
+        // rewritten before the failure).
+        assert!(e.refused, "{e}");
+        assert!(!dir.path().join("results.csv").exists());
     }
 
     #[test]
