@@ -164,8 +164,15 @@ fn refused(path: &Path, message: impl std::fmt::Display) -> HarnessError {
 /// Reads `EXPORT/views.json`.
 pub fn read_views(export: &Path) -> Result<ViewsFile, HarnessError> {
     let path = export.join("views.json");
+    if !path.exists() {
+        return Err(refused(
+            export,
+            "holds no views.json: not an export (`mirrorbox export-views` writes one)",
+        ));
+    }
+    // The file's own error names it.
     let text = mirrorbox_files::read_bounded_text(&path, 16 << 20, "views.json")
-        .map_err(|e| refused(&path, e))?;
+        .map_err(|e| HarnessError::Exchange(e.to_string()))?;
     let mut views: ViewsFile = serde_json::from_str(&text).map_err(|e| refused(&path, e))?;
     if views.format != "mirrorbox-views" || views.version != FORMAT_VERSION {
         return Err(refused(

@@ -74,6 +74,24 @@ pub fn parse_scene(text: &str, path: &Path) -> Result<Scene> {
         path: field.filter(|f| f != "."),
         message: finite_number_message(strip_position(&e.to_string())),
     };
+    // Two mistakes serde would say in its own terms ("expected value", "expected struct
+    // SceneFile"): a byte-order mark, and a document that is not one object.
+    let problem = if text.starts_with('\u{feff}') {
+        Some("the file starts with a UTF-8 byte-order mark: save it without one")
+    } else if !text.trim_start().starts_with('{') && !text.trim().is_empty() {
+        Some("a scene file is one JSON object, `{ \"camera\": …, \"objects\": … }`")
+    } else {
+        None
+    };
+    if let Some(message) = problem {
+        return Err(SceneError::Syntax {
+            file: path.to_path_buf(),
+            line: 1,
+            column: 1,
+            path: None,
+            message: message.into(),
+        });
+    }
     let mut de = serde_json::Deserializer::from_str(text);
     let file: SceneFile = serde_path_to_error::deserialize(&mut de).map_err(|e| {
         let field = e.path().to_string();
@@ -1323,6 +1341,33 @@ mod tests {
 
     fn scene_with(rest: &str) -> Result<Scene> {
         parse_scene(&format!("{{ {CAMERA}{rest} }}"), Path::new("s.json"))
+    }
+
+    /// A byte-order mark and a document that is not one object are said in words, not in
+    /// serde's ("expected value", "expected struct SceneFile with 9 elements").
+    #[test]
+    fn a_bom_or_a_document_that_is_not_an_object_is_said_in_words() {
+        let good = format!("{{ {CAMERA} }}");
+        for (text, says) in [
+            (
+                format!("\u{feff}{good}"),
+                "s.json:1:1: the file starts with a UTF-8 byte-order mark",
+            ),
+            (
+                "[]".to_string(),
+                "s.json:1:1: a scene file is one JSON object",
+            ),
+            (
+                "  \"camera\"".to_string(),
+                "a scene file is one JSON object",
+            ),
+        ] {
+            let e = parse_scene(&text, Path::new("s.json"))
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains(says), "{e}");
+        }
+        assert!(parse_scene(&good, Path::new("s.json")).is_ok());
     }
 
     fn refused(rest: &str) -> String {

@@ -298,8 +298,13 @@ pub fn output_path(flag: &str, path: &Path, ext: &str) -> Result<PathBuf, Failur
     }
     let parent = mirrorbox_files::folder_of(path);
     if !parent.is_dir() {
+        let what = if parent.exists() {
+            "is a file, not a folder"
+        } else {
+            "does not exist"
+        };
         return Err(Failure::BadInput(format!(
-            "{flag} {}: folder {} does not exist",
+            "{flag} {}: folder {} {what}",
             path.display(),
             parent.display()
         )));

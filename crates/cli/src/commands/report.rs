@@ -24,6 +24,12 @@ pub struct Args {
 
 pub fn run(args: &Args) -> Result<(), Failure> {
     if let Some(reports) = &args.index {
+        if !reports.is_dir() {
+            return Err(Failure::BadInput(format!(
+                "--index {}: not a folder; it takes the folder of report folders (reports/)",
+                reports.display()
+            )));
+        }
         // What was found leads the overview, each finding with its figure, its links relative
         // to `reports/` as written. The findings are the project's, computed from its
         // experiments' records, the first of them Table 1's: a folder without
@@ -79,6 +85,13 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         );
     }
     for dir in &args.dirs {
+        if !dir.is_dir() {
+            return Err(Failure::BadInput(format!(
+                "{}: not a folder; `report` takes a sweep's, score's, advice's or motion \
+                 report's folder",
+                dir.display()
+            )));
+        }
         // An advice (`mirrorbox advise`): its answer and files from its rounds' records.
         if dir.join("advice.json").is_file() {
             let advice = mirrorbox_harness::advise::rewrite(dir).map_err(Failure::from)?;
