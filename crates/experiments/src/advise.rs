@@ -190,9 +190,13 @@ fn advise_region_of(reports: &Path, folder: &str) -> Result<String, ReadmeError>
         let (pick_text, pick_ms, pick_error) = if pick.is_null() {
             (
                 format!("none fits; cheapest {}", method(&v["closest"])),
-                v["closest"]["ms_median"]
-                    .as_f64()
-                    .map_or("–".into(), |m| ms(m, 3)),
+                match timing(&v["closest"]) {
+                    (median, _) if median.is_nan() => "–".into(),
+                    (median, Some((lo, hi))) => {
+                        format!("{} [{}–{}]", ms(median, 3), ms(lo, 3), ms(hi, 3))
+                    }
+                    (median, None) => ms(median, 3),
+                },
                 v["closest"]["error"].as_f64().map_or("–".into(), sci),
             )
         } else {
@@ -212,7 +216,8 @@ fn advise_region_of(reports: &Path, folder: &str) -> Result<String, ReadmeError>
                 error(pick).map_or("–".into(), sci),
             )
         };
-        // Against the exhaustive run of the same scene, size and α.
+        // Against the exhaustive run of the same scene (the folder's advices share one size
+        // and α: the paragraph above says which, or that they differ).
         let exhaustive = all.iter().find(|(_, x)| {
             x["exhaustive"].as_bool() == Some(true) && x["scene"].as_str() == Some(scene)
         });
@@ -228,14 +233,39 @@ fn advise_region_of(reports: &Path, folder: &str) -> Result<String, ReadmeError>
                         let e = |p: &&Value| p["error"].as_f64().unwrap_or(f64::INFINITY);
                         e(a).total_cmp(&e(b))
                     });
+                // The exhaustive run's own timing of the pick: a pick better than its best
+                // within budget was, in that run, over the budget.
+                let pick_there = x["measured"]
+                    .as_array()
+                    .into_iter()
+                    .flatten()
+                    .find(|m| m["method"] == pick["method"]);
                 let verdict = match (error(pick), best) {
                     (_, None) => "the exhaustive run has nothing within budget".into(),
                     (Some(e), Some(b)) if e <= error(b).unwrap_or(0.0) * (1.0 + TIE) => {
+                        let over_there = pick_there.filter(|m| !fits(m, budget)).map(|m| {
+                            let (median, interval) = timing(m);
+                            let (lo, hi) = interval.unwrap_or((median, median));
+                            format!(
+                                "; but the exhaustive run timed {} over the budget, {} [{}–{}] \
+                                 ms: the two runs differ at the budget",
+                                method(pick),
+                                ms(median, 3),
+                                ms(lo, 3),
+                                ms(hi, 3)
+                            )
+                        });
                         format!(
-                            "yes: {} against the exhaustive best within budget {} ({})",
+                            "{}: {} against the exhaustive best within budget {} ({}){}",
+                            if over_there.is_some() {
+                                "at the budget"
+                            } else {
+                                "yes"
+                            },
                             sci(e),
                             error(b).map_or("–".into(), sci),
-                            method(b)
+                            method(b),
+                            over_there.unwrap_or_default()
                         )
                     }
                     (_, Some(b)) => timing_verdict(v, b, budget),
@@ -302,9 +332,13 @@ fn advise_region_of(reports: &Path, folder: &str) -> Result<String, ReadmeError>
                     100.0 * TIE
                 )
             } else if at_budget(v, &p1) || at_budget(a, &p2) {
+                let e = |run: &Value| run["pick"]["error"].as_f64().map_or("–".into(), sci);
                 format!(
-                    "`{folder}` picks `{p2}` where `{first}` picked `{p1}`: a tie at the budget \
-                     (one run's 95 % interval for the other's pick holds the budget)."
+                    "`{folder}` picks `{p2}` (error {}) where `{first}` picked `{p1}` ({}): the \
+                     runs differ at the budget (one run's 95 % interval for the other's pick \
+                     holds it), so which of the two fits is the machine's spread to decide.",
+                    e(v),
+                    e(a)
                 )
             } else {
                 format!("`{folder}` picks `{p2}` where `{first}` picked `{p1}`: they DIFFER.")
@@ -345,7 +379,8 @@ fn advise_region_of(reports: &Path, folder: &str) -> Result<String, ReadmeError>
         "Measured on {device}, {size}, α = {alpha}, error = FLIP mean over the mirror \
              pixels; a pick fits only if its ms/frame interval's upper end is within the \
              budget. The registry's rows offer {} coarse candidates per scene (before \
-             bisection; fewer where the adapter lacks a method's feature). {exhaustive}",
+             bisection; fewer are measured where a plan's limits — passes, paths, triangles — \
+             or the adapter refuse some). {exhaustive}",
         coarse_space(),
     ))];
     let mut header = [

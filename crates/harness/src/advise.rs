@@ -15,10 +15,14 @@
 //! sweep per view, `round-K/<view>`, one cached truth per view), and a candidate's time and
 //! error are its worst view's, or the views' means ([`OverViews`], [`over_views`]).
 //!
+//! A knob's bisection stops early where no value left in its bracket could beat the pick
+//! so far or tie it for less ([`worth_bisecting`]: a knob's error falls as it rises).
+//!
 //! A candidate is **within budget** only if the upper end of its ms/frame 95 % interval is.
 //! A candidate its method refuses to render (a limit of its plan) is left out, said.
 //! Of the candidates within budget, those within 2 % of the lowest error are **tied**; the
-//! cheapest of them is the pick, the others are named beside it. Before a round renders, the
+//! cheapest of them is the pick, or the lowest setting of its knob whose cost the
+//! measurement cannot tell from it ([`pick_of`]); the others are named beside it. Before a round renders, the
 //! plan's limits and memory estimate refuse what would not fit (said, never rendered).
 
 use crate::exchange::ViewSpec;
@@ -174,6 +178,10 @@ pub struct Advice {
     pub over_views: Option<OverViews>,
     /// Every coarse candidate timed in one round ([`AdviseConfig::exhaustive`]).
     pub exhaustive: bool,
+    /// Knobs whose bisection stopped because no value left in its bracket could beat the
+    /// pick or tie it more cheaply: the knob's candidate at the bracket's low end, and the
+    /// bracket (the last value within budget, the first over it).
+    pub unbisected: Vec<(String, u32, u32)>,
 }
 
 /// Whether `r` is within `budget` ms: the upper end of its 95 % interval (its median where
@@ -500,6 +508,14 @@ pub fn search(
                 }
                 k.ascending = false;
             }
+            if let (Some(lo), Some(hi)) = (k.last_within, k.first_over)
+                && hi > lo + 1
+                && !worth_bisecting(&advice.measured, k, (lo, hi), budget, config.metric)
+            {
+                advice.unbisected.retain(|(key, ..)| *key != k.at(lo).key());
+                advice.unbisected.push((k.at(lo).key(), lo, hi));
+                continue;
+            }
             while let (Some(lo), Some(hi)) = (k.last_within, k.first_over)
                 && hi > lo + 1
             {
@@ -527,28 +543,92 @@ fn renders(sweep: &SweepConfig, summary: &Summary) -> u64 {
         * u64::from(sweep.warmup + 1)
 }
 
-/// The pick, its ties, the next better choice, or the closest when nothing fits.
-pub fn choose(advice: &mut Advice, metric: Metric) {
-    let budget = advice.budget_ms;
-    let fits: Vec<&Record> = advice
-        .measured
+/// The measured record of knob `k` at value `v`, if one was measured.
+fn record_at<'a>(measured: &'a [Record], k: &Knob, v: u32) -> Option<&'a Record> {
+    measured
         .iter()
-        .filter(|r| within(r, budget))
-        .collect();
+        .find(|r| Method::parse(r.method_key()).is_ok_and(|m| k.owns(&m) && k.value(&m) == Some(v)))
+}
+
+/// Whether bisecting knob `k` between `lo` (within budget) and `hi` (over it) could change
+/// the answer. A knob's coarse values ascend in cost for less error, so a value between the
+/// two has an error no lower than `hi`'s and a cost no lower than `lo`'s: it can become the
+/// pick only if `hi`'s error beats the pick's so far (beyond a tie), or ties it while `lo`
+/// costs less than the pick (the cheapest of the tied is the pick). Without either, the
+/// bracket is left untimed: a review found a search timing `cubemap` sizes whose error did
+/// not move, after the pick had fitted with a fifth of it (135 % of the exhaustive run's
+/// frames). Where `hi` was refused (no record), nothing is known: bisected.
+fn worth_bisecting(
+    measured: &[Record],
+    k: &Knob,
+    (lo, hi): (u32, u32),
+    budget: f64,
+    metric: Metric,
+) -> bool {
+    let Some(over) = record_at(measured, k, hi) else {
+        return true;
+    };
+    let Some(pick) = pick_of(&tied_for_lowest(measured, budget, metric)) else {
+        return true;
+    };
+    let (e_over, e_pick) = (metric.of(over), metric.of(pick));
+    let lo_ms = record_at(measured, k, lo).map_or(f64::INFINITY, |r| r.ms_median);
+    e_over < e_pick / (1.0 + TIE) || (e_over <= e_pick * (1.0 + TIE) && lo_ms < pick.ms_median)
+}
+
+/// The candidates within `budget` whose error is within [`TIE`] of the lowest among them.
+fn tied_for_lowest(measured: &[Record], budget: f64, metric: Metric) -> Vec<&Record> {
+    let fits: Vec<&Record> = measured.iter().filter(|r| within(r, budget)).collect();
     let lowest = fits
         .iter()
         .map(|r| metric.of(r))
         .fold(f64::INFINITY, f64::min);
-    // Within TIE of the lowest error: a tie, and the cheapest of the tied is the pick.
-    let tied: Vec<&Record> = fits
-        .iter()
-        .copied()
+    fits.into_iter()
         .filter(|r| metric.of(r) <= lowest * (1.0 + TIE))
-        .collect();
-    let best = tied
+        .collect()
+}
+
+/// The knob a record's method is searched by and its value there: the method, its variant
+/// and the knob's value (`("ray-query", "", 256)`), or `None` for a fixed candidate.
+fn knob_setting(r: &Record) -> Option<(&'static str, String, u32)> {
+    let m = Method::parse(r.method_key()).ok()?;
+    let Advise::Knob { option, .. } = m.entry().advise else {
+        return None;
+    };
+    Some((m.name(), m.variant_options(), m.count_of(option.name)?))
+}
+
+/// The pick of the tied: the cheapest by median; and then, of the tied settings of that
+/// knob whose ms intervals overlap its own (costs the measurement cannot tell apart), the
+/// lowest value. Medians from different rounds had decided among them by drift: `ray-query`
+/// depth 1024 shipped over 256 at the same error, 7.371 ms [7.259–7.426] against 7.375
+/// [7.216–7.690].
+fn pick_of<'a>(tied: &[&'a Record]) -> Option<&'a Record> {
+    let cheapest = tied
         .iter()
         .copied()
-        .min_by(|a, b| a.ms_median.total_cmp(&b.ms_median));
+        .min_by(|a, b| a.ms_median.total_cmp(&b.ms_median))?;
+    let Some((name, variant, _)) = knob_setting(cheapest) else {
+        return Some(cheapest);
+    };
+    let ends = |r: &Record| r.ms_interval.unwrap_or([r.ms_median, r.ms_median]);
+    let [lo, hi] = ends(cheapest);
+    tied.iter()
+        .copied()
+        .filter_map(|r| {
+            let (n, v, value) = knob_setting(r)?;
+            let [a, b] = ends(r);
+            (n == name && v == variant && a <= hi && lo <= b).then_some((value, r))
+        })
+        .min_by_key(|(value, _)| *value)
+        .map(|(_, r)| r)
+}
+
+/// The pick, its ties, the next better choice, or the closest when nothing fits.
+pub fn choose(advice: &mut Advice, metric: Metric) {
+    let budget = advice.budget_ms;
+    let tied = tied_for_lowest(&advice.measured, budget, metric);
+    let best = pick_of(&tied);
     advice.pick = best.cloned();
     advice.ties = match best {
         Some(p) => tied
@@ -626,11 +706,24 @@ pub fn sentences(advice: &Advice, metric: Metric, scene: &Path) -> Vec<String> {
     match (&advice.pick, &advice.closest) {
         (Some(p), _) => {
             out.push(format!(
-                "Ship {}: the lowest error of the {} candidates measured whose 95 % interval \
-                 of ms/frame lies within {budget} ms.",
+                "Ship {}: the lowest error of the {} measured whose 95 % interval of ms/frame \
+                 lies within {budget} ms.",
                 described(p, metric),
-                advice.measured.len()
+                match advice.measured.len() {
+                    1 => "1 candidate".to_string(),
+                    n => format!("{n} candidates"),
+                }
             ));
+            // A method that builds its picture over frames was scored from a still camera.
+            if let Ok(m) = Method::parse(p.method_key())
+                && let Some(k) = m.count_of("history")
+                && k > 0
+            {
+                out.push(format!(
+                    "Its error is that of a still camera after {k} frames of history: a moving \
+                     camera sees more (reports/motion).",
+                ));
+            }
             if !advice.ties.is_empty() {
                 let ties: Vec<String> = advice.ties.iter().map(|t| described(t, metric)).collect();
                 out.push(format!(
@@ -704,13 +797,40 @@ pub fn sentences(advice: &Advice, metric: Metric, scene: &Path) -> Vec<String> {
                 .into(),
         );
     }
+    if !advice.unbisected.is_empty() {
+        let left: Vec<String> = advice
+            .unbisected
+            .iter()
+            .map(|(k, lo, hi)| format!("`{k}` (between {lo} and {hi})"))
+            .collect();
+        out.push(format!(
+            "Not bisected further, since no setting left between could beat the pick or tie \
+             it for less (a knob's error falls as it rises): {}.",
+            left.join(", ")
+        ));
+    }
+    let plural =
+        |n: usize, one: &str, many: &str| format!("{n} {}", if n == 1 { one } else { many });
     out.push(format!(
-        "Search cost: {} candidates in {} timing rounds, {} frames rendered, {:.0} s.",
-        advice.measured.len(),
-        advice.rounds,
+        "Search cost: {} in {}, {} frames rendered, {:.0} s.",
+        plural(advice.measured.len(), "candidate", "candidates"),
+        plural(advice.rounds, "timing round", "timing rounds"),
         advice.renders,
         advice.seconds
     ));
+    if let Some(r) = advice.measured.first() {
+        out.push(format!(
+            "Measured with {1} on {0}, {2} timed frames per candidate{3}; each candidate's interval \
+             is of its own round: two runs on one machine may differ by more.",
+            r.adapter,
+            r.backend,
+            r.frames,
+            r.run
+                .as_deref()
+                .and_then(|d| d.get(..10))
+                .map_or(String::new(), |d| format!(", from {d}"))
+        ));
+    }
     out
 }
 
@@ -929,6 +1049,14 @@ pub fn rewrite(out: &Path) -> Result<Advice, HarnessError> {
             r["why"].as_str().unwrap_or_default().into(),
         ));
     }
+    for u in v["unbisected"].as_array().into_iter().flatten() {
+        let value = |f: &str| u[f].as_u64().and_then(|x| u32::try_from(x).ok());
+        if let (Some(k), Some(lo), Some(hi)) =
+            (u["candidate"].as_str(), value("within"), value("over"))
+        {
+            advice.unbisected.push((k.into(), lo, hi));
+        }
+    }
     advice.unsupported = v["unsupported"]
         .as_array()
         .into_iter()
@@ -1107,6 +1235,7 @@ pub fn to_json(advice: &Advice, metric: Metric, scene: &Path) -> serde_json::Val
         "views": advice.views,
         "over_views": advice.over_views.map(OverViews::name),
         "exhaustive": advice.exhaustive,
+        "unbisected": advice.unbisected.iter().map(|(k, lo, hi)| serde_json::json!({"candidate": k, "within": lo, "over": hi})).collect::<Vec<_>>(),
         "rounds": advice.rounds,
         "renders": advice.renders,
         "seconds": advice.seconds,
@@ -1418,6 +1547,105 @@ mod tests {
             label("portal depth=4 shadows=map shadow-map-size=256"),
             "depth=4 shadows=map shadow-map-size=256"
         );
+    }
+
+    /// Beside `portal` (as in [`search_model`]), `cubemap` at a cost that grows with its size
+    /// and an error that does not move (0.5): once its bracket (512, 1024) is found, nothing
+    /// between can beat the pick (FLIP 0.05), so it is left untimed and said; `portal` is
+    /// bisected as before.
+    #[test]
+    fn a_knob_that_cannot_change_the_answer_is_not_bisected() {
+        let config = AdviseConfig {
+            sweep: SweepConfig::new(PathBuf::new(), PathBuf::new(), Vec::new(), vec![1.0]),
+            budget_ms: 3.05,
+            metric: Metric::Flip,
+            methods: vec!["portal".into(), "cubemap".into()],
+            views: Vec::new(),
+            over_views: OverViews::Worst,
+            shadows: false,
+            exhaustive: false,
+        };
+        let mut asked = Vec::new();
+        let advice = search(&config, &mut |methods| {
+            asked.extend(methods.iter().map(Method::key));
+            let measured: Vec<Record> = methods
+                .iter()
+                .map(|m| match m.count_of("depth") {
+                    Some(d) => {
+                        let (d, ms) = (f64::from(d), 1.0 + 0.1 * f64::from(d));
+                        candidate(&m.key(), ms, ms * 1.01, 1.0 / d)
+                    }
+                    None => {
+                        let size = f64::from(m.count_of("cube-size").unwrap());
+                        let ms = 0.5 + size / 256.0;
+                        candidate(&m.key(), ms, ms * 1.01, 0.5)
+                    }
+                })
+                .collect();
+            Ok(Round {
+                folders: vec![PathBuf::new(); measured.len()],
+                measured,
+                refused: Vec::new(),
+                renders: 1,
+            })
+        })
+        .unwrap();
+        let cubes: Vec<&String> = asked.iter().filter(|k| k.starts_with("cubemap")).collect();
+        assert_eq!(cubes.len(), 6, "{cubes:?}");
+        assert!(
+            advice
+                .pick
+                .as_ref()
+                .unwrap()
+                .key
+                .starts_with("portal depth=20|")
+        );
+        assert_eq!(advice.unbisected.len(), 1, "{:?}", advice.unbisected);
+        let (key, lo, hi) = &advice.unbisected[0];
+        assert!(
+            key.starts_with("cubemap") && (*lo, *hi) == (512, 1024),
+            "{key}"
+        );
+        let text = sentences(&advice, Metric::Flip, Path::new("s.json")).join("\n");
+        assert!(text.contains("Not bisected further"), "{text}");
+    }
+
+    /// Tied settings of one knob whose costs the measurement cannot tell apart: the lowest
+    /// is shipped, not the one whose median drift made cheaper; a setting whose interval
+    /// lies apart is not.
+    #[test]
+    fn of_tied_settings_of_one_knob_at_one_cost_the_lowest_is_the_pick() {
+        let mut a = Advice {
+            budget_ms: 8.0,
+            measured: vec![
+                candidate("ray-query depth=256", 7.375, 7.690, 7.2e-5),
+                candidate("ray-query depth=1024", 7.371, 7.426, 7.2e-5),
+                candidate("ray-query depth=512", 7.40, 7.50, 7.2e-5),
+            ],
+            ..Default::default()
+        };
+        // candidate() puts an interval's low end at 0.9 × the median.
+        a.measured[1].ms_interval = Some([7.259, 7.426]);
+        a.measured[0].ms_interval = Some([7.216, 7.690]);
+        choose(&mut a, Metric::Flip);
+        assert!(
+            a.pick
+                .as_ref()
+                .unwrap()
+                .key
+                .starts_with("ray-query depth=256|")
+        );
+        assert_eq!(a.ties.len(), 2);
+        // Depth 256 measured clearly dearer: of the rest, 512's interval still overlaps the
+        // cheapest's (1024's), so 512; apart from it too, the cheapest stays the pick.
+        let pick = |a: &Advice| a.pick.as_ref().unwrap().method_key().to_string();
+        a.measured[0].ms_median = 7.9;
+        a.measured[0].ms_interval = Some([7.85, 7.95]);
+        choose(&mut a, Metric::Flip);
+        assert_eq!(pick(&a), "ray-query depth=512");
+        a.measured[2].ms_interval = Some([7.45, 7.50]);
+        choose(&mut a, Metric::Flip);
+        assert_eq!(pick(&a), "ray-query depth=1024");
     }
 
     #[test]
