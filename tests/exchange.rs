@@ -440,11 +440,6 @@ fn a_bad_run_is_refused_naming_the_file_and_nothing_is_written() {
     let _ = repo();
 }
 
-/// The export is an input too: a views.json an export could not have written (no view, a
-/// name used as a path) and a truth that is missing, of another size or not radiance are
-/// refused naming the export's file, exit 2, before anything is written. (An empty list
-/// panicked; the truths were read only while writing, failed with exit 1 naming `.partial`
-/// files, and a NaN in a truth gave `"rmse": null` records.)
 /// A folder is replaced only when it holds an earlier export: a user's own `views.json` (a
 /// `--views` list kept beside their notes) had been taken for one, and the folder replaced
 /// whole. An earlier export is replaced.
@@ -481,6 +476,11 @@ fn an_export_replaces_only_an_earlier_export() {
     export(&earlier);
 }
 
+/// The export is an input too: a views.json an export could not have written (no view, a
+/// name used as a path) and a truth that is missing, of another size or not radiance are
+/// refused naming the export's file, exit 2, before anything is written. (An empty list
+/// panicked; the truths were read only while writing, failed with exit 1 naming `.partial`
+/// files, and a NaN in a truth gave `"rmse": null` records.)
 #[test]
 fn a_bad_export_is_refused_naming_its_file_before_anything_is_written() {
     let tmp = tempfile::tempdir().unwrap();
@@ -511,6 +511,15 @@ fn a_bad_export_is_refused_naming_its_file_before_anything_is_written() {
     views["alpha"] = serde_json::json!(5);
     std::fs::write(&views_file, views.to_string()).unwrap();
     refused("alpha", &["views.json", "alpha 5: a reflectance, 0 to 1"]);
+    // Views larger than a comparison fits in the memory budget (compare's default).
+    let mut views: Value = serde_json::from_str(&good_views).unwrap();
+    views["views"][0]["width"] = 8192.into();
+    views["views"][0]["height"] = 8192.into();
+    std::fs::write(&views_file, views.to_string()).unwrap();
+    refused(
+        "huge",
+        &["views.json", "views[0]: 8192×8192 would need about 7.5 GB"],
+    );
     let mut views: Value = serde_json::from_str(&good_views).unwrap();
     views["views"][0]["name"] = "../../x".into();
     std::fs::write(&views_file, views.to_string()).unwrap();

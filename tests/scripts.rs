@@ -68,6 +68,31 @@ fn a_run_that_finishes_replaces_the_reports_whole() {
     assert!(dir.path().join("cleaned").exists(), "on_exit not run");
 }
 
+/// A run killed outright (no trap) leaves `out.previous` (the committed reports) and its half
+/// in `out`: the next run puts the committed ones back before anything else, and they are
+/// what its own failure leaves.
+#[test]
+fn a_run_after_one_killed_outright_keeps_the_committed_reports() {
+    let dir = tempfile::tempdir().unwrap();
+    committed(dir.path());
+    std::fs::rename(dir.path().join("out"), dir.path().join("out.previous")).unwrap();
+    std::fs::create_dir(dir.path().join("out")).unwrap();
+    std::fs::write(dir.path().join("out/half.txt"), "half").unwrap();
+    let (code, stderr) = run_with_library(
+        dir.path(),
+        "set_reports_aside out\necho new > out/new.txt\nfalse",
+    );
+    assert_ne!(code, 0);
+    assert!(
+        stderr.contains("its committed reports are back"),
+        "{stderr}"
+    );
+    assert!(dir.path().join("out/old.txt").exists(), "{stderr}");
+    assert!(!dir.path().join("out/half.txt").exists());
+    assert!(!dir.path().join("out/new.txt").exists());
+    assert!(!dir.path().join("out.previous").exists());
+}
+
 #[test]
 fn a_first_run_that_fails_leaves_nothing_half_made() {
     let dir = tempfile::tempdir().unwrap();

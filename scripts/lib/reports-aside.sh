@@ -12,7 +12,13 @@ reports_aside_dir=
 reports_aside_extra=
 set_reports_aside() {
   reports_aside_dir=$1
-  rm -rf "$1.previous"
+  # A DIR.previous left by a run killed outright (SIGKILL, no trap ran) holds the committed
+  # reports, and DIR that run's half: put them back first, never delete them.
+  if [ -e "$1.previous" ]; then
+    rm -rf "$1"
+    mv "$1.previous" "$1"
+    echo "$1: an earlier run was killed while measuring; its committed reports are back" >&2
+  fi
   if [ -e "$1" ]; then
     mv "$1" "$1.previous"
   fi

@@ -2,8 +2,8 @@
 //! crates (scene → renderers → images → metrics → reports) and maps failures to exit codes:
 //! 0 success, 2 bad input (unreadable or invalid scene, bad arguments), 1 anything else.
 //!
-//! One module per subcommand under `commands/`; later subcommands (`trace`, `render`,
-//! `compare`, `sweep`, `table1`, `depth-scaling`, `export-mitsuba`) slot in the same way.
+//! One module per subcommand under `commands/`; a new subcommand is one more module and one
+//! more variant of the command enum.
 
 mod commands;
 

@@ -243,29 +243,42 @@ fn advise_region_of(reports: &Path, folder: &str) -> Result<String, ReadmeError>
                 let verdict = match (error(pick), best) {
                     (_, None) => "the exhaustive run has nothing within budget".into(),
                     (Some(e), Some(b)) if e <= error(b).unwrap_or(0.0) * (1.0 + TIE) => {
+                        // Its verdict word and clause, where that run timed the pick over.
                         let over_there = pick_there.filter(|m| !fits(m, budget)).map(|m| {
                             let (median, interval) = timing(m);
                             let (lo, hi) = interval.unwrap_or((median, median));
-                            format!(
-                                "; but the exhaustive run timed {} over the budget, {} [{}–{}] \
-                                 ms: the two runs differ at the budget",
-                                method(pick),
-                                ms(median, 3),
-                                ms(lo, 3),
-                                ms(hi, 3)
+                            let at = lo <= budget;
+                            (
+                                if at {
+                                    "at the budget"
+                                } else {
+                                    "over the budget there"
+                                },
+                                format!(
+                                    "; but the exhaustive run timed {} {}, {} [{}–{}] ms: {}",
+                                    method(pick),
+                                    if at {
+                                        "with an interval holding the budget"
+                                    } else {
+                                        "wholly over the budget"
+                                    },
+                                    ms(median, 3),
+                                    ms(lo, 3),
+                                    ms(hi, 3),
+                                    if at {
+                                        "the two runs differ at the budget"
+                                    } else {
+                                        "the two runs' timings disagree"
+                                    }
+                                ),
                             )
                         });
+                        let (word, clause) = over_there.unwrap_or(("yes", String::new()));
                         format!(
-                            "{}: {} against the exhaustive best within budget {} ({}){}",
-                            if over_there.is_some() {
-                                "at the budget"
-                            } else {
-                                "yes"
-                            },
+                            "{word}: {} against the exhaustive best within budget {} ({}){clause}",
                             sci(e),
                             error(b).map_or("–".into(), sci),
                             method(b),
-                            over_there.unwrap_or_default()
                         )
                     }
                     (_, Some(b)) => timing_verdict(v, b, budget),

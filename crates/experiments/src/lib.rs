@@ -1,7 +1,7 @@
 //! The experiment registry, the twin of the raster method table: every experiment mirrorbox
 //! measures is one module here — its sweeps (or sequence, or script), its report section when
 //! it has one of its own, its book chapter — and one row of [`EXPERIMENTS`]. From the table
-//! follow the CLI (`mirrorbox experiment NAME`, and the older preset commands), the main job
+//! follow the CLI (`mirrorbox experiment NAME`, `--list`, `--main-job`), the main job
 //! (`scripts/run.sh` runs `mirrorbox experiment --main-job`), the report writer (every
 //! sweep's report is offered every experiment's section) and the book (`mirrorbox readme`
 //! fills each chapter's `experiment-NAME` region, and fails when a chapter lacks it).

@@ -15,8 +15,8 @@
 //! sweep per view, `round-K/<view>`, one cached truth per view), and a candidate's time and
 //! error are its worst view's, or the views' means ([`OverViews`], [`over_views`]).
 //!
-//! A knob's bisection stops early where no value left in its bracket could beat the pick
-//! so far or tie it for less ([`worth_bisecting`]: a knob's error falls as it rises).
+//! A knob's bisection stops early where, by the errors it measured so far, no value left in
+//! its bracket could beat the pick so far or tie it for less ([`worth_bisecting`]).
 //!
 //! A candidate is **within budget** only if the upper end of its ms/frame 95 % interval is.
 //! A candidate its method refuses to render (a limit of its plan) is left out, said.
@@ -152,7 +152,9 @@ pub struct Advice {
     pub budget_ms: f64,
     /// Every candidate measured, in the order measured.
     pub measured: Vec<Record>,
-    /// The pick: the cheapest of the candidates within budget tied for the lowest error.
+    /// The pick: of the candidates within budget tied for the lowest error, the cheapest, or
+    /// the lowest setting of its knob at a cost the measurement cannot tell apart
+    /// ([`pick_of`]).
     pub pick: Option<Record>,
     /// The other candidates within budget tied for the lowest error (within [`TIE`]).
     pub ties: Vec<Record>,
@@ -512,8 +514,6 @@ pub fn search(
                 && hi > lo + 1
                 && !worth_bisecting(&advice.measured, k, (lo, hi), budget, config.metric)
             {
-                advice.unbisected.retain(|(key, ..)| *key != k.at(lo).key());
-                advice.unbisected.push((k.at(lo).key(), lo, hi));
                 continue;
             }
             while let (Some(lo), Some(hi)) = (k.last_within, k.first_over)
@@ -528,6 +528,15 @@ pub fn search(
                 todo.push(k.at(mid));
                 break;
             }
+        }
+    }
+    // The brackets left open: knobs whose bisection stopped before its values were neighbours.
+    for k in &knobs {
+        if let (Some(lo), Some(hi)) = (k.last_within, k.first_over)
+            && hi > lo + 1
+            && !config.exhaustive
+        {
+            advice.unbisected.push((k.at(lo).key(), lo, hi));
         }
     }
     choose(&mut advice, config.metric);
@@ -551,13 +560,20 @@ fn record_at<'a>(measured: &'a [Record], k: &Knob, v: u32) -> Option<&'a Record>
 }
 
 /// Whether bisecting knob `k` between `lo` (within budget) and `hi` (over it) could change
-/// the answer. A knob's coarse values ascend in cost for less error, so a value between the
-/// two has an error no lower than `hi`'s and a cost no lower than `lo`'s: it can become the
-/// pick only if `hi`'s error beats the pick's so far (beyond a tie), or ties it while `lo`
-/// costs less than the pick (the cheapest of the tied is the pick). Without either, the
-/// bracket is left untimed: a review found a search timing `cubemap` sizes whose error did
-/// not move, after the pick had fitted with a fifth of it (135 % of the exhaustive run's
-/// frames). Where `hi` was refused (no record), nothing is known: bisected.
+/// the answer, judged from the knob's errors measured so far (every value, in order):
+///
+/// - where they fall (none above the one before), a value between `lo` and `hi` is taken to
+///   have an error no lower than `hi`'s and a cost no lower than `lo`'s: it can become the
+///   pick only if `hi`'s error beats the pick's so far (beyond a tie), or ties it while
+///   `lo` costs less than the pick;
+/// - where they do not (`cubemap`'s error rises with its size on the box), only a knob
+///   whose every error lies above the pick by more than their own spread (max − min) is
+///   left: a value between is taken to stay within that spread of them;
+/// - else, and where `hi` was refused (no record), the bracket is bisected.
+///
+/// A review found a search timing `cubemap` sizes at FLIP ~0.5 after `ray-query` had fitted
+/// at 7e-5 (135 % of the exhaustive run's frames). Both are assumptions about a knob between
+/// two measured values, said in the answer beside the brackets left open.
 fn worth_bisecting(
     measured: &[Record],
     k: &Knob,
@@ -571,7 +587,27 @@ fn worth_bisecting(
     let Some(pick) = pick_of(&tied_for_lowest(measured, budget, metric)) else {
         return true;
     };
-    let (e_over, e_pick) = (metric.of(over), metric.of(pick));
+    let e_pick = metric.of(pick);
+    let mut errors: Vec<(u32, f64)> = measured
+        .iter()
+        .filter_map(|r| {
+            let m = Method::parse(r.method_key()).ok()?;
+            (k.owns(&m)).then_some((k.value(&m)?, metric.of(r)))
+        })
+        .collect();
+    errors.sort_by_key(|(v, _)| *v);
+    let (min, max) = errors
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), (_, e)| {
+            (a.min(*e), b.max(*e))
+        });
+    if min - (max - min) > e_pick * (1.0 + TIE) {
+        return false;
+    }
+    if !errors.windows(2).all(|w| w[1].1 <= w[0].1) {
+        return true;
+    }
+    let e_over = metric.of(over);
     let lo_ms = record_at(measured, k, lo).map_or(f64::INFINITY, |r| r.ms_median);
     e_over < e_pick / (1.0 + TIE) || (e_over <= e_pick * (1.0 + TIE) && lo_ms < pick.ms_median)
 }
@@ -599,10 +635,10 @@ fn knob_setting(r: &Record) -> Option<(&'static str, String, u32)> {
 }
 
 /// The pick of the tied: the cheapest by median; and then, of the tied settings of that
-/// knob whose ms intervals overlap its own (costs the measurement cannot tell apart), the
-/// lowest value. Medians from different rounds had decided among them by drift: `ray-query`
-/// depth 1024 shipped over 256 at the same error, 7.371 ms [7.259–7.426] against 7.375
-/// [7.216–7.690].
+/// knob whose cost the measurement cannot tell from its own (each median inside the other's
+/// 95 % interval), the lowest value. Medians from different rounds had decided among them by
+/// drift: `ray-query` depth 1024 shipped over 256 at the same error, 7.371 ms [7.259–7.426]
+/// against 7.375 [7.216–7.690].
 fn pick_of<'a>(tied: &[&'a Record]) -> Option<&'a Record> {
     let cheapest = tied
         .iter()
@@ -612,13 +648,16 @@ fn pick_of<'a>(tied: &[&'a Record]) -> Option<&'a Record> {
         return Some(cheapest);
     };
     let ends = |r: &Record| r.ms_interval.unwrap_or([r.ms_median, r.ms_median]);
-    let [lo, hi] = ends(cheapest);
+    let inside = |x: f64, r: &Record| {
+        let [lo, hi] = ends(r);
+        lo <= x && x <= hi
+    };
     tied.iter()
         .copied()
         .filter_map(|r| {
             let (n, v, value) = knob_setting(r)?;
-            let [a, b] = ends(r);
-            (n == name && v == variant && a <= hi && lo <= b).then_some((value, r))
+            let same_cost = inside(r.ms_median, cheapest) && inside(cheapest.ms_median, r);
+            (n == name && v == variant && same_cost).then_some((value, r))
         })
         .min_by_key(|(value, _)| *value)
         .map(|(_, r)| r)
@@ -804,8 +843,9 @@ pub fn sentences(advice: &Advice, metric: Metric, scene: &Path) -> Vec<String> {
             .map(|(k, lo, hi)| format!("`{k}` (between {lo} and {hi})"))
             .collect();
         out.push(format!(
-            "Not bisected further, since no setting left between could beat the pick or tie \
-             it for less (a knob's error falls as it rises): {}.",
+            "Not bisected further, taking a knob's error between two settings to follow \
+             those measured (falling where they fall, else within their spread), so that no \
+             setting left between could beat the pick or tie it for less: {}.",
             left.join(", ")
         ));
     }
@@ -1608,6 +1648,29 @@ mod tests {
         );
         let text = sentences(&advice, Metric::Flip, Path::new("s.json")).join("\n");
         assert!(text.contains("Not bisected further"), "{text}");
+    }
+
+    /// The rule of [`worth_bisecting`] on `cubemap`'s knob between 64 (within budget) and 128
+    /// (over), beside a fixed pick of FLIP `pick`: errors that fall are judged by 128's; errors
+    /// that rise are left only when all lie above the pick by more than their spread.
+    #[test]
+    fn a_bracket_is_bisected_unless_the_errors_measured_say_nothing_between_can_win() {
+        let (_, knobs) = candidates(&["cubemap".into()], false);
+        let k = &knobs[0];
+        let case = |errors: [f64; 3], pick: f64| {
+            let mut measured = vec![candidate("naive", 1.0, 1.1, pick)];
+            for (v, e) in [32, 64, 128].into_iter().zip(errors) {
+                let ms = if v == 128 { 3.0 } else { 1.5 };
+                measured.push(candidate(&k.at(v).key(), ms, ms * 1.01, e));
+            }
+            worth_bisecting(&measured, k, (64, 128), 2.0, Metric::Flip)
+        };
+        // Rising, far above the pick: left; rising near it: bisected.
+        assert!(!case([0.30, 0.31, 0.32], 0.1));
+        assert!(case([0.10, 0.14, 0.20], 0.12));
+        // Falling: bisected only where 128's error beats the pick.
+        assert!(!case([0.5, 0.3, 0.2], 0.1));
+        assert!(case([0.5, 0.3, 0.05], 0.1));
     }
 
     /// Tied settings of one knob whose costs the measurement cannot tell apart: the lowest

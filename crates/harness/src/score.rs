@@ -164,6 +164,16 @@ fn refused(path: &Path, message: impl std::fmt::Display) -> HarnessError {
 /// Reads `EXPORT/views.json`.
 pub fn read_views(export: &Path) -> Result<ViewsFile, HarnessError> {
     let path = export.join("views.json");
+    if !export.is_dir() {
+        return Err(refused(
+            export,
+            if export.exists() {
+                "is a file; EXPORT is the folder `mirrorbox export-views` wrote"
+            } else {
+                "does not exist; EXPORT is the folder `mirrorbox export-views` wrote"
+            },
+        ));
+    }
     if !path.exists() {
         return Err(refused(
             export,
@@ -236,6 +246,22 @@ fn check_views(views: &ViewsFile) -> Result<(), String> {
                 v.width,
                 v.height,
                 mirrorbox_image::MAX_PIXELS
+            ));
+        }
+        // What `compare` refuses above its default budget, score refuses too (it compares
+        // each picture with its truth the same way).
+        let need = u64::from(v.width)
+            * u64::from(v.height)
+            * mirrorbox_image::metrics::COMPARE_BYTES_PER_PIXEL;
+        if need > mirrorbox_raster::DEFAULT_MEMORY_BUDGET {
+            return Err(format!(
+                "views[{i}]: {}×{} would need about {:.1} GB to score ({} bytes a pixel), \
+                 above {:.1} GB: export smaller views",
+                v.width,
+                v.height,
+                need as f64 / 1e9,
+                mirrorbox_image::metrics::COMPARE_BYTES_PER_PIXEL,
+                mirrorbox_raster::DEFAULT_MEMORY_BUDGET as f64 / 1e9
             ));
         }
         let grid_sides = 1..=mirrorbox_raster::MAX_SSAA;
@@ -594,9 +620,10 @@ fn view_image(dir: &Path, view: &crate::exchange::ExportedView) -> Result<PathBu
 }
 
 /// Where `dir` has no picture of view `name`, the one it has under another name, as a hint
-/// for the refusal: one in a format score does not read (a client's `camera.jpg`) or
-/// without an extension; else what the folder holds. (An EXR or PNG of another name, one
-/// that differs only in case among them, was refused before: `check_no_stray_image`.)
+/// for the refusal: one whose extension differs only in case (`camera.EXR`), one in a format
+/// score does not read (a client's `camera.jpg`) or without an extension; else what the
+/// folder holds. (An EXR or PNG of another stem, `Camera.png` among them, was refused before:
+/// `check_no_stray_image`.)
 fn picture_elsewhere(dir: &Path, name: &str) -> String {
     let names: Vec<String> = std::fs::read_dir(dir)
         .into_iter()
@@ -604,6 +631,16 @@ fn picture_elsewhere(dir: &Path, name: &str) -> String {
         .flatten()
         .filter_map(|e| e.file_name().into_string().ok())
         .collect();
+    // `camera.EXR`: its stem is the view's, so no stray; its extension's case is the miss.
+    let wanted = [format!("{name}.exr"), format!("{name}.png")];
+    let near: Vec<&str> = names
+        .iter()
+        .map(String::as_str)
+        .filter(|n| wanted.iter().any(|w| w.eq_ignore_ascii_case(n)))
+        .collect();
+    if !near.is_empty() {
+        return format!("; {} differs only in case", near.join(", "));
+    }
     let unread: Vec<&str> = names
         .iter()
         .map(String::as_str)

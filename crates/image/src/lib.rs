@@ -478,8 +478,8 @@ fn has_rgb(path: &Path, meta: &exr::meta::MetaData) -> Result<(), ImageError> {
     Err(io_error(
         path,
         format!(
-            "an EXR's channels R, G and B are read (float or half; A ignored); its first layer \
-             has {}{}{}",
+            "an EXR's channels R, G and B are read (float or half; A ignored), from its first \
+             layer (part), which has {}{}{}",
             if shown.is_empty() {
                 "none".to_string()
             } else {

@@ -337,13 +337,13 @@ fn flip_stats(map: &[f32]) -> (f64, f64, f64) {
     (mean, rank(0.95), rank(0.99))
 }
 
-/// FLIP's per-pixel error map (row-major, values in [0, 1]).
 /// Host memory a comparison of two images needs per pixel, bytes: FLIP's filtered colour
 /// images (nv_flip's C++, ~76 bytes a pixel) and our linear and sRGB copies of both images
 /// with the FLIP map (~30); measured with heaptrack at 1024² (106 bytes a pixel at the peak)
 /// and by peak RSS at 4096² (1.75 GB, 104), with a margin. SSIM streams its planes.
 pub const COMPARE_BYTES_PER_PIXEL: u64 = 112;
 
+/// FLIP's per-pixel error map (row-major, values in [0, 1]).
 pub fn flip_map(reference: &[u8], test: &[u8], w: u32, h: u32) -> Vec<f32> {
     let r = nv_flip::FlipImageRgb8::with_data(w, h, reference);
     let t = nv_flip::FlipImageRgb8::with_data(w, h, test);

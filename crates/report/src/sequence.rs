@@ -304,6 +304,14 @@ pub fn write_motion_figures(
     info: &MotionInfo,
     records: &[FrameRecord],
 ) -> Result<(), FileError> {
+    // A folder in a file's place, refused before any is written.
+    let mut outputs: Vec<(&str, std::path::PathBuf)> = info
+        .scenarios
+        .iter()
+        .map(|s| ("report", dir.join(format!("plot_{}.svg", s.name))))
+        .collect();
+    outputs.push(("report", dir.join("report.md")));
+    mirrorbox_files::check_outputs(&outputs)?;
     for s in &info.scenarios {
         write_text(
             &dir.join(format!("plot_{}.svg", s.name)),
@@ -353,7 +361,8 @@ pub fn read_motion(dir: &Path) -> Result<(MotionInfo, Vec<FrameRecord>), String>
     Ok((info, records))
 }
 
-/// Most frames of one scenario a motion report holds (`sweep --path` renders at most 3600).
+/// Most frames of one scenario a motion report holds: a bound of reading, far above what
+/// `sweep --path` renders (`mirrorbox_harness::sequence::MAX_SEQUENCE_FRAMES`, 1000).
 const MAX_SEQUENCE_FRAMES: u32 = 1 << 16;
 
 /// Refuses a motion report whose records cannot be of a sweep: a scenario name that is not a
@@ -364,6 +373,13 @@ fn check_motion(dir: &Path, info: &MotionInfo, records: &[FrameRecord]) -> Resul
     let info_file = dir.join("motion.json");
     let frames_file = dir.join("frames.jsonl");
     for (i, s) in info.scenarios.iter().enumerate() {
+        if info.scenarios[..i].iter().any(|o| o.name == s.name) {
+            return Err(format!(
+                "{}: scenarios[{i}].name {:?} a second time",
+                info_file.display(),
+                s.name
+            ));
+        }
         let ok = (1..=64).contains(&s.name.len())
             && s.name
                 .bytes()
@@ -559,6 +575,14 @@ mod tests {
         write_motion_report(dir.path(), &info("still"), &good).unwrap();
         assert!(read_motion(dir.path()).is_ok());
         let cases: Vec<(MotionInfo, Vec<FrameRecord>, &str)> = vec![
+            (
+                MotionInfo {
+                    scenarios: [info("still").scenarios, info("still").scenarios].concat(),
+                    ..info("still")
+                },
+                good.clone(),
+                "scenarios[1].name \"still\" a second time",
+            ),
             (
                 info("/../../x"),
                 good.clone(),

@@ -182,13 +182,19 @@ pub fn write_report(
     records: &[Record],
     sections: &[Section],
 ) -> Result<(), FileError> {
-    // A folder in a report file's place is refused before any file is written (results.csv
-    // and report.md had been rewritten before report.html failed).
-    mirrorbox_files::check_outputs(
-        &["results.csv", "report.md", "report.html"].map(|f| ("report", dir.join(f))),
-    )?;
-    write_csv(&dir.join("results.csv"), records)?;
     let blocks = without_empty_chart_sections(document(info, records, sections));
+    // A folder in a report file's place (a chart's included) is refused before any file is
+    // written (results.csv and report.md had been rewritten before report.html failed).
+    let mut outputs: Vec<(&str, std::path::PathBuf)> = ["results.csv", "report.md", "report.html"]
+        .iter()
+        .map(|f| ("report", dir.join(f)))
+        .collect();
+    outputs.extend(blocks.iter().filter_map(|b| match b {
+        Block::Chart(file, _) => Some(("report", dir.join(file))),
+        _ => None,
+    }));
+    mirrorbox_files::check_outputs(&outputs)?;
+    write_csv(&dir.join("results.csv"), records)?;
     // Each truth | raster | FLIP row is followed by its 4× inset where its images are there.
     // A row none of whose images was kept (a lent GPU's 1920×1080 images stay behind: too
     // large to bring back) says so instead of linking files that are not there.

@@ -1127,7 +1127,14 @@ impl Checker<'_> {
             // The line itself, so that a user can see what the parser could not read.
             let text = |l: usize| {
                 let t = String::from_utf8_lossy(bytes.split(|&b| b == b'\n').nth(l - 1)?);
-                let t: String = t.trim().chars().take(60).collect();
+                // Control characters (an escape sequence in a broken file) shown, not sent
+                // to the terminal.
+                let t: String = t
+                    .trim()
+                    .chars()
+                    .take(60)
+                    .map(|c| if c.is_control() { '\u{fffd}' } else { c })
+                    .collect();
                 (!t.is_empty()).then(|| format!(" (`{t}`)"))
             };
             let at = line
@@ -1147,9 +1154,25 @@ impl Checker<'_> {
             }
         }
         if let Some(bad) = tris.iter().flatten().find(|p| !p.is_finite()) {
+            // The line of the first `v` whose coordinates overflow f32 (`1e39`).
+            let line = bytes
+                .split(|&b| b == b'\n')
+                .position(|l| {
+                    let t = String::from_utf8_lossy(l);
+                    let mut words = t.split_whitespace();
+                    words.next() == Some("v")
+                        && words
+                            .take(3)
+                            .any(|x| x.parse::<f32>().is_ok_and(|v| !v.is_finite()))
+                })
+                .map_or(String::new(), |i| format!(" at line {}", i + 1));
             return Err(self.invalid(
                 path,
-                format!("OBJ file \"{rel}\" has a non-finite vertex {}", show(*bad)),
+                format!(
+                    "OBJ file \"{rel}\" has a non-finite vertex {}{line}: coordinates are \
+                     finite 32-bit numbers (|x| below 3.4e38)",
+                    show(*bad)
+                ),
             ));
         }
         if tris.is_empty() {
@@ -1591,6 +1614,28 @@ mod tests {
                 .to_string();
             assert!(e.contains("objects[0].path") && e.contains(kind), "{e}");
         }
+    }
+
+    /// An overflowing vertex is named with its line and what is allowed; a broken line's
+    /// control characters (an escape sequence) are not echoed to the terminal.
+    #[test]
+    fn a_broken_obj_line_is_named_safely() {
+        let dir = tempfile::tempdir().unwrap();
+        let scene = |obj: &str| {
+            std::fs::write(dir.path().join("m.obj"), obj).unwrap();
+            let text =
+                format!(r#"{{ {CAMERA}, "objects": [ {{ "type": "mesh", "path": "m.obj" }} ] }}"#);
+            parse_scene(&text, &dir.path().join("s.json"))
+                .unwrap_err()
+                .to_string()
+        };
+        let e = scene("v 0 0 0\nv 1e39 0 0\nv 0 1 0\nf 1 2 3\n");
+        assert!(
+            e.contains("non-finite vertex") && e.contains("at line 2") && e.contains("3.4e38"),
+            "{e}"
+        );
+        let e = scene("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 \u{1b}[31m\u{7}\n");
+        assert!(!e.chars().any(|c| c.is_control() && c != '\n'), "{e:?}");
     }
 
     #[test]

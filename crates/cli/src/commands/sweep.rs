@@ -120,7 +120,7 @@ pub struct Args {
     memory: super::MemoryBudgetArgs,
 }
 
-/// `--shard` and `--truth-cache`, for `sweep` and the presets (issue 20).
+/// `--shard` and `--truth-cache`, for `sweep` and `experiment` (issue 20).
 #[derive(clap::Args, Clone, Debug, Default)]
 pub struct ShardArgs {
     /// Run one shard of the sweep: `I/N` (I from 0), or `auto/N` / `auto`, taking I from
@@ -190,11 +190,12 @@ fn parse_shard(text: &str) -> Result<Shard, Failure> {
     Ok(Shard { index, count })
 }
 
-/// The options of the experiments (`experiment NAME`, and the preset commands `table1`,
-/// `depth-scaling` …).
+/// The options of `experiment NAME` (the preset subcommands `table1`, `depth-scaling` … that
+/// once took them are gone).
 #[derive(clap::Args, Default)]
 pub struct PresetArgs {
-    /// Output folder of the committed report (default: the preset's folder in reports/).
+    /// Output folder of the report (default: the experiment's folder in reports/; a script
+    /// experiment writes where its script does and refuses --out).
     #[arg(long)]
     out: Option<PathBuf>,
     /// Timed frames per point, one per interleaved round after an untimed settling round

@@ -134,11 +134,11 @@ fn every_experiment_module_has_its_row() {
         let file = entry.file_name().to_string_lossy().into_owned();
         // A module is a file `NAME.rs` or a folder `NAME/mod.rs` (an experiment with its
         // section and regions beside its row).
-        let (module, path) = if entry.path().is_dir() {
-            (file.clone(), entry.path().join("mod.rs"))
+        let module = if entry.path().is_dir() {
+            file.clone()
         } else {
             match file.strip_suffix(".rs").filter(|m| *m != "lib") {
-                Some(m) => (m.to_string(), entry.path()),
+                Some(m) => m.to_string(),
                 None => continue,
             }
         };
@@ -146,7 +146,26 @@ fn every_experiment_module_has_its_row() {
             lib.contains(&format!("pub mod {module};")),
             "src/{file} is not a module of the crate: add `pub mod {module};`"
         );
-        let text = std::fs::read_to_string(&path).unwrap();
+    }
+    // Every `Experiment` const of every file, nested ones included (`lighting/x.rs` is
+    // module `lighting::x`): each has its row.
+    let mut files = vec![src.clone()];
+    while let Some(p) = files.pop() {
+        if p.is_dir() {
+            files.extend(std::fs::read_dir(&p).unwrap().flatten().map(|e| e.path()));
+            continue;
+        }
+        let relative = p.strip_prefix(&src).unwrap().with_extension("");
+        let parts: Vec<String> = relative
+            .iter()
+            .map(|c| c.to_string_lossy().into_owned())
+            .filter(|c| c != "mod")
+            .collect();
+        if parts.is_empty() || parts == ["lib"] || p.extension().is_none_or(|e| e != "rs") {
+            continue;
+        }
+        let module = parts.join("::");
+        let text = std::fs::read_to_string(&p).unwrap();
         for line in text
             .lines()
             .filter(|l| l.ends_with(": Experiment = Experiment {"))
@@ -159,7 +178,8 @@ fn every_experiment_module_has_its_row() {
             consts += 1;
             assert!(
                 table.contains(&format!("&{module}::{name},")),
-                "{module}::{name} is not in EXPERIMENTS"
+                "{module}::{name} ({}) is not in EXPERIMENTS",
+                p.display()
             );
         }
     }
