@@ -301,9 +301,10 @@ fn advise_region_of(reports: &Path, folder: &str) -> Result<String, ReadmeError>
             pick_ms,
             pick_error,
             format!(
-                "{} in {} rounds, {} frames, {:.0} s",
+                "{} in {} {}, {} frames, {:.0} s",
                 v["measured"].as_array().map_or(0, Vec::len),
                 v["rounds"],
+                if v["rounds"] == 1 { "round" } else { "rounds" },
                 v["renders"],
                 v["seconds"].as_f64().unwrap_or(0.0)
             ),
