@@ -1323,6 +1323,16 @@ mod tests {
         r
     }
 
+    /// A round of the model's records, none refused.
+    fn modelled(measured: Vec<Record>) -> Round {
+        Round {
+            folders: vec![PathBuf::new(); measured.len()],
+            measured,
+            refused: Vec::new(),
+            renders: 1,
+        }
+    }
+
     /// The search on `portal` alone against a model: depth d costs 1 + 0.1·d ms, its error
     /// is 1/d, and at depth `noisy` the interval reaches `noisy_hi` (a noisy round). Returns
     /// the advice and every candidate asked for, in order.
@@ -1358,12 +1368,7 @@ mod tests {
                     candidate(&m.key(), ms, hi, 1.0 / d)
                 })
                 .collect();
-            Ok(Round {
-                folders: vec![PathBuf::new(); measured.len()],
-                measured,
-                refused: Vec::new(),
-                renders: 1,
-            })
+            Ok(modelled(measured))
         })
         .unwrap();
         (advice, asked)
@@ -1622,12 +1627,7 @@ mod tests {
                     }
                 })
                 .collect();
-            Ok(Round {
-                folders: vec![PathBuf::new(); measured.len()],
-                measured,
-                refused: Vec::new(),
-                renders: 1,
-            })
+            Ok(modelled(measured))
         })
         .unwrap();
         let cubes: Vec<&String> = asked.iter().filter(|k| k.starts_with("cubemap")).collect();

@@ -663,25 +663,13 @@ mod tests {
         );
         let md = document(
             &MotionInfo {
-                commit: String::new(),
-                records_commit: String::new(),
                 draws: Some([2, 5]),
                 command: "mirrorbox motion".into(),
-                date: "today".into(),
-                device: "test".into(),
-                cpu: "test".into(),
-                width: 8,
-                height: 8,
-                truth: "whitted".into(),
                 scenarios: vec![ScenarioInfo {
-                    name: "still".into(),
-                    description: "A still camera:".into(),
-                    scene: "scenes/mirror_box.json".into(),
                     frames: 4,
-                    fps: 30.0,
-                    step: 0.0,
-                    filmstrips: Vec::new(),
+                    ..info("still").scenarios.remove(0)
                 }],
+                ..info("still")
             },
             &r,
         );
