@@ -104,6 +104,27 @@ fn edge_cases_are_refused_with_a_clear_message_and_nothing_written() {
             vec!["objects[12]", "at most 4194304", "GiB"],
         ),
         (own(&["render", heavy, "-o", png]), vec!["objects[12]"]),
+        // A mirror texture beyond the device's largest side: the advice names the flags
+        // that set its size (it had said "lower --ssaa", which was 1).
+        (
+            own(&[
+                "render",
+                "scenes/bumpy_pair.json",
+                "--method",
+                "naive",
+                "--width",
+                "16384",
+                "--height",
+                "16",
+                "--texture-scale",
+                "4",
+                "--texture-margin",
+                "4096",
+                "-o",
+                png,
+            ]),
+            vec!["render target", "lower --texture-scale or --texture-margin"],
+        ),
         // Sizes that used to abort for memory.
         (
             own(&["trace", ok, "-o", exr, "--spp", "4294836225"]),

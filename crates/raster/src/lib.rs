@@ -331,7 +331,7 @@ pub(crate) fn check_planned_frame(
         settings.method.key(),
         (w, h)
     );
-    gpu.check_target(w, h)?;
+    gpu.check_target(w, h, "; lower --ssaa or the image size")?;
     shading::SceneBuffers::check_fits(gpu, scene)?;
     Ok((w, h))
 }

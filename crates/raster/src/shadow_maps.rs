@@ -112,7 +112,11 @@ impl ShadowMaps {
                 advice: "; lower lighting.mirrored_lights (--mirrored-lights)",
             });
         }
-        gpu.check_target(plan.settings.size, plan.settings.size)?;
+        gpu.check_target(
+            plan.settings.size,
+            plan.settings.size,
+            "; lower --shadow-map-size",
+        )?;
         let size = plan.settings.size;
         let texture = layers_texture(
             device,

@@ -158,8 +158,14 @@ impl Gpu {
         Ok(())
     }
 
-    /// Refuses a render target of `width × height` beyond the device's largest texture.
-    pub fn check_target(&self, width: u32, height: u32) -> Result<(), RasterError> {
+    /// Refuses a render target of `width × height` beyond the device's largest texture,
+    /// saying `advice` (the flags that set its size: a mirror texture's are not `--ssaa`'s).
+    pub fn check_target(
+        &self,
+        width: u32,
+        height: u32,
+        advice: &'static str,
+    ) -> Result<(), RasterError> {
         let limit = self.device.limits().max_texture_dimension_2d;
         if width.max(height) > limit {
             return Err(RasterError::ExceedsDevice {
@@ -167,7 +173,7 @@ impl Gpu {
                 needed: format!("{width}×{height} pixels"),
                 limit: format!("{limit} pixels per side"),
                 adapter: self.report.name.clone(),
-                advice: "; lower --ssaa or the image size",
+                advice,
             });
         }
         Ok(())

@@ -706,7 +706,7 @@ pub const MAX_MIRROR_TEXTURE_BYTES: u64 = 2_000_000_000;
 /// bytes than [`MAX_MIRROR_TEXTURE_BYTES`], before any is created.
 pub(crate) fn check_mirror_textures(gpu: &Gpu, sizes: &[(u32, u32)]) -> Result<(), RasterError> {
     for &(w, h) in sizes {
-        gpu.check_target(w, h)?;
+        gpu.check_target(w, h, "; lower --texture-scale or --texture-margin")?;
     }
     // RGBA32F colour (at most 16 bytes) and 32-bit depth per texel.
     let bytes: u64 = sizes

@@ -30,10 +30,14 @@ fn buffers_and_targets_beyond_the_device_are_refused_with_the_numbers() {
             .is_err()
     );
     let side = limits.max_texture_dimension_2d;
-    let e = gpu.check_target(side + 1, 16).unwrap_err().to_string();
+    let e = gpu
+        .check_target(side + 1, 16, "; lower --ssaa or the image size")
+        .unwrap_err()
+        .to_string();
     assert!(
         e.contains(&format!("{} pixels per side", side)) && e.contains("--ssaa"),
         "{e}"
     );
-    gpu.check_target(side, 16).expect("at the limit is fine");
+    gpu.check_target(side, 16, "")
+        .expect("at the limit is fine");
 }
