@@ -104,6 +104,11 @@ fn edge_cases_are_refused_with_a_clear_message_and_nothing_written() {
             vec!["objects[12]", "at most 4194304", "GiB"],
         ),
         (own(&["render", heavy, "-o", png]), vec!["objects[12]"]),
+        // A folder that takes no file: refused before the work (it had failed after it).
+        (
+            own(&["trace", ok, "-o", "/proc/x.exr"]),
+            vec!["folder /proc takes no new file"],
+        ),
         // A mirror texture beyond the device's largest side: the advice names the flags
         // that set its size (it had said "lower --ssaa", which was 1).
         (

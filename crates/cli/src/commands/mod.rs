@@ -309,6 +309,26 @@ pub fn output_path(flag: &str, path: &Path, ext: &str) -> Result<PathBuf, Failur
             parent.display()
         )));
     }
+    // A folder that takes no new file (read-only, `/proc`) is found now, not after the work
+    // (a trace had run to its end and then failed, exit 1): a probe file made and removed.
+    let probe = parent.join(format!(".mirrorbox-probe-{}", std::process::id()));
+    match std::fs::OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .open(&probe)
+    {
+        Ok(_) => {
+            let _ = std::fs::remove_file(&probe);
+        }
+        Err(e) if e.kind() != std::io::ErrorKind::AlreadyExists => {
+            return Err(Failure::BadInput(format!(
+                "{flag} {}: folder {} takes no new file: {e}",
+                path.display(),
+                parent.display()
+            )));
+        }
+        Err(_) => {}
+    }
     Ok(path.to_path_buf())
 }
 
