@@ -409,7 +409,26 @@ impl Record {
                 ms_range,
             ),
             ("ms_min".into(), self.ms_min, ms(self.ms_min), ms_range),
+            // An image's sides (the images' limit, `mirrorbox_image::MAX_IMAGE_SIDE`).
+            (
+                "width".into(),
+                f64::from(self.width),
+                (1..=16384).contains(&self.width),
+                "[1, 16384]",
+            ),
+            (
+                "height".into(),
+                f64::from(self.height),
+                (1..=16384).contains(&self.height),
+                "[1, 16384]",
+            ),
         ];
+        if !["point", "floor"].contains(&self.kind.as_str()) {
+            return Some(format!(
+                "kind {:?} (allowed: \"point\" or \"floor\")",
+                self.kind
+            ));
+        }
         if let Some(&f) = self.frames_ms.iter().find(|&&f| !ms(f)) {
             checks.push(("frames_ms".into(), f, false, ms_range));
         }

@@ -1376,7 +1376,7 @@ pub(crate) mod tests {
         let p = dir.path().join("results.jsonl");
         let good = record(0, 1.0, 3, 0.1);
         type Edit = fn(&mut Record);
-        let edits: [(Edit, &str); 5] = [
+        let edits: [(Edit, &str); 8] = [
             (
                 |r| r.ms_median = -1.0,
                 "line 1: ms_median -1 (allowed: [0, 86400000] ms)",
@@ -1391,6 +1391,12 @@ pub(crate) mod tests {
                 "line 1: frames_ms 1e300",
             ),
             (|r| r.metrics.ssim = 2.0, "line 1: metrics.ssim 2"),
+            (|r| r.width = 0, "line 1: width 0 (allowed: [1, 16384])"),
+            (
+                |r| r.height = 4_000_000_000,
+                "line 1: height 4000000000 (allowed: [1, 16384])",
+            ),
+            (|r| r.kind = "zzz".into(), "line 1: kind \"zzz\""),
         ];
         for (edit, says) in edits {
             let mut r = good.clone();
