@@ -474,6 +474,29 @@ fn an_export_replaces_only_an_earlier_export() {
     let earlier = tmp.path().join("earlier");
     export(&earlier);
     export(&earlier);
+    // Views `score` could not compare within its memory budget: refused before tracing.
+    let huge = tmp.path().join("huge");
+    let out = mirrorbox(
+        &[
+            "export-views",
+            "scenes/mirror_box.json",
+            "-o",
+            huge.to_str().unwrap(),
+            "--width",
+            "8192",
+            "--height",
+            "8192",
+        ],
+        &[],
+    );
+    assert_eq!(out.code, 2, "{}", out.stderr);
+    assert!(
+        out.stderr
+            .contains("8192×8192 would need about 7.5 GB to score"),
+        "{}",
+        out.stderr
+    );
+    assert!(!huge.exists() && !tmp.path().join("huge.partial").exists());
 }
 
 /// The export is an input too: a views.json an export could not have written (no view, a

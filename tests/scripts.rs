@@ -93,6 +93,52 @@ fn a_run_after_one_killed_outright_keeps_the_committed_reports() {
     assert!(!dir.path().join("out.previous").exists());
 }
 
+/// The other states a run killed outright leaves: a first run's half (marked `out.none`) is
+/// removed, not kept as reports; the replaced reports a finished run was deleting
+/// (`out.discard`) are deleted, the new ones kept.
+#[test]
+fn a_killed_first_run_or_a_killed_clean_up_is_settled_by_the_next_run() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir(dir.path().join("out")).unwrap();
+    std::fs::write(dir.path().join("out/half.txt"), "half").unwrap();
+    std::fs::write(dir.path().join("out.none"), "").unwrap();
+    let (code, stderr) = run_with_library(dir.path(), "set_reports_aside out\nfalse");
+    assert_ne!(code, 0);
+    assert!(stderr.contains("its half is removed"), "{stderr}");
+    assert!(!dir.path().join("out").exists() && !dir.path().join("out.none").exists());
+
+    committed(dir.path());
+    std::fs::create_dir(dir.path().join("out.discard")).unwrap();
+    let (code, stderr) = run_with_library(
+        dir.path(),
+        "set_reports_aside out\necho new > out/new.txt\nkeep_new_reports",
+    );
+    assert_eq!(code, 0, "{stderr}");
+    assert!(dir.path().join("out/new.txt").exists());
+    for leftover in ["out.discard", "out.previous", "out.none"] {
+        assert!(!dir.path().join(leftover).exists(), "{leftover}");
+    }
+}
+
+/// A second run while one measures into the folder is refused before it touches anything
+/// (both had written into one folder, and a failure lost the committed reports).
+#[test]
+fn a_second_run_at_once_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    committed(dir.path());
+    let (code, stderr) = run_with_library(
+        dir.path(),
+        "exec 8>out.lock\nflock 8\nif ( set_reports_aside out ); then exit 3; fi",
+    );
+    assert_eq!(code, 0, "{stderr}");
+    assert!(
+        stderr.contains("another run is measuring into it"),
+        "{stderr}"
+    );
+    assert!(dir.path().join("out/old.txt").exists());
+    assert!(!dir.path().join("out.previous").exists());
+}
+
 #[test]
 fn a_first_run_that_fails_leaves_nothing_half_made() {
     let dir = tempfile::tempdir().unwrap();

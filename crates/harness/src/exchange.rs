@@ -257,6 +257,15 @@ pub fn export_views(
     config.height = settings.height;
     config.ssaa = settings.ssaa.max(1);
     let (mut base, _, _) = crate::base_scene(&config)?;
+    // Views `score` could not compare: refused before their truths are traced.
+    if let Some(problem) =
+        crate::score::scoring_memory_problem(base.camera.width, base.camera.height)
+    {
+        return Err(HarnessError::Exchange(format!(
+            "{}: {problem}",
+            scene_path.display()
+        )));
+    }
     // What a sweep of this scene hashes, before the export's α (a sweep sets α per point).
     let sweep_scene_hash = format!("{:016x}", base.content_hash());
     if let Some(a) = settings.alpha {

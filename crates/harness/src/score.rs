@@ -208,6 +208,24 @@ pub fn read_views(export: &Path) -> Result<ViewsFile, HarnessError> {
     Ok(views)
 }
 
+/// Why views of `width × height` could not be scored within the default memory budget, if
+/// they could not: `score` compares each picture with its truth as `compare` does (about
+/// [`mirrorbox_image::metrics::COMPARE_BYTES_PER_PIXEL`] bytes a pixel), and refuses what
+/// `compare` refuses by default. `export-views` refuses such views before tracing them.
+pub(crate) fn scoring_memory_problem(width: u32, height: u32) -> Option<String> {
+    let need =
+        u64::from(width) * u64::from(height) * mirrorbox_image::metrics::COMPARE_BYTES_PER_PIXEL;
+    (need > mirrorbox_raster::DEFAULT_MEMORY_BUDGET).then(|| {
+        format!(
+            "{width}×{height} would need about {:.1} GB to score ({} bytes a pixel), above \
+             {:.1} GB: export smaller views",
+            need as f64 / 1e9,
+            mirrorbox_image::metrics::COMPARE_BYTES_PER_PIXEL,
+            mirrorbox_raster::DEFAULT_MEMORY_BUDGET as f64 / 1e9
+        )
+    })
+}
+
 /// What an export writes and `score` relies on, checked field by field: 1 to [`MAX_VIEWS`]
 /// views; names that are file-name safe, distinct and free of `_floor` clashes (they become
 /// parts of file names); sizes an image read can have; `truth` and `floor` inside the export
@@ -248,21 +266,8 @@ fn check_views(views: &ViewsFile) -> Result<(), String> {
                 mirrorbox_image::MAX_PIXELS
             ));
         }
-        // What `compare` refuses above its default budget, score refuses too (it compares
-        // each picture with its truth the same way).
-        let need = u64::from(v.width)
-            * u64::from(v.height)
-            * mirrorbox_image::metrics::COMPARE_BYTES_PER_PIXEL;
-        if need > mirrorbox_raster::DEFAULT_MEMORY_BUDGET {
-            return Err(format!(
-                "views[{i}]: {}×{} would need about {:.1} GB to score ({} bytes a pixel), \
-                 above {:.1} GB: export smaller views",
-                v.width,
-                v.height,
-                need as f64 / 1e9,
-                mirrorbox_image::metrics::COMPARE_BYTES_PER_PIXEL,
-                mirrorbox_raster::DEFAULT_MEMORY_BUDGET as f64 / 1e9
-            ));
+        if let Some(problem) = scoring_memory_problem(v.width, v.height) {
+            return Err(format!("views[{i}]: {problem}"));
         }
         let grid_sides = 1..=mirrorbox_raster::MAX_SSAA;
         if !grid_sides.contains(&v.ssaa) {

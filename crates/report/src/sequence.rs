@@ -280,6 +280,9 @@ pub fn write_motion_report(
     info: &MotionInfo,
     records: &[FrameRecord],
 ) -> Result<(), FileError> {
+    // Before the records are rewritten: a figure's or the report's place taken by a folder
+    // had left new records beside the old report.
+    check_motion_outputs(dir, info)?;
     let mut lines = String::new();
     for r in records {
         let _ = writeln!(
@@ -296,6 +299,20 @@ pub fn write_motion_report(
     write_motion_figures(dir, info, records)
 }
 
+/// Refuses, before any is written, a folder in the place of a motion report's file: its
+/// records, info, report and figures.
+fn check_motion_outputs(dir: &Path, info: &MotionInfo) -> Result<(), FileError> {
+    let mut outputs: Vec<(&str, std::path::PathBuf)> = info
+        .scenarios
+        .iter()
+        .map(|s| ("report", dir.join(format!("plot_{}.svg", s.name))))
+        .collect();
+    for f in ["report.md", "frames.jsonl", "motion.json"] {
+        outputs.push(("report", dir.join(f)));
+    }
+    mirrorbox_files::check_outputs(&outputs)
+}
+
 /// Writes `report.md` and the `plot_<scenario>.svg`s of a sequence sweep from its records,
 /// leaving the records and the info as they are: what remaking a committed report rewrites
 /// (re-encoding the records would change their text, not their values).
@@ -304,14 +321,7 @@ pub fn write_motion_figures(
     info: &MotionInfo,
     records: &[FrameRecord],
 ) -> Result<(), FileError> {
-    // A folder in a file's place, refused before any is written.
-    let mut outputs: Vec<(&str, std::path::PathBuf)> = info
-        .scenarios
-        .iter()
-        .map(|s| ("report", dir.join(format!("plot_{}.svg", s.name))))
-        .collect();
-    outputs.push(("report", dir.join("report.md")));
-    mirrorbox_files::check_outputs(&outputs)?;
+    check_motion_outputs(dir, info)?;
     for s in &info.scenarios {
         write_text(
             &dir.join(format!("plot_{}.svg", s.name)),
