@@ -2760,6 +2760,14 @@ fn a_sequence_sweep_compares_every_frame_with_its_truth() {
     into[3] = ordinary.to_str().unwrap();
     into.push("--fresh");
     assert_refused(&into, "another kind of report (results.jsonl)");
+    // A folder where the sweep writes its records: refused before rendering.
+    let odd = dir.path().join("odd");
+    std::fs::create_dir_all(odd.join("frames.jsonl")).unwrap();
+    into[3] = odd.to_str().unwrap();
+    assert_refused(
+        &into,
+        "frames.jsonl is a folder where the sweep writes a file",
+    );
 
     // Supersampling reaches both sides: the raster's s×s grid is the truth's s² samples
     // (an exact method stays at the floor).

@@ -78,6 +78,12 @@ fn check_sequence_out(out: &Path, replace: bool) -> Result<(), HarnessError> {
              name another --out"
         )));
     }
+    // A folder where the sweep will write a file: refused before rendering, not after.
+    if let Some(f) = SEQUENCE_FILES.iter().find(|f| out.join(f).is_dir()) {
+        return Err(refuse(format!(
+            "{f} is a folder where the sweep writes a file: move it, or name another --out"
+        )));
+    }
     if !replace && let Some(f) = SEQUENCE_FILES.iter().find(|f| out.join(f).exists()) {
         return Err(refuse(format!(
             "holds an earlier sequence sweep ({f}), which this one would replace (a sequence \
