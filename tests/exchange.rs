@@ -458,14 +458,7 @@ fn an_export_replaces_only_an_earlier_export() {
         dir.to_str().unwrap(),
     ];
     args.extend(SIZE);
-    let out = mirrorbox(&args, &[]);
-    assert_eq!(out.code, 2, "{}", out.stderr);
-    assert!(
-        out.stderr
-            .contains("holds no earlier export (its views.json)"),
-        "{}",
-        out.stderr
-    );
+    crate::common::assert_refused(&args, "holds no earlier export (its views.json)");
     assert!(dir.join("notes.txt").is_file());
     assert_eq!(
         std::fs::read_to_string(dir.join("views.json")).unwrap(),
@@ -476,7 +469,7 @@ fn an_export_replaces_only_an_earlier_export() {
     export(&earlier);
     // Views `score` could not compare within its memory budget: refused before tracing.
     let huge = tmp.path().join("huge");
-    let out = mirrorbox(
+    crate::common::assert_refused(
         &[
             "export-views",
             "scenes/mirror_box.json",
@@ -487,14 +480,7 @@ fn an_export_replaces_only_an_earlier_export() {
             "--height",
             "8192",
         ],
-        &[],
-    );
-    assert_eq!(out.code, 2, "{}", out.stderr);
-    assert!(
-        out.stderr
-            .contains("8192×8192 would need about 7.5 GB to score"),
-        "{}",
-        out.stderr
+        "8192×8192 would need about 7.5 GB to score",
     );
     assert!(!huge.exists() && !tmp.path().join("huge.partial").exists());
 }
