@@ -213,8 +213,7 @@ pub fn read_views(export: &Path) -> Result<ViewsFile, HarnessError> {
 /// [`mirrorbox_image::metrics::COMPARE_BYTES_PER_PIXEL`] bytes a pixel), and refuses what
 /// `compare` refuses by default. `export-views` refuses such views before tracing them.
 pub(crate) fn scoring_memory_problem(width: u32, height: u32) -> Option<String> {
-    let need =
-        u64::from(width) * u64::from(height) * mirrorbox_image::metrics::COMPARE_BYTES_PER_PIXEL;
+    let need = mirrorbox_image::metrics::compare_bytes(width, height);
     (need > mirrorbox_raster::DEFAULT_MEMORY_BUDGET).then(|| {
         format!(
             "{width}×{height} would need about {:.1} GB to score ({} bytes a pixel), above \

@@ -343,6 +343,12 @@ fn flip_stats(map: &[f32]) -> (f64, f64, f64) {
 /// and by peak RSS at 4096² (1.75 GB, 104), with a margin. SSIM streams its planes.
 pub const COMPARE_BYTES_PER_PIXEL: u64 = 112;
 
+/// Host memory a comparison of two `width × height` images needs, bytes
+/// ([`COMPARE_BYTES_PER_PIXEL`] a pixel): what `compare` and `score` hold to a budget.
+pub fn compare_bytes(width: u32, height: u32) -> u64 {
+    u64::from(width) * u64::from(height) * COMPARE_BYTES_PER_PIXEL
+}
+
 /// FLIP's per-pixel error map (row-major, values in [0, 1]).
 pub fn flip_map(reference: &[u8], test: &[u8], w: u32, h: u32) -> Vec<f32> {
     let r = nv_flip::FlipImageRgb8::with_data(w, h, reference);

@@ -395,6 +395,9 @@ impl Record {
         let ms = |x: f64| (0.0..=MAX_FRAME_MS).contains(&x);
         let ms_range = format!("[0, {MAX_FRAME_MS}] ms");
         let ms_range = ms_range.as_str();
+        use mirrorbox_image::MAX_IMAGE_SIDE;
+        let sides = format!("[1, {MAX_IMAGE_SIDE}]");
+        let sides = sides.as_str();
         let mut checks: Vec<(String, f64, bool, &str)> = vec![
             (
                 "alpha".into(),
@@ -409,18 +412,18 @@ impl Record {
                 ms_range,
             ),
             ("ms_min".into(), self.ms_min, ms(self.ms_min), ms_range),
-            // An image's sides (the images' limit, `mirrorbox_image::MAX_IMAGE_SIDE`).
+            // An image's sides (the images' limit).
             (
                 "width".into(),
                 f64::from(self.width),
-                (1..=16384).contains(&self.width),
-                "[1, 16384]",
+                (1..=MAX_IMAGE_SIDE).contains(&self.width),
+                sides,
             ),
             (
                 "height".into(),
                 f64::from(self.height),
-                (1..=16384).contains(&self.height),
-                "[1, 16384]",
+                (1..=MAX_IMAGE_SIDE).contains(&self.height),
+                sides,
             ),
         ];
         if !["point", "floor"].contains(&self.kind.as_str()) {

@@ -37,8 +37,7 @@ pub struct Args {
 /// Refuses a comparison of images of `(width, height)` above `budget` bytes, naming what it
 /// would need: an 8192² pair had needed 7 GB, and been killed.
 fn check_compare_memory((width, height): (u32, u32), budget: u64) -> Result<(), Failure> {
-    let need =
-        u64::from(width) * u64::from(height) * mirrorbox_image::metrics::COMPARE_BYTES_PER_PIXEL;
+    let need = mirrorbox_image::metrics::compare_bytes(width, height);
     if need > budget {
         let gb = |b: u64| b as f64 / 1e9;
         return Err(Failure::BadInput(format!(
