@@ -417,8 +417,8 @@ fn check_size(path: &Path, width: u32, height: u32) -> Result<(), ImageError> {
 }
 
 /// The sample type of an EXR's R, G and B channels (its first layer): `"float"`, or `"half"`
-/// where any is half. Unsigned-integer channels are refused: read as floats they had been
-/// scored as radiance.
+/// where any is half. Unsigned-integer channels are refused (read as floats they had been
+/// scored as radiance), and so is a first layer without channels named R, G and B.
 pub fn exr_rgb_samples(path: &Path) -> Result<&'static str, ImageError> {
     rgb_samples(path, &exr_meta(path)?)
 }
@@ -451,52 +451,44 @@ fn rgb_samples(path: &Path, meta: &exr::meta::MetaData) -> Result<&'static str, 
             SampleType::F32 => {}
         }
     }
-    Ok(if half { "half" } else { "float" })
-}
-
-/// Refuses an EXR whose first layer has no channels named `R`, `G` and `B`, naming the ones
-/// it has: a luminance-only file, or one whose channels carry a layer's prefix (Blender's
-/// `View Layer.Combined.R`), which the reader does not take for R, G and B.
-fn has_rgb(path: &Path, meta: &exr::meta::MetaData) -> Result<(), ImageError> {
-    let header = meta
-        .headers
-        .first()
-        .ok_or_else(|| io_error(path, "an EXR without a layer"))?;
+    // Channels named `R`, `G` and `B` themselves: a luminance-only file, or one whose
+    // channels carry a layer's prefix (Blender's `View Layer.Combined.R`), which the reader
+    // does not take for them, is refused naming the channels it has.
     let names: Vec<String> = header
         .channels
         .list
         .iter()
         .map(|c| c.name.to_string())
         .collect();
-    if ["R", "G", "B"].iter().all(|c| names.iter().any(|n| n == c)) {
-        return Ok(());
+    if !["R", "G", "B"].iter().all(|c| names.iter().any(|n| n == c)) {
+        let prefixed = ["R", "G", "B"]
+            .iter()
+            .all(|c| names.iter().any(|n| n.ends_with(&format!(".{c}"))));
+        let shown: Vec<&str> = names.iter().take(8).map(String::as_str).collect();
+        return Err(io_error(
+            path,
+            format!(
+                "an EXR's channels R, G and B are read (float or half; A ignored), from its \
+                 first layer (part), which has {}{}{}",
+                if shown.is_empty() {
+                    "none".to_string()
+                } else {
+                    shown.join(", ")
+                },
+                if names.len() > shown.len() {
+                    ", …"
+                } else {
+                    ""
+                },
+                if prefixed {
+                    ": write them without the layer's prefix, as R, G and B"
+                } else {
+                    ""
+                }
+            ),
+        ));
     }
-    let prefixed = ["R", "G", "B"]
-        .iter()
-        .all(|c| names.iter().any(|n| n.ends_with(&format!(".{c}"))));
-    let shown: Vec<&str> = names.iter().take(8).map(String::as_str).collect();
-    Err(io_error(
-        path,
-        format!(
-            "an EXR's channels R, G and B are read (float or half; A ignored), from its first \
-             layer (part), which has {}{}{}",
-            if shown.is_empty() {
-                "none".to_string()
-            } else {
-                shown.join(", ")
-            },
-            if names.len() > shown.len() {
-                ", …"
-            } else {
-                ""
-            },
-            if prefixed {
-                ": write them without the layer's prefix, as R, G and B"
-            } else {
-                ""
-            }
-        ),
-    ))
+    Ok(if half { "half" } else { "float" })
 }
 
 fn read_exr(path: &Path) -> Result<RgbImage, ImageError> {
@@ -505,7 +497,6 @@ fn read_exr(path: &Path) -> Result<RgbImage, ImageError> {
     let meta = exr_meta(path)?;
     sized(path, &meta)?;
     rgb_samples(path, &meta)?;
-    has_rgb(path, &meta)?;
     let image = read_first_rgba_layer_from_file(
         path,
         |size, _| RgbImage::new(size.width() as u32, size.height() as u32),
