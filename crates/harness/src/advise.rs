@@ -552,11 +552,20 @@ fn renders(sweep: &SweepConfig, summary: &Summary) -> u64 {
         * u64::from(sweep.warmup + 1)
 }
 
+/// The measured records of knob `k`, each with its value.
+fn knob_records<'a>(
+    measured: &'a [Record],
+    k: &'a Knob,
+) -> impl Iterator<Item = (u32, &'a Record)> + 'a {
+    measured.iter().filter_map(|r| {
+        let m = Method::parse(r.method_key()).ok()?;
+        k.owns(&m).then_some((k.value(&m)?, r))
+    })
+}
+
 /// The measured record of knob `k` at value `v`, if one was measured.
-fn record_at<'a>(measured: &'a [Record], k: &Knob, v: u32) -> Option<&'a Record> {
-    measured
-        .iter()
-        .find(|r| Method::parse(r.method_key()).is_ok_and(|m| k.owns(&m) && k.value(&m) == Some(v)))
+fn record_at<'a>(measured: &'a [Record], k: &'a Knob, v: u32) -> Option<&'a Record> {
+    knob_records(measured, k).find_map(|(value, r)| (value == v).then_some(r))
 }
 
 /// Whether bisecting knob `k` between `lo` (within budget) and `hi` (over it) could change
@@ -588,12 +597,8 @@ fn worth_bisecting(
         return true;
     };
     let e_pick = metric.of(pick);
-    let mut errors: Vec<(u32, f64)> = measured
-        .iter()
-        .filter_map(|r| {
-            let m = Method::parse(r.method_key()).ok()?;
-            (k.owns(&m)).then_some((k.value(&m)?, metric.of(r)))
-        })
+    let mut errors: Vec<(u32, f64)> = knob_records(measured, k)
+        .map(|(v, r)| (v, metric.of(r)))
         .collect();
     errors.sort_by_key(|(v, _)| *v);
     let (min, max) = errors
