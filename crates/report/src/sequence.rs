@@ -296,7 +296,7 @@ pub fn write_motion_report(
         &dir.join("motion.json"),
         &serde_json::to_string_pretty(info).expect("the motion info encodes"),
     )?;
-    write_motion_figures(dir, info, records)
+    write_figures(dir, info, records)
 }
 
 /// Refuses, before any is written, a folder in the place of a motion report's file: its
@@ -322,6 +322,11 @@ pub fn write_motion_figures(
     records: &[FrameRecord],
 ) -> Result<(), FileError> {
     check_motion_outputs(dir, info)?;
+    write_figures(dir, info, records)
+}
+
+/// [`write_motion_figures`] once its outputs are checked.
+fn write_figures(dir: &Path, info: &MotionInfo, records: &[FrameRecord]) -> Result<(), FileError> {
     for s in &info.scenarios {
         write_text(
             &dir.join(format!("plot_{}.svg", s.name)),
