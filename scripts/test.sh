@@ -44,23 +44,53 @@ timed() {
   local name="$*"
   steps_json+="${steps_json:+,}{\"name\":\"${name//\"/\'}\",\"seconds\":$took}"
 }
+# What the build needs (compilers, headers, Vulkan's loader) comes first, alone.
 timed scripts/install-system-deps.sh
-# Mitsuba 3 for the agreement tests (tests/mitsuba.rs): a pinned venv, and libllvm19 via apt.
-timed tools/mitsuba/setup.sh
-# Only a setup that finished (skipped with MIRRORBOX_TEST_SKIP=mitsuba, it is not marked ready
-# and the tests skip, rather than fail on half a venv).
-if [ -f tools/mitsuba/.venv/.ready ]; then
-  export MIRRORBOX_MITSUBA_PYTHON="$PWD/tools/mitsuba/.venv/bin/python"
-fi
-# The web clients of the exchange (clients/web: three.js in headless Chromium) for
-# tests/exchange.rs: pinned npm packages, installed by `npm ci` (exits 1 unless
-# MIRRORBOX_TEST_SKIP names web).
-timed scripts/install-web-clients.sh
-# Slurm and munge for the sharded-sweep test on a local one-node Slurm (tests/slurm.rs, root;
-# not root: exits 1 unless MIRRORBOX_TEST_SKIP names slurm).
-timed scripts/slurm-local.sh install
-# The cluster files: Slurm scripts parse, the Kubernetes manifest validates.
-timed scripts/check-deploy.sh
+# What only the tests need is installed while the build compiles, one step after another in
+# the background (the apt steps never wait on each other's lock; the downloads wait on the
+# network, not the cores): 20-30 s of a fresh clone's wall time (docs/budgets.md). Their
+# output goes to target/test-setup.log, printed after the build; a failing step fails this
+# script there, before any test runs.
+# - Mitsuba 3 for the agreement tests (tests/mitsuba.rs): a pinned venv, libllvm19 via apt;
+# - the web clients of the exchange (clients/web: three.js in headless Chromium) for
+#   tests/exchange.rs: pinned npm packages, installed by `npm ci` (exits 1 unless
+#   MIRRORBOX_TEST_SKIP names web);
+# - Slurm and munge for the sharded-sweep test on a local one-node Slurm (tests/slurm.rs,
+#   root; not root: exits 1 unless MIRRORBOX_TEST_SKIP names slurm);
+# - the cluster files: Slurm scripts parse, the Kubernetes manifest validates.
+setup_log=target/test-setup.log
+setup_steps=target/test-setup-steps.json
+: >"$setup_steps"
+(
+  for step in tools/mitsuba/setup.sh scripts/install-web-clients.sh \
+    "scripts/slurm-local.sh install" scripts/check-deploy.sh; do
+    echo "== $step"
+    started=$SECONDS
+    # shellcheck disable=SC2086 # a step is a script and its words
+    $step
+    echo "== done in $((SECONDS - started)) s: $step"
+    printf '%s{"name":"%s","seconds":%s,"during_build":true}' "$([ -s "$setup_steps" ] && echo ,)" "$step" \
+      "$((SECONDS - started))" >>"$setup_steps"
+  done
+) >"$setup_log" 2>&1 &
+setup_pid=$!
+# Waits for the background steps, prints what they wrote, and fails on the first that failed.
+finish_setup() {
+  local rc=0
+  wait "$setup_pid" || rc=$?
+  echo "== the tests' own set-up, run during the build ($setup_log):"
+  cat "$setup_log"
+  steps_json+="${steps_json:+,}$(cat "$setup_steps")"
+  if [ "$rc" -ne 0 ]; then
+    echo "== ERROR: a set-up step above failed (exit $rc)" >&2
+    exit "$rc"
+  fi
+  # Only a Mitsuba set-up that finished (skipped with MIRRORBOX_TEST_SKIP=mitsuba, it is not
+  # marked ready and the tests skip, rather than fail on half a venv).
+  if [ -f tools/mitsuba/.venv/.ready ]; then
+    export MIRRORBOX_MITSUBA_PYTHON="$PWD/tools/mitsuba/.venv/bin/python"
+  fi
+}
 
 # JSON string contents: backslashes, quotes and control characters escaped.
 json_escape() {
@@ -124,6 +154,10 @@ print_skips() {
 # A failing step ends the script early: the skips logged so far are still listed.
 on_exit() {
   local rc=$?
+  # The background set-up is never cut off mid-install: a failing build waits for it.
+  if [ -n "${setup_pid:-}" ]; then
+    wait "$setup_pid" 2>/dev/null || true
+  fi
   if [ -z "$skips_printed" ]; then
     collect_skips || true
     print_skips || true
@@ -138,6 +172,7 @@ timed cargo fmt --all -- --check
 # no doc tests, so rustdoc is not asked to look for them. --timings: where the build's time
 # goes, per crate (target/cargo-timings/cargo-timing.html).
 timed cargo test --workspace --locked --all-targets --no-run --timings
+finish_setup
 # The tests check images, not times: they keep Mesa's on-disk shader cache, which the commands
 # that time frames turn off (issue 54, docs/budgets.md). With it off the suite compiled every
 # shader in every process: 335 s of tests instead of 148 s here.
