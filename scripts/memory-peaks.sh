@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Issue 37: the peak resident memory of every bundled scene × every registered method at its
 # defaults, each rendered in its own `mirrorbox render` process (the release binary), next to
-# the plan's memory estimate — the same sweep as tests/memory.rs, written to
-# reports/memory/peaks.md. `render --json` reports both: `peak_rss_bytes` (the process's
+# the plan's memory estimate — the combinations tests/memory.rs renders (in one process
+# there), written to reports/memory/peaks.md. `render --json` reports both: `peak_rss_bytes` (the process's
 # VmHWM) and `memory_estimate` (GPU + host bytes, `mirrorbox_raster::memory`).
 # Usage: scripts/memory-peaks.sh [WIDTH HEIGHT]   (default 32 18, as the test)
 set -euo pipefail

@@ -26,7 +26,7 @@ pub mod sequence;
 mod worker;
 
 pub use axes::{AxisSpec, AxisValues, PointAxes};
-pub use worker::{RenderJob, RenderReport, Rendered, peak_memory_bytes, serve};
+pub use worker::{RenderJob, RenderReport, Rendered, peak_memory_bytes, reset_peak_memory, serve};
 
 use mirrorbox_files::{FileError, FolderLock, with_stem_suffix, write_atomically};
 use mirrorbox_image::metrics::{MetricsError, compare_detailed};
