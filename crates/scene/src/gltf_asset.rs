@@ -181,6 +181,7 @@ pub fn load_gltf_reusing(
             ),
         ));
     }
+    check_version(&root.asset)?;
     // The gltf crate's validator indexes the POSITION accessor before checking that it exists
     // (gltf-json 1.4.1, mesh.rs:151): a reference past the accessors would panic there.
     for (m, mesh) in root.meshes.iter().enumerate() {
@@ -251,6 +252,46 @@ pub fn load_gltf_reusing(
     Ok(reader.asset)
 }
 
+/// The glTF versions read: 2.x, as the specification's "Versioning" asks of a 2.0 loader. An
+/// asset whose `minVersion` is given loads only where that version is supported (2.0); one
+/// without loads when its `version`'s major is 2, whatever its minor (a minor version adds
+/// only what a 2.0 loader may ignore). Both are `<major>.<minor>`.
+fn check_version(asset: &gltf::json::Asset) -> Result<()> {
+    let parse = |field: &str, text: &str| -> Result<(u32, u32)> {
+        text.split_once('.')
+            .filter(|(m, n)| {
+                !m.is_empty()
+                    && !n.is_empty()
+                    && m.bytes().chain(n.bytes()).all(|b| b.is_ascii_digit())
+            })
+            .and_then(|(m, n)| Some((m.parse().ok()?, n.parse().ok()?)))
+            .ok_or_else(|| {
+                err(
+                    field,
+                    format!("is \"{text}\"; a glTF version is <major>.<minor>, as \"2.0\""),
+                )
+            })
+    };
+    let (major, _) = parse("asset.version", &asset.version)?;
+    if let Some(min) = &asset.min_version {
+        if parse("asset.minVersion", min)? != (2, 0) {
+            return Err(err(
+                "asset.minVersion",
+                format!("is \"{min}\": the asset needs glTF {min}; mirrorbox reads glTF 2.0"),
+            ));
+        }
+    } else if major != 2 {
+        return Err(err(
+            "asset.version",
+            format!(
+                "is \"{}\": mirrorbox reads glTF 2.x (glTF 1.0 files convert with gltf-pipeline)",
+                asset.version
+            ),
+        ));
+    }
+    Ok(())
+}
+
 struct Reader<'a> {
     document: &'a gltf::Document,
     base: PathBuf,
@@ -268,7 +309,10 @@ struct Reader<'a> {
 }
 
 impl Reader<'_> {
-    /// The bytes behind a URI: a `data:` URI's payload, or a file beside the asset.
+    /// The bytes behind a URI: a `data:` URI's payload, or a file named relative to the
+    /// asset's folder as RFC 3986 resolves a relative reference against the asset's own
+    /// location (`../shared/a.bin` reaches outside it, `/data/a.bin` is that absolute path):
+    /// the reach of the scene file's own paths, which mirrorbox reads as given.
     fn uri_bytes(&mut self, field: &str, uri: &str, what: &str) -> Result<Vec<u8>> {
         let bytes = if let Some(rest) = uri.strip_prefix("data:") {
             let Some((header, payload)) = rest.split_once(',') else {
@@ -1181,6 +1225,59 @@ mod tests {
                 .unwrap_err()
                 .contains("plane")
         );
+    }
+
+    /// glTF 2.x loads, whatever its minor version; another major, a `minVersion` above 2.0
+    /// or a version not of the form `<major>.<minor>` is refused, naming the field.
+    #[test]
+    fn only_gltf_2_loads() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("v.gltf");
+        let options = GltfOptions {
+            scene: None,
+            triangle_budget: 1 << 10,
+            texel_budget: 1 << 10,
+            transform: Mat4::IDENTITY,
+            curved_mirrors: CurvedMirrors::Refuse,
+        };
+        for (asset, refused) in [
+            (r#"{"version": "2.0"}"#, None),
+            (r#"{"version": "2.1"}"#, None),
+            (r#"{"version": "2.0", "minVersion": "2.0"}"#, None),
+            (r#"{"version": "3.0"}"#, Some("asset.version")),
+            (r#"{"version": "1.0"}"#, Some("asset.version")),
+            (r#"{"version": "2"}"#, Some("asset.version")),
+            (r#"{"version": "two.0"}"#, Some("asset.version")),
+            (
+                r#"{"version": "2.1", "minVersion": "2.1"}"#,
+                Some("asset.minVersion"),
+            ),
+            (
+                r#"{"version": "2.0", "minVersion": "x"}"#,
+                Some("asset.minVersion"),
+            ),
+        ] {
+            std::fs::write(
+                &path,
+                format!(
+                    r#"{{"asset": {asset}, "scenes": [{{"nodes": [0]}}], "nodes": [{{"mesh": 0}}],
+                    "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0}}}}]}}],
+                    "accessors": [{{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                                    "min": [0, 0, 0], "max": [1, 1, 0]}}],
+                    "bufferViews": [{{"buffer": 0, "byteLength": 36}}],
+                    "buffers": [{{"uri": "data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA", "byteLength": 36}}]}}"#
+                ),
+            )
+            .unwrap();
+            match (load_gltf(&path, &options), refused) {
+                (Ok(_), None) => {}
+                (Err(e), Some(field)) => {
+                    let e = e.to_string();
+                    assert!(e.contains(field) && e.contains("glTF"), "{asset}: {e}");
+                }
+                (r, _) => panic!("{asset}: {:?}", r.map(|_| "loaded")),
+            }
+        }
     }
 
     #[test]
