@@ -102,8 +102,9 @@ const HINT_FACTOR: f64 = 3.0;
 /// A client's picture that comes much nearer its truth (by [`HINT_FACTOR`], in mean absolute
 /// difference of linear radiance) upside down, or — an EXR — decoded from sRGB: the two
 /// mistakes a client makes that score as a large error and nothing else (row 0 is the top;
-/// an EXR holds linear radiance: docs/exchange.md). Said, not refused: a renderer may be that
-/// far off.
+/// an EXR holds linear radiance: docs/exchange.md). Decoded, it must also come within half
+/// the distance of the nearest flat picture. Said, not refused: a renderer may be that far
+/// off.
 fn picture_hint(truth: &Path, image: &Path) -> Result<Option<String>, HarnessError> {
     let t =
         mirrorbox_image::read_image(truth).map_err(|e| HarnessError::Exchange(e.to_string()))?;
@@ -128,6 +129,24 @@ fn picture_hint(truth: &Path, image: &Path) -> Result<Option<String>, HarnessErr
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
     let decoded = is_exr.then(|| distance(&|i| p.pixels[i].map(mirrorbox_image::srgb::decode)));
+    // Decoding darkens every value, so it brings any picture brighter than a dark truth
+    // nearer, a flat grey one as well: only a decoded picture within half the distance of
+    // the nearest flat picture (the mean absolute deviation from the truth's per-channel
+    // medians) shows the truth's structure, which a renderer's sRGB-encoded output keeps.
+    let flat = || {
+        let mut sum = 0.0;
+        for c in 0..3 {
+            let mut channel: Vec<f32> = t.pixels.iter().map(|px| px[c]).collect();
+            let mid = channel.len() / 2;
+            let median = *channel.select_nth_unstable_by(mid, f32::total_cmp).1;
+            sum += t
+                .pixels
+                .iter()
+                .map(|px| f64::from((px[c] - median).abs()))
+                .sum::<f64>();
+        }
+        sum / (3 * t.pixels.len()).max(1) as f64
+    };
     let name = image.display();
     Ok(if given > HINT_FACTOR * flipped {
         Some(format!(
@@ -136,13 +155,15 @@ fn picture_hint(truth: &Path, image: &Path) -> Result<Option<String>, HarnessErr
             given / flipped.max(f64::MIN_POSITIVE)
         ))
     } else {
-        decoded.filter(|&d| given > HINT_FACTOR * d).map(|d| {
-            format!(
-                "{name}: sRGB-encoded? Decoded from sRGB it is {:.1}× nearer the truth; an EXR \
+        decoded
+            .filter(|&d| given > HINT_FACTOR * d && d < 0.5 * flat())
+            .map(|d| {
+                format!(
+                    "{name}: sRGB-encoded? Decoded from sRGB it is {:.1}× nearer the truth; an EXR \
                  holds linear radiance",
-                given / d.max(f64::MIN_POSITIVE)
-            )
-        })
+                    given / d.max(f64::MIN_POSITIVE)
+                )
+            })
     })
 }
 
@@ -1267,6 +1288,35 @@ pub fn score(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A dark truth with little structure, a client's picture of it sRGB-encoded (said), and
+    /// a flat grey picture that decoding brings 29× nearer (not said: decoded, it is no
+    /// nearer than the nearest flat picture; it had been called sRGB-encoded).
+    #[test]
+    fn only_a_picture_that_keeps_the_truths_structure_is_called_srgb_encoded() {
+        let dir = tempfile::tempdir().unwrap();
+        let (w, h) = (16u32, 16u32);
+        let image = |f: &dyn Fn(u32, u32) -> [f32; 3]| mirrorbox_image::RgbImage {
+            width: w,
+            height: h,
+            pixels: (0..w * h).map(|i| f(i % w, i / w)).collect(),
+        };
+        let truth = image(&|x, y| [0.02 + 0.01 * ((x + y) % 2) as f32, 0.02, 0.03]);
+        let save = |name: &str, img: &mirrorbox_image::RgbImage| {
+            let path = dir.path().join(name);
+            mirrorbox_image::write_exr(&path, img, &[]).unwrap();
+            path
+        };
+        let t = save("truth.exr", &truth);
+        let encoded = image(&|x, y| {
+            let i = (y * w + x) as usize;
+            truth.pixels[i].map(mirrorbox_image::srgb::encode)
+        });
+        let hint = picture_hint(&t, &save("encoded.exr", &encoded)).unwrap();
+        assert!(hint.is_some_and(|h| h.contains("sRGB-encoded?")));
+        let grey = image(&|_, _| [0.025, 0.02, 0.03].map(mirrorbox_image::srgb::encode));
+        assert_eq!(picture_hint(&t, &save("grey.exr", &grey)).unwrap(), None);
+    }
 
     fn schema(name: &str) -> serde_json::Value {
         let path = Path::new(env!("CARGO_MANIFEST_DIR"))
