@@ -7,6 +7,7 @@
 use crate::{Experiment, Measure};
 use mirrorbox_harness::advise::TIE;
 use mirrorbox_report::document::{Block, markdown, ms, sci};
+use mirrorbox_report::overview::OtherReport;
 use mirrorbox_report::readme::{ReadmeError, RegionSource};
 use serde_json::Value;
 use std::path::Path;
@@ -443,7 +444,13 @@ pub const ADVISE: Experiment = Experiment {
     ],
     chapter: "advise.md",
     main_job: false,
-    overview: None,
+    // The answers are no sweep folders: the overview lists their README, whose table
+    // `mirrorbox readme` fills (the "advise" region above).
+    overview: Some(OtherReport {
+        report: "advise/README.md",
+        data: "advise",
+        scene: "scenes/mirror_box.json, scenes/mirror_room.json, scenes/tilted_pair.json, scenes/imported/engine_box.json",
+    }),
 };
 
 #[cfg(test)]

@@ -18,15 +18,17 @@ pub struct Args {
     #[arg(long)]
     check: bool,
     /// The Markdown files to fill (their regions name the reports they quote). Default:
-    /// README.md, docs/methods.md and every docs/book/src/*.md.
+    /// README.md, docs/methods.md, reports/advise/README.md and every docs/book/src/*.md.
     files: Vec<PathBuf>,
     /// The folder of the committed reports.
     #[arg(long, default_value = "reports")]
     reports: PathBuf,
 }
 
-/// The files filled when none is named, relative to the repository root.
-const DEFAULT_FILES: [&str; 2] = ["README.md", "docs/methods.md"];
+/// The files filled when none is named, relative to the repository root: the README, the
+/// methods' page, and the advisor's reports, whose answers have no sweep report of their own
+/// for the overview to list (`reports/advise/README.md`).
+const DEFAULT_FILES: [&str; 3] = ["README.md", "docs/methods.md", "reports/advise/README.md"];
 /// The book's chapters: every `*.md` directly in this folder is filled too.
 pub const BOOK_SOURCE: &str = "docs/book/src";
 
