@@ -78,6 +78,7 @@ setup_pid=$!
 finish_setup() {
   local rc=0
   wait "$setup_pid" || rc=$?
+  setup_pid=""
   echo "== the tests' own set-up, run during the build ($setup_log):"
   cat "$setup_log"
   steps_json+="${steps_json:+,}$(cat "$setup_steps")"
@@ -154,9 +155,14 @@ print_skips() {
 # A failing step ends the script early: the skips logged so far are still listed.
 on_exit() {
   local rc=$?
-  # The background set-up is never cut off mid-install: a failing build waits for it.
+  # The background set-up is never cut off mid-install: a failing build (or format check)
+  # waits for it, says so, and shows how it ended.
   if [ -n "${setup_pid:-}" ]; then
-    wait "$setup_pid" 2>/dev/null || true
+    echo "== waiting for the tests' set-up to finish ($setup_log) before exiting" >&2
+    local setup_rc=0
+    wait "$setup_pid" 2>/dev/null || setup_rc=$?
+    tail -n 20 "$setup_log" >&2 || true
+    echo "== the set-up exited $setup_rc" >&2
   fi
   if [ -z "$skips_printed" ]; then
     collect_skips || true
