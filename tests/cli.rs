@@ -1101,6 +1101,18 @@ fn render_writes_png_and_exr_and_reports_timing_as_json() {
     assert!(v["ms_per_frame_min"].as_f64().unwrap() <= v["ms_per_frame_median"].as_f64().unwrap());
     assert!(["gpu-timestamps", "wall-clock"].contains(&v["timing_source"].as_str().unwrap()));
     assert!(!v["adapter"].as_str().unwrap().is_empty());
+    // What scripts/memory-peaks.sh reads: the process's peak (a lavapipe process holds tens
+    // of MB at least, and this one rendered under 2 GB) beside the plan's estimate, whose
+    // budget is the default --memory-budget.
+    let peak = v["peak_rss_bytes"].as_u64().expect("peak_rss_bytes");
+    assert!((10_000_000..2_000_000_000).contains(&peak), "{peak}");
+    let estimate = &v["memory_estimate"];
+    assert!(
+        estimate["gpu_bytes"].as_u64().unwrap() > 64 * 36 * 16,
+        "{estimate}"
+    );
+    assert!(estimate["host_bytes"].as_u64().unwrap() > 0, "{estimate}");
+    assert_eq!(estimate["budget_bytes"], 2u64 << 30);
     assert!(png.is_file() && png.with_extension("exr").is_file());
     let img = mirrorbox_image::read_image(&png.with_extension("exr")).unwrap();
     assert_eq!((img.width, img.height), (64, 36));
