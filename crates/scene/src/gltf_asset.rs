@@ -151,6 +151,18 @@ pub fn load_gltf_reusing(
     } else {
         (bytes, None)
     };
+    // The version first, from `asset` alone: a glTF 1.0 file (its `scenes` and `accessors`
+    // objects, not arrays) would fail the 2.0 schema below before its version was read.
+    if let Ok(VersionHead {
+        asset:
+            Some(VersionFields {
+                version: Some(version),
+                min_version,
+            }),
+    }) = serde_json::from_slice(&json)
+    {
+        check_version(&version, min_version.as_deref())?;
+    }
     // serde_path_to_error: a wrong type is named by its field path, as the scene file's are.
     let mut de = serde_json::Deserializer::from_slice(&json);
     let root: gltf::json::Root = serde_path_to_error::deserialize(&mut de).map_err(|e| {
@@ -181,7 +193,6 @@ pub fn load_gltf_reusing(
             ),
         ));
     }
-    check_version(&root.asset)?;
     // The gltf crate's validator indexes the POSITION accessor before checking that it exists
     // (gltf-json 1.4.1, mesh.rs:151): a reference past the accessors would panic there.
     for (m, mesh) in root.meshes.iter().enumerate() {
@@ -252,11 +263,25 @@ pub fn load_gltf_reusing(
     Ok(reader.asset)
 }
 
+/// A glTF file's `asset.version` and `asset.minVersion`, read before the rest (every other
+/// field skipped unparsed).
+#[derive(serde::Deserialize)]
+struct VersionHead {
+    asset: Option<VersionFields>,
+}
+
+#[derive(serde::Deserialize)]
+struct VersionFields {
+    version: Option<String>,
+    #[serde(rename = "minVersion")]
+    min_version: Option<String>,
+}
+
 /// The glTF versions read: 2.x, as the specification's "Versioning" asks of a 2.0 loader. An
 /// asset whose `minVersion` is given loads only where that version is supported (2.0); one
 /// without loads when its `version`'s major is 2, whatever its minor (a minor version adds
 /// only what a 2.0 loader may ignore). Both are `<major>.<minor>`.
-fn check_version(asset: &gltf::json::Asset) -> Result<()> {
+fn check_version(version: &str, min_version: Option<&str>) -> Result<()> {
     let parse = |field: &str, text: &str| -> Result<(u32, u32)> {
         text.split_once('.')
             .filter(|(m, n)| {
@@ -272,8 +297,8 @@ fn check_version(asset: &gltf::json::Asset) -> Result<()> {
                 )
             })
     };
-    let (major, _) = parse("asset.version", &asset.version)?;
-    if let Some(min) = &asset.min_version {
+    let (major, _) = parse("asset.version", version)?;
+    if let Some(min) = min_version {
         if parse("asset.minVersion", min)? != (2, 0) {
             return Err(err(
                 "asset.minVersion",
@@ -284,8 +309,8 @@ fn check_version(asset: &gltf::json::Asset) -> Result<()> {
         return Err(err(
             "asset.version",
             format!(
-                "is \"{}\": mirrorbox reads glTF 2.x (glTF 1.0 files convert with gltf-pipeline)",
-                asset.version
+                "is \"{version}\": mirrorbox reads glTF 2.x (glTF 1.0 files convert with \
+                 gltf-pipeline)"
             ),
         ));
     }
@@ -1198,6 +1223,30 @@ fn percent_decode(uri: &str) -> Option<String> {
 mod tests {
     use super::*;
 
+    /// Small budgets, the first scene, no transform.
+    fn small_options() -> GltfOptions {
+        GltfOptions {
+            scene: None,
+            triangle_budget: 1 << 10,
+            texel_budget: 1 << 10,
+            transform: Mat4::IDENTITY,
+            curved_mirrors: CurvedMirrors::Refuse,
+        }
+    }
+
+    /// A glTF of one triangle (three positions in a data URI), with `asset` as given and
+    /// `accessor` (more fields of its POSITION accessor, each with a trailing comma).
+    fn one_triangle(asset: &str, accessor: &str) -> String {
+        format!(
+            r#"{{"asset": {asset}, "scenes": [{{"nodes": [0]}}], "nodes": [{{"mesh": 0}}],
+            "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0}}}}]}}],
+            "accessors": [{{{accessor} "bufferView": 0, "componentType": 5126, "count": 3,
+                            "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}}],
+            "bufferViews": [{{"buffer": 0, "byteLength": 36}}],
+            "buffers": [{{"uri": "data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA", "byteLength": 36}}]}}"#
+        )
+    }
+
     #[test]
     fn a_planar_rectangle_is_a_mirror_and_other_shapes_are_not() {
         let (p, q, r, s) = (
@@ -1233,13 +1282,7 @@ mod tests {
     fn only_gltf_2_loads() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("v.gltf");
-        let options = GltfOptions {
-            scene: None,
-            triangle_budget: 1 << 10,
-            texel_budget: 1 << 10,
-            transform: Mat4::IDENTITY,
-            curved_mirrors: CurvedMirrors::Refuse,
-        };
+        let options = small_options();
         for (asset, refused) in [
             (r#"{"version": "2.0"}"#, None),
             (r#"{"version": "2.1"}"#, None),
@@ -1257,18 +1300,7 @@ mod tests {
                 Some("asset.minVersion"),
             ),
         ] {
-            std::fs::write(
-                &path,
-                format!(
-                    r#"{{"asset": {asset}, "scenes": [{{"nodes": [0]}}], "nodes": [{{"mesh": 0}}],
-                    "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0}}}}]}}],
-                    "accessors": [{{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
-                                    "min": [0, 0, 0], "max": [1, 1, 0]}}],
-                    "bufferViews": [{{"buffer": 0, "byteLength": 36}}],
-                    "buffers": [{{"uri": "data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA", "byteLength": 36}}]}}"#
-                ),
-            )
-            .unwrap();
+            std::fs::write(&path, one_triangle(asset, "")).unwrap();
             match (load_gltf(&path, &options), refused) {
                 (Ok(_), None) => {}
                 (Err(e), Some(field)) => {
@@ -1278,6 +1310,22 @@ mod tests {
                 (r, _) => panic!("{asset}: {:?}", r.map(|_| "loaded")),
             }
         }
+        // A glTF 1.0 file, whose top-level items are objects keyed by name, not arrays: its
+        // version is read before the 2.0 schema would refuse its shape.
+        std::fs::write(
+            &path,
+            r#"{"asset": {"version": "1.0"}, "scene": "main",
+                "scenes": {"main": {"nodes": ["a"]}}, "nodes": {"a": {"meshes": []}}}"#,
+        )
+        .unwrap();
+        let e = load_gltf(&path, &options)
+            .err()
+            .expect("refused")
+            .to_string();
+        assert!(
+            e.contains("asset.version") && e.contains("gltf-pipeline"),
+            "{e}"
+        );
     }
 
     #[test]
@@ -1303,23 +1351,13 @@ mod tests {
         ] {
             std::fs::write(
                 &path,
-                format!(
-                    r#"{{"asset": {{"version": "2.0"}}, "scenes": [{{"nodes": [0]}}], "nodes": [{{"mesh": 0}}],
-                    "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0}}}}]}}],
-                    "accessors": [{{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
-                                    "min": [0, 0, 0], "max": [1, 1, 0], "byteOffset": {offset}}}],
-                    "bufferViews": [{{"buffer": 0, "byteLength": 36}}],
-                    "buffers": [{{"uri": "data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA", "byteLength": 36}}]}}"#
+                one_triangle(
+                    r#"{"version": "2.0"}"#,
+                    &format!(r#""byteOffset": {offset},"#),
                 ),
             )
             .unwrap();
-            let options = GltfOptions {
-                scene: None,
-                triangle_budget: 1 << 10,
-                texel_budget: 1 << 10,
-                transform: Mat4::IDENTITY,
-                curved_mirrors: CurvedMirrors::Refuse,
-            };
+            let options = small_options();
             let e = load_gltf(&path, &options).err().expect("refused");
             assert!(e.to_string().contains(field), "{offset}: {e}");
         }
