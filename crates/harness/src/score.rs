@@ -129,10 +129,12 @@ fn picture_hint(truth: &Path, image: &Path) -> Result<Option<String>, HarnessErr
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
     let decoded = is_exr.then(|| distance(&|i| p.pixels[i].map(mirrorbox_image::srgb::decode)));
-    // Decoding darkens every value, so it brings any picture brighter than a dark truth
-    // nearer, a flat grey one as well: only a decoded picture within half the distance of
-    // the nearest flat picture (the mean absolute deviation from the truth's per-channel
-    // medians) shows the truth's structure, which a renderer's sRGB-encoded output keeps.
+    // Decoding darkens every value in (0, 1), so it brings any picture brighter than a dark
+    // truth nearer, a flat grey one as well: only a decoded picture within half the distance
+    // of the nearest flat picture (the mean absolute deviation from the truth's per-channel
+    // medians) shows the truth's structure, which a renderer's sRGB-encoded output keeps. A
+    // flat truth has no structure to keep (that distance is 0): there, decoding must bring
+    // the picture ten thousand times nearer.
     let flat = || {
         let mut sum = 0.0;
         for c in 0..3 {
@@ -156,7 +158,7 @@ fn picture_hint(truth: &Path, image: &Path) -> Result<Option<String>, HarnessErr
         ))
     } else {
         decoded
-            .filter(|&d| given > HINT_FACTOR * d && d < 0.5 * flat())
+            .filter(|&d| given > HINT_FACTOR * d && (d < 0.5 * flat() || d <= 1e-4 * given))
             .map(|d| {
                 format!(
                     "{name}: sRGB-encoded? Decoded from sRGB it is {:.1}× nearer the truth; an EXR \
@@ -1316,6 +1318,10 @@ mod tests {
         assert!(hint.is_some_and(|h| h.contains("sRGB-encoded?")));
         let grey = image(&|_, _| [0.025, 0.02, 0.03].map(mirrorbox_image::srgb::encode));
         assert_eq!(picture_hint(&t, &save("grey.exr", &grey)).unwrap(), None);
+        // A flat truth, and that grey picture exactly its encoding: said.
+        let flat = save("flat.exr", &image(&|_, _| [0.025, 0.02, 0.03]));
+        let hint = picture_hint(&flat, &save("grey.exr", &grey)).unwrap();
+        assert!(hint.is_some_and(|h| h.contains("sRGB-encoded?")));
     }
 
     fn schema(name: &str) -> serde_json::Value {
