@@ -169,7 +169,23 @@ fn about(folder: &str) -> Option<String> {
                 .find_map(|s| name.strip_suffix(s))?;
         }
     };
-    about_folder(folder).or_else(on_a_gpu).or_else(run_of)
+    // Another sweep of an experiment whose script names its folders after its own
+    // (`web_engines_room`: `web_engines` with `_room`), the longest such prefix.
+    let named_after = || {
+        let mut name = folder;
+        loop {
+            let (prefix, _) = name.rsplit_once('_')?;
+            if let Some(a) = about_folder(prefix) {
+                let rest = &folder[prefix.len() + 1..];
+                return Some(format!("{a}: its `{rest}` sweep"));
+            }
+            name = prefix;
+        }
+    };
+    about_folder(folder)
+        .or_else(on_a_gpu)
+        .or_else(run_of)
+        .or_else(named_after)
 }
 
 /// [`about`] of a folder the registry's rows name as they are.
@@ -220,6 +236,13 @@ mod tests {
             "{other}"
         );
         assert_eq!(about("mine/sweep"), None);
+        // A sweep named after an experiment's folder: that experiment's.
+        let web = about("web_engines").unwrap();
+        assert_eq!(
+            about("web_engines_room").unwrap(),
+            format!("{web}: its `room` sweep")
+        );
+        assert_eq!(about("nothing_like_it"), None);
     }
 
     /// A report's footer names its records' commit by the first seven hex digits of its hash,
