@@ -508,10 +508,7 @@ fn stereo(reports: &Path) -> Result<String, ReadmeError> {
 /// Ignoring mirrored light, as today's raster does, against truths lit through k mirrors.
 fn lighting(reports: &Path) -> Result<String, ReadmeError> {
     let s = load(reports, "lighting")?;
-    let sentences = crate::lighting::section::sentences(&s.records);
-    let grows = sentences
-        .iter()
-        .find(|t| t.starts_with("The error of ignoring mirrored light"))
+    let grows = crate::lighting::section::growth(&s.records)
         .ok_or_else(|| ReadmeError("reports/lighting holds no k sweep of lights=direct".into()))?;
     Ok(format!(
         "**Light through mirrors matters** (FLIP over the image): {} ({}, {}, {}; [figure](lighting/plot_lighting_error_vs_k.svg)).",

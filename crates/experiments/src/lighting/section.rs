@@ -134,7 +134,16 @@ pub fn sentences(records: &[Record]) -> Vec<String> {
             out.push(format!("`{method}`, {v}: {}.", describe(r)));
         }
     }
-    // How the error of ignoring mirrored light grows with k.
+    out.extend(growth(records));
+    out
+}
+
+/// How the error of ignoring mirrored light grows with k (`sentences`' last, and the
+/// overview's lighting finding): the first depth with mirrored light to miss against the
+/// shallowest, then the deepest; `None` without such a k sweep of `lights=direct`.
+pub fn growth(records: &[Record]) -> Option<String> {
+    let points = lit_points(records);
+    let method = reference_method(&points)?;
     let direct: Vec<&Record> = {
         let mut d: Vec<&Record> = points
             .iter()
@@ -153,7 +162,7 @@ pub fn sentences(records: &[Record]) -> Vec<String> {
         let lit = points.iter().copied().find(|r| {
             method_of(r) == method && k(r) == k(second) && lighting_of(r) == "mirrored, no shadows"
         });
-        out.push(format!(
+        return Some(format!(
             "The error of ignoring mirrored light (`{method}` with `lights=direct`, no shadows) \
              appears at the first mirrored depth: FLIP mean {} at k = {} (no mirrored light to \
              miss: what is left is the shadows), {} at k = {}{}{}.",
@@ -172,7 +181,7 @@ pub fn sentences(records: &[Record]) -> Vec<String> {
             }
         ));
     }
-    out
+    None
 }
 
 /// The report section of a mirrored-lights sweep (empty for any other sweep).
