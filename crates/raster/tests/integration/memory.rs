@@ -128,6 +128,7 @@ fn scene(name: &str, w: u32, h: u32) -> Scene {
 #[test]
 fn gpu_estimate_bounds_wgpus_counters_for_every_method() {
     let mut rows = Vec::new();
+    let mut refused = Vec::new();
     // Each scene at its own light-image depth, but the lit room at 3 (40 images), not its 8
     // (477): its `cubemap` and `ssr` frames with shadow maps took 5–6.5 s each, 24 of this
     // test's 30 s. `mirror_box_lit` keeps 8-deep chains.
@@ -169,7 +170,7 @@ fn gpu_estimate_bounds_wgpus_counters_for_every_method() {
                     Ok(p) => p,
                     Err(e) => {
                         // A refused configuration (too many passes …) builds nothing.
-                        rows.push(format!("{name} {} {shadows}: refused ({e})", entry.name));
+                        refused.push(format!("{name} {} {shadows}: refused ({e})", entry.name));
                         continue;
                     }
                 };
@@ -186,6 +187,21 @@ fn gpu_estimate_bounds_wgpus_counters_for_every_method() {
         }
     }
     println!("{}", rows.join("\n"));
+    // Every other row measured: a refused plan drops its row, and a refusal that crept in
+    // (the lit room's shadow maps, the largest estimates, say) would go unseen. Refused by
+    // design: `ray-query` with shadow maps (it traces its shadow legs), and `path-textures`
+    // in the lit room (over --max-passes).
+    let expected = |r: &String| {
+        (r.contains(" ray-query map: ") && r.contains("--shadows must be none for ray-query"))
+            || (r.starts_with("mirror_room_lit.json path-textures ")
+                && r.contains("scene passes per frame"))
+    };
+    let unexpected: Vec<&String> = refused.iter().filter(|r| !expected(r)).collect();
+    assert!(
+        unexpected.is_empty(),
+        "refused, so not measured: {unexpected:#?}"
+    );
+    assert_eq!(refused.len(), 4, "{refused:#?}");
 }
 
 /// A stereo pair (each eye its own frame, or `--stereo-mirrors shared`'s joint frame).

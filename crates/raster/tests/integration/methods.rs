@@ -72,14 +72,37 @@ pub(crate) fn dump(name: &str, actual: &RgbImage, expected: &RgbImage) -> String
     format!("images written to {}", dir.display())
 }
 
-/// Per-pixel largest channel difference.
+/// Per-pixel largest channel difference; a NaN on either side is infinitely far (`f32::max`
+/// would drop it, and a NaN pixel count as equal).
 pub(crate) fn differences(a: &RgbImage, b: &RgbImage) -> Vec<f32> {
     assert_eq!((a.width, a.height), (b.width, b.height));
     a.pixels
         .iter()
         .zip(&b.pixels)
-        .map(|(p, q)| (0..3).map(|c| (p[c] - q[c]).abs()).fold(0.0, f32::max))
+        .map(|(p, q)| {
+            (0..3)
+                .map(|c| {
+                    let d = (p[c] - q[c]).abs();
+                    if d.is_nan() { f32::INFINITY } else { d }
+                })
+                .fold(0.0, f32::max)
+        })
         .collect()
+}
+
+/// A NaN pixel is as far from anything as can be: the checks built on [`differences`]
+/// cannot pass on a NaN image.
+#[test]
+fn a_nan_pixel_differs_infinitely() {
+    let image = |p: [f32; 3]| RgbImage {
+        width: 1,
+        height: 1,
+        pixels: vec![p],
+    };
+    let (nan, one) = (image([1.0, f32::NAN, 1.0]), image([1.0; 3]));
+    assert_eq!(differences(&nan, &one), vec![f32::INFINITY]);
+    assert_eq!(differences(&one, &nan), vec![f32::INFINITY]);
+    assert_eq!(differences(&one, &one), vec![0.0]);
 }
 
 /// Golden comparison on the 8-bit sRGB images. Tolerance: rasterizers may differ on samples

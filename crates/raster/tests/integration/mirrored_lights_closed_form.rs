@@ -287,7 +287,9 @@ fn worst_error(case: &Case, image: &RgbImage, s: u32) -> (f64, u32, u32) {
             let expected = closed_form_pixel(case, x, y, s);
             for c in image.get(x, y) {
                 let e = (f64::from(c) - expected).abs() / expected;
-                if e > worst.0 {
+                // A NaN (or an infinite value) is the worst error there is.
+                let e = if e.is_finite() { e } else { f64::INFINITY };
+                if e > worst.0 || (e.is_infinite() && worst.0.is_finite()) {
                     worst = (e, x, y);
                 }
             }
