@@ -396,6 +396,11 @@ fn timing_commands_turn_mesas_shader_cache_off_unless_told_otherwise() {
             String::from_utf8_lossy(&out.stderr)
         );
         let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+        // Mesa's software drivers name themselves in the adapter (llvmpipe: lavapipe's
+        // device and GL's): there Mesa must be reported, or the test would pass by its
+        // absence.
+        let software_mesa = v["name"].as_str().is_some_and(|a| a.contains("llvmpipe"));
+        assert!(!software_mesa || v["mesa"].is_string(), "{v}");
         (
             v["mesa"].is_string(),
             v["shader_cache"].as_str().map(str::to_string),
