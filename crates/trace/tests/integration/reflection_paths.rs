@@ -49,6 +49,19 @@ fn whitted_for(s: &Scene) -> (SceneBvh, WhittedSettings) {
     (SceneBvh::build(&s.geometry), settings)
 }
 
+/// Whether the convex polygon `poly` (either winding) holds `p`, or lies within `tolerance`
+/// of it.
+fn holds(poly: &[Vec2], p: Vec2, tolerance: f32) -> bool {
+    let edges = || poly.iter().zip(poly.iter().cycle().skip(1));
+    let area: f32 = edges().map(|(a, b)| a.perp_dot(*b)).sum();
+    poly.len() >= 3
+        && edges().all(|(a, b)| {
+            let edge = *b - *a;
+            area.signum() * edge.perp_dot(p - *a) / edge.length().max(f32::MIN_POSITIVE)
+                >= -tolerance
+        })
+}
+
 /// Every pixel centre's traced mirror sequence is a kept path whose portal holds the pixel:
 /// no path the rasterizer needs is missing.
 #[test]
@@ -62,10 +75,16 @@ fn every_traced_mirror_sequence_is_a_kept_path() {
         for x in 0..s.camera.width {
             let centre = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
             let seen = traced_mirrors(&s, &whitted, centre);
-            let found = set.paths.iter().any(|p| p.mirrors == seen);
+            let found = set.paths.iter().find(|p| p.mirrors == seen);
+            let Some(path) = found else {
+                panic!("pixel ({x}, {y}) meets mirrors {seen:?}, which no kept path follows");
+            };
+            // Its portal holds the pixel centre, within a hundredth of a pixel (the
+            // portal's corners are projected in f32).
             assert!(
-                found,
-                "pixel ({x}, {y}) meets mirrors {seen:?}, which no kept path follows"
+                path.mirrors.is_empty() || holds(&path.portal, centre, 0.01),
+                "pixel ({x}, {y}): the path {seen:?}'s portal {:?} does not hold it",
+                path.portal
             );
             checked += usize::from(!seen.is_empty());
         }
