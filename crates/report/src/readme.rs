@@ -581,19 +581,30 @@ mod tests {
         );
     }
 
-    #[test]
-    fn job_costs_name_both_commands_and_their_longest_steps() {
+    /// The job-costs region of a reports folder holding a main job of 300 s and a test job
+    /// of `seconds` with these `steps` (a JSON array).
+    fn job_costs_of(seconds: u64, steps: &str) -> String {
         let dir = tempfile::tempdir().unwrap();
         main_job(dir.path(), 300);
         std::fs::create_dir(dir.path().join("tests")).unwrap();
         std::fs::write(
             dir.path().join(TEST_JOB),
-            r#"{"date":"2026-11-23T10:00:00Z","cpu":"a test CPU","cargo_cache":"empty","seconds":60,
-               "steps":[{"name":"a","seconds":5},{"name":"build","seconds":40},
-                        {"name":"b","seconds":3},{"name":"tests","seconds":12}]}"#,
+            format!(
+                r#"{{"date":"2026-11-23T10:00:00Z","cpu":"a test CPU","cargo_cache":"empty",
+                    "seconds":{seconds},"steps":{steps}}}"#
+            ),
         )
         .unwrap();
-        let text = generate("job-costs", dir.path(), REGIONS).unwrap().text;
+        generate("job-costs", dir.path(), REGIONS).unwrap().text
+    }
+
+    #[test]
+    fn job_costs_name_both_commands_and_their_longest_steps() {
+        let text = job_costs_of(
+            60,
+            r#"[{"name":"a","seconds":5},{"name":"build","seconds":40},
+                {"name":"b","seconds":3},{"name":"tests","seconds":12}]"#,
+        );
         assert!(text.contains(
             "| `scripts/test.sh` | the tests | 2026-11-23, a test CPU, empty cargo cache | **60** | `build` 40 s; `tests` 12 s; 2 other steps 8 s |"
         ), "{text}");
@@ -604,19 +615,13 @@ mod tests {
     /// added to the rest: their seconds overlap the build's.
     #[test]
     fn set_up_steps_during_the_build_are_summed_apart() {
-        let dir = tempfile::tempdir().unwrap();
-        main_job(dir.path(), 300);
-        std::fs::create_dir(dir.path().join("tests")).unwrap();
-        std::fs::write(
-            dir.path().join(TEST_JOB),
-            r#"{"date":"2026-11-23T10:00:00Z","cpu":"a test CPU","cargo_cache":"empty","seconds":55,
-               "steps":[{"name":"a","seconds":1},{"name":"build","seconds":40},
-                        {"name":"npm","seconds":30,"during_build":true},
-                        {"name":"pip","seconds":9,"during_build":true},
-                        {"name":"b","seconds":2},{"name":"tests","seconds":12}]}"#,
-        )
-        .unwrap();
-        let text = generate("job-costs", dir.path(), REGIONS).unwrap().text;
+        let text = job_costs_of(
+            55,
+            r#"[{"name":"a","seconds":1},{"name":"build","seconds":40},
+                {"name":"npm","seconds":30,"during_build":true},
+                {"name":"pip","seconds":9,"during_build":true},
+                {"name":"b","seconds":2},{"name":"tests","seconds":12}]"#,
+        );
         assert!(text.contains(
             "| **55** | `build` 40 s; `tests` 12 s; 2 other steps 3 s; 2 set-up steps 39 s during the build |"
         ), "{text}");
