@@ -89,6 +89,26 @@ fn every_method(gpu: &Gpu, scene: &Scene, truth: &mut Truth, label: &str) -> Vec
         .collect()
 }
 
+/// Every registered method's render of `scene` at its defaults, in the registry's order.
+pub(crate) fn every_render(gpu: &Gpu, scene: &Scene, label: &str) -> Vec<RgbImage> {
+    mirrorbox_raster::METHODS
+        .iter()
+        .map(|entry| {
+            let method = Method::defaults(entry);
+            render(gpu, scene, &settings(method.clone(), 1))
+                .unwrap_or_else(|e| panic!("{label} {method}: {e}"))
+                .image
+        })
+        .collect()
+}
+
+/// What a scene looks like without the asset it was made to show: every method's render of
+/// it ([`every_render`]), and its truth at any depth.
+pub(crate) struct Without<'a, 'b> {
+    pub renders: &'a [RgbImage],
+    pub truth: &'a mut Truth<'b>,
+}
+
 /// The bounds every method is held to against the truth at its depth: the largest share of
 /// pixels off (by more than [`OFF_BY`]) and the largest FLIP mean.
 pub(crate) struct Bounds {
@@ -98,25 +118,42 @@ pub(crate) struct Bounds {
     pub inexact: &'static [(&'static str, f64, f64)],
 }
 
-/// Every registered method on `scene` (see [`every_method`]) held to `bounds`: the summary
-/// line of the errors measured, and a message for each bound exceeded (its images written).
+/// Every registered method on `scene` (see [`every_method`]) held to `bounds`, and to
+/// drawing the asset: its image differs from its render of the scene `without` the asset on
+/// at least half as many pixels as the truth at its depth does (a bound of a share of pixels
+/// off, set by the worst asset, would let a method leave a small asset out). The summary line of the
+/// errors measured, and a message for each bound exceeded (its images written).
 pub(crate) fn check_every_method(
     gpu: &Gpu,
     scene: &Scene,
     truth: &mut Truth,
     label: &str,
     bounds: &Bounds,
+    without: &mut Without,
 ) -> (String, Vec<String>) {
     let mut line = String::new();
     let mut failures = Vec::new();
-    for e in every_method(gpu, scene, truth, label) {
+    for (e, bare) in every_method(gpu, scene, truth, label)
+        .into_iter()
+        .zip(without.renders)
+    {
+        let drawn = pixels_off(&e.image, bare);
+        let seen = pixels_off(truth.at(e.depth), without.truth.at(e.depth));
         line += &format!(
-            "; {} (depth {}) {:.2} % off, FLIP {:.2e}",
+            "; {} (depth {}) {:.2} % off, FLIP {:.2e}, drawn {:.2}× the truth's",
             e.name,
             e.depth,
             100.0 * e.off_share,
-            e.flip
+            e.flip,
+            drawn as f64 / seen.max(1) as f64
         );
+        if drawn * 2 < seen {
+            failures.push(format!(
+                "{label} {}: its image changes on {drawn} pixels with the asset, the truth's \
+                 at depth {} on {seen}: the asset is not drawn",
+                e.method, e.depth
+            ));
+        }
         let (off_bound, flip_bound) = if e.exact {
             bounds.exact
         } else {

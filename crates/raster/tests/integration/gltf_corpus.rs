@@ -204,7 +204,7 @@ const BOUNDS: Bounds = Bounds {
 /// within [`BOUNDS`] — the engine (a real CAD mesh, 110 k triangles) included.
 #[test]
 fn every_real_gltf_traces_and_renders_with_every_method() {
-    use crate::against_truth::{Truth, check_every_method, pixels_off};
+    use crate::against_truth::{Truth, Without, check_every_method, every_render, pixels_off};
     if !corpus_present() {
         return;
     }
@@ -226,7 +226,8 @@ fn every_real_gltf_traces_and_renders_with_every_method() {
             truth.at(8).pixels.iter().flatten().all(|c| c.is_finite()),
             "{rel}"
         );
-        let seen = pixels_off(truth.at(8), &trace_depth(&bare, 8)) as f64 / n;
+        let mut bare_truth = Truth::new(&bare);
+        let seen = pixels_off(truth.at(8), bare_truth.at(8)) as f64 / n;
         if seen < SEEN_SHARE {
             failures.push(format!(
                 "{rel}: seen on {:.2} % of pixels, under {} %",
@@ -234,7 +235,12 @@ fn every_real_gltf_traces_and_renders_with_every_method() {
                 100.0 * SEEN_SHARE
             ));
         }
-        let (errors, failed) = check_every_method(&gpu, &s, &mut truth, rel, &BOUNDS);
+        let bare_renders = every_render(&gpu, &bare, rel);
+        let mut without = Without {
+            renders: &bare_renders,
+            truth: &mut bare_truth,
+        };
+        let (errors, failed) = check_every_method(&gpu, &s, &mut truth, rel, &BOUNDS, &mut without);
         println!("{rel}: seen on {:.1} % of pixels{errors}", 100.0 * seen);
         failures.extend(failed);
     }

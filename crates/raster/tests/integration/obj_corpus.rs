@@ -237,7 +237,7 @@ const BOUNDS: Bounds = Bounds {
 /// file's truth at 384×216 into DIR, to look at.
 #[test]
 fn every_obj_that_loads_is_seen_and_every_method_draws_it_as_the_truth() {
-    use crate::against_truth::{Truth, check_every_method, pixels_off};
+    use crate::against_truth::{Truth, Without, check_every_method, every_render, pixels_off};
     use mirrorbox_raster::Gpu;
     if !corpus_present() {
         return;
@@ -245,7 +245,8 @@ fn every_obj_that_loads_is_seen_and_every_method_draws_it_as_the_truth() {
     let gpu = Gpu::new().unwrap();
     let mut bare = mirrorbox_scene::load::bundled_scene("mirror_box.json");
     bare.camera = bare.camera.with_size(SIZE.0, SIZE.1);
-    let bare_truth = crate::methods::trace_depth(&bare, 8);
+    let mut bare_truth = Truth::new(&bare);
+    let bare_renders = every_render(&gpu, &bare, "mirror_box");
     let n = (SIZE.0 * SIZE.1) as f64;
     let png_dir = std::env::var_os("MIRRORBOX_CORPUS_PNG");
     let mut failures = Vec::new();
@@ -263,7 +264,7 @@ fn every_obj_that_loads_is_seen_and_every_method_draws_it_as_the_truth() {
             mirrorbox_image::write_png(&Path::new(dir).join(name), &image, 1.0).unwrap();
         }
         let mut truth = Truth::new(&scene);
-        let seen = pixels_off(truth.at(8), &bare_truth) as f64 / n;
+        let seen = pixels_off(truth.at(8), bare_truth.at(8)) as f64 / n;
         if seen < SEEN_SHARE {
             failures.push(format!(
                 "{rel}: seen on {:.2} % of pixels, under {} %: not where the test placed it",
@@ -271,7 +272,12 @@ fn every_obj_that_loads_is_seen_and_every_method_draws_it_as_the_truth() {
                 100.0 * SEEN_SHARE
             ));
         }
-        let (errors, failed) = check_every_method(&gpu, &scene, &mut truth, rel, &BOUNDS);
+        let mut without = Without {
+            renders: &bare_renders,
+            truth: &mut bare_truth,
+        };
+        let (errors, failed) =
+            check_every_method(&gpu, &scene, &mut truth, rel, &BOUNDS, &mut without);
         let line = format!("{rel}: seen on {:.1} % of pixels{errors}", 100.0 * seen);
         failures.extend(failed);
         println!("{line}");
