@@ -13,11 +13,13 @@
 //! same render in a process of its own: a pipeline's first compilation, with Mesa's shader
 //! cache empty, falls in the first scene's rows only. But the later rows show what 168
 //! renders in one process keep (about 480 MB at 32×18 on lavapipe, against the 115-255 MB
-//! of a process each in the committed table), far more than those transients. One process, not 168: 168 `render` processes of
-//! the debug binary took 61 s of wall time and 89 s of CPU with Mesa's shader cache empty
-//! (a fresh machine), 23 s and 40 s with it warm; one process 45 s and 48 s, 10 s and 13 s.
-//! An adapter per render, as each process opens one, cost 80 ms each and the pipelines'
-//! creation again (23 s warm); one per scene, 17 s (docs/budgets.md).
+//! of a process each in the committed table), far more than those transients.
+//!
+//! One process, not 168: 168 `render` processes of the debug binary took 61 s of wall time
+//! and 89 s of CPU with Mesa's shader cache empty (a fresh machine), 23 s and 40 s with it
+//! warm; one process 45 s and 48 s, 10 s and 13 s. An adapter per render, as each process
+//! opens one, cost 80 ms each and the pipelines' creation again (23 s warm); one per scene,
+//! 17 s (docs/budgets.md).
 
 use crate::common::repo;
 use mirrorbox_raster::{DEFAULT_MEMORY_BUDGET, Gpu, Method, RenderSettings, plan_frame};
@@ -140,10 +142,11 @@ fn peaks() {
     if opened > PEAK_LIMIT {
         over.push(format!("opening the adapter: {} MB", mb(opened)));
     }
-    for scene in scenes() {
+    let scenes = scenes();
+    for scene in &scenes {
         let name = scene.file_stem().unwrap().to_string_lossy().to_string();
         for entry in mirrorbox_raster::METHODS {
-            match render(&gpu, &scene, Method::defaults(entry), resets) {
+            match render(&gpu, scene, Method::defaults(entry), resets) {
                 Outcome::Rendered { peak, estimate } => {
                     rendered += 1;
                     table.push_str(&format!(
@@ -170,7 +173,7 @@ fn peaks() {
     println!("{table}(written to {})", path.display());
     // Most combinations render: a plan that refused everything would pass hollow.
     assert!(
-        rendered * 10 >= scenes().len() * mirrorbox_raster::METHODS.len() * 9,
+        rendered * 10 >= scenes.len() * mirrorbox_raster::METHODS.len() * 9,
         "{table}"
     );
     assert!(over.is_empty(), "peaks above 2 GB: {over:?}");
