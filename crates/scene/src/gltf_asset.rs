@@ -151,31 +151,39 @@ pub fn load_gltf_reusing(
     } else {
         (bytes, None)
     };
-    // The version first, from `asset` alone: a glTF 1.0 file (its `scenes` and `accessors`
-    // objects, not arrays) would fail the 2.0 schema below before its version was read.
-    if let Ok(VersionHead {
-        asset:
-            Some(VersionFields {
-                version: Some(version),
-                min_version,
-            }),
-    }) = serde_json::from_slice(&json)
-    {
-        check_version(&version, min_version.as_deref())?;
-    }
     // serde_path_to_error: a wrong type is named by its field path, as the scene file's are.
     let mut de = serde_json::Deserializer::from_slice(&json);
-    let root: gltf::json::Root = serde_path_to_error::deserialize(&mut de).map_err(|e| {
-        let field = e.path().to_string();
-        let inner = e.into_inner();
-        let message = format!(
-            "{} (line {}, column {} of the JSON)",
-            crate::load::strip_position(&inner.to_string()),
-            inner.line(),
-            inner.column()
-        );
-        err(if field == "." { String::new() } else { field }, message)
-    })?;
+    let root: gltf::json::Root = match serde_path_to_error::deserialize(&mut de) {
+        Ok(root) => root,
+        Err(e) => {
+            // A file of another glTF version (1.0: its `scenes` and `accessors` objects, not
+            // arrays) fails the 2.0 schema: named by its version, read from `asset` alone,
+            // where that is what it is.
+            if let Ok(VersionHead {
+                asset:
+                    Some(VersionFields {
+                        version: Some(version),
+                        min_version,
+                    }),
+            }) = serde_json::from_slice(&json)
+            {
+                check_version(&version, min_version.as_deref())?;
+            }
+            let field = e.path().to_string();
+            let inner = e.into_inner();
+            let message = format!(
+                "{} (line {}, column {} of the JSON)",
+                crate::load::strip_position(&inner.to_string()),
+                inner.line(),
+                inner.column()
+            );
+            return Err(err(
+                if field == "." { String::new() } else { field },
+                message,
+            ));
+        }
+    };
+    check_version(&root.asset.version, root.asset.min_version.as_deref())?;
     // An extension the file requires and mirrorbox does not read refuses it, named (before
     // the validation, which would report its consequences instead: a Draco mesh's missing
     // buffer views).
@@ -263,8 +271,8 @@ pub fn load_gltf_reusing(
     Ok(reader.asset)
 }
 
-/// A glTF file's `asset.version` and `asset.minVersion`, read before the rest (every other
-/// field skipped unparsed).
+/// A glTF file's `asset.version` and `asset.minVersion` alone (every other field skipped
+/// unparsed), read where the file fails the 2.0 schema.
 #[derive(serde::Deserialize)]
 struct VersionHead {
     asset: Option<VersionFields>,
