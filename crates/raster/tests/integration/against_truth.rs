@@ -4,7 +4,7 @@
 
 use crate::methods::{differences, dump, settings};
 use mirrorbox_image::RgbImage;
-use mirrorbox_raster::{Gpu, Method, render};
+use mirrorbox_raster::{Gpu, Method, RenderOutput, render};
 use mirrorbox_scene::Scene;
 use mirrorbox_trace::{SceneBvh, TraceSettings, WhittedSettings};
 use std::collections::HashMap;
@@ -67,8 +67,7 @@ fn every_method(gpu: &Gpu, scene: &Scene, truth: &mut Truth, label: &str) -> Vec
         .iter()
         .map(|entry| {
             let method = Method::defaults(entry);
-            let out = render(gpu, scene, &settings(method.clone(), 1))
-                .unwrap_or_else(|e| panic!("{label} {method}: {e}"));
+            let out = render_at_defaults(gpu, scene, &method, label);
             let depth = out.stats.depth as u32;
             let t = truth.at(depth);
             let off = pixels_off(&out.image, t);
@@ -89,16 +88,17 @@ fn every_method(gpu: &Gpu, scene: &Scene, truth: &mut Truth, label: &str) -> Vec
         .collect()
 }
 
+/// `method` on `scene`, one frame; a method that cannot render it fails the test, naming it.
+fn render_at_defaults(gpu: &Gpu, scene: &Scene, method: &Method, label: &str) -> RenderOutput {
+    render(gpu, scene, &settings(method.clone(), 1))
+        .unwrap_or_else(|e| panic!("{label} {method}: {e}"))
+}
+
 /// Every registered method's render of `scene` at its defaults, in the registry's order.
 pub(crate) fn every_render(gpu: &Gpu, scene: &Scene, label: &str) -> Vec<RgbImage> {
     mirrorbox_raster::METHODS
         .iter()
-        .map(|entry| {
-            let method = Method::defaults(entry);
-            render(gpu, scene, &settings(method.clone(), 1))
-                .unwrap_or_else(|e| panic!("{label} {method}: {e}"))
-                .image
-        })
+        .map(|entry| render_at_defaults(gpu, scene, &Method::defaults(entry), label).image)
         .collect()
 }
 
