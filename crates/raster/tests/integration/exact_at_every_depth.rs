@@ -21,6 +21,7 @@
 //! px over whole regions and fails; what the rasterizer's precision decides is counted and
 //! printed (the floor the reports' exact-method errors sit on).
 
+use crate::methods::largest_difference;
 use glam::Vec3;
 use mirrorbox_image::RgbImage;
 use mirrorbox_raster::plan::PlanError;
@@ -56,17 +57,6 @@ fn truncated(depth: u32) -> WhittedSettings {
         max_depth: depth,
         min_throughput: 1e-4,
     }
-}
-
-/// The largest channel difference; a NaN on either side is infinitely far (`f32::max`
-/// would drop it, and a NaN image pass as equal).
-fn largest_difference(a: [f32; 3], b: [f32; 3]) -> f32 {
-    (0..3)
-        .map(|c| {
-            let d = (a[c] - b[c]).abs();
-            if d.is_nan() { f32::INFINITY } else { d }
-        })
-        .fold(0.0, f32::max)
 }
 
 #[test]

@@ -72,21 +72,24 @@ pub(crate) fn dump(name: &str, actual: &RgbImage, expected: &RgbImage) -> String
     format!("images written to {}", dir.display())
 }
 
-/// Per-pixel largest channel difference; a NaN on either side is infinitely far (`f32::max`
-/// would drop it, and a NaN pixel count as equal).
+/// The largest channel difference of two pixels; a NaN on either side is infinitely far
+/// (`f32::max` would drop it, and a NaN pixel count as equal).
+pub(crate) fn largest_difference(p: [f32; 3], q: [f32; 3]) -> f32 {
+    (0..3)
+        .map(|c| {
+            let d = (p[c] - q[c]).abs();
+            if d.is_nan() { f32::INFINITY } else { d }
+        })
+        .fold(0.0, f32::max)
+}
+
+/// Per-pixel [`largest_difference`].
 pub(crate) fn differences(a: &RgbImage, b: &RgbImage) -> Vec<f32> {
     assert_eq!((a.width, a.height), (b.width, b.height));
     a.pixels
         .iter()
         .zip(&b.pixels)
-        .map(|(p, q)| {
-            (0..3)
-                .map(|c| {
-                    let d = (p[c] - q[c]).abs();
-                    if d.is_nan() { f32::INFINITY } else { d }
-                })
-                .fold(0.0, f32::max)
-        })
+        .map(|(p, q)| largest_difference(*p, *q))
         .collect()
 }
 
