@@ -136,18 +136,12 @@ fn picture_hint(truth: &Path, image: &Path) -> Result<Option<String>, HarnessErr
     // flat truth has no structure to keep (that distance is 0): there, decoding must bring
     // the picture ten thousand times nearer.
     let flat = || {
-        let mut sum = 0.0;
-        for c in 0..3 {
+        let median = [0, 1, 2].map(|c| {
             let mut channel: Vec<f32> = t.pixels.iter().map(|px| px[c]).collect();
             let mid = channel.len() / 2;
-            let median = *channel.select_nth_unstable_by(mid, f32::total_cmp).1;
-            sum += t
-                .pixels
-                .iter()
-                .map(|px| f64::from((px[c] - median).abs()))
-                .sum::<f64>();
-        }
-        sum / (3 * t.pixels.len()).max(1) as f64
+            *channel.select_nth_unstable_by(mid, f32::total_cmp).1
+        });
+        distance(&|_| median)
     };
     let name = image.display();
     Ok(if given > HINT_FACTOR * flipped {
