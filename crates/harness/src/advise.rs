@@ -746,6 +746,8 @@ fn described(r: &Record, metric: Metric) -> String {
 /// The answer in sentences: the pick and its ties, the next better choice, or the closest.
 pub fn sentences(advice: &Advice, metric: Metric, scene: &Path) -> Vec<String> {
     let budget = mirrorbox_report::document::ms(advice.budget_ms, 3);
+    let plural =
+        |n: usize, one: &str, many: &str| format!("{n} {}", if n == 1 { one } else { many });
     let mut out = Vec::new();
     match (&advice.pick, &advice.closest) {
         (Some(p), _) => {
@@ -753,10 +755,7 @@ pub fn sentences(advice: &Advice, metric: Metric, scene: &Path) -> Vec<String> {
                 "Ship {}: the lowest error of the {} measured whose 95 % interval of ms/frame \
                  lies within {budget} ms.",
                 described(p, metric),
-                match advice.measured.len() {
-                    1 => "1 candidate".to_string(),
-                    n => format!("{n} candidates"),
-                }
+                plural(advice.measured.len(), "candidate", "candidates")
             ));
             // A method that builds its picture over frames was scored from a still camera.
             if let Ok(m) = Method::parse(p.method_key())
@@ -854,8 +853,6 @@ pub fn sentences(advice: &Advice, metric: Metric, scene: &Path) -> Vec<String> {
             left.join(", ")
         ));
     }
-    let plural =
-        |n: usize, one: &str, many: &str| format!("{n} {}", if n == 1 { one } else { many });
     out.push(format!(
         "Search cost: {} in {}, {} frames rendered, {:.0} s.",
         plural(advice.measured.len(), "candidate", "candidates"),
