@@ -1449,14 +1449,19 @@ pub fn run_sweep(
     // shown this configuration's points only, and `report` then all of them (the points of
     // an earlier configuration are marked as reused from an earlier run).
     let records = read_records(&results)?;
-    // This run's description; where it measured nothing, with the date and commit of the
-    // run that measured the points (a resumed sweep had stamped them with its own). The rest
-    // is this run's: its command, shard and the methods its adapter left out.
+    // This run's description; where it measured nothing, with the date, commit and machine
+    // of the run that measured the points — its CPU, adapter, driver, Mesa's shader cache
+    // (which moves lavapipe's timings: issue 54) and versions — not this run's (a resumed
+    // sweep had stamped them with its own). The rest is this run's: its command, shard and
+    // the methods its adapter left out.
     let mut info = sweep_info(config, &gpu, (w, h), point_keys, unsupported);
     if summary.computed == 0
         && let Ok(before) = mirrorbox_report::folder::read_sweep_info(out)
     {
         (info.date, info.commit) = (before.date, before.commit);
+        (info.cpu, info.adapter, info.backend) = (before.cpu, before.adapter, before.backend);
+        (info.device_type, info.driver) = (before.device_type, before.driver);
+        (info.shader_cache, info.versions) = (before.shader_cache, before.versions);
     }
     write_atomically(
         &out.join("sweep.json"),
@@ -1894,16 +1899,27 @@ mod tests {
         run_sweep(&config("mirror_box.json", 32, 1, 0.5), false, &mut |_| {}).unwrap();
         let results = out.path().join("sweep/results.jsonl");
         let before = std::fs::read(&results).unwrap();
-        // The same sweep again measures nothing, and keeps the date and commit of the run
-        // that measured its points.
+        // The same sweep again measures nothing, and keeps the date, commit and machine of
+        // the run that measured its points (marked here as another machine's, with Mesa's
+        // shader cache in another state, to tell them from this run's).
         let info = out.path().join("sweep/sweep.json");
-        let described =
+        let mut described =
             mirrorbox_report::folder::read_sweep_info(&info.with_file_name("")).unwrap();
+        described.cpu = "the measuring CPU".into();
+        described.adapter = "the measuring adapter".into();
+        described.driver = "the measuring driver".into();
+        described.shader_cache = "the measuring run's shader cache".into();
+        described.versions = "the measuring versions".into();
+        std::fs::write(&info, serde_json::to_string_pretty(&described).unwrap()).unwrap();
         std::thread::sleep(std::time::Duration::from_millis(1100));
         let again = run_sweep(&config("mirror_box.json", 32, 1, 0.5), false, &mut |_| {}).unwrap();
         assert_eq!(again.computed, 0);
         let now = mirrorbox_report::folder::read_sweep_info(&info.with_file_name("")).unwrap();
-        assert_eq!((now.date, now.commit), (described.date, described.commit));
+        let machine = |i: &SweepInfo| {
+            let fields = [&i.cpu, &i.adapter, &i.driver, &i.shader_cache, &i.versions];
+            (i.date.clone(), i.commit.clone(), fields.map(String::clone))
+        };
+        assert_eq!(machine(&now), machine(&described));
         let mut taller = config("mirror_box.json", 32, 1, 0.5);
         taller.height = Some(20);
         let mut finer = config("mirror_box.json", 32, 1, 0.5);
