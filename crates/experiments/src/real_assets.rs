@@ -165,11 +165,10 @@ fn findings(reports: &Path) -> Result<String, ReadmeError> {
     out += &format!(
         "- **α = 0.7 on the engine:** the exact methods' time {} (`portal`) and {} (`unrolled`) \
          of α = 1's (paired 95 % intervals): reflections fade below the attenuation cut \
-         sooner, so `portal` draws {} reflection paths, {} deep at most, instead of {}.\n",
+         sooner, so `portal` draws {} reflection paths instead of {}.\n",
         ratio(portal_07, portal),
         ratio(unrolled_07, unrolled),
         paths(portal_07),
-        portal_07.reflections,
         paths(portal),
     );
     out += &format!(
