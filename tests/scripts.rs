@@ -151,6 +151,27 @@ fn a_first_run_that_fails_leaves_nothing_half_made() {
     assert!(stderr.contains("partial output is removed"), "{stderr}");
 }
 
+/// Entries the script does not make (runs made by hand) carry over into the new reports; the
+/// rest is replaced, and an entry the new run made is not overwritten.
+#[test]
+fn named_entries_carry_over_into_the_new_reports() {
+    let dir = tempfile::tempdir().unwrap();
+    committed(dir.path());
+    for (name, text) in [("fresh_a", "by hand"), ("fresh_b", "by hand")] {
+        std::fs::create_dir_all(dir.path().join("out").join(name)).unwrap();
+        std::fs::write(dir.path().join("out").join(name).join("r.txt"), text).unwrap();
+    }
+    let body = "set_reports_aside out\nmkdir out/fresh_b\necho new > out/fresh_b/r.txt\n\
+                carry_over_reports 'fresh_*' 'none_*'\nkeep_new_reports";
+    let (code, stderr) = run_with_library(dir.path(), body);
+    assert_eq!(code, 0, "{stderr}");
+    let read = |p: &str| std::fs::read_to_string(dir.path().join("out").join(p)).ok();
+    assert_eq!(read("fresh_a/r.txt").as_deref(), Some("by hand"));
+    assert_eq!(read("fresh_b/r.txt").as_deref(), Some("new\n"));
+    assert_eq!(read("old.txt"), None, "an entry not named was carried over");
+    assert!(!dir.path().join("out.previous").exists());
+}
+
 #[test]
 fn the_measuring_scripts_use_it() {
     for script in ["measure-advise.sh", "measure-table1-runs.sh"] {

@@ -47,6 +47,18 @@ set_reports_aside() {
 on_exit() {
   reports_aside_extra="$reports_aside_extra${reports_aside_extra:+; }$1"
 }
+# carry_over_reports NAME...: the committed DIR/NAME entries (glob patterns; runs the script
+# does not make, such as ones made by hand) carried from DIR.previous into the new DIR, before
+# `keep_new_reports`. An entry the new run made itself is not overwritten.
+carry_over_reports() {
+  local d=$reports_aside_dir pattern kept
+  [ -e "$d.previous" ] || return 0
+  for pattern in "$@"; do
+    for kept in "$d.previous"/$pattern; do
+      if [ -e "$kept" ] && [ ! -e "$d/${kept##*/}" ]; then cp -r "$kept" "$d/"; fi
+    done
+  done
+}
 keep_new_reports() {
   local d=$reports_aside_dir
   reports_aside_dir=

@@ -204,7 +204,25 @@ fn main_job_region(path: &Path) -> Result<String, ReadmeError> {
 /// `reports/tests/test_timing.json`): the same shape as the main job's, without memory.
 const TEST_JOB: &str = "tests/test_timing.json";
 
-/// One line per command: its last recorded run's total, date and machine, and its two
+/// The budgets of the two commands from a fresh clone on 2 cores with an empty cargo cache
+/// (DEVELOPERS.md, docs/budgets.md): 10 minutes for the tests, 15 for the main job.
+const TEST_BUDGET_S: u64 = 600;
+const MAIN_JOB_BUDGET_S: u64 = 900;
+
+/// A recorded run against its budget: within it (and by how much), or over it by how much.
+/// The budget is for an empty cargo cache; a run with crates already downloaded is not
+/// measured against it.
+fn budget_verdict(seconds: u64, budget: u64, cargo_cache: Option<&str>) -> String {
+    if cargo_cache != Some("empty") {
+        format!("{budget} s: not comparable (cargo cache not empty)")
+    } else if seconds <= budget {
+        format!("{budget} s: within, {} s to spare", budget - seconds)
+    } else {
+        format!("{budget} s: **over by {} s**", seconds - budget)
+    }
+}
+
+/// One line per command: its last recorded run's total, date and machine, its budget, and its two
 /// longest steps (the rest summed), read from `main_job.json` and `tests/test_timing.json`.
 fn job_costs_region(reports: &Path) -> Result<String, ReadmeError> {
     let read = |name: &str| -> Result<MainJob, ReadmeError> {
@@ -213,7 +231,7 @@ fn job_costs_region(reports: &Path) -> Result<String, ReadmeError> {
             .map_err(|e| ReadmeError(e.to_string()))?;
         serde_json::from_str(&text).map_err(|e| ReadmeError(format!("{}: {e}", path.display())))
     };
-    let row = |command: &str, what: &str, job: &MainJob| {
+    let row = |command: &str, what: &str, budget: u64, job: &MainJob| {
         let (overlapped, mut steps): (Vec<&Step>, Vec<&Step>) =
             job.steps.iter().partition(|s| s.during_build);
         steps.sort_by_key(|s| std::cmp::Reverse(s.seconds));
@@ -247,6 +265,7 @@ fn job_costs_region(reports: &Path) -> Result<String, ReadmeError> {
                 }
             ),
             format!("**{}**", job.seconds),
+            budget_verdict(job.seconds, budget, job.cargo_cache.as_deref()),
             parts.join("; "),
         ]
     };
@@ -256,13 +275,24 @@ fn job_costs_region(reports: &Path) -> Result<String, ReadmeError> {
             "what",
             "last recorded run",
             "seconds",
+            "budget",
             "where the time went",
         ]
         .map(String::from)
         .to_vec(),
         vec![
-            row("scripts/test.sh", "the tests", &read(TEST_JOB)?),
-            row("scripts/run.sh", "the main job", &read("main_job.json")?),
+            row(
+                "scripts/test.sh",
+                "the tests",
+                TEST_BUDGET_S,
+                &read(TEST_JOB)?,
+            ),
+            row(
+                "scripts/run.sh",
+                "the main job",
+                MAIN_JOB_BUDGET_S,
+                &read("main_job.json")?,
+            ),
         ],
     )]))
 }
@@ -606,9 +636,13 @@ mod tests {
                 {"name":"b","seconds":3},{"name":"tests","seconds":12}]"#,
         );
         assert!(text.contains(
-            "| `scripts/test.sh` | the tests | 2026-11-23, a test CPU, empty cargo cache | **60** | `build` 40 s; `tests` 12 s; 2 other steps 8 s |"
+            "| `scripts/test.sh` | the tests | 2026-11-23, a test CPU, empty cargo cache | **60** | 600 s: within, 540 s to spare | `build` 40 s; `tests` 12 s; 2 other steps 8 s |"
         ), "{text}");
-        assert!(text.contains("| `scripts/run.sh` | the main job | 2026-11-22, a test CPU | **300** | `cargo build` 300 s |"), "{text}");
+        // A run without an empty cargo cache is not held to the budget.
+        assert!(text.contains("| `scripts/run.sh` | the main job | 2026-11-22, a test CPU | **300** | 900 s: not comparable (cargo cache not empty) | `cargo build` 300 s |"), "{text}");
+        // A run over its budget says by how much; one at it is within.
+        assert!(job_costs_of(790, "[]").contains("| **790** | 600 s: **over by 190 s** |"));
+        assert!(job_costs_of(600, "[]").contains("| **600** | 600 s: within, 0 s to spare |"));
     }
 
     /// Steps run during the build are named apart and never counted among the longest or
@@ -623,7 +657,7 @@ mod tests {
                 {"name":"b","seconds":2},{"name":"tests","seconds":12}]"#,
         );
         assert!(text.contains(
-            "| **55** | `build` 40 s; `tests` 12 s; 2 other steps 3 s; 2 set-up steps 39 s during the build |"
+            "| **55** | 600 s: within, 545 s to spare | `build` 40 s; `tests` 12 s; 2 other steps 3 s; 2 set-up steps 39 s during the build |"
         ), "{text}");
     }
 }
